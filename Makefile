@@ -1,0 +1,43 @@
+# rigcad: `make stl` runs the main job on the default profile, `make test` the tests.
+# Both create the virtual environment (.venv) they need from pyproject.toml + requirements.lock.
+
+PYTHON ?= python3.11
+VENV := .venv
+PY := $(VENV)/bin/python
+PROFILE ?= achutha2006
+EXPORTS ?= exports
+
+.PHONY: all stl design test test-all clean distclean help
+
+all: stl
+
+help:
+	@echo "make stl      - design (and, as they land, build) the default profile ($(PROFILE)) into $(EXPORTS)/"
+	@echo "make test     - the fast test suite (default run, < 10 min)"
+	@echo "make test-all - every test, slow ones included"
+	@echo "make clean    - remove $(EXPORTS)/ ; make distclean also removes $(VENV)/"
+
+$(VENV)/.installed: pyproject.toml requirements.lock
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -c requirements.lock -e ".[cad,dev]"
+	touch $@
+
+venv: $(VENV)/.installed
+
+stl: $(VENV)/.installed
+	$(VENV)/bin/rigcad design $(PROFILE) --exports $(EXPORTS)
+
+design: stl
+
+test: $(VENV)/.installed
+	$(PY) -m pytest -q -m "not slow and not stress"
+
+test-all: $(VENV)/.installed
+	$(PY) -m pytest -q
+
+clean:
+	rm -rf $(EXPORTS)
+
+distclean: clean
+	rm -rf $(VENV)

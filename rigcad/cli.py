@@ -1,0 +1,157 @@
+"""rigcad's command line: thin. Parses arguments, calls the stages, prints. A RigcadError becomes
+one readable line on stderr and a non-zero exit code; a traceback is a bug."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from contextlib import contextmanager
+from dataclasses import fields
+from pathlib import Path
+
+from rigcad import __version__
+from rigcad.errors import RigcadError
+
+DEG = math.pi / 180.0
+
+
+@contextmanager
+def _progress(total: int, desc: str):
+    """A progress bar on stderr when it is a terminal (tqdm); silent otherwise."""
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, desc=desc, unit="stage", disable=None, leave=False, file=sys.stderr)
+
+    def step(label: str) -> None:
+        bar.set_postfix_str(label)
+        bar.update(1)
+
+    try:
+        yield step
+    finally:
+        bar.close()
+
+
+def _fmt(spec, value) -> str:
+    if value is None:
+        return "-"
+    if spec.kind == "length":
+        return "inf" if math.isinf(value) else f"{value:.6g} mm"
+    if spec.kind == "angle":
+        return f"{value / DEG:.6g} deg"
+    return str(list(value) if isinstance(value, tuple) else value)
+
+
+def cmd_profile_show(args: argparse.Namespace) -> int:
+    from rigcad.export.atomic import json_bytes
+    from rigcad.profile import derive, load_profile
+    from rigcad.profile.schema import SECTIONS
+
+    profile = load_profile(args.profile)
+    geo = derive(profile)
+    if args.json:
+        sys.stdout.write(json_bytes({"parameters": profile.as_dict(), "derived": geo.as_dict()}).decode())
+        return 0
+    print(f"profile {profile.name}  ({' <- '.join(profile.sources)})")
+    if profile.description:
+        print(f"  {profile.description}")
+    for section in SECTIONS:
+        obj = getattr(profile, section)
+        print(f"\n[{section}]")
+        for f in fields(obj):
+            spec = f.metadata["spec"]
+            value = getattr(obj, f.name)
+            where = profile.marks.get((section, f.name))
+            origin = where if where else "default"
+            print(f"  {f.name:<16} {_fmt(spec, value):<22} {origin:<28} {spec.doc}")
+    print("\n[derived]")
+    rows = [
+        ("focal_length", f"{geo.focal_length:.6g} mm"),
+        ("rim_radius", f"{geo.rim_radius:.6g} mm"),
+        ("vertical_extent", f"{geo.vertical_extent:.6g} mm"),
+        ("tangent_angle", f"{geo.tangent_angle / DEG:.6g} deg"),
+        ("vertex_radius_of_curvature", f"{geo.vertex_radius_of_curvature:.6g} mm"),
+        ("vertex_z", f"{geo.vertex_z:.6g} mm"),
+        ("rim_z", f"{geo.rim_z:.6g} mm"),
+        ("focus_z", f"{geo.focus_z:.6g} mm"),
+        ("cop_z", "inf" if geo.cop_at_infinity else f"{geo.cop_z:.6g} mm"),
+        ("occlusion_theta", f"{geo.occlusion_theta / DEG:.6g} deg"),
+        ("rim_angle_at_cop", f"{geo.rim_angle_at_cop / DEG:.6g} deg"),
+        ("pixels_vertex_to_rim", "-" if geo.cop_at_infinity else f"{geo.pixels_vertex_to_rim:.4g} px"),
+    ]
+    for name, value in rows:
+        print(f"  {name:<28} {value}")
+    return 0
+
+
+def cmd_design(args: argparse.Namespace) -> int:
+    from rigcad.export.design import write_design
+    from rigcad.optics.design import run_design
+    from rigcad.profile import load_profile
+
+    profile = load_profile(args.profile)
+    with _progress(4, f"design {profile.name}") as step:
+        design = run_design(profile, progress=step)
+        out_dir = Path(args.exports) / profile.name
+        paths = write_design(design, out_dir)
+        step("written")
+    r = design.report
+    env, rng, px = r["envelope"], r["measurable_range"], r["pixels"]
+    print(f"{profile.name}: dome {env['width_mm']:.1f} x {env['height_mm']:.1f} mm "
+          f"({env['width_in']:.2f} x {env['height_in']:.2f} in), theta {rng['theta_min_deg']:.2f}..{rng['theta_max_deg']:.1f} deg, "
+          f"dome by {r['dome']['method']} (error vs closed form {r['dome']['error_vs_equal_path_mm']:.2g} mm), "
+          f"max miss at O {r['convergence']['max_miss_mm']:.2g} mm"
+          + (f", {px['vertex_to_rim_px']:.0f} px vertex to rim" if px["vertex_to_rim_px"] else ""))
+    if not rng["targets_met"]:
+        print(f"warning: the design covers theta {rng['theta_min_deg']:.2f}..{rng['theta_max_deg']:.2f} deg, "
+              f"not the target {rng['target_theta_min_deg']:g}..{rng['target_theta_max_deg']:g} deg", file=sys.stderr)
+    for p in paths:
+        print(f"  wrote {p}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="rigcad",
+        description="CAD and fabrication toolchain for the image-based BRDF acquisition rig "
+                    "(Achutha 2006): YAML profile -> optical design -> parts -> exports.",
+        epilog="Profiles are looked up by name under profiles/ or given as a path. Lengths and angles "
+               "in profiles carry units: '13.5 cm', '11 in', '5.5 mil', '20 deg'.")
+    parser.add_argument("--version", action="version", version=f"rigcad {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    p_profile = sub.add_parser("profile", help="inspect profiles", description="Inspect profiles.")
+    psub = p_profile.add_subparsers(dest="profile_command", metavar="ACTION", required=True)
+    p_show = psub.add_parser("show", help="print resolved and derived parameters, with where each came from",
+                             description="Print every resolved parameter (with the file:line that set it, "
+                                         "or 'default') and the derived geometry.")
+    p_show.add_argument("profile", help="profile name (under profiles/) or path")
+    p_show.add_argument("--json", action="store_true", help="machine-readable output, units in the keys")
+    p_show.set_defaults(func=cmd_profile_show)
+
+    p_design = sub.add_parser(
+        "design", help="2D optical design: dome profile, ray diagram, derived figures",
+        description="Integrate the dome profile, trace the design in 2D (pinhole, thin lens, misalignment) "
+                    "and write exports/<profile>/design.json, dome_profile.csv, rays.png and incidence.png.")
+    p_design.add_argument("profile", help="profile name (under profiles/) or path")
+    p_design.add_argument("--exports", default="exports", help="output root (default: exports)")
+    p_design.set_defaults(func=cmd_design)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except RigcadError as err:
+        print(f"rigcad: error: {err}", file=sys.stderr)
+        return err.exit_code
+    except KeyboardInterrupt:
+        print("rigcad: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,54 @@
+"""One exception family for rigcad.
+
+Every message names what is wrong, where (file and line when the value came from a profile),
+the offending value and what would be valid. The CLI prints ``str(err)`` on one line and exits
+with ``err.exit_code``; a traceback reaching the user is a bug.
+"""
+
+from __future__ import annotations
+
+
+class RigcadError(Exception):
+    """Base of every error rigcad raises on purpose."""
+
+    exit_code = 2
+
+    def __init__(self, message: str, *, where: str | None = None, param: str | None = None) -> None:
+        self.message = message
+        self.where = where
+        #: The profile key to blame ("section.key"), so a later stage can add its file:line.
+        self.param = param
+        super().__init__(f"{where}: {message}" if where else message)
+
+    def located(self, marks: dict[tuple[str, ...], str]) -> "RigcadError":
+        """The same error with ``where`` filled in from a profile's marks, if it names a parameter."""
+        if self.where is not None or self.param is None:
+            return self
+        where = marks.get(tuple(self.param.split(".")))
+        return type(self)(self.message, where=where, param=self.param) if where else self
+
+
+class ProfileError(RigcadError):
+    """A profile is unreadable, has an unknown or missing key, a bad unit or an out-of-range value."""
+
+
+class GeometryError(RigcadError):
+    """Valid-looking parameters that describe an impossible rig (rays miss, parts collide)."""
+
+
+class IntegrationError(RigcadError):
+    """The dome integrator failed or could not meet its requested tolerance."""
+
+
+class ExportError(RigcadError):
+    """Writing or re-reading an export failed."""
+
+
+class CheckError(RigcadError):
+    """A declared tolerance is not met (ray check, mesh check)."""
+
+    exit_code = 1
+
+
+class FabricationError(RigcadError):
+    """Slicing, splitting or printer fit failed."""

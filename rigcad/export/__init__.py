@@ -1,0 +1,1 @@
+"""Writers: every output is written atomically and returns its path or raises ExportError."""

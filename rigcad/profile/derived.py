@@ -1,0 +1,88 @@
+"""Values derived from a profile, computed once (millimetres, radians, frame: sample point O at the
+origin, optical axis +z, meridional plane x-z).
+
+The paraboloid is z(r) = vertex_z - r^2 / (4 f): convex, vertex up towards the COP, rim lowest.
+The tangent angle tau is measured between the rim's meridional tangent and the optical axis, so
+tan(tau) = 2 f / rim_radius and vertical_extent = rim_radius^2 / (4 f) (thesis Table 3.1, with the
+reading documented in the README: Figure 3.5 is lost).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from rigcad.errors import GeometryError
+from rigcad.profile.schema import Profile
+
+
+@dataclass(frozen=True)
+class Derived:
+    """Geometry every later stage uses. Lengths in mm, angles in rad, z along the optical axis."""
+
+    focal_length: float
+    rim_radius: float
+    vertical_extent: float
+    tangent_angle: float
+    vertex_z: float
+    rim_z: float
+    focus_z: float
+    cop_z: float
+    #: Radius of curvature at the vertex, 2 f.
+    vertex_radius_of_curvature: float
+    #: Polar angle (from +z, seen from O) of the paraboloid's rim: directions below it are occluded.
+    occlusion_theta: float
+    #: Angle between the axis and the ray from the COP to the rim (0 for a COP at infinity).
+    rim_angle_at_cop: float
+    #: Projector focal length in pixels: width_px * throw_ratio.
+    projector_focal_px: float
+    #: Projector pixels from the vertex's image to the rim's image (inf COP: not defined, NaN).
+    pixels_vertex_to_rim: float
+
+    @property
+    def cop_at_infinity(self) -> bool:
+        return math.isinf(self.cop_z)
+
+    def as_dict(self) -> dict[str, float | str | None]:
+        """Named with units, for JSON."""
+        units = {"tangent_angle": "_rad", "occlusion_theta": "_rad", "rim_angle_at_cop": "_rad",
+                 "projector_focal_px": "", "pixels_vertex_to_rim": ""}
+        out: dict[str, float | str | None] = {}
+        for key, value in asdict(self).items():
+            if isinstance(value, float) and math.isinf(value):
+                value = "inf"
+            elif isinstance(value, float) and math.isnan(value):
+                value = None
+            out[key + units.get(key, "_mm")] = value
+        return out
+
+
+def derive(profile: Profile) -> Derived:
+    """Compute the paraboloid and layout figures; raise GeometryError naming the parameter."""
+    par = profile.paraboloid
+    if par.focal_length is not None:
+        f, r_rim = par.focal_length, par.rim_radius
+        d_p = r_rim**2 / (4.0 * f)
+        tau = math.atan2(2.0 * f, r_rim)
+    else:
+        d_p, tau = par.vertical_extent, par.tangent_angle
+        r_rim = 2.0 * d_p * math.tan(tau)
+        f = d_p * math.tan(tau) ** 2
+    rim_z = profile.layout.sample_to_rim
+    vertex_z = rim_z + d_p
+    cop_z = vertex_z + profile.layout.cop_to_vertex
+    if not all(math.isfinite(v) and v > 0 for v in (f, r_rim, d_p)):
+        raise GeometryError(
+            f"paraboloid gives focal length {f:g} mm, rim radius {r_rim:g} mm, vertical extent {d_p:g} mm: "
+            "each must be finite and > 0", where=profile.where("paraboloid", "tangent_angle"))
+    rim_angle = 0.0 if math.isinf(cop_z) else math.atan2(r_rim, cop_z - rim_z)
+    focal_px = profile.projector.resolution[0] * profile.projector.throw_ratio
+    pixels = math.nan if math.isinf(cop_z) else focal_px * math.tan(rim_angle)
+    return Derived(
+        focal_length=f, rim_radius=r_rim, vertical_extent=d_p, tangent_angle=tau,
+        vertex_z=vertex_z, rim_z=rim_z, focus_z=vertex_z - f, cop_z=cop_z,
+        vertex_radius_of_curvature=2.0 * f,
+        occlusion_theta=math.atan2(r_rim, rim_z),
+        rim_angle_at_cop=rim_angle,
+        projector_focal_px=focal_px, pixels_vertex_to_rim=pixels,
+    )

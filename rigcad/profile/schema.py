@@ -1,0 +1,311 @@
+"""Validated, frozen profile parameters (millimetres, radians).
+
+Each section of a profile is a frozen dataclass; each field carries a :class:`Spec` saying its
+kind, unit, default, valid range and meaning. :func:`validate` turns a :class:`RawProfile` into a
+:class:`Profile` or raises :class:`ProfileError` naming the key, the file:line, the value and what
+would be valid. Nothing after this module reads YAML.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+from rigcad.errors import ProfileError
+from rigcad.profile.loader import Key, RawProfile
+from rigcad.units import UnitError, parse_quantity
+
+REQUIRED = object()
+DEG = math.pi / 180.0
+
+
+@dataclass(frozen=True)
+class Spec:
+    """How one profile key is read and checked.
+
+    ``kind`` is ``length`` (mm), ``angle`` (rad), ``int``, ``float``, ``choice`` or ``pixels``
+    (a ``[width, height]`` pair of positive integers). Bounds are in internal units.
+    """
+
+    kind: str
+    doc: str
+    default: Any = REQUIRED
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    allow_inf: bool = False
+    choices: tuple[str, ...] = ()
+
+    def describe_range(self) -> str:
+        unit, scale = {"length": ("mm", 1.0), "angle": ("deg", DEG)}.get(self.kind, ("", 1.0))
+        if self.kind == "choice":
+            return "one of " + ", ".join(self.choices)
+        parts = []
+        if self.lo is not None:
+            parts.append(f"{'>' if self.lo_open else '>='} {self.lo / scale:g} {unit}".rstrip())
+        if self.hi is not None:
+            parts.append(f"{'<' if self.hi_open else '<='} {self.hi / scale:g} {unit}".rstrip())
+        return " and ".join(parts) if parts else "any value"
+
+
+def spec(kind: str, doc: str, default: Any = REQUIRED, **kw: Any) -> Any:
+    """A dataclass field whose metadata is a :class:`Spec`."""
+    s = Spec(kind=kind, doc=doc, default=default, **kw)
+    if default is REQUIRED:
+        return field(metadata={"spec": s})
+    return field(default=None, metadata={"spec": s})
+
+
+# ---------------------------------------------------------------------------------------------
+# Sections. Geometry frame: meridional plane, sample point O at the origin, optical axis +z.
+
+
+@dataclass(frozen=True)
+class ParaboloidParams:
+    """The convex paraboloid mirror, vertex up towards the centre of projection (COP).
+
+    Give either (``vertical_extent``, ``tangent_angle``) as in the thesis's Table 3.1, or
+    (``focal_length``, ``rim_radius``).
+    """
+
+    vertical_extent: float | None = spec(
+        "length", "d_p: axial distance from the vertex down to the plane of the rim", None, lo=0, lo_open=True)
+    tangent_angle: float | None = spec(
+        "angle", "tau: angle between the rim's meridional tangent and the optical axis", None,
+        lo=0, hi=90 * DEG, lo_open=True, hi_open=True)
+    focal_length: float | None = spec("length", "f: vertex to focus", None, lo=0, lo_open=True)
+    rim_radius: float | None = spec("length", "radius of the rim circle", None, lo=0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class LayoutParams:
+    """Where the paraboloid sits between the COP and the sample point."""
+
+    cop_to_vertex: float = spec(
+        "length", "d_cp: COP down to the paraboloid's vertex (its nearest point to the COP); 'inf' for parallel rays",
+        lo=0, lo_open=True, allow_inf=True)
+    sample_to_rim: float = spec(
+        "length", "d_o: sample point up to the plane of the paraboloid's rim (its nearest point to the sample)",
+        lo=0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class ProjectorParams:
+    """The projector at the COP, looking down the optical axis."""
+
+    resolution: tuple[int, int] = spec("pixels", "[width, height] in pixels", [1024, 768])
+    throw_ratio: float = spec("float", "throw distance / image width (sets the field of view)", 1.75,
+                              lo=0, lo_open=True)
+    aperture: float = spec("length", "thin-lens aperture diameter (thesis 3.2.2)", "0.5 cm", lo=0)
+
+
+@dataclass(frozen=True)
+class CameraParams:
+    """The camera, sharing the COP through the beam splitter."""
+
+    resolution: tuple[int, int] = spec("pixels", "[width, height] in pixels", [1360, 1024])
+
+
+@dataclass(frozen=True)
+class TargetParams:
+    """What the design must achieve; the design stage checks and reports these."""
+
+    theta_min: float = spec("angle", "smallest incidence angle the design must reach", "9 deg",
+                            lo=0, hi=90 * DEG)
+    theta_max: float = spec("angle", "largest incidence angle the design must reach", "90 deg",
+                            lo=0, hi=90 * DEG)
+
+
+@dataclass(frozen=True)
+class DomeParams:
+    """How the dome profile is integrated (thesis 3.2)."""
+
+    method: str = spec("choice", "integrator: dop853/rk45 (adaptive, scipy), euler (thesis polyline), "
+                       "equal_path (closed form)", "dop853", choices=("dop853", "rk45", "euler", "equal_path"))
+    tolerance: float | None = spec(
+        "length", "adaptive integrators: certified global error in the distance along each reflected ray "
+        "(default: 1e-11 of the optical path)", None, lo=0, lo_open=True)
+    euler_steps: int = spec("int", "euler: rays evenly spaced in radius from the rim to the vertex; the polyline "
+                            "stops before the first one whose return to O is occluded",
+                            2000, lo=2, hi=50_000_000)
+    table_rows: int = spec("int", "rows of the profile table (CSV) and points of the smooth curve", 2001,
+                           lo=11, hi=1_000_000)
+
+
+@dataclass(frozen=True)
+class MisalignmentParams:
+    """2D misalignments (meridional plane); the design reports the convergence error of each."""
+
+    camera_dx: float = spec("length", "camera horizontal offset", "0 mm")
+    camera_dz: float = spec("length", "camera vertical offset", "0 mm")
+    projector_dx: float = spec("length", "projector horizontal offset", "0 mm")
+    projector_dz: float = spec("length", "projector vertical offset", "0 mm")
+    paraboloid_dx: float = spec("length", "paraboloid horizontal offset", "0 mm")
+    dome_dx: float = spec("length", "dome horizontal offset", "0 mm")
+    probe: float = spec("length", "offset used for the per-component sensitivity table", "1 mm",
+                        lo=0, lo_open=True, hi=50.0)
+    rays: int = spec("int", "rays traced across the paraboloid for each misalignment case", 401, lo=5, hi=100_000)
+
+
+SECTIONS: dict[str, type] = {
+    "paraboloid": ParaboloidParams,
+    "layout": LayoutParams,
+    "projector": ProjectorParams,
+    "camera": CameraParams,
+    "targets": TargetParams,
+    "dome": DomeParams,
+    "misalignment": MisalignmentParams,
+}
+TOP_LEVEL = {"description"}
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A validated profile. ``marks`` maps key paths to ``file:line`` for later error messages."""
+
+    name: str
+    description: str
+    paraboloid: ParaboloidParams
+    layout: LayoutParams
+    projector: ProjectorParams
+    camera: CameraParams
+    targets: TargetParams
+    dome: DomeParams
+    misalignment: MisalignmentParams
+    sources: tuple[str, ...]
+    marks: dict[Key, str] = field(compare=False, repr=False)
+
+    def where(self, section: str, key: str) -> str | None:
+        """file:line of a parameter, when it came from a file."""
+        return self.marks.get((section, key)) or self.marks.get((section,))
+
+    def as_dict(self) -> dict[str, dict[str, Any]]:
+        """Resolved parameters in internal units, keys suffixed with their unit."""
+        out: dict[str, dict[str, Any]] = {}
+        for section in SECTIONS:
+            obj = getattr(self, section)
+            out[section] = {}
+            for f in fields(obj):
+                s: Spec = f.metadata["spec"]
+                value = getattr(obj, f.name)
+                suffix = {"length": "_mm", "angle": "_rad"}.get(s.kind, "")
+                if isinstance(value, float) and math.isinf(value):
+                    value = "inf"
+                out[section][f.name + suffix] = list(value) if isinstance(value, tuple) else value
+        return out
+
+
+def _suggest(name: str, valid: list[str]) -> str:
+    close = difflib.get_close_matches(name, valid, n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def _convert(s: Spec, value: Any, key: str, where: str | None) -> Any:
+    def fail(msg: str) -> ProfileError:
+        return ProfileError(f"{key}: {msg}", where=where)
+
+    if value is None:
+        raise fail(f"has no value; expected {s.doc} ({s.describe_range()})")
+    if s.kind in ("length", "angle"):
+        try:
+            out = parse_quantity(value, s.kind)
+        except UnitError as err:
+            raise fail(str(err)) from err
+        if math.isnan(out):
+            raise fail("is NaN")
+        if math.isinf(out) and not s.allow_inf:
+            raise fail(f"must be finite ({s.describe_range()})")
+    elif s.kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise fail(f"expected a whole number, got {value!r} ({s.describe_range()})")
+        out = value
+    elif s.kind == "float":
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise fail(f"expected a plain number, got {value!r} ({s.describe_range()})")
+        out = float(value)
+        if not math.isfinite(out):
+            raise fail(f"must be finite, got {value!r}")
+    elif s.kind == "choice":
+        if value not in s.choices:
+            raise fail(f"{value!r} is not valid; {s.describe_range()}{_suggest(str(value), list(s.choices))}")
+        return value
+    elif s.kind == "pixels":
+        ok = (isinstance(value, list) and len(value) == 2
+              and all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in value))
+        if not ok:
+            raise fail(f"expected [width, height] in whole pixels > 0, got {value!r}")
+        return (value[0], value[1])
+    else:  # pragma: no cover - a programming error in a Spec
+        raise AssertionError(s.kind)
+    too_low = s.lo is not None and (out < s.lo or (s.lo_open and out == s.lo))
+    too_high = s.hi is not None and (out > s.hi or (s.hi_open and out == s.hi))
+    if too_low or too_high:
+        raise fail(f"{value!r} is out of range; valid: {s.describe_range()}")
+    return out
+
+
+def _section(raw: RawProfile, name: str, cls: type) -> Any:
+    data = raw.data.get(name, {})
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ProfileError(f"section {name!r} must be a mapping of keys, got {data!r}", where=raw.where((name,)))
+    valid = [f.name for f in fields(cls)]
+    for key in data:
+        if key not in valid:
+            raise ProfileError(
+                f"unknown key {name}.{key}{_suggest(key, valid)}; valid keys in {name}: {', '.join(valid)}",
+                where=raw.where((name, key)))
+    values = {}
+    for f in fields(cls):
+        s: Spec = f.metadata["spec"]
+        if f.name in data:
+            values[f.name] = _convert(s, data[f.name], f"{name}.{f.name}", raw.where((name, f.name)))
+        elif s.default is REQUIRED:
+            raise ProfileError(f"missing required key {name}.{f.name}: {s.doc} ({s.describe_range()})",
+                               where=raw.where((name,)) or (str(raw.sources[0]) if raw.sources else None))
+        elif s.default is None:
+            values[f.name] = None
+        else:
+            values[f.name] = _convert(s, s.default, f"{name}.{f.name} (default)", None)
+    return cls(**values)
+
+
+def validate(raw: RawProfile) -> Profile:
+    """Check every key of ``raw`` and return the frozen :class:`Profile`."""
+    valid_top = sorted(set(SECTIONS) | TOP_LEVEL)
+    for key in raw.data:
+        if key not in valid_top:
+            raise ProfileError(f"unknown section {key!r}{_suggest(key, valid_top)}; valid: {', '.join(valid_top)}",
+                               where=raw.where((key,)))
+    sections = {name: _section(raw, name, cls) for name, cls in SECTIONS.items()}
+    par: ParaboloidParams = sections["paraboloid"]
+    pair_a = (par.vertical_extent, par.tangent_angle)
+    pair_b = (par.focal_length, par.rim_radius)
+    given_a = [v is not None for v in pair_a]
+    given_b = [v is not None for v in pair_b]
+    if not ((all(given_a) and not any(given_b)) or (all(given_b) and not any(given_a))):
+        raise ProfileError(
+            "paraboloid: give either vertical_extent and tangent_angle (thesis Table 3.1), "
+            "or focal_length and rim_radius, and not a mix",
+            where=raw.where(("paraboloid",)) or (str(raw.sources[0]) if raw.sources else None))
+    tgt: TargetParams = sections["targets"]
+    if tgt.theta_min >= tgt.theta_max:
+        raise ProfileError(
+            f"targets.theta_min ({tgt.theta_min / DEG:g} deg) must be below targets.theta_max "
+            f"({tgt.theta_max / DEG:g} deg)", where=raw.where(("targets", "theta_min")))
+    description = raw.data.get("description", "")
+    if not isinstance(description, str):
+        raise ProfileError("description must be text", where=raw.where(("description",)))
+    return Profile(name=raw.name, description=description, sources=tuple(str(p) for p in raw.sources),
+                   marks=dict(raw.marks), **sections)
+
+
+def load_profile(spec_or_path: Any) -> Profile:
+    """Read, merge and validate a profile by name or path."""
+    from rigcad.profile.loader import load_raw
+
+    return validate(load_raw(spec_or_path))

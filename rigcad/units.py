@@ -1,0 +1,93 @@
+"""Units at the boundary: parse ``"13.5 cm"``, ``"11 in"``, ``"5.5 mil"``, ``"20 deg"``.
+
+Inside rigcad every length is in millimetres and every angle in radians (float64). Profiles must
+say their unit; a bare number is refused for a length or an angle (except ``0``), because a
+silently assumed unit is how a 27 cm distance becomes 27 mm.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+#: Millimetres per unit of length.
+LENGTH_UNITS: dict[str, float] = {
+    "nm": 1e-6,
+    "um": 1e-3,
+    "µm": 1e-3,
+    "micron": 1e-3,
+    "mm": 1.0,
+    "cm": 10.0,
+    "m": 1000.0,
+    "mil": 0.0254,
+    "thou": 0.0254,
+    "in": 25.4,
+    "inch": 25.4,
+    "ft": 304.8,
+}
+
+#: Radians per unit of angle.
+ANGLE_UNITS: dict[str, float] = {
+    "deg": math.pi / 180.0,
+    "°": math.pi / 180.0,
+    "arcmin": math.pi / 180.0 / 60.0,
+    "rad": 1.0,
+    "mrad": 1e-3,
+    "urad": 1e-6,
+}
+
+KINDS = {"length": LENGTH_UNITS, "angle": ANGLE_UNITS}
+
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_QUANTITY = re.compile(rf"^\s*(?P<num>{_NUMBER}|[-+]?inf(?:inity)?)\s*(?P<unit>[^\s\d.+-][^\s]*)?\s*$", re.I)
+
+
+class UnitError(ValueError):
+    """A quantity string that does not parse; the profile layer adds file and line."""
+
+
+def parse_quantity(text: object, kind: str) -> float:
+    """Parse ``text`` as a ``kind`` ("length" or "angle") quantity; return mm or rad.
+
+    ``inf`` is accepted for lengths (a centre of projection at infinity). Raises
+    :class:`UnitError` naming the valid units.
+    """
+    units = KINDS[kind]
+    valid = ", ".join(sorted(units))
+    if isinstance(text, bool):
+        raise UnitError(f"expected a {kind} with a unit ({valid}), got {text!r}")
+    if isinstance(text, (int, float)):
+        if text == 0 or (kind == "length" and math.isinf(text)):
+            return float(text)
+        raise UnitError(f"a {kind} needs a unit, e.g. '{text} {'mm' if kind == 'length' else 'deg'}' (units: {valid})")
+    if not isinstance(text, str):
+        raise UnitError(f"expected a {kind} such as '13.5 cm' or '20 deg', got {text!r}")
+    match = _QUANTITY.match(text)
+    if not match:
+        raise UnitError(f"cannot read {text!r} as a {kind}: write a number and a unit, e.g. '13.5 cm' (units: {valid})")
+    number = float(match["num"])
+    unit = match["unit"]
+    if math.isinf(number) and kind != "length":
+        raise UnitError(f"an infinite {kind} makes no sense: {text!r}")
+    if unit is None:
+        if number == 0 or math.isinf(number):
+            return number
+        raise UnitError(f"{text!r} has no unit (units for a {kind}: {valid})")
+    key = unit if unit in units else unit.lower()
+    if key not in units:
+        other = [k for k, table in KINDS.items() if k != kind and (unit in table or unit.lower() in table)]
+        hint = f" ({unit!r} is a unit of {other[0]})" if other else ""
+        raise UnitError(f"unknown {kind} unit {unit!r} in {text!r}{hint}; valid: {valid}")
+    return number * units[key]
+
+
+def mm_to_in(value_mm: float) -> float:
+    """Millimetres to inches."""
+    return value_mm / 25.4
+
+
+def format_length(value_mm: float) -> str:
+    """A length for people: millimetres with inches beside it."""
+    if math.isinf(value_mm):
+        return "inf"
+    return f"{value_mm:.4g} mm ({mm_to_in(value_mm):.4g} in)"

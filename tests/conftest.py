@@ -1,0 +1,51 @@
+"""Shared fixtures: the repository's profiles and small profiles written to tmp_path."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from rigcad.profile import derive, load_profile
+
+ROOT = Path(__file__).resolve().parents[1]
+PROFILES = ROOT / "profiles"
+
+TABLE31 = """
+paraboloid:
+  vertical_extent: 2.25 cm
+  tangent_angle: 20 deg
+layout:
+  cop_to_vertex: 27 cm
+  sample_to_rim: 13.5 cm
+"""
+
+
+@pytest.fixture(scope="session")
+def table31_text() -> str:
+    """Table 3.1 as a minimal profile text, for tests that edit one value."""
+    return TABLE31
+
+
+@pytest.fixture(scope="session")
+def table31():
+    """The thesis's Table 3.1 profile as shipped in profiles/."""
+    return load_profile(PROFILES / "achutha2006.yaml")
+
+
+@pytest.fixture(scope="session")
+def table31_geometry(table31):
+    return derive(table31)
+
+
+@pytest.fixture
+def write_profile(tmp_path):
+    """Write YAML text (dedented) to tmp_path/<name>.yaml and return its path."""
+
+    def write(text: str, name: str = "p") -> Path:
+        path = tmp_path / f"{name}.yaml"
+        path.write_text(textwrap.dedent(text).lstrip("\n"))
+        return path
+
+    return write

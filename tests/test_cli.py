@@ -1,0 +1,94 @@
+"""The command line as a user runs it: outputs, determinism, one-line errors, nothing half-written."""
+
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rigcad.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(*args, cwd=ROOT):
+    return subprocess.run([sys.executable, "-m", "rigcad.cli", *args], cwd=cwd, capture_output=True, text=True)
+
+
+def test_design_writes_report_table_and_figures(tmp_path, capsys):
+    assert main(["design", str(ROOT / "profiles/achutha2006.yaml"), "--exports", str(tmp_path)]) == 0
+    out = tmp_path / "achutha2006"
+    assert sorted(p.name for p in out.iterdir()) == ["design.json", "dome_profile.csv", "incidence.png", "rays.png"]
+    report = json.loads((out / "design.json").read_text())
+    for key in ("focal_length_mm", "rim_radius_mm", "vertex_z_mm", "rim_z_mm", "cop_z_mm"):
+        assert isinstance(report["paraboloid"][key], float), key
+    rows = list(csv.DictReader((out / "dome_profile.csv").open()))
+    assert len(rows) == 2001
+    assert float(rows[0]["incidence_theta_deg"]) == pytest.approx(90.0)
+    assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in out.glob("*.png"))
+    assert "10.66 x 9.05 in" in capsys.readouterr().out
+
+
+def test_design_is_byte_for_byte_deterministic(tmp_path):
+    for name in ("a", "b"):
+        assert main(["design", "achutha2006", "--exports", str(tmp_path / name)]) == 0
+    for path in (tmp_path / "a" / "achutha2006").iterdir():
+        twin = tmp_path / "b" / "achutha2006" / path.name
+        assert path.read_bytes() == twin.read_bytes(), path.name
+
+
+def test_bad_profile_is_one_line_with_file_and_line_and_writes_nothing(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("paraboloid:\n  vertical_extent: 2.25 cm\n  tangent_angle: 95 deg\n"
+                   "layout: {cop_to_vertex: 27 cm, sample_to_rim: 13.5 cm}\n")
+    res = run("design", str(bad), "--exports", str(tmp_path / "exports"))
+    assert res.returncode == 2
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in res.stderr
+    assert "bad.yaml:3" in lines[0] and "paraboloid.tangent_angle" in lines[0] and "< 90 deg" in lines[0]
+    assert not (tmp_path / "exports").exists()
+
+
+def test_impossible_geometry_keeps_previous_exports_intact(tmp_path):
+    good = tmp_path / "rig.yaml"
+    good.write_text((ROOT / "profiles/achutha2006.yaml").read_text())
+    exports = tmp_path / "exports"
+    assert main(["design", str(good), "--exports", str(exports)]) == 0
+    before = {p.name: p.read_bytes() for p in (exports / "rig").iterdir()}
+    good.write_text(good.read_text().replace("tangent_angle: 20 deg", "tangent_angle: 60 deg"))
+    res = run("design", str(good), "--exports", str(exports))
+    assert res.returncode == 2 and "tangent_angle" in res.stderr
+    after = {p.name: p.read_bytes() for p in (exports / "rig").iterdir()}
+    assert after == before  # no partial overwrite, no temporary files left
+
+
+def test_profile_show_lists_sources_and_derived_values():
+    res = run("profile", "show", "achutha2006")
+    assert res.returncode == 0, res.stderr
+    assert "profiles/achutha2006.yaml:14" in res.stdout  # where tangent_angle was set
+    assert "focal_length" in res.stdout and "2.98067 mm" in res.stdout
+
+
+def test_profile_show_json():
+    res = run("profile", "show", "achutha2006", "--json")
+    data = json.loads(res.stdout)
+    assert data["derived"]["rim_radius_mm"] == pytest.approx(16.3787, abs=1e-4)
+
+
+def test_help_explains_subcommands():
+    res = run("--help")
+    assert res.returncode == 0
+    assert "design" in res.stdout and "profile" in res.stdout
+
+
+def test_unknown_profile_names_the_known_ones():
+    res = run("design", "no_such_profile")
+    assert res.returncode == 2 and "achutha2006" in res.stderr
+
+
+def test_readme_ray_diagram_is_current(tmp_path):
+    # docs/rays.png is shown in the README; regenerate it with `make stl && cp exports/achutha2006/rays.png docs/`
+    assert main(["design", "achutha2006", "--exports", str(tmp_path)]) == 0
+    assert (tmp_path / "achutha2006" / "rays.png").read_bytes() == (ROOT / "docs" / "rays.png").read_bytes()
