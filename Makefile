@@ -12,7 +12,7 @@ EXPORTS ?= exports
 all: stl
 
 help:
-	@echo "make stl      - design (and, as they land, build) the default profile ($(PROFILE)) into $(EXPORTS)/"
+	@echo "make stl      - design and build the default profile ($(PROFILE)) into $(EXPORTS)/$(PROFILE)/"
 	@echo "make test     - the fast test suite (default run, < 10 min)"
 	@echo "make test-all - every test, slow ones included"
 	@echo "make clean    - remove $(EXPORTS)/ ; make distclean also removes $(VENV)/"
@@ -27,6 +27,7 @@ venv: $(VENV)/.installed
 
 stl: $(VENV)/.installed
 	$(VENV)/bin/rigcad design $(PROFILE) --exports $(EXPORTS)
+	$(VENV)/bin/rigcad build $(PROFILE) --exports $(EXPORTS)
 
 design: stl
 

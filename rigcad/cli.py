@@ -40,6 +40,8 @@ def _fmt(spec, value) -> str:
         return "inf" if math.isinf(value) else f"{value:.6g} mm"
     if spec.kind == "angle":
         return f"{value / DEG:.6g} deg"
+    if spec.kind == "layers":
+        return "; ".join(f"{name} {t / 0.0254:.4g} mil" for name, t in value) + f" (total {sum(t for _, t in value) / 0.0254:.4g} mil)"
     return str(list(value) if isinstance(value, tuple) else value)
 
 
@@ -111,6 +113,26 @@ def cmd_design(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_build(args: argparse.Namespace) -> int:
+    from rigcad.export.build import build_rig, select_parts
+    from rigcad.profile import load_profile
+
+    profile = load_profile(args.profile)
+    names = select_parts(args.parts)
+    out = Path(args.exports) / profile.name
+    with _progress(len(names) + 1, f"build {profile.name}") as step:
+        result = build_rig(profile, out, names, progress=step)
+    m = result.manifest
+    print(f"{profile.name}: {len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
+    for name in names:
+        e = m["parts"][name]
+        tag = "built" if name in result.rebuilt else "unchanged"
+        print(f"  {name:<22} {tag:<9} volume {e['volume_mm3'] / 1000:9.2f} cm^3  {e['triangles']:7d} triangles"
+              + (f"  x{e['quantity']}" if e["quantity"] > 1 else ""))
+    print(f"  manifest: {out / 'manifest.json'}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="rigcad",
@@ -137,6 +159,19 @@ def build_parser() -> argparse.ArgumentParser:
     p_design.add_argument("profile", help="profile name (under profiles/) or path")
     p_design.add_argument("--exports", default="exports", help="output root (default: exports)")
     p_design.set_defaults(func=cmd_design)
+
+    from rigcad.parts import PARTS
+
+    p_build = sub.add_parser(
+        "build", help="3D parts: STEP and STL per part, rig assembly, manifest",
+        description="Build the rig's parts into exports/<profile>/: step/<part>.step (exact B-rep, re-imported "
+                    "and checked), stl/<part>.stl (at tessellation.chord_error), rig.step (the assembly, named "
+                    "and coloured parts) and manifest.json. Unchanged parts are not rebuilt.",
+        epilog="parts: " + ", ".join(PARTS))
+    p_build.add_argument("profile", help="profile name (under profiles/) or path")
+    p_build.add_argument("--parts", nargs="+", metavar="PART", help="build only these parts (default: all)")
+    p_build.add_argument("--exports", default="exports", help="output root (default: exports)")
+    p_build.set_defaults(func=cmd_build)
     return parser
 
 

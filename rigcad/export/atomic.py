@@ -74,3 +74,62 @@ def json_bytes(data: Any) -> bytes:
 def write_json(path: Path, data: Any) -> Path:
     """Write ``data`` as deterministic JSON, atomically."""
     return write_bytes(path, json_bytes(data))
+
+
+class Staging:
+    """Stage several outputs and publish them together: each is written to a hidden temporary
+    file beside its target; :meth:`commit` renames them all into place, :meth:`abort` (or an
+    exception inside ``with``) deletes them, so a failed run leaves the previous files untouched."""
+
+    def __init__(self) -> None:
+        self._staged: list[tuple[Path, Path]] = []
+
+    def write_with(self, path: Path, writer: Callable[[Path], None]) -> Path:
+        """Stage ``path``: ``writer(tmp)`` fills a temporary file now; the rename waits for commit."""
+        path = Path(path)
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+            os.close(fd)
+        except OSError as err:
+            raise ExportError(f"cannot write {path}: {err.strerror}") from err
+        tmp_path = Path(tmp)
+        self._staged.append((tmp_path, path))
+        writer(tmp_path)
+        os.chmod(tmp_path, 0o666 & ~_umask())
+        return path
+
+    def write_bytes(self, path: Path, data: bytes) -> Path:
+        return self.write_with(path, lambda tmp: tmp.write_bytes(data))
+
+    def temp_path(self, path: Path) -> Path:
+        """Where ``path`` is staged (to read back a staged file before commit)."""
+        for tmp, target in self._staged:
+            if target == Path(path):
+                return tmp
+        raise KeyError(path)
+
+    def commit(self) -> list[Path]:
+        done = []
+        try:
+            for tmp, target in self._staged:
+                os.replace(tmp, target)
+                done.append(target)
+        except OSError as err:
+            raise ExportError(f"cannot publish {target}: {err.strerror}") from err
+        finally:
+            self.abort()
+        return done
+
+    def abort(self) -> None:
+        for tmp, _ in self._staged:
+            if tmp.exists():
+                tmp.unlink()
+        self._staged = []
+
+    def __enter__(self) -> "Staging":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is not None:
+            self.abort()

@@ -25,8 +25,9 @@ DEG = math.pi / 180.0
 class Spec:
     """How one profile key is read and checked.
 
-    ``kind`` is ``length`` (mm), ``angle`` (rad), ``int``, ``float``, ``choice`` or ``pixels``
-    (a ``[width, height]`` pair of positive integers). Bounds are in internal units.
+    ``kind`` is ``length`` (mm), ``angle`` (rad), ``int``, ``float``, ``choice``, ``pixels``
+    (a ``[width, height]`` pair of positive integers) or ``layers`` (a list of named thicknesses).
+    Bounds are in internal units.
     """
 
     kind: str
@@ -150,6 +151,116 @@ class MisalignmentParams:
     rays: int = spec("int", "rays traced across the paraboloid for each misalignment case", 401, lo=5, hi=100_000)
 
 
+_POS = {"lo": 0, "lo_open": True}
+
+DEFAULT_COATING = [
+    {"name": "black base paint", "thickness": "1.5 mil"},
+    {"name": "polyurethane primer", "thickness": "1.5 mil"},
+    {"name": "polyurethane clearcoat", "thickness": "1.5 mil"},
+    {"name": "MirraChrome", "thickness": "1 mil"},
+]
+
+
+@dataclass(frozen=True)
+class CoatingParams:
+    """Paint stack on both mirrors (thesis 3.4: 5-6 mil in all). Printed mirror surfaces sit this
+    far behind the design surfaces (dome outward, paraboloid inward)."""
+
+    layers: tuple[tuple[str, float], ...] = spec(
+        "layers", "layers bottom (on the print) to top (the mirror): [{name, thickness}]; total 5.5 mil",
+        DEFAULT_COATING)
+
+
+@dataclass(frozen=True)
+class DomeShellParams:
+    """The printed dome: a wall behind the mirror, a base flange, beam slots (thesis 3.1)."""
+
+    wall: float = spec("length", "wall thickness behind the printed mirror surface, along its normal", "4 mm", **_POS)
+    flange_width: float = spec("length", "base flange: radial width beyond the wall", "22 mm", **_POS)
+    flange_thickness: float = spec("length", "base flange thickness", "6 mm", **_POS)
+    bolts: int = spec("int", "bolts through the flange into the base plate", 8, lo=3, hi=64)
+    bolt_diameter: float = spec("length", "bolt hole diameter (M4 clearance)", "4.5 mm", **_POS)
+    slot_clearance: float = spec("length", "clearance around the beam in its wall slots (sides and top; it "
+                                 "rests on the slot's floor)", "0.3 mm", lo=0)
+
+
+@dataclass(frozen=True)
+class ParaboloidMountParams:
+    """The paraboloid mirror's body under the mirror surface, its stem and beam clamp."""
+
+    back_thickness: float = spec("length", "solid back below the rim plane", "3 mm", **_POS)
+    stem_radius: float = spec("length", "radius of the stem from the back down to the beam clamp", "4 mm", **_POS)
+    stem_length: float = spec("length", "stem length from the back to the top of the beam", "8 mm", **_POS)
+    clamp_wall: float = spec("length", "wall of the U clamp around the beam", "3 mm", **_POS)
+    clamp_length: float = spec("length", "clamp length along the beam", "14 mm", **_POS)
+
+
+@dataclass(frozen=True)
+class BeamParams:
+    """The narrow mounting beam spanning the dome (thesis Figure 3.3)."""
+
+    width: float = spec("length", "beam width (across; it occludes a strip of directions)", "6 mm", **_POS)
+    height: float = spec("length", "beam height", "10 mm", **_POS)
+    overhang: float = spec("length", "length beyond the dome's outer wall at each end", "15 mm", lo=0)
+
+
+@dataclass(frozen=True)
+class BasePlateParams:
+    """The plate under the dome: bolted to the flange, bored for the sample holder."""
+
+    thickness: float = spec("length", "plate thickness (its top is the sample plane z = 0)", "10 mm", **_POS)
+    margin: float = spec("length", "plate radius beyond the dome flange", "5 mm", lo=0)
+
+
+@dataclass(frozen=True)
+class SampleHolderParams:
+    """The cylinder that slides into the base plate; the sample's top lands on z = 0."""
+
+    radius: float = spec("length", "holder radius", "20 mm", **_POS)
+    clearance: float = spec("length", "radial clearance in the base plate's bore", "0.15 mm", lo=0)
+    sample_thickness: float = spec("length", "thickness of the material sample on the holder", "1 mm", lo=0)
+    stop_radius: float = spec("length", "radius of the stop collar under the plate", "28 mm", **_POS)
+    stop_thickness: float = spec("length", "thickness of the stop collar", "5 mm", **_POS)
+
+
+@dataclass(frozen=True)
+class CrossesParams:
+    """Calibration crosses (thesis 4.1.1)."""
+
+    arm_length: float = spec("length", "half-length of each cross arm from the centre", "15 mm", **_POS)
+    bar_width: float = spec("length", "width of the cross bars", "2 mm", **_POS)
+    thickness: float = spec("length", "thickness of the cross plate", "2 mm", **_POS)
+    projector_axis_height: float = spec("length", "height of the projector's optical axis above its mounting "
+                                        "plate (the projector crosses' centres)", "100 mm", **_POS)
+    projector_spacing: float = spec("length", "distance between the two projector crosses along the axis",
+                                    "150 mm", **_POS)
+    backplate_distance: float = spec("length", "distance from the far cross to the backplate", "100 mm", **_POS)
+    backplate_size: float = spec("length", "side of the square backplate", "120 mm", **_POS)
+
+
+@dataclass(frozen=True)
+class TemplateParams:
+    """Profile templates (thesis Figure 3.11): flat gauges with the negative of a mirror profile."""
+
+    gauged_layer: str = spec("str", "the coating layer whose top surface the templates gauge (the polishing "
+                             "stage is before the mirror paint); 'design' for the finished mirror", "polyurethane clearcoat")
+    thickness: float = spec("length", "template plate thickness", "3 mm", **_POS)
+    band: float = spec("length", "width of the template behind its gauging edge", "15 mm", **_POS)
+
+
+@dataclass(frozen=True)
+class TessellationParams:
+    """Meshes: printed parts and the mirror meshes for the ray checker."""
+
+    chord_error: float = spec("length", "printed parts (STL): max distance from the exact surface; default a "
+                              "tenth of the thesis printer's 0.007 in layer", "0.018 mm", **_POS)
+    mirror_chord_error: float = spec("length", "mirror meshes for the ray checker: max distance from the "
+                                     "exact surface", "0.001 mm", **_POS)
+    mirror_normal_error: float = spec("angle", "mirror meshes: max facet-normal error", "0.001 rad", **_POS)
+    fit_tolerance: float = spec("length", "B-spline fit of the mirror profiles in the STEP solids (<= 1 um)",
+                                "0.1 um", lo=0, lo_open=True, hi=0.001)
+
+
 SECTIONS: dict[str, type] = {
     "paraboloid": ParaboloidParams,
     "layout": LayoutParams,
@@ -158,6 +269,15 @@ SECTIONS: dict[str, type] = {
     "targets": TargetParams,
     "dome": DomeParams,
     "misalignment": MisalignmentParams,
+    "coating": CoatingParams,
+    "dome_shell": DomeShellParams,
+    "paraboloid_mount": ParaboloidMountParams,
+    "beam": BeamParams,
+    "base_plate": BasePlateParams,
+    "sample_holder": SampleHolderParams,
+    "crosses": CrossesParams,
+    "templates": TemplateParams,
+    "tessellation": TessellationParams,
 }
 TOP_LEVEL = {"description"}
 
@@ -175,6 +295,15 @@ class Profile:
     targets: TargetParams
     dome: DomeParams
     misalignment: MisalignmentParams
+    coating: CoatingParams
+    dome_shell: DomeShellParams
+    paraboloid_mount: ParaboloidMountParams
+    beam: BeamParams
+    base_plate: BasePlateParams
+    sample_holder: SampleHolderParams
+    crosses: CrossesParams
+    templates: TemplateParams
+    tessellation: TessellationParams
     sources: tuple[str, ...]
     marks: dict[Key, str] = field(compare=False, repr=False)
 
@@ -194,6 +323,8 @@ class Profile:
                 suffix = {"length": "_mm", "angle": "_rad"}.get(s.kind, "")
                 if isinstance(value, float) and math.isinf(value):
                     value = "inf"
+                if s.kind == "layers":
+                    value = [{"name": n, "thickness_mm": t} for n, t in value]
                 out[section][f.name + suffix] = list(value) if isinstance(value, tuple) else value
         return out
 
@@ -228,10 +359,33 @@ def _convert(s: Spec, value: Any, key: str, where: str | None) -> Any:
         out = float(value)
         if not math.isfinite(out):
             raise fail(f"must be finite, got {value!r}")
+    elif s.kind == "str":
+        if not isinstance(value, str) or not value:
+            raise fail(f"expected text, got {value!r}")
+        return value
     elif s.kind == "choice":
         if value not in s.choices:
             raise fail(f"{value!r} is not valid; {s.describe_range()}{_suggest(str(value), list(s.choices))}")
         return value
+    elif s.kind == "layers":
+        if not isinstance(value, list) or not value:
+            raise fail("expected a list of layers, bottom (on the print) to top (the mirror), each "
+                       "{name: ..., thickness: '1.5 mil'}")
+        layers = []
+        for i, layer in enumerate(value):
+            if not isinstance(layer, dict) or set(layer) != {"name", "thickness"} or not isinstance(layer["name"], str):
+                raise fail(f"layer {i + 1}: expected {{name: text, thickness: length}}, got {layer!r}")
+            try:
+                t = parse_quantity(layer["thickness"], "length")
+            except UnitError as err:
+                raise fail(f"layer {i + 1} ({layer['name']}): {err}") from err
+            if not (math.isfinite(t) and t >= 0):
+                raise fail(f"layer {i + 1} ({layer['name']}): thickness must be finite and >= 0, got {layer['thickness']!r}")
+            layers.append((layer["name"], t))
+        names = [n for n, _ in layers]
+        if len(set(names)) != len(names):
+            raise fail(f"layer names must be distinct, got {names}")
+        return tuple(layers)
     elif s.kind == "pixels":
         ok = (isinstance(value, list) and len(value) == 2
               and all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in value))
@@ -297,6 +451,11 @@ def validate(raw: RawProfile) -> Profile:
         raise ProfileError(
             f"targets.theta_min ({tgt.theta_min / DEG:g} deg) must be below targets.theta_max "
             f"({tgt.theta_max / DEG:g} deg)", where=raw.where(("targets", "theta_min")))
+    layer_names = [n for n, _ in sections["coating"].layers]
+    gauged = sections["templates"].gauged_layer
+    if gauged != "design" and gauged not in layer_names:
+        raise ProfileError(f"templates.gauged_layer {gauged!r} is not a coating layer; valid: design, "
+                           + ", ".join(layer_names), where=raw.where(("templates", "gauged_layer")))
     description = raw.data.get("description", "")
     if not isinstance(description, str):
         raise ProfileError("description must be text", where=raw.where(("description",)))

@@ -1,0 +1,87 @@
+"""Printable meshes: recipe -> manifold3d solid -> STL, at an absolute chord error in mm.
+
+The same recipe tree that the B-rep comes from (rigcad.parts.recipe) is meshed here directly:
+sections are sampled within the chord error, revolutions get enough sectors for it at their
+largest radius, booleans are manifold3d's (exact, robust, ~100x faster than OCCT's mesher on the
+dome at 0.018 mm). manifold3d guarantees a watertight, manifold result or reports an error.
+"""
+
+from __future__ import annotations
+
+import math
+
+import manifold3d as m3d
+import numpy as np
+
+from rigcad.errors import ExportError
+from rigcad.parts.recipe import Box, Cylinder, Difference, Prism, Revolve, Solid, Translate, Union_
+
+
+def segments_for(radius: float, chord_error: float) -> int:
+    """Sectors of a full turn so that a circle of ``radius`` mm stays within ``chord_error`` mm."""
+    if radius <= chord_error:
+        return 8
+    return max(8, math.ceil(math.pi / math.acos(1.0 - chord_error / radius)))
+
+
+def _cross_section(section, chord_error: float) -> m3d.CrossSection:
+    poly = section.polygon(chord_error)
+    cs = m3d.CrossSection([poly])
+    if cs.is_empty():
+        raise ExportError("a part's cross-section is empty after meshing (self-intersecting outline?)")
+    return cs
+
+
+def build(solid: Solid, chord_error: float) -> m3d.Manifold:
+    """The manifold of a recipe tree, every surface within ``chord_error`` mm of the exact one."""
+    if isinstance(solid, Revolve):
+        cs = _cross_section(solid.section, chord_error)
+        r_max = float(np.max(solid.section.polygon(chord_error)[:, 0]))
+        return m3d.Manifold.revolve(cs, circular_segments=segments_for(r_max, chord_error))
+    if isinstance(solid, Prism):
+        cs = _cross_section(solid.section, chord_error)
+        t = solid.thickness
+        # extrude along +z, then map (X, Y, Z) -> (X, t/2 - Z, Y): a proper rotation (det +1)
+        mat = [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, -1.0, t / 2], [0.0, 1.0, 0.0, 0.0]]
+        return m3d.Manifold.extrude(cs, t).transform(mat)
+    if isinstance(solid, Box):
+        lo, hi = np.array(solid.lo), np.array(solid.hi)
+        return m3d.Manifold.cube(tuple(hi - lo)).translate(tuple(lo))
+    if isinstance(solid, Cylinder):
+        n = segments_for(solid.radius, chord_error)
+        return m3d.Manifold.cylinder(solid.height, solid.radius, solid.radius, n).translate(solid.base)
+    if isinstance(solid, Union_):
+        return m3d.Manifold.batch_boolean([build(s, chord_error) for s in solid.items], m3d.OpType.Add)
+    if isinstance(solid, Difference):
+        return m3d.Manifold.batch_boolean([build(solid.base, chord_error)] + [build(s, chord_error) for s in solid.cuts],
+                                          m3d.OpType.Subtract)
+    if isinstance(solid, Translate):
+        return build(solid.solid, chord_error).translate(solid.offset)
+    raise TypeError(f"unknown recipe node {type(solid).__name__}")
+
+
+def mesh_arrays(man: m3d.Manifold) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices (n, 3) float64 mm, triangles (m, 3) int64) of a manifold; raises if it is invalid."""
+    if man.status() != m3d.Error.NoError or man.is_empty():
+        raise ExportError(f"mesh boolean failed: manifold3d status {man.status()}")
+    mesh = man.to_mesh64()
+    return np.asarray(mesh.vert_properties, dtype=float)[:, :3], np.asarray(mesh.tri_verts, dtype=np.int64)
+
+
+def stl_bytes(vertices: np.ndarray, faces: np.ndarray, name: str) -> bytes:
+    """Binary STL (float32, as the format has it) with facet normals; deterministic header."""
+    tri = vertices[faces]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    n = np.divide(n, length, out=np.zeros_like(n), where=length > 0)
+    rec = np.zeros(len(faces), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    rec["n"] = n
+    rec["v"] = tri
+    header = f"rigcad {name}: mm, sample point at origin, optical axis +z".encode()[:80].ljust(80, b" ")
+    return header + np.uint32(len(faces)).tobytes() + rec.tobytes()
+
+
+def mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """Signed volume (mm^3) of a closed triangle mesh (divergence theorem)."""
+    tri = vertices[faces]
+    return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)

@@ -1,0 +1,124 @@
+"""Meridians: the mirror surfaces of revolution as exact curves (r(u), z(u)) about the +z axis.
+
+Both mirrors are surfaces of revolution; every 3D stage (solids, meshes, ray checks) takes them
+from here. Each :class:`Meridian` gives points, unit normals on the *reflecting* side (the side
+light comes from), curvature, and its offset *behind* the mirror by a distance (the printed
+surface under a coating). Lengths in mm; u is the curve's own parameter, increasing from the
+bottom of the surface (rim, dome base) to its top (vertex, dome opening).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import make_interp_spline
+
+from rigcad.optics.dome import DomeProfile
+from rigcad.profile.derived import Derived
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+@dataclass(frozen=True)
+class Meridian:
+    """A meridional curve moved ``offset`` mm behind its mirror (0 = the design surface).
+
+    ``kind`` is ``dome`` or ``paraboloid``; ``u_range`` the parameter interval (bottom -> top).
+    """
+
+    kind: str
+    u_range: tuple[float, float]
+    offset: float
+    _spline: object | None = None  # dome: quintic spline D(s) of the design surface
+    _focal_length: float = 0.0
+    _vertex_z: float = 0.0
+
+    # -- the design surface -------------------------------------------------------------------
+    def _design_points(self, u: np.ndarray) -> np.ndarray:
+        if self.kind == "paraboloid":
+            # u = -r, so u increases from the rim (-rim_radius) to the vertex (0)
+            r = -u
+            return np.stack([r, self._vertex_z - r * r / (4.0 * self._focal_length)], axis=-1)
+        return self._spline(u)
+
+    def _design_tangents(self, u: np.ndarray) -> np.ndarray:
+        """d(point)/du (not unit)."""
+        if self.kind == "paraboloid":
+            r = -u
+            return np.stack([-np.ones_like(r), r / (2.0 * self._focal_length)], axis=-1)
+        return self._spline.derivative()(u)
+
+    def normals(self, u: np.ndarray) -> np.ndarray:
+        """Unit normals (n, 2) pointing to the reflecting side: up/out for the convex paraboloid,
+        towards the axis (inside) for the dome. The same for every offset (parallel curves)."""
+        t = _unit(self._design_tangents(np.asarray(u, dtype=float)))
+        # u runs bottom -> top; the left normal (-t_z, t_r) points inwards for the dome's wall and
+        # down into the body for the paraboloid, whose reflecting side is the other one.
+        left = np.stack([-t[:, 1], t[:, 0]], axis=-1)
+        return -left if self.kind == "paraboloid" else left
+
+    def points(self, u: np.ndarray) -> np.ndarray:
+        """Points (n, 2) of this (possibly offset) curve in (r, z), mm."""
+        u = np.asarray(u, dtype=float)
+        return self._design_points(u) - self.offset * self.normals(u)
+
+    def curvature(self, u: np.ndarray) -> np.ndarray:
+        """Curvature (1/mm) of this curve; the offset changes the radius by ``offset``."""
+        u = np.asarray(u, dtype=float)
+        if self.kind == "paraboloid":
+            r = -u
+            f = self._focal_length
+            k = (1.0 / (2.0 * f)) / (1.0 + (r / (2.0 * f)) ** 2) ** 1.5
+        else:
+            d1 = self._spline.derivative()(u)
+            d2 = self._spline.derivative(2)(u)
+            k = np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.linalg.norm(d1, axis=-1) ** 3
+        # The dome is concave (centre of curvature on the reflecting side), the paraboloid convex:
+        # moving behind the mirror grows the dome's radius of curvature and shrinks the paraboloid's.
+        radius = 1.0 / k
+        radius = radius - self.offset if self.kind == "paraboloid" else radius + self.offset
+        return 1.0 / radius
+
+    def behind(self, distance: float) -> "Meridian":
+        """The parallel curve ``distance`` mm further behind the mirror."""
+        return Meridian(self.kind, self.u_range, self.offset + distance, self._spline, self._focal_length,
+                        self._vertex_z)
+
+    def sample(self, count: int) -> np.ndarray:
+        """``count`` parameters evenly spaced over ``u_range``."""
+        return np.linspace(self.u_range[0], self.u_range[1], count)
+
+    def arc_length_parameters(self, spacing: float, oversample: int = 20001) -> np.ndarray:
+        """Parameters whose points are about ``spacing`` mm apart along this curve, ends included."""
+        u = self.sample(oversample)
+        p = self.points(u)
+        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+        n = max(int(np.ceil(s[-1] / spacing)), 1)
+        return np.interp(np.linspace(0.0, s[-1], n + 1), s, u)
+
+    def chord_parameters(self, chord_error: float) -> np.ndarray:
+        """Parameters such that the polyline through their points deviates from the curve by at
+        most ``chord_error`` mm (sagitta of each segment, from the largest curvature on it)."""
+        u = self.sample(20001)
+        k = np.max(self.curvature(u))
+        spacing = np.sqrt(8.0 * chord_error / k) if k > 0 else np.inf
+        return self.arc_length_parameters(min(spacing, 1e9))
+
+
+def dome_meridian(dome: DomeProfile) -> Meridian:
+    """The dome's design surface as a quintic spline through the integrated profile (smooth
+    profiles only; the thesis's Euler polyline is not a smooth surface)."""
+    if dome.kind != "smooth":
+        raise ValueError("dome_meridian needs a smooth profile (dop853, rk45 or equal_path)")
+    order = np.argsort(dome.s)[::-1]  # s decreases from the rim (bottom) to the top
+    u = -dome.s[order]  # u increases bottom -> top
+    spline = make_interp_spline(u, dome.points[order], k=5)
+    return Meridian("dome", (float(u[0]), float(u[-1])), 0.0, spline)
+
+
+def paraboloid_meridian(geo: Derived) -> Meridian:
+    """The paraboloid's design surface, closed form, from the rim (u = -rim_radius) to the vertex (u = 0)."""
+    return Meridian("paraboloid", (-geo.rim_radius, 0.0), 0.0, None, geo.focal_length, geo.vertex_z)

@@ -1,0 +1,46 @@
+"""Base plate (bolted to the dome's flange, its top face is the sample plane z = 0) and the
+sample holder that slides into its bore so the sample's top surface lands on z = 0."""
+
+from __future__ import annotations
+
+from rigcad.parts.dome import bolt_holes
+from rigcad.parts.layout import RigLayout
+from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Union_
+from rigcad.profile.schema import Profile
+
+
+def base_plate(profile: Profile, layout: RigLayout) -> Part:
+    t = profile.base_plate.thickness
+    holder = profile.sample_holder
+    plate = Cylinder((0.0, 0.0, -t), layout.plate_r, t)
+    bore = Cylinder((0.0, 0.0, -t - 1.0), holder.radius + holder.clearance, t + 2.0)
+    holes = bolt_holes(layout, profile.dome_shell.bolt_diameter, -t - 1.0, t + 2.0)
+    return Part("base_plate", Difference(plate, (bore, *holes)), (0.55, 0.57, 0.6),
+                "base plate: bolts to the dome flange; the sample holder slides into its bore")
+
+
+def holder_body(profile: Profile, top_z: float) -> Cylinder | Union_:
+    """Holder cylinder up to ``top_z`` with its stop collar under the plate."""
+    t = profile.base_plate.thickness
+    h = profile.sample_holder
+    body = Cylinder((0.0, 0.0, -t), h.radius, top_z + t)
+    collar = Cylinder((0.0, 0.0, -t - h.stop_thickness), h.stop_radius, h.stop_thickness)
+    return Union_((body, collar))
+
+
+def sample_holder(profile: Profile, layout: RigLayout) -> Part:
+    top = -profile.sample_holder.sample_thickness
+    return Part("sample_holder", holder_body(profile, top), (0.2, 0.45, 0.7),
+                f"sample holder for a {profile.sample_holder.sample_thickness:g} mm sample: its top surface "
+                "lands on the design point")
+
+
+def base_cross(profile: Profile, layout: RigLayout) -> Part:
+    """Camera calibration: a plug in place of the sample holder with a raised cross whose top is z = 0."""
+    cr = profile.crosses
+    body = holder_body(profile, -cr.thickness)
+    arm = min(cr.arm_length, profile.sample_holder.radius - 1.0)
+    bw = cr.bar_width / 2
+    bars = (Box((-arm, -bw, -cr.thickness), (arm, bw, 0.0)), Box((-bw, -arm, -cr.thickness), (bw, arm, 0.0)))
+    return Part("camera_cross_base", Union_((body, *bars)), (0.9, 0.5, 0.1),
+                "camera calibration: cross on the base plate's centre (replaces the sample holder)", in_rig=False)

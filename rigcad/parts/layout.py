@@ -1,0 +1,136 @@
+"""Where every part goes: the placements shared between parts, computed once from the profile
+and the dome design (mm, rad; sample point at the origin, optical axis +z).
+
+The printed mirror surfaces sit behind the design surfaces by the coating's total thickness
+(thesis 3.4): outward for the dome, inward for the paraboloid. The beam runs along x under the
+paraboloid; the paraboloid's stem rises from a clamp on the beam; the dome's base flange is
+bolted to the base plate whose top face is the sample plane z = 0.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from rigcad.errors import GeometryError
+from rigcad.optics.dome import DomeProfile
+from rigcad.optics.surfaces import Meridian, dome_meridian, paraboloid_meridian
+from rigcad.profile.derived import Derived
+from rigcad.profile.schema import Profile
+
+
+def u_at_height(m: Meridian, z: float) -> float:
+    """Parameter where meridian ``m`` crosses height z (it must cross it exactly once)."""
+    u = m.sample(4001)
+    dz = m.points(u)[:, 1] - z
+    sign = np.nonzero(np.diff(np.sign(dz)) != 0)[0]
+    if len(sign) == 0:
+        raise GeometryError(f"the {m.kind} surface never reaches z = {z:.3f} mm")
+    i = sign[0]
+    return brentq(lambda v: m.points(np.array([v]))[0, 1] - z, u[i], u[i + 1], xtol=1e-14)
+
+
+@dataclass(frozen=True)
+class RigLayout:
+    """Shared placements. Meridians: ``design_*`` are the coated mirror surfaces, ``printed_*``
+    the surfaces the printer makes, ``dome_outer`` the outside of the dome's wall."""
+
+    geometry: Derived
+    coating: float
+    design_dome: Meridian
+    design_paraboloid: Meridian
+    printed_dome: Meridian
+    printed_paraboloid: Meridian
+    dome_outer: Meridian
+    u_inner_base: float  #: printed dome surface at z = 0
+    u_outer_base: float  #: outer wall at z = 0
+    u_outer_flange: float  #: outer wall at the flange's top
+    flange_inner_r: float
+    flange_outer_r: float
+    bolt_circle_r: float
+    bolt_angles: tuple[float, ...]
+    plate_r: float
+    paraboloid_back_z: float  #: bottom of the paraboloid's solid back
+    beam_z: tuple[float, float]  #: bottom, top of the beam
+    beam_half_length: float
+    slot_r: float  #: the wall's largest outer radius across the beam's slot band
+
+    def describe(self) -> dict[str, float]:
+        """Placements for the manifest (mm)."""
+        return {
+            "coating_total_mm": self.coating,
+            "flange_inner_r_mm": self.flange_inner_r,
+            "flange_outer_r_mm": self.flange_outer_r,
+            "bolt_circle_r_mm": self.bolt_circle_r,
+            "base_plate_r_mm": self.plate_r,
+            "paraboloid_back_z_mm": self.paraboloid_back_z,
+            "beam_bottom_z_mm": self.beam_z[0],
+            "beam_top_z_mm": self.beam_z[1],
+            "beam_length_mm": 2 * self.beam_half_length,
+        }
+
+
+def rig_layout(profile: Profile, geometry: Derived, dome: DomeProfile) -> RigLayout:
+    """Compute the placements; raise GeometryError naming the parameter when parts cannot fit."""
+    if dome.kind != "smooth":
+        raise GeometryError(
+            f"3D parts need a smooth dome profile; dome.method = {dome.method!r} gives the thesis's polyline. "
+            "Use dop853, rk45 or equal_path", where=profile.where("dome", "method"))
+    coating = float(sum(t for _, t in profile.coating.layers))
+    design_dome = dome_meridian(dome)
+    design_para = paraboloid_meridian(geometry)
+    printed_dome = design_dome.behind(coating)
+    printed_para = design_para.behind(coating)
+    shell = profile.dome_shell
+    dome_outer = printed_dome.behind(shell.wall)
+    u_in0 = u_at_height(printed_dome, 0.0)
+    u_out0 = u_at_height(dome_outer, 0.0)
+    u_flange = u_at_height(dome_outer, shell.flange_thickness)
+    flange_in = float(dome_outer.points(np.array([u_flange]))[0, 0])
+    flange_out = flange_in + shell.flange_width
+    if shell.bolt_diameter >= shell.flange_width - 2.0:
+        raise GeometryError(
+            f"bolt holes of {shell.bolt_diameter:g} mm do not fit a {shell.flange_width:g} mm flange with 1 mm of "
+            "material each side: widen dome_shell.flange_width or shrink dome_shell.bolt_diameter",
+            where=profile.where("dome_shell", "bolt_diameter"))
+    bolt_r = 0.5 * (flange_in + flange_out)
+    angles = tuple((k + 0.5) * 2 * math.pi / shell.bolts for k in range(shell.bolts))
+
+    mount, beam = profile.paraboloid_mount, profile.beam
+    rim_printed_z = float(printed_para.points(np.array([printed_para.u_range[0]]))[0, 1])
+    back_z = rim_printed_z - mount.back_thickness
+    if mount.stem_length <= mount.clamp_wall:
+        raise GeometryError(
+            f"paraboloid_mount.stem_length ({mount.stem_length:g} mm) must exceed the clamp's top wall "
+            f"({mount.clamp_wall:g} mm)", where=profile.where("paraboloid_mount", "stem_length"))
+    beam_top = back_z - mount.stem_length
+    beam_bottom = beam_top - beam.height
+    if beam_bottom <= shell.flange_thickness:
+        raise GeometryError(
+            f"the beam would sit at z = {beam_bottom:.1f} mm, below the dome's flange: shorten "
+            "paraboloid_mount.stem_length or beam.height", where=profile.where("paraboloid_mount", "stem_length"))
+    band = np.linspace(beam_bottom, beam_top + shell.slot_clearance, 50)
+    outer_r = [float(dome_outer.points(np.array([u_at_height(dome_outer, z)]))[0, 0]) for z in band]
+    slot_r = max(outer_r)
+    plate_r = flange_out + profile.base_plate.margin
+    holder = profile.sample_holder
+    if holder.sample_thickness >= profile.base_plate.thickness:
+        raise GeometryError(
+            f"sample_holder.sample_thickness ({holder.sample_thickness:g} mm) must be under the base plate's "
+            f"thickness ({profile.base_plate.thickness:g} mm) for the holder to reach it",
+            where=profile.where("sample_holder", "sample_thickness"))
+    base_r = float(printed_dome.points(np.array([u_in0]))[0, 0])
+    if holder.stop_radius <= holder.radius + holder.clearance or holder.stop_radius >= base_r:
+        raise GeometryError(
+            f"sample_holder.stop_radius must lie between the bore ({holder.radius + holder.clearance:g} mm) and "
+            f"the dome's base ({base_r:.1f} mm)", where=profile.where("sample_holder", "stop_radius"))
+    return RigLayout(
+        geometry=geometry, coating=coating, design_dome=design_dome, design_paraboloid=design_para,
+        printed_dome=printed_dome, printed_paraboloid=printed_para, dome_outer=dome_outer,
+        u_inner_base=u_in0, u_outer_base=u_out0, u_outer_flange=u_flange,
+        flange_inner_r=flange_in, flange_outer_r=flange_out, bolt_circle_r=bolt_r, bolt_angles=angles,
+        plate_r=plate_r, paraboloid_back_z=back_z, beam_z=(beam_bottom, beam_top),
+        beam_half_length=slot_r + beam.overhang, slot_r=slot_r)
