@@ -120,12 +120,21 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
                 "stl_step_volume_rtol": MESH_VOLUME_RTOL,
             },
             "layout": layout.describe(),
+            "occlusion": _occlusion(profile, layout, geo, dome),
             "parts": {n: entries[n] for n in PARTS if n in entries},
             "assembly": assembly,
         }
         stage.write_bytes(out / "manifest.json", json_bytes(manifest))
         written = stage.commit()
     return BuildResult(manifest, rebuilt, reused, written)
+
+
+def _occlusion(profile: Profile, layout, geo, dome) -> dict:
+    """Solid angle the beam and the paraboloid's mount hide from the sample (see parts.occlusion)."""
+    from rigcad.optics.design import profile_table
+    from rigcad.parts.occlusion import blocked_solid_angle
+
+    return blocked_solid_angle(profile, layout, profile_table(geo, dome))
 
 
 def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Staging, shapes: dict) -> dict:
