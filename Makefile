@@ -7,7 +7,7 @@ PY := $(VENV)/bin/python
 PROFILE ?= achutha2006
 EXPORTS ?= exports
 
-.PHONY: all stl design test test-all clean distclean help
+.PHONY: all stl design docs test test-all clean distclean help
 
 all: stl
 
@@ -30,6 +30,10 @@ stl: $(VENV)/.installed
 	$(VENV)/bin/rigcad build $(PROFILE) --exports $(EXPORTS)
 
 design: stl
+
+docs: stl
+	cp $(EXPORTS)/achutha2006/rays.png docs/rays.png
+	mkdir -p docs/parts && cp $(EXPORTS)/achutha2006/renders/*.png docs/parts/
 
 test: $(VENV)/.installed
 	$(PY) -m pytest -q -m "not slow and not stress"

@@ -183,6 +183,8 @@ def main(argv: list[str] | None = None) -> int:
     except RigcadError as err:
         print(f"rigcad: error: {err}", file=sys.stderr)
         return err.exit_code
+    except BrokenPipeError:  # output piped into head & co.
+        return 0
     except KeyboardInterrupt:
         print("rigcad: interrupted", file=sys.stderr)
         return 130

@@ -90,3 +90,33 @@ def incidence_plot(design) -> bytes:
     fig.suptitle(f"{design.profile.name}: incidence angle per paraboloid point", fontsize=10)
     fig.tight_layout()
     return _png(fig)
+
+
+def render_mesh(vertices: np.ndarray, faces: np.ndarray, title: str, color=(0.7, 0.7, 0.75),
+                cutaway: bool = False) -> bytes:
+    """A shaded view of a triangle mesh (mm). ``cutaway`` drops the half with y < 0 to show the inside."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    tri = vertices[faces]
+    if cutaway:
+        tri = tri[tri[:, :, 1].mean(axis=1) > 0]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    light = np.array([-0.4, -0.6, 0.7])
+    light /= np.linalg.norm(light)
+    shade = 0.35 + 0.65 * np.abs(n @ light)
+    rgb = np.clip(np.outer(shade, color), 0, 1)
+    fig = plt.figure(figsize=(5, 5))
+    ax = fig.add_subplot(projection="3d")
+    ax.add_collection3d(Poly3DCollection(tri, facecolors=rgb, edgecolors="none", linewidths=0))
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    mid, span = (lo + hi) / 2, float((hi - lo).max()) / 2
+    ax.set_xlim(mid[0] - span, mid[0] + span)
+    ax.set_ylim(mid[1] - span, mid[1] + span)
+    ax.set_zlim(mid[2] - span, mid[2] + span)
+    ax.set_box_aspect((1, 1, 1))
+    ax.view_init(elev=15, azim=-90) if cutaway else ax.view_init(elev=22, azim=-60)
+    ax.set_axis_off()
+    size = hi - lo
+    ax.set_title(f"{title}\n{size[0]:.1f} x {size[1]:.1f} x {size[2]:.1f} mm", fontsize=9)
+    return _png(fig)

@@ -27,8 +27,21 @@ from rigcad.profile.schema import Profile
 #: STL and STEP volumes must agree within this fraction (the issue's 0.5 %): the mesh is
 #: inscribed in the exact surface at the chord error, so it is slightly smaller.
 MESH_VOLUME_RTOL = 5e-3
-#: Bump when the writers change so old caches are not trusted.
-CACHE_VERSION = f"{__version__}-1"
+#: Chord error of the meshes drawn for the renders (mm): only for looking at.
+RENDER_CHORD_ERROR = 0.3
+def _code_version() -> str:
+    """Hash of the code that shapes the files (parts, export, plots), so a changed writer
+    invalidates the cache without anyone remembering to bump a number."""
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256(__version__.encode())
+    for path in sorted([*root.glob("parts/*.py"), *root.glob("export/*.py"), root / "plots.py",
+                        root / "optics" / "surfaces.py"]):
+        h.update(path.name.encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+CACHE_VERSION = _code_version()
 
 
 @dataclass(frozen=True)
@@ -166,7 +179,14 @@ def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Stagin
     stl_path = out / "stl" / f"{part.name}.stl"
     stage.write_bytes(stl_path, stl)
     lo, hi = vertices.min(axis=0), vertices.max(axis=0)
-    files = {f"step/{part.name}.step": _sha(stage.temp_path(step_path).read_bytes()), f"stl/{part.name}.stl": _sha(stl)}
+    from rigcad import plots
+
+    # The picture needs no print accuracy: a coarse mesh of the same recipe renders in a second.
+    pv, pf = M.mesh_arrays(M.build(part.solid, RENDER_CHORD_ERROR))
+    png = plots.render_mesh(pv, pf, part.name, part.color, cutaway=part.name == "dome")
+    stage.write_bytes(out / "renders" / f"{part.name}.png", png)
+    files = {f"step/{part.name}.step": _sha(stage.temp_path(step_path).read_bytes()), f"stl/{part.name}.stl": _sha(stl),
+             f"renders/{part.name}.png": _sha(png)}
     return {
         "key": key,
         "description": part.description,

@@ -139,3 +139,10 @@ def test_manifest_reports_each_part(built):
     for name, e in m["parts"].items():
         assert e["volume_mm3"] > 0 and e["triangles"] > 0, name
         assert len(e["bbox_min_mm"]) == 3 and all(len(h) == 64 for h in e["files"].values())
+
+
+def test_readme_part_pictures_are_current(built):
+    # docs/parts/*.png are shown in the README; `make docs` refreshes them
+    _, out, _ = built
+    for name in PARTS:
+        assert (out / "renders" / f"{name}.png").read_bytes() == (ROOT / "docs/parts" / f"{name}.png").read_bytes(), name
