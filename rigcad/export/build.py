@@ -178,6 +178,8 @@ def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Stagin
     stl = M.stl_bytes(vertices, faces, part.name)
     stl_path = out / "stl" / f"{part.name}.stl"
     stage.write_bytes(stl_path, stl)
+    tmf_path = out / "3mf" / f"{part.name}.3mf"
+    stage.write_with(tmf_path, M.threemf_writer(vertices, faces, part.name))
     lo, hi = vertices.min(axis=0), vertices.max(axis=0)
     from rigcad import plots
 
@@ -186,7 +188,8 @@ def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Stagin
     png = plots.render_mesh(pv, pf, part.name, part.color, cutaway=part.name == "dome")
     stage.write_bytes(out / "renders" / f"{part.name}.png", png)
     files = {f"step/{part.name}.step": _sha(stage.temp_path(step_path).read_bytes()), f"stl/{part.name}.stl": _sha(stl),
-             f"renders/{part.name}.png": _sha(png)}
+             f"renders/{part.name}.png": _sha(png),
+             f"3mf/{part.name}.3mf": _sha(stage.temp_path(tmf_path).read_bytes())}
     return {
         "key": key,
         "description": part.description,

@@ -33,11 +33,16 @@ def _cross_section(section, chord_error: float) -> m3d.CrossSection:
 
 
 def build(solid: Solid, chord_error: float) -> m3d.Manifold:
-    """The manifold of a recipe tree, every surface within ``chord_error`` mm of the exact one."""
+    """The manifold of a recipe tree, every surface within ``chord_error`` mm of the exact one.
+
+    A revolved surface's facet deviates by up to its meridional sagitta plus its circumferential
+    one, so each gets half of the budget.
+    """
     if isinstance(solid, Revolve):
-        cs = _cross_section(solid.section, chord_error)
-        r_max = float(np.max(solid.section.polygon(chord_error)[:, 0]))
-        return m3d.Manifold.revolve(cs, circular_segments=segments_for(r_max, chord_error))
+        half = chord_error / 2
+        cs = _cross_section(solid.section, half)
+        r_max = float(np.max(solid.section.polygon(half)[:, 0]))
+        return m3d.Manifold.revolve(cs, circular_segments=segments_for(r_max, half))
     if isinstance(solid, Prism):
         cs = _cross_section(solid.section, chord_error)
         t = solid.thickness
@@ -85,3 +90,39 @@ def mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
     """Signed volume (mm^3) of a closed triangle mesh (divergence theorem)."""
     tri = vertices[faces]
     return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)
+
+
+def threemf_writer(vertices: np.ndarray, faces: np.ndarray, name: str):
+    """A writer(path) for a 3MF file (lib3mf, the 3MF Consortium's library), units mm.
+
+    lib3mf stamps random UUIDs on objects and build items; they are fixed here (UUID5 of the
+    part's name and geometry) so the same part gives the same bytes.
+    """
+    import hashlib
+    import uuid
+
+    import lib3mf
+
+    digest = hashlib.sha256(np.ascontiguousarray(vertices).tobytes() + np.ascontiguousarray(faces).tobytes()).hexdigest()
+    ids = [str(uuid.uuid5(uuid.NAMESPACE_URL, f"rigcad/{name}/{digest}/{k}")) for k in range(3)]
+
+    def writer(path) -> None:
+        wrapper = lib3mf.get_wrapper()
+        model = wrapper.CreateModel()
+        model.SetUnit(lib3mf.ModelUnit.MilliMeter)
+        mesh = model.AddMeshObject()
+        mesh.SetName(name)
+        pos = (lib3mf.Position * len(vertices))()
+        for i, v in enumerate(vertices.tolist()):
+            pos[i].Coordinates[0], pos[i].Coordinates[1], pos[i].Coordinates[2] = v
+        tris = (lib3mf.Triangle * len(faces))()
+        for i, f in enumerate(faces.tolist()):
+            tris[i].Indices[0], tris[i].Indices[1], tris[i].Indices[2] = f
+        mesh.SetGeometry(pos, tris)
+        mesh.SetUUID(ids[0])
+        item = model.AddBuildItem(mesh, wrapper.GetIdentityTransform())
+        item.SetUUID(ids[1])
+        model.SetBuildUUID(ids[2])
+        model.QueryWriter("3mf").WriteToFile(str(path))
+
+    return writer
