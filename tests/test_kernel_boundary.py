@@ -10,7 +10,7 @@ KERNEL = ("build123d", "OCP", "cadquery", "manifold3d", "trimesh", "pymeshlab", 
 
 
 def _imports(path: Path) -> set[str]:
-    tree = ast.parse(path.read_text())
+    tree = ast.parse(path.read_text(encoding="utf-8"))
     names = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):

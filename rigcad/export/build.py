@@ -112,7 +112,17 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
             entries[name] = _build_part(part, key, profile, out, stage, shapes)
             rebuilt.append(name)
 
-        rig = [n for n in PARTS if PARTS[n] is not None and n in entries and entries[n].get("in_rig")]
+        mirrors = dict(old.get("mirrors", {}))
+        for name in names:
+            part = PARTS[name](profile, layout)
+            for mirror, meridian in part.mirrors:
+                key = _mirror_key(meridian, profile)
+                if _cached(mirrors.get(mirror), key, out):
+                    continue
+                step(f"{mirror} mirror mesh")
+                mirrors[mirror] = _build_mirror(mirror, meridian, key, profile, out, stage)
+
+        rig = [n for n in PARTS if n in entries and entries[n].get("in_rig")]
         asm_key = hashlib.sha256("|".join(entries[n]["key"] for n in rig).encode()).hexdigest()
         asm_old = old.get("assembly")
         if rig and not _cached(asm_old, asm_key, out):
@@ -135,11 +145,33 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
             "layout": layout.describe(),
             "occlusion": _occlusion(profile, layout, geo, dome),
             "parts": {n: entries[n] for n in PARTS if n in entries},
+            "mirrors": mirrors,
             "assembly": assembly,
         }
         stage.write_bytes(out / "manifest.json", json_bytes(manifest))
         written = stage.commit()
     return BuildResult(manifest, rebuilt, reused, written)
+
+
+def _mirror_key(meridian, profile: Profile) -> str:
+    from rigcad.parts.recipe import _feed
+
+    t = profile.tessellation
+    h = hashlib.sha256(f"{CACHE_VERSION}|{t.mirror_chord_error!r}|{t.mirror_normal_error!r}".encode())
+    _feed(h, meridian)
+    return h.hexdigest()
+
+
+def _build_mirror(name: str, meridian, key: str, profile: Profile, out: Path, stage: Staging) -> dict:
+    """The design (coated) mirror surface as a structured mesh with exact vertex normals (PLY)."""
+    from rigcad.export.mirror_mesh import mirror_mesh, ply_writer
+
+    t = profile.tessellation
+    mesh = mirror_mesh(meridian, name, t.mirror_chord_error, t.mirror_normal_error)
+    path = out / "mirrors" / f"{name}.ply"
+    stage.write_with(path, ply_writer(mesh, path))
+    return {"key": key, "surface": "design (coated) mirror surface, exact vertex normals", "report": mesh.report,
+            "files": {f"mirrors/{name}.ply": _sha(stage.temp_path(path).read_bytes())}}
 
 
 def _occlusion(profile: Profile, layout, geo, dome) -> dict:

@@ -39,6 +39,7 @@ tests check the two agree).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
@@ -64,6 +65,10 @@ TARGET_FRACTION = 0.9
 #: Builds tried before giving up; each retry tightens a missed budget by the measured ratio, which
 #: converges in one step when the miss is a model error of a few per cent.
 MAX_BUILDS = 4
+
+#: A measured error above this multiple of its bound is not the second-order model's error (a few
+#: per cent): no retry, CheckError at once (a wrong normal side gives ~pi rad).
+MODEL_MISS = 2.0
 
 #: A meridian end closer than this to the axis (mm) is the axis: the ring becomes one apex vertex.
 #: One nanometre is far below any printed or optical scale, and a ring that small would give
@@ -209,7 +214,7 @@ def _plan(d: _Dense, target_chord: float, target_normal: float, apex_ends: int):
     s_rings = np.interp(np.linspace(0.0, cum[best, -1], cells[best] + 1), cum[best], d.s)
     ring_u = np.interp(s_rings, d.s, d.u)
     ring_u[0], ring_u[-1] = d.u[0], d.u[-1]
-    spacing = cum[best, -1] / cells[best] / density[best]  # model spacing per dense sample, in cells
+    spacing = cum[best, -1] / cells[best] / density[best]  # the rings' spacing (mm) at each dense sample
     model_chord = float(np.max(k * spacing**2 / 8.0 + r * nr * dphi[best, 0] ** 2 / 8.0))
     model_normal = float(np.max(0.5 * np.hypot(k * spacing, nr * dphi[best, 0])))
     return ring_u, int(sectors[best, 0]), float(_AZIMUTH_SHARES[best]), model_chord, model_normal
@@ -264,8 +269,8 @@ def _grid(meridian: Meridian, ring_u: np.ndarray, angles: np.ndarray, closed: bo
     j = np.arange(cols if closed else cols - 1)
     j1 = (j + 1) % cols
     a, b, d, c = j, j1, cols + j, cols + j1  # for a cell whose lower ring starts at vertex 0
-    order = (lambda x, y, z: (x, y, z)) if tangent_sign > 0 else (lambda x, y, z: (x, z, y))
-    quad = np.stack([np.stack(order(a, d, b), -1), np.stack(order(b, d, c), -1)], axis=1)  # (sectors, 2, 3)
+    first, second = ((a, d, b), (b, d, c)) if tangent_sign > 0 else ((a, b, d), (b, c, d))
+    quad = np.stack([np.stack(first, -1), np.stack(second, -1)], axis=1)  # (sectors, 2, 3)
     ring_start = int(apex_lo) + cols * np.arange(n_full - 1)
     fan = len(j)
     faces = np.empty((fan * (apex_lo + apex_hi) + 2 * fan * len(ring_start), 3), dtype=np.int64)
@@ -328,7 +333,7 @@ def facet_errors(vertices: np.ndarray, faces: np.ndarray, meridian: Meridian,
     facet's right-hand normal and the exact normal there, rotated to the sample's azimuth. Both are
     maxima over the samples (a lower bound of the facet's true maximum, within ~1 % at order 12).
     Vectorised, in chunks of about two million samples."""
-    d = _dense_table or _dense(meridian)
+    d = _dense_table if _dense_table is not None else _dense(meridian)
     tree = cKDTree(d.points)
     w = barycentric_lattice(order)
     chunk = max(1, 2_000_000 // len(w))
@@ -414,7 +419,8 @@ def mirror_mesh(meridian: Meridian, name: str, chord_error: float, normal_error:
 
     ``every_facet``: measure every facet instead of one sector's strip (same result, by symmetry;
     slower in proportion to the sector count). Raises ExportError for bad arguments or a meridian
-    that cannot be meshed, CheckError if the bounds are still missed after MAX_BUILDS builds.
+    that cannot be meshed, CheckError if the bounds are still missed after MAX_BUILDS builds or
+    missed by more than MODEL_MISS times (not a model error: no retry).
 
     ``report`` (units in the keys): chord_error_mm, facet_normal_error_rad (declared),
     measured_chord_error_mm, measured_facet_normal_error_rad, model_* (predicted), binding (which
@@ -423,8 +429,9 @@ def mirror_mesh(meridian: Meridian, name: str, chord_error: float, normal_error:
     hausdorff_mm (+ its two directions and hausdorff_sampling)."""
     _check_name(name)
     for label, value, unit in (("chord_error", chord_error, "mm"), ("normal_error", normal_error, "rad")):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        if isinstance(value, bool) or not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
             raise ExportError(f"mirror mesh {name!r}: {label} must be a positive number of {unit}, got {value!r}")
+    chord_error, normal_error = float(chord_error), float(normal_error)  # one repr in report and PLY header
     # the error model linearises angles (tan x ~ x to 1 % below 0.17 rad); a coarser facet-normal
     # bound is not a mesh anyone should trace rays on
     if normal_error > 0.17:
@@ -443,18 +450,19 @@ def mirror_mesh(meridian: Meridian, name: str, chord_error: float, normal_error:
         measured_chord, measured_normal = float(chord.max()), float(normal.max())
         if measured_chord <= chord_error and measured_normal <= normal_error:
             break
+        if measured_chord > MODEL_MISS * chord_error or measured_normal > MODEL_MISS * normal_error:
+            break  # not a model error: refining would not help, report it below
         if measured_chord > chord_error:
             target_chord *= TARGET_FRACTION * chord_error / measured_chord
         if measured_normal > normal_error:
             target_normal *= TARGET_FRACTION * normal_error / measured_normal
-    else:
+    if measured_chord > chord_error or measured_normal > normal_error:
         raise CheckError(
-            f"mirror mesh {name!r}: after {MAX_BUILDS} builds the measured chord error {measured_chord:.4g} mm / "
-            f"facet-normal error {measured_normal:.4g} rad still exceed the declared {chord_error} mm / "
-            f"{normal_error} rad; the meridian may be too curved for the second-order model (check its curvature)")
+            f"mirror mesh {name!r}: after {build} build(s) the measured chord error {measured_chord:.4g} mm / "
+            f"facet-normal error {measured_normal:.4g} rad exceed the declared {chord_error} mm / {normal_error} rad; "
+            "the meridian's curvature or normals may not describe its points (a kink, a wrong normal side)")
 
-    spacing = np.diff(np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(meridian.points(ring_u), axis=0),
-                                                                      axis=1))]))
+    spacing = np.linalg.norm(np.diff(meridian.points(ring_u), axis=0), axis=1)  # chords between rings, mm
     ratio_c, ratio_n = measured_chord / chord_error, measured_normal / normal_error
     report = {
         "name": name,
@@ -519,6 +527,11 @@ def _ply_header(name: str, n_vertices: int, n_faces: int, chord_error: float, no
 def write_ply(path: Path, mesh: MirrorMesh) -> Path:
     """Write ``mesh`` as binary little-endian PLY (x, y, z, nx, ny, nz as double per vertex, mm; faces
     as uchar count + uint32 indices), atomically; the same mesh gives the same bytes. Returns the path."""
+    return write_with(Path(path), ply_writer(mesh, path))
+
+
+def ply_writer(mesh: MirrorMesh, path: Path | str = "<mirror mesh>"):
+    """A writer(tmp_path) for :func:`write_ply`'s format, for staged writes."""
     _check_name(mesh.name)
     v = np.asarray(mesh.vertices, dtype=float)
     n = np.asarray(mesh.normals, dtype=float)
@@ -544,7 +557,7 @@ def write_ply(path: Path, mesh: MirrorMesh) -> Path:
             fh.write(memoryview(vertex_block).cast("B"))
             fh.write(face_block.tobytes())
 
-    return write_with(Path(path), writer)
+    return writer
 
 
 def read_ply(path: Path) -> PlyMesh:

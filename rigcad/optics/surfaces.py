@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import make_interp_spline
 
+from rigcad.errors import GeometryError
 from rigcad.optics.dome import DomeProfile
 from rigcad.profile.derived import Derived
 
@@ -38,6 +39,7 @@ class Meridian:
 
     # -- the design surface -------------------------------------------------------------------
     def _design_points(self, u: np.ndarray) -> np.ndarray:
+        u = np.atleast_1d(np.asarray(u, dtype=float))
         if self.kind == "paraboloid":
             # u = -r, so u increases from the rim (-rim_radius) to the vertex (0)
             r = -u
@@ -46,6 +48,7 @@ class Meridian:
 
     def _design_tangents(self, u: np.ndarray) -> np.ndarray:
         """d(point)/du (not unit)."""
+        u = np.atleast_1d(np.asarray(u, dtype=float))
         if self.kind == "paraboloid":
             r = -u
             return np.stack([-np.ones_like(r), r / (2.0 * self._focal_length)], axis=-1)
@@ -54,20 +57,42 @@ class Meridian:
     def normals(self, u: np.ndarray) -> np.ndarray:
         """Unit normals (n, 2) pointing to the reflecting side: up/out for the convex paraboloid,
         towards the axis (inside) for the dome. The same for every offset (parallel curves)."""
-        t = _unit(self._design_tangents(np.asarray(u, dtype=float)))
+        t = _unit(self._design_tangents(u))
         # u runs bottom -> top; the left normal (-t_z, t_r) points inwards for the dome's wall and
         # down into the body for the paraboloid, whose reflecting side is the other one.
         left = np.stack([-t[:, 1], t[:, 0]], axis=-1)
-        return -left if self.kind == "paraboloid" else left
+        return (-left if self.kind == "paraboloid" else left) + 0.0  # + 0.0: no negative zeros in files
+
+    def tangents(self, u: np.ndarray) -> np.ndarray:
+        """d(point)/du (n, 2) of this curve (mm per unit u); parallel curves share tangent directions,
+        the length scales by (1 +- offset x curvature)."""
+        u = np.atleast_1d(np.asarray(u, dtype=float))
+        t = self._design_tangents(u)
+        k = self._design_curvature(u)
+        scale = 1.0 - self.offset * k if self.kind == "paraboloid" else 1.0 + self.offset * k
+        return t * scale[:, None]
 
     def points(self, u: np.ndarray) -> np.ndarray:
         """Points (n, 2) of this (possibly offset) curve in (r, z), mm."""
-        u = np.asarray(u, dtype=float)
+        u = np.atleast_1d(np.asarray(u, dtype=float))
+        if self.offset == 0.0:
+            return self._design_points(u)
         return self._design_points(u) - self.offset * self.normals(u)
 
     def curvature(self, u: np.ndarray) -> np.ndarray:
-        """Curvature (1/mm) of this curve; the offset changes the radius by ``offset``."""
-        u = np.asarray(u, dtype=float)
+        """Unsigned curvature (1/mm) of this curve. Moving behind the mirror grows the concave
+        dome's radius of curvature by the offset and shrinks the convex paraboloid's; an offset
+        past the paraboloid's centre of curvature has no regular parallel curve and is refused."""
+        k = self._design_curvature(u)
+        radius = 1.0 / k
+        radius = radius - self.offset if self.kind == "paraboloid" else radius + self.offset
+        if np.any(radius <= 0):
+            raise GeometryError(f"an offset of {self.offset:g} mm behind the {self.kind} passes its centre of "
+                                f"curvature (radius {float(np.min(1.0 / k)):.3g} mm): no regular parallel surface")
+        return 1.0 / radius
+
+    def _design_curvature(self, u: np.ndarray) -> np.ndarray:
+        u = np.atleast_1d(np.asarray(u, dtype=float))
         if self.kind == "paraboloid":
             r = -u
             f = self._focal_length
@@ -76,11 +101,7 @@ class Meridian:
             d1 = self._spline.derivative()(u)
             d2 = self._spline.derivative(2)(u)
             k = np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.linalg.norm(d1, axis=-1) ** 3
-        # The dome is concave (centre of curvature on the reflecting side), the paraboloid convex:
-        # moving behind the mirror grows the dome's radius of curvature and shrinks the paraboloid's.
-        radius = 1.0 / k
-        radius = radius - self.offset if self.kind == "paraboloid" else radius + self.offset
-        return 1.0 / radius
+        return k
 
     def behind(self, distance: float) -> "Meridian":
         """The parallel curve ``distance`` mm further behind the mirror."""
@@ -100,19 +121,27 @@ class Meridian:
         return np.interp(np.linspace(0.0, s[-1], n + 1), s, u)
 
     def chord_parameters(self, chord_error: float) -> np.ndarray:
-        """Parameters such that the polyline through their points deviates from the curve by at
-        most ``chord_error`` mm (sagitta of each segment, from the largest curvature on it)."""
+        """Parameters such that the polyline through their points deviates from this meridian by at
+        most ``chord_error`` mm: a chord of length h on curvature k has sagitta k h^2 / 8, so points
+        are placed at equal steps of the integral of sqrt(k / (8 chord_error)) ds (the local density
+        that meets the bound), taking the largest curvature over each fine cell."""
         u = self.sample(20001)
-        k = np.max(self.curvature(u))
-        spacing = np.sqrt(8.0 * chord_error / k) if k > 0 else np.inf
-        return self.arc_length_parameters(min(spacing, 1e9))
+        p = self.points(u)
+        ds = np.linalg.norm(np.diff(p, axis=0), axis=1)
+        k = self.curvature(u)
+        k_cell = np.maximum(k[:-1], k[1:])
+        density = np.sqrt(k_cell / (8.0 * chord_error))
+        budget = np.concatenate([[0.0], np.cumsum(density * ds)])
+        n = max(int(np.ceil(budget[-1])), 1)
+        return np.interp(np.linspace(0.0, budget[-1], n + 1), budget, u)
 
 
 def dome_meridian(dome: DomeProfile) -> Meridian:
     """The dome's design surface as a quintic spline through the integrated profile (smooth
     profiles only; the thesis's Euler polyline is not a smooth surface)."""
     if dome.kind != "smooth":
-        raise ValueError("dome_meridian needs a smooth profile (dop853, rk45 or equal_path)")
+        raise GeometryError("3D surfaces need a smooth dome profile (dome.method dop853, rk45 or equal_path), "
+                            f"not the {dome.method} polyline", param="dome.method")
     order = np.argsort(dome.s)[::-1]  # s decreases from the rim (bottom) to the top
     u = -dome.s[order]  # u increases bottom -> top
     spline = make_interp_spline(u, dome.points[order], k=5)

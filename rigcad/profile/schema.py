@@ -256,7 +256,8 @@ class TessellationParams:
                               "tenth of the thesis printer's 0.007 in layer", "0.018 mm", **_POS)
     mirror_chord_error: float = spec("length", "mirror meshes for the ray checker: max distance from the "
                                      "exact surface", "0.001 mm", **_POS)
-    mirror_normal_error: float = spec("angle", "mirror meshes: max facet-normal error", "0.001 rad", **_POS)
+    mirror_normal_error: float = spec("angle", "mirror meshes: max facet-normal error (the flat-facet reading; "
+                                      "smooth traces use the exact vertex normals)", "0.01 rad", **_POS)
     fit_tolerance: float = spec("length", "B-spline fit of the mirror profiles in the STEP solids (<= 1 um)",
                                 "0.1 um", lo=0, lo_open=True, hi=0.001)
 
