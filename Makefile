@@ -7,7 +7,7 @@ PY := $(VENV)/bin/python
 PROFILE ?= achutha2006
 EXPORTS ?= exports
 
-.PHONY: all stl design docs test test-all clean distclean help
+.PHONY: all stl design docs test test-all bench clean distclean help
 
 all: stl
 
@@ -15,6 +15,7 @@ help:
 	@echo "make stl      - design and build the default profile ($(PROFILE)) into $(EXPORTS)/$(PROFILE)/"
 	@echo "make test     - the fast test suite (default run, < 10 min)"
 	@echo "make test-all - every test, slow ones included"
+	@echo "make bench    - run time against error for each accuracy knob -> bench/results/*.json, *.png"
 	@echo "make clean    - remove $(EXPORTS)/ ; make distclean also removes $(VENV)/"
 
 $(VENV)/.installed: pyproject.toml requirements.lock
@@ -37,6 +38,10 @@ docs: stl
 
 test: $(VENV)/.installed
 	$(PY) -m pytest -q -m "not slow and not stress"
+
+bench: $(VENV)/.installed
+	$(PY) bench/dome.py
+	$(PY) bench/mirror_mesh.py
 
 test-all: $(VENV)/.installed
 	$(PY) -m pytest -q

@@ -93,3 +93,16 @@ def test_dome_ends_at_the_occlusion_limit(table31_geometry):
 def test_tolerance_below_float64_is_refused(table31_geometry):
     with pytest.raises(IntegrationError, match=r"dome.tolerance = 1e-15 mm cannot be certified.*ask for"):
         build_dome(table31_geometry, "dop853", tolerance=1e-15)
+
+
+@pytest.mark.parametrize("cop", ["finite", "infinite"])
+def test_scalar_rhs_agrees_with_the_vectorised_one(table31_geometry, far_geometry, cop):
+    from rigcad.optics.dome import dt_ds, scalar_rhs
+
+    g = table31_geometry if cop == "finite" else far_geometry
+    rhs = scalar_rhs(g)
+    s = np.linspace(0.5, g.rim_radius, 13)
+    t = np.linspace(80.0, 170.0, 13)
+    vec = dt_ds(g, s, t)
+    sca = np.array([rhs(a, [b])[0] for a, b in zip(s, t)])
+    assert np.max(np.abs(vec - sca)) < 1e-12 * np.max(np.abs(vec))  # same formulas, round-off only
