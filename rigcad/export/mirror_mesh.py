@@ -323,6 +323,22 @@ def _foot_points(meridian: Meridian, d: _Dense, tree: cKDTree, rz: np.ndarray) -
     return u
 
 
+def surface_distance(points: np.ndarray, meridian: Meridian, near: float = 0.05) -> np.ndarray:
+    """Distance (n,) mm of points (n, 3) from the surface of revolution of ``meridian`` (a point
+    beyond an end of the meridian is measured to that end). Points farther than ``near`` mm from
+    every dense sample of the meridian get that sample distance (exact to its spacing); nearer
+    ones are projected onto the exact curve."""
+    d = _dense(meridian)
+    tree = cKDTree(d.points)
+    rz = np.stack([np.hypot(points[:, 0], points[:, 1]), points[:, 2]], axis=-1)
+    coarse, _ = tree.query(rz)
+    close = coarse < near
+    if np.any(close):
+        u = _foot_points(meridian, d, tree, rz[close])
+        coarse[close] = np.linalg.norm(rz[close] - meridian.points(u), axis=1)
+    return coarse
+
+
 def facet_errors(vertices: np.ndarray, faces: np.ndarray, meridian: Meridian,
                  order: int = MEASURE_ORDER, _dense_table: _Dense | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Per-facet chord error (m,) mm and facet-normal error (m,) rad against the exact surface.

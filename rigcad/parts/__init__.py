@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 from rigcad.parts.base import base_cross, base_plate, sample_holder
 from rigcad.parts.beam import beam
-from rigcad.parts.crosses import camera_cross_hung, projector_backplate, projector_cross
+from rigcad.parts.crosses import camera_cross_hung, projector_backplate, projector_cross, projector_mounting_plate
 from rigcad.parts.dome import dome
 from rigcad.parts.layout import RigLayout, rig_layout
 from rigcad.parts.paraboloid import paraboloid
@@ -24,6 +24,7 @@ PARTS: dict[str, Callable[[Profile, RigLayout], Part]] = {
     "sample_holder": sample_holder,
     "projector_cross": projector_cross,
     "projector_backplate": projector_backplate,
+    "projector_mounting_plate": projector_mounting_plate,
     "camera_cross_hung": camera_cross_hung,
     "camera_cross_base": base_cross,
     "dome_template": dome_template,

@@ -10,10 +10,12 @@ from __future__ import annotations
 
 from rigcad.parts.layout import RigLayout
 from rigcad.parts.paraboloid import stem_and_clamp
-from rigcad.parts.recipe import Box, Part, Translate, Union_
+from rigcad.parts.recipe import Box, Difference, Part, Union_
 from rigcad.profile.schema import Profile
 
 FOOT = (20.0, 30.0, 3.0)  # mm: a foot wide enough to stand the cross upright on the plate
+FENCE = (2.0, 1.5, 0.2)  # mm: wall, height and clearance of the locating fences on the mounting plate
+PLATE_THICKNESS = 6.0  # mm
 
 
 def projector_cross(profile: Profile, layout: RigLayout) -> Part:
@@ -37,6 +39,35 @@ def projector_backplate(profile: Profile, layout: RigLayout) -> Part:
                 "backplate catching the projector crosses' shadows (aligned when they coincide)", in_rig=False)
 
 
+def _footprints(profile: Profile) -> list[tuple[float, float, float, float]]:
+    """(x0, x1, y0, y1) of every foot standing on the mounting plate: two crosses, the backplate."""
+    c = profile.crosses
+    x_back = c.projector_spacing + c.backplate_distance
+    s = c.backplate_size
+    feet = [(x - FOOT[0] / 2, x + FOOT[0] / 2, -FOOT[1] / 2, FOOT[1] / 2) for x in (0.0, c.projector_spacing)]
+    feet.append((x_back - FOOT[0] / 2, x_back + 3.0 + FOOT[0] / 2, -s / 2, s / 2))
+    return feet
+
+
+def projector_mounting_plate(profile: Profile, layout: RigLayout) -> Part:
+    """The plate the projector crosses and the backplate stand on, with fences that locate their
+    feet on the projector's axis (x) at the design spacing; its top face is z = 0."""
+    wall, height, gap = FENCE
+    feet = _footprints(profile)
+    x0 = min(f[0] for f in feet) - gap - wall - 10.0
+    x1 = max(f[1] for f in feet) + gap + wall + 10.0
+    y = max(f[3] for f in feet) + gap + wall + 10.0
+    plate = Box((x0, -y, -PLATE_THICKNESS), (x1, y, 0.0))
+    fences = tuple(
+        Difference(Box((a - gap - wall, b0 - gap - wall, 0.0), (b + gap + wall, b1 + gap + wall, height)),
+                   (Box((a - gap, b0 - gap, -1.0), (b + gap, b1 + gap, height + 1.0)),))
+        for a, b, b0, b1 in feet)
+    return Part("projector_mounting_plate", Union_((plate, *fences)), (0.55, 0.57, 0.6),
+                "mounting plate for the projector crosses and backplate: fences place them on the axis, "
+                f"{profile.crosses.projector_spacing:g} mm apart; the axis is "
+                f"{profile.crosses.projector_axis_height:g} mm above its top face", in_rig=False)
+
+
 def camera_cross_hung(profile: Profile, layout: RigLayout) -> Part:
     c = profile.crosses
     top = layout.geometry.vertex_z  # the camera focuses on this cross: it sits at the paraboloid's vertex height
@@ -48,4 +79,4 @@ def camera_cross_hung(profile: Profile, layout: RigLayout) -> Part:
                 in_rig=False)
 
 
-__all__ = ["Translate", "camera_cross_hung", "projector_backplate", "projector_cross"]
+__all__ = ["camera_cross_hung", "projector_backplate", "projector_cross", "projector_mounting_plate"]

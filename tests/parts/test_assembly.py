@@ -99,3 +99,33 @@ def test_coated_mirrors_lie_on_the_design_surfaces(rig):
                 p = gp_Pnt(rr * math.cos(phi), rr * math.sin(phi), zz)
                 dist = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(p).Vertex(), shell)
                 assert abs(dist.Value() - expected) <= 1e-3, (name, r, z, depth, dist.Value())  # 1 um
+
+
+def test_projector_bench_crosses_stand_in_their_fences(rig):
+    """Bench frame: the two crosses (one moved by the spacing) and the backplate on the mounting plate."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
+
+    from rigcad.parts.recipe import Translate
+
+    profile, _, _, layout, _ = rig
+    c = profile.crosses
+
+    def solid(name, dx=0.0):
+        part = PARTS[name](profile, layout)
+        recipe = Translate(part.solid, (dx, 0.0, 0.0)) if dx else part.solid
+        return K.single_solid(K.build(recipe, 1e-4, K.FitReport()))
+
+    plate = solid("projector_mounting_plate")
+    others = [solid("projector_cross"), solid("projector_cross", c.projector_spacing), solid("projector_backplate")]
+    for other in others:
+        assert K.volume(BRepAlgoAPI_Common(plate, other).Shape()) < 1e-6  # they stand on it, inside the fences
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    BRepBndLib.Add_s(others[0], box)
+    _, _, zmin, _, _, zmax = box.Get()
+    # the cross's centre (top of the vertical bar minus the arm) sits at the axis height above the plate
+    # (Bnd_Box pads by the shape's 1e-7 mm tolerance)
+    assert zmin == pytest.approx(0.0, abs=1e-6)
+    assert zmax - c.arm_length == pytest.approx(c.projector_axis_height, abs=1e-6)
