@@ -7,14 +7,16 @@ PY := $(VENV)/bin/python
 PROFILE ?= achutha2006
 EXPORTS ?= exports
 
-.PHONY: all stl design docs test test-all bench clean distclean help
+.PHONY: all stl design docs check test test-all bench stress clean distclean help
 
 all: stl
 
 help:
 	@echo "make stl      - design and build the default profile ($(PROFILE)) into $(EXPORTS)/$(PROFILE)/"
+	@echo "make check    - 3D ray check of $(PROFILE) through the exported meshes (after make stl)"
 	@echo "make test     - the fast test suite (default run, < 10 min)"
 	@echo "make test-all - every test, slow ones included"
+	@echo "make stress   - numerical stress suite: 500 random profiles (hypothesis)"
 	@echo "make bench    - run time against error for each accuracy knob -> bench/results/*.json, *.png"
 	@echo "make clean    - remove $(EXPORTS)/ ; make distclean also removes $(VENV)/"
 
@@ -27,10 +29,12 @@ $(VENV)/.installed: pyproject.toml requirements.lock
 venv: $(VENV)/.installed
 
 stl: $(VENV)/.installed
-	$(VENV)/bin/rigcad design $(PROFILE) --exports $(EXPORTS)
-	$(VENV)/bin/rigcad build $(PROFILE) --exports $(EXPORTS)
+	$(VENV)/bin/rigcad stl $(PROFILE) --exports $(EXPORTS)
 
 design: stl
+
+check: stl
+	$(VENV)/bin/rigcad check $(PROFILE) --exports $(EXPORTS)
 
 docs: stl
 	cp $(EXPORTS)/achutha2006/rays.png docs/rays.png
@@ -42,6 +46,10 @@ test: $(VENV)/.installed
 bench: $(VENV)/.installed
 	$(PY) bench/dome.py
 	$(PY) bench/mirror_mesh.py
+	$(PY) bench/raycheck.py --exports $(EXPORTS)
+
+stress: $(VENV)/.installed
+	$(PY) -m pytest -q -m stress --hypothesis-show-statistics
 
 test-all: $(VENV)/.installed
 	$(PY) -m pytest -q

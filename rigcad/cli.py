@@ -133,6 +133,33 @@ def cmd_build(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_stl(args: argparse.Namespace) -> int:
+    """The main job: design + build, returning at once when nothing changed since the last run."""
+    from rigcad.export.manifest import inputs_key, up_to_date
+    from rigcad.profile import load_profile
+
+    profile = load_profile(args.profile)
+    out = Path(args.exports) / profile.name
+    key = inputs_key(profile)
+    if up_to_date(out, key):
+        print(f"{profile.name}: up to date ({out}/manifest.json)")
+        return 0
+    from rigcad.export.build import build_rig
+    from rigcad.export.design import write_design
+    from rigcad.optics.design import run_design
+
+    from rigcad.parts import PARTS
+
+    with _progress(len(PARTS) + 6, f"stl {profile.name}") as step:
+        design = run_design(profile, progress=step)
+        paths = write_design(design, out)
+        result = build_rig(profile, out, progress=step, design_files=paths, inputs_key=key)
+    env = design.report["envelope"]
+    print(f"{profile.name}: dome mirror {env['width_in']:.2f} x {env['height_in']:.2f} in; "
+          f"{len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="rigcad",
@@ -160,18 +187,30 @@ def build_parser() -> argparse.ArgumentParser:
     p_design.add_argument("--exports", default="exports", help="output root (default: exports)")
     p_design.set_defaults(func=cmd_design)
 
-    from rigcad.parts import PARTS
-
     p_build = sub.add_parser(
         "build", help="3D parts: STEP and STL per part, rig assembly, manifest",
         description="Build the rig's parts into exports/<profile>/: step/<part>.step (exact B-rep, re-imported "
                     "and checked), stl/<part>.stl (at tessellation.chord_error), rig.step (the assembly, named "
                     "and coloured parts) and manifest.json. Unchanged parts are not rebuilt.",
-        epilog="parts: " + ", ".join(PARTS))
+        epilog="parts: dome, paraboloid, beam, base_plate, sample_holder, projector_cross, projector_backplate, "
+               "projector_mounting_plate, camera_cross_hung, camera_cross_base, dome_template, paraboloid_template")
     p_build.add_argument("profile", help="profile name (under profiles/) or path")
     p_build.add_argument("--parts", nargs="+", metavar="PART", help="build only these parts (default: all)")
     p_build.add_argument("--exports", default="exports", help="output root (default: exports)")
     p_build.set_defaults(func=cmd_build)
+
+    p_stl = sub.add_parser(
+        "stl", help="the main job (make stl): design + build, skipped when nothing changed",
+        description="Run `design` then `build` for every part, recording the inputs' hash in manifest.json; "
+                    "when the profile and rigcad's code are unchanged and every listed file is intact, "
+                    "return at once.")
+    p_stl.add_argument("profile", help="profile name (under profiles/) or path")
+    p_stl.add_argument("--exports", default="exports", help="output root (default: exports)")
+    p_stl.set_defaults(func=cmd_stl)
+
+    from rigcad.check.cli import register as register_check
+
+    register_check(sub)
     return parser
 
 

@@ -92,3 +92,24 @@ def test_readme_ray_diagram_is_current(tmp_path):
     # docs/rays.png is shown in the README; regenerate it with `make stl && cp exports/achutha2006/rays.png docs/`
     assert main(["design", "achutha2006", "--exports", str(tmp_path)]) == 0
     assert (tmp_path / "achutha2006" / "rays.png").read_bytes() == (ROOT / "docs" / "rays.png").read_bytes()
+
+
+def test_build_help_lists_every_part():
+    from rigcad.parts import PARTS
+
+    res = run("build", "--help")
+    assert all(name in res.stdout for name in PARTS)  # the epilog is written out to keep --help light
+
+
+def test_stl_returns_at_once_when_nothing_changed_and_repairs_a_damaged_file(tmp_path):
+    exports = tmp_path / "exports"
+    first = run("stl", "achutha2006", "--exports", str(exports))
+    assert first.returncode == 0, first.stderr
+    again = run("stl", "achutha2006", "--exports", str(exports))
+    assert "up to date" in again.stdout
+    stl = exports / "achutha2006" / "stl" / "beam.stl"
+    good = stl.read_bytes()
+    stl.write_bytes(b"damaged")
+    repaired = run("stl", "achutha2006", "--exports", str(exports))
+    assert "up to date" not in repaired.stdout and "1 part(s) built" in repaired.stdout
+    assert stl.read_bytes() == good

@@ -18,6 +18,7 @@ import numpy as np
 from rigcad import __version__
 from rigcad.errors import ExportError, ProfileError
 from rigcad.export.atomic import Staging, json_bytes
+from rigcad.export.manifest import code_version, file_sha, profile_digest
 from rigcad.optics.dome import build_dome
 from rigcad.parts import PARTS, rig_layout
 from rigcad.parts.recipe import Part
@@ -29,19 +30,8 @@ from rigcad.profile.schema import Profile
 MESH_VOLUME_RTOL = 5e-3
 #: Chord error of the meshes drawn for the renders (mm): only for looking at.
 RENDER_CHORD_ERROR = 0.3
-def _code_version() -> str:
-    """Hash of the code that shapes the files (parts, export, plots), so a changed writer
-    invalidates the cache without anyone remembering to bump a number."""
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256(__version__.encode())
-    for path in sorted([*root.glob("parts/*.py"), *root.glob("export/*.py"), root / "plots.py",
-                        root / "optics" / "surfaces.py"]):
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
-
-
-CACHE_VERSION = _code_version()
+#: The code that shapes the files (parts, export, plots, surfaces): a change rebuilds what it wrote.
+CACHE_VERSION = code_version("parts/*.py", "export/*.py", "plots.py", "optics/surfaces.py")
 
 
 @dataclass(frozen=True)
@@ -54,10 +44,6 @@ class BuildResult:
 
 def _sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
-
-
-def _file_sha(path: Path) -> str | None:
-    return _sha(path.read_bytes()) if path.is_file() else None
 
 
 def part_key(part: Part, profile: Profile) -> str:
@@ -79,11 +65,16 @@ def select_parts(names: list[str] | None) -> list[str]:
 def _cached(entry: dict | None, key: str, out: Path) -> bool:
     if not entry or entry.get("key") != key:
         return False
-    return all(_file_sha(out / rel) == digest for rel, digest in entry.get("files", {}).items())
+    return all(file_sha(out / rel) == digest for rel, digest in entry.get("files", {}).items())
 
 
-def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progress=None) -> BuildResult:
-    """Build the selected parts (all by default) into ``out``; see the module docstring."""
+def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progress=None,
+              design_files: list[Path] | None = None, inputs_key: str | None = None) -> BuildResult:
+    """Build the selected parts (all by default) into ``out``; see the module docstring.
+
+    ``design_files`` (written by the design stage into ``out``) and ``inputs_key`` are recorded in
+    the manifest so that `rigcad stl` can tell, without computing anything, that nothing changed.
+    """
     from rigcad.export import mesh as M
 
     step = progress or (lambda label: None)
@@ -132,8 +123,10 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
             assembly = asm_old
         manifest = {
             "rigcad_version": __version__,
-            "profile": {"name": profile.name, "sources": list(profile.sources),
-                        "sha256": _sha(json_bytes(profile.as_dict()))},
+            "profile": {"name": profile.name, "sources": list(profile.sources), "sha256": profile_digest(profile)},
+            "inputs_key": inputs_key if inputs_key and not parts else None,
+            "design_files": {p.relative_to(out).as_posix(): file_sha(p) for p in design_files or []}
+            or old.get("design_files"),
             "frame": "mm; sample point at the origin; optical axis +z; parts in their working positions",
             "tolerances": {
                 "stl_chord_error_mm": tol.chord_error,

@@ -221,11 +221,24 @@ def _check_clear(geo: Derived, prof_points: np.ndarray) -> None:
                             "check paraboloid.tangent_angle and layout", param="paraboloid.tangent_angle")
 
 
+def rows_even_in_theta(geo: Derived, t_of_s, s_end: float, rows: int) -> np.ndarray:
+    """Parabola radii (rows,) from the rim to ``s_end`` whose dome points are evenly spaced in the
+    incidence angle theta: the dome point's speed in s varies by orders of magnitude on pointed
+    paraboloids, so rows even in s would leave the top of the dome under-sampled."""
+    fine = np.linspace(geo.rim_radius, s_end, 20001)
+    r = reflected_rays(geo, fine)
+    theta = theta_of(r.P + t_of_s(fine)[:, None] * r.u)
+    targets = np.linspace(theta[0], theta[-1], rows)
+    s = np.interp(targets, theta[::-1], fine[::-1])  # theta falls monotonically from the rim inwards
+    s[0], s[-1] = geo.rim_radius, s_end
+    return s
+
+
 def build_equal_path(geo: Derived, rows: int) -> DomeProfile:
-    """The closed-form dome sampled at ``rows`` parabola radii evenly spaced in s."""
+    """The closed-form dome sampled at ``rows`` points evenly spaced in theta."""
     st = start(geo)
     s_end = _occlusion_s(geo, st.path_length)
-    s = np.linspace(geo.rim_radius, s_end, rows)
+    s = rows_even_in_theta(geo, lambda x: equal_path_t(geo, x, st.path_length), s_end, rows)
     t = equal_path_t(geo, s, st.path_length)
     r = reflected_rays(geo, s)
     pts = r.P + t[:, None] * r.u
@@ -294,8 +307,8 @@ AUTO_RELATIVE_TOLERANCE = 1e-11
 
 
 def build_adaptive(geo: Derived, method: str, tol: float | None, rows: int) -> DomeProfile:
-    """The dome ODE solved by scipy (``dop853`` or ``rk45``), sampled at ``rows`` radii evenly spaced
-    in s through the dense output.
+    """The dome ODE solved by scipy (``dop853`` or ``rk45``), sampled through the dense output at
+    ``rows`` points evenly spaced in theta.
 
     Contract: the *global* error in t on those rows is at most ``tol`` (mm), as estimated by a
     second solve at a 100x tighter tolerance. scipy controls only the local error per step, so the
@@ -308,7 +321,8 @@ def build_adaptive(geo: Derived, method: str, tol: float | None, rows: int) -> D
     if tol is None:
         tol = AUTO_RELATIVE_TOLERANCE * st.path_length
     s_end = _occlusion_s(geo, st.path_length)
-    s = np.linspace(geo.rim_radius, s_end, rows)
+    first = _solve(geo, method, tol, st, s_end)
+    s = rows_even_in_theta(geo, lambda x: first.sol(x)[0], s_end, rows)
     floor = 100 * np.finfo(float).eps * 2.0 * st.t  # scipy's smallest rtol, on the largest t
     local = tol
     evaluations = 0

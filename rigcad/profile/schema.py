@@ -148,6 +148,16 @@ class MisalignmentParams:
     dome_dx: float = spec("length", "dome horizontal offset", "0 mm")
     probe: float = spec("length", "offset used for the per-component sensitivity table", "1 mm",
                         lo=0, lo_open=True, hi=50.0)
+    camera_tilt: float = spec("angle", "3D ray check: camera tilt about +y (in the x-z plane), pivot at the COP",
+                              "0 deg", lo=-10 * DEG, hi=10 * DEG)
+    projector_tilt: float = spec("angle", "3D ray check: projector tilt about +y, pivot at the COP", "0 deg",
+                                 lo=-10 * DEG, hi=10 * DEG)
+    paraboloid_tilt: float = spec("angle", "3D ray check: paraboloid tilt about +y, pivot at its vertex", "0 deg",
+                                  lo=-10 * DEG, hi=10 * DEG)
+    dome_tilt: float = spec("angle", "3D ray check: dome tilt about +y, pivot at the sample point O", "0 deg",
+                            lo=-10 * DEG, hi=10 * DEG)
+    probe_tilt: float = spec("angle", "tilt used for the 3D ray check's sensitivity table", "1 mrad",
+                             lo=0, lo_open=True, hi=10 * DEG)
     rays: int = spec("int", "rays traced across the paraboloid for each misalignment case", 401, lo=5, hi=100_000)
 
 
@@ -262,6 +272,66 @@ class TessellationParams:
                                 "0.1 um", lo=0, lo_open=True, hi=0.001)
 
 
+@dataclass(frozen=True)
+class RayCheckParams:
+    """3D ray check (rigcad check): how rays are traced and the tolerances it enforces. Spots are the
+    distance from the sample point O to each returning ray (mm); angles between a ray's arrival
+    direction and the design's for its projector pixel (rad)."""
+
+    mode: str = spec("choice", "surfaces traced: mesh (flat facets of the mirror meshes, what an STL says), "
+                     "smooth (mirror meshes with interpolated vertex normals), analytic (exact surfaces)",
+                     "smooth", choices=("mesh", "smooth", "analytic"))
+    rays: int = spec("int", "pinhole rays aimed across the paraboloid's useful annulus (seeded)", 100_000,
+                     lo=100, hi=50_000_000)
+    seed: int = spec("int", "seed of the ray sampling", 2006, lo=0)
+    lens_azimuths: int = spec("int", "thin lens: aperture-edge rays per chief ray (thesis 3.2.2 traced 2 in 2D)",
+                              8, lo=2, hi=64)
+    max_spot_radius: float = spec("length", "largest distance from O to a returning pinhole ray, in `mode`",
+                                  "0.01 mm", **_POS)
+    max_facet_spot_radius: float = spec("length", "the same for the flat-facet (STL-literal) reading",
+                                        "3 mm", **_POS)
+    max_angle_error: float = spec("angle", "largest arrival-direction error against the design, per pixel, "
+                                  "in `mode`", "0.01 deg", **_POS)
+    max_mesh_angle_error: float = spec("angle", "largest arrival-direction difference mesh minus exact "
+                                       "surfaces, in `mode` (mesh or smooth)", "0.01 deg",
+                                       **_POS)
+    theta_coverage_tolerance: float = spec("angle", "the traced theta range must reach each end of "
+                                           "targets.theta_min..theta_max within this", "1.5 deg", lo=0)
+    min_px_per_deg: float = spec("float", "fewest projector pixels per degree of theta (thesis 3.2.1: about 1)",
+                                 0.9, lo=0)
+    max_lost_fraction: float = spec("float", "largest fraction of rays aimed at the useful annulus that are "
+                                    "occluded or escape", 0.08, lo=0, hi=1)
+
+
+@dataclass(frozen=True)
+class TolerancingParams:
+    """Seeded Monte Carlo of the 3D ray check over fabrication and alignment tolerances: each build
+    moves every component by an offset uniform in a disc of radius ``*_offset`` (x-y), uniform in
+    +-``*_height`` (z), and tilts it by an angle uniform in 0..``*_tilt`` about a random horizontal
+    axis (pivots: COP for camera and projector, vertex for the paraboloid, O for the dome)."""
+
+    builds: int = spec("int", "random builds", 200, lo=1, hi=100_000)
+    seed: int = spec("int", "seed of the builds", 2006, lo=0)
+    rays: int = spec("int", "pinhole rays per build", 4000, lo=100, hi=10_000_000)
+    projector_offset: float = spec("length", "projector: lateral placement tolerance", "0.5 mm", lo=0)
+    projector_height: float = spec("length", "projector: height tolerance", "1 mm", lo=0)
+    projector_tilt: float = spec("angle", "projector: tilt tolerance", "0.5 deg", lo=0, hi=10 * DEG)
+    camera_offset: float = spec("length", "camera: lateral placement tolerance", "0.5 mm", lo=0)
+    camera_height: float = spec("length", "camera: height tolerance", "1 mm", lo=0)
+    camera_tilt: float = spec("angle", "camera: tilt tolerance", "0.5 deg", lo=0, hi=10 * DEG)
+    paraboloid_offset: float = spec("length", "paraboloid: lateral placement tolerance", "0.1 mm", lo=0)
+    paraboloid_height: float = spec("length", "paraboloid: height tolerance", "0.2 mm", lo=0)
+    paraboloid_tilt: float = spec("angle", "paraboloid: tilt tolerance", "0.2 deg", lo=0, hi=10 * DEG)
+    dome_offset: float = spec("length", "dome: lateral placement tolerance", "0.3 mm", lo=0)
+    dome_height: float = spec("length", "dome: height tolerance", "0.3 mm", lo=0)
+    dome_tilt: float = spec("angle", "dome: tilt tolerance", "0.1 deg", lo=0, hi=10 * DEG)
+    max_spot_radius: float = spec("length", "a build meets the target when its largest spot radius is at most this",
+                                  "3 mm", **_POS)
+    max_angle_error: float = spec("angle", "... and its largest arrival-direction error at most this", "1 deg",
+                                  **_POS)
+    min_yield: float = spec("float", "fewest builds (fraction) that must meet both targets", 0.9, lo=0, hi=1)
+
+
 SECTIONS: dict[str, type] = {
     "paraboloid": ParaboloidParams,
     "layout": LayoutParams,
@@ -279,6 +349,8 @@ SECTIONS: dict[str, type] = {
     "crosses": CrossesParams,
     "templates": TemplateParams,
     "tessellation": TessellationParams,
+    "raycheck": RayCheckParams,
+    "tolerancing": TolerancingParams,
 }
 TOP_LEVEL = {"description"}
 
@@ -305,6 +377,8 @@ class Profile:
     crosses: CrossesParams
     templates: TemplateParams
     tessellation: TessellationParams
+    raycheck: RayCheckParams
+    tolerancing: TolerancingParams
     sources: tuple[str, ...]
     marks: dict[Key, str] = field(compare=False, repr=False)
 

@@ -75,12 +75,18 @@ def test_euler_polyline_converges_at_first_order(far_geometry):
 
 
 def test_methods_agree_on_the_table31_design(table31_geometry):
+    from rigcad.optics.dome import equal_path_t, reflected_rays
+
     exact = build_dome(table31_geometry, "equal_path", rows=1001)
     ode = build_dome(table31_geometry, "dop853", tolerance=1e-9, rows=1001)
     # The ODE and the equal-path closed form are independent derivations of one condition:
-    # they agree to the ODE's certified 1e-9 mm (x2 for the estimate's own error).
-    assert np.max(np.abs(exact.points - ode.points)) < 2e-9
+    # at the ODE's own rows they agree to its certified 1e-9 mm (x2 for the estimate's own error).
+    r = reflected_rays(table31_geometry, ode.s)
+    closed = r.P + equal_path_t(table31_geometry, ode.s, exact.path_length)[:, None] * r.u
+    assert np.max(np.linalg.norm(closed - ode.points, axis=1)) < 2e-9
     assert ode.occlusion_s == pytest.approx(exact.occlusion_s, abs=1e-12)
+    # both place their rows evenly in theta: the same rows to the integration error
+    assert np.max(np.abs(np.degrees(exact.theta - ode.theta))) < 1e-6
 
 
 def test_dome_ends_at_the_occlusion_limit(table31_geometry):

@@ -1,0 +1,304 @@
+"""The 3D ray check stage (issue 5): profile -> meshes and exact surfaces -> traces -> figures ->
+tolerance table; ``exports/<profile>/check/{raycheck.json, spot.png, theta_map.png}``.
+
+Readings traced on the same rays (seeded, uniform in projector-image area over the paraboloid's
+useful annulus): ``analytic`` (exact surfaces, float64: the reference), and with meshes ``mesh``
+(flat facets, what an STL says), ``smooth`` (interpolated vertex normals), ``exact_normals`` (exact
+normal at the mesh hit) and ``mesh_float32`` (Embree's own float32 hit and normal, no refinement).
+Spot radius = distance from O to a returning ray (mm); angle errors between arrival directions
+(rad). Frame: mm, O at the origin, +z up.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from rigcad.check import montecarlo as MC
+from rigcad.check import tolerances as T
+from rigcad.check.scene import (Optics, analytic_optics, mesh_optics, mixed, rig_geometry, rig_meshes,
+                                share_scenes)
+from rigcad.check.sources import DesignMap, annulus_rays, pixel_grid, pixel_rays, thin_lens_rays
+from rigcad.check.trace3d import STATUS_NAMES, Trace3D, convergence_point, trace
+from rigcad.profile.schema import Profile
+
+DEG = math.pi / 180.0
+#: Rays of the exact-normal reading (its foot points cost ~10 us a ray): enough for its maximum
+#: to be stable to a few per cent (the error is smooth over the annulus).
+EXACT_NORMAL_RAYS = 20_000
+#: Chief rays of the thin-lens check (each with lens_azimuths edge rays).
+THIN_LENS_RAYS = 5_000
+#: Radial step (px) of the fan that measures pixels per degree: 0.05 px resolves the 1-1.3 px/deg
+#: derivative to well under 1 %.
+FAN_STEP_PX = 0.05
+
+
+@dataclass
+class RayCheck:
+    """Everything the check computed; ``report`` is JSON-ready (units in keys), ``rows`` the
+    tolerance table; arrays kept for the figures."""
+
+    profile: Profile
+    report: dict
+    rows: list
+    trace: Trace3D
+    design_dirs: np.ndarray
+    theta_map: np.ndarray | None
+    status_map: np.ndarray | None
+    fan: dict
+
+    @property
+    def passed(self) -> bool:
+        return all(r.ok for r in self.rows)
+
+
+from rigcad.check.montecarlo import _angles  # noqa: E402
+
+
+def _losses(tr: Trace3D, rays_chief: np.ndarray, design_dirs: np.ndarray) -> dict:
+    n = len(tr.status)
+    phi = np.degrees(np.arctan2(rays_chief[:, 1], rays_chief[:, 0])) % 360
+    theta = np.degrees(np.arccos(np.clip(design_dirs[:, 2], -1, 1)))
+    out = {}
+    for code, name in STATUS_NAMES.items():
+        sel = tr.status == code
+        if code == 0 or not sel.any():
+            continue
+        counts, _ = np.histogram(phi[sel], bins=12, range=(0, 360))
+        out[name] = {
+            "rays": int(sel.sum()), "fraction": float(sel.sum() / n),
+            "segment": int(np.bincount(tr.segment[sel]).argmax()),
+            "phi_deg_counts_per_30deg": counts.tolist(),
+            "design_theta_deg_range": [float(np.nanmin(theta[sel])), float(np.nanmax(theta[sel]))]
+            if np.isfinite(theta[sel]).any() else None,
+        }
+    return out
+
+
+def reading(tr: Trace3D, design_dirs: np.ndarray, exact: Trace3D | None, chief: np.ndarray) -> dict:
+    """Figures of one reading (units in keys)."""
+    ok = tr.ok
+    f = MC.figures(tr, design_dirs, exact)
+    th = tr.theta[ok]
+    f["theta_min_deg"] = float(np.degrees(th.min())) if th.size else float("nan")
+    f["theta_max_deg"] = float(np.degrees(th.max())) if th.size else float("nan")
+    lost = ~ok
+    f["lost_fraction"] = float(lost.mean())
+    f["losses"] = _losses(tr, chief, design_dirs)
+    if exact is not None:
+        both = ok & exact.ok
+        d = _angles(tr.arrival[both], exact.arrival[both])
+        f["mesh_minus_exact_angle_rad"] = {"max": float(d.max()) if d.size else float("nan"),
+                                           "rms": float(np.sqrt(np.mean(d ** 2))) if d.size else float("nan")}
+        dm = np.abs(tr.miss[both] - exact.miss[both])
+        f["mesh_minus_exact_spot_mm"] = {"max": float(dm.max()) if dm.size else float("nan")}
+        f["status_agreement_with_exact"] = float(np.mean(tr.status == exact.status))
+    return f
+
+
+def pixels_per_degree(optics: Optics, design: DesignMap, azimuth: float = 45 * DEG) -> dict:
+    """Trace a radial fan of pixels at ``azimuth`` (off the beam) from the occlusion limit to the
+    rim every FAN_STEP_PX px; theta against pixel radius and its derivative (px/deg)."""
+    r_in, r_out = design.pixel_radius(np.array([design.alpha_min, design.alpha_max]))
+    rho = np.arange(r_in, r_out, FAN_STEP_PX)
+    tr = trace(optics, *_xy(design, rho, azimuth))
+    ok = tr.ok
+    theta = np.degrees(tr.theta[ok])
+    r = rho[ok]
+    dpd = np.abs(np.gradient(r, theta)) if len(r) > 2 else np.array([np.nan])
+    return {"pixel_radius_px": r, "theta_deg": theta, "px_per_deg": dpd,
+            "summary": {"azimuth_deg": azimuth / DEG, "px_per_deg_min": float(np.min(dpd)),
+                        "px_per_deg_mean": float((r.max() - r.min()) / (theta.max() - theta.min())),
+                        "px_per_deg_max": float(np.max(dpd)), "fan_step_px": FAN_STEP_PX}}
+
+
+def _xy(design, rho, azimuth):
+    rays = pixel_rays(design, rho * math.cos(azimuth), rho * math.sin(azimuth))
+    return rays.origins, rays.dirs
+
+
+def run_raycheck(profile: Profile, exports: Path | None = None, rays: int | None = None, mode: str | None = None,
+                 chord_error: float | None = None, normal_error: float | None = None,
+                 monte_carlo: bool = True, grid: bool = True, builds: int | None = None,
+                 optics_cache: dict | None = None, progress=None) -> RayCheck:
+    """Run the 3D check (see the module docstring). ``rays``/``mode``/``builds`` override the
+    profile's raycheck and tolerancing settings; ``chord_error`` (mm)/``normal_error`` (rad) the
+    mirror tessellation. ``optics_cache``: a dict reused across calls (tests) to keep BVHs."""
+    step = progress or (lambda label: None)
+    rc = profile.raycheck
+    if rays is not None:
+        profile = replace(profile, raycheck=replace(rc, rays=rays))
+    if mode is not None:
+        profile = replace(profile, raycheck=replace(profile.raycheck, mode=mode))
+    if chord_error is not None or normal_error is not None:
+        tess = profile.tessellation
+        profile = replace(profile, tessellation=replace(
+            tess, mirror_chord_error=tess.mirror_chord_error if chord_error is None else chord_error,
+            mirror_normal_error=tess.mirror_normal_error if normal_error is None else normal_error))
+    if builds is not None:
+        profile = replace(profile, tolerancing=replace(profile.tolerancing, builds=builds))
+    rc, tol = profile.raycheck, profile.tolerancing
+    timings = {}
+    t0 = time.perf_counter()
+    step("design")
+    rig = rig_geometry(profile)
+    design = DesignMap.from_rig(rig)
+    analytic = analytic_optics(rig)
+    timings["design_s"] = time.perf_counter() - t0
+
+    meshes = None
+    meshed = None
+    if rc.mode != "analytic":
+        step("meshes")
+        t0 = time.perf_counter()
+        key = (profile.name, profile.tessellation.mirror_chord_error, profile.tessellation.mirror_normal_error,
+               str(exports))
+        cache = optics_cache if optics_cache is not None else {}
+        if key not in cache:
+            meshes = rig_meshes(rig, exports, profile.tessellation.mirror_chord_error,
+                                profile.tessellation.mirror_normal_error) if exports is None else rig_meshes(rig, exports)
+            t1 = time.perf_counter()
+            cache[key] = (meshes, mesh_optics(meshes, "smooth"), t1 - t0, time.perf_counter() - t1)
+        meshes, meshed, timings["meshes_s"], timings["embree_build_s"] = cache[key]
+    check_optics = analytic if meshed is None else share_scenes(meshed, rc.mode)
+
+    step("pinhole")
+    t0 = time.perf_counter()
+    src = annulus_rays(design, rc.rays, rc.seed)
+    ddirs = design.direction(src.chief)
+    exact = trace(analytic, src.origins, src.dirs)
+    readings = {"analytic": reading(exact, ddirs, None, src.chief)}
+    main = exact
+    if meshed is not None:
+        for name in ("mesh", "smooth"):
+            tr = trace(share_scenes(meshed, name), src.origins, src.dirs)
+            readings[name] = reading(tr, ddirs, exact, src.chief)
+            if name == rc.mode:
+                main = tr
+        k = min(EXACT_NORMAL_RAYS, rc.rays)
+        sub = exact.__class__(*(getattr(exact, f)[:k] for f in exact.__dataclass_fields__))
+        for name, optics in (("exact_normals", share_scenes(meshed, "exact_normals")),
+                             ("mesh_float32", share_scenes(meshed, "mesh", refine=False)),
+                             ("smooth_float32", share_scenes(meshed, "smooth", refine=False))):
+            tr = trace(optics, src.origins[:k], src.dirs[:k])
+            readings[name] = reading(tr, ddirs[:k], sub, src.chief[:k])
+            readings[name]["rays_traced"] = k
+        for part in ("paraboloid", "dome"):  # which mirror's mesh causes the error
+            for name in ("mesh", "smooth"):
+                tr = trace(mixed(analytic, share_scenes(meshed, name), part), src.origins, src.dirs)
+                r = reading(tr, ddirs, exact, src.chief)
+                readings[f"{name}_{part}_mesh_only"] = {k2: r[k2] for k2 in (
+                    "max_spot_radius_mm", "rms_spot_radius_mm", "mesh_minus_exact_angle_rad")}
+    timings["pinhole_s"] = time.perf_counter() - t0
+
+    step("pixels")
+    t0 = time.perf_counter()
+    fan = pixels_per_degree(check_optics, design)
+    theta_map = status_map = None
+    grid_report = None
+    if grid:
+        r_out = float(design.pixel_radius(np.array([design.alpha_max]))[0])
+        window = 2 * int(math.ceil(r_out)) + 8  # the paraboloid's image and a 4 px margin
+        g, (h, w), (r0, c0) = pixel_grid(design, profile.projector.resolution, window=window)
+        gt = trace(check_optics, g.origins, g.dirs)
+        theta_map = np.degrees(gt.theta).reshape(h, w)
+        status_map = gt.status.reshape(h, w)
+        gd = design.direction(g.chief)
+        err = _angles(gt.arrival[gt.ok], gd[gt.ok])
+        border = np.concatenate([status_map[0], status_map[-1], status_map[:, 0], status_map[:, -1]])
+        width, height = profile.projector.resolution
+        grid_report = {
+            "resolution": [width, height], "traced_window_px": [w, h], "window_origin_row_col": [r0, c0],
+            "window_border_all_missed": bool(np.all(border == 1)),
+            "pixels_total": width * height,
+            "pixels_on_paraboloid": int(np.sum(gt.status != 1)),
+            "pixels_reaching_sample": int(gt.ok.sum()),
+            "pixels_lost": {STATUS_NAMES[k]: int(np.sum(gt.status == k)) for k in STATUS_NAMES if k > 1},
+            "max_angle_error_rad": float(err.max()) if err.size else float("nan"),
+            "theta_min_deg": float(np.nanmin(theta_map)), "theta_max_deg": float(np.nanmax(theta_map)),
+            "max_spot_radius_mm": float(np.nanmax(gt.miss)),
+        }
+    timings["pixels_s"] = time.perf_counter() - t0
+
+    step("thin lens")
+    t0 = time.perf_counter()
+    k = min(THIN_LENS_RAYS, rc.rays)
+    chief = annulus_rays(design, k, rc.seed + 7)
+    ctr = trace(check_optics, chief.origins, chief.dirs)
+    focal = float(np.nanmean(exact.path_length))  # thesis 3.2.2: mean source-to-sample path
+    edge = thin_lens_rays(chief, focal, profile.projector.aperture, rc.lens_azimuths)
+    etr = trace(check_optics, edge.origins, edge.dirs)
+    c_arr = np.repeat(ctr.arrival, rc.lens_azimuths, axis=0)
+    both = etr.ok & np.repeat(ctr.ok, rc.lens_azimuths)
+    off = _angles(etr.arrival[both], c_arr[both])
+    lens = {
+        "aperture_mm": profile.projector.aperture, "focal_distance_mm": focal, "chief_rays": k,
+        "edge_rays_per_chief": rc.lens_azimuths,
+        "mean_abs_angular_offset_rad": float(off.mean()), "max_abs_angular_offset_rad": float(off.max()),
+        "mean_miss_mm": float(np.nanmean(etr.miss)), "max_miss_mm": float(np.nanmax(etr.miss)),
+        "edge_rays_lost_fraction": float(1 - etr.ok.mean()),
+    }
+    timings["thin_lens_s"] = time.perf_counter() - t0
+
+    step("misalignment")
+    t0 = time.perf_counter()
+    mis = profile.misalignment
+    mis_optics = check_optics
+    sens = MC.sensitivity(mis_optics, rig, design, mis.probe, mis.probe_tilt, tol.rays, rc.seed + 11)
+    decl = MC.declared(profile)
+    declared_report = None
+    if decl != MC.Misalignment.none():
+        declared_report = {}
+        for device in ("projector", "camera"):
+            tr, dd, md = MC.trace_path(mis_optics, rig, design, decl, device, tol.rays, rc.seed + 13)
+            declared_report[device + "_path"] = MC.figures(tr, dd, None, md)
+    timings["misalignment_s"] = time.perf_counter() - t0
+    mc = None
+    if monte_carlo:
+        step("monte carlo")
+        t0 = time.perf_counter()
+        mc = MC.monte_carlo(mis_optics, rig, design, tol)
+        timings["monte_carlo_s"] = time.perf_counter() - t0
+
+    report = {
+        "profile": {"name": profile.name, "sources": list(profile.sources)},
+        "frame": "mm; sample point O at the origin; optical axis +z; projector pixel x to +x, rows to -y",
+        "mode": rc.mode,
+        "backend": check_optics.backend,
+        "backends": {"analytic": analytic.backend, **({"mesh": meshed.backend} if meshed else {})},
+        "rays": rc.rays, "seed": rc.seed,
+        "meshes": None if meshes is None else {
+            "sources": meshes.sources(), "tolerances": meshes.tolerances,
+            "triangles": {"paraboloid": len(meshes.paraboloid.faces), "dome": len(meshes.dome.faces),
+                          "paraboloid_mount": len(meshes.mount.faces), "beam": len(meshes.beam.faces)}},
+        "readings": readings,
+        "pixels_per_degree": fan["summary"],
+        "pixel_grid": grid_report,
+        "thin_lens": lens,
+        "misalignment": {"probe_mm": mis.probe, "probe_tilt_rad": mis.probe_tilt, "sensitivity": sens,
+                         "declared": declared_report},
+        "monte_carlo": mc,
+        "timings_s": timings,
+    }
+    rows = T.evaluate(profile, report)
+    report["checks"] = [r.as_dict() for r in rows]
+    report["passed"] = all(r.ok for r in rows)
+    return RayCheck(profile, report, rows, main, ddirs, theta_map, status_map, fan)
+
+
+def write_raycheck(result: RayCheck, out_dir: Path) -> list[Path]:
+    """Write raycheck.json, spot.png, theta_map.png under ``out_dir`` (atomically); returns paths."""
+    from rigcad.check import plots
+    from rigcad.export.atomic import write_json
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths = [write_json(out_dir / "raycheck.json", result.report)]
+    paths.append(plots.spot_diagram(result, out_dir / "spot.png"))
+    if result.theta_map is not None:
+        paths.append(plots.theta_map(result, out_dir / "theta_map.png"))
+    return paths

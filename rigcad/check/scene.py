@@ -1,0 +1,283 @@
+"""The rig as the ray checker sees it: mirror meshes, occluders, exact surfaces, rigid poses.
+
+Frame: mm, sample point O at the origin, optical axis +z. Three rigid bodies can move
+(misalignment): the paraboloid (its mirror with its back, stem and clamp), the dome, and the two
+sources (camera, projector; see sources.py). The beam rests in the dome's slots and moves with the dome.
+
+:func:`rig_meshes` is the one place that obtains the meshes: the exported files when present
+(``exports/<profile>/mirrors/{dome,paraboloid}.ply`` written by ``rigcad build``, and
+``stl/paraboloid.stl``, ``stl/beam.stl``), else built from the profile (``mirror_mesh`` at the
+profile's ``tessellation.mirror_*`` tolerances; the occluders from the layout's boxes and
+cylinders). Where each came from is recorded.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rigcad.check import rays as R
+from rigcad.errors import CheckError
+from rigcad.optics.dome import DomeProfile, build_dome
+from rigcad.parts.layout import RigLayout, rig_layout
+from rigcad.profile.derived import Derived, derive
+from rigcad.profile.schema import Profile
+
+#: Sides of the cylinders of the occluder meshes built when no STL was exported: the polygon's
+#: inscribed radius is r cos(pi/256), 0.0075 % short (1 um on the 16 mm back): below any effect
+#: on which ray is blocked.
+OCCLUDER_SECTIONS = 256
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A rigid placement: global = rotation @ local + translation (mm)."""
+
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    @classmethod
+    def misaligned(cls, offset=(0.0, 0.0, 0.0), tilt: float = 0.0, tilt_axis=(0.0, 1.0, 0.0),
+                   pivot=(0.0, 0.0, 0.0)) -> "Pose":
+        """Tilt by ``tilt`` rad about ``tilt_axis`` through ``pivot``, then shift by ``offset`` mm."""
+        axis = np.asarray(tilt_axis, float)
+        axis = axis / np.linalg.norm(axis)
+        k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        rot = np.eye(3) + math.sin(tilt) * k + (1 - math.cos(tilt)) * (k @ k)  # Rodrigues
+        pivot = np.asarray(pivot, float)
+        return cls(rot, pivot + np.asarray(offset, float) - rot @ pivot)
+
+    @property
+    def is_identity(self) -> bool:
+        return bool(np.array_equal(self.rotation, np.eye(3)) and not np.any(self.translation))
+
+    def localize(self, points: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Points and directions (n, 3) from the global frame into this body's frame."""
+        if self.is_identity:
+            return points, dirs
+        return (points - self.translation) @ self.rotation, dirs @ self.rotation
+
+    def globalize_points(self, points: np.ndarray) -> np.ndarray:
+        return points if self.is_identity else points @ self.rotation.T + self.translation
+
+    def globalize_dirs(self, dirs: np.ndarray) -> np.ndarray:
+        return dirs if self.is_identity else dirs @ self.rotation.T
+
+
+@dataclass(frozen=True)
+class RigGeometry:
+    """What the 3D check needs from the design: derived figures, the dome profile, the layout."""
+
+    profile: Profile
+    geometry: Derived
+    dome: DomeProfile
+    layout: RigLayout
+
+
+def rig_geometry(profile: Profile) -> RigGeometry:
+    geo = derive(profile)
+    dp = profile.dome
+    dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=dp.table_rows)
+    return RigGeometry(profile, geo, dome, rig_layout(profile, geo, dome))
+
+
+@dataclass(frozen=True)
+class RigMeshes:
+    """Mirror meshes (design surfaces) and occluder meshes, with where each came from."""
+
+    paraboloid: R.TriMesh
+    dome: R.TriMesh
+    mount: R.TriMesh
+    beam: R.TriMesh
+    tolerances: dict  #: chord_error_mm, normal_error_rad of the mirror meshes
+
+    def sources(self) -> dict[str, str]:
+        return {m.name: m.source for m in (self.paraboloid, self.dome, self.mount, self.beam)}
+
+
+def _ply_tolerances(comments: tuple[str, ...]) -> dict[str, float]:
+    """The tolerances a rigcad mirror PLY was made at, from its header comment
+    ``rings R sectors S chord_error_mm C facet_normal_error_rad N`` (empty if absent)."""
+    out = {}
+    for c in comments:
+        words = c.split()
+        for key in ("chord_error_mm", "facet_normal_error_rad"):
+            if key in words[:-1]:
+                try:
+                    out[key] = float(words[words.index(key) + 1])
+                except ValueError:
+                    pass
+    return out
+
+
+def _occluder_meshes(profile: Profile, layout: RigLayout) -> tuple[R.TriMesh, R.TriMesh]:
+    """The paraboloid's mount (back, stem, clamp) and the beam as meshes from their boxes and
+    cylinders (used when no STL was exported)."""
+    import trimesh
+
+    mount, beam = profile.paraboloid_mount, profile.beam
+    z0, z1 = layout.beam_z
+    c = profile.dome_shell.slot_clearance
+    rim = layout.printed_paraboloid.points(np.array([layout.printed_paraboloid.u_range[0]]))[0]
+    back = layout.paraboloid_back_z
+    half_out = beam.width / 2 + c + mount.clamp_wall
+    clamp_top = z1 + mount.clamp_wall
+    parts = [
+        trimesh.creation.cylinder(radius=float(rim[0]), segment=[[0, 0, back], [0, 0, float(rim[1])]],
+                                  sections=OCCLUDER_SECTIONS),
+        trimesh.creation.cylinder(radius=mount.stem_radius, segment=[[0, 0, clamp_top], [0, 0, back]],
+                                  sections=OCCLUDER_SECTIONS),
+        trimesh.creation.box(bounds=[[-mount.clamp_length / 2, -half_out, z0], [mount.clamp_length / 2, half_out, clamp_top]]),
+    ]
+    m = trimesh.util.concatenate(parts)
+    hl, w = layout.beam_half_length, beam.width / 2
+    b = trimesh.creation.box(bounds=[[-hl, -w, z0], [hl, w, z1]])
+    src = "built from the layout (boxes, cylinders): no exported STL"
+    return (R.TriMesh("paraboloid_mount", np.asarray(m.vertices, float), np.asarray(m.faces, np.int64), source=src),
+            R.TriMesh("beam", np.asarray(b.vertices, float), np.asarray(b.faces, np.int64), source=src))
+
+
+def _read_stl(path: Path, name: str) -> R.TriMesh:
+    import trimesh
+
+    try:
+        m = trimesh.load_mesh(path, file_type="stl", process=False)
+    except (OSError, ValueError) as err:
+        raise CheckError(f"cannot read {path}: {err}") from err
+    return R.TriMesh(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64), source=str(path))
+
+
+def rig_meshes(rig: RigGeometry, exports: Path | None = None, chord_error: float | None = None,
+               normal_error: float | None = None) -> RigMeshes:
+    """The meshes the checker traces (see the module docstring). ``chord_error`` (mm) and
+    ``normal_error`` (rad) override the profile's ``tessellation.mirror_*`` (then the exported
+    PLYs, made at the profile's values, are not used)."""
+    from rigcad.export.mirror_mesh import mirror_mesh, read_ply
+
+    tess = rig.profile.tessellation
+    override = chord_error is not None or normal_error is not None
+    chord = tess.mirror_chord_error if chord_error is None else chord_error
+    normal = tess.mirror_normal_error if normal_error is None else normal_error
+    out_dir = Path(exports) / rig.profile.name if exports is not None else None
+    mirrors = {}
+    for name, meridian in (("paraboloid", rig.layout.design_paraboloid), ("dome", rig.layout.design_dome)):
+        ply = out_dir / "mirrors" / f"{name}.ply" if out_dir is not None else None
+        mesh = None
+        if ply is not None and ply.is_file() and not override:
+            data = read_ply(ply)
+            tol = _ply_tolerances(data.comments)
+            # use the export only when it was made at the tolerances asked for
+            if (tol.get("chord_error_mm"), tol.get("facet_normal_error_rad")) == (chord, normal):
+                mesh = R.TriMesh(name, data.vertices, data.faces, data.normals, meridian, source=str(ply))
+        if mesh is None:
+            mm = mirror_mesh(meridian, name, chord, normal)
+            mesh = R.TriMesh(name, mm.vertices, mm.faces, mm.normals, meridian,
+                             source=f"mirror_mesh() at {chord:g} mm / {normal:g} rad (no matching exported PLY)")
+        mirrors[name] = mesh
+    stl = out_dir / "stl" if out_dir is not None else None
+    if stl is not None and (stl / "paraboloid.stl").is_file() and (stl / "beam.stl").is_file():
+        mount = _read_stl(stl / "paraboloid.stl", "paraboloid_mount")
+        beam = _read_stl(stl / "beam.stl", "beam")
+    else:
+        mount, beam = _occluder_meshes(rig.profile, rig.layout)
+    return RigMeshes(mirrors["paraboloid"], mirrors["dome"], mount, beam,
+                     {"chord_error_mm": chord, "normal_error_rad": normal})
+
+
+@dataclass
+class Optics:
+    """Intersectors of the three bodies, in their own frames, and the poses that place them.
+
+    ``paraboloid``: part 0 is the mirror, parts >= 1 its mount; ``dome``: part 0 the mirror, part 1
+    the beam (it rests in the dome's slots and moves with it; one query per segment instead of
+    two); ``beam``: the beam alone, also placed by the dome's pose (the return segment starts on
+    the dome, which must not be re-hit at its origin). ``mode`` is mesh, smooth, exact_normals or
+    analytic."""
+
+    mode: str
+    paraboloid: object
+    dome: object
+    beam: object
+    paraboloid_pose: Pose = field(default_factory=Pose)
+    dome_pose: Pose = field(default_factory=Pose)
+    timer: R.Timer | None = None
+
+    @property
+    def backend(self) -> str:
+        return "; ".join(sorted({self.paraboloid.backend, self.dome.backend, self.beam.backend}))
+
+    def placed(self, paraboloid_pose: Pose | None = None, dome_pose: Pose | None = None) -> "Optics":
+        """The same intersectors with other poses (no BVH rebuilt)."""
+        return Optics(self.mode, self.paraboloid, self.dome, self.beam, paraboloid_pose or Pose(),
+                      dome_pose or Pose(), self.timer)
+
+
+MESH_MODES = {"mesh": "facet", "smooth": "vertex", "exact_normals": "exact"}
+
+
+def analytic_optics(rig: RigGeometry) -> Optics:
+    """Exact surfaces and the occluders as boxes and cylinders (float64 throughout)."""
+    geo, lay, prof = rig.geometry, rig.layout, rig.profile
+    mount, beam = prof.paraboloid_mount, prof.beam
+    z0, z1 = lay.beam_z
+    c = prof.dome_shell.slot_clearance
+    rim = lay.printed_paraboloid.points(np.array([lay.printed_paraboloid.u_range[0]]))[0]
+    half_out = beam.width / 2 + c + mount.clamp_wall
+    clamp_top = z1 + mount.clamp_wall
+    para = R.Group([
+        R.ExactParaboloid(geo.focal_length, geo.vertex_z, geo.rim_radius),
+        R.ZCylinder(float(rim[0]), lay.paraboloid_back_z, float(rim[1])),
+        R.ZCylinder(mount.stem_radius, clamp_top, lay.paraboloid_back_z),
+        R.Box((-mount.clamp_length / 2, -half_out, z0), (mount.clamp_length / 2, half_out, clamp_top)),
+    ])
+    hl, w = lay.beam_half_length, beam.width / 2
+    beam_box = R.Box((-hl, -w, z0), (hl, w, z1))
+    return Optics("analytic", para, R.Group([R.ExactDome(lay.design_dome), beam_box]), beam_box)
+
+
+def mesh_optics(meshes: RigMeshes, mode: str = "smooth", refine: bool = True, timer: R.Timer | None = None,
+                backend: str = "embree") -> Optics:
+    """Embree scenes over the meshes (``backend='numpy'``: the brute-force reference, small meshes).
+    ``mode``: mesh (facet normals), smooth (interpolated vertex normals), exact_normals."""
+    if mode not in MESH_MODES:
+        raise ValueError(f"mode {mode!r}: expected one of {', '.join(MESH_MODES)}")
+    model = MESH_MODES[mode]
+    timer = timer or R.Timer()
+    if backend == "numpy":
+        make = lambda ms: R.NumpyMesh(ms, model)  # noqa: E731
+    else:
+        make = lambda ms: R.EmbreeMesh(ms, model, refine=refine, timer=timer)  # noqa: E731
+    return Optics(mode, make([meshes.paraboloid, meshes.mount]), make([meshes.dome, meshes.beam]),
+                  make([meshes.beam]), timer=timer)
+
+
+def share_scenes(optics: Optics, mode: str, refine: bool = True) -> Optics:
+    """The same Embree scenes read with another normal model, or without the float64 refinement
+    (``refine=False``: Embree's float32 hit and facet normal); no BVH is rebuilt."""
+    import copy
+
+    out = copy.copy(optics)
+    out.mode = mode if refine else f"{mode}_float32"
+    for name in ("paraboloid", "dome", "beam"):
+        member = copy.copy(getattr(optics, name))
+        member.normal_model = MESH_MODES[mode]
+        if hasattr(member, "refine"):
+            member.refine = refine
+            member.backend = member.backend.split(" + ")[0].split(" (float32 hits")[0] + (
+                " + float64 re-intersection of the hit triangle" if refine else " (float32 hits, not refined)")
+        setattr(out, name, member)
+    return out
+
+
+def mixed(analytic: Optics, meshed: Optics, mesh_part: str) -> Optics:
+    """Exact surfaces except ``mesh_part`` (paraboloid or dome) from ``meshed``: attributes the
+    mesh error to one mirror."""
+    import copy
+
+    out = copy.copy(analytic)
+    out.mode = f"{meshed.mode}_{mesh_part}_only"
+    setattr(out, mesh_part, getattr(meshed, mesh_part))
+    return out

@@ -1,0 +1,146 @@
+"""Ray sources at the centre of projection (COP): pinhole pixel grid, seeded rays across the
+paraboloid's useful annulus, thin-lens aperture rays (thesis 3.2.2); and the design's incidence
+direction for any ray from the COP (the 2D design, rotated to the ray's azimuth).
+
+Projector frame: the COP at (0, 0, cop_z), looking down -z. Pixel (column i, row j) of a W x H
+image has its centre at image coordinates x = i + 0.5 - W/2 (towards +x), y = H/2 - j - 0.5
+(rows run towards -y), and the direction (x, y, -f_px) with f_px = W x throw_ratio
+(``derived.projector_focal_px``). A source pose (misalignment) moves and tilts that frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import make_interp_spline
+
+from rigcad.check.rays import unit
+from rigcad.check.scene import Pose, RigGeometry
+from rigcad.errors import CheckError
+from rigcad.optics.design import profile_table
+
+
+@dataclass(frozen=True)
+class DesignMap:
+    """The design's incidence angle theta (rad) as a function of the angle alpha (rad) between a
+    COP ray and the axis, from the 2D design's profile table (quintic spline through its rows):
+    valid for alpha_min <= alpha <= alpha_max (the useful annulus: occlusion limit to rim)."""
+
+    alpha_min: float
+    alpha_max: float
+    spline: object
+    cop_z: float
+    focal_px: float
+    s_min: float = 0.0
+    s_max: float = 0.0
+    by_radius: object = None  #: theta (rad) of the paraboloid point at radius s (mm), quintic spline
+
+    @classmethod
+    def from_rig(cls, rig: RigGeometry) -> "DesignMap":
+        geo = rig.geometry
+        if geo.cop_at_infinity:
+            raise CheckError("the 3D ray check needs a finite COP (layout.cop_to_vertex)")
+        table = profile_table(geo, rig.dome)
+        alpha = np.radians(table["cop_angle_deg"])
+        theta = np.radians(table["incidence_theta_deg"])
+        order = np.argsort(alpha)
+        a, t = alpha[order], theta[order]
+        keep = np.concatenate([[True], np.diff(a) > 0])
+        s = table["paraboloid_r_mm"]
+        so = np.argsort(s)
+        return cls(float(a[0]), float(a[-1]), make_interp_spline(a[keep], t[keep], k=5), geo.cop_z,
+                   geo.projector_focal_px, float(s[so][0]), float(s[so][-1]),
+                   make_interp_spline(s[so], theta[so], k=5))
+
+    def direction_at(self, local_points: np.ndarray) -> np.ndarray:
+        """Design arrival directions (n, 3) for rays that hit the paraboloid at ``local_points``
+        (n, 3) in its own frame (the 'calibrated' reference: which paraboloid point a pixel lights
+        is what calibration measures); NaN outside the useful annulus."""
+        s = np.hypot(local_points[:, 0], local_points[:, 1])
+        inside = (s >= self.s_min) & (s <= self.s_max)
+        theta = np.where(inside, self.by_radius(np.clip(s, self.s_min, self.s_max)), np.nan)
+        phi = np.arctan2(local_points[:, 1], local_points[:, 0])
+        return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=-1)
+
+    def direction(self, dirs: np.ndarray) -> np.ndarray:
+        """Design arrival directions (n, 3) (unit, from O towards the light) for COP rays ``dirs``
+        (n, 3) of the aligned projector; NaN outside the useful annulus."""
+        rho = np.hypot(dirs[:, 0], dirs[:, 1])
+        alpha = np.arctan2(rho, -dirs[:, 2])
+        inside = (alpha >= self.alpha_min) & (alpha <= self.alpha_max)
+        theta = np.where(inside, self.spline(np.clip(alpha, self.alpha_min, self.alpha_max)), np.nan)
+        phi = np.arctan2(dirs[:, 1], dirs[:, 0])
+        return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=-1)
+
+    def pixel_radius(self, alpha: np.ndarray) -> np.ndarray:
+        return self.focal_px * np.tan(alpha)
+
+
+@dataclass(frozen=True)
+class Rays:
+    """Rays from a source: origins and unit dirs (n, 3) in the global frame; ``chief`` (n, 3) the
+    aligned pinhole direction each stands for (for the design's direction); ``pixel`` (n, 2) image
+    coordinates (px) or NaN."""
+
+    origins: np.ndarray
+    dirs: np.ndarray
+    chief: np.ndarray
+    pixel: np.ndarray
+
+
+def _place(pose: Pose | None, origins: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    if pose is None or pose.is_identity:
+        return origins, dirs
+    return pose.globalize_points(origins), pose.globalize_dirs(dirs)
+
+
+def pixel_grid(design: DesignMap, resolution: tuple[int, int], pose: Pose | None = None,
+               window: int | None = None) -> tuple[Rays, tuple[int, int], tuple[int, int]]:
+    """One pinhole ray per pixel centre (row-major, rows j then columns i). ``window``: only the
+    centred square of that many pixels a side (the paraboloid's image is ~200 px across; the rest
+    of the image misses it). Returns the rays, the traced (height, width) and the (row, column) of
+    the first traced pixel."""
+    width, height = resolution
+    w = min(width, window) if window else width
+    h = min(height, window) if window else height
+    c0, r0 = (width - w) // 2, (height - h) // 2
+    jj, ii = np.meshgrid(np.arange(r0, r0 + h), np.arange(c0, c0 + w), indexing="ij")
+    x = ii.ravel() + 0.5 - width / 2
+    y = height / 2 - jj.ravel() - 0.5
+    d = unit(np.stack([x, y, np.full_like(x, -design.focal_px)], axis=-1))
+    o = np.tile([0.0, 0.0, design.cop_z], (len(d), 1))
+    go, gd = _place(pose, o, d)
+    return Rays(go, gd, d, np.stack([x, y], axis=-1)), (h, w), (r0, c0)
+
+
+def annulus_rays(design: DesignMap, count: int, seed: int, pose: Pose | None = None) -> Rays:
+    """``count`` pinhole rays uniform in image area over the useful annulus (pixel radius from the
+    occlusion limit to the rim), seeded."""
+    rng = np.random.default_rng(seed)
+    r_in, r_out = design.pixel_radius(np.array([design.alpha_min, design.alpha_max]))
+    rho = np.sqrt(rng.uniform(r_in ** 2, r_out ** 2, count))
+    phi = rng.uniform(0.0, 2 * np.pi, count)
+    return pixel_rays(design, rho * np.cos(phi), rho * np.sin(phi), pose)
+
+
+def pixel_rays(design: DesignMap, x: np.ndarray, y: np.ndarray, pose: Pose | None = None) -> Rays:
+    """Pinhole rays through image points (x, y) px (frame of the module docstring)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    d = unit(np.stack([x, y, np.full_like(x, -design.focal_px)], axis=-1))
+    o = np.tile([0.0, 0.0, design.cop_z], (len(d), 1))
+    go, gd = _place(pose, o, d)
+    return Rays(go, gd, d, np.stack([x, y], axis=-1))
+
+
+def thin_lens_rays(chief: Rays, focal_distance: float, aperture: float, azimuths: int) -> Rays:
+    """Aperture-edge rays of a thin lens of diameter ``aperture`` (mm) in the plane of the COP,
+    perpendicular to the axis, focused at ``focal_distance`` mm along each chief ray (unfolded,
+    thesis 3.2.2): ``azimuths`` rays per chief ray, from edge points at angles 2 pi k / azimuths,
+    aimed at the chief ray's point at the focal distance. Ray k of chief ray i is row i*azimuths+k."""
+    beta = 2 * np.pi * np.arange(azimuths) / azimuths
+    edge = 0.5 * aperture * np.stack([np.cos(beta), np.sin(beta), np.zeros_like(beta)], axis=-1)
+    q = chief.origins + focal_distance * chief.dirs  # (n, 3)
+    e = (chief.origins[:, None, :] + edge[None]).reshape(-1, 3)
+    d = unit(np.repeat(q, azimuths, axis=0) - e)
+    return Rays(e, d, np.repeat(chief.chief, azimuths, axis=0), np.repeat(chief.pixel, azimuths, axis=0))

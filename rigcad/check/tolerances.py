@@ -1,0 +1,111 @@
+"""The tolerances the 3D ray check enforces: each a named profile key with its unit, the measured
+value it is compared with, and on failure a message that names the key, its file:line and what
+to change. :func:`evaluate` builds the table; :func:`raise_if_failed` turns failures into one
+CheckError.
+
+Internal numerical tolerances of the checker (not profile keys) are module constants beside the
+code that uses them, each with its reason (rays.py, scene.py, raycheck.py).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rigcad.errors import CheckError
+
+DEG = math.pi / 180.0
+
+
+@dataclass(frozen=True)
+class Row:
+    """One line of the check table. ``unit`` is mm, deg, px/deg or '' (fractions)."""
+
+    name: str
+    key: str
+    measured: float
+    limit: float
+    relation: str  # "<=" or ">="
+    unit: str
+    where: str | None
+    hint: str = ""
+
+    @property
+    def ok(self) -> bool:
+        if not math.isfinite(self.measured):
+            return False
+        return self.measured <= self.limit if self.relation == "<=" else self.measured >= self.limit
+
+    def as_dict(self) -> dict:
+        return {"check": self.name, "profile_key": self.key, "measured": self.measured, "limit": self.limit,
+                "relation": self.relation, "unit": self.unit, "where": self.where, "ok": self.ok,
+                **({"hint": self.hint} if not self.ok and self.hint else {})}
+
+
+def evaluate(profile, report: dict) -> list[Row]:
+    """The table for a run_raycheck report."""
+    rc, tg, tol, tess = profile.raycheck, profile.targets, profile.tolerancing, profile.tessellation
+    w = profile.where
+    r = report["readings"]
+    main = r[rc.mode]
+    tess_where = ", ".join(x for x in (w("tessellation", "mirror_chord_error"), w("tessellation", "mirror_normal_error")) if x) or "default"
+    tess_hint = (f"mirror meshes at tessellation.mirror_chord_error {tess.mirror_chord_error:g} mm / "
+                 f"mirror_normal_error {tess.mirror_normal_error:g} rad ({tess_where})")
+    rows = [
+        Row("spot radius (pinhole, max)", "raycheck.max_spot_radius", main["max_spot_radius_mm"], rc.max_spot_radius,
+            "<=", "mm", w("raycheck", "max_spot_radius"),
+            f"reading {rc.mode}; " + (tess_hint + ": tighten them" if rc.mode != "analytic" else "the design itself")),
+        Row("angle error vs design (pinhole, max)", "raycheck.max_angle_error", main["max_angle_error_rad"] / DEG,
+            rc.max_angle_error / DEG, "<=", "deg", w("raycheck", "max_angle_error"), f"reading {rc.mode}"),
+    ]
+    if "mesh" in r:
+        rows.append(Row("spot radius, flat facets (STL-literal, max)", "raycheck.max_facet_spot_radius",
+                        r["mesh"]["max_spot_radius_mm"], rc.max_facet_spot_radius, "<=", "mm",
+                        w("raycheck", "max_facet_spot_radius"), tess_hint + ": tighten mirror_normal_error"))
+    if rc.mode in ("mesh", "smooth"):
+        e = main["mesh_minus_exact_angle_rad"]["max"]
+        parts = {p: r[f"{rc.mode}_{p}_mesh_only"]["mesh_minus_exact_angle_rad"]["max"] for p in ("paraboloid", "dome")}
+        worst = max(parts, key=parts.get)
+        rows.append(Row("mesh minus exact angle error (max)", "raycheck.max_mesh_angle_error", e / DEG,
+                        rc.max_mesh_angle_error / DEG, "<=", "deg", w("raycheck", "max_mesh_angle_error"),
+                        f"{tess_hint}; the {worst} mesh alone gives {parts[worst] / DEG:.3g} deg: tighten "
+                        "tessellation.mirror_normal_error and mirror_chord_error"))
+    th_lo, th_hi = main["theta_min_deg"], main["theta_max_deg"]
+    rows.append(Row("theta range reaches targets.theta_min", "raycheck.theta_coverage_tolerance",
+                    th_lo - tg.theta_min / DEG, rc.theta_coverage_tolerance / DEG, "<=", "deg",
+                    w("raycheck", "theta_coverage_tolerance"), f"traced theta from {th_lo:.2f} deg"))
+    rows.append(Row("theta range reaches targets.theta_max", "raycheck.theta_coverage_tolerance",
+                    tg.theta_max / DEG - th_hi, rc.theta_coverage_tolerance / DEG, "<=", "deg",
+                    w("raycheck", "theta_coverage_tolerance"), f"traced theta up to {th_hi:.2f} deg"))
+    rows.append(Row("pixels per degree (min along theta)", "raycheck.min_px_per_deg",
+                    report["pixels_per_degree"]["px_per_deg_min"], rc.min_px_per_deg, ">=", "px/deg",
+                    w("raycheck", "min_px_per_deg"), "projector.throw_ratio or the paraboloid's size set it"))
+    rows.append(Row("rays lost (occluded, escaped)", "raycheck.max_lost_fraction", main["lost_fraction"],
+                    rc.max_lost_fraction, "<=", "", w("raycheck", "max_lost_fraction"),
+                    "see readings.<mode>.losses for where; the beam's width sets most of it"))
+    mc = report.get("monte_carlo")
+    if mc is not None:
+        rows.append(Row("Monte Carlo yield (spot and mirror angle targets)", "tolerancing.min_yield", mc["yield"],
+                        tol.min_yield, ">=", "", w("tolerancing", "min_yield"),
+                        f"p90 spot {mc['max_spot_radius_mm']['p90']:.3g} mm, p90 angle "
+                        f"{mc['max_mirror_angle_error_rad']['p90'] / DEG:.3g} deg: tighten the tolerancing.* placements"))
+    return rows
+
+
+def table(rows: list[Row]) -> str:
+    """A readable fixed-width table of the rows."""
+    lines = [f"{'check':<50} {'measured':>12} {'':2} {'limit':>10} {'unit':<7} {'':4}"]
+    for row in rows:
+        lines.append(f"{row.name:<50} {row.measured:>12.4g} {row.relation:2} {row.limit:>10.4g} {row.unit:<7} "
+                     f"{'ok' if row.ok else 'FAIL'}")
+    return "\n".join(lines)
+
+
+def raise_if_failed(rows: list[Row], profile_name: str) -> None:
+    """CheckError listing every failed row: key, file:line, measured vs limit, hint."""
+    failed = [r for r in rows if not r.ok]
+    if not failed:
+        return
+    parts = [f"{r.key} ({r.where or 'default'}): {r.name} {r.measured:.4g} {r.unit} not {r.relation} "
+             f"{r.limit:.4g} {r.unit}; {r.hint}" for r in failed]
+    raise CheckError(f"{profile_name}: {len(failed)} ray-check tolerance(s) not met: " + " | ".join(parts))

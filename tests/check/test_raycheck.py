@@ -1,0 +1,97 @@
+"""The check stage: every profile passes its declared tolerances at its default tessellation, a too
+coarse tessellation fails naming the key, the CLI writes its files and exits 1 on a failure."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import pytest
+
+from rigcad.check import cli as check_cli
+from rigcad.check.raycheck import run_raycheck, write_raycheck
+from rigcad.check.tolerances import raise_if_failed, table
+from rigcad.errors import CheckError, RigcadError
+from rigcad.profile import load_profile
+
+ROOT = Path(__file__).resolve().parents[2]
+#: rig profiles (profiles/printers/ holds printer definitions, not rigs)
+PROFILES = sorted((ROOT / "profiles").glob("*.yaml"))
+
+
+def test_there_are_profiles():
+    assert PROFILES, "no profile found: the parametrised check below would pass vacuously"
+
+
+@pytest.mark.parametrize("path", PROFILES, ids=[p.stem for p in PROFILES])
+def test_every_profile_meets_its_declared_tolerances(path, optics_cache):
+    """Default tessellation, the profile's mode; fewer rays and builds than `rigcad check` for speed
+    (maxima over 20000 rays come within a few per cent of those over 100000: smooth error fields)."""
+    profile = load_profile(path)
+    result = run_raycheck(profile, rays=20000, builds=20, grid=True, optics_cache=optics_cache)
+    assert len(result.rows) >= 8, "the table has every declared tolerance"
+    raise_if_failed(result.rows, profile.name)  # the failure message is the readable table's content
+    rep = result.report
+    if rep["mode"] != "analytic":
+        # mesh minus exact is reported with the tessellation that caused it
+        assert rep["meshes"]["tolerances"]["normal_error_rad"] == profile.tessellation.mirror_normal_error
+        assert "mesh_minus_exact_angle_rad" in rep["readings"][rep["mode"]]
+        assert rep["backend"].startswith("embreex")
+
+
+def test_a_too_coarse_tessellation_fails_naming_it(table31, optics_cache):
+    result = run_raycheck(table31, rays=5000, chord_error=0.1, normal_error=0.1, monte_carlo=False,
+                          grid=False, optics_cache=optics_cache)
+    assert not result.passed
+    with pytest.raises(CheckError) as err:
+        raise_if_failed(result.rows, table31.name)
+    msg = str(err.value)
+    assert "raycheck.max_mesh_angle_error" in msg and "tessellation.mirror_normal_error" in msg, msg
+    assert "achutha2006.yaml:" in msg, "the failing key's file:line is named"
+    assert err.value.exit_code == 1
+    assert "FAIL" in table(result.rows)
+
+
+def _parser():
+    parser = argparse.ArgumentParser(prog="rigcad")
+    check_cli.register(parser.add_subparsers(dest="command"))
+    return parser
+
+
+def test_cli_writes_the_report_and_figures(tmp_path, capsys):
+    args = _parser().parse_args(["check", "achutha2006", "--exports", str(tmp_path), "--mode", "analytic",
+                                 "--rays", "3000", "--builds", "5"])
+    assert args.func(args) == 0
+    out = tmp_path / "achutha2006" / "check"
+    rep = json.loads((out / "raycheck.json").read_text())
+    assert rep["passed"] and rep["backend"].startswith("analytic")
+    assert (out / "spot.png").stat().st_size > 1000 and (out / "theta_map.png").stat().st_size > 1000
+    assert "spot radius" in capsys.readouterr().out
+
+
+def test_cli_exits_nonzero_with_a_table_on_failure(tmp_path, write_profile, capsys):
+    path = write_profile(f"""
+        extends: {ROOT / "profiles" / "achutha2006.yaml"}
+        raycheck:
+          mode: analytic
+          max_lost_fraction: 0.01
+        """, name="strict")
+    args = _parser().parse_args(["check", str(path), "--exports", str(tmp_path), "--rays", "3000",
+                                 "--no-monte-carlo"])
+    with pytest.raises(RigcadError) as err:
+        args.func(args)
+    assert err.value.exit_code == 1  # rigcad.cli.main turns this into exit status 1
+    assert "raycheck.max_lost_fraction" in str(err.value) and "strict.yaml:" in str(err.value)
+    assert "FAIL" in capsys.readouterr().out
+    assert (tmp_path / "strict" / "check" / "raycheck.json").is_file(), "the report is written before failing"
+
+
+def test_write_raycheck_is_deterministic_apart_from_timings(tmp_path, table31):
+    a = run_raycheck(table31, mode="analytic", rays=2000, monte_carlo=False)
+    b = run_raycheck(table31, mode="analytic", rays=2000, monte_carlo=False)
+    for r in (a, b):
+        r.report.pop("timings_s")
+    pa = write_raycheck(a, tmp_path / "a")
+    pb = write_raycheck(b, tmp_path / "b")
+    assert [p.read_bytes() for p in pa] == [p.read_bytes() for p in pb]

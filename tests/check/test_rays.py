@@ -1,0 +1,100 @@
+"""Intersectors: Embree against the float64 brute-force reference hit for hit, the float64
+refinement, the exact surfaces against their own definitions."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rigcad.check import rays as R
+from rigcad.check.sources import annulus_rays
+
+
+def _paraboloid_rays(design_map, n, seed):
+    r = annulus_rays(design_map, n, seed)
+    return r.origins, r.dirs
+
+
+def test_embree_is_the_backend_and_agrees_with_the_float64_reference_hit_for_hit(coarse_meshes, design_map):
+    # Not skipped when embreex is missing: it is a pinned dependency, so its absence is a failure.
+    R.require_embree()
+    mesh = coarse_meshes.paraboloid
+    o, d = _paraboloid_rays(design_map, 1500, 1)
+    # add rays that miss (beyond the rim) so that misses are compared too
+    o2, d2 = _paraboloid_rays(design_map, 500, 2)
+    d2[:, :2] *= 1.3
+    o, d = np.vstack([o, o2]), R.unit(np.vstack([d, d2]))
+    emb = R.EmbreeMesh([mesh], "vertex").intersect(o, d)
+    ref = R.NumpyMesh([mesh], "vertex").intersect(o, d)
+    hit = np.isfinite(ref.t)
+    # not vacuous: most rays hit, some miss
+    assert hit.sum() > 1400 and (~hit).sum() > 100, (hit.sum(), (~hit).sum())
+    assert np.array_equal(np.isfinite(emb.t), hit), "Embree and the reference disagree on which rays hit"
+    # both re-intersect the same triangle in float64 (or, on an edge, its neighbour: same plane
+    # to within the facet angle x the float32 edge error): distances agree to 1e-9 mm
+    assert np.max(np.abs(emb.t[hit] - ref.t[hit])) < 1e-9
+    cosang = np.clip(np.sum(emb.normal[hit] * ref.normal[hit], axis=1), -1, 1)
+    # interpolated normals: same barycentrics up to rounding, 1e-9 rad
+    assert np.max(np.arccos(cosang)) < 1e-6
+
+
+def test_float64_refinement_beats_embrees_float32_hit(coarse_meshes, design_map):
+    mesh = coarse_meshes.dome
+    o, d = _paraboloid_rays(design_map, 3000, 3)
+    para = R.ExactParaboloid(*_para_args(coarse_meshes))
+    h = para.intersect(o, d)
+    ok = np.isfinite(h.t)
+    p = o[ok] + h.t[ok, None] * d[ok]
+    u = d[ok] - 2 * np.sum(d[ok] * h.normal[ok], axis=1)[:, None] * h.normal[ok]
+    refined = R.EmbreeMesh([mesh], "facet").intersect(p, u)
+    raw = R.EmbreeMesh([mesh], "facet", refine=False).intersect(p, u)
+    both = np.isfinite(refined.t) & np.isfinite(raw.t)
+    assert both.sum() > 2500
+    err_raw = np.abs(raw.t[both] - refined.t[both])
+    # float32 at ~200 mm resolves ~1.5e-5 mm: the raw distances differ by about that, never by
+    # more than a few hundred ulps (1e-2 mm would be a wrong triangle)
+    assert 1e-8 < np.median(err_raw) < 1e-3, np.median(err_raw)
+    # Embree's Ng is our right-hand facet normal, same sign (float32 rounding: ~1e-7 in cos)
+    cosang = np.sum(raw.normal[both] * refined.normal[both], axis=1)
+    assert np.min(cosang) > 1 - 1e-6
+
+
+def _para_args(meshes):
+    m = meshes.paraboloid.meridian
+    return m._focal_length, m._vertex_z, -m.u_range[0]
+
+
+def test_exact_surfaces_hit_their_own_definitions(rig, design_map, analytic):
+    geo = rig.geometry
+    o, d = _paraboloid_rays(design_map, 5000, 4)
+    para = R.ExactParaboloid(geo.focal_length, geo.vertex_z, geo.rim_radius)
+    h = para.intersect(o, d)
+    assert np.all(np.isfinite(h.t)), "every ray aimed at the useful annulus hits the paraboloid"
+    p = o + h.t[:, None] * d
+    resid = p[:, 2] - (geo.vertex_z - (p[:, 0] ** 2 + p[:, 1] ** 2) / (4 * geo.focal_length))
+    # closed form in float64 at z ~ 150 mm: rounding, 1e-11 mm
+    assert np.max(np.abs(resid)) < 1e-10
+    u = d - 2 * np.sum(d * h.normal, axis=1)[:, None] * h.normal
+    dome = R.ExactDome(rig.layout.design_dome)
+    hd = dome.intersect(p, u)
+    ok = np.isfinite(hd.t)
+    assert ok.mean() > 0.99, "rays from the useful annulus reach the dome"
+    q = p[ok] + hd.t[ok, None] * u[ok]
+    rz = np.stack([np.hypot(q[:, 0], q[:, 1]), q[:, 2]], axis=-1)
+    uu = np.interp(rz[:, 1], *R._dense(rig.layout.design_dome)[1][:, 1:2].T, R._dense(rig.layout.design_dome)[0])
+    # Newton on the spline: the hit lies on the meridian to 1e-9 mm (its radius at the hit's height)
+    from scipy.optimize import brentq  # independent of the checker's Newton: a root of z(u) = z_hit
+    m = rig.layout.design_dome
+    for k in range(0, len(q), 500):
+        uk = brentq(lambda v: m.points(np.array([v]))[0, 1] - rz[k, 1], uu[k] - 0.05, uu[k] + 0.05, xtol=1e-15)
+        assert abs(m.points(np.array([uk]))[0, 0] - rz[k, 0]) < 1e-9
+
+
+def test_occluder_primitives():
+    box = R.Box((-1, -1, -1), (1, 1, 1))
+    o = np.array([[-5.0, 0, 0], [-5.0, 3, 0], [0.0, 0, 0]])
+    d = np.array([[1.0, 0, 0], [1.0, 0, 0], [0, 0, 1.0]])
+    h = box.intersect(o, d)
+    assert h.t[0] == 4.0 and np.isinf(h.t[1]) and h.t[2] == 0.0
+    cyl = R.ZCylinder(2.0, 0.0, 1.0)
+    h = cyl.intersect(np.array([[-5.0, 0, 0.5], [-5.0, 0, 1.5]]), np.array([[1.0, 0, 0], [1.0, 0, 0]]))
+    assert abs(h.t[0] - 3.0) < 1e-12 and np.isinf(h.t[1])
