@@ -36,8 +36,9 @@ design: stl
 check: stl
 	$(VENV)/bin/rigcad check $(PROFILE) --exports $(EXPORTS)
 
-docs: stl
+docs: check
 	cp $(EXPORTS)/achutha2006/rays.png docs/rays.png
+	cp $(EXPORTS)/achutha2006/check/spot.png $(EXPORTS)/achutha2006/check/theta_map.png docs/
 	mkdir -p docs/parts && cp $(EXPORTS)/achutha2006/renders/*.png docs/parts/
 
 test: $(VENV)/.installed
