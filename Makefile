@@ -5,16 +5,22 @@ PYTHON ?= python3.11
 VENV := .venv
 PY := $(VENV)/bin/python
 PROFILE ?= achutha2006
+PRINTER ?= prusa_mk3s
+# Debian packages the project runs (the G-code slicer); installed when missing, never assumed.
+SYSTEM_TOOLS := prusa-slicer
+SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 EXPORTS ?= exports
 
-.PHONY: all stl design docs check test test-all bench stress clean distclean help
+.PHONY: all stl design docs check gcode tools test test-all test-slow bench stress clean distclean help
 
 all: stl
 
 help:
 	@echo "make stl      - design and build the default profile ($(PROFILE)) into $(EXPORTS)/$(PROFILE)/"
 	@echo "make check    - 3D ray check of $(PROFILE) through the exported meshes (after make stl)"
+	@echo "make gcode    - print files + G-code (PrusaSlicer) for PRINTER=$(PRINTER) -> $(EXPORTS)/$(PROFILE)/fab/$(PRINTER)/"
 	@echo "make test     - the fast test suite (default run, < 10 min)"
+	@echo "make test-slow - only the slow tests (the whole rig through PrusaSlicer)"
 	@echo "make test-all - every test, slow ones included"
 	@echo "make stress   - numerical stress suite: 500 random profiles (hypothesis)"
 	@echo "make bench    - run time against error for each accuracy knob -> bench/results/*.json, *.png"
@@ -27,6 +33,13 @@ $(VENV)/.installed: pyproject.toml requirements.lock
 	touch $@
 
 venv: $(VENV)/.installed
+
+tools:
+	@missing=""; for t in $(SYSTEM_TOOLS); do command -v $$t >/dev/null || missing="$$missing $$t"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing$$missing (apt-get)"; \
+	  $(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
 
 stl: $(VENV)/.installed
 	$(VENV)/bin/rigcad stl $(PROFILE) --exports $(EXPORTS)
@@ -41,18 +54,25 @@ docs: check
 	cp $(EXPORTS)/achutha2006/check/spot.png $(EXPORTS)/achutha2006/check/theta_map.png docs/
 	mkdir -p docs/parts && cp $(EXPORTS)/achutha2006/renders/*.png docs/parts/
 
-test: $(VENV)/.installed
+test: $(VENV)/.installed tools
 	$(PY) -m pytest -q -m "not slow and not stress"
+
+test-slow: $(VENV)/.installed tools
+	$(PY) -m pytest -q -m slow
+
+gcode: $(VENV)/.installed tools
+	$(VENV)/bin/rigcad fab $(PROFILE) --printer $(PRINTER) --exports $(EXPORTS) --gcode
 
 bench: $(VENV)/.installed
 	$(PY) bench/dome.py
 	$(PY) bench/mirror_mesh.py
 	$(PY) bench/raycheck.py --exports $(EXPORTS)
+	$(PY) bench/fab_stages.py
 
 stress: $(VENV)/.installed
 	$(PY) -m pytest -q -m stress --hypothesis-show-statistics
 
-test-all: $(VENV)/.installed
+test-all: $(VENV)/.installed tools
 	$(PY) -m pytest -q
 
 clean:

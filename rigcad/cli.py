@@ -211,6 +211,10 @@ def build_parser() -> argparse.ArgumentParser:
     from rigcad.check.cli import register as register_check
 
     register_check(sub)
+
+    from rigcad.fab.cli import register as register_fab
+
+    register_fab(sub)
     return parser
 
 

@@ -19,7 +19,7 @@ from rigcad import __version__
 from rigcad.errors import ExportError, ProfileError
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import code_version, file_sha, profile_digest
-from rigcad.optics.dome import build_dome
+from rigcad.optics.design import converged_dome
 from rigcad.parts import PARTS, rig_layout
 from rigcad.parts.recipe import Part
 from rigcad.profile.derived import derive
@@ -79,8 +79,7 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
 
     step = progress or (lambda label: None)
     geo = derive(profile)
-    dp = profile.dome
-    dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=dp.table_rows)
+    dome = converged_dome(profile, geo)
     layout = rig_layout(profile, geo, dome)
     names = select_parts(parts)
     old_path = out / "manifest.json"

@@ -91,20 +91,43 @@ def _stat(values: np.ndarray) -> dict[str, float]:
     return {"min": float(v.min()), "max": float(v.max())}
 
 
+#: A smooth dome's curve (quintic spline through its rows) must return the chief rays to O within
+#: this fraction of the optical path; rows are doubled until it does (pointed paraboloids need more).
+CURVE_MISS_RTOL = 1e-9
+MAX_ROWS = 1 << 17
+
+
+def converged_dome(profile: Profile, geo: Derived) -> DomeProfile:
+    """The profile's dome, with at least ``dome.table_rows`` rows and as many more (doubling) as its
+    smooth curve needs to trace every chief ray to O within CURVE_MISS_RTOL of the optical path."""
+    dp = profile.dome
+    rows = dp.table_rows
+    para = Paraboloid(geo.focal_length, geo.vertex_z, geo.rim_radius)
+    while True:
+        try:
+            dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=rows)
+        except RigcadError as err:
+            located = err.located(profile.marks)
+            if located is err:
+                raise
+            raise located from err
+        if dome.kind != "smooth" or rows >= MAX_ROWS:
+            return dome
+        origins, dirs = chief_rays(geo, para, dome, profile.misalignment.rays)
+        tr = trace(para, DomeCurve.from_profile(dome), origins, dirs)
+        miss = np.abs(tr.miss[tr.ok])
+        if not miss.size or miss.max() <= CURVE_MISS_RTOL * dome.path_length:
+            return dome
+        rows = min(2 * rows - 1, MAX_ROWS)
+
+
 def run_design(profile: Profile, progress=None) -> Design:
     """Build and check the 2D design. Raises GeometryError for an impossible rig."""
     step = progress or (lambda label: None)
     geo = derive(profile)
     para = Paraboloid(geo.focal_length, geo.vertex_z, geo.rim_radius)
     step("dome profile")
-    dp = profile.dome
-    try:
-        dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=dp.table_rows)
-    except RigcadError as err:
-        located = err.located(profile.marks)
-        if located is err:
-            raise
-        raise located from err
+    dome = converged_dome(profile, geo)
     curve = DomeCurve.from_profile(dome)
     aperture = profile.projector.aperture
 

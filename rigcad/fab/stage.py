@@ -1,0 +1,419 @@
+"""The fabrication stage: profile + printer -> exports/<profile>/fab/<printer>/.
+
+For every part: fit it to the printer (or split it, rigcad.fab.split), choose each piece's
+orientation (rigcad.fab.orientation: least staircase on a mirror), slice it in-process
+(rigcad.fab.staircase: layer count, the staircase map from the slices against the closed form,
+the polishing allowance, the optical effect), write its STL in print position and, with
+``gcode``, its G-code through PrusaSlicer (rigcad.fab.slicer). Flat templates become DXF and SVG
+cutting outlines (rigcad.fab.outlines). fab.json (units in keys) and fab.md (with the staircase
+maps) report it all. Outputs are staged and published together (rigcad.export.atomic).
+
+Files: stl/<piece>.stl, gcode/<piece>.gcode, printer.ini, outlines/<part>.{dxf,svg},
+staircase/<part>.png, fab.json, fab.md. Timings are returned, not written (fab.json is
+deterministic).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rigcad import __version__
+from rigcad.errors import FabricationError, RigcadError
+from rigcad.export.atomic import Staging, json_bytes
+from rigcad.fab import figures, outlines
+from rigcad.fab import orientation as O
+from rigcad.fab import slicer as S
+from rigcad.fab import split as SP
+from rigcad.fab import staircase as ST
+from rigcad.fab.mirror import MirrorSurface, mirror_faces
+from rigcad.fab.printers import Printer
+from rigcad.parts.recipe import Prism
+
+#: Parts cut from plate rather than printed.
+CUT_PARTS = ("dome_template", "paraboloid_template")
+#: Two orientations whose mean cusp differs by less than this fraction tie (upright and upside
+#: down give the same |n . D| everywhere); the tie goes to less support on the mirror.
+CUSP_TIE_RTOL = 1e-3
+
+
+@dataclass
+class FabResult:
+    report: dict
+    written: list[Path]
+    timings_s: dict[str, float] = field(default_factory=dict)
+    slicer_s: dict[str, float] = field(default_factory=dict)
+    problems: list[str] = field(default_factory=list)
+
+
+def _sha(b: bytes) -> str:
+    return hashlib.sha256(b).hexdigest()
+
+
+def _mirror(part, layout) -> MirrorSurface | None:
+    if not part.mirrors:
+        return None
+    name, design = part.mirrors[0]
+    return MirrorSurface(name, design.behind(layout.coating), design)
+
+
+def evaluate(vertices, faces, orient: O.Orientation, printer: Printer, mirror_f) -> dict:
+    """One candidate orientation of one piece: fit, staircase (closed form), supports."""
+    spin, extents = O.fit_spin(vertices, orient.direction, printer.usable)
+    row = {"orientation": orient.name, "build_direction": [round(float(v), 12) for v in orient.direction],
+           "fits": spin is not None, "spin_deg": None if spin is None else math.degrees(spin),
+           "extents_mm": extents, "overhang_area_mm2": O.overhang_area(vertices, faces, orient.direction)}
+    if mirror_f is not None and len(mirror_f.index):
+        mask = np.zeros(len(faces), bool)
+        mask[mirror_f.index] = True
+        row["mirror_overhang_area_mm2"] = O.overhang_area(vertices, faces, orient.direction, mask)
+        row["staircase_closed_form"] = ST.surface_staircase(mirror_f, orient.direction, printer.layer_height)
+    return row
+
+
+def choose(rows: list[dict]) -> int:
+    """Index of the best candidate: among those that fit, the least mean cusp on the mirror (ties
+    within CUSP_TIE_RTOL), then the least support on the mirror, then the least overhang, then the
+    lowest height; without a mirror, the least overhang, then the lowest height."""
+    ok = [i for i, r in enumerate(rows) if r["fits"]]
+    if not ok:
+        return 0
+    if all("staircase_closed_form" in rows[i] for i in ok):
+        best = min(rows[i]["staircase_closed_form"]["cusp_mean_mm"] for i in ok)
+        ok = [i for i in ok if rows[i]["staircase_closed_form"]["cusp_mean_mm"] <= best * (1 + CUSP_TIE_RTOL)]
+        return min(ok, key=lambda i: (round(rows[i]["mirror_overhang_area_mm2"], 3),
+                                      round(rows[i]["overhang_area_mm2"], 3), rows[i]["extents_mm"]["z_mm"], i))
+    return min(ok, key=lambda i: (round(rows[i]["overhang_area_mm2"], 3), rows[i]["extents_mm"]["z_mm"], i))
+
+
+def _estimate(volume: float, layers: int, printer: Printer) -> dict:
+    """Time and material without a slicer (model material only, no support): mm3, g, s."""
+    t = layers * printer.layer_time_s
+    if printer.deposition_rate_mm3_s > 0:
+        t += volume / printer.deposition_rate_mm3_s
+    return {"method": "rigcad estimate: volume / deposition rate + layers x layer time (no support)",
+            "print_time_s": t, "material_cm3": volume / 1000.0,
+            "material_g": volume / 1000.0 * printer.material_density_g_cm3}
+
+
+def run_fab(profile, printer: Printer, out: Path, *, gcode: bool = False, parts: list[str] | None = None,
+            progress=None, workers: int | None = None) -> FabResult:
+    """Run the stage into ``out`` (exports/<profile>/fab/<printer>); see the module docstring."""
+    from rigcad.export import mesh as M
+    from rigcad.export.build import select_parts
+    from rigcad.optics.dome import build_dome
+    from rigcad.parts import PARTS, rig_layout
+    from rigcad.profile.derived import derive
+
+    say = progress or (lambda msg: None)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    geo = derive(profile)
+    dp = profile.dome
+    dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=dp.table_rows)
+    layout = rig_layout(profile, geo, dome)
+    timings["design_and_layout"] = time.perf_counter() - t0
+    chord = profile.tessellation.chord_error
+    tol_mirror = chord + 2e-3  # mesh vertices lie on the surface; facets within the chord error
+    names = select_parts(parts)
+    bed_c = (printer.build_volume.x / 2, printer.build_volume.y / 2)
+    old_path = out / "fab.json"
+    old = json.loads(old_path.read_text()) if old_path.is_file() else {}
+    report_parts: dict[str, dict] = {}
+    problems: list[str] = []
+    jobs: list[S.SliceJob] = []
+    job_part: dict[str, str] = {}
+
+    with Staging() as stage:
+        for name in names:
+            part = PARTS[name](profile, layout)
+            if name in CUT_PARTS and isinstance(part.solid, Prism):
+                t = time.perf_counter()
+                o = outlines.outline(part, chord)
+                dxf, svg = outlines.dxf_bytes(o), outlines.svg_bytes(o)
+                stage.write_bytes(out / "outlines" / f"{name}.dxf", dxf)
+                stage.write_bytes(out / "outlines" / f"{name}.svg", svg)
+                report_parts[name] = {"process": "cut from plate (laser / water-jet)", "quantity": part.quantity,
+                                      "plate_thickness_mm": o.thickness, "outline_size_mm": list(o.size),
+                                      "outline_points": len(o.polygon), "chord_error_mm": chord,
+                                      "files": {f"outlines/{name}.dxf": _sha(dxf), f"outlines/{name}.svg": _sha(svg)}}
+                timings[f"outline:{name}"] = time.perf_counter() - t
+                continue
+            say(name)
+            try:
+                entry, part_jobs = _fab_part(part, layout, printer, chord, tol_mirror, bed_c, stage, out, timings)
+            except RigcadError as err:
+                problems.append(f"{name}: {err}")
+                report_parts[name] = {"error": str(err)}
+                continue
+            report_parts[name] = entry
+            for job in part_jobs:
+                jobs.append(job)
+                job_part[job.name] = name
+
+        slicer_s: dict[str, float] = {}
+        report_gcode = {"requested": gcode, "slicer": printer.slicer}
+        ini = None
+        if gcode and printer.slicer == "prusa-slicer" and jobs:
+            t = time.perf_counter()
+            cached = {}
+            for pname, entry in old.get("parts", {}).items():
+                for pc in entry.get("pieces", []):
+                    g = pc.get("gcode") or {}
+                    path = out / "gcode" / f"{pc['name']}.gcode"
+                    if g.get("key") and path.is_file() and _sha(path.read_bytes()) == g.get("sha256"):
+                        cached[pc["name"]] = (g["key"], path.read_bytes())
+            try:
+                results, version = S.slice_all(jobs, cached, workers)
+            except FabricationError as err:
+                problems.append(str(err))
+                report_gcode["error"] = str(err)
+                results, version = [], None
+            report_gcode["slicer_version"] = version
+            for job, res in zip(jobs, results):
+                stage.write_bytes(out / "gcode" / f"{job.name}.gcode", res.gcode)
+                slicer_s[job.name] = res.seconds
+                pc = next(p for p in report_parts[job_part[job.name]]["pieces"] if p["name"] == job.name)
+                pc["gcode"] = {"key": job.key(version), "sha256": _sha(res.gcode), "estimates": res.estimates,
+                               "slicer_warnings": list(res.warnings)}
+                if res.warnings:
+                    problems.append(f"{job.name}: slicer warnings: {'; '.join(res.warnings)}")
+            timings["gcode"] = time.perf_counter() - t
+            ini = S.printer_ini(printer, support=False)
+        elif gcode and printer.slicer != "prusa-slicer":
+            report_gcode["note"] = (f"printer '{printer.name}' has no slicer rigcad can run (slicer: {printer.slicer}); "
+                                    "time and material are rigcad's estimates")
+        if ini is not None:
+            stage.write_bytes(out / "printer.ini", ini.encode())
+
+        t = time.perf_counter()
+        report = {
+            "rigcad_version": __version__,
+            "profile": profile.name,
+            "printer": printer.describe(),
+            "frame": "part frame: mm, sample point at the origin, optical axis +z, working position; print "
+                     "frame: build direction +z, bed at z = 0",
+            "tolerances": {"stl_chord_error_mm": chord, "mirror_face_tolerance_mm": tol_mirror,
+                           "pin_min_wall_mm": SP.MIN_WALL, "pin_mirror_clearance_mm": SP.MIRROR_CLEARANCE,
+                           "orientation_cusp_tie_rtol": CUSP_TIE_RTOL,
+                           "overhang_angle_deg": math.degrees(O.OVERHANG_ANGLE)},
+            "gcode": report_gcode,
+            "totals": _totals(report_parts),
+            "parts": report_parts,
+            "problems": problems,
+        }
+        stage.write_bytes(out / "fab.json", json_bytes(report))
+        stage.write_bytes(out / "fab.md", markdown(report).encode())
+        timings["report"] = time.perf_counter() - t
+        written = stage.commit()
+    return FabResult(report, written, timings, slicer_s, problems)
+
+
+def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, bed_c, stage: Staging, out: Path,
+              timings: dict) -> tuple[dict, list]:
+    from rigcad.export import mesh as M
+
+    name = part.name
+    t = time.perf_counter()
+    man = M.build(part.solid, chord)
+    mirror = _mirror(part, layout)
+    timings[f"{name}:mesh"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    v, f = M.mesh_arrays(man)
+    whole_fits = any(O.fit_spin(v, o.direction, printer.usable)[0] is not None
+                     for o in (O.mirror_candidates(None) if mirror else O.generic_candidates()))
+    if whole_fits:
+        plan = SP.SplitPlan(1, 1, 0.0, (float(v[:, 2].min()), float(v[:, 2].max())))
+    else:
+        def fits(cell, plan, i, j):
+            if cell.is_empty():
+                return True
+            cv, _ = M.mesh_arrays(cell)
+            rng = plan.sector_range(i) if plan.sectors > 1 else None
+            cands = O.mirror_candidates(rng) if mirror else O.generic_candidates()
+            return any(O.fit_spin(cv, o.direction, printer.usable)[0] is not None for o in cands)
+
+        plan = SP.plan_split(man, fits)
+    pieces, pins, drilled = SP.split_part(man, name, plan, printer.alignment_pin, mirror)
+    timings[f"{name}:fit_split"] = time.perf_counter() - t
+
+    entry = {"process": printer.process, "quantity": part.quantity, "description": part.description,
+             "volume_mm3": man.volume(), "split": plan.describe(),
+             "mirror": mirror.name if mirror else None}
+    if plan.count > 1:
+        entry["pins"] = [{"centre_mm": list(p.centre), "axis": list(p.axis), "face": p.face} for p in pins]
+        entry["reassembly"] = reassembly(man, drilled, pieces, mirror, tol_mirror, pins, printer)
+    piece_rows = []
+    jobs = []
+    map_pts, map_cusp = [], []
+    t = time.perf_counter()
+    for pc in pieces:
+        pv, pf = M.mesh_arrays(pc.manifold)
+        mf = mirror_faces(pv, pf, mirror, tol_mirror) if mirror else None
+        cands = O.mirror_candidates(pc.sector_range) if mirror else O.generic_candidates()
+        rows = [evaluate(pv, pf, o, printer, mf) for o in cands]
+        k = choose(rows)
+        if not rows[k]["fits"]:
+            raise FabricationError(f"piece {pc.name} fits the printer in no orientation")
+        best = O.Orientation(cands[k].name, cands[k].direction, math.radians(rows[k]["spin_deg"]))
+        rot = best.rotation()
+        layers, shift = ST.slice_layers(pc.manifold, rot, printer.layer_height, printer.first_layer_height)
+        placed = O.place(pv, best, bed_c)
+        stl = M.stl_bytes(placed, pf, pc.name)
+        stage.write_bytes(out / "stl" / f"{pc.name}.stl", stl)
+        volume = pc.manifold.volume()
+        row = {"name": pc.name, "orientation": best.name, "build_direction": rows[k]["build_direction"],
+               "spin_deg": rows[k]["spin_deg"], "extents_mm": rows[k]["extents_mm"], "layers": layers.count,
+               "volume_mm3": volume, "needs_support": rows[k]["overhang_area_mm2"] > 0,
+               "candidates": rows, "stl_sha256": _sha(stl), "estimate": _estimate(volume, layers.count, printer)}
+        if mf is not None and len(mf.index):
+            steps = ST.step_map(layers, rot, shift, mirror, tol_mirror)
+            row["mirror_area_mm2"] = mf.area
+            row["staircase_from_slices"] = steps.summary()
+            row["polishing"] = ST.polishing_allowance(steps)
+            row["optical_effect_as_printed"] = ST.optical_effect(mf, best.direction, mirror.name)
+            map_pts.append(steps.points)
+            map_cusp.append(steps.cusp_slices)
+        piece_rows.append(row)
+        if printer.slicer == "prusa-slicer":
+            jobs.append(S.SliceJob(pc.name, stl, S.printer_ini(printer, row["needs_support"]), bed_c))
+    timings[f"{name}:orient_slice"] = time.perf_counter() - t
+    entry["pieces"] = piece_rows
+    entry["layers_total"] = sum(r["layers"] for r in piece_rows)
+    if map_pts:
+        pts, cusp = np.concatenate(map_pts), np.concatenate(map_cusp)
+        orients = sorted({r["orientation"] for r in piece_rows})
+        png = figures.staircase_map(pts, cusp, printer.layer_height,
+                                    f"{name} on {printer.name}: cusp from slices, {printer.layer_height:.4g} mm layers, "
+                                    f"{', '.join(orients)}")
+        stage.write_bytes(out / "staircase" / f"{name}.png", png)
+        ok = np.isfinite(cusp)
+        entry["staircase_map"] = {"png": f"staircase/{name}.png", "png_sha256": _sha(png),
+                                  "cusp_mean_mm": float(cusp[ok].mean()), "cusp_max_mm": float(cusp[ok].max()),
+                                  "cusp_p95_mm": float(np.percentile(cusp[ok], 95))}
+        entry["polishing"] = {"sanding_depth_mm": max(r["polishing"]["sanding_depth_mm"] for r in piece_rows if "polishing" in r),
+                              "stock_to_add_mm": max(r["polishing"]["stock_to_add_mm"] for r in piece_rows if "polishing" in r)}
+    return entry, jobs
+
+
+def reassembly(man, drilled, pieces, mirror, tol, pins, printer) -> dict:
+    """The pieces put back together against the part: volumes, the mirror's area and its distance
+    from the exact surface, the pins' distance from the mirror."""
+    import manifold3d as m3d
+
+    from rigcad.export import mesh as M
+
+    union = m3d.Manifold.batch_boolean([p.manifold for p in pieces], m3d.OpType.Add)
+    out = {"part_volume_mm3": man.volume(), "drilled_volume_mm3": drilled.volume(),
+           "pieces_volume_sum_mm3": sum(p.manifold.volume() for p in pieces),
+           "union_volume_mm3": union.volume(), "pin_holes": len(pins),
+           "symmetric_difference_mm3": (union - drilled).volume() + (drilled - union).volume()}
+    if mirror is not None:
+        v, f = M.mesh_arrays(man)
+        whole = mirror_faces(v, f, mirror, tol)
+        area, dmax = 0.0, 0.0
+        for p in pieces:
+            pv, pf = M.mesh_arrays(p.manifold)
+            mf = mirror_faces(pv, pf, mirror, tol)
+            area += mf.area
+            if len(mf.index):
+                used = np.unique(pf[mf.index])
+                dmax = max(dmax, float(np.abs(mirror.signed_distance(pv[used])).max()))
+        out["mirror_area_part_mm2"] = whole.area
+        out["mirror_area_pieces_mm2"] = area
+        out["mirror_max_distance_pieces_mm"] = dmax
+        if pins:
+            c = np.array([p.centre for p in pins])
+            out["pin_centre_min_depth_behind_mirror_mm"] = float(-mirror.signed_distance(c).max())
+            out["pin_hole_min_clearance_to_mirror_mm"] = float(-mirror.signed_distance(c).max()
+                                                               - printer.alignment_pin.hole_radius)
+    return out
+
+
+def _totals(parts: dict) -> dict:
+    pieces = [pc for e in parts.values() for pc in e.get("pieces", [])]
+    qty = {pc["name"]: e.get("quantity", 1) for e in parts.values() for pc in e.get("pieces", [])}
+    est_t = sum(pc["estimate"]["print_time_s"] * qty[pc["name"]] for pc in pieces)
+    est_g = sum(pc["estimate"]["material_g"] * qty[pc["name"]] for pc in pieces)
+    out = {"pieces": sum(qty.values()), "estimate_print_time_s": est_t, "estimate_material_g": est_g}
+    sl = [pc for pc in pieces if "gcode" in pc]
+    if sl and len(sl) == len(pieces):
+        out["slicer_print_time_s"] = sum(pc["gcode"]["estimates"].get("print_time_s", 0) * qty[pc["name"]] for pc in sl)
+        out["slicer_filament_g"] = sum(pc["gcode"]["estimates"].get("filament_g", 0) * qty[pc["name"]] for pc in sl)
+    return out
+
+
+def _hms(s: float) -> str:
+    s = int(round(s))
+    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
+
+
+def markdown(report: dict) -> str:
+    """fab.md: one page a fabricator reads, with the staircase maps."""
+    pr = report["printer"]
+    lines = [f"# Fabrication: {report['profile']} on {pr['name']}", "",
+             f"{pr['description']} ({pr['process']}); build volume {' x '.join(f'{v:g}' for v in pr['build_volume_mm'])} mm; "
+             f"layer {pr['layer_height_mm']:.4g} mm; material {pr['material']}. Source: `{pr['source']}`.", "",
+             "| part | qty | pieces | orientation | layers | time | material | mirror cusp mean / max (mm) | sanding / stock (mm) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for name, e in report["parts"].items():
+        if "error" in e:
+            lines.append(f"| {name} | | | **not printable:** {e['error']} | | | | | |")
+            continue
+        if "pieces" not in e:
+            lines.append(f"| {name} | {e['quantity']} | cut | {e['process']}: `outlines/{name}.dxf`, `.svg` "
+                         f"({e['outline_size_mm'][0]:.1f} x {e['outline_size_mm'][1]:.1f} mm, plate {e['plate_thickness_mm']:g} mm) | | | | | |")
+            continue
+        pcs = e["pieces"]
+        t = sum((pc.get("gcode", {}).get("estimates", {}).get("print_time_s") or pc["estimate"]["print_time_s"]) for pc in pcs)
+        g = sum((pc.get("gcode", {}).get("estimates", {}).get("filament_g") or pc["estimate"]["material_g"]) for pc in pcs)
+        src = "slicer" if all("gcode" in pc for pc in pcs) else "est."
+        orient = ", ".join(sorted({pc["orientation"] for pc in pcs}))
+        sm = e.get("staircase_map")
+        cusp = f"{sm['cusp_mean_mm']:.3f} / {sm['cusp_max_mm']:.3f}" if sm else "-"
+        pol = f"{e['polishing']['sanding_depth_mm']:.3f} / {e['polishing']['stock_to_add_mm']:.3f}" if "polishing" in e else "-"
+        lines.append(f"| {name} | {e['quantity']} | {len(pcs)} | {orient} | {e['layers_total']} | {_hms(t)} ({src}) | "
+                     f"{g:.0f} g | {cusp} | {pol} |")
+    tot = report["totals"]
+    lines += ["", f"Totals (with quantities): {tot['pieces']} pieces, {_hms(tot['estimate_print_time_s'])} and "
+              f"{tot['estimate_material_g']:.0f} g by rigcad's estimate (model material, no support)"
+              + (f"; slicer: {_hms(tot['slicer_print_time_s'])}, {tot['slicer_filament_g']:.0f} g" if "slicer_print_time_s" in tot else "")
+              + ".", ""]
+    for name, e in report["parts"].items():
+        if not e.get("staircase_map"):
+            continue
+        lines += [f"## {name}: staircase on the mirror", ""]
+        if e["split"]["pieces"] > 1:
+            s = e["split"]
+            r = e.get("reassembly", {})
+            lines.append(f"Split into {s['pieces']} pieces ({s['sectors']} sectors at "
+                         f"{', '.join(f'{a:.1f}' for a in s['sector_planes_deg'])} deg"
+                         + (f", bands cut at z = {', '.join(f'{z:.1f}' for z in s['band_cuts_z_mm'])} mm" if s["band_cuts_z_mm"] else "")
+                         + f"), {r.get('pin_holes', 0)} pin holes of {pr['alignment_pin']['diameter_mm']:g} mm "
+                         f"(at least {r.get('pin_hole_min_clearance_to_mirror_mm', float('nan')):.2f} mm behind the mirror).")
+            lines.append("")
+        lines += ["| piece | orientation | closed-form cusp mean (mm) | from slices mean / max (mm) | ray error median (deg, as printed) |",
+                  "|---|---|---|---|---|"]
+        for pc in e["pieces"]:
+            if "staircase_from_slices" not in pc:
+                continue
+            cand = {c["orientation"]: c for c in pc["candidates"]}
+            cf = ", ".join(f"{o}: {c['staircase_closed_form']['cusp_mean_mm']:.4f}" + ("" if c["fits"] else " (no fit)")
+                           for o, c in cand.items())
+            s = pc["staircase_from_slices"]
+            lines.append(f"| {pc['name']} | **{pc['orientation']}** | {cf} | {s['cusp_from_slices_mean_mm']:.4f} / "
+                         f"{s['cusp_from_slices_max_mm']:.4f} | {pc['optical_effect_as_printed']['ray_angle_error_median_deg']:.1f} |")
+        lines += ["", f"![staircase map of {name}]({e['staircase_map']['png']})", "",
+                  "As printed, the steps' treads and risers tilt the surface normal by tens of degrees (ideal steps), "
+                  "so every reflected ray is lost: the steps must be sanded away (depth above) before the coating. "
+                  "Printing the mirror forward by the stock keeps every valley behind the design surface.", ""]
+    if report["problems"]:
+        lines += ["## Problems", ""] + [f"- {p}" for p in report["problems"]] + [""]
+    return "\n".join(lines)

@@ -1,0 +1,61 @@
+"""Fixtures for the fabrication tests: the Table 3.1 rig's layout and one fab run on the desktop
+printer (no G-code) shared by the tests that read its outputs."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from rigcad.fab.printers import load_printer
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _repo_cwd():
+    """Printer files are found under profiles/printers relative to the working directory."""
+    import os
+
+    old = os.getcwd()
+    os.chdir(ROOT)
+    yield
+    os.chdir(old)
+
+
+@pytest.fixture(scope="session")
+def layout(table31):
+    from rigcad.optics.dome import build_dome
+    from rigcad.parts import rig_layout
+    from rigcad.profile.derived import derive
+
+    geo = derive(table31)
+    dp = table31.dome
+    dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=dp.table_rows)
+    return rig_layout(table31, geo, dome)
+
+
+@pytest.fixture(scope="session")
+def prusa():
+    return load_printer(ROOT / "profiles" / "printers" / "prusa_mk3s.yaml")
+
+
+@pytest.fixture(scope="session")
+def vantage():
+    return load_printer(ROOT / "profiles" / "printers" / "vantage_i.yaml")
+
+
+@pytest.fixture(scope="session")
+def prusa_run(table31, prusa, tmp_path_factory):
+    """One fab run of the small parts and the dome on the desktop printer, without G-code."""
+    from rigcad.fab.stage import run_fab
+
+    out = tmp_path_factory.mktemp("fab") / "prusa_mk3s"
+    res = run_fab(table31, prusa, out, parts=["dome", "paraboloid", "beam", "sample_holder", "camera_cross_hung",
+                                              "dome_template", "paraboloid_template"])
+    return out, res
+
+
+def have_slicer() -> bool:
+    return shutil.which("prusa-slicer") is not None
