@@ -23,7 +23,7 @@ from rigcad.check import tolerances as T
 from rigcad.check.scene import (Optics, analytic_optics, mesh_optics, mixed, rig_geometry, rig_meshes,
                                 share_scenes)
 from rigcad.check.sources import DesignMap, annulus_rays, pixel_grid, pixel_rays, thin_lens_rays
-from rigcad.check.trace3d import STATUS_NAMES, Trace3D, convergence_point, trace
+from rigcad.check.trace3d import STATUS_NAMES, Trace3D, trace
 from rigcad.profile.schema import Profile
 
 DEG = math.pi / 180.0

@@ -75,7 +75,6 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
     ``design_files`` (written by the design stage into ``out``) and ``inputs_key`` are recorded in
     the manifest so that `rigcad stl` can tell, without computing anything, that nothing changed.
     """
-    from rigcad.export import mesh as M
 
     step = progress or (lambda label: None)
     geo = derive(profile)
@@ -281,4 +280,4 @@ def _build_assembly(rig: list[str], profile: Profile, layout, out: Path, stage: 
             "files": {"rig.step": _sha(stage.temp_path(path).read_bytes())}}
 
 
-__all__ = ["BuildResult", "build_rig", "np"]
+__all__ = ["BuildResult", "build_rig"]

@@ -7,15 +7,14 @@ Inside: mm, float64.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from rigcad.errors import FabricationError, ProfileError
-from rigcad.profile.loader import RawProfile, load_raw
-# _convert and _suggest are the schema's own value readers: reused so printer files follow the
-# same unit and range rules (a public name for them would be a small change in schema.py).
-from rigcad.profile.schema import REQUIRED, Spec, _convert, _suggest, spec
+from rigcad.profile.loader import load_raw
+# The schema's own readers, so printer files follow the same unit, range and error rules.
+from rigcad.profile.schema import REQUIRED, Spec, convert_value, read_section, spec, suggest
 
 #: Where printer profiles live, relative to the working directory (as profiles/ for rigs).
 PRINTERS_DIR = Path("profiles") / "printers"
@@ -127,29 +126,6 @@ def available_printers() -> list[str]:
     return sorted(p.stem for p in PRINTERS_DIR.glob("*.yaml")) if PRINTERS_DIR.is_dir() else []
 
 
-def _section(cls, raw: RawProfile, name: str) -> Any:
-    data = raw.data.get(name, {})
-    where_sec = raw.where((name,))
-    if not isinstance(data, dict):
-        raise ProfileError(f"{name}: expected a mapping of keys, got {data!r}", where=where_sec)
-    valid = [f.name for f in fields(cls)]
-    for key in data:
-        if key not in valid:
-            raise ProfileError(f"unknown key {name}.{key}{_suggest(key, valid)}; valid: {', '.join(valid)}",
-                               where=raw.where((name, key)))
-    values = {}
-    for f in fields(cls):
-        s: Spec = f.metadata["spec"]
-        key = f"{name}.{f.name}"
-        if f.name not in data:
-            if s.default is REQUIRED:
-                raise ProfileError(f"{key} is missing: {s.doc} ({s.describe_range()})", where=where_sec)
-            values[f.name] = _convert(s, s.default, key, where_sec)
-            continue
-        values[f.name] = _convert(s, data[f.name], key, raw.where((name, f.name)))
-    return cls(**values)
-
-
 def load_printer(name: str | Path) -> Printer:
     """Read and validate a printer profile; errors name the file:line, key, value and what is valid."""
     path = printer_path(name)
@@ -157,7 +133,7 @@ def load_printer(name: str | Path) -> Printer:
     valid = sorted([*_TOP, *_SECTIONS])
     for key in raw.data:
         if key not in valid:
-            raise ProfileError(f"unknown printer key {key!r}{_suggest(key, valid)}; valid: {', '.join(valid)}",
+            raise ProfileError(f"unknown printer key {key!r}{suggest(key, valid)}; valid: {', '.join(valid)}",
                                where=raw.where((key,)))
     top: dict[str, Any] = {}
     for key, s in _TOP.items():
@@ -165,10 +141,10 @@ def load_printer(name: str | Path) -> Printer:
             if s.default is REQUIRED:
                 raise ProfileError(f"printer key {key!r} is missing: {s.doc} ({s.describe_range()})",
                                    where=f"{path}:1")
-            top[key] = s.default if s.default is None or s.kind == "str" else _convert(s, s.default, key, None)
+            top[key] = s.default if s.default is None or s.kind == "str" else convert_value(s, s.default, key, None)
             continue
-        top[key] = _convert(s, raw.data[key], key, raw.where((key,)))
-    sections = {k: _section(cls, raw, k) for k, cls in _SECTIONS.items()}
+        top[key] = convert_value(s, raw.data[key], key, raw.where((key,)))
+    sections = {k: read_section(raw, k, cls) for k, cls in _SECTIONS.items()}
     if top["process"] == "fdm" and top["nozzle"] is None:
         raise ProfileError("an fdm printer needs 'nozzle' (e.g. '0.4 mm')", where=f"{path}:1")
     if top["process"] == "sla" and top["pixel"] is None:

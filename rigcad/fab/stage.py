@@ -105,7 +105,6 @@ def _estimate(volume: float, layers: int, printer: Printer) -> dict:
 def run_fab(profile, printer: Printer, out: Path, *, gcode: bool = False, parts: list[str] | None = None,
             progress=None, workers: int | None = None) -> FabResult:
     """Run the stage into ``out`` (exports/<profile>/fab/<printer>); see the module docstring."""
-    from rigcad.export import mesh as M
     from rigcad.export.build import select_parts
     from rigcad.optics.dome import build_dome
     from rigcad.parts import PARTS, rig_layout

@@ -405,12 +405,12 @@ class Profile:
         return out
 
 
-def _suggest(name: str, valid: list[str]) -> str:
+def suggest(name: str, valid: list[str]) -> str:
     close = difflib.get_close_matches(name, valid, n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
-def _convert(s: Spec, value: Any, key: str, where: str | None) -> Any:
+def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
     def fail(msg: str) -> ProfileError:
         return ProfileError(f"{key}: {msg}", where=where)
 
@@ -441,7 +441,7 @@ def _convert(s: Spec, value: Any, key: str, where: str | None) -> Any:
         return value
     elif s.kind == "choice":
         if value not in s.choices:
-            raise fail(f"{value!r} is not valid; {s.describe_range()}{_suggest(str(value), list(s.choices))}")
+            raise fail(f"{value!r} is not valid; {s.describe_range()}{suggest(str(value), list(s.choices))}")
         return value
     elif s.kind == "layers":
         if not isinstance(value, list) or not value:
@@ -477,7 +477,10 @@ def _convert(s: Spec, value: Any, key: str, where: str | None) -> Any:
     return out
 
 
-def _section(raw: RawProfile, name: str, cls: type) -> Any:
+def read_section(raw: RawProfile, name: str, cls: type) -> Any:
+    """Validate section ``name`` of ``raw`` into the frozen dataclass ``cls`` (whose fields carry
+    Specs): unknown keys, missing values, bad units and out-of-range values are refused with
+    file:line. Also used for sections of other YAML files (printers)."""
     data = raw.data.get(name, {})
     if data is None:
         data = {}
@@ -487,20 +490,20 @@ def _section(raw: RawProfile, name: str, cls: type) -> Any:
     for key in data:
         if key not in valid:
             raise ProfileError(
-                f"unknown key {name}.{key}{_suggest(key, valid)}; valid keys in {name}: {', '.join(valid)}",
+                f"unknown key {name}.{key}{suggest(key, valid)}; valid keys in {name}: {', '.join(valid)}",
                 where=raw.where((name, key)))
     values = {}
     for f in fields(cls):
         s: Spec = f.metadata["spec"]
         if f.name in data:
-            values[f.name] = _convert(s, data[f.name], f"{name}.{f.name}", raw.where((name, f.name)))
+            values[f.name] = convert_value(s, data[f.name], f"{name}.{f.name}", raw.where((name, f.name)))
         elif s.default is REQUIRED:
             raise ProfileError(f"missing required key {name}.{f.name}: {s.doc} ({s.describe_range()})",
                                where=raw.where((name,)) or (str(raw.sources[0]) if raw.sources else None))
         elif s.default is None:
             values[f.name] = None
         else:
-            values[f.name] = _convert(s, s.default, f"{name}.{f.name} (default)", None)
+            values[f.name] = convert_value(s, s.default, f"{name}.{f.name} (default)", None)
     return cls(**values)
 
 
@@ -509,9 +512,9 @@ def validate(raw: RawProfile) -> Profile:
     valid_top = sorted(set(SECTIONS) | TOP_LEVEL)
     for key in raw.data:
         if key not in valid_top:
-            raise ProfileError(f"unknown section {key!r}{_suggest(key, valid_top)}; valid: {', '.join(valid_top)}",
+            raise ProfileError(f"unknown section {key!r}{suggest(key, valid_top)}; valid: {', '.join(valid_top)}",
                                where=raw.where((key,)))
-    sections = {name: _section(raw, name, cls) for name, cls in SECTIONS.items()}
+    sections = {name: read_section(raw, name, cls) for name, cls in SECTIONS.items()}
     par: ParaboloidParams = sections["paraboloid"]
     pair_a = (par.vertical_extent, par.tangent_angle)
     pair_b = (par.focal_length, par.rim_radius)

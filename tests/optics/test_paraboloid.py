@@ -1,5 +1,4 @@
 import numpy as np
-import pytest
 
 from rigcad.optics.paraboloid import Paraboloid, reflect, unit
 
