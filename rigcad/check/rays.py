@@ -501,13 +501,18 @@ class Box:
         inside = (origins >= self.lo) & (origins <= self.hi)
         t_lo = np.where(dirs == 0, np.where(inside, -np.inf, np.inf), np.minimum(t1, t2)).max(axis=1)
         t_hi = np.where(dirs == 0, np.where(inside, np.inf, -np.inf), np.maximum(t1, t2)).min(axis=1)
-        t = np.where((t_lo <= t_hi) & (t_hi > 0), np.maximum(t_lo, 0.0), np.inf)
-        if tmax is not None:
-            t = np.where(t <= tmax, t, np.inf)
-        hits = Hits.empty(len(origins))
-        hits.t = t
-        hits.part[np.isfinite(t)] = 0
-        return hits
+        return _solid_hits(t_lo, t_hi, tmax)
+
+
+def _solid_hits(t_lo: np.ndarray, t_hi: np.ndarray, tmax) -> "Hits":
+    """Hits on a convex solid from each ray's entry/exit distances (a ray starting inside hits at 0)."""
+    t = np.where((t_lo <= t_hi) & (t_hi > 0), np.maximum(t_lo, 0.0), np.inf)
+    if tmax is not None:
+        t = np.where(t <= tmax, t, np.inf)
+    hits = Hits.empty(len(t))
+    hits.t = t
+    hits.part[np.isfinite(t)] = 0
+    return hits
 
 
 class ZCylinder:
@@ -535,13 +540,7 @@ class ZCylinder:
         zh = np.where(dirs[:, 2] == 0, np.where(inside_z, np.inf, -np.inf), np.maximum(z_a, z_b))
         t_lo = np.fmax(np.where(disc >= 0, r_in, np.inf), zl)
         t_hi = np.fmin(np.where(disc >= 0, r_out, -np.inf), zh)
-        t = np.where((t_lo <= t_hi) & (t_hi > 0), np.maximum(t_lo, 0.0), np.inf)
-        if tmax is not None:
-            t = np.where(t <= tmax, t, np.inf)
-        hits = Hits.empty(len(origins))
-        hits.t = t
-        hits.part[np.isfinite(t)] = 0
-        return hits
+        return _solid_hits(t_lo, t_hi, tmax)
 
 
 class Group:

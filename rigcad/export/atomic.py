@@ -16,16 +16,21 @@ from typing import Any
 from rigcad.errors import ExportError
 
 
-def write_with(path: Path, writer: Callable[[Path], None]) -> Path:
-    """Call ``writer(tmp_path)`` on a temporary file beside ``path``, then rename it onto ``path``."""
-    path = Path(path)
+def _temp_beside(path: Path) -> Path:
+    """A new, empty, hidden temporary file in ``path``'s folder (created if needed)."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
         os.close(fd)
     except OSError as err:
         raise ExportError(f"cannot write {path}: {err.strerror}") from err
-    tmp_path = Path(tmp)
+    return Path(tmp)
+
+
+def write_with(path: Path, writer: Callable[[Path], None]) -> Path:
+    """Call ``writer(tmp_path)`` on a temporary file beside ``path``, then rename it onto ``path``."""
+    path = Path(path)
+    tmp_path = _temp_beside(path)
     try:
         writer(tmp_path)
         os.chmod(tmp_path, 0o666 & ~_umask())
@@ -87,13 +92,7 @@ class Staging:
     def write_with(self, path: Path, writer: Callable[[Path], None]) -> Path:
         """Stage ``path``: ``writer(tmp)`` fills a temporary file now; the rename waits for commit."""
         path = Path(path)
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-            os.close(fd)
-        except OSError as err:
-            raise ExportError(f"cannot write {path}: {err.strerror}") from err
-        tmp_path = Path(tmp)
+        tmp_path = _temp_beside(path)
         self._staged.append((tmp_path, path))
         writer(tmp_path)
         os.chmod(tmp_path, 0o666 & ~_umask())

@@ -95,6 +95,8 @@ def _stat(values: np.ndarray) -> dict[str, float]:
 #: this fraction of the optical path; rows are doubled until it does (pointed paraboloids need more).
 CURVE_MISS_RTOL = 1e-9
 MAX_ROWS = 1 << 17
+#: A design whose incidence angles span less than this is refused: it measures nothing useful.
+MIN_THETA_SPAN_DEG = 1.0
 
 
 def converged_dome(profile: Profile, geo: Derived) -> DomeProfile:
@@ -111,13 +113,25 @@ def converged_dome(profile: Profile, geo: Derived) -> DomeProfile:
             if located is err:
                 raise
             raise located from err
-        if dome.kind != "smooth" or rows >= MAX_ROWS:
+        span = float(np.degrees(np.ptp(dome.theta)))
+        if span < MIN_THETA_SPAN_DEG:
+            raise GeometryError(
+                f"the design measures only {span:.3g} deg of incidence angle (theta {np.degrees(dome.theta.min()):.2f}.."
+                f"{np.degrees(dome.theta.max()):.2f} deg): the paraboloid's rim is too close to the sample plane or its "
+                "rim ray too flat; raise layout.sample_to_rim or lower paraboloid.tangent_angle",
+                where=profile.where("layout", "sample_to_rim"))
+        if dome.kind != "smooth":
             return dome
         origins, dirs = chief_rays(geo, para, dome, profile.misalignment.rays)
         tr = trace(para, DomeCurve.from_profile(dome), origins, dirs)
         miss = np.abs(tr.miss[tr.ok])
         if not miss.size or miss.max() <= CURVE_MISS_RTOL * dome.path_length:
             return dome
+        if rows >= MAX_ROWS:
+            raise GeometryError(
+                f"the dome's curve still misses the sample point by {miss.max():.2g} mm with {rows} rows: the design "
+                "is too close to degenerate to build reliably; change layout.sample_to_rim or paraboloid.tangent_angle",
+                where=profile.where("dome", "table_rows"))
         rows = min(2 * rows - 1, MAX_ROWS)
 
 
