@@ -40,6 +40,12 @@ NEWTON_STEPS = 8
 #: Bisection steps of the dome intersection on the tabulated meridian before Newton: the bracket
 #: starts below ~500 mm and 2^-30 of it is 5e-7 mm, well inside Newton's basin.
 BISECTION_STEPS = 30
+#: The fast path's Newton counts as landed on the dome within this distance (mm): float64 round-off
+#: on ~300 mm coordinates is ~1e-13; anything above 1e-9 takes the bracketing path instead.
+FAST_PATH_RESIDUAL = 1e-9
+#: Newton steps from the design correspondence: it starts within ~1e-3 mm on an aligned rig and
+#: converges quadratically (1e-3 -> 1e-6 -> 1e-12); a ray that needs more takes the general path.
+FAST_PATH_NEWTON_STEPS = 3
 
 
 def unit(v: np.ndarray) -> np.ndarray:
@@ -424,10 +430,72 @@ class ExactDome:
         self.u_tab, self.r_tab, self.z_tab = u, p[:, 0], p[:, 1]
         self.z_lo, self.z_hi, self.r_max = float(p[0, 1]), float(p[-1, 1]), float(p[:, 0].max())
 
+    def _newton(self, o: np.ndarray, d: np.ndarray, t: np.ndarray, u: np.ndarray, steps: int = NEWTON_STEPS):
+        """Polish (t, u) so that o + t d lies on the spline's surface; returns t, u, residual (mm)."""
+        spline, deriv = self.m._spline, self.m._spline.derivative()
+        if self.m.offset != 0.0:  # pragma: no cover - the checker traces design surfaces
+            raise CheckError("ExactDome traces the design surface (offset 0)")
+        u_lo, u_hi = self.m.u_range
+        for _ in range(steps):
+            c = spline(u)
+            dc = deriv(u)
+            px = o + t[:, None] * d
+            rho = np.hypot(px[:, 0], px[:, 1])
+            f1 = rho - c[:, 0]
+            f2 = px[:, 2] - c[:, 1]
+            a11 = (px[:, 0] * d[:, 0] + px[:, 1] * d[:, 1]) / rho
+            a12 = -dc[:, 0]
+            a21 = d[:, 2]
+            a22 = -dc[:, 1]
+            det = a11 * a22 - a12 * a21
+            t = t - (a22 * f1 - a12 * f2) / det
+            u = np.clip(u - (-a21 * f1 + a11 * f2) / det, u_lo, u_hi)
+        c = spline(u)
+        px = o + t[:, None] * d
+        residual = np.hypot(np.hypot(px[:, 0], px[:, 1]) - c[:, 0], px[:, 2] - c[:, 1])
+        return t, u, residual
+
     def intersect(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray | None = None) -> Hits:
+        """First hit of rays from inside the dome.
+
+        Fast path first: a ray leaving the paraboloid at radius s meets the aligned, axisymmetric
+        design dome at its profile point for s (the design's own correspondence, u = -s), so Newton
+        starts there; rays whose Newton does not land on the surface inside the mirror's range
+        (misaligned rigs, stray rays) take the general bracketing path. Tests check both agree."""
         o, d = origins, dirs
         n = len(o)
         hits = Hits.empty(n)
+        u_lo, u_hi = self.m.u_range
+        u0 = np.clip(-np.hypot(o[:, 0], o[:, 1]), u_lo, u_hi)
+        c0 = self.m._spline(u0)
+        # seed t: where the ray reaches the seed point's height (or, for a level ray, its radius)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t0 = np.where(np.abs(d[:, 2]) > 1e-3, (c0[:, 1] - o[:, 2]) / d[:, 2],
+                          (c0[:, 0] - np.hypot(o[:, 0], o[:, 1])) / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-12))
+        t, u, res = self._newton(o, d, np.where(np.isfinite(t0) & (t0 > 0), t0, 1.0), u0, FAST_PATH_NEWTON_STEPS)
+        fast = (res < FAST_PATH_RESIDUAL) & np.isfinite(t) & (t > 0) & (u > u_lo) & (u < u_hi)
+        rest = np.nonzero(~fast)[0]
+        idx = np.nonzero(fast)[0]
+        t_all, u_all = t[idx], u[idx]
+        if len(rest):
+            r_idx, r_t, r_u = self._bracketed(o[rest], d[rest])
+            idx = np.concatenate([idx, rest[r_idx]])
+            t_all = np.concatenate([t_all, r_t])
+            u_all = np.concatenate([u_all, r_u])
+        ok = np.isfinite(t_all) & (t_all > 0)
+        if tmax is not None:
+            ok &= t_all <= tmax[idx]
+        idx, t, u = idx[ok], t_all[ok], u_all[ok]
+        hits.t[idx] = t
+        hits.part[idx] = 0
+        n2 = self.m.normals(u)
+        cphi, sphi = _azimuth(o[idx] + t[:, None] * d[idx])
+        hits.normal[idx] = np.stack([n2[:, 0] * cphi, n2[:, 0] * sphi, n2[:, 1]], axis=-1)
+        return hits
+
+    def _bracketed(self, o: np.ndarray, d: np.ndarray):
+        """General path: bracket the crossing on the tabulated meridian (bisection), then Newton."""
+        n = len(o)
         dxy2 = d[:, 0] ** 2 + d[:, 1] ** 2
         oxy_d = o[:, 0] * d[:, 0] + o[:, 1] * d[:, 1]
         oxy2 = o[:, 0] ** 2 + o[:, 1] ** 2
@@ -454,36 +522,9 @@ class ExactDome:
             lo = np.where(out, lo, mid)
         idx = np.nonzero(cross)[0]
         t = 0.5 * (lo[idx] + hi[idx])
-        oo, dd = o[idx], d[idx]
-        u = np.interp(oo[:, 2] + t * dd[:, 2], self.z_tab, self.u_tab)
-        spline, deriv = self.m._spline, self.m._spline.derivative()
-        if self.m.offset != 0.0:  # pragma: no cover - the checker traces design surfaces
-            raise CheckError("ExactDome traces the design surface (offset 0)")
-        u_lo, u_hi = self.m.u_range
-        for _ in range(NEWTON_STEPS):
-            c = spline(u)
-            dc = deriv(u)
-            px = oo + t[:, None] * dd
-            rho = np.hypot(px[:, 0], px[:, 1])
-            f1 = rho - c[:, 0]
-            f2 = px[:, 2] - c[:, 1]
-            a11 = (px[:, 0] * dd[:, 0] + px[:, 1] * dd[:, 1]) / rho
-            a12 = -dc[:, 0]
-            a21 = dd[:, 2]
-            a22 = -dc[:, 1]
-            det = a11 * a22 - a12 * a21
-            t = t - (a22 * f1 - a12 * f2) / det
-            u = np.clip(u - (-a21 * f1 + a11 * f2) / det, u_lo, u_hi)
-        ok = np.isfinite(t) & (t > 0)
-        if tmax is not None:
-            ok &= t <= tmax[idx]
-        idx, t, u = idx[ok], t[ok], u[ok]
-        hits.t[idx] = t
-        hits.part[idx] = 0
-        n2 = self.m.normals(u)
-        cphi, sphi = _azimuth(o[idx] + t[:, None] * d[idx])
-        hits.normal[idx] = np.stack([n2[:, 0] * cphi, n2[:, 0] * sphi, n2[:, 1]], axis=-1)
-        return hits
+        u = np.interp(o[idx, 2] + t * d[idx, 2], self.z_tab, self.u_tab)
+        t, u, _ = self._newton(o[idx], d[idx], t, u)
+        return idx, t, u
 
 
 class Box:

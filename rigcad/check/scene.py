@@ -21,7 +21,8 @@ import numpy as np
 
 from rigcad.check import rays as R
 from rigcad.errors import CheckError
-from rigcad.optics.dome import DomeProfile, build_dome
+from rigcad.optics.design import converged_dome
+from rigcad.optics.dome import DomeProfile
 from rigcad.parts.layout import RigLayout, rig_layout
 from rigcad.profile.derived import Derived, derive
 from rigcad.profile.schema import Profile
@@ -79,8 +80,7 @@ class RigGeometry:
 
 def rig_geometry(profile: Profile) -> RigGeometry:
     geo = derive(profile)
-    dp = profile.dome
-    dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=dp.table_rows)
+    dome = converged_dome(profile, geo)  # the same dome the build exported
     return RigGeometry(profile, geo, dome, rig_layout(profile, geo, dome))
 
 

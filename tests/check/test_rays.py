@@ -4,6 +4,7 @@ refinement, the exact surfaces against their own definitions."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from rigcad.check import rays as R
 from rigcad.check.sources import annulus_rays
@@ -98,3 +99,35 @@ def test_occluder_primitives():
     cyl = R.ZCylinder(2.0, 0.0, 1.0)
     h = cyl.intersect(np.array([[-5.0, 0, 0.5], [-5.0, 0, 1.5]]), np.array([[1.0, 0, 0], [1.0, 0, 0]]))
     assert abs(h.t[0] - 3.0) < 1e-12 and np.isinf(h.t[1])
+
+
+@pytest.mark.parametrize("shift_mm", [0.0, 1.0])
+def test_axisymmetric_fast_path_agrees_with_the_general_dome_intersection(rig, analytic, design_map, shift_mm,
+                                                                         monkeypatch):
+    """The exact dome first tries Newton from the design's own correspondence (exact when aligned);
+    the general bracketing path must give the same hits, and an aligned rig must never need it."""
+    from rigcad.check.sources import annulus_rays
+    from rigcad.check.trace3d import reflect
+
+    dome = analytic.dome.members[0]
+    src = annulus_rays(design_map, 5000, 3)
+    origins = src.origins + np.array([shift_mm, 0.0, 0.0])  # a shifted COP: rays off the correspondence
+    h1 = analytic.paraboloid.intersect(origins, src.dirs)
+    on = h1.part == 0
+    o = origins[on] + h1.t[on, None] * src.dirs[on]
+    u = reflect(src.dirs[on], h1.normal[on])
+    general_calls = []
+    bracketed = type(dome)._bracketed
+
+    def counting(self, oo, dd):
+        general_calls.append(len(oo))
+        return bracketed(self, oo, dd)
+
+    monkeypatch.setattr(type(dome), "_bracketed", counting)
+    fast = dome.intersect(o, u)
+    idx, t_general, _ = bracketed(dome, o, u)
+    assert np.array_equal(np.sort(np.nonzero(fast.part == 0)[0]), np.sort(idx))  # same rays hit
+    # same hits: both are Newton-polished on the same spline (round-off on ~300 mm coordinates)
+    assert np.max(np.abs(fast.t[idx] - t_general)) < 1e-9
+    if shift_mm == 0.0:
+        assert sum(general_calls) == 0  # aligned: every ray takes the fast path
