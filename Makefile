@@ -63,11 +63,15 @@ test-slow: $(VENV)/.installed tools
 gcode: $(VENV)/.installed tools
 	$(VENV)/bin/rigcad fab $(PROFILE) --printer $(PRINTER) --exports $(EXPORTS) --gcode
 
-bench: $(VENV)/.installed
+bench: $(VENV)/.installed stl
 	$(PY) bench/dome.py
 	$(PY) bench/mirror_mesh.py
 	$(PY) bench/raycheck.py --exports $(EXPORTS)
 	$(PY) bench/fab_stages.py
+	$(PY) bench/tessellation.py
+	$(PY) bench/ray_count.py --exports $(EXPORTS)
+	$(PY) bench/float32.py --exports $(EXPORTS)
+	$(PY) bench/make_stl.py
 
 stress: $(VENV)/.installed
 	$(PY) -m pytest -q -m stress --hypothesis-show-statistics

@@ -252,7 +252,7 @@ def _stl_mirror_errors(vertices: np.ndarray, faces: np.ndarray, printed) -> dict
     mirror_faces = faces[on[faces].all(axis=1)]
     if not len(mirror_faces):
         raise ExportError(f"no STL facet lies on the printed {printed.kind} surface: the mesh and the recipe disagree")
-    # lattice order 6 (28 samples, centroid included) keeps this to ~1 s on the dome's 50k facets
+    # lattice order 6 (28 samples, centroid included): ~2.5 s on the dome's 48k mirror facets at 0.018 mm
     chord, normal = facet_errors(vertices, mirror_faces, printed, order=6)
     return {"facets": int(len(mirror_faces)), "chord_error_mm": float(chord.max()),
             "facet_normal_error_rad": float(normal.max()),

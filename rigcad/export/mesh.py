@@ -112,12 +112,9 @@ def threemf_writer(vertices: np.ndarray, faces: np.ndarray, name: str):
         model.SetUnit(lib3mf.ModelUnit.MilliMeter)
         mesh = model.AddMeshObject()
         mesh.SetName(name)
-        pos = (lib3mf.Position * len(vertices))()
-        for i, v in enumerate(vertices.tolist()):
-            pos[i].Coordinates[0], pos[i].Coordinates[1], pos[i].Coordinates[2] = v
-        tris = (lib3mf.Triangle * len(faces))()
-        for i, f in enumerate(faces.tolist()):
-            tris[i].Indices[0], tris[i].Indices[1], tris[i].Indices[2] = f
+        # one copy each from numpy's buffers: lib3mf's Position is 3 float32, its Triangle 3 uint32
+        pos = (lib3mf.Position * len(vertices)).from_buffer_copy(np.ascontiguousarray(vertices, dtype="<f4").tobytes())
+        tris = (lib3mf.Triangle * len(faces)).from_buffer_copy(np.ascontiguousarray(faces, dtype="<u4").tobytes())
         mesh.SetGeometry(pos, tris)
         mesh.SetUUID(ids[0])
         item = model.AddBuildItem(mesh, wrapper.GetIdentityTransform())

@@ -41,7 +41,6 @@ def cmd_fab(args: argparse.Namespace) -> int:
 def register(subparsers) -> argparse.ArgumentParser:
     """Add the `fab` command to rigcad's subparsers (rigcad.cli.build_parser)."""
     from rigcad.fab.printers import available_printers
-    from rigcad.parts import PARTS
 
     p = subparsers.add_parser(
         "fab", help="fabrication: fit/split, print orientation, staircase, G-code, cutting outlines, report",
@@ -50,7 +49,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "polishing allowance, optical effect), write STL in print position, G-code through PrusaSlicer "
                     "(--gcode), DXF/SVG outlines of the templates, fab.json and fab.md into "
                     "exports/<profile>/fab/<printer>/.",
-        epilog="printers: " + ", ".join(available_printers()) + "; parts: " + ", ".join(PARTS))
+        epilog="printers: " + ", ".join(available_printers()) + "; parts: as for `rigcad build --help`")
     p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--printer", required=True, help="printer name (under profiles/printers/) or path")
     p.add_argument("--exports", default="exports", help="output root (default: exports)")
