@@ -39,6 +39,15 @@ BAND_COUNTS = (1, 2, 3, 4)
 #: Pins per cut face: one per this length (mm) of the face, at least two, at most six.
 PIN_SPACING = 60.0
 _BIG = 1e4
+#: Band cuts (horizontal planes across a thin shell) get a tongue and groove instead of pins:
+#: the groove is sunk into the lower piece, the tongue is the same region (less the clearance)
+#: given to the upper piece. Depths tried (mm, the pin depth first), the widest groove (mm) and
+#: the smallest tongue cross-section kept per sector (mm^2).
+TONGUE_DEPTHS = (None, 4.0, 3.0, 2.0)
+TONGUE_MAX_WIDTH = 3.0
+TONGUE_MIN_AREA = 5.0
+#: Grid splits of flat / off-axis parts: cuts per axis tried.
+GRID_COUNTS = (1, 2, 3, 4, 5, 6)
 
 
 @dataclass(frozen=True)
@@ -76,6 +85,57 @@ class Pin:
     face: str
 
 
+@dataclass(frozen=True)
+class GridPlan:
+    """A flat or off-axis part cut by vertical planes in its own bounding box: ``x_cuts`` (planes
+    x = c) and ``y_cuts`` (planes y = c), mm; cell (i, j) is the i-th x slab and j-th y slab."""
+
+    x_cuts: tuple[float, ...]
+    y_cuts: tuple[float, ...]
+
+    @property
+    def nx(self) -> int:
+        return len(self.x_cuts) + 1
+
+    @property
+    def ny(self) -> int:
+        return len(self.y_cuts) + 1
+
+    @property
+    def count(self) -> int:
+        return self.nx * self.ny
+
+    # the sector interface (no sectors: pieces orient as generic parts)
+    sectors = 1
+    bands = 1
+
+    def sector_range(self, i: int):
+        return None
+
+    def describe(self) -> dict:
+        return {"kind": "grid of vertical planes in the part's bounding box", "sectors": 1, "bands": 1,
+                "grid": [self.nx, self.ny], "pieces": self.count, "x_cuts_mm": list(self.x_cuts),
+                "y_cuts_mm": list(self.y_cuts), "sector_planes_deg": [], "band_cuts_z_mm": []}
+
+
+@dataclass
+class Tongue:
+    """A tongue and groove on a band cut at ``z`` (mm): ``groove`` is removed from the lower
+    pieces, ``tongue`` (the groove less the clearance) belongs to the upper pieces."""
+
+    z: float
+    depth: float
+    groove: m3d.Manifold = field(repr=False)
+    tongue: m3d.Manifold = field(repr=False)
+    face: str = ""
+    min_clearance_to_mirror: float | None = None
+
+    def describe(self) -> dict:
+        return {"face": self.face, "z_mm": self.z, "depth_mm": self.depth,
+                "groove_volume_mm3": self.groove.volume(), "tongue_volume_mm3": self.tongue.volume(),
+                "min_clearance_to_mirror_mm": self.min_clearance_to_mirror}
+
+
 @dataclass
 class Piece:
     name: str
@@ -98,6 +158,79 @@ def cell(man: m3d.Manifold, plan: SplitPlan, i: int, j: int) -> m3d.Manifold:
         if j < plan.bands - 1:
             out = out.trim_by_plane((0.0, 0.0, -1.0), -plan.band_z[j + 1])
     return out
+
+
+def grid_cell(man: m3d.Manifold, plan: GridPlan, i: int, j: int) -> m3d.Manifold:
+    """Cell (x slab i, y slab j) of ``man``."""
+    out = man
+    xs, ys = plan.x_cuts, plan.y_cuts
+    if i > 0:
+        out = out.trim_by_plane((1.0, 0.0, 0.0), xs[i - 1])
+    if i < len(xs):
+        out = out.trim_by_plane((-1.0, 0.0, 0.0), -xs[i])
+    if j > 0:
+        out = out.trim_by_plane((0.0, 1.0, 0.0), ys[j - 1])
+    if j < len(ys):
+        out = out.trim_by_plane((0.0, -1.0, 0.0), -ys[j])
+    return out
+
+
+def any_cell(man: m3d.Manifold, plan, i: int, j: int) -> m3d.Manifold:
+    return grid_cell(man, plan, i, j) if isinstance(plan, GridPlan) else cell(man, plan, i, j)
+
+
+def is_off_axis(man: m3d.Manifold, rtol: float = 0.05) -> bool:
+    """A part not centred on the optical axis (its bounding box's centre off z by more than
+    ``rtol`` of its size): it is split by a grid in its own bounding box, not into sectors."""
+    bb = np.asarray(man.bounding_box(), dtype=float)
+    c = (bb[:2] + bb[3:5]) / 2
+    size = float(max(bb[3] - bb[0], bb[4] - bb[1]))
+    return bool(np.any(np.abs(c) > rtol * size))
+
+
+def plan_grid(man: m3d.Manifold, fits) -> GridPlan:
+    """The fewest-pieces grid of equal slabs (x cuts then y cuts, the long side cut first) whose
+    every cell ``fits(cell_manifold, plan, i, j)``; raises if none."""
+    bb = np.asarray(man.bounding_box(), dtype=float)
+    x0, y0, x1, y1 = bb[0], bb[1], bb[3], bb[4]
+    long_x = (x1 - x0) >= (y1 - y0)
+    options = sorted(((a, b) for a in GRID_COUNTS for b in GRID_COUNTS),
+                     key=lambda ab: (ab[0] * ab[1], -ab[0] if long_x else -ab[1]))
+    for nx, ny in options:
+        plan = GridPlan(tuple(float(v) for v in np.linspace(x0, x1, nx + 1)[1:-1]),
+                        tuple(float(v) for v in np.linspace(y0, y1, ny + 1)[1:-1]))
+        if all(fits(grid_cell(man, plan, i, j), plan, i, j) for i in range(nx) for j in range(ny)):
+            return plan
+    raise FabricationError(f"no grid of up to {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} pieces fits this printer; "
+                           "use a larger printer")
+
+
+def _grid_interfaces(plan: GridPlan):
+    out = []
+    xs = (-_BIG, *plan.x_cuts, _BIG)
+    ys = (-_BIG, *plan.y_cuts, _BIG)
+    for k, x in enumerate(plan.x_cuts):
+        for j in range(plan.ny):
+            def keep(p, lo=ys[j], hi=ys[j + 1]):
+                return (p[:, 1] > lo) & (p[:, 1] < hi)
+            out.append((f"x cut {x:.1f} mm, y slab {j + 1}", np.array([1.0, 0.0, 0.0]), np.array([x, 0.0, 0.0]), keep))
+    for k, y in enumerate(plan.y_cuts):
+        for i in range(plan.nx):
+            def keep(p, lo=xs[i], hi=xs[i + 1]):
+                return (p[:, 0] > lo) & (p[:, 0] < hi)
+            out.append((f"y cut {y:.1f} mm, x slab {i + 1}", np.array([0.0, 1.0, 0.0]), np.array([0.0, y, 0.0]), keep))
+    return out
+
+
+def _grid_planes_clear(pts: np.ndarray, plan: GridPlan, face_normal: np.ndarray, face_origin: np.ndarray,
+                       margin: float) -> np.ndarray:
+    ok = np.ones(len(pts), bool)
+    for axis, cuts in ((0, plan.x_cuts), (1, plan.y_cuts)):
+        for c in cuts:
+            if abs(face_normal[axis]) > 0.5 and abs(face_origin[axis] - c) < 1e-9:
+                continue
+            ok &= np.abs(pts[:, axis] - c) >= margin
+    return ok
 
 
 def _plane_frame(normal: np.ndarray, origin: np.ndarray) -> np.ndarray:
@@ -213,8 +346,9 @@ def _interfaces(plan: SplitPlan, bb: np.ndarray) -> list[tuple[str, np.ndarray, 
 
 
 def _other_planes_clear(pts: np.ndarray, plan: SplitPlan, face_normal: np.ndarray, face_origin: np.ndarray,
-                        margin: float) -> np.ndarray:
-    """Points (n, 3) at least ``margin`` from every cut plane but the face's own."""
+                        margin: float, below: float = 0.0) -> np.ndarray:
+    """Points (n, 3) at least ``margin`` from every cut plane but the face's own (and, under a band
+    cut, ``below`` more: its groove)."""
     ok = np.ones(len(pts), bool)
     for i in range(plan.sectors if plan.sectors > 1 else 0):
         a = plan.sector_range(i)[0]
@@ -228,17 +362,32 @@ def _other_planes_clear(pts: np.ndarray, plan: SplitPlan, face_normal: np.ndarra
     for z in plan.band_z[1:-1]:
         if abs(face_normal[2]) > 0.5 and abs(z - face_origin[2]) < 1e-9:
             continue
-        ok &= np.abs(pts[:, 2] - z) >= margin
+        ok &= (pts[:, 2] - z >= margin) | (z - pts[:, 2] >= margin + below)
     return ok
 
 
-def place_pins(man: m3d.Manifold, plan: SplitPlan, pin: AlignmentPin, mirror: MirrorSurface | None) -> list[Pin]:
-    """Pin holes on every cut face (see the module docstring); raises if a face gets fewer than two."""
+def place_pins(man: m3d.Manifold, plan, pin: AlignmentPin, mirror: MirrorSurface | None,
+               tongues: list[Tongue] | None = None) -> list[Pin]:
+    """Pin holes on every cut face (see the module docstring); raises if a face gets fewer than two.
+    With ``tongues``, the band cuts carry those instead of pins, and pins keep clear of them."""
     r = pin.hole_radius
     guard = r + MIN_WALL
     bb = np.asarray(man.bounding_box(), dtype=float)
     pins: list[Pin] = []
-    for name, n, origin, keep in _interfaces(plan, bb):
+    if isinstance(plan, GridPlan):
+        faces = _grid_interfaces(plan)
+
+        def clear(p, n, origin):
+            return _grid_planes_clear(p, plan, n, origin, guard)
+    else:
+        faces = _interfaces(plan, bb)
+        below = max((t.depth for t in tongues), default=0.0) if tongues else 0.0
+        if tongues:
+            faces = [f for f in faces if abs(f[1][2]) < 0.5]  # band cuts: tongue and groove
+
+        def clear(p, n, origin):
+            return _other_planes_clear(p, plan, n, origin, guard, below)
+    for name, n, origin, keep in faces:
         frame = _plane_frame(n, origin)
         inv = np.linalg.inv(np.vstack([frame, [0, 0, 0, 1]]))[:3]
         face = man.transform(frame.tolist()).slice(0.0)
@@ -257,12 +406,17 @@ def place_pins(man: m3d.Manifold, plan: SplitPlan, pin: AlignmentPin, mirror: Mi
                                    f"(needs {2 * guard:.2f} mm of material)")
         c2 = np.concatenate(cand)
         pts = np.column_stack([c2, np.zeros(len(c2))]) @ inv[:, :3].T + inv[:, 3]
-        mask = keep(pts) & _other_planes_clear(pts, plan, n, origin, guard)
+        mask = keep(pts) & clear(pts, n, origin)
         # the pin runs +-depth along n: both ends must also stay clear of the other planes
-        mask &= _other_planes_clear(pts + pin.depth * n, plan, n, origin, guard)
-        mask &= _other_planes_clear(pts - pin.depth * n, plan, n, origin, guard)
-        if mirror is not None:
-            mask &= _mirror_clear(pts, n, pin, mirror)
+        mask &= clear(pts + pin.depth * n, n, origin)
+        mask &= clear(pts - pin.depth * n, n, origin)
+        if mirror is not None and mask.any():  # only where the cheap tests pass (same result, faster)
+            idx = np.flatnonzero(mask)
+            near = mirror.signed_distance(pts[idx]) < -(MIRROR_CLEARANCE + r)  # a necessary condition
+            idx = idx[near]
+            mask[:] = False
+            if len(idx):
+                mask[idx] = _mirror_clear(pts[idx], n, pin, mirror)
         pts = pts[mask]
         if len(pts) < 2:
             raise FabricationError(f"{name}: no room for two {pin.diameter:g} mm pins at {MIRROR_CLEARANCE:g} mm from "
@@ -275,6 +429,92 @@ def place_pins(man: m3d.Manifold, plan: SplitPlan, pin: AlignmentPin, mirror: Mi
                                    f"hole; use thinner pins (alignment_pin.diameter)")
         pins += [Pin(tuple(float(v) for v in p), tuple(float(v) for v in n), name) for p in chosen]
     return pins
+
+
+def _mirror_region(mirror: MirrorSurface, zs: np.ndarray, clearance: float, rmax: float) -> m3d.CrossSection:
+    """The region of a horizontal plane (as annuli about the axis) whose points stay at least
+    ``clearance`` behind the mirror at every height in ``zs``."""
+    r = np.arange(0.0, rmax, 0.02)
+    ok = np.ones(len(r), bool)
+    for z in zs:
+        q = np.column_stack([r, np.zeros_like(r), np.full_like(r, z)])
+        ok &= mirror.signed_distance(q) < -(clearance + 0.02)
+    n = 720
+    grow = 1.0 / math.cos(math.pi / n)  # a polygon hole of circumradius R/cos contains the circle R
+    out = m3d.CrossSection()
+    k = 0
+    while k < len(r):
+        if not ok[k]:
+            k += 1
+            continue
+        e = k
+        while e + 1 < len(r) and ok[e + 1]:
+            e += 1
+        outer = (m3d.CrossSection.square((4 * _BIG, 4 * _BIG), True) if e == len(r) - 1
+                 else m3d.CrossSection.circle(float(r[e]), n))
+        ring = outer - m3d.CrossSection.circle(float(r[k]) * grow, n) if r[k] > 0 else outer
+        out = out + ring
+        k = e + 1
+    return out
+
+
+def make_tongues(man: m3d.Manifold, plan: SplitPlan, pin: AlignmentPin, mirror: MirrorSurface | None) -> list[Tongue]:
+    """A tongue and groove on every band cut (see TONGUE_DEPTHS): the groove is the cut face under
+    the plane, kept MIN_WALL inside the part over its depth and MIRROR_CLEARANCE behind the mirror,
+    at most TONGUE_MAX_WIDTH wide; raises if a sector gets no tongue."""
+    out = []
+    if not isinstance(plan, SplitPlan) or plan.bands < 2:
+        return out
+    bb = np.asarray(man.bounding_box(), dtype=float)
+    rmax = float(np.hypot(np.abs(bb[[0, 3]]).max(), np.abs(bb[[1, 4]]).max())) + 1.0
+    clr = pin.clearance
+    for j, z in enumerate(plan.band_z[1:-1]):
+        z = float(z)
+        why = ""
+        for depth in TONGUE_DEPTHS:
+            depth = float(pin.depth if depth is None else depth)
+            levels = np.linspace(z - depth - MIN_WALL, z - 1e-3, 9)
+            region = None
+            for zl in levels:
+                sl = man.slice(float(zl))
+                region = sl if region is None else region ^ sl
+            region = region.offset(-MIN_WALL, m3d.JoinType.Round)
+            if mirror is not None:
+                region = region ^ _mirror_region(mirror, np.linspace(z - depth, z, 9), MIRROR_CLEARANCE, rmax)
+            groove2 = region - region.offset(-TONGUE_MAX_WIDTH, m3d.JoinType.Round)
+            tongue2 = groove2.offset(-clr / 2, m3d.JoinType.Round)
+            if groove2.is_empty() or tongue2.is_empty():
+                why = f"no room for a groove {depth:g} mm deep"
+                continue
+            g = m3d.Manifold.extrude(groove2, depth + 1.0).translate((0.0, 0.0, z - depth))
+            g = g.trim_by_plane((0.0, 0.0, -1.0), -z)
+            t = m3d.Manifold.extrude(tongue2, depth + 1.0 - clr).translate((0.0, 0.0, z - depth + clr))
+            t = t.trim_by_plane((0.0, 0.0, -1.0), -z)
+            areas = [cell(t, plan, i, j).volume() / (depth - clr) for i in range(plan.sectors)]
+            if min(areas) < TONGUE_MIN_AREA:
+                why = f"a sector gets a tongue of only {min(areas):.1f} mm^2 at {depth:g} mm depth"
+                continue
+            # the groove widened by the wall lies inside the part
+            wall = m3d.Manifold.extrude(groove2.offset(MIN_WALL, m3d.JoinType.Round), depth + MIN_WALL) \
+                .translate((0.0, 0.0, z - depth - MIN_WALL))
+            outside = (wall - man).volume()
+            if outside > 1e-3 * wall.volume():
+                why = f"the groove {depth:g} mm deep leaves less than {MIN_WALL:g} mm of wall"
+                continue
+            clear = None
+            if mirror is not None:
+                pts2 = np.concatenate([np.asarray(p, float) for p in groove2.to_polygons()])
+                pts = np.concatenate([np.column_stack([pts2, np.full(len(pts2), zl)])
+                                      for zl in np.linspace(z - depth, z, 9)])
+                clear = float(-mirror.signed_distance(pts).max())
+                if clear < MIRROR_CLEARANCE:
+                    why = f"the groove comes {clear:.2f} mm from the mirror"
+                    continue
+            out.append(Tongue(z, depth, g, t, f"band cut z {z:.1f} mm", clear))
+            break
+        else:
+            raise FabricationError(f"band cut z {z:.1f} mm: no tongue and groove fits ({why})")
+    return out
 
 
 def _mirror_clear(pts: np.ndarray, axis: np.ndarray, pin: AlignmentPin, mirror: MirrorSurface) -> np.ndarray:
@@ -316,15 +556,33 @@ def _farthest(pts: np.ndarray, want: int, valid) -> list[np.ndarray]:
     return chosen
 
 
-def split_part(man: m3d.Manifold, name: str, plan: SplitPlan, pin: AlignmentPin,
-               mirror: MirrorSurface | None) -> tuple[list[Piece], list[Pin], m3d.Manifold]:
-    """Drill the pin holes and cut ``man`` into the plan's pieces. Returns the pieces, the pins
-    and the drilled part (what the pieces reassemble to)."""
+def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
+               mirror: MirrorSurface | None, tongues: list | None = None) -> tuple[list[Piece], list[Pin], m3d.Manifold]:
+    """Drill the pin holes, sink the band cuts' grooves and cut ``man`` into the plan's pieces.
+    Returns the pieces, the pins and the drilled part (what the pieces reassemble to: the part less
+    the pin holes and the clearance between tongue and groove); ``tongues``, a list, receives the
+    tongues."""
     if plan.count == 1:
         return [Piece(name, 0, 0, None, man)], [], man
-    pins = place_pins(man, plan, pin, mirror)
+    if isinstance(plan, GridPlan):
+        pins = place_pins(man, plan, pin, mirror)
+        holes = [_cylinder(np.array(p.axis), np.array(p.centre), pin.hole_radius, pin.depth) for p in pins]
+        drilled = m3d.Manifold.batch_boolean([man, *holes], m3d.OpType.Subtract)
+        pieces = []
+        for j in range(plan.ny):
+            for i in range(plan.nx):
+                tag = ([f"x{i + 1}of{plan.nx}"] if plan.nx > 1 else []) + ([f"y{j + 1}of{plan.ny}"] if plan.ny > 1 else [])
+                piece = grid_cell(drilled, plan, i, j)
+                if not piece.is_empty():
+                    pieces.append(Piece(f"{name}_{'_'.join(tag)}", i, j, None, piece))
+        return pieces, pins, drilled
+    tg = make_tongues(man, plan, pin, mirror)
+    if tongues is not None:
+        tongues.extend(tg)
+    pins = place_pins(man, plan, pin, mirror, tg)
     holes = [_cylinder(np.array(p.axis), np.array(p.centre), pin.hole_radius, pin.depth) for p in pins]
-    drilled = m3d.Manifold.batch_boolean([man, *holes], m3d.OpType.Subtract)
+    gaps = [t.groove - t.tongue for t in tg]
+    drilled = m3d.Manifold.batch_boolean([man, *holes, *gaps], m3d.OpType.Subtract)
     pieces = []
     for j in range(plan.bands):
         for i in range(plan.sectors):
@@ -334,6 +592,10 @@ def split_part(man: m3d.Manifold, name: str, plan: SplitPlan, pin: AlignmentPin,
             if plan.bands > 1:
                 tag.append(f"b{j + 1}of{plan.bands}")
             piece = cell(drilled, plan, i, j)
+            if j < plan.bands - 1 and tg:  # the groove under the cut above
+                piece = piece - tg[j].groove
+            if j > 0 and tg:  # the tongue below the cut under
+                piece = piece + cell(tg[j - 1].tongue, plan, i, j - 1)
             if piece.is_empty():
                 continue
             pieces.append(Piece(f"{name}_{'_'.join(tag)}", i, j,

@@ -236,11 +236,18 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
                 return True
             cv, _ = M.mesh_arrays(cell)
             rng = plan.sector_range(i) if plan.sectors > 1 else None
-            cands = O.mirror_candidates(rng) if mirror else O.generic_candidates()
+            cands = O.mirror_candidates(rng) if mirror and isinstance(plan, SP.SplitPlan) else O.generic_candidates()
             return any(O.fit_spin(cv, o.direction, printer.usable)[0] is not None for o in cands)
 
-        plan = SP.plan_split(man, fits)
-    pieces, pins, drilled = SP.split_part(man, name, plan, printer.alignment_pin, mirror)
+        if SP.is_off_axis(man):  # flat / off-axis parts: a grid in their own bounding box
+            plan = SP.plan_grid(man, fits)
+        else:
+            try:
+                plan = SP.plan_split(man, fits)
+            except FabricationError:
+                plan = SP.plan_grid(man, fits)
+    tongues: list = []
+    pieces, pins, drilled = SP.split_part(man, name, plan, printer.alignment_pin, mirror, tongues)
     timings[f"{name}:fit_split"] = time.perf_counter() - t
 
     entry = {"process": printer.process, "quantity": part.quantity, "description": part.description,
@@ -248,6 +255,8 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
              "mirror": mirror.name if mirror else None}
     if plan.count > 1:
         entry["pins"] = [{"centre_mm": list(p.centre), "axis": list(p.axis), "face": p.face} for p in pins]
+        if tongues:
+            entry["tongues"] = [t.describe() for t in tongues]
         entry["reassembly"] = reassembly(man, drilled, pieces, mirror, tol_mirror, pins, printer)
     piece_rows = []
     jobs = []
@@ -256,7 +265,7 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
     for pc in pieces:
         pv, pf = M.mesh_arrays(pc.manifold)
         mf = mirror_faces(pv, pf, mirror, tol_mirror) if mirror else None
-        cands = O.mirror_candidates(pc.sector_range) if mirror else O.generic_candidates()
+        cands = O.mirror_candidates(pc.sector_range) if mirror and isinstance(plan, SP.SplitPlan) else O.generic_candidates()
         rows = [evaluate(pv, pf, o, printer, mf) for o in cands]
         k = choose(rows)
         if not rows[k]["fits"]:
@@ -396,7 +405,10 @@ def markdown(report: dict) -> str:
                          f"{', '.join(f'{a:.1f}' for a in s['sector_planes_deg'])} deg"
                          + (f", bands cut at z = {', '.join(f'{z:.1f}' for z in s['band_cuts_z_mm'])} mm" if s["band_cuts_z_mm"] else "")
                          + f"), {r.get('pin_holes', 0)} pin holes of {pr['alignment_pin']['diameter_mm']:g} mm "
-                         f"(at least {r.get('pin_hole_min_clearance_to_mirror_mm', float('nan')):.2f} mm behind the mirror).")
+                         f"(at least {r.get('pin_hole_min_clearance_to_mirror_mm', float('nan')):.2f} mm behind the mirror)"
+                         + "".join(f"; band cut z = {t['z_mm']:.1f} mm joined by a tongue and groove {t['depth_mm']:g} mm deep "
+                                   f"({t['min_clearance_to_mirror_mm']:.2f} mm behind the mirror)" for t in e.get("tongues", []))
+                         + ".")
             lines.append("")
         lines += ["| piece | orientation | closed-form cusp mean (mm) | from slices mean / max (mm) | ray error median (deg, as printed) |",
                   "|---|---|---|---|---|"]
