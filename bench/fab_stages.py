@@ -8,7 +8,6 @@ timed assertions).
 from __future__ import annotations
 
 import argparse
-import json
 import tempfile
 import time
 from pathlib import Path
