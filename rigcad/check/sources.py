@@ -24,6 +24,27 @@ from rigcad.optics.design import profile_table
 TABLE_CELLS = 1 << 16
 
 
+def _lookup(x: np.ndarray, table: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """Linear interpolation in an evenly spaced table (np.interp's result without its binary
+    search: the cell index is arithmetic). Values outside the table take its end values; NaN stays NaN."""
+    grid, values = table
+    h = (grid[-1] - grid[0]) / (len(grid) - 1)
+    f = np.clip((x - grid[0]) / h, 0.0, len(grid) - 1.0)
+    bad = np.isnan(f)
+    f = np.where(bad, 0.0, f)
+    i = np.minimum(f.astype(np.int64), len(grid) - 2)
+    w = f - i
+    return np.where(bad, np.nan, values[i] * (1.0 - w) + values[i + 1] * w)
+
+
+def _arrival(theta: np.ndarray, x: np.ndarray, y: np.ndarray, rho: np.ndarray) -> np.ndarray:
+    """Unit vectors (n, 3) at polar angle theta in the azimuth of (x, y) (rho = hypot(x, y))."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c, s = np.where(rho > 0, x / rho, 1.0), np.where(rho > 0, y / rho, 0.0)
+    st = np.sin(theta)
+    return np.stack([st * c, st * s, np.cos(theta)], axis=-1)
+
+
 @dataclass(frozen=True)
 class DesignMap:
     """The design's incidence angle theta (rad) as a function of the angle alpha (rad) between a
@@ -69,9 +90,8 @@ class DesignMap:
         is what calibration measures); NaN outside the useful annulus."""
         s = np.hypot(local_points[:, 0], local_points[:, 1])
         inside = (s >= self.s_min) & (s <= self.s_max)
-        theta = np.where(inside, np.interp(s, *self.radius_table), np.nan)
-        phi = np.arctan2(local_points[:, 1], local_points[:, 0])
-        return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=-1)
+        theta = np.where(inside, _lookup(s, self.radius_table), np.nan)
+        return _arrival(theta, local_points[:, 0], local_points[:, 1], s)
 
     def direction(self, dirs: np.ndarray) -> np.ndarray:
         """Design arrival directions (n, 3) (unit, from O towards the light) for COP rays ``dirs``
@@ -79,9 +99,8 @@ class DesignMap:
         rho = np.hypot(dirs[:, 0], dirs[:, 1])
         alpha = np.arctan2(rho, -dirs[:, 2])
         inside = (alpha >= self.alpha_min) & (alpha <= self.alpha_max)
-        theta = np.where(inside, np.interp(alpha, *self.alpha_table), np.nan)
-        phi = np.arctan2(dirs[:, 1], dirs[:, 0])
-        return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=-1)
+        theta = np.where(inside, _lookup(alpha, self.alpha_table), np.nan)
+        return _arrival(theta, dirs[:, 0], dirs[:, 1], rho)
 
     def pixel_radius(self, alpha: np.ndarray) -> np.ndarray:
         return self.focal_px * np.tan(alpha)

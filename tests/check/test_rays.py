@@ -131,3 +131,13 @@ def test_axisymmetric_fast_path_agrees_with_the_general_dome_intersection(rig, a
     assert np.max(np.abs(fast.t[idx] - t_general)) < 1e-9
     if shift_mm == 0.0:
         assert sum(general_calls) == 0  # aligned: every ray takes the fast path
+
+
+def test_table_lookup_is_np_interp():
+    from rigcad.check.sources import _lookup
+
+    grid = np.linspace(0.05, 0.3, 4097)
+    values = np.sin(7 * grid)
+    x = np.concatenate([np.random.default_rng(1).uniform(0.0, 0.4, 5000), [np.nan, grid[0], grid[-1]]])
+    # same linear interpolation (ends clamped like np.interp), computed without a binary search
+    assert np.allclose(_lookup(x, (grid, values)), np.interp(x, grid, values), rtol=0, atol=1e-15, equal_nan=True)
