@@ -12,8 +12,7 @@ from pathlib import Path
 
 from rigcad import __version__
 from rigcad.errors import RigcadError
-
-DEG = math.pi / 180.0
+from rigcad.units import DEG
 
 
 @contextmanager

@@ -10,6 +10,9 @@ from __future__ import annotations
 import math
 import re
 
+#: Radians per degree: the one conversion constant the code uses internally (reports say "_deg").
+DEG = math.pi / 180.0
+
 #: Millimetres per unit of length.
 LENGTH_UNITS: dict[str, float] = {
     "nm": 1e-6,
@@ -28,9 +31,9 @@ LENGTH_UNITS: dict[str, float] = {
 
 #: Radians per unit of angle.
 ANGLE_UNITS: dict[str, float] = {
-    "deg": math.pi / 180.0,
-    "°": math.pi / 180.0,
-    "arcmin": math.pi / 180.0 / 60.0,
+    "deg": DEG,
+    "°": DEG,
+    "arcmin": DEG / 60.0,
     "rad": 1.0,
     "mrad": 1e-3,
     "urad": 1e-6,

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
-DEG = math.pi / 180.0
+from rigcad.units import DEG
 
 
 def cmd_check(args: argparse.Namespace) -> int:

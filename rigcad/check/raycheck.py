@@ -26,7 +26,6 @@ from rigcad.check.sources import DesignMap, annulus_rays, pixel_grid, pixel_rays
 from rigcad.check.trace3d import STATUS_NAMES, Trace3D, trace
 from rigcad.profile.schema import Profile
 
-DEG = math.pi / 180.0
 #: Rays of the exact-normal reading (its foot points cost ~10 us a ray): enough for its maximum
 #: to be stable to a few per cent (the error is smooth over the annulus).
 EXACT_NORMAL_RAYS = 20_000
@@ -57,6 +56,7 @@ class RayCheck:
 
 
 from rigcad.check.montecarlo import _angles  # noqa: E402
+from rigcad.units import DEG
 
 
 def _losses(tr: Trace3D, rays_chief: np.ndarray, design_dirs: np.ndarray) -> dict:

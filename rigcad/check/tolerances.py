@@ -13,8 +13,7 @@ import math
 from dataclasses import dataclass
 
 from rigcad.errors import CheckError
-
-DEG = math.pi / 180.0
+from rigcad.units import DEG
 
 
 @dataclass(frozen=True)

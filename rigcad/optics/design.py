@@ -6,7 +6,6 @@ rad inside (the report states degrees where its key says ``_deg``).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,8 +18,7 @@ from rigcad.optics.thin_lens import ThinLensResult, thin_lens_check
 from rigcad.optics.trace2d import STATUS_NAMES, DomeCurve, Trace, parallel_rays, trace
 from rigcad.profile.derived import Derived, derive
 from rigcad.profile.schema import Profile
-
-DEG = math.pi / 180.0
+from rigcad.units import DEG
 
 
 @dataclass(frozen=True)

@@ -15,10 +15,9 @@ from typing import Any
 
 from rigcad.errors import ProfileError
 from rigcad.profile.loader import Key, RawProfile
-from rigcad.units import UnitError, parse_quantity
+from rigcad.units import DEG, UnitError, parse_quantity
 
 REQUIRED = object()
-DEG = math.pi / 180.0
 
 
 @dataclass(frozen=True)
