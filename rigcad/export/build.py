@@ -134,7 +134,7 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
                 "stl_step_volume_rtol": MESH_VOLUME_RTOL,
             },
             "layout": layout.describe(),
-            "occlusion": _occlusion(profile, layout, geo, dome),
+            "occlusion": _occlusion(profile, layout, geo, dome, old.get("occlusion")),
             "parts": {n: entries[n] for n in PARTS if n in entries},
             "mirrors": mirrors,
             "assembly": assembly,
@@ -165,12 +165,16 @@ def _build_mirror(name: str, meridian, key: str, profile: Profile, out: Path, st
             "files": {f"mirrors/{name}.ply": _sha(stage.temp_path(path).read_bytes())}}
 
 
-def _occlusion(profile: Profile, layout, geo, dome) -> dict:
-    """Solid angle the beam and the paraboloid's mount hide from the sample (see parts.occlusion)."""
+def _occlusion(profile: Profile, layout, geo, dome, previous: dict | None) -> dict:
+    """Solid angle the beam and the paraboloid's mount hide from the sample (see parts.occlusion);
+    the previous manifest's figures are reused when the profile and the code are the same."""
     from rigcad.optics.design import profile_table
     from rigcad.parts.occlusion import blocked_solid_angle
 
-    return blocked_solid_angle(profile, layout, profile_table(geo, dome))
+    key = hashlib.sha256(f"{CACHE_VERSION}|{profile_digest(profile)}".encode()).hexdigest()
+    if previous and previous.get("key") == key:
+        return previous
+    return {**blocked_solid_angle(profile, layout, profile_table(geo, dome)), "key": key}
 
 
 def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Staging, shapes: dict) -> dict:
