@@ -16,6 +16,7 @@ from rigcad.export.atomic import write_json
 from rigcad.fab.printers import load_printer
 from rigcad.fab.stage import run_fab
 from rigcad.profile import load_profile
+from rigcad.rig import Rig
 
 
 def main() -> None:
@@ -25,12 +26,13 @@ def main() -> None:
     ap.add_argument("--profile", default="achutha2006")
     args = ap.parse_args()
     profile = load_profile(args.profile)
+    rig = Rig.from_profile(profile)
     out: dict = {"profile": profile.name, "printers": {}}
     for name in args.printers:
         printer = load_printer(name)
         with tempfile.TemporaryDirectory() as tmp:
             t = time.perf_counter()
-            res = run_fab(profile, printer, Path(tmp), gcode=args.gcode)
+            res = run_fab(rig, printer, Path(tmp), gcode=args.gcode)
             total = time.perf_counter() - t
         rows = {}
         for part, e in res.report["parts"].items():

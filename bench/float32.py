@@ -28,10 +28,11 @@ import numpy as np
 from _common import arguments, png, pyplot, run_info
 
 from rigcad.check.montecarlo import _angles
-from rigcad.check.scene import analytic_optics, mesh_optics, rig_geometry, rig_meshes, share_scenes
-from rigcad.check.sources import DesignMap, annulus_rays
+from rigcad.check.scene import analytic_optics, mesh_optics, rig_meshes, share_scenes
+from rigcad.check.sources import annulus_rays
 from rigcad.check.trace3d import trace
 from rigcad.export.atomic import write_bytes, write_json
+from rigcad.rig import Rig
 from rigcad.profile import load_profile
 
 RAYS = 200_000
@@ -75,8 +76,8 @@ def main() -> None:
     levels = LEVELS[1:2] if args.quick else LEVELS
     run = run_info()
     profile = load_profile(args.profile)
-    rig = rig_geometry(profile)
-    design = DesignMap.from_rig(rig)
+    rig = Rig.from_profile(profile)
+    design = rig.incidence
     rays = annulus_rays(design, n, SEED)
     t0 = time.perf_counter()
     exact = trace(analytic_optics(rig), rays.origins, rays.dirs)

@@ -27,10 +27,11 @@ import numpy as np
 from _common import arguments, loglog_slope, png, pyplot, run_info
 
 from rigcad.check.montecarlo import _angles
-from rigcad.check.scene import mesh_optics, rig_geometry, rig_meshes
-from rigcad.check.sources import DesignMap, annulus_rays
+from rigcad.check.scene import mesh_optics, rig_meshes
+from rigcad.check.sources import annulus_rays
 from rigcad.check.trace3d import trace
 from rigcad.export.atomic import write_bytes, write_json
+from rigcad.rig import Rig
 from rigcad.profile import load_profile
 
 COUNTS = (1_000, 3_000, 10_000, 30_000, 100_000, 300_000, 1_000_000)
@@ -79,8 +80,8 @@ def main() -> None:
     counts, seeds = ((1_000, 3_000, 10_000), 3) if args.quick else (COUNTS, SEEDS)
     run = run_info()
     profile = load_profile(args.profile)
-    rig = rig_geometry(profile)
-    design = DesignMap.from_rig(rig)
+    rig = Rig.from_profile(profile)
+    design = rig.incidence
     meshes = rig_meshes(rig, Path(args.exports))
     optics = mesh_optics(meshes, "smooth")
     rng = np.random.default_rng(7)

@@ -21,11 +21,12 @@ import numpy as np
 
 from rigcad.check import montecarlo as MC
 from rigcad.check.rays import Timer, embree_version
-from rigcad.check.scene import analytic_optics, mesh_optics, rig_geometry, rig_meshes, share_scenes
-from rigcad.check.sources import DesignMap, annulus_rays
+from rigcad.check.scene import analytic_optics, mesh_optics, rig_meshes, share_scenes
+from rigcad.check.sources import annulus_rays
 from rigcad.check.trace3d import trace
 from rigcad.export.atomic import write_bytes, write_json
 from rigcad.plots import _png, plt
+from rigcad.rig import Rig
 from rigcad.profile import load_profile
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -50,8 +51,8 @@ def main() -> None:
     ap.add_argument("--exports", default="exports")
     args = ap.parse_args()
     profile = load_profile(args.profile)
-    rig = rig_geometry(profile)
-    design = DesignMap.from_rig(rig)
+    rig = Rig.from_profile(profile)
+    design = rig.incidence
     t0 = time.perf_counter()
     meshes = rig_meshes(rig, Path(args.exports))
     mesh_s = time.perf_counter() - t0

@@ -32,17 +32,17 @@ from _common import arguments, png, pyplot, run_info, timed
 
 from rigcad.check.raycheck import reading
 from rigcad.check import rays as R
-from rigcad.check.scene import (RigMeshes, _occluder_meshes, analytic_optics, mesh_optics, rig_geometry,
+from rigcad.check.scene import (RigMeshes, _occluder_meshes, analytic_optics, mesh_optics,
                                 share_scenes)
-from rigcad.check.sources import DesignMap, annulus_rays
+from rigcad.check.sources import annulus_rays
 from rigcad.check.trace3d import trace
 from rigcad.export import mesh as M
 from rigcad.export.atomic import write_bytes, write_json
 from rigcad.export.build import _coating, _stl_mirror_errors
 from rigcad.export.mirror_mesh import mirror_mesh
-from rigcad.optics.design import converged_dome
-from rigcad.parts import PARTS, rig_layout
-from rigcad.profile import derive, load_profile
+from rigcad.parts import PARTS
+from rigcad.rig import Rig
+from rigcad.profile import load_profile
 
 STL_CHORDS_MM = (0.3, 0.1, 0.05, 0.018, 0.01, 0.005)
 REPEATS = 3
@@ -102,7 +102,7 @@ def mirror_row(rig, design, rays, exact, sweep: str, chord, normal) -> dict:
         ply_bytes[name] = mm.report["bytes"]
         mirrors[name] = R.TriMesh(name, mm.vertices, mm.faces, mm.normals, meridian, source="mirror_mesh()")
         del mm
-    mount, beam = _occluder_meshes(rig.profile, rig.layout)
+    mount, beam = _occluder_meshes(rig)
     meshes = RigMeshes(mirrors["paraboloid"], mirrors["dome"], mount, beam, {"chord_error_mm": c, "normal_error_rad": n})
     base = mesh_optics(meshes, "smooth")
     bvh_s = base.paraboloid.build_s + base.dome.build_s + base.beam.build_s
@@ -134,8 +134,8 @@ def main() -> None:
     repeats = 1 if args.quick else REPEATS
     run = run_info()
     profile = load_profile(args.profile)
-    geo = derive(profile)
-    layout = rig_layout(profile, geo, converged_dome(profile, geo))
+    rig = Rig.from_profile(profile)
+    layout = rig.layout
     volumes = exact_volumes(profile, layout)
     result = {"profile": profile.name, "default_chord_error_mm": profile.tessellation.chord_error,
               "default_mirror_chord_error_mm": profile.tessellation.mirror_chord_error,
@@ -151,8 +151,7 @@ def main() -> None:
                   f"3MF {t['threemf_write_s']:.2f} s; dome chord {d['measured_chord_error_mm']:.4f} mm normal "
                   f"{d['measured_facet_normal_error_rad']:.4f} rad; paraboloid normal {p['measured_facet_normal_error_rad']:.4f}"
                   f" rad; max |dV/V| {t['max_abs_volume_rel_error']:.2e}", flush=True)
-    rig = rig_geometry(profile)
-    design = DesignMap.from_rig(rig)
+    design = rig.incidence
     rays = annulus_rays(design, n_rays, SEED)
     exact = trace(analytic_optics(rig), rays.origins, rays.dirs)
     for sweep, chord, normal in mirror_rows:

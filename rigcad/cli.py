@@ -50,7 +50,7 @@ def cmd_profile_show(args: argparse.Namespace) -> int:
     from rigcad.profile.schema import SECTIONS
 
     profile = load_profile(args.profile)
-    geo = derive(profile)
+    geo = derive(profile)  # the profile's own figures; no dome is integrated to show them
     if args.json:
         sys.stdout.write(json_bytes({"parameters": profile.as_dict(), "derived": geo.as_dict()}).decode())
         return 0
@@ -88,18 +88,19 @@ def cmd_profile_show(args: argparse.Namespace) -> int:
 
 def cmd_design(args: argparse.Namespace) -> int:
     from rigcad.export.design import write_design
-    from rigcad.optics.design import run_design
-    from rigcad.profile import load_profile
+    from rigcad.rig import load
 
-    profile = load_profile(args.profile)
-    with _progress(4, f"design {profile.name}") as step:
-        design = run_design(profile, progress=step)
-        out_dir = Path(args.exports) / profile.name
+    with _progress(3, "design") as step:
+        rig = load(args.profile)
+        step("dome integrated")
+        design = rig.design
+        step("traced")
+        out_dir = Path(args.exports) / rig.name
         paths = write_design(design, out_dir)
         step("written")
     r = design.report
     env, rng, px = r["envelope"], r["measurable_range"], r["pixels"]
-    print(f"{profile.name}: dome {env['width_mm']:.1f} x {env['height_mm']:.1f} mm "
+    print(f"{rig.name}: dome {env['width_mm']:.1f} x {env['height_mm']:.1f} mm "
           f"({env['width_in']:.2f} x {env['height_in']:.2f} in), theta {rng['theta_min_deg']:.2f}..{rng['theta_max_deg']:.1f} deg, "
           f"dome by {r['dome']['method']} (error vs closed form {r['dome']['error_vs_equal_path_mm']:.2g} mm), "
           f"max miss at O {r['convergence']['max_miss_mm']:.2g} mm"
@@ -114,15 +115,16 @@ def cmd_design(args: argparse.Namespace) -> int:
 
 def cmd_build(args: argparse.Namespace) -> int:
     from rigcad.export.build import build_rig, select_parts
-    from rigcad.profile import load_profile
+    from rigcad.rig import load
 
-    profile = load_profile(args.profile)
     names = select_parts(args.parts)
-    out = Path(args.exports) / profile.name
-    with _progress(len(names) + 1, f"build {profile.name}") as step:
-        result = build_rig(profile, out, names, progress=step)
+    with _progress(len(names) + 2, "build") as step:
+        rig = load(args.profile)
+        step("dome integrated")
+        out = Path(args.exports) / rig.name
+        result = build_rig(rig, out, names, progress=step)
     m = result.manifest
-    print(f"{profile.name}: {len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
+    print(f"{rig.name}: {len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
     for name in names:
         e = m["parts"][name]
         tag = "built" if name in result.rebuilt else "unchanged"
@@ -144,16 +146,17 @@ def cmd_stl(args: argparse.Namespace) -> int:
         print(f"{profile.name}: up to date ({out}/manifest.json)")
         return 0
     from rigcad.export.build import build_rig
-    from rigcad.export.design import write_design
-    from rigcad.optics.design import run_design
-
+    from rigcad.export.design import design_files
     from rigcad.parts import PARTS
+    from rigcad.rig import Rig
 
     with _progress(len(PARTS) + 6, f"stl {profile.name}") as step:
-        design = run_design(profile, progress=step)
-        paths = write_design(design, out)
-        result = build_rig(profile, out, progress=step, design_files=paths, inputs_key=key)
-    env = design.report["envelope"]
+        rig = Rig.from_profile(profile)
+        step("dome integrated")
+        files = design_files(rig.design)
+        step("design traced")
+        result = build_rig(rig, out, progress=step, design=files, inputs_key=key)
+    env = rig.design.report["envelope"]
     print(f"{profile.name}: dome mirror {env['width_in']:.2f} x {env['height_in']:.2f} in; "
           f"{len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
     return 0

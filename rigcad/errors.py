@@ -36,6 +36,14 @@ class GeometryError(RigcadError):
     """Valid-looking parameters that describe an impossible rig (rays miss, parts collide)."""
 
 
+class KernelError(GeometryError):
+    """The CAD kernel (OpenCascade) could not build a part the profile describes: the message names
+    the part, the profile keys that shape it and a way out. Exit code 1, like a failed check: the
+    profile was valid, the part was not buildable."""
+
+    exit_code = 1
+
+
 class IntegrationError(RigcadError):
     """The dome integrator failed or could not meet its requested tolerance."""
 

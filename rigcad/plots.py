@@ -15,9 +15,9 @@ import numpy as np  # noqa: E402
 _PNG_META = {"Software": None}
 
 
-def _png(fig) -> bytes:
+def _png(fig, dpi: int = 110) -> bytes:
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, metadata=_PNG_META)
+    fig.savefig(buf, format="png", dpi=dpi, metadata=_PNG_META)
     plt.close(fig)
     return buf.getvalue()
 
@@ -120,3 +120,77 @@ def render_mesh(vertices: np.ndarray, faces: np.ndarray, title: str, color=(0.7,
     size = hi - lo
     ax.set_title(f"{title}\n{size[0]:.1f} x {size[1]:.1f} x {size[2]:.1f} mm", fontsize=9)
     return _png(fig)
+
+
+# -- the 3D ray check (rigcad check) -----------------------------------------------------------
+def spot_diagram(result) -> bytes:
+    """Left: where the returning rays cross the sample plane z = 0 (um), theta <= 80 deg (nearer
+    grazing the landing point is ill-conditioned); right: the spot radius (distance from O to each
+    ray) against theta."""
+    tr = result.trace
+    ok = tr.ok
+    theta = np.degrees(tr.theta[ok])
+    land = tr.landing[ok] * 1e3
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.8))
+    sel = theta <= 80
+    sc = a.scatter(land[sel, 0], land[sel, 1], c=theta[sel], s=1, cmap="viridis")
+    fig.colorbar(sc, ax=a, label="theta (deg)")
+    a.set_aspect("equal")
+    a.set_xlabel("x on the sample (um)")
+    a.set_ylabel("y on the sample (um)")
+    rep = result.report
+    a.set_title(f"{rep['profile']['name']}: landing points, mode {rep['mode']}")
+    b.semilogy(theta, np.maximum(tr.miss[ok] * 1e3, 1e-9), ",", alpha=0.5)
+    b.set_xlabel("theta (deg)")
+    b.set_ylabel("distance from O to the ray (um)")
+    b.set_title("spot radius per ray")
+    b.grid(True, alpha=0.3)
+    return _png(fig)
+
+
+def theta_map(result) -> bytes:
+    """Incidence angle theta per projector pixel over the traced window, lost pixels grey; and
+    theta against pixel radius along the fan (with px/deg)."""
+    tm = result.theta_map
+    g = result.report["pixel_grid"]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.8))
+    r0, c0 = g["window_origin_row_col"]
+    h, w = tm.shape
+    a.imshow(np.where(result.status_map > 1, 1.0, np.nan), cmap="Greys", vmin=0, vmax=2,
+             extent=(c0, c0 + w, r0 + h, r0), interpolation="nearest")
+    im = a.imshow(tm, cmap="viridis", extent=(c0, c0 + w, r0 + h, r0), interpolation="nearest")
+    fig.colorbar(im, ax=a, label="theta (deg)")
+    a.set_xlabel("projector column (px)")
+    a.set_ylabel("projector row (px)")
+    a.set_title("incidence angle per pixel (grey: occluded)")
+    f = result.fan
+    b.plot(f["theta_deg"], f["pixel_radius_px"], "-")
+    b2 = b.twinx()
+    b2.plot(f["theta_deg"], f["px_per_deg"], "r-", lw=0.8)
+    b2.set_ylabel("pixels per degree", color="r")
+    b.set_xlabel("theta (deg)")
+    b.set_ylabel("pixel radius from the axis (px)")
+    b.set_title(f"fan at azimuth {f['summary']['azimuth_deg']:.0f} deg")
+    b.grid(True, alpha=0.3)
+    return _png(fig)
+
+
+# -- fabrication (rigcad fab) ---------------------------------------------------------------------
+def staircase_map(points: np.ndarray, cusp: np.ndarray, layer: float, title: str) -> bytes:
+    """Cusp height (um) over the mirror at its contour points: azimuth (deg) x height z (mm) in
+    the part's working frame; ``points`` (n, 3) mm, ``cusp`` (n,) mm."""
+    ok = np.isfinite(cusp)
+    p, c = points[ok], cusp[ok] * 1000.0
+    if len(p) > 60000:  # enough dots for the eye; a fixed stride keeps the picture deterministic
+        s = int(np.ceil(len(p) / 60000))
+        p, c = p[::s], c[::s]
+    az = np.degrees(np.arctan2(p[:, 1], p[:, 0])) % 360.0
+    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    sc = ax.scatter(az, p[:, 2], c=c, s=1.5, cmap="viridis", vmin=0.0, vmax=layer * 1000.0, linewidths=0)
+    fig.colorbar(sc, ax=ax, label="cusp height (um)")
+    ax.set_xlim(0, 360)
+    ax.set_xlabel("azimuth about the optical axis (deg)")
+    ax.set_ylabel("height z (mm, working position)")
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    return _png(fig, dpi=100)

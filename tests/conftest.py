@@ -10,7 +10,7 @@ import pytest
 from rigcad.profile import derive, load_profile
 
 ROOT = Path(__file__).resolve().parents[1]
-PROFILES = ROOT / "profiles"
+PROFILES = ROOT / "rigcad" / "profiles"
 
 TABLE31 = """
 paraboloid:
@@ -37,6 +37,14 @@ def table31():
 @pytest.fixture(scope="session")
 def table31_geometry(table31):
     return derive(table31)
+
+
+@pytest.fixture(scope="session")
+def table31_rig(table31):
+    """The Table 3.1 rig, built once for the session (its dome integrated once)."""
+    from rigcad.rig import Rig
+
+    return Rig.from_profile(table31)
 
 
 @pytest.fixture

@@ -12,11 +12,12 @@ from rigcad.units import DEG
 def cmd_check(args: argparse.Namespace) -> int:
     from rigcad.check.raycheck import run_raycheck, write_raycheck
     from rigcad.check.tolerances import raise_if_failed, table
-    from rigcad.profile import load_profile
+    from rigcad.rig import load
 
-    profile = load_profile(args.profile)
+    rig = load(args.profile)
+    profile = rig.profile
     exports = Path(args.exports)
-    result = run_raycheck(profile, exports=exports, rays=args.rays, mode=args.mode,
+    result = run_raycheck(rig, exports=exports, rays=args.rays, mode=args.mode,
                           monte_carlo=not args.no_monte_carlo, builds=args.builds,
                           progress=lambda label: print(f"  {label} ...", file=sys.stderr) if args.verbose else None)
     paths = write_raycheck(result, exports / profile.name / "check")

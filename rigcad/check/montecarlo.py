@@ -14,45 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigcad.check.rays import _cross, _dot
-from rigcad.check.scene import Optics, Pose, RigGeometry
-from rigcad.check.sources import DesignMap, annulus_rays
+from rigcad.check.scene import Optics
+from rigcad.check.sources import annulus_rays
+from rigcad.optics.frames import COMPONENTS, DOFS, Misalignment
+from rigcad.optics.incidence import DesignMap
 from rigcad.check.trace3d import Trace3D, convergence_point, trace
-
-COMPONENTS = ("projector", "camera", "paraboloid", "dome")
-DOFS = ("dx", "dz", "tilt")  # x and y are equivalent by symmetry (the beam aside)
-
-
-@dataclass(frozen=True)
-class Misalignment:
-    """Offsets (mm, (3,)) and tilts (rad, with a unit horizontal axis) of the four components."""
-
-    offsets: dict
-    tilts: dict
-    axes: dict
-
-    @classmethod
-    def none(cls) -> "Misalignment":
-        return cls({c: (0.0, 0.0, 0.0) for c in COMPONENTS}, {c: 0.0 for c in COMPONENTS},
-                   {c: (0.0, 1.0, 0.0) for c in COMPONENTS})
-
-    def with_(self, component: str, offset=None, tilt=None, axis=None) -> "Misalignment":
-        o, t, a = dict(self.offsets), dict(self.tilts), dict(self.axes)
-        if offset is not None:
-            o[component] = tuple(offset)
-        if tilt is not None:
-            t[component] = float(tilt)
-        if axis is not None:
-            a[component] = tuple(axis)
-        return Misalignment(o, t, a)
-
-    def pose(self, component: str, rig: RigGeometry) -> Pose:
-        geo = rig.geometry
-        pivot = {"projector": (0, 0, geo.cop_z), "camera": (0, 0, geo.cop_z),
-                 "paraboloid": (0, 0, geo.vertex_z), "dome": (0, 0, 0)}[component]
-        if not any(self.offsets[component]) and self.tilts[component] == 0.0:
-            return Pose()
-        return Pose.misaligned(self.offsets[component], self.tilts[component], self.axes[component], pivot)
-
 
 def declared(profile) -> Misalignment:
     """The misalignment the profile declares (misalignment.*: dx, dz and tilts about +y)."""
@@ -64,14 +30,14 @@ def declared(profile) -> Misalignment:
     return m.with_("dome", offset=(mis.dome_dx, 0.0, 0.0), tilt=mis.dome_tilt)
 
 
-def trace_path(optics: Optics, rig: RigGeometry, design: DesignMap, mis: Misalignment, device: str,
+def trace_path(optics: Optics, rig, design: DesignMap, mis: Misalignment, device: str,
                count: int, seed: int) -> tuple[Trace3D, np.ndarray, np.ndarray]:
     """Trace ``count`` seeded pinhole rays of ``device`` (projector or camera) through the
     misaligned rig; returns the trace, the design arrival direction of each ray's pixel, and the
     design direction of the paraboloid point it hit (rotated with the paraboloid)."""
-    rays = annulus_rays(design, count, seed, mis.pose(device, rig))
-    pp = mis.pose("paraboloid", rig)
-    placed = optics.placed(pp, mis.pose("dome", rig))
+    rays = annulus_rays(design, count, seed, mis.pose(device, rig.geometry))
+    pp = mis.pose("paraboloid", rig.geometry)
+    placed = optics.placed(pp, mis.pose("dome", rig.geometry))
     tr = trace(placed, rays.origins, rays.dirs)
     local, _ = pp.localize(tr.p1, tr.p1)
     return tr, design.direction(rays.chief), pp.globalize_dirs(design.direction_at(local))
@@ -112,7 +78,7 @@ def _angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.arctan2(np.linalg.norm(_cross(a, b), axis=1), _dot(a, b))
 
 
-def sensitivity(optics: Optics, rig: RigGeometry, design: DesignMap, probe: float, probe_tilt: float,
+def sensitivity(optics: Optics, rig, design: DesignMap, probe: float, probe_tilt: float,
                 count: int, seed: int) -> dict:
     """Per component and degree of freedom: the figures at ``probe`` mm (``probe_tilt`` rad) and
     per unit (mm of convergence error per mm or per mrad)."""
@@ -152,7 +118,7 @@ def sample_build(rng: np.random.Generator, tol) -> Misalignment:
     return m
 
 
-def monte_carlo(optics: Optics, rig: RigGeometry, design: DesignMap, tol) -> dict:
+def monte_carlo(optics: Optics, rig, design: DesignMap, tol) -> dict:
     """``tol.builds`` seeded random builds; per build, the worse of the projector's and the camera's
     path: largest spot radius (mm) and mirror angle error (rad, see :func:`figures`: per-pixel
     errors of a misplaced source are calibrated away, thesis 4.1); the yield meeting both targets."""

@@ -1,4 +1,4 @@
-"""The 3D ray check stage (issue 5): profile -> meshes and exact surfaces -> traces -> figures ->
+"""The 3D ray check stage (issue 5): a Rig -> meshes and exact surfaces -> traces -> figures ->
 tolerance table; ``exports/<profile>/check/{raycheck.json, spot.png, theta_map.png}``.
 
 Readings traced on the same rays (seeded, uniform in projector-image area over the paraboloid's
@@ -20,9 +20,9 @@ import numpy as np
 
 from rigcad.check import montecarlo as MC
 from rigcad.check import tolerances as T
-from rigcad.check.scene import (Optics, analytic_optics, mesh_optics, mixed, rig_geometry, rig_meshes,
-                                share_scenes)
-from rigcad.check.sources import DesignMap, annulus_rays, pixel_grid, pixel_rays, thin_lens_rays
+from rigcad.check.scene import Optics, analytic_optics, mesh_optics, mixed, placed_as, rig_meshes, share_scenes
+from rigcad.check.sources import annulus_rays, pixel_grid, pixel_rays, thin_lens_rays
+from rigcad.optics.incidence import DesignMap
 from rigcad.check.trace3d import STATUS_NAMES, Trace3D, trace
 from rigcad.profile.schema import Profile
 
@@ -100,12 +100,12 @@ def reading(tr: Trace3D, design_dirs: np.ndarray, exact: Trace3D | None, chief: 
     return f
 
 
-def pixels_per_degree(optics: Optics, design: DesignMap, azimuth: float = 45 * DEG) -> dict:
+def pixels_per_degree(optics: Optics, design: DesignMap, azimuth: float = 45 * DEG, pose=None) -> dict:
     """Trace a radial fan of pixels at ``azimuth`` (off the beam) from the occlusion limit to the
     rim every FAN_STEP_PX px; theta against pixel radius and its derivative (px/deg)."""
     r_in, r_out = design.pixel_radius(np.array([design.alpha_min, design.alpha_max]))
     rho = np.arange(r_in, r_out, FAN_STEP_PX)
-    tr = trace(optics, *_xy(design, rho, azimuth))
+    tr = trace(optics, *_xy(design, rho, azimuth, pose))
     ok = tr.ok
     theta = np.degrees(tr.theta[ok])
     r = rho[ok]
@@ -116,25 +116,29 @@ def pixels_per_degree(optics: Optics, design: DesignMap, azimuth: float = 45 * D
                         "px_per_deg_max": float(np.max(dpd)), "fan_step_px": FAN_STEP_PX}}
 
 
-def _xy(design, rho, azimuth):
-    rays = pixel_rays(design, rho * math.cos(azimuth), rho * math.sin(azimuth))
+def _xy(design, rho, azimuth, pose=None):
+    rays = pixel_rays(design, rho * math.cos(azimuth), rho * math.sin(azimuth), pose)
     return rays.origins, rays.dirs
 
 
-def run_raycheck(profile: Profile, exports: Path | None = None, rays: int | None = None, mode: str | None = None,
+def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode: str | None = None,
                  chord_error: float | None = None, normal_error: float | None = None,
                  monte_carlo: bool = True, grid: bool = True, builds: int | None = None,
                  optics_cache: dict | None = None, progress=None) -> RayCheck:
-    """Run the 3D check (see the module docstring). ``rays``/``mode``/``builds`` override the
-    profile's raycheck and tolerancing settings; ``chord_error`` (mm)/``normal_error`` (rad) the
-    mirror tessellation. ``optics_cache``: a dict reused across calls (tests) to keep BVHs."""
+    """Run the 3D check of ``rig`` (a :class:`rigcad.rig.Rig`; see the module docstring).
+    ``rays``/``mode``/``builds`` override the profile's raycheck and tolerancing settings;
+    ``chord_error`` (mm)/``normal_error`` (rad) the mirror tessellation. ``optics_cache``: a dict
+    reused across calls (tests) to keep BVHs. A moved rig (``rig.moved``) is traced where its
+    components stand; the sensitivity table and the Monte Carlo perturb the design's alignment."""
     step = progress or (lambda label: None)
+    profile = rig.profile
     rc = profile.raycheck
     if rays is not None:
         profile = replace(profile, raycheck=replace(rc, rays=rays))
     if mode is not None:
         profile = replace(profile, raycheck=replace(profile.raycheck, mode=mode))
-    if chord_error is not None or normal_error is not None:
+    override_tess = chord_error is not None or normal_error is not None
+    if override_tess:
         tess = profile.tessellation
         profile = replace(profile, tessellation=replace(
             tess, mirror_chord_error=tess.mirror_chord_error if chord_error is None else chord_error,
@@ -145,8 +149,7 @@ def run_raycheck(profile: Profile, exports: Path | None = None, rays: int | None
     timings = {}
     t0 = time.perf_counter()
     step("design")
-    rig = rig_geometry(profile)
-    design = DesignMap.from_rig(rig)
+    design = rig.incidence
     analytic = analytic_optics(rig)
     timings["design_s"] = time.perf_counter() - t0
 
@@ -159,16 +162,19 @@ def run_raycheck(profile: Profile, exports: Path | None = None, rays: int | None
                str(exports))
         cache = optics_cache if optics_cache is not None else {}
         if key not in cache:
-            meshes = rig_meshes(rig, exports, profile.tessellation.mirror_chord_error,
-                                profile.tessellation.mirror_normal_error) if exports is None else rig_meshes(rig, exports)
+            tess = profile.tessellation
+            meshes = rig_meshes(rig, exports, tess.mirror_chord_error, tess.mirror_normal_error) \
+                if exports is None or override_tess else rig_meshes(rig, exports)
             t1 = time.perf_counter()
             cache[key] = (meshes, mesh_optics(meshes, "smooth"), t1 - t0, time.perf_counter() - t1)
         meshes, meshed, timings["meshes_s"], timings["embree_build_s"] = cache[key]
+        meshed = placed_as(meshed, rig)
     check_optics = analytic if meshed is None else share_scenes(meshed, rc.mode)
 
     step("pinhole")
     t0 = time.perf_counter()
-    src = annulus_rays(design, rc.rays, rc.seed)
+    projector = rig.pose("projector")
+    src = annulus_rays(design, rc.rays, rc.seed, projector)
     ddirs = design.direction(src.chief)
     exact = trace(analytic, src.origins, src.dirs)
     readings = {"analytic": reading(exact, ddirs, None, src.chief)}
@@ -197,13 +203,13 @@ def run_raycheck(profile: Profile, exports: Path | None = None, rays: int | None
 
     step("pixels")
     t0 = time.perf_counter()
-    fan = pixels_per_degree(check_optics, design)
+    fan = pixels_per_degree(check_optics, design, pose=projector)
     theta_map = status_map = None
     grid_report = None
     if grid:
         r_out = float(design.pixel_radius(np.array([design.alpha_max]))[0])
         window = 2 * int(math.ceil(r_out)) + 8  # the paraboloid's image and a 4 px margin
-        g, (h, w), (r0, c0) = pixel_grid(design, profile.projector.resolution, window=window)
+        g, (h, w), (r0, c0) = pixel_grid(design, profile.projector.resolution, projector, window=window)
         gt = trace(check_optics, g.origins, g.dirs)
         theta_map = np.degrees(gt.theta).reshape(h, w)
         status_map = gt.status.reshape(h, w)
@@ -227,7 +233,7 @@ def run_raycheck(profile: Profile, exports: Path | None = None, rays: int | None
     step("thin lens")
     t0 = time.perf_counter()
     k = min(THIN_LENS_RAYS, rc.rays)
-    chief = annulus_rays(design, k, rc.seed + 7)
+    chief = annulus_rays(design, k, rc.seed + 7, projector)
     ctr = trace(check_optics, chief.origins, chief.dirs)
     focal = float(np.nanmean(exact.path_length))  # thesis 3.2.2: mean source-to-sample path
     edge = thin_lens_rays(chief, focal, profile.projector.aperture, rc.lens_azimuths)
@@ -292,13 +298,13 @@ def run_raycheck(profile: Profile, exports: Path | None = None, rays: int | None
 
 def write_raycheck(result: RayCheck, out_dir: Path) -> list[Path]:
     """Write raycheck.json, spot.png, theta_map.png under ``out_dir`` (atomically); returns paths."""
-    from rigcad.check import plots
-    from rigcad.export.atomic import write_json
+    from rigcad import plots
+    from rigcad.export.atomic import write_bytes, write_json
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = [write_json(out_dir / "raycheck.json", result.report)]
-    paths.append(plots.spot_diagram(result, out_dir / "spot.png"))
+    paths.append(write_bytes(out_dir / "spot.png", plots.spot_diagram(result)))
     if result.theta_map is not None:
-        paths.append(plots.theta_map(result, out_dir / "theta_map.png"))
+        paths.append(write_bytes(out_dir / "theta_map.png", plots.theta_map(result)))
     return paths

@@ -30,11 +30,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigcad.errors import CheckError
+from rigcad.optics.solids import slab, z_cylinder
 from rigcad.optics.surfaces import Meridian
 
-#: Dense meridian samples for seeding foot points and the dome intersection (as mirror_mesh).
+#: Dense meridian samples that bracket the dome intersection (as mirror_mesh).
 DENSE_SAMPLES = 20001
-#: Newton steps on the meridian (foot points, the dome's intersection). Quadratic convergence from
+#: Newton steps of the dome intersection. Quadratic convergence from
 #: a seed within ~0.01 mm reaches rounding in 3-4 steps; 8 leaves margin.
 NEWTON_STEPS = 8
 #: Bisection steps of the dome intersection on the tabulated meridian before Newton: the bracket
@@ -168,20 +169,9 @@ def _refine(c: dict, pi: np.ndarray, o: np.ndarray, d: np.ndarray):
 
 def foot_normals(meridian: Meridian, points: np.ndarray) -> np.ndarray:
     """Exact unit normals (n, 3) on the reflecting side at the foot points of ``points`` (n, 3) on
-    the surface of revolution of ``meridian`` (Newton on the meridian's tangential residual)."""
-    rho = np.hypot(points[:, 0], points[:, 1])
-    rz = np.stack([rho, points[:, 2]], axis=-1)
-    u = _seed_u(meridian, rz)
-    lo, hi = meridian.u_range
-    for _ in range(NEWTON_STEPS):
-        c = meridian.points(u)
-        n = meridian.normals(u)
-        tang = np.stack([n[:, 1], -n[:, 0]], axis=-1)  # unit tangent (either sense)
-        h = 1e-7 * max(1.0, hi - lo)
-        dc = (meridian.points(np.clip(u + h, lo, hi)) - meridian.points(np.clip(u - h, lo, hi)))
-        dsdu = np.einsum("ij,ij->i", dc, tang) / (np.clip(u + h, lo, hi) - np.clip(u - h, lo, hi))
-        u = np.clip(u + np.einsum("ij,ij->i", rz - c, tang) / dsdu, lo, hi)
-    n = meridian.normals(u)
+    the surface of revolution of ``meridian`` (the meridian's one foot-point solver)."""
+    rz = np.stack([np.hypot(points[:, 0], points[:, 1]), points[:, 2]], axis=-1)
+    n = meridian.normals(meridian.foot_points(rz))
     cphi, sphi = _azimuth(points)
     return np.stack([n[:, 0] * cphi, n[:, 0] * sphi, n[:, 1]], axis=-1)
 
@@ -192,25 +182,6 @@ def _azimuth(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         c = np.where(rho > 0, points[:, 0] / rho, 1.0)
         s = np.where(rho > 0, points[:, 1] / rho, 0.0)
     return c, s
-
-
-_DENSE_CACHE: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-
-
-def _dense(meridian: Meridian) -> tuple[np.ndarray, np.ndarray]:
-    key = id(meridian)
-    if key not in _DENSE_CACHE:
-        u = meridian.sample(DENSE_SAMPLES)
-        _DENSE_CACHE[key] = (u, meridian.points(u))
-    return _DENSE_CACHE[key]
-
-
-def _seed_u(meridian: Meridian, rz: np.ndarray) -> np.ndarray:
-    """Meridian parameter near each (r, z): paraboloid u = -r; dome from z (monotonic along it)."""
-    if meridian.kind == "paraboloid":
-        return np.clip(-rz[:, 0], *meridian.u_range)
-    u, p = _dense(meridian)
-    return np.interp(rz[:, 1], p[:, 1], u)
 
 
 class EmbreeMesh:
@@ -528,7 +499,7 @@ class ExactDome:
 
 
 class Box:
-    """Axis-aligned box [lo, hi] (mm), an occluder (slab test, float64)."""
+    """Axis-aligned box [lo, hi] (mm), an occluder (the slab test, float64)."""
 
     backend = "analytic float64 (box)"
 
@@ -536,13 +507,7 @@ class Box:
         self.lo, self.hi = np.asarray(lo, float), np.asarray(hi, float)
 
     def intersect(self, origins, dirs, tmax=None) -> Hits:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t1 = (self.lo - origins) / dirs
-            t2 = (self.hi - origins) / dirs
-        inside = (origins >= self.lo) & (origins <= self.hi)
-        t_lo = np.where(dirs == 0, np.where(inside, -np.inf, np.inf), np.minimum(t1, t2)).max(axis=1)
-        t_hi = np.where(dirs == 0, np.where(inside, np.inf, -np.inf), np.maximum(t1, t2)).min(axis=1)
-        return _solid_hits(t_lo, t_hi, tmax)
+        return _solid_hits(*slab(origins, dirs, self.lo, self.hi), tmax)
 
 
 def _solid_hits(t_lo: np.ndarray, t_hi: np.ndarray, tmax) -> "Hits":
@@ -565,23 +530,7 @@ class ZCylinder:
         self.r, self.z0, self.z1, self.c = radius, z0, z1, np.array([cx, cy])
 
     def intersect(self, origins, dirs, tmax=None) -> Hits:
-        ox, oy = origins[:, 0] - self.c[0], origins[:, 1] - self.c[1]
-        a = dirs[:, 0] ** 2 + dirs[:, 1] ** 2
-        b = ox * dirs[:, 0] + oy * dirs[:, 1]
-        c = ox * ox + oy * oy - self.r ** 2
-        disc = b * b - a * c
-        with np.errstate(invalid="ignore", divide="ignore"):
-            sq = np.sqrt(disc)
-            r_in = np.where(a > 0, (-b - sq) / a, np.where(c <= 0, -np.inf, np.inf))
-            r_out = np.where(a > 0, (-b + sq) / a, np.where(c <= 0, np.inf, -np.inf))
-            z_a = (self.z0 - origins[:, 2]) / dirs[:, 2]
-            z_b = (self.z1 - origins[:, 2]) / dirs[:, 2]
-        inside_z = (origins[:, 2] >= self.z0) & (origins[:, 2] <= self.z1)
-        zl = np.where(dirs[:, 2] == 0, np.where(inside_z, -np.inf, np.inf), np.minimum(z_a, z_b))
-        zh = np.where(dirs[:, 2] == 0, np.where(inside_z, np.inf, -np.inf), np.maximum(z_a, z_b))
-        t_lo = np.fmax(np.where(disc >= 0, r_in, np.inf), zl)
-        t_hi = np.fmin(np.where(disc >= 0, r_out, -np.inf), zh)
-        return _solid_hits(t_lo, t_hi, tmax)
+        return _solid_hits(*z_cylinder(origins, dirs, self.r, self.z0, self.z1, tuple(self.c)), tmax)
 
 
 class Group:

@@ -7,13 +7,12 @@ sources (camera, projector; see sources.py). The beam rests in the dome's slots 
 :func:`rig_meshes` is the one place that obtains the meshes: the exported files when present
 (``exports/<profile>/mirrors/{dome,paraboloid}.ply`` written by ``rigcad build``, and
 ``stl/paraboloid.stl``, ``stl/beam.stl``), else built from the profile (``mirror_mesh`` at the
-profile's ``tessellation.mirror_*`` tolerances; the occluders from the layout's boxes and
-cylinders). Where each came from is recorded.
+profile's ``tessellation.mirror_*`` tolerances; the occluders from the boxes and cylinders the
+part recipes declare). Where each came from is recorded.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -21,67 +20,13 @@ import numpy as np
 
 from rigcad.check import rays as R
 from rigcad.errors import CheckError
-from rigcad.optics.design import converged_dome
-from rigcad.optics.dome import DomeProfile
-from rigcad.parts.layout import RigLayout, rig_layout
-from rigcad.profile.derived import Derived, derive
-from rigcad.profile.schema import Profile
+from rigcad.optics.frames import Pose
+from rigcad.parts.recipe import Box
 
 #: Sides of the cylinders of the occluder meshes built when no STL was exported: the polygon's
 #: inscribed radius is r cos(pi/256), 0.0075 % short (1 um on the 16 mm back): below any effect
 #: on which ray is blocked.
 OCCLUDER_SECTIONS = 256
-
-
-@dataclass(frozen=True)
-class Pose:
-    """A rigid placement: global = rotation @ local + translation (mm)."""
-
-    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
-    translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
-
-    @classmethod
-    def misaligned(cls, offset=(0.0, 0.0, 0.0), tilt: float = 0.0, tilt_axis=(0.0, 1.0, 0.0),
-                   pivot=(0.0, 0.0, 0.0)) -> "Pose":
-        """Tilt by ``tilt`` rad about ``tilt_axis`` through ``pivot``, then shift by ``offset`` mm."""
-        axis = np.asarray(tilt_axis, float)
-        axis = axis / np.linalg.norm(axis)
-        k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-        rot = np.eye(3) + math.sin(tilt) * k + (1 - math.cos(tilt)) * (k @ k)  # Rodrigues
-        pivot = np.asarray(pivot, float)
-        return cls(rot, pivot + np.asarray(offset, float) - rot @ pivot)
-
-    @property
-    def is_identity(self) -> bool:
-        return bool(np.array_equal(self.rotation, np.eye(3)) and not np.any(self.translation))
-
-    def localize(self, points: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Points and directions (n, 3) from the global frame into this body's frame."""
-        if self.is_identity:
-            return points, dirs
-        return (points - self.translation) @ self.rotation, dirs @ self.rotation
-
-    def globalize_points(self, points: np.ndarray) -> np.ndarray:
-        return points if self.is_identity else points @ self.rotation.T + self.translation
-
-    def globalize_dirs(self, dirs: np.ndarray) -> np.ndarray:
-        return dirs if self.is_identity else dirs @ self.rotation.T
-
-
-@dataclass(frozen=True)
-class RigGeometry:
-    """What the 3D check needs from the design: derived figures, the dome profile, the layout."""
-
-    profile: Profile
-    geometry: Derived
-    dome: DomeProfile
-    layout: RigLayout
-
-
-def rig_geometry(profile: Profile) -> RigGeometry:
-    geo = derive(profile)
-    dome = converged_dome(profile, geo)  # the same dome the build exported
-    return RigGeometry(profile, geo, dome, rig_layout(profile, geo, dome))
 
 
 @dataclass(frozen=True)
@@ -113,29 +58,21 @@ def _ply_tolerances(comments: tuple[str, ...]) -> dict[str, float]:
     return out
 
 
-def _occluder_meshes(profile: Profile, layout: RigLayout) -> tuple[R.TriMesh, R.TriMesh]:
-    """The paraboloid's mount (back, stem, clamp) and the beam as meshes from their boxes and
-    cylinders (used when no STL was exported)."""
+def _occluder_meshes(rig) -> tuple[R.TriMesh, R.TriMesh]:
+    """The paraboloid's mount (back, stem, clamp) and the beam as meshes of the occluders their
+    recipes declare (used when no STL was exported)."""
     import trimesh
 
-    mount, beam = profile.paraboloid_mount, profile.beam
-    z0, z1 = layout.beam_z
-    c = profile.dome_shell.slot_clearance
-    rim = layout.printed_paraboloid.points(np.array([layout.printed_paraboloid.u_range[0]]))[0]
-    back = layout.paraboloid_back_z
-    half_out = beam.width / 2 + c + mount.clamp_wall
-    clamp_top = z1 + mount.clamp_wall
-    parts = [
-        trimesh.creation.cylinder(radius=float(rim[0]), segment=[[0, 0, back], [0, 0, float(rim[1])]],
-                                  sections=OCCLUDER_SECTIONS),
-        trimesh.creation.cylinder(radius=mount.stem_radius, segment=[[0, 0, clamp_top], [0, 0, back]],
-                                  sections=OCCLUDER_SECTIONS),
-        trimesh.creation.box(bounds=[[-mount.clamp_length / 2, -half_out, z0], [mount.clamp_length / 2, half_out, clamp_top]]),
-    ]
-    m = trimesh.util.concatenate(parts)
-    hl, w = layout.beam_half_length, beam.width / 2
-    b = trimesh.creation.box(bounds=[[-hl, -w, z0], [hl, w, z1]])
-    src = "built from the layout (boxes, cylinders): no exported STL"
+    def mesh(solid):
+        if isinstance(solid, Box):
+            return trimesh.creation.box(bounds=[solid.lo, solid.hi])
+        x, y, z = solid.base
+        return trimesh.creation.cylinder(radius=solid.radius, segment=[[x, y, z], [x, y, z + solid.height]],
+                                         sections=OCCLUDER_SECTIONS)
+
+    m = trimesh.util.concatenate([mesh(solid) for _, solid in rig.occluders["paraboloid"]])
+    b = trimesh.util.concatenate([mesh(solid) for _, solid in rig.occluders["beam"]])
+    src = "built from the occluders the part recipes declare (boxes, cylinders): no exported STL"
     return (R.TriMesh("paraboloid_mount", np.asarray(m.vertices, float), np.asarray(m.faces, np.int64), source=src),
             R.TriMesh("beam", np.asarray(b.vertices, float), np.asarray(b.faces, np.int64), source=src))
 
@@ -150,7 +87,7 @@ def _read_stl(path: Path, name: str) -> R.TriMesh:
     return R.TriMesh(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64), source=str(path))
 
 
-def rig_meshes(rig: RigGeometry, exports: Path | None = None, chord_error: float | None = None,
+def rig_meshes(rig, exports: Path | None = None, chord_error: float | None = None,
                normal_error: float | None = None) -> RigMeshes:
     """The meshes the checker traces (see the module docstring). ``chord_error`` (mm) and
     ``normal_error`` (rad) override the profile's ``tessellation.mirror_*`` (then the exported
@@ -182,7 +119,7 @@ def rig_meshes(rig: RigGeometry, exports: Path | None = None, chord_error: float
         mount = _read_stl(stl / "paraboloid.stl", "paraboloid_mount")
         beam = _read_stl(stl / "beam.stl", "beam")
     else:
-        mount, beam = _occluder_meshes(rig.profile, rig.layout)
+        mount, beam = _occluder_meshes(rig)
     return RigMeshes(mirrors["paraboloid"], mirrors["dome"], mount, beam,
                      {"chord_error_mm": chord, "normal_error_rad": normal})
 
@@ -218,24 +155,30 @@ class Optics:
 MESH_MODES = {"mesh": "facet", "smooth": "vertex", "exact_normals": "exact"}
 
 
-def analytic_optics(rig: RigGeometry) -> Optics:
-    """Exact surfaces and the occluders as boxes and cylinders (float64 throughout)."""
-    geo, lay, prof = rig.geometry, rig.layout, rig.profile
-    mount, beam = prof.paraboloid_mount, prof.beam
-    z0, z1 = lay.beam_z
-    c = prof.dome_shell.slot_clearance
-    rim = lay.printed_paraboloid.points(np.array([lay.printed_paraboloid.u_range[0]]))[0]
-    half_out = beam.width / 2 + c + mount.clamp_wall
-    clamp_top = z1 + mount.clamp_wall
-    para = R.Group([
-        R.ExactParaboloid(geo.focal_length, geo.vertex_z, geo.rim_radius),
-        R.ZCylinder(float(rim[0]), lay.paraboloid_back_z, float(rim[1])),
-        R.ZCylinder(mount.stem_radius, clamp_top, lay.paraboloid_back_z),
-        R.Box((-mount.clamp_length / 2, -half_out, z0), (mount.clamp_length / 2, half_out, clamp_top)),
-    ])
-    hl, w = lay.beam_half_length, beam.width / 2
-    beam_box = R.Box((-hl, -w, z0), (hl, w, z1))
-    return Optics("analytic", para, R.Group([R.ExactDome(lay.design_dome), beam_box]), beam_box)
+def _intersector(solid):
+    """A recipe occluder (Box or z Cylinder) as a float64 intersector."""
+    if isinstance(solid, Box):
+        return R.Box(solid.lo, solid.hi)
+    x, y, z = solid.base
+    return R.ZCylinder(solid.radius, z, z + solid.height, x, y)
+
+
+def analytic_optics(rig) -> Optics:
+    """Exact surfaces and the occluders the part recipes declare (float64 throughout), placed
+    where ``rig`` (a :class:`rigcad.rig.Rig`) puts its paraboloid and dome."""
+    geo = rig.geometry
+    para = R.Group([R.ExactParaboloid(geo.focal_length, geo.vertex_z, geo.rim_radius)]
+                   + [_intersector(solid) for _, solid in rig.occluders["paraboloid"]])
+    beam = [_intersector(solid) for _, solid in rig.occluders["beam"]]
+    beam_box = beam[0] if len(beam) == 1 else R.Group(beam)
+    optics = Optics("analytic", para, R.Group([R.ExactDome(rig.layout.design_dome), beam_box]), beam_box)
+    return placed_as(optics, rig)
+
+
+def placed_as(optics: Optics, rig) -> Optics:
+    """``optics`` with the paraboloid and the dome where ``rig`` puts them (no BVH rebuilt)."""
+    pp, dp = rig.pose("paraboloid"), rig.pose("dome")
+    return optics if pp.is_identity and dp.is_identity else optics.placed(pp, dp)
 
 
 def mesh_optics(meshes: RigMeshes, mode: str = "smooth", refine: bool = True, timer: R.Timer | None = None,

@@ -1,4 +1,4 @@
-"""The build stage: profile -> every part's exact solid (STEP), printable mesh (STL), the mirror
+"""The build stage: a Rig -> every part's exact solid (STEP), printable mesh (STL), the mirror
 meshes for the ray checker, the rig assembly, and manifest.json.
 
 Each part's cache key is the content hash of its recipe plus the tolerances that shape its files:
@@ -19,10 +19,8 @@ from rigcad import __version__
 from rigcad.errors import ExportError, ProfileError
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import code_version, file_sha, profile_digest
-from rigcad.optics.design import converged_dome
-from rigcad.parts import PARTS, rig_layout
+from rigcad.parts import PARTS
 from rigcad.parts.recipe import Part
-from rigcad.profile.derived import derive
 from rigcad.profile.schema import Profile
 
 #: STL and STEP volumes must agree within this fraction (the issue's 0.5 %): the mesh is
@@ -68,18 +66,18 @@ def _cached(entry: dict | None, key: str, out: Path) -> bool:
     return all(file_sha(out / rel) == digest for rel, digest in entry.get("files", {}).items())
 
 
-def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progress=None,
-              design_files: list[Path] | None = None, inputs_key: str | None = None) -> BuildResult:
-    """Build the selected parts (all by default) into ``out``; see the module docstring.
+def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
+              design: dict[str, bytes] | None = None, inputs_key: str | None = None) -> BuildResult:
+    """Build the selected parts (all by default) of ``rig`` (a :class:`rigcad.rig.Rig`) into
+    ``out``; see the module docstring.
 
-    ``design_files`` (written by the design stage into ``out``) and ``inputs_key`` are recorded in
-    the manifest so that `rigcad stl` can tell, without computing anything, that nothing changed.
+    ``design``: the design stage's files (name -> bytes, ``export.design.design_files``), staged and
+    published with the parts; their hashes and ``inputs_key`` go into the manifest so that
+    `rigcad stl` can tell, without computing anything, that nothing changed.
     """
 
     step = progress or (lambda label: None)
-    geo = derive(profile)
-    dome = converged_dome(profile, geo)
-    layout = rig_layout(profile, geo, dome)
+    profile, layout = rig.profile, rig.layout
     names = select_parts(parts)
     old_path = out / "manifest.json"
     old = json.loads(old_path.read_text()) if old_path.is_file() else {}
@@ -90,8 +88,12 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
     tol = profile.tessellation
 
     with Staging() as stage:
+        design_shas = {}
+        for name, data in (design or {}).items():
+            stage.write_bytes(out / name, data)
+            design_shas[name] = _sha(data)
         for name in names:
-            part = PARTS[name](profile, layout)
+            part = rig.recipe(name)
             key = part_key(part, profile)
             if _cached(old_parts.get(name), key, out):
                 reused.append(name)
@@ -103,28 +105,26 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
 
         mirrors = dict(old.get("mirrors", {}))
         for name in names:
-            part = PARTS[name](profile, layout)
-            for mirror, meridian in part.mirrors:
+            for mirror, meridian in rig.recipe(name).mirrors:
                 key = _mirror_key(meridian, profile)
                 if _cached(mirrors.get(mirror), key, out):
                     continue
                 step(f"{mirror} mirror mesh")
                 mirrors[mirror] = _build_mirror(mirror, meridian, key, profile, out, stage)
 
-        rig = [n for n in PARTS if n in entries and entries[n].get("in_rig")]
-        asm_key = hashlib.sha256("|".join(entries[n]["key"] for n in rig).encode()).hexdigest()
+        rig_parts = [n for n in PARTS if n in entries and entries[n].get("in_rig")]
+        asm_key = hashlib.sha256("|".join(entries[n]["key"] for n in rig_parts).encode()).hexdigest()
         asm_old = old.get("assembly")
-        if rig and not _cached(asm_old, asm_key, out):
+        if rig_parts and not _cached(asm_old, asm_key, out):
             step("assembly")
-            assembly = _build_assembly(rig, profile, layout, out, stage, shapes, asm_key)
+            assembly = _build_assembly(rig_parts, rig, out, stage, shapes, asm_key)
         else:
             assembly = asm_old
         manifest = {
             "rigcad_version": __version__,
             "profile": {"name": profile.name, "sources": list(profile.sources), "sha256": profile_digest(profile)},
             "inputs_key": inputs_key if inputs_key and not parts else None,
-            "design_files": {p.relative_to(out).as_posix(): file_sha(p) for p in design_files or []}
-            or old.get("design_files"),
+            "design_files": design_shas or old.get("design_files"),
             "frame": "mm; sample point at the origin; optical axis +z; parts in their working positions",
             "tolerances": {
                 "stl_chord_error_mm": tol.chord_error,
@@ -134,7 +134,7 @@ def build_rig(profile: Profile, out: Path, parts: list[str] | None = None, progr
                 "stl_step_volume_rtol": MESH_VOLUME_RTOL,
             },
             "layout": layout.describe(),
-            "occlusion": _occlusion(profile, layout, geo, dome, old.get("occlusion")),
+            "occlusion": _occlusion(rig, old.get("occlusion")),
             "parts": {n: entries[n] for n in PARTS if n in entries},
             "mirrors": mirrors,
             "assembly": assembly,
@@ -165,16 +165,16 @@ def _build_mirror(name: str, meridian, key: str, profile: Profile, out: Path, st
             "files": {f"mirrors/{name}.ply": _sha(stage.temp_path(path).read_bytes())}}
 
 
-def _occlusion(profile: Profile, layout, geo, dome, previous: dict | None) -> dict:
+def _occlusion(rig, previous: dict | None) -> dict:
     """Solid angle the beam and the paraboloid's mount hide from the sample (see parts.occlusion);
     the previous manifest's figures are reused when the profile and the code are the same."""
     from rigcad.optics.design import profile_table
     from rigcad.parts.occlusion import blocked_solid_angle
 
-    key = hashlib.sha256(f"{CACHE_VERSION}|{profile_digest(profile)}".encode()).hexdigest()
+    key = hashlib.sha256(f"{CACHE_VERSION}|{profile_digest(rig.profile)}".encode()).hexdigest()
     if previous and previous.get("key") == key:
         return previous
-    return {**blocked_solid_angle(profile, layout, profile_table(geo, dome)), "key": key}
+    return {**blocked_solid_angle(rig.occluders, profile_table(rig.geometry, rig.dome)), "key": key}
 
 
 def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Staging, shapes: dict) -> dict:
@@ -184,9 +184,7 @@ def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Stagin
 
     tol = profile.tessellation
     fits = K.FitReport()
-    shape = K.single_solid(K.build(part.solid, tol.fit_tolerance, fits))
-    if not K.is_valid(shape):
-        raise ExportError(f"{part.name}: the kernel produced an invalid solid (BRepCheck)")
+    shape = K.part_solid(part, tol.fit_tolerance, fits, profile)
     if fits.max_error > 1e-3:
         raise ExportError(f"{part.name}: B-spline fit error {fits.max_error:.3g} mm exceeds 1 um; lower "
                           "tessellation.fit_tolerance")
@@ -264,23 +262,23 @@ def _stl_mirror_errors(vertices: np.ndarray, faces: np.ndarray, printed) -> dict
                            "samples each, foot points on the exact meridian"}
 
 
-def _build_assembly(rig: list[str], profile: Profile, layout, out: Path, stage: Staging, shapes: dict,
-                    key: str) -> dict:
+def _build_assembly(names: list[str], rig, out: Path, stage: Staging, shapes: dict, key: str) -> dict:
     from rigcad.export.step import reimport_check, step_writer
     from rigcad.parts import _kernel as K
 
+    profile = rig.profile
     items = []
     total = 0.0
-    for name in rig:
-        part = PARTS[name](profile, layout)
+    for name in names:
+        part = rig.recipe(name)
         if name not in shapes:
-            shapes[name] = K.single_solid(K.build(part.solid, profile.tessellation.fit_tolerance, K.FitReport()))
+            shapes[name] = K.part_solid(part, profile.tessellation.fit_tolerance, K.FitReport(), profile)
         items.append((name, shapes[name], part.color))
         total += K.volume(shapes[name])
     path = out / "rig.step"
     stage.write_with(path, step_writer(items, f"{profile.name}_rig"))
     check = reimport_check(stage.temp_path(path), total, len(items))
-    return {"key": key, "parts": rig, "step_reimport": check,
+    return {"key": key, "parts": names, "step_reimport": check,
             "files": {"rig.step": _sha(stage.temp_path(path).read_bytes())}}
 
 

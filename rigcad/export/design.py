@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigcad.export.atomic import write_bytes, write_json
+from rigcad.export.atomic import write_bytes
 from rigcad.optics.design import Design
 
 
@@ -22,17 +22,21 @@ def table_csv(table: dict[str, np.ndarray]) -> bytes:
     return out.getvalue().encode()
 
 
-def write_design(design: Design, out_dir: Path) -> list[Path]:
-    """Render everything in memory first, then write each file atomically; returns the paths."""
+def design_files(design: Design) -> dict[str, bytes]:
+    """The design stage's files, rendered in memory: name -> bytes."""
     from rigcad import plots
 
-    files = {
+    return {
         "design.json": _design_json(design),
         "dome_profile.csv": table_csv(design.table),
         "rays.png": plots.ray_diagram(design),
         "incidence.png": plots.incidence_plot(design),
     }
-    return [write_bytes(out_dir / name, data) for name, data in files.items()]
+
+
+def write_design(design: Design, out_dir: Path) -> list[Path]:
+    """Write the design files into ``out_dir``, each atomically; returns the paths."""
+    return [write_bytes(out_dir / name, data) for name, data in design_files(design).items()]
 
 
 def _design_json(design: Design) -> bytes:
@@ -47,4 +51,4 @@ def _design_json(design: Design) -> bytes:
     return json_bytes(report)
 
 
-__all__ = ["table_csv", "write_design", "write_json"]
+__all__ = ["design_files", "table_csv", "write_design"]

@@ -45,7 +45,6 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from rigcad.errors import CheckError, ExportError
 from rigcad.export.atomic import write_with
@@ -80,14 +79,6 @@ AXIS_MM = 1e-9
 #: linear in position), the edge midpoints and the centroid, and comes within ~1 % of the peak of a
 #: quadratic chord-error function anywhere in the facet.
 MEASURE_ORDER = 12
-
-#: Newton steps for the foot point on the meridian. Each step shrinks the tangential residual by a
-#: factor of about curvature x distance (< 0.02 mm^-1 x 0.1 mm here), so 3-4 steps reach rounding.
-NEWTON_STEPS = 8
-
-#: Tangential residual (mm) at which a foot point counts as converged. A foot-point error d moves
-#: the distance by ~ k d^2 / 2 and the normal by ~ k d: both negligible at 1e-11 mm.
-FOOT_POINT_TOL_MM = 1e-11
 
 #: Hausdorff check: reference grid refinement (per cell, in u and in azimuth) and lattice order of
 #: the points sampled on this mesh's facets. A reference 4x finer has ~1/16 of this mesh's chord
@@ -300,47 +291,22 @@ def barycentric_lattice(order: int) -> np.ndarray:
     return np.stack([i, j, order - i - j], axis=-1) / order
 
 
-def _foot_points(meridian: Meridian, d: _Dense, tree: cKDTree, rz: np.ndarray) -> np.ndarray:
-    """Meridian parameters (N,) of the points of the curve nearest to ``rz`` (N, 2) in (r, z), mm.
-
-    Seeded at the nearest dense sample, then Newton on the tangential offset: du = t.(p - c) / (ds/du),
-    clamped to u_range (a point beyond an end is nearest to that end)."""
-    _, nearest = tree.query(rz)
-    u = d.u[nearest]
-    lo, hi = meridian.u_range
-    for _ in range(NEWTON_STEPS):
-        c = meridian.points(u)
-        n = meridian.normals(u)
-        step = d.tangent_sign * ((rz[:, 0] - c[:, 0]) * n[:, 1] - (rz[:, 1] - c[:, 1]) * n[:, 0])  # mm along +u
-        new = np.clip(u + step / np.interp(u, d.u, d.dsdu), lo, hi)
-        moved = np.abs(new - u) * np.interp(u, d.u, d.dsdu)
-        u = new
-        if np.max(moved, initial=0.0) < FOOT_POINT_TOL_MM:
-            break
-    else:
-        raise CheckError(f"foot points on the {meridian.kind} meridian did not converge in {NEWTON_STEPS} "
-                         f"Newton steps (last step {np.max(moved):.3g} mm)")
-    return u
-
-
 def surface_distance(points: np.ndarray, meridian: Meridian, near: float = 0.05) -> np.ndarray:
     """Distance (n,) mm of points (n, 3) from the surface of revolution of ``meridian`` (a point
     beyond an end of the meridian is measured to that end). Points farther than ``near`` mm from
     every dense sample of the meridian get that sample distance (exact to its spacing); nearer
     ones are projected onto the exact curve."""
-    d = _dense(meridian)
-    tree = cKDTree(d.points)
     rz = np.stack([np.hypot(points[:, 0], points[:, 1]), points[:, 2]], axis=-1)
-    coarse, _ = tree.query(rz)
+    coarse, _ = meridian._table.tree.query(rz)  # the foot-point solver's own samples
     close = coarse < near
     if np.any(close):
-        u = _foot_points(meridian, d, tree, rz[close])
+        u = meridian.foot_points(rz[close])
         coarse[close] = np.linalg.norm(rz[close] - meridian.points(u), axis=1)
     return coarse
 
 
 def facet_errors(vertices: np.ndarray, faces: np.ndarray, meridian: Meridian,
-                 order: int = MEASURE_ORDER, _dense_table: _Dense | None = None) -> tuple[np.ndarray, np.ndarray]:
+                 order: int = MEASURE_ORDER) -> tuple[np.ndarray, np.ndarray]:
     """Per-facet chord error (m,) mm and facet-normal error (m,) rad against the exact surface.
 
     Each facet of ``faces`` (m, 3) into ``vertices`` (n, 3) (mm, frame of the module) is sampled at
@@ -349,8 +315,6 @@ def facet_errors(vertices: np.ndarray, faces: np.ndarray, meridian: Meridian,
     facet's right-hand normal and the exact normal there, rotated to the sample's azimuth. Both are
     maxima over the samples (a lower bound of the facet's true maximum, within ~1 % at order 12).
     Vectorised, in chunks of about two million samples."""
-    d = _dense_table if _dense_table is not None else _dense(meridian)
-    tree = cKDTree(d.points)
     w = barycentric_lattice(order)
     chunk = max(1, 2_000_000 // len(w))
     chord = np.empty(len(faces))
@@ -361,7 +325,7 @@ def facet_errors(vertices: np.ndarray, faces: np.ndarray, meridian: Meridian,
         fn /= np.linalg.norm(fn, axis=1, keepdims=True)
         pts = np.einsum("kv,mvc->mkc", w, tri).reshape(-1, 3)
         rz = np.stack([np.hypot(pts[:, 0], pts[:, 1]), pts[:, 2]], axis=-1)
-        u = _foot_points(meridian, d, tree, rz)
+        u = meridian.foot_points(rz)
         dist = np.linalg.norm(rz - meridian.points(u), axis=1)
         n2 = meridian.normals(u)
         phi = np.arctan2(pts[:, 1], pts[:, 0])
@@ -462,7 +426,7 @@ def mirror_mesh(meridian: Meridian, name: str, chord_error: float, normal_error:
         grid = _grid(meridian, ring_u, angles, True, d.tangent_sign)
         vertices, normals, faces = grid.vertices, grid.normals, grid.faces
         measured = faces if every_facet else faces[grid.sector_faces(1)]
-        chord, normal = facet_errors(vertices, measured, meridian, _dense_table=d)
+        chord, normal = facet_errors(vertices, measured, meridian)
         measured_chord, measured_normal = float(chord.max()), float(normal.max())
         if measured_chord <= chord_error and measured_normal <= normal_error:
             break

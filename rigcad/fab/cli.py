@@ -11,12 +11,13 @@ from pathlib import Path
 def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.fab.printers import load_printer
     from rigcad.fab.stage import run_fab
-    from rigcad.profile import load_profile
+    from rigcad.rig import load
 
-    profile = load_profile(args.profile)
+    rig = load(args.profile)
+    profile = rig.profile
     printer = load_printer(args.printer)
     out = Path(args.exports) / profile.name / "fab" / printer.name
-    res = run_fab(profile, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs,
+    res = run_fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs,
                   progress=lambda msg: print(f"  {msg}", file=sys.stderr) if args.verbose else None)
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")

@@ -8,16 +8,11 @@ into the part's material.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from rigcad.optics.surfaces import Meridian
-
-#: Samples of the meridian for the nearest-point search; the Newton step on the tangent makes the
-#: distance exact to ~curvature x spacing^2 (dome: 400 mm / 20000 = 0.02 mm -> < 1e-6 mm).
-_SAMPLES = 20001
 
 
 @dataclass(frozen=True)
@@ -28,41 +23,17 @@ class MirrorSurface:
     name: str
     printed: Meridian
     design: Meridian
-    _u: np.ndarray = field(init=False, repr=False, compare=False)
-    _tree: cKDTree = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        u = self.printed.sample(_SAMPLES)
-        object.__setattr__(self, "_u", u)
-        object.__setattr__(self, "_tree", cKDTree(self.printed.points(u)))
-
-    def foot(self, rz: np.ndarray) -> np.ndarray:
-        """Meridian parameter u (n,) of the nearest point to each (r, z) in ``rz`` (n, 2)."""
-        _, idx = self._tree.query(rz)
-        u = self._u[idx]
-        lo, hi = self.printed.u_range
-        for _ in range(2):  # Newton on the tangent: (q - P(u)) . P'(u) = 0
-            p = self.printed.points(u)
-            h = 1e-6 * (hi - lo)
-            dp = (self.printed.points(np.clip(u + h, lo, hi)) - self.printed.points(np.clip(u - h, lo, hi)))
-            du = np.clip(u + h, lo, hi) - np.clip(u - h, lo, hi)
-            tangent = dp / du[:, None]
-            step = np.einsum("ij,ij->i", rz - p, tangent) / np.einsum("ij,ij->i", tangent, tangent)
-            u = np.clip(u + step, lo, hi)
-        return u
 
     def signed_distance(self, points: np.ndarray) -> np.ndarray:
         """Signed distance (n,) mm of 3D points (n, 3) to the printed surface (+ = reflecting side)."""
         points = np.asarray(points, dtype=float)
-        rz = np.stack([np.hypot(points[:, 0], points[:, 1]), points[:, 2]], axis=-1)
-        u = self.foot(rz)
-        return np.einsum("ij,ij->i", rz - self.printed.points(u), self.printed.normals(u))
+        return self.printed.distance(np.stack([np.hypot(points[:, 0], points[:, 1]), points[:, 2]], axis=-1))
 
     def normals(self, points: np.ndarray) -> np.ndarray:
         """Unit normals (n, 3) of the surface at the feet of ``points`` (n, 3), reflecting side."""
         points = np.asarray(points, dtype=float)
         r = np.hypot(points[:, 0], points[:, 1])
-        u = self.foot(np.stack([r, points[:, 2]], axis=-1))
+        u = self.printed.foot_points(np.stack([r, points[:, 2]], axis=-1))
         n2 = self.printed.normals(u)
         phi = np.arctan2(points[:, 1], points[:, 0])
         return np.stack([n2[:, 0] * np.cos(phi), n2[:, 0] * np.sin(phi), n2[:, 1]], axis=-1)

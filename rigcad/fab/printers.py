@@ -1,4 +1,4 @@
-"""Printer profiles (profiles/printers/<name>.yaml): build volume, layer height, nozzle or laser
+"""Printer profiles (``printers/<name>.yaml`` on the profile search path): build volume, layer height, nozzle or laser
 spot, material, and what rigcad needs to estimate a print. Read through the one YAML reader
 (rigcad.profile.loader, with its file:line marks and ``extends``) and validated with the same
 :class:`rigcad.profile.schema.Spec` rules as rig profiles: every length carries its unit.
@@ -11,13 +11,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from rigcad.errors import FabricationError, ProfileError
-from rigcad.profile.loader import load_raw
+from rigcad.errors import ProfileError
+from rigcad.profile.loader import find_file, load_raw, search_path
 # The schema's own readers, so printer files follow the same unit, range and error rules.
 from rigcad.profile.schema import REQUIRED, Spec, convert_value, read_section, spec, suggest
 
-#: Where printer profiles live, relative to the working directory (as profiles/ for rigs).
-PRINTERS_DIR = Path("profiles") / "printers"
+#: Printer files live in this folder under each folder of the profile search path.
+PRINTERS_SUBDIR = "printers"
 
 _POS = dict(lo=0, lo_open=True)
 
@@ -112,18 +112,13 @@ _SECTIONS = {"build_volume": BuildVolume, "alignment_pin": AlignmentPin}
 
 
 def printer_path(name: str | Path) -> Path:
-    """A printer file by path, or by name under profiles/printers/."""
-    path = Path(name)
-    candidates = [path] if path.suffix == ".yaml" else [path.with_suffix(".yaml"), PRINTERS_DIR / f"{path.name}.yaml"]
-    for c in candidates:
-        if c.is_file():
-            return c
-    known = available_printers()
-    raise FabricationError(f"no printer {str(name)!r}; printers in {PRINTERS_DIR}/: {', '.join(known) or '(none)'}")
+    """A printer file by path, or by name under ``printers/`` on the profile search path."""
+    return find_file(name, "printer", sub=PRINTERS_SUBDIR)
 
 
 def available_printers() -> list[str]:
-    return sorted(p.stem for p in PRINTERS_DIR.glob("*.yaml")) if PRINTERS_DIR.is_dir() else []
+    """Printer names on the search path (first folder wins for a name)."""
+    return sorted({p.stem for d in search_path(PRINTERS_SUBDIR) if d.is_dir() for p in d.glob("*.yaml")})
 
 
 def load_printer(name: str | Path) -> Printer:

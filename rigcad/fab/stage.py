@@ -1,4 +1,4 @@
-"""The fabrication stage: profile + printer -> exports/<profile>/fab/<printer>/.
+"""The fabrication stage: a Rig + printer -> exports/<profile>/fab/<printer>/.
 
 For every part: fit it to the printer (or split it, rigcad.fab.split), choose each piece's
 orientation (rigcad.fab.orientation: least staircase on a mirror), slice it in-process
@@ -27,7 +27,8 @@ import numpy as np
 from rigcad import __version__
 from rigcad.errors import FabricationError, RigcadError
 from rigcad.export.atomic import Staging, json_bytes
-from rigcad.fab import figures, outlines
+from rigcad import plots
+from rigcad.fab import outlines
 from rigcad.fab import orientation as O
 from rigcad.fab import slicer as S
 from rigcad.fab import split as SP
@@ -102,21 +103,17 @@ def _estimate(volume: float, layers: int, printer: Printer) -> dict:
             "material_g": volume / 1000.0 * printer.material_density_g_cm3}
 
 
-def run_fab(profile, printer: Printer, out: Path, *, gcode: bool = False, parts: list[str] | None = None,
+def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: list[str] | None = None,
             progress=None, workers: int | None = None) -> FabResult:
-    """Run the stage into ``out`` (exports/<profile>/fab/<printer>); see the module docstring."""
+    """Run the stage for ``rig`` (a :class:`rigcad.rig.Rig`: the same converged dome, layout and
+    recipes as the exported parts) into ``out`` (exports/<profile>/fab/<printer>); see the module
+    docstring."""
     from rigcad.export.build import select_parts
-    from rigcad.optics.dome import build_dome
-    from rigcad.parts import PARTS, rig_layout
-    from rigcad.profile.derived import derive
 
     say = progress or (lambda msg: None)
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    geo = derive(profile)
-    dp = profile.dome
-    dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=dp.table_rows)
-    layout = rig_layout(profile, geo, dome)
+    profile, layout = rig.profile, rig.layout
     timings["design_and_layout"] = time.perf_counter() - t0
     chord = profile.tessellation.chord_error
     tol_mirror = chord + 2e-3  # mesh vertices lie on the surface; facets within the chord error
@@ -131,7 +128,7 @@ def run_fab(profile, printer: Printer, out: Path, *, gcode: bool = False, parts:
 
     with Staging() as stage:
         for name in names:
-            part = PARTS[name](profile, layout)
+            part = rig.recipe(name)
             if name in CUT_PARTS and isinstance(part.solid, Prism):
                 t = time.perf_counter()
                 o = outlines.outline(part, chord)
@@ -298,9 +295,9 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
     if map_pts:
         pts, cusp = np.concatenate(map_pts), np.concatenate(map_cusp)
         orients = sorted({r["orientation"] for r in piece_rows})
-        png = figures.staircase_map(pts, cusp, printer.layer_height,
-                                    f"{name} on {printer.name}: cusp from slices, {printer.layer_height:.4g} mm layers, "
-                                    f"{', '.join(orients)}")
+        png = plots.staircase_map(pts, cusp, printer.layer_height,
+                                  f"{name} on {printer.name}: cusp from slices, {printer.layer_height:.4g} mm layers, "
+                                  f"{', '.join(orients)}")
         stage.write_bytes(out / "staircase" / f"{name}.png", png)
         ok = np.isfinite(cusp)
         entry["staircase_map"] = {"png": f"staircase/{name}.png", "png_sha256": _sha(png),

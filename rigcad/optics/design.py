@@ -16,7 +16,7 @@ from rigcad.optics.misalignment import COMPONENT_OFFSETS, Offsets, convergence_e
 from rigcad.optics.paraboloid import Paraboloid, unit
 from rigcad.optics.thin_lens import ThinLensResult, thin_lens_check
 from rigcad.optics.trace2d import STATUS_NAMES, DomeCurve, Trace, parallel_rays, trace
-from rigcad.profile.derived import Derived, derive
+from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
 from rigcad.units import DEG
 
@@ -133,14 +133,11 @@ def converged_dome(profile: Profile, geo: Derived) -> DomeProfile:
         rows = min(2 * rows - 1, MAX_ROWS)
 
 
-def run_design(profile: Profile, progress=None) -> Design:
-    """Build and check the 2D design. Raises GeometryError for an impossible rig."""
+def run_design(rig, progress=None) -> Design:
+    """Trace and check the 2D design of ``rig`` (a :class:`rigcad.rig.Rig`: its geometry, converged
+    dome and curve). Raises GeometryError for an impossible rig."""
     step = progress or (lambda label: None)
-    geo = derive(profile)
-    para = Paraboloid(geo.focal_length, geo.vertex_z, geo.rim_radius)
-    step("dome profile")
-    dome = converged_dome(profile, geo)
-    curve = DomeCurve.from_profile(dome)
+    profile, geo, para, dome, curve = rig.profile, rig.geometry, rig.paraboloid, rig.dome, rig.curve
     aperture = profile.projector.aperture
 
     # Top aperture: the dome ends at the occlusion limit; the projector's bundle must pass inside it.

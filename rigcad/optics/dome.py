@@ -21,9 +21,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.interpolate import make_interp_spline
 from scipy.optimize import brentq
 
 from rigcad.errors import GeometryError, IntegrationError
@@ -191,6 +193,19 @@ class DomeProfile:
     @property
     def theta(self) -> np.ndarray:
         return theta_of(self.points)
+
+    @cached_property
+    def spline(self):
+        """The one smooth curve through this profile's rows: a quintic interpolating spline of the
+        dome point (r, z) in mm against u = -s, so u increases from the dome's base (the rim ray,
+        s = rim radius) to its top. Every smooth reading of the dome uses it: the 2D tracer
+        (trace2d.DomeCurve), the 3D surfaces (surfaces.Meridian), and through them the solids,
+        meshes, ray checks and fabrication. Built on first use and kept (smooth profiles only)."""
+        if self.kind != "smooth":
+            raise GeometryError(f"the {self.method} dome is a polyline of flat mirror segments: it has no smooth "
+                                "curve (use dome.method dop853, rk45 or equal_path)", param="dome.method")
+        order = np.argsort(self.s)[::-1]  # s decreases from the rim (bottom) to the top
+        return make_interp_spline(-self.s[order], self.points[order], k=5)
 
 
 def _occlusion_s(geo: Derived, path_length: float) -> float:

@@ -1,8 +1,8 @@
 """2D ray trace in the meridional plane: COP -> paraboloid -> dome -> sample plane z = 0.
 
-The dome is traced as a geometric curve, independent of how it was built: a smooth profile as a
-quintic interpolating spline through its points (normals from the spline's derivative), the
-thesis's polyline as its flat segments. Both halves of the section are traced (x < 0 mirrored),
+The dome is traced as a geometric curve, independent of how it was built: a smooth profile as its
+one quintic interpolating spline (``DomeProfile.spline``, shared with the 3D surfaces; normals from
+its derivative), the thesis's polyline as its flat segments. Both halves of the section are traced (x < 0 mirrored),
 so horizontal misalignments that break the symmetry are handled. Vectorised over rays (n, 2).
 """
 
@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import make_interp_spline
 
 from rigcad.optics.dome import DomeProfile
 from rigcad.optics.paraboloid import Paraboloid, reflect, unit
@@ -31,15 +30,19 @@ class DomeCurve:
     kind: str
     s: np.ndarray  #: increasing node parameters
     points: np.ndarray  #: (m, 2) node points
-    spline: object | None
+    spline: object | None  #: the profile's spline in u = -s (DomeProfile.spline); None for a polyline
     dx: float = 0.0
 
     @classmethod
     def from_profile(cls, profile: DomeProfile, dx: float = 0.0) -> "DomeCurve":
         order = np.argsort(profile.s)
         s, pts = profile.s[order], profile.points[order]
-        spline = make_interp_spline(s, pts, k=5) if profile.kind == "smooth" else None
+        spline = profile.spline if profile.kind == "smooth" else None
         return cls(profile.kind, s, pts, spline, dx)
+
+    def _at(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Point D (n, 2) and derivative dD/ds (n, 2) at design parameters ``sigma`` (the spline runs in u = -s)."""
+        return self.spline(-sigma), -self.spline(-sigma, 1)
 
     def shifted(self, dx: float) -> "DomeCurve":
         return DomeCurve(self.kind, self.s, self.points, self.spline, self.dx + dx)
@@ -82,17 +85,14 @@ class DomeCurve:
         lo, hi = self.s[seg[idx]], self.s[seg[idx] + 1]
         sig = lo + frac[idx] * (hi - lo)
         oo, dd = o[idx], d[idx]
-        deriv = self.spline.derivative()
         for _ in range(8):
-            D = self.spline(sig)
-            T = deriv(sig)
+            D, T = self._at(sig)
             g = (D[:, 0] - oo[:, 0]) * dd[:, 1] - (D[:, 1] - oo[:, 1]) * dd[:, 0]
             dg = T[:, 0] * dd[:, 1] - T[:, 1] * dd[:, 0]
             with np.errstate(invalid="ignore", divide="ignore"):
                 step = np.where(dg != 0, g / dg, 0.0)
             sig = np.clip(sig - step, lo, hi)
-        D = self.spline(sig)
-        T = deriv(sig)
+        D, T = self._at(sig)
         lam[idx] = np.sum((D - oo) * dd, axis=-1)
         normal[idx] = unit(np.stack([-T[:, 1], T[:, 0]], axis=-1))
         return lam, normal

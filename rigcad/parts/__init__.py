@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import is_dataclass, replace
 
 from rigcad.parts.base import base_cross, base_plate, sample_holder
 from rigcad.parts.beam import beam
@@ -31,4 +32,36 @@ PARTS: dict[str, Callable[[Profile, RigLayout], Part]] = {
     "paraboloid_template": paraboloid_template,
 }
 
-__all__ = ["PARTS", "Part", "RigLayout", "rig_layout"]
+__all__ = ["PARTS", "Part", "RigLayout", "make_recipes", "rig_layout"]
+
+
+class _Reads:
+    """The profile as a part function sees it, noting each ``section.key`` it reads."""
+
+    def __init__(self, profile: Profile) -> None:
+        self._profile = profile
+        self.keys: list[str] = []
+
+    def __getattr__(self, name: str):
+        value = getattr(self._profile, name)
+        return _SectionReads(name, value, self.keys) if is_dataclass(value) else value
+
+
+class _SectionReads:
+    def __init__(self, section: str, values, keys: list[str]) -> None:
+        self._section, self._values, self._keys = section, values, keys
+
+    def __getattr__(self, key: str):
+        self._keys.append(f"{self._section}.{key}")
+        return getattr(self._values, key)
+
+
+def make_recipes(profile: Profile, layout: RigLayout) -> dict[str, Part]:
+    """Every part's recipe, in build order, each with the profile keys its function read
+    (``Part.shaped_by``: what an error names when the kernel cannot build it)."""
+    out = {}
+    for name, make in PARTS.items():
+        reads = _Reads(profile)
+        part = make(reads, layout)  # type: ignore[arg-type]  # reads every attribute through to the profile
+        out[name] = replace(part, shaped_by=tuple(dict.fromkeys(reads.keys)))
+    return out

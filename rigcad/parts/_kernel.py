@@ -30,8 +30,11 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS_Shape
 from OCP.TopTools import TopTools_ListOfShape
 
-from rigcad.errors import GeometryError
-from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Prism, Revolve, Section, Solid, Translate, Union_
+from OCP.Standard import Standard_Failure
+
+from rigcad.errors import GeometryError, KernelError
+from rigcad.parts.recipe import (Box, Curve, Cylinder, Difference, Line, Part, Prism, Revolve, Section, Solid,
+                                 Translate, Union_)
 
 #: Points of the exact curve given to each B-spline fit, and (more) used to measure it.
 FIT_POINTS = 1001
@@ -173,3 +176,35 @@ def single_solid(shape: TopoDS_Shape) -> TopoDS_Shape:
 def is_valid(shape: TopoDS_Shape) -> bool:
     """OCCT's BRepCheck verdict."""
     return BRepCheck_Analyzer(shape).IsValid()
+
+
+def part_solid(part: Part, tol: float, report: FitReport, profile=None) -> TopoDS_Shape:
+    """The one valid solid of ``part``'s recipe (B-spline fits at ``tol`` mm, recorded in ``report``).
+    Any kernel failure (OCCT's Standard_Failure family, such as StdFail_NotDone; a boolean that
+    fails; a result that is not exactly one solid, or not valid) becomes a KernelError naming the
+    part, the profile keys that shaped it (with the first one's file:line when ``profile`` is
+    given) and what to try."""
+    try:
+        shape = single_solid(build(part.solid, tol, report))
+    except Standard_Failure as err:
+        raise kernel_error(part, f"{type(err).__name__}: {str(err).strip() or 'no message'}", profile) from err
+    except GeometryError as err:
+        raise kernel_error(part, err.message, profile) from err
+    if not is_valid(shape):
+        raise kernel_error(part, "the solid it produced is not valid (BRepCheck)", profile)
+    return shape
+
+
+def kernel_error(part: Part, what: str, profile=None) -> KernelError:
+    keys = list(part.shaped_by)
+    where = None
+    if profile is not None:
+        marked = [k for k in keys if tuple(k.split(".")) in profile.marks]
+        if marked:  # a key the user set is the likeliest cause: name it first
+            keys = marked + [k for k in keys if k not in marked]
+            where = profile.marks[tuple(marked[0].split("."))]
+    shaped = ", ".join(keys[:6]) + (", ..." if len(keys) > 6 else "") if keys else "the layout"
+    return KernelError(f"part {part.name!r}: OpenCascade could not build it ({what}). It is shaped by {shaped} "
+                       "(and the mirrors' layout): look for a size near zero, a clearance or offset that cuts it "
+                       f"apart, or features that no longer overlap; change {keys[0] if keys else 'the profile'} "
+                       "and build again", where=where, param=keys[0] if keys else None)

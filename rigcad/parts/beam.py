@@ -12,5 +12,6 @@ def beam(profile: Profile, layout: RigLayout) -> Part:
     z0, z1 = layout.beam_z
     half = layout.beam_half_length
     w = profile.beam.width / 2
-    return Part("beam", Box((-half, -w, z0), (half, w, z1)), (0.35, 0.35, 0.38),
-                "mounting beam along x through the dome's slots")
+    box = Box((-half, -w, z0), (half, w, z1))
+    return Part("beam", box, (0.35, 0.35, 0.38), "mounting beam along x through the dome's slots",
+                occluders=(("beam", box),))

@@ -9,7 +9,7 @@ place of the paraboloid (rig frame), and one on the base plate (``base.base_cros
 from __future__ import annotations
 
 from rigcad.parts.layout import RigLayout
-from rigcad.parts.paraboloid import stem_and_clamp
+from rigcad.parts.paraboloid import mount, stem_and_clamp
 from rigcad.parts.recipe import Box, Difference, Part, Union_
 from rigcad.profile.schema import Profile
 
@@ -73,7 +73,7 @@ def camera_cross_hung(profile: Profile, layout: RigLayout) -> Part:
     top = layout.geometry.vertex_z  # the camera focuses on this cross: it sits at the paraboloid's vertex height
     L, bw = c.arm_length, c.bar_width / 2
     bars = (Box((-L, -bw, top - c.thickness), (L, bw, top)), Box((-bw, -L, top - c.thickness), (bw, L, top)))
-    stem = stem_and_clamp(profile, layout, top - c.thickness)
+    stem = stem_and_clamp(mount(profile, layout, top - c.thickness))
     return Part("camera_cross_hung", Union_((*bars, stem)), (0.9, 0.5, 0.1),
                 "camera calibration: cross hung on the beam in place of the paraboloid, at its vertex height",
                 in_rig=False)

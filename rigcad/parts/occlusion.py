@@ -4,7 +4,8 @@ that the beam, the clamp and the stem block (kernel-free, numpy).
 Each direction (theta, phi) at O has one design light path (rotational symmetry): COP -> P on the
 paraboloid -> D on the dome -> O, with P and D in the meridional plane at azimuth phi. A direction
 is blocked when the segment P -> D or D -> O passes through the beam, or the paraboloid's clamp or
-stem (their bounding boxes and cylinder). Directions below the paraboloid's occlusion angle are
+stem: the occluders their part recipes declare (``Part.occluders``), boxes as they are and the
+stem by its bounding box. Directions below the paraboloid's occlusion angle are
 outside the measurable zone and not counted.
 """
 
@@ -14,27 +15,29 @@ import math
 
 import numpy as np
 
-from rigcad.parts.layout import RigLayout
-from rigcad.profile.schema import Profile
+from rigcad.optics.solids import segments_hit_box
+from rigcad.parts.recipe import Box, Cylinder
+
+#: The occluders counted, by the names their recipes give them (the paraboloid's back lies inside
+#: the occlusion cone of its rim and is not counted).
+COUNTED = ("beam", "clamp", "stem")
 
 
-def _segment_hits_box(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Slab test: does each segment a[i] -> b[i] (n, 3) cross the box [lo, hi]?"""
-    d = b - a
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t1 = (lo - a) / d
-        t2 = (hi - a) / d
-    t_lo = np.where(d == 0, np.where((a >= lo) & (a <= hi), -np.inf, np.inf), np.minimum(t1, t2))
-    t_hi = np.where(d == 0, np.where((a >= lo) & (a <= hi), np.inf, -np.inf), np.maximum(t1, t2))
-    enter = np.max(t_lo, axis=1)
-    leave = np.min(t_hi, axis=1)
-    return (enter <= leave) & (leave > 1e-9) & (enter < 1 - 1e-9)
+def bounds(solid: Box | Cylinder) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned bounding box (lo, hi) (3,) mm of an occluder."""
+    if isinstance(solid, Box):
+        return np.array(solid.lo, float), np.array(solid.hi, float)
+    x, y, z = solid.base
+    r = solid.radius
+    return np.array([x - r, y - r, z]), np.array([x + r, y + r, z + solid.height])
 
 
-def blocked_solid_angle(profile: Profile, layout: RigLayout, table: dict[str, np.ndarray],
+def blocked_solid_angle(occluders: dict[str, tuple], table: dict[str, np.ndarray],
                         n_theta: int = 400, n_phi: int = 1440) -> dict[str, float]:
     """Solid angle (sr) of the measurable zone's incidence directions blocked by the beam,
-    clamp and stem, on a midpoint grid of ``n_theta`` x ``n_phi`` cells (sr weights sin(theta))."""
+    clamp and stem (``occluders``: part name -> ((name, Box or Cylinder), ...), as
+    ``Rig.occluders``), on a midpoint grid of ``n_theta`` x ``n_phi`` cells (sr weights sin(theta)).
+    ``table``: the design's profile table (``optics.design.profile_table``)."""
     theta_deg = table["incidence_theta_deg"]
     order = np.argsort(theta_deg)
     th_tab = np.radians(theta_deg[order])
@@ -52,22 +55,15 @@ def blocked_solid_angle(profile: Profile, layout: RigLayout, table: dict[str, np
     P = np.column_stack([rP[i] * c, rP[i] * s, zP[i]])
     O = np.zeros_like(D)
 
-    mount, beam = profile.paraboloid_mount, profile.beam
-    z0, z1 = layout.beam_z
-    cl = profile.dome_shell.slot_clearance
-    half_out = beam.width / 2 + cl + mount.clamp_wall
-    boxes = {
-        "beam": (np.array([-layout.beam_half_length, -beam.width / 2, z0]),
-                 np.array([layout.beam_half_length, beam.width / 2, z1])),
-        "clamp": (np.array([-mount.clamp_length / 2, -half_out, z0]),
-                  np.array([mount.clamp_length / 2, half_out, z1 + mount.clamp_wall])),
-        "stem": (np.array([-mount.stem_radius, -mount.stem_radius, z1 + mount.clamp_wall]),
-                 np.array([mount.stem_radius, mount.stem_radius, layout.paraboloid_back_z])),
-    }
+    solids = {name: solid for group in occluders.values() for name, solid in group}
+    missing = [n for n in COUNTED if n not in solids]
+    if missing:
+        raise ValueError(f"the part recipes declare no occluder named {', '.join(missing)}")
+    boxes = {name: bounds(solids[name]) for name in COUNTED}
     blocked = np.zeros(len(D), dtype=bool)
     by = {}
     for name, (lo, hi) in boxes.items():
-        hit = _segment_hits_box(O, D, lo, hi) | _segment_hits_box(P, D, lo, hi)
+        hit = segments_hit_box(O, D, lo, hi) | segments_hit_box(P, D, lo, hi)
         by[name] = hit
         blocked |= hit
     weight = (np.sin(th) * np.diff(th_edges))[i] * (2 * math.pi / n_phi)

@@ -161,8 +161,10 @@ class Part:
     """One part: its solid, how a viewer should show it, and what it is for.
 
     ``mirrors`` names the mirror meridians (design surfaces, coating included) that this part
-    carries, for the ray checker's meshes. ``in_rig`` is False for tools kept out of the rig
-    assembly (calibration targets, templates) or placed elsewhere in it.
+    carries, for the ray checker's meshes. ``occluders`` names the convex solids (boxes, z
+    cylinders) that stand for the rest of the part where light passes it: the ray checker and the
+    occlusion report trace them, so a part's size is stated once, here. ``in_rig`` is False for
+    tools kept out of the rig assembly (calibration targets, templates) or placed elsewhere in it.
     """
 
     name: str
@@ -172,6 +174,9 @@ class Part:
     quantity: int = 1
     in_rig: bool = True
     mirrors: tuple[tuple[str, Meridian], ...] = field(default=(), compare=False)
+    occluders: tuple[tuple[str, Box | Cylinder], ...] = field(default=(), compare=False)
+    #: The profile keys ("section.key") this part's function read: named when the kernel fails.
+    shaped_by: tuple[str, ...] = field(default=(), compare=False)
 
     def content_hash(self) -> str:
         """SHA-256 of the solid's full definition (every number, every curve's coefficients)."""

@@ -1,12 +1,16 @@
 """The only YAML reader in rigcad: files -> nested dicts with a file:line mark per key.
 
-A profile may say ``extends: other`` (a file beside it, with or without ``.yaml``) and override
-a few keys; mappings merge key by key, anything else is replaced. Each value keeps the mark of
+Profiles are found by name on a search path (:func:`search_path`): the working directory's
+``profiles/``, the folders in ``$RIGCAD_PROFILES`` (``os.pathsep``-separated) and the profiles
+shipped inside the package (``rigcad/profiles/``), in that order; or given as a path. A profile may
+say ``extends: other`` (a name looked up first beside it, then on the search path, or a file) and
+override a few keys; mappings merge key by key, anything else is replaced. Each value keeps the mark of
 the file and line that set it, so validation errors point at the line to edit.
 """
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -45,8 +49,16 @@ def _mark(path: Path, node: yaml.Node) -> str:
 
 
 def _display(path: Path) -> str:
+    """How a file is named in messages and outputs: a shipped profile as ``rigcad/profiles/...``
+    wherever rigcad is installed (outputs do not depend on the install folder), others relative to
+    the working directory when under it."""
+    resolved = path.resolve()
     try:
-        return str(path.resolve().relative_to(Path.cwd().resolve()))
+        return str(Path("rigcad") / "profiles" / resolved.relative_to(PACKAGE_PROFILES.resolve()))
+    except ValueError:
+        pass
+    try:
+        return str(resolved.relative_to(Path.cwd().resolve()))
     except ValueError:
         return str(path)
 
@@ -101,19 +113,48 @@ def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def resolve_profile_path(spec: str | Path, search: Path | None = None) -> Path:
-    """Find a profile by path, or by name under ``search`` (default ``profiles/``)."""
+#: The profiles shipped with rigcad (rig profiles; printers under ``printers/``).
+PACKAGE_PROFILES = Path(__file__).resolve().parents[1] / "profiles"
+#: Environment variable naming extra profile folders, ``os.pathsep``-separated.
+PROFILES_ENV = "RIGCAD_PROFILES"
+
+
+def search_path(sub: str = "") -> list[Path]:
+    """Folders searched for a profile given by name, first match wins: ``./profiles``, each folder
+    of ``$RIGCAD_PROFILES``, the package's profiles; ``sub`` (e.g. ``printers``) is appended to each."""
+    dirs = [Path("profiles")]
+    dirs += [Path(p) for p in os.environ.get(PROFILES_ENV, "").split(os.pathsep) if p]
+    dirs.append(PACKAGE_PROFILES)
+    return [d / sub if sub else d for d in dirs]
+
+
+def find_file(spec: str | Path, kind: str, sub: str = "", near: Path | None = None) -> Path:
+    """A ``kind`` file ("profile", "printer") by path, or by name in ``near`` and then on
+    :func:`search_path` (``sub`` below each folder); a missing name lists where it looked and the
+    names found there. Raises ProfileError."""
     path = Path(spec)
-    candidates = [path, path.with_suffix(".yaml")] if path.suffix == "" else [path]
-    base = search if search is not None else Path("profiles")
-    if not path.is_absolute():
-        candidates += [base / c.name for c in list(candidates)]
+    named = path.suffix == ""
+    candidates = [path, path.with_suffix(".yaml")] if named else [path]
     for candidate in candidates:
         if candidate.is_file():
             return candidate
-    known = sorted(p.stem for p in base.glob("*.yaml")) if base.is_dir() else []
-    hint = f"; profiles in {base}/: {', '.join(known)}" if known else ""
-    raise ProfileError(f"no profile {str(spec)!r}{hint}")
+    folders = ([near] if near is not None else []) + search_path(sub)
+    if not path.is_absolute() and len(path.parts) == 1:
+        for folder in folders:
+            candidate = folder / (path.name if not named else f"{path.name}.yaml")
+            if candidate.is_file():
+                return candidate
+    looked = []
+    for folder in dict.fromkeys(folders):
+        names = sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
+        looked.append(f"{_display(folder)}/ ({', '.join(names) if names else 'none'})")
+    raise ProfileError(f"no {kind} {str(spec)!r}: looked for {candidates[-1].name} in " + "; ".join(looked)
+                       + f" (set ${PROFILES_ENV} to add folders)")
+
+
+def resolve_profile_path(spec: str | Path, near: Path | None = None) -> Path:
+    """Find a rig profile by path, or by name beside ``near`` and on the search path."""
+    return find_file(spec, "profile", near=near)
 
 
 def load_raw(spec: str | Path) -> RawProfile:
@@ -136,7 +177,7 @@ def load_raw(spec: str | Path) -> RawProfile:
         elif not isinstance(parent, str):
             raise ProfileError(f"'extends' takes a profile name or file, got {parent!r}", where=marks.get(("extends",)))
         else:
-            current = resolve_profile_path(parent, search=current.parent)
+            current = resolve_profile_path(parent, near=current.parent)
     data: dict[str, Any] = {}
     marks: dict[Key, str] = {}
     for layer_data, layer_marks in reversed(layers):

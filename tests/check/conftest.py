@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from rigcad.check.scene import analytic_optics, mesh_optics, rig_geometry, rig_meshes
-from rigcad.check.sources import DesignMap
+from rigcad.check.scene import analytic_optics, mesh_optics, rig_meshes
 
 #: A coarse tessellation for fast tests: 66k + 121k triangles, built in ~0.5 s.
 COARSE = (0.01, 0.01)
@@ -14,13 +13,13 @@ FINE = (0.003, 0.003)
 
 
 @pytest.fixture(scope="session")
-def rig(table31):
-    return rig_geometry(table31)
+def rig(table31_rig):
+    return table31_rig
 
 
 @pytest.fixture(scope="session")
 def design_map(rig):
-    return DesignMap.from_rig(rig)
+    return rig.incidence
 
 
 @pytest.fixture(scope="session")

@@ -14,10 +14,11 @@ from rigcad.check.raycheck import run_raycheck, write_raycheck
 from rigcad.check.tolerances import raise_if_failed, table
 from rigcad.errors import CheckError, RigcadError
 from rigcad.profile import load_profile
+from rigcad.rig import Rig
 
 ROOT = Path(__file__).resolve().parents[2]
 #: rig profiles (profiles/printers/ holds printer definitions, not rigs)
-PROFILES = sorted((ROOT / "profiles").glob("*.yaml"))
+PROFILES = sorted((ROOT / "rigcad" / "profiles").glob("*.yaml"))
 
 
 def test_there_are_profiles():
@@ -29,7 +30,7 @@ def test_every_profile_meets_its_declared_tolerances(path, optics_cache):
     """Default tessellation, the profile's mode; fewer rays and builds than `rigcad check` for speed
     (maxima over 20000 rays come within a few per cent of those over 100000: smooth error fields)."""
     profile = load_profile(path)
-    result = run_raycheck(profile, rays=20000, builds=20, grid=True, optics_cache=optics_cache)
+    result = run_raycheck(Rig.from_profile(profile), rays=20000, builds=20, grid=True, optics_cache=optics_cache)
     assert len(result.rows) >= 8, "the table has every declared tolerance"
     raise_if_failed(result.rows, profile.name)  # the failure message is the readable table's content
     rep = result.report
@@ -40,8 +41,8 @@ def test_every_profile_meets_its_declared_tolerances(path, optics_cache):
         assert rep["backend"].startswith("embreex")
 
 
-def test_a_too_coarse_tessellation_fails_naming_it(table31, optics_cache):
-    result = run_raycheck(table31, rays=5000, chord_error=0.1, normal_error=0.1, monte_carlo=False,
+def test_a_too_coarse_tessellation_fails_naming_it(table31, table31_rig, optics_cache):
+    result = run_raycheck(table31_rig, rays=5000, chord_error=0.1, normal_error=0.1, monte_carlo=False,
                           grid=False, optics_cache=optics_cache)
     assert not result.passed
     with pytest.raises(CheckError) as err:
@@ -72,7 +73,7 @@ def test_cli_writes_the_report_and_figures(tmp_path, capsys):
 
 def test_cli_exits_nonzero_with_a_table_on_failure(tmp_path, write_profile, capsys):
     path = write_profile(f"""
-        extends: {ROOT / "profiles" / "achutha2006.yaml"}
+        extends: {ROOT / "rigcad" / "profiles" / "achutha2006.yaml"}
         raycheck:
           mode: analytic
           max_lost_fraction: 0.01
@@ -88,8 +89,8 @@ def test_cli_exits_nonzero_with_a_table_on_failure(tmp_path, write_profile, caps
 
 
 def test_write_raycheck_is_deterministic_apart_from_timings(tmp_path, table31):
-    a = run_raycheck(table31, mode="analytic", rays=2000, monte_carlo=False)
-    b = run_raycheck(table31, mode="analytic", rays=2000, monte_carlo=False)
+    a = run_raycheck(Rig.from_profile(table31), mode="analytic", rays=2000, monte_carlo=False)
+    b = run_raycheck(Rig.from_profile(table31), mode="analytic", rays=2000, monte_carlo=False)
     for r in (a, b):
         r.report.pop("timings_s")
     pa = write_raycheck(a, tmp_path / "a")

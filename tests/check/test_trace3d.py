@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from rigcad.check import montecarlo as MC
-from rigcad.check.scene import Pose, share_scenes
+from rigcad.check.scene import share_scenes
+from rigcad.optics.frames import Pose
 from rigcad.check.sources import annulus_rays, pixel_rays
 from rigcad.check.trace3d import OCCLUDED_BY_BEAM, convergence_point, trace
 from rigcad.optics.misalignment import Offsets, misaligned_trace

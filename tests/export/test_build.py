@@ -12,6 +12,7 @@ import trimesh
 from rigcad.export.build import build_rig
 from rigcad.parts import PARTS
 from rigcad.profile import load_profile
+from rigcad.rig import Rig
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -19,9 +20,10 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     out = tmp_path_factory.mktemp("build") / "achutha2006"
-    profile = load_profile(ROOT / "profiles/achutha2006.yaml")
-    result = build_rig(profile, out)
-    return profile, out, result
+    profile = load_profile(ROOT / "rigcad/profiles/achutha2006.yaml")
+    rig = Rig.from_profile(profile)
+    result = build_rig(rig, out)
+    return rig, out, result
 
 
 def _read_step(path):
@@ -80,16 +82,16 @@ def test_mirror_fits_within_one_micrometre(built):
 
 
 def test_second_run_rebuilds_nothing_and_changes_nothing(built):
-    profile, out, _ = built
+    rig, out, _ = built
     before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
-    again = build_rig(profile, out)
+    again = build_rig(rig, out)
     assert again.rebuilt == [] and sorted(again.reused) == sorted(PARTS)
     assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
 
 
 def test_clean_rebuild_is_byte_identical(built, tmp_path):
-    profile, out, _ = built
-    build_rig(profile, tmp_path / "again")
+    rig, out, _ = built
+    build_rig(Rig.from_profile(rig.profile), tmp_path / "again")
     for path in out.rglob("*"):
         if path.is_file():
             twin = tmp_path / "again" / path.relative_to(out)
@@ -97,20 +99,20 @@ def test_clean_rebuild_is_byte_identical(built, tmp_path):
 
 
 def test_changed_key_rebuilds_only_dependent_parts(built, tmp_path, write_profile):
-    profile, out, _ = built
+    _, out, _ = built
     import shutil
 
     work = tmp_path / "rig"
     shutil.copytree(out, work)
-    text = (ROOT / "profiles/achutha2006.yaml").read_text() + "beam:\n  width: 5 mm\n"
+    text = (ROOT / "rigcad/profiles/achutha2006.yaml").read_text() + "beam:\n  width: 5 mm\n"
     changed = load_profile(write_profile(text, name="achutha2006"))
-    result = build_rig(changed, work)
+    result = build_rig(Rig.from_profile(changed), work)
     # the beam's width shapes the beam, the dome's slots and both clamps; nothing else
     assert sorted(result.rebuilt) == ["beam", "camera_cross_hung", "dome", "paraboloid"]
 
 
 def test_failed_run_leaves_the_last_good_exports(built, tmp_path, monkeypatch):
-    profile, out, _ = built
+    _, out, _ = built
     import shutil
 
     from rigcad.errors import ExportError
@@ -119,16 +121,20 @@ def test_failed_run_leaves_the_last_good_exports(built, tmp_path, monkeypatch):
     work = tmp_path / "rig"
     shutil.copytree(out, work)
     before = {p: p.read_bytes() for p in work.rglob("*") if p.is_file()}
-    changed = load_profile(ROOT / "profiles/achutha2006.yaml")
+    changed = load_profile(ROOT / "rigcad/profiles/achutha2006.yaml")
     changed = type(changed)(**{**changed.__dict__, "tessellation": type(changed.tessellation)(
         **{**changed.tessellation.__dict__, "chord_error": 0.02})})
 
-    def broken(*args, **kwargs):
-        raise ExportError("injected failure after some parts were staged")
+    real = B._build_part
 
-    monkeypatch.setitem(B.PARTS, "dome_template", broken)
+    def broken(part, *args, **kwargs):
+        if part.name == "dome_template":
+            raise ExportError("injected failure after some parts were staged")
+        return real(part, *args, **kwargs)
+
+    monkeypatch.setattr(B, "_build_part", broken)
     with pytest.raises(ExportError):
-        build_rig(changed, work)
+        build_rig(Rig.from_profile(changed), work)
     after = {p: p.read_bytes() for p in work.rglob("*") if p.is_file()}
     assert after == before  # nothing overwritten, no temporary files left
 
@@ -160,7 +166,7 @@ def test_stl_lies_on_the_step_surface_within_the_chord_error(built, name):
 
     from rigcad.parts._kernel import single_solid
 
-    profile, out, _ = built
+    rig, out, _ = built
     shell = BRepClass3d.OuterShell_s(single_solid(_read_step(out / "step" / f"{name}.step")))
     mesh = trimesh.load(out / "stl" / f"{name}.stl")
     rng = np.random.default_rng(2)
@@ -170,7 +176,7 @@ def test_stl_lies_on_the_step_surface_within_the_chord_error(built, name):
     def dist(p):
         return BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex(), shell).Value()
 
-    chord = profile.tessellation.chord_error
+    chord = rig.profile.tessellation.chord_error
     # vertices sit on the exact surfaces (float32 STL rounding ~1e-5 mm, plus the 0.1 um B-spline fit)
     assert max(dist(p) for p in verts) < 1e-4
     # facet interiors are within the chord error (the polygons are inscribed); 1 % for float32
@@ -206,7 +212,8 @@ def test_mirror_meshes_lie_on_the_equal_path_dome(built):
     from rigcad.optics.dome import equal_path_t, reflected_rays, start
     from rigcad.profile import derive
 
-    profile, out, result = built
+    rig, out, result = built
+    profile = rig.profile
     rep = result.manifest["mirrors"]["dome"]["report"]
     assert rep["measured_chord_error_mm"] <= profile.tessellation.mirror_chord_error
     assert rep["measured_facet_normal_error_rad"] <= profile.tessellation.mirror_normal_error
@@ -234,7 +241,8 @@ def test_mirror_meshes_lie_on_the_equal_path_dome(built):
 
 
 def test_stl_mirror_surfaces_report_their_errors(built):
-    profile, _, result = built
+    rig, _, result = built
+    profile = rig.profile
     for part, mirror in (("dome", "dome"), ("paraboloid", "paraboloid")):
         rep = result.manifest["parts"][part]["stl_mirror_surface"][mirror]
         assert rep["facets"] > 100

@@ -25,34 +25,27 @@ def _repo_cwd():
 
 
 @pytest.fixture(scope="session")
-def layout(table31):
-    from rigcad.optics.dome import build_dome
-    from rigcad.parts import rig_layout
-    from rigcad.profile.derived import derive
-
-    geo = derive(table31)
-    dp = table31.dome
-    dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=dp.table_rows)
-    return rig_layout(table31, geo, dome)
+def layout(table31_rig):
+    return table31_rig.layout
 
 
 @pytest.fixture(scope="session")
 def prusa():
-    return load_printer(ROOT / "profiles" / "printers" / "prusa_mk3s.yaml")
+    return load_printer(ROOT / "rigcad" / "profiles" / "printers" / "prusa_mk3s.yaml")
 
 
 @pytest.fixture(scope="session")
 def vantage():
-    return load_printer(ROOT / "profiles" / "printers" / "vantage_i.yaml")
+    return load_printer(ROOT / "rigcad" / "profiles" / "printers" / "vantage_i.yaml")
 
 
 @pytest.fixture(scope="session")
-def prusa_run(table31, prusa, tmp_path_factory):
+def prusa_run(table31_rig, prusa, tmp_path_factory):
     """One fab run of the small parts and the dome on the desktop printer, without G-code."""
     from rigcad.fab.stage import run_fab
 
     out = tmp_path_factory.mktemp("fab") / "prusa_mk3s"
-    res = run_fab(table31, prusa, out, parts=["dome", "paraboloid", "beam", "sample_holder", "camera_cross_hung",
+    res = run_fab(table31_rig, prusa, out, parts=["dome", "paraboloid", "beam", "sample_holder", "camera_cross_hung",
                                               "dome_template", "paraboloid_template"])
     return out, res
 

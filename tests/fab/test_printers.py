@@ -39,5 +39,5 @@ def test_unknown_key_is_refused_with_a_suggestion(tmp_path):
 
 
 def test_unknown_printer_lists_the_known_ones():
-    with pytest.raises(FabricationError, match="prusa_mk3s"):
+    with pytest.raises(ProfileError, match="prusa_mk3s"):
         load_printer("no_such_printer")

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 from rigcad.errors import GeometryError
-from rigcad.optics.design import run_design
+from rigcad.rig import Rig
 from rigcad.optics.misalignment import Offsets, convergence_error, misaligned_trace
 from rigcad.profile import load_profile
 
 
 @pytest.fixture(scope="module")
 def design(table31):
-    return run_design(table31)
+    return Rig.from_profile(table31).design
 
 
 def test_reproduces_the_thesis_outcome(design):
@@ -53,7 +53,7 @@ def test_thin_lens_focal_distance_is_the_common_path_length(design):
 def test_thin_lens_offsets_vanish_with_the_aperture(table31):
     from rigcad.optics.thin_lens import thin_lens_check
 
-    d = run_design(table31)
+    d = Rig.from_profile(table31).design
     cop = np.array([0.0, d.geometry.cop_z])
     small = thin_lens_check(d.paraboloid, d.curve, cop, d.chief_dirs, 0.05).summary()
     large = thin_lens_check(d.paraboloid, d.curve, cop, d.chief_dirs, 0.5).summary()
@@ -90,7 +90,7 @@ def test_every_component_has_a_sensitivity(design):
 
 
 def _design_of(write_profile, text):
-    return run_design(load_profile(write_profile(text)))
+    return Rig.from_profile(load_profile(write_profile(text))).design
 
 
 def test_rim_ray_going_up_is_refused_naming_the_angle(write_profile, table31_text):

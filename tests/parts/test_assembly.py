@@ -11,11 +11,10 @@ import trimesh
 
 from rigcad.export.build import build_rig
 from rigcad.optics.design import profile_table
-from rigcad.optics.dome import build_dome
-from rigcad.parts import PARTS, rig_layout
 from rigcad.parts import _kernel as K
 from rigcad.parts.occlusion import blocked_solid_angle
-from rigcad.profile import derive, load_profile
+from rigcad.profile import load_profile
+from rigcad.rig import Rig
 
 ROOT = Path(__file__).resolve().parents[2]
 RIG = ["dome", "paraboloid", "beam", "base_plate", "sample_holder"]
@@ -23,19 +22,16 @@ RIG = ["dome", "paraboloid", "beam", "base_plate", "sample_holder"]
 
 @pytest.fixture(scope="module")
 def rig():
-    profile = load_profile(ROOT / "profiles/achutha2006.yaml")
-    geo = derive(profile)
-    dome = build_dome(geo, profile.dome.method, tolerance=profile.dome.tolerance, rows=profile.dome.table_rows)
-    layout = rig_layout(profile, geo, dome)
-    shapes = {n: K.single_solid(K.build(PARTS[n](profile, layout).solid, 1e-4, K.FitReport())) for n in RIG}
-    return profile, geo, dome, layout, shapes
+    r = Rig.from_profile(load_profile(ROOT / "rigcad/profiles/achutha2006.yaml"))
+    shapes = {n: K.single_solid(K.build(r.recipe(n).solid, 1e-4, K.FitReport())) for n in RIG}
+    return r, shapes
 
 
 @pytest.mark.parametrize("a, b", list(itertools.combinations(RIG, 2)))
 def test_no_interference_between_rig_parts(rig, a, b):
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
 
-    shapes = rig[4]
+    shapes = rig[1]
     common = BRepAlgoAPI_Common(shapes[a], shapes[b]).Shape()
     # intended contacts (flange on plate, beam on its slot floor, clamp on the beam, collar under
     # the plate) share faces only: zero volume. 1e-6 mm^3 is far below any real overlap.
@@ -43,9 +39,10 @@ def test_no_interference_between_rig_parts(rig, a, b):
 
 
 def test_only_beam_and_mount_stand_between_dome_and_sample(rig, tmp_path):
-    profile, geo, dome, layout, _ = rig
+    r = rig[0]
+    geo = r.geometry
     out = tmp_path / "rig"
-    build_rig(profile, out, RIG)
+    build_rig(r, out, RIG)
     meshes = {n: trimesh.load(out / "stl" / f"{n}.stl") for n in RIG}
     rng = np.random.default_rng(11)
     n = 20000
@@ -70,7 +67,7 @@ def test_only_beam_and_mount_stand_between_dome_and_sample(rig, tmp_path):
     assert miss.mean() < 1e-3
     # the blocked fraction seen by rays agrees with the analytic occlusion report (2 sigma of 20k samples)
     frac_rays = np.mean(who != "dome")
-    report = blocked_solid_angle(profile, layout, profile_table(geo, dome))
+    report = blocked_solid_angle(r.occluders, profile_table(geo, r.dome))
     rays_only_return = report["blocked_fraction"]  # report counts P->D too: an upper bound
     assert frac_rays <= rays_only_return + 2 * math.sqrt(frac_rays * (1 - frac_rays) / n)
     assert frac_rays > 0.01  # the beam does hide a strip
@@ -84,7 +81,8 @@ def test_coated_mirrors_lie_on_the_design_surfaces(rig):
     from OCP.BRepClass3d import BRepClass3d
     from OCP.gp import gp_Pnt
 
-    profile, geo, dome, layout, shapes = rig
+    r, shapes = rig
+    layout = r.layout
     coat = layout.coating
     assert coat == pytest.approx(5.5 * 0.0254)  # the thesis's 5.5 mil default stack
     for name, design in (("dome", layout.design_dome), ("paraboloid", layout.design_paraboloid)):
@@ -107,11 +105,11 @@ def test_projector_bench_crosses_stand_in_their_fences(rig):
 
     from rigcad.parts.recipe import Translate
 
-    profile, _, _, layout, _ = rig
-    c = profile.crosses
+    r = rig[0]
+    c = r.profile.crosses
 
     def solid(name, dx=0.0):
-        part = PARTS[name](profile, layout)
+        part = r.recipe(name)
         recipe = Translate(part.solid, (dx, 0.0, 0.0)) if dx else part.solid
         return K.single_solid(K.build(recipe, 1e-4, K.FitReport()))
 

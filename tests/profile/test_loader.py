@@ -61,3 +61,43 @@ def test_missing_profile_lists_known_ones(tmp_path, monkeypatch):
     (tmp_path / "profiles" / "known.yaml").write_text("{}\n")
     with pytest.raises(ProfileError, match="known"):
         load_raw("unknown")
+
+
+def test_shipped_profile_loads_by_name_from_any_folder(tmp_path, monkeypatch):
+    """The packaged profiles are on the search path: no repository checkout needed; they are named
+    the same wherever rigcad is installed (outputs must not depend on the install folder)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("RIGCAD_PROFILES", raising=False)
+    raw = load_raw("achutha2006")
+    assert str(raw.sources[0]) == "rigcad/profiles/achutha2006.yaml"
+    assert raw.marks[("layout", "cop_to_vertex")].startswith("rigcad/profiles/achutha2006.yaml:")
+
+
+def test_extends_a_shipped_profile_by_name_from_elsewhere(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "mine.yaml").write_text("extends: achutha2006\nlayout:\n  cop_to_vertex: 30 cm\n")
+    raw = load_raw(tmp_path / "mine.yaml")
+    assert raw.data["layout"]["cop_to_vertex"] == "30 cm"
+    assert raw.data["layout"]["sample_to_rim"] == "13.5 cm"  # from the shipped parent
+    assert len(raw.sources) == 2
+
+
+def test_env_folder_is_searched_before_the_package(tmp_path, monkeypatch):
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    (lab / "achutha2006.yaml").write_text("description: the lab's own copy\n")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("RIGCAD_PROFILES", str(lab))
+    raw = load_raw("achutha2006")
+    assert raw.data == {"description": "the lab's own copy"}
+
+
+def test_missing_name_says_where_it_looked(tmp_path, monkeypatch):
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("RIGCAD_PROFILES", str(lab))
+    with pytest.raises(ProfileError) as err:
+        load_raw("nope")
+    msg = str(err.value)
+    assert "profiles/ (none)" in msg and "lab/ (none)" in msg and "(achutha2006)" in msg and "RIGCAD_PROFILES" in msg

@@ -16,7 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rigcad.errors import RigcadError
-from rigcad.optics.design import run_design
+from rigcad.rig import Rig
 from rigcad.profile.loader import RawProfile
 from rigcad.profile.schema import validate
 
@@ -39,7 +39,7 @@ def profiles(draw):
 
 def check_profile(data: dict) -> str:
     try:
-        design = run_design(validate(RawProfile("stress", data, {}, ())))
+        design = Rig.from_profile(validate(RawProfile("stress", data, {}, ()))).design
     except RigcadError as err:
         message = str(err)
         # a refusal names what to change

@@ -1,0 +1,210 @@
+"""The Rig: everything every stage needs, built once from a validated profile and then frozen.
+
+``Rig.from_profile`` derives the geometry and integrates the dome (to the rows its smooth curve
+needs: ``optics.design.converged_dome``) exactly once; the rest is computed from those on first
+use and kept: the layout and every part's recipe (``rigcad.parts``), the 2D design with its
+report, the map from a projector pixel (a COP ray) to its incidence direction, the occluders the
+part recipes declare. Every stage (design, build, check, fab) and every figure takes a Rig; no stage
+goes back to the YAML, derives the geometry or integrates a dome itself (a test keeps to this).
+
+A Rig is a value: it pickles (for worker processes), and ``rig.moved(...)`` returns a perturbed
+copy (a :class:`rigcad.optics.frames.Misalignment` of the projector, camera, paraboloid or dome)
+that shares everything the move does not change; nothing is ever changed in place.
+
+Frame: mm, sample point O at the origin, optical axis +z; angles in radians.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from rigcad.errors import ProfileError, RigcadError
+from rigcad.optics.dome import DomeProfile
+from rigcad.optics.frames import COMPONENTS, Misalignment, Pose
+from rigcad.profile.derived import Derived
+from rigcad.profile.schema import Profile
+
+if TYPE_CHECKING:  # pragma: no cover
+    from rigcad.optics.design import Design
+    from rigcad.optics.incidence import DesignMap
+    from rigcad.optics.paraboloid import Paraboloid
+    from rigcad.optics.trace2d import DomeCurve
+    from rigcad.parts.layout import RigLayout
+    from rigcad.parts.recipe import Part
+
+#: Geometry a move does not change: carried over by :meth:`Rig.moved` instead of recomputed.
+_SHARED = ("paraboloid", "curve", "design", "layout", "recipes", "incidence", "occluders")
+
+
+@dataclass(frozen=True)
+class Rig:
+    """One rig: the resolved ``profile``, its ``geometry`` (derived figures), its converged
+    ``dome`` profile, and a ``misalignment`` of its movable components (none by default)."""
+
+    profile: Profile
+    geometry: Derived
+    dome: DomeProfile
+    misalignment: Misalignment = field(default_factory=Misalignment.none)
+
+    # -- construction ------------------------------------------------------------------------------
+    @classmethod
+    def from_profile(cls, profile: Profile) -> "Rig":
+        """Derive the geometry and integrate the dome, once. Raises GeometryError (naming the
+        profile key and its file:line) for an impossible rig."""
+        from rigcad.optics.design import converged_dome
+        from rigcad.profile.derived import derive
+
+        geometry = derive(profile)
+        return cls(profile, geometry, converged_dome(profile, geometry))
+
+    @property
+    def name(self) -> str:
+        return self.profile.name
+
+    # -- the shared geometry, computed on first use ------------------------------------------------
+    @cached_property
+    def paraboloid(self) -> "Paraboloid":
+        """The paraboloid mirror in the meridional plane (closed form)."""
+        from rigcad.optics.paraboloid import Paraboloid
+
+        g = self.geometry
+        return Paraboloid(g.focal_length, g.vertex_z, g.rim_radius)
+
+    @cached_property
+    def curve(self) -> "DomeCurve":
+        """The dome as the 2D tracer reads it (the dome's one spline, or the thesis's polyline)."""
+        from rigcad.optics.trace2d import DomeCurve
+
+        return DomeCurve.from_profile(self.dome)
+
+    @cached_property
+    def design(self) -> "Design":
+        """The 2D optical design: traced checks and the report (design.json), figures with units."""
+        from rigcad.optics.design import run_design
+
+        return run_design(self)
+
+    @cached_property
+    def layout(self) -> "RigLayout":
+        """Placements and mirror surfaces (design, printed) shared by the parts. Raises
+        GeometryError (with file:line) when the parts cannot be laid out (a polyline dome, a bolt
+        that does not fit its flange, ...)."""
+        from rigcad.parts.layout import rig_layout
+
+        with _located(self.profile):
+            return rig_layout(self.profile, self.geometry, self.dome)
+
+    @cached_property
+    def recipes(self) -> dict[str, "Part"]:
+        """Every part's kernel-free recipe, in build order (``rigcad.parts.PARTS``)."""
+        from rigcad.parts import make_recipes
+
+        return make_recipes(self.profile, self.layout)
+
+    @cached_property
+    def incidence(self) -> "DesignMap":
+        """Projector pixel / COP ray -> design incidence direction at O (finite COP only)."""
+        from rigcad.optics.incidence import DesignMap
+
+        with _located(self.profile):
+            return DesignMap.from_design(self.geometry, self.dome)
+
+    @cached_property
+    def occluders(self) -> dict[str, tuple]:
+        """Convex solids standing for the parts where light passes them, from the part recipes
+        (``Part.occluders``): part name -> ((name, recipe Box or Cylinder), ...)."""
+        return {name: part.occluders for name, part in self.recipes.items() if part.occluders}
+
+    def recipe(self, name: str) -> "Part":
+        """One part's recipe; an unknown name lists the parts."""
+        if name not in self.recipes:
+            raise ProfileError(f"unknown part {name!r}; parts: {', '.join(self.recipes)}")
+        return self.recipes[name]
+
+    def pose(self, component: str) -> Pose:
+        """Where ``component`` (projector, camera, paraboloid, dome) stands: identity as designed."""
+        return self.misalignment.pose(component, self.geometry)
+
+    # -- perturbed copies --------------------------------------------------------------------------
+    def moved(self, component: str, offset=(0.0, 0.0, 0.0), tilt: float = 0.0, axis=(0.0, 1.0, 0.0)) -> "Rig":
+        """A copy with ``component`` shifted by ``offset`` (mm, (3,)) and tilted by ``tilt`` rad
+        about the horizontal unit ``axis`` (pivots: see Misalignment.pose); the other components
+        keep their placement. Shares the geometry (dome, layout, recipes, maps) with this rig."""
+        if component not in COMPONENTS:
+            raise ProfileError(f"cannot move {component!r}: components are {', '.join(COMPONENTS)}")
+        moved = dataclasses.replace(self, misalignment=self.misalignment.with_(component, offset, tilt, axis))
+        for key in _SHARED:
+            if key in self.__dict__:
+                moved.__dict__[key] = self.__dict__[key]  # a cached_property's value, shared read-only
+        return moved
+
+    # -- the stages, as a Python API ---------------------------------------------------------------
+    def part(self, name: str):
+        """The part's exact solid as a build123d ``Part`` (mm, working position), with
+        ``.to_cadquery()`` and ``.mesh()``; see :class:`rigcad.api.RigPart`."""
+        from rigcad.api import RigPart
+
+        return RigPart.build(self, name)
+
+    def mesh(self, name: str, chord_error: float | None = None):
+        """The part's printable mesh as a ``trimesh.Trimesh`` (the STL's mesh; ``chord_error`` mm,
+        default the profile's ``tessellation.chord_error``)."""
+        from rigcad.api import part_mesh
+
+        return part_mesh(self, name, chord_error)
+
+    def export(self, folder: str | Path | None = None, parts: list[str] | None = None, progress=None):
+        """Write the design files and the parts (STEP, STL, 3MF, PLY mirrors, renders, rig.step,
+        manifest.json) into ``folder`` (default ``exports/<profile>``), all published together.
+        Returns the build's :class:`rigcad.export.build.BuildResult`."""
+        from rigcad.export.build import build_rig
+        from rigcad.export.design import design_files
+        from rigcad.export.manifest import inputs_key
+
+        out = Path(folder) if folder is not None else Path("exports") / self.name
+        key = inputs_key(self.profile) if parts is None and self.misalignment == Misalignment.none() else None
+        return build_rig(self, out, parts, progress=progress, design=design_files(self.design), inputs_key=key)
+
+    def check(self, rays: int | None = None, mode: str | None = None, exports: str | Path | None = None, **options):
+        """The 3D ray check (``rigcad.check.raycheck.run_raycheck``): returns a RayCheck whose
+        ``report`` holds every figure and ``rows`` the declared tolerances with pass/fail."""
+        from rigcad.check.raycheck import run_raycheck
+
+        return run_raycheck(self, exports=Path(exports) if exports is not None else None, rays=rays, mode=mode,
+                            **options)
+
+    def fab(self, printer, folder: str | Path | None = None, gcode: bool = False, parts: list[str] | None = None,
+            progress=None):
+        """Fabrication for ``printer`` (a name on the profile search path, a path, or a Printer):
+        fit, split, orient, slice, report into ``folder`` (default ``exports/<profile>/fab/<printer>``)."""
+        from rigcad.fab.printers import Printer, load_printer
+        from rigcad.fab.stage import run_fab
+
+        p = printer if isinstance(printer, Printer) else load_printer(printer)
+        out = Path(folder) if folder is not None else Path("exports") / self.name / "fab" / p.name
+        return run_fab(self, p, out, gcode=gcode, parts=parts, progress=progress)
+
+
+@contextmanager
+def _located(profile: Profile):
+    """Re-raise a RigcadError that names a profile key with that key's file:line."""
+    try:
+        yield
+    except RigcadError as err:
+        located = err.located(profile.marks)
+        if located is err:
+            raise
+        raise located from err
+
+
+def load(profile: str | Path | Profile) -> Rig:
+    """The rig of a profile given by name (searched in ``./profiles``, ``$RIGCAD_PROFILES``, then the
+    profiles shipped with rigcad), by path, or as a loaded :class:`Profile`."""
+    from rigcad.profile.schema import load_profile
+
+    return Rig.from_profile(profile if isinstance(profile, Profile) else load_profile(profile))
