@@ -64,6 +64,10 @@ def dxf_bytes(o: Outline) -> bytes:
         lo = o.polygon.min(axis=0)
         msp.add_text(f"{o.name} t={o.thickness:g} mm", height=3.0,
                      dxfattribs={"layer": "NOTE", "insert": (float(lo[0]), float(lo[1]) - 6.0)})
+        # ezdxf adds a CLASS per entity type in use from a set, whose order follows string hashing
+        # (random per process): declaring them first, sorted, fixes the CLASSES section's order
+        for dxftype in sorted(doc.entitydb.dxf_types_in_use()):
+            doc.classes.add_class(dxftype)
         buf = io.StringIO()
         doc.write(buf)
     finally:

@@ -30,8 +30,6 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS_Shape
 from OCP.TopTools import TopTools_ListOfShape
 
-from OCP.Standard import Standard_Failure
-
 from rigcad.errors import GeometryError, KernelError
 from rigcad.parts.recipe import (Box, Curve, Cylinder, Difference, Line, Part, Prism, Revolve, Section, Solid,
                                  Translate, Union_)
@@ -180,16 +178,21 @@ def is_valid(shape: TopoDS_Shape) -> bool:
 
 def part_solid(part: Part, tol: float, report: FitReport, profile=None) -> TopoDS_Shape:
     """The one valid solid of ``part``'s recipe (B-spline fits at ``tol`` mm, recorded in ``report``).
-    Any kernel failure (OCCT's Standard_Failure family, such as StdFail_NotDone; a boolean that
+    Any kernel failure (OCCT's Standard_Failure family, such as StdFail_NotDone or
+    Standard_DomainError; a boolean that
     fails; a result that is not exactly one solid, or not valid) becomes a KernelError naming the
     part, the profile keys that shaped it (with the first one's file:line when ``profile`` is
     given) and what to try."""
     try:
         shape = single_solid(build(part.solid, tol, report))
-    except Standard_Failure as err:
-        raise kernel_error(part, f"{type(err).__name__}: {str(err).strip() or 'no message'}", profile) from err
     except GeometryError as err:
         raise kernel_error(part, err.message, profile) from err
+    except Exception as err:
+        # OCP raises OCCT's Standard_Failure family (StdFail_NotDone, Standard_DomainError, ...) as
+        # classes of its own that all derive from Exception alone: recognised by their module
+        if not type(err).__module__.startswith("OCP"):
+            raise
+        raise kernel_error(part, f"{type(err).__name__}: {str(err).strip() or 'no message'}", profile) from err
     if not is_valid(shape):
         raise kernel_error(part, "the solid it produced is not valid (BRepCheck)", profile)
     return shape

@@ -55,3 +55,23 @@ def test_outlines_are_deterministic(table31, layout):
     o = outline(part, table31.tessellation.chord_error)
     assert dxf_bytes(o) == dxf_bytes(o)
     assert svg_bytes(o) == svg_bytes(o)
+
+
+def test_dxf_is_the_same_in_every_process():
+    """Python salts string hashes per process; the DXF must not depend on it (ezdxf collects its
+    CLASS entries in a set). Two interpreters with different PYTHONHASHSEED write the same bytes."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import hashlib, rigcad; from rigcad.fab.outlines import dxf_bytes, outline; "
+            "rig = rigcad.load('achutha2006'); "
+            "print(hashlib.sha256(dxf_bytes(outline(rig.recipe('paraboloid_template'), 0.018))).hexdigest())")
+    digests = set()
+    for seed in ("0", "4"):  # two seeds known to order the classes differently without the fix
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+        assert res.returncode == 0, res.stderr
+        digests.add(res.stdout.strip())
+    assert len(digests) == 1, digests
+    assert len(next(iter(digests))) == 64  # a sha256 hex digest, not an empty line
