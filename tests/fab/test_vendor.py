@@ -1,14 +1,18 @@
 """PrusaSlicer's vendor presets: the installed PrusaResearch bundle read and flattened as
-PrusaSlicer does, with file:line errors and "did you mean" for a wrong name."""
+PrusaSlicer does, and the printer file's slicer section validated with file:line."""
 
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import pytest
 
 from rigcad.errors import FabricationError, ProfileError
 from rigcad.fab import vendor as V
+from rigcad.fab.printers import load_printer
+
+from .conftest import ROOT, have_slicer
 
 MK3S = "Original Prusa i3 MK3S & MK3S+"
 PRINT = "0.15mm QUALITY @MK3"
@@ -21,6 +25,29 @@ def have_bundle() -> bool:
 
 
 needs_bundle = pytest.mark.skipif(not have_bundle(), reason=NO_BUNDLE)
+needs_slicer = pytest.mark.skipif(not (have_slicer() and have_bundle()), reason=NO_BUNDLE)
+
+
+def printer_yaml(tmp_path: Path, slicer: str, drop: tuple[str, ...] = (), edit: dict[str, str] | None = None) -> Path:
+    """The shipped MK3S printer file with its slicer section replaced (and keys dropped or edited)."""
+    text = (ROOT / "profiles" / "printers" / "prusa_mk3s.yaml").read_text()
+    head, _, tail = text.partition("slicer:\n")
+    tail = tail[tail.index("alignment_pin:"):]
+    lines = [ln for ln in head.splitlines() if not any(ln.startswith(k + ":") for k in drop)]
+    for key, value in (edit or {}).items():
+        lines = [f"{key}: {value}" if ln.startswith(key + ":") else ln for ln in lines]
+    path = tmp_path / "mk3s.yaml"
+    path.write_text("\n".join(lines) + "\n" + slicer + tail)
+    return path
+
+
+def slicer_section(printer=MK3S, print_=PRINT, filament=PLA, overrides: str = "") -> str:
+    return (f"slicer:\n  vendor_bundle: PrusaResearch\n  printer_preset: {printer}\n  print_preset: {print_}\n"
+            f"  filament_preset: {filament}\n" + (f"  overrides:\n{overrides}" if overrides else ""))
+
+
+def line_of(path: Path, needle: str) -> int:
+    return next(i for i, ln in enumerate(path.read_text().splitlines(), 1) if needle in ln)
 
 
 # -- the bundle ------------------------------------------------------------------------------------
@@ -121,3 +148,86 @@ def test_yaml_values_become_prusaslicer_text():
     assert V.ini_value([215, 210]) == "215,210" and V.ini_value(["a", "b"]) == '"a";"b"'
     with pytest.raises(ProfileError, match="brim_width"):
         V.ini_value({"no": 1}, "brim_width")
+
+
+# -- the printer file's slicer section --------------------------------------------------------------
+
+@needs_bundle
+def test_the_shipped_mk3s_resolves_its_presets():
+    p = load_printer("prusa_mk3s")
+    cfg = p.slicer_config
+    assert cfg is not None and p.slicer == "prusa-slicer" and p.slicer_unavailable is None
+    assert (cfg.printer_preset, cfg.print_preset, cfg.filament_preset) == (MK3S, PRINT, PLA)
+    eff = cfg.effective()
+    assert eff["printer_model"] == "MK3S" and eff["print_settings_id"] == PRINT
+    assert eff["perimeters"] == "3" and eff["fill_density"] == "20%"  # the printer file's overrides
+    assert "inherits" not in eff and "compatible_printers_condition" not in eff
+    # rigcad's figures agree with the preset (checked at load): the staircase maths uses the layers PrusaSlicer prints
+    assert p.layer_height == float(eff["layer_height"]) and p.nozzle == float(eff["nozzle_diameter"])
+    assert p.describe()["slicer_presets"]["print_preset"] == PRINT
+
+
+@needs_bundle
+def test_figures_left_out_come_from_the_preset(tmp_path):
+    drop = ("layer_height", "first_layer_height", "nozzle", "filament_diameter", "material", "material_density_g_cm3")
+    p = load_printer(printer_yaml(tmp_path, slicer_section(print_="0.20mm QUALITY @MK3"), drop=drop))
+    assert set(p.from_preset) == set(drop)
+    assert (p.layer_height, p.first_layer_height, p.nozzle, p.filament_diameter) == (0.2, 0.2, 0.4, 1.75)
+    assert p.material == "PLA" and p.material_density_g_cm3 == 1.24
+
+
+@needs_bundle
+def test_a_figure_that_disagrees_with_the_preset_is_refused(tmp_path):
+    path = printer_yaml(tmp_path, slicer_section(), edit={"layer_height": "0.2 mm"})
+    with pytest.raises(ProfileError) as err:
+        load_printer(path)
+    msg = str(err.value)
+    assert f"mk3s.yaml:{line_of(path, 'layer_height: 0.2')}" in msg
+    assert "layer_height" in msg and "0.2" in msg and "'0.15'" in msg and PRINT in msg
+    path = printer_yaml(tmp_path, slicer_section(), edit={"  x": "240 mm"})
+    with pytest.raises(ProfileError, match=r"mk3s.yaml:\d+: build_volume.x: 240 mm disagrees.*bed_shape"):
+        load_printer(path)
+
+
+@needs_bundle
+def test_a_misspelt_preset_in_the_printer_file_names_its_line(tmp_path):
+    path = printer_yaml(tmp_path, slicer_section(print_="0.15mm QUALTY @MK3"))
+    with pytest.raises(ProfileError) as err:
+        load_printer(path)
+    assert f"mk3s.yaml:{line_of(path, 'print_preset:')}" in str(err.value)
+    assert f"did you mean {PRINT!r}" in str(err.value)
+
+
+@needs_bundle
+def test_an_unknown_override_names_the_key_its_line_and_a_suggestion(tmp_path):
+    path = printer_yaml(tmp_path, slicer_section(overrides="    perimeters: 3\n    brim_widht: 5\n"))
+    with pytest.raises(ProfileError) as err:
+        load_printer(path)
+    msg = str(err.value)
+    assert f"mk3s.yaml:{line_of(path, 'brim_widht')}" in msg
+    assert "'brim_widht'" in msg and "did you mean 'brim_width'" in msg
+    path = printer_yaml(tmp_path, slicer_section(overrides="    inherits: x\n"))
+    with pytest.raises(ProfileError, match="slicer.overrides.inherits: a bundle's bookkeeping key"):
+        load_printer(path)
+
+
+@needs_slicer
+def test_an_override_value_prusaslicer_refuses_names_its_line(tmp_path):
+    path = printer_yaml(tmp_path, slicer_section(overrides="    perimeters: 3\n    gcode_flavor: klipperish\n"))
+    with pytest.raises(ProfileError) as err:
+        load_printer(path)
+    msg = str(err.value)
+    assert f"mk3s.yaml:{line_of(path, 'gcode_flavor')}" in msg and "klipperish" in msg
+    assert "valid: (" in msg and "marlin2" in msg  # PrusaSlicer's own list of flavours
+
+
+@needs_bundle
+def test_a_users_flat_config_replaces_the_bundle(tmp_path):
+    eff = load_printer("prusa_mk3s").slicer_config.effective()
+    (tmp_path / "my_mk3s.ini").write_text("# generated by PrusaSlicer 2.5.0\n" + "".join(
+        f"{k} = {v}\n" for k, v in sorted(eff.items())))
+    p = load_printer(printer_yaml(tmp_path, "slicer:\n  vendor_bundle: my_mk3s.ini\n"))
+    assert p.slicer_config.kind == "config" and p.slicer_config.effective() == eff
+    path = printer_yaml(tmp_path, "slicer:\n  vendor_bundle: my_mk3s.ini\n  print_preset: x\n")
+    with pytest.raises(ProfileError, match=rf"mk3s.yaml:{line_of(path, 'print_preset')}: .*flat PrusaSlicer"):
+        load_printer(path)
