@@ -8,7 +8,7 @@ the polishing allowance, the optical effect), write its STL in print position an
 cutting outlines (rigcad.fab.outlines). fab.json (units in keys) and fab.md (with the staircase
 maps) report it all. Outputs are staged and published together (rigcad.export.atomic).
 
-Files: stl/<piece>.stl, gcode/<piece>.gcode, printer.ini, outlines/<part>.{dxf,svg},
+Files: stl/<piece>.stl, gcode/<piece>.gcode, 3mf/<piece>.3mf (PrusaSlicer project), printer.ini, outlines/<part>.{dxf,svg},
 staircase/<part>.png, fab.json, fab.md. Timings are returned, not written (fab.json is
 deterministic).
 """
@@ -166,8 +166,10 @@ def run_fab(profile, printer: Printer, out: Path, *, gcode: bool = False, parts:
                 for pc in entry.get("pieces", []):
                     g = pc.get("gcode") or {}
                     path = out / "gcode" / f"{pc['name']}.gcode"
-                    if g.get("key") and path.is_file() and _sha(path.read_bytes()) == g.get("sha256"):
-                        cached[pc["name"]] = (g["key"], path.read_bytes())
+                    proj = out / "3mf" / f"{pc['name']}.3mf"
+                    if (g.get("key") and path.is_file() and _sha(path.read_bytes()) == g.get("sha256")
+                            and proj.is_file() and _sha(proj.read_bytes()) == g.get("project_sha256")):
+                        cached[pc["name"]] = (g["key"], path.read_bytes(), proj.read_bytes())
             try:
                 results, version = S.slice_all(jobs, cached, workers)
             except FabricationError as err:
@@ -177,10 +179,12 @@ def run_fab(profile, printer: Printer, out: Path, *, gcode: bool = False, parts:
             report_gcode["slicer_version"] = version
             for job, res in zip(jobs, results):
                 stage.write_bytes(out / "gcode" / f"{job.name}.gcode", res.gcode)
+                stage.write_bytes(out / "3mf" / f"{job.name}.3mf", res.project)
                 slicer_s[job.name] = res.seconds
                 pc = next(p for p in report_parts[job_part[job.name]]["pieces"] if p["name"] == job.name)
                 pc["gcode"] = {"key": job.key(version), "sha256": _sha(res.gcode), "estimates": res.estimates,
-                               "slicer_warnings": list(res.warnings)}
+                               "slicer_warnings": list(res.warnings), "project": f"3mf/{job.name}.3mf",
+                               "project_sha256": _sha(res.project), "placement": res.placement}
                 if res.warnings:
                     problems.append(f"{job.name}: slicer warnings: {'; '.join(res.warnings)}")
             timings["gcode"] = time.perf_counter() - t
@@ -291,7 +295,7 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
             map_cusp.append(steps.cusp_slices)
         piece_rows.append(row)
         if printer.slicer == "prusa-slicer":
-            jobs.append(S.SliceJob(pc.name, stl, S.printer_ini(printer, row["needs_support"]), bed_c))
+            jobs.append(S.slice_job(printer, pc.name, stl, row["needs_support"], bed_c))
     timings[f"{name}:orient_slice"] = time.perf_counter() - t
     entry["pieces"] = piece_rows
     entry["layers_total"] = sum(r["layers"] for r in piece_rows)

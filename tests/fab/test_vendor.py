@@ -1,14 +1,21 @@
 """PrusaSlicer's vendor presets: the installed PrusaResearch bundle read and flattened as
-PrusaSlicer does, and the printer file's slicer section validated with file:line."""
+PrusaSlicer does, the printer file's slicer section validated with file:line, and a real slice
+of a small cube whose G-code and 3MF project carry the vendor's settings (read back by regex,
+zipfile and PrusaSlicer itself)."""
 
 from __future__ import annotations
 
+import io
 import re
+import subprocess
+import zipfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from rigcad.errors import FabricationError, ProfileError
+from rigcad.fab import slicer as S
 from rigcad.fab import vendor as V
 from rigcad.fab.printers import load_printer
 
@@ -231,3 +238,120 @@ def test_a_users_flat_config_replaces_the_bundle(tmp_path):
     path = printer_yaml(tmp_path, "slicer:\n  vendor_bundle: my_mk3s.ini\n  print_preset: x\n")
     with pytest.raises(ProfileError, match=rf"mk3s.yaml:{line_of(path, 'print_preset')}: .*flat PrusaSlicer"):
         load_printer(path)
+
+
+# -- brim and skirt ---------------------------------------------------------------------------------
+
+def box(sx: float, sy: float, sz: float) -> bytes:
+    from rigcad.export.mesh import stl_bytes
+
+    v = np.array([[x, y, z] for x in (0, sx) for y in (0, sy) for z in (0, sz)], float)
+    f = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6],
+                  [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    return stl_bytes(v, f, "box")
+
+
+def test_footprint_reads_contact_from_the_stl():
+    fp = S.footprint(box(30, 10, 50))
+    # exact for a box: float32 holds these integers exactly
+    assert fp.extents == (30.0, 10.0, 50.0) and fp.contact_area == 300.0 and fp.contact_size == (30.0, 10.0)
+    assert fp.slenderness == 5.0
+
+
+@needs_bundle
+def test_the_brim_rule(tmp_path):
+    p = load_printer("prusa_mk3s")
+    settings, rec = S.placement(p, S.footprint(box(40, 40, 20)))  # 1600 mm2, squat
+    assert settings["brim_width"] == "0" and not rec["brim_wanted"] and rec["skirts"] == 1
+    settings, rec = S.placement(p, S.footprint(box(30, 30, 80)))  # 900 mm2 but 80 / 30 > 2
+    assert settings["brim_width"] == "5" and "height / contact side" in rec["brim_reason"]
+    settings, rec = S.placement(p, S.footprint(box(12, 12, 10)))  # 144 mm2 < 400
+    assert settings["brim_width"] == "5" and "contact area" in rec["brim_reason"]
+    # a bed-filling slender piece: no room for a brim (1 mm margin kept) nor the preset's skirt
+    settings, rec = S.placement(p, S.footprint(box(246, 20, 100)))
+    assert settings["brim_width"] == "0" and "none printed" in rec["brim_note"]
+    assert settings["skirts"] == "0" and "off" in rec["skirt_note"]
+    over = load_printer(printer_yaml(tmp_path, slicer_section(overrides="    brim_width: 3\n")))
+    settings, rec = S.placement(over, S.footprint(box(12, 12, 10)))
+    assert "brim_width" not in settings and rec["brim_width_mm"] == 3.0  # the override wins
+    assert "brim_width = 3\n" in S.printer_ini(over, False, settings)
+
+
+# -- a real slice -----------------------------------------------------------------------------------
+
+def comments(text: str) -> dict[str, str]:
+    """'; key = value' lines, as PrusaSlicer writes its configuration into G-code and 3MF."""
+    return dict(re.findall(r"^; (\w+) = (.*)$", text, re.M))
+
+
+def test_without_prusaslicer_the_printer_still_loads_and_gcode_says_why(tmp_path, monkeypatch):
+    monkeypatch.setattr(V, "bundle_dirs", lambda: [tmp_path / "nowhere"])
+    p = load_printer("prusa_mk3s")
+    assert p.slicer_config is None and "apt-get" in p.slicer_unavailable
+    assert p.layer_height == 0.15  # the printer file's own figure stands
+    job = S.slice_job(p, "x", b"", False, (0.0, 0.0))
+    assert job.problem == p.slicer_unavailable
+    if have_slicer():
+        with pytest.raises(FabricationError, match=r"no G-code was written: .*nowhere.*apt-get"):
+            S.slice_all([job])
+
+
+@needs_slicer
+def test_a_cube_sliced_for_the_mk3s_carries_the_vendor_settings(tmp_path):
+    p = load_printer("prusa_mk3s")
+    job = S.slice_job(p, "cube", box(20, 20, 20), False, (125.0, 105.0))
+    (res,), version = S.slice_all([job], workers=1)
+    text = res.gcode.decode()
+    cfg = comments(text.split("; prusaslicer_config = begin\n")[1].split("; prusaslicer_config = end")[0])
+    assert cfg["printer_model"] == "MK3S" and cfg["bed_temperature"] == "60"
+    assert cfg["first_layer_bed_temperature"] == "60" and cfg["temperature"] == "215"  # Prusament PLA
+    assert cfg["layer_height"] == "0.15" and cfg["perimeters"] == "3" and cfg["fill_density"] == "20%"
+    start = text[:text.index(";LAYER_CHANGE")]
+    assert 'M862.3 P "MK3S"' in start and "G80 ; mesh bed leveling" in start and "intro line" in start
+    assert "M140 S60" in start and "M109 S215" in start
+    assert " UTC" not in text.splitlines()[0]  # the date is dropped
+    assert res.estimates["print_time_s"] > 0 and res.estimates["filament_g"] > 0  # read from the G-code's tail
+
+    z = zipfile.ZipFile(io.BytesIO(res.project))
+    assert all(i.date_time == S.ZIP_EPOCH for i in z.infolist())
+    model = z.read("3D/3dmodel.model").decode()
+    assert re.search(r'name="CreationDate">\d', model) is None
+    inside = comments(z.read(S.PROJECT_CONFIG).decode())
+    assert inside == cfg  # the project holds exactly the settings that sliced the G-code
+
+    (again,), _ = S.slice_all([job], workers=1)
+    assert again.gcode == res.gcode and again.project == res.project  # deterministic bytes
+
+    # independent reader: PrusaSlicer opens the project alone (no --load) and slices the same G-code
+    (tmp_path / "cube.3mf").write_bytes(res.project)
+    proc = subprocess.run(["prusa-slicer", "--export-gcode", "-o", "again.gcode", "cube.3mf"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-500:]
+    assert S.normalise((tmp_path / "again.gcode").read_bytes()) == res.gcode
+
+
+@needs_slicer
+def test_a_slender_piece_is_printed_with_a_brim():
+    p = load_printer("prusa_mk3s")
+    (res,), _ = S.slice_all([S.slice_job(p, "pin", box(8, 8, 30), False, (125.0, 105.0))], workers=1)
+    assert comments(res.gcode.decode())["brim_width"] == "5" and res.placement["brim_width_mm"] == 5.0
+
+
+@pytest.mark.slow
+@needs_slicer
+def test_a_rig_part_on_the_mk3s_gets_vendor_gcode_and_a_project(table31, tmp_path):
+    """A real piece through the fab stage: G-code with the vendor's start, a 3MF project beside it."""
+    from rigcad.fab.stage import run_fab
+
+    p = load_printer("prusa_mk3s")
+    res = run_fab(table31, p, tmp_path, parts=["sample_holder"], gcode=True, workers=1)
+    assert res.problems == [], res.problems
+    for pc in res.report["parts"]["sample_holder"]["pieces"]:
+        text = (tmp_path / "gcode" / f"{pc['name']}.gcode").read_text()
+        assert 'M862.3 P "MK3S"' in text and "G80 ; mesh bed leveling" in text
+        assert comments(text)["bed_temperature"] == "60"
+        project = tmp_path / pc["gcode"]["project"]
+        with zipfile.ZipFile(project) as z:
+            assert comments(z.read(S.PROJECT_CONFIG).decode())["printer_model"] == "MK3S"
+        assert "brim_width_mm" in pc["gcode"]["placement"]
+    assert "PrusaResearch.ini" in (tmp_path / "printer.ini").read_text().splitlines()[1]
