@@ -236,7 +236,8 @@ def _read_slicer(raw: RawProfile, path: Path) -> tuple[V.VendorConfig | None, st
                                f"{', '.join(_SLICER_KEYS)}", where=raw.where(("slicer", key)))
     for key in _SLICER_KEYS[:4]:
         if key in sec and (not isinstance(sec[key], str) or not sec[key].strip()):
-            raise ProfileError(f"slicer.{key}: expected a name (text), got {sec[key]!r}", where=raw.where(("slicer", key)))
+            raise ProfileError(f"slicer.{key}: expected a name (text), got {sec[key]!r}",
+                               where=raw.where(("slicer", key)))
     if "vendor_bundle" not in sec:
         raise ProfileError("slicer.vendor_bundle is missing: an installed PrusaSlicer bundle (e.g. PrusaResearch) or "
                            "the path of a PrusaSlicer .ini", where=raw.where(("slicer",)))
@@ -288,7 +289,8 @@ def _preset_figures(cfg: V.VendorConfig, raw: RawProfile) -> dict[str, Any]:
 def _check_agreement(top: dict, vol: BuildVolume, preset: dict, cfg: V.VendorConfig, raw: RawProfile) -> None:
     """Figures the printer file states must agree with the resolved preset (see the module doc)."""
     eff = cfg.effective()
-    names = f"{cfg.printer_preset} / {cfg.print_preset} / {cfg.filament_preset}" if cfg.kind == "bundle" else str(cfg.source)
+    names = (f"{cfg.printer_preset} / {cfg.print_preset} / {cfg.filament_preset}" if cfg.kind == "bundle"
+             else str(cfg.source))
     for key, pkey in _PRESET_FIGURES.items():
         if key not in preset or key not in raw.data:
             continue
@@ -296,8 +298,8 @@ def _check_agreement(top: dict, vol: BuildVolume, preset: dict, cfg: V.VendorCon
         same = (mine.lower() == theirs.lower()) if key == "material" else abs(mine - theirs) < AGREE_TOL
         if not same:
             raise ProfileError(f"{key}: {mine!r} disagrees with the slicer preset's {pkey} = {eff[pkey]!r} ({names}); "
-                               f"PrusaSlicer prints with the preset, so state the same value, leave {key} out, choose a "
-                               f"matching preset or set slicer.overrides.{pkey}",
+                               f"PrusaSlicer prints with the preset, so state the same value, leave {key} out, "
+                               f"choose a matching preset or set slicer.overrides.{pkey}",
                                where=raw.where((key,)) or raw.where(("slicer",)))
     if "bed_shape" in eff:
         try:

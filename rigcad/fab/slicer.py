@@ -197,7 +197,8 @@ def placement(printer: Printer, fp: Footprint) -> tuple[dict[str, str], dict]:
         ring = brim + float(eff.get("skirt_distance", "0") or 0) + skirts * 1.25 * nozzle  # a loop ~1.25 nozzle wide
         if ring > room:
             settings["skirts"] = "0"
-            rec["skirt_note"] = f"the preset's skirt needs {ring:.1f} mm around the piece, {max(room, 0.0):.1f} mm free: off"
+            rec["skirt_note"] = (f"the preset's skirt needs {ring:.1f} mm around the piece, "
+                                 f"{max(room, 0.0):.1f} mm free: off")
             skirts = 0
     rec["skirts"] = skirts
     return settings, rec

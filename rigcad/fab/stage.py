@@ -8,9 +8,9 @@ the polishing allowance, the optical effect), write its STL in print position an
 cutting outlines (rigcad.fab.outlines). fab.json (units in keys) and fab.md (with the staircase
 maps) report it all. Outputs are staged and published together (rigcad.export.atomic).
 
-Files: stl/<piece>.stl, gcode/<piece>.gcode, 3mf/<piece>.3mf (PrusaSlicer project), printer.ini, outlines/<part>.{dxf,svg},
+Files: stl/<piece>.stl, gcode/<piece>.gcode, printer.ini, outlines/<part>.{dxf,svg},
 staircase/<part>.png, fab.json, fab.md. Timings are returned, not written (fab.json is
-deterministic).
+deterministic). With G-code, also 3mf/<piece>.3mf: the PrusaSlicer project that made it.
 """
 
 from __future__ import annotations

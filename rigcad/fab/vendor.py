@@ -430,7 +430,8 @@ def resolve(source: Path, printer: str | None, print_: str | None, filament: str
         missing = [g for g in ("printer", "print", "filament") if not names[g]]
         if missing:
             raise ProfileError(f"slicer: a vendor bundle needs {', '.join(g + '_preset' for g in missing)} "
-                               f"(e.g. {missing[0]}_preset: {b.presets(missing[0])[0]!r})", where=where.get("vendor_bundle"))
+                               f"(e.g. {missing[0]}_preset: {b.presets(missing[0])[0]!r})",
+                               where=where.get("vendor_bundle"))
         merged: dict[str, str] = {}
         for g in GROUPS:
             merged.update(b.flatten(g, names[g], where.get(f"{g}_preset")))

@@ -24,7 +24,8 @@ from .conftest import ROOT, have_slicer
 MK3S = "Original Prusa i3 MK3S & MK3S+"
 PRINT = "0.15mm QUALITY @MK3"
 PLA = "Prusament PLA"
-NO_BUNDLE = "PrusaSlicer's vendor bundles are not installed (apt-get install prusa-slicer); the project's CI installs it"
+NO_BUNDLE = ("PrusaSlicer's vendor bundles are not installed (apt-get install prusa-slicer); "
+             "the project's CI installs it")
 
 
 def have_bundle() -> bool:
