@@ -3,6 +3,23 @@ spot, material, and what rigcad needs to estimate a print. Read through the one 
 (rigcad.profile.loader, with its file:line marks and ``extends``) and validated with the same
 :class:`rigcad.profile.schema.Spec` rules as rig profiles: every length carries its unit.
 Inside: mm, float64.
+
+``slicer`` is ``none``, ``prusa-slicer`` (a generic configuration rigcad writes itself) or a
+mapping naming PrusaSlicer's own presets (rigcad.fab.vendor)::
+
+    slicer:
+      vendor_bundle: PrusaResearch        # an installed bundle, or the path of a PrusaSlicer .ini
+      printer_preset: Original Prusa i3 MK3S & MK3S+
+      print_preset: 0.15mm QUALITY @MK3
+      filament_preset: Prusament PLA
+      overrides: {brim_width: 5}          # any PrusaSlicer setting, checked against its key list
+
+The resolved preset (with the overrides) is what PrusaSlicer prints with, so it is the truth
+for the figures both state: layer_height, first_layer_height, nozzle, filament_diameter,
+material and material_density_g_cm3 may be left out of the printer file and are then read from
+the preset; stated, they must agree with it (as must build_volume with the preset's bed_shape and
+max_print_height), otherwise loading fails naming both values. When no PrusaSlicer is installed
+(so no bundle), the printer file's own figures stand and G-code reports why it cannot be made.
 """
 
 from __future__ import annotations
@@ -11,8 +28,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from rigcad.errors import ProfileError
-from rigcad.profile.loader import find_file, load_raw, search_path
+from rigcad.errors import FabricationError, ProfileError
+from rigcad.fab import vendor as V
+from rigcad.profile.loader import RawProfile, find_file, load_raw, search_path
 # The schema's own readers, so printer files follow the same unit, range and error rules.
 from rigcad.profile.schema import REQUIRED, Spec, convert_value, read_section, spec, suggest
 
@@ -67,6 +85,12 @@ class Printer:
     alignment_pin: AlignmentPin
     source: str
     marks: dict = field(compare=False, repr=False, default_factory=dict)
+    #: PrusaSlicer's presets and overrides, resolved (None for slicer none / generic prusa-slicer).
+    slicer_config: V.VendorConfig | None = None
+    #: Why presets named in the printer file could not be read (no PrusaSlicer installed), or None.
+    slicer_unavailable: str | None = None
+    #: Figures read from the preset because the printer file left them out.
+    from_preset: tuple[str, ...] = ()
 
     @property
     def usable(self) -> tuple[float, float, float]:
@@ -84,6 +108,8 @@ class Printer:
                "material": self.material, "material_density_g_cm3": self.material_density_g_cm3,
                "deposition_rate_mm3_s": self.deposition_rate_mm3_s, "layer_time_s": self.layer_time_s,
                "slicer": self.slicer,
+               "slicer_presets": self.slicer_config.describe() if self.slicer_config else None,
+               "figures_from_preset": list(self.from_preset),
                "alignment_pin": {"diameter_mm": self.alignment_pin.diameter,
                                  "clearance_mm": self.alignment_pin.clearance,
                                  "depth_mm": self.alignment_pin.depth}}
@@ -106,8 +132,18 @@ _TOP: dict[str, Spec] = {
     "deposition_rate_mm3_s": Spec("float", "volume deposited per second, for estimates without a slicer "
                                   "(mm3/s; 0 for SLA)", 0.0, lo=0),
     "layer_time_s": Spec("float", "time per layer beyond the deposition, for estimates (s)", 0.0, lo=0),
-    "slicer": Spec("choice", "slicer rigcad runs for G-code", "none", choices=("none", "prusa-slicer")),
+    "slicer": Spec("choice", "slicer rigcad runs for G-code (or a mapping of PrusaSlicer presets)", "none",
+                   choices=("none", "prusa-slicer")),
 }
+#: Keys of the ``slicer`` mapping.
+_SLICER_KEYS = ("vendor_bundle", "printer_preset", "print_preset", "filament_preset", "overrides")
+#: Printer keys a PrusaSlicer preset also states -> (preset key, unit of the preset's number).
+_PRESET_FIGURES = {"layer_height": "layer_height", "first_layer_height": "first_layer_height",
+                   "nozzle": "nozzle_diameter", "filament_diameter": "filament_diameter",
+                   "material_density_g_cm3": "filament_density", "material": "filament_type"}
+#: Two figures agree when they differ by less than this (mm, or g/cm3 for the density): far
+#: below any printer's resolution, above the rounding of decimal text such as "0.15".
+AGREE_TOL = 1e-6
 _SECTIONS = {"build_volume": BuildVolume, "alignment_pin": AlignmentPin}
 
 
@@ -130,16 +166,35 @@ def load_printer(name: str | Path) -> Printer:
         if key not in valid:
             raise ProfileError(f"unknown printer key {key!r}{suggest(key, valid)}; valid: {', '.join(valid)}",
                                where=raw.where((key,)))
+    slicer_cfg, unavailable = None, None
+    if isinstance(raw.data.get("slicer"), dict):
+        slicer_cfg, unavailable = _read_slicer(raw, path)
+    preset = _preset_figures(slicer_cfg, raw) if slicer_cfg else {}
     top: dict[str, Any] = {}
+    from_preset = []
     for key, s in _TOP.items():
+        if key == "slicer" and (slicer_cfg or unavailable):
+            top[key] = "prusa-slicer"
+            continue
         if key not in raw.data:
+            if key in preset:
+                top[key] = preset[key]
+                from_preset.append(key)
+                continue
             if s.default is REQUIRED:
-                raise ProfileError(f"printer key {key!r} is missing: {s.doc} ({s.describe_range()})",
+                need = " (or name a PrusaSlicer print preset, which states it)" if key in _PRESET_FIGURES else ""
+                if unavailable:
+                    need = f" (the slicer presets would state it, but {unavailable})"
+                raise ProfileError(f"printer key {key!r} is missing: {s.doc} ({s.describe_range()}){need}",
                                    where=f"{path}:1")
             top[key] = s.default if s.default is None or s.kind == "str" else convert_value(s, s.default, key, None)
             continue
         top[key] = convert_value(s, raw.data[key], key, raw.where((key,)))
     sections = {k: read_section(raw, k, cls) for k, cls in _SECTIONS.items()}
+    if top["first_layer_height"] is None:
+        top["first_layer_height"] = top["layer_height"]
+    if slicer_cfg:
+        _check_agreement(top, sections["build_volume"], preset, slicer_cfg, raw)
     if top["process"] == "fdm" and top["nozzle"] is None:
         raise ProfileError("an fdm printer needs 'nozzle' (e.g. '0.4 mm')", where=f"{path}:1")
     if top["process"] == "sla" and top["pixel"] is None:
@@ -155,8 +210,6 @@ def load_printer(name: str | Path) -> Printer:
     if 2 * margin >= min(vol.x, vol.y):
         raise ProfileError(f"bed_margin: {margin:g} mm leaves no bed ({vol.x:g} x {vol.y:g} mm)",
                            where=raw.where(("bed_margin",)))
-    if top["first_layer_height"] is None:
-        top["first_layer_height"] = top["layer_height"]
     return Printer(name=raw.name, description=top["description"], process=top["process"], build_volume=vol,
                    bed_margin=margin, layer_height=top["layer_height"],
                    first_layer_height=top["first_layer_height"], nozzle=top["nozzle"], pixel=top["pixel"],
@@ -164,5 +217,99 @@ def load_printer(name: str | Path) -> Printer:
                    material_density_g_cm3=top["material_density_g_cm3"],
                    deposition_rate_mm3_s=top["deposition_rate_mm3_s"], layer_time_s=top["layer_time_s"],
                    slicer=top["slicer"], alignment_pin=sections["alignment_pin"],
-                   source=" <- ".join(str(s) for s in raw.sources), marks=dict(raw.marks))
+                   source=" <- ".join(str(s) for s in raw.sources), marks=dict(raw.marks),
+                   slicer_config=slicer_cfg, slicer_unavailable=unavailable, from_preset=tuple(from_preset))
 
+
+def _read_slicer(raw: RawProfile, path: Path) -> tuple[V.VendorConfig | None, str | None]:
+    """The ``slicer`` mapping -> resolved PrusaSlicer presets; (None, reason) when no bundle is
+    installed at all (PrusaSlicer missing), so the rest of rigcad still runs."""
+    sec = raw.data["slicer"]
+    for key in sec:
+        if key not in _SLICER_KEYS:
+            raise ProfileError(f"unknown key slicer.{key}{suggest(key, list(_SLICER_KEYS))}; valid keys in slicer: "
+                               f"{', '.join(_SLICER_KEYS)}", where=raw.where(("slicer", key)))
+    for key in _SLICER_KEYS[:4]:
+        if key in sec and (not isinstance(sec[key], str) or not sec[key].strip()):
+            raise ProfileError(f"slicer.{key}: expected a name (text), got {sec[key]!r}",
+                               where=raw.where(("slicer", key)))
+    if "vendor_bundle" not in sec:
+        raise ProfileError("slicer.vendor_bundle is missing: an installed PrusaSlicer bundle (e.g. PrusaResearch) or "
+                           "the path of a PrusaSlicer .ini", where=raw.where(("slicer",)))
+    overrides = sec.get("overrides") or {}
+    if not isinstance(overrides, dict):
+        raise ProfileError(f"slicer.overrides: expected a mapping of PrusaSlicer settings, e.g. {{brim_width: 5}}, "
+                           f"got {overrides!r}", where=raw.where(("slicer", "overrides")))
+    where = {k: raw.where(("slicer", k)) for k in _SLICER_KEYS}
+    where.update({f"overrides.{k}": raw.where(("slicer", "overrides", k)) for k in overrides})
+    try:
+        source = V.find_bundle(sec["vendor_bundle"], path.parent, where["vendor_bundle"])
+    except FabricationError as err:  # nothing installed: only G-code needs the presets
+        return None, str(err)
+    cfg = V.resolve(source, sec.get("printer_preset"), sec.get("print_preset"), sec.get("filament_preset"),
+                    overrides, where=where)
+    return cfg, None
+
+
+def _number(cfg: V.VendorConfig, key: str, text: str, where: str | None, base: float | None = None) -> float:
+    """A preset's number (the first of a per-extruder vector; ``75%`` of ``base``)."""
+    first = text.split(",")[0].strip()
+    try:
+        if first.endswith("%") and base is not None:
+            return base * float(first[:-1]) / 100.0
+        return float(first)
+    except ValueError as err:
+        raise ProfileError(f"slicer: the preset's {key} = {text!r} is not a number ({cfg.vendor}, {cfg.source})",
+                           where=where) from err
+
+
+def _preset_figures(cfg: V.VendorConfig, raw: RawProfile) -> dict[str, Any]:
+    """rigcad's figures as the resolved preset states them (mm, g/cm3, text)."""
+    eff = cfg.effective()
+    at = raw.where(("slicer",))
+    out: dict[str, Any] = {}
+    for key, pkey in _PRESET_FIGURES.items():
+        if pkey not in eff or not eff[pkey].strip():
+            continue
+        if key == "material":
+            out[key] = eff[pkey].split(";")[0].strip().strip('"')
+        elif key == "first_layer_height":
+            base = out.get("layer_height")
+            out[key] = _number(cfg, pkey, eff[pkey], at, base)
+        else:
+            out[key] = _number(cfg, pkey, eff[pkey], at)
+    return out
+
+
+def _check_agreement(top: dict, vol: BuildVolume, preset: dict, cfg: V.VendorConfig, raw: RawProfile) -> None:
+    """Figures the printer file states must agree with the resolved preset (see the module doc)."""
+    eff = cfg.effective()
+    names = (f"{cfg.printer_preset} / {cfg.print_preset} / {cfg.filament_preset}" if cfg.kind == "bundle"
+             else str(cfg.source))
+    for key, pkey in _PRESET_FIGURES.items():
+        if key not in preset or key not in raw.data:
+            continue
+        mine, theirs = top[key], preset[key]
+        same = (mine.lower() == theirs.lower()) if key == "material" else abs(mine - theirs) < AGREE_TOL
+        if not same:
+            raise ProfileError(f"{key}: {mine!r} disagrees with the slicer preset's {pkey} = {eff[pkey]!r} ({names}); "
+                               f"PrusaSlicer prints with the preset, so state the same value, leave {key} out, "
+                               f"choose a matching preset or set slicer.overrides.{pkey}",
+                               where=raw.where((key,)) or raw.where(("slicer",)))
+    if "bed_shape" in eff:
+        try:
+            pts = [tuple(float(c) for c in p.split("x")) for p in eff["bed_shape"].split(",")]
+        except ValueError:
+            pts = []
+        if pts:
+            size = (max(p[0] for p in pts) - min(p[0] for p in pts), max(p[1] for p in pts) - min(p[1] for p in pts))
+            for axis, mine, theirs in (("x", vol.x, size[0]), ("y", vol.y, size[1])):
+                if abs(mine - theirs) >= AGREE_TOL:
+                    raise ProfileError(f"build_volume.{axis}: {mine:g} mm disagrees with the preset's bed_shape = "
+                                       f"{eff['bed_shape']} ({theirs:g} mm; {names})",
+                                       where=raw.where(("build_volume", axis)))
+    if "max_print_height" in eff:
+        h = _number(cfg, "max_print_height", eff["max_print_height"], raw.where(("slicer",)))
+        if abs(vol.z - h) >= AGREE_TOL:
+            raise ProfileError(f"build_volume.z: {vol.z:g} mm disagrees with the preset's max_print_height = {h:g} mm "
+                               f"({names})", where=raw.where(("build_volume", "z")))

@@ -1,25 +1,49 @@
-"""G-code through a real slicer: PrusaSlicer's command line, headless (Debian package prusa-slicer).
+"""G-code and project files through a real slicer: PrusaSlicer's command line, headless (Debian
+package prusa-slicer).
 
-rigcad writes the printer configuration (.ini) from the printer profile, runs
-``prusa-slicer --export-gcode --load printer.ini --center X,Y -o piece.gcode piece.stl`` for each
-piece (in parallel, up to the cores), normalises the G-code's first line (it carries a date), and
-reads the slicer's own estimates from the comment lines near the end. A piece whose STL and
-configuration did not change (content hash, with the slicer's version) is not sliced again.
-A missing slicer raises a FabricationError saying how to install it; the caller decides whether
-the rest goes on.
+For each piece rigcad writes one configuration (.ini) and runs ``prusa-slicer --export-gcode
+--export-3mf --load piece.ini --center X,Y -o DIR piece.stl`` (in parallel, up to the cores).
+The configuration is, in this order, later keys winning:
+
+1. the printer's PrusaSlicer presets, flattened (rigcad.fab.vendor: the vendor's start G-code with
+   its printer-model check and mesh bed levelling, the filament's temperatures, ...);
+2. rigcad's own settings: the layer heights its staircase maths used, support when the piece has
+   overhangs, and the brim and skirt rule below;
+3. the printer file's ``slicer.overrides``.
+
+A printer without presets (``slicer: prusa-slicer``) gets rigcad's generic configuration instead
+(no start G-code, no temperatures: only for trying a mesh).
+
+Brim rule (presets only): a piece gets a BRIM_WIDTH brim when its contact with the bed is small
+(area below BRIM_MIN_CONTACT) or it is slender (height above BRIM_MAX_SLENDERNESS times the
+smaller side of its contact patch's bounding box): both peel or tip off a PEI sheet. The brim,
+and the preset's skirt around it, must leave the printer's bed margin free; what does not fit is
+narrowed or dropped, and the piece's report says so. An override of brim_width or skirts wins.
+
+The G-code's first line loses its date; the 3MF project (PrusaSlicer's CLI stores no settings in
+it) gets the G-code's own configuration block as Metadata/Slic3r_PE.config, the file PrusaSlicer
+reads settings from, and is rewritten with fixed zip dates and without creation dates, so the
+same input gives the same bytes. PrusaSlicer's estimates are read from the G-code's comments. A
+piece whose STL and configuration did not change (content hash, with the slicer's version) is
+not sliced again. A missing slicer raises a FabricationError saying how to install it; the caller
+decides whether the rest goes on.
 """
 
 from __future__ import annotations
 
 import hashlib
+import io
 import os
 import re
 import shutil
 import subprocess
 import tempfile
+import zipfile
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 from rigcad.errors import FabricationError
 from rigcad.fab.printers import Printer
@@ -28,6 +52,21 @@ SLICER = "prusa-slicer"
 INSTALL_HINT = "install it with `apt-get install prusa-slicer` (Debian/Ubuntu) or from https://www.prusa3d.com/"
 #: Seconds one slice may take before it is abandoned (the dome quarter takes ~20 s on one core).
 TIMEOUT_S = 900
+#: Part of every cache key: bump when the post-processing of G-code or 3MF changes.
+OUTPUT_FORMAT = "rigcad-slice-2"
+
+#: Brim width (mm) when the rule asks for one: PrusaSlicer's usual 5 mm, several loops of a 0.4 mm nozzle.
+BRIM_WIDTH = 5.0
+#: Contact area (mm2) below which a piece gets a brim: a 20 x 20 mm patch, about the smallest a
+#: PLA part on a PEI sheet holds reliably through a long print.
+BRIM_MIN_CONTACT = 400.0
+#: Height / smaller side of the contact patch above which a piece gets a brim (lever against the bed).
+BRIM_MAX_SLENDERNESS = 2.0
+#: A brim narrower than this (mm) is not worth printing; the rule drops it and says so.
+BRIM_MIN_USEFUL = 2.0
+#: A facet touches the bed when its vertices are within this (mm) of the lowest point and it
+#: faces down; the STL is float32 (about 1e-5 mm at 200 mm), so 1e-3 mm is well clear of rounding.
+CONTACT_TOL = 1e-3
 
 
 def find_slicer() -> str | None:
@@ -46,11 +85,11 @@ def slicer_version(exe: str) -> str:
     raise FabricationError(f"{exe} --help did not name its version; is it PrusaSlicer? {INSTALL_HINT}")
 
 
-def printer_ini(printer: Printer, support: bool) -> str:
-    """PrusaSlicer configuration from the printer profile (mm). Skirt and brim are off so a part
-    may use the bed up to the profile's margin; support is on for pieces with overhangs."""
+def _generic(printer: Printer, support: bool) -> dict[str, str]:
+    """rigcad's generic configuration for a printer without presets (mm). Skirt and brim are off
+    so a part may use the bed up to the profile's margin; support is on for pieces with overhangs."""
     v = printer.build_volume
-    lines = {
+    return {
         "printer_technology": "FFF",
         "bed_shape": f"0x0,{v.x:g}x0,{v.x:g}x{v.y:g},0x{v.y:g}",
         "max_print_height": f"{v.z:g}",
@@ -68,19 +107,129 @@ def printer_ini(printer: Printer, support: bool) -> str:
         "fill_density": "20%",
         "perimeters": "3",
     }
-    head = f"# rigcad: printer '{printer.name}' ({printer.description})\n"
-    return head + "".join(f"{k} = {val}\n" for k, val in lines.items())
+
+
+def printer_ini(printer: Printer, support: bool, piece: dict[str, str] | None = None) -> str:
+    """The PrusaSlicer configuration for one piece (see the module docstring for its layers):
+    ``piece`` holds rigcad's per-piece settings (brim, skirt) from :func:`placement`."""
+    cfg = printer.slicer_config
+    if cfg is None:
+        note = f"; presets not used: {printer.slicer_unavailable}" if printer.slicer_unavailable else ""
+        head = f"# rigcad: printer '{printer.name}' ({printer.description}): generic settings{note}\n"
+        return head + "".join(f"{k} = {val}\n" for k, val in _generic(printer, support).items())
+    lines = dict(cfg.settings)
+    lines.update({"layer_height": f"{printer.layer_height:g}", "first_layer_height": f"{printer.first_layer_height:g}",
+                  "support_material": "1" if support else "0"})
+    lines.update(piece or {})
+    lines.update(cfg.overrides)
+    names = (f"{cfg.printer_preset} + {cfg.print_preset} + {cfg.filament_preset}" if cfg.kind == "bundle"
+             else "a user configuration")
+    head = (f"# rigcad: printer '{printer.name}' ({printer.description})\n"
+            f"# {names} from {cfg.source} ({cfg.vendor}), then rigcad's layer heights, support, brim and skirt, "
+            f"then the printer file's overrides ({', '.join(k for k, _ in cfg.overrides) or 'none'})\n")
+    return head + "".join(f"{k} = {lines[k]}\n" for k in sorted(lines))
+
+
+@dataclass(frozen=True)
+class Footprint:
+    """What the bed sees of a piece in print position (mm, mm2)."""
+
+    extents: tuple[float, float, float]
+    contact_area: float
+    contact_size: tuple[float, float]  # bounding box of the contact patch in x, y
+
+    @property
+    def slenderness(self) -> float:
+        """Height over the contact patch's smaller side (inf without contact)."""
+        side = min(self.contact_size)
+        return self.extents[2] / side if side > 0 else float("inf")
+
+
+def footprint(stl: bytes) -> Footprint:
+    """Extents and bed contact of a binary STL (as rigcad.export.mesh.stl_bytes writes it)."""
+    if len(stl) < 84:
+        raise FabricationError("not a binary STL (shorter than its 84-byte header)")
+    n = int(np.frombuffer(stl, "<u4", 1, 80)[0])
+    rec = np.frombuffer(stl, [("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")], n, 84)
+    tri = rec["v"].astype(np.float64)  # (n, 3, 3)
+    pts = tri.reshape(-1, 3)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])  # (n, 3), length = 2 area
+    down = (tri[:, :, 2].max(axis=1) <= lo[2] + CONTACT_TOL) & (normal[:, 2] < 0)
+    area = float(np.abs(normal[down, 2]).sum() / 2)
+    if down.any():
+        cp = tri[down].reshape(-1, 3)
+        size = (float(np.ptp(cp[:, 0])), float(np.ptp(cp[:, 1])))
+    else:
+        size = (0.0, 0.0)
+    return Footprint(tuple(float(v) for v in hi - lo), area, size)
+
+
+def placement(printer: Printer, fp: Footprint) -> tuple[dict[str, str], dict]:
+    """rigcad's brim and skirt for a piece centred on the bed (the module docstring's rule):
+    the settings for the .ini and a record of why, for the report."""
+    cfg = printer.slicer_config
+    over = dict(cfg.overrides) if cfg else {}
+    eff = cfg.effective() if cfg else {}
+    v = printer.build_volume
+    room = min(v.x - fp.extents[0], v.y - fp.extents[1]) / 2 - printer.bed_margin  # free bed each side (mm)
+    why = []
+    if fp.contact_area < BRIM_MIN_CONTACT:
+        why.append(f"contact area {fp.contact_area:.0f} mm2 < {BRIM_MIN_CONTACT:g} mm2")
+    if fp.slenderness > BRIM_MAX_SLENDERNESS:
+        why.append(f"height / contact side {fp.slenderness:.2f} > {BRIM_MAX_SLENDERNESS:g}")
+    rec: dict = {"contact_area_mm2": fp.contact_area, "slenderness": fp.slenderness,
+                 "free_bed_each_side_mm": room, "brim_wanted": bool(why), "brim_reason": "; ".join(why) or None}
+    settings: dict[str, str] = {}
+    if "brim_width" in over:
+        brim = float(over["brim_width"])
+        rec["brim_note"] = "brim_width from the printer file's overrides"
+    else:
+        brim = min(BRIM_WIDTH, np.floor(max(room, 0.0) * 10) / 10) if why else 0.0
+        if why and brim < BRIM_MIN_USEFUL:
+            rec["brim_note"] = f"brim wanted but only {max(room, 0.0):.1f} mm of bed around the piece: none printed"
+            brim = 0.0
+        settings["brim_width"] = f"{brim:g}"
+    rec["brim_width_mm"] = brim
+    skirts = int(float(eff.get("skirts", "0") or 0))
+    if skirts and "skirts" not in over:
+        nozzle = printer.nozzle or 0.4
+        ring = brim + float(eff.get("skirt_distance", "0") or 0) + skirts * 1.25 * nozzle  # a loop ~1.25 nozzle wide
+        if ring > room:
+            settings["skirts"] = "0"
+            rec["skirt_note"] = (f"the preset's skirt needs {ring:.1f} mm around the piece, "
+                                 f"{max(room, 0.0):.1f} mm free: off")
+            skirts = 0
+    rec["skirts"] = skirts
+    return settings, rec
+
+
+def slice_job(printer: Printer, name: str, stl: bytes, support: bool, center: tuple[float, float]) -> "SliceJob":
+    """The slicing job for one piece in print position: its configuration with rigcad's
+    per-piece settings (printers with presets) and the reason it cannot run, if any."""
+    if printer.slicer_config is None:
+        return SliceJob(name, stl, printer_ini(printer, support), center, problem=printer.slicer_unavailable)
+    settings, rec = placement(printer, footprint(stl))
+    rec["support_material"] = support
+    return SliceJob(name, stl, printer_ini(printer, support, settings), center, tuple(sorted(rec.items())))
 
 
 @dataclass(frozen=True)
 class SliceJob:
+    """One piece to slice: its STL in print position, its configuration, the bed point to centre
+    it on; ``placement`` records rigcad's per-piece settings (brim, skirt, support) and why;
+    ``problem`` says why it cannot be sliced (presets named but not installed)."""
+
     name: str
     stl: bytes
     ini: str
     center: tuple[float, float]
+    placement: tuple[tuple[str, object], ...] = ()
+    problem: str | None = None
 
     def key(self, version: str) -> str:
         h = hashlib.sha256(version.encode())
+        h.update(OUTPUT_FORMAT.encode())
         h.update(self.ini.encode())
         h.update(repr(self.center).encode())
         h.update(self.stl)
@@ -94,14 +243,55 @@ class SliceResult:
     seconds: float  # wall time of the slicer run (0 when reused)
     estimates: dict
     warnings: tuple[str, ...]
+    project: bytes = b""  # the PrusaSlicer 3MF project, settings inside
+    placement: dict = field(default_factory=dict)
 
 
 _GENERATED = re.compile(rb"^(; generated by PrusaSlicer[^\n]*?) on \d{4}-\d\d-\d\d at \d\d:\d\d:\d\d UTC", re.M)
+_CONFIG_BLOCK = re.compile(rb"^; prusaslicer_config = begin\n(.*?)^; prusaslicer_config = end", re.M | re.S)
+_MODEL_DATES = re.compile(rb'(<metadata name="(?:CreationDate|ModificationDate)">)[^<]*(</metadata>)')
+#: The 3MF member PrusaSlicer reads a project's settings from ("; key = value" lines).
+PROJECT_CONFIG = "Metadata/Slic3r_PE.config"
+#: Zip entry date of every 3MF member: the earliest a zip can hold, so no clock leaks in.
+ZIP_EPOCH = (1980, 1, 1, 0, 0, 0)
 
 
 def normalise(gcode: bytes) -> bytes:
     """Drop the date from the 'generated by' line: same input, same bytes."""
     return _GENERATED.sub(rb"\1", gcode, count=1)
+
+
+def project_3mf(exported: bytes, gcode: bytes) -> bytes:
+    """PrusaSlicer's CLI 3MF (model and placement, no settings) made into a project: the G-code's
+    configuration block, exactly what sliced it, stored as Metadata/Slic3r_PE.config in the
+    format PrusaSlicer writes ("; generated by ..." then "; key = value" lines); creation dates
+    emptied and zip dates fixed so the bytes are deterministic."""
+    block = _CONFIG_BLOCK.search(gcode)
+    if block is None:
+        raise FabricationError("the G-code has no '; prusaslicer_config = begin ... end' block to put into the 3MF")
+    first = gcode.split(b"\n", 1)[0]
+    config = first + b"\n\n" + block.group(1)
+    out = io.BytesIO()
+    try:
+        with zipfile.ZipFile(io.BytesIO(exported)) as src, zipfile.ZipFile(out, "w") as dst:
+            for info in src.infolist():
+                if info.filename == PROJECT_CONFIG:
+                    continue
+                data = src.read(info.filename)
+                if info.filename.endswith(".model"):
+                    data = _MODEL_DATES.sub(rb"\1\2", data)
+                _add(dst, info.filename, data)
+            _add(dst, PROJECT_CONFIG, config)
+    except zipfile.BadZipFile as err:
+        raise FabricationError(f"{SLICER} wrote a 3MF that is not a zip: {err}") from err
+    return out.getvalue()
+
+
+def _add(z: zipfile.ZipFile, name: str, data: bytes) -> None:
+    info = zipfile.ZipInfo(name, ZIP_EPOCH)
+    info.compress_type = zipfile.ZIP_DEFLATED
+    info.external_attr = 0o644 << 16
+    z.writestr(info, data)
 
 
 def parse_estimates(gcode: bytes) -> dict:
@@ -138,15 +328,21 @@ def _warnings(text: str) -> tuple[str, ...]:
     return tuple(bad)
 
 
+def _safe(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", name) or "piece"
+
+
 def _run(exe: str, job: SliceJob) -> SliceResult:
     import time
 
     with tempfile.TemporaryDirectory(prefix="rigcad-slice-") as tmp:
         d = Path(tmp)
-        (d / "piece.stl").write_bytes(job.stl)
-        (d / "printer.ini").write_text(job.ini)
-        cmd = [exe, "--export-gcode", "--load", "printer.ini", "--center", f"{job.center[0]:g},{job.center[1]:g}",
-               "-o", "piece.gcode", "piece.stl"]
+        stl = f"{_safe(job.name)}.stl"  # PrusaSlicer names the object (and its G-code label) after the file
+        (d / stl).write_bytes(job.stl)
+        (d / "piece.ini").write_text(job.ini)
+        (d / "out").mkdir()
+        cmd = [exe, "--export-gcode", "--export-3mf", "--load", "piece.ini",
+               "--center", f"{job.center[0]:g},{job.center[1]:g}", "-o", "out", stl]
         t0 = time.perf_counter()
         try:
             proc = subprocess.run(cmd, cwd=d, capture_output=True, text=True, timeout=TIMEOUT_S)
@@ -154,31 +350,37 @@ def _run(exe: str, job: SliceJob) -> SliceResult:
             raise FabricationError(f"{job.name}: {SLICER} took over {TIMEOUT_S} s") from err
         seconds = time.perf_counter() - t0
         log = proc.stdout + "\n" + proc.stderr
-        if proc.returncode != 0 or not (d / "piece.gcode").is_file():
+        gcodes, projects = sorted((d / "out").glob("*.gcode")), sorted((d / "out").glob("*.3mf"))
+        if proc.returncode != 0 or len(gcodes) != 1 or len(projects) != 1:
             lines = [ln for ln in log.splitlines() if ln.strip() and "[trace]" not in ln][-3:]
             hint = " (the piece does not fit the bed: split or orient it first)" if "could not fit" in log else ""
             raise FabricationError(f"{job.name}: {SLICER} failed with exit code {proc.returncode}{hint}: "
                                    + " | ".join(lines))
-        gcode = normalise((d / "piece.gcode").read_bytes())
-    return SliceResult(job.name, gcode, seconds, parse_estimates(gcode), _warnings(log))
+        gcode = normalise(gcodes[0].read_bytes())
+        project = project_3mf(projects[0].read_bytes(), gcode)
+    return SliceResult(job.name, gcode, seconds, parse_estimates(gcode), _warnings(log), project, dict(job.placement))
 
 
-def slice_all(jobs: list[SliceJob], cached: dict[str, tuple[str, bytes]] | None = None,
+def slice_all(jobs: list[SliceJob], cached: dict[str, tuple] | None = None,
               workers: int | None = None) -> tuple[list[SliceResult], str]:
     """Slice every job, ``workers`` at a time (default: the cores, at most 4). ``cached`` maps a
-    job name to (key, gcode bytes) of an earlier run; a job with the same key is reused.
-    Returns the results in job order and the slicer's version."""
+    job name to (key, gcode bytes, 3MF bytes) of an earlier run; a job with the same key is
+    reused. Returns the results in job order and the slicer's version."""
     exe = find_slicer()
     if exe is None:
         raise FabricationError(f"{SLICER} is not installed, so no G-code was written; {INSTALL_HINT}")
+    blocked = [j for j in jobs if j.problem]
+    if blocked:
+        raise FabricationError(f"no G-code was written: {blocked[0].problem}")
     version = slicer_version(exe)
     cached = cached or {}
     results: dict[str, SliceResult] = {}
     todo = []
     for job in jobs:
         old = cached.get(job.name)
-        if old and old[0] == job.key(version):
-            results[job.name] = SliceResult(job.name, old[1], 0.0, parse_estimates(old[1]), ())
+        if old and len(old) == 3 and old[0] == job.key(version) and old[2]:
+            results[job.name] = SliceResult(job.name, old[1], 0.0, parse_estimates(old[1]), (), old[2],
+                                            dict(job.placement))
         else:
             todo.append(job)
     n = workers or min(4, os.cpu_count() or 1)

@@ -10,7 +10,7 @@ maps) report it all. Outputs are staged and published together (rigcad.export.at
 
 Files: stl/<piece>.stl, gcode/<piece>.gcode, printer.ini, outlines/<part>.{dxf,svg},
 staircase/<part>.png, fab.json, fab.md. Timings are returned, not written (fab.json is
-deterministic).
+deterministic). With G-code, also 3mf/<piece>.3mf: the PrusaSlicer project that made it.
 """
 
 from __future__ import annotations
@@ -163,8 +163,10 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                 for pc in entry.get("pieces", []):
                     g = pc.get("gcode") or {}
                     path = out / "gcode" / f"{pc['name']}.gcode"
-                    if g.get("key") and path.is_file() and _sha(path.read_bytes()) == g.get("sha256"):
-                        cached[pc["name"]] = (g["key"], path.read_bytes())
+                    proj = out / "3mf" / f"{pc['name']}.3mf"
+                    if (g.get("key") and path.is_file() and _sha(path.read_bytes()) == g.get("sha256")
+                            and proj.is_file() and _sha(proj.read_bytes()) == g.get("project_sha256")):
+                        cached[pc["name"]] = (g["key"], path.read_bytes(), proj.read_bytes())
             try:
                 results, version = S.slice_all(jobs, cached, workers)
             except FabricationError as err:
@@ -174,10 +176,12 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
             report_gcode["slicer_version"] = version
             for job, res in zip(jobs, results):
                 stage.write_bytes(out / "gcode" / f"{job.name}.gcode", res.gcode)
+                stage.write_bytes(out / "3mf" / f"{job.name}.3mf", res.project)
                 slicer_s[job.name] = res.seconds
                 pc = next(p for p in report_parts[job_part[job.name]]["pieces"] if p["name"] == job.name)
                 pc["gcode"] = {"key": job.key(version), "sha256": _sha(res.gcode), "estimates": res.estimates,
-                               "slicer_warnings": list(res.warnings)}
+                               "slicer_warnings": list(res.warnings), "project": f"3mf/{job.name}.3mf",
+                               "project_sha256": _sha(res.project), "placement": res.placement}
                 if res.warnings:
                     problems.append(f"{job.name}: slicer warnings: {'; '.join(res.warnings)}")
             timings["gcode"] = time.perf_counter() - t
@@ -288,7 +292,7 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
             map_cusp.append(steps.cusp_slices)
         piece_rows.append(row)
         if printer.slicer == "prusa-slicer":
-            jobs.append(S.SliceJob(pc.name, stl, S.printer_ini(printer, row["needs_support"]), bed_c))
+            jobs.append(S.slice_job(printer, pc.name, stl, row["needs_support"], bed_c))
     timings[f"{name}:orient_slice"] = time.perf_counter() - t
     entry["pieces"] = piece_rows
     entry["layers_total"] = sum(r["layers"] for r in piece_rows)

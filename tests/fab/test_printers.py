@@ -41,3 +41,17 @@ def test_unknown_key_is_refused_with_a_suggestion(tmp_path):
 def test_unknown_printer_lists_the_known_ones():
     with pytest.raises(ProfileError, match="prusa_mk3s"):
         load_printer("no_such_printer")
+
+
+def test_the_generic_prusa_slicer_printer_still_loads(tmp_path):
+    """`slicer: prusa-slicer` (no presets) keeps rigcad's generic configuration."""
+    from rigcad.fab.slicer import printer_ini
+
+    path = tmp_path / "generic.yaml"
+    path.write_text("process: fdm\nbuild_volume: {x: 200 mm, y: 200 mm, z: 180 mm}\nlayer_height: 0.2 mm\n"
+                    "nozzle: 0.4 mm\nfilament_diameter: 1.75 mm\nmaterial_density_g_cm3: 1.24\nslicer: prusa-slicer\n")
+    p = load_printer(path)
+    assert p.slicer == "prusa-slicer" and p.slicer_config is None and p.slicer_unavailable is None
+    ini = printer_ini(p, support=True)
+    assert "bed_shape = 0x0,200x0,200x200,0x200\n" in ini and "support_material = 1\n" in ini
+    assert "start_gcode" not in ini  # PrusaSlicer's default start G-code: no presets, no vendor G-code

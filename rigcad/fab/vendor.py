@@ -1,0 +1,497 @@
+"""PrusaSlicer's own presets: the vendor bundles it ships (PrusaResearch.ini and others) and a
+user's exported configuration, read into plain ``key -> text`` settings rigcad hands back to
+PrusaSlicer.
+
+A vendor bundle is an INI file with sections ``[vendor]``, ``[printer_model:ID]`` and presets
+``[printer:NAME]``, ``[print:NAME]``, ``[filament:NAME]`` (and SLA ones rigcad does not use).
+A preset may say ``inherits = a; b``: the parents are flattened first and applied left to right,
+later parents overriding earlier ones, the preset's own keys overriding them all. That is
+PrusaSlicer's rule (``flatten_configbundle_hierarchy`` in PresetBundle.cpp: own keys win, then
+the parents from the last to the first fill in what is still missing). Names starting with
+``*`` are abstract building blocks, never selected. Values stay in PrusaSlicer's own text form
+(``\\n`` escapes in G-code, ``20%``, comma-separated vectors): rigcad writes them back verbatim.
+
+The INI reader is written by hand: configparser lowercases keys and gives ``%`` and inline ``;``
+meanings PrusaSlicer's files do not have. It follows boost's ``read_ini``, which PrusaSlicer uses:
+whole-line comments start with ``;`` or ``#``, ``key = value`` with both sides trimmed, no key or
+section twice. Files are parsed once per process (keyed by path, size and modification time).
+"""
+
+from __future__ import annotations
+
+import difflib
+import functools
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rigcad.errors import FabricationError, ProfileError
+
+SLICER = "prusa-slicer"
+INSTALL_HINT = ("install PrusaSlicer, which ships the vendor bundles: `apt-get update && apt-get install "
+                "prusa-slicer` (Debian/Ubuntu) or from https://www.prusa3d.com/")
+#: Preset groups rigcad reads, in the order PrusaSlicer composes a full FFF configuration
+#: (PresetBundle::full_fff_config: print, then printer, then filament).
+GROUPS = ("print", "printer", "filament")
+#: Keys that only mean something inside a bundle (inheritance, renames, the GUI's compatibility
+#: filters, which PrusaSlicer also drops from a full configuration); never handed to the slicer.
+BUNDLE_ONLY = frozenset({"inherits", "renamed_from", "alias", "compatible_printers", "compatible_printers_condition",
+                         "compatible_prints", "compatible_prints_condition"})
+
+
+# -- the INI reader ---------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class IniFile:
+    """An INI file as PrusaSlicer reads it: ``top`` holds keys before any section (a flat config
+    file), ``sections`` the rest; ``lines`` maps (section or "", key) to its 1-based line."""
+
+    path: Path
+    top: dict[str, str]
+    sections: dict[str, dict[str, str]]
+    section_lines: dict[str, int]
+    lines: dict[tuple[str, str], int]
+
+    def where(self, section: str, key: str | None = None) -> str:
+        line = self.lines.get((section, key)) if key is not None else None
+        return f"{self.path}:{line or self.section_lines.get(section, 1)}"
+
+
+def read_ini(path: str | Path) -> IniFile:
+    """Parse an INI file (cached per process while the file is unchanged)."""
+    path = Path(path)
+    try:
+        st = path.stat()
+    except OSError as err:
+        raise FabricationError(f"cannot read PrusaSlicer configuration {path}: {err.strerror}") from err
+    return _read_ini(path.resolve(), st.st_size, st.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=32)
+def _read_ini(path: Path, size: int, mtime_ns: int) -> IniFile:  # size, mtime: part of the cache key
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        raise FabricationError(f"cannot read PrusaSlicer configuration {path}: {err}") from err
+    top: dict[str, str] = {}
+    sections: dict[str, dict[str, str]] = {}
+    section_lines: dict[str, int] = {}
+    lines: dict[tuple[str, str], int] = {}
+    current, name = top, ""
+    for n, raw in enumerate(text.splitlines(), 1):
+        s = raw.strip()
+        if not s or s[0] in ";#":
+            continue
+        if s[0] == "[":
+            if not s.endswith("]"):
+                raise FabricationError(f"{path}:{n}: unclosed section header {s!r}")
+            name = s[1:-1].strip()
+            if name in sections:
+                raise FabricationError(f"{path}:{n}: section [{name}] is given twice "
+                                       f"(first at line {section_lines[name]})")
+            current = sections[name] = {}
+            section_lines[name] = n
+            continue
+        key, eq, value = s.partition("=")
+        key = key.strip()
+        if not eq or not key:
+            raise FabricationError(f"{path}:{n}: expected 'key = value' or '[section]', got {s[:60]!r}")
+        if key in current:
+            raise FabricationError(f"{path}:{n}: key {key!r} is given twice in [{name}] "
+                                   f"(first at line {lines[(name, key)]})")
+        current[key] = value.strip()
+        lines[(name, key)] = n
+    return IniFile(path, top, sections, section_lines, lines)
+
+
+def split_inherits(value: str) -> list[str]:
+    """``a; "b; c"`` -> ["a", "b; c"]: PrusaSlicer's ``unescape_strings_cstyle`` on an inherits
+    list (``;``-separated, a name may be double-quoted with ``\\"`` and ``\\\\`` escapes)."""
+    out: list[str] = []
+    i, n = 0, len(value)
+    while i < n:
+        while i < n and value[i] in " \t":
+            i += 1
+        if i < n and value[i] == '"':
+            i += 1
+            buf = []
+            while i < n and value[i] != '"':
+                if value[i] == "\\" and i + 1 < n:
+                    i += 1
+                buf.append(value[i])
+                i += 1
+            i += 1
+            item = "".join(buf)
+            while i < n and value[i] != ";":
+                i += 1
+        else:
+            j = value.find(";", i)
+            j = n if j < 0 else j
+            item, i = value[i:j].strip(), j
+        if item:
+            out.append(item)
+        i += 1  # past the ';'
+    return out
+
+
+# -- finding the bundles ----------------------------------------------------------------------------
+
+def bundle_dirs() -> list[Path]:
+    """Where PrusaSlicer keeps its vendor bundles, in the order rigcad searches: beside the
+    installed executable (Debian: /usr/bin -> /usr/share/PrusaSlicer/profiles; an unpacked
+    release: resources/profiles), the usual system folders, then the user's updated copies
+    (~/.config/PrusaSlicer/vendor, written by PrusaSlicer's configuration updater)."""
+    dirs: list[Path] = []
+    exe = shutil.which(SLICER)
+    if exe:
+        real = Path(os.path.realpath(exe)).parent
+        dirs += [real.parent / "share" / "PrusaSlicer" / "profiles", real / "resources" / "profiles"]
+    dirs += [Path("/usr/share/PrusaSlicer/profiles"), Path("/usr/local/share/PrusaSlicer/profiles"),
+             Path.home() / ".config" / "PrusaSlicer" / "vendor"]
+    seen: list[Path] = []
+    for d in dirs:
+        if d not in seen:
+            seen.append(d)
+    return seen
+
+
+def available_bundles(dirs: list[Path] | None = None) -> dict[str, Path]:
+    """Vendor bundle name -> file (the first folder holding a name wins)."""
+    out: dict[str, Path] = {}
+    for d in dirs if dirs is not None else bundle_dirs():
+        if d.is_dir():
+            for p in sorted(d.glob("*.ini")):
+                out.setdefault(p.stem, p)
+    return out
+
+
+def find_bundle(spec: str, base: Path | None = None, where: str | None = None,
+                dirs: list[Path] | None = None) -> Path:
+    """A bundle by name (``PrusaResearch``) among the installed ones, or an .ini file by path
+    (relative paths from ``base``, the printer file's folder). Errors say where rigcad looked."""
+    if spec.endswith(".ini") or "/" in spec or os.sep in spec:
+        path = Path(spec).expanduser()
+        if not path.is_absolute() and base is not None:
+            path = base / path
+        if path.is_file():
+            return path
+        raise ProfileError(f"slicer.vendor_bundle: no file {str(path)!r} (a bundle name such as 'PrusaResearch', "
+                           "or the path of a PrusaSlicer .ini, relative to the printer file)", where=where)
+    search = dirs if dirs is not None else bundle_dirs()
+    found = available_bundles(search)
+    if spec in found:
+        return found[spec]
+    looked = ", ".join(str(d) for d in search)
+    if not found:
+        raise FabricationError(f"slicer.vendor_bundle {spec!r}: no PrusaSlicer vendor bundles found (looked in "
+                               f"{looked}); {INSTALL_HINT}", where=where)
+    close = difflib.get_close_matches(spec, list(found), n=1)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    raise ProfileError(f"slicer.vendor_bundle: no bundle {spec!r}{hint}; installed: {', '.join(sorted(found))} "
+                       f"(looked in {looked})", where=where)
+
+
+# -- bundles and their presets -----------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Bundle:
+    """A parsed vendor bundle; :meth:`flatten` gives a preset with its inherits chain applied."""
+
+    ini: IniFile
+    _flat: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def path(self) -> Path:
+        return self.ini.path
+
+    @property
+    def vendor(self) -> dict[str, str]:
+        return self.ini.sections.get("vendor", {})
+
+    def label(self) -> str:
+        v = self.vendor
+        return f"{v.get('name', self.path.stem)} {v.get('config_version', '')}".strip()
+
+    def printer_models(self) -> dict[str, dict[str, str]]:
+        return {k.split(":", 1)[1]: v for k, v in self.ini.sections.items() if k.startswith("printer_model:")}
+
+    def presets(self, group: str, abstract: bool = False) -> list[str]:
+        """Preset names of ``group`` in file order; ``abstract`` also lists the ``*name*`` ones."""
+        head = group + ":"
+        names = [k[len(head):] for k in self.ini.sections if k.startswith(head)]
+        return [n for n in names if abstract or not n.startswith("*")]
+
+    def _section(self, group: str, name: str) -> dict[str, str] | None:
+        return self.ini.sections.get(f"{group}:{name}")
+
+    def flatten(self, group: str, name: str, where: str | None = None) -> dict[str, str]:
+        """The preset's settings with its inherits chain applied (a fresh dict, bundle-only keys
+        kept so a caller can see them; :data:`BUNDLE_ONLY` says which they are)."""
+        if self._section(group, name) is None or name.startswith("*"):
+            raise ProfileError(self._unknown(group, name), where=where)
+        return dict(self._flatten(group, name, ()))
+
+    def _flatten(self, group: str, name: str, chain: tuple[str, ...]) -> dict[str, str]:
+        key = (group, name)
+        if key in self._flat:
+            return self._flat[key]
+        if name in chain:
+            raise FabricationError(f"[{group}:{name}] inherits itself: {' -> '.join(chain + (name,))}",
+                                   where=self.ini.where(f"{group}:{chain[-1]}", "inherits"))
+        own = self._section(group, name)
+        if own is None:
+            raise FabricationError(f"[{group}:{chain[-1]}] inherits an unknown preset {name!r}",
+                                   where=self.ini.where(f"{group}:{chain[-1]}", "inherits"))
+        out: dict[str, str] = {}
+        for parent in split_inherits(own.get("inherits", "")):
+            out.update(self._flatten(group, parent, chain + (name,)))
+        out.update(own)
+        out.pop("inherits", None)
+        self._flat[key] = out
+        return out
+
+    def _unknown(self, group: str, name: str) -> str:
+        names = self.presets(group)
+        if name.startswith("*") and self._section(group, name) is not None:
+            return (f"{group}_preset {name!r} is an abstract building block of {self.path.name} (names in '*' are "
+                    f"never selected); choose a preset that inherits it")
+        for other in names:
+            if self._section(group, other).get("renamed_from", "").strip('"') == name:
+                return f"{group}_preset {name!r} was renamed to {other!r} in {self.path.name} ({self.label()})"
+        close = difflib.get_close_matches(name, names, n=3, cutoff=0.6)
+        hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+        return (f"{group}_preset {name!r} is not in {self.path} ({self.label()}, {len(names)} {group} presets){hint}"
+                f" (list them with `python -m rigcad.fab.vendor {self.path.stem} {group}`)")
+
+
+def load_bundle(path: str | Path) -> Bundle:
+    """The bundle at ``path``, parsed once per process (while the file is unchanged); each
+    preset is flattened once, on first use."""
+    path = Path(path)
+    try:
+        st = path.stat()
+    except OSError as err:
+        raise FabricationError(f"cannot read PrusaSlicer configuration {path}: {err.strerror}") from err
+    return _load_bundle(path.resolve(), st.st_size, st.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=16)
+def _load_bundle(path: Path, size: int, mtime_ns: int) -> Bundle:
+    return Bundle(_read_ini(path, size, mtime_ns))
+
+
+# -- PrusaSlicer's own key list ----------------------------------------------------------------------
+
+def slicer_keys(exe: str | None = None) -> frozenset[str]:
+    """Every configuration key the installed PrusaSlicer knows: its full default configuration
+    (``--save``) and the options of ``--help-fff``. Empty when PrusaSlicer is not installed."""
+    exe = exe or shutil.which(SLICER)
+    return _slicer_options(exe)[0] if exe else frozenset()
+
+
+def slicer_help(key: str, exe: str | None = None) -> str:
+    """The tail of ``--help-fff``'s text on ``key``: its unit, choices and default, e.g.
+    "(reprap, ..., marlin2, ...; default: reprap)"; "" when unknown."""
+    exe = exe or shutil.which(SLICER)
+    return _slicer_options(exe)[1].get(key, "") if exe else ""
+
+
+@functools.lru_cache(maxsize=4)
+def _slicer_options(exe: str) -> tuple[frozenset[str], dict[str, str]]:
+    keys: set[str] = set()
+    with tempfile.TemporaryDirectory(prefix="rigcad-keys-") as tmp:
+        out = Path(tmp) / "defaults.ini"
+        try:
+            subprocess.run([exe, "--save", str(out)], capture_output=True, timeout=120)
+            help_fff = subprocess.run([exe, "--help-fff"], capture_output=True, text=True, timeout=120).stdout
+        except (OSError, subprocess.TimeoutExpired) as err:
+            raise FabricationError(f"{exe} does not run: {err}; {INSTALL_HINT}") from err
+        if out.is_file():
+            keys |= set(read_ini(out).top)
+    # after the actions and transforms, one option per " --bed-temperature N  text" line, its
+    # text continued on indented lines and ending in "(unit, choices; default: x)"
+    helps: dict[str, str] = {}
+    key = None
+    for line in help_fff.split("Print options are processed", 1)[-1].splitlines():
+        if line.startswith(" --"):
+            key = line[3:].split()[0].split(",")[0].replace("-", "_")
+            keys.add(key)
+            helps[key] = line[3:].split(None, 1)[1] if len(line[3:].split(None, 1)) > 1 else ""
+        elif key and line.startswith("  "):
+            helps[key] += " " + line.strip()
+        else:
+            key = None
+    tails = {k: m.group(0) for k, v in helps.items() if (m := re.search(r"\([^()]*\)\s*$", v.strip()))}
+    return frozenset(keys), tails
+
+
+def check_values(settings: dict[str, str], where: dict[str, str | None], exe: str | None = None) -> None:
+    """Let PrusaSlicer itself parse ``settings`` (``--load`` then ``--save``, ~0.1 s) and turn a
+    value it refuses into a ProfileError at the key's file:line. Skipped without PrusaSlicer."""
+    exe = exe or shutil.which(SLICER)
+    if exe is None or not settings:
+        return
+    text = "".join(f"{k} = {v}\n" for k, v in sorted(settings.items()))
+    _check_values(exe, text, tuple(sorted(where.items(), key=lambda kv: kv[0])))
+
+
+@functools.lru_cache(maxsize=64)
+def _check_values(exe: str, text: str, where: tuple[tuple[str, str | None], ...]) -> None:
+    with tempfile.TemporaryDirectory(prefix="rigcad-check-") as tmp:
+        d = Path(tmp)
+        (d / "in.ini").write_text(text, encoding="utf-8")
+        try:
+            proc = subprocess.run([exe, "--config-compatibility", "disable", "--loglevel", "1", "--load", "in.ini",
+                                   "--save", "out.ini"], cwd=d, capture_output=True, text=True, timeout=120)
+        except (OSError, subprocess.TimeoutExpired) as err:
+            raise FabricationError(f"{exe} does not run: {err}; {INSTALL_HINT}") from err
+    if proc.returncode == 0:
+        return
+    log = (proc.stdout + proc.stderr).strip().splitlines()
+    msg = next((ln for ln in log if "Invalid value" in ln or "rror" in ln), log[-1] if log else "")
+    marks = dict(where)
+    key = next((k for k in marks if f"parameter {k}:" in msg), None)
+    detail = msg.split("Invalid value provided for ", 1)[-1]
+    valid = f"; valid: {slicer_help(key, exe)}" if key and slicer_help(key, exe) else ""
+    raise ProfileError(f"slicer.overrides{'.' + key if key else ''}: PrusaSlicer refuses it: {detail}{valid}",
+                       where=marks.get(key) if key else None)
+
+
+# -- the configuration rigcad hands to PrusaSlicer -------------------------------------------------
+
+@dataclass(frozen=True)
+class VendorConfig:
+    """PrusaSlicer settings resolved from a bundle's presets (or a user's flat .ini) and the
+    printer file's overrides. ``settings``: the flattened presets, bundle-only keys dropped and
+    ``*_settings_id`` set as the GUI sets them (the vendor G-code tests them); ``overrides``: the
+    printer file's, already in PrusaSlicer's text form. Both sorted by key (deterministic)."""
+
+    source: Path
+    kind: str  # "bundle" or "config"
+    vendor: str
+    printer_preset: str | None
+    print_preset: str | None
+    filament_preset: str | None
+    settings: tuple[tuple[str, str], ...]
+    overrides: tuple[tuple[str, str], ...]
+
+    def effective(self) -> dict[str, str]:
+        """What PrusaSlicer prints with before rigcad's per-piece settings: presets, then overrides."""
+        out = dict(self.settings)
+        out.update(self.overrides)
+        return out
+
+    def describe(self) -> dict:
+        return {"source": str(self.source), "kind": self.kind, "vendor": self.vendor,
+                "printer_preset": self.printer_preset, "print_preset": self.print_preset,
+                "filament_preset": self.filament_preset, "overrides": dict(self.overrides)}
+
+
+def ini_value(value, key: str = "value", where: str | None = None) -> str:
+    """A YAML value in PrusaSlicer's text form: booleans 1/0, numbers as written, text with
+    newlines and backslashes escaped (PrusaSlicer's ``escape_string_cstyle``), lists of numbers
+    comma-separated (per-extruder vectors), lists of text ``;``-separated and quoted."""
+    def esc(s: str) -> str:
+        return s.replace("\\", "\\\\").replace("\n", "\\n").replace("\r", "\\r")
+
+    if isinstance(value, bool):
+        return "1" if value else "0"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, str):
+        return esc(value)
+    if isinstance(value, list) and value:
+        if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            return ",".join(ini_value(v) for v in value)
+        if all(isinstance(v, str) for v in value):
+            return ";".join('"' + esc(v).replace('"', '\\"') + '"' for v in value)
+    raise ProfileError(f"slicer.overrides.{key}: {value!r} is not a PrusaSlicer value (a number, true/false, text, "
+                       "or a list of numbers or of texts)", where=where)
+
+
+def resolve(source: Path, printer: str | None, print_: str | None, filament: str | None,
+            overrides: dict[str, object], where: dict[str, str | None] | None = None) -> VendorConfig:
+    """Resolve the printer file's ``slicer`` section against ``source`` (a bundle or a flat
+    configuration, see :func:`find_bundle`). ``where`` maps "vendor_bundle", "printer_preset", ...,
+    and "overrides.KEY" to their file:line. Unknown preset names and override keys are refused
+    with a "did you mean"; override values are checked by PrusaSlicer itself when installed."""
+    where = where or {}
+    path = Path(source)
+    ini = read_ini(path)
+    names = {"printer": printer, "print": print_, "filament": filament}
+    if ini.sections and not ini.top:
+        b = load_bundle(path)
+        missing = [g for g in ("printer", "print", "filament") if not names[g]]
+        if missing:
+            raise ProfileError(f"slicer: a vendor bundle needs {', '.join(g + '_preset' for g in missing)} "
+                               f"(e.g. {missing[0]}_preset: {b.presets(missing[0])[0]!r})",
+                               where=where.get("vendor_bundle"))
+        merged: dict[str, str] = {}
+        for g in GROUPS:
+            merged.update(b.flatten(g, names[g], where.get(f"{g}_preset")))
+        kind, vendor = "bundle", b.label()
+    else:
+        given = [g + "_preset" for g, n in names.items() if n]
+        if given:
+            raise ProfileError(f"slicer: {path} is a flat PrusaSlicer configuration (no [print:...] sections), so "
+                               f"{', '.join(given)} mean nothing; drop them or name a vendor bundle",
+                               where=where.get(given[0]))
+        merged = dict(ini.top)
+        kind, vendor = "config", "user configuration"
+    settings = {k: v for k, v in merged.items() if k not in BUNDLE_ONLY}
+    if kind == "bundle":
+        settings.update({"print_settings_id": print_, "printer_settings_id": printer,
+                         "filament_settings_id": '"' + filament.replace('"', '\\"') + '"'})
+    known = (set(merged) | slicer_keys()) - BUNDLE_ONLY
+    over: dict[str, str] = {}
+    for key, value in overrides.items():
+        at = where.get(f"overrides.{key}")
+        if key in BUNDLE_ONLY:
+            raise ProfileError(f"slicer.overrides.{key}: a bundle's bookkeeping key, not a PrusaSlicer setting",
+                               where=at)
+        if key not in known:
+            close = difflib.get_close_matches(key, sorted(known), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise ProfileError(f"slicer.overrides: unknown PrusaSlicer setting {key!r}{hint}; valid keys are those of "
+                               f"`prusa-slicer --help-fff` with '_' for '-' ({len(known)} known)", where=at)
+        over[key] = ini_value(value, key, at)
+    check_values(over, {k: where.get(f"overrides.{k}") for k in over})
+    return VendorConfig(source=path, kind=kind, vendor=vendor, printer_preset=printer, print_preset=print_,
+                        filament_preset=filament, settings=tuple(sorted(settings.items())),
+                        overrides=tuple(sorted(over.items())))
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m rigcad.fab.vendor [BUNDLE [GROUP [PRESET]]]``: list bundles, presets, or one
+    flattened preset."""
+    import sys
+
+    args = sys.argv[1:] if argv is None else argv
+    try:
+        if not args:
+            found = available_bundles()
+            print("\n".join(f"{k}\t{v}" for k, v in found.items()) or f"none in {bundle_dirs()}; {INSTALL_HINT}")
+            return 0
+        b = load_bundle(find_bundle(args[0], Path.cwd()))
+        if len(args) == 1:
+            for g in ("printer", "print", "filament"):
+                print(f"{g}: {len(b.presets(g))} presets")
+        elif len(args) == 2:
+            print("\n".join(b.presets(args[1])))
+        else:
+            for k, v in sorted(b.flatten(args[1], args[2]).items()):
+                print(f"{k} = {v}")
+    except (ProfileError, FabricationError) as err:
+        print(f"rigcad: {err}", file=sys.stderr)
+        return err.exit_code
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
