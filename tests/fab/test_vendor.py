@@ -38,7 +38,7 @@ needs_slicer = pytest.mark.skipif(not (have_slicer() and have_bundle()), reason=
 
 def printer_yaml(tmp_path: Path, slicer: str, drop: tuple[str, ...] = (), edit: dict[str, str] | None = None) -> Path:
     """The shipped MK3S printer file with its slicer section replaced (and keys dropped or edited)."""
-    text = (ROOT / "profiles" / "printers" / "prusa_mk3s.yaml").read_text()
+    text = (ROOT / "rigcad" / "profiles" / "printers" / "prusa_mk3s.yaml").read_text()
     head, _, tail = text.partition("slicer:\n")
     tail = tail[tail.index("alignment_pin:"):]
     lines = [ln for ln in head.splitlines() if not any(ln.startswith(k + ":") for k in drop)]
@@ -340,12 +340,12 @@ def test_a_slender_piece_is_printed_with_a_brim():
 
 @pytest.mark.slow
 @needs_slicer
-def test_a_rig_part_on_the_mk3s_gets_vendor_gcode_and_a_project(table31, tmp_path):
+def test_a_rig_part_on_the_mk3s_gets_vendor_gcode_and_a_project(table31_rig, tmp_path):
     """A real piece through the fab stage: G-code with the vendor's start, a 3MF project beside it."""
     from rigcad.fab.stage import run_fab
 
     p = load_printer("prusa_mk3s")
-    res = run_fab(table31, p, tmp_path, parts=["sample_holder"], gcode=True, workers=1)
+    res = run_fab(table31_rig, p, tmp_path, parts=["sample_holder"], gcode=True, workers=1)
     assert res.problems == [], res.problems
     for pc in res.report["parts"]["sample_holder"]["pieces"]:
         text = (tmp_path / "gcode" / f"{pc['name']}.gcode").read_text()
