@@ -47,6 +47,7 @@ import numpy as np
 
 from rigcad.errors import FabricationError
 from rigcad.fab.printers import Printer
+from rigcad.fab.vendor import TEXT
 
 SLICER = "prusa-slicer"
 INSTALL_HINT = "install it with `apt-get install prusa-slicer` (Debian/Ubuntu) or from https://www.prusa3d.com/"
@@ -76,7 +77,7 @@ def find_slicer() -> str | None:
 def slicer_version(exe: str) -> str:
     """The slicer's version line (part of every cache key)."""
     try:
-        out = subprocess.run([exe, "--help"], capture_output=True, text=True, timeout=60)
+        out = subprocess.run([exe, "--help"], capture_output=True, timeout=60, **TEXT)
     except (OSError, subprocess.TimeoutExpired) as err:
         raise FabricationError(f"{exe} does not run: {err}; {INSTALL_HINT}") from err
     for line in out.stdout.splitlines():
@@ -345,7 +346,7 @@ def _run(exe: str, job: SliceJob) -> SliceResult:
                "--center", f"{job.center[0]:g},{job.center[1]:g}", "-o", "out", stl]
         t0 = time.perf_counter()
         try:
-            proc = subprocess.run(cmd, cwd=d, capture_output=True, text=True, timeout=TIMEOUT_S)
+            proc = subprocess.run(cmd, cwd=d, capture_output=True, timeout=TIMEOUT_S, **TEXT)
         except subprocess.TimeoutExpired as err:
             raise FabricationError(f"{job.name}: {SLICER} took over {TIMEOUT_S} s") from err
         seconds = time.perf_counter() - t0

@@ -31,6 +31,10 @@ from pathlib import Path
 
 from rigcad.errors import FabricationError, ProfileError
 
+#: Text mode for PrusaSlicer's output: UTF-8 whatever the locale (a "C" locale, as set by some
+#: libraries on import or found on CI, would make Python decode it as ASCII and fail on a degree sign).
+TEXT = {"text": True, "encoding": "utf-8", "errors": "replace"}
+
 SLICER = "prusa-slicer"
 INSTALL_HINT = ("install PrusaSlicer, which ships the vendor bundles: `apt-get update && apt-get install "
                 "prusa-slicer` (Debian/Ubuntu) or from https://www.prusa3d.com/")
@@ -307,7 +311,7 @@ def _slicer_options(exe: str) -> tuple[frozenset[str], dict[str, str]]:
         out = Path(tmp) / "defaults.ini"
         try:
             subprocess.run([exe, "--save", str(out)], capture_output=True, timeout=120)
-            help_fff = subprocess.run([exe, "--help-fff"], capture_output=True, text=True, timeout=120).stdout
+            help_fff = subprocess.run([exe, "--help-fff"], capture_output=True, timeout=120, **TEXT).stdout
         except (OSError, subprocess.TimeoutExpired) as err:
             raise FabricationError(f"{exe} does not run: {err}; {INSTALL_HINT}") from err
         if out.is_file():
@@ -346,7 +350,7 @@ def _check_values(exe: str, text: str, where: tuple[tuple[str, str | None], ...]
         (d / "in.ini").write_text(text, encoding="utf-8")
         try:
             proc = subprocess.run([exe, "--config-compatibility", "disable", "--loglevel", "1", "--load", "in.ini",
-                                   "--save", "out.ini"], cwd=d, capture_output=True, text=True, timeout=120)
+                                   "--save", "out.ini"], cwd=d, capture_output=True, timeout=120, **TEXT)
         except (OSError, subprocess.TimeoutExpired) as err:
             raise FabricationError(f"{exe} does not run: {err}; {INSTALL_HINT}") from err
     if proc.returncode == 0:
