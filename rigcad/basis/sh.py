@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigcad.basis.zonal import Zone, _assemble, check_order, zonal_basis, zone_quadrature
+from rigcad.basis.zonal import Zone, check_order, real_basis, zonal_basis, zone_quadrature
 from rigcad.errors import BasisError
 
 
@@ -43,7 +43,7 @@ def sh_basis(theta_rad: np.ndarray, phi_rad: np.ndarray, order: int) -> np.ndarr
     """
     L = check_order(order)
     th = np.asarray(theta_rad, dtype=float)
-    return _assemble(np.cos(th), phi_rad, L, 1.0)
+    return real_basis(np.cos(th), phi_rad, L, 1.0)
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ from typing import Callable
 
 import numpy as np
 
+from rigcad.basis.brdf import Ward
 from rigcad.basis.gram import IlluminationSampling, basis_images, gram, quantise_images
 from rigcad.basis.zonal import Zone, angles_to_directions, check_order, zonal_basis, zone_quadrature
 from rigcad.errors import BasisError
@@ -220,8 +221,6 @@ def lobe_width_study(zone: Zone, sampling: IlluminationSampling, order: int, alp
     ``rel_l2_error`` (of the uncorrected responses against :func:`reference_coefficients`) and
     ``reference_error`` (the reference's own error estimate, absolute).
     """
-    from rigcad.basis.brdf import Ward  # local: only this study needs a model
-
     pitch = sampling.pitch_rad()
     rows = []
     for alpha in alphas:

@@ -150,8 +150,13 @@ def normalized_legendre(t: np.ndarray, order: int) -> np.ndarray:
     return out
 
 
-def _assemble(t: np.ndarray, phi: np.ndarray, order: int, radial_scale: float) -> np.ndarray:
-    """Basis values (..., K) from shifted arguments t and azimuths phi (broadcast together)."""
+def real_basis(t: np.ndarray, phi: np.ndarray, order: int, radial_scale: float) -> np.ndarray:
+    """Real-form basis values (..., K) from Legendre arguments t in [-1, 1] and azimuths phi (radians).
+
+    ``radial_scale * N_l^m(t)`` times 1/sqrt(2 pi) (m = 0) or cos/sin(|m| phi)/sqrt(pi) (m != 0):
+    with t the zone's shifted cosine and radial_scale = sqrt(2/(b - a)) this is the zonal basis;
+    with t = cos(theta) and radial_scale = 1, the real spherical harmonics.
+    """
     t, phi = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(phi, dtype=float))
     N = normalized_legendre(t, order)
     out = np.empty(t.shape + ((order + 1) ** 2,))
@@ -178,7 +183,7 @@ def zonal_basis(theta_rad: np.ndarray, phi_rad: np.ndarray, order: int, zone: Zo
     """
     L = check_order(order)
     t = zone.shifted_cosine(theta_rad)
-    return _assemble(t, phi_rad, L, math.sqrt(2.0 / (zone.x_high - zone.x_low)))
+    return real_basis(t, phi_rad, L, math.sqrt(2.0 / (zone.x_high - zone.x_low)))
 
 
 def zonal_basis_directions(directions: np.ndarray, order: int, zone: Zone) -> np.ndarray:
