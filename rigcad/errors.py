@@ -60,3 +60,7 @@ class CheckError(RigcadError):
 
 class FabricationError(RigcadError):
     """Slicing, splitting or printer fit failed."""
+
+
+class BasisError(RigcadError):
+    """Basis-illumination maths refused its input: a bad zone, order, sampling, BRDF parameter or BRDF file."""

@@ -1,0 +1,147 @@
+"""Discrete Gram matrices, thesis 4.2.1 quantisation and re-orthonormalisation on a synthetic equal-area sampling."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rigcad.basis.gram import (IlluminationSampling, basis_images, discrete_gram, equal_area_sampling, gram,
+                               off_identity, quantise_images, reorthonormalise)
+from rigcad.basis.zonal import Zone
+from rigcad.errors import BasisError
+
+ZONE = Zone(math.pi / 20, math.pi / 2)  # thesis eq. 3.4
+
+
+@pytest.fixture(scope="module")
+def fine():
+    """128 x 512 equal-area cells (65 536 samples, pitch ~0.56 deg) and the order-8 basis on them."""
+    s = equal_area_sampling(ZONE, 128, 512)
+    return s, basis_images(s, 8, ZONE)
+
+
+def test_equal_area_cells_tile_the_zone():
+    s = equal_area_sampling(ZONE, 16, 64)
+    # equal cells summing to 2 pi (cos alpha - cos beta): round-off only
+    assert abs(s.weight_sr.sum() - 2 * math.pi * math.cos(math.pi / 20)) < 1e-12
+    assert np.ptp(s.weight_sr) == 0.0
+    assert ZONE.contains(s.theta_rad).all()
+
+
+def test_gram_converges_to_identity_at_second_order():
+    errs = [off_identity(discrete_gram(equal_area_sampling(ZONE, n, 4 * n), 4, ZONE)).max_abs
+            for n in (16, 32, 64, 128)]
+    orders = [math.log2(errs[i] / errs[i + 1]) for i in range(3)]
+    # midpoint rule in cos(theta) is second order and the azimuth rule is exact for these trigonometric
+    # degrees, so the observed order must be 2 (measured 1.93, 1.98, 2.00)
+    assert all(1.85 < p < 2.15 for p in orders), (errs, orders)
+    # and the finest grid is already close to I (measured 1.8e-3)
+    assert errs[-1] < 3e-3, errs
+
+
+def test_quantisation_follows_thesis_4_2_1(fine):
+    s, B = fine
+    for bits, dtype in ((8, np.uint8), (16, np.uint16)):
+        q = quantise_images(B, bits)
+        assert q.positive.dtype == dtype and q.negative.dtype == dtype
+        assert q.positive.shape == (81, s.size)
+        # one scale for all images: the largest |value| of any image
+        assert q.scale == np.max(np.abs(B))
+        # positive and negative parts are separate images, never both lit on one pixel
+        assert not np.any((q.positive > 0) & (q.negative > 0))
+        assert q.positive.max() == q.levels or q.negative.max() == q.levels
+        # rounding to nearest: at most half a level of error anywhere (plus float round-off)
+        assert np.max(np.abs(q.values() - B)) <= 0.5 * q.scale / q.levels * (1 + 1e-12)
+    qt = quantise_images(B, 8, rounding="truncate")
+    err = B - qt.values()
+    # truncation towards zero: error below one level, same sign as the value
+    assert np.max(np.abs(err)) < qt.scale / qt.levels and np.all(err * B >= 0)
+
+
+def test_quantisation_perturbs_the_gram_within_its_a_priori_bound(fine):
+    s, B = fine
+    G = gram(B, s)
+    for bits in (8, 16):
+        q = quantise_images(B, bits)
+        dG = np.abs(gram(q.values(), s) - G)
+        delta = 0.5 * q.scale / q.levels
+        omega = s.weight_sr.sum()
+        norms = np.sqrt(np.diag(G))
+        # |sum w (Z_i e_j + e_i Z_j + e_i e_j)| <= delta sqrt(omega) (||Z_i|| + ||Z_j||) + delta^2 omega
+        # (Cauchy-Schwarz with |e| <= delta): a bound from outside the code, not a fitted number
+        bound = delta * math.sqrt(omega) * (norms[:, None] + norms[None, :]) + delta**2 * omega
+        assert np.all(dG <= bound), float(np.max(dG / bound))
+
+
+def test_quantised_gram_figures(fine):
+    s, B = fine
+    G = off_identity(gram(B, s))
+    G8 = off_identity(gram(quantise_images(B, 8).values(), s))
+    # order 8 on 128 x 512 cells: the sampling itself leaves 1.2e-2 on the diagonal (second-order
+    # midpoint error) and 8-bit quantisation barely adds to it (measured 1.23e-2 -> 1.22e-2); the bound
+    # says the quantised basis is still within 2 % of orthonormal before any correction
+    assert G8.max_abs < 2e-2, (G, G8)
+    assert abs(G8.max_abs - G.max_abs) < 3e-3, (G, G8)
+
+
+def test_reorthonormalised_quantised_set(fine):
+    s, B = fine
+    q = quantise_images(B, 8).values()
+    for method in ("lowdin", "cholesky"):
+        r = reorthonormalise(q, s, method, reference=B)
+        # exactly orthonormal on the samples up to round-off of a K = 81 eigen/Cholesky solve
+        assert off_identity(r.gram_after).max_abs < 1e-12, method
+        # applying the transform to the vectors is what applying it to responses means
+        assert np.allclose(r.functions, q @ r.transform, rtol=0, atol=1e-12)
+    lo = reorthonormalise(q, s, "lowdin", reference=B)
+    E = gram(q, s) - np.eye(81)
+    e = np.sqrt(np.sum((q - B) ** 2 * s.weight_sr[:, None], axis=0))
+    # Loewdin to first order: F = Q (I - E/2), so ||F_k - Z_k|| <= ||Q_k - Z_k|| + ||E[:, k]|| / 2;
+    # 10 % slack covers the second-order terms (|E| ~ 1e-2, so they are ~1e-4 relative)
+    bound = 1.1 * (e + 0.5 * np.linalg.norm(E, axis=0))
+    assert np.all(lo.deviation <= bound), float(np.max(lo.deviation / bound))
+    # measured max deviation 9.1e-3: the re-orthonormalised set stays within 1 % of the analytic basis
+    assert lo.deviation.max() < 1e-2, lo.deviation.max()
+    ch = reorthonormalise(q, s, "cholesky", reference=B)
+    # Gram-Schmidt keeps the first function's direction: only its length changes
+    f0, q0 = ch.functions[:, 0], q[:, 0]
+    assert np.allclose(f0 / np.linalg.norm(f0), q0 / np.linalg.norm(q0), rtol=0, atol=1e-14)
+
+
+def test_reorthonormalised_set_survives_8_bit_quantisation(fine):
+    s, B = fine
+    lo = reorthonormalise(B, s, "lowdin", reference=B)
+    for bits, target in ((8, 1e-2), (16, 1e-4)):
+        shown = quantise_images(lo.functions, bits).values()
+        err = off_identity(gram(shown, s)).max_abs
+        # the issue's target for 8 bits is 1e-2 (measured 6.8e-3 at order 8); 16 bits measured 8e-6
+        assert err < target, (bits, err)
+
+
+def test_singular_sets_and_bad_samplings_are_refused():
+    s = equal_area_sampling(ZONE, 8, 16)
+    B = basis_images(s, 1, ZONE)
+    with pytest.raises(BasisError, match="singular"):
+        reorthonormalise(np.column_stack([B[:, 0], B[:, 0]]), s)
+    with pytest.raises(BasisError, match="bits = 12"):
+        quantise_images(B, 12)
+    with pytest.raises(BasisError, match="differ in length"):
+        IlluminationSampling(np.zeros(3), np.zeros(3), np.ones(2), np.ones(3, bool))
+    with pytest.raises(BasisError, match="weight_sr"):
+        IlluminationSampling(np.zeros(2), np.zeros(2), np.array([1.0, -1.0]), np.ones(2, bool))
+
+
+def test_invalid_samples_carry_no_light():
+    s = equal_area_sampling(ZONE, 32, 128)
+    valid = s.valid.copy()
+    valid[::3] = False
+    theta = s.theta_rad.copy()
+    theta[::3] = 0.01  # outside the zone, e.g. a pixel whose ray lands in the cap: must be masked, not evaluated
+    masked = IlluminationSampling(theta, s.phi_rad, s.weight_sr, valid)
+    B = basis_images(masked, 3, ZONE)
+    assert np.all(B[~valid] == 0.0)
+    G = gram(B, masked)
+    # a third of the solid angle is missing, so the constant function's norm drops to ~2/3 of 1
+    assert abs(G[0, 0] - valid.mean()) < 1e-12
