@@ -12,19 +12,30 @@ from pathlib import Path
 
 from rigcad import __version__
 from rigcad.errors import RigcadError
+from rigcad.export.atomic import profile_lock
 from rigcad.units import DEG
+
+
+#: Set (to anything) to have every progress step also printed as a line ``rigcad-event: <label>``
+#: on stderr: a machine-readable trace of where a run is (the fault tests kill runs at these).
+EVENTS_ENV = "RIGCAD_EVENTS"
 
 
 @contextmanager
 def _progress(total: int, desc: str):
     """A progress bar on stderr when it is a terminal (tqdm); silent otherwise."""
+    import os
+
     from tqdm import tqdm
 
     bar = tqdm(total=total, desc=desc, unit="stage", disable=None, leave=False, file=sys.stderr)
+    events = bool(os.environ.get(EVENTS_ENV))
 
     def step(label: str) -> None:
         bar.set_postfix_str(label)
         bar.update(1)
+        if events:
+            print(f"rigcad-event: {label}", file=sys.stderr, flush=True)
 
     try:
         yield step
@@ -96,7 +107,7 @@ def cmd_design(args: argparse.Namespace) -> int:
         design = rig.design
         step("traced")
         out_dir = Path(args.exports) / rig.name
-        paths = write_design(design, out_dir)
+        paths = write_design(design, out_dir, profile_lock(args.exports, rig.name))
         step("written")
     r = design.report
     env, rng, px = r["envelope"], r["measurable_range"], r["pixels"]
@@ -122,7 +133,7 @@ def cmd_build(args: argparse.Namespace) -> int:
         rig = load(args.profile)
         step("dome integrated")
         out = Path(args.exports) / rig.name
-        result = build_rig(rig, out, names, progress=step)
+        result = build_rig(rig, out, names, progress=step, lock=profile_lock(args.exports, rig.name))
     m = result.manifest
     print(f"{rig.name}: {len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
     for name in names:
@@ -155,7 +166,8 @@ def cmd_stl(args: argparse.Namespace) -> int:
         step("dome integrated")
         files = design_files(rig.design)
         step("design traced")
-        result = build_rig(rig, out, progress=step, design=files, inputs_key=key)
+        result = build_rig(rig, out, progress=step, design=files, inputs_key=key,
+                           lock=profile_lock(args.exports, profile.name))
     env = rig.design.report["envelope"]
     print(f"{profile.name}: dome mirror {env['width_in']:.2f} x {env['height_in']:.2f} in; "
           f"{len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
@@ -230,6 +242,12 @@ def main(argv: list[str] | None = None) -> int:
         return err.exit_code
     except BrokenPipeError:  # output piped into head & co.
         return 0
+    except OSError as err:  # an I/O failure outside the writers' own guards: still one line
+        from rigcad.export.atomic import write_error
+
+        failure = write_error(Path(err.filename or "."), err)
+        print(f"rigcad: error: {failure}", file=sys.stderr)
+        return failure.exit_code
     except KeyboardInterrupt:
         print("rigcad: interrupted", file=sys.stderr)
         return 130

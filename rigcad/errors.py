@@ -52,6 +52,13 @@ class ExportError(RigcadError):
     """Writing or re-reading an export failed."""
 
 
+class WriteError(ExportError):
+    """An output could not be written (no space, permission, read-only, a file vanished): the
+    message names the path and what to do; the previous outputs are unchanged. Exit code 1."""
+
+    exit_code = 1
+
+
 class CheckError(RigcadError):
     """A declared tolerance is not met (ray check, mesh check)."""
 

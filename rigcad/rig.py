@@ -166,9 +166,12 @@ class Rig:
         from rigcad.export.design import design_files
         from rigcad.export.manifest import inputs_key
 
+        from rigcad.export.atomic import profile_lock
+
         out = Path(folder) if folder is not None else Path("exports") / self.name
         key = inputs_key(self.profile) if parts is None and self.misalignment == Misalignment.none() else None
-        return build_rig(self, out, parts, progress=progress, design=design_files(self.design), inputs_key=key)
+        return build_rig(self, out, parts, progress=progress, design=design_files(self.design), inputs_key=key,
+                         lock=profile_lock(out.parent, out.name))
 
     def check(self, rays: int | None = None, mode: str | None = None, exports: str | Path | None = None, **options):
         """The 3D ray check (``rigcad.check.raycheck.run_raycheck``): returns a RayCheck whose
@@ -185,9 +188,12 @@ class Rig:
         from rigcad.fab.printers import Printer, load_printer
         from rigcad.fab.stage import run_fab
 
+        from rigcad.export.atomic import profile_lock
+
         p = printer if isinstance(printer, Printer) else load_printer(printer)
+        lock = profile_lock("exports", self.name) if folder is None else None  # default: beside the folder
         out = Path(folder) if folder is not None else Path("exports") / self.name / "fab" / p.name
-        return run_fab(self, p, out, gcode=gcode, parts=parts, progress=progress)
+        return run_fab(self, p, out, gcode=gcode, parts=parts, progress=progress, lock=lock)
 
 
 @contextmanager

@@ -165,7 +165,8 @@ def test_a_part_the_kernel_cannot_build_is_one_line_exit_1_nothing_written(tmp_p
     assert len(lines) == 1 and "Traceback" not in res.stderr, res.stderr
     assert "thin.yaml:3" in lines[0] and "'paraboloid'" in lines[0] and "paraboloid_mount.clamp_length" in lines[0]
     assert "OpenCascade could not build it" in lines[0]
-    assert not (tmp_path / "exports").exists() or not any(p.is_file() for p in (tmp_path / "exports").rglob("*"))
+    written = [p for p in (tmp_path / "exports").rglob("*") if p.is_file()] if (tmp_path / "exports").exists() else []
+    assert [p.name for p in written] in ([], [".thin.lock"]), written  # at most the run's lock, no output
 
 
 def test_kernel_error_is_a_geometry_error_naming_the_part(table31_rig):

@@ -12,6 +12,7 @@ from rigcad.units import DEG
 def cmd_check(args: argparse.Namespace) -> int:
     from rigcad.check.raycheck import run_raycheck, write_raycheck
     from rigcad.check.tolerances import raise_if_failed, table
+    from rigcad.export.atomic import profile_lock
     from rigcad.rig import load
 
     rig = load(args.profile)
@@ -20,7 +21,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     result = run_raycheck(rig, exports=exports, rays=args.rays, mode=args.mode,
                           monte_carlo=not args.no_monte_carlo, builds=args.builds,
                           progress=lambda label: print(f"  {label} ...", file=sys.stderr) if args.verbose else None)
-    paths = write_raycheck(result, exports / profile.name / "check")
+    paths = write_raycheck(result, exports / profile.name / "check", profile_lock(exports, profile.name))
     rep = result.report
     main = rep["readings"][rep["mode"]]
     print(f"{profile.name}: mode {rep['mode']}, {rep['rays']} rays, backend {rep['backend']}")

@@ -296,15 +296,17 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
     return RayCheck(profile, report, rows, main, ddirs, theta_map, status_map, fan)
 
 
-def write_raycheck(result: RayCheck, out_dir: Path) -> list[Path]:
-    """Write raycheck.json, spot.png, theta_map.png under ``out_dir`` (atomically); returns paths."""
+def write_raycheck(result: RayCheck, out_dir: Path, lock: Path | None = None) -> list[Path]:
+    """Write raycheck.json, spot.png, theta_map.png into ``out_dir``, published together
+    (export.atomic.Staging, under ``lock``); returns the paths."""
     from rigcad import plots
-    from rigcad.export.atomic import write_bytes, write_json
+    from rigcad.export.atomic import Staging, json_bytes
 
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    paths = [write_json(out_dir / "raycheck.json", result.report)]
-    paths.append(write_bytes(out_dir / "spot.png", plots.spot_diagram(result)))
+    files = {"raycheck.json": json_bytes(result.report), "spot.png": plots.spot_diagram(result)}
     if result.theta_map is not None:
-        paths.append(write_bytes(out_dir / "theta_map.png", plots.theta_map(result)))
-    return paths
+        files["theta_map.png"] = plots.theta_map(result)
+    with Staging(out_dir, lock) as stage:
+        for name, data in files.items():
+            stage.write_bytes(out_dir / name, data)
+        return stage.commit()

@@ -67,27 +67,28 @@ def _cached(entry: dict | None, key: str, out: Path) -> bool:
 
 
 def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
-              design: dict[str, bytes] | None = None, inputs_key: str | None = None) -> BuildResult:
+              design: dict[str, bytes] | None = None, inputs_key: str | None = None,
+              lock: Path | None = None) -> BuildResult:
     """Build the selected parts (all by default) of ``rig`` (a :class:`rigcad.rig.Rig`) into
     ``out``; see the module docstring.
 
     ``design``: the design stage's files (name -> bytes, ``export.design.design_files``), staged and
     published with the parts; their hashes and ``inputs_key`` go into the manifest so that
-    `rigcad stl` can tell, without computing anything, that nothing changed.
+    `rigcad stl` can tell, without computing anything, that nothing changed. The whole folder is
+    published at once under ``lock`` (export.atomic.Staging).
     """
 
     step = progress or (lambda label: None)
     profile, layout = rig.profile, rig.layout
     names = select_parts(parts)
-    old_path = out / "manifest.json"
-    old = json.loads(old_path.read_text()) if old_path.is_file() else {}
-    old_parts = old.get("parts", {})
-    entries = dict(old_parts)
     rebuilt, reused = [], []
     shapes: dict[str, object] = {}
     tol = profile.tessellation
 
-    with Staging() as stage:
+    with Staging(out, lock) as stage:
+        old = _read_manifest(out / "manifest.json")
+        old_parts = old.get("parts", {})
+        entries = dict(old_parts)
         design_shas = {}
         for name, data in (design or {}).items():
             stage.write_bytes(out / name, data)
@@ -140,8 +141,17 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
             "assembly": assembly,
         }
         stage.write_bytes(out / "manifest.json", json_bytes(manifest))
+        step("publishing")
         written = stage.commit()
     return BuildResult(manifest, rebuilt, reused, written)
+
+
+def _read_manifest(path: Path) -> dict:
+    """The previous manifest, or {} when there is none or it is unreadable (then nothing is reused)."""
+    try:
+        return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+    except (OSError, ValueError):
+        return {}
 
 
 def _mirror_key(meridian, profile: Profile) -> str:

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import hashlib
 import io
+import json
 from pathlib import Path
 
 import numpy as np
 
-from rigcad.export.atomic import write_bytes
+from rigcad.export.atomic import Staging, json_bytes
 from rigcad.optics.design import Design
 
 
@@ -34,14 +36,28 @@ def design_files(design: Design) -> dict[str, bytes]:
     }
 
 
-def write_design(design: Design, out_dir: Path) -> list[Path]:
-    """Write the design files into ``out_dir``, each atomically; returns the paths."""
-    return [write_bytes(out_dir / name, data) for name, data in design_files(design).items()]
+def write_design(design: Design, out_dir: Path, lock: Path | None = None) -> list[Path]:
+    """Write the design files into ``out_dir``, published together with the folder's other files
+    carried over (export.atomic.Staging, under ``lock``); returns the paths."""
+    files = design_files(design)
+    with Staging(out_dir, lock) as stage:
+        for name, data in files.items():
+            stage.write_bytes(out_dir / name, data)
+        manifest = out_dir / "manifest.json"
+        if manifest.is_file():  # the build's manifest vouches for these files: keep it truthful
+            try:
+                m = json.loads(manifest.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                m = None
+            shas = {name: hashlib.sha256(data).hexdigest() for name, data in files.items()}
+            if isinstance(m, dict) and m.get("design_files") != shas:
+                m["design_files"] = shas
+                m["inputs_key"] = None  # the parts may no longer match this design: `rigcad stl` rebuilds
+                stage.write_bytes(manifest, json_bytes(m))
+        return stage.commit()
 
 
 def _design_json(design: Design) -> bytes:
-    from rigcad.export.atomic import json_bytes
-
     report = dict(design.report)
     report["files"] = {
         "dome_profile.csv": "dome profile table, one row per dome point (units in the header)",

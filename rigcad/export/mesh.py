@@ -9,6 +9,7 @@ dome at 0.018 mm). manifold3d guarantees a watertight, manifold result or report
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import manifold3d as m3d
 import numpy as np
@@ -120,6 +121,9 @@ def threemf_writer(vertices: np.ndarray, faces: np.ndarray, name: str):
         item = model.AddBuildItem(mesh, wrapper.GetIdentityTransform())
         item.SetUUID(ids[1])
         model.SetBuildUUID(ids[2])
-        model.QueryWriter("3mf").WriteToFile(str(path))
+        # into memory, then written by Python: a full disk is then an OSError rigcad reports, never
+        # lib3mf's native abort while writing the file ("Could not deflate data", exit 134)
+        data = bytes(model.QueryWriter("3mf").WriteToBuffer())
+        Path(path).write_bytes(data)
 
     return writer

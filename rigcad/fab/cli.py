@@ -11,6 +11,7 @@ from pathlib import Path
 def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.fab.printers import load_printer
     from rigcad.fab.stage import run_fab
+    from rigcad.export.atomic import profile_lock
     from rigcad.rig import load
 
     rig = load(args.profile)
@@ -18,6 +19,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
     printer = load_printer(args.printer)
     out = Path(args.exports) / profile.name / "fab" / printer.name
     res = run_fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs,
+                  lock=profile_lock(args.exports, profile.name),
                   progress=lambda msg: print(f"  {msg}", file=sys.stderr) if args.verbose else None)
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")

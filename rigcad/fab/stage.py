@@ -104,7 +104,7 @@ def _estimate(volume: float, layers: int, printer: Printer) -> dict:
 
 
 def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: list[str] | None = None,
-            progress=None, workers: int | None = None) -> FabResult:
+            progress=None, workers: int | None = None, lock: Path | None = None) -> FabResult:
     """Run the stage for ``rig`` (a :class:`rigcad.rig.Rig`: the same converged dome, layout and
     recipes as the exported parts) into ``out`` (exports/<profile>/fab/<printer>); see the module
     docstring."""
@@ -119,14 +119,17 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
     tol_mirror = chord + 2e-3  # mesh vertices lie on the surface; facets within the chord error
     names = select_parts(parts)
     bed_c = (printer.build_volume.x / 2, printer.build_volume.y / 2)
-    old_path = out / "fab.json"
-    old = json.loads(old_path.read_text()) if old_path.is_file() else {}
     report_parts: dict[str, dict] = {}
     problems: list[str] = []
     jobs: list[S.SliceJob] = []
     job_part: dict[str, str] = {}
 
-    with Staging() as stage:
+    with Staging(out, lock) as stage:
+        old_path = out / "fab.json"
+        try:
+            old = json.loads(old_path.read_text(encoding="utf-8")) if old_path.is_file() else {}
+        except (OSError, ValueError):
+            old = {}  # unreadable: nothing is reused
         for name in names:
             part = rig.recipe(name)
             if name in CUT_PARTS and isinstance(part.solid, Prism):
