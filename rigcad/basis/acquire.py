@@ -43,7 +43,7 @@ import numpy as np
 
 from rigcad.basis.brdf import AshikhminShirleyMicrofacet, AshikhminShirleyPhong, CookTorrance, Lambert, Ward
 from rigcad.basis.gram import gram, quantise_images
-from rigcad.basis.projector import (ProjectorBasis, Progress, _step, check_basis_order, illumination,
+from rigcad.basis.projector import (ProjectorBasis, Progress, check_basis_order, illumination, progress_step,
                                     illuminated, projector_basis, trace_pixels)
 from rigcad.basis.sh import sh_basis, zonal_to_sh, zonal_to_sh_matrix
 from rigcad.basis.simulate import lobe_width_study, reference_set, relative_l2, responses
@@ -204,7 +204,7 @@ def simulate_on_rig(rig, order: int = 6, *, basis: ProjectorBasis | None = None,
     L = check_basis_order(order)
     if bits not in (8, 16):
         raise BasisError(f"bits = {bits!r}: need 8 or 16 (projector image depth)")
-    step = _step(progress)
+    step = progress_step(progress)
     basis = basis if basis is not None else projector_basis(rig, L)
     if basis.order != L:
         raise BasisError(f"basis of order {basis.order} given for a simulation of order {L}")

@@ -83,7 +83,8 @@ BASIS_STEPS = 5
 Progress = Callable[[str], None] | None
 
 
-def _step(progress: Progress) -> Callable[[str], None]:
+def progress_step(progress: Progress) -> Callable[[str], None]:
+    """``progress`` itself, or a callback that does nothing (the stages call it after each step)."""
     return progress or (lambda label: None)
 
 
@@ -109,7 +110,7 @@ def camera_focal_px(rig) -> float:
     rigcad assumes the camera, behind the beam splitter at the projector's COP (thesis 3.1,
     Figure 3.4), frames the paraboloid as the projector does: the same field of view across the
     sensor's height, f_camera = f_projector x camera height / projector height (2389 px for
-    Table 3.1: the rim at 134 px from the image centre, ~1.3 camera pixels per degree)."""
+    Table 3.1: the rim at 134 px from the image centre, 1.5 camera pixels per degree on average)."""
     return rig.incidence.focal_px * rig.profile.camera.resolution[1] / rig.profile.projector.resolution[1]
 
 
@@ -556,7 +557,7 @@ def projector_basis(rig, order: int = 6, *, alpha_rad: float | None = None,
     from rigcad.check.trace3d import STATUS_NAMES
 
     L = check_basis_order(order)
-    step = _step(progress)
+    step = progress_step(progress)
     zone = zone_of(rig, alpha_rad)
     design = trace_pixels(rig, "projector")
     step("projector pixels traced")
@@ -667,7 +668,7 @@ def write_basis(basis: ProjectorBasis, out_dir: str | Path, *, lowdin_images: bo
     from rigcad.export.atomic import Staging, json_bytes
     from rigcad.export.png import gray_png
 
-    step = _step(progress)
+    step = progress_step(progress)
     out = Path(out_dir)
     kinds = [("analytic", "projector")] + ([("lowdin", "projector_lowdin")] if lowdin_images else [])
     written = []
