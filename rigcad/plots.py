@@ -198,7 +198,7 @@ def staircase_map(points: np.ndarray, cusp: np.ndarray, layer: float, title: str
 
 # -- basis illumination (rigcad basis) --------------------------------------------------------------
 def _pyramid(tiles: np.ndarray, indices: np.ndarray, scale: float, title: str, tile_in: tuple[float, float],
-             extent=None, xlabel: str | None = None, ylabel: str | None = None) -> bytes:
+             extent=None, xlabel: str | None = None, ylabel: str | None = None, aspect: str = "auto") -> bytes:
     """Tiles (K, rows, cols) of signed values laid out as the SH pyramid: row l, column m (-l..l);
     diverging colours on one scale +-``scale``, NaN (black) where nothing is shown."""
     L = int(indices[:, 0].max())
@@ -211,7 +211,7 @@ def _pyramid(tiles: np.ndarray, indices: np.ndarray, scale: float, title: str, t
         ax.set_axis_off()
     for k, (l, m) in enumerate(indices):
         ax = axes[l, m + L]
-        im = ax.imshow(tiles[k], cmap=cmap, vmin=-scale, vmax=scale, interpolation="nearest", aspect="auto",
+        im = ax.imshow(tiles[k], cmap=cmap, vmin=-scale, vmax=scale, interpolation="nearest", aspect=aspect,
                        extent=extent)
         ax.set_title(f"l={l} m={m:+d}", fontsize=7, pad=2)
         if extent is not None and l == L and m == -L:
@@ -220,8 +220,8 @@ def _pyramid(tiles: np.ndarray, indices: np.ndarray, scale: float, title: str, t
             ax.set_xlabel(xlabel, fontsize=7)
             ax.set_ylabel(ylabel, fontsize=7)
     fig.suptitle(title, fontsize=9)
-    fig.subplots_adjust(left=0.03, right=0.93, bottom=0.04, top=0.9, wspace=0.08, hspace=0.35)
-    cax = fig.add_axes([0.945, 0.15, 0.012, 0.7])
+    fig.subplots_adjust(left=0.03, right=0.9, bottom=0.04, top=0.9, wspace=0.08, hspace=0.35)
+    cax = fig.add_axes([0.92, 0.15, 0.012, 0.7])
     fig.colorbar(im, cax=cax).set_label("value (1/sqrt(sr))", fontsize=7)
     return _png(fig, dpi=100)
 
@@ -238,7 +238,7 @@ def basis_contact_sheet(basis) -> bytes:
                     f"{basis.profile}: projector images of the zonal basis, order {basis.order} "
                     f"(zone {z['alpha_deg']:.2f}..{z['beta_deg']:.0f} deg; {rep['projector']['pixels_lit']} lit "
                     f"pixels of {px.resolution[0]} x {px.resolution[1]}; 8 bit, positive minus negative)",
-                    (1.05, 1.05))
+                    (1.05, 1.05), aspect="equal")
 
 
 def basis_latlong_sheet(basis) -> bytes:
@@ -248,7 +248,7 @@ def basis_latlong_sheet(basis) -> bytes:
     extent = (ph[0] - step_p / 2, ph[-1] + step_p / 2, th[-1] + step_t / 2, th[0] - step_t / 2)
     return _pyramid(basis.latlong, basis.indices, float(np.max(np.abs(basis.latlong))),
                     f"{basis.profile}: latitude-longitude maps of the zonal basis, order {basis.order} "
-                    f"(thesis 4.2.1; float values)", (1.5, 0.55), extent, "phi (deg)", "theta (deg)")
+                    f"(thesis 4.2.1; float values)", (1.5, 0.7), extent, "phi (deg)", "theta (deg)")
 
 
 def basis_simulation(report: dict) -> bytes:
