@@ -72,6 +72,7 @@ bench: $(VENV)/.installed stl
 	$(PY) bench/ray_count.py --exports $(EXPORTS)
 	$(PY) bench/float32.py --exports $(EXPORTS)
 	$(PY) bench/make_stl.py
+	$(PY) bench/basis.py
 
 stress: $(VENV)/.installed
 	$(PY) -m pytest -q -m stress --hypothesis-show-statistics

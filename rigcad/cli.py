@@ -229,6 +229,10 @@ def build_parser() -> argparse.ArgumentParser:
     from rigcad.fab.cli import register as register_fab
 
     register_fab(sub)
+
+    from rigcad.basis.cli import register as register_basis
+
+    register_basis(sub)
     return parser
 
 

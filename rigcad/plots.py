@@ -194,3 +194,107 @@ def staircase_map(points: np.ndarray, cusp: np.ndarray, layer: float, title: str
     ax.set_title(title, fontsize=9)
     fig.tight_layout()
     return _png(fig, dpi=100)
+
+
+# -- basis illumination (rigcad basis) --------------------------------------------------------------
+def _pyramid(tiles: np.ndarray, indices: np.ndarray, scale: float, title: str, tile_in: tuple[float, float],
+             extent=None, xlabel: str | None = None, ylabel: str | None = None, aspect: str = "auto") -> bytes:
+    """Tiles (K, rows, cols) of signed values laid out as the SH pyramid: row l, column m (-l..l);
+    diverging colours on one scale +-``scale``, NaN (black) where nothing is shown."""
+    L = int(indices[:, 0].max())
+    cols = 2 * L + 1
+    fig, axes = plt.subplots(L + 1, cols, figsize=(tile_in[0] * cols + 0.8, tile_in[1] * (L + 1) + 0.9),
+                             squeeze=False)
+    cmap = plt.get_cmap("RdBu_r").with_extremes(bad="black")
+    im = None
+    for ax in axes.ravel():
+        ax.set_axis_off()
+    for k, (l, m) in enumerate(indices):
+        ax = axes[l, m + L]
+        im = ax.imshow(tiles[k], cmap=cmap, vmin=-scale, vmax=scale, interpolation="nearest", aspect=aspect,
+                       extent=extent)
+        ax.set_title(f"l={l} m={m:+d}", fontsize=7, pad=2)
+        if extent is not None and l == L and m == -L:
+            ax.set_axis_on()
+            ax.tick_params(labelsize=6)
+            ax.set_xlabel(xlabel, fontsize=7)
+            ax.set_ylabel(ylabel, fontsize=7)
+    fig.suptitle(title, fontsize=9)
+    fig.subplots_adjust(left=0.03, right=0.9, bottom=0.04, top=0.9, wspace=0.08, hspace=0.35)
+    cax = fig.add_axes([0.92, 0.15, 0.012, 0.7])
+    fig.colorbar(im, cax=cax).set_label("value (1/sqrt(sr))", fontsize=7)
+    return _png(fig, dpi=100)
+
+
+def basis_contact_sheet(basis) -> bytes:
+    """Every projector image of a ProjectorBasis (8-bit, positive minus negative, the traced window
+    only), as the SH pyramid; black: pixels that do not light the sample."""
+    px = basis.pixels
+    shown = basis.displayed("analytic", 8)
+    tiles = np.where(basis.illumination.lit[:, None], shown, np.nan).T.reshape((-1,) + px.shape)
+    rep = basis.report
+    z = rep["zone"]
+    return _pyramid(tiles, basis.indices, basis.images[8].scale,
+                    f"{basis.profile}: projector images of the zonal basis, order {basis.order} "
+                    f"(zone {z['alpha_deg']:.2f}..{z['beta_deg']:.0f} deg; {rep['projector']['pixels_lit']} lit "
+                    f"pixels of {px.resolution[0]} x {px.resolution[1]}; 8 bit, positive minus negative)",
+                    (1.05, 1.05), aspect="equal")
+
+
+def basis_latlong_sheet(basis) -> bytes:
+    """The latitude-longitude maps of thesis 4.2.1 (theta down, phi across), as the SH pyramid."""
+    th, ph = np.degrees(basis.latlong_theta_rad), np.degrees(basis.latlong_phi_rad)
+    step_t, step_p = (th[1] - th[0]) if len(th) > 1 else 1.0, (ph[1] - ph[0]) if len(ph) > 1 else 1.0
+    extent = (ph[0] - step_p / 2, ph[-1] + step_p / 2, th[-1] + step_t / 2, th[0] - step_t / 2)
+    return _pyramid(basis.latlong, basis.indices, float(np.max(np.abs(basis.latlong))),
+                    f"{basis.profile}: latitude-longitude maps of the zonal basis, order {basis.order} "
+                    f"(thesis 4.2.1; float values)", (1.5, 0.7), extent, "phi (deg)", "theta (deg)")
+
+
+def basis_simulation(report: dict) -> bytes:
+    """The simulated acquisition on the rig (rigcad.basis.acquire's report): coefficient errors
+    (Gram recovery) per model and order, against eq. 4.3 over the lit part of the zone and over the
+    whole zone, for the rig as designed and moved; and the lobe-width study."""
+    rigs = report["rigs"]
+    names = list(report["models"])
+    orders = report["orders"]
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5.4))
+    markers = ["o", "s", "^", "D", "v"]
+    colours = plt.get_cmap("tab10")
+    for ax, key, rec, title in ((axes[0], "coefficients_vs_lit_zone_rel_l2", "none",
+                                 "no correction, against eq. 4.3 over the lit zone"),
+                                (axes[1], "coefficients_vs_zone_rel_l2", "gram",
+                                 "Gram recovery, against eq. 4.3 over the whole zone")):
+        for ri, (rk, rv) in enumerate(rigs.items()):
+            for oi, o in enumerate(orders):
+                y = [rv["models"][n][f"order_{o}"][key][rec] for n in names]
+                x = np.arange(len(names)) + (ri - (len(rigs) - 1) / 2) * 0.22
+                ax.semilogy(x, y, markers[oi % len(markers)], color=colours(ri), ms=5,
+                            label=f"{rv['rig']}, order {o}" if ax is axes[0] else None)
+        ax.axhline(0.01, color="0.4", ls="--", lw=0.8)
+        ax.set_xticks(np.arange(len(names)))
+        ax.set_xticklabels(names, fontsize=8, rotation=20)
+        ax.set_ylabel("relative L2 error of the zonal coefficients")
+        ax.set_title(f"{report['bits']} bit, {title}", fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=len(rigs), frameon=False)
+    lobe = report["lobe_width_study"]["rows"]
+    ax = axes[2]
+    if lobe:
+        r = [row["width_over_pitch"] for row in lobe]
+        e = [max(row["rel_l2_error"], 1e-13) for row in lobe]  # log axis: round-off shown at 1e-13
+        ax.loglog(r, e, "o-")
+        ax.axvline(1.0, color="0.4", ls="--", lw=0.8)
+        ax.set_xlabel("lobe width / projector pixel pitch")
+        ax.set_ylabel("relative L2 error (no correction)")
+        ax.set_title(f"Ward lobe narrowing (order {report['lobe_width_study']['order']}, "
+                     f"pitch {np.degrees(lobe[0]['pitch_rad']):.2f} deg)", fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+    else:
+        ax.set_axis_off()
+    fig.suptitle(f"{report['profile']}: simulated acquisition on the rig (thesis 3.3.1), zone "
+                 f"{report['zone']['alpha_deg']:.2f}..{report['zone']['beta_deg']:.0f} deg, "
+                 f"{report['camera']['exitant_directions']} exitant directions", fontsize=10)
+    fig.tight_layout(rect=(0, 0.05 + 0.035 * len(orders), 1, 1))
+    return _png(fig, dpi=100)

@@ -181,6 +181,14 @@ class Rig:
         return run_raycheck(self, exports=Path(exports) if exports is not None else None, rays=rays, mode=mode,
                             **options)
 
+    def basis(self, order: int = 6, alpha: float | None = None):
+        """The zonal basis up to ``order`` as this rig's projector shows it (thesis 3.3, 4.2.1): images,
+        Gram matrices over the lit pixels, latitude-longitude maps; ``alpha`` rad the zone's lower
+        edge (default: the occlusion limit). See :func:`rigcad.basis.projector.projector_basis`."""
+        from rigcad.basis.projector import projector_basis
+
+        return projector_basis(self, order, alpha_rad=alpha)
+
     def fab(self, printer, folder: str | Path | None = None, gcode: bool = False, parts: list[str] | None = None,
             progress=None):
         """Fabrication for ``printer`` (a name on the profile search path, a path, or a Printer):

@@ -1,4 +1,4 @@
-"""Smoke test of the issue-7 bench scripts: each runs in its --quick mode into tmp_path and writes
+"""Smoke test of the issue-7 bench scripts (and issue 16's basis.py): each runs in its --quick mode into tmp_path and writes
 its JSON (units in keys, the run's load recorded) and PNG. Nothing here is timed or compared with
 a number: the benchmarks' figures are in bench/results/, produced by `make bench`."""
 
@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-SCRIPTS = ("ray_count", "float32", "tessellation", "make_stl")
+SCRIPTS = ("ray_count", "float32", "tessellation", "make_stl", "basis")
 
 
 @pytest.mark.parametrize("name", SCRIPTS)

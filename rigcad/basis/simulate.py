@@ -25,13 +25,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Mapping
 
 import numpy as np
 
 from rigcad.basis.brdf import Ward
 from rigcad.basis.gram import IlluminationSampling, basis_images, gram, quantise_images
-from rigcad.basis.zonal import Zone, angles_to_directions, check_order, zonal_basis, zone_quadrature
+from rigcad.basis.zonal import Zone, angles_to_directions, check_order, zonal_basis, zonal_moments, zone_rule
 from rigcad.errors import BasisError
 
 Brdf = Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -111,9 +111,9 @@ def simulate_acquisition(brdf: Brdf, wo: np.ndarray, sampling: IlluminationSampl
     return Acquisition(r, c, correction, bits)
 
 
-def _graded_nodes(lo: float, hi: float, centre: float, h0: float, per_panel: int,
-                  ratio: float = 1.5, h_max: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
-    """Composite Gauss-Legendre nodes and weights on [lo, hi], panels of width h0 at ``centre`` growing by ``ratio``."""
+def _graded_breaks(lo: float, hi: float, centre: float, h0: float, ratio: float = 1.5,
+                   h_max: float = 0.25) -> np.ndarray:
+    """Panel boundaries on [lo, hi]: width h0 at ``centre``, growing by ``ratio`` up to ``h_max``."""
     c = min(max(centre, lo), hi)
     breaks = [c]
     x, h = c, h0
@@ -124,20 +124,33 @@ def _graded_nodes(lo: float, hi: float, centre: float, h0: float, per_panel: int
     while x < hi:
         x, h = x + h, min(h * ratio, h_max)
         breaks.append(min(x, hi))
-    b = np.unique(np.array(breaks))
+    return np.unique(np.array(breaks))
+
+
+def _gauss_on(breaks: np.ndarray, per_panel: int) -> tuple[np.ndarray, np.ndarray]:
+    """Composite Gauss-Legendre nodes and weights, ``per_panel`` per panel between ``breaks``."""
     g, w = np.polynomial.legendre.leggauss(per_panel)
-    left, width = b[:-1, None], np.diff(b)[:, None]
+    left, width = breaks[:-1, None], np.diff(breaks)[:, None]
     return (left + 0.5 * width * (g + 1.0)).ravel(), (0.5 * width * w).ravel()
 
 
-def lobe_quadrature(zone: Zone, centre: np.ndarray, width_rad: float, per_panel: int = 8,
-                    refine: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Product quadrature over the zone graded towards the unit direction ``centre`` (3,): (theta, phi, weight_sr).
+def _graded_nodes(lo: float, hi: float, centre: float, h0: float, per_panel: int,
+                  ratio: float = 1.5, h_max: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
+    """Composite Gauss-Legendre nodes and weights on [lo, hi], panels of width h0 at ``centre`` growing by ``ratio``."""
+    return _gauss_on(_graded_breaks(lo, hi, centre, h0, ratio, h_max), per_panel)
 
-    Polar variable u with cos(u) = t (as :func:`zone_quadrature`), azimuth phi; panels of
-    ``width_rad / 2 / refine`` (in angle on the sphere) at the centre, growing geometrically away
-    from it, ``per_panel`` Gauss-Legendre nodes each.
-    """
+
+#: Widest azimuth panel (rad) when an illumination indicator is given: its 8 Gauss nodes are then at
+#: most ~1.5 deg apart, so a lit or dark strip wider than that (the rig's beam hides >= 2.3 deg of
+#: azimuth) has a node inside and its edges are found.
+MASKED_PANEL_RAD = 0.15
+#: Bisection steps that place an indicator's edge between two nodes (~0.03 rad): to 3e-14 rad.
+EDGE_BISECTIONS = 40
+
+
+def _lobe_parts(zone: Zone, centre: np.ndarray, width_rad: float, per_panel: int, refine: float,
+                h_max_phi: float = 0.25) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The graded rule of :func:`lobe_rule` as (theta_rad (n_t,), polar weights (n_t,), azimuth panel breaks)."""
     if not (width_rad > 0 and math.isfinite(width_rad)):
         raise BasisError(f"lobe width_rad = {width_rad!r}: need a positive angle in radians")
     a, b = zone.x_low, zone.x_high
@@ -149,10 +162,74 @@ def lobe_quadrature(zone: Zone, centre: np.ndarray, width_rad: float, per_panel:
     dth_du = max((b - a) * math.sin(u_c) / (2.0 * max(math.sin(th_c), 1e-12)), 1e-12)
     h = 0.5 * width_rad / refine
     u, wu = _graded_nodes(0.0, math.pi, u_c, min(h / dth_du, 0.25), per_panel)
-    p, wp = _graded_nodes(ph_c - math.pi, ph_c + math.pi, ph_c, min(h / max(math.sin(th_c), 1e-3), 0.25), per_panel)
+    breaks = _graded_breaks(ph_c - math.pi, ph_c + math.pi, ph_c, min(h / max(math.sin(th_c), 1e-3), h_max_phi),
+                            h_max=h_max_phi)
     t = np.cos(u)
     theta = np.arccos(np.clip(0.5 * (a + b) + 0.5 * (b - a) * t, -1.0, 1.0))
-    w_pol = 0.5 * (b - a) * np.sin(u) * wu
+    return theta, 0.5 * (b - a) * np.sin(u) * wu, breaks
+
+
+def lobe_rule(zone: Zone, centre: np.ndarray, width_rad: float, per_panel: int = 8,
+              refine: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The factors of :func:`lobe_quadrature`'s product rule: (theta_rad (n_t,), polar weights
+    (n_t,), phi_rad (n_p,), azimuth weights (n_p,)); node (i, j) has weight w_t[i] w_p[j] sr."""
+    theta, w_pol, breaks = _lobe_parts(zone, centre, width_rad, per_panel, refine)
+    p, wp = _gauss_on(breaks, per_panel)
+    return theta, w_pol, p, wp
+
+
+def _split_rows(illuminated: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, breaks: np.ndarray,
+                per_panel: int) -> tuple[np.ndarray, np.ndarray]:
+    """Azimuth rules per polar row over the lit part of each row: (phi (n_t, k), weight (n_t, k)),
+    zero weight where unlit or padded. The indicator is evaluated on the Gauss nodes between
+    ``breaks`` (one full turn); between two nodes where it changes, its edge is placed by bisection
+    and becomes a panel boundary of that row, so each panel is wholly lit or dark and Gauss
+    integrates it at full order. A lit or dark feature narrower than the node spacing may be missed."""
+    g, w = np.polynomial.legendre.leggauss(per_panel)
+    phi, _ = _gauss_on(breaks, per_panel)
+    n_t, n_p = len(theta), len(phi)
+    span = float(breaks[-1] - breaks[0])
+
+    def lit(th, ph):
+        return np.asarray(illuminated(angles_to_directions(th, ph)), dtype=bool)
+
+    M = lit(np.repeat(theta, n_p), np.tile(phi, n_t)).reshape(n_t, n_p)
+    phx = np.append(phi, phi[0] + span)
+    Mx = np.concatenate([M, M[:, :1]], axis=1)
+    i, j = np.nonzero(Mx[:, 1:] != Mx[:, :-1])
+    lo, hi, state = phx[j], phx[j + 1], Mx[i, j]
+    for _ in range(EDGE_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        same = lit(theta[i], mid) == state
+        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+    edges = breaks[0] + np.mod(0.5 * (lo + hi) - breaks[0], span)
+    rows = [np.unique(np.concatenate([breaks, edges[i == r]])) for r in range(n_t)]
+    counts = np.array([len(b) - 1 for b in rows])
+    mids = np.concatenate([0.5 * (b[:-1] + b[1:]) for b in rows])
+    on = lit(np.repeat(theta, counts), mids)
+    lit_panels = np.add.reduceat(on.astype(int), np.r_[0, np.cumsum(counts)[:-1]])
+    k = max(1, int(lit_panels.max())) * per_panel
+    PHI, W = np.zeros((n_t, k)), np.zeros((n_t, k))
+    start = 0
+    for r, b in enumerate(rows):
+        sel = on[start:start + counts[r]]
+        start += counts[r]
+        left, width = b[:-1][sel], np.diff(b)[sel]
+        nodes = (left[:, None] + 0.5 * width[:, None] * (g + 1.0)).ravel()
+        PHI[r, :len(nodes)] = nodes
+        W[r, :len(nodes)] = (0.5 * width[:, None] * w).ravel()
+    return PHI, W
+
+
+def lobe_quadrature(zone: Zone, centre: np.ndarray, width_rad: float, per_panel: int = 8,
+                    refine: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Product quadrature over the zone graded towards the unit direction ``centre`` (3,): (theta, phi, weight_sr).
+
+    Polar variable u with cos(u) = t (as :func:`zone_quadrature`), azimuth phi; panels of
+    ``width_rad / 2 / refine`` (in angle on the sphere) at the centre, growing geometrically away
+    from it, ``per_panel`` Gauss-Legendre nodes each.
+    """
+    theta, w_pol, p, wp = lobe_rule(zone, centre, width_rad, per_panel, refine)
     TH, PH = np.meshgrid(theta, p, indexing="ij")
     return TH.ravel(), PH.ravel(), (w_pol[:, None] * wp[None, :]).ravel()
 
@@ -171,29 +248,61 @@ class Reference:
     error_estimate: float
 
 
+def reference_set(brdfs: Mapping[str, Brdf], wo: np.ndarray, order: int, zone: Zone,
+                  lobe_width_rad: float | None = None, per_panel: int = 8,
+                  illuminated: Callable[[np.ndarray], np.ndarray] | None = None) -> dict[str, "Reference"]:
+    """:func:`reference_coefficients` of several BRDFs on shared quadrature nodes: name -> Reference.
+
+    ``illuminated``: an optional indicator of the incidence directions that receive light, a
+    callable from unit vectors (n, 3) to booleans (n,) (evaluated once per node set, shared by the
+    BRDFs); the integrand is multiplied by it, giving eq. 4.3 over the part of the zone a real
+    projector lights. A discontinuous indicator makes the rule converge only to first order at its
+    edges; the error estimate (refined panels) shows it.
+    """
+    L = check_order(order)
+    wo = _wo(wo)
+    K = (L + 1) ** 2
+    out = {name: np.empty((2, wo.shape[0], K)) for name in brdfs}
+    for o in range(wo.shape[0]):
+        for r, refine in enumerate((1.0, 2.0)):
+            if illuminated is None:
+                if lobe_width_rad is None:
+                    n = int(6 * (L + 8) * refine)
+                    th, wt, ph, wp = zone_rule(zone, n, 2 * n)
+                else:
+                    th, wt, ph, wp = lobe_rule(zone, mirror(wo[o]), lobe_width_rad, per_panel, refine)
+                weight = wt[:, None] * wp[None, :]
+            else:
+                if lobe_width_rad is None:  # the uniform rule's nodes, azimuth in Gauss panels
+                    n = int(6 * (L + 8) * refine)
+                    th, wt, _, _ = zone_rule(zone, n, 1)
+                    panels = max(1, math.ceil(2 * math.pi / min(MASKED_PANEL_RAD, 2 * math.pi * per_panel / (2 * n))))
+                    breaks = np.linspace(0.0, 2 * math.pi, panels + 1)
+                else:
+                    th, wt, breaks = _lobe_parts(zone, mirror(wo[o]), lobe_width_rad, per_panel, refine,
+                                                 MASKED_PANEL_RAD)
+                ph, wp = _split_rows(illuminated, th, breaks, per_panel)  # (n_t, k) each
+                weight = wt[:, None] * wp
+            wi = angles_to_directions(th[:, None], ph if ph.ndim == 2 else ph[None, :])
+            weight = weight * wi[..., 2]
+            for name, brdf in brdfs.items():
+                g = np.asarray(brdf(wi, wo[o][None, None, :]), dtype=float) * weight
+                out[name][r, o] = zonal_moments(th, ph, g, L, zone)
+    return {name: Reference(v[1], float(np.max(np.abs(v[1] - v[0])))) for name, v in out.items()}
+
+
 def reference_coefficients(brdf: Brdf, wo: np.ndarray, order: int, zone: Zone,
-                           lobe_width_rad: float | None = None, per_panel: int = 8) -> Reference:
+                           lobe_width_rad: float | None = None, per_panel: int = 8,
+                           illuminated: Callable[[np.ndarray], np.ndarray] | None = None) -> Reference:
     """Zonal coefficients of f(., wo) cos(theta_i) over the zone by product Gauss quadrature (eq. 4.3).
 
     ``lobe_width_rad``: angular width of the specular lobe in incidence directions around the
     mirror direction of each wo (for example 2 alpha for Ward/Beckmann roughness alpha); None means
     a smooth integrand (uniform Gauss rule, 6 (order + 8) polar nodes). The error estimate repeats
     the graded rule with panels half as wide (or the uniform rule with twice the nodes).
+    ``illuminated``: see :func:`reference_set`. Summed separably (:func:`zonal_moments`).
     """
-    L = check_order(order)
-    wo = _wo(wo)
-    out = np.empty((2, wo.shape[0], (L + 1) ** 2))
-    for o in range(wo.shape[0]):
-        for r, refine in enumerate((1.0, 2.0)):
-            if lobe_width_rad is None:
-                n = int(6 * (L + 8) * refine)
-                th, ph, w = zone_quadrature(zone, n, 2 * n)
-            else:
-                th, ph, w = lobe_quadrature(zone, mirror(wo[o]), lobe_width_rad, per_panel, refine)
-            wi = angles_to_directions(th, ph)
-            g = np.asarray(brdf(wi, wo[o][None, :]), dtype=float) * wi[:, 2] * w
-            out[r, o] = g @ zonal_basis(th, ph, L, zone)
-    return Reference(out[1], float(np.max(np.abs(out[1] - out[0]))))
+    return reference_set({"f": brdf}, wo, order, zone, lobe_width_rad, per_panel, illuminated)["f"]
 
 
 def relative_l2(estimate: np.ndarray, truth: np.ndarray) -> float:

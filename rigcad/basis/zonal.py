@@ -208,15 +208,10 @@ def angles_to_directions(theta_rad: np.ndarray, phi_rad: np.ndarray) -> np.ndarr
     return np.stack([st * np.cos(ph), st * np.sin(ph), np.cos(th)], axis=-1)
 
 
-def zone_quadrature(zone: Zone, n_polar: int, n_azimuth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Product rule over the zone: (theta_rad, phi_rad, weight_sr), each flat of n_polar * n_azimuth.
-
-    Polar: t = cos(u) (so d omega = (b - a)/2 sin(u) du d phi) with Gauss-Legendre in u over [0, pi];
-    this absorbs the sqrt(1 - t^2) edge factors of the m != 0 zonal functions, so integrands mixing
-    zonal and spherical functions (sh.py) converge geometrically in n_polar instead of algebraically.
-    Azimuth: equispaced nodes (periodic trapezoid rule), exact for trigonometric polynomials of
-    degree < n_azimuth. Weights sum to the zone's solid angle to round-off.
-    """
+def zone_rule(zone: Zone, n_polar: int, n_azimuth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The factors of :func:`zone_quadrature`'s product rule: (theta_rad (n_polar,), polar weights
+    (n_polar,), phi_rad (n_azimuth,), azimuth weights (n_azimuth,)); node (i, j) has weight
+    w_theta[i] * w_phi[j] sr."""
     if n_polar < 1 or n_azimuth < 1:
         raise BasisError(f"quadrature sizes n_polar = {n_polar}, n_azimuth = {n_azimuth}: need >= 1 each")
     g, w = np.polynomial.legendre.leggauss(int(n_polar))
@@ -227,7 +222,54 @@ def zone_quadrature(zone: Zone, n_polar: int, n_azimuth: int) -> tuple[np.ndarra
     theta = np.arccos(np.clip(x, -1.0, 1.0))
     w_polar = 0.5 * (b - a) * np.sin(u) * (0.5 * math.pi * w)
     phi = 2.0 * math.pi * np.arange(int(n_azimuth)) / n_azimuth
-    w_az = 2.0 * math.pi / n_azimuth
+    return theta, w_polar, phi, np.full(int(n_azimuth), 2.0 * math.pi / n_azimuth)
+
+
+def zone_quadrature(zone: Zone, n_polar: int, n_azimuth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Product rule over the zone: (theta_rad, phi_rad, weight_sr), each flat of n_polar * n_azimuth.
+
+    Polar: t = cos(u) (so d omega = (b - a)/2 sin(u) du d phi) with Gauss-Legendre in u over [0, pi];
+    this absorbs the sqrt(1 - t^2) edge factors of the m != 0 zonal functions, so integrands mixing
+    zonal and spherical functions (sh.py) converge geometrically in n_polar instead of algebraically.
+    Azimuth: equispaced nodes (periodic trapezoid rule), exact for trigonometric polynomials of
+    degree < n_azimuth. Weights sum to the zone's solid angle to round-off.
+    """
+    theta, w_polar, phi, w_az = zone_rule(zone, n_polar, n_azimuth)
     TH, PH = np.meshgrid(theta, phi, indexing="ij")
-    W = np.broadcast_to(w_polar[:, None] * w_az, TH.shape)
+    W = np.broadcast_to(w_polar[:, None] * w_az[None, :], TH.shape)
     return TH.ravel(), PH.ravel(), np.ascontiguousarray(W).ravel()
+
+
+def zonal_moments(theta_rad: np.ndarray, phi_rad: np.ndarray, values: np.ndarray, order: int, zone: Zone) -> np.ndarray:
+    """sum_ij values[..., i, j] Z_k(theta_i, phi_j) for every k (shape values.shape[:-2] + (K,)): the
+    zonal coefficients of a function sampled on a product grid theta (n_t,) x phi (n_p,) with its
+    quadrature weights already multiplied in; ``phi_rad`` (n_t, n_p) gives each polar row its own
+    azimuths instead. Separable (Legendre factors on theta, cos/sin(m phi)
+    on phi, as :func:`real_basis`), so it costs O(n_t n_p order) instead of O(n_t n_p K) for the
+    dense ``values.ravel() @ zonal_basis(...)``, which it equals to round-off (tested)."""
+    L = check_order(order)
+    g = np.asarray(values, dtype=float)
+    th, ph = np.asarray(theta_rad, dtype=float), np.asarray(phi_rad, dtype=float)
+    rows = ph.ndim == 2  # an azimuth rule of its own per polar row
+    n_p = ph.shape[-1] if ph.ndim else 1
+    if g.shape[-2:] != (th.size, n_p) or (rows and ph.shape != (th.size, n_p)) or ph.ndim > 2:
+        raise BasisError(f"values have shape {g.shape}, phi {ph.shape}: need values (..., {th.size}, n_phi) "
+                         "(theta x phi) and phi (n_phi,) or (n_theta, n_phi)")
+    N = normalized_legendre(zone.shifted_cosine(th), L)  # (n_t, L+1, L+1)
+    radial = math.sqrt(2.0 / (zone.x_high - zone.x_low))
+    out = np.empty(g.shape[:-2] + ((L + 1) ** 2,))
+    ls = np.arange(L + 1)
+
+    def azimuthal(trig):  # sum over phi of g times trig(phi), shape (..., n_t)
+        return (g * trig).sum(axis=-1) if rows else g @ trig
+
+    for m in range(L + 1):
+        if m == 0:
+            a = g.sum(axis=-1) * (radial / math.sqrt(2.0 * math.pi))  # (..., n_t)
+            out[..., ls * ls + ls] = a @ N[:, :, 0]
+            continue
+        lm = ls[m:]
+        c = radial / math.sqrt(math.pi)
+        out[..., lm * lm + lm + m] = azimuthal(c * np.cos(m * ph)) @ N[:, m:, m]
+        out[..., lm * lm + lm - m] = azimuthal(c * np.sin(m * ph)) @ N[:, m:, m]
+    return out

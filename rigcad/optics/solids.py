@@ -52,3 +52,12 @@ def z_cylinder(origins: np.ndarray, dirs: np.ndarray, radius: float, z0: float, 
     t_lo = np.fmax(np.where(disc >= 0, r_in, np.inf), zl)
     t_hi = np.fmin(np.where(disc >= 0, r_out, -np.inf), zh)
     return t_lo, t_hi
+
+
+def segments_hit_cylinder(a: np.ndarray, b: np.ndarray, radius: float, z0: float, z1: float,
+                          centre: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+    """Does each segment a[i] -> b[i] (n, 3) pass through the solid z-cylinder (``radius`` mm about
+    ``centre``, z0..z1 mm)? End points touching within 1e-9 of the length do not count, as
+    :func:`segments_hit_box`."""
+    enter, leave = z_cylinder(a, b - a, radius, z0, z1, centre)
+    return (enter <= leave) & (leave > 1e-9) & (enter < 1 - 1e-9)

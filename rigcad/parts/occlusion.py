@@ -32,27 +32,31 @@ def bounds(solid: Box | Cylinder) -> tuple[np.ndarray, np.ndarray]:
     return np.array([x - r, y - r, z]), np.array([x + r, y + r, z + solid.height])
 
 
+def design_path(table: dict[str, np.ndarray], theta: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The design light path of incidence directions (theta, phi) (n,) rad at O: the paraboloid point
+    P and the dome point D (n, 3) mm, in the meridional plane at azimuth phi, by linear interpolation
+    in theta between the rows of the design's profile table (``optics.design.profile_table``)."""
+    order = np.argsort(table["incidence_theta_deg"])
+    th_tab = np.radians(table["incidence_theta_deg"][order])
+    rD, zD, rP, zP = (np.interp(theta, th_tab, table[k][order])
+                      for k in ("dome_r_mm", "dome_z_mm", "paraboloid_r_mm", "paraboloid_z_mm"))
+    c, s = np.cos(phi), np.sin(phi)
+    return np.column_stack([rP * c, rP * s, zP]), np.column_stack([rD * c, rD * s, zD])
+
+
 def blocked_solid_angle(occluders: dict[str, tuple], table: dict[str, np.ndarray],
                         n_theta: int = 400, n_phi: int = 1440) -> dict[str, float]:
     """Solid angle (sr) of the measurable zone's incidence directions blocked by the beam,
     clamp and stem (``occluders``: part name -> ((name, Box or Cylinder), ...), as
     ``Rig.occluders``), on a midpoint grid of ``n_theta`` x ``n_phi`` cells (sr weights sin(theta)).
     ``table``: the design's profile table (``optics.design.profile_table``)."""
-    theta_deg = table["incidence_theta_deg"]
-    order = np.argsort(theta_deg)
-    th_tab = np.radians(theta_deg[order])
+    th_tab = np.radians(np.sort(table["incidence_theta_deg"]))
     th_edges = np.linspace(th_tab[0], th_tab[-1], n_theta + 1)
     th = 0.5 * (th_edges[:-1] + th_edges[1:])
     phi = (np.arange(n_phi) + 0.5) * 2 * math.pi / n_phi
-    rD = np.interp(th, th_tab, table["dome_r_mm"][order])
-    zD = np.interp(th, th_tab, table["dome_z_mm"][order])
-    rP = np.interp(th, th_tab, table["paraboloid_r_mm"][order])
-    zP = np.interp(th, th_tab, table["paraboloid_z_mm"][order])
     T, F = np.meshgrid(np.arange(n_theta), phi, indexing="ij")
-    c, s = np.cos(F).ravel(), np.sin(F).ravel()
     i = T.ravel()
-    D = np.column_stack([rD[i] * c, rD[i] * s, zD[i]])
-    P = np.column_stack([rP[i] * c, rP[i] * s, zP[i]])
+    P, D = design_path(table, th[i], F.ravel())
     O = np.zeros_like(D)
 
     solids = {name: solid for group in occluders.values() for name, solid in group}

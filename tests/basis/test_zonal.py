@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rigcad.basis.zonal import (Zone, basis_count, basis_index, basis_indices, normalized_legendre, zonal_basis,
-                                zone_quadrature)
+                                zonal_moments, zone_quadrature, zone_rule)
 from rigcad.errors import BasisError, RigcadError
 
 #: The rig's zone, thesis eq. 3.4: theta in [pi/20, pi/2].
@@ -109,6 +109,30 @@ def test_zone_quadrature_integrates_the_basis():
     B = zonal_basis(th, ph, 8, THESIS_ZONE)
     # the u-substituted rule converges geometrically; 30 nodes resolve degree-16 products (measured 3e-15)
     assert np.max(np.abs(B.T @ (B * w[:, None]) - np.eye(81))) < 1e-12
+
+
+@pytest.mark.parametrize("zone", ZONES)
+def test_separable_moments_equal_the_dense_sum(zone):
+    # zonal_moments sums separably what values.ravel() @ zonal_basis(...) sums densely, on an uneven grid
+    rng = np.random.default_rng(3)
+    theta = np.sort(rng.uniform(zone.alpha_rad, zone.beta_rad, 23))
+    phi = rng.uniform(0, 2 * math.pi, 17)
+    values = rng.normal(size=(2, 23, 17))
+    T, P = np.meshgrid(theta, phi, indexing="ij")
+    dense = values.reshape(2, -1) @ zonal_basis(T.ravel(), P.ravel(), 8, zone)
+    sep = zonal_moments(theta, phi, values, 8, zone)
+    # two summation orders of ~400 terms of size O(10): round-off (measured 7e-14 against sums of O(50))
+    assert np.max(np.abs(sep - dense)) < 1e-12 * max(1.0, np.max(np.abs(dense))), np.max(np.abs(sep - dense))
+    with pytest.raises(BasisError, match=r"need values \(\.\.\., 23, n_phi\)"):
+        zonal_moments(theta, phi, values[..., :5], 8, zone)
+
+
+def test_zone_rule_is_the_factor_of_zone_quadrature():
+    th, wt, ph, wp = zone_rule(THESIS_ZONE, 7, 5)
+    t2, p2, w2 = zone_quadrature(THESIS_ZONE, 7, 5)
+    # the flat rule is the outer product of the factors, bit for bit
+    assert np.array_equal(np.repeat(th, 5), t2) and np.array_equal(np.tile(ph, 7), p2)
+    assert np.array_equal(np.outer(wt, wp).ravel(), w2)
 
 
 def test_indices_follow_the_sh_ordering():

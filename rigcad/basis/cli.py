@@ -1,0 +1,109 @@
+"""``rigcad basis PROFILE [--order N] [--exports DIR] [--alpha-deg A] [--lowdin] [--simulate]``: the
+projector images of the zonal basis, their Gram matrices and (``--simulate``) the simulated
+acquisition on the rig, from the command line (wired into rigcad.cli by :func:`register`)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+
+def _order(text: str):
+    """The order as an int when it reads as one, else the text (refused with one line by check_basis_order)."""
+    try:
+        return int(text)
+    except ValueError:
+        return text
+
+
+def cmd_basis(args: argparse.Namespace) -> int:
+    from rigcad.basis.acquire import simulate_on_rig, simulation_steps, write_simulation
+    from rigcad.basis.projector import BASIS_STEPS, check_basis_order, projector_basis, write_basis
+    from rigcad.cli import _progress
+    from rigcad.rig import load
+
+    order = check_basis_order(_order(args.order))  # before any work: a bad order is one line, nothing written
+    alpha = None if args.alpha_deg is None else math.radians(args.alpha_deg)
+    rig = load(args.profile)
+    out = Path(args.exports) / rig.name / "basis"
+    total = BASIS_STEPS + (order + 1) ** 2 + 1 + (simulation_steps() if args.simulate else 0)
+    t0 = time.perf_counter()
+    with _progress(total, f"basis {rig.name}") as step:
+        basis = projector_basis(rig, order, alpha_rad=alpha, progress=step)
+        paths = write_basis(basis, out, lowdin_images=args.lowdin, progress=step)
+        t_images = time.perf_counter() - t0
+        sim = None
+        if args.simulate:
+            sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step)
+            paths += write_simulation(sim, out)
+    rep = basis.report
+    z, px, sa = rep["zone"], rep["projector"], rep["solid_angle"]
+    print(f"{rig.name}: zonal basis to order {order} ({rep['functions']} functions) over "
+          f"{z['alpha_deg']:.3f}..{z['beta_deg']:.0f} deg; {px['pixels_lit']} lit projector pixels "
+          f"({px['lit_fraction_of_zone']:.1%} of the zone's solid angle), pitch {px['pitch_deg']:.2f} deg")
+    print(f"  pixel solid angles: {sa['pixel_sum_sr']:.6f} sr against 2 pi (cos alpha - cos beta) = "
+          f"{sa['zone_closed_form_sr']:.6f} sr (relative {sa['relative_error']:+.2e}; edge bound "
+          f"{sa['edge_bound_sr']:.3g} sr)")
+    print("  Gram matrix over the lit pixels, largest |G - I|: order  analytic  8-bit  16-bit  "
+          "no occluders  Loewdin 8-bit (deviation)")
+    for key, g in rep["gram"].items():
+        if key.startswith("order_"):
+            print(f"    {key[6:]:>5}  {g['analytic']['max_abs']:.2e}  {g['analytic_8bit']['max_abs']:.2e}  "
+                  f"{g['analytic_16bit']['max_abs']:.2e}  {g['analytic_without_occluders']['max_abs']:.2e}      "
+                  f"{g['lowdin_8bit']['max_abs']:.2e} ({g['lowdin_deviation_from_analytic']['max']:.3f})")
+    print(f"  {len(paths)} files in {out}/ ({t_images:.1f} s)")
+    if sim is not None:
+        r = sim.report
+        print(f"  simulated acquisition ({r['camera']['exitant_directions']} exitant directions, {r['bits']}-bit "
+              f"images; relative L2 of the zonal coefficients; {time.perf_counter() - t0 - t_images:.1f} s):")
+        print("    model          order  lit zone (none)  zone (none)  zone (gram)   " +
+              "  ".join(f"moved {i}: lit zone (none)" for i in range(1, len(r["rigs"]))))
+        for name in r["models"]:
+            for o in r["orders"]:
+                cells = []
+                for rv in r["rigs"].values():
+                    f = rv["models"][name][f"order_{o}"]
+                    cells.append(f)
+                a = cells[0]
+                print(f"    {name:<14} {o:>5}  {a['coefficients_vs_lit_zone_rel_l2']['none']:15.2e}  "
+                      f"{a['coefficients_vs_zone_rel_l2']['none']:11.2e}  {a['coefficients_vs_zone_rel_l2']['gram']:11.2e}   "
+                      + "  ".join(f"{c['coefficients_vs_lit_zone_rel_l2']['none']:24.2e}" for c in cells[1:]))
+        for i, (key, rv) in enumerate(r["rigs"].items()):
+            if i:
+                print(f"    moved {i}: {rv['rig']}")
+        for rv in r["rigs"].values():
+            card = rv["gray_card_order_1"]
+            print(f"    gray card (4.1.2, orders 0-1), {rv['rig']}: albedo error {card['gram']['albedo_max_rel_error']:.2e} "
+                  f"(Gram), {card['none']['albedo_max_rel_error']:.2e} (none)")
+    return 0
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add ``basis`` to rigcad's subcommands."""
+    from rigcad.basis.acquire import CAMERA_STRIDE_PX
+
+    p = subparsers.add_parser(
+        "basis", help="zonal basis images for the projector, Gram matrices, simulated acquisition",
+        description="Compute the zonal basis functions (thesis 3.3) at every projector pixel's incidence "
+                    "direction (the rig's own map; pixels that do not reach the sample black), preprocess them as "
+                    "thesis 4.2.1 (one scale, positive and negative parts, 8 and 16 bit) and write "
+                    "exports/<profile>/basis/: projector/{8bit,16bit}/*.png, the latitude-longitude maps "
+                    "latlong/, contact_sheet.png, latlong_sheet.png and basis.json (solid-angle check, Gram "
+                    "matrices over the lit pixels, the re-orthonormalised set). --simulate adds the thesis's "
+                    "basis validation (3.3.1) on the rig as designed and moved within its tolerances: "
+                    "simulation.json and simulation.png.")
+    p.add_argument("profile", help="profile name (under profiles/) or path")
+    p.add_argument("--order", default="6", help="largest l, 0..12 (default 6: thesis 3.3.1, specular materials)")
+    p.add_argument("--exports", default="exports", help="output root (default: exports)")
+    p.add_argument("--alpha-deg", type=float, help="the zone's lower edge in degrees (default: the rig's occlusion "
+                                                   "limit, its lowest measurable incidence angle)")
+    p.add_argument("--lowdin", action="store_true", help="also write the re-orthonormalised (Loewdin) images")
+    p.add_argument("--simulate", action="store_true", help="simulated acquisition: five analytic BRDFs, the rig "
+                                                           "as designed and moved by its tolerances")
+    p.add_argument("--camera-stride-px", type=int, default=CAMERA_STRIDE_PX,
+                   help=f"simulate every N-th camera pixel in both directions (default {CAMERA_STRIDE_PX}: ~50 "
+                        "exitant directions)")
+    p.set_defaults(func=cmd_basis)
+    return p
