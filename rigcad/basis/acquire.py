@@ -354,7 +354,7 @@ def write_simulation(sim: RigSimulation, out_dir) -> list:
     from rigcad.export.atomic import Staging, json_bytes
 
     out = Path(out_dir)
-    with Staging() as st:
+    with Staging(out) as st:
         st.write_bytes(out / "simulation.json", json_bytes(sim.report))
         st.write_bytes(out / "simulation.png", plots.basis_simulation(sim.report))
         return st.commit()

@@ -672,7 +672,10 @@ def write_basis(basis: ProjectorBasis, out_dir: str | Path, *, lowdin_images: bo
     out = Path(out_dir)
     kinds = [("analytic", "projector")] + ([("lowdin", "projector_lowdin")] if lowdin_images else [])
     written = []
-    with Staging() as st:
+    def carry(rel: Path) -> bool:  # images of an earlier run that this one does not write are dropped
+        return not (rel.parts[0] in ("projector", "projector_lowdin", "latlong") and rel.match("*bit/z_*.png"))
+
+    with Staging(out, carry=carry) as st:
         for k, (l, m) in enumerate(basis.indices):
             for part in ("positive", "negative"):
                 name = image_name(int(l), int(m), part)
@@ -692,10 +695,5 @@ def write_basis(basis: ProjectorBasis, out_dir: str | Path, *, lowdin_images: bo
         report = {**basis.report, "files": files, "lowdin_images_written": lowdin_images}
         written.append(st.write_bytes(out / "basis.json", json_bytes(report)))
         paths = st.commit()
-    keep = {p.resolve() for p in paths}
-    for folder in ("projector", "projector_lowdin", "latlong"):
-        for stale in sorted((out / folder).glob("*bit/z_*.png")):
-            if stale.resolve() not in keep:
-                stale.unlink()
     step("contact sheets and basis.json written")
     return paths

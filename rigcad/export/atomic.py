@@ -101,12 +101,18 @@ class Staging:
     ``.<name>.lock`` beside ``folder``) for its whole duration: two runs on one folder never
     interleave; the second waits and says who holds the lock.
 
+    ``carry(rel_path) -> bool`` chooses which untouched files of the previous folder are carried
+    over (default: all); a run that owns a family of files (say ``*bit/z_*.png``) drops the stale
+    ones of an earlier run by refusing them here.
+
     I/O failures (no space, permission, read-only file system, a file vanished) raise WriteError
     naming the path; the previous outputs are untouched.
     """
 
-    def __init__(self, folder: Path, lock: Path | None = None, say=None) -> None:
+    def __init__(self, folder: Path, lock: Path | None = None, say=None,
+                 carry: Callable[[Path], bool] | None = None) -> None:
         self.folder = Path(folder)
+        self._carry = carry
         self.lock_path = Path(lock) if lock is not None else self.folder.parent / f".{self.folder.name}.lock"
         self._say = say
         self._lock = None
@@ -171,7 +177,7 @@ class Staging:
         if new is None:
             raise ExportError("Staging.commit outside its `with` block")
         if self.folder.is_dir():
-            _guard(self.folder, lambda: _carry_over(self.folder, new))
+            _guard(self.folder, lambda: _carry_over(self.folder, new, self._carry))
         _guard(self.folder, lambda: os.chmod(new, 0o777 & ~_umask()))
         if self.folder.exists():
             _guard(self.folder, lambda: _exchange(new, self.folder))
@@ -209,9 +215,10 @@ def write_error(path: Path, err: OSError) -> "WriteError":
     return WriteError(f"cannot write {err.filename or path}: {hint}; the previous outputs are unchanged")
 
 
-def _carry_over(old: Path, new: Path) -> None:
-    """Hard-link (or copy) every file of ``old`` that ``new`` does not have yet, skipping rigcad's
-    own hidden staging folders, locks and temporaries."""
+def _carry_over(old: Path, new: Path, carry: Callable[[Path], bool] | None = None) -> None:
+    """Hard-link (or copy) every file of ``old`` that ``new`` does not have yet (and ``carry``
+    accepts, given its path relative to ``old``), skipping rigcad's own hidden staging folders,
+    locks and temporaries."""
     for dirpath, dirnames, filenames in os.walk(old):
         rel = Path(dirpath).relative_to(old)
         dirnames[:] = [d for d in dirnames if not _ours(d)]
@@ -219,7 +226,7 @@ def _carry_over(old: Path, new: Path) -> None:
             if _ours(name):
                 continue
             target = new / rel / name
-            if target.exists():
+            if target.exists() or (carry is not None and not carry(rel / name)):
                 continue
             target.parent.mkdir(parents=True, exist_ok=True)
             try:
