@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 
 #: Radians per degree: the one conversion constant the code uses internally (reports say "_deg").
 DEG = math.pi / 180.0
@@ -42,7 +43,12 @@ ANGLE_UNITS: dict[str, float] = {
 KINDS = {"length": LENGTH_UNITS, "angle": ANGLE_UNITS}
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_QUANTITY = re.compile(rf"^\s*(?P<num>{_NUMBER}|[-+]?inf(?:inity)?)\s*(?P<unit>[^\s\d.+-][^\s]*)?\s*$", re.I)
+_QUANTITY = re.compile(rf"^\s*(?P<num>{_NUMBER}|[-+]?inf(?:inity)?)\s*(?P<unit>[^\s\d.+-][^\s]*)?\s*$",
+                       re.I | re.ASCII)
+#: Longest number literal read (characters): float64 carries 17 significant digits.
+MAX_NUMBER_CHARS = 40
+#: The non-ASCII characters a quantity may hold: unit symbols only.
+_UNIT_SYMBOLS = frozenset(ch for table in (LENGTH_UNITS, ANGLE_UNITS) for unit in table for ch in unit if ord(ch) > 127)
 
 
 class UnitError(ValueError):
@@ -65,11 +71,22 @@ def parse_quantity(text: object, kind: str) -> float:
         raise UnitError(f"a {kind} needs a unit, e.g. '{text} {'mm' if kind == 'length' else 'deg'}' (units: {valid})")
     if not isinstance(text, str):
         raise UnitError(f"expected a {kind} such as '13.5 cm' or '20 deg', got {text!r}")
+    for i, ch in enumerate(text):
+        if ord(ch) > 127 and ch not in _UNIT_SYMBOLS:
+            name = unicodedata.name(ch, "unnamed").lower()
+            raise UnitError(f"character {i + 1} of the value is U+{ord(ch):04X} ({name}): numbers take ASCII "
+                            "digits, '.', 'e' and ASCII spaces, e.g. '13.5 cm'")
     match = _QUANTITY.match(text)
     if not match:
         raise UnitError(f"cannot read {text!r} as a {kind}: write a number and a unit, e.g. '13.5 cm' (units: {valid})")
+    if len(match["num"]) > MAX_NUMBER_CHARS:
+        raise UnitError(f"a number of {len(match['num'])} characters: write at most {MAX_NUMBER_CHARS} "
+                        "(float64 keeps 17 significant digits), e.g. '1.5e3 mm'")
     number = float(match["num"])
     unit = match["unit"]
+    literal_inf = "inf" in match["num"].lower()
+    if math.isinf(number) and not literal_inf:
+        raise UnitError(f"{match['num']} is beyond float64's range (~1.8e308); write 'inf' if you mean infinity")
     if math.isinf(number) and kind != "length":
         raise UnitError(f"an infinite {kind} makes no sense: {text!r}")
     if unit is None:
@@ -81,7 +98,10 @@ def parse_quantity(text: object, kind: str) -> float:
         other = [k for k, table in KINDS.items() if k != kind and (unit in table or unit.lower() in table)]
         hint = f" ({unit!r} is a unit of {other[0]})" if other else ""
         raise UnitError(f"unknown {kind} unit {unit!r} in {text!r}{hint}; valid: {valid}")
-    return number * units[key]
+    value = number * units[key]
+    if math.isinf(value) and not literal_inf:
+        raise UnitError(f"{text!r} is beyond float64's range once converted to {'mm' if kind == 'length' else 'rad'}")
+    return value
 
 
 def mm_to_in(value_mm: float) -> float:

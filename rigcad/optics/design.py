@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigcad.errors import GeometryError, RigcadError
-from rigcad.optics.dome import DomeProfile, build_dome, reflected_rays
+from rigcad.errors import GeometryError, ProfileError, RigcadError
+from rigcad.optics.dome import DomeProfile, build_dome, reflected_rays, start
 from rigcad.optics.misalignment import COMPONENT_OFFSETS, Offsets, convergence_error, misaligned_trace, offsets_for
 from rigcad.optics.paraboloid import Paraboloid, unit
 from rigcad.optics.thin_lens import ThinLensResult, thin_lens_check
@@ -93,6 +93,10 @@ def _stat(values: np.ndarray) -> dict[str, float]:
 #: this fraction of the optical path; rows are doubled until it does (pointed paraboloids need more).
 CURVE_MISS_RTOL = 1e-9
 MAX_ROWS = 1 << 17
+#: The share of the curve's allowance (CURVE_MISS_RTOL x path) an explicit dome.tolerance may take.
+TOLERANCE_SHARE = 0.5
+#: Doubling the rows must cut the curve's miss below this fraction, or the rows are the limit.
+STALL_RATIO = 0.5
 #: A design whose incidence angles span less than this is refused: it measures nothing useful.
 MIN_THETA_SPAN_DEG = 1.0
 
@@ -103,6 +107,15 @@ def converged_dome(profile: Profile, geo: Derived) -> DomeProfile:
     dp = profile.dome
     rows = dp.table_rows
     para = Paraboloid(geo.focal_length, geo.vertex_z, geo.rim_radius)
+    if dp.tolerance is not None and dp.method in ("dop853", "rk45"):
+        need = TOLERANCE_SHARE * CURVE_MISS_RTOL * start(geo).path_length
+        if dp.tolerance > need:  # no number of rows could bring the curve within its requirement
+            raise ProfileError(
+                f"dome.tolerance = {dp.tolerance:g} mm is looser than this rig's dome can be: its curve must return "
+                f"every chief ray to O within {CURVE_MISS_RTOL:g} of the {start(geo).path_length:.0f} mm optical path "
+                f"({2 * need:.2g} mm); ask for a tolerance well below that, e.g. {need / 10:.1g} mm, or leave it unset",
+                where=profile.where("dome", "tolerance"))
+    previous = None
     while True:
         try:
             dome = build_dome(geo, dp.method, tolerance=dp.tolerance, euler_steps=dp.euler_steps, rows=rows)
@@ -123,13 +136,23 @@ def converged_dome(profile: Profile, geo: Derived) -> DomeProfile:
         origins, dirs = chief_rays(geo, para, dome, profile.misalignment.rays)
         tr = trace(para, DomeCurve.from_profile(dome), origins, dirs)
         miss = np.abs(tr.miss[tr.ok])
-        if not miss.size or miss.max() <= CURVE_MISS_RTOL * dome.path_length:
+        need = CURVE_MISS_RTOL * dome.path_length
+        if not miss.size or miss.max() <= need:
             return dome
+        worst = float(miss.max())
+        if previous is not None and worst > STALL_RATIO * previous and dp.tolerance is not None:
+            # more rows no longer help (a quintic spline's error falls ~32x per doubling): the rows
+            # themselves are off by the integrator's tolerance
+            raise ProfileError(
+                f"dome.tolerance = {dp.tolerance:g} mm leaves the dome's curve {worst:.2g} mm off the sample point "
+                f"however many rows it has ({previous:.2g} mm with half as many); the curve needs {need:.2g} mm: ask for "
+                f"dome.tolerance <= {dp.tolerance * need / worst / 2:.1g} mm, or leave it unset", where=profile.where("dome", "tolerance"))
         if rows >= MAX_ROWS:
             raise GeometryError(
-                f"the dome's curve still misses the sample point by {miss.max():.2g} mm with {rows} rows: the design "
+                f"the dome's curve still misses the sample point by {worst:.2g} mm with {rows} rows: the design "
                 "is too close to degenerate to build reliably; change layout.sample_to_rim or paraboloid.tangent_angle",
                 where=profile.where("dome", "table_rows"))
+        previous = worst
         rows = min(2 * rows - 1, MAX_ROWS)
 
 

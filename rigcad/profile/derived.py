@@ -57,6 +57,11 @@ class Derived:
         return out
 
 
+#: Fewest projector pixels from the paraboloid's vertex to its rim (the thesis's rig has ~100): below
+#: this the rig lights the sample from a handful of directions, and its dome cannot be certified.
+MIN_PIXELS_ACROSS = 10
+
+
 def derive(profile: Profile) -> Derived:
     """Compute the paraboloid and layout figures; raise GeometryError naming the parameter."""
     par = profile.paraboloid
@@ -78,6 +83,13 @@ def derive(profile: Profile) -> Derived:
     rim_angle = 0.0 if math.isinf(cop_z) else math.atan2(r_rim, cop_z - rim_z)
     focal_px = profile.projector.resolution[0] * profile.projector.throw_ratio
     pixels = math.nan if math.isinf(cop_z) else focal_px * math.tan(rim_angle)
+    if math.isfinite(pixels) and pixels < MIN_PIXELS_ACROSS:
+        keys = ("focal_length", "rim_radius") if par.focal_length is not None else ("tangent_angle", "vertical_extent")
+        raise GeometryError(
+            f"the paraboloid spans {pixels:.3g} projector pixels from vertex to rim (rim radius {r_rim:.3g} mm seen "
+            f"from {cop_z - rim_z:.4g} mm): at least {MIN_PIXELS_ACROSS} are needed to light the sample from distinct "
+            f"directions; raise paraboloid.{keys[0]} or paraboloid.{keys[1]}, or lower layout.cop_to_vertex",
+            where=profile.where("paraboloid", keys[0]))
     return Derived(
         focal_length=f, rim_radius=r_rim, vertical_extent=d_p, tangent_angle=tau,
         vertex_z=vertex_z, rim_z=rim_z, focus_z=vertex_z - f, cop_z=cop_z,

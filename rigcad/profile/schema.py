@@ -19,6 +19,14 @@ from rigcad.units import DEG, UnitError, parse_quantity
 
 REQUIRED = object()
 
+#: Largest finite length a profile may give (mm): rigcad designs bench-top rigs; past this a value
+#: is a typo (a unit slip) and, far past it, float64 loses the micrometres the dome is built to.
+MAX_LENGTH_MM = 10_000.0
+#: Largest seed (numpy's SeedSequence takes any int; this keeps seeds portable as int64).
+MAX_SEED = 2**63 - 1
+#: Largest projector or camera side (pixels).
+MAX_PIXELS = 100_000
+
 
 @dataclass(frozen=True)
 class Spec:
@@ -98,7 +106,7 @@ class ProjectorParams:
 
     resolution: tuple[int, int] = spec("pixels", "[width, height] in pixels", [1024, 768])
     throw_ratio: float = spec("float", "throw distance / image width (sets the field of view)", 1.75,
-                              lo=0, lo_open=True)
+                              lo=0, lo_open=True, hi=100)
     aperture: float = spec("length", "thin-lens aperture diameter (thesis 3.2.2)", "0.5 cm", lo=0)
 
 
@@ -127,7 +135,7 @@ class DomeParams:
                        "equal_path (closed form)", "dop853", choices=("dop853", "rk45", "euler", "equal_path"))
     tolerance: float | None = spec(
         "length", "adaptive integrators: certified global error in the distance along each reflected ray "
-        "(default: 1e-11 of the optical path)", None, lo=0, lo_open=True)
+        "(default: 1e-11 of the optical path)", None, lo=0, lo_open=True, hi=1e-3)
     euler_steps: int = spec("int", "euler: rays evenly spaced in radius from the rim to the vertex; the polyline "
                             "stops before the first one whose return to O is occluded",
                             2000, lo=2, hi=50_000_000)
@@ -284,7 +292,7 @@ class RayCheckParams:
                      "smooth", choices=("mesh", "smooth", "analytic"))
     rays: int = spec("int", "pinhole rays aimed across the paraboloid's useful annulus (seeded)", 100_000,
                      lo=100, hi=50_000_000)
-    seed: int = spec("int", "seed of the ray sampling", 2006, lo=0)
+    seed: int = spec("int", "seed of the ray sampling", 2006, lo=0, hi=MAX_SEED)
     lens_azimuths: int = spec("int", "thin lens: aperture-edge rays per chief ray (thesis 3.2.2 traced 2 in 2D)",
                               8, lo=2, hi=64)
     max_spot_radius: float = spec("length", "largest distance from O to a returning pinhole ray, in `mode`",
@@ -312,7 +320,7 @@ class TolerancingParams:
     axis (pivots: COP for camera and projector, vertex for the paraboloid, O for the dome)."""
 
     builds: int = spec("int", "random builds", 200, lo=1, hi=100_000)
-    seed: int = spec("int", "seed of the builds", 2006, lo=0)
+    seed: int = spec("int", "seed of the builds", 2006, lo=0, hi=MAX_SEED)
     rays: int = spec("int", "pinhole rays per build", 4000, lo=100, hi=10_000_000)
     projector_offset: float = spec("length", "projector: lateral placement tolerance", "0.5 mm", lo=0)
     projector_height: float = spec("length", "projector: height tolerance", "1 mm", lo=0)
@@ -405,6 +413,12 @@ class Profile:
         return out
 
 
+def _r(value: Any, limit: int = 60) -> str:
+    """``repr(value)`` cut to ``limit`` characters: an error quotes what was given, not a whole document."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 4] + " ..."
+
+
 def suggest(name: str, valid: list[str]) -> str:
     close = difflib.get_close_matches(name, valid, n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
@@ -425,23 +439,29 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
             raise fail("is NaN")
         if math.isinf(out) and not s.allow_inf:
             raise fail(f"must be finite ({s.describe_range()})")
+        if s.kind == "length" and math.isfinite(out) and abs(out) > MAX_LENGTH_MM:
+            raise fail(f"{_r(value)} is longer than {MAX_LENGTH_MM / 1000:g} m, the largest length rigcad accepts "
+                       "(a bench-top rig; check the unit)")
     elif s.kind == "int":
         if isinstance(value, bool) or not isinstance(value, int):
-            raise fail(f"expected a whole number, got {value!r} ({s.describe_range()})")
+            raise fail(f"expected a whole number, got {_r(value)} ({s.describe_range()})")
         out = value
     elif s.kind == "float":
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise fail(f"expected a plain number, got {value!r} ({s.describe_range()})")
-        out = float(value)
+            raise fail(f"expected a plain number, got {_r(value)} ({s.describe_range()})")
+        try:
+            out = float(value)
+        except OverflowError:
+            out = math.inf
         if not math.isfinite(out):
-            raise fail(f"must be finite, got {value!r}")
+            raise fail(f"must be finite, got {_r(value)} ({s.describe_range()})")
     elif s.kind == "str":
         if not isinstance(value, str) or not value:
-            raise fail(f"expected text, got {value!r}")
+            raise fail(f"expected text, got {_r(value)}")
         return value
     elif s.kind == "choice":
         if value not in s.choices:
-            raise fail(f"{value!r} is not valid; {s.describe_range()}{suggest(str(value), list(s.choices))}")
+            raise fail(f"{_r(value)} is not valid; {s.describe_range()}{suggest(str(value), list(s.choices))}")
         return value
     elif s.kind == "layers":
         if not isinstance(value, list) or not value:
@@ -450,13 +470,13 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
         layers = []
         for i, layer in enumerate(value):
             if not isinstance(layer, dict) or set(layer) != {"name", "thickness"} or not isinstance(layer["name"], str):
-                raise fail(f"layer {i + 1}: expected {{name: text, thickness: length}}, got {layer!r}")
+                raise fail(f"layer {i + 1}: expected {{name: text, thickness: length}}, got {_r(layer)}")
             try:
                 t = parse_quantity(layer["thickness"], "length")
             except UnitError as err:
                 raise fail(f"layer {i + 1} ({layer['name']}): {err}") from err
-            if not (math.isfinite(t) and t >= 0):
-                raise fail(f"layer {i + 1} ({layer['name']}): thickness must be finite and >= 0, got {layer['thickness']!r}")
+            if not (math.isfinite(t) and 0 <= t <= MAX_LENGTH_MM):
+                raise fail(f"layer {i + 1} ({layer['name']}): thickness must be finite and >= 0, got {_r(layer['thickness'])}")
             layers.append((layer["name"], t))
         names = [n for n, _ in layers]
         if len(set(names)) != len(names):
@@ -464,16 +484,16 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
         return tuple(layers)
     elif s.kind == "pixels":
         ok = (isinstance(value, list) and len(value) == 2
-              and all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in value))
+              and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= MAX_PIXELS for v in value))
         if not ok:
-            raise fail(f"expected [width, height] in whole pixels > 0, got {value!r}")
+            raise fail(f"expected [width, height] in whole pixels, each 1..{MAX_PIXELS}, got {_r(value)}")
         return (value[0], value[1])
     else:  # pragma: no cover - a programming error in a Spec
         raise AssertionError(s.kind)
     too_low = s.lo is not None and (out < s.lo or (s.lo_open and out == s.lo))
     too_high = s.hi is not None and (out > s.hi or (s.hi_open and out == s.hi))
     if too_low or too_high:
-        raise fail(f"{value!r} is out of range; valid: {s.describe_range()}")
+        raise fail(f"{_r(value)} is out of range; valid: {s.describe_range()}")
     return out
 
 
@@ -485,7 +505,7 @@ def read_section(raw: RawProfile, name: str, cls: type) -> Any:
     if data is None:
         data = {}
     if not isinstance(data, dict):
-        raise ProfileError(f"section {name!r} must be a mapping of keys, got {data!r}", where=raw.where((name,)))
+        raise ProfileError(f"section {name!r} must be a mapping of keys, got {_r(data)}", where=raw.where((name,)))
     valid = [f.name for f in fields(cls)]
     for key in data:
         if key not in valid:
@@ -512,7 +532,7 @@ def validate(raw: RawProfile) -> Profile:
     valid_top = sorted(set(SECTIONS) | TOP_LEVEL)
     for key in raw.data:
         if key not in valid_top:
-            raise ProfileError(f"unknown section {key!r}{suggest(key, valid_top)}; valid: {', '.join(valid_top)}",
+            raise ProfileError(f"unknown section {_r(key)}{suggest(key, valid_top)}; valid: {', '.join(valid_top)}",
                                where=raw.where((key,)))
     sections = {name: read_section(raw, name, cls) for name, cls in SECTIONS.items()}
     par: ParaboloidParams = sections["paraboloid"]
@@ -533,7 +553,7 @@ def validate(raw: RawProfile) -> Profile:
     layer_names = [n for n, _ in sections["coating"].layers]
     gauged = sections["templates"].gauged_layer
     if gauged != "design" and gauged not in layer_names:
-        raise ProfileError(f"templates.gauged_layer {gauged!r} is not a coating layer; valid: design, "
+        raise ProfileError(f"templates.gauged_layer {_r(gauged)} is not a coating layer; valid: design, "
                            + ", ".join(layer_names), where=raw.where(("templates", "gauged_layer")))
     description = raw.data.get("description", "")
     if not isinstance(description, str):

@@ -104,7 +104,7 @@ def test_cop_inside_the_dome_is_refused(write_profile, table31_text):
 
 
 def test_top_opening_cutting_the_projector_bundle_is_refused(write_profile, table31_text):
-    text = table31_text.replace("2.25 cm", "1 mm").replace("13.5 cm", "1 m")
+    text = table31_text.replace("2.25 cm", "2.5 mm").replace("13.5 cm", "1 m")
     with pytest.raises(GeometryError, match="top opening.*cop_to_vertex"):
         _design_of(write_profile, text)
 
