@@ -417,7 +417,9 @@ def instruments(profile: Profile, layout) -> tuple[Part, ...]:
     stack = t.shims_nominal * tw.shim_thickness
     h = SHIM_SIDE / 2
     z_body = t.projector_box[0][2]
-    shims = Union_(tuple(Box((x - h, y - h, z_body - stack), (x + h, y + h, z_body)) for x, y in _projector_feet(t)))
+    shims = tuple(Part(f"projector_shims_{i + 1}", Box((x - h, y - h, z_body - stack), (x + h, y + h, z_body)),
+                       (0.9, 0.8, 0.3), f"{t.shims_nominal} shims under projector foot {i + 1}")
+                  for i, (x, y) in enumerate(_projector_feet(t)))
     (cx0, _, cz0), (cx1, _, cz1) = t.camera_box
     ccx, ccz = 0.5 * (cx0 + cx1), 0.5 * (cz0 + cz1)
     cam_shims = Box((ccx - h, t.bracket_y, ccz - h), (ccx + h, t.bracket_y + stack, ccz + h))
@@ -433,7 +435,7 @@ def instruments(profile: Profile, layout) -> tuple[Part, ...]:
              f"{profile.beam_splitter.length:g} x {profile.beam_splitter.thickness:g} mm at 45 deg"),
         Part("focusing_lens", Box((t.lens_x - ln.thickness / 2, -r, zc - r), (t.lens_x + ln.thickness / 2, r, zc + r)),
              glass, f"focusing lens {ln.diameter:g} mm (its square bounding box)"),
-        Part("projector_shims", shims, (0.9, 0.8, 0.3), f"{t.shims_nominal} shims under each projector foot"),
+        *shims,
         Part("camera_shims", cam_shims, (0.9, 0.8, 0.3), f"{t.shims_nominal} shims behind the camera"),
         _marker("cop_marker", t.cop, (1.0, 0.1, 0.1)),
         _marker("projector_cop_marker", t.projector_cop, (1.0, 0.6, 0.1)),
