@@ -317,7 +317,9 @@ def optimize_history(report: dict) -> bytes:
         ax.scatter(idx[~feas], val[~feas], s=8, color="0.75", label="violates a constraint")
         ax.scatter(idx[feas & ~pol], val[feas & ~pol], s=10, color="tab:blue", label="feasible (global search)")
         ax.scatter(idx[feas & pol], val[feas & pol], s=12, color="tab:orange", label="feasible (local polish)")
-        if feas.any():
+        if sense.startswith("target "):
+            ax.axhline(float(sense.split()[1]), color="k", lw=1.2, label="target")
+        elif feas.any():
             best = np.where(feas, val if sense == "minimize" else -val, np.inf)
             run = np.minimum.accumulate(best)
             ok = np.isfinite(run)

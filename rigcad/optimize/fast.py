@@ -110,18 +110,6 @@ def _outward(D: np.ndarray, u: np.ndarray) -> np.ndarray:
     return n / np.linalg.norm(n, axis=-1, keepdims=True)
 
 
-def clip_band(points: np.ndarray, z0: float, z1: float) -> np.ndarray:
-    """The (r, z) polyline's points with z0 <= z <= z1, plus its crossings of the two planes."""
-    z = points[:, 1]
-    keep = [points[(z >= z0) & (z <= z1)]]
-    for level in (z0, z1):
-        d = z - level
-        i = np.nonzero(d[:-1] * d[1:] < 0)[0]
-        f = d[i] / (d[i] - d[i + 1])
-        keep.append(points[i] + f[:, None] * (points[i + 1] - points[i]))
-    return np.concatenate(keep)
-
-
 def _blocked_quadrant(P: np.ndarray, D: np.ndarray, boxes) -> np.ndarray:
     """Azimuth (rad, within one quadrant) of the directions at each theta whose path P -> D -> O
     crosses one of ``boxes`` ((a, b, z0, z1): |x| <= a, |y| <= b, z0 <= z <= z1, centred on the axis).
@@ -130,35 +118,30 @@ def _blocked_quadrant(P: np.ndarray, D: np.ndarray, boxes) -> np.ndarray:
     band when |r cos phi| <= a and |r sin phi| <= b, i.e. phi in [acos(a/r), asin(b/r)] (first
     quadrant), an interval that shrinks as r grows; so a segment's crossing of the band blocks the
     interval of its smallest radius there. Returns the length of the union of the intervals, (n,)."""
-    segments = ((P, D), (np.zeros_like(D), D))
-    los, his = [], []
-    for a, b, z0, z1 in boxes:
-        for A, B in segments:
-            dz = B[:, 1] - A[:, 1]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ta, tb = (z0 - A[:, 1]) / dz, (z1 - A[:, 1]) / dz
-            lo = np.clip(np.minimum(ta, tb), 0.0, 1.0)
-            hi = np.clip(np.maximum(ta, tb), 0.0, 1.0)
-            flat = dz == 0
-            inside = (A[:, 1] >= z0) & (A[:, 1] <= z1)
-            lo = np.where(flat, 0.0, lo)
-            hi = np.where(flat, np.where(inside, 1.0, -1.0), hi)
-            crosses = hi > lo
-            r = np.minimum(A[:, 0] + lo * (B[:, 0] - A[:, 0]), A[:, 0] + hi * (B[:, 0] - A[:, 0]))
-            r = np.maximum(r, 1e-12)
-            i_lo = np.arccos(np.minimum(1.0, a / r))
-            i_hi = np.arcsin(np.minimum(1.0, b / r))
-            ok = crosses & (i_hi > i_lo)
-            los.append(np.where(ok, i_lo, 0.0))
-            his.append(np.where(ok, i_hi, 0.0))
-    lo, hi = np.stack(los, axis=1), np.stack(his, axis=1)  # (n, k)
+    box = np.asarray(boxes, float)  # (k, 4): a, b, z0, z1
+    a, b, z0, z1 = (box[:, i][None, None, :] for i in range(4))
+    A = np.stack([P, np.zeros_like(D)], axis=1)[:, :, None, :]  # (n, 2 segments, 1, 2)
+    B = D[:, None, None, :]
+    Az, Bz = A[..., 1], B[..., 1]
+    dz = Bz - Az
+    flat = dz == 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ta, tb = (z0 - Az) / dz, (z1 - Az) / dz
+    lo = np.where(flat, 0.0, np.clip(np.minimum(ta, tb), 0.0, 1.0))
+    hi = np.where(flat, np.where((Az >= z0) & (Az <= z1), 1.0, -1.0), np.clip(np.maximum(ta, tb), 0.0, 1.0))
+    Ar, dr = A[..., 0], B[..., 0] - A[..., 0]
+    r = np.maximum(np.minimum(Ar + lo * dr, Ar + hi * dr), 1e-12)  # r is linear along the segment
+    i_lo = np.arccos(np.minimum(1.0, a / r))
+    i_hi = np.arcsin(np.minimum(1.0, b / r))
+    ok = (hi > lo) & (i_hi > i_lo)
+    lo = np.where(ok, i_lo, 0.0).reshape(len(P), -1)
+    hi = np.where(ok, i_hi, 0.0).reshape(len(P), -1)
     order = np.argsort(lo, axis=1)
     lo, hi = np.take_along_axis(lo, order, 1), np.take_along_axis(hi, order, 1)
     total = np.zeros(len(P))
     reach = np.zeros(len(P))  # end of the union swept so far
     for k in range(lo.shape[1]):
-        start_k = np.maximum(lo[:, k], reach)
-        total += np.maximum(hi[:, k] - start_k, 0.0)
+        total += np.maximum(hi[:, k] - np.maximum(lo[:, k], reach), 0.0)
         reach = np.maximum(reach, hi[:, k])
     return total
 

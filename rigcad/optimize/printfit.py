@@ -24,17 +24,33 @@ from scipy.spatial import ConvexHull, QhullError
 
 from rigcad.fab.orientation import SPINS, mirror_candidates, tilt_to_z
 from rigcad.fab.split import BAND_COUNTS, SECTOR_COUNTS, band_cuts
-from rigcad.optimize.fast import Outline, clip_band
+from rigcad.optimize.fast import Outline
 
 _COS, _SIN = np.cos(SPINS), np.sin(SPINS)
 
 
-def _section_in_band(outline: Outline, z0: float, z1: float) -> np.ndarray:
-    """The section's (r, z) points inside the band, with the polylines' crossings of its planes."""
+def _polylines(outline: Outline) -> tuple[np.ndarray, np.ndarray]:
+    """The section's three polylines (outer wall, mirror, flange ring) as one array of (r, z) rows and
+    the mask of the segments that join consecutive rows of the same polyline."""
     fl = outline.flange
-    ring = np.concatenate([fl, fl[:1]])
-    return np.concatenate([clip_band(outline.outer, z0, z1), clip_band(outline.inner, z0, z1),
-                           clip_band(ring, z0, z1)])
+    lines = [outline.outer, outline.inner, np.concatenate([fl, fl[:1]])]
+    pts = np.concatenate(lines)
+    joined = np.ones(len(pts) - 1, bool)
+    ends = np.cumsum([len(x) for x in lines])[:-1]
+    joined[ends - 1] = False
+    return pts, joined
+
+
+def _section_in_band(pts: np.ndarray, joined: np.ndarray, z0: float, z1: float) -> np.ndarray:
+    """The polylines' points with z0 <= z <= z1, plus their crossings of the two planes."""
+    z = pts[:, 1]
+    keep = [pts[(z >= z0) & (z <= z1)]]
+    for level in (z0, z1):
+        d = z - level
+        i = np.nonzero((d[:-1] * d[1:] < 0) & joined)[0]
+        f = d[i] / (d[i] - d[i + 1])
+        keep.append(pts[i] + f[:, None] * (pts[i + 1] - pts[i]))
+    return np.concatenate(keep)
 
 
 @lru_cache(maxsize=32)
@@ -63,15 +79,14 @@ def revolved_fit_margins(section: np.ndarray, a0: float, a1: float, directions) 
     each build direction: (len(directions), 2 * len(SPINS) + 1) mm, the widths along the printer's x
     and y at every spin of SPINS, then the height (exact: module docstring)."""
     hi, lo, ez = _sweep(float(a0), float(a1), tuple(tuple(float(v) for v in d) for d in directions))
-    r, z = section[:, 0], section[:, 1]
-    zz = np.outer(ez, z)
-    ext = (np.outer(hi, r) + zz).max(axis=1) - (np.outer(lo, r) + zz).min(axis=1)
+    pts = np.ascontiguousarray(section.T)  # (2, n)
+    ext = (np.column_stack([hi, ez]) @ pts).max(axis=1) - (np.column_stack([lo, ez]) @ pts).min(axis=1)
     return ext.reshape(len(directions), -1)
 
 
 def revolved_fit_margin(section: np.ndarray, a0: float, a1: float, direction, usable) -> float:
     """``fab.orientation.fit_margin`` of the revolved section, for one build direction."""
-    return _margins(revolved_fit_margins(section, a0, a1, [direction]), usable)[0]
+    return float(_margins(revolved_fit_margins(section, a0, a1, [direction]), usable)[0])
 
 
 def _margins(ext: np.ndarray, usable) -> np.ndarray:
@@ -88,14 +103,19 @@ def _candidates(sectors: int) -> tuple:
     return tuple(o.direction for o in cands if o.name != "upside_down")
 
 
-def _cell_margin(outline: Outline, sectors: int, z0: float, z1: float, usable) -> float:
-    section = _section_in_band(outline, z0, z1)
+def _hull(section: np.ndarray) -> np.ndarray:
+    """The section's 2D convex hull vertices: each extent is linear in (r, z), so they give them all."""
+    try:
+        return section[ConvexHull(section).vertices]
+    except (QhullError, ValueError):  # an empty or degenerate sliver of band: its points will do
+        return section
+
+
+def _cell_margin(section: np.ndarray, sectors: int, usable) -> float:
+    """Best margin (mm) of one cell: the band's section revolved over one sector, in its candidate
+    orientations (every sector of a plan is the same solid: the slots and holes are ignored)."""
     if len(section) < 2:
         return math.inf  # an empty cell fits anywhere
-    try:  # the extents are linear in (r, z) for each direction: the section's hull gives them all
-        section = section[ConvexHull(section).vertices]
-    except QhullError:  # a degenerate sliver of band: its points will do
-        pass
     ext = revolved_fit_margins(section, 0.0, 2 * math.pi / sectors, _candidates(sectors))
     return float(_margins(ext, usable).max())
 
@@ -122,14 +142,18 @@ def dome_fit(outline: Outline, usable: tuple[float, float, float], max_pieces: i
     the dome of ``outline`` fits the ``usable`` box (x, y, z mm; ``Printer.usable``), and a margin
     (mm): the first fitting plan's smallest room left (>= 0), or when no plan of at most
     ``max_pieces`` fits, minus how much too large the best of them is (< 0)."""
-    pts = outline.points()
+    pts, joined = _polylines(outline)
     z_lo, z_hi = float(pts[:, 1].min()), float(pts[:, 1].max())
+    sections: dict[tuple[float, float], np.ndarray] = {}
     best = -math.inf
     for s, b in plans(max_pieces):
         for cuts in _cuts(z_lo, z_hi, b):
             m = math.inf
             for j in range(b):
-                m = min(m, _cell_margin(outline, s, float(cuts[j]), float(cuts[j + 1]), usable))
+                band = (float(cuts[j]), float(cuts[j + 1]))
+                if band not in sections:
+                    sections[band] = _hull(_section_in_band(pts, joined, *band))
+                m = min(m, _cell_margin(sections[band], s, usable))
                 if m < best:  # this cut cannot beat the best so far
                     break
             if m >= 0:

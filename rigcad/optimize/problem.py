@@ -23,6 +23,10 @@ from rigcad.profile.derived import derive
 from rigcad.profile.schema import Profile
 from rigcad.units import DEG
 
+#: Room (mm) the printer fit keeps in every direction beyond the printer's own bed margin: the
+#: model's outline is sampled (its extents err by < 0.05 mm, measured) and the fabrication stage
+#: cuts a meshed part; a design exactly at the edge of the bed is not one to print.
+PRINT_RESERVE = 0.5
 #: Scale of one unit of violation, per unit, for the penalty merit (a constraint's g / scale).
 UNIT_SCALE = {"mm": 1.0, "deg": 0.1, "px/deg": 0.01, "": 0.001}
 
@@ -119,7 +123,8 @@ def evaluate(problem: Problem, x) -> dict:
     density = pr.density_g_cm3 if pr is not None else 1.24  # PLA when no printer is named
     fig["dome_mass_g"] = fig["dome_volume_mm3"] / 1000.0 * density
     if pr is not None:
-        fit = dome_fit(fd.outline, pr.usable, c.max_pieces)
+        usable = tuple(u - PRINT_RESERVE for u in pr.usable)
+        fit = dome_fit(fd.outline, usable, c.max_pieces)
         fig["dome_pieces"] = fit["pieces"]
         fig["dome_sectors"], fig["dome_bands"] = fit["sectors"], fit["bands"]
         fig["printer_margin_mm"] = fit["margin_mm"]
@@ -134,11 +139,11 @@ def evaluate(problem: Problem, x) -> dict:
     if c.max_occluded_fraction is not None:
         g["max_occluded_fraction"] = fig["occluded_fraction"] - c.max_occluded_fraction
     if c.raycheck:
-        rc, tg = profile.raycheck, profile.targets
-        g["raycheck.theta_min_coverage"] = fig["theta_min_deg"] - (tg.theta_min + rc.theta_coverage_tolerance) / DEG
-        g["raycheck.theta_max_coverage"] = (tg.theta_max - rc.theta_coverage_tolerance) / DEG - fig["theta_max_deg"]
-        g["raycheck.min_px_per_deg"] = rc.min_px_per_deg - fig["px_per_deg_min"]
-        g["raycheck.max_lost_fraction"] = fig["occluded_fraction"] - rc.max_lost_fraction
+        rc, tg, k = profile.raycheck, profile.targets, 1.0 - c.raycheck_margin
+        g["raycheck.theta_min_coverage"] = fig["theta_min_deg"] - (tg.theta_min + k * rc.theta_coverage_tolerance) / DEG
+        g["raycheck.theta_max_coverage"] = (tg.theta_max - k * rc.theta_coverage_tolerance) / DEG - fig["theta_max_deg"]
+        g["raycheck.min_px_per_deg"] = rc.min_px_per_deg / k - fig["px_per_deg_min"]
+        g["raycheck.max_lost_fraction"] = fig["occluded_fraction"] - k * rc.max_lost_fraction
     objectives = {name: float(fig[OBJECTIVES[name][0]]) for name, _ in spec.objectives}
     row.update(figures=fig, objectives=objectives, constraints=g, feasible=all(v <= 0 for v in g.values()),
                time_s=time.perf_counter() - t0)

@@ -17,10 +17,13 @@ from pathlib import Path
 
 from rigcad.engine import Engine
 from rigcad.optimize.problem import CONSTRAINT_UNITS, Problem, apply, make_problem
-from rigcad.optimize.search import OptimizeError, Result, infeasible_message, optimize
+from rigcad.errors import RigcadError
+from rigcad.optimize.search import OptimizeError, Result, infeasible_message, optimize, preference
 from rigcad.optimize.spec import COATING_TOTAL, OBJECTIVES, read_optimize
 from rigcad.units import DEG
 
+#: Designs tried on the certified path, best first, before the run gives up.
+MAX_CERTIFY = 8
 #: Relative change below which a free parameter counts as unchanged (not written to the profile).
 UNCHANGED_RTOL = 1e-9
 
@@ -76,6 +79,10 @@ def design_yaml(problem: Problem, row: dict, base_name: str, note: str) -> str:
             continue
         section, _, name = p.key.partition(".")
         sections.setdefault(section, []).append(f"  {name}: {p.shown(v)}")
+    if row.get("dome_tolerance_mm") is not None:
+        sections.setdefault("dome", []).append(
+            f"  tolerance: {row['dome_tolerance_mm']:g} mm   # the base's {problem.base.dome.tolerance:g} mm cannot be "
+            "certified in float64 on this geometry")
     f = row["figures"]
     head = [f"# Chosen by `rigcad optimize {base_name}` ({note}).",
             f"# theta {f['theta_min_deg']:.3f}..{f['theta_max_deg']:.1f} deg, {f['px_per_deg_mean']:.4f} px/deg mean "
@@ -88,12 +95,38 @@ def design_yaml(problem: Problem, row: dict, base_name: str, note: str) -> str:
     return "\n".join(head) + "\n\n" + "\n\n".join(body) + "\n"
 
 
+#: Looser dome tolerances (mm) tried, in order, when float64 cannot certify the base profile's
+#: explicit ``dome.tolerance`` on a chosen geometry; each stays far below what the dome's curve
+#: needs (CURVE_MISS_RTOL of the optical path, ~6e-7 mm) and the meshes' micrometres.
+LOOSER_TOLERANCES = (3e-9, 1e-8, 3e-8, 1e-7)
+
+
+def certified_rig(problem: Problem, row: dict):
+    """The Rig of ``row``'s design (``Rig.from_profile``), and the dome tolerance it needed (mm) when
+    the base profile's explicit one cannot be certified there (None: the base's own)."""
+    import dataclasses
+
+    from rigcad.errors import IntegrationError
+    from rigcad.rig import Rig
+
+    profile = apply(problem.base, problem.names, row["x"])
+    base_tol = profile.dome.tolerance
+    tries = [None] + [t for t in LOOSER_TOLERANCES if base_tol is not None and t > base_tol]
+    for tol in tries:
+        p = profile if tol is None else dataclasses.replace(profile, dome=dataclasses.replace(profile.dome, tolerance=tol))
+        try:
+            return Rig.from_profile(p), tol
+        except IntegrationError as err:
+            if err.param != "dome.tolerance" or tol == tries[-1]:
+                raise
+    raise AssertionError("unreachable")
+
+
 def certify(problem: Problem, row: dict) -> dict:
     """The chosen design on the certified path (converged DOP853 dome, the 2D design's report) beside
     the fast path's figures: the differences say how far the optimiser's evaluation can be trusted."""
-    from rigcad.rig import Rig
-
-    rig = Rig.from_profile(apply(problem.base, problem.names, row["x"]))
+    rig, tol = certified_rig(problem, row)
+    row["dome_tolerance_mm"] = tol
     r = rig.design.report
     f = row["figures"]
     pairs = {"theta_min_deg": r["measurable_range"]["theta_min_deg"],
@@ -104,7 +137,8 @@ def certify(problem: Problem, row: dict) -> dict:
     return {"certified": pairs, "fast_minus_certified": {k: f[k] - v for k, v in pairs.items()},
             "note": "px_per_deg_min of the certified design: np.gradient over its 2001+ rows (second order); the fast "
                     "path's is exact at its nodes", "dome_rows": int(len(rig.dome.s)),
-            "dome_error_estimate_mm": rig.dome.error_estimate}
+            "dome_error_estimate_mm": rig.dome.error_estimate, "dome_tolerance_mm": rig.dome.tolerance,
+            "dome_tolerance_loosened": tol is not None}
 
 
 def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine | None = None, overrides=None,
@@ -141,13 +175,33 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
     }
     files: dict[str, bytes] = {}
     profile_path = None
+    rejected = []
     if result.chosen is not None:
-        report["certified_check"] = certify(problem, result.chosen)
+        # the certified path (converged DOP853 dome at the profile's dome.tolerance) has the last word:
+        # a design it refuses (e.g. a tolerance float64 cannot certify there) gives way to the next
+        for row, why in preference(problem, result)[:MAX_CERTIFY]:
+            try:
+                report["certified_check"] = certify(problem, row)
+            except RigcadError as err:
+                rejected.append({"index": row["index"], "error": str(err)})
+                continue
+            result.chosen, result.reason = row, why
+            break
+        else:
+            result.chosen = None
+        report["rejected_by_certified_path"] = rejected
+        report["chosen"] = _row_json(problem, result.chosen) if result.chosen else None
+        report["reason"] = result.reason
+        report["status"] = "ok" if result.chosen is not None else "infeasible"
+    if result.chosen is not None:
         note = f"seed {spec.seed}, {len(result.history)} evaluations, {result.method}; {result.reason}"
         stem = f"{name}_design"
         files[f"{stem}.yaml"] = design_yaml(problem, result.chosen, name, note).encode()
         profile_path = out / f"{stem}.yaml"
         report["design_profile"] = str(profile_path)
+    elif rejected:
+        report["infeasible"] = (f"the {len(rejected)} best designs were refused by the certified path "
+                                f"(Rig.from_profile); the first: {rejected[0]['error']}")
     else:
         report["infeasible"] = infeasible_message(problem, result.history)
     files["optimize.json"] = json_bytes(report)

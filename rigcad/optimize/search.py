@@ -27,7 +27,7 @@ import numpy as np
 from rigcad.engine import Engine, run, split
 from rigcad.errors import RigcadError
 from rigcad.optimize.problem import CONSTRAINT_KEYS, CONSTRAINT_UNITS, UNIT_SCALE, Problem, evaluate_task, violation
-from rigcad.optimize.spec import OBJECTIVES
+from rigcad.optimize.spec import OBJECTIVES, target_of
 
 #: Merit of a design that violates a constraint: above every feasible design's merit (objectives
 #: in their merit units stay far below), then ordered by the size of the violation.
@@ -83,15 +83,18 @@ class Evaluator:
         return rows
 
 
-def _signs(problem: Problem) -> np.ndarray:
-    return np.array([1.0 if sense == "minimize" else -1.0 for _, sense in problem.spec.objectives])
-
-
 def scaled_objectives(problem: Problem, row: dict) -> np.ndarray:
-    """Objectives as minimised merit units (sense applied, divided by each objective's scale)."""
-    spec = problem.spec
-    scales = np.array([OBJECTIVES[n][2] for n, _ in spec.objectives])
-    return _signs(problem) * np.array([row["objectives"][n] for n, _ in spec.objectives]) / scales
+    """Objectives as minimised merit units: divided by each objective's scale, negated when
+    maximised; for a target, the squared scaled distance from it."""
+    out = []
+    for name, sense in problem.spec.objectives:
+        v = row["objectives"][name] / OBJECTIVES[name][2]
+        target = target_of(sense)
+        if target is not None:
+            out.append((v - target / OBJECTIVES[name][2]) ** 2)
+        else:
+            out.append(v if sense == "minimize" else -v)
+    return np.array(out)
 
 
 def merit(problem: Problem, row: dict) -> float:
@@ -132,21 +135,42 @@ def improvement(problem: Problem, row: dict, ref: dict | None) -> float:
     return float(np.min((b - a) / np.maximum(np.abs(b), 1e-12)))
 
 
-def choose(problem: Problem, front: list[dict], ref: dict | None) -> tuple[dict, str]:
-    """The chosen design of a Pareto front and why (see the module docstring)."""
-    scores = [improvement(problem, r, ref) for r in front]
-    k = int(np.argmax(scores))
-    if scores[k] > 0:
-        return front[k], f"beats the base design in every objective, by at least {100 * scores[k]:.2f} %"
+def ranked(problem: Problem, front: list[dict], ref: dict | None) -> list[tuple[dict, str]]:
+    """The front's designs in order of preference, each with why (see the module docstring)."""
+    scores = np.array([improvement(problem, r, ref) for r in front])
     F = np.array([scaled_objectives(problem, r) for r in front])
     lo, hi = F.min(axis=0), F.max(axis=0)
     d = np.max((F - lo) / np.where(hi > lo, hi - lo, 1.0), axis=1)
-    return front[int(np.argmin(d))], "no design beats the base in every objective: the front's point nearest the ideal"
+    out = []
+    for k in sorted(range(len(front)), key=lambda i: (-scores[i] if scores[i] > 0 else math.inf, d[i], i)):
+        why = (f"beats the base design in every objective, by at least {100 * scores[k]:.2f} %" if scores[k] > 0
+               else "no design beats the base in every objective: the front's point nearest the ideal")
+        out.append((front[k], why))
+    return out
 
 
-def _polish(ev: Evaluator, x0_unit: np.ndarray, budget: int, objective, bounds_on: list[tuple[int, float]]) -> None:
+def choose(problem: Problem, front: list[dict], ref: dict | None) -> tuple[dict, str]:
+    """The chosen design of a Pareto front and why (see the module docstring)."""
+    return ranked(problem, front, ref)[0]
+
+
+def preference(problem: Problem, result: "Result") -> list[tuple[dict, str]]:
+    """Every feasible design worth writing, best first: the chosen one, then (two or more objectives)
+    the rest of the front by the same rule, or (one objective) the others by merit."""
+    if result.chosen is None:
+        return []
+    if len(problem.spec.objectives) > 1:
+        return ranked(problem, result.front, result.base)
+    feas = sorted((r for r in result.history if r["feasible"]), key=lambda r: (r["merit"], r["index"]))
+    return [(r, "lowest merit of the feasible designs" if i == 0 else f"feasible design {i + 1} by merit")
+            for i, r in enumerate(feas)]
+
+
+def _polish(ev: Evaluator, x0_unit: np.ndarray, budget: int, objective, bounds_on: list[tuple[int, float]],
+            restore: bool = False) -> None:
     """COBYLA from ``x0_unit``: minimise scaled objective ``objective`` subject to every constraint
-    and, for each (objective index, limit) in ``bounds_on``, that objective <= limit (scaled)."""
+    and, for each (objective index, limit) in ``bounds_on``, that objective <= limit (scaled). With
+    ``restore``: minimise the scaled violation instead, unconstrained (no design is feasible yet)."""
     from scipy.optimize import minimize
 
     problem = ev.problem
@@ -164,6 +188,8 @@ def _polish(ev: Evaluator, x0_unit: np.ndarray, budget: int, objective, bounds_o
 
     def f(u):
         r = row_at(u)
+        if restore:
+            return min(violation(r), REFUSED)
         return REFUSED if r["objectives"] is None else float(scaled_objectives(problem, r)[objective])
 
     def g(u):  # >= 0 when met (COBYLA's convention)
@@ -178,7 +204,7 @@ def _polish(ev: Evaluator, x0_unit: np.ndarray, budget: int, objective, bounds_o
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            minimize(f, x0_unit, method="COBYLA", constraints=[{"type": "ineq", "fun": g}],
+            minimize(f, x0_unit, method="COBYLA", constraints=[] if restore else [{"type": "ineq", "fun": g}],
                      bounds=[(0.0, 1.0)] * len(x0_unit),
                      options={"maxiter": max(budget, len(x0_unit) + 2), "rhobeg": POLISH_STEP, "tol": 1e-9})
         except _Budget:
@@ -250,6 +276,19 @@ def optimize(problem: Problem, engine: Engine = Engine(), progress=None) -> Resu
             _polish(ev, problem.to_unit(chosen["x"]), spec.evaluations - len(ev.history.rows), 0, limits)
             front = pareto(problem, ev.history.rows)
             chosen, reason = choose(problem, front, base_row)
+    if chosen is None:  # nothing feasible: spend the polish on the violation, to say how close it gets
+        valued = [r for r in ev.history.rows if r["constraints"] is not None]
+        if valued and len(ev.history.rows) < spec.evaluations:
+            start_row = min(valued, key=lambda r: (violation(r), r["index"]))
+            _polish(ev, problem.to_unit(start_row["x"]), spec.evaluations - len(ev.history.rows), 0, [], restore=True)
+            feas = [r for r in ev.history.rows if r["feasible"]]
+            if feas:  # restoration found feasible designs: choose among them as the search would
+                if len(spec.objectives) == 1:
+                    chosen, reason = min(feas, key=lambda r: r["merit"]), "lowest merit of the feasible designs"
+                    front = pareto(problem, ev.history.rows)
+                else:
+                    front = pareto(problem, ev.history.rows)
+                    chosen, reason = choose(problem, front, base_row)
     timings = {"global_s": t1 - t0, "polish_s": time.perf_counter() - t1, "total_s": time.perf_counter() - t0}
     result = Result(ev.history.rows, chosen, reason, front, base_row, method, timings)
     return result

@@ -6,7 +6,7 @@ constraints and the search settings, validated with the profile's own rules (uni
         layout.cop_to_vertex: [20 cm, 45 cm]
         paraboloid.tangent_angle: [12 deg, 28 deg]
         coating.total: [4 mil, 7 mil]  # the paint stack scaled to this total thickness
-      objectives:                      # name: minimize | maximize (OBJECTIVES)
+      objectives:                      # name: minimize | maximize | {target: value} (OBJECTIVES)
         theta_min: minimize
         px_per_deg_cv: minimize
       constraints:
@@ -16,6 +16,7 @@ constraints and the search settings, validated with the profile's own rules (uni
         min_feature_nozzles: 2         # dome wall and the paraboloid's vertex radius >= 2 nozzles
         max_occluded_fraction: 0.06    # pixels the mount hides
         raycheck: true                 # the design-level checks of the raycheck section pass
+        raycheck_margin: 0.03          # ... with 3 % of each limit to spare
       seed: 2006
       evaluations: 300                 # budget: global search + local polish
       workers: 1                       # processes (rigcad.engine); 0 = every core
@@ -49,7 +50,11 @@ OBJECTIVES: dict[str, tuple[str, str, float]] = {
 COATING_TOTAL = "coating.total"
 _SEARCH = {"parameters", "objectives", "constraints", "seed", "evaluations", "workers", "nodes"}
 _CONSTRAINTS = {"printer", "max_pieces", "max_cop_height", "min_feature_nozzles", "max_occluded_fraction",
-                "raycheck"}
+                "raycheck", "raycheck_margin"}
+#: Default share of each raycheck limit kept in reserve (the 3D check measures on a finite fan of
+#: pixels and 1e5 seeded rays: its px/deg minimum and lost fraction differ from the exact ones by
+#: ~1e-3; see README).
+RAYCHECK_MARGIN = 0.03
 #: Most free parameters and evaluations a run may ask for (a bench-top design space).
 MAX_PARAMETERS = 12
 MAX_EVALUATIONS = 100_000
@@ -87,6 +92,7 @@ class Constraints:
     min_feature_nozzles: float | None = None
     max_occluded_fraction: float | None = None
     raycheck: bool = True
+    raycheck_margin: float = RAYCHECK_MARGIN
 
 
 @dataclass(frozen=True)
@@ -106,7 +112,8 @@ class OptimizeSpec:
                                for n, s in self.objectives],
                 "constraints": {"printer": c.printer, "max_pieces": c.max_pieces,
                                 "max_cop_height_mm": c.max_cop_height, "min_feature_nozzles": c.min_feature_nozzles,
-                                "max_occluded_fraction": c.max_occluded_fraction, "raycheck": c.raycheck},
+                                "max_occluded_fraction": c.max_occluded_fraction, "raycheck": c.raycheck,
+                                "raycheck_margin": c.raycheck_margin},
                 "seed": self.seed, "evaluations": self.evaluations, "workers": self.workers,
                 "quadrature_nodes": self.nodes}
 
@@ -212,10 +219,23 @@ def _objectives(data, raw: RawProfile) -> tuple[tuple[str, str], ...]:
         if name not in OBJECTIVES:
             raise ProfileError(f"optimize.objectives.{name}: unknown objective{suggest(str(name), list(OBJECTIVES))}; "
                                "valid: " + ", ".join(OBJECTIVES), where=at)
+        if isinstance(sense, dict) and set(sense) == {"target"}:
+            unit = OBJECTIVES[name][1]
+            kind = {"deg": "angle", "mm": "length"}.get(unit, "float")
+            value = convert_value(Spec(kind, name), sense["target"], f"optimize.objectives.{name}.target",
+                                  where(("optimize", "objectives", name, "target")))
+            out.append((name, f"target {value / DEG if kind == 'angle' else value!r}"))
+            continue
         if sense not in ("minimize", "maximize"):
-            raise ProfileError(f"optimize.objectives.{name}: {sense!r} is not valid; one of minimize, maximize", where=at)
+            raise ProfileError(f"optimize.objectives.{name}: {sense!r} is not valid; one of minimize, maximize, or "
+                               "{target: value} (with its unit)", where=at)
         out.append((name, sense))
     return tuple(out)
+
+
+def target_of(sense: str) -> float | None:
+    """The target value (the objective's unit) of a ``target ...`` sense, else None."""
+    return float(sense.split(" ", 1)[1]) if sense.startswith("target ") else None
 
 
 def _constraints(data, raw: RawProfile) -> Constraints:
@@ -262,4 +282,8 @@ def _constraints(data, raw: RawProfile) -> Constraints:
     rc = data.get("raycheck", True)
     if not isinstance(rc, bool):
         raise ProfileError(f"optimize.constraints.raycheck: expected true or false, got {rc!r}"[:200], where=at("raycheck"))
-    return Constraints(printer, pieces, ceiling, nozzles, occluded, rc)
+    margin = RAYCHECK_MARGIN
+    if data.get("raycheck_margin") is not None:
+        margin = convert_value(Spec("float", "share", lo=0, hi=0.5), data["raycheck_margin"],
+                               "optimize.constraints.raycheck_margin", at("raycheck_margin"))
+    return Constraints(printer, pieces, ceiling, nozzles, occluded, rc, margin)
