@@ -32,7 +32,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
     base, chosen = rep["base"], rep["chosen"]
     print(f"{rep['profile']}: {rep['method']}, {len(rep['evaluations'])} evaluations on {rep['engine']} "
           f"({rep['workers']} worker(s)) in {rep['timings_s']['total_s']:.1f} s; median evaluation "
-          f"{1e3 * rep['evaluation_time_s']['median_s']:.2f} ms; {len(rep['pareto'])} design(s) on the Pareto front")
+          f"{1e3 * rep['evaluation_time_s']['cpu_median_s']:.2f} ms CPU; {len(rep['pareto'])} design(s) on the Pareto front")
     print(f"  chosen: {rep['reason']}")
     print(f"  {'':<24} {'base':>12} {'chosen':>12}")
     keys = [(k, k) for k in ("theta_min_deg", "px_per_deg_cv", "px_per_deg_mean", "px_per_deg_min",

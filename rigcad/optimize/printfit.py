@@ -54,10 +54,11 @@ def _section_in_band(pts: np.ndarray, joined: np.ndarray, z0: float, z1: float) 
 
 
 @lru_cache(maxsize=32)
-def _sweep(a0: float, a1: float, directions: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _sweep(a0: float, a1: float, directions: tuple) -> tuple[np.ndarray, np.ndarray]:
     """For the unit directions e of every build direction in ``directions`` x (the spins' x and y,
     the height): the coefficients of a section point's largest and smallest projection on e over
-    the arc a0..a1, r * hi + z * ez and r * lo + z * ez (see the module docstring). (k,) each."""
+    the arc a0..a1, r * hi + z * e_z and r * lo + z * e_z (see the module docstring), as (k, 2)
+    matrices [hi, e_z] and [lo, e_z] to multiply the (2, n) section by."""
     dirs = []
     for d in directions:
         T = tilt_to_z(np.asarray(d, dtype=float))
@@ -71,16 +72,18 @@ def _sweep(a0: float, a1: float, directions: tuple) -> tuple[np.ndarray, np.ndar
     c0, c1 = np.cos(a0 - beta), np.cos(a1 - beta)
     inside = np.mod(beta - a0, 2 * math.pi) <= span + 1e-12
     opposite = np.mod(beta + math.pi - a0, 2 * math.pi) <= span + 1e-12
-    return rho * np.where(inside, 1.0, np.maximum(c0, c1)), rho * np.where(opposite, -1.0, np.minimum(c0, c1)), e[:, 2]
+    hi = rho * np.where(inside, 1.0, np.maximum(c0, c1))
+    lo = rho * np.where(opposite, -1.0, np.minimum(c0, c1))
+    return np.column_stack([hi, e[:, 2]]), np.column_stack([lo, e[:, 2]])
 
 
 def revolved_fit_margins(section: np.ndarray, a0: float, a1: float, directions) -> np.ndarray:
     """Extents of the section (n, 2) of (r, z) rows revolved about z from angle a0 to a1 (rad), for
     each build direction: (len(directions), 2 * len(SPINS) + 1) mm, the widths along the printer's x
     and y at every spin of SPINS, then the height (exact: module docstring)."""
-    hi, lo, ez = _sweep(float(a0), float(a1), tuple(tuple(float(v) for v in d) for d in directions))
+    hi, lo = _sweep(float(a0), float(a1), tuple(tuple(float(v) for v in d) for d in directions))
     pts = np.ascontiguousarray(section.T)  # (2, n)
-    ext = (np.column_stack([hi, ez]) @ pts).max(axis=1) - (np.column_stack([lo, ez]) @ pts).min(axis=1)
+    ext = (hi @ pts).max(axis=1) - (lo @ pts).min(axis=1)
     return ext.reshape(len(directions), -1)
 
 

@@ -100,7 +100,7 @@ def apply(profile: Profile, keys: list[str], x) -> Profile:
 def evaluate(problem: Problem, x) -> dict:
     """Objectives, constraints and figures of the design at ``x`` (internal units). A design the
     geometry refuses (GeometryError...) comes back with ``error`` set and no figures."""
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     spec = problem.spec
     x = [float(v) for v in x]
     row: dict = {"x": x, "error": None}
@@ -110,7 +110,7 @@ def evaluate(problem: Problem, x) -> dict:
         fd = fast_design(profile, geo, spec.nodes)
     except RigcadError as err:
         row.update(figures=None, objectives=None, constraints=None, feasible=False, error=err.message,
-                   time_s=time.perf_counter() - t0)
+                   time_s=time.perf_counter() - t0, cpu_s=time.process_time() - c0)
         return row
     fig = dict(fd.figures)
     c = spec.constraints
@@ -127,7 +127,8 @@ def evaluate(problem: Problem, x) -> dict:
         fit = dome_fit(fd.outline, usable, c.max_pieces)
         fig["dome_pieces"] = fit["pieces"]
         fig["dome_sectors"], fig["dome_bands"] = fit["sectors"], fit["bands"]
-        fig["printer_margin_mm"] = fit["margin_mm"]
+        fig["printer_margin_mm"] = fit["margin_mm"] + PRINT_RESERVE  # room left on the printer itself
+        fig["printer_reserve_mm"] = PRINT_RESERVE
         g["printer.pieces"] = -fit["margin_mm"]
         if c.min_feature_nozzles is not None:
             need = c.min_feature_nozzles * pr.feature
@@ -146,7 +147,7 @@ def evaluate(problem: Problem, x) -> dict:
         g["raycheck.max_lost_fraction"] = fig["occluded_fraction"] - k * rc.max_lost_fraction
     objectives = {name: float(fig[OBJECTIVES[name][0]]) for name, _ in spec.objectives}
     row.update(figures=fig, objectives=objectives, constraints=g, feasible=all(v <= 0 for v in g.values()),
-               time_s=time.perf_counter() - t0)
+               time_s=time.perf_counter() - t0, cpu_s=time.process_time() - c0)
     return row
 
 
@@ -163,7 +164,7 @@ CONSTRAINT_KEYS = {
     "design.cop_above_dome": "the COP must lie above the dome",
     "design.beam_above_flange": "the beam must sit above the dome's flange",
     "printer.pieces": "optimize.constraints.printer / max_pieces: the dome must print in at most max_pieces pieces "
-                      "(value: how many mm too large the best split is)",
+                      "with PRINT_RESERVE mm to spare (value: how many mm too large the best split is)",
     "min_feature.dome_wall": "optimize.constraints.min_feature_nozzles: dome_shell.wall against the nozzle",
     "min_feature.paraboloid_vertex": "optimize.constraints.min_feature_nozzles: the paraboloid's vertex radius "
                                      "of curvature against the nozzle",
