@@ -3,7 +3,9 @@ the certified path (``Rig.from_profile`` + the 2D design), and publish, all toge
 ``exports/<profile>/optimize/``:
 
 * ``<profile>_design.yaml``: the chosen design as a profile that ``extends:`` PROFILE and sets only
-  the parameters that changed (``rigcad stl exports/<profile>/optimize/<profile>_design.yaml``);
+  the parameters that changed (``rigcad stl exports/<profile>/optimize/<profile>_design.yaml``); when
+  PROFILE is not on the profile search path by name, it is written beside PROFILE's file instead,
+  where its ``extends:`` resolves;
 * ``optimize.json``: the settings, every evaluation (parameters, objectives, constraint values,
   time), the Pareto set, the base and chosen designs, the certified check of the chosen one;
 * ``history.png`` (merit per evaluation) and ``pareto.png`` (objectives, front, base, chosen).
@@ -196,8 +198,11 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
     if result.chosen is not None:
         note = f"seed {spec.seed}, {len(result.history)} evaluations, {result.method}; {result.reason}"
         stem = f"{name}_design"
-        files[f"{stem}.yaml"] = design_yaml(problem, result.chosen, name, note).encode()
-        profile_path = out / f"{stem}.yaml"
+        text = design_yaml(problem, result.chosen, name, note).encode()
+        home = _design_home(profile_spec, name, out)
+        profile_path = home / f"{stem}.yaml"
+        if home == out:
+            files[f"{stem}.yaml"] = text
         report["design_profile"] = str(profile_path)
     elif rejected:
         report["infeasible"] = (f"the {len(rejected)} best designs were refused by the certified path "
@@ -211,9 +216,28 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
         for fname, data in files.items():
             stage.write_bytes(out / fname, data)
         written = stage.commit()
+    if profile_path is not None and profile_path.parent != out:
+        from rigcad.export.atomic import write_bytes
+
+        written.append(write_bytes(profile_path, text))
     if result.chosen is None:
         raise OptimizeError(f"{name}: {report['infeasible']} (every evaluation in {out / 'optimize.json'})")
     return OptimizeRun(report, written, profile_path, result)
+
+
+def _design_home(profile_spec, name: str, out: Path) -> Path:
+    """Where the design profile goes: ``out`` when its ``extends: name`` resolves from there to the
+    searched profile (a name on the search path: ./profiles, $RIGCAD_PROFILES, the shipped ones),
+    else beside the searched profile's own file, where the name always resolves."""
+    from rigcad.errors import ProfileError
+    from rigcad.profile.loader import find_file, resolve_profile_path
+
+    base = resolve_profile_path(profile_spec).resolve()
+    try:
+        found = find_file(name, "profile", near=out, as_path=False).resolve()
+    except ProfileError:
+        found = None
+    return out if found == base else base.parent
 
 
 def _time_stats(rows: list[dict]) -> dict:
