@@ -118,6 +118,8 @@ def evaluate(problem: Problem, x) -> dict:
         "design.top_clearance": -fig["top_clearance_mm"],
         "design.cop_above_dome": -fig["cop_above_dome_mm"],
         "design.beam_above_flange": -fig["beam_above_flange_mm"],
+        # parts.layout: the sample holder's stop lies inside the printed dome's base
+        "design.holder_inside_base": profile.sample_holder.stop_radius - float(fd.outline.flange[3][0]),
     }
     pr = problem.printer
     density = pr.density_g_cm3 if pr is not None else 1.24  # PLA when no printer is named
@@ -154,6 +156,7 @@ def evaluate(problem: Problem, x) -> dict:
 #: Units of each constraint value (for the report and the penalty scale).
 CONSTRAINT_UNITS = {
     "design.top_clearance": "mm", "design.cop_above_dome": "mm", "design.beam_above_flange": "mm",
+    "design.holder_inside_base": "mm",
     "printer.pieces": "mm", "min_feature.dome_wall": "mm", "min_feature.paraboloid_vertex": "mm",
     "max_cop_height": "mm", "max_occluded_fraction": "", "raycheck.theta_min_coverage": "deg",
     "raycheck.theta_max_coverage": "deg", "raycheck.min_px_per_deg": "px/deg", "raycheck.max_lost_fraction": "",
@@ -163,6 +166,7 @@ CONSTRAINT_KEYS = {
     "design.top_clearance": "the dome's top opening must clear the projector's ray bundle",
     "design.cop_above_dome": "the COP must lie above the dome",
     "design.beam_above_flange": "the beam must sit above the dome's flange",
+    "design.holder_inside_base": "sample_holder.stop_radius must lie inside the dome's base",
     "printer.pieces": "optimize.constraints.printer / max_pieces: the dome must print in at most max_pieces pieces "
                       "with PRINT_RESERVE mm to spare (value: how many mm too large the best split is)",
     "min_feature.dome_wall": "optimize.constraints.min_feature_nozzles: dome_shell.wall against the nozzle",

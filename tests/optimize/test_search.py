@@ -77,3 +77,16 @@ def test_a_ceiling_below_any_working_cop_names_the_constraint_and_its_best_value
     best = float(err[0].split("best value reached ")[1].split(" mm")[0])
     assert 72.5 <= best < 72.5 + 10.0, err[0]  # the search gets near the lower corner of the bounds
     assert (tmp_path / "exports" / "ceiling" / "optimize" / "optimize.json").exists()  # every evaluation kept
+
+
+def test_design_profile_of_a_profile_off_the_search_path_is_written_where_it_resolves(write_profile, tmp_path):
+    from rigcad.cli import main
+    from rigcad.profile import load_profile
+
+    text = PLANTED.replace("evaluations: 120", "evaluations: 30")
+    path = write_profile("offpath", text)  # tmp_path is not ./profiles nor $RIGCAD_PROFILES
+    assert main(["optimize", str(path), "--exports", str(tmp_path / "exports")]) == 0
+    design = path.parent / "offpath_design.yaml"
+    profile = load_profile(design)  # its `extends: offpath` resolves beside it
+    assert profile.sources[1].endswith("offpath.yaml")
+    assert profile.paraboloid.tangent_angle != load_profile(path).paraboloid.tangent_angle
