@@ -90,3 +90,28 @@ def test_design_profile_of_a_profile_off_the_search_path_is_written_where_it_res
     profile = load_profile(design)  # its `extends: offpath` resolves beside it
     assert profile.sources[1].endswith("offpath.yaml")
     assert profile.paraboloid.tangent_angle != load_profile(path).paraboloid.tangent_angle
+
+
+def test_written_files_are_the_same_bytes_with_one_and_two_workers(write_profile, tmp_path):
+    """Same profile, same bytes: the design profile and both figures; optimize.json differs only in
+    its timings (keys ending in _s)."""
+    import json
+
+    from rigcad.optimize.run import run_optimize
+
+    path = write_profile("files", TWO.replace("evaluations: 40", "evaluations: 24"))
+    seen = []
+    for w in (1, 2):
+        out = tmp_path / f"exports{w}"
+        run = run_optimize(path, out, Engine(workers=w))
+        folder = out / "files" / "optimize"
+        rep = json.loads((folder / "optimize.json").read_text())
+
+        def strip(v):
+            if isinstance(v, dict):
+                return {k: strip(x) for k, x in v.items() if not k.endswith("_s") and k != "workers" and k != "engine"}
+            return [strip(x) for x in v] if isinstance(v, list) else v
+
+        seen.append((run.profile_path.read_bytes(), (folder / "history.png").read_bytes(),
+                     (folder / "pareto.png").read_bytes(), strip(rep)))
+    assert seen[0] == seen[1]
