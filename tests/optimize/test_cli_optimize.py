@@ -1,7 +1,7 @@
 """`rigcad optimize achutha2006_optimize` as a user runs it: the issue's target (beat Table 3.1 on
 the lowest measurable theta and the px/deg coefficient of variation, printing on the Prusa MK3S in
 at most 4 dome pieces, within 300 evaluations), the outputs, and the written profile built and
-passed through `rigcad check` (the smallest part, few rays, no Monte Carlo: kept light)."""
+passed through `rigcad check` (the smallest part, 50 000 rays, no Monte Carlo: kept light)."""
 
 from __future__ import annotations
 
@@ -64,6 +64,7 @@ def test_written_profile_builds_and_passes_rigcad_check(optimized, tmp_path, cap
     path = str(folder / "achutha2006_optimize_design.yaml")
     exports = str(tmp_path / "exports")
     assert main(["build", path, "--parts", "paraboloid", "--exports", exports]) == 0
-    # 20 000 rays: the lost fraction's sampling error (0.2 %) stays inside the search's 3 % reserve
-    assert main(["check", path, "--exports", exports, "--rays", "20000", "--no-monte-carlo"]) == 0, \
+    # 50 000 rays: the lost fraction's sampling error (0.12 %) is well inside the search's 3 % reserve
+    # (the limit 8 %, held to 7.76 %; measured 7.65 % with 100 000 rays)
+    assert main(["check", path, "--exports", exports, "--rays", "50000", "--no-monte-carlo"]) == 0, \
         capsys.readouterr()
