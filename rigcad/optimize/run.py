@@ -49,6 +49,14 @@ def load_problem(profile_spec, overrides: dict | None = None) -> Problem:
     profile = validate(raw)
     spec = read_optimize(raw, profile)
     if overrides:
+        from rigcad.errors import ProfileError
+        from rigcad.optimize.spec import MAX_EVALUATIONS
+
+        limits = {"seed": (0, 2**63 - 1), "evaluations": (10, MAX_EVALUATIONS), "workers": (0, 256)}
+        for key, value in overrides.items():
+            lo, hi = limits[key]
+            if value is not None and not lo <= value <= hi:
+                raise ProfileError(f"--{key} {value}: expected a whole number {lo}..{hi}", param=f"--{key}")
         spec = dataclasses.replace(spec, **{k: v for k, v in overrides.items() if v is not None})
     return make_problem(profile, spec)
 

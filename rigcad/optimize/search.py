@@ -67,6 +67,7 @@ class Evaluator:
         self.problem, self.engine, self.progress = problem, engine, progress
         self.history = History()
         self.best = math.inf
+        self.budget = problem.spec.evaluations  #: the polish stops when the history reaches it
 
     def __call__(self, X: np.ndarray, phase: str) -> list[dict]:
         X = np.atleast_2d(np.asarray(X, float))
@@ -230,7 +231,6 @@ def optimize(problem: Problem, engine: Engine = Engine(), progress=None) -> Resu
     """Run the search (module docstring). Raises OptimizeError when no design meets the constraints."""
     spec = problem.spec
     ev = Evaluator(problem, engine, progress)
-    ev.budget = spec.evaluations
     t0 = time.perf_counter()
     base_unit = np.clip(problem.to_unit(problem.base_x), 0.0, 1.0)
     d = len(spec.parameters)

@@ -50,3 +50,8 @@ def test_other_commands_accept_the_section(write_profile):
     from rigcad.profile import load_profile
 
     assert load_profile(write_profile("good", GOOD)).layout.cop_to_vertex == 270.0
+
+
+def test_command_line_overrides_are_checked(write_profile):
+    with pytest.raises(ProfileError, match=r"--evaluations 5: expected a whole number 10"):
+        load_problem(write_profile("good", GOOD), {"evaluations": 5})
