@@ -73,6 +73,7 @@ bench: $(VENV)/.installed stl
 	$(PY) bench/float32.py --exports $(EXPORTS)
 	$(PY) bench/make_stl.py
 	$(PY) bench/basis.py
+	$(PY) bench/optimize.py
 
 stress: $(VENV)/.installed
 	$(PY) -m pytest -q -m stress --hypothesis-show-statistics

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from rigcad.export.atomic import write_bytes, write_json
-from rigcad.optics.dome import _occlusion_s, _solve, build_dome, build_euler, equal_path_t, reflected_rays, start
+from rigcad.optics.dome import _solve, occlusion_s, build_dome, build_euler, equal_path_t, reflected_rays, start
 from rigcad.profile import derive, load_profile
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -59,7 +59,7 @@ def ellipse_error(g, pts: np.ndarray, L0: np.ndarray) -> float:
 def run_case(name: str, g) -> dict:
     st = start(g)
     L = st.path_length
-    s_end = _occlusion_s(g, L)
+    s_end = occlusion_s(g, L)
     far = g.cop_at_infinity
     const = np.hypot(st.point[0], st.point[1] - g.focus_z) + np.hypot(*st.point) if far else None
     rows = []

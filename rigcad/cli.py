@@ -234,6 +234,10 @@ def build_parser() -> argparse.ArgumentParser:
     from rigcad.basis.cli import register as register_basis
 
     register_basis(sub)
+
+    from rigcad.optimize.cli import register as register_optimize
+
+    register_optimize(sub)
     return parser
 
 

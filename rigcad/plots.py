@@ -298,3 +298,98 @@ def basis_simulation(report: dict) -> bytes:
                  f"{report['camera']['exitant_directions']} exitant directions", fontsize=10)
     fig.tight_layout(rect=(0, 0.05 + 0.035 * len(orders), 1, 1))
     return _png(fig, dpi=100)
+
+
+def optimize_history(report: dict) -> bytes:
+    """``rigcad optimize``: the merit of every evaluation in order (feasible, infeasible, polish) and
+    the best so far; a second panel per objective for two or more."""
+    rows = [r for r in report["evaluations"] if r["objectives"] is not None]
+    objectives = report["spec"]["objectives"]
+    n = len(objectives)
+    fig, axes = plt.subplots(1, n, figsize=(6.5 * n, 4.2), squeeze=False)
+    for k, obj in enumerate(objectives):
+        ax = axes[0, k]
+        name, sense = obj["name"], obj["sense"]
+        idx = np.array([r["index"] for r in rows])
+        val = np.array([r["objectives"][name] for r in rows])
+        feas = np.array([r["feasible"] for r in rows])
+        pol = np.array([r["phase"] == "polish" for r in rows])
+        ax.scatter(idx[~feas], val[~feas], s=8, color="0.75", label="violates a constraint")
+        ax.scatter(idx[feas & ~pol], val[feas & ~pol], s=10, color="tab:blue", label="feasible (global search)")
+        ax.scatter(idx[feas & pol], val[feas & pol], s=12, color="tab:orange", label="feasible (local polish)")
+        if sense.startswith("target "):
+            ax.axhline(float(sense.split()[1]), color="k", lw=1.2, label="target")
+        elif feas.any():
+            best = np.where(feas, val if sense == "minimize" else -val, np.inf)
+            run = np.minimum.accumulate(best)
+            ok = np.isfinite(run)
+            ax.step(idx[ok], (run if sense == "minimize" else -run)[ok], where="post", color="k", lw=1.2,
+                    label="best feasible so far" if n == 1 else None)
+        base = report.get("base")
+        if base and base.get("objectives"):
+            ax.axhline(base["objectives"][name], color="tab:red", ls="--", lw=1, label="base design")
+        unit = obj["unit"]
+        ax.set_xlabel("evaluation")
+        ax.set_ylabel(f"{name} ({unit})" if unit else name)
+        ax.set_title(f"{name}: {sense}", fontsize=10)
+        ax.grid(alpha=0.3)
+        if feas.any():
+            lo, hi = np.nanmin(val[feas]), np.nanmax(val[feas])
+            ref = base["objectives"][name] if base and base.get("objectives") else lo
+            lo, hi = min(lo, ref), max(hi, ref)
+            pad = 0.15 * (hi - lo) + 1e-9
+            ax.set_ylim(lo - pad, hi + pad)
+        if k == 0:
+            ax.legend(fontsize=7, loc="best")
+    fig.suptitle(f"{report['profile']}: {report['method']}, {len(report['evaluations'])} evaluations, seed "
+                 f"{report['spec']['seed']}", fontsize=10)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def optimize_pareto(report: dict) -> bytes:
+    """``rigcad optimize``: the first two objectives of every feasible design, the Pareto front, the
+    base design (e.g. Table 3.1) and the chosen design."""
+    objectives = report["spec"]["objectives"]
+    a = objectives[0]
+    b = objectives[1] if len(objectives) > 1 else {"name": "px_per_deg_cv", "unit": "", "sense": "minimize"}
+    rows = [r for r in report["evaluations"] if r["objectives"] is not None]
+
+    def val(r, o):
+        return r["objectives"][o["name"]] if o["name"] in r["objectives"] else r["figures"][_FIGURE.get(o["name"], o["name"])]
+
+    fig, ax = plt.subplots(figsize=(7, 5.2))
+    inf = [r for r in rows if not r["feasible"]]
+    feas = [r for r in rows if r["feasible"]]
+    if inf:
+        ax.scatter([val(r, a) for r in inf], [val(r, b) for r in inf], s=7, color="0.8", label="violates a constraint")
+    if feas:
+        ax.scatter([val(r, a) for r in feas], [val(r, b) for r in feas], s=10, color="tab:blue", alpha=0.6,
+                   label="feasible")
+    front = sorted(report["pareto"], key=lambda r: val(r, a))
+    if front:
+        ax.plot([val(r, a) for r in front], [val(r, b) for r in front], "-o", color="tab:green", ms=4, lw=1.2,
+                label=f"Pareto front ({len(front)})")
+    base = report.get("base")
+    if base and base.get("objectives"):
+        ax.plot([val(base, a)], [val(base, b)], "r*", ms=14, label="base design")
+    chosen = report.get("chosen")
+    if chosen:
+        ax.plot([val(chosen, a)], [val(chosen, b)], "D", color="tab:orange", ms=9, mec="k", label="chosen design")
+    ax.set_xlabel(f"{a['name']} ({a['unit']})" if a["unit"] else a["name"])
+    ax.set_ylabel(f"{b['name']} ({b['unit']})" if b["unit"] else b["name"])
+    ax.set_title(f"{report['profile']}: objectives of every design", fontsize=10)
+    if feas:
+        xs = [val(r, a) for r in feas] + ([val(base, a)] if base and base.get("objectives") else [])
+        ys = [val(r, b) for r in feas] + ([val(base, b)] if base and base.get("objectives") else [])
+        px, py = 0.1 * (max(xs) - min(xs)) + 1e-9, 0.1 * (max(ys) - min(ys)) + 1e-9
+        ax.set_xlim(min(xs) - px, max(xs) + px)
+        ax.set_ylim(min(ys) - py, max(ys) + py)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return _png(fig)
+
+
+#: Figure keys of the objectives (rigcad.optimize.spec.OBJECTIVES), for the Pareto plot's second axis.
+_FIGURE = {"px_per_deg_cv": "px_per_deg_cv", "theta_min": "theta_min_deg"}

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-SCRIPTS = ("ray_count", "float32", "tessellation", "make_stl", "basis")
+SCRIPTS = ("ray_count", "float32", "tessellation", "make_stl", "basis", "optimize")
 
 
 @pytest.mark.parametrize("name", SCRIPTS)

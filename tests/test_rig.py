@@ -37,7 +37,10 @@ def test_no_stage_derives_the_geometry_or_integrates_a_dome_itself():
     profile's derived figures without a dome (cli.py, derive only). The stages take a Rig."""
     allowed = {"rig.py": {"derive", "converged_dome"}, "cli.py": {"derive"},
                # the definitions themselves, and the integrator that converged_dome drives
-               "profile/derived.py": set(), "optics/design.py": {"build_dome"}}
+               "profile/derived.py": set(), "optics/design.py": {"build_dome"},
+               # the optimiser derives each candidate design's closed-form geometry (never a dome: its
+               # fast path reads the closed-form dome); the chosen design is built by Rig.from_profile
+               "optimize/problem.py": {"derive"}}
     files = sorted(PKG.rglob("*.py"))
     assert len(files) > 40  # the package is there: an empty glob would pass vacuously
     offenders = {}

@@ -81,6 +81,24 @@ def fit_spin(vertices: np.ndarray, direction, usable: tuple[float, float, float]
     return float(SPINS[i]), {"x_mm": float(wx[i]), "y_mm": float(hy[i]), "z_mm": height}
 
 
+def fit_margin(vertices: np.ndarray, direction, usable: tuple[float, float, float]) -> float:
+    """The room left (mm) when the part is tilted along ``direction`` and spun to its best spin of
+    SPINS: the smallest of the three margins of the usable box (x, y, z mm), the spin chosen to make
+    it largest. >= 0 exactly when :func:`fit_spin` finds a fit (the same extents); continuous in the
+    part's size, for optimisers (rigcad.optimize)."""
+    p = vertices @ tilt_to_z(np.asarray(direction, dtype=float)).T
+    height = float(np.ptp(p[:, 2]))
+    xy = p[:, :2]
+    try:
+        xy = xy[ConvexHull(xy).vertices]
+    except Exception:  # degenerate footprint (a flat part): the points themselves will do
+        pass
+    c, s = np.cos(SPINS), np.sin(SPINS)
+    wx = np.ptp(xy[:, 0, None] * c - xy[:, 1, None] * s, axis=0)
+    hy = np.ptp(xy[:, 0, None] * s + xy[:, 1, None] * c, axis=0)
+    return float(min(usable[2] - height, np.minimum(usable[0] - wx, usable[1] - hy).max()))
+
+
 def place(vertices: np.ndarray, orientation: Orientation, bed_xy: tuple[float, float]) -> np.ndarray:
     """Vertices in the printer frame: rotated, lowest point on z = 0, footprint centred at ``bed_xy``."""
     p = vertices @ orientation.rotation().T

@@ -278,7 +278,7 @@ def choose_phase(man: m3d.Manifold, sectors: int, step_deg: float = 2.5) -> floa
     return math.radians(float(np.interp(mid, np.arange(n), grid)) if mid < n - 1 else grid[int(mid)])
 
 
-def _band_cuts(z0: float, z1: float, bands: int):
+def band_cuts(z0: float, z1: float, bands: int):
     """Band boundaries to try: for two bands the cut from low to high (a dome's wall is steepest
     low down, where vertical pins stay inside it), otherwise equal bands."""
     if bands == 2:
@@ -297,7 +297,7 @@ def plan_split(man: m3d.Manifold, fits) -> SplitPlan:
     for s, b in options:
         if s not in phases:
             phases[s] = choose_phase(man, s)
-        for cuts in _band_cuts(z0, z1, b):
+        for cuts in band_cuts(z0, z1, b):
             plan = SplitPlan(s, b, phases[s], cuts)
             if all(fits(cell(man, plan, i, j), plan, i, j) for i in range(s) for j in range(b)):
                 return plan

@@ -208,13 +208,39 @@ class DomeProfile:
         return make_interp_spline(-self.s[order], self.points[order], k=5)
 
 
-def _occlusion_s(geo: Derived, path_length: float) -> float:
+def scalar_theta(geo: Derived, path_length: float):
+    """theta(s) (rad) of the closed-form dome (:func:`equal_path_t`) in plain float arithmetic, for
+    root finding (numpy's per-call overhead on 1-element arrays is ~10x the arithmetic). Same
+    formulas as :func:`reflected_rays` and :func:`equal_path_t`; a test checks they agree."""
+    f, vz, cz, inf = geo.focal_length, geo.vertex_z, geo.cop_z, geo.cop_at_infinity
+    sqrt = math.sqrt
+
+    def theta(s: float) -> float:
+        px, pz = s, vz - s * s / (4.0 * f)
+        if inf:
+            dx, dz, source = 0.0, -1.0, vz - pz
+        else:
+            ex, ez = px, pz - cz
+            source = sqrt(ex * ex + ez * ez)
+            dx, dz = ex / source, ez / source
+        mx = s / (2.0 * f)
+        nm = sqrt(mx * mx + 1.0)
+        nx, nz = mx / nm, 1.0 / nm
+        dn = dx * nx + dz * nz
+        ux, uz = dx - 2.0 * dn * nx, dz - 2.0 * dn * nz
+        K = path_length - source
+        t = (K * K - (px * px + pz * pz)) / (2.0 * (K + px * ux + pz * uz))
+        return math.atan2(px + t * ux, pz + t * uz)
+
+    return theta
+
+
+def occlusion_s(geo: Derived, path_length: float) -> float:
     """Parabola radius whose dome point is seen from O exactly at the rim (closed form + brentq)."""
+    theta = scalar_theta(geo, path_length)
+
     def g(s: float) -> float:
-        t = equal_path_t(geo, np.array([s]), path_length)
-        r = reflected_rays(geo, np.array([s]))
-        D = r.P[0] + t[0] * r.u[0]
-        return math.atan2(D[0], D[1]) - geo.occlusion_theta
+        return theta(s) - geo.occlusion_theta
 
     lo, hi = 1e-12 * geo.rim_radius, geo.rim_radius
     if g(lo) >= 0:
@@ -252,7 +278,7 @@ def rows_even_in_theta(geo: Derived, t_of_s, s_end: float, rows: int) -> np.ndar
 def build_equal_path(geo: Derived, rows: int) -> DomeProfile:
     """The closed-form dome sampled at ``rows`` points evenly spaced in theta."""
     st = start(geo)
-    s_end = _occlusion_s(geo, st.path_length)
+    s_end = occlusion_s(geo, st.path_length)
     s = rows_even_in_theta(geo, lambda x: equal_path_t(geo, x, st.path_length), s_end, rows)
     t = equal_path_t(geo, s, st.path_length)
     r = reflected_rays(geo, s)
@@ -335,7 +361,7 @@ def build_adaptive(geo: Derived, method: str, tol: float | None, rows: int) -> D
     auto = tol is None
     if tol is None:
         tol = AUTO_RELATIVE_TOLERANCE * st.path_length
-    s_end = _occlusion_s(geo, st.path_length)
+    s_end = occlusion_s(geo, st.path_length)
     first = _solve(geo, method, tol, st, s_end)
     s = rows_even_in_theta(geo, lambda x: first.sol(x)[0], s_end, rows)
     floor = 100 * np.finfo(float).eps * 2.0 * st.t  # scipy's smallest rtol, on the largest t

@@ -450,7 +450,8 @@ SECTIONS: dict[str, type] = {
     "raycheck": RayCheckParams,
     "tolerancing": TolerancingParams,
 }
-TOP_LEVEL = {"description"}
+#: ``optimize`` is read and validated by rigcad.optimize.spec (rigcad optimize), ignored by the other stages.
+TOP_LEVEL = {"description", "optimize"}
 
 
 @dataclass(frozen=True)

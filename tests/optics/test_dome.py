@@ -102,6 +102,19 @@ def test_tolerance_below_float64_is_refused(table31_geometry):
 
 
 @pytest.mark.parametrize("cop", ["finite", "infinite"])
+def test_scalar_theta_agrees_with_the_vectorised_closed_form(table31_geometry, far_geometry, cop):
+    from rigcad.optics.dome import equal_path_t, reflected_rays, scalar_theta, start, theta_of
+
+    g = table31_geometry if cop == "finite" else far_geometry
+    L = start(g).path_length
+    s = np.linspace(0.5, g.rim_radius, 13)
+    r = reflected_rays(g, s)
+    vec = theta_of(r.P + equal_path_t(g, s, L)[:, None] * r.u)
+    sca = np.array([scalar_theta(g, L)(a) for a in s])
+    assert np.max(np.abs(vec - sca)) < 1e-13  # rad: same formulas, round-off only
+
+
+@pytest.mark.parametrize("cop", ["finite", "infinite"])
 def test_scalar_rhs_agrees_with_the_vectorised_one(table31_geometry, far_geometry, cop):
     from rigcad.optics.dome import dt_ds, scalar_rhs
 

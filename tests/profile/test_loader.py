@@ -100,4 +100,4 @@ def test_missing_name_says_where_it_looked(tmp_path, monkeypatch):
     with pytest.raises(ProfileError) as err:
         load_raw("nope")
     msg = str(err.value)
-    assert "profiles/ (none)" in msg and "lab/ (none)" in msg and "(achutha2006)" in msg and "RIGCAD_PROFILES" in msg
+    assert "profiles/ (none)" in msg and "lab/ (none)" in msg and "rigcad/profiles/ (achutha2006" in msg and "RIGCAD_PROFILES" in msg

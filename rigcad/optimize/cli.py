@@ -1,0 +1,73 @@
+"""``rigcad optimize PROFILE``: inverse design from the command line (wired by rigcad.cli)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+
+def cmd_optimize(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    from rigcad.engine import Engine
+    from rigcad.optimize.run import load_problem, run_optimize
+
+    overrides = {"seed": args.seed, "evaluations": args.evaluations, "workers": args.workers}
+    problem = load_problem(args.profile, overrides)  # refuses a bad optimize section before any work
+    spec = problem.spec
+    engine = Engine(workers=spec.workers, scheduler=args.scheduler)
+    bar = tqdm(total=spec.evaluations, desc=f"optimize {problem.base.name}", unit="design", disable=None,
+               leave=False, file=sys.stderr)
+
+    def progress(done: int, best: float) -> None:
+        bar.update(done - bar.n)
+        bar.set_postfix_str(f"best merit {best:.6g}")
+
+    try:
+        run = run_optimize(args.profile, Path(args.exports), engine, overrides, progress)
+    finally:
+        bar.close()
+    rep = run.report
+    base, chosen = rep["base"], rep["chosen"]
+    print(f"{rep['profile']}: {rep['method']}, {len(rep['evaluations'])} evaluations on {rep['engine']} "
+          f"({rep['workers']} worker(s)) in {rep['timings_s']['total_s']:.1f} s; median evaluation "
+          f"{1e3 * rep['evaluation_time_s']['cpu_median_s']:.2f} ms CPU; {len(rep['pareto'])} design(s) on the Pareto front")
+    print(f"  chosen: {rep['reason']}")
+    print(f"  {'':<24} {'base':>12} {'chosen':>12}")
+    keys = [(k, k) for k in ("theta_min_deg", "px_per_deg_cv", "px_per_deg_mean", "px_per_deg_min",
+                             "occluded_fraction", "dome_outer_width_mm", "dome_outer_height_mm", "dome_mass_g",
+                             "cop_z_mm", "dome_pieces")]
+    for label, k in keys:
+        b = base["figures"].get(k) if base["figures"] else None
+        c = chosen["figures"].get(k)
+        fmt = (lambda v: "-" if v is None else (f"{v:.5g}" if isinstance(v, float) else str(v)))
+        print(f"  {label:<24} {fmt(b):>12} {fmt(c):>12}")
+    for key, value in chosen["parameters"].items():
+        print(f"  {key:<32} {value:.6g}  (base {base['parameters'][key]:.6g})")
+    cert = rep["certified_check"]["fast_minus_certified"]
+    print("  certified path (converged DOP853 dome) minus fast path: "
+          + ", ".join(f"{k} {-v:+.2g}" for k, v in cert.items()))
+    for p in run.written:
+        print(f"  wrote {p}")
+    print(f"  build it: rigcad stl {run.profile_path}")
+    return 0
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add ``optimize`` to rigcad's subcommands."""
+    p = subparsers.add_parser(
+        "optimize", help="inverse design: search the profile's optimize: section for the rig that meets its targets",
+        description="Seeded global search (differential evolution for one objective, NSGA-II for two or more) "
+                    "and a local polish over the free parameters of the profile's optimize: section, under its "
+                    "constraints; writes exports/<profile>/optimize/{<profile>_design.yaml, optimize.json, "
+                    "history.png, pareto.png}. Exit 1 naming the constraint that could not be met.",
+        epilog="Example: rigcad optimize achutha2006_optimize (rigcad/profiles/achutha2006_optimize.yaml)")
+    p.add_argument("profile", help="profile name (under profiles/) or path, with an optimize: section")
+    p.add_argument("--exports", default="exports", help="output root (default: exports)")
+    p.add_argument("--seed", type=int, help="seed (default: optimize.seed)")
+    p.add_argument("--evaluations", type=int, help="evaluation budget (default: optimize.evaluations)")
+    p.add_argument("--workers", type=int, help="worker processes, 0 = every core (default: optimize.workers)")
+    p.add_argument("--scheduler", help="a Dask scheduler address, or local-dask (default: loky / serial)")
+    p.set_defaults(func=cmd_optimize)
+    return p

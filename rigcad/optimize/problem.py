@@ -1,0 +1,193 @@
+"""One design evaluation: free parameters -> a profile (``dataclasses.replace``, no YAML) -> derived
+geometry -> the fast design (``optimize.fast``) and the printer fit (``optimize.printfit``) -> every
+objective and every constraint. Constraint values g are <= 0 when met (units in ``CONSTRAINT_UNITS``).
+
+A :class:`Problem` is what every evaluation needs, small and picklable (it is the engine's shared
+object); :func:`evaluate_task` is the engine's job function.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigcad.errors import RigcadError
+from rigcad.optimize.fast import fast_design
+from rigcad.optimize.printfit import dome_fit
+from rigcad.optimize.spec import COATING_TOTAL, OBJECTIVES, OptimizeSpec
+from rigcad.profile.derived import derive
+from rigcad.profile.schema import Profile
+from rigcad.units import DEG
+
+#: Room (mm) the printer fit keeps in every direction beyond the printer's own bed margin: the
+#: model's outline is sampled (its extents err by < 0.05 mm, measured) and the fabrication stage
+#: cuts a meshed part; a design exactly at the edge of the bed is not one to print.
+PRINT_RESERVE = 0.5
+#: Scale of one unit of violation, per unit, for the penalty merit (a constraint's g / scale).
+UNIT_SCALE = {"mm": 1.0, "deg": 0.1, "px/deg": 0.01, "": 0.001}
+
+
+@dataclass(frozen=True)
+class PrinterFacts:
+    """What the constraints read from a printer (mm; g/cm3)."""
+
+    name: str
+    usable: tuple[float, float, float]
+    feature: float  #: nozzle (FDM) or pixel (SLA)
+    density_g_cm3: float
+
+
+@dataclass(frozen=True)
+class Problem:
+    base: Profile
+    spec: OptimizeSpec
+    printer: PrinterFacts | None
+
+    @property
+    def names(self) -> list[str]:
+        return [p.key for p in self.spec.parameters]
+
+    @property
+    def lo(self) -> np.ndarray:
+        return np.array([p.lo for p in self.spec.parameters])
+
+    @property
+    def hi(self) -> np.ndarray:
+        return np.array([p.hi for p in self.spec.parameters])
+
+    def to_x(self, unit: np.ndarray) -> np.ndarray:
+        """Physical values (mm, rad, numbers) of a point of the unit cube."""
+        return self.lo + np.clip(unit, 0.0, 1.0) * (self.hi - self.lo)
+
+    def to_unit(self, x: np.ndarray) -> np.ndarray:
+        return (np.asarray(x, float) - self.lo) / (self.hi - self.lo)
+
+    @property
+    def base_x(self) -> np.ndarray:
+        return np.array([p.base for p in self.spec.parameters])
+
+
+def make_problem(profile: Profile, spec: OptimizeSpec) -> Problem:
+    facts = None
+    if spec.constraints.printer is not None:
+        from rigcad.fab.printers import load_printer
+
+        p = load_printer(spec.constraints.printer)
+        facts = PrinterFacts(p.name, p.usable, float(p.nozzle if p.nozzle is not None else p.pixel),
+                             float(p.material_density_g_cm3))
+    return Problem(profile, spec, facts)
+
+
+def apply(profile: Profile, keys: list[str], x) -> Profile:
+    """``profile`` with the free parameters ``keys`` set to ``x`` (internal units)."""
+    changes: dict[str, dict] = {}
+    for key, value in zip(keys, x):
+        value = float(value)
+        if key == COATING_TOTAL:
+            total = sum(t for _, t in profile.coating.layers)
+            layers = tuple((n, t * value / total) for n, t in profile.coating.layers)
+            changes.setdefault("coating", {})["layers"] = layers
+            continue
+        section, _, name = key.partition(".")
+        changes.setdefault(section, {})[name] = value
+    return dataclasses.replace(profile, **{s: dataclasses.replace(getattr(profile, s), **kw) for s, kw in changes.items()})
+
+
+def evaluate(problem: Problem, x) -> dict:
+    """Objectives, constraints and figures of the design at ``x`` (internal units). A design the
+    geometry refuses (GeometryError...) comes back with ``error`` set and no figures."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    spec = problem.spec
+    x = [float(v) for v in x]
+    row: dict = {"x": x, "error": None}
+    try:
+        profile = apply(problem.base, problem.names, x)
+        geo = derive(profile)
+        fd = fast_design(profile, geo, spec.nodes)
+    except RigcadError as err:
+        row.update(figures=None, objectives=None, constraints=None, feasible=False, error=err.message,
+                   time_s=time.perf_counter() - t0, cpu_s=time.process_time() - c0)
+        return row
+    fig = dict(fd.figures)
+    c = spec.constraints
+    g: dict[str, float] = {
+        "design.top_clearance": -fig["top_clearance_mm"],
+        "design.cop_above_dome": -fig["cop_above_dome_mm"],
+        "design.beam_above_flange": -fig["beam_above_flange_mm"],
+        # parts.layout: the sample holder's stop lies inside the printed dome's base
+        "design.holder_inside_base": profile.sample_holder.stop_radius - float(fd.outline.flange[3][0]),
+    }
+    pr = problem.printer
+    density = pr.density_g_cm3 if pr is not None else 1.24  # PLA when no printer is named
+    fig["dome_mass_g"] = fig["dome_volume_mm3"] / 1000.0 * density
+    if pr is not None:
+        usable = tuple(u - PRINT_RESERVE for u in pr.usable)
+        fit = dome_fit(fd.outline, usable, c.max_pieces)
+        fig["dome_pieces"] = fit["pieces"]
+        fig["dome_sectors"], fig["dome_bands"] = fit["sectors"], fit["bands"]
+        fig["printer_margin_mm"] = fit["margin_mm"] + PRINT_RESERVE  # room left on the printer itself
+        fig["printer_reserve_mm"] = PRINT_RESERVE
+        g["printer.pieces"] = -fit["margin_mm"]
+        if c.min_feature_nozzles is not None:
+            need = c.min_feature_nozzles * pr.feature
+            coating = float(sum(t for _, t in profile.coating.layers))
+            g["min_feature.dome_wall"] = need - profile.dome_shell.wall
+            g["min_feature.paraboloid_vertex"] = need - (geo.vertex_radius_of_curvature - coating)
+    if c.max_cop_height is not None:
+        g["max_cop_height"] = fig["cop_z_mm"] - c.max_cop_height
+    if c.max_occluded_fraction is not None:
+        g["max_occluded_fraction"] = fig["occluded_fraction"] - c.max_occluded_fraction
+    if c.raycheck:
+        rc, tg, k = profile.raycheck, profile.targets, 1.0 - c.raycheck_margin
+        g["raycheck.theta_min_coverage"] = fig["theta_min_deg"] - (tg.theta_min + k * rc.theta_coverage_tolerance) / DEG
+        g["raycheck.theta_max_coverage"] = (tg.theta_max - k * rc.theta_coverage_tolerance) / DEG - fig["theta_max_deg"]
+        g["raycheck.min_px_per_deg"] = rc.min_px_per_deg / k - fig["px_per_deg_min"]
+        g["raycheck.max_lost_fraction"] = fig["occluded_fraction"] - k * rc.max_lost_fraction
+    objectives = {name: float(fig[OBJECTIVES[name][0]]) for name, _ in spec.objectives}
+    row.update(figures=fig, objectives=objectives, constraints=g, feasible=all(v <= 0 for v in g.values()),
+               time_s=time.perf_counter() - t0, cpu_s=time.process_time() - c0)
+    return row
+
+
+#: Units of each constraint value (for the report and the penalty scale).
+CONSTRAINT_UNITS = {
+    "design.top_clearance": "mm", "design.cop_above_dome": "mm", "design.beam_above_flange": "mm",
+    "design.holder_inside_base": "mm",
+    "printer.pieces": "mm", "min_feature.dome_wall": "mm", "min_feature.paraboloid_vertex": "mm",
+    "max_cop_height": "mm", "max_occluded_fraction": "", "raycheck.theta_min_coverage": "deg",
+    "raycheck.theta_max_coverage": "deg", "raycheck.min_px_per_deg": "px/deg", "raycheck.max_lost_fraction": "",
+}
+#: What each constraint means, for messages (the profile key that sets its limit).
+CONSTRAINT_KEYS = {
+    "design.top_clearance": "the dome's top opening must clear the projector's ray bundle",
+    "design.cop_above_dome": "the COP must lie above the dome",
+    "design.beam_above_flange": "the beam must sit above the dome's flange",
+    "design.holder_inside_base": "sample_holder.stop_radius must lie inside the dome's base",
+    "printer.pieces": "optimize.constraints.printer / max_pieces: the dome must print in at most max_pieces pieces "
+                      "with PRINT_RESERVE mm to spare (value: how many mm too large the best split is)",
+    "min_feature.dome_wall": "optimize.constraints.min_feature_nozzles: dome_shell.wall against the nozzle",
+    "min_feature.paraboloid_vertex": "optimize.constraints.min_feature_nozzles: the paraboloid's vertex radius "
+                                     "of curvature against the nozzle",
+    "max_cop_height": "optimize.constraints.max_cop_height: the COP's height above the sample plane",
+    "max_occluded_fraction": "optimize.constraints.max_occluded_fraction: pixels the mount hides",
+    "raycheck.theta_min_coverage": "raycheck.theta_coverage_tolerance: theta must reach targets.theta_min",
+    "raycheck.theta_max_coverage": "raycheck.theta_coverage_tolerance: theta must reach targets.theta_max",
+    "raycheck.min_px_per_deg": "raycheck.min_px_per_deg: fewest projector pixels per degree",
+    "raycheck.max_lost_fraction": "raycheck.max_lost_fraction: pixels the mount hides",
+}
+
+
+def violation(row: dict) -> float:
+    """Sum of the scaled constraint violations (0 when feasible; inf for a refused design)."""
+    if row["constraints"] is None:
+        return math.inf
+    return float(sum(max(v, 0.0) / UNIT_SCALE[CONSTRAINT_UNITS[k]] for k, v in row["constraints"].items()))
+
+
+def evaluate_task(problem: Problem, batch: list) -> list[dict]:
+    """The engine's job: evaluate a batch of points (internal units)."""
+    return [evaluate(problem, x) for x in batch]

@@ -1,0 +1,259 @@
+"""``rigcad optimize PROFILE``: read the ``optimize:`` section, search, check the chosen design on
+the certified path (``Rig.from_profile`` + the 2D design), and publish, all together, into
+``exports/<profile>/optimize/``:
+
+* ``<profile>_design.yaml``: the chosen design as a profile that ``extends:`` PROFILE and sets only
+  the parameters that changed (``rigcad stl exports/<profile>/optimize/<profile>_design.yaml``); when
+  PROFILE is not on the profile search path by name, it is written beside PROFILE's file instead,
+  where its ``extends:`` resolves;
+* ``optimize.json``: the settings, every evaluation (parameters, objectives, constraint values,
+  time), the Pareto set, the base and chosen designs, the certified check of the chosen one;
+* ``history.png`` (merit per evaluation) and ``pareto.png`` (objectives, front, base, chosen).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from rigcad.engine import Engine
+from rigcad.optimize.problem import CONSTRAINT_UNITS, Problem, apply, make_problem
+from rigcad.errors import RigcadError
+from rigcad.optimize.search import OptimizeError, Result, infeasible_message, optimize, preference
+from rigcad.optimize.spec import COATING_TOTAL, OBJECTIVES, read_optimize
+from rigcad.units import DEG
+
+#: Designs tried on the certified path, best first, before the run gives up.
+MAX_CERTIFY = 8
+#: Relative change below which a free parameter counts as unchanged (not written to the profile).
+UNCHANGED_RTOL = 1e-9
+
+
+@dataclass
+class OptimizeRun:
+    report: dict
+    written: list[Path]
+    profile_path: Path | None
+    result: Result
+
+
+def load_problem(profile_spec, overrides: dict | None = None) -> Problem:
+    """The profile (by name or path) and its validated optimize section; ``overrides`` replaces
+    search settings (seed, evaluations, workers) from the command line."""
+    import dataclasses
+
+    from rigcad.profile.loader import load_raw
+    from rigcad.profile.schema import validate
+
+    raw = load_raw(profile_spec)
+    profile = validate(raw)
+    spec = read_optimize(raw, profile)
+    if overrides:
+        from rigcad.errors import ProfileError
+        from rigcad.optimize.spec import MAX_EVALUATIONS
+
+        limits = {"seed": (0, 2**63 - 1), "evaluations": (10, MAX_EVALUATIONS), "workers": (0, 256)}
+        for key, value in overrides.items():
+            lo, hi = limits[key]
+            if value is not None and not lo <= value <= hi:
+                raise ProfileError(f"--{key} {value}: expected a whole number {lo}..{hi}", param=f"--{key}")
+        spec = dataclasses.replace(spec, **{k: v for k, v in overrides.items() if v is not None})
+    return make_problem(profile, spec)
+
+
+def _values(problem: Problem, x) -> dict:
+    out = {}
+    for p, v in zip(problem.spec.parameters, x):
+        unit = {"length": "_mm", "angle": "_deg"}.get(p.kind, "")
+        out[p.key + unit] = v / DEG if p.kind == "angle" else v
+    return out
+
+
+def _row_json(problem: Problem, r: dict) -> dict:
+    return {"index": r["index"], "phase": r["phase"], "parameters": _values(problem, r["x"]),
+            "objectives": r["objectives"], "constraints": r["constraints"], "feasible": r["feasible"],
+            "merit": r["merit"], "error": r["error"], "time_s": r["time_s"], "cpu_s": r["cpu_s"],
+            "figures": r["figures"]}
+
+
+def design_yaml(problem: Problem, row: dict, base_name: str, note: str) -> str:
+    """The chosen design as a profile extending ``base_name``, setting only what changed."""
+    profile = apply(problem.base, problem.names, row["x"])
+    sections: dict[str, list[str]] = {}
+    for p, v in zip(problem.spec.parameters, row["x"]):
+        if abs(v - p.base) <= UNCHANGED_RTOL * max(abs(p.base), 1e-12):
+            continue
+        if p.key == COATING_TOTAL:
+            lines = [f"    - {{name: {n!r}, thickness: {t:.12g} mm}}" for n, t in profile.coating.layers]
+            sections.setdefault("coating", []).append("  layers:\n" + "\n".join(lines))
+            continue
+        section, _, name = p.key.partition(".")
+        sections.setdefault(section, []).append(f"  {name}: {p.shown(v)}")
+    if row.get("dome_tolerance_mm") is not None:
+        sections.setdefault("dome", []).append(
+            f"  tolerance: {row['dome_tolerance_mm']:g} mm   # the base's {problem.base.dome.tolerance:g} mm cannot be "
+            "certified in float64 on this geometry")
+    f = row["figures"]
+    head = [f"# Chosen by `rigcad optimize {base_name}` ({note}).",
+            f"# theta {f['theta_min_deg']:.3f}..{f['theta_max_deg']:.1f} deg, {f['px_per_deg_mean']:.4f} px/deg mean "
+            f"(CV {f['px_per_deg_cv']:.4f}, min {f['px_per_deg_min']:.4f}), dome {f['dome_outer_width_mm']:.1f} x "
+            f"{f['dome_outer_height_mm']:.1f} mm"
+            + (f", {f['dome_pieces']} piece(s) on {problem.printer.name}" if f.get("dome_pieces") else "") + ".",
+            f"extends: {base_name}",
+            f"description: {base_name} as chosen by rigcad optimize"]
+    body = [f"{s}:\n" + "\n".join(lines) for s, lines in sections.items()]
+    return "\n".join(head) + "\n\n" + "\n\n".join(body) + "\n"
+
+
+#: Looser dome tolerances (mm) tried, in order, when float64 cannot certify the base profile's
+#: explicit ``dome.tolerance`` on a chosen geometry; each stays far below what the dome's curve
+#: needs (CURVE_MISS_RTOL of the optical path, ~6e-7 mm) and the meshes' micrometres.
+LOOSER_TOLERANCES = (3e-9, 1e-8, 3e-8, 1e-7)
+
+
+def certified_rig(problem: Problem, row: dict):
+    """The Rig of ``row``'s design (``Rig.from_profile``), and the dome tolerance it needed (mm) when
+    the base profile's explicit one cannot be certified there (None: the base's own)."""
+    import dataclasses
+
+    from rigcad.errors import IntegrationError
+    from rigcad.rig import Rig
+
+    profile = apply(problem.base, problem.names, row["x"])
+    base_tol = profile.dome.tolerance
+    tries = [None] + [t for t in LOOSER_TOLERANCES if base_tol is not None and t > base_tol]
+    for tol in tries:
+        p = profile if tol is None else dataclasses.replace(profile, dome=dataclasses.replace(profile.dome, tolerance=tol))
+        try:
+            return Rig.from_profile(p), tol
+        except IntegrationError as err:
+            if err.param != "dome.tolerance" or tol == tries[-1]:
+                raise
+    raise AssertionError("unreachable")
+
+
+def certify(problem: Problem, row: dict) -> dict:
+    """The chosen design on the certified path (converged DOP853 dome, the 2D design's report) beside
+    the fast path's figures: the differences say how far the optimiser's evaluation can be trusted."""
+    rig, tol = certified_rig(problem, row)
+    row["dome_tolerance_mm"] = tol
+    r = rig.design.report
+    f = row["figures"]
+    pairs = {"theta_min_deg": r["measurable_range"]["theta_min_deg"],
+             "px_per_deg_mean": r["pixels"]["px_per_deg_mean"],
+             "px_per_deg_min": r["pixels"]["px_per_deg_min"],
+             "dome_width_mm": r["envelope"]["width_mm"], "dome_height_mm": r["envelope"]["height_mm"],
+             "top_clearance_mm": r["top_aperture"]["clearance_mm"]}
+    return {"certified": pairs, "fast_minus_certified": {k: f[k] - v for k, v in pairs.items()},
+            "note": "px_per_deg_min of the certified design: np.gradient over its 2001+ rows (second order); the fast "
+                    "path's is exact at its nodes", "dome_rows": int(len(rig.dome.s)),
+            "dome_error_estimate_mm": rig.dome.error_estimate, "dome_tolerance_mm": rig.dome.tolerance,
+            "dome_tolerance_loosened": tol is not None}
+
+
+def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine | None = None, overrides=None,
+                 progress=None) -> OptimizeRun:
+    """Search and publish (module docstring). Raises OptimizeError (after publishing the record of
+    every evaluation) when no design meets the constraints."""
+    from rigcad import __version__, plots
+    from rigcad.export.atomic import Staging, json_bytes, profile_lock
+
+    problem = load_problem(profile_spec, overrides)
+    spec = problem.spec
+    engine = engine or Engine(workers=spec.workers)
+    result = optimize(problem, engine, progress)
+    name = problem.base.name
+    out = Path(exports) / name / "optimize"
+    report = {
+        "rigcad_version": __version__,
+        "profile": name, "sources": list(problem.base.sources),
+        "method": result.method, "engine": engine.name, "workers": engine.n_workers,
+        "spec": spec.describe(),
+        "units": {"parameters": "keys end in _mm, _deg or nothing (a number)", "constraints": {
+            k: v or "fraction" for k, v in CONSTRAINT_UNITS.items()},
+            "constraint_sign": "value <= 0 when met", "merit": "first objective / its scale (minimised); infeasible "
+            f"designs {1e6:g} x (1 + scaled violation) above; refused designs 1e12"},
+        "objective_scales": {n: OBJECTIVES[n][2] for n, _ in spec.objectives},
+        "status": "ok" if result.chosen is not None else "infeasible",
+        "reason": result.reason,
+        "base": _row_json(problem, result.base),
+        "chosen": _row_json(problem, result.chosen) if result.chosen else None,
+        "pareto": [_row_json(problem, r) for r in result.front],
+        "timings_s": result.timings,
+        "evaluation_time_s": _time_stats(result.history),
+        "evaluations": [_row_json(problem, r) for r in result.history],
+    }
+    files: dict[str, bytes] = {}
+    profile_path = None
+    rejected = []
+    if result.chosen is not None:
+        # the certified path (converged DOP853 dome at the profile's dome.tolerance) has the last word:
+        # a design it refuses (e.g. a tolerance float64 cannot certify there) gives way to the next
+        for row, why in preference(problem, result)[:MAX_CERTIFY]:
+            try:
+                report["certified_check"] = certify(problem, row)
+            except RigcadError as err:
+                rejected.append({"index": row["index"], "error": str(err)})
+                continue
+            result.chosen, result.reason = row, why
+            break
+        else:
+            result.chosen = None
+        report["rejected_by_certified_path"] = rejected
+        report["chosen"] = _row_json(problem, result.chosen) if result.chosen else None
+        report["reason"] = result.reason
+        report["status"] = "ok" if result.chosen is not None else "infeasible"
+    if result.chosen is not None:
+        note = f"seed {spec.seed}, {len(result.history)} evaluations, {result.method}; {result.reason}"
+        stem = f"{name}_design"
+        text = design_yaml(problem, result.chosen, name, note).encode()
+        home = _design_home(profile_spec, name, out)
+        profile_path = home / f"{stem}.yaml"
+        if home == out:
+            files[f"{stem}.yaml"] = text
+        report["design_profile"] = str(profile_path)
+    elif rejected:
+        report["infeasible"] = (f"the {len(rejected)} best designs were refused by the certified path "
+                                f"(Rig.from_profile); the first: {rejected[0]['error']}")
+    else:
+        report["infeasible"] = infeasible_message(problem, result.history)
+    files["optimize.json"] = json_bytes(report)
+    files["history.png"] = plots.optimize_history(report)
+    files["pareto.png"] = plots.optimize_pareto(report)
+    with Staging(out, profile_lock(exports, name), carry=lambda rel: False) as stage:
+        for fname, data in files.items():
+            stage.write_bytes(out / fname, data)
+        written = stage.commit()
+    if profile_path is not None and profile_path.parent != out:
+        from rigcad.export.atomic import write_bytes
+
+        written.append(write_bytes(profile_path, text))
+    if result.chosen is None:
+        raise OptimizeError(f"{name}: {report['infeasible']} (every evaluation in {out / 'optimize.json'})")
+    return OptimizeRun(report, written, profile_path, result)
+
+
+def _design_home(profile_spec, name: str, out: Path) -> Path:
+    """Where the design profile goes: ``out`` when its ``extends: name`` resolves from there to the
+    searched profile (a name on the search path: ./profiles, $RIGCAD_PROFILES, the shipped ones),
+    else beside the searched profile's own file, where the name always resolves."""
+    from rigcad.errors import ProfileError
+    from rigcad.profile.loader import find_file, resolve_profile_path
+
+    base = resolve_profile_path(profile_spec).resolve()
+    try:
+        found = find_file(name, "profile", near=out, as_path=False).resolve()
+    except ProfileError:
+        found = None
+    return out if found == base else base.parent
+
+
+def _time_stats(rows: list[dict]) -> dict:
+    import numpy as np
+
+    t = np.array([r["time_s"] for r in rows])
+    c = np.array([r["cpu_s"] for r in rows])
+    return {"evaluations": int(len(t)), "median_s": float(np.median(t)), "max_s": float(t.max()),
+            "cpu_median_s": float(np.median(c)), "cpu_max_s": float(c.max()),
+            "note": "per evaluation in its worker (one core): wall time (time_s) and the process's CPU time (cpu_s, "
+                    "what the evaluation cost whatever else the machine runs)"}

@@ -1,0 +1,70 @@
+"""`rigcad optimize achutha2006_optimize` as a user runs it: the issue's target (beat Table 3.1 on
+the lowest measurable theta and the px/deg coefficient of variation, printing on the Prusa MK3S in
+at most 4 dome pieces, within 300 evaluations), the outputs, and the written profile built and
+passed through `rigcad check` (the smallest part, 50 000 rays, no Monte Carlo: kept light)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import yaml
+
+from rigcad.cli import main
+
+
+@pytest.fixture(scope="module")
+def optimized(tmp_path_factory):
+    out = tmp_path_factory.mktemp("opt") / "exports"
+    code = main(["optimize", "achutha2006_optimize", "--exports", str(out), "--workers", "1"])
+    assert code == 0
+    folder = out / "achutha2006_optimize" / "optimize"
+    return folder, json.loads((folder / "optimize.json").read_text())
+
+
+def test_beats_table31_on_both_objectives_within_the_budget(optimized):
+    _, rep = optimized
+    base, chosen = rep["base"], rep["chosen"]
+    assert base["parameters"] == {"layout.cop_to_vertex_mm": 270.0, "layout.sample_to_rim_mm": 135.0,
+                                  "paraboloid.vertical_extent_mm": 22.5,
+                                  "paraboloid.tangent_angle_deg": pytest.approx(20.0, abs=1e-12)}  # Table 3.1
+    assert chosen["objectives"]["theta_min"] < base["objectives"]["theta_min"]
+    assert chosen["objectives"]["px_per_deg_cv"] < base["objectives"]["px_per_deg_cv"]
+    assert chosen["feasible"] and chosen["figures"]["dome_pieces"] <= 4
+    assert len(rep["evaluations"]) <= 300
+    assert rep["spec"]["constraints"]["printer"] == "prusa_mk3s"
+    # the certified path (converged DOP853 dome) agrees with the evaluation the search trusted
+    diff = rep["certified_check"]["fast_minus_certified"]
+    assert abs(diff["theta_min_deg"]) < 1e-9 and abs(diff["px_per_deg_mean"]) < 1e-9  # deg, px/deg: both exact
+    assert abs(diff["px_per_deg_min"]) < 1e-4  # px/deg: the certified one is np.gradient on its rows
+
+
+def test_every_evaluation_is_recorded_with_units(optimized):
+    folder, rep = optimized
+    row = rep["evaluations"][1]
+    assert set(row) >= {"parameters", "objectives", "constraints", "time_s", "feasible", "phase"}
+    assert all(k.endswith(("_mm", "_deg")) for k in row["parameters"])
+    assert {r["phase"] for r in rep["evaluations"]} == {"global", "polish"}
+    for name in ("history.png", "pareto.png"):
+        assert (folder / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_written_profile_extends_the_base_and_sets_only_what_changed(optimized):
+    folder, rep = optimized
+    path = folder / "achutha2006_optimize_design.yaml"
+    data = yaml.safe_load(path.read_text())
+    assert data["extends"] == "achutha2006_optimize"
+    changed = {k for k, v in rep["chosen"]["parameters"].items() if v != rep["base"]["parameters"][k]}
+    written = {f"{s}.{k}" for s, kv in data.items() if isinstance(kv, dict) for k in kv if s != "dome"}
+    assert written == {k.rsplit("_", 1)[0] for k in changed}
+
+
+def test_written_profile_builds_and_passes_rigcad_check(optimized, tmp_path, capsys):
+    folder, _ = optimized
+    path = str(folder / "achutha2006_optimize_design.yaml")
+    exports = str(tmp_path / "exports")
+    assert main(["build", path, "--parts", "paraboloid", "--exports", exports]) == 0
+    # 50 000 rays: the lost fraction's sampling error (0.12 %) is well inside the search's 3 % reserve
+    # (the limit 8 %, held to 7.76 %; measured 7.65 % with 100 000 rays)
+    assert main(["check", path, "--exports", exports, "--rays", "50000", "--no-monte-carlo"]) == 0, \
+        capsys.readouterr()
