@@ -11,6 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 _PNG_META = {"Software": None}
 
@@ -83,6 +84,11 @@ def incidence_plot(design) -> bytes:
         a2.grid(alpha=0.3)
         sec = a1.secondary_xaxis("top", functions=(lambda r: np.interp(r, t["paraboloid_r_mm"][::-1], pix[::-1]),
                                                      lambda p: np.interp(p, pix[::-1], t["paraboloid_r_mm"][::-1])))
+        # ticks only inside the pixel range: beyond it the inverse map clamps, and ticks past the rim
+        # would all land on the rim's radius, printed over each other
+        lo, hi = float(np.nanmin(pix)), float(np.nanmax(pix))
+        ticks = MaxNLocator(nbins=6).tick_values(lo, hi)
+        sec.set_xticks(ticks[(ticks >= lo) & (ticks <= hi)])
         sec.set_xlabel("projector pixel from the axis")
     else:
         a2.text(0.5, 0.5, "COP at infinity: no pixel grid", ha="center", va="center")
@@ -92,34 +98,65 @@ def incidence_plot(design) -> bytes:
     return _png(fig)
 
 
-def render_mesh(vertices: np.ndarray, faces: np.ndarray, title: str, color=(0.7, 0.7, 0.75),
-                cutaway: bool = False) -> bytes:
-    """A shaded view of a triangle mesh (mm). ``cutaway`` drops the half with y < 0 to show the inside."""
+def _shaded(ax, tri: np.ndarray, color, alpha: float = 1.0) -> None:
+    """Flat-shaded triangles (m, 3, 3) mm on a 3D axes, lit from the viewer's upper left."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    tri = vertices[faces]
-    if cutaway:
-        tri = tri[tri[:, :, 1].mean(axis=1) > 0]
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
     light = np.array([-0.4, -0.6, 0.7])
     light /= np.linalg.norm(light)
     shade = 0.35 + 0.65 * np.abs(n @ light)
     rgb = np.clip(np.outer(shade, color), 0, 1)
-    fig = plt.figure(figsize=(5, 5))
-    ax = fig.add_subplot(projection="3d")
+    if alpha < 1.0:
+        rgb = np.column_stack([rgb, np.full(len(rgb), alpha)])
     ax.add_collection3d(Poly3DCollection(tri, facecolors=rgb, edgecolors="none", linewidths=0))
-    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
-    mid, span = (lo + hi) / 2, float((hi - lo).max()) / 2
-    ax.set_xlim(mid[0] - span, mid[0] + span)
-    ax.set_ylim(mid[1] - span, mid[1] + span)
-    ax.set_zlim(mid[2] - span, mid[2] + span)
-    ax.set_box_aspect((1, 1, 1))
-    ax.view_init(elev=15, azim=-90) if cutaway else ax.view_init(elev=22, azim=-60)
+
+
+def _fit_axes(ax, lo: np.ndarray, hi: np.ndarray) -> None:
+    """Axis limits on the geometry's own extents (mm), equal scale on all three axes: the box's
+    aspect is the geometry's, so a long beam fills the frame's width instead of a cube's diagonal."""
+    mid, size = (lo + hi) / 2, np.maximum(hi - lo, 1e-3)
+    size = np.maximum(size, 0.04 * size.max())  # a flat part keeps a visible thickness
+    for setter, m, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid, size / 2):
+        setter(m - h, m + h)
+    ax.set_box_aspect(tuple(size), zoom=1.1)
     ax.set_axis_off()
+
+
+def _trimmed_png(fig, dpi: int = 110, pad: int = 12) -> bytes:
+    """The figure as PNG, cropped to what is drawn (non-white pixels) plus ``pad`` px: a 3D axes
+    leaves most of its frame empty whatever its margins."""
+    fig.set_dpi(dpi)
+    fig.canvas.draw()
+    rgba = np.asarray(fig.canvas.buffer_rgba())
+    plt.close(fig)
+    ink = np.nonzero((rgba[:, :, :3] < 250).any(axis=2))
+    if len(ink[0]):
+        r0, r1 = max(ink[0].min() - pad, 0), min(ink[0].max() + pad + 1, rgba.shape[0])
+        c0, c1 = max(ink[1].min() - pad, 0), min(ink[1].max() + pad + 1, rgba.shape[1])
+        rgba = rgba[r0:r1, c0:c1]
+    buf = io.BytesIO()
+    plt.imsave(buf, np.ascontiguousarray(rgba), format="png", metadata=_PNG_META)
+    return buf.getvalue()
+
+
+def render_mesh(vertices: np.ndarray, faces: np.ndarray, title: str, color=(0.7, 0.7, 0.75),
+                cutaway: bool = False) -> bytes:
+    """A shaded view of a triangle mesh (mm), cropped to the part. ``cutaway`` drops the half
+    with y < 0 to show the inside."""
+    tri = vertices[faces]
+    if cutaway:
+        tri = tri[tri[:, :, 1].mean(axis=1) > 0]
+    fig = plt.figure(figsize=(5, 5))
+    ax = fig.add_axes((0, 0, 1, 0.9), projection="3d")
+    _shaded(ax, tri, color)
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    _fit_axes(ax, lo, hi)
+    ax.view_init(elev=15, azim=-90) if cutaway else ax.view_init(elev=22, azim=-60)
     size = hi - lo
-    ax.set_title(f"{title}\n{size[0]:.1f} x {size[1]:.1f} x {size[2]:.1f} mm", fontsize=9)
-    return _png(fig)
+    fig.suptitle(f"{title}\n{size[0]:.1f} x {size[1]:.1f} x {size[2]:.1f} mm", fontsize=9, y=0.97)
+    return _trimmed_png(fig)
 
 
 # -- the 3D ray check (rigcad check) -----------------------------------------------------------
@@ -139,12 +176,13 @@ def spot_diagram(result) -> bytes:
     a.set_xlabel("x on the sample (um)")
     a.set_ylabel("y on the sample (um)")
     rep = result.report
-    a.set_title(f"{rep['profile']['name']}: landing points, mode {rep['mode']}")
+    a.set_title(f"{rep['profile']['name']}: landing points\nmode {rep['mode']}, theta <= 80 deg", fontsize=10)
     b.semilogy(theta, np.maximum(tr.miss[ok] * 1e3, 1e-9), ",", alpha=0.5)
     b.set_xlabel("theta (deg)")
     b.set_ylabel("distance from O to the ray (um)")
-    b.set_title("spot radius per ray")
+    b.set_title("spot radius per ray", fontsize=10)
     b.grid(True, alpha=0.3)
+    fig.tight_layout()
     return _png(fig)
 
 
