@@ -255,6 +255,10 @@ def build_parser() -> argparse.ArgumentParser:
     from rigcad.basis.cli import register as register_basis
 
     register_basis(sub)
+
+    from rigcad.manual.cli import register as register_manual
+
+    register_manual(sub)
     return parser
 
 
