@@ -247,8 +247,9 @@ def rig_picture(meshes, rays: dict | None, title: str, elev: float = 18.0, azim:
 
 def assembly_step(meshes, step: int, title: str, elev: float = 18.0, azim: float = -62.0) -> bytes:
     """Exploded picture of assembly step ``step``: parts 0..step-1 of ``meshes`` (assembly order) in
-    place (grey), part ``step`` in its colour lifted by its exploded offset, with a dashed line down
-    to where it goes; enclosing parts cut away in front."""
+    place (grey), part ``step`` highlighted (orange) at its exploded offset, with a dashed line to
+    where it goes; enclosing parts cut away in front. A part that goes in from below is seen from
+    below."""
     cut = _encloses(meshes)
     fig = plt.figure(figsize=(6, 6.5))
     ax = fig.add_axes((0, 0, 1, 0.92), projection="3d")
@@ -260,17 +261,19 @@ def assembly_step(meshes, step: int, title: str, elev: float = 18.0, azim: float
         off = m.explode if k == step else np.zeros(3)
         tri = m.vertices[m.faces] + off
         tri = _cut_front(tri) if m.name in cut and k < step else tri
-        groups.append((tri, m.color if k == step else (0.78, 0.78, 0.8), 1.0))
+        groups.append((tri, (0.95, 0.55, 0.15) if k == step else (0.8, 0.8, 0.82), 1.0))
         lo, hi = np.minimum(lo, m.lo + off), np.maximum(hi, m.hi + off)
     _draw(ax, groups)
     new = meshes[step]
     if np.any(new.explode):
+        ax.computed_zorder = False  # the path over the parts
         c = 0.5 * (new.lo + new.hi)
         a, b = c + new.explode, c
-        ax.plot([a[0], b[0]], [a[1], b[1]], [a[2], b[2]], "--", color="tab:red", lw=1.2)
-        ax.scatter([b[0]], [b[1]], [b[2]], color="tab:red", s=12, marker="v")
+        ax.plot([a[0], b[0]], [a[1], b[1]], [a[2], b[2]], "--", color="tab:red", lw=1.4, zorder=5)
+        ax.scatter([b[0]], [b[1]], [b[2]], color="tab:red", s=16, marker="v" if new.explode[2] > 0 else "^",
+                   zorder=6)
     _fit_axes(ax, lo, hi)
-    ax.view_init(elev=elev, azim=azim)
+    ax.view_init(elev=-elev if new.explode[2] < 0 else elev, azim=azim)
     return _trimmed_png(fig, title)
 
 

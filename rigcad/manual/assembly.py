@@ -28,7 +28,7 @@ VIEW_CHORD_ERROR_MM = 0.3
 #: Gap between exploded parts, as a fraction of the assembled rig's height.
 EXPLODE_GAP = 0.08
 #: The order the thesis's rig goes together (parts known today); parts not listed follow, by height.
-KNOWN_ORDER = ("base_plate", "sample_holder", "paraboloid", "beam", "dome")
+KNOWN_ORDER = ("base_plate", "sample_holder", "beam", "paraboloid", "dome")
 
 
 @dataclass(frozen=True)

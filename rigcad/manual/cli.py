@@ -54,4 +54,7 @@ def register(subparsers) -> None:
     m.add_argument("profile", help="profile name (under profiles/) or path")
     m.add_argument("--printer", required=True, help="printer name (under printers/ on the profile search path) or path")
     m.add_argument("--exports", default="exports", help="output root (default: exports)")
+    m.add_argument("--gcode", action="store_true",
+                   help="slice the pieces with PrusaSlicer so that times and filament are the slicer's (cached "
+                        "per piece); default: rigcad's estimate")
     m.set_defaults(func=cmd_manual)
