@@ -38,7 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from rigcad.parts.recipe import Part
 
 #: Geometry a move does not change: carried over by :meth:`Rig.moved` instead of recomputed.
-_SHARED = ("paraboloid", "curve", "design", "layout", "recipes", "incidence", "occluders")
+_SHARED = ("paraboloid", "curve", "design", "layout", "recipes", "instruments", "incidence", "occluders")
 
 
 @dataclass(frozen=True)
@@ -105,6 +105,15 @@ class Rig:
         from rigcad.parts import make_recipes
 
         return make_recipes(self.profile, self.layout)
+
+    @cached_property
+    def instruments(self) -> tuple["Part", ...]:
+        """The bought items (projector, camera, beam splitter, focusing lens, nominal shim stacks) and
+        the centre-of-projection markers as named solids in their working positions, for rig.step
+        and the tower's checks (``rigcad.parts.tower.instruments``); not printed."""
+        from rigcad.parts.tower import instruments
+
+        return instruments(self.profile, self.layout)
 
     @cached_property
     def incidence(self) -> "DesignMap":

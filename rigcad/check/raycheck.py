@@ -201,6 +201,13 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
                     "max_spot_radius_mm", "rms_spot_radius_mm", "mesh_minus_exact_angle_rad")}
     timings["pinhole_s"] = time.perf_counter() - t0
 
+    step("tower")
+    t0 = time.perf_counter()
+    from rigcad.check.tower import tower_report  # the camera through the beam splitter; bundle clearance
+
+    tower = tower_report(check_optics, rig, design, rc.rays, rc.seed + 17)
+    timings["tower_s"] = time.perf_counter() - t0
+
     step("pixels")
     t0 = time.perf_counter()
     fan = pixels_per_degree(check_optics, design, pose=projector)
@@ -285,6 +292,7 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
         "pixels_per_degree": fan["summary"],
         "pixel_grid": grid_report,
         "thin_lens": lens,
+        "tower": tower,
         "misalignment": {"probe_mm": mis.probe, "probe_tilt_rad": mis.probe_tilt, "sensitivity": sens,
                          "declared": declared_report},
         "monte_carlo": mc,

@@ -86,6 +86,24 @@ def evaluate(profile, report: dict) -> list[Row]:
     rows.append(Row("rays lost (occluded, escaped)", "raycheck.max_lost_fraction", main["lost_fraction"],
                     rc.max_lost_fraction, "<=", "", w("raycheck", "max_lost_fraction"),
                     "see readings.<mode>.losses for where; the beam's width sets most of it"))
+    tower = report.get("tower")
+    if tower is not None:
+        cam = tower["camera_through_splitter"]
+        bs_where = w("beam_splitter", "thickness")
+        rows.append(Row("camera via splitter: spot radius (max)", "raycheck.max_spot_radius",
+                        cam["max_spot_radius_mm"], rc.max_spot_radius, "<=", "mm", w("raycheck", "max_spot_radius"),
+                        f"the plate's astigmatism (beam_splitter.thickness, {bs_where or 'default'}): a thinner plate"))
+        rows.append(Row("camera via splitter: angle error, calibrated (max)", "raycheck.max_angle_error",
+                        cam["max_mirror_angle_error_rad"] / DEG, rc.max_angle_error / DEG, "<=", "deg",
+                        w("raycheck", "max_angle_error"),
+                        f"against the paraboloid point each camera ray meets (thesis 4.1.1); uncalibrated "
+                        f"{cam['max_angle_error_rad'] / DEG:.3g} deg; a thinner beam_splitter.thickness"))
+        bc = tower["bundle_clearance"]
+        blocked = bc["projector"]["blocked"] + bc["projector_widened"]["blocked"] + bc["camera"]["blocked"]
+        who = sorted({n for k in ("projector", "projector_widened", "camera") for n in bc[k]["blocked_by"]})
+        rows.append(Row("tower parts in the ray bundles (rays)", "tower.clearance", float(blocked),
+                        0.0, "<=", "", w("tower", "clearance"),
+                        f"blocked by {', '.join(who)}: move them or raise tower.splitter_distance"))
     mc = report.get("monte_carlo")
     if mc is not None:
         rows.append(Row("Monte Carlo yield (spot and mirror angle targets)", "tolerancing.min_yield", mc["yield"],

@@ -114,7 +114,9 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
                 mirrors[mirror] = _build_mirror(mirror, meridian, key, profile, out, stage)
 
         rig_parts = [n for n in PARTS if n in entries and entries[n].get("in_rig")]
-        asm_key = hashlib.sha256("|".join(entries[n]["key"] for n in rig_parts).encode()).hexdigest()
+        # the instruments and COP markers (parts.tower.instruments) join the printed parts in rig.step
+        asm_key = hashlib.sha256("|".join([entries[n]["key"] for n in rig_parts]
+                                          + [f"{p.name}:{p.content_hash()}" for p in rig.instruments]).encode()).hexdigest()
         asm_old = old.get("assembly")
         if rig_parts and not _cached(asm_old, asm_key, out):
             step("assembly")
@@ -285,10 +287,14 @@ def _build_assembly(names: list[str], rig, out: Path, stage: Staging, shapes: di
             shapes[name] = K.part_solid(part, profile.tessellation.fit_tolerance, K.FitReport(), profile)
         items.append((name, shapes[name], part.color))
         total += K.volume(shapes[name])
+    for part in rig.instruments:  # not printed: simple named solids, built here only
+        shape = K.part_solid(part, profile.tessellation.fit_tolerance, K.FitReport(), profile)
+        items.append((part.name, shape, part.color))
+        total += K.volume(shape)
     path = out / "rig.step"
     stage.write_with(path, step_writer(items, f"{profile.name}_rig"))
     check = reimport_check(stage.temp_path(path), total, len(items))
-    return {"key": key, "parts": names, "step_reimport": check,
+    return {"key": key, "parts": names, "instruments": [p.name for p in rig.instruments], "step_reimport": check,
             "files": {"rig.step": _sha(stage.temp_path(path).read_bytes())}}
 
 

@@ -14,6 +14,7 @@ from rigcad.parts.layout import RigLayout, rig_layout
 from rigcad.parts.paraboloid import paraboloid
 from rigcad.parts.recipe import Part
 from rigcad.parts.templates import dome_template, paraboloid_template
+from rigcad.parts.tower import lens_mount, splitter_holder, tower_column, tower_shelf, tower_shim
 from rigcad.profile.schema import Profile
 
 #: Every part, in build order.
@@ -30,6 +31,11 @@ PARTS: dict[str, Callable[[Profile, RigLayout], Part]] = {
     "camera_cross_base": base_cross,
     "dome_template": dome_template,
     "paraboloid_template": paraboloid_template,
+    "tower_column": tower_column,
+    "tower_shelf": tower_shelf,
+    "splitter_holder": splitter_holder,
+    "lens_mount": lens_mount,
+    "tower_shim": tower_shim,
 }
 
 __all__ = ["PARTS", "Part", "RigLayout", "make_recipes", "rig_layout"]

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import brentq
@@ -20,6 +21,9 @@ from rigcad.optics.dome import DomeProfile
 from rigcad.optics.surfaces import Meridian, dome_meridian, paraboloid_meridian
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
+
+if TYPE_CHECKING:  # pragma: no cover
+    from rigcad.parts.tower import TowerLayout
 
 
 def u_at_height(m: Meridian, z: float) -> float:
@@ -57,6 +61,8 @@ class RigLayout:
     beam_z: tuple[float, float]  #: bottom, top of the beam
     beam_half_length: float
     slot_r: float  #: the wall's largest outer radius across the beam's slot band
+    dome_top_z: float  #: the dome's highest point
+    tower: "TowerLayout"  #: the COP tower and its instruments (rigcad.parts.tower)
 
     def describe(self) -> dict[str, float]:
         """Placements for the manifest (mm)."""
@@ -70,6 +76,8 @@ class RigLayout:
             "beam_bottom_z_mm": self.beam_z[0],
             "beam_top_z_mm": self.beam_z[1],
             "beam_length_mm": 2 * self.beam_half_length,
+            "dome_top_z_mm": self.dome_top_z,
+            "tower": self.tower.describe(),
         }
 
 
@@ -127,10 +135,16 @@ def rig_layout(profile: Profile, geometry: Derived, dome: DomeProfile) -> RigLay
         raise GeometryError(
             f"sample_holder.stop_radius must lie between the bore ({holder.radius + holder.clearance:g} mm) and "
             f"the dome's base ({base_r:.1f} mm)", where=profile.where("sample_holder", "stop_radius"))
+    from rigcad.parts.tower import tower_layout
+
+    u_top = printed_dome.u_range[1]
+    dome_top_z = max(float(printed_dome.points(np.array([u_top]))[0, 1]),
+                     float(dome_outer.points(np.array([u_top]))[0, 1]))
+    tower = tower_layout(profile, geometry, plate_r, dome_top_z)
     return RigLayout(
         geometry=geometry, coating=coating, design_dome=design_dome, design_paraboloid=design_para,
         printed_dome=printed_dome, printed_paraboloid=printed_para, dome_outer=dome_outer,
         u_inner_base=u_in0, u_outer_base=u_out0, u_outer_flange=u_flange,
         flange_inner_r=flange_in, flange_outer_r=flange_out, bolt_circle_r=bolt_r, bolt_angles=angles,
         plate_r=plate_r, paraboloid_back_z=back_z, beam_z=(beam_bottom, beam_top),
-        beam_half_length=slot_r + beam.overhang, slot_r=slot_r)
+        beam_half_length=slot_r + beam.overhang, slot_r=slot_r, dome_top_z=dome_top_z, tower=tower)

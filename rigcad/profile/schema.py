@@ -26,6 +26,12 @@ MAX_LENGTH_MM = 10_000.0
 MAX_SEED = 2**63 - 1
 #: Largest projector or camera side (pixels).
 MAX_PIXELS = 100_000
+#: Mounting threads an instrument may name, with their major diameters (mm): ISO metric coarse, and
+#: the unified 1/4-20 and 3/8-16 UNC of camera tripod sockets (ISO 1222).
+MOUNT_THREADS: dict[str, float] = {"M3": 3.0, "M4": 4.0, "M5": 5.0, "M6": 6.0, "1/4-20 UNC": 6.35,
+                                   "3/8-16 UNC": 9.525}
+
+_POS = {"lo": 0, "lo_open": True}
 
 
 @dataclass(frozen=True)
@@ -108,13 +114,92 @@ class ProjectorParams:
     throw_ratio: float = spec("float", "throw distance / image width (sets the field of view)", 1.75,
                               lo=0, lo_open=True, hi=100)
     aperture: float = spec("length", "thin-lens aperture diameter (thesis 3.2.2)", "0.5 cm", lo=0)
+    # The body as the COP tower holds it (rigcad.parts.tower). The thesis names the BenQ PB6210 and
+    # its resolution only; these sizes are ASSUMED (a 2006 XGA DLP of its class), no datasheet at hand.
+    body_width: float = spec("length", "body width across its optical axis (assumed)", "284 mm", **_POS)
+    body_height: float = spec("length", "body height (assumed)", "109 mm", **_POS)
+    body_depth: float = spec("length", "body depth along its optical axis, lens excluded (assumed)", "235 mm", **_POS)
+    lens_diameter: float = spec("length", "diameter of the lens barrel (assumed)", "50 mm", **_POS)
+    lens_length: float = spec("length", "lens barrel's protrusion from the body's front face (assumed)", "20 mm",
+                              lo=0)
+    pupil_depth: float = spec("length", "entrance pupil (the COP) behind the lens barrel's front, along the axis "
+                              "(assumed)", "10 mm", lo=0)
+    pupil_height: float = spec("length", "optical axis above the body's bottom face (assumed)", "55 mm", **_POS)
+    pupil_lateral: float = spec("length", "optical axis's offset from the body's centre line, across (assumed)",
+                                "0 mm")
+    mount_thread: str = spec("choice", "thread of the body's mounting holes (ceiling mount; assumed)", "M4",
+                             choices=tuple(MOUNT_THREADS))
 
 
 @dataclass(frozen=True)
 class CameraParams:
-    """The camera, sharing the COP through the beam splitter."""
+    """The camera, sharing the COP through the beam splitter: behind it on the optical axis, looking
+    down through the plate (thesis Figure 3.4, right)."""
 
     resolution: tuple[int, int] = spec("pixels", "[width, height] in pixels", [1360, 1024])
+    # The Prosilica EC 1350C of thesis 3.1: resolution from the thesis; the sizes are ASSUMED
+    # (a C-mount FireWire machine-vision camera of its class), no datasheet at hand.
+    body_width: float = spec("length", "body width across its optical axis (assumed)", "46 mm", **_POS)
+    body_height: float = spec("length", "body height, mounting face to top (assumed)", "33 mm", **_POS)
+    body_depth: float = spec("length", "body depth along its optical axis, lens excluded (assumed)", "59 mm",
+                             **_POS)
+    lens_diameter: float = spec("length", "diameter of the C-mount lens (assumed)", "30 mm", **_POS)
+    lens_length: float = spec("length", "lens protrusion from the body's front face (assumed)", "40 mm", lo=0)
+    pupil_depth: float = spec("length", "entrance pupil (the COP) behind the lens's front, along the axis "
+                              "(assumed)", "15 mm", lo=0)
+    pupil_height: float = spec("length", "optical axis above the body's mounting (tripod) face (assumed: centred)",
+                               "16.5 mm", **_POS)
+    mount_thread: str = spec("choice", "thread of the tripod hole in the mounting face (assumed)", "1/4-20 UNC",
+                             choices=tuple(MOUNT_THREADS))
+
+
+@dataclass(frozen=True)
+class LensParams:
+    """The lens that focuses the projector on the paraboloid (thesis 3.1, item 6), on the projector's
+    axis between its lens and the beam splitter. Sizes ASSUMED (a 50 mm close-up lens)."""
+
+    diameter: float = spec("length", "lens diameter (assumed)", "50 mm", **_POS)
+    thickness: float = spec("length", "edge thickness held by the mount (assumed)", "6 mm", **_POS)
+    distance: float = spec("length", "from the projector's COP to the lens's centre, along the projector's axis",
+                           "25 mm", **_POS)
+    rim: float = spec("length", "radial seat of the mount under the lens's edge (the clear aperture is the "
+                      "diameter less twice this)", "2 mm", **_POS)
+
+
+@dataclass(frozen=True)
+class BeamSplitterParams:
+    """The plate beam splitter at 45 deg on the optical axis (thesis 3.1, item 4; Figure 3.4): its
+    coated front face reflects the projector down onto the paraboloid; the camera looks through the
+    plate, whose thickness shifts the transmitted axis sideways (rigcad.optics.splitter)."""
+
+    width: float = spec("length", "plate width across the plane of incidence (assumed)", "50 mm", **_POS)
+    length: float = spec("length", "plate length along the 45 deg slope (assumed)", "50 mm", **_POS)
+    thickness: float = spec("length", "plate thickness (assumed: a common 1 mm plate splitter)", "1 mm", **_POS)
+    index: float = spec("float", "refractive index of the plate (N-BK7 at 587.6 nm, 1.5168; the glass is assumed)",
+                        1.5168, lo=1.0, hi=4.0)
+
+
+@dataclass(frozen=True)
+class TowerParams:
+    """The COP tower (rigcad.parts.tower): a column on the bench beside the rig, a shelf for the
+    projector at 90 deg, an arm to the optical axis carrying the splitter holder, the lens mount and
+    the camera bracket above the splitter. Adjustment travel is each way from the nominal position."""
+
+    splitter_distance: float = spec("length", "from the COP down to the splitter's centre, along the optical axis "
+                                    "(the projector's COP is as far from the axis)", "70 mm", **_POS)
+    travel_along: float = spec("length", "adjustment each way along the optical axis (camera: its bracket's slot; "
+                               "projector: its shelf's slots along its own axis); at least tolerancing's "
+                               "camera_height and projector_height", "2 mm", lo=0)
+    travel_across: float = spec("length", "adjustment each way across the optical axis (camera: its bracket's "
+                                "slot and shims; projector: its shelf's slots and shims); at least tolerancing's "
+                                "camera_offset and projector_offset", "2 mm", lo=0)
+    shim_thickness: float = spec("length", "thickness of one printed adjustment shim", "0.5 mm", **_POS)
+    column_width: float = spec("length", "side of the square column", "50 mm", **_POS)
+    wall: float = spec("length", "wall of the column, the shelf, the arm and the brackets", "5 mm", **_POS)
+    clearance: float = spec("length", "least gap between the tower and the rig's parts, and between the tower "
+                            "and the ray bundle", "5 mm", **_POS)
+    bolt_diameter: float = spec("length", "clearance hole of the bolts joining the tower's parts (M4)", "4.5 mm",
+                                **_POS)
 
 
 @dataclass(frozen=True)
@@ -169,7 +254,6 @@ class MisalignmentParams:
     rays: int = spec("int", "rays traced across the paraboloid for each misalignment case", 401, lo=5, hi=100_000)
 
 
-_POS = {"lo": 0, "lo_open": True}
 
 DEFAULT_COATING = [
     {"name": "black base paint", "thickness": "1.5 mil"},
@@ -349,6 +433,9 @@ SECTIONS: dict[str, type] = {
     "layout": LayoutParams,
     "projector": ProjectorParams,
     "camera": CameraParams,
+    "lens": LensParams,
+    "beam_splitter": BeamSplitterParams,
+    "tower": TowerParams,
     "targets": TargetParams,
     "dome": DomeParams,
     "misalignment": MisalignmentParams,
@@ -377,6 +464,9 @@ class Profile:
     layout: LayoutParams
     projector: ProjectorParams
     camera: CameraParams
+    lens: LensParams
+    beam_splitter: BeamSplitterParams
+    tower: TowerParams
     targets: TargetParams
     dome: DomeParams
     misalignment: MisalignmentParams
@@ -558,6 +648,16 @@ def validate(raw: RawProfile) -> Profile:
     if gauged != "design" and gauged not in layer_names:
         raise ProfileError(f"templates.gauged_layer {_r(gauged)} is not a coating layer; valid: design, "
                            + ", ".join(layer_names), where=raw.where(("templates", "gauged_layer")))
+    tower: TowerParams = sections["tower"]
+    tol: TolerancingParams = sections["tolerancing"]
+    for key, need in (("travel_along", ("camera_height", "projector_height")),
+                      ("travel_across", ("camera_offset", "projector_offset"))):
+        worst = max(need, key=lambda k: getattr(tol, k))
+        if getattr(tower, key) < getattr(tol, worst):
+            raise ProfileError(
+                f"tower.{key} ({getattr(tower, key):g} mm) does not cover tolerancing.{worst} "
+                f"({getattr(tol, worst):g} mm): the adjustment must reach every placement the tolerances allow; "
+                f"raise tower.{key} to at least {getattr(tol, worst):g} mm", where=raw.where(("tower", key)))
     description = raw.data.get("description", "")
     if not isinstance(description, str):
         raise ProfileError("description must be text", where=raw.where(("description",)))

@@ -68,8 +68,15 @@ def test_assembly_has_named_coloured_rig_parts(built):
     asm = bd.import_step(out / "rig.step")
     labels = sorted(c.label for c in asm.children)
     rig = sorted(n for n, e in result.manifest["parts"].items() if e["in_rig"])
-    assert labels == rig == ["base_plate", "beam", "dome", "paraboloid", "sample_holder"]
+    assert rig == ["base_plate", "beam", "dome", "lens_mount", "paraboloid", "sample_holder", "splitter_holder",
+                   "tower_column", "tower_shelf"]
+    instruments = sorted(result.manifest["assembly"]["instruments"])
+    assert {"projector_body", "camera_body", "beam_splitter", "focusing_lens", "cop_marker"} <= set(instruments)
+    assert labels == sorted(rig + instruments)
     assert all(c.color is not None for c in asm.children)
+    # the COP marker is centred on the design COP
+    marker = next(c for c in asm.children if c.label == "cop_marker")
+    assert tuple(marker.bounding_box().center()) == pytest.approx((0.0, 0.0, built[0].geometry.cop_z), abs=1e-6)
 
 
 def test_mirror_fits_within_one_micrometre(built):

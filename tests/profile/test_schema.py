@@ -101,3 +101,29 @@ def test_target_range_order(write_profile, TABLE31):
 def test_cop_at_infinity_is_allowed_but_not_elsewhere(write_profile, TABLE31):
     load_profile(write_profile(TABLE31.replace("27 cm", "inf")))
     assert "must be finite" in _err(write_profile, TABLE31.replace("13.5 cm", "inf"))
+
+
+def test_instrument_defaults_are_the_thesis_resolutions_and_assumed_sizes(table31):
+    # Resolutions are the thesis's (3.1); every body size's doc says it is assumed.
+    from dataclasses import fields
+
+    assert table31.camera.resolution == (1360, 1024)
+    for section in ("projector", "camera", "lens", "beam_splitter"):
+        obj = getattr(table31, section)
+        for f in fields(obj):
+            if f.name.startswith(("body_", "lens_", "pupil_")) or f.name in ("diameter", "thickness", "width"):
+                assert "assumed" in f.metadata["spec"].doc, f"{section}.{f.name} must say it is assumed"
+    assert table31.beam_splitter.thickness == pytest.approx(1.0)
+    assert table31.tower.splitter_distance == pytest.approx(70.0)
+
+
+def test_tower_travel_must_cover_the_tolerances(write_profile, TABLE31):
+    msg = _err(write_profile, TABLE31 + "tower:\n  travel_across: 0.3 mm\n")
+    assert "tower.travel_across" in msg and "tolerancing.camera_offset" in msg and "p.yaml:8" in msg
+    msg = _err(write_profile, TABLE31 + "tolerancing:\n  projector_height: 3 mm\n")
+    assert "tower.travel_along" in msg and "tolerancing.projector_height" in msg
+
+
+def test_unknown_mount_thread_lists_the_valid_ones(write_profile, TABLE31):
+    msg = _err(write_profile, TABLE31 + "camera:\n  mount_thread: M7\n")
+    assert "camera.mount_thread" in msg and "1/4-20 UNC" in msg

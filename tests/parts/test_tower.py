@@ -1,0 +1,166 @@
+"""The COP tower: valid solids, no interference with the rig or the instruments, adjustment travel
+that covers the tolerances (probed with bolts in the slots), and errors that name the parameter."""
+
+import itertools
+import math
+
+import manifold3d as m3d
+import numpy as np
+import pytest
+
+from rigcad.errors import GeometryError
+from rigcad.export import mesh as M
+from rigcad.parts import _kernel as K
+from rigcad.parts.recipe import Cylinder, Part
+from rigcad.parts.tower import TOWER_PARTS, clearance_hole
+from rigcad.profile import load_profile
+from rigcad.rig import Rig
+
+RIG = ["dome", "paraboloid", "beam", "base_plate", "sample_holder"]
+IN_RIG_TOWER = ["tower_column", "tower_shelf", "splitter_holder", "lens_mount"]
+#: Intended contacts (the shelf on the column, the holder and lens mount on the shelf, the projector
+#: on its shims, the camera on its shims) share faces only: zero volume; 1e-6 mm^3 is far below any
+#: real overlap (a 0.01 mm overlap over the smallest contact, 30 x 30 mm, is 9 mm^3).
+CONTACT_MM3 = 1e-6
+
+
+def _solid(part):
+    return K.part_solid(part, 1e-4, K.FitReport())
+
+
+@pytest.fixture(scope="module")
+def rig(table31_rig):
+    return table31_rig
+
+
+@pytest.fixture(scope="module")
+def shapes(rig):
+    out = {n: _solid(rig.recipe(n)) for n in RIG + IN_RIG_TOWER}
+    out.update({p.name: _solid(p) for p in rig.instruments})
+    return out
+
+
+def _common(a, b) -> float:
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
+
+    return K.volume(BRepAlgoAPI_Common(a, b).Shape())
+
+
+@pytest.mark.parametrize("name", TOWER_PARTS)
+def test_tower_parts_are_valid_solids_and_watertight_meshes(rig, name):
+    part = rig.recipe(name)
+    shape = _solid(part)  # one valid solid (BRepCheck) or a KernelError
+    man = M.build(part.solid, rig.profile.tessellation.chord_error)
+    assert man.status() == m3d.Error.NoError
+    v, f = M.mesh_arrays(man)
+    # boxes, z cylinders and flat prisms: the mesh is exact but for the cylinders' chords
+    assert M.mesh_volume(v, f) == pytest.approx(K.volume(shape), rel=1e-3)
+
+
+def test_no_tower_part_cuts_into_the_rig_the_instruments_or_another_tower_part(rig, shapes):
+    others = RIG + [p.name for p in rig.instruments if not p.name.endswith("_marker")]
+    pairs = [(a, b) for a in IN_RIG_TOWER for b in others] + list(itertools.combinations(IN_RIG_TOWER, 2))
+    bad = {(a, b): v for a, b in pairs if (v := _common(shapes[a], shapes[b])) > CONTACT_MM3}
+    assert not bad, bad
+
+
+def test_instruments_do_not_cut_into_each_other_or_the_rig(rig, shapes):
+    names = [p.name for p in rig.instruments if not p.name.endswith("_marker")]
+    bad = {}
+    for a, b in itertools.combinations(names, 2):
+        if {a, b} in ({"projector_body", "projector_lens"}, {"camera_body", "camera_lens"}):
+            continue  # a lens is screwed to its body: they share a face
+        if (v := _common(shapes[a], shapes[b])) > CONTACT_MM3:
+            bad[(a, b)] = v
+    for a in names:
+        for b in RIG:
+            if (v := _common(shapes[a], shapes[b])) > CONTACT_MM3:
+                bad[(a, b)] = v
+    assert not bad, bad
+
+
+def test_both_centres_of_projection_sit_at_cop_z(rig):
+    from rigcad.optics.splitter import mirror_point, transmit, virtual_source, cone_dirs
+
+    t = rig.layout.tower
+    cop = np.array([0.0, 0.0, rig.geometry.cop_z])
+    # the projector: its real COP's image in the plate's front face is the design COP
+    assert np.allclose(mirror_point(t.plate, t.projector_cop), cop, atol=1e-9)
+    # the camera: its rays through the plate meet (least squares) at the design COP
+    dirs = cone_dirs(rig.geometry.rim_angle_at_cop)
+    p, d, inside = transmit(t.plate, np.tile(t.camera.cop, (len(dirs), 1)), dirs)
+    assert inside.all()
+    assert np.linalg.norm(virtual_source(p, d) - cop) < 1e-9  # exact up to round-off: the plate is uniform
+    # the instruments' boxes put each entrance pupil at its COP
+    cam, prof = rig.profile.camera, rig.profile.projector
+    assert t.camera_lens_box[0][2] == pytest.approx(t.camera.cop[2] - cam.pupil_depth)
+    assert t.projector_lens_box[0][0] == pytest.approx(t.projector_cop[0] - prof.pupil_depth)
+
+
+def _bolt_fits(shape, x, y, z0, height, diameter) -> bool:
+    bolt = _solid(Part("bolt", Cylinder((x, y, z0), diameter / 2 - 0.05, height), (0, 0, 0), ""))
+    return _common(shape, bolt) < CONTACT_MM3
+
+
+def test_projector_slots_travel_covers_the_tolerances(rig, shapes):
+    # a bolt of the projector's thread moves in each shelf slot by tower.travel_along along x and
+    # travel_across along y, which cover tolerancing.projector_height / projector_offset; one
+    # 0.3 mm further it meets the shelf
+    t, tw, tol = rig.layout.tower, rig.profile.tower, rig.profile.tolerancing
+    assert tw.travel_along >= tol.projector_height and tw.travel_across >= tol.projector_offset
+    d = clearance_hole(rig.profile.projector.mount_thread) - 0.5  # the thread itself
+    (x0, y0, _), (x1, y1, _) = t.projector_box
+    z0 = t.shelf_top_z - t.shelf_thickness - 1.0
+    shelf = shapes["tower_shelf"]
+    x, y = x0 + 30.0, y0 + 30.0  # a foot (FOOT_INSET)
+    for dx, dy in ((tw.travel_along, 0), (-tw.travel_along, 0), (0, tw.travel_across), (0, -tw.travel_across)):
+        assert _bolt_fits(shelf, x + dx, y + dy, z0, t.shelf_thickness + 2, d), (dx, dy)
+    assert not _bolt_fits(shelf, x + tw.travel_along + 0.3 + 0.25, y, z0, t.shelf_thickness + 2, d)
+
+
+def test_camera_slot_travel_covers_the_tolerances(rig, shapes):
+    # the camera's tripod screw moves in the bracket's slot by travel_along (z) and travel_across (x)
+    from rigcad.parts.recipe import Box
+
+    t, tw, tol = rig.layout.tower, rig.profile.tower, rig.profile.tolerancing
+    assert tw.travel_along >= tol.camera_height and tw.travel_across >= tol.camera_offset
+    d = clearance_hole(rig.profile.camera.mount_thread) - 0.5
+    (cx0, _, cz0), (cx1, _, cz1) = t.camera_box
+    cx, cz = (cx0 + cx1) / 2, (cz0 + cz1) / 2
+    holder = shapes["splitter_holder"]
+    yo = t.wall_y[1]
+
+    def fits(x, z):  # a square screw of side d along y through the bracket
+        screw = _solid(Part("screw", Box((x - d / 2 + 0.05, -yo - 2, z - d / 2 + 0.05),
+                                         (x + d / 2 - 0.05, t.bracket_y + 0.5, z + d / 2 - 0.05)), (0, 0, 0), ""))
+        return _common(holder, screw) < CONTACT_MM3
+
+    for dx, dz in ((tw.travel_across, 0), (-tw.travel_across, 0), (0, tw.travel_along), (0, -tw.travel_along)):
+        assert fits(cx + dx, cz + dz), (dx, dz)
+    assert not fits(cx, cz + tw.travel_along + 0.55)
+    # shims across y: travel_across each way from the nominal stack
+    assert t.shims_nominal * tw.shim_thickness >= tw.travel_across
+    assert t.shims_per_stack * tw.shim_thickness >= 2 * tw.travel_across
+
+
+def _rig_of(write_profile, table31_text, extra):
+    return Rig.from_profile(load_profile(write_profile(table31_text + extra)))
+
+
+def test_a_splitter_too_close_to_the_cop_names_the_key(write_profile, table31_text):
+    with pytest.raises(GeometryError) as info:
+        _rig_of(write_profile, table31_text, "tower:\n  splitter_distance: 30 mm\n").layout
+    msg = str(info.value)
+    assert "tower.splitter_distance" in msg and "p.yaml:8" in msg
+
+
+def test_a_lens_that_does_not_fit_names_the_key(write_profile, table31_text):
+    with pytest.raises(GeometryError) as info:
+        _rig_of(write_profile, table31_text, "lens:\n  distance: 65 mm\n").layout
+    assert "lens.distance" in str(info.value) and "p.yaml:8" in str(info.value)
+
+
+def test_a_too_small_splitter_names_the_key(write_profile, table31_text):
+    with pytest.raises(GeometryError) as info:
+        _rig_of(write_profile, table31_text, "beam_splitter:\n  length: 12 mm\n  width: 12 mm\n").layout
+    assert "beam_splitter.length" in str(info.value)
