@@ -221,7 +221,7 @@ def _encloses(meshes) -> set[str]:
     return encloses(meshes)
 
 
-def rig_picture(meshes, rays: dict | None, title: str, elev: float = 18.0, azim: float = -62.0) -> bytes:
+def rig_picture(meshes, rays: dict | None, title: str, elev: float = 18.0, azim: float = -118.0) -> bytes:
     """The assembled rig: every part (``rigcad.manual.assembly.PartMesh``) in its working position,
     the parts that enclose others (the dome) cut away in front, and ``rays`` (view.traced_rays: COP ->
     paraboloid -> dome -> sample polylines, mm) coloured by incidence angle."""
@@ -245,35 +245,37 @@ def rig_picture(meshes, rays: dict | None, title: str, elev: float = 18.0, azim:
                                       if rays is not None else ""))
 
 
-def assembly_step(meshes, step: int, title: str, elev: float = 18.0, azim: float = -62.0) -> bytes:
-    """Exploded picture of assembly step ``step``: parts 0..step-1 of ``meshes`` (assembly order) in
-    place (grey), part ``step`` highlighted (orange) at its exploded offset, with a dashed line to
-    where it goes; enclosing parts cut away in front. A part that goes in from below is seen from
-    below."""
+def assembly_step(meshes, done: list[int], new: list[int], offsets: dict, title: str, elev: float = 18.0,
+                  azim: float = -118.0) -> bytes:
+    """Exploded picture of one assembly step: the parts ``done`` (indices into ``meshes``,
+    ``rigcad.manual.assembly.PartMesh``) in place (grey), the parts ``new`` highlighted (orange)
+    moved by ``offsets`` (index -> (3,) mm), with a dashed line to where they go; enclosing parts
+    cut away in front. Parts that go in from below are seen from below."""
     cut = _encloses(meshes)
     fig = plt.figure(figsize=(6, 6.5))
     ax = fig.add_axes((0, 0, 1, 0.92), projection="3d")
-    shown = meshes[: step + 1]
-    lo = np.min([m.lo for m in shown], axis=0)
-    hi = np.max([m.hi for m in shown], axis=0)
+    shown = [*done, *new]
+    lo = np.min([meshes[i].lo for i in shown], axis=0)
+    hi = np.max([meshes[i].hi for i in shown], axis=0)
     groups = []
-    for k, m in enumerate(shown):
-        off = m.explode if k == step else np.zeros(3)
+    for i in shown:
+        m = meshes[i]
+        off = offsets.get(i, np.zeros(3)) if i in new else np.zeros(3)
         tri = m.vertices[m.faces] + off
-        tri = _cut_front(tri) if m.name in cut and k < step else tri
-        groups.append((tri, (0.95, 0.55, 0.15) if k == step else (0.8, 0.8, 0.82), 1.0))
+        tri = _cut_front(tri) if m.name in cut and i in done else tri
+        groups.append((tri, (0.95, 0.55, 0.15) if i in new else (0.8, 0.8, 0.82), 1.0))
         lo, hi = np.minimum(lo, m.lo + off), np.maximum(hi, m.hi + off)
     _draw(ax, groups)
-    new = meshes[step]
-    if np.any(new.explode):
+    lift = offsets.get(new[0], np.zeros(3))
+    if np.any(lift):
         ax.computed_zorder = False  # the path over the parts
-        c = 0.5 * (new.lo + new.hi)
-        a, b = c + new.explode, c
-        ax.plot([a[0], b[0]], [a[1], b[1]], [a[2], b[2]], "--", color="tab:red", lw=1.4, zorder=5)
-        ax.scatter([b[0]], [b[1]], [b[2]], color="tab:red", s=16, marker="v" if new.explode[2] > 0 else "^",
-                   zorder=6)
+        for i in new:
+            c = 0.5 * (meshes[i].lo + meshes[i].hi)
+            a = c + lift
+            ax.plot([a[0], c[0]], [a[1], c[1]], [a[2], c[2]], "--", color="tab:red", lw=1.4, zorder=5)
+            ax.scatter([c[0]], [c[1]], [c[2]], color="tab:red", s=16, marker="v" if lift[2] > 0 else "^", zorder=6)
     _fit_axes(ax, lo, hi)
-    ax.view_init(elev=-elev if new.explode[2] < 0 else elev, azim=azim)
+    ax.view_init(elev=-elev if lift[2] < 0 else elev, azim=azim)
     return _trimmed_png(fig, title)
 
 

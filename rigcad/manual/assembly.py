@@ -8,9 +8,11 @@ appears in the view, the exploded pictures and the manual's assembly steps witho
 
 Exploded view (one rule, every part): the base part is the widest part at or below the sample
 plane (its top at z <= 0: the base plate). Parts above it are taken by their top (z max) from low
-to high, and each is lifted until its bottom clears, by a gap, everything lifted before it, so
-the enclosing dome ends up above the paraboloid and the beam; parts below the base go down the
-same way. Frame: mm, sample point O at the origin, optical axis +z.
+to high, and each is lifted until its bottom clears, by a gap, every part placed before it whose
+x-y footprint it overlaps, so the enclosing dome ends up above the paraboloid and the beam while a
+column beside the rig stays on the bench; parts below the base go down the same way. The
+instruments (``rig.instruments``: projector, camera, lenses, splitter, shim stacks) join the parts;
+the centre-of-projection markers are shown but never moved or assembled. Frame: mm, sample point O at the origin, optical axis +z.
 """
 
 from __future__ import annotations
@@ -43,6 +45,8 @@ class PartMesh:
     description: str
     quantity: int
     explode: np.ndarray
+    bought: bool = False  #: an instrument or optic (``rig.instruments``), not printed
+    marker: bool = False  #: a centre-of-projection marker: shown in the view, not assembled
 
     @property
     def lo(self) -> np.ndarray:
@@ -58,17 +62,22 @@ def rig_meshes(rig, chord_error: float = VIEW_CHORD_ERROR_MM) -> list[PartMesh]:
     from rigcad.export import mesh as M
 
     raw = []
-    for name, part in rig.recipes.items():
+    # the instruments are bought, but for the shim stacks: those are the printed tower_shim
+    bought = {p.name for p in getattr(rig, "instruments", ()) if "shim" not in p.name}
+    for part in [*rig.recipes.values(), *getattr(rig, "instruments", ())]:
         if not part.in_rig:
             continue
         v, f = M.mesh_arrays(M.build(part.solid, chord_error))
         raw.append((part, np.asarray(v, float), np.asarray(f, np.int64)))
     if not raw:
         raise GeometryError(f"{rig.name}: no part stands in the rig (every recipe has in_rig = False)")
-    offsets = explode_offsets({p.name: (v.min(axis=0), v.max(axis=0)) for p, v, _ in raw})
-    meshes = {p.name: PartMesh(p.name, v, f, tuple(p.color), p.description, p.quantity, offsets[p.name])
+    markers = {p.name for p, _, _ in raw if p.name.endswith("_marker")}
+    offsets = explode_offsets({p.name: (v.min(axis=0), v.max(axis=0)) for p, v, _ in raw if p.name not in markers})
+    meshes = {p.name: PartMesh(p.name, v, f, tuple(p.color), p.description, p.quantity,
+                               offsets.get(p.name, np.zeros(3)), p.name in bought, p.name in markers)
               for p, v, f in raw}
-    return [meshes[n] for n in assembly_order({n: (m.lo, m.hi) for n, m in meshes.items()})]
+    order = assembly_order({n: (m.lo, m.hi) for n, m in meshes.items() if not m.marker}, bought)
+    return [meshes[n] for n in order] + [meshes[n] for n in sorted(markers)]
 
 
 def _base(boxes: dict[str, tuple[np.ndarray, np.ndarray]]) -> str:
@@ -89,29 +98,73 @@ def explode_offsets(boxes: dict[str, tuple[np.ndarray, np.ndarray]]) -> dict[str
     gap = EXPLODE_GAP * (hi_all - lo_all)
     centre = 0.5 * (boxes[base][0][2] + boxes[base][1][2])
     out = {base: np.zeros(3)}
+    placed = {base: (boxes[base][0], boxes[base][1])}
+
+    def overlaps(a, b) -> bool:  # x-y footprints overlap: only then does one part stack on the other
+        return bool(np.all(a[0][:2] < b[1][:2]) and np.all(b[0][:2] < a[1][:2]))
+
     above = sorted((n for n in boxes if n != base and 0.5 * (boxes[n][0][2] + boxes[n][1][2]) >= centre),
                    key=lambda n: (boxes[n][1][2], n))
     below = sorted((n for n in boxes if n != base and n not in above), key=lambda n: (-boxes[n][0][2], n))
-    top = boxes[base][1][2]
     for n in above:
-        dz = max(0.0, top + gap - boxes[n][0][2])
+        under = [hi[2] for lo, hi in placed.values() if overlaps((lo, hi), boxes[n])]
+        dz = max([0.0] + [top + gap - boxes[n][0][2] for top in under])
         out[n] = np.array([0.0, 0.0, dz])
-        top = max(top, boxes[n][1][2] + dz)
-    bottom = boxes[base][0][2]
+        placed[n] = (boxes[n][0] + out[n], boxes[n][1] + out[n])
     for n in below:
-        dz = min(0.0, bottom - gap - boxes[n][1][2])
+        over = [lo[2] for lo, hi in placed.values() if overlaps((lo, hi), boxes[n])]
+        dz = min([0.0] + [bottom - gap - boxes[n][1][2] for bottom in over])
         out[n] = np.array([0.0, 0.0, dz])
-        bottom = min(bottom, boxes[n][0][2] + dz)
+        placed[n] = (boxes[n][0] + out[n], boxes[n][1] + out[n])
     return out
 
 
-def assembly_order(boxes: dict[str, tuple[np.ndarray, np.ndarray]]) -> list[str]:
+def assembly_order(boxes: dict[str, tuple[np.ndarray, np.ndarray]], bought=frozenset()) -> list[str]:
     """The base part first, then the thesis's rig order for the parts it has (KNOWN_ORDER), then
-    any other part from the lowest top to the highest."""
+    any other part from the lowest bottom to the highest (what a part stands on goes in first; at
+    the same height printed parts before bought ones)."""
     base = _base(boxes)
     known = [n for n in KNOWN_ORDER if n in boxes and n != base]
-    rest = sorted((n for n in boxes if n != base and n not in known), key=lambda n: (boxes[n][1][2], n))
+    rest = sorted((n for n in boxes if n != base and n not in known),
+                  key=lambda n: (round(float(boxes[n][0][2])), n in bought, n))
     return [base, *known, *rest]
 
 
-__all__ = ["PartMesh", "VIEW_CHORD_ERROR_MM", "assembly_order", "explode_offsets", "rig_meshes"]
+def steps(meshes: list[PartMesh]) -> list[list[int]]:
+    """Assembly steps: indices into ``meshes`` (markers left out); parts named alike but for a
+    trailing number (projector_shims_1..4) go in one step."""
+    import re
+
+    out: list[list[int]] = []
+    stems: dict[str, int] = {}
+    for i, m in enumerate(meshes):
+        if m.marker:
+            continue
+        stem = re.sub(r"_\d+$", "", m.name)
+        if stem != m.name and stem in stems:
+            out[stems[stem]].append(i)
+            continue
+        stems[stem] = len(out)
+        out.append([i])
+    return out
+
+
+def step_offsets(meshes: list[PartMesh], done: list[int], new: list[int]) -> dict[int, np.ndarray]:
+    """Where the parts of one step are drawn before they go in: lifted (or lowered, for a part below
+    the base) just clear of the parts already in place whose x-y footprint they overlap."""
+    if not done:
+        return {i: np.zeros(3) for i in new}
+    lo = np.min([meshes[i].lo for i in new], axis=0)
+    hi = np.max([meshes[i].hi for i in new], axis=0)
+    size = max(float(np.ptp([meshes[i].hi[2] for i in done] + [meshes[i].lo[2] for i in done])), 1.0)
+    gap = EXPLODE_GAP * size
+    down = all(meshes[i].explode[2] < 0 for i in new)
+    dz = 0.0
+    for i in done:
+        m = meshes[i]
+        if np.all(m.lo[:2] < hi[:2]) and np.all(lo[:2] < m.hi[:2]):
+            dz = min(dz, m.lo[2] - gap - hi[2]) if down else max(dz, m.hi[2] + gap - lo[2])
+    return {i: np.array([0.0, 0.0, dz]) for i in new}
+
+
+__all__ = ["PartMesh", "VIEW_CHORD_ERROR_MM", "assembly_order", "explode_offsets", "rig_meshes", "step_offsets", "steps"]

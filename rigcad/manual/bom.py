@@ -109,26 +109,146 @@ def coating_rows(rig) -> list[CoatRow]:
 
 
 # -- the bill -------------------------------------------------------------------------------------
-def fasteners(rig) -> list[dict]:
-    """The dome flange's bolts, nuts and washers (through flange and base plate)."""
+#: Holes cut into a part's recipe run this far (mm) past each face it goes through (the recipes'
+#: convention, so that the boolean leaves no skin): a bolt's grip is the holes' joint span less twice it.
+HOLE_OVERSHOOT_MM = 1.0
+#: A vertical cut counts as a bolt hole (or slot) when it is at most this wide (mm) in x and y: the
+#: bore for the sample holder and the hole that passes the projector's bundle are wider.
+BOLT_HOLE_MAX_MM = 16.0
+#: Thread engaged in an instrument's own mounting hole, in thread diameters (a metal body: 1-1.5 d).
+ENGAGEMENT_DIAMETERS = 1.5
+#: Inch bolt lengths (in) for the instruments' UNC mounting threads.
+INCH_LENGTHS = (0.25, 0.375, 0.5, 0.625, 0.75, 0.875, 1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0)
+
+
+def _holes(solid, offset=(0.0, 0.0, 0.0), cut=False):
+    """Vertical bolt holes and slots cut into a recipe: (x, y, z0, z1, width, round) per hole, mm."""
+    from rigcad.parts.recipe import Box, Cylinder, Difference, Translate, Union_
+
+    off = np.asarray(offset, float)
+    if isinstance(solid, Difference):
+        yield from _holes(solid.base, off, cut)
+        for c in solid.cuts:
+            yield from _holes(c, off, True)
+    elif isinstance(solid, Union_):
+        for c in solid.items:
+            yield from _holes(c, off, cut)
+    elif isinstance(solid, Translate):
+        yield from _holes(solid.solid, off + np.asarray(solid.offset, float), cut)
+    elif cut and isinstance(solid, Cylinder) and 2 * solid.radius <= BOLT_HOLE_MAX_MM:
+        b = np.asarray(solid.base, float) + off
+        yield (b[0], b[1], b[2], b[2] + solid.height, 2 * solid.radius, True)
+    elif cut and isinstance(solid, Box):
+        lo, hi = np.asarray(solid.lo, float) + off, np.asarray(solid.hi, float) + off
+        w = hi - lo
+        if w[0] <= BOLT_HOLE_MAX_MM and w[1] <= BOLT_HOLE_MAX_MM and w[2] < max(w[0], w[1]) * 4:
+            yield ((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2], hi[2], min(w[0], w[1]), False)
+
+
+def bolt_joints(rig) -> list[dict]:
+    """Every bolted joint of the rig, found in the recipes: vertical holes of the in-rig printed parts
+    that share an axis (x, y within 0.05 mm) and touch in z are one bolt through those parts; a round
+    hole of one part alone is a bolt into what it stands on (the bench). Grouped by (parts joined,
+    thread, length): count, grip, the bolt, its nut and washers."""
+    holes = []
+    for name, part in rig.recipes.items():
+        if part.in_rig:
+            holes += [(name, *h) for h in _holes(part.solid)]
+    axes: dict[tuple, list] = {}
+    for h in holes:
+        axes.setdefault((round(h[1] / 0.05), round(h[2] / 0.05)), []).append(h)
+    groups: dict[tuple, dict] = {}
+    for stack in axes.values():
+        stack.sort(key=lambda h: h[3])
+        runs, run = [], [stack[0]]
+        for h in stack[1:]:
+            if h[3] <= max(r[4] for r in run) + 1e-6:
+                run.append(h)
+            else:
+                runs.append(run)
+                run = [h]
+        runs.append(run)
+        for run in runs:
+            parts = tuple(sorted({h[0] for h in run}))
+            if len(parts) == 1 and not all(h[6] for h in run):
+                continue  # a slot or channel of one part alone (a clamp, the projector's slots): no bolt of its own
+            grip = max(h[4] for h in run) - min(h[3] for h in run) - 2 * HOLE_OVERSHOOT_MM
+            hole = min(h[5] for h in run)
+            key = (parts, round(grip, 3), round(hole, 3))
+            groups.setdefault(key, {"parts": parts, "grip_mm": grip, "hole_mm": hole, "count": 0})["count"] += 1
+    rows = []
+    for g in sorted(groups.values(), key=lambda g: (-len(g["parts"]), g["parts"], g["grip_mm"])):
+        thread, _, pitch, nut, washer = thread_for_hole(g["hole_mm"])
+        alone = len(g["parts"]) == 1
+        row = {**g, "thread": thread, "joins": " + ".join(g["parts"]) + (" to what it stands on" if alone else "")}
+        if alone:  # into the bench or a part's slot: the user's fixing; the grip is what a bolt passes
+            row.update(item=f"{thread} bolt, length to suit (passes {g['grip_mm']:g} mm of {g['parts'][0]})",
+                       short=f"{thread} bolts", length_mm=None, nuts=0, washers=g["count"],
+                       note="into the bench (or what the part stands on): choose its length on site")
+        else:
+            length, need = bolt_length(g["grip_mm"], pitch, nut, washer)
+            row.update(item=f"{thread} x {length} mm socket-head bolt (ISO 4762)", short=f"{thread} x {length} mm bolts",
+                       length_mm=length, nuts=g["count"], washers=2 * g["count"],
+                       note=f"needs {need:.1f} mm: {g['grip_mm']:g} mm grip + 2 washers + nut {nut:g} mm + "
+                            f"{PROTRUSION_PITCHES} pitches")
+        rows.append(row)
+    return rows
+
+
+def instrument_screws(rig) -> list[dict]:
+    """The screws that hold the projector and the camera by their own mounting threads (the
+    profile's ``projector.mount_thread``, ``camera.mount_thread``), through the tower's shelf or
+    bracket and the nominal shim stack, engaged ENGAGEMENT_DIAMETERS diameters into the body."""
+    from rigcad.profile.schema import MOUNT_THREADS
+
     p = rig.profile
-    shell = p.dome_shell
-    thread, hole, pitch, nut, washer = thread_for_hole(shell.bolt_diameter)
-    grip = shell.flange_thickness + p.base_plate.thickness
-    length, need = bolt_length(grip, pitch, nut, washer)
-    n = shell.bolts
-    why = (f"dome flange ({shell.flange_thickness:g} mm) to base plate ({p.base_plate.thickness:g} mm) through "
-           f"{shell.bolt_diameter:g} mm holes (dome_shell.bolt_diameter: {thread} medium clearance, ISO 273)")
-    return [
-        {"item": f"{thread} x {length} mm socket-head bolt (ISO 4762)", "short": f"{thread} x {length} mm bolts",
-         "quantity": n,
-         "use": why, "length_mm": length,
-         "note": f"needs {need:.1f} mm: {grip:g} mm grip + 2 washers + nut {nut:g} mm + {PROTRUSION_PITCHES} pitches"},
-        {"item": f"{thread} hex nut (ISO 4032)", "short": f"{thread} nuts", "quantity": n, "use": "under the base plate", "length_mm": None,
-         "note": f"{nut:g} mm high"},
-        {"item": f"{thread} washer (ISO 7089)", "short": f"{thread} washers", "quantity": 2 * n, "use": "under each bolt head and nut",
-         "length_mm": None, "note": f"{washer:g} mm thick"},
-    ]
+    t = getattr(rig.layout, "tower", None)
+    if t is None:
+        return []
+    feet = sum(1 for part in rig.instruments if part.name.startswith("projector_shims_"))
+    stack = t.shims_nominal * p.tower.shim_thickness
+    rows = []
+    for who, thread, count, through in (("projector", p.projector.mount_thread, feet, t.shelf_thickness),
+                                        ("camera", p.camera.mount_thread, 1, p.tower.wall)):
+        d = MOUNT_THREADS[thread]
+        need = through + stack + ENGAGEMENT_DIAMETERS * d
+        if thread.startswith("M"):
+            length = next((L for L in BOLT_LENGTHS if L >= need - 1e-9), None)
+            size = f"{thread} x {length} mm" if length else f"{thread}, {need:.0f} mm"
+        else:
+            inch = next((L for L in INCH_LENGTHS if L * 25.4 >= need - 1e-9), None)
+            size = f"{thread} x {inch:g} in" if inch else f"{thread}, {need:.0f} mm"
+        rows.append({"item": f"{size} screw ({who}'s mounting thread)", "quantity": count, "instrument": who,
+                     "use": f"{who} to the tower through {through:g} mm and {t.shims_nominal} shims",
+                     "note": f"needs {need:.1f} mm: {through:g} mm + {stack:g} mm of shims + "
+                             f"{ENGAGEMENT_DIAMETERS:g} x {d:g} mm into the body ({who}.mount_thread)"})
+    return rows
+
+
+def fasteners(rig) -> list[dict]:
+    """Bolts, nuts and washers of every bolted joint (bolt_joints), then the instruments' screws."""
+    rows = []
+    for j in bolt_joints(rig):
+        rows.append({"item": j["item"], "short": j["short"], "quantity": j["count"], "use": j["joins"],
+                     "length_mm": j["length_mm"], "note": j["note"], "thread": j["thread"]})
+    nuts: dict[str, int] = {}
+    washers: dict[str, int] = {}
+    for j in bolt_joints(rig):
+        nuts[j["thread"]] = nuts.get(j["thread"], 0) + j["nuts"]
+        washers[j["thread"]] = washers.get(j["thread"], 0) + j["washers"]
+    for thread, n in nuts.items():
+        if n:
+            nut = next(r for r in METRIC if r[0] == thread)
+            rows.append({"item": f"{thread} hex nut (ISO 4032)", "short": f"{thread} nuts", "quantity": n,
+                         "use": "one per through bolt", "length_mm": None, "note": f"{nut[3]:g} mm high"})
+    for thread, n in washers.items():
+        if n:
+            w = next(r for r in METRIC if r[0] == thread)
+            rows.append({"item": f"{thread} washer (ISO 7089)", "short": f"{thread} washers", "quantity": n,
+                         "use": "under each bolt head and nut", "length_mm": None, "note": f"{w[4]:g} mm thick"})
+    for r in instrument_screws(rig):
+        rows.append({**r, "short": r["item"], "length_mm": None})
+    return rows
 
 
 def dowel_pins(fab_report: dict, printer) -> dict | None:

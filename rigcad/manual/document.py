@@ -143,6 +143,20 @@ STEP_TEXT = {
                   "the beam, mirror up; the stem centres it over the sample point.",
     "dome": "Lower the dome, with the beam and the paraboloid in it, onto the base plate: flange holes over the "
             "plate's holes.",
+    "tower_column": "Stand the tower's column on the bench beside the base plate (the bench is level with the "
+                    "sample holder's stop collar).",
+    "tower_shelf": "Lay the shelf on the column's top flange, its end with the bundle hole over the optical axis.",
+    "projector_shims_1": "Put a stack of the printed `tower_shim`s on each of the projector's four slots in the "
+                         "shelf (the nominal stack; add or remove shims to set the projector's height).",
+    "projector_body": "Stand the projector on its shim stacks, its lens towards the beam splitter (looking -x), and "
+                      "screw it down through the shelf's slots, finger tight until the calibration.",
+    "camera_shims": "Put the camera's shim stack against the bracket (more or fewer shims move the camera across "
+                    "the axis in y).",
+    "camera_body": "Screw the camera to the bracket above the beam splitter through its slot, looking down the "
+                   "optical axis.",
+    "beam_splitter": "Slide the plate beam splitter into the holder's 45 deg grooves through the +y wall, coated "
+                     "face towards the projector (+x) and down. Handle it by its edges.",
+    "focusing_lens": "Drop the focusing lens into the lens mount's square pocket.",
 }
 
 
@@ -155,6 +169,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     figures (for manual.json)."""
     from rigcad import plots
     from rigcad.export import mesh as M
+    from rigcad.manual import assembly as A
     from rigcad.manual.assembly import VIEW_CHORD_ERROR_MM, rig_meshes
     from rigcad.manual.view import traced_rays
     from rigcad.parts.templates import gauged_depth
@@ -288,18 +303,33 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
 
     # -- 5 assemble
     d.h(2, "5. Assemble")
-    fasteners = bill["fasteners"]
-    for k, m in enumerate(meshes):
-        text = STEP_TEXT.get(m.name, f"Place the {m.name.replace('_', ' ')}: {m.description}.")
-        if m.name == "dome" and fasteners:
-            text += (f" Bolt the flange to the plate with the {fasteners[0]['quantity']} {fasteners[0]['short']}, "
-                     f"a washer under each head and each nut ({fasteners[1]['short']} under the plate); tighten "
-                     "crosswise, by hand.")
-        d.h(3, f"Step {k + 1}: {m.name}" + (f" (x{m.quantity})" if m.quantity > 1 else ""))
+    d.p("Each step shows what is already in place (grey) and what goes in (orange), drawn clear of it with "
+        "a dashed line to its place. Bought items (instruments, optics) are marked so.")
+    joints = B.bolt_joints(rig)
+    screws = B.instrument_screws(rig)
+    done: list[int] = []
+    for k, members in enumerate(A.steps(meshes)):
+        first = meshes[members[0]]
+        label = first.name if len(members) == 1 else re.sub(r"_\d+$", "", first.name) + f" (x{len(members)})"
+        text = STEP_TEXT.get(first.name)
+        if text is None:
+            text = (f"Place the {label.replace('_', ' ')}" + (" (bought)" if first.bought else "")
+                    + f": {first.description}.")
+        for j in joints:
+            if first.name in j["parts"] and all(n in [meshes[i].name for i in done + members] for n in j["parts"]):
+                text += (f" Bolt it ({j['joins']}) with {j['count']} {j['short']}"
+                         + (", a washer under each head and each nut; tighten crosswise, by hand." if j["nuts"]
+                            else " into what it stands on."))
+        for r in screws:
+            if first.name == f"{r['instrument']}_body":
+                text += f" Screws: {r['quantity']} x {r['item']}."
+        d.h(3, f"Step {k + 1}: {label}" + (f" (x{first.quantity})" if first.quantity > 1 else ""))
         d.p(text)
-        path = f"images/step_{k + 1:02d}_{m.name}.png"
-        files[path] = plots.assembly_step(meshes, k, f"step {k + 1}: {m.name}")
-        d.img(path, f"Step {k + 1}: the {m.name.replace('_', ' ')} (coloured) goes where the dashed line points")
+        path = f"images/step_{k + 1:02d}_{re.sub(r'_[0-9]+$', '', first.name)}.png"
+        files[path] = plots.assembly_step(meshes, done, members, A.step_offsets(meshes, done, members),
+                                          f"step {k + 1}: {label}")
+        d.img(path, f"Step {k + 1}: the {label.replace('_', ' ')} (orange) goes where the dashed line points")
+        done += members
         step(f"step {k + 1}")
 
     # -- 6 calibrate
@@ -386,8 +416,8 @@ def cmd_manual(args) -> int:
     rig = load(args.profile)
     printer = load_printer(args.printer)
     root = Path(args.exports) / rig.name
-    steps = len(rig.recipes) + 4 + sum(1 for p in rig.recipes.values() if p.in_rig)
-    with _progress(steps, f"manual {rig.name} ({printer.name})") as step:
+    total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
+    with _progress(total, f"manual {rig.name} ({printer.name})") as step:
         fab = run_fab(rig, printer, root / "fab" / printer.name, gcode=args.gcode,
                       lock=profile_lock(args.exports, rig.name), progress=step)
         for problem in fab.problems:

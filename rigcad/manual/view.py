@@ -56,7 +56,8 @@ def three_js() -> str:
 def traced_rays(rig, count: int = VIEW_RAYS, seed: int | None = None) -> dict:
     """``count`` pinhole rays from the COP over the paraboloid's useful annulus (seeded: the
     profile's raycheck.seed), traced through the exact surfaces; the ones that reach the sample as
-    polylines (k, 4, 3) mm (COP, paraboloid, dome, sample) with their incidence angle theta (k,) rad."""
+    polylines (k, 4, 3) mm (COP, paraboloid, dome, sample) with their incidence angle theta (k,) rad;
+    with a COP tower (k, 5, 3), from the projector's COP by the splitter's front face."""
     from rigcad.check.scene import analytic_optics
     from rigcad.check.sources import annulus_rays
     from rigcad.check.trace3d import trace
@@ -66,7 +67,24 @@ def traced_rays(rig, count: int = VIEW_RAYS, seed: int | None = None) -> dict:
     tr = trace(analytic_optics(rig), src.origins, src.dirs)
     ok = tr.ok
     lines = np.stack([src.origins[ok], tr.p1[ok], tr.p2[ok], tr.landing[ok]], axis=1)
-    return {"lines": lines, "theta": tr.theta[ok], "traced": int(count), "reached": int(ok.sum())}
+    tower = getattr(rig.layout, "tower", None)
+    if tower is not None and len(lines):
+        lines = _folded(lines, tower)
+    return {"lines": lines, "theta": tr.theta[ok], "traced": int(count), "reached": int(ok.sum()),
+            "folded_at_splitter": tower is not None}
+
+
+def _folded(lines: np.ndarray, tower) -> np.ndarray:
+    """Polylines (k, 4, 3) from the design COP folded at the beam splitter's front face: the light
+    comes from the projector's real COP (the design COP's mirror image in that face), reflects at
+    the face and goes on down as traced; (k, 5, 3)."""
+    c = np.asarray(tower.plate.center, float)
+    n = np.asarray(tower.plate.normal, float)
+    o, d = lines[:, 0], lines[:, 1] - lines[:, 0]
+    s = ((c - o) @ n) / (d @ n)
+    hit = o + s[:, None] * d
+    start = np.broadcast_to(np.asarray(tower.projector_cop, float), o.shape)
+    return np.concatenate([start[:, None], hit[:, None], lines[:, 1:]], axis=1)
 
 
 def _b64(a: np.ndarray, dtype) -> str:
@@ -104,7 +122,7 @@ def view_html(rig, meshes: list[PartMesh], rays: dict) -> bytes:
     seg = np.concatenate([lines[:, :-1], lines[:, 1:]], axis=2).reshape(-1, 3) if len(lines) else np.zeros((0, 3))
     theta_deg = np.degrees(rays["theta"])
     rgb = np.asarray([cmap(t / 90.0)[:3] for t in theta_deg]).reshape(-1, 3) if len(lines) else np.zeros((0, 3))
-    colours = np.repeat(rgb, 6, axis=0)  # 3 segments x 2 ends per ray
+    colours = np.repeat(rgb, 2 * (lines.shape[1] - 1) if len(lines) else 0, axis=0)  # 2 ends per segment
     g = rig.geometry
     data = {
         "profile": rig.name,

@@ -87,15 +87,36 @@ def test_revolved_area_matches_the_paraboloids_closed_form(table31_rig):
     assert abs(area - exact) / exact < 1e-7, (area, exact)
 
 
-def test_bolts_come_from_the_hole_and_the_grip(tmp_path, table31_rig):
-    rows = B.fasteners(table31_rig)
-    assert rows[0]["quantity"] == table31_rig.profile.dome_shell.bolts == 8
-    assert rows[0]["item"].startswith("M4 x 25 mm")  # 6 + 10 mm grip + 2 x 0.8 + 3.2 + 2 x 0.7 = 22.2 -> 25
-    thick = _profile(tmp_path, "bolts", "base_plate:\n  thickness: 20 mm\ndome_shell:\n  bolt_diameter: 5.5 mm\n"
+def _dome_joint(rig):
+    joints = [j for j in B.bolt_joints(rig) if j["parts"] == ("base_plate", "dome")]
+    assert len(joints) == 1, B.bolt_joints(rig)
+    return joints[0]
+
+
+def test_bolts_are_found_in_the_recipes_and_sized_from_the_grip(tmp_path, table31_rig):
+    p = table31_rig.profile
+    j = _dome_joint(table31_rig)
+    # the holes of the flange and the plate line up: one bolt each, through both
+    assert j["count"] == p.dome_shell.bolts == 8
+    assert j["grip_mm"] == pytest.approx(p.dome_shell.flange_thickness + p.base_plate.thickness, abs=1e-9)
+    assert j["item"].startswith("M4 x 25 mm")  # 6 + 10 mm grip + 2 x 0.8 + 3.2 + 2 x 0.7 = 22.2 -> 25
+    other = _profile(tmp_path, "bolts", "base_plate:\n  thickness: 20 mm\ndome_shell:\n  bolt_diameter: 5.5 mm\n"
                                         "  bolts: 12\n  flange_width: 24 mm\n")
-    rows = B.fasteners(thick)
+    j = _dome_joint(other)
     # M5 (5.5 mm medium clearance): 6 + 20 + 2 x 1.0 + 4.7 + 2 x 0.8 = 34.3 mm -> 35 mm
-    assert rows[0]["item"].startswith("M5 x 35 mm") and rows[0]["quantity"] == 12 and rows[2]["quantity"] == 24
+    assert j["item"].startswith("M5 x 35 mm") and j["count"] == 12 and j["washers"] == 24
+    # every through bolt of the rig joins parts that exist, with some grip
+    for j in B.bolt_joints(table31_rig):
+        assert all(n in table31_rig.recipes for n in j["parts"]) and j["grip_mm"] > 0 and j["count"] > 0
+
+
+def test_instrument_screws_follow_the_mounting_threads(tmp_path, table31_rig):
+    rows = {r["instrument"]: r for r in B.instrument_screws(table31_rig)}
+    assert rows["projector"]["item"].startswith(table31_rig.profile.projector.mount_thread + " x ")
+    assert rows["camera"]["item"].startswith("1/4-20 UNC x ")
+    assert rows["projector"]["quantity"] == 4  # one per foot (shim stack) of the projector
+    other = _profile(tmp_path, "thread", "projector:\n  mount_thread: M6\n")
+    assert {r["instrument"]: r for r in B.instrument_screws(other)}["projector"]["item"].startswith("M6 x ")
 
 
 def test_calibration_circle_is_the_rim_at_the_projectors_resolution(table31_rig):
@@ -139,7 +160,7 @@ def written(table31_rig, fab_reports, tmp_path_factory):
     return out, paths
 
 
-def test_the_manual_is_written_with_its_pictures_and_one_self_contained_page(written, fab_reports):
+def test_the_manual_is_written_with_its_pictures_and_one_self_contained_page(written, fab_reports, table31_rig):
     out, paths = written
     md = (out / "manual.md").read_text(encoding="utf-8")
     page = (out / "manual.html").read_text(encoding="utf-8")
@@ -153,8 +174,11 @@ def test_the_manual_is_written_with_its_pictures_and_one_self_contained_page(wri
     assert f"| {pins['item']} | {pins['quantity']} |" in md
     assert "M4 x 25 mm socket-head bolt" in md
     assert (out / "calibration" / "circle.png").is_file()
-    steps = sorted(p.name for p in (out / "images").glob("step_*.png"))
-    assert len(steps) == 5 and steps[-1].endswith("dome.png")
+    from rigcad.manual.assembly import rig_meshes, steps
+
+    shots = sorted(p.name for p in (out / "images").glob("step_*.png"))
+    assert len(shots) == len(steps(rig_meshes(table31_rig))) and "step_05_dome.png" in shots
+    assert md.count("### Step ") == len(shots)
 
 
 def test_the_manual_is_deterministic(table31_rig, fab_reports):
