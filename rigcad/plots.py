@@ -159,7 +159,7 @@ def _fit_axes(ax, lo: np.ndarray, hi: np.ndarray) -> None:
     size = np.maximum(size, 0.04 * size.max())  # a flat part keeps a visible thickness
     for setter, m, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid, size / 2):
         setter(m - h, m + h)
-    ax.set_box_aspect(tuple(size), zoom=1.1)
+    ax.set_box_aspect(tuple(size), zoom=0.95)  # below 1: no corner of the box leaves the frame
     ax.set_axis_off()
 
 

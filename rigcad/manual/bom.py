@@ -343,7 +343,8 @@ def _describe(obj) -> str:
             text = f"{v[0]} x {v[1]} px"
         else:
             text = str(list(v) if isinstance(v, tuple) else v)
-        out.append(f"{f.name.replace('_', ' ')} {text}")
+        assumed = "assumed" in (getattr(spec, "doc", "") or "").lower()
+        out.append(f"{f.name.replace('_', ' ')} {text}" + (" (assumed)" if assumed else ""))
     return "; ".join(out)
 
 
