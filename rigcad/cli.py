@@ -229,7 +229,8 @@ def build_parser() -> argparse.ArgumentParser:
                     "and checked), stl/<part>.stl (at tessellation.chord_error), rig.step (the assembly, named "
                     "and coloured parts) and manifest.json. Unchanged parts are not rebuilt.",
         epilog="parts: dome, paraboloid, beam, base_plate, sample_holder, projector_cross, projector_backplate, "
-               "projector_mounting_plate, camera_cross_hung, camera_cross_base, dome_template, paraboloid_template")
+               "projector_mounting_plate, camera_cross_hung, camera_cross_base, dome_template, paraboloid_template, "
+               "tower_column, tower_shelf, splitter_holder, lens_mount, tower_shim")
     p_build.add_argument("profile", help="profile name (under profiles/) or path")
     p_build.add_argument("--parts", nargs="+", metavar="PART", help="build only these parts (default: all)")
     p_build.add_argument("--exports", default="exports", help="output root (default: exports)")

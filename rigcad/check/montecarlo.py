@@ -32,13 +32,18 @@ def declared(profile) -> Misalignment:
 
 def trace_path(optics: Optics, rig, design: DesignMap, mis: Misalignment, device: str,
                count: int, seed: int) -> tuple[Trace3D, np.ndarray, np.ndarray]:
-    """Trace ``count`` seeded pinhole rays of ``device`` (projector or camera) through the
-    misaligned rig; returns the trace, the design arrival direction of each ray's pixel, and the
+    """Trace ``count`` seeded pinhole rays of ``device`` (projector or camera; the camera's through
+    the beam splitter, check.tower.through_splitter) through the misaligned rig; returns the trace, the design arrival direction of each ray's pixel, and the
     design direction of the paraboloid point it hit (rotated with the paraboloid)."""
     rays = annulus_rays(design, count, seed, mis.pose(device, rig.geometry))
+    origins, dirs = rays.origins, rays.dirs
+    if device == "camera":  # the camera looks through the beam splitter, from its compensated COP
+        from rigcad.check.tower import through_splitter
+
+        origins, dirs, _ = through_splitter(rig, origins, dirs)
     pp = mis.pose("paraboloid", rig.geometry)
     placed = optics.placed(pp, mis.pose("dome", rig.geometry))
-    tr = trace(placed, rays.origins, rays.dirs)
+    tr = trace(placed, origins, dirs)
     local, _ = pp.localize(tr.p1, tr.p1)
     return tr, design.direction(rays.chief), pp.globalize_dirs(design.direction_at(local))
 

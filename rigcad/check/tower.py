@@ -33,6 +33,14 @@ NOT_OBSTACLES = {"projector": ("projector_lens", "projector_body", "beam_splitte
                  "camera": ("camera_lens", "camera_body", "beam_splitter", "focusing_lens")}
 
 
+def through_splitter(rig, origins: np.ndarray, dirs: np.ndarray, compensate: bool = True):
+    """Camera rays (origins at the design COP as placed by the rig's camera pose, unit dirs: (n, 3))
+    from the camera's real COP (moved by the plate's compensation unless ``compensate`` is False)
+    through the plate: returns exit points, directions (n, 3) and ``inside`` (n,)."""
+    t = rig.layout.tower
+    return transmit(t.plate, origins + (np.asarray(t.camera.offset) if compensate else 0.0), dirs)
+
+
 def camera_rays(rig, design, count: int, seed: int, compensate: bool = True) -> tuple[Rays, np.ndarray, np.ndarray]:
     """The camera's seeded pinhole rays over the paraboloid's useful annulus, from its real COP (the
     design COP moved by the plate's compensation, and by the rig's camera misalignment), after the
@@ -40,11 +48,9 @@ def camera_rays(rig, design, count: int, seed: int, compensate: bool = True) -> 
     inside its edges."""
     from rigcad.check.sources import annulus_rays
 
-    t = rig.layout.tower
     rays = annulus_rays(design, count, seed, rig.pose("camera"))
-    origins = rays.origins + (np.asarray(t.camera.offset) if compensate else 0.0)
-    p, d, inside = transmit(t.plate, origins, rays.dirs)
-    return Rays(p, d, rays.chief, rays.pixel), inside, origins
+    p, d, inside = through_splitter(rig, rays.origins, rays.dirs, compensate)
+    return Rays(p, d, rays.chief, rays.pixel), inside, rays.origins
 
 
 def camera_view(optics, rig, design, count: int, seed: int, compensate: bool = True) -> tuple[Trace3D, dict]:
@@ -149,4 +155,4 @@ def tower_report(optics, rig, design, count: int, seed: int) -> dict:
             "camera_through_splitter_uncompensated": raw, "bundle_clearance": bundle_clearance(rig, design)}
 
 
-__all__ = ["bundle_clearance", "camera_rays", "camera_view", "tower_report"]
+__all__ = ["bundle_clearance", "camera_rays", "camera_view", "through_splitter", "tower_report"]

@@ -137,6 +137,7 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
                 "stl_step_volume_rtol": MESH_VOLUME_RTOL,
             },
             "layout": layout.describe(),
+            "tower_hardware": _tower_hardware(rig),
             "occlusion": _occlusion(rig, old.get("occlusion")),
             "parts": {n: entries[n] for n in PARTS if n in entries},
             "mirrors": mirrors,
@@ -146,6 +147,13 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
         step("publishing")
         written = stage.commit()
     return BuildResult(manifest, rebuilt, reused, written)
+
+
+def _tower_hardware(rig) -> list[dict]:
+    """The COP tower's bought hardware, computed from its parts (parts.tower.hardware)."""
+    from rigcad.parts.tower import hardware
+
+    return hardware(rig.profile, rig.layout)
 
 
 def _read_manifest(path: Path) -> dict:

@@ -385,6 +385,53 @@ def tower_shim(profile: Profile, layout) -> Part:
 
 TOWER_PARTS = ("tower_column", "tower_shelf", "splitter_holder", "lens_mount", "tower_shim")
 
+#: What a bolt needs past its grip (mm): a washer and a nut (0.8 d) for a through bolt, and two
+#: threads proud; or, screwed into an instrument, the thread engaged in its socket (assumed 5 mm).
+NUT_FACTOR = 0.8
+WASHER = 1.0
+SOCKET_ENGAGEMENT = 5.0
+#: Bolt lengths are rounded up to this step (mm): ISO 4762 lengths run in 5 mm steps from 10 to 50.
+LENGTH_STEP = 5.0
+
+
+def _length(grip: float, extra: float) -> float:
+    return LENGTH_STEP * math.ceil((grip + extra) / LENGTH_STEP - 1e-9)
+
+
+def hardware(profile: Profile, layout) -> list[dict]:
+    """The tower's bought hardware, computed from the parts (mm; units in keys): each item's name,
+    quantity, thread and length (grip plus nut or socket engagement, rounded up to LENGTH_STEP), and
+    what it joins. The bench bolts are the user's (their length depends on the bench)."""
+    t, tw, pj, cm, bs, ln = layout.tower, profile.tower, profile.projector, profile.camera, \
+        profile.beam_splitter, profile.lens
+    m4 = "M4"
+    nut = NUT_FACTOR * MOUNT_THREADS[m4] + WASHER + 1.0  # + two threads of 0.7 mm pitch, rounded
+    through = _length(tw.wall + t.shelf_thickness, nut)
+    shim_max = t.shims_per_stack * tw.shim_thickness
+    bracket = t.bracket_y + t.wall_y[1]  # the camera bracket's thickness (y)
+    _, _, _, lens_pts = _lens_foot(t, profile)
+    return [
+        {"item": "bolt, washer and nut", "thread": m4, "length_mm": through, "quantity": 4,
+         "joins": "the column's top flange to the shelf"},
+        {"item": "bolt, washer and nut", "thread": m4, "length_mm": through, "quantity": len(_holder_flange_points(t, profile)),
+         "joins": "the splitter holder's flanges to the shelf"},
+        {"item": "bolt, washer and nut", "thread": m4, "length_mm": through, "quantity": len(lens_pts),
+         "joins": "the lens mount's slotted foot to the shelf"},
+        {"item": "bench bolt or screw", "thread": f"{tw.bolt_diameter:g} mm clearance holes", "length_mm": None,
+         "quantity": 4, "joins": "the column's foot to the bench (length: the bench's)"},
+        {"item": "screw and washer", "thread": pj.mount_thread,
+         "length_mm": _length(t.shelf_thickness + shim_max, SOCKET_ENGAGEMENT), "quantity": len(_projector_feet(t)),
+         "joins": "the projector's mounting holes, through the shelf's slots and its shim stacks"},
+        {"item": "screw and washer", "thread": cm.mount_thread,
+         "length_mm": _length(bracket + shim_max, SOCKET_ENGAGEMENT), "quantity": 1,
+         "joins": "the camera's tripod socket, through the bracket's slot and its shim stack"},
+        {"item": "plate beam splitter", "thread": None, "length_mm": None, "quantity": 1,
+         "size_mm": [bs.width, bs.length, bs.thickness], "index": bs.index,
+         "joins": "slides into the splitter holder's grooves through its +y wall, coated face towards the projector"},
+        {"item": "focusing lens", "thread": None, "length_mm": None, "quantity": 1,
+         "size_mm": [ln.diameter, ln.thickness], "joins": "drops into the lens mount's pocket"},
+    ]
+
 
 # -- the instruments and markers in rig.step -------------------------------------------------------
 #: Side of the centre-of-projection markers (mm): visible in a viewer, small against every body.
@@ -443,5 +490,5 @@ def instruments(profile: Profile, layout) -> tuple[Part, ...]:
     )
 
 
-__all__ = ["TOWER_PARTS", "TowerLayout", "instruments", "lens_mount", "splitter_holder", "tower_column",
+__all__ = ["TOWER_PARTS", "TowerLayout", "hardware", "instruments", "lens_mount", "splitter_holder", "tower_column",
            "tower_layout", "tower_shelf", "tower_shim"]

@@ -182,8 +182,9 @@ class BeamSplitterParams:
 @dataclass(frozen=True)
 class TowerParams:
     """The COP tower (rigcad.parts.tower): a column on the bench beside the rig, a shelf for the
-    projector at 90 deg, an arm to the optical axis carrying the splitter holder, the lens mount and
-    the camera bracket above the splitter. Adjustment travel is each way from the nominal position."""
+    projector at 90 deg that reaches over the optical axis, where the splitter holder (with the camera
+    bracket above the splitter) and the lens mount stand. Adjustment travel is each way from the
+    nominal position."""
 
     splitter_distance: float = spec("length", "from the COP down to the splitter's centre, along the optical axis "
                                     "(the projector's COP is as far from the axis)", "70 mm", **_POS)
@@ -195,7 +196,8 @@ class TowerParams:
                                 "camera_offset and projector_offset", "2 mm", lo=0)
     shim_thickness: float = spec("length", "thickness of one printed adjustment shim", "0.5 mm", **_POS)
     column_width: float = spec("length", "side of the square column", "50 mm", **_POS)
-    wall: float = spec("length", "wall of the column, the shelf, the arm and the brackets", "5 mm", **_POS)
+    wall: float = spec("length", "wall of the column, the splitter holder and the lens mount (the shelf is "
+                       "twice as thick)", "5 mm", **_POS)
     clearance: float = spec("length", "least gap between the tower and the rig's parts, and between the tower "
                             "and the ray bundle", "5 mm", **_POS)
     bolt_diameter: float = spec("length", "clearance hole of the bolts joining the tower's parts (M4)", "4.5 mm",

@@ -164,3 +164,19 @@ def test_a_too_small_splitter_names_the_key(write_profile, table31_text):
     with pytest.raises(GeometryError) as info:
         _rig_of(write_profile, table31_text, "beam_splitter:\n  length: 12 mm\n  width: 12 mm\n").layout
     assert "beam_splitter.length" in str(info.value)
+
+
+def test_hardware_is_computed_from_the_parts(rig, write_profile, table31_text):
+    from rigcad.parts.tower import hardware
+
+    items = hardware(rig.profile, rig.layout)
+    m4 = [i for i in items if i["item"] == "bolt, washer and nut"]
+    assert sum(i["quantity"] for i in m4) == 4 + 4 + 2  # column, holder flanges, lens foot
+    assert all(i["length_mm"] == 25.0 for i in m4)  # 5 mm flange + 10 mm shelf + washer, nut, threads = 20.2 mm
+    screw = next(i for i in items if i["thread"] == rig.profile.projector.mount_thread and i["item"].startswith("screw"))
+    # more travel: more shims in each stack, a longer screw through them
+    more = Rig.from_profile(load_profile(write_profile(table31_text + "tower:\n  travel_across: 6 mm\n")))
+    screw2 = next(i for i in hardware(more.profile, more.layout) if i["item"].startswith("screw")
+                  and i["thread"] == more.profile.projector.mount_thread)
+    assert screw2["length_mm"] > screw["length_mm"]
+    assert more.recipe("tower_shim").quantity == 5 * 24  # 12 mm of 0.5 mm shims per stack
