@@ -115,10 +115,6 @@ HOLE_OVERSHOOT_MM = 1.0
 #: A vertical cut counts as a bolt hole (or slot) when it is at most this wide (mm) in x and y: the
 #: bore for the sample holder and the hole that passes the projector's bundle are wider.
 BOLT_HOLE_MAX_MM = 16.0
-#: Thread engaged in an instrument's own mounting hole, in thread diameters (a metal body: 1-1.5 d).
-ENGAGEMENT_DIAMETERS = 1.5
-#: Inch bolt lengths (in) for the instruments' UNC mounting threads.
-INCH_LENGTHS = (0.25, 0.375, 0.5, 0.625, 0.75, 0.875, 1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0)
 
 
 def _holes(solid, offset=(0.0, 0.0, 0.0), cut=False):
@@ -146,13 +142,18 @@ def _holes(solid, offset=(0.0, 0.0, 0.0), cut=False):
 
 
 def bolt_joints(rig) -> list[dict]:
-    """Every bolted joint of the rig, found in the recipes: vertical holes of the in-rig printed parts
+    """Every bolted joint of the rig outside the COP tower (whose joints the tower module computes:
+    tower_hardware), found in the recipes: vertical holes of the in-rig printed parts
     that share an axis (x, y within 0.05 mm) and touch in z are one bolt through those parts; a round
     hole of one part alone is a bolt into what it stands on (the bench). Grouped by (parts joined,
     thread, length): count, grip, the bolt, its nut and washers."""
+    try:
+        from rigcad.parts.tower import TOWER_PARTS
+    except ImportError:  # pragma: no cover - a rig without the tower module
+        TOWER_PARTS = ()
     holes = []
     for name, part in rig.recipes.items():
-        if part.in_rig:
+        if part.in_rig and name not in TOWER_PARTS:  # the tower's own joints: tower_hardware
             holes += [(name, *h) for h in _holes(part.solid)]
     axes: dict[tuple, list] = {}
     for h in holes:
@@ -195,38 +196,19 @@ def bolt_joints(rig) -> list[dict]:
     return rows
 
 
-def instrument_screws(rig) -> list[dict]:
-    """The screws that hold the projector and the camera by their own mounting threads (the
-    profile's ``projector.mount_thread``, ``camera.mount_thread``), through the tower's shelf or
-    bracket and the nominal shim stack, engaged ENGAGEMENT_DIAMETERS diameters into the body."""
-    from rigcad.profile.schema import MOUNT_THREADS
-
-    p = rig.profile
-    t = getattr(rig.layout, "tower", None)
-    if t is None:
+def tower_hardware(rig) -> list[dict]:
+    """The COP tower's bolts and screws as the tower computes them (``rigcad.parts.tower.hardware``,
+    the one home of the tower's joints: bracket, shims, slots); its optics are listed with the
+    profile's instruments. Empty for a rig without a tower."""
+    if getattr(rig.layout, "tower", None) is None:
         return []
-    feet = sum(1 for part in rig.instruments if part.name.startswith("projector_shims_"))
-    stack = t.shims_nominal * p.tower.shim_thickness
-    rows = []
-    for who, thread, count, through in (("projector", p.projector.mount_thread, feet, t.shelf_thickness),
-                                        ("camera", p.camera.mount_thread, 1, p.tower.wall)):
-        d = MOUNT_THREADS[thread]
-        need = through + stack + ENGAGEMENT_DIAMETERS * d
-        if thread.startswith("M"):
-            length = next((L for L in BOLT_LENGTHS if L >= need - 1e-9), None)
-            size = f"{thread} x {length} mm" if length else f"{thread}, {need:.0f} mm"
-        else:
-            inch = next((L for L in INCH_LENGTHS if L * 25.4 >= need - 1e-9), None)
-            size = f"{thread} x {inch:g} in" if inch else f"{thread}, {need:.0f} mm"
-        rows.append({"item": f"{size} screw ({who}'s mounting thread)", "quantity": count, "instrument": who,
-                     "use": f"{who} to the tower through {through:g} mm and {t.shims_nominal} shims",
-                     "note": f"needs {need:.1f} mm: {through:g} mm + {stack:g} mm of shims + "
-                             f"{ENGAGEMENT_DIAMETERS:g} x {d:g} mm into the body ({who}.mount_thread)"})
-    return rows
+    from rigcad.parts.tower import hardware
+
+    return [h for h in hardware(rig.profile, rig.layout) if h.get("thread")]
 
 
 def fasteners(rig) -> list[dict]:
-    """Bolts, nuts and washers of every bolted joint (bolt_joints), then the instruments' screws."""
+    """Bolts, nuts and washers of every bolted joint (bolt_joints), then the tower's (tower_hardware)."""
     rows = []
     for j in bolt_joints(rig):
         rows.append({"item": j["item"], "short": j["short"], "quantity": j["count"], "use": j["joins"],
@@ -246,8 +228,12 @@ def fasteners(rig) -> list[dict]:
             w = next(r for r in METRIC if r[0] == thread)
             rows.append({"item": f"{thread} washer (ISO 7089)", "short": f"{thread} washers", "quantity": n,
                          "use": "under each bolt head and nut", "length_mm": None, "note": f"{w[4]:g} mm thick"})
-    for r in instrument_screws(rig):
-        rows.append({**r, "short": r["item"], "length_mm": None})
+    for h in tower_hardware(rig):
+        item = (f"{h['thread']} x {h['length_mm']:g} mm {h['item']}" if h.get("length_mm")
+                else f"{h['item']} ({h['thread']})")
+        rows.append({"item": item, "short": item, "quantity": h["quantity"],
+                     "use": h["joins"], "length_mm": h.get("length_mm"), "note": "COP tower (parts.tower.hardware)",
+                     "thread": h["thread"], "tower": True})
     return rows
 
 
@@ -370,5 +356,5 @@ def bill(rig, fab_report: dict, printer) -> dict:
             "totals": fab_report.get("totals", {})}
 
 
-__all__ = ["bill", "bolt_length", "coating_rows", "dowel_pins", "fasteners", "printed", "purchased",
-           "revolved_area", "thread_for_hole"]
+__all__ = ["bill", "bolt_joints", "bolt_length", "coating_rows", "dowel_pins", "fasteners", "printed", "purchased",
+           "revolved_area", "thread_for_hole", "tower_hardware"]

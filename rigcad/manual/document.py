@@ -306,7 +306,19 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     d.p("Each step shows what is already in place (grey) and what goes in (orange), drawn clear of it with "
         "a dashed line to its place. Bought items (instruments, optics) are marked so.")
     joints = B.bolt_joints(rig)
-    screws = B.instrument_screws(rig)
+    tower_rows = B.tower_hardware(rig)
+    order = [meshes[i].name for st in A.steps(meshes) for i in st]
+
+    def keys(name: str) -> set[str]:
+        words = name.replace("tower_", "").replace("_body", "").replace("_", " ")
+        return {name.replace("_", " "), words}
+
+    # each tower item goes with the last step (in assembly order) whose part its "joins" text names
+    tower_at = {}
+    for h in tower_rows:
+        named = [n for n in order if any(re.search(rf"\b{re.escape(k)}'?s?\b", h["joins"]) for k in keys(n))]
+        if named:
+            tower_at.setdefault(named[-1], []).append(h)
     done: list[int] = []
     for k, members in enumerate(A.steps(meshes)):
         first = meshes[members[0]]
@@ -320,9 +332,9 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
                 text += (f" Bolt it ({j['joins']}) with {j['count']} {j['short']}"
                          + (", a washer under each head and each nut; tighten crosswise, by hand." if j["nuts"]
                             else " into what it stands on."))
-        for r in screws:
-            if first.name == f"{r['instrument']}_body":
-                text += f" Screws: {r['quantity']} x {r['item']}."
+        for h in tower_at.get(first.name, []):
+            size = f"{h['thread']} x {h['length_mm']:g} mm" if h.get("length_mm") else h["thread"]
+            text += f" Fix it with {h['quantity']} x {h['item']} ({size}): {h['joins']}."
         d.h(3, f"Step {k + 1}: {label}" + (f" (x{first.quantity})" if first.quantity > 1 else ""))
         d.p(text)
         path = f"images/step_{k + 1:02d}_{re.sub(r'_[0-9]+$', '', first.name)}.png"

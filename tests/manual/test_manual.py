@@ -110,13 +110,16 @@ def test_bolts_are_found_in_the_recipes_and_sized_from_the_grip(tmp_path, table3
         assert all(n in table31_rig.recipes for n in j["parts"]) and j["grip_mm"] > 0 and j["count"] > 0
 
 
-def test_instrument_screws_follow_the_mounting_threads(tmp_path, table31_rig):
-    rows = {r["instrument"]: r for r in B.instrument_screws(table31_rig)}
-    assert rows["projector"]["item"].startswith(table31_rig.profile.projector.mount_thread + " x ")
-    assert rows["camera"]["item"].startswith("1/4-20 UNC x ")
-    assert rows["projector"]["quantity"] == 4  # one per foot (shim stack) of the projector
+def test_the_tower_hardware_is_the_towers_and_follows_the_mounting_threads(tmp_path, table31_rig):
+    from rigcad.parts.tower import hardware
+
+    rows = B.fasteners(table31_rig)
+    tower = [r for r in rows if r.get("tower")]
+    assert len(tower) == len([h for h in hardware(table31_rig.profile, table31_rig.layout) if h.get("thread")]) > 0
+    assert not any(set(j["parts"]) & {"tower_column", "tower_shelf"} for j in B.bolt_joints(table31_rig)), \
+        "the tower's joints have one home (parts.tower.hardware), not two"
     other = _profile(tmp_path, "thread", "projector:\n  mount_thread: M6\n")
-    assert {r["instrument"]: r for r in B.instrument_screws(other)}["projector"]["item"].startswith("M6 x ")
+    assert any(r["item"].startswith("M6 x ") and "projector" in r["use"] for r in B.fasteners(other))
 
 
 def test_calibration_circle_is_the_rim_at_the_projectors_resolution(table31_rig):
