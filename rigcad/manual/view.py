@@ -260,7 +260,8 @@ _PAGE = r"""<!DOCTYPE html>
     camera.aspect = host.clientWidth / host.clientHeight; camera.updateProjectionMatrix();
     renderer.setSize(host.clientWidth, host.clientHeight); controls.handleResize(); render();
   });
-  (function animate() { requestAnimationFrame(animate); controls.update(); render(); })();
+  controls.addEventListener("change", render);  // draw when the view moves, not every frame
+  (function animate() { requestAnimationFrame(animate); controls.update(); })();
   render();
   window.rigcad = { parts: Object.keys(parts), setVisible: setVisible, setExplode: setExplode,
                     frames: function () { return frames; }, webgl: !!renderer.getContext(), ready: true };

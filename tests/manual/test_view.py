@@ -118,7 +118,7 @@ def test_in_chromium_no_request_leaves_the_page_and_the_canvas_draws_the_rig(vie
             page.on("pageerror", lambda e: errors.append(str(e)))
             page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
             page.goto(path.as_uri())
-            page.wait_for_function("window.rigcad && window.rigcad.ready && window.rigcad.frames() > 2",
+            page.wait_for_function("window.rigcad && window.rigcad.ready && window.rigcad.frames() >= 1",
                                    timeout=60_000)
             assert page.evaluate("window.rigcad.webgl"), "no WebGL context"
             names = page.evaluate("window.rigcad.parts")
