@@ -209,8 +209,9 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     pieces = sum(r["pieces"] * r["quantity"] for r in timed)
     d.p(f"In all: **{pieces} printed pieces, {B._hms(total_t)} of printing and {total_g:.0f} g of "
         f"{printer.material}**" + ("" if all(r["source"] == "slicer" for r in timed) else
-                                   " (rigcad's estimate where no G-code was sliced: `rigcad manual ... --gcode` "
-                                   "uses PrusaSlicer's own figures)") + ".")
+                                   " (rigcad's estimate where no G-code was sliced"
+                                   + (": `rigcad manual ... --gcode` uses PrusaSlicer's own figures)"
+                                      if printer.slicer == "prusa-slicer" else ")")) + ".")
     d.h(3, "Hardware")
     hw = [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"]]
     if bill["pins"]:
