@@ -198,3 +198,20 @@ def test_rigcad_manual_refuses_an_unknown_printer_in_one_line(tmp_path):
                           "--exports", str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert run.returncode != 0 and run.stderr.startswith("rigcad: error:") and len(run.stderr.splitlines()) == 1
     assert "nosuch" in run.stderr and not any(tmp_path.iterdir())
+
+
+def test_printed_times_are_the_slicers_when_it_sliced(fab_reports, table31_rig):
+    """With G-code (fab --gcode) each piece carries PrusaSlicer's estimates: the bill takes those."""
+    import copy
+
+    report = copy.deepcopy(fab_reports["prusa_mk3s"])
+    pieces = report["parts"]["base_plate"]["pieces"]
+    for k, pc in enumerate(pieces):
+        pc["gcode"] = {"estimates": {"print_time_s": 3600.0 * (k + 1), "filament_g": 10.0 * (k + 1)}}
+    row = next(r for r in B.printed(table31_rig, report) if r["part"] == "base_plate")
+    n = len(pieces)
+    assert row["source"] == "slicer"
+    assert row["time_s"] == 3600.0 * n * (n + 1) / 2 and row["material_g"] == 10.0 * n * (n + 1) / 2
+    estimate = next(r for r in B.printed(table31_rig, fab_reports["prusa_mk3s"]) if r["part"] == "base_plate")
+    assert estimate["source"] == "rigcad estimate"
+    assert estimate["time_s"] == pytest.approx(sum(pc["estimate"]["print_time_s"] for pc in pieces), rel=1e-12)
