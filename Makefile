@@ -6,12 +6,13 @@ VENV := .venv
 PY := $(VENV)/bin/python
 PROFILE ?= achutha2006
 PRINTER ?= prusa_mk3s
-# Debian packages the project runs (the G-code slicer); installed when missing, never assumed.
-SYSTEM_TOOLS := prusa-slicer
+# Debian packages the project runs (the G-code slicer; the browser the 3D view is tested in, driven by
+# playwright as /usr/bin/chromium); installed when missing, never assumed.
+SYSTEM_TOOLS := prusa-slicer chromium
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 EXPORTS ?= exports
 
-.PHONY: all stl design docs check gcode tools test test-all test-slow bench stress clean distclean help
+.PHONY: all stl design docs check gcode view manual tools test test-all test-slow bench stress clean distclean help
 
 all: stl
 
@@ -19,6 +20,8 @@ help:
 	@echo "make stl      - design and build the default profile ($(PROFILE)) into $(EXPORTS)/$(PROFILE)/"
 	@echo "make check    - 3D ray check of $(PROFILE) through the exported meshes (after make stl)"
 	@echo "make gcode    - print files + G-code (PrusaSlicer) for PRINTER=$(PRINTER) -> $(EXPORTS)/$(PROFILE)/fab/$(PRINTER)/"
+	@echo "make view     - the assembled rig in 3D: $(EXPORTS)/$(PROFILE)/view/rig.html (one self-contained file)"
+	@echo "make manual   - assembly and calibration manual for PRINTER=$(PRINTER) -> $(EXPORTS)/$(PROFILE)/manual/$(PRINTER)/"
 	@echo "make test     - the fast test suite (default run, < 10 min)"
 	@echo "make test-slow - only the slow tests (the whole rig through PrusaSlicer)"
 	@echo "make test-all - every test, slow ones included"
@@ -49,7 +52,14 @@ design: stl
 check: stl
 	$(VENV)/bin/rigcad check $(PROFILE) --exports $(EXPORTS)
 
-docs: check
+view: $(VENV)/.installed
+	$(VENV)/bin/rigcad view $(PROFILE) --exports $(EXPORTS)
+
+manual: $(VENV)/.installed stl
+	$(VENV)/bin/rigcad manual $(PROFILE) --printer $(PRINTER) --exports $(EXPORTS)
+
+docs: check view
+	cp $(EXPORTS)/achutha2006/view/rig.png docs/rig.png
 	cp $(EXPORTS)/achutha2006/rays.png docs/rays.png
 	cp $(EXPORTS)/achutha2006/check/spot.png $(EXPORTS)/achutha2006/check/theta_map.png docs/
 	mkdir -p docs/parts && cp $(EXPORTS)/achutha2006/renders/*.png docs/parts/

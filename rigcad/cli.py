@@ -68,15 +68,21 @@ def cmd_profile_show(args: argparse.Namespace) -> int:
     print(f"profile {profile.name}  ({' <- '.join(profile.sources)})")
     if profile.description:
         print(f"  {profile.description}")
-    for section in SECTIONS:
-        obj = getattr(profile, section)
+    table = {section: [(f.name, _fmt(f.metadata["spec"], getattr(getattr(profile, section), f.name)),
+                        profile.marks.get((section, f.name)) or "default", f.metadata["spec"].doc)
+                       for f in fields(getattr(profile, section))] for section in SECTIONS}
+    # a value wider than this (the coating's layer list) goes on its own line under its row, so that
+    # one long cell does not push every other row's columns to the right
+    cap = 32
+    widths = [max(len(row[i]) for rows in table.values() for row in rows if i != 1 or len(row[1]) <= cap)
+              for i in range(3)]
+    for section, rows in table.items():
         print(f"\n[{section}]")
-        for f in fields(obj):
-            spec = f.metadata["spec"]
-            value = getattr(obj, f.name)
-            where = profile.marks.get((section, f.name))
-            origin = where if where else "default"
-            print(f"  {f.name:<16} {_fmt(spec, value):<22} {origin:<28} {spec.doc}")
+        for name, value, origin, doc in rows:
+            long = len(value) > cap
+            print("  " + _columns((name, "(below)" if long else value, origin, doc), widths))
+            if long:
+                print("  " + " " * (widths[0] + 1) + value)
     print("\n[derived]")
     rows = [
         ("focal_length", f"{geo.focal_length:.6g} mm"),
@@ -92,9 +98,29 @@ def cmd_profile_show(args: argparse.Namespace) -> int:
         ("rim_angle_at_cop", f"{geo.rim_angle_at_cop / DEG:.6g} deg"),
         ("pixels_vertex_to_rim", "-" if geo.cop_at_infinity else f"{geo.pixels_vertex_to_rim:.4g} px"),
     ]
+    width = max(len(name) for name, _ in rows)
     for name, value in rows:
-        print(f"  {name:<28} {value}")
+        print(f"  {name:<{width}} {value}")
     return 0
+
+
+def _columns(row, widths) -> str:
+    """One line of a table: each cell padded to its column's width (the widest cell), the last free."""
+    return " ".join(f"{cell:<{w}}" for cell, w in zip(row, widths)) + " " + " ".join(row[len(widths):])
+
+
+def _part_lines(result, names) -> list[str]:
+    """One line per part of a build: built or unchanged, volume, triangles, quantity; columns as wide
+    as the longest part name."""
+    m = result.manifest
+    width = max((len(n) for n in names), default=0)
+    lines = []
+    for name in names:
+        e = m["parts"][name]
+        tag = "built" if name in result.rebuilt else "unchanged"
+        lines.append(f"  {name:<{width}} {tag:<9} volume {e['volume_mm3'] / 1000:9.2f} cm^3  {e['triangles']:7d} triangles"
+                     + (f"  x{e['quantity']}" if e["quantity"] > 1 else ""))
+    return lines
 
 
 def cmd_design(args: argparse.Namespace) -> int:
@@ -134,13 +160,8 @@ def cmd_build(args: argparse.Namespace) -> int:
         step("dome integrated")
         out = Path(args.exports) / rig.name
         result = build_rig(rig, out, names, progress=step, lock=profile_lock(args.exports, rig.name))
-    m = result.manifest
     print(f"{rig.name}: {len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
-    for name in names:
-        e = m["parts"][name]
-        tag = "built" if name in result.rebuilt else "unchanged"
-        print(f"  {name:<22} {tag:<9} volume {e['volume_mm3'] / 1000:9.2f} cm^3  {e['triangles']:7d} triangles"
-              + (f"  x{e['quantity']}" if e["quantity"] > 1 else ""))
+    print("\n".join(_part_lines(result, names)))
     print(f"  manifest: {out / 'manifest.json'}")
     return 0
 
@@ -171,6 +192,7 @@ def cmd_stl(args: argparse.Namespace) -> int:
     env = rig.design.report["envelope"]
     print(f"{profile.name}: dome mirror {env['width_in']:.2f} x {env['height_in']:.2f} in; "
           f"{len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
+    print("\n".join(_part_lines(result, list(PARTS))))
     return 0
 
 
@@ -238,6 +260,9 @@ def build_parser() -> argparse.ArgumentParser:
     from rigcad.optimize.cli import register as register_optimize
 
     register_optimize(sub)
+    from rigcad.manual.cli import register as register_manual
+
+    register_manual(sub)
     return parser
 
 

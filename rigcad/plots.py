@@ -11,6 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 _PNG_META = {"Software": None}
 
@@ -83,6 +84,11 @@ def incidence_plot(design) -> bytes:
         a2.grid(alpha=0.3)
         sec = a1.secondary_xaxis("top", functions=(lambda r: np.interp(r, t["paraboloid_r_mm"][::-1], pix[::-1]),
                                                      lambda p: np.interp(p, pix[::-1], t["paraboloid_r_mm"][::-1])))
+        # ticks only inside the pixel range: beyond it the inverse map clamps, and ticks past the rim
+        # would all land on the rim's radius, printed over each other
+        lo, hi = float(np.nanmin(pix)), float(np.nanmax(pix))
+        ticks = MaxNLocator(nbins=6).tick_values(lo, hi)
+        sec.set_xticks(ticks[(ticks >= lo) & (ticks <= hi)])
         sec.set_xlabel("projector pixel from the axis")
     else:
         a2.text(0.5, 0.5, "COP at infinity: no pixel grid", ha="center", va="center")
@@ -92,34 +98,185 @@ def incidence_plot(design) -> bytes:
     return _png(fig)
 
 
-def render_mesh(vertices: np.ndarray, faces: np.ndarray, title: str, color=(0.7, 0.7, 0.75),
-                cutaway: bool = False) -> bytes:
-    """A shaded view of a triangle mesh (mm). ``cutaway`` drops the half with y < 0 to show the inside."""
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
-    tri = vertices[faces]
-    if cutaway:
-        tri = tri[tri[:, :, 1].mean(axis=1) > 0]
+def _shade(tri: np.ndarray, color, alpha: float = 1.0) -> np.ndarray:
+    """RGBA (m, 4) of flat-shaded triangles (m, 3, 3) mm, lit from the viewer's upper left."""
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
     light = np.array([-0.4, -0.6, 0.7])
     light /= np.linalg.norm(light)
     shade = 0.35 + 0.65 * np.abs(n @ light)
-    rgb = np.clip(np.outer(shade, color), 0, 1)
-    fig = plt.figure(figsize=(5, 5))
-    ax = fig.add_subplot(projection="3d")
-    ax.add_collection3d(Poly3DCollection(tri, facecolors=rgb, edgecolors="none", linewidths=0))
-    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
-    mid, span = (lo + hi) / 2, float((hi - lo).max()) / 2
-    ax.set_xlim(mid[0] - span, mid[0] + span)
-    ax.set_ylim(mid[1] - span, mid[1] + span)
-    ax.set_zlim(mid[2] - span, mid[2] + span)
-    ax.set_box_aspect((1, 1, 1))
-    ax.view_init(elev=15, azim=-90) if cutaway else ax.view_init(elev=22, azim=-60)
+    return np.column_stack([np.clip(np.outer(shade, color), 0, 1), np.full(len(tri), alpha)])
+
+
+def _shaded(ax, tri: np.ndarray, color, alpha: float = 1.0) -> None:
+    """Flat-shaded triangles (m, 3, 3) mm on a 3D axes, lit from the viewer's upper left."""
+    _draw(ax, [(tri, color, alpha)])
+
+
+def _draw(ax, groups) -> None:
+    """Several meshes ((triangles (m, 3, 3) mm, colour, alpha), ...) as ONE collection, so that
+    matplotlib's painter's sort orders every triangle against every other, not part against part.
+    Long thin triangles (a plate's fan) are split at their longest edge first: sorted by centroid
+    they would poke through their neighbours."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    tris, cols = [], []
+    for tri, color, alpha in groups:
+        if not len(tri):
+            continue
+        tri = _split_long(tri)
+        tris.append(tri)
+        cols.append(_shade(tri, color, alpha))
+    if tris:
+        ax.add_collection3d(Poly3DCollection(np.concatenate(tris), facecolors=np.concatenate(cols),
+                                             edgecolors="none", linewidths=0))
+
+
+def _split_long(tri: np.ndarray, rounds: int = 4) -> np.ndarray:
+    """Triangles (m, 3, 3) with every edge longer than 1/12 of the mesh's size split in two at its
+    midpoint (at most ``rounds`` times): painter's sorting works on pieces of similar size."""
+    size = float(np.ptp(tri.reshape(-1, 3), axis=0).max()) if len(tri) else 0.0
+    limit = size / 12
+    for _ in range(rounds):
+        e = np.stack([np.linalg.norm(tri[:, (k + 1) % 3] - tri[:, k], axis=1) for k in range(3)], axis=1)
+        k = e.argmax(axis=1)
+        long = e[np.arange(len(tri)), k] > limit
+        if not long.any():
+            break
+        t = tri[long]
+        kk = k[long]
+        i = np.arange(len(t))
+        a, b, c = t[i, kk], t[i, (kk + 1) % 3], t[i, (kk + 2) % 3]
+        m = 0.5 * (a + b)
+        tri = np.concatenate([tri[~long], np.stack([a, m, c], 1), np.stack([m, b, c], 1)])
+    return tri
+
+
+def _fit_axes(ax, lo: np.ndarray, hi: np.ndarray) -> None:
+    """Axis limits on the geometry's own extents (mm), equal scale on all three axes: the box's
+    aspect is the geometry's, so a long beam fills the frame's width instead of a cube's diagonal."""
+    mid, size = (lo + hi) / 2, np.maximum(hi - lo, 1e-3)
+    size = np.maximum(size, 0.04 * size.max())  # a flat part keeps a visible thickness
+    for setter, m, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid, size / 2):
+        setter(m - h, m + h)
+    ax.set_box_aspect(tuple(size), zoom=0.95)  # below 1: no corner of the box leaves the frame
     ax.set_axis_off()
+
+
+def _trimmed_png(fig, title: str = "", dpi: int = 110, pad: int = 12) -> bytes:
+    """The figure as PNG, cropped to what is drawn (non-white pixels) plus ``pad`` px, with
+    ``title`` above it: a 3D axes leaves most of its frame empty whatever its margins."""
+    fig.set_dpi(dpi)
+    fig.canvas.draw()
+    rgba = np.asarray(fig.canvas.buffer_rgba())
+    plt.close(fig)
+    ink = np.nonzero((rgba[:, :, :3] < 250).any(axis=2))
+    if len(ink[0]):
+        r0, r1 = max(ink[0].min() - pad, 0), min(ink[0].max() + pad + 1, rgba.shape[0])
+        c0, c1 = max(ink[1].min() - pad, 0), min(ink[1].max() + pad + 1, rgba.shape[1])
+        rgba = rgba[r0:r1, c0:c1]
+    lines = title.count("\n") + 1 if title else 0
+    head = 16 * lines + 8 if title else 0  # px: 9 pt text at 110 dpi is ~14 px a line
+    h, w = rgba.shape[:2]
+    w_out = max(w, 7 * max(len(t) for t in title.split("\n")) + 2 * pad) if title else w  # ~7 px a character
+    out = plt.figure(figsize=(w_out / dpi, (h + head) / dpi), dpi=dpi)
+    out.figimage(np.ascontiguousarray(rgba), xo=int((w_out - w) // 2), yo=0, origin="upper")
+    if title:
+        out.text(0.5, 1.0 - 4 / (h + head), title, ha="center", va="top", fontsize=9)
+    buf = io.BytesIO()
+    out.savefig(buf, format="png", dpi=dpi, metadata=_PNG_META)
+    plt.close(out)
+    return buf.getvalue()
+
+
+def render_mesh(vertices: np.ndarray, faces: np.ndarray, title: str, color=(0.7, 0.7, 0.75),
+                cutaway: bool = False) -> bytes:
+    """A shaded view of a triangle mesh (mm), cropped to the part. ``cutaway`` drops the half
+    with y < 0 to show the inside."""
+    tri = vertices[faces]
+    if cutaway:
+        tri = tri[tri[:, :, 1].mean(axis=1) > 0]
+    fig = plt.figure(figsize=(5, 5))
+    ax = fig.add_axes((0, 0, 1, 0.9), projection="3d")
+    _shaded(ax, tri, color)
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    _fit_axes(ax, lo, hi)
+    ax.view_init(elev=15, azim=-90) if cutaway else ax.view_init(elev=22, azim=-60)
     size = hi - lo
-    ax.set_title(f"{title}\n{size[0]:.1f} x {size[1]:.1f} x {size[2]:.1f} mm", fontsize=9)
-    return _png(fig)
+    return _trimmed_png(fig, f"{title}\n{size[0]:.1f} x {size[1]:.1f} x {size[2]:.1f} mm")
+
+
+# -- the assembled rig (rigcad view, rigcad manual) ---------------------------------------------------
+def _cut_front(tri: np.ndarray) -> np.ndarray:
+    """Triangles (m, 3, 3) of the far half (y > 0): a cutaway that shows what a part encloses. Long
+    triangles (a flange's planar ring is triangulated in long chords) are split first, so that none
+    reaches across the cut."""
+    tri = _split_long(tri, rounds=8)
+    return tri[(tri[:, :, 1] > -1e-9).all(axis=1)]
+
+
+def _encloses(meshes) -> set[str]:
+    from rigcad.manual.view import encloses
+
+    return encloses(meshes)
+
+
+def rig_picture(meshes, rays: dict | None, title: str, elev: float = 18.0, azim: float = -118.0) -> bytes:
+    """The assembled rig: every part (``rigcad.manual.assembly.PartMesh``) in its working position,
+    the parts that enclose others (the dome) cut away in front, and ``rays`` (view.traced_rays: COP ->
+    paraboloid -> dome -> sample polylines, mm) coloured by incidence angle."""
+    cut = _encloses(meshes)
+    fig = plt.figure(figsize=(7, 8))
+    ax = fig.add_axes((0, 0, 1, 0.93), projection="3d")
+    lo = np.min([m.lo for m in meshes], axis=0)
+    hi = np.max([m.hi for m in meshes], axis=0)
+    _draw(ax, [(_cut_front(m.vertices[m.faces]) if m.name in cut else m.vertices[m.faces], m.color, 1.0)
+               for m in meshes])
+    if rays is not None and len(rays["lines"]):
+        cmap = plt.get_cmap("viridis")
+        ax.computed_zorder = False  # rays over the parts: the dome's front is cut away, so they are in view
+        for line, t in zip(rays["lines"][::3], rays["theta"][::3]):
+            ax.plot(line[:, 0], line[:, 1], line[:, 2], color=cmap(np.degrees(t) / 90.0), lw=0.6, zorder=5)
+        lo = np.minimum(lo, rays["lines"].reshape(-1, 3).min(axis=0))
+        hi = np.maximum(hi, rays["lines"].reshape(-1, 3).max(axis=0))
+    _fit_axes(ax, lo, hi)
+    ax.view_init(elev=elev, azim=azim)
+    return _trimmed_png(fig, title + ("\nfront of the dome cut away; rays coloured by incidence angle, 0 (dark) .. 90 deg (yellow)"
+                                      if rays is not None else ""))
+
+
+def assembly_step(meshes, done: list[int], new: list[int], offsets: dict, title: str, elev: float = 18.0,
+                  azim: float = -118.0) -> bytes:
+    """Exploded picture of one assembly step: the parts ``done`` (indices into ``meshes``,
+    ``rigcad.manual.assembly.PartMesh``) in place (grey), the parts ``new`` highlighted (orange)
+    moved by ``offsets`` (index -> (3,) mm), with a dashed line to where they go; enclosing parts
+    cut away in front. Parts that go in from below are seen from below."""
+    cut = _encloses(meshes)
+    fig = plt.figure(figsize=(6, 6.5))
+    ax = fig.add_axes((0, 0, 1, 0.92), projection="3d")
+    shown = [*done, *new]
+    lo = np.min([meshes[i].lo for i in shown], axis=0)
+    hi = np.max([meshes[i].hi for i in shown], axis=0)
+    groups = []
+    for i in shown:
+        m = meshes[i]
+        off = offsets.get(i, np.zeros(3)) if i in new else np.zeros(3)
+        tri = m.vertices[m.faces] + off
+        tri = _cut_front(tri) if m.name in cut and i in done else tri
+        groups.append((tri, (0.95, 0.55, 0.15) if i in new else (0.8, 0.8, 0.82), 1.0))
+        lo, hi = np.minimum(lo, m.lo + off), np.maximum(hi, m.hi + off)
+    _draw(ax, groups)
+    lift = offsets.get(new[0], np.zeros(3))
+    if np.any(lift):
+        ax.computed_zorder = False  # the path over the parts
+        for i in new:
+            c = 0.5 * (meshes[i].lo + meshes[i].hi)
+            a = c + lift
+            ax.plot([a[0], c[0]], [a[1], c[1]], [a[2], c[2]], "--", color="tab:red", lw=1.4, zorder=5)
+            ax.scatter([c[0]], [c[1]], [c[2]], color="tab:red", s=16, marker="v" if lift[2] > 0 else "^", zorder=6)
+    _fit_axes(ax, lo, hi)
+    ax.view_init(elev=-elev if lift[2] < 0 else elev, azim=azim)
+    return _trimmed_png(fig, title)
 
 
 # -- the 3D ray check (rigcad check) -----------------------------------------------------------
@@ -139,12 +296,13 @@ def spot_diagram(result) -> bytes:
     a.set_xlabel("x on the sample (um)")
     a.set_ylabel("y on the sample (um)")
     rep = result.report
-    a.set_title(f"{rep['profile']['name']}: landing points, mode {rep['mode']}")
+    a.set_title(f"{rep['profile']['name']}: landing points\nmode {rep['mode']}, theta <= 80 deg", fontsize=10)
     b.semilogy(theta, np.maximum(tr.miss[ok] * 1e3, 1e-9), ",", alpha=0.5)
     b.set_xlabel("theta (deg)")
     b.set_ylabel("distance from O to the ray (um)")
-    b.set_title("spot radius per ray")
+    b.set_title("spot radius per ray", fontsize=10)
     b.grid(True, alpha=0.3)
+    fig.tight_layout()
     return _png(fig)
 
 

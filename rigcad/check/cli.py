@@ -18,6 +18,11 @@ def cmd_check(args: argparse.Namespace) -> int:
     rig = load(args.profile)
     profile = rig.profile
     exports = Path(args.exports)
+    mirrors = exports / profile.name / "mirrors"
+    missing = [n for n in ("paraboloid", "dome") if not (mirrors / f"{n}.ply").is_file()]
+    if missing and (args.mode or profile.raycheck.mode) != "analytic":
+        print(f"note: no exported {' and '.join(missing)} mesh in {mirrors}/ (run `rigcad stl {args.profile}`): "
+              "meshing the mirrors from the profile", file=sys.stderr)
     result = run_raycheck(rig, exports=exports, rays=args.rays, mode=args.mode,
                           monte_carlo=not args.no_monte_carlo, builds=args.builds,
                           progress=lambda label: print(f"  {label} ...", file=sys.stderr) if args.verbose else None)
@@ -28,6 +33,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     print(f"  spot radius max {main['max_spot_radius_mm']:.3g} mm (rms {main['rms_spot_radius_mm']:.3g}), "
           f"angle error max {main['max_angle_error_rad'] / DEG:.3g} deg, theta {main['theta_min_deg']:.2f}.."
           f"{main['theta_max_deg']:.2f} deg, lost {main['lost_fraction']:.2%}")
+    meshed = sorted(n for n, src in (rep["meshes"] or {}).get("sources", {}).items() if not src.startswith(str(exports)))
+    if meshed and not missing:
+        print(f"  note: meshed from the profile, not the exports: {', '.join(meshed)}", file=sys.stderr)
     print(table(result.rows))
     for p in paths:
         print(f"  wrote {p}")

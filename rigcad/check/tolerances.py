@@ -70,12 +70,16 @@ def evaluate(profile, report: dict) -> list[Row]:
                         f"{tess_hint}; the {worst} mesh alone gives {parts[worst] / DEG:.3g} deg: tighten "
                         "tessellation.mirror_normal_error and mirror_chord_error"))
     th_lo, th_hi = main["theta_min_deg"], main["theta_max_deg"]
-    rows.append(Row("theta range reaches targets.theta_min", "raycheck.theta_coverage_tolerance",
-                    th_lo - tg.theta_min / DEG, rc.theta_coverage_tolerance / DEG, "<=", "deg",
-                    w("raycheck", "theta_coverage_tolerance"), f"traced theta from {th_lo:.2f} deg"))
-    rows.append(Row("theta range reaches targets.theta_max", "raycheck.theta_coverage_tolerance",
-                    tg.theta_max / DEG - th_hi, rc.theta_coverage_tolerance / DEG, "<=", "deg",
-                    w("raycheck", "theta_coverage_tolerance"), f"traced theta up to {th_hi:.2f} deg"))
+    # measured: the traced end of the range itself; limit: the target widened by the coverage tolerance
+    cov = rc.theta_coverage_tolerance / DEG
+    rows.append(Row(f"smallest theta traced (targets.theta_min {tg.theta_min / DEG:g} + {cov:g})",
+                    "raycheck.theta_coverage_tolerance", th_lo, tg.theta_min / DEG + cov, "<=", "deg",
+                    w("raycheck", "theta_coverage_tolerance"),
+                    f"traced theta from {th_lo:.2f} deg; targets.theta_min {tg.theta_min / DEG:g} deg"))
+    rows.append(Row(f"largest theta traced (targets.theta_max {tg.theta_max / DEG:g} - {cov:g})",
+                    "raycheck.theta_coverage_tolerance", th_hi, tg.theta_max / DEG - cov, ">=", "deg",
+                    w("raycheck", "theta_coverage_tolerance"),
+                    f"traced theta up to {th_hi:.2f} deg; targets.theta_max {tg.theta_max / DEG:g} deg"))
     rows.append(Row("pixels per degree (min along theta)", "raycheck.min_px_per_deg",
                     report["pixels_per_degree"]["px_per_deg_min"], rc.min_px_per_deg, ">=", "px/deg",
                     w("raycheck", "min_px_per_deg"), "projector.throw_ratio or the paraboloid's size set it"))

@@ -273,6 +273,9 @@ class CoatingParams:
     layers: tuple[tuple[str, float], ...] = spec(
         "layers", "layers bottom (on the print) to top (the mirror): [{name, thickness}]; total 5.5 mil",
         DEFAULT_COATING)
+    margin: float = spec("float", "paint to have at hand per layer, as a multiple of the film's volume on the "
+                         "mirrors (rigcad manual): spray guns land about half of what they spray (HVLP transfer "
+                         "efficiency ~50-65 %), plus a test panel", 2.5, lo=1, hi=100)
 
 
 @dataclass(frozen=True)

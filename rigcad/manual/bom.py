@@ -1,0 +1,360 @@
+"""The bill of materials, computed: printed pieces (with time and filament from the fab stage's
+report), cut templates, bolts, nuts and washers (their size and length from the flange and the
+plate), dowel pins (their count from the fab stage's split, their size from the printer), the
+purchased optics and instruments named by the profile, and the paint and clearcoat volumes (the
+mirror areas from the part recipes' mirror meridians, times each coating layer's thickness, times
+``coating.margin``).
+
+Nothing is typed in twice: a part added to ``rigcad.parts`` appears in the printed list, a mirror
+added to a recipe adds its area to the paint, a printer that splits the dome differently changes
+the pin count. Units: mm, mm^2, cm^3 (ml), g, s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigcad.errors import GeometryError
+
+# -- metric fasteners (ISO tables: the one place rigcad states them) --------------------------------
+#: ISO 273 medium-series clearance hole (mm) -> thread; with its coarse pitch (ISO 261), ISO 4032
+#: hex nut height (m max), ISO 7089 washer thickness, all mm.
+METRIC = (  # thread, clearance hole, pitch, nut height, washer thickness
+    ("M2", 2.4, 0.4, 1.6, 0.3),
+    ("M2.5", 2.9, 0.45, 2.0, 0.5),
+    ("M3", 3.4, 0.5, 2.4, 0.5),
+    ("M4", 4.5, 0.7, 3.2, 0.8),
+    ("M5", 5.5, 0.8, 4.7, 1.0),
+    ("M6", 6.6, 1.0, 5.2, 1.6),
+    ("M8", 9.0, 1.25, 6.8, 1.6),
+    ("M10", 11.0, 1.5, 8.4, 2.0),
+    ("M12", 13.5, 1.75, 10.8, 2.5),
+)
+#: ISO 4762 / ISO 4017 preferred lengths (mm) of socket-head and hex bolts.
+BOLT_LENGTHS = (5, 6, 8, 10, 12, 16, 20, 25, 30, 35, 40, 45, 50, 55, 60, 65, 70, 80, 90, 100, 110, 120, 130, 140,
+                150, 160, 180, 200)
+#: A bolt shows at least this many thread pitches beyond its nut (common practice: 1-2 pitches).
+PROTRUSION_PITCHES = 2
+#: A dowel pin is cut this much (mm) shorter than its two holes' depths together (2 x alignment_pin.depth),
+#: so that an end sitting on a hole's bottom (and its burr) never holds the cut faces apart.
+PIN_END_GAP_MM = 0.5
+
+
+def thread_for_hole(hole: float) -> tuple:
+    """The largest ISO metric thread whose medium clearance hole fits in ``hole`` mm."""
+    fits = [row for row in METRIC if row[1] <= hole + 1e-9]
+    if not fits:
+        raise GeometryError(f"a {hole:g} mm hole takes no ISO metric bolt from M2 (2.4 mm clearance) up",
+                            param="dome_shell.bolt_diameter")
+    return fits[-1]
+
+
+def bolt_length(grip: float, pitch: float, nut: float, washer: float) -> tuple[int, float]:
+    """The shortest preferred length (mm) for a bolt through ``grip`` mm of parts with a washer under
+    its head and under its nut, and PROTRUSION_PITCHES pitches beyond the nut; and the length needed."""
+    need = grip + 2 * washer + nut + PROTRUSION_PITCHES * pitch
+    for length in BOLT_LENGTHS:
+        if length >= need - 1e-9:
+            return length, need
+    raise GeometryError(f"bolts of {need:.1f} mm are longer than the longest preferred length "
+                        f"({BOLT_LENGTHS[-1]} mm): the flange and plate are too thick",
+                        param="base_plate.thickness")
+
+
+# -- mirror areas and coating ---------------------------------------------------------------------
+def revolved_area(meridian, samples: int = 20001) -> float:
+    """Area (mm^2) of the surface swept by ``meridian`` (r, z) over its parameter range, revolved a
+    full turn about z: 2 pi * integral of r ds (midpoint rule on ``samples`` points; second order:
+    1e-9 relative at the default, checked against the paraboloid's closed form)."""
+    p = meridian.points(meridian.sample(samples))
+    ds = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    r_mid = 0.5 * (p[1:, 0] + p[:-1, 0])
+    return float(2 * math.pi * np.sum(np.abs(r_mid) * ds))
+
+
+@dataclass(frozen=True)
+class CoatRow:
+    """One coating layer on one mirror: where its top lies behind the design surface (mm), the
+    area it covers (mm^2), its film volume and the volume to have at hand (cm^3 = ml)."""
+
+    layer: str
+    mirror: str
+    part: str
+    thickness_mm: float
+    top_behind_design_mm: float
+    area_mm2: float
+    film_cm3: float
+    to_buy_cm3: float
+
+
+def coating_rows(rig) -> list[CoatRow]:
+    """Every coating layer (``coating.layers``, bottom to top) on every mirror the part recipes
+    carry (``Part.mirrors``: design meridians). A layer's area is that of its own mid-surface
+    (behind the design surface by the layers above it plus half its own thickness)."""
+    layers = rig.profile.coating.layers
+    margin = rig.profile.coating.margin
+    rows = []
+    for part_name, part in rig.recipes.items():
+        for mirror, design in part.mirrors:
+            above = float(sum(t for _, t in layers))
+            for name, t in layers:
+                above -= t
+                area = revolved_area(design.behind(above + t / 2))
+                film = area * t / 1000.0
+                rows.append(CoatRow(name, mirror, part_name, t, above, area, film, film * margin))
+    return rows
+
+
+# -- the bill -------------------------------------------------------------------------------------
+#: Holes cut into a part's recipe run this far (mm) past each face it goes through (the recipes'
+#: convention, so that the boolean leaves no skin): a bolt's grip is the holes' joint span less twice it.
+HOLE_OVERSHOOT_MM = 1.0
+#: A vertical cut counts as a bolt hole (or slot) when it is at most this wide (mm) in x and y: the
+#: bore for the sample holder and the hole that passes the projector's bundle are wider.
+BOLT_HOLE_MAX_MM = 16.0
+
+
+def _holes(solid, offset=(0.0, 0.0, 0.0), cut=False):
+    """Vertical bolt holes and slots cut into a recipe: (x, y, z0, z1, width, round) per hole, mm."""
+    from rigcad.parts.recipe import Box, Cylinder, Difference, Translate, Union_
+
+    off = np.asarray(offset, float)
+    if isinstance(solid, Difference):
+        yield from _holes(solid.base, off, cut)
+        for c in solid.cuts:
+            yield from _holes(c, off, True)
+    elif isinstance(solid, Union_):
+        for c in solid.items:
+            yield from _holes(c, off, cut)
+    elif isinstance(solid, Translate):
+        yield from _holes(solid.solid, off + np.asarray(solid.offset, float), cut)
+    elif cut and isinstance(solid, Cylinder) and 2 * solid.radius <= BOLT_HOLE_MAX_MM:
+        b = np.asarray(solid.base, float) + off
+        yield (b[0], b[1], b[2], b[2] + solid.height, 2 * solid.radius, True)
+    elif cut and isinstance(solid, Box):
+        lo, hi = np.asarray(solid.lo, float) + off, np.asarray(solid.hi, float) + off
+        w = hi - lo
+        if w[0] <= BOLT_HOLE_MAX_MM and w[1] <= BOLT_HOLE_MAX_MM and w[2] < max(w[0], w[1]) * 4:
+            yield ((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2], hi[2], min(w[0], w[1]), False)
+
+
+def bolt_joints(rig) -> list[dict]:
+    """Every bolted joint of the rig outside the COP tower (whose joints the tower module computes:
+    tower_hardware), found in the recipes: vertical holes of the in-rig printed parts
+    that share an axis (x, y within 0.05 mm) and touch in z are one bolt through those parts; a round
+    hole of one part alone is a bolt into what it stands on (the bench). Grouped by (parts joined,
+    thread, length): count, grip, the bolt, its nut and washers."""
+    try:
+        from rigcad.parts.tower import TOWER_PARTS
+    except ImportError:  # pragma: no cover - a rig without the tower module
+        TOWER_PARTS = ()
+    holes = []
+    for name, part in rig.recipes.items():
+        if part.in_rig and name not in TOWER_PARTS:  # the tower's own joints: tower_hardware
+            holes += [(name, *h) for h in _holes(part.solid)]
+    axes: dict[tuple, list] = {}
+    for h in holes:
+        axes.setdefault((round(h[1] / 0.05), round(h[2] / 0.05)), []).append(h)
+    groups: dict[tuple, dict] = {}
+    for stack in axes.values():
+        stack.sort(key=lambda h: h[3])
+        runs, run = [], [stack[0]]
+        for h in stack[1:]:
+            if h[3] <= max(r[4] for r in run) + 1e-6:
+                run.append(h)
+            else:
+                runs.append(run)
+                run = [h]
+        runs.append(run)
+        for run in runs:
+            parts = tuple(sorted({h[0] for h in run}))
+            if len(parts) == 1 and not all(h[6] for h in run):
+                continue  # a slot or channel of one part alone (a clamp, the projector's slots): no bolt of its own
+            grip = max(h[4] for h in run) - min(h[3] for h in run) - 2 * HOLE_OVERSHOOT_MM
+            hole = min(h[5] for h in run)
+            key = (parts, round(grip, 3), round(hole, 3))
+            groups.setdefault(key, {"parts": parts, "grip_mm": grip, "hole_mm": hole, "count": 0})["count"] += 1
+    rows = []
+    for g in sorted(groups.values(), key=lambda g: (-len(g["parts"]), g["parts"], g["grip_mm"])):
+        thread, _, pitch, nut, washer = thread_for_hole(g["hole_mm"])
+        alone = len(g["parts"]) == 1
+        row = {**g, "thread": thread, "joins": " + ".join(g["parts"]) + (" to what it stands on" if alone else "")}
+        if alone:  # into the bench or a part's slot: the user's fixing; the grip is what a bolt passes
+            row.update(item=f"{thread} bolt, length to suit (passes {g['grip_mm']:g} mm of {g['parts'][0]})",
+                       short=f"{thread} bolts", length_mm=None, nuts=0, washers=g["count"],
+                       note="into the bench (or what the part stands on): choose its length on site")
+        else:
+            length, need = bolt_length(g["grip_mm"], pitch, nut, washer)
+            row.update(item=f"{thread} x {length} mm socket-head bolt (ISO 4762)", short=f"{thread} x {length} mm bolts",
+                       length_mm=length, nuts=g["count"], washers=2 * g["count"],
+                       note=f"needs {need:.1f} mm: {g['grip_mm']:g} mm grip + 2 washers + nut {nut:g} mm + "
+                            f"{PROTRUSION_PITCHES} pitches")
+        rows.append(row)
+    return rows
+
+
+def tower_hardware(rig) -> list[dict]:
+    """The COP tower's bolts and screws as the tower computes them (``rigcad.parts.tower.hardware``,
+    the one home of the tower's joints: bracket, shims, slots); its optics are listed with the
+    profile's instruments. Empty for a rig without a tower."""
+    if getattr(rig.layout, "tower", None) is None:
+        return []
+    from rigcad.parts.tower import hardware
+
+    return [h for h in hardware(rig.profile, rig.layout) if h.get("thread")]
+
+
+def fasteners(rig) -> list[dict]:
+    """Bolts, nuts and washers of every bolted joint (bolt_joints), then the tower's (tower_hardware)."""
+    rows = []
+    for j in bolt_joints(rig):
+        rows.append({"item": j["item"], "short": j["short"], "quantity": j["count"], "use": j["joins"],
+                     "length_mm": j["length_mm"], "note": j["note"], "thread": j["thread"]})
+    nuts: dict[str, int] = {}
+    washers: dict[str, int] = {}
+    for j in bolt_joints(rig):
+        nuts[j["thread"]] = nuts.get(j["thread"], 0) + j["nuts"]
+        washers[j["thread"]] = washers.get(j["thread"], 0) + j["washers"]
+    for thread, n in nuts.items():
+        if n:
+            nut = next(r for r in METRIC if r[0] == thread)
+            rows.append({"item": f"{thread} hex nut (ISO 4032)", "short": f"{thread} nuts", "quantity": n,
+                         "use": "one per through bolt", "length_mm": None, "note": f"{nut[3]:g} mm high"})
+    for thread, n in washers.items():
+        if n:
+            w = next(r for r in METRIC if r[0] == thread)
+            rows.append({"item": f"{thread} washer (ISO 7089)", "short": f"{thread} washers", "quantity": n,
+                         "use": "under each bolt head and nut", "length_mm": None, "note": f"{w[4]:g} mm thick"})
+    for h in tower_hardware(rig):
+        item = (f"{h['thread']} x {h['length_mm']:g} mm {h['item']}" if h.get("length_mm")
+                else f"{h['item']} ({h['thread']})")
+        rows.append({"item": item, "short": item, "quantity": h["quantity"],
+                     "use": h["joins"], "length_mm": h.get("length_mm"), "note": "COP tower (parts.tower.hardware)",
+                     "thread": h["thread"], "tower": True})
+    return rows
+
+
+def dowel_pins(fab_report: dict, printer) -> dict | None:
+    """The dowel pins the split pieces need: count (pins per part x the part's quantity), diameter and
+    cut length from the printer's alignment_pin; None when no part is split."""
+    count = sum(len(e.get("pins", [])) * e.get("quantity", 1) for e in fab_report["parts"].values())
+    if not count:
+        return None
+    pin = printer.alignment_pin
+    length = 2 * pin.depth - PIN_END_GAP_MM
+    per_part = {n: len(e["pins"]) * e.get("quantity", 1) for n, e in fab_report["parts"].items() if e.get("pins")}
+    filament = math.isclose(pin.diameter, getattr(printer, "filament_diameter", float("nan")) or float("nan"))
+    return {"item": f"dowel pin {pin.diameter:g} mm x {length:g} mm", "quantity": count,
+            "diameter_mm": pin.diameter, "length_mm": length, "per_part": per_part,
+            "use": ", ".join(f"{n}: {k}" for n, k in per_part.items()),
+            "note": (f"holes {pin.diameter + pin.clearance:g} mm x {pin.depth:g} mm deep into each piece "
+                     f"(alignment_pin in {printer.source})"
+                     + ("; cut from the printer's own filament" if filament else ""))}
+
+
+def _hms(seconds: float) -> str:
+    s = int(round(seconds))
+    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
+
+
+def printed(rig, fab_report: dict) -> list[dict]:
+    """One row per part of the fab report: printed pieces with time and material (the slicer's when
+    G-code was made, else rigcad's estimate), or the plate a template is cut from."""
+    rows = []
+    for name, e in fab_report["parts"].items():
+        part = rig.recipes.get(name)
+        use = "rig" if part is not None and part.in_rig else "tool"
+        if "error" in e:
+            rows.append({"part": name, "use": use, "quantity": None, "process": "not printable", "note": e["error"]})
+            continue
+        if "pieces" not in e:
+            rows.append({"part": name, "use": use, "quantity": e["quantity"], "process": e["process"],
+                         "pieces": 0, "time_s": None, "material_g": None, "source": None,
+                         "note": f"{e['plate_thickness_mm']:g} mm plate, outline {e['outline_size_mm'][0]:.1f} x "
+                                 f"{e['outline_size_mm'][1]:.1f} mm (fab outlines/{name}.dxf, .svg)"})
+            continue
+        pcs = e["pieces"]
+        sliced = all("gcode" in pc and pc["gcode"].get("estimates", {}).get("print_time_s") for pc in pcs)
+        t = sum(pc["gcode"]["estimates"]["print_time_s"] if sliced else pc["estimate"]["print_time_s"] for pc in pcs)
+        g = sum((pc["gcode"]["estimates"].get("filament_g") or pc["estimate"]["material_g"]) if sliced
+                else pc["estimate"]["material_g"] for pc in pcs)
+        q = e["quantity"]
+        rows.append({"part": name, "use": use, "quantity": q, "process": e["process"], "pieces": len(pcs),
+                     "time_s": t * q, "material_g": g * q, "source": "slicer" if sliced else "rigcad estimate",
+                     "note": ", ".join(sorted({pc["orientation"] for pc in pcs}))})
+    return rows
+
+
+def purchased(rig) -> list[dict]:
+    """Optics and instruments the profile names (its projector and camera; with the COP tower, the
+    beam splitter and the lens): one row each, every figure from the profile."""
+    p = rig.profile
+    rows = []
+    for section in ("projector", "camera", "beam_splitter", "splitter", "lens"):
+        obj = getattr(p, section, None)
+        if obj is None:
+            continue
+        rows.append({"item": section.replace("_", " "), "quantity": 1,
+                     "spec": _describe(obj), "source": p.where(section, _first_field(obj)) or "default"})
+    return rows
+
+
+def _first_field(obj) -> str:
+    from dataclasses import fields
+
+    return fields(obj)[0].name
+
+
+def _describe(obj) -> str:
+    """A one-line description of a profile section: every field with its unit."""
+    from dataclasses import fields
+
+    from rigcad.units import DEG
+
+    out = []
+    for f in fields(obj):
+        spec = f.metadata.get("spec")
+        v = getattr(obj, f.name)
+        if v is None:
+            continue
+        kind = getattr(spec, "kind", "")
+        if kind == "length":
+            text = f"{v:.4g} mm"
+        elif kind == "angle":
+            text = f"{v / DEG:.4g} deg"
+        elif kind == "pixels":
+            text = f"{v[0]} x {v[1]} px"
+        else:
+            text = str(list(v) if isinstance(v, tuple) else v)
+        assumed = "assumed" in (getattr(spec, "doc", "") or "").lower()
+        out.append(f"{f.name.replace('_', ' ')} {text}" + (" (assumed)" if assumed else ""))
+    return "; ".join(out)
+
+
+def bill(rig, fab_report: dict, printer) -> dict:
+    """Every list of the bill, for the manual (units in the keys)."""
+    coats = coating_rows(rig)
+    layers: dict[str, dict] = {}
+    for c in coats:
+        row = layers.setdefault(c.layer, {"layer": c.layer, "thickness_mm": c.thickness_mm, "film_cm3": 0.0,
+                                          "to_buy_cm3": 0.0, "area_mm2": 0.0})
+        row["film_cm3"] += c.film_cm3
+        row["to_buy_cm3"] += c.to_buy_cm3
+        row["area_mm2"] += c.area_mm2
+    mirrors = {}
+    for c in coats:
+        mirrors.setdefault(c.mirror, {"mirror": c.mirror, "part": c.part, "design_area_mm2": None})
+    for part in rig.recipes.values():
+        for mirror, design in part.mirrors:
+            mirrors[mirror]["design_area_mm2"] = revolved_area(design)
+    return {"printed": printed(rig, fab_report), "fasteners": fasteners(rig), "pins": dowel_pins(fab_report, printer),
+            "purchased": purchased(rig), "coating": list(layers.values()), "coating_by_mirror": [c.__dict__ for c in coats],
+            "mirrors": list(mirrors.values()), "coating_margin": rig.profile.coating.margin,
+            "totals": fab_report.get("totals", {})}
+
+
+__all__ = ["bill", "bolt_joints", "bolt_length", "coating_rows", "dowel_pins", "fasteners", "printed", "purchased",
+           "revolved_area", "thread_for_hole", "tower_hardware"]

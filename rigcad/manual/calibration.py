@@ -1,0 +1,97 @@
+"""Calibration as thesis 4.1.1 does it, with the figures rigcad can compute for it.
+
+- The projector's circle image: a bright disc at the projector's resolution whose edge is the
+  paraboloid's rim as the design map sees it (pixel radius = focal length in px x tan of the rim
+  ray's angle at the COP; image centre on the optical axis), so that "the projected circle matches
+  the circumference of the parabola base". Frame of the image: as rigcad.check.sources.pixel_grid
+  (pixel centre x = column + 0.5 - width / 2, y = height / 2 - row - 0.5).
+- What the film over the dome's base shows: the reflected light converges to the sample point O;
+  light projected past the rim (a circle too large) falls straight onto the film outside the
+  paraboloid's shadow, whose radius is computed here, and the beam's shadow strip with it.
+- The projector crosses (on their mounting plate) and the backplate: aligned, both shadows are
+  centred on the backplate at the axis height; a projector off the crosses' line by d mm separates
+  the two shadows by d x (X / a - b / (s + a)) (a: projector to near cross, s: cross spacing,
+  b: far cross to backplate, X = s + b), tabulated for a few distances a.
+- The camera crosses (hung at the paraboloid's vertex, on the base at z = 0): a camera off the axis
+  by d mm sees them apart by d x (1 / (cop_z - z_vertex) - 1 / cop_z) rad.
+
+Lengths mm, angles rad inside; figures written with their unit in the key.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+
+import numpy as np
+
+from rigcad.errors import GeometryError
+
+#: Distances (mm) from the projector's COP to the near cross for the shadow table: the bench set-up
+#: is the user's; these span a projector a hand's width to an arm's length from the first cross.
+PROJECTOR_DISTANCES_MM = (150.0, 300.0, 600.0)
+
+
+def circle_image(rig) -> tuple[bytes, dict]:
+    """The calibration circle at the projector's resolution (8-bit grey PNG: 255 inside the rim's
+    pixel radius, 0 outside; pixel centres tested) and its figures."""
+    from PIL import Image
+
+    if rig.geometry.cop_at_infinity:
+        raise GeometryError("the calibration circle needs a finite COP (layout.cop_to_vertex)",
+                            param="layout.cop_to_vertex")
+    design = rig.incidence
+    width, height = rig.profile.projector.resolution
+    radius = float(design.pixel_radius(np.array([design.alpha_max]))[0])
+    x = np.arange(width) + 0.5 - width / 2
+    y = height / 2 - np.arange(height) - 0.5
+    inside = x[None, :] ** 2 + y[:, None] ** 2 <= radius ** 2
+    if radius > min(width, height) / 2:
+        raise GeometryError(f"the paraboloid's rim is {radius:.1f} px from the image centre, outside the "
+                            f"{width} x {height} px projector image", param="projector.throw_ratio")
+    buf = io.BytesIO()
+    Image.fromarray(np.where(inside, 255, 0).astype(np.uint8), mode="L").save(buf, format="PNG")
+    info = {"resolution_px": [width, height], "centre_px_from_top_left": [width / 2, height / 2],
+            "radius_px": radius, "lit_pixels": int(inside.sum()),
+            "rim_angle_at_cop_deg": math.degrees(design.alpha_max),
+            "occlusion_radius_px": float(design.pixel_radius(np.array([design.alpha_min]))[0])}
+    return buf.getvalue(), info
+
+
+def film_shadows(rig) -> dict:
+    """What the projector throws straight onto the film at z = 0 past the paraboloid (mm): the
+    paraboloid rim's shadow radius and the beam's shadow half-width (their images from the COP)."""
+    g = rig.geometry
+    zc = g.cop_z
+    beam_top = rig.layout.beam_z[1]
+    w = rig.profile.beam.width
+    return {"paraboloid_shadow_radius_mm": g.rim_radius * zc / (zc - g.rim_z),
+            "beam_shadow_half_width_mm": (w / 2) * zc / (zc - beam_top),
+            "cop_z_mm": zc, "rim_z_mm": g.rim_z, "rim_radius_mm": g.rim_radius, "beam_top_z_mm": beam_top}
+
+
+def projector_shadows(rig, distances=PROJECTOR_DISTANCES_MM) -> dict:
+    """The projector crosses' shadows on the backplate, aligned and per mm of projector offset."""
+    c = rig.profile.crosses
+    s, b, L = c.projector_spacing, c.backplate_distance, c.arm_length
+    X = s + b
+    rows = []
+    for a in distances:
+        rows.append({"projector_to_near_cross_mm": a,
+                     "near_shadow_arm_mm": L * (X + a) / a, "far_shadow_arm_mm": L * (X + a) / (s + a),
+                     "separation_per_mm_offset": X / a - b / (s + a)})
+    return {"axis_height_mm": c.projector_axis_height, "spacing_mm": s, "backplate_distance_mm": b,
+            "arm_length_mm": L, "rows": rows}
+
+
+def camera_crosses(rig) -> dict:
+    """The camera crosses: heights and their angular separation per mm of camera offset."""
+    g = rig.geometry
+    per_mm = 1.0 / (g.cop_z - g.vertex_z) - 1.0 / g.cop_z
+    return {"hung_cross_z_mm": g.vertex_z, "base_cross_z_mm": 0.0, "cop_z_mm": g.cop_z,
+            "separation_mrad_per_mm_offset": 1e3 * per_mm,
+            "hung_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / (g.cop_z - g.vertex_z),
+            "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
+
+
+__all__ = ["camera_crosses", "circle_image", "film_shadows", "projector_shadows"]

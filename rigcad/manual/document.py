@@ -1,0 +1,446 @@
+"""``rigcad manual PROFILE --printer NAME``: the assembly and calibration manual of one rig for one
+printer, written to ``exports/<profile>/manual/<printer>/``:
+
+- ``manual.md`` with its pictures in ``images/`` (assembled rig, one exploded view per assembly
+  step, the calibration tools) and ``calibration/circle.png`` (the projector's calibration image at
+  its resolution);
+- ``manual.html``: the same document as one printable, self-contained page (pictures inline);
+- ``manual.json``: every computed figure of the bill and the calibration, units in the keys.
+
+The document is built once as a list of blocks and written twice (Markdown, HTML), so the two never
+differ. Its figures come from the Rig (recipes, layout, design map), the printer and the fab stage's
+report (run here for that printer: ``rigcad.fab``), never typed in.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import re
+import sys
+from pathlib import Path
+
+from rigcad import __version__
+from rigcad.manual import bom as B
+from rigcad.manual import calibration as C
+
+MIL = 0.0254  # mm
+
+# -- a small document model ---------------------------------------------------------------------
+
+
+class Doc:
+    """Blocks: ("h", level, text), ("p", text), ("ul", [text]), ("ol", [text]), ("table", header,
+    rows), ("img", relative path, caption). Inline: `code` and **bold**."""
+
+    def __init__(self) -> None:
+        self.blocks: list[tuple] = []
+
+    def h(self, level: int, text: str) -> None:
+        self.blocks.append(("h", level, text))
+
+    def p(self, text: str) -> None:
+        self.blocks.append(("p", text))
+
+    def ul(self, items) -> None:
+        self.blocks.append(("ul", list(items)))
+
+    def ol(self, items) -> None:
+        self.blocks.append(("ol", list(items)))
+
+    def table(self, header, rows) -> None:
+        self.blocks.append(("table", list(header), [list(r) for r in rows]))
+
+    def img(self, path: str, caption: str) -> None:
+        self.blocks.append(("img", path, caption))
+
+    def markdown(self) -> str:
+        out = []
+        for b in self.blocks:
+            kind = b[0]
+            if kind == "h":
+                out.append("#" * b[1] + " " + b[2])
+            elif kind == "p":
+                out.append(b[1])
+            elif kind in ("ul", "ol"):
+                out.append("\n".join((f"{i + 1}. " if kind == "ol" else "- ") + t for i, t in enumerate(b[1])))
+            elif kind == "table":
+                out.append("\n".join(["| " + " | ".join(b[1]) + " |", "|" + "---|" * len(b[1])]
+                                     + ["| " + " | ".join(str(c) for c in r) + " |" for r in b[2]]))
+            elif kind == "img":
+                out.append(f"![{b[2]}]({b[1]})\n\n*{b[2]}*")
+            out.append("")
+        return "\n".join(out)
+
+    def html(self, title: str, images: dict[str, bytes]) -> str:
+        """One page: the pictures inline as data: URIs (``images``: relative path -> PNG bytes)."""
+        body = []
+        for b in self.blocks:
+            kind = b[0]
+            if kind == "h":
+                body.append(f"<h{b[1]}>{_inline(b[2])}</h{b[1]}>")
+            elif kind == "p":
+                body.append(f"<p>{_inline(b[1])}</p>")
+            elif kind in ("ul", "ol"):
+                tag = "ol" if kind == "ol" else "ul"
+                body.append(f"<{tag}>" + "".join(f"<li>{_inline(t)}</li>" for t in b[1]) + f"</{tag}>")
+            elif kind == "table":
+                head = "".join(f"<th>{_inline(c)}</th>" for c in b[1])
+                rows = "".join("<tr>" + "".join(f"<td>{_inline(str(c))}</td>" for c in r) + "</tr>" for r in b[2])
+                body.append(f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>")
+            elif kind == "img":
+                data = base64.b64encode(images[b[1]]).decode("ascii")
+                body.append(f'<figure><img src="data:image/png;base64,{data}" alt="{html.escape(b[2])}">'
+                            f"<figcaption>{_inline(b[2])}</figcaption></figure>")
+        return _HTML.replace("@@TITLE@@", html.escape(title)).replace("@@BODY@@", "\n".join(body))
+
+
+def _inline(text: str) -> str:
+    t = html.escape(text, quote=False)
+    t = re.sub(r"`([^`]+)`", r"<code>\1</code>", t)
+    return re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", t)
+
+
+_HTML = """<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<title>@@TITLE@@</title>
+<meta http-equiv="Content-Security-Policy" content="default-src 'none'; style-src 'unsafe-inline'; img-src data:">
+<style>
+  body { font: 11pt/1.45 sans-serif; max-width: 190mm; margin: 12mm auto; color: #111; }
+  h1 { font-size: 18pt; } h2 { font-size: 14pt; border-bottom: 1px solid #999; margin-top: 1.6em; }
+  h3 { font-size: 12pt; }
+  table { border-collapse: collapse; margin: 0.6em 0; font-size: 9.5pt; }
+  th, td { border: 1px solid #bbb; padding: 2px 6px; vertical-align: top; text-align: left; }
+  th { background: #eee; }
+  code { font-size: 9.5pt; background: #f3f3f3; padding: 0 2px; }
+  figure { margin: 0.8em 0; text-align: center; page-break-inside: avoid; }
+  figure img { max-width: 100%; max-height: 150mm; }
+  figcaption { font-size: 9pt; color: #444; }
+  @media print { body { margin: 0; max-width: none; } h2 { page-break-before: always; }
+                 h2:first-of-type { page-break-before: avoid; } tr { page-break-inside: avoid; } }
+</style>
+</head>
+<body>
+@@BODY@@
+</body>
+</html>
+"""
+
+# -- the manual -------------------------------------------------------------------------------------
+
+#: What to do at each assembly step, for the parts the thesis's rig has; a part without an entry is
+#: placed as its recipe's description says.
+STEP_TEXT = {
+    "base_plate": "Lay the base plate on the bench, its top face up: that face is the sample plane z = 0.",
+    "sample_holder": "Slide the sample holder into the plate's bore from below until its collar stops against "
+                     "the plate; with a sample of `sample_holder.sample_thickness` its top is on z = 0.",
+    "beam": "With the dome off the plate, pass the beam through the dome's two wall slots so that it rests on "
+            "the slots' floors and overhangs the wall equally at both ends (drawn here in place, without the "
+            "dome).",
+    "paraboloid": "Reach in through the dome's open base and push the paraboloid's U clamp onto the middle of "
+                  "the beam, mirror up; the stem centres it over the sample point.",
+    "dome": "Lower the dome, with the beam and the paraboloid in it, onto the base plate: flange holes over the "
+            "plate's holes.",
+    "tower_column": "Stand the tower's column on the bench beside the base plate (the bench is level with the "
+                    "sample holder's stop collar).",
+    "tower_shelf": "Lay the shelf on the column's top flange, its end with the bundle hole over the optical axis.",
+    "projector_shims_1": "Put a stack of the printed `tower_shim`s on each of the projector's four slots in the "
+                         "shelf (the nominal stack; add or remove shims to set the projector's height).",
+    "projector_body": "Stand the projector on its shim stacks, its lens towards the beam splitter (looking -x), and "
+                      "screw it down through the shelf's slots, finger tight until the calibration.",
+    "camera_shims": "Put the camera's shim stack against the bracket (more or fewer shims move the camera across "
+                    "the axis in y).",
+    "camera_body": "Screw the camera to the bracket above the beam splitter through its slot, looking down the "
+                   "optical axis.",
+    "beam_splitter": "Slide the plate beam splitter into the holder's 45 deg grooves through the +y wall, coated "
+                     "face towards the projector (+x) and down. Handle it by its edges.",
+    "focusing_lens": "Drop the focusing lens into the lens mount's square pocket.",
+}
+
+
+def _mil(mm: float) -> str:
+    return f"{mm / MIL:.3g} mil"
+
+
+def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, dict[str, bytes], dict]:
+    """The document, its files (relative path -> bytes: pictures and the calibration image) and the
+    figures (for manual.json)."""
+    from rigcad import plots
+    from rigcad.export import mesh as M
+    from rigcad.manual import assembly as A
+    from rigcad.manual.assembly import VIEW_CHORD_ERROR_MM, rig_meshes
+    from rigcad.manual.view import traced_rays
+    from rigcad.parts.templates import gauged_depth
+
+    step = progress or (lambda label: None)
+    p = rig.profile
+    bill = B.bill(rig, fab_report, printer)
+    files: dict[str, bytes] = {}
+    meshes = rig_meshes(rig)
+    files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig")
+    step("rig picture")
+
+    d = Doc()
+    d.h(1, f"{rig.name}: assembly and calibration manual ({printer.name})")
+    d.p(f"The rig of profile `{rig.name}` ({' <- '.join(p.sources)}), printed on **{printer.description}** "
+        f"(`{printer.source}`). Every figure below is computed by rigcad {__version__} from the profile, the "
+        f"part recipes and the printer; the print files are in `fab/{printer.name}/` beside this folder, the "
+        "parts (STEP, STL) in `step/` and `stl/`, the 3D view in `view/rig.html` (`rigcad view`).")
+    d.img("images/rig.png", "The assembled rig (front of the dome cut away) with rays traced from the centre of "
+                            "projection, coloured by their incidence angle at the sample")
+
+    # -- 1 bill of materials
+    d.h(2, "1. Bill of materials")
+    d.h(3, "Printed and cut parts")
+    rows = []
+    for r in bill["printed"]:
+        if r.get("time_s") is None:
+            rows.append([f"`{r['part']}`", r["use"], r["quantity"] or "-", "cut" if r["quantity"] else "-",
+                         r["process"], "-", "-", r["note"]])
+        else:
+            rows.append([f"`{r['part']}`", r["use"], r["quantity"], r["pieces"], r["process"], B._hms(r["time_s"]),
+                         f"{r['material_g']:.0f} g", f"{r['note']} ({r['source']})"])
+    d.table(["part", "use", "qty", "pieces", "process", "print time (with qty)", "material", "orientation"], rows)
+    timed = [r for r in bill["printed"] if r.get("time_s") is not None]
+    total_t = sum(r["time_s"] for r in timed)
+    total_g = sum(r["material_g"] for r in timed)
+    pieces = sum(r["pieces"] * r["quantity"] for r in timed)
+    d.p(f"In all: **{pieces} printed pieces, {B._hms(total_t)} of printing and {total_g:.0f} g of "
+        f"{printer.material}**" + ("" if all(r["source"] == "slicer" for r in timed) else
+                                   " (rigcad's estimate where no G-code was sliced"
+                                   + (": `rigcad manual ... --gcode` uses PrusaSlicer's own figures)"
+                                      if printer.slicer == "prusa-slicer" else ")")) + ".")
+    d.h(3, "Hardware")
+    hw = [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"]]
+    if bill["pins"]:
+        pin = bill["pins"]
+        hw.append([pin["item"], pin["quantity"], f"aligning split pieces ({pin['use']})", pin["note"]])
+    d.table(["item", "qty", "where", "note"], hw)
+    if not bill["pins"]:
+        d.p(f"No part is split on {printer.name}: no dowel pins.")
+    d.h(3, "Optics and instruments")
+    if bill["purchased"]:
+        d.table(["item", "qty", "as the profile gives it", "set in"],
+                [[r["item"], r["quantity"], r["spec"], f"`{r['source']}`"] for r in bill["purchased"]])
+    d.h(3, "Paint and clearcoat")
+    d.p(f"Volumes of each layer of `coating.layers` over the mirrors ({', '.join(m['mirror'] for m in bill['mirrors'])}: "
+        + ", ".join(f"{m['design_area_mm2'] / 100:.1f} cm²" for m in bill["mirrors"])
+        + f" of design surface), as dry film; 'to have at hand' is `coating.margin` = {bill['coating_margin']:g} "
+          "times that.")
+    d.table(["layer (bottom to top)", "thickness", "area covered", "film", "to have at hand"],
+            [[c["layer"], f"{_mil(c['thickness_mm'])} ({c['thickness_mm']:.4f} mm)", f"{c['area_mm2'] / 100:.1f} cm²",
+              f"{c['film_cm3']:.2f} ml", f"**{c['to_buy_cm3']:.1f} ml**"] for c in bill["coating"]])
+
+    # -- 2 print
+    d.h(2, "2. Print")
+    items = []
+    for name, e in fab_report["parts"].items():
+        if "pieces" in e:
+            names = ", ".join(f"`{pc['name']}`" for pc in e["pieces"])
+            support = any(pc["needs_support"] for pc in e["pieces"])
+            items.append(f"`{name}` x{e['quantity']}: {len(e['pieces'])} piece(s) {names}, printed "
+                         f"{', '.join(sorted({pc['orientation'] for pc in e['pieces']}))}"
+                         + ("; needs support" if support else "")
+                         + (f"; {len(e['pins'])} pin holes" if e.get("pins") else ""))
+        elif "error" not in e:
+            items.append(f"`{name}`: cut from a {e['plate_thickness_mm']:g} mm plate (`outlines/{name}.dxf`, `.svg`)")
+        else:
+            items.append(f"`{name}`: **not printable on {printer.name}**: {e['error']}")
+    d.p(f"Print files: `fab/{printer.name}/stl/` (each piece in its print orientation)"
+        + (f", G-code in `fab/{printer.name}/gcode/`" if fab_report["gcode"].get("requested") else "")
+        + f"; `fab/{printer.name}/fab.md` has the staircase maps.")
+    d.ul(items)
+    if bill["pins"]:
+        d.p(f"Split pieces: cut {bill['pins']['quantity']} pins of {bill['pins']['length_mm']:g} mm from "
+            f"{bill['pins']['diameter_mm']:g} mm rod (or filament), push them into one piece's holes, join the "
+            "next piece on them and glue the cut faces.")
+
+    # -- 3 sand
+    gd = gauged_depth(p)
+    total = float(sum(t for _, t in p.coating.layers))
+    gauged = p.templates.gauged_layer
+    d.h(2, "3. Sand the mirrors to the template")
+    sand = []
+    for name, e in fab_report["parts"].items():
+        if "polishing" in e:
+            sand.append(f"`{name}`: sand away the print's staircase, {e['polishing']['sanding_depth_mm']:.3f} mm "
+                        "deep at most (the steps' height; the mirror was printed forward by "
+                        f"{e['polishing']['stock_to_add_mm']:.3f} mm of stock, so sanding stops before the design)")
+    d.ul(sand)
+    d.p(f"The templates (`dome_template`, `paraboloid_template`, cut from plate) carry the surface of the "
+        f"**{gauged}** layer. Sanded to size, the bare print lies {total - gd:.3f} mm ({_mil(total - gd)}: the layers "
+        f"up to and including the {gauged}) behind the template's edge all along it: check with a feeler gauge "
+        "or against the light, in several meridional planes.")
+    for name in ("dome_template", "paraboloid_template"):
+        if name in rig.recipes:
+            part = rig.recipes[name]
+            v, f = M.mesh_arrays(M.build(part.solid, VIEW_CHORD_ERROR_MM))
+            files[f"images/{name}.png"] = plots.render_mesh(v, f, name, part.color)
+    for name in ("dome_template", "paraboloid_template"):
+        if f"images/{name}.png" in files:
+            d.img(f"images/{name}.png", f"`{name}`: {rig.recipes[name].description}")
+
+    # -- 4 coat
+    d.h(2, "4. Coat, layer by layer, checking with the template")
+    layers = p.coating.layers
+    rows, cum = [], 0.0
+    by_layer = {c["layer"]: c for c in bill["coating"]}
+    for k, (name, t) in enumerate(layers):
+        cum += t
+        gap = (total - gd) - cum  # template edge to the coat's top (mm): positive = a gap under the template
+        if abs(gap) < 1e-9:
+            check = "**flush**: polish until the template fits along its whole edge"
+        elif gap > 0:
+            check = f"a gap of {gap:.3f} mm ({_mil(gap)}) under the template"
+        else:
+            check = f"past the gauged layer: the template stands {-gap:.3f} mm ({_mil(-gap)}) proud; do not force it"
+        rows.append([k + 1, name, f"{_mil(t)}", f"{_mil(cum)}", check, f"{by_layer[name]['to_buy_cm3']:.1f} ml"])
+    d.table(["#", "layer", "thickness", "total so far", "template check after this layer", "paint at hand"], rows)
+    d.p(f"The finished surface is the design surface: the prints sit {total:.4f} mm ({_mil(total)}) behind it "
+        "(`coating.layers`), the dome outwards, the paraboloid inwards.")
+    step("bill and steps")
+
+    # -- 5 assemble
+    d.h(2, "5. Assemble")
+    d.p("Each step shows what is already in place (grey) and what goes in (orange), drawn clear of it with "
+        "a dashed line to its place. Bought items (instruments, optics) are marked so.")
+    joints = B.bolt_joints(rig)
+    tower_rows = B.tower_hardware(rig)
+    order = [meshes[i].name for st in A.steps(meshes) for i in st]
+
+    def keys(name: str) -> set[str]:
+        words = name.replace("tower_", "").replace("_body", "").replace("_", " ")
+        return {name.replace("_", " "), words}
+
+    # each tower item goes with the last step (in assembly order) whose part its "joins" text names
+    tower_at = {}
+    for h in tower_rows:
+        named = [n for n in order if any(re.search(rf"\b{re.escape(k)}'?s?\b", h["joins"]) for k in keys(n))]
+        if named:
+            tower_at.setdefault(named[-1], []).append(h)
+    done: list[int] = []
+    for k, members in enumerate(A.steps(meshes)):
+        first = meshes[members[0]]
+        label = first.name if len(members) == 1 else re.sub(r"_\d+$", "", first.name) + f" (x{len(members)})"
+        text = STEP_TEXT.get(first.name)
+        if text is None:
+            text = (f"Place the {label.replace('_', ' ')}" + (" (bought)" if first.bought else "")
+                    + f": {first.description}.")
+        for j in joints:
+            if first.name in j["parts"] and all(n in [meshes[i].name for i in done + members] for n in j["parts"]):
+                text += (f" Bolt it ({j['joins']}) with {j['count']} {j['short']}"
+                         + (", a washer under each head and each nut; tighten crosswise, by hand." if j["nuts"]
+                            else " into what it stands on."))
+        for h in tower_at.get(first.name, []):
+            size = f"{h['thread']} x {h['length_mm']:g} mm" if h.get("length_mm") else h["thread"]
+            text += f" Fix it with {h['quantity']} x {h['item']} ({size}): {h['joins']}."
+        d.h(3, f"Step {k + 1}: {label}" + (f" (x{first.quantity})" if first.quantity > 1 else ""))
+        d.p(text)
+        path = f"images/step_{k + 1:02d}_{re.sub(r'_[0-9]+$', '', first.name)}.png"
+        files[path] = plots.assembly_step(meshes, done, members, A.step_offsets(meshes, done, members),
+                                          f"step {k + 1}: {label}")
+        d.img(path, f"Step {k + 1}: the {label.replace('_', ' ')} (orange) goes where the dashed line points")
+        done += members
+        step(f"step {k + 1}")
+
+    # -- 6 calibrate
+    circle, info = C.circle_image(rig)
+    files["calibration/circle.png"] = circle
+    film = C.film_shadows(rig)
+    pshadow = C.projector_shadows(rig)
+    cam = C.camera_crosses(rig)
+    d.h(2, "6. Calibrate (thesis 4.1.1)")
+    d.h(3, "Projector: the crosses and the backplate")
+    d.p(f"Stand the two `projector_cross`es and the `projector_backplate` in the fences of the "
+        f"`projector_mounting_plate`: the crosses' centres are {pshadow['axis_height_mm']:g} mm above the plate "
+        f"(the projector's axis height, `crosses.projector_axis_height`), {pshadow['spacing_mm']:g} mm apart, the "
+        f"backplate {pshadow['backplate_distance_mm']:g} mm behind the far cross. Project a white image and move the "
+        "projector until the two shadows coincide, centred on the backplate at the axis height. A projector off "
+        "the crosses' line by 1 mm separates the two shadows by:")
+    d.table(["projector to near cross", "near cross's shadow arm", "far cross's shadow arm", "shadows apart per mm of offset"],
+            [[f"{r['projector_to_near_cross_mm']:g} mm", f"{r['near_shadow_arm_mm']:.1f} mm",
+              f"{r['far_shadow_arm_mm']:.1f} mm", f"{r['separation_per_mm_offset']:.2f} mm"] for r in pshadow["rows"]])
+    d.p(f"(Arms of {pshadow['arm_length_mm']:g} mm, `crosses.arm_length`; the closer the projector, the finer the "
+        f"check. The profile allows `tolerancing.projector_offset` = {p.tolerancing.projector_offset:g} mm.)")
+    d.h(3, "Projector: the circle on the paraboloid")
+    d.p(f"Project `calibration/circle.png` ({info['resolution_px'][0]} x {info['resolution_px'][1]} px, the "
+        f"projector's resolution): a bright disc of radius **{info['radius_px']:.1f} px** centred on pixel "
+        f"({info['centre_px_from_top_left'][0]:g}, {info['centre_px_from_top_left'][1]:g}) from the top left, the "
+        f"paraboloid's rim as the design maps it (the rim ray leaves the COP at {info['rim_angle_at_cop_deg']:.3f} "
+        f"deg from the axis). Cover the dome's base with a semitransparent film marked at the sample point O. "
+        "With the projector placed as designed the reflected light converges to the mark; move the circle in the "
+        "image until the spot is symmetric about the mark, then adjust its radius until the light converges to a "
+        f"point. A circle larger than the rim throws direct light onto the film around the paraboloid's shadow, "
+        f"a disc of **{film['paraboloid_shadow_radius_mm']:.1f} mm** radius about O, crossed by the beam's shadow, "
+        f"a strip **{2 * film['beam_shadow_half_width_mm']:.1f} mm** wide. The directions below "
+        f"{info['occlusion_radius_px']:.1f} px from the centre are hidden by the paraboloid itself (occlusion limit).")
+    d.img("calibration/circle.png", f"calibration/circle.png: the calibration image, {info['resolution_px'][0]} x "
+                                    f"{info['resolution_px'][1]} px, shown at page width")
+    d.h(3, "Camera: the two crosses")
+    d.p(f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
+        f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm) and put the `camera_cross_base` in the sample holder's place "
+        f"(its top on z = 0). From the COP (z = {cam['cop_z_mm']:.1f} mm) the hung cross's arms span "
+        f"{cam['hung_cross_arm_mrad']:.1f} mrad and the base cross's {cam['base_cross_arm_mrad']:.1f} mrad. Move the "
+        "camera until the two overlap symmetrically in its image, then focus on the hung cross. A camera off the "
+        f"axis by 1 mm shows them {cam['separation_mrad_per_mm_offset']:.2f} mrad apart "
+        f"(`tolerancing.camera_offset` = {p.tolerancing.camera_offset:g} mm).")
+    for name in ("projector_cross", "camera_cross_hung"):
+        if name in rig.recipes:
+            part = rig.recipes[name]
+            v, f = M.mesh_arrays(M.build(part.solid, VIEW_CHORD_ERROR_MM))
+            files[f"images/{name}.png"] = plots.render_mesh(v, f, name, part.color)
+            d.img(f"images/{name}.png", f"`{name}`: {part.description}")
+    d.p("Then the camera's pixel-to-paraboloid correspondence as in the thesis: a checkerboard on the base "
+        "plate, the calibrated circle projected, and the paraboloid's image located in the camera's picture.")
+    step("calibration")
+    figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
+               "bill": bill, "calibration": {"circle": info, "film": film, "projector_crosses": pshadow,
+                                             "camera_crosses": cam},
+               "coating_gauged_layer": gauged, "coating_total_mm": total,
+               "assembly_order": [m.name for m in meshes]}
+    return d, files, figures
+
+
+def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = None, progress=None) -> list[Path]:
+    """Write the manual's folder ``out`` (all files published together; see the module docstring)."""
+    from rigcad.export.atomic import Staging, json_bytes
+
+    doc, files, figures = build_manual(rig, printer, fab_report, progress)
+    title = f"{rig.name}: assembly and calibration manual ({printer.name})"
+    page = doc.html(title, files).encode("utf-8")
+    with Staging(out, lock, carry=lambda rel: False) as stage:
+        for rel, data in sorted(files.items()):
+            stage.write_bytes(out / rel, data)
+        stage.write_bytes(out / "manual.md", doc.markdown().encode("utf-8"))
+        stage.write_bytes(out / "manual.html", page)
+        stage.write_bytes(out / "manual.json", json_bytes(figures))
+        return stage.commit()
+
+
+def cmd_manual(args) -> int:
+    from rigcad.cli import _progress
+    from rigcad.export.atomic import profile_lock
+    from rigcad.fab.printers import load_printer
+    from rigcad.fab.stage import run_fab
+    from rigcad.rig import load
+
+    rig = load(args.profile)
+    printer = load_printer(args.printer)
+    root = Path(args.exports) / rig.name
+    total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
+    with _progress(total, f"manual {rig.name} ({printer.name})") as step:
+        fab = run_fab(rig, printer, root / "fab" / printer.name, gcode=args.gcode,
+                      lock=profile_lock(args.exports, rig.name), progress=step)
+        for problem in fab.problems:
+            print(f"rigcad: fab: {problem}", file=sys.stderr)
+        out = root / "manual" / printer.name
+        written = write_manual(rig, printer, fab.report, out, profile_lock(args.exports, rig.name), progress=step)
+    html_path = out / "manual.html"
+    print(f"{rig.name}: manual for {printer.name} -> {out}/ (manual.md, manual.html "
+          f"{html_path.stat().st_size / 1e6:.1f} MB, {len(written)} files)")
+    return 0
+
+
+__all__ = ["Doc", "build_manual", "cmd_manual", "write_manual"]

@@ -1,0 +1,217 @@
+"""`rigcad manual`: the bill of materials is computed, not typed (the coating stack changes the paint,
+the printer changes the pins), its figures agree with closed forms and direct geometry, and the
+manual's files (Markdown, one self-contained HTML page, the calibration image) are written."""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import rigcad
+from rigcad.fab.printers import load_printer
+from rigcad.manual import bom as B
+from rigcad.manual import calibration as C
+from rigcad.manual.document import build_manual, write_manual
+
+MIL = 0.0254
+
+
+def _profile(tmp_path, name: str, body: str):
+    path = tmp_path / f"{name}.yaml"
+    path.write_text("extends: achutha2006\n" + textwrap.dedent(body), encoding="utf-8")
+    return rigcad.load(path)
+
+
+@pytest.fixture(scope="module")
+def fab_reports(table31_rig, tmp_path_factory):
+    """The base plate through the fab stage on two printers: the MK3S's 250 x 210 mm bed splits the
+    303 mm plate (pins), the Vantage's takes it whole (none). ~6 s."""
+    out = {}
+    for name in ("prusa_mk3s", "vantage_i"):
+        out[name] = table31_rig.fab(name, tmp_path_factory.mktemp(name) / "fab", parts=["base_plate"]).report
+    return out
+
+
+def test_pin_count_follows_the_printer(fab_reports):
+    prusa = B.dowel_pins(fab_reports["prusa_mk3s"], load_printer("prusa_mk3s"))
+    vantage = B.dowel_pins(fab_reports["vantage_i"], load_printer("vantage_i"))
+    split = fab_reports["prusa_mk3s"]["parts"]["base_plate"]
+    assert prusa is not None and prusa["quantity"] == len(split["pins"]) > 0, prusa
+    assert vantage is None, "the Vantage prints the plate whole: no pins"
+    pin = load_printer("prusa_mk3s").alignment_pin
+    assert prusa["diameter_mm"] == pin.diameter and prusa["length_mm"] == 2 * pin.depth - B.PIN_END_GAP_MM
+
+
+def test_paint_volumes_follow_the_coating_stack(tmp_path, table31_rig):
+    thick = _profile(tmp_path, "thick", """
+        coating:
+          layers:
+            - {name: black base paint, thickness: 3 mil}
+            - {name: polyurethane clearcoat, thickness: 2 mil}
+            - {name: MirraChrome, thickness: 1 mil}
+        templates:
+          gauged_layer: polyurethane clearcoat
+        """)
+    base = {(c.layer, c.mirror): c for c in B.coating_rows(table31_rig)}
+    new = {(c.layer, c.mirror): c for c in B.coating_rows(thick)}
+    assert ("polyurethane primer", "dome") in base and ("polyurethane primer", "dome") not in new
+    for mirror in ("dome", "paraboloid"):
+        b, n = base[("black base paint", mirror)], new[("black base paint", mirror)]
+        # twice the thickness, nearly the same area (the layer moves by under 0.1 mm on a 16-150 mm
+        # surface): the film doubles to within 1e-3
+        assert n.film_cm3 / b.film_cm3 == pytest.approx(2.0, rel=1e-3)
+        assert n.to_buy_cm3 == pytest.approx(n.film_cm3 * thick.profile.coating.margin, rel=1e-12)
+
+
+def test_paint_margin_is_the_profiles(tmp_path, table31_rig):
+    more = _profile(tmp_path, "margin", "coating:\n  margin: 4\n")
+    a = sum(c.to_buy_cm3 for c in B.coating_rows(table31_rig))
+    b = sum(c.to_buy_cm3 for c in B.coating_rows(more))
+    assert b / a == pytest.approx(4.0 / table31_rig.profile.coating.margin, rel=1e-12)
+
+
+def test_revolved_area_matches_the_paraboloids_closed_form(table31_rig):
+    """Area of z = z_v - r^2 / (4 f) for r <= R: (8 pi f^2 / 3) ((1 + R^2 / (4 f^2))^(3/2) - 1)."""
+    g = table31_rig.geometry
+    f, R = g.focal_length, g.rim_radius
+    exact = 8 * math.pi * f * f / 3 * ((1 + R * R / (4 * f * f)) ** 1.5 - 1)
+    area = B.revolved_area(table31_rig.layout.design_paraboloid)
+    # midpoint rule on 20001 points: second order, ~1e-9 relative; 1e-7 leaves room
+    assert abs(area - exact) / exact < 1e-7, (area, exact)
+
+
+def _dome_joint(rig):
+    joints = [j for j in B.bolt_joints(rig) if j["parts"] == ("base_plate", "dome")]
+    assert len(joints) == 1, B.bolt_joints(rig)
+    return joints[0]
+
+
+def test_bolts_are_found_in_the_recipes_and_sized_from_the_grip(tmp_path, table31_rig):
+    p = table31_rig.profile
+    j = _dome_joint(table31_rig)
+    # the holes of the flange and the plate line up: one bolt each, through both
+    assert j["count"] == p.dome_shell.bolts == 8
+    assert j["grip_mm"] == pytest.approx(p.dome_shell.flange_thickness + p.base_plate.thickness, abs=1e-9)
+    assert j["item"].startswith("M4 x 25 mm")  # 6 + 10 mm grip + 2 x 0.8 + 3.2 + 2 x 0.7 = 22.2 -> 25
+    other = _profile(tmp_path, "bolts", "base_plate:\n  thickness: 20 mm\ndome_shell:\n  bolt_diameter: 5.5 mm\n"
+                                        "  bolts: 12\n  flange_width: 24 mm\n")
+    j = _dome_joint(other)
+    # M5 (5.5 mm medium clearance): 6 + 20 + 2 x 1.0 + 4.7 + 2 x 0.8 = 34.3 mm -> 35 mm
+    assert j["item"].startswith("M5 x 35 mm") and j["count"] == 12 and j["washers"] == 24
+    # every through bolt of the rig joins parts that exist, with some grip
+    for j in B.bolt_joints(table31_rig):
+        assert all(n in table31_rig.recipes for n in j["parts"]) and j["grip_mm"] > 0 and j["count"] > 0
+
+
+def test_the_tower_hardware_is_the_towers_and_follows_the_mounting_threads(tmp_path, table31_rig):
+    from rigcad.parts.tower import hardware
+
+    rows = B.fasteners(table31_rig)
+    tower = [r for r in rows if r.get("tower")]
+    assert len(tower) == len([h for h in hardware(table31_rig.profile, table31_rig.layout) if h.get("thread")]) > 0
+    assert not any(set(j["parts"]) & {"tower_column", "tower_shelf"} for j in B.bolt_joints(table31_rig)), \
+        "the tower's joints have one home (parts.tower.hardware), not two"
+    other = _profile(tmp_path, "thread", "projector:\n  mount_thread: M6\n")
+    assert any(r["item"].startswith("M6 x ") and "projector" in r["use"] for r in B.fasteners(other))
+
+
+def test_calibration_circle_is_the_rim_at_the_projectors_resolution(table31_rig):
+    from PIL import Image
+
+    png, info = C.circle_image(table31_rig)
+    img = np.asarray(Image.open(io.BytesIO(png)))
+    w, h = table31_rig.profile.projector.resolution
+    assert img.shape == (h, w) and set(np.unique(img)) == {0, 255}
+    # the derived figures' closed form (profile.derived, not the design map) gives the rim's pixel radius
+    assert info["radius_px"] == pytest.approx(table31_rig.geometry.pixels_vertex_to_rim, rel=1e-9)
+    lit = int((img == 255).sum())
+    r = info["radius_px"]
+    # pixel centres inside a circle: pi r^2 within the pixels its edge crosses (~ its perimeter)
+    assert abs(lit - math.pi * r * r) < 2 * math.pi * r
+    rows, cols = np.nonzero(img == 255)
+    assert (rows.min() + rows.max() + 1) / 2 == pytest.approx(h / 2, abs=0.5)
+    assert (cols.min() + cols.max() + 1) / 2 == pytest.approx(w / 2, abs=0.5)
+
+
+def test_cross_shadow_separation_against_a_direct_construction(table31_rig):
+    """The two cross centres' shadows cast from a COP off their line by 1 mm, by intersecting the rays
+    with the backplate's plane directly."""
+    c = table31_rig.profile.crosses
+    table = C.projector_shadows(table31_rig)
+    for row in table["rows"]:
+        a = row["projector_to_near_cross_mm"]
+        cop = np.array([-a, 1.0])  # (along the axis, across it), mm
+        X = c.projector_spacing + c.backplate_distance
+        hits = []
+        for x in (0.0, c.projector_spacing):
+            d = np.array([x, 0.0]) - cop
+            hits.append(cop[1] + d[1] * (X - cop[0]) / d[0])
+        assert abs(hits[0] - hits[1]) == pytest.approx(row["separation_per_mm_offset"], rel=1e-12)
+
+
+@pytest.fixture(scope="module")
+def written(table31_rig, fab_reports, tmp_path_factory):
+    out = tmp_path_factory.mktemp("manual") / "prusa_mk3s"
+    paths = write_manual(table31_rig, load_printer("prusa_mk3s"), fab_reports["prusa_mk3s"], out)
+    return out, paths
+
+
+def test_the_manual_is_written_with_its_pictures_and_one_self_contained_page(written, fab_reports, table31_rig):
+    out, paths = written
+    md = (out / "manual.md").read_text(encoding="utf-8")
+    page = (out / "manual.html").read_text(encoding="utf-8")
+    for ref in re.findall(r"\]\(([^)]+)\)", md):
+        assert (out / ref).is_file(), f"manual.md shows {ref}, which was not written"
+    assert not re.search(r"""(src|href)\s*=\s*["'](?!data:)""", page), "the page refers to a file or URL"
+    assert page.count("data:image/png;base64,") == len(re.findall(r"!\[", md))
+    for step in ("Bill of materials", "Sand the mirrors", "Coat, layer by layer", "Assemble", "Calibrate"):
+        assert step in md
+    pins = B.dowel_pins(fab_reports["prusa_mk3s"], load_printer("prusa_mk3s"))
+    assert f"| {pins['item']} | {pins['quantity']} |" in md
+    assert "M4 x 25 mm socket-head bolt" in md
+    assert (out / "calibration" / "circle.png").is_file()
+    from rigcad.manual.assembly import rig_meshes, steps
+
+    shots = sorted(p.name for p in (out / "images").glob("step_*.png"))
+    assert len(shots) == len(steps(rig_meshes(table31_rig))) and "step_05_dome.png" in shots
+    assert md.count("### Step ") == len(shots)
+
+
+def test_the_manual_is_deterministic(table31_rig, fab_reports, written):
+    """A second build gives the same bytes as the files written by the first."""
+    out, _ = written
+    doc, files, _ = build_manual(table31_rig, load_printer("prusa_mk3s"), fab_reports["prusa_mk3s"])
+    assert doc.markdown().encode("utf-8") == (out / "manual.md").read_bytes()
+    for rel, data in files.items():
+        assert (out / rel).read_bytes() == data, rel
+
+
+def test_rigcad_manual_refuses_an_unknown_printer_in_one_line(tmp_path):
+    run = subprocess.run([sys.executable, "-m", "rigcad.cli", "manual", "achutha2006", "--printer", "nosuch",
+                          "--exports", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert run.returncode != 0 and run.stderr.startswith("rigcad: error:") and len(run.stderr.splitlines()) == 1
+    assert "nosuch" in run.stderr and not any(tmp_path.iterdir())
+
+
+def test_printed_times_are_the_slicers_when_it_sliced(fab_reports, table31_rig):
+    """With G-code (fab --gcode) each piece carries PrusaSlicer's estimates: the bill takes those."""
+    import copy
+
+    report = copy.deepcopy(fab_reports["prusa_mk3s"])
+    pieces = report["parts"]["base_plate"]["pieces"]
+    for k, pc in enumerate(pieces):
+        pc["gcode"] = {"estimates": {"print_time_s": 3600.0 * (k + 1), "filament_g": 10.0 * (k + 1)}}
+    row = next(r for r in B.printed(table31_rig, report) if r["part"] == "base_plate")
+    n = len(pieces)
+    assert row["source"] == "slicer"
+    assert row["time_s"] == 3600.0 * n * (n + 1) / 2 and row["material_g"] == 10.0 * n * (n + 1) / 2
+    estimate = next(r for r in B.printed(table31_rig, fab_reports["prusa_mk3s"]) if r["part"] == "base_plate")
+    assert estimate["source"] == "rigcad estimate"
+    assert estimate["time_s"] == pytest.approx(sum(pc["estimate"]["print_time_s"] for pc in pieces), rel=1e-12)
