@@ -458,6 +458,8 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
                "support_model": rows[k]["support_model"],
                "estimate": E.estimate(E.Features(volume, pc.manifold.surface_area(), layers.count,
                                                  rows[k]["support_model"]["support_envelope_mm3"],
+                                                 rows[k]["support_model"]["mirror_under_mm2"]
+                                                 + rows[k]["support_model"]["other_under_mm2"],
                                                  E.shell_thickness(printer)), printer)}
         if mf is not None and len(mf.index):
             steps = ST.step_map(layers, rot, shift, mirror, tol_mirror)
@@ -550,7 +552,7 @@ def markdown(report: dict) -> str:
     lines = [f"# Fabrication: {report['profile']} on {pr['name']}", "",
              f"{pr['description']} ({pr['process']}); build volume {' x '.join(f'{v:g}' for v in pr['build_volume_mm'])} mm; "
              f"layer {pr['layer_height_mm']:.4g} mm; material {pr['material']}. Source: `{pr['source']}`.", "",
-             "| part | qty | pieces | orientation | layers | time | material | mirror cusp mean / max (mm) | sanding / stock (mm) |",
+             "| part | qty | pieces | orientation | layers | time | material | mirror cusp mean / max (mm) | sanding depth / stock printed (mm) |",
              "|---|---|---|---|---|---|---|---|---|"]
     for name, e in report["parts"].items():
         if "error" in e:
@@ -567,7 +569,8 @@ def markdown(report: dict) -> str:
         orient = ", ".join(sorted({pc["orientation"] for pc in pcs}))
         sm = e.get("staircase_map")
         cusp = f"{sm['cusp_mean_mm']:.3f} / {sm['cusp_max_mm']:.3f}" if sm else "-"
-        pol = f"{e['polishing']['sanding_depth_mm']:.3f} / {e['polishing']['stock_to_add_mm']:.3f}" if "polishing" in e else "-"
+        stock = e["sanding_stock"]["stock_mm"] if e.get("sanding_stock") else e.get("polishing", {}).get("stock_to_add_mm")
+        pol = f"{e['polishing']['sanding_depth_mm']:.3f} / {stock:.3f}" if "polishing" in e else "-"
         lines.append(f"| {name} | {e['quantity']} | {len(pcs)} | {orient} | {e['layers_total']} | {_hms(t)} ({src}) | "
                      f"{g:.0f} g | {cusp} | {pol} |")
     tot = report["totals"]

@@ -75,19 +75,24 @@ def test_the_fab_mirrors_lie_the_stock_in_front_of_the_sanded_surface(prusa_run,
             rot, shift = np.array(tr["rotation"]), np.array(tr["translation_mm"])
             p = (tri.reshape(-1, 3) - shift) @ rot  # back to the part frame: R^T (p - t)
             d = sanded.distance(np.column_stack([np.hypot(p[:, 0], p[:, 1]), p[:, 2]])).reshape(-1, 3)
-            # float32 STL coordinates (~2e-5 mm at 300 mm) and the B-spline fit (0.1 um) bound 1e-4 mm
-            on = (np.abs(d - stock) < 1e-4).all(axis=1)
+            # on the mirror: within the chord error of the stocked surface (the split's cuts put
+            # vertices on the facets along the cut edges)
+            on = (np.abs(d - stock) < chord).all(axis=1)
+            # the mesh's own vertices lie on it: float32 STL coordinates (~2e-5 mm at 300 mm) and the
+            # B-spline fit (0.1 um) bound 1e-4 mm; the cut-edge vertices are a small share
+            assert np.mean(np.abs(d[on] - stock) < 1e-4) > 0.95, pc["name"]
             t = tri[on]
             cross = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
             area += 0.5 * np.linalg.norm(cross, axis=1).sum()
-            # nothing of the print stands further into the light than the stock
-            assert d.max() <= stock + 1e-4, (pc["name"], d.max(), stock)
+            # nothing of the print stands further into the light than the stock and the chord error
+            # (the split's cuts put vertices on the facets, which lie in front of a concave mirror)
+            assert d.max() <= stock + chord, (pc["name"], d.max(), stock)
             # facet centres: within the chord error of the stocked surface
             c = p.reshape(-1, 3, 3)[on].mean(axis=1)
             dc = sanded.distance(np.column_stack([np.hypot(c[:, 0], c[:, 1]), c[:, 2]]))
             assert np.abs(dc - stock).max() <= chord, (pc["name"], np.abs(dc - stock).max())
-        # those vertices are the whole mirror (the report's area, within 1 %: faces along the cut
-        # edges and slots have one vertex off the surface)
+        # those faces are the whole mirror: the report's area (before the stock; the stock's own
+        # change of area is stock x curvature ~ 1e-3 relative), within 1 %
         assert abs(area - st["mirror_area_without_stock_mm2"]) < 0.01 * area, (part, area)
         # volumes grow by mirror area x stock within 1 % (the thin shell; curvature is second order)
         assert abs(st["volume_added_over_area_times_stock"] - 1) < 0.01, st

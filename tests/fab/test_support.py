@@ -90,9 +90,8 @@ def test_contact_area_of_beads_over_a_plate_is_the_dilated_patch():
     a = sqrt(r^2 - h^2) (rounded corners: (10 + 2a)^2 - (4 - pi) a^2), to the sampling's noise."""
     v, f = M.mesh_arrays(m3d.Manifold.cube((40.0, 40.0, 2.0)).translate((-20.0, -20.0, 0.0)))
     h, reach = 0.3, 0.6
-    xs = np.arange(-5.0, 5.0 + 1e-9, 0.02)
-    pts = np.array([(x, y, 2.0 + h) for y in np.arange(-5.0, 5.0 + 1e-9, 0.2) for x in xs])
-    beads = SU.SupportBeads(pts, 0.0, 1)
+    seg = np.array([(-5.0, y, 5.0, y, 2.0 + h) for y in np.arange(-5.0, 5.0 + 1e-9, 0.2)])
+    beads = SU.SupportBeads(seg, 10.0 * len(seg), 1)
     tri = v[f]
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     top = np.nonzero(n[:, 2] > 0)[0]
