@@ -181,6 +181,8 @@ def load_printer(name: str | Path) -> Printer:
     top: dict[str, Any] = {}
     from_preset = []
     for key, s in _TOP.items():
+        if key == "sanding_stock":
+            continue  # 'auto' or a length, read below
         if key == "slicer" and (slicer_cfg or unavailable):
             top[key] = "prusa-slicer"
             continue
@@ -198,11 +200,12 @@ def load_printer(name: str | Path) -> Printer:
             top[key] = s.default if s.default is None or s.kind == "str" else convert_value(s, s.default, key, None)
             continue
         top[key] = convert_value(s, raw.data[key], key, raw.where((key,)))
-    stock = top["sanding_stock"]
+    stock = raw.data.get("sanding_stock", "auto")
     if stock == "auto":
         top["sanding_stock"] = None
-    else:
-        top["sanding_stock"] = convert_value(Spec("length", _TOP["sanding_stock"].doc, lo=0, hi=MAX_SANDING_STOCK),
+    else:  # 'auto' or a length: a bare number or other text gets the length rules' message
+        top["sanding_stock"] = convert_value(Spec("length", "'auto' or " + _TOP["sanding_stock"].doc, lo=0,
+                                                  hi=MAX_SANDING_STOCK),
                                              stock, "sanding_stock", raw.where(("sanding_stock",)))
     sections = {k: read_section(raw, k, cls) for k, cls in _SECTIONS.items()}
     if top["first_layer_height"] is None:
