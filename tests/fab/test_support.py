@@ -104,19 +104,6 @@ def test_contact_area_of_beads_over_a_plate_is_the_dilated_patch():
 
 
 @pytest.mark.skipif(not have_slicer(), reason="prusa-slicer is not installed")
-def test_the_slicers_support_stays_off_the_paraboloid(table31_rig, prusa, tmp_path):
-    """The real slicer on the paraboloid (printed upright: support under its back and clamp)."""
-    from rigcad.fab.stage import run_fab
-
-    res = run_fab(table31_rig, prusa, tmp_path, parts=["paraboloid"], gcode=True, workers=1)
-    assert res.problems == [], res.problems
-    sc = res.report["parts"]["paraboloid"]["pieces"][0]["gcode"]["support_contact"]
-    assert sc["support_extruded_length_mm"] > 0 and sc["other_mm2"] > 0  # there is support, on other faces
-    assert sc["mirror_mm2"] == 0.0, sc
-    assert (tmp_path / sc["png"]).is_file()
-
-
-@pytest.mark.skipif(not have_slicer(), reason="prusa-slicer is not installed")
 def test_the_gcode_reader_sees_support_on_a_mirror_where_there_is_some(table31_rig, prusa):
     """A positive control: the paraboloid upside down (its mirror's rim band overhangs) through
     PrusaSlicer with support. The G-code's support touches the mirror, and its area agrees with
