@@ -354,6 +354,34 @@ def staircase_map(points: np.ndarray, cusp: np.ndarray, layer: float, title: str
     return _png(fig, dpi=100)
 
 
+def support_contact(points: np.ndarray, touched: np.ndarray, on_mirror: np.ndarray, beads: np.ndarray,
+                    title: str) -> bytes:
+    """Where the slicer's support touches a piece in print position (mm): the piece's surface
+    samples (grey; the mirror light blue), those touched by support (orange on other faces, red
+    on the mirror) and the support beads (faint), seen from the front (x-z) and from the side
+    (y-z). ``points`` (n, 3), masks (n,), ``beads`` (m, 3)."""
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.4))
+    stride = max(1, int(np.ceil(len(points) / 40000)))  # a fixed stride: deterministic pictures
+    bead_stride = max(1, int(np.ceil(len(beads) / 30000)))
+    for ax, (i, name) in zip(axes, ((0, "x"), (1, "y"))):
+        p, m = points[::stride], on_mirror[::stride]
+        ax.scatter(p[~m, i], p[~m, 2], s=0.4, c="0.75", linewidths=0, label="other faces")
+        ax.scatter(p[m, i], p[m, 2], s=0.4, c="#9cc3e6", linewidths=0, label="mirror")
+        if len(beads):
+            b = beads[::bead_stride]
+            ax.scatter(b[:, i], b[:, 2], s=0.3, c="#e0c080", alpha=0.3, linewidths=0, label="support beads")
+        t_o, t_m = touched & ~on_mirror, touched & on_mirror
+        ax.scatter(points[t_o, i], points[t_o, 2], s=1.5, c="#e07b00", linewidths=0, label="support contact, other")
+        ax.scatter(points[t_m, i], points[t_m, 2], s=3.0, c="#d00000", linewidths=0, label="support contact, mirror")
+        ax.set_xlabel(f"{name} (mm, print position)")
+        ax.set_ylabel("z (mm, build direction)")
+        ax.set_aspect("equal", adjustable="datalim")
+    axes[0].legend(loc="upper right", fontsize=6, markerscale=6)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    return _png(fig, dpi=100)
+
+
 # -- basis illumination (rigcad basis) --------------------------------------------------------------
 def _pyramid(tiles: np.ndarray, indices: np.ndarray, scale: float, title: str, tile_in: tuple[float, float],
              extent=None, xlabel: str | None = None, ylabel: str | None = None, aspect: str = "auto") -> bytes:

@@ -88,8 +88,11 @@ def test_fab_pieces_are_cut_from_the_exported_dome(tmp_path):
     build = rig.export(tmp_path / "x", parts=["dome"])
     fab = rig.fab("vantage_i", tmp_path / "fab", parts=["dome"])
     exported = build.manifest["parts"]["dome"]["stl_volume_mm3"]
-    pieces = sum(pc["volume_mm3"] for pc in fab.report["parts"]["dome"]["pieces"])
-    assert abs(pieces - exported) <= 1e-12 * exported, (pieces, exported)
+    entry = fab.report["parts"]["dome"]
+    designed = entry["sanding_stock"]["part_volume_without_stock_mm3"]  # the part before its sanding stock
+    assert abs(designed - exported) <= 1e-12 * exported, (designed, exported)
+    pieces = sum(pc["volume_mm3"] for pc in entry["pieces"])  # the printed pieces: that part, stock added
+    assert abs(pieces - entry["volume_mm3"]) <= 1e-12 * pieces, (pieces, entry["volume_mm3"])
 
 
 def test_rig_pickles_and_moves_without_changing(table31_rig):

@@ -8,7 +8,14 @@ import sys
 from pathlib import Path
 
 
+def _hm(seconds: float) -> str:
+    s = int(round(seconds))
+    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
+
+
 def cmd_fab(args: argparse.Namespace) -> int:
+    from rigcad.cli import _progress
+    from rigcad.export.build import select_parts
     from rigcad.fab.printers import load_printer
     from rigcad.fab.stage import run_fab
     from rigcad.export.atomic import profile_lock
@@ -18,9 +25,16 @@ def cmd_fab(args: argparse.Namespace) -> int:
     profile = rig.profile
     printer = load_printer(args.printer)
     out = Path(args.exports) / profile.name / "fab" / printer.name
-    res = run_fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs,
-                  lock=profile_lock(args.exports, profile.name),
-                  progress=lambda msg: print(f"  {msg}", file=sys.stderr) if args.verbose else None)
+    names = select_parts(args.parts)
+    with _progress(len(names), f"fab {profile.name}") as step:
+        def progress(msg: str) -> None:
+            step(msg)
+            if args.verbose:
+                print(f"  {msg}", file=sys.stderr)
+
+        res = run_fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs,
+                      lock=profile_lock(args.exports, profile.name), progress=progress,
+                      slicing=lambda total: _progress(total, f"slicing ({printer.slicer})"))
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")
     for name, e in res.report["parts"].items():
@@ -28,9 +42,29 @@ def cmd_fab(args: argparse.Namespace) -> int:
             orient = ", ".join(sorted({pc["orientation"] for pc in e["pieces"]}))
             sm = e.get("staircase_map")
             extra = f"; mirror cusp mean {sm['cusp_mean_mm']:.3f} mm, max {sm['cusp_max_mm']:.3f} mm" if sm else ""
+            st = e.get("sanding_stock")
+            extra += f"; printed {st['stock_mm']:.3f} mm forward (sanding stock)" if st else ""
+            sliced = [pc["gcode"] for pc in e["pieces"] if "gcode" in pc]
+            if sliced and len(sliced) == len(e["pieces"]):
+                t = sum(g["estimates"].get("print_time_s", 0) for g in sliced)
+                g_ = sum(g["estimates"].get("filament_g", 0) for g in sliced)
+                extra += f"; slicer {_hm(t)}, {g_:.0f} g"
+                sc = [g["support_contact"] for g in sliced if "support_contact" in g]
+                if sc and (e.get("mirror") or any(c["other_mm2"] for c in sc)):
+                    extra += (f"; support contact mirror {sum(c['mirror_mm2'] for c in sc):.0f} mm2, "
+                              f"other {sum(c['other_mm2'] for c in sc):.0f} mm2")
+            else:
+                est = sum(pc["estimate"]["print_time_s"] for pc in e["pieces"])
+                extra += f"; est. {_hm(est)}, {sum(pc['estimate']['material_g'] for pc in e['pieces']):.0f} g"
             print(f"  {name}: {len(e['pieces'])} piece(s), {orient}, {e['layers_total']} layers{extra}")
         elif "error" not in e:
-            print(f"  {name}: outlines/{name}.dxf, .svg")
+            print(f"  {name}: outlines/{name}.dxf, .svg" + (" (+ _printed, _sanded stages)" if "stages" in e else ""))
+    if "slicer_print_time_s" in tot:
+        print(f"  total ({printer.slicer}, with quantities): {_hm(tot['slicer_print_time_s'])}, "
+              f"{tot['slicer_filament_g']:.0f} g filament")
+    else:
+        print(f"  total (rigcad estimate, with quantities): {_hm(tot['estimate_print_time_s'])}, "
+              f"{tot['estimate_material_g']:.0f} g")
     if args.timings:
         for k, v in sorted(res.timings_s.items()):
             print(f"  time {k}: {v:.2f} s")

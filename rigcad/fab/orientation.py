@@ -1,9 +1,13 @@
 """Print orientation and fit: a build direction D (a unit vector in the part's frame) becomes the
 printer's +z; a spin about +z then fits the part's footprint on the bed.
 
-The orientation is chosen to minimise the staircase on the part's mirror surface (area-weighted
-mean cusp height, rigcad.fab.staircase), then the mirror area that would need support, then the
-height; parts without a mirror minimise the overhang area that needs support, then the height.
+On a part with a mirror the orientation is chosen for the least support contact on the mirror
+first (support scars on an optical surface are worse than the staircase: thesis 4.4, the grooves
+and their polishing ruined the first rig), then the least staircase (area-weighted mean cusp
+height, rigcad.fab.staircase), then the overhang, then the height. Support contact counts both
+ways support touches a face (:func:`support_contact`): under an overhanging face, and standing on
+a face below an overhang. Parts without a mirror minimise the overhang area that needs support,
+then the height. Thin plates (:func:`plate_axis`) print flat, split where they do not fit.
 """
 
 from __future__ import annotations
@@ -120,6 +124,101 @@ def overhang_area(vertices: np.ndarray, faces: np.ndarray, direction, mask: np.n
     if mask is not None:
         down &= mask
     return float(0.5 * area2[down].sum())
+
+
+#: A part is a thin plate when its smallest bounding-box side is under this fraction of the next:
+#: on edge it is a fin (the projector mounting plate, 7.5 mm thick, would stand 144 mm tall) that
+#: sways under the nozzle and levers itself off the bed, so it prints flat.
+THIN_PLATE_RATIO = 0.1
+
+
+def plate_axis(vertices: np.ndarray) -> int | None:
+    """The part-frame axis (0, 1, 2) of a thin plate's thickness (THIN_PLATE_RATIO), or None."""
+    size = np.ptp(np.asarray(vertices, dtype=float), axis=0)
+    order = np.argsort(size)
+    return int(order[0]) if size[order[0]] <= THIN_PLATE_RATIO * size[order[1]] else None
+
+
+def flat_candidates(axis: int) -> list[Orientation]:
+    """A thin plate's two flat orientations (its thickness along the build direction)."""
+    n = "xyz"[axis]
+    e = [0.0, 0.0, 0.0]
+    e[axis] = 1.0
+    return [Orientation(f"flat (+{n} up)", tuple(e)), Orientation(f"flat (-{n} up)", tuple(-v for v in e))]
+
+
+def support_contact(vertices: np.ndarray, faces: np.ndarray, direction, mirror: np.ndarray | None = None) -> dict:
+    """Where support would touch the part printed along ``direction`` (the model's view; the
+    slicer's own support is measured from its G-code, rigcad.fab.support): overhang faces
+    (OVERHANG_ANGLE) take support from below, on their own area; that support stands on the bed
+    or, when a ray straight down from the face meets the part first, on the face it meets (its
+    footprint there: the overhang's projected area over the met face's |n . D|, at most 5x).
+    ``mirror`` masks the mirror's faces. Returns mm2 on mirror and other faces, each split into
+    ``under`` (the face overhangs) and ``on`` (support stands on it)."""
+    import trimesh
+
+    d = np.asarray(direction, dtype=float)
+    d = d / np.linalg.norm(d)
+    tri = vertices[faces]
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area2 = np.linalg.norm(cross, axis=1)
+    ok = area2 > 0
+    nz = np.divide(cross @ d, area2, out=np.zeros_like(area2), where=ok)
+    area = 0.5 * area2
+    height = tri @ d
+    on_bed = (height.max(axis=1) - (vertices @ d).min()) < 1e-6
+    down = (nz < -math.sin(OVERHANG_ANGLE)) & ~on_bed & ok
+    is_m = np.zeros(len(faces), bool) if mirror is None else np.asarray(mirror, bool)
+    out = {"mirror_under_mm2": float(area[down & is_m].sum()), "other_under_mm2": float(area[down & ~is_m].sum()),
+           "mirror_on_mm2": 0.0, "other_on_mm2": 0.0, "support_envelope_mm3": 0.0}
+    idx = np.nonzero(down)[0]
+    if len(idx):
+        mesh = trimesh.Trimesh(vertices, faces, process=False)
+        centre, face, share = _subdivide(tri[idx], area[idx], SUPPORT_CELL_MM2)
+        src = idx[face]
+        origins = centre - 1e-3 * d  # just below the face: the ray must not meet the face itself
+        locs, rays, hit_tri = mesh.ray.intersects_location(origins, np.repeat(-d[None, :], len(centre), axis=0),
+                                                           multiple_hits=False)
+        first = np.full(len(centre), -1)
+        drop = (centre @ d) - (vertices @ d).min()  # to the bed, unless the part is met first
+        first[rays] = hit_tri
+        drop[rays] = (centre[rays] - locs) @ d
+        proj = share * np.abs(nz[src])  # the column's cross-section (mm2)
+        hit = first >= 0
+        dst = first[hit]
+        footprint = proj[hit] / np.maximum(np.abs(nz[dst]), 0.2)
+        out["mirror_on_mm2"] = float(footprint[is_m[dst]].sum())
+        out["other_on_mm2"] = float(footprint[~is_m[dst]].sum())
+        # the columns under every overhang, down to what they stand on: what support would fill
+        out["support_envelope_mm3"] = float((proj * np.maximum(drop, 0.0)).sum())
+    out["mirror_mm2"] = out["mirror_under_mm2"] + out["mirror_on_mm2"]
+    out["other_mm2"] = out["other_under_mm2"] + out["other_on_mm2"]
+    return out
+
+
+#: Overhang faces are cut into sub-triangles of at most about this area (mm2) for the columns of
+#: support under them: a 2 mm grid, the support's own line spacing.
+SUPPORT_CELL_MM2 = 4.0
+
+
+def _subdivide(tri: np.ndarray, area: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each triangle (n, 3, 3) cut into k^2 equal sub-triangles (k from ``cell``): their centroids
+    (m, 3), the triangle each belongs to (m,) and their areas (m,)."""
+    k = np.maximum(np.ceil(np.sqrt(area / cell)), 1).astype(int)
+    pts, owner, share = [], [], []
+    for n in np.unique(k):
+        sel = np.nonzero(k == n)[0]
+        i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+        up = (i + j) <= n - 1
+        dn = (i + j) <= n - 2
+        bary = np.concatenate([np.column_stack([i[up] + 1 / 3, j[up] + 1 / 3]),
+                               np.column_stack([i[dn] + 2 / 3, j[dn] + 2 / 3])]) / n  # (n^2, 2)
+        a, b, c = tri[sel, 0], tri[sel, 1], tri[sel, 2]
+        p = a[:, None] + bary[None, :, 0, None] * (b - a)[:, None] + bary[None, :, 1, None] * (c - a)[:, None]
+        pts.append(p.reshape(-1, 3))
+        owner.append(np.repeat(sel, len(bary)))
+        share.append(np.repeat(area[sel] / (n * n), len(bary)))
+    return np.concatenate(pts), np.concatenate(owner), np.concatenate(share)
 
 
 def generic_candidates() -> list[Orientation]:

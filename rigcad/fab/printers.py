@@ -84,6 +84,8 @@ class Printer:
     slicer: str
     alignment_pin: AlignmentPin
     source: str
+    #: Stock printed in front of every mirror (mm), or None for 'auto' (what the staircase needs).
+    sanding_stock: float | None = None
     marks: dict = field(compare=False, repr=False, default_factory=dict)
     #: PrusaSlicer's presets and overrides, resolved (None for slicer none / generic prusa-slicer).
     slicer_config: V.VendorConfig | None = None
@@ -108,6 +110,7 @@ class Printer:
                "material": self.material, "material_density_g_cm3": self.material_density_g_cm3,
                "deposition_rate_mm3_s": self.deposition_rate_mm3_s, "layer_time_s": self.layer_time_s,
                "slicer": self.slicer,
+               "sanding_stock_mm": "auto" if self.sanding_stock is None else self.sanding_stock,
                "slicer_presets": self.slicer_config.describe() if self.slicer_config else None,
                "figures_from_preset": list(self.from_preset),
                "alignment_pin": {"diameter_mm": self.alignment_pin.diameter,
@@ -134,7 +137,12 @@ _TOP: dict[str, Spec] = {
     "layer_time_s": Spec("float", "time per layer beyond the deposition, for estimates (s)", 0.0, lo=0),
     "slicer": Spec("choice", "slicer rigcad runs for G-code (or a mapping of PrusaSlicer presets)", "none",
                    choices=("none", "prusa-slicer")),
+    "sanding_stock": Spec("str", "material printed in front of every mirror surface, sanded off down to the "
+                          "templates before the coating: 'auto' (the stock the staircase of each part needs in its "
+                          "print orientation) or a length such as '0.1 mm' ('0 mm': none)", "auto"),
 }
+#: Largest sanding stock a printer file may ask for (mm): several layers of any printer; more is a unit slip.
+MAX_SANDING_STOCK = 2.0
 #: Keys of the ``slicer`` mapping.
 _SLICER_KEYS = ("vendor_bundle", "printer_preset", "print_preset", "filament_preset", "overrides")
 #: Printer keys a PrusaSlicer preset also states -> (preset key, unit of the preset's number).
@@ -173,6 +181,8 @@ def load_printer(name: str | Path) -> Printer:
     top: dict[str, Any] = {}
     from_preset = []
     for key, s in _TOP.items():
+        if key == "sanding_stock":
+            continue  # 'auto' or a length, read below
         if key == "slicer" and (slicer_cfg or unavailable):
             top[key] = "prusa-slicer"
             continue
@@ -190,6 +200,13 @@ def load_printer(name: str | Path) -> Printer:
             top[key] = s.default if s.default is None or s.kind == "str" else convert_value(s, s.default, key, None)
             continue
         top[key] = convert_value(s, raw.data[key], key, raw.where((key,)))
+    stock = raw.data.get("sanding_stock", "auto")
+    if stock == "auto":
+        top["sanding_stock"] = None
+    else:  # 'auto' or a length: a bare number or other text gets the length rules' message
+        top["sanding_stock"] = convert_value(Spec("length", "'auto' or " + _TOP["sanding_stock"].doc, lo=0,
+                                                  hi=MAX_SANDING_STOCK),
+                                             stock, "sanding_stock", raw.where(("sanding_stock",)))
     sections = {k: read_section(raw, k, cls) for k, cls in _SECTIONS.items()}
     if top["first_layer_height"] is None:
         top["first_layer_height"] = top["layer_height"]
@@ -216,7 +233,7 @@ def load_printer(name: str | Path) -> Printer:
                    filament_diameter=top["filament_diameter"], material=top["material"],
                    material_density_g_cm3=top["material_density_g_cm3"],
                    deposition_rate_mm3_s=top["deposition_rate_mm3_s"], layer_time_s=top["layer_time_s"],
-                   slicer=top["slicer"], alignment_pin=sections["alignment_pin"],
+                   slicer=top["slicer"], alignment_pin=sections["alignment_pin"], sanding_stock=top["sanding_stock"],
                    source=" <- ".join(str(s) for s in raw.sources), marks=dict(raw.marks),
                    slicer_config=slicer_cfg, slicer_unavailable=unavailable, from_preset=tuple(from_preset))
 

@@ -39,7 +39,7 @@ import shutil
 import subprocess
 import tempfile
 import zipfile
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -363,10 +363,11 @@ def _run(exe: str, job: SliceJob) -> SliceResult:
 
 
 def slice_all(jobs: list[SliceJob], cached: dict[str, tuple] | None = None,
-              workers: int | None = None) -> tuple[list[SliceResult], str]:
+              workers: int | None = None, on_done=None) -> tuple[list[SliceResult], str]:
     """Slice every job, ``workers`` at a time (default: the cores, at most 4). ``cached`` maps a
     job name to (key, gcode bytes, 3MF bytes) of an earlier run; a job with the same key is
-    reused. Returns the results in job order and the slicer's version."""
+    reused. ``on_done(result)`` is called as each piece is done (reused ones first). Returns the
+    results in job order and the slicer's version."""
     exe = find_slicer()
     if exe is None:
         raise FabricationError(f"{SLICER} is not installed, so no G-code was written; {INSTALL_HINT}")
@@ -382,10 +383,16 @@ def slice_all(jobs: list[SliceJob], cached: dict[str, tuple] | None = None,
         if old and len(old) == 3 and old[0] == job.key(version) and old[2]:
             results[job.name] = SliceResult(job.name, old[1], 0.0, parse_estimates(old[1]), (), old[2],
                                             dict(job.placement))
+            if on_done:
+                on_done(results[job.name])
         else:
             todo.append(job)
     n = workers or min(4, os.cpu_count() or 1)
     with ThreadPoolExecutor(max_workers=max(1, n)) as pool:
-        for res in pool.map(lambda j: _run(exe, j), todo):
+        futures = [pool.submit(_run, exe, j) for j in todo]
+        for fut in as_completed(futures):
+            res = fut.result()
             results[res.name] = res
+            if on_done:
+                on_done(res)
     return [results[j.name] for j in jobs], version

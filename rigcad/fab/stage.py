@@ -1,16 +1,19 @@
 """The fabrication stage: a Rig + printer -> exports/<profile>/fab/<printer>/.
 
 For every part: fit it to the printer (or split it, rigcad.fab.split), choose each piece's
-orientation (rigcad.fab.orientation: least staircase on a mirror), slice it in-process
-(rigcad.fab.staircase: layer count, the staircase map from the slices against the closed form,
-the polishing allowance, the optical effect), write its STL in print position and, with
-``gcode``, its G-code through PrusaSlicer (rigcad.fab.slicer). Flat templates become DXF and SVG
-cutting outlines (rigcad.fab.outlines). fab.json (units in keys) and fab.md (with the staircase
-maps) report it all. Outputs are staged and published together (rigcad.export.atomic).
+orientation (rigcad.fab.orientation: no support on a mirror, then the least staircase; thin
+plates flat), print each mirror forward by its sanding stock (:func:`_with_stock`), slice it
+in-process (rigcad.fab.staircase: layer count, the staircase map from the slices against the
+closed form, the polishing allowance, the optical effect), write its STL in print position and,
+with ``gcode``, its G-code through PrusaSlicer (rigcad.fab.slicer) with the support contact read
+from it (rigcad.fab.support). Time and material: rigcad.fab.estimate (fitted to PrusaSlicer), and
+the slicer's own figures where it ran. Flat templates become DXF and SVG cutting outlines
+(rigcad.fab.outlines), one per finishing stage. fab.json (units in keys) and fab.md (with the
+pictures) report it all. Outputs are staged and published together (rigcad.export.atomic).
 
-Files: stl/<piece>.stl, gcode/<piece>.gcode, printer.ini, outlines/<part>.{dxf,svg},
-staircase/<part>.png, fab.json, fab.md. Timings are returned, not written (fab.json is
-deterministic). With G-code, also 3mf/<piece>.3mf: the PrusaSlicer project that made it.
+Files: stl/<piece>.stl, gcode/<piece>.gcode, printer.ini, outlines/<part>[_printed|_sanded].{dxf,svg},
+staircase/<part>.png, support/<piece>.png, fab.json, fab.md. Timings are returned, not written
+(fab.json is deterministic). With G-code, also 3mf/<piece>.3mf: the PrusaSlicer project that made it.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ import hashlib
 import json
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +31,7 @@ from rigcad import __version__
 from rigcad.errors import FabricationError, RigcadError
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad import plots
+from rigcad.fab import estimate as E
 from rigcad.fab import outlines
 from rigcad.fab import orientation as O
 from rigcad.fab import slicer as S
@@ -58,10 +62,22 @@ def _sha(b: bytes) -> str:
 
 
 def _mirror(part, layout) -> MirrorSurface | None:
+    """The part's printed mirror: the design surface behind by the coating, forward by the layout's
+    sanding stock (the surface the printer makes)."""
     if not part.mirrors:
         return None
     name, design = part.mirrors[0]
-    return MirrorSurface(name, design.behind(layout.coating), design)
+    stock = {"dome": layout.dome_stock, "paraboloid": layout.paraboloid_stock}.get(name, 0.0)
+    return MirrorSurface(name, design.behind(layout.coating - stock), design)
+
+
+def sanding_stock(printer: Printer, needed: float) -> tuple[float, str]:
+    """The stock (mm) printed in front of a mirror and where it comes from: the printer file's
+    ``sanding_stock``, or (auto) ``needed``, the stock the part's staircase needs in its print
+    orientation (:func:`stock_bound`: no valley behind the sanded surface)."""
+    if printer.sanding_stock is not None:
+        return printer.sanding_stock, "printer file (sanding_stock)"
+    return needed, "auto: the staircase's bound in the chosen orientations (stock_bound)"
 
 
 def evaluate(vertices, faces, orient: O.Orientation, printer: Printer, mirror_f) -> dict:
@@ -70,44 +86,49 @@ def evaluate(vertices, faces, orient: O.Orientation, printer: Printer, mirror_f)
     row = {"orientation": orient.name, "build_direction": [round(float(v), 12) for v in orient.direction],
            "fits": spin is not None, "spin_deg": None if spin is None else math.degrees(spin),
            "extents_mm": extents, "overhang_area_mm2": O.overhang_area(vertices, faces, orient.direction)}
+    mask = None
     if mirror_f is not None and len(mirror_f.index):
         mask = np.zeros(len(faces), bool)
         mask[mirror_f.index] = True
         row["mirror_overhang_area_mm2"] = O.overhang_area(vertices, faces, orient.direction, mask)
         row["staircase_closed_form"] = ST.surface_staircase(mirror_f, orient.direction, printer.layer_height)
+    if spin is not None:
+        row["support_model"] = O.support_contact(vertices, faces, orient.direction, mask)
     return row
 
 
+#: Support contact on a mirror (mm2, the model's estimate) below this counts as none: a few
+#: facets at a sector's edge, far under one support line's footprint.
+MIRROR_SUPPORT_TIE_MM2 = 1.0
+
+
 def choose(rows: list[dict]) -> int:
-    """Index of the best candidate: among those that fit, the least mean cusp on the mirror (ties
-    within CUSP_TIE_RTOL), then the least support on the mirror, then the least overhang, then the
-    lowest height; without a mirror, the least overhang, then the lowest height."""
+    """Index of the best candidate: among those that fit, the least support contact on the mirror
+    (the model's estimate; below MIRROR_SUPPORT_TIE_MM2 counts as none), then the least mean cusp
+    on the mirror (ties within CUSP_TIE_RTOL), then the least overhang, then the lowest height;
+    without a mirror, the least overhang, then the lowest height."""
     ok = [i for i, r in enumerate(rows) if r["fits"]]
     if not ok:
         return 0
     if all("staircase_closed_form" in rows[i] for i in ok):
+        def on_mirror(i):
+            a = rows[i]["support_model"]["mirror_mm2"]
+            return 0.0 if a < MIRROR_SUPPORT_TIE_MM2 else round(a, 0)
+
+        least = min(on_mirror(i) for i in ok)
+        ok = [i for i in ok if on_mirror(i) == least]
         best = min(rows[i]["staircase_closed_form"]["cusp_mean_mm"] for i in ok)
         ok = [i for i in ok if rows[i]["staircase_closed_form"]["cusp_mean_mm"] <= best * (1 + CUSP_TIE_RTOL)]
-        return min(ok, key=lambda i: (round(rows[i]["mirror_overhang_area_mm2"], 3),
-                                      round(rows[i]["overhang_area_mm2"], 3), rows[i]["extents_mm"]["z_mm"], i))
+        return min(ok, key=lambda i: (round(rows[i]["overhang_area_mm2"], 3), rows[i]["extents_mm"]["z_mm"], i))
     return min(ok, key=lambda i: (round(rows[i]["overhang_area_mm2"], 3), rows[i]["extents_mm"]["z_mm"], i))
 
 
-def _estimate(volume: float, layers: int, printer: Printer) -> dict:
-    """Time and material without a slicer (model material only, no support): mm3, g, s."""
-    t = layers * printer.layer_time_s
-    if printer.deposition_rate_mm3_s > 0:
-        t += volume / printer.deposition_rate_mm3_s
-    return {"method": "rigcad estimate: volume / deposition rate + layers x layer time (no support)",
-            "print_time_s": t, "material_cm3": volume / 1000.0,
-            "material_g": volume / 1000.0 * printer.material_density_g_cm3}
-
-
 def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: list[str] | None = None,
-            progress=None, workers: int | None = None, lock: Path | None = None) -> FabResult:
+            progress=None, workers: int | None = None, lock: Path | None = None, slicing=None) -> FabResult:
     """Run the stage for ``rig`` (a :class:`rigcad.rig.Rig`: the same converged dome, layout and
     recipes as the exported parts) into ``out`` (exports/<profile>/fab/<printer>); see the module
-    docstring."""
+    docstring. ``progress(label)`` is called as each part is done; ``slicing(total)``, when
+    given, is a context manager yielding ``step(label)``, called as each piece is sliced."""
     from rigcad.export.build import select_parts
 
     say = progress or (lambda msg: None)
@@ -123,6 +144,8 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
     problems: list[str] = []
     jobs: list[S.SliceJob] = []
     job_part: dict[str, str] = {}
+    stocks: dict[str, float] = {}  # mirror name -> stock printed in front of it (mm)
+    meshes: dict[str, tuple] = {}  # piece -> (vertices in print position, faces, mirror face indices)
 
     with Staging(out, lock) as stage:
         old_path = out / "fab.json"
@@ -142,15 +165,24 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                                       "plate_thickness_mm": o.thickness, "outline_size_mm": list(o.size),
                                       "outline_points": len(o.polygon), "chord_error_mm": chord,
                                       "files": {f"outlines/{name}.dxf": _sha(dxf), f"outlines/{name}.svg": _sha(svg)}}
+                report_parts[name]["stages"] = _stage_templates(rig, name, printer, stocks, chord, stage, out)
                 timings[f"outline:{name}"] = time.perf_counter() - t
+                say(name)
                 continue
-            say(name)
             try:
-                entry, part_jobs = _fab_part(part, layout, printer, chord, tol_mirror, bed_c, stage, out, timings)
+                if part.mirrors:
+                    entry, part_jobs = _with_stock(rig, part, printer, chord, tol_mirror, bed_c, stage, out, timings,
+                                                   stocks, meshes)
+                else:
+                    entry, part_jobs = _fab_part(part, layout, printer, chord, tol_mirror, bed_c, stage, out, timings,
+                                                 meshes)
+                entry.pop("_plan", None)
             except RigcadError as err:
                 problems.append(f"{name}: {err}")
                 report_parts[name] = {"error": str(err)}
+                say(name)
                 continue
+            say(name)
             report_parts[name] = entry
             for job in part_jobs:
                 jobs.append(job)
@@ -170,8 +202,12 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                     if (g.get("key") and path.is_file() and _sha(path.read_bytes()) == g.get("sha256")
                             and proj.is_file() and _sha(proj.read_bytes()) == g.get("project_sha256")):
                         cached[pc["name"]] = (g["key"], path.read_bytes(), proj.read_bytes())
+            from contextlib import nullcontext
+
             try:
-                results, version = S.slice_all(jobs, cached, workers)
+                with (slicing(len(jobs)) if slicing else nullcontext(None)) as step:
+                    results, version = S.slice_all(jobs, cached, workers,
+                                                   on_done=(lambda r: step(f"sliced {r.name}")) if step else None)
             except FabricationError as err:
                 problems.append(str(err))
                 report_gcode["error"] = str(err)
@@ -187,6 +223,9 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                                "project_sha256": _sha(res.project), "placement": res.placement}
                 if res.warnings:
                     problems.append(f"{job.name}: slicer warnings: {'; '.join(res.warnings)}")
+                if job.name in meshes:
+                    pc["gcode"]["support_contact"] = _support_contact(job.name, res.gcode, meshes[job.name], printer,
+                                                                      stage, out)
             timings["gcode"] = time.perf_counter() - t
             ini = S.printer_ini(printer, support=False)
         elif gcode and printer.slicer != "prusa-slicer":
@@ -218,8 +257,121 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
     return FabResult(report, written, timings, slicer_s, problems)
 
 
+def _support_contact(name: str, gcode: bytes, mesh: tuple, printer: Printer, stage: Staging, out: Path) -> dict:
+    """Support contact of one piece from its G-code's support extrusions (rigcad.fab.support), mm2
+    on its mirror and its other faces; a picture (support/<piece>.png) for pieces with a mirror."""
+    from rigcad.fab import support as SU
+
+    vertices, faces, mirror_index = mesh
+    settings = printer.slicer_config.effective() if printer.slicer_config else {}
+    beads = SU.support_beads(gcode)
+    areas = SU.contact_areas(vertices, faces, mirror_index, beads, SU.contact_reach(settings, printer.layer_height))
+    pts, touched, on_m = areas.pop("_points"), areas.pop("_touched"), areas.pop("_mirror")
+    areas["method"] = ("surface samples within reach_mm of the G-code's ;TYPE:Support material / Support material "
+                       "interface extrusions (rigcad.fab.support)")
+    if len(mirror_index):
+        png = plots.support_contact(pts, touched, on_m, beads.points,
+                                    f"{name}: support contact from the G-code: mirror {areas['mirror_mm2']:.0f} mm2, "
+                                    f"other faces {areas['other_mm2']:.0f} mm2")
+        stage.write_bytes(out / "support" / f"{name}.png", png)
+        areas["png"] = f"support/{name}.png"
+        areas["png_sha256"] = _sha(png)
+    return areas
+
+
+#: The mirror each template gauges.
+TEMPLATE_MIRROR = {"dome_template": "dome", "paraboloid_template": "paraboloid"}
+
+
+def _stage_templates(rig, name: str, printer: Printer, stocks: dict, chord: float, stage: Staging,
+                     out: Path) -> dict:
+    """Templates that gauge the mirror at each stage of its finishing (thesis 3.4, Figure 3.11):
+    ``printed`` (the surface the printer makes: the stock in front of the sanded one), ``sanded``
+    (the surface the coating goes on: the design surface behind by the whole coating) and
+    ``coated`` (the profile's gauged layer: ``outlines/<template>.dxf``). Depths in mm behind the
+    design surface; the printed stage needs the stock, known when the mirror's part is in the
+    same run or the printer file states it."""
+    from rigcad.parts import templates as T
+
+    make = {"dome_template": T.dome_template, "paraboloid_template": T.paraboloid_template}[name]
+    mirror = TEMPLATE_MIRROR[name]
+    coating = rig.layout.coating
+    stock = stocks.get(mirror, printer.sanding_stock)
+    rows = {"coated": {"gauges": f"the {rig.profile.templates.gauged_layer} surface",
+                       "depth_behind_design_mm": T.gauged_depth(rig.profile),
+                       "files": [f"outlines/{name}.dxf", f"outlines/{name}.svg"]}}
+    depths = {"sanded": ("the sanded surface, under the whole coating", coating)}
+    if stock is not None:
+        depths["printed"] = (f"the printed surface, {stock:.3f} mm of sanding stock in front of the sanded one",
+                             coating - stock)
+    else:
+        rows["printed"] = {"note": f"not written: the stock is 'auto' and the {mirror} is not in this run "
+                                   "(fab it too, or set sanding_stock in the printer file)"}
+    for label, (what, depth) in depths.items():
+        o = outlines.outline(make(rig.profile, rig.layout, depth), chord)
+        files = {}
+        for ext, data in (("dxf", outlines.dxf_bytes(o)), ("svg", outlines.svg_bytes(o))):
+            path = f"outlines/{name}_{label}.{ext}"
+            stage.write_bytes(out / path, data)
+            files[path] = _sha(data)
+        rows[label] = {"gauges": what, "depth_behind_design_mm": depth, "files": files}
+    return rows
+
+
+def _with_stock(rig, part, printer: Printer, chord: float, tol_mirror: float, bed_c, stage: Staging, out: Path,
+                timings: dict, stocks: dict, meshes: dict) -> tuple[dict, list]:
+    """A mirror part printed with its sanding stock: the split and the orientations are chosen on
+    the part as designed (0.1 mm changes neither), the stock follows (:func:`sanding_stock`), then
+    the part with its mirror moved forward by the stock is split the same way and fabricated.
+    Records the stock in ``stocks`` and in the entry."""
+    from rigcad.parts import PARTS
+
+    name = part.name
+    mirror = part.mirrors[0][0]
+    t = time.perf_counter()
+    first, _ = _fab_part(part, rig.layout, printer, chord, tol_mirror, bed_c, stage, out, timings, orient_only=True)
+    steep = [pc["mirror_max_abs_normal_along_build"] for pc in first["pieces"]
+             if pc["mirror_max_abs_normal_along_build"] is not None]
+    bound = stock_bound(printer.layer_height, max(steep, default=0.0), chord)
+    stock, source = sanding_stock(printer, bound)
+    stocks[mirror] = stock
+    record = {"stock_mm": stock, "source": source, "needed_bound_mm": bound,
+              "needed_bound_formula": "layer/2 x max |n . D| over the mirror + STL chord error",
+              "part_volume_without_stock_mm3": first["volume_mm3"],
+              "mirror_area_without_stock_mm2": sum(pc["mirror_area_mm2"] for pc in first["pieces"])}
+    timings[f"{name}:orient_for_stock"] = time.perf_counter() - t
+    layout = rig.layout.with_sanding_stock(**{mirror: stock, ("paraboloid" if mirror == "dome" else "dome"): 0.0})
+    stocked = replace(part, solid=PARTS[name](rig.profile, layout).solid)  # the same part, its mirror moved
+    new, new_jobs = _fab_part(stocked, layout, printer, chord, tol_mirror, bed_c, stage, out, timings, meshes,
+                              plan=first["_plan"])
+    record["volume_added_mm3"] = new["volume_mm3"] - first["volume_mm3"]
+    record["mirror_area_times_stock_mm3"] = record["mirror_area_without_stock_mm2"] * stock
+    record["volume_added_over_area_times_stock"] = (record["volume_added_mm3"] / record["mirror_area_times_stock_mm3"]
+                                                    if record["mirror_area_times_stock_mm3"] > 0 else None)
+    changed = [pc["name"] for pc, q in zip(first["pieces"], new["pieces"]) if pc["orientation"] != q["orientation"]]
+    if changed:
+        record["orientation_changed_by_stock"] = changed
+    # the stepped surface measured on the slices of the stocked mesh: any valley behind the sanded
+    # surface is what sanding to the template would leave unfilled (0 when the bound holds)
+    if "polishing" in new:
+        record["valley_behind_sanded_surface_mm"] = max(0.0, new["polishing"]["stock_to_add_mm"] - stock)
+    new["sanding_stock"] = record
+    return new, new_jobs
+
+
+def stock_bound(layer: float, steepest: float, chord: float) -> float:
+    """The stock (mm) that keeps every valley of the staircase in front of the sanded surface,
+    whatever the layers' phase: a layer's wall stands at its mid-height contour, so its inner
+    corner lies layer/2 x |n . D| behind the surface (D the build direction, n the mirror's
+    normal), and the STL's facets depart from the surface by up to the chord error."""
+    return 0.5 * layer * steepest + chord
+
+
 def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, bed_c, stage: Staging, out: Path,
-              timings: dict) -> tuple[dict, list]:
+              timings: dict, meshes: dict | None = None, plan=None, orient_only: bool = False) -> tuple[dict, list]:
+    """One printed part: mesh, fit or split (``plan``: a split decided before, or None to find the
+    fewest pieces), orient every piece, slice it, its STL and slicing job; ``orient_only`` stops
+    after choosing the orientations (what the sanding stock needs to know, :func:`_with_stock`)."""
     from rigcad.export import mesh as M
 
     name = part.name
@@ -230,9 +382,17 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
 
     t = time.perf_counter()
     v, f = M.mesh_arrays(man)
-    whole_fits = any(O.fit_spin(v, o.direction, printer.usable)[0] is not None
-                     for o in (O.mirror_candidates(None) if mirror else O.generic_candidates()))
-    if whole_fits:
+    plate = None if mirror else O.plate_axis(v)
+
+    def candidates(sector=None, sectors: bool = False) -> list[O.Orientation]:
+        if mirror:
+            return O.mirror_candidates(sector if sectors else None)
+        return O.flat_candidates(plate) if plate is not None else O.generic_candidates()
+
+    whole_fits = plan is None and any(O.fit_spin(v, o.direction, printer.usable)[0] is not None for o in candidates())
+    if plan is not None:
+        pass
+    elif whole_fits:
         plan = SP.SplitPlan(1, 1, 0.0, (float(v[:, 2].min()), float(v[:, 2].max())))
     else:
         def fits(cell, plan, i, j):
@@ -240,7 +400,7 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
                 return True
             cv, _ = M.mesh_arrays(cell)
             rng = plan.sector_range(i) if plan.sectors > 1 else None
-            cands = O.mirror_candidates(rng) if mirror and isinstance(plan, SP.SplitPlan) else O.generic_candidates()
+            cands = candidates(rng, isinstance(plan, SP.SplitPlan))
             return any(O.fit_spin(cv, o.direction, printer.usable)[0] is not None for o in cands)
 
         if SP.is_off_axis(man):  # flat / off-axis parts: a grid in their own bounding box
@@ -256,8 +416,8 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
 
     entry = {"process": printer.process, "quantity": part.quantity, "description": part.description,
              "volume_mm3": man.volume(), "split": plan.describe(),
-             "mirror": mirror.name if mirror else None}
-    if plan.count > 1:
+             "mirror": mirror.name if mirror else None, "_plan": plan}
+    if plan.count > 1 and not orient_only:
         entry["pins"] = [{"centre_mm": list(p.centre), "axis": list(p.axis), "face": p.face} for p in pins]
         if tongues:
             entry["tongues"] = [t.describe() for t in tongues]
@@ -269,25 +429,42 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
     for pc in pieces:
         pv, pf = M.mesh_arrays(pc.manifold)
         mf = mirror_faces(pv, pf, mirror, tol_mirror) if mirror else None
-        cands = O.mirror_candidates(pc.sector_range) if mirror and isinstance(plan, SP.SplitPlan) else O.generic_candidates()
+        cands = candidates(pc.sector_range, isinstance(plan, SP.SplitPlan))
         rows = [evaluate(pv, pf, o, printer, mf) for o in cands]
         k = choose(rows)
         if not rows[k]["fits"]:
             raise FabricationError(f"piece {pc.name} fits the printer in no orientation")
         best = O.Orientation(cands[k].name, cands[k].direction, math.radians(rows[k]["spin_deg"]))
         rot = best.rotation()
+        steep = float(np.abs(mf.normals @ np.asarray(best.direction)).max()) if mf is not None and len(mf.index) else None
+        if orient_only:
+            piece_rows.append({"name": pc.name, "orientation": best.name, "mirror_area_mm2": mf.area if mf else 0.0,
+                               "mirror_max_abs_normal_along_build": steep})
+            continue
         layers, shift = ST.slice_layers(pc.manifold, rot, printer.layer_height, printer.first_layer_height)
         placed = O.place(pv, best, bed_c)
+        if meshes is not None:
+            meshes[pc.name] = (placed, pf, mf.index if mf is not None else np.zeros(0, int))
         stl = M.stl_bytes(placed, pf, pc.name)
         stage.write_bytes(out / "stl" / f"{pc.name}.stl", stl)
         volume = pc.manifold.volume()
+        # print position = rotation @ part frame + translation (what O.place did), for readers of the STL
+        translation = (placed - pv @ rot.T).mean(axis=0)
         row = {"name": pc.name, "orientation": best.name, "build_direction": rows[k]["build_direction"],
                "spin_deg": rows[k]["spin_deg"], "extents_mm": rows[k]["extents_mm"], "layers": layers.count,
+               "print_transform": {"rotation": rot.tolist(), "translation_mm": translation.tolist()},
                "volume_mm3": volume, "needs_support": rows[k]["overhang_area_mm2"] > 0,
-               "candidates": rows, "stl_sha256": _sha(stl), "estimate": _estimate(volume, layers.count, printer)}
+               "candidates": rows, "stl_sha256": _sha(stl),
+               "support_model": rows[k]["support_model"],
+               "estimate": E.estimate(E.Features(volume, pc.manifold.surface_area(), layers.count,
+                                                 rows[k]["support_model"]["support_envelope_mm3"],
+                                                 rows[k]["support_model"]["mirror_under_mm2"]
+                                                 + rows[k]["support_model"]["other_under_mm2"],
+                                                 E.shell_thickness(printer)), printer)}
         if mf is not None and len(mf.index):
             steps = ST.step_map(layers, rot, shift, mirror, tol_mirror)
             row["mirror_area_mm2"] = mf.area
+            row["mirror_max_abs_normal_along_build"] = steep
             row["staircase_from_slices"] = steps.summary()
             row["polishing"] = ST.polishing_allowance(steps)
             row["optical_effect_as_printed"] = ST.optical_effect(mf, best.direction, mirror.name)
@@ -298,6 +475,8 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
             jobs.append(S.slice_job(printer, pc.name, stl, row["needs_support"], bed_c))
     timings[f"{name}:orient_slice"] = time.perf_counter() - t
     entry["pieces"] = piece_rows
+    if orient_only:
+        return entry, []
     entry["layers_total"] = sum(r["layers"] for r in piece_rows)
     if map_pts:
         pts, cusp = np.concatenate(map_pts), np.concatenate(map_cusp)
@@ -373,7 +552,7 @@ def markdown(report: dict) -> str:
     lines = [f"# Fabrication: {report['profile']} on {pr['name']}", "",
              f"{pr['description']} ({pr['process']}); build volume {' x '.join(f'{v:g}' for v in pr['build_volume_mm'])} mm; "
              f"layer {pr['layer_height_mm']:.4g} mm; material {pr['material']}. Source: `{pr['source']}`.", "",
-             "| part | qty | pieces | orientation | layers | time | material | mirror cusp mean / max (mm) | sanding / stock (mm) |",
+             "| part | qty | pieces | orientation | layers | time | material | mirror cusp mean / max (mm) | sanding depth / stock printed (mm) |",
              "|---|---|---|---|---|---|---|---|---|"]
     for name, e in report["parts"].items():
         if "error" in e:
@@ -390,14 +569,42 @@ def markdown(report: dict) -> str:
         orient = ", ".join(sorted({pc["orientation"] for pc in pcs}))
         sm = e.get("staircase_map")
         cusp = f"{sm['cusp_mean_mm']:.3f} / {sm['cusp_max_mm']:.3f}" if sm else "-"
-        pol = f"{e['polishing']['sanding_depth_mm']:.3f} / {e['polishing']['stock_to_add_mm']:.3f}" if "polishing" in e else "-"
+        stock = e["sanding_stock"]["stock_mm"] if e.get("sanding_stock") else e.get("polishing", {}).get("stock_to_add_mm")
+        pol = f"{e['polishing']['sanding_depth_mm']:.3f} / {stock:.3f}" if "polishing" in e else "-"
         lines.append(f"| {name} | {e['quantity']} | {len(pcs)} | {orient} | {e['layers_total']} | {_hms(t)} ({src}) | "
                      f"{g:.0f} g | {cusp} | {pol} |")
     tot = report["totals"]
     lines += ["", f"Totals (with quantities): {tot['pieces']} pieces, {_hms(tot['estimate_print_time_s'])} and "
-              f"{tot['estimate_material_g']:.0f} g by rigcad's estimate (model material, no support)"
+              f"{tot['estimate_material_g']:.0f} g by rigcad's estimate (rigcad.fab.estimate, fitted to PrusaSlicer)"
               + (f"; slicer: {_hms(tot['slicer_print_time_s'])}, {tot['slicer_filament_g']:.0f} g" if "slicer_print_time_s" in tot else "")
               + ".", ""]
+    stocked = [(n, e) for n, e in report["parts"].items() if e.get("sanding_stock")]
+    if stocked:
+        lines += ["## Sanding stock", "",
+                  "Every mirror is printed forward, into the light, by the stock: sand down to the `_sanded` template "
+                  "(the steps' valleys then lie in front of it), coat, and the coating brings the surface to the design "
+                  "surface. Templates: `outlines/<mirror>_template_printed` gauges the print, `_sanded` the sanded "
+                  "surface, `<mirror>_template` the coating layer the profile names.", "",
+                  "| part | stock (mm) | from | volume added (cm3) | / (mirror area x stock) | valley left behind the sanded surface (mm) |",
+                  "|---|---|---|---|---|---|"]
+        for n, e in stocked:
+            st = e["sanding_stock"]
+            ratio = st.get("volume_added_over_area_times_stock")
+            lines.append(f"| {n} | {st['stock_mm']:.3f} | {st['source']} | {st.get('volume_added_mm3', 0) / 1000:.2f} | "
+                         f"{'-' if ratio is None else f'{ratio:.4f}'} | {st.get('valley_behind_sanded_surface_mm', 0):.4f} |")
+        lines.append("")
+    contact = [(pc, e) for e in report["parts"].values() for pc in e.get("pieces", [])
+               if pc.get("gcode", {}).get("support_contact")]
+    if contact:
+        lines += ["## Support contact (from the G-code's support extrusions)", "",
+                  "| piece | orientation | on the mirror (mm2) | on other faces (mm2) | model: mirror / other (mm2) | picture |",
+                  "|---|---|---|---|---|---|"]
+        for pc, e in contact:
+            sc, sm = pc["gcode"]["support_contact"], pc.get("support_model", {})
+            pic = f"![{pc['name']}]({sc['png']})" if "png" in sc else ""
+            lines.append(f"| {pc['name']} | {pc['orientation']} | {sc['mirror_mm2']:.0f} | {sc['other_mm2']:.0f} | "
+                         f"{sm.get('mirror_mm2', 0):.0f} / {sm.get('other_mm2', 0):.0f} | {pic} |")
+        lines.append("")
     for name, e in report["parts"].items():
         if not e.get("staircase_map"):
             continue
@@ -428,7 +635,7 @@ def markdown(report: dict) -> str:
         lines += ["", f"![staircase map of {name}]({e['staircase_map']['png']})", "",
                   "As printed, the steps' treads and risers tilt the surface normal by tens of degrees (ideal steps), "
                   "so every reflected ray is lost: the steps must be sanded away (depth above) before the coating. "
-                  "Printing the mirror forward by the stock keeps every valley behind the design surface.", ""]
+                  "The mirror is printed forward by the sanding stock (above), so that every valley lies in front of the sanded surface.", ""]
     if report["problems"]:
         lines += ["## Problems", ""] + [f"- {p}" for p in report["problems"]] + [""]
     return "\n".join(lines)

@@ -23,9 +23,11 @@ def bolt_holes(layout: RigLayout, diameter: float, z0: float, height: float) -> 
 
 
 def dome(profile: Profile, layout: RigLayout) -> Part:
-    """Printed dome: inner face = the coated mirror surface moved behind by the coating."""
+    """Printed dome: inner face = the coated mirror surface moved behind by the coating (and forward
+    by the layout's sanding stock: ``as_printed_dome``)."""
     shell = profile.dome_shell
-    inner, outer = layout.printed_dome, layout.dome_outer
+    inner, outer = layout.as_printed_dome, layout.dome_outer
+    u_base = u_at_height(inner, 0.0) if layout.dome_stock else layout.u_inner_base
     u_top_in = inner.u_range[1]
     top_in = _pt(inner, u_top_in)
     # The top edge runs along the mirror's normal: the outer curve's end is the inner's end moved by the wall.
@@ -34,9 +36,9 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
     t_f = shell.flange_thickness
     fl_in = _pt(outer, u_fl)
     r_out = layout.flange_outer_r
-    base_in = _pt(inner, layout.u_inner_base)
+    base_in = _pt(inner, u_base)
     section = Section((
-        Curve(inner, layout.u_inner_base, u_top_in),
+        Curve(inner, u_base, u_top_in),
         Line(top_in, top_out),
         Curve(outer, u_top_in, u_fl),
         Line(fl_in, (r_out, t_f)),

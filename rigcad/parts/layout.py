@@ -10,7 +10,7 @@ bolted to the base plate whose top face is the sample plane z = 0.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -63,11 +63,35 @@ class RigLayout:
     slot_r: float  #: the wall's largest outer radius across the beam's slot band
     dome_top_z: float  #: the dome's highest point
     tower: "TowerLayout"  #: the COP tower and its instruments (rigcad.parts.tower)
+    #: Sanding stock (mm) printed in front of ``printed_dome`` / ``printed_paraboloid`` (0 for the
+    #: design exports; the fab stage sets it, :meth:`with_sanding_stock`).
+    dome_stock: float = 0.0
+    paraboloid_stock: float = 0.0
+
+    @property
+    def as_printed_dome(self) -> Meridian:
+        """The dome's mirror as the printer makes it: ``printed_dome`` moved into the light by the stock."""
+        return self.printed_dome.behind(-self.dome_stock) if self.dome_stock else self.printed_dome
+
+    @property
+    def as_printed_paraboloid(self) -> Meridian:
+        """The paraboloid's mirror as printed: ``printed_paraboloid`` moved into the light by the stock."""
+        return self.printed_paraboloid.behind(-self.paraboloid_stock) if self.paraboloid_stock else self.printed_paraboloid
+
+    def with_sanding_stock(self, dome: float, paraboloid: float) -> "RigLayout":
+        """This layout with the mirrors printed ``dome`` / ``paraboloid`` mm into the light, so that
+        sanding down to ``printed_*`` (then coating) reaches the design surface; every other
+        placement (the dome's outer wall, the paraboloid's back) stays."""
+        if dome < 0 or paraboloid < 0:
+            raise GeometryError(f"sanding stock must be >= 0 mm (dome {dome:g} mm, paraboloid {paraboloid:g} mm)")
+        return replace(self, dome_stock=float(dome), paraboloid_stock=float(paraboloid))
 
     def describe(self) -> dict[str, float]:
         """Placements for the manifest (mm)."""
         return {
             "coating_total_mm": self.coating,
+            **({"sanding_stock_dome_mm": self.dome_stock, "sanding_stock_paraboloid_mm": self.paraboloid_stock}
+               if self.dome_stock or self.paraboloid_stock else {}),
             "flange_inner_r_mm": self.flange_inner_r,
             "flange_outer_r_mm": self.flange_outer_r,
             "bolt_circle_r_mm": self.bolt_circle_r,

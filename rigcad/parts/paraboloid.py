@@ -60,15 +60,19 @@ def stem_and_clamp(m: Mount) -> Solid:
 
 
 def paraboloid(profile: Profile, layout: RigLayout) -> Part:
-    """Printed paraboloid: its convex face is the coated mirror moved inward by the coating."""
-    m = layout.printed_paraboloid
+    """Printed paraboloid: its convex face is the coated mirror moved inward by the coating (and
+    outward by the layout's sanding stock, ``as_printed_paraboloid``: the stock's layer meets the
+    rim along the mirror's normal, so the back keeps its size)."""
+    body, m = layout.printed_paraboloid, layout.as_printed_paraboloid
     u_rim, u_vertex = m.u_range
+    rim0 = tuple(float(v) for v in body.points(np.array([u_rim]))[0])
     rim = tuple(float(v) for v in m.points(np.array([u_rim]))[0])
     vertex = tuple(float(v) for v in m.points(np.array([u_vertex]))[0])
     back = layout.paraboloid_back_z
+    edge = (Line((rim0[0], back), rim0), Line(rim0, rim)) if layout.paraboloid_stock else (Line((rim[0], back), rim),)
     section = Section((
-        Line((0.0, back), (rim[0], back)),
-        Line((rim[0], back), rim),
+        Line((0.0, back), (rim0[0], back)),
+        *edge,
         Curve(m, u_rim, u_vertex),
         Line(vertex, (0.0, back)),
     ))

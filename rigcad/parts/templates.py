@@ -27,8 +27,10 @@ def _pt(m, u) -> tuple[float, float]:
     return tuple(float(v) for v in m.points(np.array([u]))[0])
 
 
-def dome_template(profile: Profile, layout: RigLayout) -> Part:
-    g = layout.design_dome.behind(gauged_depth(profile))
+def dome_template(profile: Profile, layout: RigLayout, depth: float | None = None) -> Part:
+    """The dome's template; ``depth`` (mm behind the design surface) gauges another surface than
+    the profile's gauged layer (the fab stage's printed and sanded stages)."""
+    g = layout.design_dome.behind(gauged_depth(profile) if depth is None else depth)
     front = g.behind(-profile.templates.band)  # on the reflecting side: the template's body
     u0, u1 = u_at_height(g, 0.0), g.u_range[1]
     section = Section((
@@ -42,8 +44,9 @@ def dome_template(profile: Profile, layout: RigLayout) -> Part:
                 "(hold it in a meridional plane against the inside of the dome)", in_rig=False)
 
 
-def paraboloid_template(profile: Profile, layout: RigLayout) -> Part:
-    g = layout.design_paraboloid.behind(gauged_depth(profile))
+def paraboloid_template(profile: Profile, layout: RigLayout, depth: float | None = None) -> Part:
+    """The paraboloid's template (``depth`` as for :func:`dome_template`)."""
+    g = layout.design_paraboloid.behind(gauged_depth(profile) if depth is None else depth)
     u_rim, u_v = g.u_range
     rim = _pt(g, u_rim)
     vertex_z = _pt(g, u_v)[1]

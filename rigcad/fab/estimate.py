@@ -1,0 +1,137 @@
+"""Print time and material without a slicer: a model of what PrusaSlicer does, fitted to
+PrusaSlicer's own figures on this rig's pieces (``bench/fab_stages.py --estimates --fit``).
+
+A piece is read as the slicer builds it: a shell of ``perimeters`` beads around every surface
+(``shell_mm`` thick: perimeters x extrusion width), the core inside it at the infill's share,
+support under its overhangs (the columns from each overhang down to what it stands on, and the
+overhang's area for the dense interface layers: rigcad.fab.orientation.support_contact), and a
+fixed cost per piece (the vendor's start G-code: heating, mesh bed levelling, purge line, skirt).
+Material and time are linear in those, with non-negative coefficients (scipy's NNLS, each piece's
+relative error weighing alike):
+
+    material (mm3) = m_shell V_shell + m_core V_core + m_support V_support + m_piece
+    time (s)       = t_shell V_shell + t_core V_core + t_support V_support + t_overhang A_overhang
+                     + t_layer layers + t_piece
+
+Where V_shell = min(V, surface area x shell_mm), V_core = V - V_shell. The coefficients below were
+fitted on the Prusa MK3S (0.15 mm QUALITY, 3 perimeters, 20 % infill, PrusaSlicer 2.5) and hold
+there within MAX_REL_ERROR on every piece (bench table, README); another printer scales the
+volume terms by its own deposition rate and the layer term by its layer time against the MK3S
+file's (8 mm3/s, 1 s): a first-order transfer, not a calibration.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Largest error (relative to PrusaSlicer) the fit is held to on every piece of the default profile.
+MAX_REL_ERROR = 0.25
+#: The calibration printer's figures the time scales against (rigcad/profiles/printers/prusa_mk3s.yaml).
+CALIBRATION = {"printer": "prusa_mk3s", "deposition_rate_mm3_s": 8.0, "layer_time_s": 1.0}
+
+
+@dataclass(frozen=True)
+class Fit:
+    """Coefficients of the model (see the module docstring): material per mm3 of shell, core and
+    support envelope (mm3/mm3) and per piece (mm3); time per mm3 (s/mm3), per mm2 of overhang
+    (s/mm2), per layer (s) and per piece (s)."""
+
+    m_shell: float
+    m_core: float
+    m_support: float
+    m_piece: float
+    t_shell: float
+    t_core: float
+    t_support: float
+    t_overhang: float
+    t_layer: float
+    t_piece: float
+    source: str
+
+
+#: Fitted by `bench/fab_stages.py --estimates --fit` on achutha2006 / prusa_mk3s (16 pieces,
+#: PrusaSlicer 2.5.0); bench/results/fab_estimates.json holds the table and the leave-one-out errors.
+FIT = Fit(m_shell=0.827627, m_core=0.158985, m_support=0.246222, m_piece=844.977,
+          t_shell=0.336918, t_core=0.0551712, t_support=0.141063, t_overhang=0.334485, t_layer=3.58497,
+          t_piece=621.682, source="fitted to PrusaSlicer 2.5.0 on achutha2006 / prusa_mk3s")
+
+
+@dataclass(frozen=True)
+class Features:
+    """What the model reads of a piece (mm, mm2, mm3)."""
+
+    volume_mm3: float
+    surface_mm2: float
+    layers: int
+    support_envelope_mm3: float
+    overhang_mm2: float
+    shell_mm: float
+
+    @property
+    def shell_volume_mm3(self) -> float:
+        return min(self.volume_mm3, self.surface_mm2 * self.shell_mm)
+
+    @property
+    def core_volume_mm3(self) -> float:
+        return self.volume_mm3 - self.shell_volume_mm3
+
+    def material_row(self) -> np.ndarray:
+        return np.array([self.shell_volume_mm3, self.core_volume_mm3, self.support_envelope_mm3, 1.0])
+
+    def time_row(self) -> np.ndarray:
+        return np.array([self.shell_volume_mm3, self.core_volume_mm3, self.support_envelope_mm3, self.overhang_mm2,
+                         float(self.layers), 1.0])
+
+
+def shell_thickness(printer) -> float:
+    """Perimeters x extrusion width (mm), from the printer's slicer settings, else 3 beads of
+    1.125 x the nozzle (PrusaSlicer's default width); an SLA print is solid (0: all shell)."""
+    if printer.process != "fdm":
+        return float("inf")
+    eff = printer.slicer_config.effective() if printer.slicer_config else {}
+    nozzle = printer.nozzle or 0.4
+    try:
+        perimeters = int(float(eff.get("perimeters", 3)))
+        width = str(eff.get("perimeter_extrusion_width", eff.get("extrusion_width", "0"))).strip()
+        w = nozzle * float(width[:-1]) / 100 if width.endswith("%") else float(width or 0)
+    except ValueError:
+        perimeters, w = 3, 0.0
+    return perimeters * (w if w > 0 else 1.125 * nozzle)
+
+
+def estimate(features: Features, printer, fit: Fit = FIT) -> dict:
+    """Time (s) and material (cm3, g) of one piece on ``printer`` by the fitted model."""
+    mat = float(features.material_row() @ np.array([fit.m_shell, fit.m_core, fit.m_support, fit.m_piece]))
+    if printer.process != "fdm":
+        mat = features.volume_mm3  # resin: the part itself (no infill; supports not modelled)
+    rate = printer.deposition_rate_mm3_s or CALIBRATION["deposition_rate_mm3_s"]
+    scale_v = CALIBRATION["deposition_rate_mm3_s"] / rate
+    scale_l = (printer.layer_time_s / CALIBRATION["layer_time_s"]) if printer.layer_time_s > 0 else 1.0
+    row = features.time_row()
+    t = float(row[:4] @ np.array([fit.t_shell, fit.t_core, fit.t_support, fit.t_overhang])) * scale_v
+    t += row[4] * fit.t_layer * scale_l + fit.t_piece
+    if printer.process != "fdm":  # resin: a whole layer is exposed at once, the time is per layer
+        t = features.layers * printer.layer_time_s
+    return {"method": f"rigcad model fitted to PrusaSlicer (rigcad.fab.estimate; {fit.source})",
+            "print_time_s": t, "material_cm3": mat / 1000.0,
+            "material_g": mat / 1000.0 * printer.material_density_g_cm3,
+            "features": {"volume_mm3": features.volume_mm3, "surface_mm2": features.surface_mm2,
+                         "layers": features.layers, "support_envelope_mm3": features.support_envelope_mm3,
+                         "overhang_mm2": features.overhang_mm2, "shell_mm": features.shell_mm}}
+
+
+def fit(rows: list[tuple[Features, float, float]], density_g_cm3: float, source: str) -> Fit:
+    """Fit the model to (features, slicer time s, slicer filament g) of many pieces: NNLS on the
+    relative error (each piece weighs alike, as the 25 % target does)."""
+    from scipy.optimize import nnls
+
+    f = [r[0] for r in rows]
+    t = np.array([r[1] for r in rows], dtype=float)
+    m = np.array([r[2] for r in rows], dtype=float) / density_g_cm3 * 1000.0  # mm3
+    A = np.array([x.material_row() for x in f]) / m[:, None]
+    cm, _ = nnls(A, np.ones(len(f)))
+    B = np.array([x.time_row() for x in f]) / t[:, None]
+    ct, _ = nnls(B, np.ones(len(f)))
+    return Fit(*(float(v) for v in cm), *(float(v) for v in ct), source=source)

@@ -1,0 +1,38 @@
+"""`rigcad fab` as a user runs it: progress for every part (and every piece sliced), and a
+terminal summary with the slicer's time and filament (issue 14, item 5)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from .conftest import ROOT, have_slicer
+
+
+def _fab(tmp_path, *args):
+    env = dict(os.environ, RIGCAD_EVENTS="1", PYTHONPATH=str(ROOT))
+    return subprocess.run([sys.executable, "-m", "rigcad.cli", "fab", "achutha2006", "--exports", str(tmp_path), *args],
+                          cwd=tmp_path, capture_output=True, text=True, env=env, timeout=600)
+
+
+def test_fab_reports_progress_per_part_and_a_summary(tmp_path):
+    proc = _fab(tmp_path, "--printer", "vantage_i", "--parts", "beam", "sample_holder", "dome_template")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    events = [ln.split(": ", 1)[1] for ln in proc.stderr.splitlines() if ln.startswith("rigcad-event: ")]
+    assert events == ["beam", "sample_holder", "dome_template"]  # one progress step per part, in order
+    assert "total (rigcad estimate, with quantities):" in proc.stdout
+    assert "beam: 1 piece(s)" in proc.stdout and "est. " in proc.stdout
+
+
+@pytest.mark.skipif(not have_slicer(), reason="prusa-slicer is not installed")
+def test_fab_gcode_reports_each_piece_sliced_and_the_slicers_figures(tmp_path):
+    proc = _fab(tmp_path, "--printer", "prusa_mk3s", "--gcode", "--parts", "beam", "sample_holder", "--jobs", "2")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    events = [ln.split(": ", 1)[1] for ln in proc.stderr.splitlines() if ln.startswith("rigcad-event: ")]
+    assert events[:2] == ["beam", "sample_holder"]
+    assert sorted(events[2:]) == ["sliced beam", "sliced sample_holder"]  # as each piece is done
+    assert "total (prusa-slicer, with quantities):" in proc.stdout and " g filament" in proc.stdout
+    assert "; slicer " in proc.stdout  # per part: the slicer's time and filament
