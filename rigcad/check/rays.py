@@ -392,7 +392,9 @@ class ExactDome:
 
     backend = "analytic float64 (dome meridian spline, Newton)"
 
-    def __init__(self, meridian: Meridian) -> None:
+    def __init__(self, meridian: Meridian, correspondence: bool = True) -> None:
+        #: False: every ray takes the bracketing path (the reference the kernels are tested against)
+        self.correspondence = correspondence
         self.m = meridian
         u = meridian.sample(DENSE_SAMPLES)
         p = meridian.points(u)
@@ -437,6 +439,9 @@ class ExactDome:
         n = len(o)
         hits = Hits.empty(n)
         u_lo, u_hi = self.m.u_range
+        if not self.correspondence:
+            idx, t, u = self._bracketed(o, d)
+            return self._hits(hits, o, d, idx, t, u, tmax)
         u0 = np.clip(-np.hypot(o[:, 0], o[:, 1]), u_lo, u_hi)
         c0 = self.m._spline(u0)
         # seed t: where the ray reaches the seed point's height (or, for a level ray, its radius)
@@ -453,6 +458,9 @@ class ExactDome:
             idx = np.concatenate([idx, rest[r_idx]])
             t_all = np.concatenate([t_all, r_t])
             u_all = np.concatenate([u_all, r_u])
+        return self._hits(hits, o, d, idx, t_all, u_all, tmax)
+
+    def _hits(self, hits: Hits, o, d, idx, t_all, u_all, tmax) -> Hits:
         ok = np.isfinite(t_all) & (t_all > 0)
         if tmax is not None:
             ok &= t_all <= tmax[idx]

@@ -11,7 +11,7 @@ those pairs are not traced (no self-intersection at the ray's origin either).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -43,7 +43,8 @@ class Trace3D:
     paraboloid and dome hit points ``p1``, ``p2`` (n, 3) mm (NaN where not reached), the final
     direction ``v`` (n, 3), ``landing`` (n, 3) on z = 0, total ``path_length`` mm, and ``miss``: the
     distance from O to the returning ray's line (mm; the convergence error, well conditioned even
-    at grazing incidence, where the landing point is not)."""
+    at grazing incidence, where the landing point is not). ``kernels``: rays per kernel of the
+    analytic tracer (rigcad.check.analytic), or ``{"vectorised": n}`` for the numpy path."""
 
     status: np.ndarray
     segment: np.ndarray
@@ -53,6 +54,7 @@ class Trace3D:
     landing: np.ndarray
     path_length: np.ndarray
     miss: np.ndarray
+    kernels: dict = field(default_factory=dict)
 
     @property
     def ok(self) -> np.ndarray:
@@ -76,8 +78,12 @@ class Trace3D:
         return np.where(self.ok, np.arctan2(a[:, 1], a[:, 0]), np.nan)
 
 
-def trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
-    """Trace rays (origins, unit dirs: (n, 3), global frame) through ``optics``."""
+def trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray, vectorised: bool = False) -> Trace3D:
+    """Trace rays (origins, unit dirs: (n, 3), global frame) through ``optics``: by the compiled
+    analytic kernels when ``optics`` has them (``optics.fast``, analytic optics), else (or with
+    ``vectorised=True``) by the intersectors' numpy passes below."""
+    if optics.fast is not None and not vectorised:
+        return optics.fast.trace(optics, origins, dirs)
     n = len(origins)
     dirs = unit(np.asarray(dirs, float))
     origins = np.asarray(origins, float)
@@ -141,7 +147,7 @@ def trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     path[i3] = t1[keep][ok] + t2[ok] + t3[ok]
     miss = np.full(n, np.nan)
     miss[i3] = np.linalg.norm(_cross(q2[ok], w[ok]), axis=1)  # |O - line|, O at the origin
-    return Trace3D(status, segment, p1, p2, v, landing, path, miss)
+    return Trace3D(status, segment, p1, p2, v, landing, path, miss, {"vectorised": n})
 
 
 def convergence_point(tr: Trace3D) -> np.ndarray:

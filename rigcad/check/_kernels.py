@@ -1,0 +1,477 @@
+"""Compiled (numba) kernels of the analytic tracer (rigcad.check.analytic): one loop per ray in
+float64, the same arithmetic as the vectorised reference in rays.py / trace3d.py.
+
+Frame: mm, sample point O at the origin, optical axis +z. Poses are (R (3, 3), T (3,)) with
+global = R @ local + T (rigcad.optics.frames.Pose). Occluders are rows of an (k, 11) array:
+``[0, lo_x, lo_y, lo_z, hi_x, hi_y, hi_z]`` for a box, ``[1, radius, z0, z1, cx, cy, 0]`` for a
+z-cylinder (rigcad.optics.solids gives the same entry distances, vectorised), each followed by
+a bounding sphere ``[cx, cy, cz, radius]`` (columns 7..10) that lets most rays skip the test.
+
+Statuses are trace3d's codes (kept in step by tests/check/test_analytic.py).
+
+Why numba: a ray through the aligned rig costs ~100 float64 operations; as numpy array passes
+that is ~100 trips through memory per ray (~5 M rays/s on one core), fused in one compiled loop
+it is ~20 M rays/s (bench/raycheck.py measures both against raw Embree). ``cache=True`` keeps the
+machine code on disk (``__pycache__``) so worker processes do not recompile.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+_JIT = dict(cache=True, nogil=True, error_model="numpy")
+
+# trace3d status codes (duplicated for the compiled code; test_analytic checks they agree)
+OK, MISSED_PARABOLOID, OCCLUDED_BY_MOUNT, OCCLUDED_BY_BEAM, OCCLUDED_BY_PARABOLOID, ESCAPED_TOP, \
+    MISSED_DOME, ESCAPED_AFTER_DOME = range(8)
+
+#: Distance (mm) a ray must travel before it can hit the paraboloid (rays.ExactParaboloid's eps).
+PARABOLOID_EPS = 1e-9
+
+
+@nb.njit(**_JIT)
+def _slab(o, d, lo, hi, tlo, thi):
+    """One axis of the slab test: the interval (tlo, thi) narrowed (tlo > thi: no hit)."""
+    if d == 0.0:
+        if o < lo or o > hi:
+            return np.inf, -np.inf
+        return tlo, thi
+    t1 = (lo - o) / d
+    t2 = (hi - o) / d
+    if t1 > t2:
+        t1, t2 = t2, t1
+    return max(tlo, t1), min(thi, t2)
+
+
+@nb.njit(**_JIT)
+def _box(ox, oy, oz, dx, dy, dz, lx, ly, lz, hx, hy, hz):
+    """Entry distance of a ray into the box [l, h] (0 from inside, inf for none): solids.slab."""
+    tlo, thi = _slab(ox, dx, lx, hx, -np.inf, np.inf)
+    tlo, thi = _slab(oy, dy, ly, hy, tlo, thi)
+    tlo, thi = _slab(oz, dz, lz, hz, tlo, thi)
+    if tlo <= thi and thi > 0.0:
+        return max(tlo, 0.0)
+    return np.inf
+
+
+@nb.njit(**_JIT)
+def _cylinder(ox, oy, oz, dx, dy, dz, r, z0, z1, cx, cy):
+    """Entry distance into a solid z-cylinder (0 from inside, inf for none): solids.z_cylinder."""
+    ox = ox - cx
+    oy = oy - cy
+    a = dx * dx + dy * dy
+    b = ox * dx + oy * dy
+    c = ox * ox + oy * oy - r * r
+    disc = b * b - a * c
+    if a > 0.0:
+        if disc >= 0.0:
+            sq = math.sqrt(disc)
+            r_in = (-b - sq) / a
+            r_out = (-b + sq) / a
+        else:
+            r_in, r_out = np.inf, -np.inf
+    elif disc >= 0.0:
+        r_in = -np.inf if c <= 0.0 else np.inf
+        r_out = np.inf if c <= 0.0 else -np.inf
+    else:
+        r_in, r_out = np.inf, -np.inf
+    if dz == 0.0:
+        inside = z0 <= oz <= z1
+        zl = -np.inf if inside else np.inf
+        zh = np.inf if inside else -np.inf
+    else:
+        za = (z0 - oz) / dz
+        zb = (z1 - oz) / dz
+        zl, zh = (za, zb) if za < zb else (zb, za)
+    tlo = max(r_in, zl)
+    thi = min(r_out, zh)
+    if tlo <= thi and thi > 0.0:
+        return max(tlo, 0.0)
+    return np.inf
+
+
+@nb.njit(**_JIT)
+def _occluders(occ, ox, oy, oz, dx, dy, dz, tmax):
+    """Nearest entry distance (<= tmax) into any occluder row of ``occ`` (inf for none). Columns
+    7..10 of a row hold a sphere around the solid (centre, radius): a ray whose line passes
+    outside it, or that reaches it only beyond tmax, skips the exact test."""
+    best = np.inf
+    for k in range(occ.shape[0]):
+        wx, wy, wz = occ[k, 7] - ox, occ[k, 8] - oy, occ[k, 9] - oz
+        b = wx * dx + wy * dy + wz * dz
+        r2 = occ[k, 10] * occ[k, 10]
+        h = r2 - (wx * wx + wy * wy + wz * wz - b * b)  # (half chord)^2 of the sphere on the line
+        if h < 0.0 or (b < 0.0 and b * b > h) or (b > tmax and (b - tmax) * (b - tmax) > h):
+            continue
+        if occ[k, 0] == 0.0:
+            t = _box(ox, oy, oz, dx, dy, dz, occ[k, 1], occ[k, 2], occ[k, 3], occ[k, 4], occ[k, 5], occ[k, 6])
+        else:
+            t = _cylinder(ox, oy, oz, dx, dy, dz, occ[k, 1], occ[k, 2], occ[k, 3], occ[k, 4], occ[k, 5])
+        if t <= tmax and t < best:
+            best = t
+    return best
+
+
+@nb.njit(**_JIT)
+def _paraboloid(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax):
+    """Nearest hit beyond PARABOLOID_EPS of z = zv - r^2 / (4 f), r <= rim (ExactParaboloid)."""
+    i4f = 0.25 / f
+    a = (dx * dx + dy * dy) * i4f
+    b = (ox * dx + oy * dy) * (2.0 * i4f) + dz
+    c = (ox * ox + oy * oy) * i4f + oz - zv
+    disc = b * b - 4.0 * a * c
+    if not disc >= 0.0:
+        return np.inf
+    sq = math.sqrt(disc)
+    q = -0.5 * (b + math.copysign(sq, b))
+    best = np.inf
+    r1 = q / a if abs(a) > 1e-300 else np.nan
+    r2 = c / q
+    for r in (r1, r2):
+        if math.isfinite(r) and r > PARABOLOID_EPS:
+            px = ox + r * dx
+            py = oy + r * dy
+            if px * px + py * py <= rim * rim and r < best:
+                best = r
+    return best if best <= tmax else np.inf
+
+
+@nb.njit(**_JIT)
+def _paraboloid_bounded(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax):
+    """:func:`_paraboloid`, skipped when the ray's line passes outside the mirror's bounding sphere
+    (centre on the axis halfway between vertex and rim plane) or reaches it beyond tmax."""
+    sag = rim * rim / (4.0 * f)
+    wz = zv - 0.5 * sag - oz
+    b = -ox * dx - oy * dy + wz * dz
+    h = rim * rim + 0.25 * sag * sag - (ox * ox + oy * oy + wz * wz - b * b)
+    if h < 0.0 or (b > tmax and (b - tmax) * (b - tmax) > h):
+        return np.inf
+    return _paraboloid(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax)
+
+
+@nb.njit(**_JIT)
+def _to_local(R, T, ident, px, py, pz):
+    """Point from the global frame into a body's (R^T (p - T))."""
+    if ident:
+        return px, py, pz
+    x, y, z = px - T[0], py - T[1], pz - T[2]
+    return (x * R[0, 0] + y * R[1, 0] + z * R[2, 0], x * R[0, 1] + y * R[1, 1] + z * R[2, 1],
+            x * R[0, 2] + y * R[1, 2] + z * R[2, 2])
+
+
+@nb.njit(**_JIT)
+def _dir_to_local(R, ident, x, y, z):
+    if ident:
+        return x, y, z
+    return (x * R[0, 0] + y * R[1, 0] + z * R[2, 0], x * R[0, 1] + y * R[1, 1] + z * R[2, 1],
+            x * R[0, 2] + y * R[1, 2] + z * R[2, 2])
+
+
+@nb.njit(**_JIT)
+def _dir_to_global(R, ident, x, y, z):
+    if ident:
+        return x, y, z
+    return (R[0, 0] * x + R[0, 1] * y + R[0, 2] * z, R[1, 0] * x + R[1, 1] * y + R[1, 2] * z,
+            R[2, 0] * x + R[2, 1] * y + R[2, 2] * z)
+
+
+@nb.njit(**_JIT)
+def _to_global(R, T, ident, x, y, z):
+    if ident:
+        return x, y, z
+    gx, gy, gz = _dir_to_global(R, ident, x, y, z)
+    return gx + T[0], gy + T[1], gz + T[2]
+
+
+@nb.njit(**_JIT)
+def _piece(brk, u, hint):
+    """Index of the spline piece holding u (the last whose left breakpoint is <= u), walking from
+    ``hint`` (Newton moves u by little, so this is a step or two; a far hint costs a binary search)."""
+    m = brk.shape[0] - 1
+    lo = min(max(hint, 0), m - 1)
+    for _ in range(4):
+        if brk[lo] > u and lo > 0:
+            lo -= 1
+        elif lo < m - 1 and brk[lo + 1] <= u:
+            lo += 1
+        else:
+            return lo
+    lo, hi = 0, m - 1
+    while lo < hi:
+        mid = (lo + hi + 1) >> 1
+        if brk[mid] <= u:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
+@nb.njit(**_JIT)
+def _spline(brk, cr, cz, u, hint):
+    """Dome meridian (r, z), d/du at parameter u and the piece used: piecewise quintic (PPoly
+    coefficients, highest power first) on breakpoints ``brk``."""
+    lo = _piece(brk, u, hint)
+    x = u - brk[lo]
+    r = cr[lo, 0]
+    z = cz[lo, 0]
+    dr = 0.0
+    dz = 0.0
+    for k in range(1, 6):
+        dr = dr * x + r
+        dz = dz * x + z
+        r = r * x + cr[lo, k]
+        z = z * x + cz[lo, k]
+    return r, z, dr, dz, lo
+
+
+@nb.njit(**_JIT)
+def _reflect(dx, dy, dz, nx, ny, nz):
+    k = 2.0 * (dx * nx + dy * ny + dz * nz)
+    return dx - k * nx, dy - k * ny, dz - k * nz
+
+
+@nb.njit(**_JIT)
+def _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1, t2, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ,
+                body, status, segment, v, landing, path, miss):
+    """Segment 3 (dome -> plane z = 0, blocked by the paraboloid body or the beam): trace3d.
+    ``body`` False: the caller knows the ray passes clear of the paraboloid's body."""
+    v[i, 0], v[i, 1], v[i, 2] = wx, wy, wz
+    t3 = -q2z / wz if wz < 0.0 else np.inf
+    if not math.isfinite(t3):
+        status[i] = ESCAPED_AFTER_DOME
+        segment[i] = 3
+        return
+    hp = np.inf
+    if body:
+        lx, ly, lz = _to_local(R1, T1, id1, q2x, q2y, q2z)
+        ldx, ldy, ldz = _dir_to_local(R1, id1, wx, wy, wz)
+        hp = _paraboloid_bounded(lx, ly, lz, ldx, ldy, ldz, f, zv, rim, t3)
+        ho = _occluders(para_occ, lx, ly, lz, ldx, ldy, ldz, t3)
+        if ho < hp:
+            hp = ho
+    bx, by, bz = _to_local(R2, T2, id2, q2x, q2y, q2z)
+    bdx, bdy, bdz = _dir_to_local(R2, id2, wx, wy, wz)
+    hb = _occluders(beam_occ, bx, by, bz, bdx, bdy, bdz, t3)
+    by_para = math.isfinite(hp)
+    by_beam = math.isfinite(hb) and not (by_para and hp < hb)
+    if by_beam:
+        status[i] = OCCLUDED_BY_BEAM
+        segment[i] = 3
+        return
+    if by_para:
+        status[i] = OCCLUDED_BY_PARABOLOID
+        segment[i] = 3
+        return
+    status[i] = OK
+    segment[i] = 0
+    landing[i, 0], landing[i, 1], landing[i, 2] = q2x + t3 * wx, q2y + t3 * wy, q2z + t3 * wz
+    path[i] = t1 + t2 + t3
+    cx = q2y * wz - q2z * wy
+    cy = q2z * wx - q2x * wz
+    cz = q2x * wy - q2y * wx
+    miss[i] = math.sqrt(cx * cx + cy * cy + cz * cz)
+
+
+@nb.njit(**_JIT)
+def _blank(i, status, segment, p1, p2, v, landing, path, miss):
+    for a in (p1, p2, v, landing):
+        a[i, 0] = np.nan
+        a[i, 1] = np.nan
+        a[i, 2] = np.nan
+    path[i] = np.nan
+    miss[i] = np.nan
+    status[i] = OK
+    segment[i] = 0
+
+
+@nb.njit(**_JIT)
+def _mirror_leg(ox, oy, oz, dx, dy, dz, f, zv, rim, para_occ):
+    """Segment 1 in the paraboloid's frame: (t, part) with part 0 the mirror, 1 its mount, -1 none."""
+    tm = _paraboloid(ox, oy, oz, dx, dy, dz, f, zv, rim, np.inf)
+    to = _occluders(para_occ, ox, oy, oz, dx, dy, dz, tm)  # only a mount nearer than the mirror counts
+    if to < tm:
+        return to, 1
+    if math.isfinite(tm):
+        return tm, 0
+    return np.inf, -1
+
+
+@nb.njit(**_JIT)
+def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed, s0, inv_h, table, flags, status,
+                    segment, p1, p2, v, landing, path, miss, handled):
+    """Aligned rig, every ray from the COP (0, 0, cop_z): the paraboloid hit in closed form, the dome
+    hit and its normal from the correspondence table (a cubic per cell of paraboloid radius s:
+    ``table[cell, quantity, power]`` for dome r, dome z, normal r, normal z), turned to the ray's
+    azimuth. ``flags[cell]``: bit 0, the leg to the dome may cross the beam's heights; bit 1, the
+    return leg may pass the paraboloid's body (both from the table, with a margin): the exact
+    tests run only there; the beam is tested on every return. ``mount_shadowed``: the mount lies
+    under the mirror, so a ray that hits the mirror from the COP cannot meet it first.
+    Rays outside the table's radii are left for the general kernel (``handled`` False)."""
+    n = dirs.shape[0]
+    cells = table.shape[0]
+    s1 = s0 + cells / inv_h
+    E = np.eye(3)
+    Z = np.zeros(3)
+    inv2f = 1.0 / (2.0 * f)
+    for i in range(n):
+        _blank(i, status, segment, p1, p2, v, landing, path, miss)
+        handled[i] = True
+        dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
+        norm = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+        dx, dy, dz = dx * norm, dy * norm, dz * norm
+        t1 = _paraboloid(0.0, 0.0, cop_z, dx, dy, dz, f, zv, rim, np.inf)
+        if not mount_shadowed or not math.isfinite(t1):
+            to = _occluders(para_occ, 0.0, 0.0, cop_z, dx, dy, dz, t1)
+            if to < t1 or not math.isfinite(t1):
+                status[i] = OCCLUDED_BY_MOUNT if math.isfinite(to) else MISSED_PARABOLOID
+                segment[i] = 1
+                continue
+        ax, ay, az = t1 * dx, t1 * dy, cop_z + t1 * dz
+        s = math.sqrt(ax * ax + ay * ay)
+        if not (s0 <= s <= s1):
+            handled[i] = False
+            continue
+        p1[i, 0], p1[i, 1], p1[i, 2] = ax, ay, az
+        nx, ny = ax * inv2f, ay * inv2f
+        nn = 1.0 / math.sqrt(nx * nx + ny * ny + 1.0)
+        ux, uy, uz = _reflect(dx, dy, dz, nx * nn, ny * nn, nn)
+        # the correspondence: a cubic in the cell of s
+        x = (s - s0) * inv_h
+        c = min(int(x), cells - 1)
+        x = (x - c) / inv_h
+        r2 = ((table[c, 0, 0] * x + table[c, 0, 1]) * x + table[c, 0, 2]) * x + table[c, 0, 3]
+        z2 = ((table[c, 1, 0] * x + table[c, 1, 1]) * x + table[c, 1, 2]) * x + table[c, 1, 3]
+        nr = ((table[c, 2, 0] * x + table[c, 2, 1]) * x + table[c, 2, 2]) * x + table[c, 2, 3]
+        nzz = ((table[c, 3, 0] * x + table[c, 3, 1]) * x + table[c, 3, 2]) * x + table[c, 3, 3]
+        m = 1.0 / math.sqrt(nr * nr + nzz * nzz)
+        nr, nzz = nr * m, nzz * m
+        inv_s = 1.0 / s
+        cphi, sphi = ax * inv_s, ay * inv_s
+        q2x, q2y = r2 * cphi, r2 * sphi
+        ex, ey, ez = q2x - ax, q2y - ay, z2 - az
+        t2 = math.sqrt(ex * ex + ey * ey + ez * ez)
+        fl = flags[c]
+        if fl & 1:
+            tb = _occluders(beam_occ, ax, ay, az, ux, uy, uz, t2)
+            if tb < t2:
+                status[i] = OCCLUDED_BY_BEAM
+                segment[i] = 2
+                continue
+        p2[i, 0], p2[i, 1], p2[i, 2] = q2x, q2y, z2
+        wx, wy, wz = _reflect(ux, uy, uz, nr * cphi, nr * sphi, nzz)
+        _return_leg(i, q2x, q2y, z2, wx, wy, wz, t1, t2, E, Z, True, E, Z, True, f, zv, rim, para_occ, beam_occ,
+                    (fl & 2) != 0, status, segment, v, landing, path, miss)
+
+
+@nb.njit(**_JIT)
+def general_first(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, brk, cr, cz, u_lo, u_hi,
+                  newton_steps, residual_tol, step_tol, status, segment, p1, p2, v, landing, path, miss,
+                  t1_out, q1, u_out, t2_out, u2_out, state):
+    """Any rig, any rays (rows ``idx``): segment 1 and the dome hit by Newton on (t, u) against
+    the meridian spline, started at the design's correspondence (the dome point u = -s of the
+    paraboloid radius s the ray reflects at). ``state`` per row: 0 lost on segment 1, 1 dome hit
+    converged (residual < residual_tol mm, u inside the mirror), 2 left for the bracketing path."""
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        _blank(i, status, segment, p1, p2, v, landing, path, miss)
+        dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
+        norm = math.sqrt(dx * dx + dy * dy + dz * dz)
+        dx, dy, dz = dx / norm, dy / norm, dz / norm
+        lx, ly, lz = _to_local(R1, T1, id1, origins[i, 0], origins[i, 1], origins[i, 2])
+        ldx, ldy, ldz = _dir_to_local(R1, id1, dx, dy, dz)
+        t1, part = _mirror_leg(lx, ly, lz, ldx, ldy, ldz, f, zv, rim, para_occ)
+        if part != 0:
+            status[i] = MISSED_PARABOLOID if part < 0 else OCCLUDED_BY_MOUNT
+            segment[i] = 1
+            state[k] = 0
+            continue
+        ax, ay, az = lx + t1 * ldx, ly + t1 * ldy, lz + t1 * ldz
+        s = math.sqrt(ax * ax + ay * ay)
+        nx, ny, nz = ax / (2.0 * f), ay / (2.0 * f), 1.0
+        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+        nx, ny, nz = _dir_to_global(R1, id1, nx / nn, ny / nn, nz / nn)
+        gx, gy, gz = _to_global(R1, T1, id1, ax, ay, az)
+        p1[i, 0], p1[i, 1], p1[i, 2] = gx, gy, gz
+        ux, uy, uz = _reflect(dx, dy, dz, nx, ny, nz)
+        q1[k, 0], q1[k, 1], q1[k, 2] = gx, gy, gz
+        u_out[k, 0], u_out[k, 1], u_out[k, 2] = ux, uy, uz
+        t1_out[k] = t1
+        # dome frame; Newton from the correspondence u = -s
+        ox, oy, oz = _to_local(R2, T2, id2, gx, gy, gz)
+        ex, ey, ez = _dir_to_local(R2, id2, ux, uy, uz)
+        u = min(max(-s, u_lo), u_hi)
+        piece = int((u - u_lo) / (u_hi - u_lo) * (brk.shape[0] - 1))
+        r0, z0, _, _, piece = _spline(brk, cr, cz, u, piece)
+        rho0 = math.sqrt(ox * ox + oy * oy)
+        if abs(ez) > 1e-3:
+            t = (z0 - oz) / ez
+        else:
+            t = (r0 - rho0) / max(math.sqrt(ex * ex + ey * ey), 1e-12)
+        if not (math.isfinite(t) and t > 0.0):
+            t = 1.0
+        for _ in range(newton_steps):
+            cr_, cz_, dcr, dcz, piece = _spline(brk, cr, cz, u, piece)
+            px, py, pz = ox + t * ex, oy + t * ey, oz + t * ez
+            rho = math.sqrt(px * px + py * py)
+            f1 = rho - cr_
+            f2 = pz - cz_
+            a11 = (px * ex + py * ey) / rho
+            a12 = -dcr
+            a21 = ez
+            a22 = -dcz
+            det = a11 * a22 - a12 * a21
+            dt = (a22 * f1 - a12 * f2) / det
+            du = (-a21 * f1 + a11 * f2) / det
+            t = t - dt
+            u = min(max(u - du, u_lo), u_hi)
+            if abs(dt) < step_tol and abs(du) < step_tol:
+                break
+        cr_, cz_, _, _, piece = _spline(brk, cr, cz, u, piece)
+        px, py, pz = ox + t * ex, oy + t * ey, oz + t * ez
+        res = math.hypot(math.sqrt(px * px + py * py) - cr_, pz - cz_)
+        if res < residual_tol and math.isfinite(t) and t > 0.0 and u_lo < u < u_hi:
+            state[k] = 1
+            t2_out[k] = t
+            u2_out[k] = u
+        else:
+            state[k] = 2
+
+
+@nb.njit(**_JIT)
+def general_second(idx, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ, brk, cr, cz, t1_in, q1, u_in,
+                   t2_in, u2_in, state, status, segment, p1, p2, v, landing, path, miss):
+    """Segments 2 (the beam between the mirrors) and 3 for the rows ``idx`` that reached the dome
+    leg (``state`` 1: hit at (t2, u2); 3: no dome hit), after the bracketing path filled its rows."""
+    for k in range(idx.shape[0]):
+        if state[k] == 0:
+            continue
+        i = idx[k]
+        gx, gy, gz = q1[k, 0], q1[k, 1], q1[k, 2]
+        ux, uy, uz = u_in[k, 0], u_in[k, 1], u_in[k, 2]
+        ox, oy, oz = _to_local(R2, T2, id2, gx, gy, gz)
+        ex, ey, ez = _dir_to_local(R2, id2, ux, uy, uz)
+        td = t2_in[k] if state[k] == 1 else np.inf
+        tb = _occluders(beam_occ, ox, oy, oz, ex, ey, ez, td)
+        if tb < td:
+            status[i] = OCCLUDED_BY_BEAM
+            segment[i] = 2
+            continue
+        if not math.isfinite(td):
+            status[i] = ESCAPED_TOP if uz > 0.0 else MISSED_DOME
+            segment[i] = 2
+            continue
+        px, py, pz = ox + td * ex, oy + td * ey, oz + td * ez
+        _, _, dcr, dcz, _ = _spline(brk, cr, cz, u2_in[k], -1)
+        m = math.sqrt(dcr * dcr + dcz * dcz)
+        nr, nzz = -dcz / m, dcr / m  # the left normal of the rising meridian: towards the axis
+        rho = math.sqrt(px * px + py * py)
+        cphi, sphi = (px / rho, py / rho) if rho > 0.0 else (1.0, 0.0)
+        nx, ny, nz = _dir_to_global(R2, id2, nr * cphi, nr * sphi, nzz)
+        q2x, q2y, q2z = _to_global(R2, T2, id2, px, py, pz)
+        p2[i, 0], p2[i, 1], p2[i, 2] = q2x, q2y, q2z
+        wx, wy, wz = _reflect(ux, uy, uz, nx, ny, nz)
+        _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1_in[k], td, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ,
+                    beam_occ, True, status, segment, v, landing, path, miss)
