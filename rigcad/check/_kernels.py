@@ -367,13 +367,79 @@ def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed,
 
 
 @nb.njit(**_JIT)
+def _interp(x, xs, ys):
+    """np.interp(x, xs, ys) for increasing xs (ends clamped), by binary search."""
+    n = xs.shape[0]
+    if x <= xs[0]:
+        return ys[0]
+    if x >= xs[n - 1]:
+        return ys[n - 1]
+    lo, hi = 0, n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) >> 1
+        if xs[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    w = (x - xs[lo]) / (xs[hi] - xs[lo])
+    return ys[lo] * (1.0 - w) + ys[hi] * w
+
+
+@nb.njit(**_JIT)
+def _bracketed(ox, oy, oz, dx, dy, dz, tab_u, tab_r, tab_z, r_max, brk, cr, cz, u_lo, u_hi, newton_steps,
+               piece_of, piece_scale):
+    """The general dome hit (rays.ExactDome._bracketed, per ray): bracket the crossing on the
+    tabulated meridian between the ray's start and where it leaves the cylinder r_max + 1 mm or
+    the mirror's heights (bisection, 30 steps), then Newton on the spline. (t, u); t inf for none."""
+    dxy2 = dx * dx + dy * dy
+    oxy_d = ox * dx + oy * dy
+    oxy2 = ox * ox + oy * oy
+    big = (r_max + 1.0) * (r_max + 1.0)
+    z_lo, z_hi = tab_z[0], tab_z[tab_z.shape[0] - 1]
+    t_cyl = (-oxy_d + math.sqrt(max(oxy_d * oxy_d - dxy2 * (oxy2 - big), 0.0))) / dxy2
+    t_top = (z_hi - oz) / dz if dz > 0.0 else np.inf
+    t_bot = (z_lo - oz) / dz if dz < 0.0 else np.inf
+    t_end = min(t_cyl, t_top, t_bot) if not math.isnan(t_cyl) else min(t_top, t_bot)
+    if not math.isfinite(t_end):
+        return np.inf, 0.0
+    h0 = math.sqrt(oxy2) - _interp(oz, tab_z, tab_r)
+    he = math.sqrt(max(oxy2 + 2 * t_end * oxy_d + t_end * t_end * dxy2, 0.0)) - _interp(oz + t_end * dz, tab_z, tab_r)
+    if not (h0 < 0.0 and he >= 0.0):
+        return np.inf, 0.0
+    lo, hi = 0.0, t_end
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        h = math.sqrt(max(oxy2 + 2 * mid * oxy_d + mid * mid * dxy2, 0.0)) - _interp(oz + mid * dz, tab_z, tab_r)
+        if h >= 0.0:
+            hi = mid
+        else:
+            lo = mid
+    t = 0.5 * (lo + hi)
+    u = _interp(oz + t * dz, tab_z, tab_u)
+    piece = piece_of[min(int((u - u_lo) * piece_scale), piece_of.shape[0] - 1)]
+    for _ in range(newton_steps):
+        cr_, cz_, dcr, dcz, piece = _spline(brk, cr, cz, u, piece)
+        px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
+        rho = math.sqrt(px * px + py * py)
+        f1 = rho - cr_
+        f2 = pz - cz_
+        a11 = (px * dx + py * dy) / rho
+        det = a11 * (-dcz) - (-dcr) * dz
+        t = t - ((-dcz) * f1 - (-dcr) * f2) / det
+        u = min(max(u - (-dz * f1 + a11 * f2) / det, u_lo), u_hi)
+    return t, u
+
+
+@nb.njit(**_JIT)
 def general_first(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, brk, cr, cz, u_lo, u_hi,
-                  newton_steps, residual_tol, step_tol, status, segment, p1, p2, v, landing, path, miss,
-                  t1_out, q1, u_out, t2_out, u2_out, state):
+                  piece_of, piece_scale, tab_u, tab_r, tab_z, r_max, newton_steps, residual_tol, step_tol, status,
+                  segment, p1, p2, v, landing, path, miss, t1_out, q1, u_out, t2_out, u2_out, state):
     """Any rig, any rays (rows ``idx``): segment 1 and the dome hit by Newton on (t, u) against
     the meridian spline, started at the design's correspondence (the dome point u = -s of the
     paraboloid radius s the ray reflects at). ``state`` per row: 0 lost on segment 1, 1 dome hit
-    converged (residual < residual_tol mm, u inside the mirror), 2 left for the bracketing path."""
+    converged (residual < residual_tol mm, u inside the mirror), 2 taken by the bracketing path
+    (:func:`_bracketed`) and hit, 3 no dome hit. ``piece_of``: the spline piece at each of its
+    uniform cells of u (``piece_scale`` cells per unit u), Newton's first guess."""
     for k in range(idx.shape[0]):
         i = idx[k]
         _blank(i, status, segment, p1, p2, v, landing, path, miss)
@@ -403,7 +469,7 @@ def general_first(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para
         ox, oy, oz = _to_local(R2, T2, id2, gx, gy, gz)
         ex, ey, ez = _dir_to_local(R2, id2, ux, uy, uz)
         u = min(max(-s, u_lo), u_hi)
-        piece = int((u - u_lo) / (u_hi - u_lo) * (brk.shape[0] - 1))
+        piece = piece_of[min(int((u - u_lo) * piece_scale), piece_of.shape[0] - 1)]
         r0, z0, _, _, piece = _spline(brk, cr, cz, u, piece)
         rho0 = math.sqrt(ox * ox + oy * oy)
         if abs(ez) > 1e-3:
@@ -437,14 +503,21 @@ def general_first(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para
             t2_out[k] = t
             u2_out[k] = u
         else:
-            state[k] = 2
+            t, u = _bracketed(ox, oy, oz, ex, ey, ez, tab_u, tab_r, tab_z, r_max, brk, cr, cz, u_lo, u_hi,
+                              newton_steps, piece_of, piece_scale)
+            if math.isfinite(t) and t > 0.0:
+                state[k] = 2
+                t2_out[k] = t
+                u2_out[k] = u
+            else:
+                state[k] = 3
 
 
 @nb.njit(**_JIT)
 def general_second(idx, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ, brk, cr, cz, t1_in, q1, u_in,
                    t2_in, u2_in, state, status, segment, p1, p2, v, landing, path, miss):
     """Segments 2 (the beam between the mirrors) and 3 for the rows ``idx`` that reached the dome
-    leg (``state`` 1: hit at (t2, u2); 3: no dome hit), after the bracketing path filled its rows."""
+    leg (``state`` 1 or 2: hit at (t2, u2); 3: no dome hit)."""
     for k in range(idx.shape[0]):
         if state[k] == 0:
             continue
@@ -453,7 +526,7 @@ def general_second(idx, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ
         ux, uy, uz = u_in[k, 0], u_in[k, 1], u_in[k, 2]
         ox, oy, oz = _to_local(R2, T2, id2, gx, gy, gz)
         ex, ey, ez = _dir_to_local(R2, id2, ux, uy, uz)
-        td = t2_in[k] if state[k] == 1 else np.inf
+        td = t2_in[k] if state[k] == 1 or state[k] == 2 else np.inf
         tb = _occluders(beam_occ, ox, oy, oz, ex, ey, ez, td)
         if tb < td:
             status[i] = OCCLUDED_BY_BEAM

@@ -12,7 +12,7 @@ Two kernels, and the one that ran is recorded per trace (``Trace3D.kernels``):
 * ``general_newton`` - any rig and any rays (misaligned components, thin-lens rays): Newton on
   (t, u) against the spline, started at the correspondence; a ray whose Newton does not land on
   the mirror (a miss past its ends, a stray ray) takes the bracketing path of
-  :class:`rigcad.check.rays.ExactDome` (``bracketed_fallback``).
+  :class:`rigcad.check.rays.ExactDome`, compiled (``bracketed_fallback``).
 
 Accuracy (tests/check/test_analytic.py, against the vectorised reference that brackets every ray
 and polishes by Newton): aligned within 1e-9 mm and 1e-12 rad ray for ray, misaligned within 1e-7
@@ -34,12 +34,15 @@ from rigcad.optics.frames import Pose
 #: a cubic's error h^4 f''''/384 is then ~1e-14 mm here (measured at the cell midpoints: see
 #: ``table_error``), far inside the 1e-9 mm the fast path promises.
 TABLE_CELLS = 1 << 16
+#: Uniform cells of the dome parameter that seed the spline-piece search (~4 per piece).
+PIECE_CELLS = 8192
 #: Newton steps of the general kernel: from the correspondence (within ~1 mm for a mm-scale
 #: misalignment) quadratic convergence reaches rounding in ~5; 12 leaves margin, the loop stops
 #: when a step is under NEWTON_STEP_TOL.
 NEWTON_STEPS = 12
-#: A Newton step (mm of t, units of u: mm of paraboloid radius) below this ends the iteration.
-NEWTON_STEP_TOL = 1e-13
+#: A Newton step (mm of t, units of u: mm of paraboloid radius) below this ends the iteration:
+#: 1e-12 mm is a few ulps of the ~200 mm distances, where the steps stop shrinking.
+NEWTON_STEP_TOL = 1e-12
 #: The general kernel's hit counts as on the dome within this residual (mm), as rays.FAST_PATH_RESIDUAL.
 RESIDUAL_TOL = R.FAST_PATH_RESIDUAL
 #: Margin (mm of paraboloid radius) kept inside the dome's ends by the table: rays within it of an
@@ -91,6 +94,8 @@ class AnalyticTracer:
     table: np.ndarray
     flags: np.ndarray
     mount_shadowed: bool
+    piece_of: np.ndarray
+    piece_scale: float
     table_error: dict
     dome: R.ExactDome
 
@@ -112,6 +117,10 @@ class AnalyticTracer:
         breaks = np.concatenate([pr.x[keep], [pr.x[keep[-1] + 1]]])
         coef_r = np.ascontiguousarray(pr.c[:, keep].T)
         coef_z = np.ascontiguousarray(pz.c[:, keep].T)
+        # Newton's first guess of the spline piece: the piece at each of PIECE_CELLS uniform cells of u
+        piece_scale = PIECE_CELLS / (u_hi - u_lo)
+        cell_u = u_lo + (np.arange(PIECE_CELLS) + 0.5) / piece_scale
+        piece_of = np.clip(np.searchsorted(breaks, cell_u, side="right") - 1, 0, len(breaks) - 2).astype(np.int64)
         s0, s1 = -u_hi + TABLE_MARGIN, -u_lo - TABLE_MARGIN
         s = np.linspace(s0, s1, TABLE_CELLS + 1)
         values = _aligned_hits(exact_para, exact_dome, geo.cop_z, s)
@@ -130,7 +139,7 @@ class AnalyticTracer:
                        "measured": "at every cell's midpoint, against Newton on the spline"}
         return cls(geo.focal_length, geo.vertex_z, geo.rim_radius, geo.cop_z, para_occ, beam_occ, breaks, coef_r,
                    coef_z, float(u_lo), float(u_hi), float(s0), float(TABLE_CELLS / (s1 - s0)), table, flags,
-                   shadowed, table_error, exact_dome)
+                   shadowed, piece_of, float(piece_scale), table_error, exact_dome)
 
     def trace(self, optics, origins: np.ndarray, dirs: np.ndarray):
         """Trace rays (n, 3) through ``optics`` (its poses) with the kernels: a Trace3D with
@@ -174,19 +183,12 @@ class AnalyticTracer:
         R2, T2, id2 = _pose(dp)
         common = (self.focal_length, self.vertex_z, self.rim_radius, self.para_occ)
         K.general_first(idx, origins, dirs, R1, T1, id1, R2, T2, id2, *common, self.breaks, self.coef_r,
-                        self.coef_z, self.u_lo, self.u_hi, NEWTON_STEPS, RESIDUAL_TOL, NEWTON_STEP_TOL, *out,
-                        t1, q1, u, t2, u2, state)
-        fall = np.nonzero(state == 2)[0]
-        if len(fall):  # the vectorised bracketing path of ExactDome for the rows Newton did not settle
-            lo, ld = dp.localize(q1[fall], u[fall])
-            hit, t, uu = self.dome._bracketed(lo, ld)
-            good = np.isfinite(t) & (t > 0)
-            state[fall] = 3
-            rows = fall[hit[good]]
-            state[rows], t2[rows], u2[rows] = 1, t[good], uu[good]
+                        self.coef_z, self.u_lo, self.u_hi, self.piece_of, self.piece_scale, self.dome.u_tab,
+                        self.dome.r_tab, self.dome.z_tab, self.dome.r_max, NEWTON_STEPS, RESIDUAL_TOL,
+                        NEWTON_STEP_TOL, *out, t1, q1, u, t2, u2, state)
         K.general_second(idx, R1, T1, id1, R2, T2, id2, *common, self.beam_occ, self.breaks, self.coef_r,
                          self.coef_z, t1, q1, u, t2, u2, state, *out)
-        return int(len(fall))
+        return int(np.count_nonzero(state >= 2))
 
 
 #: Margin (mm) of the per-cell flags: a leg counts as clear of a solid's bounding shape only by at

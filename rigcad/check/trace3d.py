@@ -156,9 +156,11 @@ def convergence_point(tr: Trace3D) -> np.ndarray:
     if np.count_nonzero(ok) < 2:
         return np.full(3, np.nan)
     p, w = tr.p2[ok], tr.v[ok]
-    # sum over rays of (I - w w^T) (x - p) = 0
-    a = len(w) * np.eye(3) - w.T @ w
-    b = p.sum(axis=0) - w.T @ _dot(w, p)
+    # sum over rays of (I - w w^T) (x - p) = 0; sums by einsum's own loops, not BLAS, whose
+    # threaded reductions may round differently with the thread count (tolerancing promises the
+    # same bits on any number of workers)
+    a = len(w) * np.eye(3) - np.einsum("ij,ik->jk", w, w)
+    b = p.sum(axis=0) - np.einsum("ij,i->j", w, _dot(w, p))
     return np.linalg.solve(a, b)
 
 

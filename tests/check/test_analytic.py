@@ -88,6 +88,8 @@ def test_general_kernel_agrees_with_the_exact_newton_path(analytic, reference, d
     fast = T.trace(placed, o, d)
     slow = T.trace(ref, o, d)
     assert fast.kernels["general_newton"] == len(o), fast.kernels
+    if case != "thin_lens":  # rays inside the occlusion limit escape: Newton fails, the compiled bracketing runs
+        assert fast.kernels["bracketed_fallback"] > 0, fast.kernels
     assert np.array_equal(fast.status, slow.status)
     ok = slow.ok
     assert ok.sum() > 0.8 * len(o) * (0.8 if case != "thin_lens" else 1.0)
