@@ -11,6 +11,8 @@ those pairs are not traced (no self-intersection at the ray's origin either).
 
 from __future__ import annotations
 
+import contextvars
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -78,12 +80,35 @@ class Trace3D:
         return np.where(self.ok, np.arctan2(a[:, 1], a[:, 0]), np.nan)
 
 
+#: Called with the ray count after every trace inside :func:`counting` (a progress bar's feed).
+_COUNTER: contextvars.ContextVar = contextvars.ContextVar("rigcad_rays_traced", default=None)
+
+
+@contextmanager
+def counting(callback):
+    """Within the block, every :func:`trace` reports its ray count to ``callback(n)``."""
+    token = _COUNTER.set(callback)
+    try:
+        yield
+    finally:
+        _COUNTER.reset(token)
+
+
 def trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray, vectorised: bool = False) -> Trace3D:
     """Trace rays (origins, unit dirs: (n, 3), global frame) through ``optics``: by the compiled
     analytic kernels when ``optics`` has them (``optics.fast``, analytic optics), else (or with
-    ``vectorised=True``) by the intersectors' numpy passes below."""
+    ``vectorised=True``) by the intersectors' numpy passes (:func:`_trace`)."""
     if optics.fast is not None and not vectorised:
-        return optics.fast.trace(optics, origins, dirs)
+        out = optics.fast.trace(optics, origins, dirs)
+    else:
+        out = _trace(optics, origins, dirs)
+    report = _COUNTER.get()
+    if report is not None:
+        report(len(origins))
+    return out
+
+
+def _trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     n = len(origins)
     dirs = unit(np.asarray(dirs, float))
     origins = np.asarray(origins, float)

@@ -107,3 +107,15 @@ def test_the_backend_and_the_kernels_are_recorded(analytic, design_map):
     assert sum(v for k, v in tr.kernels.items() if k != "bracketed_fallback") == 100
     vec = T.trace(analytic, rays.origins, rays.dirs, vectorised=True)
     assert vec.kernels == {"vectorised": 100}
+
+
+def test_traces_report_their_rays_to_a_progress_counter(analytic, design_map):
+    from rigcad.check.trace3d import counting
+
+    rays = annulus_rays(design_map, 300, 2)
+    seen = []
+    with counting(seen.append):
+        T.trace(analytic, rays.origins, rays.dirs)
+        T.trace(analytic, rays.origins[:100], rays.dirs[:100], vectorised=True)
+    T.trace(analytic, rays.origins, rays.dirs)  # outside the block: not counted
+    assert seen == [300, 100]
