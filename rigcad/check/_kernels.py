@@ -235,14 +235,13 @@ def _reflect(dx, dy, dz, nx, ny, nz):
 
 @nb.njit(**_JIT)
 def _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1, t2, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ,
-                body, status, segment, v, landing, path, miss):
+                body, status, segment, p1, p2, v, landing, path, miss):
     """Segment 3 (dome -> plane z = 0, blocked by the paraboloid body or the beam): trace3d.
     ``body`` False: the caller knows the ray passes clear of the paraboloid's body."""
     v[i, 0], v[i, 1], v[i, 2] = wx, wy, wz
     t3 = -q2z / wz if wz < 0.0 else np.inf
     if not math.isfinite(t3):
-        status[i] = ESCAPED_AFTER_DOME
-        segment[i] = 3
+        _lost(i, ESCAPED_AFTER_DOME, 3, status, segment, p1, p2, v, landing, path, miss)
         return
     hp = np.inf
     if body:
@@ -258,12 +257,10 @@ def _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1, t2, R1, T1, id1, R2, T2, id2, 
     by_para = math.isfinite(hp)
     by_beam = math.isfinite(hb) and not (by_para and hp < hb)
     if by_beam:
-        status[i] = OCCLUDED_BY_BEAM
-        segment[i] = 3
+        _lost(i, OCCLUDED_BY_BEAM, 3, status, segment, p1, p2, v, landing, path, miss)
         return
     if by_para:
-        status[i] = OCCLUDED_BY_PARABOLOID
-        segment[i] = 3
+        _lost(i, OCCLUDED_BY_PARABOLOID, 3, status, segment, p1, p2, v, landing, path, miss)
         return
     status[i] = OK
     segment[i] = 0
@@ -300,24 +297,39 @@ def _mirror_leg(ox, oy, oz, dx, dy, dz, f, zv, rim, para_occ):
 
 
 @nb.njit(**_JIT)
-def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed, s0, inv_h, table, flags, status,
-                    segment, p1, p2, v, landing, path, miss, handled):
-    """Aligned rig, every ray from the COP (0, 0, cop_z): the paraboloid hit in closed form, the dome
-    hit and its normal from the correspondence table (a cubic per cell of paraboloid radius s:
-    ``table[cell, quantity, power]`` for dome r, dome z, normal r, normal z), turned to the ray's
-    azimuth. ``flags[cell]``: bit 0, the leg to the dome may cross the beam's heights; bit 1, the
-    return leg may pass the paraboloid's body (both from the table, with a margin): the exact
-    tests run only there; the beam is tested on every return. ``mount_shadowed``: the mount lies
-    under the mirror, so a ray that hits the mirror from the COP cannot meet it first.
-    Rays outside the table's radii are left for the general kernel (``handled`` False)."""
+def _lost(i, code, seg, status, segment, p1, p2, v, landing, path, miss):
+    """Row i lost on segment ``seg``: its status, NaN where the path did not reach."""
+    status[i] = code
+    segment[i] = seg
+    if seg <= 1:
+        p1[i, 0] = p1[i, 1] = p1[i, 2] = np.nan
+    if seg <= 2:
+        p2[i, 0] = p2[i, 1] = p2[i, 2] = np.nan
+        v[i, 0] = v[i, 1] = v[i, 2] = np.nan
+    landing[i, 0] = landing[i, 1] = landing[i, 2] = np.nan
+    path[i] = np.nan
+    miss[i] = np.nan
+
+
+@nb.njit(**_JIT)
+def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed, s0, s1, brk, cr, cz, piece_of,
+                    piece_scale, u_lo, flag_inv_h, flags, status, segment, p1, p2, v, landing, path, miss, handled):
+    """Aligned rig, every ray from the COP (0, 0, cop_z): the paraboloid hit in closed form; the dome
+    hit by the design correspondence (the ray reflected at paraboloid radius s lands on the dome's
+    meridian at u = -s: the spline's point and normal there, turned to the ray's azimuth; measured
+    against Newton when the tracer is built). ``flags[cell]`` per cell of s from s0 (``flag_inv_h``
+    cells per mm): bit 0, the leg to the dome may cross the beam's heights; bit 1, the return leg
+    may pass the paraboloid's body; the exact tests run only there; the beam is tested on every
+    return. ``mount_shadowed``: the mount lies under the mirror, so a ray that hits the mirror from
+    the COP cannot meet it first. Rays outside [s0, s1] are left for the general kernel
+    (``handled`` False)."""
     n = dirs.shape[0]
-    cells = table.shape[0]
-    s1 = s0 + cells / inv_h
     E = np.eye(3)
     Z = np.zeros(3)
     inv2f = 1.0 / (2.0 * f)
+    ncells = flags.shape[0]
+    npo = piece_of.shape[0]
     for i in range(n):
-        _blank(i, status, segment, p1, p2, v, landing, path, miss)
         handled[i] = True
         dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
         norm = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -326,8 +338,8 @@ def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed,
         if not mount_shadowed or not math.isfinite(t1):
             to = _occluders(para_occ, 0.0, 0.0, cop_z, dx, dy, dz, t1)
             if to < t1 or not math.isfinite(t1):
-                status[i] = OCCLUDED_BY_MOUNT if math.isfinite(to) else MISSED_PARABOLOID
-                segment[i] = 1
+                _lost(i, OCCLUDED_BY_MOUNT if math.isfinite(to) else MISSED_PARABOLOID, 1, status, segment, p1, p2,
+                      v, landing, path, miss)
                 continue
         ax, ay, az = t1 * dx, t1 * dy, cop_z + t1 * dz
         s = math.sqrt(ax * ax + ay * ay)
@@ -338,32 +350,26 @@ def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed,
         nx, ny = ax * inv2f, ay * inv2f
         nn = 1.0 / math.sqrt(nx * nx + ny * ny + 1.0)
         ux, uy, uz = _reflect(dx, dy, dz, nx * nn, ny * nn, nn)
-        # the correspondence: a cubic in the cell of s
-        x = (s - s0) * inv_h
-        c = min(int(x), cells - 1)
-        x = (x - c) / inv_h
-        r2 = ((table[c, 0, 0] * x + table[c, 0, 1]) * x + table[c, 0, 2]) * x + table[c, 0, 3]
-        z2 = ((table[c, 1, 0] * x + table[c, 1, 1]) * x + table[c, 1, 2]) * x + table[c, 1, 3]
-        nr = ((table[c, 2, 0] * x + table[c, 2, 1]) * x + table[c, 2, 2]) * x + table[c, 2, 3]
-        nzz = ((table[c, 3, 0] * x + table[c, 3, 1]) * x + table[c, 3, 2]) * x + table[c, 3, 3]
-        m = 1.0 / math.sqrt(nr * nr + nzz * nzz)
-        nr, nzz = nr * m, nzz * m
+        # the correspondence: the meridian at u = -s
+        u = -s
+        r2, z2, dr, dzu, _ = _spline(brk, cr, cz, u, piece_of[min(int((u - u_lo) * piece_scale), npo - 1)])
+        m = 1.0 / math.sqrt(dr * dr + dzu * dzu)
+        nr, nzz = -dzu * m, dr * m  # the left normal of the rising meridian: towards the axis
         inv_s = 1.0 / s
         cphi, sphi = ax * inv_s, ay * inv_s
         q2x, q2y = r2 * cphi, r2 * sphi
         ex, ey, ez = q2x - ax, q2y - ay, z2 - az
         t2 = math.sqrt(ex * ex + ey * ey + ez * ez)
-        fl = flags[c]
+        fl = flags[min(int((s - s0) * flag_inv_h), ncells - 1)]
         if fl & 1:
             tb = _occluders(beam_occ, ax, ay, az, ux, uy, uz, t2)
             if tb < t2:
-                status[i] = OCCLUDED_BY_BEAM
-                segment[i] = 2
+                _lost(i, OCCLUDED_BY_BEAM, 2, status, segment, p1, p2, v, landing, path, miss)
                 continue
         p2[i, 0], p2[i, 1], p2[i, 2] = q2x, q2y, z2
         wx, wy, wz = _reflect(ux, uy, uz, nr * cphi, nr * sphi, nzz)
         _return_leg(i, q2x, q2y, z2, wx, wy, wz, t1, t2, E, Z, True, E, Z, True, f, zv, rim, para_occ, beam_occ,
-                    (fl & 2) != 0, status, segment, v, landing, path, miss)
+                    (fl & 2) != 0, status, segment, p1, p2, v, landing, path, miss)
 
 
 @nb.njit(**_JIT)
@@ -547,4 +553,111 @@ def general_second(idx, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ
         p2[i, 0], p2[i, 1], p2[i, 2] = q2x, q2y, q2z
         wx, wy, wz = _reflect(ux, uy, uz, nx, ny, nz)
         _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1_in[k], td, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ,
-                    beam_occ, True, status, segment, v, landing, path, miss)
+                    beam_occ, True, status, segment, p1, p2, v, landing, path, miss)
+
+
+@nb.njit(**_JIT)
+def refine_mesh_hits(geom, prim, origins, dirs, tri, vnormals, offsets, has_normals, vertex_model, tmax, t_out,
+                     part_out, normal_out):
+    """Embree's hits (geometry ``geom``, triangle ``prim``; -1 none) re-intersected in float64
+    (Moller-Trumbore on that triangle, rays.EmbreeMesh) with their normals: the facet's, or the
+    vertex normals interpolated with the barycentric weights (``vertex_model``, meshes that have
+    them). ``tri[offsets[g] + prim]``: v0, e1 = v1 - v0, e2 = v2 - v0 and the unit facet normal
+    (12 values); ``vnormals`` the three vertex normals. Hits beyond ``tmax`` (if its length is
+    the rays') are dropped."""
+    n = geom.shape[0]
+    ng = offsets.shape[0] - 1
+    limited = tmax.shape[0] == n
+    for i in range(n):
+        g = geom[i]
+        p = prim[i]
+        if p < 0 or g < 0 or g >= ng:
+            t_out[i] = np.inf
+            part_out[i] = -1
+            normal_out[i, 0] = np.nan
+            normal_out[i, 1] = np.nan
+            normal_out[i, 2] = np.nan
+            continue
+        r = offsets[g] + p
+        dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
+        e1x, e1y, e1z = tri[r, 3], tri[r, 4], tri[r, 5]
+        e2x, e2y, e2z = tri[r, 6], tri[r, 7], tri[r, 8]
+        px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
+        inv = 1.0 / (e1x * px + e1y * py + e1z * pz)
+        sx, sy, sz = origins[i, 0] - tri[r, 0], origins[i, 1] - tri[r, 1], origins[i, 2] - tri[r, 2]
+        b1 = (sx * px + sy * py + sz * pz) * inv
+        qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
+        b2 = (dx * qx + dy * qy + dz * qz) * inv
+        t = (e2x * qx + e2y * qy + e2z * qz) * inv
+        if limited and t > tmax[i]:
+            t_out[i] = np.inf
+            part_out[i] = -1
+            normal_out[i, 0] = np.nan
+            normal_out[i, 1] = np.nan
+            normal_out[i, 2] = np.nan
+            continue
+        t_out[i] = t
+        part_out[i] = g
+        if vertex_model and has_normals[g]:
+            w0 = 1.0 - b1 - b2
+            nx = w0 * vnormals[r, 0, 0] + b1 * vnormals[r, 1, 0] + b2 * vnormals[r, 2, 0]
+            ny = w0 * vnormals[r, 0, 1] + b1 * vnormals[r, 1, 1] + b2 * vnormals[r, 2, 1]
+            nz = w0 * vnormals[r, 0, 2] + b1 * vnormals[r, 1, 2] + b2 * vnormals[r, 2, 2]
+            m = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+            normal_out[i, 0], normal_out[i, 1], normal_out[i, 2] = nx * m, ny * m, nz * m
+        else:
+            normal_out[i, 0], normal_out[i, 1], normal_out[i, 2] = tri[r, 9], tri[r, 10], tri[r, 11]
+
+
+@nb.njit(**_JIT)
+def refine_mesh_hits_v(geom, prim, origins, dirs, vertices, faces, vnormals, voff, foff, has_normals, vertex_model,
+                       tmax, t_out, part_out, normal_out):
+    """:func:`refine_mesh_hits` reading the meshes' own arrays (all geometries stacked: vertex rows
+    from ``voff[g]``, face rows from ``foff[g]``) instead of a per-face table: ~6x less memory to
+    gather from at random, which is what a hit costs."""
+    n = geom.shape[0]
+    ng = foff.shape[0] - 1
+    limited = tmax.shape[0] == n
+    for i in range(n):
+        g = geom[i]
+        p = prim[i]
+        if p < 0 or g < 0 or g >= ng:
+            t_out[i] = np.inf
+            part_out[i] = -1
+            normal_out[i, 0] = np.nan
+            normal_out[i, 1] = np.nan
+            normal_out[i, 2] = np.nan
+            continue
+        r = foff[g] + p
+        a, b, c = voff[g] + faces[r, 0], voff[g] + faces[r, 1], voff[g] + faces[r, 2]
+        v0x, v0y, v0z = vertices[a, 0], vertices[a, 1], vertices[a, 2]
+        e1x, e1y, e1z = vertices[b, 0] - v0x, vertices[b, 1] - v0y, vertices[b, 2] - v0z
+        e2x, e2y, e2z = vertices[c, 0] - v0x, vertices[c, 1] - v0y, vertices[c, 2] - v0z
+        dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
+        px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
+        inv = 1.0 / (e1x * px + e1y * py + e1z * pz)
+        sx, sy, sz = origins[i, 0] - v0x, origins[i, 1] - v0y, origins[i, 2] - v0z
+        b1 = (sx * px + sy * py + sz * pz) * inv
+        qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
+        b2 = (dx * qx + dy * qy + dz * qz) * inv
+        t = (e2x * qx + e2y * qy + e2z * qz) * inv
+        if limited and t > tmax[i]:
+            t_out[i] = np.inf
+            part_out[i] = -1
+            normal_out[i, 0] = np.nan
+            normal_out[i, 1] = np.nan
+            normal_out[i, 2] = np.nan
+            continue
+        t_out[i] = t
+        part_out[i] = g
+        if vertex_model and has_normals[g]:
+            w0 = 1.0 - b1 - b2
+            nx = w0 * vnormals[a, 0] + b1 * vnormals[b, 0] + b2 * vnormals[c, 0]
+            ny = w0 * vnormals[a, 1] + b1 * vnormals[b, 1] + b2 * vnormals[c, 1]
+            nz = w0 * vnormals[a, 2] + b1 * vnormals[b, 2] + b2 * vnormals[c, 2]
+        else:
+            nx = e1y * e2z - e1z * e2y
+            ny = e1z * e2x - e1x * e2z
+            nz = e1x * e2y - e1y * e2x
+        m = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+        normal_out[i, 0], normal_out[i, 1], normal_out[i, 2] = nx * m, ny * m, nz * m

@@ -5,10 +5,13 @@ Two kernels, and the one that ran is recorded per trace (``Trace3D.kernels``):
 
 * ``pinhole_aligned`` - an aligned rig (identity poses) and rays from the COP. The paraboloid hit
   is the quadratic's root; the rest of the path depends on the paraboloid radius s alone (the rig
-  is a surface of revolution), so the dome hit (r, z) and the dome normal (n_r, n_z) come from
-  the design correspondence table: the exact hits (Newton on the spline, from the design's own
-  correspondence u = -s) at ``TABLE_CELLS + 1`` radii, interpolated by a cubic spline per cell,
-  turned to the ray's azimuth. The beam and the mount are tested per ray (they break the symmetry).
+  is a surface of revolution), and the design's correspondence gives the dome hit: the ray
+  reflected at radius s lands on the dome's meridian at u = -s (the dome was built along those
+  rays), so the hit and its normal are the spline's point and derivative there (a lookup of the
+  piece and a quintic), turned to the ray's azimuth. The correspondence is measured against
+  Newton when the tracer is built (``table_error``; past CORRESPONDENCE_TOL the kernel is not
+  used). The beam and the mount are tested per ray (they break the symmetry), only where per-cell
+  flags of s say a leg can reach them.
 * ``general_newton`` - any rig and any rays (misaligned components, thin-lens rays): Newton on
   (t, u) against the spline, started at the correspondence; a ray whose Newton does not land on
   the mirror (a miss past its ends, a stray ray) takes the bracketing path of
@@ -16,7 +19,7 @@ Two kernels, and the one that ran is recorded per trace (``Trace3D.kernels``):
 
 Accuracy (tests/check/test_analytic.py, against the vectorised reference that brackets every ray
 and polishes by Newton): aligned within 1e-9 mm and 1e-12 rad ray for ray, misaligned within 1e-7
-mm. The table's own interpolation error is measured when it is built (``table_error``).
+mm.
 Frame: mm, O at the origin, +z up.
 """
 
@@ -25,15 +28,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import CubicSpline, PPoly
+from scipy.interpolate import PPoly
 
 from rigcad.check import rays as R
 from rigcad.optics.frames import Pose
 
-#: Cells of the correspondence table over the dome's paraboloid radii (~16 mm / 2^16 = 0.24 um):
-#: a cubic's error h^4 f''''/384 is then ~1e-14 mm here (measured at the cell midpoints: see
-#: ``table_error``), far inside the 1e-9 mm the fast path promises.
-TABLE_CELLS = 1 << 16
+#: Cells of paraboloid radius of the per-cell occlusion flags (16 mm / 2^16 = 0.23 um; 64 KB).
+FLAG_CELLS = 1 << 16
+#: Radii at which the correspondence is measured against Newton when the tracer is built.
+CHECK_RADII = 4097
+#: The aligned kernel runs only if the correspondence lands within this of Newton's hit (mm); the
+#: Table 3.1 dome's measures ~1e-13 mm (its spline interpolates rows built on the design's rays).
+CORRESPONDENCE_TOL = 1e-11
 #: Uniform cells of the dome parameter that seed the spline-piece search (~4 per piece).
 PIECE_CELLS = 8192
 #: Newton steps of the general kernel: from the correspondence (within ~1 mm for a mm-scale
@@ -45,7 +51,7 @@ NEWTON_STEPS = 12
 NEWTON_STEP_TOL = 1e-12
 #: The general kernel's hit counts as on the dome within this residual (mm), as rays.FAST_PATH_RESIDUAL.
 RESIDUAL_TOL = R.FAST_PATH_RESIDUAL
-#: Margin (mm of paraboloid radius) kept inside the dome's ends by the table: rays within it of an
+#: Margin (mm of paraboloid radius) kept inside the dome's ends by the aligned kernel: rays within it of an
 #: end (where the hit may fall off the mirror) take the general kernel.
 TABLE_MARGIN = 1e-6
 
@@ -90,16 +96,17 @@ class AnalyticTracer:
     u_lo: float
     u_hi: float
     s0: float
-    inv_h: float
-    table: np.ndarray
+    s1: float
+    flag_inv_h: float
     flags: np.ndarray
     mount_shadowed: bool
     piece_of: np.ndarray
     piece_scale: float
+    pinhole: bool
     table_error: dict
     dome: R.ExactDome
 
-    backend = "analytic float64, numba kernels (pinhole_aligned: correspondence table; general_newton)"
+    backend = "analytic float64, numba kernels (pinhole_aligned: design correspondence; general_newton)"
 
     @classmethod
     def build(cls, rig, paraboloid, dome_group, beam) -> "AnalyticTracer":
@@ -122,24 +129,24 @@ class AnalyticTracer:
         cell_u = u_lo + (np.arange(PIECE_CELLS) + 0.5) / piece_scale
         piece_of = np.clip(np.searchsorted(breaks, cell_u, side="right") - 1, 0, len(breaks) - 2).astype(np.int64)
         s0, s1 = -u_hi + TABLE_MARGIN, -u_lo - TABLE_MARGIN
-        s = np.linspace(s0, s1, TABLE_CELLS + 1)
-        values = _aligned_hits(exact_para, exact_dome, geo.cop_z, s)
-        cs = CubicSpline(s, values, axis=0)
-        flags = _cell_flags(geo, s, values, para_occ, beam_occ)
-        shadowed = _mount_shadowed(geo, para_occ)
-        table = np.ascontiguousarray(np.transpose(cs.c, (1, 2, 0)))  # (cell, quantity, power)
-        mid = 0.5 * (s[1:] + s[:-1])
-        exact_mid = _aligned_hits(exact_para, exact_dome, geo.cop_z, mid)
-        err = cs(mid) - exact_mid
-        nerr = np.abs(np.arctan2(cs(mid)[:, 2] * exact_mid[:, 3] - cs(mid)[:, 3] * exact_mid[:, 2],
-                                 np.sum(cs(mid)[:, 2:] * exact_mid[:, 2:], axis=1)))
-        table_error = {"cells": TABLE_CELLS, "cell_mm": float((s1 - s0) / TABLE_CELLS),
-                       "max_dome_point_error_mm": float(np.max(np.hypot(err[:, 0], err[:, 1]))),
+        # the design correspondence (the aligned ray reflected at paraboloid radius s meets the
+        # meridian at u = -s), measured against Newton on the spline at CHECK_RADII radii
+        s_check = np.linspace(s0, s1, CHECK_RADII)
+        exact = _aligned_hits(exact_para, exact_dome, geo.cop_z, s_check)
+        corr = _correspondence(exact_dome, s_check)
+        nerr = np.abs(np.arctan2(corr[:, 2] * exact[:, 3] - corr[:, 3] * exact[:, 2],
+                                 np.sum(corr[:, 2:] * exact[:, 2:], axis=1)))
+        table_error = {"radii_checked": CHECK_RADII,
+                       "max_dome_point_error_mm": float(np.max(np.hypot(*(corr[:, :2] - exact[:, :2]).T))),
                        "max_dome_normal_error_rad": float(np.max(nerr)),
-                       "measured": "at every cell's midpoint, against Newton on the spline"}
+                       "measured": "the meridian at u = -s against Newton on the spline, aligned COP rays"}
+        pinhole = table_error["max_dome_point_error_mm"] < CORRESPONDENCE_TOL
+        s_flags = np.linspace(s0, s1, FLAG_CELLS + 1)
+        flags = _cell_flags(geo, s_flags, _correspondence(exact_dome, s_flags), para_occ, beam_occ)
+        shadowed = _mount_shadowed(geo, para_occ)
         return cls(geo.focal_length, geo.vertex_z, geo.rim_radius, geo.cop_z, para_occ, beam_occ, breaks, coef_r,
-                   coef_z, float(u_lo), float(u_hi), float(s0), float(TABLE_CELLS / (s1 - s0)), table, flags,
-                   shadowed, piece_of, float(piece_scale), table_error, exact_dome)
+                   coef_z, float(u_lo), float(u_hi), float(s0), float(s1), float(FLAG_CELLS / (s1 - s0)), flags,
+                   shadowed, piece_of, float(piece_scale), pinhole, table_error, exact_dome)
 
     def trace(self, optics, origins: np.ndarray, dirs: np.ndarray):
         """Trace rays (n, 3) through ``optics`` (its poses) with the kernels: a Trace3D with
@@ -159,11 +166,12 @@ class AnalyticTracer:
         aligned = pp.is_identity and dp.is_identity
         kernels = {"pinhole_aligned": 0, "general_newton": 0, "bracketed_fallback": 0}
         rest = None
-        if n and aligned and np.all(origins[:, 0] == 0.0) and np.all(origins[:, 1] == 0.0) \
+        if n and aligned and self.pinhole and np.all(origins[:, 0] == 0.0) and np.all(origins[:, 1] == 0.0) \
                 and np.all(origins[:, 2] == self.cop_z):
             handled = np.empty(n, np.bool_)
             K.pinhole_aligned(self.cop_z, dirs, self.focal_length, self.vertex_z, self.rim_radius, self.para_occ,
-                              self.beam_occ, self.mount_shadowed, self.s0, self.inv_h, self.table, self.flags,
+                              self.beam_occ, self.mount_shadowed, self.s0, self.s1, self.breaks, self.coef_r,
+                              self.coef_z, self.piece_of, self.piece_scale, self.u_lo, self.flag_inv_h, self.flags,
                               *out, handled)
             rest = np.nonzero(~handled)[0]
             kernels["pinhole_aligned"] = n - len(rest)
@@ -197,7 +205,7 @@ FLAG_MARGIN_MM = 0.5
 
 
 def _cell_flags(geo, s: np.ndarray, values: np.ndarray, para_occ: np.ndarray, beam_occ: np.ndarray) -> np.ndarray:
-    """Per table cell (int8): bit 0 when the aligned leg paraboloid -> dome may cross the beam's
+    """Per cell of s (int8): bit 0 when the aligned leg paraboloid -> dome may cross the beam's
     heights, bit 1 when the return leg dome -> O may pass within FLAG_MARGIN_MM of the cylinder
     that bounds the paraboloid and its mount; from the exact node values (s (m+1,), values (m+1, 4))
     at both ends of each cell."""
@@ -254,10 +262,15 @@ def _mount_shadowed(geo, para_occ: np.ndarray) -> bool:
     return True
 
 
+def _correspondence(dome: R.ExactDome, s: np.ndarray) -> np.ndarray:
+    """The meridian's point (r, z) and normal (n_r, n_z) at u = -s (m, 4)."""
+    return np.column_stack([dome.m._spline(-s), dome.m.normals(-s)])
+
+
 def _aligned_hits(para: R.ExactParaboloid, dome: R.ExactDome, cop_z: float, s: np.ndarray) -> np.ndarray:
     """(r, z) of the dome hit and the dome normal (n_r, n_z) of the aligned COP ray that reflects at
     paraboloid radius s (m,), in the x-z plane: (m, 4). Newton on the spline from the design's
-    correspondence (u = -s); every ray must land (the table covers the dome's own radii)."""
+    correspondence (u = -s); every ray must land (the radii are the dome's own)."""
     f, zv = para.f, para.zv
     p = np.stack([s, np.zeros_like(s), zv - s * s / (4 * f)], axis=-1)
     d = R.unit(p - np.array([0.0, 0.0, cop_z]))
@@ -272,8 +285,8 @@ def _aligned_hits(para: R.ExactParaboloid, dome: R.ExactDome, cop_z: float, s: n
         idx, tb, ub = dome._bracketed(q[bad], u[bad])
         rows = np.nonzero(bad)[0][idx]
         t[rows], uu[rows] = tb, ub
-        if len(idx) < bad.sum():  # pragma: no cover - the table stays inside the dome's radii
-            raise R.CheckError("the correspondence table has radii whose aligned ray misses the dome")
+        if len(idx) < bad.sum():  # pragma: no cover - the radii are inside the dome's
+            raise R.CheckError("the aligned correspondence has radii whose ray misses the dome")
     hit = q + t[:, None] * u
     n2 = dome.m.normals(uu)
     return np.column_stack([hit[:, 0], hit[:, 2], n2[:, 0], n2[:, 1]])

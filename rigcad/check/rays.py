@@ -230,6 +230,24 @@ class EmbreeMesh:
             self._tri_cache[g] = c
         return self._tri_cache[g]
 
+    def _packed(self):
+        """Every geometry's per-face float64 data in one table for the compiled refinement
+        (_kernels.refine_mesh_hits): rows v0, e1, e2, unit facet normal (12); vertex normals
+        (3, 3) per face (zeros for meshes without); the first row of each geometry; which have
+        vertex normals. Built once, shared by the copies share_scenes makes."""
+        if "packed" not in self._tri_cache:
+            tris, vns, offsets, has = [], [], [0], []
+            for m in self.meshes:
+                tri = m.vertices[m.faces]
+                e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+                tris.append(np.hstack([tri[:, 0], e1, e2, unit(np.cross(e1, e2))]))
+                vns.append(np.zeros((len(m.faces), 3, 3)) if m.normals is None else m.normals[m.faces])
+                offsets.append(offsets[-1] + len(m.faces))
+                has.append(m.normals is not None)
+            self._tri_cache["packed"] = (np.ascontiguousarray(np.vstack(tris)), np.ascontiguousarray(np.vstack(vns)),
+                                         np.array(offsets, np.int64), np.array(has, np.bool_))
+        return self._tri_cache["packed"]
+
     @property
     def triangles(self) -> int:
         return int(sum(len(m.faces) for m in self.meshes))
@@ -259,6 +277,17 @@ class EmbreeMesh:
         res = self.raw(o32, d32, t32)
         geom = res["geomID"]
         prim = res["primID"]
+        if self.refine and self.normal_model in ("facet", "vertex"):
+            # the float64 re-intersection and the normals in one compiled pass over the hits
+            from rigcad.check._kernels import refine_mesh_hits
+
+            tri, vn, offsets, has = self._packed()
+            refine_mesh_hits(geom.astype(np.int64, copy=False), prim.astype(np.int64, copy=False),
+                             np.ascontiguousarray(origins, float), np.ascontiguousarray(dirs, float), tri, vn,
+                             offsets, has, self.normal_model == "vertex",
+                             np.empty(0) if tmax is None else np.ascontiguousarray(tmax, float),
+                             hits.t, hits.part, hits.normal)
+            return hits
         found = (prim >= 0) & (geom >= 0) & (geom < len(self.meshes))
         for g, mesh in enumerate(self.meshes):  # a handful of geometries, not rays
             idx = np.nonzero(found & (geom == g))[0] if len(self.meshes) > 1 else np.nonzero(found)[0]
