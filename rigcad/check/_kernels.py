@@ -437,51 +437,48 @@ def _bracketed(ox, oy, oz, dx, dy, dz, tab_u, tab_r, tab_z, r_max, brk, cr, cz, 
 
 
 @nb.njit(**_JIT)
-def general_first(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, brk, cr, cz, u_lo, u_hi,
-                  piece_of, piece_scale, tab_u, tab_r, tab_z, r_max, newton_steps, residual_tol, step_tol, status,
-                  segment, p1, p2, v, landing, path, miss, t1_out, q1, u_out, t2_out, u2_out, state):
-    """Any rig, any rays (rows ``idx``): segment 1 and the dome hit by Newton on (t, u) against
-    the meridian spline, started at the design's correspondence (the dome point u = -s of the
-    paraboloid radius s the ray reflects at). ``state`` per row: 0 lost on segment 1, 1 dome hit
-    converged (residual < residual_tol mm, u inside the mirror), 2 taken by the bracketing path
-    (:func:`_bracketed`) and hit, 3 no dome hit. ``piece_of``: the spline piece at each of its
-    uniform cells of u (``piece_scale`` cells per unit u), Newton's first guess."""
+def general(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ, brk, cr, cz, u_lo, u_hi,
+            piece_of, piece_scale, tab_u, tab_r, tab_z, r_max, newton_steps, residual_tol, step_tol, status, segment,
+            p1, p2, v, landing, path, miss):
+    """Any rig, any rays (rows ``idx``): the paraboloid in its frame (closed form), the dome hit by
+    Newton on (t, u) against the meridian spline, started at the design's correspondence (u = -s
+    of the paraboloid radius s the ray reflects at); a ray whose Newton does not land on the mirror
+    (residual >= residual_tol mm, or u at an end) takes :func:`_bracketed`. ``piece_of``: the spline
+    piece at each of its uniform cells of u (``piece_scale`` cells per unit u), the first guess of
+    the piece search. Returns the number of rays that took the bracketing path."""
+    fallbacks = 0
+    npo = piece_of.shape[0]
     for k in range(idx.shape[0]):
         i = idx[k]
         _blank(i, status, segment, p1, p2, v, landing, path, miss)
         dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
-        norm = math.sqrt(dx * dx + dy * dy + dz * dz)
-        dx, dy, dz = dx / norm, dy / norm, dz / norm
+        norm = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+        dx, dy, dz = dx * norm, dy * norm, dz * norm
         lx, ly, lz = _to_local(R1, T1, id1, origins[i, 0], origins[i, 1], origins[i, 2])
         ldx, ldy, ldz = _dir_to_local(R1, id1, dx, dy, dz)
         t1, part = _mirror_leg(lx, ly, lz, ldx, ldy, ldz, f, zv, rim, para_occ)
         if part != 0:
-            status[i] = MISSED_PARABOLOID if part < 0 else OCCLUDED_BY_MOUNT
-            segment[i] = 1
-            state[k] = 0
+            _lost(i, MISSED_PARABOLOID if part < 0 else OCCLUDED_BY_MOUNT, 1, status, segment, p1, p2, v, landing,
+                  path, miss)
             continue
         ax, ay, az = lx + t1 * ldx, ly + t1 * ldy, lz + t1 * ldz
         s = math.sqrt(ax * ax + ay * ay)
-        nx, ny, nz = ax / (2.0 * f), ay / (2.0 * f), 1.0
-        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
-        nx, ny, nz = _dir_to_global(R1, id1, nx / nn, ny / nn, nz / nn)
+        nx, ny = ax / (2.0 * f), ay / (2.0 * f)
+        nn = 1.0 / math.sqrt(nx * nx + ny * ny + 1.0)
+        nx, ny, nz = _dir_to_global(R1, id1, nx * nn, ny * nn, nn)
         gx, gy, gz = _to_global(R1, T1, id1, ax, ay, az)
         p1[i, 0], p1[i, 1], p1[i, 2] = gx, gy, gz
         ux, uy, uz = _reflect(dx, dy, dz, nx, ny, nz)
-        q1[k, 0], q1[k, 1], q1[k, 2] = gx, gy, gz
-        u_out[k, 0], u_out[k, 1], u_out[k, 2] = ux, uy, uz
-        t1_out[k] = t1
         # dome frame; Newton from the correspondence u = -s
         ox, oy, oz = _to_local(R2, T2, id2, gx, gy, gz)
         ex, ey, ez = _dir_to_local(R2, id2, ux, uy, uz)
         u = min(max(-s, u_lo), u_hi)
-        piece = piece_of[min(int((u - u_lo) * piece_scale), piece_of.shape[0] - 1)]
+        piece = piece_of[min(int((u - u_lo) * piece_scale), npo - 1)]
         r0, z0, _, _, piece = _spline(brk, cr, cz, u, piece)
-        rho0 = math.sqrt(ox * ox + oy * oy)
         if abs(ez) > 1e-3:
             t = (z0 - oz) / ez
         else:
-            t = (r0 - rho0) / max(math.sqrt(ex * ex + ey * ey), 1e-12)
+            t = (r0 - math.sqrt(ox * ox + oy * oy)) / max(math.sqrt(ex * ex + ey * ey), 1e-12)
         if not (math.isfinite(t) and t > 0.0):
             t = 1.0
         for _ in range(newton_steps):
@@ -491,69 +488,44 @@ def general_first(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para
             f1 = rho - cr_
             f2 = pz - cz_
             a11 = (px * ex + py * ey) / rho
-            a12 = -dcr
-            a21 = ez
-            a22 = -dcz
-            det = a11 * a22 - a12 * a21
-            dt = (a22 * f1 - a12 * f2) / det
-            du = (-a21 * f1 + a11 * f2) / det
+            inv = 1.0 / (a11 * (-dcz) + dcr * ez)
+            dt = ((-dcz) * f1 + dcr * f2) * inv
+            du = (-ez * f1 + a11 * f2) * inv
             t = t - dt
             u = min(max(u - du, u_lo), u_hi)
             if abs(dt) < step_tol and abs(du) < step_tol:
                 break
-        cr_, cz_, _, _, piece = _spline(brk, cr, cz, u, piece)
+        cr_, cz_, dcr, dcz, piece = _spline(brk, cr, cz, u, piece)
         px, py, pz = ox + t * ex, oy + t * ey, oz + t * ez
         res = math.hypot(math.sqrt(px * px + py * py) - cr_, pz - cz_)
-        if res < residual_tol and math.isfinite(t) and t > 0.0 and u_lo < u < u_hi:
-            state[k] = 1
-            t2_out[k] = t
-            u2_out[k] = u
-        else:
+        if not (res < residual_tol and math.isfinite(t) and t > 0.0 and u_lo < u < u_hi):
+            fallbacks += 1
             t, u = _bracketed(ox, oy, oz, ex, ey, ez, tab_u, tab_r, tab_z, r_max, brk, cr, cz, u_lo, u_hi,
                               newton_steps, piece_of, piece_scale)
-            if math.isfinite(t) and t > 0.0:
-                state[k] = 2
-                t2_out[k] = t
-                u2_out[k] = u
+            if not (math.isfinite(t) and t > 0.0):
+                t = np.inf
             else:
-                state[k] = 3
-
-
-@nb.njit(**_JIT)
-def general_second(idx, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ, brk, cr, cz, t1_in, q1, u_in,
-                   t2_in, u2_in, state, status, segment, p1, p2, v, landing, path, miss):
-    """Segments 2 (the beam between the mirrors) and 3 for the rows ``idx`` that reached the dome
-    leg (``state`` 1 or 2: hit at (t2, u2); 3: no dome hit)."""
-    for k in range(idx.shape[0]):
-        if state[k] == 0:
+                _, _, dcr, dcz, piece = _spline(brk, cr, cz, u, piece)
+        # segment 2: the beam between the mirrors (it moves with the dome)
+        tb = _occluders(beam_occ, ox, oy, oz, ex, ey, ez, t)
+        if tb < t:
+            _lost(i, OCCLUDED_BY_BEAM, 2, status, segment, p1, p2, v, landing, path, miss)
             continue
-        i = idx[k]
-        gx, gy, gz = q1[k, 0], q1[k, 1], q1[k, 2]
-        ux, uy, uz = u_in[k, 0], u_in[k, 1], u_in[k, 2]
-        ox, oy, oz = _to_local(R2, T2, id2, gx, gy, gz)
-        ex, ey, ez = _dir_to_local(R2, id2, ux, uy, uz)
-        td = t2_in[k] if state[k] == 1 or state[k] == 2 else np.inf
-        tb = _occluders(beam_occ, ox, oy, oz, ex, ey, ez, td)
-        if tb < td:
-            status[i] = OCCLUDED_BY_BEAM
-            segment[i] = 2
+        if not math.isfinite(t):
+            _lost(i, ESCAPED_TOP if uz > 0.0 else MISSED_DOME, 2, status, segment, p1, p2, v, landing, path, miss)
             continue
-        if not math.isfinite(td):
-            status[i] = ESCAPED_TOP if uz > 0.0 else MISSED_DOME
-            segment[i] = 2
-            continue
-        px, py, pz = ox + td * ex, oy + td * ey, oz + td * ez
-        _, _, dcr, dcz, _ = _spline(brk, cr, cz, u2_in[k], -1)
-        m = math.sqrt(dcr * dcr + dcz * dcz)
-        nr, nzz = -dcz / m, dcr / m  # the left normal of the rising meridian: towards the axis
+        px, py, pz = ox + t * ex, oy + t * ey, oz + t * ez
+        m = 1.0 / math.sqrt(dcr * dcr + dcz * dcz)
+        nr, nzz = -dcz * m, dcr * m  # the left normal of the rising meridian: towards the axis
         rho = math.sqrt(px * px + py * py)
         cphi, sphi = (px / rho, py / rho) if rho > 0.0 else (1.0, 0.0)
         nx, ny, nz = _dir_to_global(R2, id2, nr * cphi, nr * sphi, nzz)
         q2x, q2y, q2z = _to_global(R2, T2, id2, px, py, pz)
         p2[i, 0], p2[i, 1], p2[i, 2] = q2x, q2y, q2z
         wx, wy, wz = _reflect(ux, uy, uz, nx, ny, nz)
-        _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1_in[k], td, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ,
-                    beam_occ, True, status, segment, p1, p2, v, landing, path, miss)
+        _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1, t, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ,
+                    True, status, segment, p1, p2, v, landing, path, miss)
+    return fallbacks
 
 
 @nb.njit(**_JIT)

@@ -183,20 +183,12 @@ class AnalyticTracer:
         return Trace3D(*out, kernels=kernels)
 
     def _general(self, K, idx, origins, dirs, pp, dp, out) -> int:
-        m = len(idx)
-        t1, t2, u2 = np.empty(m), np.empty(m), np.empty(m)
-        q1, u = np.empty((m, 3)), np.empty((m, 3))
-        state = np.empty(m, np.int8)
         R1, T1, id1 = _pose(pp)
         R2, T2, id2 = _pose(dp)
-        common = (self.focal_length, self.vertex_z, self.rim_radius, self.para_occ)
-        K.general_first(idx, origins, dirs, R1, T1, id1, R2, T2, id2, *common, self.breaks, self.coef_r,
-                        self.coef_z, self.u_lo, self.u_hi, self.piece_of, self.piece_scale, self.dome.u_tab,
-                        self.dome.r_tab, self.dome.z_tab, self.dome.r_max, NEWTON_STEPS, RESIDUAL_TOL,
-                        NEWTON_STEP_TOL, *out, t1, q1, u, t2, u2, state)
-        K.general_second(idx, R1, T1, id1, R2, T2, id2, *common, self.beam_occ, self.breaks, self.coef_r,
-                         self.coef_z, t1, q1, u, t2, u2, state, *out)
-        return int(np.count_nonzero(state >= 2))
+        return int(K.general(idx, origins, dirs, R1, T1, id1, R2, T2, id2, self.focal_length, self.vertex_z,
+                             self.rim_radius, self.para_occ, self.beam_occ, self.breaks, self.coef_r, self.coef_z,
+                             self.u_lo, self.u_hi, self.piece_of, self.piece_scale, self.dome.u_tab, self.dome.r_tab,
+                             self.dome.z_tab, self.dome.r_max, NEWTON_STEPS, RESIDUAL_TOL, NEWTON_STEP_TOL, *out))
 
 
 #: Margin (mm) of the per-cell flags: a leg counts as clear of a solid's bounding shape only by at
