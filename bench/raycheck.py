@@ -11,8 +11,10 @@ reading against raw embreex on the same rays, side by side in one process:
   trace of the same rays;
 * the vectorised (numpy) analytic path of before, on a subset, for the record.
 
-Ratios are raw Embree time over the reading's time (above 1: faster than raw Embree). Best of
-REPEATS runs for every timing (the machine may be shared: the best run is the least disturbed).
+Ratios are raw Embree time over the reading's time (above 1: faster than raw Embree). Each of
+REPEATS rounds times every reading right after its raw Embree, so each ratio compares runs under
+the same load (the machine is shared); the median ratio over the rounds is reported, with each
+round's, and the best times.
 
 Run from the repository root: ``.venv/bin/python bench/raycheck.py [--rays N] [--exports DIR]``.
 Writes bench/results/raycheck.json and raycheck.png. Timings (keys ending in ``_s`` and rates)
@@ -45,7 +47,7 @@ from rigcad.profile import load_profile  # noqa: E402
 from rigcad.rig import Rig  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
-REPEATS = 3
+REPEATS = 5
 #: Issue 12's targets: raw Embree time / reading time.
 TARGETS = {"analytic_aligned": 10.0, "analytic_misaligned": 2.0, "smooth": 0.8, "mesh": 0.8}
 #: Rays of the vectorised analytic path (seconds per 100 k rays).
@@ -77,11 +79,6 @@ def mesh_run(optics, timer, origins, dirs):
         member.scene.run(o32, d32, dists=None if t32 is None else t32.copy(), output=1)
         raw += time.perf_counter() - t0
     return dt, raw, timer.embree_rays, tr
-
-
-def best_mesh(optics, timer, origins, dirs):
-    runs = [mesh_run(optics, timer, origins, dirs) for _ in range(REPEATS)]
-    return min(r[0] for r in runs), min(r[1] for r in runs), runs[0][2], runs[-1][3]
 
 
 def main() -> None:
@@ -119,35 +116,41 @@ def main() -> None:
     pp, dp = mis.pose("paraboloid", geo), mis.pose("dome", geo)
     trace(analytic.placed(pp, dp), mis_rays.origins[:1000], mis_rays.dirs[:1000])
 
-    raws = {}
-    for mode in ("smooth", "mesh"):
-        dt, raw, casts, tr = best_mesh(share_scenes(base, mode), timer, o, d)
-        f = MC.figures(tr, design.direction(rays.chief))
-        raws[mode] = raw
-        result["readings"][mode] = {
-            "trace_s": dt, "raw_embree_s": raw, "embree_rays_cast": casts,
-            "end_to_end_rays_per_s": args.rays / dt, "raw_embree_rays_per_s": args.rays / raw,
-            "raw_over_reading": raw / dt, "target": TARGETS[mode],
-            "max_spot_radius_mm": f["max_spot_radius_mm"], "max_angle_error_rad": f["max_angle_error_rad"]}
-        print(mode, {k: round(v, 4) if isinstance(v, float) else v for k, v in result["readings"][mode].items()})
-
-    dt, tr = best(lambda: trace(analytic, o, d))
-    f = MC.figures(tr, design.direction(rays.chief))
-    result["readings"]["analytic_aligned"] = {
-        "trace_s": dt, "rays_per_s": args.rays / dt, "kernels": tr.kernels, "raw_embree_s": raws["smooth"],
-        "raw_over_reading": raws["smooth"] / dt, "target": TARGETS["analytic_aligned"],
-        "max_spot_radius_mm": f["max_spot_radius_mm"], "max_angle_error_rad": f["max_angle_error_rad"]}
-    print("analytic_aligned", result["readings"]["analytic_aligned"])
-
+    # every repeat times each reading and its raw Embree back to back, so that a ratio compares
+    # runs under the same load (the machine is shared); reported: the median ratio over repeats
     placed_mesh = share_scenes(base, "smooth").placed(pp, dp)
-    _, raw_mis, casts, _ = best_mesh(placed_mesh, timer, mis_rays.origins, mis_rays.dirs)
     placed = analytic.placed(pp, dp)
-    dt, tr = best(lambda: trace(placed, mis_rays.origins, mis_rays.dirs))
-    result["readings"]["analytic_misaligned"] = {
-        "trace_s": dt, "rays_per_s": args.rays / dt, "kernels": tr.kernels, "raw_embree_s": raw_mis,
-        "embree_rays_cast": casts, "raw_over_reading": raw_mis / dt, "target": TARGETS["analytic_misaligned"],
-        "build": {c: {"offset_mm": list(mis.offsets[c]), "tilt_rad": mis.tilts[c]} for c in mis.offsets}}
-    print("analytic_misaligned", {k: v for k, v in result["readings"]["analytic_misaligned"].items() if k != "build"})
+    runs = {n: [] for n in ("smooth", "mesh", "analytic_aligned", "analytic_misaligned")}
+    last = {}
+    for _ in range(REPEATS):
+        for mode in ("smooth", "mesh"):
+            dt, raw, casts, tr = mesh_run(share_scenes(base, mode), timer, o, d)
+            runs[mode].append((dt, raw, casts))
+            last[mode] = tr
+        t0 = time.perf_counter()
+        last["analytic_aligned"] = trace(analytic, o, d)
+        runs["analytic_aligned"].append((time.perf_counter() - t0, runs["smooth"][-1][1], None))
+        _, raw_mis, casts, _ = mesh_run(placed_mesh, timer, mis_rays.origins, mis_rays.dirs)
+        t0 = time.perf_counter()
+        last["analytic_misaligned"] = trace(placed, mis_rays.origins, mis_rays.dirs)
+        runs["analytic_misaligned"].append((time.perf_counter() - t0, raw_mis, casts))
+    for name, rr in runs.items():
+        ratios = sorted(raw / dt for dt, raw, _ in rr)
+        tr = last[name]
+        rec = {"trace_s": min(r[0] for r in rr), "raw_embree_s": min(r[1] for r in rr),
+               "raw_over_reading": float(np.median(ratios)), "raw_over_reading_per_repeat": ratios,
+               "rays_per_s": args.rays / min(r[0] for r in rr), "raw_embree_rays_per_s": args.rays / min(r[1] for r in rr),
+               "target": TARGETS[name], "kernels": tr.kernels}
+        if rr[0][2] is not None:
+            rec["embree_rays_cast"] = rr[0][2]
+        if name != "analytic_misaligned":
+            f = MC.figures(tr, design.direction(rays.chief))
+            rec.update({"max_spot_radius_mm": f["max_spot_radius_mm"], "max_angle_error_rad": f["max_angle_error_rad"]})
+        else:
+            rec["build"] = {c: {"offset_mm": list(mis.offsets[c]), "tilt_rad": mis.tilts[c]} for c in mis.offsets}
+        result["readings"][name] = rec
+        print(name, {k: v for k, v in rec.items() if k != "build"})
+    raws = {"smooth": result["readings"]["smooth"]["raw_embree_s"]}
 
     k = min(VECTORISED_RAYS, args.rays)
     dt, _ = best(lambda: trace(analytic, o[:k], d[:k], vectorised=True), repeats=1)

@@ -307,11 +307,12 @@ def tolerance_histograms(profile, columns: dict, summary: dict) -> bytes:
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
     spot = np.asarray(columns["max_spot_radius_mm"], float)
     ang = np.degrees(np.asarray(columns["max_mirror_angle_error_rad"], float))
-    for ax, v, target, label in ((a1, spot, tol.max_spot_radius, "largest spot radius per build (mm)"),
-                                 (a2, ang, np.degrees(tol.max_angle_error), "largest calibrated angle error per build (deg)")):
+    for ax, v, target, label, unit in ((a1, spot, tol.max_spot_radius, "largest spot radius per build (mm)", "mm"),
+                                       (a2, ang, np.degrees(tol.max_angle_error),
+                                        "largest calibrated angle error per build (deg)", "deg")):
         finite = v[np.isfinite(v)]
         ax.hist(finite, bins=60, color="tab:blue", alpha=0.8)
-        ax.axvline(target, color="tab:red", lw=1.5, label=f"target {target:g}")
+        ax.axvline(target, color="tab:red", lw=1.5, label=f"target {target:g} {unit}")
         ax.set_xlabel(label)
         ax.set_ylabel("builds")
         ax.legend(fontsize=8)
@@ -340,7 +341,7 @@ def tolerance_sensitivity(profile, limits: list[dict]) -> bytes:
     a2.barh(y, finite, 0.5, color=colors)
     a2.axvline(1.0, color="tab:red", lw=1)
     a2.set_xscale("log")
-    a2.set_xlabel("inverse limit (angle target) / tolerance  (grey: none below the search cap)")
+    a2.set_xlabel("inverse limit (angle target) / tolerance\n(grey: none below the search cap)")
     a2.grid(alpha=0.3, axis="x")
     fig.suptitle(f"{profile.name}: sensitivity and inverse limits", fontsize=10)
     fig.tight_layout()

@@ -529,14 +529,14 @@ def general(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, 
 
 
 @nb.njit(**_JIT)
-def refine_mesh_hits(geom, prim, origins, dirs, tri, vnormals, offsets, has_normals, vertex_model, tmax, t_out,
-                     part_out, normal_out):
+def refine_mesh_hits(geom, prim, origins, dirs, tri, offsets, has_normals, vertex_model, tmax, t_out, part_out,
+                     normal_out):
     """Embree's hits (geometry ``geom``, triangle ``prim``; -1 none) re-intersected in float64
     (Moller-Trumbore on that triangle, rays.EmbreeMesh) with their normals: the facet's, or the
     vertex normals interpolated with the barycentric weights (``vertex_model``, meshes that have
-    them). ``tri[offsets[g] + prim]``: v0, e1 = v1 - v0, e2 = v2 - v0 and the unit facet normal
-    (12 values); ``vnormals`` the three vertex normals. Hits beyond ``tmax`` (if its length is
-    the rays') are dropped."""
+    them). ``tri[offsets[g] + prim]``: v0, e1 = v1 - v0, e2 = v2 - v0, the unit facet normal and
+    the three vertex normals (21 values). Hits beyond ``tmax`` (if its length is the rays') are
+    dropped."""
     n = geom.shape[0]
     ng = offsets.shape[0] - 1
     limited = tmax.shape[0] == n
@@ -572,64 +572,10 @@ def refine_mesh_hits(geom, prim, origins, dirs, tri, vnormals, offsets, has_norm
         part_out[i] = g
         if vertex_model and has_normals[g]:
             w0 = 1.0 - b1 - b2
-            nx = w0 * vnormals[r, 0, 0] + b1 * vnormals[r, 1, 0] + b2 * vnormals[r, 2, 0]
-            ny = w0 * vnormals[r, 0, 1] + b1 * vnormals[r, 1, 1] + b2 * vnormals[r, 2, 1]
-            nz = w0 * vnormals[r, 0, 2] + b1 * vnormals[r, 1, 2] + b2 * vnormals[r, 2, 2]
+            nx = w0 * tri[r, 12] + b1 * tri[r, 15] + b2 * tri[r, 18]
+            ny = w0 * tri[r, 13] + b1 * tri[r, 16] + b2 * tri[r, 19]
+            nz = w0 * tri[r, 14] + b1 * tri[r, 17] + b2 * tri[r, 20]
             m = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
             normal_out[i, 0], normal_out[i, 1], normal_out[i, 2] = nx * m, ny * m, nz * m
         else:
             normal_out[i, 0], normal_out[i, 1], normal_out[i, 2] = tri[r, 9], tri[r, 10], tri[r, 11]
-
-
-@nb.njit(**_JIT)
-def refine_mesh_hits_v(geom, prim, origins, dirs, vertices, faces, vnormals, voff, foff, has_normals, vertex_model,
-                       tmax, t_out, part_out, normal_out):
-    """:func:`refine_mesh_hits` reading the meshes' own arrays (all geometries stacked: vertex rows
-    from ``voff[g]``, face rows from ``foff[g]``) instead of a per-face table: ~6x less memory to
-    gather from at random, which is what a hit costs."""
-    n = geom.shape[0]
-    ng = foff.shape[0] - 1
-    limited = tmax.shape[0] == n
-    for i in range(n):
-        g = geom[i]
-        p = prim[i]
-        if p < 0 or g < 0 or g >= ng:
-            t_out[i] = np.inf
-            part_out[i] = -1
-            normal_out[i, 0] = np.nan
-            normal_out[i, 1] = np.nan
-            normal_out[i, 2] = np.nan
-            continue
-        r = foff[g] + p
-        a, b, c = voff[g] + faces[r, 0], voff[g] + faces[r, 1], voff[g] + faces[r, 2]
-        v0x, v0y, v0z = vertices[a, 0], vertices[a, 1], vertices[a, 2]
-        e1x, e1y, e1z = vertices[b, 0] - v0x, vertices[b, 1] - v0y, vertices[b, 2] - v0z
-        e2x, e2y, e2z = vertices[c, 0] - v0x, vertices[c, 1] - v0y, vertices[c, 2] - v0z
-        dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
-        px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
-        inv = 1.0 / (e1x * px + e1y * py + e1z * pz)
-        sx, sy, sz = origins[i, 0] - v0x, origins[i, 1] - v0y, origins[i, 2] - v0z
-        b1 = (sx * px + sy * py + sz * pz) * inv
-        qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
-        b2 = (dx * qx + dy * qy + dz * qz) * inv
-        t = (e2x * qx + e2y * qy + e2z * qz) * inv
-        if limited and t > tmax[i]:
-            t_out[i] = np.inf
-            part_out[i] = -1
-            normal_out[i, 0] = np.nan
-            normal_out[i, 1] = np.nan
-            normal_out[i, 2] = np.nan
-            continue
-        t_out[i] = t
-        part_out[i] = g
-        if vertex_model and has_normals[g]:
-            w0 = 1.0 - b1 - b2
-            nx = w0 * vnormals[a, 0] + b1 * vnormals[b, 0] + b2 * vnormals[c, 0]
-            ny = w0 * vnormals[a, 1] + b1 * vnormals[b, 1] + b2 * vnormals[c, 1]
-            nz = w0 * vnormals[a, 2] + b1 * vnormals[b, 2] + b2 * vnormals[c, 2]
-        else:
-            nx = e1y * e2z - e1z * e2y
-            ny = e1z * e2x - e1x * e2z
-            nz = e1x * e2y - e1y * e2x
-        m = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
-        normal_out[i, 0], normal_out[i, 1], normal_out[i, 2] = nx * m, ny * m, nz * m

@@ -41,7 +41,7 @@ def worst_figures(job: LimitJob, p: Parameter, amount: float) -> dict:
     optics, design = worker_optics(job.rig, job.key)
     worst: dict = {}
     for mis in p.moves(amount):
-        f = build_figures(optics, job.rig, design, mis, job.rays, job.ray_seed, p.devices)
+        f = build_figures(optics, job.rig, design, mis, job.rays, job.ray_seed, p.devices, key=job.key)
         for k, v in f.items():
             worst[k] = max(worst.get(k, -math.inf), v)
     return worst

@@ -61,14 +61,28 @@ def worker_optics(rig, key: str):
     return worker_cache(("tolerance-optics", key), build)
 
 
-def build_figures(optics, rig, design, mis, rays: int, ray_seed: int, devices=("projector", "camera")) -> dict:
+def aligned_rays(design, rays: int, ray_seed: int, key: str):
+    """The seeded aligned pinhole rays and their design directions, made once per worker."""
+    def build():
+        from rigcad.check.sources import annulus_rays
+
+        r = annulus_rays(design, rays, ray_seed)
+        return r, design.direction(r.chief)
+
+    return worker_cache(("tolerance-rays", key, rays, ray_seed), build)
+
+
+def build_figures(optics, rig, design, mis, rays: int, ray_seed: int, devices=("projector", "camera"),
+                  key: str | None = None) -> dict:
     """Figures of one build ``mis`` (a Misalignment): per light path (``projector_*``,
-    ``camera_*``) and the worse of them (no prefix); NaN figures (every ray lost) count as inf."""
+    ``camera_*``) and the worse of them (no prefix); NaN figures (every ray lost) count as inf.
+    ``key``: the rig's worker-cache key (the rays are then made once per worker)."""
     from rigcad.check import montecarlo as MC
 
+    base = None if key is None else aligned_rays(design, rays, ray_seed, key)
     out = {}
     for device in devices:
-        tr, ddirs, mdirs = MC.trace_path(optics, rig, design, mis, device, rays, ray_seed)
+        tr, ddirs, mdirs = MC.trace_path(optics, rig, design, mis, device, rays, ray_seed, base)
         f = MC.figures(tr, ddirs, None, mdirs)
         f["lost_fraction"] = 1.0 - f["rays_ok"] / f["rays"]
         for k in PATH_FIGURES:
@@ -94,7 +108,7 @@ def _batch(job: Job, batch: range) -> list[dict]:
             (dx, dy, dz), t, (ax, ay, _) = mis.offsets[c], mis.tilts[c], mis.axes[c]
             row.update({f"{c}_dx_mm": float(dx), f"{c}_dy_mm": float(dy), f"{c}_dz_mm": float(dz),
                         f"{c}_tilt_rad": float(t), f"{c}_tilt_axis_azimuth_rad": float(math.atan2(ay, ax))})
-        row.update(build_figures(optics, job.rig, design, mis, job.rays, job.ray_seed))
+        row.update(build_figures(optics, job.rig, design, mis, job.rays, job.ray_seed, key=job.key))
         rows.append(row)
     return rows
 

@@ -55,8 +55,10 @@ def markdown(profile, summary: dict, limits: list[dict] | None, correlations: di
              "| figure | mean | p50 | p90 | p99 | max |", "|---|---|---|---|---|---|"]
     for k in PATH_FIGURES:
         s = summary["figures"][k]
-        if k.endswith("_rad"):
-            name, conv = k[:-4] + " (deg)", 1 / DEG
+        if k == "max_angle_error_rad":
+            name, conv = "max_pixel_angle_error, uncalibrated (deg)", 1 / DEG
+        elif k.endswith("_rad"):
+            name, conv = k[:-4] + ", calibrated (deg)", 1 / DEG
         else:
             name, conv = k, 1.0
         lines.append(f"| {name} | " + " | ".join(f"{s[q] * conv:.4g}" for q in ("mean", "p50", "p90", "p99", "max")) + " |")
