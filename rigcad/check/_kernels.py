@@ -235,9 +235,9 @@ def _reflect(dx, dy, dz, nx, ny, nz):
 
 @nb.njit(**_JIT)
 def _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1, t2, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ,
-                body, status, segment, p1, p2, v, landing, path, miss):
+                body, beam, status, segment, p1, p2, v, landing, path, miss):
     """Segment 3 (dome -> plane z = 0, blocked by the paraboloid body or the beam): trace3d.
-    ``body`` False: the caller knows the ray passes clear of the paraboloid's body."""
+    ``body`` (``beam``) False: the caller knows the ray passes clear of the paraboloid's body (the beam)."""
     v[i, 0], v[i, 1], v[i, 2] = wx, wy, wz
     t3 = -q2z / wz if wz < 0.0 else np.inf
     if not math.isfinite(t3):
@@ -251,9 +251,11 @@ def _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1, t2, R1, T1, id1, R2, T2, id2, 
         ho = _occluders(para_occ, lx, ly, lz, ldx, ldy, ldz, t3)
         if ho < hp:
             hp = ho
-    bx, by, bz = _to_local(R2, T2, id2, q2x, q2y, q2z)
-    bdx, bdy, bdz = _dir_to_local(R2, id2, wx, wy, wz)
-    hb = _occluders(beam_occ, bx, by, bz, bdx, bdy, bdz, t3)
+    hb = np.inf
+    if beam:
+        bx, by, bz = _to_local(R2, T2, id2, q2x, q2y, q2z)
+        bdx, bdy, bdz = _dir_to_local(R2, id2, wx, wy, wz)
+        hb = _occluders(beam_occ, bx, by, bz, bdx, bdy, bdz, t3)
     by_para = math.isfinite(hp)
     by_beam = math.isfinite(hb) and not (by_para and hp < hb)
     if by_beam:
@@ -312,15 +314,28 @@ def _lost(i, code, seg, status, segment, p1, p2, v, landing, path, miss):
 
 
 @nb.njit(**_JIT)
+def _y_meets(rho_lo, rho_hi, sphi, beam_y):
+    """Can a point at radius rho_lo..rho_hi of azimuth sine ``sphi`` have y in beam_y[0]..beam_y[1]?
+    (An unbounded radius range: always.)"""
+    if not math.isfinite(rho_hi):
+        return True
+    a, b = rho_lo * sphi, rho_hi * sphi
+    if a > b:
+        a, b = b, a
+    return b >= beam_y[0] and a <= beam_y[1]
+
+
+@nb.njit(**_JIT)
 def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed, s0, s1, brk, cr, cz, piece_of,
-                    piece_scale, u_lo, flag_inv_h, flags, status, segment, p1, p2, v, landing, path, miss, handled):
+                    piece_scale, u_lo, flag_inv_h, flags, beam_rho, beam_y, status, segment, p1, p2, v, landing, path,
+                    miss, handled):
     """Aligned rig, every ray from the COP (0, 0, cop_z): the paraboloid hit in closed form; the dome
     hit by the design correspondence (the ray reflected at paraboloid radius s lands on the dome's
     meridian at u = -s: the spline's point and normal there, turned to the ray's azimuth; measured
     against Newton when the tracer is built). ``flags[cell]`` per cell of s from s0 (``flag_inv_h``
-    cells per mm): bit 0, the leg to the dome may cross the beam's heights; bit 1, the return leg
-    may pass the paraboloid's body; the exact tests run only there; the beam is tested on every
-    return. ``mount_shadowed``: the mount lies under the mirror, so a ray that hits the mirror from
+    cells per mm), analytic._cell_flags: bit 0 (2), the leg to the dome (the return leg) may cross
+    the beam's heights, at radii ``beam_rho[cell]``; the box is tested only if radius x sin(azimuth)
+    can fall in the beam's y extent ``beam_y``; bit 1, the return leg may pass the paraboloid's body. ``mount_shadowed``: the mount lies under the mirror, so a ray that hits the mirror from
     the COP cannot meet it first. Rays outside [s0, s1] are left for the general kernel
     (``handled`` False)."""
     n = dirs.shape[0]
@@ -360,16 +375,18 @@ def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed,
         q2x, q2y = r2 * cphi, r2 * sphi
         ex, ey, ez = q2x - ax, q2y - ay, z2 - az
         t2 = math.sqrt(ex * ex + ey * ey + ez * ez)
-        fl = flags[min(int((s - s0) * flag_inv_h), ncells - 1)]
-        if fl & 1:
+        cell = min(int((s - s0) * flag_inv_h), ncells - 1)
+        fl = flags[cell]
+        if fl & 1 and _y_meets(beam_rho[cell, 0], beam_rho[cell, 1], sphi, beam_y):
             tb = _occluders(beam_occ, ax, ay, az, ux, uy, uz, t2)
             if tb < t2:
                 _lost(i, OCCLUDED_BY_BEAM, 2, status, segment, p1, p2, v, landing, path, miss)
                 continue
         p2[i, 0], p2[i, 1], p2[i, 2] = q2x, q2y, z2
         wx, wy, wz = _reflect(ux, uy, uz, nr * cphi, nr * sphi, nzz)
+        ret_beam = (fl & 4) != 0 and _y_meets(beam_rho[cell, 2], beam_rho[cell, 3], sphi, beam_y)
         _return_leg(i, q2x, q2y, z2, wx, wy, wz, t1, t2, E, Z, True, E, Z, True, f, zv, rim, para_occ, beam_occ,
-                    (fl & 2) != 0, status, segment, p1, p2, v, landing, path, miss)
+                    (fl & 2) != 0, ret_beam, status, segment, p1, p2, v, landing, path, miss)
 
 
 @nb.njit(**_JIT)
@@ -524,7 +541,7 @@ def general(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, 
         p2[i, 0], p2[i, 1], p2[i, 2] = q2x, q2y, q2z
         wx, wy, wz = _reflect(ux, uy, uz, nx, ny, nz)
         _return_leg(i, q2x, q2y, q2z, wx, wy, wz, t1, t, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, beam_occ,
-                    True, status, segment, p1, p2, v, landing, path, miss)
+                    True, True, status, segment, p1, p2, v, landing, path, miss)
     return fallbacks
 
 

@@ -101,6 +101,8 @@ class AnalyticTracer:
     s1: float
     flag_inv_h: float
     flags: np.ndarray
+    beam_rho: np.ndarray
+    beam_y: np.ndarray
     mount_shadowed: bool
     piece_of: np.ndarray
     piece_scale: float
@@ -144,11 +146,12 @@ class AnalyticTracer:
                        "measured": "the meridian at u = -s against Newton on the spline, aligned COP rays"}
         pinhole = table_error["max_dome_point_error_mm"] < CORRESPONDENCE_TOL
         s_flags = np.linspace(s0, s1, FLAG_CELLS + 1)
-        flags = _cell_flags(geo, s_flags, _correspondence(exact_dome, s_flags), para_occ, beam_occ)
+        flags, beam_rho = _cell_flags(geo, s_flags, _correspondence(exact_dome, s_flags), para_occ, beam_occ)
+        beam_y = np.array([beam_occ[:, 2].min() - FLAG_MARGIN_MM, beam_occ[:, 5].max() + FLAG_MARGIN_MM])
         shadowed = _mount_shadowed(geo, para_occ)
         return cls(geo.focal_length, geo.vertex_z, geo.rim_radius, geo.cop_z, para_occ, beam_occ, breaks, coef_r,
                    coef_z, float(u_lo), float(u_hi), float(s0), float(s1), float(FLAG_CELLS / (s1 - s0)), flags,
-                   shadowed, piece_of, float(piece_scale), pinhole, table_error, exact_dome)
+                   beam_rho, beam_y, shadowed, piece_of, float(piece_scale), pinhole, table_error, exact_dome)
 
     def trace(self, optics, origins: np.ndarray, dirs: np.ndarray):
         """Trace rays (n, 3) through ``optics`` (its poses) with the kernels: a Trace3D with
@@ -174,7 +177,7 @@ class AnalyticTracer:
             K.pinhole_aligned(self.cop_z, dirs, self.focal_length, self.vertex_z, self.rim_radius, self.para_occ,
                               self.beam_occ, self.mount_shadowed, self.s0, self.s1, self.breaks, self.coef_r,
                               self.coef_z, self.piece_of, self.piece_scale, self.u_lo, self.flag_inv_h, self.flags,
-                              *out, handled)
+                              self.beam_rho, self.beam_y, *out, handled)
             rest = np.nonzero(~handled)[0]
             kernels["pinhole_aligned"] = n - len(rest)
         elif n:
@@ -198,18 +201,26 @@ class AnalyticTracer:
 FLAG_MARGIN_MM = 0.5
 
 
-def _cell_flags(geo, s: np.ndarray, values: np.ndarray, para_occ: np.ndarray, beam_occ: np.ndarray) -> np.ndarray:
-    """Per cell of s (int8): bit 0 when the aligned leg paraboloid -> dome may cross the beam's
-    heights, bit 1 when the return leg dome -> O may pass within FLAG_MARGIN_MM of the cylinder
-    that bounds the paraboloid and its mount; from the exact node values (s (m+1,), values (m+1, 4))
-    at both ends of each cell."""
+def _cell_flags(geo, s: np.ndarray, values: np.ndarray, para_occ: np.ndarray, beam_occ: np.ndarray):
+    """Per cell of s: ``flags`` (int8) and ``beam_rho`` ((cells, 4) mm). Bit 0: the aligned leg
+    paraboloid -> dome may cross the beam's heights, at radii beam_rho[:, 0..1]; bit 2: the return
+    leg dome -> O may, at radii beam_rho[:, 2..3]; bit 1: the return leg may pass within
+    FLAG_MARGIN_MM of the cylinder that bounds the paraboloid and its mount. Both legs lie in the
+    ray's meridional plane (an aligned rig, rays from the axis), so a leg meets the beam only where
+    radius x sin(azimuth) falls in the beam's y extent: the kernel tests that before the box. From
+    the exact node values (s (m+1,), values (m+1, 4)) at both ends of each cell, with the margin."""
     f, zv = geo.focal_length, geo.vertex_z
+    m = FLAG_MARGIN_MM
     zp = zv - s * s / (4 * f)
     r2, z2, nr, nz = values.T
-    # the leg to the dome in the meridional plane spans heights zp..z2
-    bz0, bz1 = beam_occ[:, 3].min(), beam_occ[:, 6].max()
+    bz0, bz1 = beam_occ[:, 3].min() - m, beam_occ[:, 6].max() + m
+    # the leg to the dome: a straight segment (s, zp) -> (r2, z2) in the meridional plane
     lo_z, hi_z = np.minimum(zp, z2), np.maximum(zp, z2)
-    beam = (hi_z >= bz0 - FLAG_MARGIN_MM) & (lo_z <= bz1 + FLAG_MARGIN_MM)
+    beam = (hi_z >= bz0) & (lo_z <= bz1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        za, zb = np.maximum(lo_z, bz0), np.minimum(hi_z, bz1)
+        slope = (r2 - s) / (z2 - zp)
+        leg = np.stack([s + (za - zp) * slope, s + (zb - zp) * slope], axis=-1)
     # the return leg: the incoming direction u reflected about the dome normal (exact per node)
     n1 = np.stack([s / (2 * f), np.ones_like(s)], axis=-1)
     n1 /= np.linalg.norm(n1, axis=1)[:, None]
@@ -218,6 +229,11 @@ def _cell_flags(geo, s: np.ndarray, values: np.ndarray, para_occ: np.ndarray, be
     u = d - 2 * np.sum(d * n1, axis=1)[:, None] * n1
     n2 = np.stack([nr, nz], axis=-1)
     w = u - 2 * np.sum(u * n2, axis=1)[:, None] * n2
+    down = w[:, 1] < 0
+    ret_beam = down & (z2 >= bz0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        za, zb = np.maximum(0.0, bz0), np.minimum(z2, bz1)
+        ret = np.stack([r2 + (za - z2) * w[:, 0] / w[:, 1], r2 + (zb - z2) * w[:, 0] / w[:, 1]], axis=-1)
     radius = [geo.rim_radius]
     zs = [geo.rim_z, geo.vertex_z]
     for row in para_occ:
@@ -227,14 +243,23 @@ def _cell_flags(geo, s: np.ndarray, values: np.ndarray, para_occ: np.ndarray, be
         else:
             radius.append(float(np.hypot(row[4], row[5]) + row[1]))
             zs += [row[2], row[3]]
-    r_body, z_lo, z_hi = max(radius) + FLAG_MARGIN_MM, min(zs) - FLAG_MARGIN_MM, max(zs) + FLAG_MARGIN_MM
+    r_body, z_lo, z_hi = max(radius) + m, min(zs) - m, max(zs) + m
     with np.errstate(divide="ignore", invalid="ignore"):
         za, zb = np.full_like(z2, z_lo), np.minimum(z_hi, z2)
         ra = r2 + (za - z2) * w[:, 0] / w[:, 1]
         rb = r2 + (zb - z2) * w[:, 0] / w[:, 1]
-    body = ~((z2 < z_lo) | ((w[:, 1] < 0) & (np.minimum(ra, rb) > r_body)))
-    node = beam.astype(np.int8) | (body.astype(np.int8) << 1)
-    return np.ascontiguousarray(node[:-1] | node[1:])
+    body = ~((z2 < z_lo) | (down & (np.minimum(ra, rb) > r_body)))
+    node = beam.astype(np.int8) | (body.astype(np.int8) << 1) | (ret_beam.astype(np.int8) << 2)
+    flags = np.ascontiguousarray(node[:-1] | node[1:])
+    rho = np.empty((len(flags), 4))
+    for k, arr in ((0, leg), (2, ret)):
+        both = np.concatenate([arr[:-1], arr[1:]], axis=1)
+        rho[:, k] = np.maximum(np.nanmin(np.where(np.isfinite(both), both, np.inf), axis=1) - m, 0.0)
+        rho[:, k + 1] = np.nanmax(np.where(np.isfinite(both), both, -np.inf), axis=1) + m
+    # a cell whose legs' radii are not finite keeps the exact tests (no radius bound)
+    rho[~np.isfinite(rho[:, 0]) | ~np.isfinite(rho[:, 1]), 0:2] = (0.0, np.inf)
+    rho[~np.isfinite(rho[:, 2]) | ~np.isfinite(rho[:, 3]), 2:4] = (0.0, np.inf)
+    return flags, np.ascontiguousarray(rho)
 
 
 def _mount_shadowed(geo, para_occ: np.ndarray) -> bool:
