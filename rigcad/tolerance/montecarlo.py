@@ -97,7 +97,8 @@ def _batch(job: Job, batch: range) -> list[dict]:
     """One task: the samples ``batch`` (rows of the table, in order)."""
     from rigcad.check.montecarlo import sample_build
 
-    optics, design = worker_optics(job.rig, job.key)
+    key = job.key  # hashed once per task, not per sample
+    optics, design = worker_optics(job.rig, key)
     tol = job.rig.profile.tolerancing
     seeds = spawn_seeds(job.seed, job.samples)
     rows = []
@@ -108,7 +109,7 @@ def _batch(job: Job, batch: range) -> list[dict]:
             (dx, dy, dz), t, (ax, ay, _) = mis.offsets[c], mis.tilts[c], mis.axes[c]
             row.update({f"{c}_dx_mm": float(dx), f"{c}_dy_mm": float(dy), f"{c}_dz_mm": float(dz),
                         f"{c}_tilt_rad": float(t), f"{c}_tilt_axis_azimuth_rad": float(math.atan2(ay, ax))})
-        row.update(build_figures(optics, job.rig, design, mis, job.rays, job.ray_seed, key=job.key))
+        row.update(build_figures(optics, job.rig, design, mis, job.rays, job.ray_seed, key=key))
         rows.append(row)
     return rows
 
