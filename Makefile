@@ -77,6 +77,7 @@ bench: $(VENV)/.installed stl
 	$(PY) bench/dome.py
 	$(PY) bench/mirror_mesh.py
 	$(PY) bench/raycheck.py --exports $(EXPORTS)
+	$(PY) bench/tolerance.py
 	$(PY) bench/fab_stages.py
 	$(PY) bench/tessellation.py
 	$(PY) bench/ray_count.py --exports $(EXPORTS)

@@ -43,6 +43,25 @@ def _progress(total: int, desc: str):
         bar.close()
 
 
+@contextmanager
+def progress_bar(total: int, desc: str, unit: str):
+    """A counting progress bar on stderr (tqdm: count, rate in ``unit``/s, ETA), refreshed at
+    least once a second while it advances; silent when stderr is not a terminal. Yields
+    ``update(done)`` taking the absolute count (engine callbacks pass totals, not increments)."""
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, desc=desc, unit=unit, disable=None, leave=False, file=sys.stderr,
+               mininterval=0.25, maxinterval=1.0, smoothing=0.1)
+
+    def update(done: int) -> None:
+        bar.update(done - bar.n)
+
+    try:
+        yield update
+    finally:
+        bar.close()
+
+
 def _fmt(spec, value) -> str:
     if value is None:
         return "-"
@@ -263,6 +282,9 @@ def build_parser() -> argparse.ArgumentParser:
     from rigcad.manual.cli import register as register_manual
 
     register_manual(sub)
+    from rigcad.tolerance.cli import register as register_tolerance
+
+    register_tolerance(sub)
     return parser
 
 

@@ -579,3 +579,69 @@ def optimize_pareto(report: dict) -> bytes:
 
 #: Figure keys of the objectives (rigcad.optimize.spec.OBJECTIVES), for the Pareto plot's second axis.
 _FIGURE = {"px_per_deg_cv": "px_per_deg_cv", "theta_min": "theta_min_deg"}
+
+
+def tolerance_histograms(profile, columns: dict, summary: dict) -> bytes:
+    """Monte Carlo of the rig's builds: histograms of the worst spot radius (mm) and calibrated
+    angle error (deg) per build, the targets marked, the yield in the title."""
+    tol = profile.tolerancing
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
+    spot = np.asarray(columns["max_spot_radius_mm"], float)
+    ang = np.degrees(np.asarray(columns["max_mirror_angle_error_rad"], float))
+    for ax, v, target, label, unit in ((a1, spot, tol.max_spot_radius, "largest spot radius per build (mm)", "mm"),
+                                       (a2, ang, np.degrees(tol.max_angle_error),
+                                        "largest calibrated angle error per build (deg)", "deg")):
+        finite = v[np.isfinite(v)]
+        ax.hist(finite, bins=60, color="tab:blue", alpha=0.8)
+        ax.axvline(target, color="tab:red", lw=1.5, label=f"target {target:g} {unit}")
+        ax.set_xlabel(label)
+        ax.set_ylabel("builds")
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"{profile.name}: {summary['samples']} builds, yield {summary['yield']:.1%} "
+                 f"(required {tol.min_yield:.0%})", fontsize=10)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def tolerance_sensitivity(profile, limits: list[dict]) -> bytes:
+    """Per toleranced parameter (ranked): the share of the spot and angle targets it uses alone at
+    its tolerance, and its inverse limit over its tolerance (log scale)."""
+    names = [r["parameter"] for r in limits]
+    y = np.arange(len(names))[::-1]
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 0.35 * len(names) + 1.8), sharey=True)
+    a1.barh(y + 0.2, [r["spot_budget_used"] * 100 for r in limits], 0.4, label="spot radius", color="tab:blue")
+    a1.barh(y - 0.2, [r["angle_budget_used"] * 100 for r in limits], 0.4, label="angle error", color="tab:orange")
+    a1.set_yticks(y, names)
+    a1.set_xlabel("share of the target used at the tolerance (%)")
+    a1.legend(fontsize=8)
+    a1.grid(alpha=0.3, axis="x")
+    ratio = [r["limit_over_tolerance"] for r in limits]
+    finite = [v if np.isfinite(v) else np.nan for v in ratio]
+    colors = ["tab:green" if r["limit_found"] else "0.6" for r in limits]
+    a2.barh(y, finite, 0.5, color=colors)
+    a2.axvline(1.0, color="tab:red", lw=1)
+    a2.set_xscale("log")
+    a2.set_xlabel("inverse limit (angle target) / tolerance\n(grey: none below the search cap)")
+    a2.grid(alpha=0.3, axis="x")
+    fig.suptitle(f"{profile.name}: sensitivity and inverse limits", fontsize=10)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def sweep_plot(key: str, unit: str, rows: list[dict], columns: list[tuple[str, str]]) -> bytes:
+    """A parameter sweep: each of ``columns`` ((row key, axis label)) against the swept value."""
+    x = np.array([r["value"] for r in rows], float)
+    fig, axes = plt.subplots(1, len(columns), figsize=(4 * len(columns), 3.6))
+    for ax, (k, label) in zip(np.atleast_1d(axes), columns):
+        yv = np.array([r.get(k, np.nan) if r.get(k) is not None else np.nan for r in rows], float)
+        ok = np.array([r["ok"] for r in rows])
+        ax.plot(x[ok], yv[ok], "o-", ms=3, color="tab:blue")
+        if (~ok).any():
+            ax.plot(x[~ok], np.zeros((~ok).sum()), "x", color="tab:red", label="refused")
+            ax.legend(fontsize=8)
+        ax.set_xlabel(f"{key} ({unit})")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return _png(fig)

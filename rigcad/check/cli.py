@@ -4,9 +4,24 @@ from __future__ import annotations
 
 import argparse
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 from rigcad.units import DEG
+
+
+@contextmanager
+def _rays_bar(desc: str):
+    """A progress bar of rays traced (count and rays/s; the stage as its postfix) on stderr when it
+    is a terminal (tqdm). Yields (add(n), stage(label))."""
+    from tqdm import tqdm
+
+    bar = tqdm(desc=desc, unit="ray", unit_scale=True, disable=None, leave=False, file=sys.stderr,
+               mininterval=0.25, maxinterval=1.0)
+    try:
+        yield bar.update, bar.set_postfix_str
+    finally:
+        bar.close()
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -17,15 +32,23 @@ def cmd_check(args: argparse.Namespace) -> int:
 
     rig = load(args.profile)
     profile = rig.profile
+    from rigcad.check.trace3d import counting
+
     exports = Path(args.exports)
     mirrors = exports / profile.name / "mirrors"
     missing = [n for n in ("paraboloid", "dome") if not (mirrors / f"{n}.ply").is_file()]
     if missing and (args.mode or profile.raycheck.mode) != "analytic":
         print(f"note: no exported {' and '.join(missing)} mesh in {mirrors}/ (run `rigcad stl {args.profile}`): "
               "meshing the mirrors from the profile", file=sys.stderr)
-    result = run_raycheck(rig, exports=exports, rays=args.rays, mode=args.mode,
-                          monte_carlo=not args.no_monte_carlo, builds=args.builds,
-                          progress=lambda label: print(f"  {label} ...", file=sys.stderr) if args.verbose else None)
+    with _rays_bar(f"check {profile.name}") as (bar, stage):
+        def step(label: str) -> None:
+            stage(label)
+            if args.verbose:
+                print(f"  {label} ...", file=sys.stderr)
+
+        with counting(bar):
+            result = run_raycheck(rig, exports=exports, rays=args.rays, mode=args.mode,
+                                  monte_carlo=not args.no_monte_carlo, builds=args.builds, progress=step)
     paths = write_raycheck(result, exports / profile.name / "check", profile_lock(exports, profile.name))
     rep = result.report
     main = rep["readings"][rep["mode"]]

@@ -31,12 +31,23 @@ def declared(profile) -> Misalignment:
 
 
 def trace_path(optics: Optics, rig, design: DesignMap, mis: Misalignment, device: str,
-               count: int, seed: int) -> tuple[Trace3D, np.ndarray, np.ndarray]:
+               count: int, seed: int, aligned=None) -> tuple[Trace3D, np.ndarray, np.ndarray]:
     """Trace ``count`` seeded pinhole rays of ``device`` (projector or camera; the camera's through
-    the beam splitter, check.tower.through_splitter) through the misaligned rig; returns the trace, the design arrival direction of each ray's pixel, and the
-    design direction of the paraboloid point it hit (rotated with the paraboloid)."""
-    rays = annulus_rays(design, count, seed, mis.pose(device, rig.geometry))
-    origins, dirs = rays.origins, rays.dirs
+    the beam splitter, check.tower.through_splitter) through the misaligned rig; returns the trace,
+    the design arrival direction of each ray's pixel, and the design direction of the paraboloid
+    point it hit (rotated with the paraboloid). ``aligned``: (rays, design directions) of
+    ``annulus_rays(design, count, seed)`` made once by a caller that traces many builds (the same
+    numbers: the source pose is applied to them here)."""
+    pose = mis.pose(device, rig.geometry)
+    if aligned is None:
+        rays = annulus_rays(design, count, seed, pose)
+        ddirs = design.direction(rays.chief)
+        origins, dirs = rays.origins, rays.dirs
+    else:
+        rays, ddirs = aligned
+        origins, dirs = rays.origins, rays.dirs
+        if not pose.is_identity:
+            origins, dirs = pose.globalize_points(origins), pose.globalize_dirs(dirs)
     if device == "camera":  # the camera looks through the beam splitter, from its compensated COP
         from rigcad.check.tower import through_splitter
 
@@ -45,7 +56,7 @@ def trace_path(optics: Optics, rig, design: DesignMap, mis: Misalignment, device
     placed = optics.placed(pp, mis.pose("dome", rig.geometry))
     tr = trace(placed, origins, dirs)
     local, _ = pp.localize(tr.p1, tr.p1)
-    return tr, design.direction(rays.chief), pp.globalize_dirs(design.direction_at(local))
+    return tr, ddirs, pp.globalize_dirs(design.direction_at(local))
 
 
 def figures(tr: Trace3D, design_dirs: np.ndarray, reference: Trace3D | None = None,

@@ -178,6 +178,7 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
     ddirs = design.direction(src.chief)
     exact = trace(analytic, src.origins, src.dirs)
     readings = {"analytic": reading(exact, ddirs, None, src.chief)}
+    readings["analytic"]["kernels"] = exact.kernels  # which analytic kernel traced how many rays
     main = exact
     if meshed is not None:
         for name in ("mesh", "smooth"):
@@ -186,7 +187,8 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
             if name == rc.mode:
                 main = tr
         k = min(EXACT_NORMAL_RAYS, rc.rays)
-        sub = exact.__class__(*(getattr(exact, f)[:k] for f in exact.__dataclass_fields__))
+        sub = exact.__class__(*(v[:k] if isinstance(v, np.ndarray) else v
+                                for v in (getattr(exact, f) for f in exact.__dataclass_fields__)))
         for name, optics in (("exact_normals", share_scenes(meshed, "exact_normals")),
                              ("mesh_float32", share_scenes(meshed, "mesh", refine=False)),
                              ("smooth_float32", share_scenes(meshed, "smooth", refine=False))):

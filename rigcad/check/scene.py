@@ -141,15 +141,20 @@ class Optics:
     paraboloid_pose: Pose = field(default_factory=Pose)
     dome_pose: Pose = field(default_factory=Pose)
     timer: R.Timer | None = None
+    #: the compiled analytic tracer (rigcad.check.analytic.AnalyticTracer) over the same exact
+    #: surfaces, for analytic optics; trace3d.trace uses it unless asked for the numpy passes
+    fast: object | None = None
 
     @property
     def backend(self) -> str:
+        if self.fast is not None:
+            return "; ".join(sorted({self.fast.backend, self.beam.backend}))
         return "; ".join(sorted({self.paraboloid.backend, self.dome.backend, self.beam.backend}))
 
     def placed(self, paraboloid_pose: Pose | None = None, dome_pose: Pose | None = None) -> "Optics":
         """The same intersectors with other poses (no BVH rebuilt)."""
         return Optics(self.mode, self.paraboloid, self.dome, self.beam, paraboloid_pose or Pose(),
-                      dome_pose or Pose(), self.timer)
+                      dome_pose or Pose(), self.timer, self.fast)
 
 
 MESH_MODES = {"mesh": "facet", "smooth": "vertex", "exact_normals": "exact"}
@@ -171,7 +176,10 @@ def analytic_optics(rig) -> Optics:
                    + [_intersector(solid) for _, solid in rig.occluders["paraboloid"]])
     beam = [_intersector(solid) for _, solid in rig.occluders["beam"]]
     beam_box = beam[0] if len(beam) == 1 else R.Group(beam)
-    optics = Optics("analytic", para, R.Group([R.ExactDome(rig.layout.design_dome), beam_box]), beam_box)
+    dome = R.Group([R.ExactDome(rig.layout.design_dome), beam_box])
+    from rigcad.check.analytic import AnalyticTracer
+
+    optics = Optics("analytic", para, dome, beam_box, fast=AnalyticTracer.build(rig, para, dome, beam_box))
     return placed_as(optics, rig)
 
 
@@ -222,5 +230,6 @@ def mixed(analytic: Optics, meshed: Optics, mesh_part: str) -> Optics:
 
     out = copy.copy(analytic)
     out.mode = f"{meshed.mode}_{mesh_part}_only"
+    out.fast = None  # the compiled kernels trace exact surfaces only
     setattr(out, mesh_part, getattr(meshed, mesh_part))
     return out

@@ -11,7 +11,9 @@ those pairs are not traced (no self-intersection at the ray's origin either).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import contextvars
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -43,7 +45,8 @@ class Trace3D:
     paraboloid and dome hit points ``p1``, ``p2`` (n, 3) mm (NaN where not reached), the final
     direction ``v`` (n, 3), ``landing`` (n, 3) on z = 0, total ``path_length`` mm, and ``miss``: the
     distance from O to the returning ray's line (mm; the convergence error, well conditioned even
-    at grazing incidence, where the landing point is not)."""
+    at grazing incidence, where the landing point is not). ``kernels``: rays per kernel of the
+    analytic tracer (rigcad.check.analytic), or ``{"vectorised": n}`` for the numpy path."""
 
     status: np.ndarray
     segment: np.ndarray
@@ -53,6 +56,7 @@ class Trace3D:
     landing: np.ndarray
     path_length: np.ndarray
     miss: np.ndarray
+    kernels: dict = field(default_factory=dict)
 
     @property
     def ok(self) -> np.ndarray:
@@ -76,8 +80,35 @@ class Trace3D:
         return np.where(self.ok, np.arctan2(a[:, 1], a[:, 0]), np.nan)
 
 
-def trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
-    """Trace rays (origins, unit dirs: (n, 3), global frame) through ``optics``."""
+#: Called with the ray count after every trace inside :func:`counting` (a progress bar's feed).
+_COUNTER: contextvars.ContextVar = contextvars.ContextVar("rigcad_rays_traced", default=None)
+
+
+@contextmanager
+def counting(callback):
+    """Within the block, every :func:`trace` reports its ray count to ``callback(n)``."""
+    token = _COUNTER.set(callback)
+    try:
+        yield
+    finally:
+        _COUNTER.reset(token)
+
+
+def trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray, vectorised: bool = False) -> Trace3D:
+    """Trace rays (origins, unit dirs: (n, 3), global frame) through ``optics``: by the compiled
+    analytic kernels when ``optics`` has them (``optics.fast``, analytic optics), else (or with
+    ``vectorised=True``) by the intersectors' numpy passes (:func:`_trace`)."""
+    if optics.fast is not None and not vectorised:
+        out = optics.fast.trace(optics, origins, dirs)
+    else:
+        out = _trace(optics, origins, dirs)
+    report = _COUNTER.get()
+    if report is not None:
+        report(len(origins))
+    return out
+
+
+def _trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     n = len(origins)
     dirs = unit(np.asarray(dirs, float))
     origins = np.asarray(origins, float)
@@ -141,7 +172,7 @@ def trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     path[i3] = t1[keep][ok] + t2[ok] + t3[ok]
     miss = np.full(n, np.nan)
     miss[i3] = np.linalg.norm(_cross(q2[ok], w[ok]), axis=1)  # |O - line|, O at the origin
-    return Trace3D(status, segment, p1, p2, v, landing, path, miss)
+    return Trace3D(status, segment, p1, p2, v, landing, path, miss, {"vectorised": n})
 
 
 def convergence_point(tr: Trace3D) -> np.ndarray:
@@ -150,9 +181,11 @@ def convergence_point(tr: Trace3D) -> np.ndarray:
     if np.count_nonzero(ok) < 2:
         return np.full(3, np.nan)
     p, w = tr.p2[ok], tr.v[ok]
-    # sum over rays of (I - w w^T) (x - p) = 0
-    a = len(w) * np.eye(3) - w.T @ w
-    b = p.sum(axis=0) - w.T @ _dot(w, p)
+    # sum over rays of (I - w w^T) (x - p) = 0; sums by einsum's own loops, not BLAS, whose
+    # threaded reductions may round differently with the thread count (tolerancing promises the
+    # same bits on any number of workers)
+    a = len(w) * np.eye(3) - np.einsum("ij,ik->jk", w, w)
+    b = p.sum(axis=0) - np.einsum("ij,i->j", w, _dot(w, p))
     return np.linalg.solve(a, b)
 
 

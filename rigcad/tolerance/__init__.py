@@ -1,0 +1,13 @@
+"""Tolerancing at scale (issue 12): the seeded Monte Carlo of perturbed rigs on rigcad.engine
+(joblib loky by default, Dask with a scheduler), the sensitivity ranking, inverse limits by
+bisection on the analytic tracer, and parameter sweeps of whole designs.
+
+Modules: ``params`` (the toleranced parameters: which component, which degree of freedom, unit,
+profile key), ``montecarlo`` (per-sample perturbations from their own SeedSequence children and
+figures; the summary), ``limits`` (one-at-a-time sensitivity and inverse limits), ``sweep``
+(designs over a parameter range), ``report`` (Parquet, CSV, JSON, tolerance.md and the figures
+from rigcad.plots), ``cli`` (``rigcad tolerance`` and ``rigcad sweep``).
+
+Frame and units as everywhere: mm, radians, O at the origin, +z up; every written number names its
+unit in its key or column header.
+"""

@@ -1,0 +1,159 @@
+"""``rigcad tolerance`` and ``rigcad sweep`` (wired by rigcad.cli)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from rigcad.units import DEG
+
+
+def _engine(args):
+    from rigcad.engine import Engine
+
+    return Engine(workers=args.workers, scheduler=args.scheduler)
+
+
+def _engine_progress(update):
+    return lambda tasks_done, tasks, done, total: update(done)
+
+
+def cmd_tolerance(args: argparse.Namespace) -> int:
+    from rigcad.cli import progress_bar
+    from rigcad.errors import CheckError
+    from rigcad.export.atomic import profile_lock
+    from rigcad.rig import load
+    from rigcad.tolerance.limits import run_limits
+    from rigcad.tolerance.montecarlo import Job, rank_correlations, run_monte_carlo
+    from rigcad.tolerance.report import write_tolerance
+
+    rig = load(args.profile)
+    profile = rig.profile
+    tol = profile.tolerancing
+    engine = _engine(args)
+    samples = tol.builds if args.samples is None else args.samples
+    rays = tol.rays if args.rays is None else args.rays
+    if samples < 1 or rays < 100:
+        from rigcad.errors import ProfileError
+
+        raise ProfileError(f"--samples {samples} / --rays {rays}: need at least 1 sample and 100 rays per path",
+                           param="--samples")
+    t0 = time.perf_counter()
+    with progress_bar(samples, f"tolerance {profile.name} ({engine.name})", "sample") as update:
+        mc = run_monte_carlo(rig, samples, rays, engine, progress=_engine_progress(update))
+    mc_s = time.perf_counter() - t0
+    limits = None
+    limits_s = 0.0
+    if not args.no_limits:
+        from rigcad.tolerance.params import PARAMETERS
+
+        t1 = time.perf_counter()
+        with progress_bar(len(PARAMETERS), "inverse limits", "parameter") as update:
+            limits = run_limits(rig, Job(rig, rays, 0, 0, 0).key, rays, int(tol.seed) + 1, engine,
+                                progress=_engine_progress(update))
+        limits_s = time.perf_counter() - t1
+    corr = rank_correlations(mc.columns) if samples > 2 else None
+    run_info = {"engine": engine.name, "workers": engine.n_workers, "scheduler": args.scheduler,
+                "monte_carlo_s": mc_s, "samples_per_s": samples / mc_s, "limits_s": limits_s,
+                "note": "the one file that differs run to run; every other file is the same bytes for any engine"}
+    out = Path(args.exports) / profile.name / "tolerance"
+    paths = write_tolerance(out, profile, mc, limits, corr, run_info, profile_lock(Path(args.exports), profile.name))
+    s = mc.summary
+    fs, fa = s["figures"]["max_spot_radius_mm"], s["figures"]["max_mirror_angle_error_rad"]
+    print(f"{profile.name}: {samples} builds x {rays} rays per path on {engine.name} ({engine.n_workers} worker(s)) "
+          f"in {mc_s:.1f} s ({samples / mc_s:.0f} samples/s)")
+    print(f"  yield {s['yield']:.2%} (required {tol.min_yield:.0%}); spot p90 {fs['p90']:.3g} mm, max {fs['max']:.3g} mm; "
+          f"angle p90 {fa['p90'] / DEG:.3g} deg, max {fa['max'] / DEG:.3g} deg")
+    if limits:
+        print("  most sensitive: " + ", ".join(f"{r['parameter']} ({max(r['spot_budget_used'], r['angle_budget_used']):.0%})"
+                                               for r in limits[:3]))
+    for p in paths:
+        print(f"  wrote {p}")
+    if s["yield"] < tol.min_yield:
+        where = profile.where("tolerancing", "min_yield") or "default"
+        raise CheckError(f"{profile.name}: tolerance yield {s['yield']:.2%} is below tolerancing.min_yield "
+                         f"{tol.min_yield:.0%} ({where}); see {out / 'tolerance.md'} for the parameters to tighten")
+    return 0
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from rigcad import plots
+    from rigcad.cli import progress_bar
+    from rigcad.export.atomic import Staging, json_bytes, profile_lock
+    from rigcad.fab.printers import load_printer
+    from rigcad.profile.loader import load_raw
+    from rigcad.tolerance.sweep import finite_or_none, parse_set, run_sweep, sweep_csv
+
+    spec = parse_set(args.set)
+    raw = load_raw(args.profile)
+    printer = None if args.printer == "none" else load_printer(args.printer)
+    engine = _engine(args)
+    t0 = time.perf_counter()
+    with progress_bar(len(spec.values), f"sweep {spec.name} ({engine.name})", "design") as update:
+        rows = run_sweep(raw, spec, args.rays, 2006, printer, engine, progress=_engine_progress(update))
+    wall = time.perf_counter() - t0
+    out = Path(args.exports) / raw.name / "sweep" / spec.name
+    scale = 1.0
+    unit = spec.unit or "-"
+    cols = [("dome_width_mm", "dome width (mm)"), ("check_max_spot_radius_mm", "max spot radius (mm)"),
+            ("check_theta_min_deg", "traced theta min (deg)"), ("check_px_per_deg_min", "min px/deg")]
+    if printer is not None:
+        cols.append(("parts_to_split_count", f"parts to split ({printer.name})"))
+    plot_rows = [dict(r, value=r["value"] * scale) for r in rows]
+    files = {"sweep.csv": sweep_csv(spec, rows),
+             "sweep.json": json_bytes({"key": spec.name, "unit": spec.unit, "values": list(spec.values),
+                                       "rays": args.rays,
+                                       "rows": [{k: finite_or_none(v) for k, v in r.items()} for r in rows]}),
+             "sweep.png": plots.sweep_plot(spec.name, unit, plot_rows, cols)}
+    with Staging(out, profile_lock(Path(args.exports), raw.name), carry=lambda rel: False) as stage:
+        for name, data in files.items():
+            stage.write_bytes(out / name, data)
+        paths = stage.commit()
+    good = [r for r in rows if r["ok"]]
+    print(f"{raw.name}: {len(rows)} designs of {spec.name} on {engine.name} in {wall:.1f} s; "
+          f"{len(good)} built, {len(rows) - len(good)} refused")
+    for r in rows:
+        if not r["ok"]:
+            print(f"  {spec.name} = {r['value']:.6g} {spec.unit}: {r['error']}", file=sys.stderr)
+    for p in paths:
+        print(f"  wrote {p}")
+    return 0
+
+
+def _engine_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--workers", type=int, default=0,
+                   help="worker processes (default 0: every core; 1: in this process)")
+    p.add_argument("--scheduler", metavar="ADDR",
+                   help="run the tasks on Dask: a dask.distributed scheduler address (tcp://host:8786) or "
+                        "'local-dask' (a LocalCluster of --workers processes); needs pip install 'rigcad[dask]'")
+    p.add_argument("--exports", default="exports", help="exports root (default: exports)")
+
+
+def register(subparsers) -> None:
+    """Add ``tolerance`` and ``sweep`` to rigcad's subcommands."""
+    p = subparsers.add_parser(
+        "tolerance", help="Monte Carlo tolerancing at scale: per-sample table, sensitivity, inverse limits",
+        description="Trace --samples random builds (tolerancing.*) through the analytic tracer on this machine's "
+                    "cores (joblib) or Dask; write exports/<profile>/tolerance/{samples.parquet, samples.csv, "
+                    "summary.json, tolerance.md, histograms.png, sensitivity.png, run.json}. Exit 1 when the "
+                    "yield is below tolerancing.min_yield.")
+    p.add_argument("profile", help="profile name (under profiles/) or path")
+    p.add_argument("--samples", type=int, help="random builds (default: tolerancing.builds)")
+    p.add_argument("--rays", type=int, help="pinhole rays per light path (default: tolerancing.rays)")
+    p.add_argument("--no-limits", action="store_true", help="skip the sensitivity ranking and inverse limits")
+    _engine_args(p)
+    p.set_defaults(func=cmd_tolerance)
+
+    s = subparsers.add_parser(
+        "sweep", help="parameter sweep: one row per design (design, check and printer-fit figures)",
+        description="Build one design per value of --set section.key=A..B:N (or v1,v2,...; units as in a "
+                    "profile, e.g. layout.cop_to_vertex=25cm..35cm:21) on the same engine as tolerance; write "
+                    "exports/<profile>/sweep/<key>/{sweep.csv, sweep.json, sweep.png}.")
+    s.add_argument("profile", help="profile name (under profiles/) or path")
+    s.add_argument("--set", required=True, metavar="SECTION.KEY=A..B:N", help="the swept key and its values")
+    s.add_argument("--rays", type=int, default=20000, help="pinhole rays of each design's check (default 20000)")
+    s.add_argument("--printer", default="prusa_mk3s", help="printer for the fit column, or 'none' (default prusa_mk3s)")
+    _engine_args(s)
+    s.set_defaults(func=cmd_sweep)

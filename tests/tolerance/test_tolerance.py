@@ -1,0 +1,148 @@
+"""rigcad.tolerance: bit-identical Monte Carlo on every engine, inverse limits checked by tracing at
+the limit with the vectorised exact path, sweeps, and the command line."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+import numpy as np
+import pytest
+
+from rigcad.check import montecarlo as MC
+from rigcad.check.scene import analytic_optics
+from rigcad.check.trace3d import trace
+from rigcad.engine import LOCAL_DASK, Engine, EngineError
+from rigcad.errors import ProfileError
+from rigcad.tolerance.limits import run_limits
+from rigcad.tolerance.montecarlo import Job, run_monte_carlo
+from rigcad.tolerance.params import PARAMETERS
+
+#: A small run for the engine comparisons: 12 builds x 300 rays per path, batched 3 to a task
+SAMPLES, RAYS = 12, 300
+
+
+@pytest.fixture(scope="module")
+def serial_mc(table31_rig):
+    return run_monte_carlo(table31_rig, SAMPLES, RAYS, Engine(1))
+
+
+def _same(a, b):
+    assert a.summary == b.summary  # every summary figure, bit for bit (floats compared exactly)
+    assert list(a.columns) == list(b.columns)
+    for k in a.columns:
+        assert np.array_equal(a.columns[k], b.columns[k]), k
+
+
+def test_monte_carlo_is_not_vacuous(serial_mc, table31_rig):
+    c = serial_mc.columns
+    assert len(c["sample"]) == SAMPLES and np.array_equal(c["sample"], np.arange(SAMPLES))
+    tol = table31_rig.profile.tolerancing
+    # every build is perturbed within its tolerances, and builds differ
+    assert np.all(np.hypot(c["dome_dx_mm"], c["dome_dy_mm"]) <= tol.dome_offset)
+    assert np.all(c["paraboloid_tilt_rad"] <= tol.paraboloid_tilt)
+    assert len(set(c["max_spot_radius_mm"].tolist())) == SAMPLES
+    # sub-millimetre placement errors move the spot by ~0.1-3 mm (the sensitivity table's scale)
+    assert 0.05 < serial_mc.summary["figures"]["max_spot_radius_mm"]["p50"] < 3
+
+
+def test_workers_and_batching_give_the_same_bits(serial_mc, table31_rig):
+    seen = []
+    two = run_monte_carlo(table31_rig, SAMPLES, RAYS, Engine(2), progress=lambda *a: seen.append(a))
+    _same(serial_mc, two)
+    assert seen and seen[-1][2:] == (SAMPLES, SAMPLES), seen  # the progress callback counts samples
+
+
+def test_local_dask_gives_the_same_bits(serial_mc, table31_rig):
+    pytest.importorskip("distributed")  # the dask extra, installed by `make test`
+    _same(serial_mc, run_monte_carlo(table31_rig, SAMPLES, RAYS, Engine(2, LOCAL_DASK)))
+
+
+def test_a_sample_does_not_depend_on_the_run_size(serial_mc, table31_rig):
+    # sample i draws from SeedSequence child i: the first 5 of 12 are the first 5 of a 5-sample run
+    few = run_monte_carlo(table31_rig, 5, RAYS, Engine(1))
+    for k in ("dome_dx_mm", "max_spot_radius_mm", "max_mirror_angle_error_rad"):
+        assert np.array_equal(few.columns[k], serial_mc.columns[k][:5])
+
+
+@pytest.mark.parametrize("name", ["dome_offset", "paraboloid_tilt"])
+def test_inverse_limit_holds_at_the_limit_and_fails_at_twice_it(table31_rig, name):
+    rig = table31_rig
+    tol = rig.profile.tolerancing
+    p = next(q for q in PARAMETERS if q.name == name)
+    rays = 2000
+    [row] = run_limits(rig, Job(rig, rays, 0, 0, 0).key, rays, int(tol.seed) + 1, Engine(1), parameters=[p])
+    limit = row[f"limit_{p.unit}"]
+    assert row["limit_found"] and limit > p.tolerance(tol)  # the profile's tolerance is inside its limit
+
+    # independent check: the same rays through the vectorised exact path (numpy passes, every dome
+    # hit bracketed), at the limit and at twice it, worst of the two directions
+    optics = analytic_optics(rig)
+    design = rig.incidence
+
+    def worst(amount):
+        out = 0.0
+        for mis in p.moves(amount):
+            rays_ = MC.annulus_rays(design, rays, int(tol.seed) + 1, mis.pose("projector", rig.geometry))
+            placed = optics.placed(mis.pose("paraboloid", rig.geometry), mis.pose("dome", rig.geometry))
+            tr = trace(placed, rays_.origins, rays_.dirs, vectorised=True)
+            local, _ = placed.paraboloid_pose.localize(tr.p1, tr.p1)
+            mdirs = placed.paraboloid_pose.globalize_dirs(design.direction_at(local))
+            out = max(out, MC.figures(tr, design.direction(rays_.chief), None, mdirs)["max_mirror_angle_error_rad"])
+        return out
+
+    at = worst(limit)
+    # within 5 % of the declared error at the limit (the issue's bound; bisection stops at 1e-3 of the move)
+    assert 0.95 * tol.max_angle_error <= at <= tol.max_angle_error, (at, tol.max_angle_error)
+    assert worst(2 * limit) > tol.max_angle_error  # and twice the limit fails
+
+
+def test_sweep_rows_and_refusals(table31):
+    from rigcad.profile.loader import load_raw
+    from rigcad.tolerance.sweep import parse_set, run_sweep
+
+    spec = parse_set("layout.cop_to_vertex=25cm..35cm:3")
+    assert spec.values == (250.0, 300.0, 350.0) and spec.unit == "mm"
+    rows = run_sweep(load_raw(table31.sources[0]), spec, 3000, 1, None, Engine(1))
+    assert [r["value"] for r in rows] == [250.0, 300.0, 350.0]
+    # at 25 cm the profile's dome.tolerance (1e-9 mm) is below what float64 certifies: a refused row
+    # naming the key, not a failed sweep
+    assert not rows[0]["ok"] and "dome.tolerance" in rows[0]["error"]
+    assert rows[1]["ok"] and rows[2]["ok"]
+    # a farther COP sees the paraboloid under a smaller angle: fewer pixels from vertex to rim
+    assert rows[1]["pixels_vertex_to_rim"] > rows[2]["pixels_vertex_to_rim"]
+    assert all(r["check_max_spot_radius_mm"] < 1e-6 for r in rows[1:])  # each design converges on O
+    for bad, words in (("layout.cop_to_vertx=1cm..2cm:3", "unknown key layout.cop_to_vertx"),
+                       ("layout.cop_to_vertex=25..35:3", "cop_to_vertex"),
+                       ("layout.cop_to_vertex=25cm..35cm:1", "at least 2"),
+                       ("beam.width=-1mm..2mm:3", "beam.width")):
+        with pytest.raises(ProfileError, match=words):
+            parse_set(bad)
+
+
+def test_cli_tolerance_writes_its_files(tmp_path, capsys):
+    from rigcad.cli import main
+
+    code = main(["tolerance", "achutha2006", "--samples", "6", "--rays", "200", "--workers", "1", "--no-limits",
+                 "--exports", str(tmp_path)])
+    assert code == 0
+    out = tmp_path / "achutha2006" / "tolerance"
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["histograms.png", "run.json", "samples.csv", "samples.parquet", "summary.json", "tolerance.md"]
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(out / "samples.parquet")
+    assert table.num_rows == 6 and "dome_tilt_rad" in table.column_names and "meets_targets" in table.column_names
+    header = [c.strip('"') for c in (out / "samples.csv").read_text().splitlines()[0].split(",")]
+    # every number written names its unit in its header (or is a count / flag)
+    assert all(c.endswith(("_mm", "_rad", "_fraction")) for c in header if c not in ("sample", "meets_targets")), header
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["samples"] == 6 and 0 <= summary["yield"] <= 1
+    assert "Yield" in (out / "tolerance.md").read_text()
+
+
+def test_scheduler_without_dask_says_what_to_install(table31_rig, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
+    with pytest.raises(EngineError, match=r"pip install 'rigcad\[dask\]'"):
+        run_monte_carlo(table31_rig, 2, 100, Engine(1, LOCAL_DASK))
