@@ -19,6 +19,7 @@ from rigcad.errors import RigcadError
 from rigcad.optimize.fast import fast_design
 from rigcad.optimize.printfit import dome_fit
 from rigcad.optimize.spec import COATING_TOTAL, OBJECTIVES, OptimizeSpec
+from rigcad.parts.tower import shelf_bottom_z
 from rigcad.profile.derived import derive
 from rigcad.profile.schema import Profile
 from rigcad.units import DEG
@@ -121,6 +122,10 @@ def evaluate(problem: Problem, x) -> dict:
         # parts.layout: the sample holder's stop lies inside the printed dome's base
         "design.holder_inside_base": profile.sample_holder.stop_radius - float(fd.outline.flange[3][0]),
     }
+    if not geo.cop_at_infinity:
+        # parts.tower: the projector's shelf must clear the dome's top (tower_layout refuses it otherwise)
+        dome_top = float(max(fd.outline.outer[:, 1].max(), fd.outline.inner[:, 1].max()))
+        g["design.tower_above_dome"] = dome_top + profile.tower.clearance - shelf_bottom_z(profile, geo.cop_z)
     pr = problem.printer
     density = pr.density_g_cm3 if pr is not None else 1.24  # PLA when no printer is named
     fig["dome_mass_g"] = fig["dome_volume_mm3"] / 1000.0 * density
@@ -156,7 +161,7 @@ def evaluate(problem: Problem, x) -> dict:
 #: Units of each constraint value (for the report and the penalty scale).
 CONSTRAINT_UNITS = {
     "design.top_clearance": "mm", "design.cop_above_dome": "mm", "design.beam_above_flange": "mm",
-    "design.holder_inside_base": "mm",
+    "design.holder_inside_base": "mm", "design.tower_above_dome": "mm",
     "printer.pieces": "mm", "min_feature.dome_wall": "mm", "min_feature.paraboloid_vertex": "mm",
     "max_cop_height": "mm", "max_occluded_fraction": "", "raycheck.theta_min_coverage": "deg",
     "raycheck.theta_max_coverage": "deg", "raycheck.min_px_per_deg": "px/deg", "raycheck.max_lost_fraction": "",
@@ -167,6 +172,8 @@ CONSTRAINT_KEYS = {
     "design.cop_above_dome": "the COP must lie above the dome",
     "design.beam_above_flange": "the beam must sit above the dome's flange",
     "design.holder_inside_base": "sample_holder.stop_radius must lie inside the dome's base",
+    "design.tower_above_dome": "the COP tower's projector shelf must clear the dome's top by tower.clearance "
+                               "(raise the COP or lower tower.splitter_distance)",
     "printer.pieces": "optimize.constraints.printer / max_pieces: the dome must print in at most max_pieces pieces "
                       "with PRINT_RESERVE mm to spare (value: how many mm too large the best split is)",
     "min_feature.dome_wall": "optimize.constraints.min_feature_nozzles: dome_shell.wall against the nozzle",

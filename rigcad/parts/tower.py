@@ -99,6 +99,22 @@ def _box(lo, hi) -> tuple[tuple[float, float, float], tuple[float, float, float]
     return tuple(float(v) for v in lo), tuple(float(v) for v in hi)
 
 
+def shims_nominal(profile: Profile) -> int:
+    """Shims under the projector and behind the camera at the nominal placement: the travel across."""
+    tw = profile.tower
+    return math.ceil(tw.travel_across / tw.shim_thickness - 1e-9)
+
+
+def shelf_bottom_z(profile: Profile, cop_z: float) -> float:
+    """Height (mm) of the underside of the projector's shelf for a COP at ``cop_z`` mm: the projector's
+    real COP lies ``tower.splitter_distance`` below it, its body ``projector.pupil_height`` lower, on its
+    nominal shims, on the shelf (2 walls thick). It must clear the dome's top by ``tower.clearance``
+    (tower_layout refuses it otherwise; the optimiser holds it as a constraint)."""
+    tw = profile.tower
+    return (cop_z - tw.splitter_distance - profile.projector.pupil_height
+            - shims_nominal(profile) * tw.shim_thickness - 2 * tw.wall)
+
+
 def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z: float) -> TowerLayout:
     """Place the tower; raise GeometryError naming the parameter when something does not fit."""
     tw, bs, pj, cm, ln = profile.tower, profile.beam_splitter, profile.projector, profile.camera, profile.lens
@@ -162,8 +178,8 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
             where=profile.where("lens", "distance"))
     p_body0 = p_lens_front + pj.lens_length
     body_y0 = -pj.pupil_lateral - pj.body_width / 2
-    shims_nominal = math.ceil(tw.travel_across / tw.shim_thickness - 1e-9)
-    shims_per_stack = 2 * shims_nominal
+    shims = shims_nominal(profile)
+    shims_per_stack = 2 * shims
     body_z0 = z_s - pj.pupil_height
     projector_box = _box((p_body0, body_y0, body_z0),
                          (p_body0 + pj.body_depth, body_y0 + pj.body_width, body_z0 + pj.body_height))
@@ -174,8 +190,8 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
     projector_lens_box = _box((p_lens_front, -pj.lens_diameter / 2, z_s - pj.lens_diameter / 2),
                               (p_body0, pj.lens_diameter / 2, z_s + pj.lens_diameter / 2))
 
-    shelf_top = body_z0 - shims_nominal * tw.shim_thickness
     shelf_t = 2 * tw.wall
+    shelf_top = shelf_bottom_z(profile, cop_z) + shelf_t
     if shelf_top > pz0 - tw.clearance:
         raise GeometryError(
             f"the shelf (top z = {shelf_top:.1f} mm) would reach the splitter's lower edge (z = {pz0:.1f} mm): "
@@ -190,7 +206,7 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
     wall_out = bs.width / 2 + GROOVE_GAP + tw.wall
     holder_x = (px0 - GROOVE_GAP - 1.0 - tw.wall, px1 + tw.wall)
     holder_top = pz1 + tw.wall
-    bracket_y = face_y - shims_nominal * tw.shim_thickness
+    bracket_y = face_y - shims * tw.shim_thickness
     if bracket_y < -wall_out + tw.wall:
         raise GeometryError(f"the camera bracket would stand outside the splitter holder's wall: camera.pupil_height "
                             f"({cm.pupil_height:g} mm) is larger than the splitter's half width allows",
@@ -205,7 +221,7 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
         projector_box=projector_box, projector_lens_box=projector_lens_box, camera_box=camera_box,
         camera_lens_box=camera_lens_box, lens_x=lens_x,
         bundle_radius_at_shelf=bundle_r(cop_z - (shelf_top - shelf_t)),
-        shims_nominal=shims_nominal, shims_per_stack=shims_per_stack)
+        shims_nominal=shims, shims_per_stack=shims_per_stack)
 
 
 # -- the printed parts -----------------------------------------------------------------------------
