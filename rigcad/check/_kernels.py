@@ -157,13 +157,12 @@ def _to_local(R, T, ident, px, py, pz):
     """Point from the global frame into a body's (R^T (p - T))."""
     if ident:
         return px, py, pz
-    x, y, z = px - T[0], py - T[1], pz - T[2]
-    return (x * R[0, 0] + y * R[1, 0] + z * R[2, 0], x * R[0, 1] + y * R[1, 1] + z * R[2, 1],
-            x * R[0, 2] + y * R[1, 2] + z * R[2, 2])
+    return _dir_to_local(R, False, px - T[0], py - T[1], pz - T[2])
 
 
 @nb.njit(**_JIT)
 def _dir_to_local(R, ident, x, y, z):
+    """Direction from the global frame into a body's (R^T d)."""
     if ident:
         return x, y, z
     return (x * R[0, 0] + y * R[1, 0] + z * R[2, 0], x * R[0, 1] + y * R[1, 1] + z * R[2, 1],

@@ -60,12 +60,9 @@ def tilt_to_z(d: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * kx + (1 - c) * kx @ kx
 
 
-def fit_spin(vertices: np.ndarray, direction, usable: tuple[float, float, float]) -> tuple[float | None, dict]:
-    """The spin (rad) that fits the tilted part in the usable box (x, y, z mm), or None.
-
-    Spin 0 when it fits; otherwise the spin with the largest smallest margin. Also returns the
-    extents (mm) at the chosen (or unrotated) spin.
-    """
+def _spun_extents(vertices: np.ndarray, direction) -> tuple[float, np.ndarray, np.ndarray]:
+    """Height (mm) of the part tilted along ``direction``, and its footprint's widths in x and y
+    (mm, one per spin of SPINS), from the convex hull of its tilted footprint."""
     p = vertices @ tilt_to_z(np.asarray(direction, dtype=float)).T
     height = float(np.ptp(p[:, 2]))
     xy = p[:, :2]
@@ -74,9 +71,18 @@ def fit_spin(vertices: np.ndarray, direction, usable: tuple[float, float, float]
     except Exception:  # degenerate footprint (a flat part): the points themselves will do
         pass
     c, s = np.cos(SPINS), np.sin(SPINS)
-    w = (xy[:, 0, None] * c - xy[:, 1, None] * s)
-    h = (xy[:, 0, None] * s + xy[:, 1, None] * c)
-    wx, hy = np.ptp(w, axis=0), np.ptp(h, axis=0)
+    wx = np.ptp(xy[:, 0, None] * c - xy[:, 1, None] * s, axis=0)
+    hy = np.ptp(xy[:, 0, None] * s + xy[:, 1, None] * c, axis=0)
+    return height, wx, hy
+
+
+def fit_spin(vertices: np.ndarray, direction, usable: tuple[float, float, float]) -> tuple[float | None, dict]:
+    """The spin (rad) that fits the tilted part in the usable box (x, y, z mm), or None.
+
+    Spin 0 when it fits; otherwise the spin with the largest smallest margin. Also returns the
+    extents (mm) at the chosen (or unrotated) spin.
+    """
+    height, wx, hy = _spun_extents(vertices, direction)
     margin = np.minimum(usable[0] - wx, usable[1] - hy)
     extents = {"x_mm": float(wx[0]), "y_mm": float(hy[0]), "z_mm": height}
     if height > usable[2] or margin.max() < 0:
@@ -90,16 +96,7 @@ def fit_margin(vertices: np.ndarray, direction, usable: tuple[float, float, floa
     SPINS: the smallest of the three margins of the usable box (x, y, z mm), the spin chosen to make
     it largest. >= 0 exactly when :func:`fit_spin` finds a fit (the same extents); continuous in the
     part's size, for optimisers (rigcad.optimize)."""
-    p = vertices @ tilt_to_z(np.asarray(direction, dtype=float)).T
-    height = float(np.ptp(p[:, 2]))
-    xy = p[:, :2]
-    try:
-        xy = xy[ConvexHull(xy).vertices]
-    except Exception:  # degenerate footprint (a flat part): the points themselves will do
-        pass
-    c, s = np.cos(SPINS), np.sin(SPINS)
-    wx = np.ptp(xy[:, 0, None] * c - xy[:, 1, None] * s, axis=0)
-    hy = np.ptp(xy[:, 0, None] * s + xy[:, 1, None] * c, axis=0)
+    height, wx, hy = _spun_extents(vertices, direction)
     return float(min(usable[2] - height, np.minimum(usable[0] - wx, usable[1] - hy).max()))
 
 
