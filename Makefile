@@ -65,7 +65,7 @@ docs: check view
 	mkdir -p docs/parts && cp $(EXPORTS)/achutha2006/renders/*.png docs/parts/
 
 test: $(VENV)/.installed tools
-	$(PY) -m pytest -q -m "not slow and not stress"
+	$(PY) -m pytest -q -n auto --dist loadfile -m "not slow and not stress"
 
 test-slow: $(VENV)/.installed tools
 	$(PY) -m pytest -q -m slow
