@@ -440,16 +440,24 @@ def _bracketed(ox, oy, oz, dx, dy, dz, tab_u, tab_r, tab_z, r_max, brk, cr, cz, 
     u = _interp(oz + t * dz, tab_z, tab_u)
     piece = piece_of[min(int((u - u_lo) * piece_scale), piece_of.shape[0] - 1)]
     for _ in range(newton_steps):
-        cr_, cz_, dcr, dcz, piece = _spline(brk, cr, cz, u, piece)
-        px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
-        rho = math.sqrt(px * px + py * py)
-        f1 = rho - cr_
-        f2 = pz - cz_
-        a11 = (px * dx + py * dy) / rho
-        det = a11 * (-dcz) - (-dcr) * dz
-        t = t - ((-dcz) * f1 - (-dcr) * f2) / det
-        u = min(max(u - (-dz * f1 + a11 * f2) / det, u_lo), u_hi)
+        dt, du, piece = _newton_step(brk, cr, cz, ox, oy, oz, dx, dy, dz, t, u, piece)
+        t = t - dt
+        u = min(max(u - du, u_lo), u_hi)
     return t, u
+
+
+@nb.njit(**_JIT)
+def _newton_step(brk, cr, cz, ox, oy, oz, dx, dy, dz, t, u, piece):
+    """One Newton step on (t, u) for the ray o + t d meeting the revolved meridian (r(u), z(u)):
+    residuals rho(t) - r(u), z(t) - z(u); returns (dt, du, piece) to subtract."""
+    cr_, cz_, dcr, dcz, piece = _spline(brk, cr, cz, u, piece)
+    px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
+    rho = math.sqrt(px * px + py * py)
+    f1 = rho - cr_
+    f2 = pz - cz_
+    a11 = (px * dx + py * dy) / rho
+    inv = 1.0 / (a11 * (-dcz) + dcr * dz)
+    return ((-dcz) * f1 + dcr * f2) * inv, (-dz * f1 + a11 * f2) * inv, piece
 
 
 @nb.njit(**_JIT)
@@ -498,15 +506,7 @@ def general(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, 
         if not (math.isfinite(t) and t > 0.0):
             t = 1.0
         for _ in range(newton_steps):
-            cr_, cz_, dcr, dcz, piece = _spline(brk, cr, cz, u, piece)
-            px, py, pz = ox + t * ex, oy + t * ey, oz + t * ez
-            rho = math.sqrt(px * px + py * py)
-            f1 = rho - cr_
-            f2 = pz - cz_
-            a11 = (px * ex + py * ey) / rho
-            inv = 1.0 / (a11 * (-dcz) + dcr * ez)
-            dt = ((-dcz) * f1 + dcr * f2) * inv
-            du = (-ez * f1 + a11 * f2) * inv
+            dt, du, piece = _newton_step(brk, cr, cz, ox, oy, oz, ex, ey, ez, t, u, piece)
             t = t - dt
             u = min(max(u - du, u_lo), u_hi)
             if abs(dt) < step_tol and abs(du) < step_tol:
