@@ -325,67 +325,100 @@ def _y_meets(rho_lo, rho_hi, sphi, beam_y):
 
 
 @nb.njit(**_JIT)
-def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed, s0, s1, brk, cr, cz, piece_of,
-                    piece_scale, u_lo, flag_inv_h, flags, beam_rho, beam_y, status, segment, p1, p2, v, landing, path,
-                    miss, handled):
-    """Aligned rig, every ray from the COP (0, 0, cop_z): the paraboloid hit in closed form; the dome
-    hit by the design correspondence (the ray reflected at paraboloid radius s lands on the dome's
-    meridian at u = -s: the spline's point and normal there, turned to the ray's azimuth; measured
-    against Newton when the tracer is built). ``flags[cell]`` per cell of s from s0 (``flag_inv_h``
-    cells per mm), analytic._cell_flags: bit 0 (2), the leg to the dome (the return leg) may cross
-    the beam's heights, at radii ``beam_rho[cell]``; the box is tested only if radius x sin(azimuth)
-    can fall in the beam's y extent ``beam_y``; bit 1, the return leg may pass the paraboloid's body. ``mount_shadowed``: the mount lies under the mirror, so a ray that hits the mirror from
-    the COP cannot meet it first. Rays outside [s0, s1] are left for the general kernel
-    (``handled`` False)."""
+def _cubic(tab, c, k, t):
+    """Function ``k`` of table cell ``c`` at local coordinate t in [0, 1] (a cubic, highest power first)."""
+    return ((tab[c, k, 0] * t + tab[c, k, 1]) * t + tab[c, k, 2]) * t + tab[c, k, 3]
+
+
+#: Columns of the aligned kernel's table (analytic.PINHOLE_COLUMNS names them).
+T_S, T_Z1, T_T1, T_R2, T_Z2, T_T2, T_WR, T_WZ, T_MISS = range(9)
+
+
+@nb.njit(**_JIT)
+def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed, x0, x_inv_h, table, flags, beam_rho,
+                    beam_y, status, segment, p1, p2, v, landing, path, miss, handled):
+    """Aligned rig, every ray from the COP (0, 0, cop_z). The rig is a surface of revolution, so a
+    ray's path lies in its meridional plane and, but for the occluders, depends on one number: the
+    sine x of its angle from the axis. ``table`` (cells, 9, 4) holds that path's meridional values
+    (analytic.PINHOLE_COLUMNS: paraboloid radius s and height, t1, dome hit r2, z2, t2, the return
+    direction (wr, wz) and the signed miss) as cubics on uniform cells of x from ``x0``
+    (``x_inv_h`` cells per unit x), fitted to the exact trace (Newton on the dome spline) and
+    measured against it when the tracer is built; the kernel turns them to the ray's azimuth.
+    The beam and the mount break the symmetry: they are tested per ray, in 3D, only where the
+    table cell's ``flags[cell]`` (analytic._cell_flags) say a leg can reach them: bit 0 (bit 2), the leg to the dome (the return leg) may cross the beam's
+    heights at radii ``beam_rho[cell]`` and is tested only if radius x sin(azimuth) can fall in
+    the beam's y extent ``beam_y``; bit 1, the return leg may pass the paraboloid's body.
+    ``mount_shadowed``: the mount lies under the mirror, so a ray from the COP that reaches the
+    mirror cannot meet it first. Rays outside the table (``handled`` False) are left for the
+    general kernel."""
     n = dirs.shape[0]
-    E = np.eye(3)
-    Z = np.zeros(3)
-    inv2f = 1.0 / (2.0 * f)
-    ncells = flags.shape[0]
-    npo = piece_of.shape[0]
+    ncells = table.shape[0]
     for i in range(n):
-        handled[i] = True
         dx, dy, dz = dirs[i, 0], dirs[i, 1], dirs[i, 2]
-        norm = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
-        dx, dy, dz = dx * norm, dy * norm, dz * norm
-        t1 = _paraboloid(0.0, 0.0, cop_z, dx, dy, dz, f, zv, rim, np.inf)
-        if not mount_shadowed or not math.isfinite(t1):
-            to = _occluders(para_occ, 0.0, 0.0, cop_z, dx, dy, dz, t1)
-            if to < t1 or not math.isfinite(t1):
-                _lost(i, OCCLUDED_BY_MOUNT if math.isfinite(to) else MISSED_PARABOLOID, 1, status, segment, p1, p2,
-                      v, landing, path, miss)
-                continue
-        ax, ay, az = t1 * dx, t1 * dy, cop_z + t1 * dz
-        s = math.sqrt(ax * ax + ay * ay)
-        if not (s0 <= s <= s1):
+        rho2 = dx * dx + dy * dy
+        if not (dz < 0.0 and rho2 > 0.0):
             handled[i] = False
             continue
-        p1[i, 0], p1[i, 1], p1[i, 2] = ax, ay, az
-        nx, ny = ax * inv2f, ay * inv2f
-        nn = 1.0 / math.sqrt(nx * nx + ny * ny + 1.0)
-        ux, uy, uz = _reflect(dx, dy, dz, nx * nn, ny * nn, nn)
-        # the correspondence: the meridian at u = -s
-        u = -s
-        r2, z2, dr, dzu, _ = _spline(brk, cr, cz, u, piece_of[min(int((u - u_lo) * piece_scale), npo - 1)])
-        m = 1.0 / math.sqrt(dr * dr + dzu * dzu)
-        nr, nzz = -dzu * m, dr * m  # the left normal of the rising meridian: towards the axis
-        inv_s = 1.0 / s
-        cphi, sphi = ax * inv_s, ay * inv_s
-        q2x, q2y = r2 * cphi, r2 * sphi
-        ex, ey, ez = q2x - ax, q2y - ay, z2 - az
-        t2 = math.sqrt(ex * ex + ey * ey + ez * ez)
-        cell = min(int((s - s0) * flag_inv_h), ncells - 1)
-        fl = flags[cell]
-        if fl & 1 and _y_meets(beam_rho[cell, 0], beam_rho[cell, 1], sphi, beam_y):
-            tb = _occluders(beam_occ, ax, ay, az, ux, uy, uz, t2)
-            if tb < t2:
+        rho = math.sqrt(rho2)
+        w = (rho / math.sqrt(rho2 + dz * dz) - x0) * x_inv_h
+        if not (0.0 <= w <= ncells):
+            handled[i] = False
+            continue
+        handled[i] = True
+        c = min(int(w), ncells - 1)
+        t = w - c
+        s = _cubic(table, c, T_S, t)
+        z1 = _cubic(table, c, T_Z1, t)
+        t1 = _cubic(table, c, T_T1, t)
+        inv = 1.0 / rho
+        cphi, sphi = dx * inv, dy * inv
+        ax, ay = s * cphi, s * sphi
+        if not mount_shadowed:
+            nd = 1.0 / math.sqrt(rho2 + dz * dz)
+            if _occluders(para_occ, 0.0, 0.0, cop_z, dx * nd, dy * nd, dz * nd, t1) < t1:
+                _lost(i, OCCLUDED_BY_MOUNT, 1, status, segment, p1, p2, v, landing, path, miss)
+                continue
+        p1[i, 0], p1[i, 1], p1[i, 2] = ax, ay, z1
+        r2 = _cubic(table, c, T_R2, t)
+        z2 = _cubic(table, c, T_Z2, t)
+        t2 = _cubic(table, c, T_T2, t)
+        fl = flags[c]
+        if fl & 1 and _y_meets(beam_rho[c, 0], beam_rho[c, 1], sphi, beam_y):
+            ur, uz = (r2 - s) / t2, (z2 - z1) / t2
+            if _occluders(beam_occ, ax, ay, z1, ur * cphi, ur * sphi, uz, t2) < t2:
                 _lost(i, OCCLUDED_BY_BEAM, 2, status, segment, p1, p2, v, landing, path, miss)
                 continue
+        q2x, q2y = r2 * cphi, r2 * sphi
         p2[i, 0], p2[i, 1], p2[i, 2] = q2x, q2y, z2
-        wx, wy, wz = _reflect(ux, uy, uz, nr * cphi, nr * sphi, nzz)
-        ret_beam = (fl & 4) != 0 and _y_meets(beam_rho[cell, 2], beam_rho[cell, 3], sphi, beam_y)
-        _return_leg(i, q2x, q2y, z2, wx, wy, wz, t1, t2, E, Z, True, E, Z, True, f, zv, rim, para_occ, beam_occ,
-                    (fl & 2) != 0, ret_beam, status, segment, p1, p2, v, landing, path, miss)
+        wr = _cubic(table, c, T_WR, t)
+        wz = _cubic(table, c, T_WZ, t)
+        wx, wy = wr * cphi, wr * sphi
+        v[i, 0], v[i, 1], v[i, 2] = wx, wy, wz
+        if not wz < 0.0:
+            _lost(i, ESCAPED_AFTER_DOME, 3, status, segment, p1, p2, v, landing, path, miss)
+            continue
+        t3 = -z2 / wz
+        if fl & 2:
+            hp = _paraboloid_bounded(q2x, q2y, z2, wx, wy, wz, f, zv, rim, t3)
+            ho = _occluders(para_occ, q2x, q2y, z2, wx, wy, wz, t3)
+            hp = min(hp, ho)
+        else:
+            hp = np.inf
+        hb = np.inf
+        if fl & 4 and _y_meets(beam_rho[c, 2], beam_rho[c, 3], sphi, beam_y):
+            hb = _occluders(beam_occ, q2x, q2y, z2, wx, wy, wz, t3)
+        if math.isfinite(hb) and not hp < hb:
+            _lost(i, OCCLUDED_BY_BEAM, 3, status, segment, p1, p2, v, landing, path, miss)
+            continue
+        if math.isfinite(hp):
+            _lost(i, OCCLUDED_BY_PARABOLOID, 3, status, segment, p1, p2, v, landing, path, miss)
+            continue
+        status[i] = OK
+        segment[i] = 0
+        lr = r2 + t3 * wr
+        landing[i, 0], landing[i, 1], landing[i, 2] = lr * cphi, lr * sphi, z2 + t3 * wz
+        path[i] = t1 + t2 + t3
+        miss[i] = abs(_cubic(table, c, T_MISS, t))
 
 
 @nb.njit(**_JIT)

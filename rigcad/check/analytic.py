@@ -3,15 +3,16 @@ spline) traced by compiled kernels (rigcad/check/_kernels.py), float64 throughou
 
 Two kernels, and the one that ran is recorded per trace (``Trace3D.kernels``):
 
-* ``pinhole_aligned`` - an aligned rig (identity poses) and rays from the COP. The paraboloid hit
-  is the quadratic's root; the rest of the path depends on the paraboloid radius s alone (the rig
-  is a surface of revolution), and the design's correspondence gives the dome hit: the ray
-  reflected at radius s lands on the dome's meridian at u = -s (the dome was built along those
-  rays), so the hit and its normal are the spline's point and derivative there (a lookup of the
-  piece and a quintic), turned to the ray's azimuth. The correspondence is measured against
-  Newton when the tracer is built (``table_error``; past CORRESPONDENCE_TOL the kernel is not
-  used). The beam and the mount are tested per ray (they break the symmetry), only where per-cell
-  flags of s say a leg can reach them.
+* ``pinhole_aligned`` - an aligned rig (identity poses) and rays from the COP. The rig is a surface
+  of revolution, so a ray's path lies in its meridional plane and, but for the occluders, depends
+  on one number: the sine x of the ray's angle from the axis. When the tracer is built, the exact
+  path (``general_newton`` below: the paraboloid's quadratic, Newton on the dome's meridian
+  spline) is traced at the nodes of PINHOLE_CELLS uniform cells of x, and its meridional values
+  (PINHOLE_COLUMNS) are fitted by a cubic spline; a ray then costs a cell lookup, nine cubics and
+  its turn to its azimuth. The table is measured against the exact path at every cell's midpoint
+  (``table_error``; past PINHOLE_POINT_TOL / PINHOLE_DIRECTION_TOL the kernel is not used). The
+  beam and the mount are tested per ray (they break the symmetry), only where per-cell flags of
+  the paraboloid radius say a leg can reach them.
 * ``general_newton`` - any rig and any rays (misaligned components, thin-lens rays): Newton on
   (t, u) against the spline, started at the correspondence; a ray whose Newton does not land on
   the mirror (a miss past its ends, a stray ray) takes the bracketing path of
@@ -33,13 +34,21 @@ from scipy.interpolate import PPoly
 from rigcad.check import rays as R
 from rigcad.optics.frames import Pose
 
-#: Cells of paraboloid radius of the per-cell occlusion flags (16 mm / 2^16 = 0.23 um; 64 KB).
-FLAG_CELLS = 1 << 16
-#: Radii at which the correspondence is measured against Newton when the tracer is built.
-CHECK_RADII = 4097
-#: The aligned kernel runs only if the correspondence lands within this of Newton's hit (mm); the
-#: Table 3.1 dome's measures ~1e-13 mm (its spline interpolates rows built on the design's rays).
-CORRESPONDENCE_TOL = 1e-11
+#: Uniform cells of x (the sine of a COP ray's angle from the axis) of the aligned kernel's table.
+#: The cubic spline's error falls as h^4 (bench/raycheck.py's table sweep on Table 3.1:
+#: 4096 cells 2e-12 mm, 8192 cells ~1e-13 mm, then float64 round-off); 8192 cells x 9 cubics are
+#: 2.4 MB.
+PINHOLE_CELLS = 8192
+#: What the table holds per x: the paraboloid hit (radius s, height z1) and the distance t1 to it
+#: from the COP, the dome hit (r2, z2) and the distance t2 to it, the return direction (wr, wz)
+#: and the signed miss r2 wz - z2 wr (mm; its absolute value is the distance from O to the return
+#: ray's line, which lies in the meridional plane through O). Kept in step with _kernels.T_*.
+PINHOLE_COLUMNS = ("s_mm", "z1_mm", "t1_mm", "r2_mm", "z2_mm", "t2_mm", "wr", "wz", "miss_signed_mm")
+#: The aligned kernel runs only if the table lands within this of the exact path at every cell's
+#: midpoint (mm: points and distances; rad: the return direction). Measured on Table 3.1: ~3e-13
+#: mm, ~3e-15 rad (the issue's bounds: 1e-9 mm, 1e-12 rad).
+PINHOLE_POINT_TOL = 1e-11
+PINHOLE_DIRECTION_TOL = 1e-13
 #: Uniform cells of the dome parameter that seed the spline-piece search (~4 per piece).
 PIECE_CELLS = 8192
 #: Newton steps of the general kernel: from the correspondence (within ~1 mm for a mm-scale
@@ -99,24 +108,27 @@ class AnalyticTracer:
     u_hi: float
     s0: float
     s1: float
-    flag_inv_h: float
-    flags: np.ndarray
-    beam_rho: np.ndarray
     beam_y: np.ndarray
     mount_shadowed: bool
     piece_of: np.ndarray
     piece_scale: float
-    pinhole: bool
-    table_error: dict
     dome: R.ExactDome
+    #: the aligned kernel's table (PINHOLE_CELLS, 9, 4), its cells' occlusion flags and beam radii
+    #: (_cell_flags), x0, cells per unit x, and the table's measured error
+    table: np.ndarray | None = None
+    flags: np.ndarray | None = None
+    beam_rho: np.ndarray | None = None
+    x0: float = 0.0
+    x_inv_h: float = 0.0
+    table_error: dict | None = None
+    pinhole: bool = False
 
-    backend = "analytic float64, numba kernels (pinhole_aligned: design correspondence; general_newton)"
+    backend = "analytic float64, numba kernels (pinhole_aligned: table of the exact meridional trace; general_newton)"
 
     @classmethod
     def build(cls, rig, paraboloid, dome_group, beam) -> "AnalyticTracer":
         """From the rig's geometry and the intersectors of :func:`rigcad.check.scene.analytic_optics`."""
         geo = rig.geometry
-        exact_para = paraboloid.members[0]
         exact_dome = dome_group.members[0]
         para_occ = _occluder_rows(paraboloid.members[1:])
         beam_occ = _occluder_rows([beam])
@@ -132,26 +144,75 @@ class AnalyticTracer:
         piece_scale = PIECE_CELLS / (u_hi - u_lo)
         cell_u = u_lo + (np.arange(PIECE_CELLS) + 0.5) / piece_scale
         piece_of = np.clip(np.searchsorted(breaks, cell_u, side="right") - 1, 0, len(breaks) - 2).astype(np.int64)
-        s0, s1 = -u_hi + TABLE_MARGIN, -u_lo - TABLE_MARGIN
-        # the design correspondence (the aligned ray reflected at paraboloid radius s meets the
-        # meridian at u = -s), measured against Newton on the spline at CHECK_RADII radii
-        s_check = np.linspace(s0, s1, CHECK_RADII)
-        exact = _aligned_hits(exact_para, exact_dome, geo.cop_z, s_check)
-        corr = _correspondence(exact_dome, s_check)
-        nerr = np.abs(np.arctan2(corr[:, 2] * exact[:, 3] - corr[:, 3] * exact[:, 2],
-                                 np.sum(corr[:, 2:] * exact[:, 2:], axis=1)))
-        table_error = {"radii_checked": CHECK_RADII,
-                       "max_dome_point_error_mm": float(np.max(np.hypot(*(corr[:, :2] - exact[:, :2]).T))),
-                       "max_dome_normal_error_rad": float(np.max(nerr)),
-                       "measured": "the meridian at u = -s against Newton on the spline, aligned COP rays"}
-        pinhole = table_error["max_dome_point_error_mm"] < CORRESPONDENCE_TOL
-        s_flags = np.linspace(s0, s1, FLAG_CELLS + 1)
-        flags, beam_rho = _cell_flags(geo, s_flags, _correspondence(exact_dome, s_flags), para_occ, beam_occ)
+        s0 = -u_hi + TABLE_MARGIN
+        s1 = min(-u_lo, geo.rim_radius) - TABLE_MARGIN
         beam_y = np.array([beam_occ[:, 2].min() - FLAG_MARGIN_MM, beam_occ[:, 5].max() + FLAG_MARGIN_MM])
         shadowed = _mount_shadowed(geo, para_occ)
-        return cls(geo.focal_length, geo.vertex_z, geo.rim_radius, geo.cop_z, para_occ, beam_occ, breaks, coef_r,
-                   coef_z, float(u_lo), float(u_hi), float(s0), float(s1), float(FLAG_CELLS / (s1 - s0)), flags,
-                   beam_rho, beam_y, shadowed, piece_of, float(piece_scale), pinhole, table_error, exact_dome)
+        out = cls(geo.focal_length, geo.vertex_z, geo.rim_radius, geo.cop_z, para_occ, beam_occ, breaks, coef_r,
+                  coef_z, float(u_lo), float(u_hi), float(s0), float(s1), beam_y, shadowed, piece_of,
+                  float(piece_scale), exact_dome)
+        out._build_table(geo)
+        return out
+
+    def _build_table(self, geo) -> None:
+        """The aligned kernel's table: the exact trace (:func:`_kernels.general`, no occluders) of
+        COP rays at the nodes of PINHOLE_CELLS uniform cells of x = sin(angle from the axis) over
+        the paraboloid radii [s0, s1], fitted by a cubic spline per PINHOLE_COLUMNS, then measured
+        against the exact trace at every cell's midpoint; and each cell's occlusion flags."""
+        from scipy.interpolate import CubicSpline
+
+        f, zv, cz = self.focal_length, self.vertex_z, self.cop_z
+        x0, x1 = (s / np.hypot(s, cz - (zv - s * s / (4 * f))) for s in (self.s0, self.s1))
+        nodes = np.linspace(x0, x1, PINHOLE_CELLS + 1)
+        vals, lost = self._meridional(nodes)
+        mids = 0.5 * (nodes[1:] + nodes[:-1])
+        exact, lost_mid = self._meridional(mids)
+        self.x0, self.x_inv_h = float(x0), float(PINHOLE_CELLS / (x1 - x0))
+        if lost or lost_mid:  # pragma: no cover - the radii are the dome's own
+            self.table_error = {"cells": PINHOLE_CELLS, "unusable": f"{lost + lost_mid} table rays miss the dome"}
+            return
+        self.flags, self.beam_rho = _cell_flags(geo, vals[:, 0], _correspondence(self.dome, vals[:, 0]),
+                                                self.para_occ, self.beam_occ)
+        cs = CubicSpline(nodes, vals, axis=0)
+        h = (x1 - x0) / PINHOLE_CELLS
+        # local coordinate t = (x - node) / h in [0, 1]: coefficient of t^p is c_p h^p
+        self.table = np.ascontiguousarray(np.transpose(cs.c, (1, 2, 0)) * (h ** np.arange(3, -1, -1)))
+        got = _eval_table(self.table, np.full(PINHOLE_CELLS, 0.5))
+        point = [k for k, name in enumerate(PINHOLE_COLUMNS) if name.endswith("_mm")]
+        wr, wz = got[:, 6], got[:, 7]
+        dir_err = np.abs(np.arctan2(wr * exact[:, 7] - wz * exact[:, 6], wr * exact[:, 6] + wz * exact[:, 7]))
+        self.table_error = {"cells": PINHOLE_CELLS, "checked": "every cell's midpoint, against the exact trace",
+                            "max_point_error_mm": float(np.max(np.abs(got[:, point] - exact[:, point]))),
+                            "max_direction_error_rad": float(np.max(dir_err)),
+                            "max_direction_norm_error": float(np.max(np.abs(np.hypot(wr, wz) - 1.0)))}
+        self.pinhole = (self.table_error["max_point_error_mm"] < PINHOLE_POINT_TOL
+                        and self.table_error["max_direction_error_rad"] < PINHOLE_DIRECTION_TOL
+                        and self.table_error["max_direction_norm_error"] < PINHOLE_DIRECTION_TOL)
+
+    def _meridional(self, x: np.ndarray) -> tuple[np.ndarray, int]:
+        """PINHOLE_COLUMNS of the exact trace of the COP rays at sines ``x`` (m,) in the x-z plane
+        (no occluders), and how many of them do not reach the dome."""
+        from rigcad.check import _kernels as K
+
+        m = len(x)
+        origins = np.tile([0.0, 0.0, self.cop_z], (m, 1))
+        dirs = np.column_stack([x, np.zeros(m), -np.sqrt(1.0 - x * x)])
+        status, segment = np.empty(m, np.int64), np.empty(m, np.int8)
+        p1, p2, v, landing = (np.empty((m, 3)) for _ in range(4))
+        path, miss = np.empty(m), np.empty(m)
+        none = np.zeros((0, 11))
+        ident, zero = np.eye(3), np.zeros(3)
+        K.general(np.arange(m), origins, dirs, ident, zero, True, ident, zero, True, self.focal_length,
+                  self.vertex_z, self.rim_radius, none, none, self.breaks, self.coef_r, self.coef_z, self.u_lo,
+                  self.u_hi, self.piece_of, self.piece_scale, self.dome.u_tab, self.dome.r_tab, self.dome.z_tab,
+                  self.dome.r_max, NEWTON_STEPS, RESIDUAL_TOL, NEWTON_STEP_TOL, status, segment, p1, p2, v, landing,
+                  path, miss)
+        reached = (status == K.OK) | ((status == K.ESCAPED_AFTER_DOME) & (segment == 3))
+        t1 = np.hypot(p1[:, 0], p1[:, 2] - self.cop_z)
+        t2 = np.hypot(p2[:, 0] - p1[:, 0], p2[:, 2] - p1[:, 2])
+        signed = p2[:, 0] * v[:, 2] - p2[:, 2] * v[:, 0]
+        cols = np.column_stack([p1[:, 0], p1[:, 2], t1, p2[:, 0], p2[:, 2], t2, v[:, 0], v[:, 2], signed])
+        return cols, int(np.count_nonzero(~reached))
 
     def trace(self, optics, origins: np.ndarray, dirs: np.ndarray):
         """Trace rays (n, 3) through ``optics`` (its poses) with the kernels: a Trace3D with
@@ -175,8 +236,7 @@ class AnalyticTracer:
                 and np.all(origins[:, 2] == self.cop_z):
             handled = np.empty(n, np.bool_)
             K.pinhole_aligned(self.cop_z, dirs, self.focal_length, self.vertex_z, self.rim_radius, self.para_occ,
-                              self.beam_occ, self.mount_shadowed, self.s0, self.s1, self.breaks, self.coef_r,
-                              self.coef_z, self.piece_of, self.piece_scale, self.u_lo, self.flag_inv_h, self.flags,
+                              self.beam_occ, self.mount_shadowed, self.x0, self.x_inv_h, self.table, self.flags,
                               self.beam_rho, self.beam_y, *out, handled)
             rest = np.nonzero(~handled)[0]
             kernels["pinhole_aligned"] = n - len(rest)
@@ -197,7 +257,8 @@ class AnalyticTracer:
 
 
 #: Margin (mm) of the per-cell flags: a leg counts as clear of a solid's bounding shape only by at
-#: least this much; a cell spans 0.23 um of paraboloid radius, over which a leg moves < 0.01 mm.
+#: least this much; a table cell spans ~2 um of paraboloid radius on Table 3.1, over which a leg
+#: moves < 0.05 mm.
 FLAG_MARGIN_MM = 0.5
 
 
@@ -286,26 +347,8 @@ def _correspondence(dome: R.ExactDome, s: np.ndarray) -> np.ndarray:
     return np.column_stack([dome.m._spline(-s), dome.m.normals(-s)])
 
 
-def _aligned_hits(para: R.ExactParaboloid, dome: R.ExactDome, cop_z: float, s: np.ndarray) -> np.ndarray:
-    """(r, z) of the dome hit and the dome normal (n_r, n_z) of the aligned COP ray that reflects at
-    paraboloid radius s (m,), in the x-z plane: (m, 4). Newton on the spline from the design's
-    correspondence (u = -s); every ray must land (the radii are the dome's own)."""
-    f, zv = para.f, para.zv
-    p = np.stack([s, np.zeros_like(s), zv - s * s / (4 * f)], axis=-1)
-    d = R.unit(p - np.array([0.0, 0.0, cop_z]))
-    h = para.intersect(np.tile([0.0, 0.0, cop_z], (len(s), 1)), d)
-    q = np.array([0.0, 0.0, cop_z]) + h.t[:, None] * d
-    u = d - 2 * np.sum(d * h.normal, axis=1)[:, None] * h.normal
-    c0 = dome.m._spline(-s)
-    t0 = (c0[:, 1] - q[:, 2]) / u[:, 2]
-    t, uu, res = dome._newton(q, u, t0, -s.copy(), R.NEWTON_STEPS)
-    bad = ~(res < 1e-11)  # mm: Newton at rounding; the bracketing path otherwise
-    if np.any(bad):
-        idx, tb, ub = dome._bracketed(q[bad], u[bad])
-        rows = np.nonzero(bad)[0][idx]
-        t[rows], uu[rows] = tb, ub
-        if len(idx) < bad.sum():  # pragma: no cover - the radii are inside the dome's
-            raise R.CheckError("the aligned correspondence has radii whose ray misses the dome")
-    hit = q + t[:, None] * u
-    n2 = dome.m.normals(uu)
-    return np.column_stack([hit[:, 0], hit[:, 2], n2[:, 0], n2[:, 1]])
+def _eval_table(table: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Every column of each cell of ``table`` (cells, k, 4) at its local coordinate t (cells,):
+    (cells, k) (the kernel's Horner, vectorised)."""
+    t = t[:, None]
+    return ((table[:, :, 0] * t + table[:, :, 1]) * t + table[:, :, 2]) * t + table[:, :, 3]
