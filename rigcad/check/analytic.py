@@ -110,6 +110,7 @@ class AnalyticTracer:
     s1: float
     beam_y: np.ndarray
     mount_shadowed: bool
+    body_sphere: np.ndarray
     piece_of: np.ndarray
     piece_scale: float
     dome: R.ExactDome
@@ -149,7 +150,8 @@ class AnalyticTracer:
         beam_y = np.array([beam_occ[:, 2].min() - FLAG_MARGIN_MM, beam_occ[:, 5].max() + FLAG_MARGIN_MM])
         shadowed = _mount_shadowed(geo, para_occ)
         out = cls(geo.focal_length, geo.vertex_z, geo.rim_radius, geo.cop_z, para_occ, beam_occ, breaks, coef_r,
-                  coef_z, float(u_lo), float(u_hi), float(s0), float(s1), beam_y, shadowed, piece_of,
+                  coef_z, float(u_lo), float(u_hi), float(s0), float(s1), beam_y, shadowed,
+                  _body_sphere(geo, para_occ), piece_of,
                   float(piece_scale), exact_dome)
         out._build_table(geo)
         return out
@@ -203,7 +205,7 @@ class AnalyticTracer:
         none = np.zeros((0, 11))
         ident, zero = np.eye(3), np.zeros(3)
         K.general(np.arange(m), origins, dirs, ident, zero, True, ident, zero, True, self.focal_length,
-                  self.vertex_z, self.rim_radius, none, none, self.breaks, self.coef_r, self.coef_z, self.u_lo,
+                  self.vertex_z, self.rim_radius, none, True, np.zeros(4), none, self.breaks, self.coef_r, self.coef_z, self.u_lo,
                   self.u_hi, self.piece_of, self.piece_scale, self.dome.u_tab, self.dome.r_tab, self.dome.z_tab,
                   self.dome.r_max, NEWTON_STEPS, RESIDUAL_TOL, NEWTON_STEP_TOL, status, segment, p1, p2, v, landing,
                   path, miss)
@@ -251,9 +253,10 @@ class AnalyticTracer:
         R1, T1, id1 = _pose(pp)
         R2, T2, id2 = _pose(dp)
         return int(K.general(idx, origins, dirs, R1, T1, id1, R2, T2, id2, self.focal_length, self.vertex_z,
-                             self.rim_radius, self.para_occ, self.beam_occ, self.breaks, self.coef_r, self.coef_z,
-                             self.u_lo, self.u_hi, self.piece_of, self.piece_scale, self.dome.u_tab, self.dome.r_tab,
-                             self.dome.z_tab, self.dome.r_max, NEWTON_STEPS, RESIDUAL_TOL, NEWTON_STEP_TOL, *out))
+                             self.rim_radius, self.para_occ, self.mount_shadowed, self.body_sphere, self.beam_occ,
+                             self.breaks, self.coef_r, self.coef_z, self.u_lo, self.u_hi, self.piece_of,
+                             self.piece_scale, self.dome.u_tab, self.dome.r_tab, self.dome.z_tab, self.dome.r_max,
+                             NEWTON_STEPS, RESIDUAL_TOL, NEWTON_STEP_TOL, *out))
 
 
 #: Margin (mm) of the per-cell flags: a leg counts as clear of a solid's bounding shape only by at
@@ -321,6 +324,17 @@ def _cell_flags(geo, s: np.ndarray, values: np.ndarray, para_occ: np.ndarray, be
     rho[~np.isfinite(rho[:, 0]) | ~np.isfinite(rho[:, 1]), 0:2] = (0.0, np.inf)
     rho[~np.isfinite(rho[:, 2]) | ~np.isfinite(rho[:, 3]), 2:4] = (0.0, np.inf)
     return flags, np.ascontiguousarray(rho)
+
+
+def _body_sphere(geo, para_occ: np.ndarray) -> np.ndarray:
+    """A sphere (centre x, y, z, radius; mm, the paraboloid's frame) around the mirror's bounding
+    sphere (the kernels' _paraboloid_bounded) and every mount row's: the box around those spheres,
+    circumscribed (with the rows' 1e-6 relative margin)."""
+    sag = geo.rim_radius ** 2 / (4 * geo.focal_length)
+    spheres = [[0.0, 0.0, geo.vertex_z - 0.5 * sag, np.hypot(geo.rim_radius, 0.5 * sag)]] + para_occ[:, 7:11].tolist()
+    sp = np.array(spheres)
+    lo, hi = (sp[:, :3] - sp[:, 3:]).min(axis=0), (sp[:, :3] + sp[:, 3:]).max(axis=0)
+    return np.array([*(0.5 * (lo + hi)), 0.5 * np.linalg.norm(hi - lo) * (1 + 1e-6) + 1e-9])
 
 
 def _mount_shadowed(geo, para_occ: np.ndarray) -> bool:
