@@ -156,34 +156,35 @@ class AnalyticTracer:
         out._build_table(geo)
         return out
 
-    def _build_table(self, geo) -> None:
+    def _build_table(self, geo, cells: int = PINHOLE_CELLS) -> None:
         """The aligned kernel's table: the exact trace (:func:`_kernels.general`, no occluders) of
-        COP rays at the nodes of PINHOLE_CELLS uniform cells of x = sin(angle from the axis) over
+        COP rays at the nodes of ``cells`` uniform cells of x = sin(angle from the axis) over
         the paraboloid radii [s0, s1], fitted by a cubic spline per PINHOLE_COLUMNS, then measured
         against the exact trace at every cell's midpoint; and each cell's occlusion flags."""
         from scipy.interpolate import CubicSpline
 
         f, zv, cz = self.focal_length, self.vertex_z, self.cop_z
         x0, x1 = (s / np.hypot(s, cz - (zv - s * s / (4 * f))) for s in (self.s0, self.s1))
-        nodes = np.linspace(x0, x1, PINHOLE_CELLS + 1)
+        nodes = np.linspace(x0, x1, cells + 1)
         vals, lost = self._meridional(nodes)
         mids = 0.5 * (nodes[1:] + nodes[:-1])
         exact, lost_mid = self._meridional(mids)
-        self.x0, self.x_inv_h = float(x0), float(PINHOLE_CELLS / (x1 - x0))
+        self.x0, self.x_inv_h = float(x0), float(cells / (x1 - x0))
+        self.table, self.pinhole = None, False
         if lost or lost_mid:  # pragma: no cover - the radii are the dome's own
-            self.table_error = {"cells": PINHOLE_CELLS, "unusable": f"{lost + lost_mid} table rays miss the dome"}
+            self.table_error = {"cells": cells, "unusable": f"{lost + lost_mid} table rays miss the dome"}
             return
         self.flags, self.beam_rho = _cell_flags(geo, vals[:, 0], _correspondence(self.dome, vals[:, 0]),
                                                 self.para_occ, self.beam_occ)
         cs = CubicSpline(nodes, vals, axis=0)
-        h = (x1 - x0) / PINHOLE_CELLS
+        h = (x1 - x0) / cells
         # local coordinate t = (x - node) / h in [0, 1]: coefficient of t^p is c_p h^p
         self.table = np.ascontiguousarray(np.transpose(cs.c, (1, 2, 0)) * (h ** np.arange(3, -1, -1)))
-        got = _eval_table(self.table, np.full(PINHOLE_CELLS, 0.5))
+        got = _eval_table(self.table, np.full(cells, 0.5))
         point = [k for k, name in enumerate(PINHOLE_COLUMNS) if name.endswith("_mm")]
         wr, wz = got[:, 6], got[:, 7]
         dir_err = np.abs(np.arctan2(wr * exact[:, 7] - wz * exact[:, 6], wr * exact[:, 6] + wz * exact[:, 7]))
-        self.table_error = {"cells": PINHOLE_CELLS, "checked": "every cell's midpoint, against the exact trace",
+        self.table_error = {"cells": cells, "checked": "every cell's midpoint, against the exact trace",
                             "max_point_error_mm": float(np.max(np.abs(got[:, point] - exact[:, point]))),
                             "max_direction_error_rad": float(np.max(dir_err)),
                             "max_direction_norm_error": float(np.max(np.abs(np.hypot(wr, wz) - 1.0)))}

@@ -1,6 +1,7 @@
 """The compiled analytic tracer (rigcad.check.analytic) against the vectorised exact path that
 brackets every dome hit and polishes it by Newton (rays.ExactDome(correspondence=False)): ray for
-ray, aligned (the correspondence-table kernel) and misaligned (Newton from the correspondence)."""
+ray, aligned (the kernel reading its table of the exact meridional trace) and misaligned (Newton
+from the design's correspondence)."""
 
 from __future__ import annotations
 
@@ -145,3 +146,31 @@ def test_kernels_agree_on_another_rig(table31_text, write_profile, edit):
         bound = 1e-9 if pose is None else 1e-7  # mm: the issue's bounds, aligned and misaligned
         assert np.max(np.linalg.norm(a.p2[ok] - b.p2[ok], axis=1)) < bound
         assert np.max(np.abs(a.miss[ok] - b.miss[ok])) < bound
+
+
+def test_the_aligned_table_converges_at_fourth_order_and_a_coarse_one_is_not_used(analytic, rig, design_map):
+    """The table's cubic splines: error falls as h^4 (the measured order, not the code's claim);
+    a table too coarse for PINHOLE_POINT_TOL switches the aligned kernel off, and the general
+    kernel traces the same rays to the same results."""
+    from rigcad.check import analytic as A
+
+    errors = {}
+    for cells in (64, 128, 256):
+        coarse = copy.copy(analytic.fast)
+        coarse._build_table(rig.geometry, cells)
+        errors[cells] = coarse.table_error["max_point_error_mm"]
+        assert not coarse.pinhole and errors[cells] > A.PINHOLE_POINT_TOL
+    for a, b in ((64, 128), (128, 256)):
+        assert 3.7 < np.log2(errors[a] / errors[b]) < 4.3, errors
+    fine = analytic.fast.table_error
+    assert fine["cells"] == A.PINHOLE_CELLS and fine["max_point_error_mm"] < A.PINHOLE_POINT_TOL
+    assert fine["max_direction_error_rad"] < A.PINHOLE_DIRECTION_TOL
+    gated = copy.copy(analytic)
+    gated.fast = coarse
+    o, d = _rays(design_map, 3000, 5)
+    a, b = T.trace(gated, o, d), T.trace(analytic, o, d)
+    assert a.kernels["pinhole_aligned"] == 0 and a.kernels["general_newton"] == len(o)
+    assert b.kernels["pinhole_aligned"] > 0.95 * len(o)
+    assert np.array_equal(a.status, b.status)
+    ok = a.ok
+    assert np.max(np.linalg.norm(a.p2[ok] - b.p2[ok], axis=1)) < 1e-9
