@@ -9,7 +9,10 @@ reading against raw embreex on the same rays, side by side in one process:
 * the analytic tracer on a misaligned rig (kernel ``general_newton``: one Monte Carlo build of the
   profile's tolerancing.*, every component moved) against the raw Embree of the misaligned smooth
   trace of the same rays;
-* the vectorised (numpy) analytic path of before, on a subset, for the record.
+* the vectorised (numpy) analytic path of before, on a subset, for the record;
+* the accuracy knob of the aligned kernel, its table's cells (analytic.PINHOLE_CELLS): per size,
+  the build time, the error the build measures against the exact trace, and the trace time of the
+  same rays (the kernel forced on for the coarse tables, which the tracer itself would not use).
 
 Ratios are raw Embree time over the reading's time (above 1: faster than raw Embree). Each of
 REPEATS rounds times every reading right after its raw Embree, so each ratio compares runs under
@@ -24,6 +27,7 @@ vary run to run; they are never asserted.
 from __future__ import annotations
 
 import argparse
+import copy
 import os
 import platform
 import sys
@@ -48,6 +52,8 @@ from rigcad.rig import Rig  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
 REPEATS = 5
+#: Table sizes of the aligned kernel's sweep.
+TABLE_CELLS = (1024, 2048, 4096, 8192, 16384, 32768)
 #: Issue 12's targets: raw Embree time / reading time.
 TARGETS = {"analytic_aligned": 10.0, "analytic_misaligned": 2.0, "smooth": 0.8, "mesh": 0.8}
 #: Rays of the vectorised analytic path (seconds per 100 k rays).
@@ -79,6 +85,30 @@ def mesh_run(optics, timer, origins, dirs):
         member.scene.run(o32, d32, dists=None if t32 is None else t32.copy(), output=1)
         raw += time.perf_counter() - t0
     return dt, raw, timer.embree_rays, tr
+
+
+def table_sweep(analytic, geo, o, d) -> list[dict]:
+    """Run time against error of the aligned kernel's table size (best of 3 traces each)."""
+    from rigcad.check import analytic as A
+
+    rows = []
+    for cells in TABLE_CELLS:
+        tracer = copy.copy(analytic.fast)
+        t0 = time.perf_counter()
+        tracer._build_table(geo, cells)
+        build_s = time.perf_counter() - t0
+        used = tracer.pinhole
+        tracer.pinhole = True
+        optics = copy.copy(analytic)
+        optics.fast = tracer
+        dt, tr = best(lambda: trace(optics, o, d), repeats=3)
+        err = tracer.table_error
+        rows.append({"cells": cells, "default": cells == A.PINHOLE_CELLS, "used_by_the_tracer": used,
+                     "table_bytes": int(tracer.table.nbytes), "build_s": build_s, "trace_s": dt,
+                     "max_point_error_mm": err["max_point_error_mm"],
+                     "max_direction_error_rad": err["max_direction_error_rad"], "kernels": tr.kernels})
+        print("table", rows[-1])
+    return rows
 
 
 def main() -> None:
@@ -157,6 +187,7 @@ def main() -> None:
     result["readings"]["analytic_vectorised_numpy"] = {
         "rays": k, "trace_s": dt, "rays_per_s": k / dt, "raw_over_reading": raws["smooth"] * k / args.rays / dt}
     print("analytic_vectorised_numpy", result["readings"]["analytic_vectorised_numpy"])
+    result["pinhole_table_sweep"] = table_sweep(analytic, geo, o, d)
     OUT.mkdir(parents=True, exist_ok=True)
     write_json(OUT / "raycheck.json", result)
 
