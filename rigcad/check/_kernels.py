@@ -23,9 +23,10 @@ import numba as nb
 import numpy as np
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
-#: The helpers are inlined into the kernels by numba itself (not left to LLVM): a helper that takes
-#: arrays and is called per ray otherwise pays a reference count increment and decrement per array
-#: per call; inlined, numba prunes them (the misaligned kernel: 0.65 -> 0.39 s per 1 M rays).
+#: Helpers that take arrays are inlined by numba itself (not left to LLVM): called per ray, they
+#: otherwise pay a reference count increment and decrement per array per call; inlined, numba
+#: prunes them (the misaligned kernel: 0.65 -> 0.39 s per 1 M rays). Scalar helpers are left to
+#: LLVM, which inlines them as well: the same speed, and half the first compile (~22 s, then cached).
 _INLINE = dict(_JIT, inline="always")
 
 # trace3d status codes (duplicated for the compiled code; test_analytic checks they agree)
@@ -36,7 +37,7 @@ OK, MISSED_PARABOLOID, OCCLUDED_BY_MOUNT, OCCLUDED_BY_BEAM, OCCLUDED_BY_PARABOLO
 PARABOLOID_EPS = 1e-9
 
 
-@nb.njit(**_INLINE)
+@nb.njit(**_JIT)
 def _slab(o, d, lo, hi, tlo, thi):
     """One axis of the slab test: the interval (tlo, thi) narrowed (tlo > thi: no hit)."""
     if d == 0.0:
@@ -50,7 +51,7 @@ def _slab(o, d, lo, hi, tlo, thi):
     return max(tlo, t1), min(thi, t2)
 
 
-@nb.njit(**_INLINE)
+@nb.njit(**_JIT)
 def _box(ox, oy, oz, dx, dy, dz, lx, ly, lz, hx, hy, hz):
     """Entry distance of a ray into the box [l, h] (0 from inside, inf for none): solids.slab."""
     tlo, thi = _slab(ox, dx, lx, hx, -np.inf, np.inf)
@@ -61,7 +62,7 @@ def _box(ox, oy, oz, dx, dy, dz, lx, ly, lz, hx, hy, hz):
     return np.inf
 
 
-@nb.njit(**_INLINE)
+@nb.njit(**_JIT)
 def _cylinder(ox, oy, oz, dx, dy, dz, r, z0, z1, cx, cy):
     """Entry distance into a solid z-cylinder (0 from inside, inf for none): solids.z_cylinder."""
     ox = ox - cx
@@ -97,7 +98,7 @@ def _cylinder(ox, oy, oz, dx, dy, dz, r, z0, z1, cx, cy):
     return np.inf
 
 
-@nb.njit(**_INLINE)
+@nb.njit(**_JIT)
 def _reaches_sphere(cx, cy, cz, radius, ox, oy, oz, dx, dy, dz, tmax):
     """Can the ray o + t d (unit d), 0 <= t <= tmax, meet the sphere (centre c)? False only when
     its line passes outside the sphere or meets it wholly behind the origin or beyond tmax."""
@@ -125,7 +126,7 @@ def _occluders(occ, ox, oy, oz, dx, dy, dz, tmax):
     return best
 
 
-@nb.njit(**_INLINE)
+@nb.njit(**_JIT)
 def _paraboloid(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax):
     """Nearest hit beyond PARABOLOID_EPS of z = zv - r^2 / (4 f), r <= rim (ExactParaboloid)."""
     i4f = 0.25 / f
@@ -149,7 +150,7 @@ def _paraboloid(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax):
     return best if best <= tmax else np.inf
 
 
-@nb.njit(**_INLINE)
+@nb.njit(**_JIT)
 def _paraboloid_bounded(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax):
     """:func:`_paraboloid`, skipped when the ray cannot reach the mirror's bounding sphere (centre
     on the axis halfway between vertex and rim plane)."""
@@ -234,7 +235,7 @@ def _spline(brk, cr, cz, u, hint):
     return r, z, dr, dz, lo
 
 
-@nb.njit(**_INLINE)
+@nb.njit(**_JIT)
 def _reflect(dx, dy, dz, nx, ny, nz):
     k = 2.0 * (dx * nx + dy * ny + dz * nz)
     return dx - k * nx, dy - k * ny, dz - k * nz
