@@ -1,0 +1,90 @@
+"""The compiled mesh reading: trace3d's source -> paraboloid -> dome -> z = 0 trace through Embree
+meshes (modes ``mesh``: facet normals, ``smooth``: interpolated vertex normals) with the float64
+glue between the casts in numba passes (rigcad/check/_mesh_kernels.py) instead of numpy array
+passes. Frame: mm, sample point O at the origin, optical axis +z; poses as trace3d.
+
+Four Embree casts per trace, each the intersector's own ``EmbreeMesh.raw`` (so its Timer sees
+them, as bench/raycheck.py replays them): (1) the source rays in the paraboloid scene; (2) the
+rays reflected by the mirror in the dome+beam scene; (3, 4) the rays reflected by the dome and
+going down, in the paraboloid scene and in the beam scene, with tmax the distance to z = 0. Each
+cast takes only the rays still alive (the numpy path also casts the rays going up after the dome,
+whose fate is already known). Results equal trace3d._trace's, the reference (tests/check/
+test_meshtrace.py: same status and segment, points and directions within 1e-12 mm / rad).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rigcad.check import _mesh_kernels as K
+from rigcad.check.rays import EmbreeMesh
+
+
+def supports(optics) -> bool:
+    """True when every intersector of ``optics`` is an EmbreeMesh read with the float64
+    refinement and facet or vertex normals (exact_normals, float32 readings and mixed optics
+    take the numpy passes)."""
+    members = (optics.paraboloid, optics.dome, optics.beam)
+    return all(isinstance(m, EmbreeMesh) and m.refine and m.normal_model in ("facet", "vertex") for m in members)
+
+
+def _pose(pose):
+    """(R, T, identity) of a Pose as the kernels take it."""
+    return (np.ascontiguousarray(pose.rotation, float), np.ascontiguousarray(pose.translation, float),
+            bool(pose.is_identity))
+
+
+def _scene(mesh: EmbreeMesh):
+    """(packed face table, offsets, per-geometry smooth flag) of an Embree intersector."""
+    tri, offsets, has = mesh._packed()
+    return tri, offsets, has & (mesh.normal_model == "vertex")
+
+
+def trace(optics, origins: np.ndarray, dirs: np.ndarray):
+    """Trace rays (origins, dirs: (n, 3), global frame; dirs need not be unit) through Embree
+    ``optics`` (:func:`supports`): a trace3d.Trace3D with ``kernels = {"mesh_compiled": n}``."""
+    from rigcad.check.trace3d import Trace3D
+
+    origins = np.ascontiguousarray(origins, float)
+    dirs = np.ascontiguousarray(dirs, float)
+    n = len(origins)
+    pR, pT, pid = _pose(optics.paraboloid_pose)
+    dR, dT, did = _pose(optics.dome_pose)
+    status = np.empty(n, np.int64)
+    segment = np.empty(n, np.int8)
+    p1, p2, v, landing = (np.empty((n, 3)) for _ in range(4))
+    path, miss = np.empty(n), np.empty(n)
+    out = Trace3D(status, segment, p1, p2, v, landing, path, miss, {"mesh_compiled": n})
+    if n == 0:
+        return out
+
+    para, dome, beam = optics.paraboloid, optics.dome, optics.beam
+    o32, d32 = np.empty((n, 3), np.float32), np.empty((n, 3), np.float32)
+    K.source_casts(origins, dirs, pR, pT, pid, o32, d32)
+    r1 = para.raw(o32, d32, None)
+    tri_p, off_p, smooth_p = _scene(para)
+    idx1, t1, u = np.empty(n, np.int64), np.empty(n), np.empty((n, 3))
+    o32, d32 = np.empty((n, 3), np.float32), np.empty((n, 3), np.float32)
+    k1 = K.after_paraboloid(r1["geomID"], r1["primID"], origins, dirs, pR, pT, pid, dR, dT, did, tri_p, off_p,
+                            smooth_p, status, segment, p1, p2, v, landing, path, miss, idx1, t1, u, o32, d32)
+    del r1
+    if k1 == 0:
+        return out
+
+    r2 = dome.raw(o32[:k1], d32[:k1], None)
+    tri_d, off_d, smooth_d = _scene(dome)
+    idx2, t12, t3 = np.empty(k1, np.int64), np.empty(k1), np.empty(k1)
+    o3, d3, o4, d4 = (np.empty((k1, 3), np.float32) for _ in range(4))
+    m3, m4 = np.empty(k1, np.float32), np.empty(k1, np.float32)
+    k2 = K.after_dome(k1, r2["geomID"], r2["primID"], idx1, t1, u, pR, pT, pid, dR, dT, did, tri_d, off_d,
+                      smooth_d, status, segment, p1, p2, v, idx2, t12, t3, o3, d3, m3, o4, d4, m4)
+    del r2
+    if k2 == 0:
+        return out
+
+    r3 = para.raw(o3[:k2], d3[:k2], m3[:k2])
+    r4 = beam.raw(o4[:k2], d4[:k2], m4[:k2])
+    tri_b, off_b, _ = _scene(beam)
+    K.after_return(k2, r3["geomID"], r3["primID"], r4["geomID"], r4["primID"], idx2, t12, t3, pR, pT, pid,
+                   dR, dT, did, tri_p, off_p, tri_b, off_b, status, segment, p2, v, landing, path, miss)
+    return out
