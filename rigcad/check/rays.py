@@ -254,14 +254,16 @@ class EmbreeMesh:
         return int(sum(len(m.faces) for m in self.meshes))
 
     def raw(self, origins32: np.ndarray, dirs32: np.ndarray, tmax32: np.ndarray | None):
-        """One raw EmbreeScene.run (float32 in, Embree's dict out), timed into ``timer``."""
+        """One raw EmbreeScene.run (float32 in, Embree's dict out), timed into ``timer``. With
+        ``timer.keep_inputs`` the inputs are recorded for a replay (tmax copied before the call:
+        Embree writes the hit distances into it)."""
+        if self.timer.keep_inputs:
+            self.timer.calls.append((self, origins32, dirs32, None if tmax32 is None else tmax32.copy()))
         t0 = time.perf_counter()
         out = self.scene.run(origins32, dirs32, dists=tmax32, output=1)
         dt = time.perf_counter() - t0
         self.timer.embree_s += dt
         self.timer.embree_rays += len(origins32)
-        if self.timer.keep_inputs:
-            self.timer.calls.append((self, origins32, dirs32, None if tmax32 is None else tmax32.copy()))
         return out
 
     def intersect(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray | None = None) -> Hits:
