@@ -87,17 +87,23 @@ def test_every_cast_goes_through_the_timed_raw_call(rig, default_meshes):
     finally:
         timer.keep_inputs = False
     calls, timer.calls = timer.calls, []
-    assert [c[0] for c in calls] == [optics.paraboloid, optics.dome, optics.paraboloid, optics.beam]
+    blocks = -(-len(o) // meshtrace.BLOCK)
+    assert blocks > 1  # the rays span several blocks
+    assert [c[0] for c in calls] == [optics.paraboloid, optics.dome, optics.paraboloid, optics.beam] * blocks
     assert timer.embree_rays == sum(len(c[1]) for c in calls)
-    # cast 2 takes the rays on the mirror, casts 3 and 4 those going down from the dome
+    # cast 1 takes every ray, cast 2 those on the mirror, casts 3 and 4 those going down from the dome
     on_mirror = ~np.isnan(tr.p1[:, 0])
     down = ~np.isnan(tr.p2[:, 0]) & (tr.status != T.ESCAPED_AFTER_DOME)
-    assert [len(c[1]) for c in calls] == [len(o), on_mirror.sum(), down.sum(), down.sum()]
+    assert [sum(len(c[1]) for c in calls[k::4]) for k in range(4)] == [len(o), on_mirror.sum(), down.sum(), down.sum()]
     assert all(c[1].dtype == np.float32 and c[2].dtype == np.float32 for c in calls)
-    assert calls[0][3] is None and calls[2][3].dtype == np.float32
-    # tmax of the return casts: the distance to z = 0 in float32
+    assert all(c[3] is None for c in calls[0::4] + calls[1::4])
+    # tmax of the return casts (as recorded before Embree's call): the distance to z = 0, float32
     t3 = -tr.p2[down, 2] / tr.v[down, 2]
-    assert np.allclose(calls[2][3], t3, rtol=1e-6)
+    for k in (2, 3):
+        tmax = np.concatenate([c[3] for c in calls[k::4]])
+        assert tmax.dtype == np.float32 and np.allclose(tmax, t3, rtol=1e-6, atol=0)
+    # the recorded inputs are the trace's own (not scratch reused by the next block)
+    assert not any(np.shares_memory(calls[k][1], calls[k + 4][1]) for k in range(4))
 
 
 def test_edge_cases_and_readings_left_to_numpy(rig, default_meshes):
