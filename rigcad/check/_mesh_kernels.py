@@ -163,6 +163,19 @@ def _reflect(dx, dy, dz, nx, ny, nz):
 
 
 @nb.njit(**_JIT)
+def _lost(i, seg, p2, v, landing, path, miss):
+    """NaN in what ray i, lost on segment ``seg``, does not reach: p2 and v (lost before the dome
+    reflects it: seg 2), the landing point, path length and miss."""
+    nan = np.nan
+    if seg <= 2:
+        p2[i, 0] = p2[i, 1] = p2[i, 2] = nan
+        v[i, 0] = v[i, 1] = v[i, 2] = nan
+    landing[i, 0] = landing[i, 1] = landing[i, 2] = nan
+    path[i] = nan
+    miss[i] = nan
+
+
+@nb.njit(**_JIT)
 def source_casts(origins, dirs, pR, pT, pid, o32, d32):
     """Cast 1's float32 inputs: the source rays (n, 3) in the paraboloid's frame (dirs made unit)."""
     for i in range(origins.shape[0]):
@@ -180,30 +193,22 @@ def after_paraboloid(geom, prim, origins, dirs, pR, pT, pid, dR, dT, did, tri, o
                      status, segment, p1, p2, v, landing, path, miss, idx1, t1, u, o32, d32):
     """Segment 1 for every ray (n,): Embree's paraboloid-scene hit (geometry 0 the mirror, >= 1
     its mount) refined in float64, the status of the lost, p1 and the reflected direction u of
-    the rest, and cast 2's float32 inputs (dome frame) for them, compacted. Initialises every
-    per-ray output (NaN where a later pass does not write). Returns the rays alive, k; their
-    indices in idx1[:k], distances t1[:k], directions u[:k]."""
+    the rest, and cast 2's float32 inputs (dome frame) for them, compacted. Each pass writes each
+    output of a ray once (NaN for what a lost ray does not reach). Returns the rays alive, k;
+    their indices in idx1[:k], distances t1[:k], directions u[:k]."""
     n = origins.shape[0]
     nan = np.nan
     k = 0
     for i in range(n):
         _prefetch_hit(geom, prim, offsets, tri, i + PREFETCH_AHEAD)
-        p2[i, 0] = p2[i, 1] = p2[i, 2] = nan
-        v[i, 0] = v[i, 1] = v[i, 2] = nan
-        landing[i, 0] = landing[i, 1] = landing[i, 2] = nan
-        path[i] = nan
-        miss[i] = nan
         g = geom[i]
         p = prim[i]
-        if p < 0 or g < 0 or g >= offsets.shape[0] - 1:
-            status[i] = MISSED_PARABOLOID
+        none = p < 0 or g < 0 or g >= offsets.shape[0] - 1
+        if none or g > 0:
+            status[i] = MISSED_PARABOLOID if none else OCCLUDED_BY_MOUNT
             segment[i] = 1
             p1[i, 0] = p1[i, 1] = p1[i, 2] = nan
-            continue
-        if g > 0:
-            status[i] = OCCLUDED_BY_MOUNT
-            segment[i] = 1
-            p1[i, 0] = p1[i, 1] = p1[i, 2] = nan
+            _lost(i, 2, p2, v, landing, path, miss)
             continue
         x, y, z = dirs[i, 0], dirs[i, 1], dirs[i, 2]
         m = math.sqrt(x * x + y * y + z * z)
@@ -232,7 +237,7 @@ def after_paraboloid(geom, prim, origins, dirs, pR, pT, pid, dR, dT, did, tri, o
 
 @nb.njit(**_JIT)
 def after_dome(k1, geom, prim, idx1, t1, u, pR, pT, pid, dR, dT, did, tri, offsets, smooth_g,
-               status, segment, p1, p2, v, idx2, t12, t3, o3, d3, m3, o4, d4, m4):
+               status, segment, p1, p2, v, landing, path, miss, idx2, t12, t3, o3, d3, m3, o4, d4, m4):
     """Segment 2 for the k1 rays alive: Embree's dome-scene hit (geometry 0 the dome, 1 the beam)
     refined in float64, the status of the lost (beam; none: escaped through the top if going
     up, else below the base), p2 and the reflected direction v of the rest, the distance t3 to
@@ -249,10 +254,12 @@ def after_dome(k1, geom, prim, idx1, t1, u, pR, pT, pid, dR, dT, did, tri, offse
         if p < 0 or g < 0 or g >= offsets.shape[0] - 1:
             status[i] = ESCAPED_TOP if uz > 0 else MISSED_DOME
             segment[i] = 2
+            _lost(i, 2, p2, v, landing, path, miss)
             continue
         if g != 0:
             status[i] = OCCLUDED_BY_BEAM
             segment[i] = 2
+            _lost(i, 2, p2, v, landing, path, miss)
             continue
         ox, oy, oz = _to_local(dR, dT, did, p1[i, 0], p1[i, 1], p1[i, 2])
         dx, dy, dz = _dir_to_local(dR, did, ux, uy, uz)
@@ -268,6 +275,7 @@ def after_dome(k1, geom, prim, idx1, t1, u, pR, pT, pid, dR, dT, did, tri, offse
         if not math.isfinite(tz):
             status[i] = ESCAPED_AFTER_DOME
             segment[i] = 3
+            _lost(i, 3, p2, v, landing, path, miss)
             continue
         idx2[k] = i
         t12[k] = t1[j] + t
@@ -320,10 +328,12 @@ def after_return(k2, geom3, prim3, geom4, prim4, idx2, t12, t3, pR, pT, pid, dR,
         if math.isfinite(tb) and not (by_para and tp < tb):
             status[i] = OCCLUDED_BY_BEAM
             segment[i] = 3
+            _lost(i, 3, p2, v, landing, path, miss)
             continue
         if by_para:
             status[i] = OCCLUDED_BY_PARABOLOID
             segment[i] = 3
+            _lost(i, 3, p2, v, landing, path, miss)
             continue
         landing[i, 0], landing[i, 1], landing[i, 2] = qx + tz * wx, qy + tz * wy, qz + tz * wz
         path[i] = t12[j] + tz

@@ -111,7 +111,8 @@ def _block(optics, poses, origins, dirs, status, segment, p1, p2, v, landing, pa
     idx2, t12, t3 = work["idx2"], work["t12"], work["t3"]
     o3, d3, m3, o4, d4, m4 = (w[k] for k in ("o3", "d3", "m3", "o4", "d4", "m4"))
     k2 = K.after_dome(k1, r2["geomID"], r2["primID"], idx1, t1, u, pR, pT, pid, dR, dT, did, tri_d, off_d,
-                      smooth_d, status, segment, p1, p2, v, idx2, t12, t3, o3, d3, m3, o4, d4, m4)
+                      smooth_d, status, segment, p1, p2, v, landing, path, miss, idx2, t12, t3, o3, d3, m3, o4,
+                      d4, m4)
     del r2
     if k2 == 0:
         return
