@@ -29,6 +29,9 @@ from rigcad.check._kernels import (ESCAPED_AFTER_DOME, ESCAPED_TOP, MISSED_DOME,
                                    OCCLUDED_BY_BEAM, OCCLUDED_BY_MOUNT, OCCLUDED_BY_PARABOLOID, OK)
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
+#: The per-ray helpers are inlined by numba itself (its IR): as separate functions each call
+#: returns a status that the caller checks, which cost 2-3x on these short loops (measured).
+_INLINE = dict(_JIT, inline="always")
 
 #: Embree's tmax for a ray without one (float32; rays.EmbreeMesh.intersect uses the same).
 FAR = 1e37
@@ -64,7 +67,7 @@ def _prefetch_row(typingctx, arr, row):
     return sig, codegen
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _prefetch_hit(geom, prim, offsets, tri, j):
     """Prefetch the face row of hit j (if it is one) of an Embree result."""
     if j < geom.shape[0]:
@@ -91,7 +94,7 @@ def _fma(typingctx, a, b, c):
 # takes through OpenBLAS's dgemm on this x86-64 (measured: the same bits on every row), so that the
 # compiled path and the numpy reference (Pose.localize / globalize_*) agree to the bit; with
 # another BLAS they agree to rounding (~1e-13 mm at ~400 mm).
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _dir_to_local(R, ident, x, y, z):
     """Direction from the global frame into a body's: R^T d."""
     if ident:
@@ -100,7 +103,7 @@ def _dir_to_local(R, ident, x, y, z):
             _fma(z, R[2, 2], _fma(y, R[1, 2], x * R[0, 2])))
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _to_local(R, T, ident, px, py, pz):
     """Point from the global frame into a body's: R^T (p - T)."""
     if ident:
@@ -108,7 +111,7 @@ def _to_local(R, T, ident, px, py, pz):
     return _dir_to_local(R, False, px - T[0], py - T[1], pz - T[2])
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _dir_to_global(R, ident, x, y, z):
     """Direction from a body's frame into the global one: R d."""
     if ident:
@@ -117,7 +120,7 @@ def _dir_to_global(R, ident, x, y, z):
             _fma(z, R[2, 2], _fma(y, R[2, 1], x * R[2, 0])))
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _to_global(R, T, ident, x, y, z):
     """Point from a body's frame into the global one: R p + T."""
     if ident:
@@ -126,7 +129,7 @@ def _to_global(R, T, ident, x, y, z):
     return gx + T[0], gy + T[1], gz + T[2]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _mt(tri, r, ox, oy, oz, dx, dy, dz):
     """Moller-Trumbore in float64 on the plane of face row r: t and barycentrics b1, b2 (as
     _kernels.refine_mesh_hits: NaN / inf for a ray parallel to the face)."""
@@ -142,7 +145,7 @@ def _mt(tri, r, ox, oy, oz, dx, dy, dz):
     return t, b1, b2
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _normal(tri, r, b1, b2, smooth):
     """The face's unit normal (local frame): vertex normals interpolated (``smooth``) or the facet's."""
     if smooth:
@@ -155,14 +158,14 @@ def _normal(tri, r, b1, b2, smooth):
     return tri[r, 9], tri[r, 10], tri[r, 11]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _reflect(dx, dy, dz, nx, ny, nz):
     """Mirror reflection of d about the unit normal n (trace3d.reflect)."""
     k = 2.0 * (dx * nx + dy * ny + dz * nz)
     return dx - k * nx, dy - k * ny, dz - k * nz
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _lost(i, seg, p2, v, landing, path, miss):
     """NaN in what ray i, lost on segment ``seg``, does not reach: p2 and v (lost before the dome
     reflects it: seg 2), the landing point, path length and miss."""
@@ -295,7 +298,7 @@ def after_dome(k1, geom, prim, idx1, t1, u, pR, pT, pid, dR, dT, did, tri, offse
     return k
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_INLINE)
 def _return_hit(geom, prim, tri, offsets, ox, oy, oz, dx, dy, dz, tmax):
     """A return cast's Embree hit refined in float64: t (inf for none or beyond tmax)."""
     if prim < 0 or geom < 0 or geom >= offsets.shape[0] - 1:
