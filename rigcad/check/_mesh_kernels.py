@@ -5,7 +5,7 @@ float64, facet or interpolated vertex normals, reflections, the poses, the statu
 
 Frame: mm, sample point O at the origin, optical axis +z. Poses are (R (3, 3), T (3,)) with
 global = R @ local + T (rigcad.optics.frames.Pose). ``tri`` is EmbreeMesh._packed's table: per
-face v0, e1 = v1 - v0, e2 = v2 - v0, the unit facet normal, the three vertex normals (21 values),
+face v0, e1 = v1 - v0, e2 = v2 - v0, the unit facet normal, the three vertex normals (24 values with 3 of padding: 3 cache lines),
 row ``offsets[g] + prim`` for geometry g. Each pass writes the float32 origins and directions (and
 tmax: 1e37 for inf) of the next casts straight from the loop, for the rays still alive only.
 
@@ -36,45 +36,58 @@ _INLINE = dict(_JIT, inline="always")
 #: Embree's tmax for a ray without one (float32; rays.EmbreeMesh.intersect uses the same).
 FAR = 1e37
 #: Rays ahead whose face rows are prefetched: Embree's hits land on faces in no useful order, so
-#: each row (168 bytes, 3-4 cache lines of a table of 13-130 MB) is a cache miss; a few rays
-#: ahead hides it (measured: 4 to 32 all give the same ~3x on the row gathers).
+#: each row (3 cache lines of a table of 13-150 MB) is a cache miss; a few rays ahead hides most
+#: of it (measured: 2-3x on the passes; 4 to 32 rays ahead all give the same).
 PREFETCH_AHEAD = 8
 
 
-@intrinsic
-def _prefetch_row(typingctx, arr, row):
-    """Prefetch (llvm.prefetch: a hint, never a fault) the cache lines of row ``row`` of a
-    C-contiguous 2D array of at most 4 lines (the packed face table's 21 float64)."""
-    if not (isinstance(arr, types.Array) and arr.ndim == 2 and arr.layout == "C"):
-        return None
-    sig = types.void(arr, types.intp)
+def _prefetcher(lines: int):
+    """An intrinsic that prefetches (llvm.prefetch: a hint, never a fault) the first ``lines``
+    64-byte lines of a row of a C-contiguous 2D array (EmbreeMesh._packed's rows are 3 lines,
+    aligned; facet normals read the first 2)."""
 
-    def codegen(context, builder, signature, args):
-        aryty = signature.args[0]
-        ary = context.make_array(aryty)(context, builder, args[0])
-        zero = context.get_constant(types.intp, 0)
-        ptr = cgutils.get_item_pointer(context, builder, aryty, ary, [args[1], zero], wraparound=False)
-        i8p = ir.IntType(8).as_pointer()
-        i32 = ir.IntType(32)
-        fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(ir.VoidType(), [i8p, i32, i32, i32]),
-                                            "llvm.prefetch.p0i8")
-        base = builder.bitcast(ptr, i8p)
-        for off in (0, 64, 128, 167):  # read, keep in all cache levels, data cache
-            builder.call(fn, [builder.gep(base, [ir.Constant(ir.IntType(64), off)]), ir.Constant(i32, 0),
-                              ir.Constant(i32, 3), ir.Constant(i32, 1)])
-        return context.get_dummy_value()
+    @intrinsic
+    def prefetch(typingctx, arr, row):
+        if not (isinstance(arr, types.Array) and arr.ndim == 2 and arr.layout == "C"):
+            return None
+        sig = types.void(arr, types.intp)
 
-    return sig, codegen
+        def codegen(context, builder, signature, args):
+            aryty = signature.args[0]
+            ary = context.make_array(aryty)(context, builder, args[0])
+            zero = context.get_constant(types.intp, 0)
+            ptr = cgutils.get_item_pointer(context, builder, aryty, ary, [args[1], zero], wraparound=False)
+            i8p = ir.IntType(8).as_pointer()
+            i32 = ir.IntType(32)
+            fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(ir.VoidType(), [i8p, i32, i32, i32]),
+                                                "llvm.prefetch.p0i8")
+            base = builder.bitcast(ptr, i8p)
+            for k in range(lines):  # read, keep in all cache levels, data cache
+                builder.call(fn, [builder.gep(base, [ir.Constant(ir.IntType(64), 64 * k)]), ir.Constant(i32, 0),
+                                  ir.Constant(i32, 3), ir.Constant(i32, 1)])
+            return context.get_dummy_value()
+
+        return sig, codegen
+
+    return prefetch
+
+
+_prefetch_3_lines = _prefetcher(3)
+_prefetch_2_lines = _prefetcher(2)
 
 
 @nb.njit(**_INLINE)
-def _prefetch_hit(geom, prim, offsets, tri, j):
-    """Prefetch the face row of hit j (if it is one) of an Embree result."""
+def _prefetch_hit(geom, prim, offsets, tri, j, smooth):
+    """Prefetch the face row of hit j (if it is one) of an Embree result: the lines the normal
+    model reads (vertex normals: 3, facet: 2)."""
     if j < geom.shape[0]:
         g = geom[j]
         p = prim[j]
         if p >= 0 and 0 <= g < offsets.shape[0] - 1:
-            _prefetch_row(tri, offsets[g] + p)
+            if smooth:
+                _prefetch_3_lines(tri, offsets[g] + p)
+            else:
+                _prefetch_2_lines(tri, offsets[g] + p)
 
 
 @intrinsic
@@ -201,9 +214,10 @@ def after_paraboloid(geom, prim, origins, dirs, pR, pT, pid, dR, dT, did, tri, o
     their indices in idx1[:k], distances t1[:k], directions u[:k]."""
     n = origins.shape[0]
     nan = np.nan
+    smooth = smooth_g[0]
     k = 0
     for i in range(n):
-        _prefetch_hit(geom, prim, offsets, tri, i + PREFETCH_AHEAD)
+        _prefetch_hit(geom, prim, offsets, tri, i + PREFETCH_AHEAD, smooth)
         g = geom[i]
         p = prim[i]
         none = p < 0 or g < 0 or g >= offsets.shape[0] - 1
@@ -220,7 +234,7 @@ def after_paraboloid(geom, prim, origins, dirs, pR, pT, pid, dR, dT, did, tri, o
         dx, dy, dz = _dir_to_local(pR, pid, x, y, z)
         r = offsets[0] + p
         t, b1, b2 = _mt(tri, r, ox, oy, oz, dx, dy, dz)
-        nx, ny, nz = _normal(tri, r, b1, b2, smooth_g[0])
+        nx, ny, nz = _normal(tri, r, b1, b2, smooth)
         qx, qy, qz = _to_global(pR, pT, pid, ox + t * dx, oy + t * dy, oz + t * dz)
         nx, ny, nz = _dir_to_global(pR, pid, nx, ny, nz)
         ux, uy, uz = _reflect(x, y, z, nx, ny, nz)
@@ -247,9 +261,10 @@ def after_dome(k1, geom, prim, idx1, t1, u, pR, pT, pid, dR, dT, did, tri, offse
     z = 0 (inf going up: escaped), and the float32 inputs of casts 3 (paraboloid frame) and 4
     (dome frame, the beam) with tmax t3, for the rays that go down. Returns k2: idx2[:k2],
     t1 + t2 in t12[:k2], t3[:k2]."""
+    smooth = smooth_g[0]
     k = 0
     for j in range(k1):
-        _prefetch_hit(geom, prim, offsets, tri, j + PREFETCH_AHEAD)
+        _prefetch_hit(geom, prim, offsets, tri, j + PREFETCH_AHEAD, smooth)
         i = idx1[j]
         g = geom[j]
         p = prim[j]
@@ -268,7 +283,7 @@ def after_dome(k1, geom, prim, idx1, t1, u, pR, pT, pid, dR, dT, did, tri, offse
         dx, dy, dz = _dir_to_local(dR, did, ux, uy, uz)
         r = offsets[0] + p
         t, b1, b2 = _mt(tri, r, ox, oy, oz, dx, dy, dz)
-        nx, ny, nz = _normal(tri, r, b1, b2, smooth_g[0])
+        nx, ny, nz = _normal(tri, r, b1, b2, smooth)
         qx, qy, qz = _to_global(dR, dT, did, ox + t * dx, oy + t * dy, oz + t * dz)
         nx, ny, nz = _dir_to_global(dR, did, nx, ny, nz)
         wx, wy, wz = _reflect(ux, uy, uz, nx, ny, nz)
