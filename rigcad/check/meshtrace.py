@@ -94,7 +94,8 @@ def _block(optics, poses, origins, dirs, status, segment, p1, p2, v, landing, pa
     n = len(origins)
     # the timer keeps the inputs of every cast for a replay (bench/raycheck.py): then they are new
     # arrays, not this thread's scratch
-    w = {k: np.empty_like(work[k][:n]) for k in work if k[0] in "odm"} if para.timer.keep_inputs else work
+    keep = para.timer.keep_inputs or dome.timer.keep_inputs or beam.timer.keep_inputs
+    w = {k: np.empty_like(work[k][:n]) for k in work if k[0] in "odm"} if keep else work
     o1, d1 = w["o1"][:n], w["d1"][:n]
     K.source_casts(origins, dirs, pR, pT, pid, o1, d1)
     r1 = para.raw(o1, d1, None)
