@@ -10,6 +10,12 @@ going down, in the paraboloid scene and in the beam scene, with tmax the distanc
 cast takes only the rays still alive (the numpy path also casts the rays going up after the dome,
 whose fate is already known). Results equal trace3d._trace's, the reference (tests/check/
 test_meshtrace.py: same status and segment, points and directions within 1e-12 mm / rad).
+
+Measured (bench/meshglue.py, 1 M annulus rays, achutha2006's exported meshes, 2-core VM, load
+~0.7): the glue between the casts 0.22 s (smooth) and 0.19 s (mesh) per million rays, against
+1.07 s and 0.84 s for the numpy passes; Embree itself ~1.2 s. What is left: the float64
+re-intersection's face rows, gathered at random from a 150 MB table (prefetched), and the
+dependent divisions and square roots of each ray's refinement and reflection.
 """
 
 from __future__ import annotations
