@@ -5,8 +5,8 @@ float64, facet or interpolated vertex normals, reflections, the poses, the statu
 
 Frame: mm, sample point O at the origin, optical axis +z. Poses are (R (3, 3), T (3,)) with
 global = R @ local + T (rigcad.optics.frames.Pose). ``tri`` is EmbreeMesh._packed's table: per
-face v0, e1 = v1 - v0, e2 = v2 - v0, the unit facet normal, the three vertex normals (24 values with 3 of padding: 3 cache lines),
-row ``offsets[g] + prim`` for geometry g. Each pass writes the float32 origins and directions (and
+face v0, e1 = v1 - v0, e2 = v2 - v0, the unit facet normal, the three vertex normals and 3 zeros
+(24 values: 3 cache lines), row ``offsets[g] + prim`` for geometry g. Each pass writes the float32 origins and directions (and
 tmax: 1e37 for inf) of the next casts straight from the loop, for the rays still alive only.
 
 Why: the numpy glue between the casts (float32 conversions, localize/globalize, masks, gathers,
