@@ -3,7 +3,8 @@ reading against raw embreex on the same rays, side by side in one process:
 
 * mesh readings (``smooth``: vertex normals, ``mesh``: flat facets) end to end (Embree, the float64
   re-intersection and normals, reflections, occluders) against the very EmbreeScene.run calls the
-  tracer made, replayed with their recorded float32 inputs and timed alone (``raw``);
+  tracer made, replayed with their recorded float32 inputs and timed alone (``raw``; recorded by
+  an untimed second trace of the same rays, so that the timed trace is a user's: see mesh_run);
 * the analytic tracer (exact surfaces, float64, compiled kernels) on the aligned rig (kernel
   ``pinhole_aligned``: the correspondence table) against the aligned smooth trace's raw Embree;
 * the analytic tracer on a misaligned rig (kernel ``general_newton``: one Monte Carlo build of the
@@ -71,20 +72,29 @@ def best(fn, repeats=REPEATS):
 
 
 def mesh_run(optics, timer, origins, dirs):
-    """One end-to-end mesh trace, then its Embree calls replayed alone: (trace_s, raw_s, casts, trace)."""
+    """One end-to-end mesh trace as a user runs it (timed), then its Embree calls replayed alone:
+    (trace_s, raw_s, casts, trace). The calls are recorded by a second, untimed trace of the same
+    rays (the trace is deterministic: the same calls with the same inputs, checked by their ray
+    count): recording keeps every cast's float32 inputs, new memory that a user's trace does not
+    allocate, and that costs more than the arithmetic on it on a VM whose fresh pages are slow."""
     timer.embree_s, timer.embree_rays, timer.calls = 0.0, 0, []
-    timer.keep_inputs = True
+    timer.keep_inputs = False
     t0 = time.perf_counter()
     tr = trace(optics, origins, dirs)
     dt = time.perf_counter() - t0
+    casts = timer.embree_rays
+    timer.embree_rays, timer.keep_inputs = 0, True
+    trace(optics, origins, dirs)
     timer.keep_inputs = False
     calls, timer.calls = list(timer.calls), []
+    if sum(len(c[1]) for c in calls) != casts:
+        raise RuntimeError("the recording trace made other Embree calls than the timed one")
     raw = 0.0
     for member, o32, d32, t32 in calls:
         t0 = time.perf_counter()
         member.scene.run(o32, d32, dists=None if t32 is None else t32.copy(), output=1)
         raw += time.perf_counter() - t0
-    return dt, raw, timer.embree_rays, tr
+    return dt, raw, casts, tr
 
 
 def table_sweep(analytic, geo, o, d) -> list[dict]:

@@ -184,6 +184,7 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
         for name in ("mesh", "smooth"):
             tr = trace(share_scenes(meshed, name), src.origins, src.dirs)
             readings[name] = reading(tr, ddirs, exact, src.chief)
+            readings[name]["kernels"] = tr.kernels  # the compiled mesh passes or the numpy ones
             if name == rc.mode:
                 main = tr
         k = min(EXACT_NORMAL_RAYS, rc.rays)

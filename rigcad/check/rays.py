@@ -231,22 +231,28 @@ class EmbreeMesh:
         return self._tri_cache[g]
 
     def _packed(self):
-        """Every geometry's per-face float64 data in one table for the compiled refinement
-        (_kernels.refine_mesh_hits), one row of 21 per face: v0, e1 = v1 - v0, e2 = v2 - v0, the
-        unit facet normal, then the three vertex normals (zeros for meshes without); the first
-        row of each geometry; which have vertex normals. One contiguous row per face: a hit costs
-        ~3 cache lines gathered at random. Built once, shared by the copies share_scenes makes."""
+        """Every geometry's per-face float64 data in one table for the compiled passes
+        (_kernels.refine_mesh_hits, _mesh_kernels), one row of 24 per face: v0, e1 = v1 - v0,
+        e2 = v2 - v0, the unit facet normal, then the three vertex normals (zeros for meshes
+        without), 3 zeros; the first row of each geometry; which have vertex normals. One row of
+        192 bytes per face starting on a 64-byte cache line: a hit gathers 3 whole lines at
+        random (2 for facet normals), not 3-4 straddled ones. Built once, shared by the copies
+        share_scenes makes."""
         if "packed" not in self._tri_cache:
             rows, offsets, has = [], [0], []
             for m in self.meshes:
                 tri = m.vertices[m.faces]
                 e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
                 vn = np.zeros((len(m.faces), 9)) if m.normals is None else m.normals[m.faces].reshape(-1, 9)
-                rows.append(np.hstack([tri[:, 0], e1, e2, unit(np.cross(e1, e2)), vn]))
+                rows.append(np.hstack([tri[:, 0], e1, e2, unit(np.cross(e1, e2)), vn, np.zeros((len(m.faces), 3))]))
                 offsets.append(offsets[-1] + len(m.faces))
                 has.append(m.normals is not None)
-            self._tri_cache["packed"] = (np.ascontiguousarray(np.vstack(rows)), np.array(offsets, np.int64),
-                                         np.array(has, np.bool_))
+            table = np.vstack(rows)
+            buf = np.empty(table.size + 8)
+            start = (-buf.ctypes.data % 64) // 8  # first float64 on a 64-byte boundary
+            packed = buf[start:start + table.size].reshape(table.shape)
+            packed[:] = table
+            self._tri_cache["packed"] = (packed, np.array(offsets, np.int64), np.array(has, np.bool_))
         return self._tri_cache["packed"]
 
     @property
@@ -254,14 +260,16 @@ class EmbreeMesh:
         return int(sum(len(m.faces) for m in self.meshes))
 
     def raw(self, origins32: np.ndarray, dirs32: np.ndarray, tmax32: np.ndarray | None):
-        """One raw EmbreeScene.run (float32 in, Embree's dict out), timed into ``timer``."""
+        """One raw EmbreeScene.run (float32 in, Embree's dict out), timed into ``timer``. With
+        ``timer.keep_inputs`` the inputs are recorded for a replay (tmax copied before the call:
+        Embree writes the hit distances into it)."""
+        if self.timer.keep_inputs:
+            self.timer.calls.append((self, origins32, dirs32, None if tmax32 is None else tmax32.copy()))
         t0 = time.perf_counter()
         out = self.scene.run(origins32, dirs32, dists=tmax32, output=1)
         dt = time.perf_counter() - t0
         self.timer.embree_s += dt
         self.timer.embree_rays += len(origins32)
-        if self.timer.keep_inputs:
-            self.timer.calls.append((self, origins32, dirs32, None if tmax32 is None else tmax32.copy()))
         return out
 
     def intersect(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray | None = None) -> Hits:

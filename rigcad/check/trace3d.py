@@ -46,7 +46,8 @@ class Trace3D:
     direction ``v`` (n, 3), ``landing`` (n, 3) on z = 0, total ``path_length`` mm, and ``miss``: the
     distance from O to the returning ray's line (mm; the convergence error, well conditioned even
     at grazing incidence, where the landing point is not). ``kernels``: rays per kernel of the
-    analytic tracer (rigcad.check.analytic), or ``{"vectorised": n}`` for the numpy path."""
+    analytic tracer (rigcad.check.analytic), ``{"mesh_compiled": n}`` for the compiled mesh reading
+    (rigcad.check.meshtrace), or ``{"vectorised": n}`` for the numpy path."""
 
     status: np.ndarray
     segment: np.ndarray
@@ -96,10 +97,15 @@ def counting(callback):
 
 def trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray, vectorised: bool = False) -> Trace3D:
     """Trace rays (origins, unit dirs: (n, 3), global frame) through ``optics``: by the compiled
-    analytic kernels when ``optics`` has them (``optics.fast``, analytic optics), else (or with
-    ``vectorised=True``) by the intersectors' numpy passes (:func:`_trace`)."""
+    analytic kernels when ``optics`` has them (``optics.fast``, analytic optics), by the compiled
+    mesh passes for Embree meshes read with facet or vertex normals (rigcad.check.meshtrace),
+    else (or with ``vectorised=True``) by the intersectors' numpy passes (:func:`_trace`)."""
+    from rigcad.check import meshtrace
+
     if optics.fast is not None and not vectorised:
         out = optics.fast.trace(optics, origins, dirs)
+    elif not vectorised and meshtrace.supports(optics):
+        out = meshtrace.trace(optics, origins, dirs)
     else:
         out = _trace(optics, origins, dirs)
     report = _COUNTER.get()
