@@ -597,8 +597,8 @@ def refine_mesh_hits(geom, prim, origins, dirs, tri, offsets, has_normals, verte
     (Moller-Trumbore on that triangle, rays.EmbreeMesh) with their normals: the facet's, or the
     vertex normals interpolated with the barycentric weights (``vertex_model``, meshes that have
     them). ``tri[offsets[g] + prim]``: v0, e1 = v1 - v0, e2 = v2 - v0, the unit facet normal and
-    the three vertex normals (21 values, then 3 of padding: EmbreeMesh._packed). Hits beyond ``tmax`` (if its length is the rays') are
-    dropped."""
+    the three vertex normals (21 values, then 3 of padding: EmbreeMesh._packed). Hits beyond
+    ``tmax`` (if its length is the rays') are dropped."""
     n = geom.shape[0]
     ng = offsets.shape[0] - 1
     limited = tmax.shape[0] == n
