@@ -4,7 +4,7 @@ result whatever ran them.
 The contract: a job is a top-level function ``func(shared, task) -> result`` (picklable by name),
 one ``shared`` object for every task (a Rig, tables...) and a list of ``tasks``. Results come back
 in task order. A task must depend only on its own arguments (draw its randomness from a seed it
-carries, e.g. a :func:`spawn_seeds` child), so the results are bit-identical for any worker count
+carries, e.g. a :func:`child_seed`), so the results are bit-identical for any worker count
 and either engine. ``shared`` is pickled once in the parent and unpickled once per worker process
 (cached by its SHA-256); expensive per-worker state built from it (an Embree scene) goes in
 :func:`worker_cache`, built in the worker, never pickled.
@@ -64,10 +64,11 @@ class Engine:
         return "loky" if self.n_workers > 1 else "serial"
 
 
-def spawn_seeds(seed: int, count: int) -> list[np.random.SeedSequence]:
-    """``count`` independent child seeds of ``seed`` (``SeedSequence.spawn``): sample i draws from
-    child i whatever batch or worker it lands in."""
-    return np.random.SeedSequence(int(seed)).spawn(int(count))
+def child_seed(seed: int, i: int) -> np.random.SeedSequence:
+    """Child i of ``SeedSequence(seed)``, the one ``.spawn`` would give as its i-th (same entropy,
+    spawn key (i,)), made alone: sample i draws from it whatever batch or worker it lands in, and
+    a task builds only its own samples' seeds (spawning all 10,000 took 0.13 s per task)."""
+    return np.random.SeedSequence(int(seed), spawn_key=(int(i),))
 
 
 def split(count: int, size: int) -> list[range]:

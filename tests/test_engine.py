@@ -3,19 +3,27 @@
 import numpy as np
 import pytest
 
-from rigcad.engine import LOCAL_DASK, Engine, EngineError, run, spawn_seeds, split, worker_cache
+from rigcad.engine import LOCAL_DASK, Engine, EngineError, child_seed, run, split, worker_cache
 
 
 def _draw(shared, batch):
     """A task: per sample a draw from its own spawned seed, scaled by the shared object."""
-    seeds = spawn_seeds(shared["seed"], shared["count"])
     table = worker_cache(("table", shared["seed"]), lambda: np.arange(5.0))
-    return [float(np.random.default_rng(seeds[i]).normal() * shared["scale"] + table[i % 5]) for i in batch]
+    return [float(np.random.default_rng(child_seed(shared["seed"], i)).normal() * shared["scale"] + table[i % 5])
+            for i in batch]
 
 
 def _jobs(count=40, size=7):
     shared = {"seed": 123, "count": count, "scale": 2.5}
     return shared, split(count, size)
+
+
+def test_a_child_seed_is_the_one_spawn_gives():
+    spawned = np.random.SeedSequence(123).spawn(50)
+    for i in (0, 1, 17, 49):
+        assert np.array_equal(child_seed(123, i).generate_state(8), spawned[i].generate_state(8))
+        assert np.random.default_rng(child_seed(123, i)).normal() == np.random.default_rng(spawned[i]).normal()
+    assert not np.array_equal(child_seed(123, 1).generate_state(8), spawned[2].generate_state(8))
 
 
 def test_split_covers_every_item_once():

@@ -51,7 +51,7 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
 
         t1 = time.perf_counter()
         with progress_bar(len(PARAMETERS), "inverse limits", "parameter") as update:
-            limits = run_limits(rig, Job(rig, rays, 0, 0, 0).key, rays, int(tol.seed) + 1, engine,
+            limits = run_limits(rig, Job(rig, rays, 0, 0).key, rays, int(tol.seed) + 1, engine,
                                 progress=_engine_progress(update))
         limits_s = time.perf_counter() - t1
     corr = rank_correlations(mc.columns) if samples > 2 else None

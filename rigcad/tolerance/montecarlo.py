@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigcad.engine import Engine, run, spawn_seeds, split, worker_cache
+from rigcad.engine import Engine, child_seed, run, split, worker_cache
 from rigcad.optics.frames import COMPONENTS
 
 #: Rays a task traces (both paths of all its samples): ~0.2-0.4 s on one core (kernel and
@@ -39,13 +39,12 @@ STATS = ("mean", "p50", "p90", "p99", "max")
 @dataclass(frozen=True)
 class Job:
     """What every task needs (pickled once per worker): the rig, rays per path and their seed,
-    the per-sample seed root and the sample count (for the spawned children)."""
+    and the per-sample seed root (sample i draws from its child i)."""
 
     rig: object
     rays: int
     ray_seed: int
     seed: int
-    samples: int
 
     @property
     def key(self) -> str:
@@ -102,10 +101,9 @@ def _batch(job: Job, batch: range) -> list[dict]:
     key = job.key  # hashed once per task, not per sample
     optics, design = worker_optics(job.rig, key)
     tol = job.rig.profile.tolerancing
-    seeds = spawn_seeds(job.seed, job.samples)
     rows = []
     for i in batch:
-        mis = sample_build(np.random.default_rng(seeds[i]), tol)
+        mis = sample_build(np.random.default_rng(child_seed(job.seed, i)), tol)
         row = {"sample": i}
         for c in COMPONENTS:
             (dx, dy, dz), t, (ax, ay, _) = mis.offsets[c], mis.tilts[c], mis.axes[c]
@@ -138,7 +136,7 @@ def run_monte_carlo(rig, samples: int | None = None, rays: int | None = None, en
     tol = rig.profile.tolerancing
     samples = int(tol.builds if samples is None else samples)
     rays = int(tol.rays if rays is None else rays)
-    job = Job(rig, rays, int(tol.seed) + 1, int(tol.seed), samples)
+    job = Job(rig, rays, int(tol.seed) + 1, int(tol.seed))
     tasks = split(samples, batch_size(samples, rays, engine.n_workers))
     parts = run(_batch, job, tasks, engine, progress=progress, sizes=[len(t) for t in tasks])
     rows = [r for part in parts for r in part]

@@ -72,7 +72,7 @@ def test_inverse_limit_holds_at_the_limit_and_fails_at_twice_it(table31_rig, nam
     tol = rig.profile.tolerancing
     p = next(q for q in PARAMETERS if q.name == name)
     rays = 2000
-    [row] = run_limits(rig, Job(rig, rays, 0, 0, 0).key, rays, int(tol.seed) + 1, Engine(1), parameters=[p])
+    [row] = run_limits(rig, Job(rig, rays, 0, 0).key, rays, int(tol.seed) + 1, Engine(1), parameters=[p])
     limit = row[f"limit_{p.unit}"]
     assert row["limit_found"] and limit > p.tolerance(tol)  # the profile's tolerance is inside its limit
 
