@@ -24,8 +24,8 @@ import numpy as np
 from rigcad.engine import Engine, child_seed, run, split, worker_cache
 from rigcad.optics.frames import COMPONENTS
 
-#: Rays a task traces (both paths of all its samples): ~0.2-0.4 s on one core (kernel and
-#: figures: ~7 ms per sample of 2 x 1000 rays, measured), above the 100 ms that keeps the
+#: Rays a task traces (both paths of all its samples): ~0.2 s on one core (kernel and figures:
+#: ~4 ms per sample of 2 x 1000 rays, bench/tolerance.py), above the 100 ms that keeps the
 #: engine's per-task overhead (~ms) negligible, and short enough that the progress bar, which
 #: advances as tasks finish, moves at least about once a second.
 TASK_RAYS = 100_000
