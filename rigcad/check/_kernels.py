@@ -383,9 +383,10 @@ def pinhole_aligned(cop_z, dirs, f, zv, rim, para_occ, beam_occ, mount_shadowed,
     (``x_inv_h`` cells per unit x), fitted to the exact trace (Newton on the dome spline) and
     measured against it when the tracer is built; the kernel turns them to the ray's azimuth.
     The beam and the mount break the symmetry: they are tested per ray, in 3D, only where the
-    table cell's ``flags[cell]`` (analytic._cell_flags) say a leg can reach them: bit 0 (bit 2), the leg to the dome (the return leg) may cross the beam's
-    heights at radii ``beam_rho[cell]`` and is tested only if radius x sin(azimuth) can fall in
-    the beam's y extent ``beam_y``; bit 1, the return leg may pass the paraboloid's body.
+    table cell's ``flags[cell]`` (analytic._cell_flags) say a leg can reach them: bit 0 (bit 2),
+    the leg to the dome (the return leg) may cross the beam's heights at radii
+    ``beam_rho[cell]`` and is tested only if radius x sin(azimuth) can fall in the beam's y extent
+    ``beam_y``; bit 1, the return leg may pass the paraboloid's body.
     ``mount_shadowed``: the mount lies under the mirror, so a ray from the COP that reaches the
     mirror cannot meet it first. Rays outside the table (``handled`` False) are left for the
     general kernel."""
@@ -533,8 +534,8 @@ def _newton_step(brk, cr, cz, ox, oy, oz, dx, dy, dz, t, u, piece):
 
 @nb.njit(**_JIT)
 def general(idx, origins, dirs, R1, T1, id1, R2, T2, id2, f, zv, rim, para_occ, mount_shadowed, body_sphere, beam_occ,
-            brk, cr, cz, u_lo, u_hi, piece_of, piece_scale, tab_u, tab_r, tab_z, r_max, newton_steps, residual_tol, step_tol,
-            status, segment, p1, p2, v, landing, path, miss):
+            brk, cr, cz, u_lo, u_hi, piece_of, piece_scale, tab_u, tab_r, tab_z, r_max, newton_steps, residual_tol,
+            step_tol, status, segment, p1, p2, v, landing, path, miss):
     """Any rig, any rays (rows ``idx``): the paraboloid in its frame (closed form), the dome hit by
     Newton on (t, u) against the meridian spline, started at the design's correspondence (u = -s
     of the paraboloid radius s the ray reflects at); a ray whose Newton does not land on the mirror

@@ -6,8 +6,9 @@ float64, facet or interpolated vertex normals, reflections, the poses, the statu
 Frame: mm, sample point O at the origin, optical axis +z. Poses are (R (3, 3), T (3,)) with
 global = R @ local + T (rigcad.optics.frames.Pose). ``tri`` is EmbreeMesh._packed's table: per
 face v0, e1 = v1 - v0, e2 = v2 - v0, the unit facet normal, the three vertex normals and 3 zeros
-(24 values: 3 cache lines), row ``offsets[g] + prim`` for geometry g. Each pass writes the float32 origins and directions (and
-tmax: 1e37 for inf) of the next casts straight from the loop, for the rays still alive only.
+(24 values: 3 cache lines), row ``offsets[g] + prim`` for geometry g. Each pass writes the
+float32 origins and directions (and tmax: 1e37 for inf) of the next casts straight from the loop,
+for the rays still alive only.
 
 Why: the numpy glue between the casts (float32 conversions, localize/globalize, masks, gathers,
 reflections, Hits.closer, result arrays) cost ~1.1 s per million rays, as much as Embree itself;
@@ -27,7 +28,7 @@ from numba.extending import intrinsic
 
 from rigcad.check._kernels import (ESCAPED_AFTER_DOME, ESCAPED_TOP, MISSED_DOME, MISSED_PARABOLOID,
                                    OCCLUDED_BY_BEAM, OCCLUDED_BY_MOUNT, OCCLUDED_BY_PARABOLOID, OK, _dir_to_global,
-                                   _dir_to_local, _to_global, _to_local)
+                                   _dir_to_local, _reflect, _to_global, _to_local)
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
 #: The per-ray helpers are inlined by numba itself (its IR): as separate functions each call
@@ -118,13 +119,6 @@ def _normal(tri, r, b1, b2, smooth):
         m = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
         return nx * m, ny * m, nz * m
     return tri[r, 9], tri[r, 10], tri[r, 11]
-
-
-@nb.njit(**_INLINE)
-def _reflect(dx, dy, dz, nx, ny, nz):
-    """Mirror reflection of d about the unit normal n (trace3d.reflect)."""
-    k = 2.0 * (dx * nx + dy * ny + dz * nz)
-    return dx - k * nx, dy - k * ny, dz - k * nz
 
 
 @nb.njit(**_INLINE)

@@ -196,20 +196,20 @@ class AnalyticTracer:
         """PINHOLE_COLUMNS of the exact trace of the COP rays at sines ``x`` (m,) in the x-z plane
         (no occluders), and how many of them do not reach the dome."""
         from rigcad.check import _kernels as K
+        from rigcad.check.trace3d import Trace3D
 
         m = len(x)
         origins = np.tile([0.0, 0.0, self.cop_z], (m, 1))
         dirs = np.column_stack([x, np.zeros(m), -np.sqrt(1.0 - x * x)])
-        status, segment = np.empty(m, np.int64), np.empty(m, np.int8)
-        p1, p2, v, landing = (np.empty((m, 3)) for _ in range(4))
-        path, miss = np.empty(m), np.empty(m)
+        tr = Trace3D.allocate(m)
+        status, segment, p1, p2, v = tr.status, tr.segment, tr.p1, tr.p2, tr.v
         none = np.zeros((0, 11))
         ident, zero = np.eye(3), np.zeros(3)
         K.general(np.arange(m), origins, dirs, ident, zero, True, ident, zero, True, self.focal_length,
-                  self.vertex_z, self.rim_radius, none, True, np.zeros(4), none, self.breaks, self.coef_r, self.coef_z, self.u_lo,
-                  self.u_hi, self.piece_of, self.piece_scale, self.dome.u_tab, self.dome.r_tab, self.dome.z_tab,
-                  self.dome.r_max, NEWTON_STEPS, RESIDUAL_TOL, NEWTON_STEP_TOL, status, segment, p1, p2, v, landing,
-                  path, miss)
+                  self.vertex_z, self.rim_radius, none, True, np.zeros(4), none, self.breaks, self.coef_r,
+                  self.coef_z, self.u_lo, self.u_hi, self.piece_of, self.piece_scale, self.dome.u_tab,
+                  self.dome.r_tab, self.dome.z_tab, self.dome.r_max, NEWTON_STEPS, RESIDUAL_TOL, NEWTON_STEP_TOL,
+                  *tr.arrays)
         reached = (status == K.OK) | ((status == K.ESCAPED_AFTER_DOME) & (segment == 3))
         t1 = np.hypot(p1[:, 0], p1[:, 2] - self.cop_z)
         t2 = np.hypot(p2[:, 0] - p1[:, 0], p2[:, 2] - p1[:, 2])
@@ -226,11 +226,8 @@ class AnalyticTracer:
         origins = np.ascontiguousarray(origins, float)
         dirs = np.ascontiguousarray(dirs, float)
         n = len(origins)
-        status = np.empty(n, np.int64)
-        segment = np.empty(n, np.int8)
-        p1, p2, v, landing = (np.empty((n, 3)) for _ in range(4))
-        path, miss = np.empty(n), np.empty(n)
-        out = (status, segment, p1, p2, v, landing, path, miss)
+        result = Trace3D.allocate(n)
+        out = result.arrays
         pp, dp = optics.paraboloid_pose, optics.dome_pose
         aligned = pp.is_identity and dp.is_identity
         kernels = {"pinhole_aligned": 0, "general_newton": 0, "bracketed_fallback": 0}
@@ -248,7 +245,8 @@ class AnalyticTracer:
         if rest is not None and len(rest):
             kernels["general_newton"] = len(rest)
             kernels["bracketed_fallback"] = self._general(K, rest, origins, dirs, pp, dp, out)
-        return Trace3D(*out, kernels=kernels)
+        result.kernels = kernels
+        return result
 
     def _general(self, K, idx, origins, dirs, pp, dp, out) -> int:
         R1, T1, id1 = _pose(pp)

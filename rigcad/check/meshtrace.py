@@ -79,11 +79,8 @@ def trace(optics, origins: np.ndarray, dirs: np.ndarray):
     origins = np.ascontiguousarray(origins, float)
     dirs = np.ascontiguousarray(dirs, float)
     n = len(origins)
-    status = np.empty(n, np.int64)
-    segment = np.empty(n, np.int8)
-    p1, p2, v, landing = (np.empty((n, 3)) for _ in range(4))
-    path, miss = np.empty(n), np.empty(n)
-    out = Trace3D(status, segment, p1, p2, v, landing, path, miss, {"mesh_compiled": n})
+    out = Trace3D.allocate(n, {"mesh_compiled": n})
+    status, segment, p1, p2, v, landing, path, miss = out.arrays
     poses = _pose(optics.paraboloid_pose) + _pose(optics.dome_pose)
     work = _scratch(min(n, BLOCK))
     for a in range(0, n, BLOCK):

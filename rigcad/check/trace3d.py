@@ -59,6 +59,18 @@ class Trace3D:
     miss: np.ndarray
     kernels: dict = field(default_factory=dict)
 
+    @classmethod
+    def allocate(cls, n: int, kernels: dict | None = None) -> "Trace3D":
+        """Uninitialised arrays for n rays, for a compiled kernel to fill (every entry written)."""
+        return cls(np.empty(n, np.int64), np.empty(n, np.int8), *(np.empty((n, 3)) for _ in range(4)), np.empty(n),
+                   np.empty(n), dict(kernels or {}))
+
+    @property
+    def arrays(self) -> tuple:
+        """The per-ray arrays in the kernels' argument order (status, segment, p1, p2, v, landing,
+        path_length, miss)."""
+        return (self.status, self.segment, self.p1, self.p2, self.v, self.landing, self.path_length, self.miss)
+
     @property
     def ok(self) -> np.ndarray:
         return self.status == OK
