@@ -19,16 +19,17 @@ def test_embree_is_the_backend_and_agrees_with_the_float64_reference_hit_for_hit
     # Not skipped when embreex is missing: it is a pinned dependency, so its absence is a failure.
     R.require_embree()
     mesh = coarse_meshes.paraboloid
-    o, d = _paraboloid_rays(design_map, 1500, 1)
+    # (the reference tests every ray against every triangle, ~25 ms a ray: 440 rays)
+    o, d = _paraboloid_rays(design_map, 320, 1)
     # add rays that miss (beyond the rim) so that misses are compared too
-    o2, d2 = _paraboloid_rays(design_map, 500, 2)
+    o2, d2 = _paraboloid_rays(design_map, 120, 2)
     d2[:, :2] *= 1.3
     o, d = np.vstack([o, o2]), R.unit(np.vstack([d, d2]))
     emb = R.EmbreeMesh([mesh], "vertex").intersect(o, d)
     ref = R.NumpyMesh([mesh], "vertex").intersect(o, d)
     hit = np.isfinite(ref.t)
     # not vacuous: most rays hit, some miss
-    assert hit.sum() > 1400 and (~hit).sum() > 100, (hit.sum(), (~hit).sum())
+    assert hit.sum() > 300 and (~hit).sum() > 20, (hit.sum(), (~hit).sum())
     assert np.array_equal(np.isfinite(emb.t), hit), "Embree and the reference disagree on which rays hit"
     # both re-intersect the same triangle in float64 (or, on an edge, its neighbour: same plane
     # to within the facet angle x the float32 edge error): distances agree to 1e-9 mm
