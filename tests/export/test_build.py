@@ -155,11 +155,23 @@ def test_manifest_reports_each_part(built):
         assert len(e["bbox_min_mm"]) == 3 and all(len(h) == 64 for h in e["files"].values())
 
 
+def _pixels(path: Path) -> np.ndarray:
+    from matplotlib.image import imread
+
+    return imread(path)
+
+
 def test_readme_part_pictures_are_current(built):
-    # docs/parts/*.png are shown in the README; `make docs` refreshes them
+    # docs/parts/*.png are shown in the README; `make docs` refreshes them. The same files on one
+    # machine are the same bytes (test_clean_rebuild_is_byte_identical); another CPU's last bits can
+    # shade a few edge pixels differently (seen: up to 287 of 102 000 pixels, by at most 16/255),
+    # while a part that moved or changed shape changes the frame or thousands of pixels.
     _, out, _ = built
     for name in PARTS:
-        assert (out / "renders" / f"{name}.png").read_bytes() == (ROOT / "docs/parts" / f"{name}.png").read_bytes(), name
+        new, old = _pixels(out / "renders" / f"{name}.png"), _pixels(ROOT / "docs/parts" / f"{name}.png")
+        assert new.shape == old.shape, (name, new.shape, old.shape)
+        off = np.abs(new - old).max(axis=-1)
+        assert (off > 2 / 255).mean() < 0.01 and off.max() < 0.25, (name, int((off > 2 / 255).sum()), float(off.max()))
 
 
 @pytest.mark.parametrize("name", ["dome", "paraboloid"])

@@ -229,12 +229,12 @@ def run_case(arena: Path, payload, capsys, command: str = "design") -> tuple[int
     capsys.readouterr()
     _opened.clear()
     _watching = True
-    t0 = time.process_time()  # CPU seconds of this process: a loaded machine does not stretch them
+    t0 = time.thread_time()  # CPU seconds of this thread: neither a loaded machine nor threads an earlier test left running stretch them
     try:
         rc = main([command, str(path), "--exports", str(out)])
     finally:
         _watching = False
-    elapsed = time.process_time() - t0
+    elapsed = time.thread_time() - t0
     err = capsys.readouterr().err
     lines = [line for line in err.splitlines() if line.strip()]
     assert rc in (1, 2), f"accepted (exit {rc})"
@@ -358,13 +358,13 @@ def _hypothesis_case(arena_path: Path, text: str) -> None:
     err = io.StringIO()
     _opened.clear()
     _watching = True
-    t0 = time.process_time()  # CPU seconds of this process: a loaded machine does not stretch them
+    t0 = time.thread_time()  # CPU seconds of this thread: neither a loaded machine nor threads an earlier test left running stretch them
     try:
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
             rc = main(["profile", "show", str(path)])
     finally:
         _watching = False
-    elapsed = time.process_time() - t0
+    elapsed = time.thread_time() - t0
     lines = [line for line in err.getvalue().splitlines() if line.strip()]
     if rc != 0:
         assert rc in (1, 2) and len(lines) == 1 and lines[0].startswith("rigcad: error: "), err.getvalue()[-2000:]
