@@ -54,26 +54,33 @@ class DomeCurve:
         lam = np.full(n, np.nan)
         seg = np.full(n, -1)
         frac = np.zeros(n)
+        # Screen every (ray, node) pair with one matrix product, cross(P - o, d) = P x d - o x d, then
+        # evaluate the exact crossing only on the segments where that sign changes or comes within its
+        # rounding (|error| < 64 eps (|P| + |o|) for unit d): the same numbers as testing every segment.
+        reach = np.abs(P).max() if len(P) else 0.0
         block = max(1, _CHUNK // max(len(P), 1))
         for a in range(0, n, block):
-            oo, dd = o[a:a + block, None, :], d[a:a + block, None, :]
-            rel = P[None, :, :] - oo
-            cross = rel[..., 0] * dd[..., 1] - rel[..., 1] * dd[..., 0]
-            c0, c1 = cross[:, :-1], cross[:, 1:]
+            oo, dd = o[a:a + block], d[a:a + block]
+            screen = P @ np.stack([dd[:, 1], -dd[:, 0]]) - (oo[:, 0] * dd[:, 1] - oo[:, 1] * dd[:, 0])
+            near = np.abs(screen) <= 64 * np.finfo(float).eps * (reach + np.abs(oo).max(axis=1))
+            pos = screen > 0
+            cand = (pos[:-1] != pos[1:]) | near[:-1] | near[1:]
+            j, i = np.nonzero(cand)  # segment, ray within the block
+            rel0, rel1 = P[j] - oo[i], P[j + 1] - oo[i]
+            c0 = rel0[:, 0] * dd[i, 1] - rel0[:, 1] * dd[i, 0]
+            c1 = rel1[:, 0] * dd[i, 1] - rel1[:, 1] * dd[i, 0]
             change = (c0 == 0) | (np.sign(c0) != np.sign(c1))
             with np.errstate(invalid="ignore", divide="ignore"):
                 f = c0 / (c0 - c1)
             f = np.where(np.isfinite(f), f, 0.0)
-            hit = P[None, :-1, :] + f[..., None] * (P[None, 1:, :] - P[None, :-1, :])
-            along = np.sum((hit - oo) * dd, axis=-1)
+            hit = P[j] + f[:, None] * (P[j + 1] - P[j])
+            along = np.sum((hit - oo[i]) * dd[i], axis=-1)
             ok = change & (along > 1e-9)
-            along = np.where(ok, along, np.inf)
-            j = np.argmin(along, axis=1)
-            best = along[np.arange(len(j)), j]
-            found = np.isfinite(best)
-            lam[a:a + block] = np.where(found, best, np.nan)
-            seg[a:a + block] = np.where(found, j, -1)
-            frac[a:a + block] = f[np.arange(len(j)), j]
+            i, j, f, along = i[ok], j[ok], f[ok], along[ok]
+            first = np.lexsort((j, along, i))  # per ray: the nearest crossing, the lowest segment on a tie
+            keep = first[np.r_[True, i[first][1:] != i[first][:-1]]] if len(first) else first
+            rows = a + i[keep]
+            lam[rows], seg[rows], frac[rows] = along[keep], j[keep], f[keep]
         found = seg >= 0
         normal = np.full((n, 2), np.nan)
         if self.kind == "polyline":
