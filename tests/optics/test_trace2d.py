@@ -53,3 +53,38 @@ def test_a_ray_off_the_paraboloid_is_reported_missed(system):
     assert tr.status[0] != OK and np.isnan(tr.miss[0])
     # A ray near the vertex reflects back through the top opening: lost, not silently counted.
     assert tr.status[1] != OK
+
+
+def _first_crossing_every_segment(P, o, d):
+    """The polyline's first crossing along each ray, by solving o + t d = P_j + f (P_j+1 - P_j) on
+    every segment: the reference the screened search must reproduce."""
+    lam = np.full(len(o), np.nan)
+    e = P[1:] - P[:-1]
+    for k in range(len(o)):
+        det = e[:, 0] * d[k, 1] - e[:, 1] * d[k, 0]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            f = ((o[k, 0] - P[:-1, 0]) * d[k, 1] - (o[k, 1] - P[:-1, 1]) * d[k, 0]) / det
+            t = ((P[:-1, 0] - o[k, 0]) * e[:, 1] - (P[:-1, 1] - o[k, 1]) * e[:, 0]) / -det
+        t = t[(f >= -1e-12) & (f <= 1 + 1e-12) & (t > 1e-9)]  # a node hit: f rounds to either side of it
+        lam[k] = t.min() if t.size else np.nan
+    return lam
+
+
+def test_screened_crossing_search_finds_every_first_crossing(system):
+    g, _, dome = system
+    curve = DomeCurve.from_profile(dome)
+    flat = DomeCurve("polyline", curve.s, curve.points, None)
+    P = curve.points
+    rng = np.random.default_rng(3)
+    o = rng.uniform(-1, 1, (300, 2)) * np.abs(P).max()
+    a = rng.uniform(0, 2 * np.pi, 300)
+    d = np.stack([np.cos(a), np.sin(a)], axis=1)
+    # and rays aimed exactly at nodes, where the crossing sits on the screen's rounding margin
+    v = P[::40] - [0.0, g.cop_z / 3]
+    o = np.vstack([o, np.tile([0.0, g.cop_z / 3], (len(v), 1))])
+    d = np.vstack([d, v / np.linalg.norm(v, axis=1)[:, None]])
+    ref = np.fmin(_first_crossing_every_segment(P, o, d), _first_crossing_every_segment(P * [-1, 1], o, d))  # both halves
+    lam, _ = flat.intersect(o, d)
+    hit = np.isfinite(ref)
+    assert 100 < hit.sum() < len(o) and np.array_equal(np.isfinite(lam), hit)
+    assert np.max(np.abs(lam[hit] - ref[hit])) < 1e-9
