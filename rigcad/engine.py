@@ -20,6 +20,7 @@ from __future__ import annotations
 import hashlib
 import os
 import pickle
+import socket
 import time
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
@@ -30,6 +31,8 @@ from rigcad.errors import RigcadError
 
 #: Scheduler value that starts a Dask LocalCluster for the run.
 LOCAL_DASK = "local-dask"
+#: Seconds to reach a Dask scheduler given by address before the run is refused.
+CONNECT_TIMEOUT_S = 10
 
 #: Called after each finished task with (tasks done, tasks in all, items done, items in all).
 Progress = Callable[[int, int, int, int], None] | None
@@ -140,6 +143,18 @@ def run(func: Callable[[Any, Any], Any], shared: Any, tasks: Sequence[Any], engi
     return _run_on_dask(func, shared, tasks, engine, report, sizes, total_items, out)
 
 
+def _listening(address: str) -> None:
+    """Raise OSError at once when nothing listens at a tcp/tls scheduler address: distributed's
+    Client would retry a refused connection for its whole timeout before saying so."""
+    from distributed.comm import parse_address
+    from distributed.comm.addressing import parse_host_port
+
+    protocol, location = parse_address(address)
+    if protocol in ("tcp", "tls"):
+        with socket.create_connection(parse_host_port(location), timeout=CONNECT_TIMEOUT_S):
+            pass
+
+
 def _run_on_dask(func, shared, tasks, engine, report, sizes, total_items, out) -> list:
     try:
         from distributed import Client, LocalCluster, as_completed
@@ -153,8 +168,9 @@ def _run_on_dask(func, shared, tasks, engine, report, sizes, total_items, out) -
                                    dashboard_address=None, host="127.0.0.1")
             client = Client(cluster)
         else:
-            client = Client(engine.scheduler, timeout="10s")
-    except (OSError, TimeoutError) as err:
+            _listening(engine.scheduler)
+            client = Client(engine.scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
+    except (OSError, TimeoutError, ValueError) as err:  # ValueError: an address Dask cannot read
         if cluster is not None:
             cluster.close()
         raise EngineError(f"cannot reach the Dask scheduler {engine.scheduler!r}: {err}; give a running "

@@ -51,10 +51,13 @@ def test_local_dask_matches_serial():
     assert run(_draw, shared, tasks, Engine(2, LOCAL_DASK)) == run(_draw, shared, tasks, Engine(1))
 
 
-def test_unreachable_scheduler_is_one_clear_error():
+@pytest.mark.parametrize("address", ["tcp://127.0.0.1:9", "127.0.0.1:9", "bogus://x", "tcp://localhost",
+                                     "tcp://no-such-host.invalid:8786"])
+def test_unreachable_scheduler_is_one_clear_error(address):
     pytest.importorskip("distributed")
-    with pytest.raises(EngineError, match="cannot reach the Dask scheduler"):
-        run(_draw, *_jobs(count=2, size=1), Engine(1, "tcp://127.0.0.1:9"))
+    with pytest.raises(EngineError, match="cannot reach the Dask scheduler") as err:
+        run(_draw, *_jobs(count=2, size=1), Engine(1, address))
+    assert address in str(err.value) and "tcp://host:8786" in str(err.value)
 
 
 def test_negative_workers_refused():

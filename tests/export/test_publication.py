@@ -59,11 +59,16 @@ def _stl(profile: Path, exports: Path, env=None, **kw):
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, **kw)
 
 
+#: Where the runs of the changed profile are killed: its own progress events, from the design
+#: stage to the moment it starts publishing (the mirror parts rebuild; the others are unchanged).
+KILL_AT = ("dome integrated", "paraboloid", "tower_column", "publishing")
+
+
 def test_a_killed_stl_never_publishes_half_a_run(tmp_path):
-    """A good build of one profile, then cold builds of a changed one (every mirror part rebuilds)
-    killed with SIGKILL at points taken from the run's own progress events, the last one just as
-    it starts publishing. After each kill every file matches the manifest beside it; the next run
-    completes and leaves no temporary file."""
+    """A good build of one profile, then builds of a changed one (every mirror part rebuilds)
+    killed with SIGKILL at its progress events, the last one just as it starts publishing. After
+    each kill every file matches the manifest beside it; the next run completes and leaves no
+    temporary file."""
     exports = tmp_path / "exports"
     good = _profile(tmp_path / "a")
     assert _stl(good, exports).wait(timeout=600) == 0
@@ -73,28 +78,22 @@ def test_a_killed_stl_never_publishes_half_a_run(tmp_path):
                        + "".join(f"    - {{name: {n}, thickness: 2 mil}}\n" for n in (
                            "black base paint", "polyurethane primer", "polyurethane clearcoat", "MirraChrome")))
     env = {**os.environ, "RIGCAD_EVENTS": "1"}
-    # the events of one run, to choose kill points from
-    probe = _stl(changed, tmp_path / "probe", env=env)
-    _, err = probe.communicate(timeout=600)
-    events = [line.split(": ", 1)[1] for line in err.splitlines() if line.startswith("rigcad-event: ")]
-    assert "publishing" in events and len(events) >= 8, events
-    kill_at = sorted({1, len(events) // 3, 2 * len(events) // 3, events.index("publishing") + 1})
-    for k in kill_at:
+    for event in KILL_AT:
         run = _stl(changed, exports, env=env)
-        seen = 0
+        seen = []
         for line in run.stderr:
             if line.startswith("rigcad-event: "):
-                seen += 1
-                if seen == k:
+                seen.append(line.split(": ", 1)[1].strip())
+                if seen[-1] == event:
                     run.send_signal(signal.SIGKILL)
                     break
         run.wait(timeout=600)
+        assert seen[-1] == event, f"the run ended before the event {event!r}: {seen}"
         # publishing takes milliseconds: the kill sent at its event may land during it or after it
-        finished_ok = events[k - 1] == "publishing" and run.returncode == 0
-        assert run.returncode == -signal.SIGKILL or finished_ok, f"the run ended before event {k}"
-        assert _consistent(out) == [], f"killed at event {k} ({events[k - 1]}): {_consistent(out)}"
+        assert run.returncode == -signal.SIGKILL or (event == "publishing" and run.returncode == 0), event
+        assert _consistent(out) == [], f"killed at {event!r}: {_consistent(out)}"
         now = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
-        assert now == before or _consistent(out) == [], k  # the old run, or the whole new one
+        assert now == before or _consistent(out) == [], event  # the old run, or the whole new one
     done = _stl(changed, exports)
     assert done.wait(timeout=600) == 0, done.stderr.read()
     assert _consistent(out) == [] and _leftovers(exports) == []
