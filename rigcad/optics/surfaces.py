@@ -24,6 +24,10 @@ from rigcad.profile.derived import Derived
 #: apart, well inside Newton's basin (the mirrors' radii of curvature are >= 5.9 mm); the same count
 #: the mirror meshes plan with.
 FOOT_SAMPLES = 20001
+#: Samples per leaf of the seeds' KD tree. The samples lie on a curve, so a query from a point
+#: millimetres off it visits many small leaves: 128 (scipy's default is 16) finds the same nearest
+#: sample about 1.8x faster on fabrication's points, 2.4x on points far behind the mirrors.
+FOOT_TREE_LEAFSIZE = 128
 #: Newton steps for a foot point. Each step shrinks the tangential residual by about curvature x
 #: distance (< 0.02 / mm x 0.1 mm on a facet), so 3-4 steps reach rounding.
 FOOT_NEWTON_STEPS = 8
@@ -152,7 +156,7 @@ class Meridian:
         # the sign that makes (n_z, -n_r) point along +u (finite-difference tangent against the normal)
         t = np.gradient(p, u, axis=0)
         side = float(np.sign(t[0, 0] * n[0, 1] - t[0, 1] * n[0, 0]))
-        return _FootTable(u, p, np.gradient(s, u), side, cKDTree(p))
+        return _FootTable(u, p, np.gradient(s, u), side, cKDTree(p, leafsize=FOOT_TREE_LEAFSIZE))
 
     def foot_points(self, rz: np.ndarray) -> np.ndarray:
         """Parameters u (n,) of the points of this curve nearest to ``rz`` (n, 2) in (r, z), mm.
