@@ -143,7 +143,7 @@ def step_map(layers: Layers, rotation: np.ndarray, shift: np.ndarray, mirror: Mi
     stride = max(1, int(np.ceil(total / max_points)))
     d_part = rotation.T @ np.array([0.0, 0.0, 1.0])
     pts_out, cusp_out = [], []
-    # per layer: mirror points, and the segments of the layer for the next layer's search
+    # per layer: the segments of the layer (for the next layer's search) and its examined points
     per_layer = []
     for z, polys in zip(layers.heights, layers.contours):
         if not polys:
@@ -154,8 +154,17 @@ def step_map(layers: Layers, rotation: np.ndarray, shift: np.ndarray, mirror: Mi
         pick = a[::stride]
         printer = np.column_stack([pick, np.full(len(pick), z)]) - shift
         part = printer @ rotation  # rotation.T applied to row vectors: printer -> part
-        on = np.abs(mirror.signed_distance(part)) < tol
-        per_layer.append((a, b, pick[on], part[on]))
+        per_layer.append((a, b, pick, part))
+    # the mirror's own points: one foot-point solve for every layer (each point converges on its
+    # own, so the same bits as layer by layer)
+    picked = [entry[3] for entry in per_layer if entry is not None]
+    if picked:
+        on_mirror = np.abs(mirror.signed_distance(np.concatenate(picked))) < tol
+        masks = iter(np.split(on_mirror, np.cumsum([len(p) for p in picked])[:-1]))
+        for k, entry in enumerate(per_layer):
+            if entry is not None:
+                on = next(masks)
+                per_layer[k] = (entry[0], entry[1], entry[2][on], entry[3][on])
     for k, entry in enumerate(per_layer):
         if entry is None or len(entry[2]) == 0:
             continue
@@ -173,8 +182,7 @@ def step_map(layers: Layers, rotation: np.ndarray, shift: np.ndarray, mirror: Mi
         return StepMap(tuple(d_part), t, np.zeros((0, 3)), empty, empty, empty, empty)
     pts = np.concatenate(pts_out)
     cusp = np.concatenate(cusp_out)
-    top = mirror.signed_distance(pts + 0.5 * t * d_part)
-    bottom = mirror.signed_distance(pts - 0.5 * t * d_part)
+    top, bottom = np.split(mirror.signed_distance(np.concatenate([pts + 0.5 * t * d_part, pts - 0.5 * t * d_part])), 2)
     closed = closed_form_cusp(mirror.normals(pts), d_part, t)
     return StepMap(tuple(float(v) for v in d_part), t, pts, cusp, closed,
                    np.maximum(top, bottom), np.minimum(top, bottom))
