@@ -244,28 +244,40 @@ def _plane_frame(normal: np.ndarray, origin: np.ndarray) -> np.ndarray:
     return np.hstack([rot, (-rot @ origin)[:, None]])
 
 
-def _loops_on_planes(man: m3d.Manifold, sectors: int, phase: float) -> int:
-    """Loops of the part's slices on the sector half-planes (features crossed add loops)."""
+def _loops_on_half_plane(man: m3d.Manifold, a: float) -> int:
+    """Loops of the part's slice on the half-plane through the axis at angle ``a`` (rad)."""
+    n = np.array([-math.sin(a), math.cos(a), 0.0])
+    frame = _plane_frame(n, np.zeros(3))
+    cs = man.transform(frame.tolist()).slice(0.0)
+    # keep the half-plane on the radial side of angle a: in the plane frame, radial = (0, 1)
+    # since e1 = z and e2 = n x z = radial
+    half = m3d.CrossSection.square((_BIG, _BIG)).translate((-_BIG / 2, 0.0))
+    return len((cs ^ half).to_polygons())
+
+
+def _loops_on_planes(man: m3d.Manifold, sectors: int, phase: float, seen: dict | None = None) -> int:
+    """Loops of the part's slices on the sector half-planes (features crossed add loops).
+    ``seen`` maps angles (rad, exact floats) already sliced on ``man`` to their loops."""
+    seen = {} if seen is None else seen
     total = 0
     for i in range(sectors):
         a = phase + i * 2 * math.pi / sectors
-        n = np.array([-math.sin(a), math.cos(a), 0.0])
-        frame = _plane_frame(n, np.zeros(3))
-        cs = man.transform(frame.tolist()).slice(0.0)
-        # keep the half-plane on the radial side of angle a: in the plane frame, radial = (0, 1)
-        # since e1 = z and e2 = n x z = radial
-        half = m3d.CrossSection.square((_BIG, _BIG)).translate((-_BIG / 2, 0.0))
-        total += len((cs ^ half).to_polygons())
+        if a not in seen:
+            seen[a] = _loops_on_half_plane(man, a)
+        total += seen[a]
     return total
 
 
-def choose_phase(man: m3d.Manifold, sectors: int, step_deg: float = 2.5) -> float:
-    """Sector phase (rad) crossing the fewest features; the middle of the widest range of such."""
+def choose_phase(man: m3d.Manifold, sectors: int, step_deg: float = 2.5, seen: dict | None = None) -> float:
+    """Sector phase (rad) crossing the fewest features; the middle of the widest range of such.
+    ``seen``: the slices counted so far on ``man`` (see _loops_on_planes), shared between sector
+    counts (2 and 4 sectors share half their half-planes, bit for bit)."""
     if sectors == 1:
         return 0.0
     period = 360.0 / sectors
     grid = np.arange(0.0, period, step_deg)
-    loops = np.array([_loops_on_planes(man, sectors, math.radians(g)) for g in grid])
+    seen = {} if seen is None else seen
+    loops = np.array([_loops_on_planes(man, sectors, math.radians(g), seen) for g in grid])
     best = loops == loops.min()
     # widest circular run of best phases
     n = len(grid)
@@ -294,9 +306,10 @@ def plan_split(man: m3d.Manifold, fits) -> SplitPlan:
     z0, z1 = bb[2], bb[5]
     options = sorted(((s, b) for s in SECTOR_COUNTS for b in BAND_COUNTS), key=lambda sb: (sb[0] * sb[1], sb[1]))
     phases: dict[int, float] = {}
+    seen: dict[float, int] = {}  # half-plane angle -> loops, shared by the sector counts
     for s, b in options:
         if s not in phases:
-            phases[s] = choose_phase(man, s)
+            phases[s] = choose_phase(man, s, seen=seen)
         for cuts in band_cuts(z0, z1, b):
             plan = SplitPlan(s, b, phases[s], cuts)
             if all(fits(cell(man, plan, i, j), plan, i, j) for i in range(s) for j in range(b)):
