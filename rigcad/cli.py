@@ -12,7 +12,7 @@ from pathlib import Path
 
 from rigcad import __version__
 from rigcad.errors import RigcadError
-from rigcad.export.atomic import profile_lock
+from rigcad.export.atomic import profile_lock, tidy
 from rigcad.units import DEG
 
 
@@ -194,6 +194,7 @@ def cmd_stl(args: argparse.Namespace) -> int:
     out = Path(args.exports) / profile.name
     key = inputs_key(profile)
     if up_to_date(out, key):
+        tidy(out, profile_lock(args.exports, profile.name))
         print(f"{profile.name}: up to date ({out}/manifest.json)")
         return 0
     from rigcad.export.build import build_rig

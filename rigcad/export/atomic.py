@@ -289,6 +289,20 @@ def clean_leftovers(folder: Path) -> list[Path]:
     return removed
 
 
+def tidy(folder: Path, lock: Path) -> list[Path]:
+    """Remove a killed run's leftovers beside ``folder`` when this run publishes nothing (an
+    up-to-date folder: a run killed after its exchange, while it deleted the old tree, left the new
+    one complete). The lock is taken only when there is something to remove."""
+    folder = Path(folder)
+    if not any(folder.parent.glob(f".{folder.name}.new-*")) and not any(folder.parent.glob(f".{folder.name}.old-*")):
+        return []
+    held = hold_lock(lock)
+    try:
+        return clean_leftovers(folder)
+    finally:
+        held.release()
+
+
 def profile_lock(exports: Path, profile: str) -> Path:
     """The one lock of everything written for ``profile`` under the exports root ``exports``
     (stl, design, check and fab runs all hold it): ``exports/.<profile>.lock``."""

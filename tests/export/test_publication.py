@@ -169,6 +169,23 @@ def test_stale_leftovers_of_a_killed_run_are_removed_by_the_next(tmp_path):
     assert (out / "keep.txt").read_text() == "the last good run" and (out / "new.txt").read_bytes() == b"new"
 
 
+def test_an_up_to_date_run_removes_what_a_run_killed_while_publishing_left(tmp_path):
+    """Killed after its exchange, while deleting the old tree, a run leaves its new folder complete
+    and an .old- sibling: the next `rigcad stl` finds the folder up to date and publishes nothing,
+    so it removes the sibling itself (rigcad.export.atomic.tidy), under the profile's lock."""
+    from rigcad.export.atomic import tidy
+
+    exports = tmp_path / "exports"
+    out = exports / "rig"
+    out.mkdir(parents=True)
+    lock = exports / ".rig.lock"
+    assert tidy(out, lock) == [] and not lock.exists()  # nothing to remove: no lock taken
+    old = exports / ".rig.old-85ub6_oa"
+    old.mkdir()
+    (old / "dome.step").write_text("the previous run, half deleted")
+    assert tidy(out, lock) == [old] and not old.exists() and out.is_dir()
+
+
 def test_a_second_run_waits_for_the_first_and_says_who_holds_the_lock(tmp_path):
     lock = tmp_path / ".rig.lock"
     held = hold_lock(lock)
