@@ -269,18 +269,21 @@ _AT_FDCWD, _RENAME_EXCHANGE = -100, 2
 _renameat2 = _load_renameat2() if sys.platform.startswith("linux") else None
 
 
+def _stale_siblings(folder: Path) -> list[Path]:
+    """The staged (``.<name>.new-*``) and retired (``.<name>.old-*``) trees beside ``folder``."""
+    parent = folder.parent
+    if not parent.is_dir():
+        return []
+    return [*parent.glob(f".{folder.name}.new-*"), *parent.glob(f".{folder.name}.old-*")]
+
+
 def clean_leftovers(folder: Path) -> list[Path]:
     """Remove what a killed run on ``folder`` left: ``.<name>.new-*`` / ``.old-*`` siblings and
     rigcad's ``.*.tmp`` files inside. Call with the folder's lock held. Returns what was removed."""
     removed = []
-    parent = folder.parent
-    if parent.is_dir():
-        for p in parent.glob(f".{folder.name}.new-*"):
-            shutil.rmtree(p, ignore_errors=True)
-            removed.append(p)
-        for p in parent.glob(f".{folder.name}.old-*"):
-            shutil.rmtree(p, ignore_errors=True)
-            removed.append(p)
+    for p in _stale_siblings(folder):
+        shutil.rmtree(p, ignore_errors=True)
+        removed.append(p)
     if folder.is_dir():
         for p in folder.rglob(".*.tmp"):
             if p.is_file():
@@ -293,8 +296,7 @@ def tidy(folder: Path, lock: Path) -> list[Path]:
     """Remove a killed run's leftovers beside ``folder`` when this run publishes nothing (an
     up-to-date folder: a run killed after its exchange, while it deleted the old tree, left the new
     one complete). The lock is taken only when there is something to remove."""
-    folder = Path(folder)
-    if not any(folder.parent.glob(f".{folder.name}.new-*")) and not any(folder.parent.glob(f".{folder.name}.old-*")):
+    if not _stale_siblings(Path(folder)):
         return []
     held = hold_lock(lock)
     try:
