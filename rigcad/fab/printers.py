@@ -24,6 +24,7 @@ max_print_height), otherwise loading fails naming both values. When no PrusaSlic
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -143,6 +144,8 @@ _TOP: dict[str, Spec] = {
 }
 #: Largest sanding stock a printer file may ask for (mm): several layers of any printer; more is a unit slip.
 MAX_SANDING_STOCK = 2.0
+#: Control characters, never in a printer file's text (a line break would start a new slicer setting).
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 #: Keys of the ``slicer`` mapping.
 _SLICER_KEYS = ("vendor_bundle", "printer_preset", "print_preset", "filament_preset", "overrides")
 #: Printer keys a PrusaSlicer preset also states -> (preset key, unit of the preset's number).
@@ -156,8 +159,25 @@ _SECTIONS = {"build_volume": BuildVolume, "alignment_pin": AlignmentPin}
 
 
 def printer_path(name: str | Path) -> Path:
-    """A printer file by path, or by name under ``printers/`` on the profile search path."""
-    return find_file(name, "printer", sub=PRINTERS_SUBDIR)
+    """A printer file by path, or by name under ``printers/`` on the profile search path. Only a
+    YAML file (``.yaml``/``.yml``, its link target too) outside the system folders
+    (rigcad.fab.vendor.SYSTEM_DIRS) is read: ``--printer /etc/shadow`` is refused before the file
+    is opened, so its content is never shown."""
+    spec = Path(name)
+    if spec.suffix not in ("", ".yaml", ".yml"):
+        raise ProfileError(f"printer {str(name)[:200]!r} is not a printer file: printer files are YAML (.yaml), "
+                           f"found by name in {', '.join(str(d) + '/' for d in search_path(PRINTERS_SUBDIR))}")
+    if not spec.suffix:
+        spec = spec.with_suffix(".yaml")
+    refused = ProfileError(f"printer {str(name)[:200]!r} leads to a system folder or to a file that is not YAML, "
+                           "so it is not read; name a printer or give the path of its .yaml file")
+    if (spec.is_absolute() or len(spec.parts) > 1) and V.in_system_dir(spec.resolve()):
+        raise refused
+    path = find_file(spec if len(spec.parts) > 1 or spec.is_absolute() else spec.stem, "printer", sub=PRINTERS_SUBDIR)
+    real = path.resolve()
+    if V.in_system_dir(real) or real.suffix not in (".yaml", ".yml"):
+        raise refused
+    return path
 
 
 def available_printers() -> list[str]:
@@ -200,6 +220,9 @@ def load_printer(name: str | Path) -> Printer:
             top[key] = s.default if s.default is None or s.kind == "str" else convert_value(s, s.default, key, None)
             continue
         top[key] = convert_value(s, raw.data[key], key, raw.where((key,)))
+        if s.kind == "str" and isinstance(top[key], str) and _CONTROL.search(top[key]):
+            raise ProfileError(f"{key}: one line of text, without line breaks or control characters (it is written "
+                               "into the slicer's configuration)", where=raw.where((key,)))
     stock = raw.data.get("sanding_stock", "auto")
     if stock == "auto":
         top["sanding_stock"] = None

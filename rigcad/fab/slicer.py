@@ -1,9 +1,12 @@
 """G-code and project files through a real slicer: PrusaSlicer's command line, headless (Debian
 package prusa-slicer).
 
-For each piece rigcad writes one configuration (.ini) and runs ``prusa-slicer --export-gcode
---export-3mf --load piece.ini --center X,Y -o DIR piece.stl`` (in parallel, up to the cores).
-The configuration is, in this order, later keys winning:
+For each piece rigcad writes one configuration (.ini) into a private temporary folder and runs
+``prusa-slicer --export-gcode --load piece.ini --center X,Y --output DIR/piece.gcode piece.stl``,
+then ``--export-3mf`` the same way to ``DIR/piece.3mf`` (pieces in parallel, up to the cores);
+the folder must then hold exactly those files. The configuration holds only settings that shape a
+print (rigcad.fab.allowlist: no program, path or host ever reaches PrusaSlicer) and is, in this
+order, later keys winning:
 
 1. the printer's PrusaSlicer presets, flattened (rigcad.fab.vendor: the vendor's start G-code with
    its printer-model check and mesh bed levelling, the filament's temperatures, ...);
@@ -36,6 +39,7 @@ import io
 import os
 import re
 import shutil
+import stat
 import subprocess
 import tempfile
 import zipfile
@@ -46,6 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from rigcad.errors import FabricationError
+from rigcad.fab import allowlist as A
 from rigcad.fab.printers import Printer
 from rigcad.fab.vendor import TEXT
 
@@ -54,7 +59,7 @@ INSTALL_HINT = "install it with `apt-get install prusa-slicer` (Debian/Ubuntu) o
 #: Seconds one slice may take before it is abandoned (the dome quarter takes ~20 s on one core).
 TIMEOUT_S = 900
 #: Part of every cache key: bump when the post-processing of G-code or 3MF changes.
-OUTPUT_FORMAT = "rigcad-slice-2"
+OUTPUT_FORMAT = "rigcad-slice-3"
 
 #: Brim width (mm) when the rule asks for one: PrusaSlicer's usual 5 mm, several loops of a 0.4 mm nozzle.
 BRIM_WIDTH = 5.0
@@ -112,12 +117,14 @@ def _generic(printer: Printer, support: bool) -> dict[str, str]:
 
 def printer_ini(printer: Printer, support: bool, piece: dict[str, str] | None = None) -> str:
     """The PrusaSlicer configuration for one piece (see the module docstring for its layers):
-    ``piece`` holds rigcad's per-piece settings (brim, skirt) from :func:`placement`."""
+    ``piece`` holds rigcad's per-piece settings (brim, skirt) from :func:`placement`. Every
+    setting is checked against rigcad.fab.allowlist before it is written; text rigcad adds in
+    comments (the printer's name and description, the bundle's path) is escaped to one line."""
     cfg = printer.slicer_config
     if cfg is None:
         note = f"; presets not used: {printer.slicer_unavailable}" if printer.slicer_unavailable else ""
-        head = f"# rigcad: printer '{printer.name}' ({printer.description}): generic settings{note}\n"
-        return head + "".join(f"{k} = {val}\n" for k, val in _generic(printer, support).items())
+        return _render([f"rigcad: printer '{printer.name}' ({printer.description}): generic settings{note}"],
+                       _generic(printer, support))
     lines = dict(cfg.settings)
     lines.update({"layer_height": f"{printer.layer_height:g}", "first_layer_height": f"{printer.first_layer_height:g}",
                   "support_material": "1" if support else "0"})
@@ -125,10 +132,24 @@ def printer_ini(printer: Printer, support: bool, piece: dict[str, str] | None = 
     lines.update(cfg.overrides)
     names = (f"{cfg.printer_preset} + {cfg.print_preset} + {cfg.filament_preset}" if cfg.kind == "bundle"
              else "a user configuration")
-    head = (f"# rigcad: printer '{printer.name}' ({printer.description})\n"
-            f"# {names} from {cfg.source} ({cfg.vendor}), then rigcad's layer heights, support, brim and skirt, "
-            f"then the printer file's overrides ({', '.join(k for k, _ in cfg.overrides) or 'none'})\n")
-    return head + "".join(f"{k} = {lines[k]}\n" for k in sorted(lines))
+    head = [f"rigcad: printer '{printer.name}' ({printer.description})",
+            f"{names} from {cfg.source} ({cfg.vendor}), then rigcad's layer heights, support, brim and skirt, "
+            f"then the printer file's overrides ({', '.join(k for k, _ in cfg.overrides) or 'none'})"]
+    return _render(head, lines)
+
+
+def _one_line(text: str) -> str:
+    """``text`` with every control character escaped, so a comment stays one comment line."""
+    return re.sub(r"[\x00-\x1f\x7f]", lambda m: {"\n": "\\n", "\r": "\\r", "\t": "\\t"}.get(
+        m.group(), f"\\x{ord(m.group()):02x}"), text)
+
+
+def _render(comments: list[str], settings: dict[str, str]) -> str:
+    """A PrusaSlicer .ini: ``# comment`` lines, then ``key = value`` sorted by key, after
+    rigcad.fab.allowlist.check_config (only settings that shape a print, each value one line)."""
+    A.check_config(settings, "the configuration rigcad writes for PrusaSlicer")
+    return ("".join(f"# {_one_line(c)}\n" for c in comments)
+            + "".join(f"{k} = {settings[k]}\n" for k in sorted(settings)))
 
 
 @dataclass(frozen=True)
@@ -251,6 +272,7 @@ class SliceResult:
 _GENERATED = re.compile(rb"^(; generated by PrusaSlicer[^\n]*?) on \d{4}-\d\d-\d\d at \d\d:\d\d:\d\d UTC", re.M)
 _CONFIG_BLOCK = re.compile(rb"^; prusaslicer_config = begin\n(.*?)^; prusaslicer_config = end", re.M | re.S)
 _MODEL_DATES = re.compile(rb'(<metadata name="(?:CreationDate|ModificationDate)">)[^<]*(</metadata>)')
+_CONFIG_LINE = re.compile(rb"^; (\w+) = (.*)$")
 #: The 3MF member PrusaSlicer reads a project's settings from ("; key = value" lines).
 PROJECT_CONFIG = "Metadata/Slic3r_PE.config"
 #: Zip entry date of every 3MF member: the earliest a zip can hold, so no clock leaks in.
@@ -264,14 +286,27 @@ def normalise(gcode: bytes) -> bytes:
 
 def project_3mf(exported: bytes, gcode: bytes) -> bytes:
     """PrusaSlicer's CLI 3MF (model and placement, no settings) made into a project: the G-code's
-    configuration block, exactly what sliced it, stored as Metadata/Slic3r_PE.config in the
+    configuration block, the allow-listed settings that sliced it (rigcad.fab.allowlist; PrusaSlicer
+    reads the others, never given, as its defaults), stored as Metadata/Slic3r_PE.config in the
     format PrusaSlicer writes ("; generated by ..." then "; key = value" lines); creation dates
-    emptied and zip dates fixed so the bytes are deterministic."""
+    emptied and zip dates fixed so the bytes are deterministic. The result is read back and
+    checked (:func:`check_project`): a project never carries a program or a path to PrusaSlicer."""
     block = _CONFIG_BLOCK.search(gcode)
     if block is None:
         raise FabricationError("the G-code has no '; prusaslicer_config = begin ... end' block to put into the 3MF")
+    kept = []
+    for line in block.group(1).splitlines(keepends=True):
+        m = _CONFIG_LINE.match(line)
+        if m is None:
+            continue
+        key, value = m.group(1).decode(), m.group(2).decode("utf-8", "replace")
+        if key in A.ALLOWED_KEYS:
+            kept.append(line)
+        elif key in A.REFUSED and not A.harmless(key, value):
+            raise FabricationError(f"{SLICER} sliced with {key} set ({A.REFUSED[key][0]}), which rigcad never "
+                                   "hands it; the G-code is not kept")
     first = gcode.split(b"\n", 1)[0]
-    config = first + b"\n\n" + block.group(1)
+    config = first + b"\n\n" + b"".join(kept)
     out = io.BytesIO()
     try:
         with zipfile.ZipFile(io.BytesIO(exported)) as src, zipfile.ZipFile(out, "w") as dst:
@@ -285,7 +320,34 @@ def project_3mf(exported: bytes, gcode: bytes) -> bytes:
             _add(dst, PROJECT_CONFIG, config)
     except zipfile.BadZipFile as err:
         raise FabricationError(f"{SLICER} wrote a 3MF that is not a zip: {err}") from err
-    return out.getvalue()
+    project = out.getvalue()
+    check_project(project)
+    return project
+
+
+#: Per-object and per-volume keys PrusaSlicer 2.5's CLI writes into Metadata/Slic3r_PE_model.config.
+MODEL_KEYS = frozenset({"name", "volume_type", "matrix", "source_file", "source_object_id", "source_volume_id",
+                        "source_offset_x", "source_offset_y", "source_offset_z", "source_in_inches",
+                        "source_in_meters"})
+_MODEL_CONFIG = "Metadata/Slic3r_PE_model.config"
+
+
+def check_project(project: bytes) -> None:
+    """Read a 3MF project as PrusaSlicer would and refuse (FabricationError) any setting in it
+    that is not on rigcad.fab.allowlist's list, so opening the project runs nothing: the
+    project's configuration, and the per-object settings of its model configuration."""
+    try:
+        with zipfile.ZipFile(io.BytesIO(project)) as z:
+            names = set(z.namelist())
+            config = z.read(PROJECT_CONFIG).decode("utf-8", "replace") if PROJECT_CONFIG in names else ""
+            model = z.read(_MODEL_CONFIG).decode("utf-8", "replace") if _MODEL_CONFIG in names else ""
+    except zipfile.BadZipFile as err:
+        raise FabricationError(f"the 3MF project is not a zip: {err}") from err
+    settings = dict(re.findall(r"^; (\S+) = (.*)$", config, re.M))
+    A.check_config(settings, f"the 3MF project's {PROJECT_CONFIG}")
+    for key in re.findall(r'<metadata type="(?:object|volume)" key="([^"]*)"', model):
+        if key not in MODEL_KEYS and key not in A.ALLOWED_KEYS:
+            raise FabricationError(f"the 3MF project's {_MODEL_CONFIG}: setting {key} is not kept: {A.why_refused(key)}")
 
 
 def _add(z: zipfile.ZipFile, name: str, data: bytes) -> None:
@@ -333,32 +395,62 @@ def _safe(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]", "_", name) or "piece"
 
 
-def _run(exe: str, job: SliceJob) -> SliceResult:
+#: The names of the files in a slicing folder besides the piece's STL: what rigcad writes and
+#: the two outputs it asks PrusaSlicer for by explicit path.
+RUN_INI, RUN_GCODE, RUN_3MF = "piece.ini", "piece.gcode", "piece.3mf"
+
+
+def _slicer(exe: str, args: list[str], d: Path, job: SliceJob) -> tuple[subprocess.CompletedProcess, float]:
     import time
 
+    t0 = time.perf_counter()
+    try:
+        proc = subprocess.run([exe, *args], cwd=d, capture_output=True, timeout=TIMEOUT_S, **TEXT)
+    except subprocess.TimeoutExpired as err:
+        raise FabricationError(f"{job.name}: {SLICER} took over {TIMEOUT_S} s") from err
+    log = proc.stdout + "\n" + proc.stderr
+    if proc.returncode != 0:
+        lines = [ln for ln in log.splitlines() if ln.strip() and "[trace]" not in ln][-3:]
+        hint = " (the piece does not fit the bed: split or orient it first)" if "could not fit" in log else ""
+        raise FabricationError(f"{job.name}: {SLICER} failed with exit code {proc.returncode}{hint}: "
+                               + " | ".join(lines))
+    return proc, time.perf_counter() - t0
+
+
+def _output(d: Path, name: str, job: SliceJob) -> bytes:
+    """The output rigcad asked for at ``d/name``: a regular file (not a link), read without
+    following links."""
+    path = d / name
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    except OSError as err:
+        raise FabricationError(f"{job.name}: {SLICER} did not write {name} where rigcad asked ({err.strerror})") from err
+    with os.fdopen(fd, "rb") as fh:
+        if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+            raise FabricationError(f"{job.name}: {SLICER}'s {name} is not a regular file")
+        return fh.read()
+
+
+def _run(exe: str, job: SliceJob) -> SliceResult:
+    """Slice one piece in a private temporary folder: PrusaSlicer writes the G-code, then the 3MF,
+    each to the explicit path rigcad gives with --output (no name template, no other folder).
+    Afterwards the folder must hold exactly rigcad's inputs and those two files."""
     with tempfile.TemporaryDirectory(prefix="rigcad-slice-") as tmp:
         d = Path(tmp)
         stl = f"{_safe(job.name)}.stl"  # PrusaSlicer names the object (and its G-code label) after the file
         (d / stl).write_bytes(job.stl)
-        (d / "piece.ini").write_text(job.ini)
-        (d / "out").mkdir()
-        cmd = [exe, "--export-gcode", "--export-3mf", "--load", "piece.ini",
-               "--center", f"{job.center[0]:g},{job.center[1]:g}", "-o", "out", stl]
-        t0 = time.perf_counter()
-        try:
-            proc = subprocess.run(cmd, cwd=d, capture_output=True, timeout=TIMEOUT_S, **TEXT)
-        except subprocess.TimeoutExpired as err:
-            raise FabricationError(f"{job.name}: {SLICER} took over {TIMEOUT_S} s") from err
-        seconds = time.perf_counter() - t0
-        log = proc.stdout + "\n" + proc.stderr
-        gcodes, projects = sorted((d / "out").glob("*.gcode")), sorted((d / "out").glob("*.3mf"))
-        if proc.returncode != 0 or len(gcodes) != 1 or len(projects) != 1:
-            lines = [ln for ln in log.splitlines() if ln.strip() and "[trace]" not in ln][-3:]
-            hint = " (the piece does not fit the bed: split or orient it first)" if "could not fit" in log else ""
-            raise FabricationError(f"{job.name}: {SLICER} failed with exit code {proc.returncode}{hint}: "
-                                   + " | ".join(lines))
-        gcode = normalise(gcodes[0].read_bytes())
-        project = project_3mf(projects[0].read_bytes(), gcode)
+        (d / RUN_INI).write_text(job.ini, encoding="utf-8")
+        center = f"{job.center[0]:g},{job.center[1]:g}"
+        proc, seconds = _slicer(exe, ["--export-gcode", "--load", RUN_INI, "--center", center,
+                                      "--output", str(d / RUN_GCODE), stl], d, job)
+        _slicer(exe, ["--export-3mf", "--center", center, "--output", str(d / RUN_3MF), stl], d, job)
+        extra = sorted(set(os.listdir(d)) - {stl, RUN_INI, RUN_GCODE, RUN_3MF})
+        if extra:
+            raise FabricationError(f"{job.name}: {SLICER} wrote {', '.join(extra)[:200]}, which rigcad did not ask for; "
+                                   "the outputs are not kept")
+        gcode = normalise(_output(d, RUN_GCODE, job))
+        project = project_3mf(_output(d, RUN_3MF, job), gcode)
+    log = proc.stdout + "\n" + proc.stderr
     return SliceResult(job.name, gcode, seconds, parse_estimates(gcode), _warnings(log), project, dict(job.placement))
 
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rigcad.errors import FabricationError, ProfileError
+from rigcad.fab import allowlist as A
 
 #: Text mode for PrusaSlicer's output: UTF-8 whatever the locale (a "C" locale, as set by some
 #: libraries on import or found on CI, would make Python decode it as ASCII and fail on a degree sign).
@@ -65,8 +66,17 @@ class IniFile:
         return f"{self.path}:{line or self.section_lines.get(section, 1)}"
 
 
+#: Largest PrusaSlicer configuration read (bytes): the biggest bundle PrusaSlicer 2.5 ships,
+#: PrusaResearch.ini, is 0.4 MB; a user's exported .ini is ~20 kB.
+MAX_INI_BYTES = 16 * 1024 * 1024
+#: Control characters no PrusaSlicer configuration holds (tab allowed; line ends split lines).
+_INI_CONTROL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
+
+
 def read_ini(path: str | Path) -> IniFile:
-    """Parse an INI file (cached per process while the file is unchanged)."""
+    """Parse an INI file (cached per process while the file is unchanged). Errors name the file
+    and line, never the file's content: a file that is not a PrusaSlicer configuration is not
+    quoted back."""
     path = Path(path)
     try:
         st = path.stat()
@@ -77,10 +87,23 @@ def read_ini(path: str | Path) -> IniFile:
 
 @functools.lru_cache(maxsize=32)
 def _read_ini(path: Path, size: int, mtime_ns: int) -> IniFile:  # size, mtime: part of the cache key
+    not_ini = f"{path} is not a PrusaSlicer configuration"
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise FabricationError(f"cannot read PrusaSlicer configuration {path}: {err}") from err
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_INI_BYTES + 1)
+    except OSError as err:
+        raise FabricationError(f"cannot read PrusaSlicer configuration {path}: {err.strerror}") from err
+    if len(data) > MAX_INI_BYTES:
+        raise FabricationError(f"{not_ini}: larger than {MAX_INI_BYTES >> 20} MiB (PrusaSlicer's bundles are < 1 MB)")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data.count(b"\n", 0, err.start) + 1
+        raise FabricationError(f"{not_ini}: not UTF-8 (byte offset {err.start})", where=f"{path}:{line}") from None
+    bad = _INI_CONTROL.search(text)
+    if bad:
+        line = text.count("\n", 0, bad.start()) + 1
+        raise FabricationError(f"{not_ini}: control character U+{ord(bad.group()):04X}", where=f"{path}:{line}")
     top: dict[str, str] = {}
     sections: dict[str, dict[str, str]] = {}
     section_lines: dict[str, int] = {}
@@ -92,21 +115,21 @@ def _read_ini(path: Path, size: int, mtime_ns: int) -> IniFile:  # size, mtime: 
             continue
         if s[0] == "[":
             if not s.endswith("]"):
-                raise FabricationError(f"{path}:{n}: unclosed section header {s!r}")
+                raise FabricationError(f"{not_ini}: an unclosed section header", where=f"{path}:{n}")
             name = s[1:-1].strip()
             if name in sections:
-                raise FabricationError(f"{path}:{n}: section [{name}] is given twice "
-                                       f"(first at line {section_lines[name]})")
+                raise FabricationError(f"section [{name[:60]}] is given twice (first at line {section_lines[name]})",
+                                       where=f"{path}:{n}")
             current = sections[name] = {}
             section_lines[name] = n
             continue
         key, eq, value = s.partition("=")
         key = key.strip()
         if not eq or not key:
-            raise FabricationError(f"{path}:{n}: expected 'key = value' or '[section]', got {s[:60]!r}")
+            raise FabricationError(f"{not_ini}: expected 'key = value' or '[section]'", where=f"{path}:{n}")
         if key in current:
-            raise FabricationError(f"{path}:{n}: key {key!r} is given twice in [{name}] "
-                                   f"(first at line {lines[(name, key)]})")
+            raise FabricationError(f"key {key[:60]!r} is given twice in [{name[:60]}] (first at line "
+                                   f"{lines[(name, key)]})", where=f"{path}:{n}")
         current[key] = value.strip()
         lines[(name, key)] = n
     return IniFile(path, top, sections, section_lines, lines)
@@ -173,19 +196,54 @@ def available_bundles(dirs: list[Path] | None = None) -> dict[str, Path]:
     return out
 
 
+#: Folders whose files are never a slicer configuration or a printer file (kernel, devices, system
+#: settings and secrets): refused before they are opened, wherever a search path points.
+SYSTEM_DIRS = tuple(Path(p) for p in ("/proc", "/sys", "/dev", "/etc", "/run", "/boot"))
+#: A bundle named rather than given by path: a file name without folder or suffix.
+_BUNDLE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9 _+.-]{0,127}")
+
+
+def in_system_dir(path: Path) -> bool:
+    """Whether ``path`` (resolved) lies under one of :data:`SYSTEM_DIRS`."""
+    return any(path == d or d in path.parents for d in SYSTEM_DIRS)
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    return path == folder or folder in path.parents
+
+
 def find_bundle(spec: str, base: Path | None = None, where: str | None = None,
                 dirs: list[Path] | None = None) -> Path:
-    """A bundle by name (``PrusaResearch``) among the installed ones, or an .ini file by path
-    (relative paths from ``base``, the printer file's folder). Errors say where rigcad looked."""
-    if spec.endswith(".ini") or "/" in spec or os.sep in spec:
-        path = Path(spec).expanduser()
-        if not path.is_absolute() and base is not None:
-            path = base / path
-        if path.is_file():
-            return path
-        raise ProfileError(f"slicer.vendor_bundle: no file {str(path)!r} (a bundle name such as 'PrusaResearch', "
-                           "or the path of a PrusaSlicer .ini, relative to the printer file)", where=where)
+    """A bundle by name (``PrusaResearch``) among the installed ones, or a PrusaSlicer ``.ini`` by
+    path, relative to ``base`` (the printer file's folder). A path is read only when it stays,
+    links resolved, inside ``base``, a folder of the profile search path or an installed bundle
+    folder, and outside :data:`SYSTEM_DIRS`, as ``extends:`` is resolved; anything else is refused
+    before it is opened, so its content is never shown. Errors say where rigcad looked."""
+    from rigcad.profile.loader import search_path
+
     search = dirs if dirs is not None else bundle_dirs()
+    named = not spec.endswith(".ini") and "/" not in spec and "\\" not in spec and os.sep not in spec
+    if named and not _BUNDLE_NAME.fullmatch(spec):
+        raise ProfileError(f"slicer.vendor_bundle: {spec[:60]!r} is neither an installed bundle's name (letters, "
+                           "digits, '_', '-', e.g. PrusaResearch) nor the path of a PrusaSlicer .ini", where=where)
+    if not named:
+        given = Path(spec)
+        path = given if given.is_absolute() or base is None else base / given
+        real = path.resolve()
+        roots = list(dict.fromkeys(r.resolve() for r in ([base] if base is not None else []) + search_path()
+                                   + list(search)))
+        if given.suffix != ".ini" or real.suffix != ".ini":
+            problem = "is not a PrusaSlicer .ini file"
+        elif in_system_dir(real) or not any(_inside(real, r) for r in roots):
+            problem = "leads outside the printer file's folder and the profile search path"
+        elif not real.is_file():
+            raise ProfileError(f"slicer.vendor_bundle: no file {spec!r} (a bundle name such as 'PrusaResearch', "
+                               "or the path of a PrusaSlicer .ini, relative to the printer file)", where=where)
+        else:
+            return real
+        raise ProfileError(f"slicer.vendor_bundle: {spec[:200]!r} {problem}, so it is not read; name an installed "
+                           "bundle (e.g. PrusaResearch) or a .ini beside the printer file or in "
+                           + ", ".join(str(r) + "/" for r in roots[:4]), where=where)
     found = available_bundles(search)
     if spec in found:
         return found[spec]
@@ -198,8 +256,6 @@ def find_bundle(spec: str, base: Path | None = None, where: str | None = None,
     raise ProfileError(f"slicer.vendor_bundle: no bundle {spec!r}{hint}; installed: {', '.join(sorted(found))} "
                        f"(looked in {looked})", where=where)
 
-
-# -- bundles and their presets -----------------------------------------------------------------------
 
 @dataclass(frozen=True)
 class Bundle:
@@ -257,6 +313,22 @@ class Bundle:
         out.pop("inherits", None)
         self._flat[key] = out
         return out
+
+    def where_set(self, group: str, name: str, key: str) -> str:
+        """file:line of the section that gives ``key`` its value in preset ``name`` (its own
+        keys first, then its parents from the last to the first, as :meth:`_flatten` applies them)."""
+        def find(n: str, seen: tuple[str, ...]) -> str | None:
+            own = self._section(group, n)
+            if own is None or n in seen:
+                return None
+            if key in own:
+                return self.ini.where(f"{group}:{n}", key)
+            for parent in reversed(split_inherits(own.get("inherits", ""))):
+                hit = find(parent, seen + (n,))
+                if hit:
+                    return hit
+            return None
+        return find(name, ()) or self.ini.where(f"{group}:{name}")
 
     def _unknown(self, group: str, name: str) -> str:
         names = self.presets(group)
@@ -437,9 +509,15 @@ def resolve(source: Path, printer: str | None, print_: str | None, filament: str
                                f"(e.g. {missing[0]}_preset: {b.presets(missing[0])[0]!r})",
                                where=where.get("vendor_bundle"))
         merged: dict[str, str] = {}
+        group_of: dict[str, str] = {}
         for g in GROUPS:
-            merged.update(b.flatten(g, names[g], where.get(f"{g}_preset")))
+            flat = b.flatten(g, names[g], where.get(f"{g}_preset"))
+            merged.update(flat)
+            group_of.update(dict.fromkeys(flat, g))
         kind, vendor = "bundle", b.label()
+
+        def line_of(key: str) -> str:
+            return b.where_set(group_of[key], names[group_of[key]], key)
     else:
         given = [g + "_preset" for g, n in names.items() if n]
         if given:
@@ -448,7 +526,10 @@ def resolve(source: Path, printer: str | None, print_: str | None, filament: str
                                where=where.get(given[0]))
         merged = dict(ini.top)
         kind, vendor = "config", "user configuration"
-    settings = {k: v for k, v in merged.items() if k not in BUNDLE_ONLY}
+
+        def line_of(key: str) -> str:
+            return ini.where("", key)
+    settings = A.filter_preset({k: v for k, v in merged.items() if k not in BUNDLE_ONLY}, line_of)
     if kind == "bundle":
         settings.update({"print_settings_id": print_, "printer_settings_id": printer,
                          "filament_settings_id": '"' + filament.replace('"', '\\"') + '"'})
@@ -459,12 +540,17 @@ def resolve(source: Path, printer: str | None, print_: str | None, filament: str
         if key in BUNDLE_ONLY:
             raise ProfileError(f"slicer.overrides.{key}: a bundle's bookkeeping key, not a PrusaSlicer setting",
                                where=at)
-        if key not in known:
-            close = difflib.get_close_matches(key, sorted(known), n=1)
+        if key not in A.ALLOWED_KEYS and key not in A.REFUSED:
+            if key in known:
+                raise ProfileError(f"slicer.overrides.{key}: refused: {A.why_refused(key)}", where=at)
+            close = difflib.get_close_matches(key, sorted(A.ALLOWED_KEYS), n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
-            raise ProfileError(f"slicer.overrides: unknown PrusaSlicer setting {key!r}{hint}; valid keys are those of "
-                               f"`prusa-slicer --help-fff` with '_' for '-' ({len(known)} known)", where=at)
-        over[key] = ini_value(value, key, at)
+            raise ProfileError(f"slicer.overrides: unknown PrusaSlicer setting {key!r}{hint}; valid keys are the "
+                               f"{len(A.ALLOWED_KEYS)} settings that shape a print (rigcad.fab.allowlist.ALLOWED, "
+                               "PrusaSlicer's names as in `prusa-slicer --help-fff` with '_' for '-')", where=at)
+        text = ini_value(value, key, at)
+        A.check_override(key, text, at)
+        over[key] = text
     check_values(over, {k: where.get(f"overrides.{k}") for k in over})
     return VendorConfig(source=path, kind=kind, vendor=vendor, printer_preset=printer, print_preset=print_,
                         filament_preset=filament, settings=tuple(sorted(settings.items())),

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from rigcad.errors import FabricationError, ProfileError
+from rigcad.fab import allowlist as A
 from rigcad.fab import slicer as S
 from rigcad.fab import vendor as V
 from rigcad.fab.printers import load_printer
@@ -318,7 +319,12 @@ def test_a_cube_sliced_for_the_mk3s_carries_the_vendor_settings(tmp_path):
     model = z.read("3D/3dmodel.model").decode()
     assert re.search(r'name="CreationDate">\d', model) is None
     inside = comments(z.read(S.PROJECT_CONFIG).decode())
-    assert inside == cfg  # the project holds exactly the settings that sliced the G-code
+    # the project holds exactly the allow-listed settings that sliced the G-code; the rest are
+    # PrusaSlicer's defaults (never handed to it), which it reads back as defaults
+    assert inside == {k: v for k, v in cfg.items() if k in A.ALLOWED_KEYS}
+    assert {k: cfg[k] for k in set(cfg) - set(inside)} == {
+        "post_process": "", "gcode_substitutions": "", "output_filename_format": "[input_filename_base].gcode",
+        "threads": cfg["threads"]}
 
     (again,), _ = S.slice_all([job], workers=1)
     assert again.gcode == res.gcode and again.project == res.project  # deterministic bytes
