@@ -133,6 +133,8 @@ REFUSED: dict[str, tuple[str, object]] = {
                  "printhost_password", "octoprint_host", "octoprint_apikey", "octoprint_cafile", "serial_port")},
     **{k: ("a print host's setting; rigcad uploads nothing", lambda v: True)
        for k in ("host_type", "printhost_authorization_type", "serial_speed")},
+    **{k: ("PrusaSlicer's own bookkeeping of its GUI presets, not the print", lambda v: True)
+       for k in ("preset_name", "preset_names")},
 }
 
 
@@ -169,8 +171,9 @@ RANGES: dict[str, tuple[float, float, str, str]] = {
                  "max_print_speed")},
 }
 
-#: Control characters: never in a value (a raw line break would start a new setting).
-_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+#: Control characters but tab: never in a value (a raw line break would start a new setting; tabs
+#: align comments in some vendors' G-code).
+_CONTROL = re.compile(r"[\x00-\x08\x0a-\x1f\x7f]")
 #: A temperature command with a literal value in custom G-code: M104/M109 nozzle, M140/M190 bed.
 _TEMP_GCODE = re.compile(r"^\s*(M10[49]|M1[49]0)\b[^;\n]*?\b[SR](-?\d+(?:\.\d*)?)\b", re.M | re.I)
 _GCODE_KEYS = ALLOWED["custom G-code (for the printer; never run here)"]

@@ -145,7 +145,7 @@ _TOP: dict[str, Spec] = {
 #: Largest sanding stock a printer file may ask for (mm): several layers of any printer; more is a unit slip.
 MAX_SANDING_STOCK = 2.0
 #: Control characters, never in a printer file's text (a line break would start a new slicer setting).
-_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+_CONTROL = re.compile(r"[\x00-\x08\x0a-\x1f\x7f]")
 #: Keys of the ``slicer`` mapping.
 _SLICER_KEYS = ("vendor_bundle", "printer_preset", "print_preset", "filament_preset", "overrides")
 #: Printer keys a PrusaSlicer preset also states -> (preset key, unit of the preset's number).

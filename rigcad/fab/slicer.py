@@ -144,6 +144,20 @@ def _one_line(text: str) -> str:
         m.group(), f"\\x{ord(m.group()):02x}"), text)
 
 
+def check_ini(text: str, what: str) -> None:
+    """A PrusaSlicer .ini as rigcad hands it over: comments and ``key = value`` lines only, every
+    setting allowed (rigcad.fab.allowlist.check_config); FabricationError otherwise."""
+    settings: dict[str, str] = {}
+    for n, line in enumerate(text.split("\n"), 1):
+        if not line.strip() or line.startswith("#"):
+            continue
+        key, eq, value = line.partition(" = ")
+        if not eq or not re.fullmatch(r"\w+", key) or "\r" in line:
+            raise FabricationError(f"{what}, line {n}: not a 'key = value' line")
+        settings[key] = value
+    A.check_config(settings, what)
+
+
 def _render(comments: list[str], settings: dict[str, str]) -> str:
     """A PrusaSlicer .ini: ``# comment`` lines, then ``key = value`` sorted by key, after
     rigcad.fab.allowlist.check_config (only settings that shape a print, each value one line)."""
@@ -466,6 +480,8 @@ def slice_all(jobs: list[SliceJob], cached: dict[str, tuple] | None = None,
     blocked = [j for j in jobs if j.problem]
     if blocked:
         raise FabricationError(f"no G-code was written: {blocked[0].problem}")
+    for job in jobs:  # every job's configuration, before any slicing starts
+        check_ini(job.ini, f"{job.name}'s configuration")
     version = slicer_version(exe)
     cached = cached or {}
     results: dict[str, SliceResult] = {}
