@@ -8,11 +8,11 @@ Inside: mm, float64.
 mapping naming PrusaSlicer's own presets (rigcad.fab.vendor)::
 
     slicer:
-      vendor_bundle: PrusaResearch        # an installed bundle, or the path of a PrusaSlicer .ini
+      vendor_bundle: PrusaResearch        # an installed bundle, or a PrusaSlicer .ini beside this file or on the search path
       printer_preset: Original Prusa i3 MK3S & MK3S+
       print_preset: 0.15mm QUALITY @MK3
       filament_preset: Prusament PLA
-      overrides: {brim_width: 5}          # any PrusaSlicer setting, checked against its key list
+      overrides: {brim_width: 5}          # settings that shape a print (rigcad.fab.allowlist), values checked
 
 The resolved preset (with the overrides) is what PrusaSlicer prints with, so it is the truth
 for the figures both state: layer_height, first_layer_height, nozzle, filament_diameter,
