@@ -14,14 +14,15 @@ def _hm(seconds: float) -> str:
 
 
 def cmd_fab(args: argparse.Namespace) -> int:
+    from rigcad.fab.printers import load_printer
+
+    printer = load_printer(args.printer)  # first: a refused printer file costs no rig and no CAD kernel import
     from rigcad.cli import _progress
     from rigcad.export.build import select_parts
-    from rigcad.fab.printers import load_printer
     from rigcad.fab.stage import run_fab
     from rigcad.export.atomic import profile_lock
     from rigcad.rig import load
 
-    printer = load_printer(args.printer)  # first: a refused printer file costs no rig
     rig = load(args.profile)
     profile = rig.profile
     out = Path(args.exports) / profile.name / "fab" / printer.name

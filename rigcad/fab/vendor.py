@@ -533,7 +533,6 @@ def resolve(source: Path, printer: str | None, print_: str | None, filament: str
     if kind == "bundle":
         settings.update({"print_settings_id": print_, "printer_settings_id": printer,
                          "filament_settings_id": '"' + filament.replace('"', '\\"') + '"'})
-    known = (set(merged) | slicer_keys()) - BUNDLE_ONLY
     over: dict[str, str] = {}
     for key, value in overrides.items():
         at = where.get(f"overrides.{key}")
@@ -541,7 +540,7 @@ def resolve(source: Path, printer: str | None, print_: str | None, filament: str
             raise ProfileError(f"slicer.overrides.{key}: a bundle's bookkeeping key, not a PrusaSlicer setting",
                                where=at)
         if key not in A.ALLOWED_KEYS and key not in A.REFUSED:
-            if key in known:
+            if key in (set(merged) | slicer_keys()) - BUNDLE_ONLY:  # PrusaSlicer knows it: not a print setting
                 raise ProfileError(f"slicer.overrides.{key}: refused: {A.why_refused(key)}", where=at)
             close = difflib.get_close_matches(key, sorted(A.ALLOWED_KEYS), n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
