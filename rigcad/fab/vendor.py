@@ -257,6 +257,8 @@ def find_bundle(spec: str, base: Path | None = None, where: str | None = None,
                        f"(looked in {looked})", where=where)
 
 
+# -- bundles and their presets -----------------------------------------------------------------------
+
 @dataclass(frozen=True)
 class Bundle:
     """A parsed vendor bundle; :meth:`flatten` gives a preset with its inherits chain applied."""
