@@ -26,7 +26,8 @@ def test_every_prusaslicer_setting_is_classified():
 
 @needs_bundle
 def test_every_installed_vendor_preset_passes_the_allow_list():
-    """The ranges and checks refuse no preset PrusaSlicer ships (1,393 presets in the 18 bundles of Debian's prusa-slicer 2.5.0)."""
+    """The ranges and checks refuse no preset PrusaSlicer ships (1,393 presets in the 18 bundles
+    of Debian's prusa-slicer 2.5.0)."""
     n = 0
     for path in V.available_bundles().values():
         b = V.load_bundle(path)
