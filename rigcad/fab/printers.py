@@ -8,7 +8,7 @@ Inside: mm, float64.
 mapping naming PrusaSlicer's own presets (rigcad.fab.vendor)::
 
     slicer:
-      vendor_bundle: PrusaResearch        # an installed bundle, or a PrusaSlicer .ini beside this file or on the search path
+      vendor_bundle: PrusaResearch        # an installed bundle, or a .ini beside this file or on the search path
       printer_preset: Original Prusa i3 MK3S & MK3S+
       print_preset: 0.15mm QUALITY @MK3
       filament_preset: Prusament PLA

@@ -361,7 +361,8 @@ def check_project(project: bytes) -> None:
     A.check_config(settings, f"the 3MF project's {PROJECT_CONFIG}")
     for key in re.findall(r'<metadata type="(?:object|volume)" key="([^"]*)"', model):
         if key not in MODEL_KEYS and key not in A.ALLOWED_KEYS:
-            raise FabricationError(f"the 3MF project's {_MODEL_CONFIG}: setting {key} is not kept: {A.why_refused(key)}")
+            raise FabricationError(f"the 3MF project's {_MODEL_CONFIG}: setting {key} is not kept: "
+                                   f"{A.why_refused(key)}")
 
 
 def _add(z: zipfile.ZipFile, name: str, data: bytes) -> None:
@@ -438,7 +439,8 @@ def _output(d: Path, name: str, job: SliceJob) -> bytes:
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
     except OSError as err:
-        raise FabricationError(f"{job.name}: {SLICER} did not write {name} where rigcad asked ({err.strerror})") from err
+        raise FabricationError(f"{job.name}: {SLICER} did not write {name} where rigcad asked "
+                               f"({err.strerror})") from err
     with os.fdopen(fd, "rb") as fh:
         if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
             raise FabricationError(f"{job.name}: {SLICER}'s {name} is not a regular file")
@@ -460,8 +462,8 @@ def _run(exe: str, job: SliceJob) -> SliceResult:
         _slicer(exe, ["--export-3mf", "--center", center, "--output", str(d / RUN_3MF), stl], d, job)
         extra = sorted(set(os.listdir(d)) - {stl, RUN_INI, RUN_GCODE, RUN_3MF})
         if extra:
-            raise FabricationError(f"{job.name}: {SLICER} wrote {', '.join(extra)[:200]}, which rigcad did not ask for; "
-                                   "the outputs are not kept")
+            raise FabricationError(f"{job.name}: {SLICER} wrote {', '.join(extra)[:200]}, which rigcad did not ask "
+                                   "for; the outputs are not kept")
         gcode = normalise(_output(d, RUN_GCODE, job))
         project = project_3mf(_output(d, RUN_3MF, job), gcode)
     log = proc.stdout + "\n" + proc.stderr

@@ -53,5 +53,6 @@ def test_every_installed_vendor_preset_passes_the_allow_list():
 ])
 def test_overrides_out_of_range_or_not_shaping_the_print_are_refused(tmp_path, key, value, expect):
     path = printer_yaml(tmp_path, slicer_section(overrides=f"    {key}: {json.dumps(value)}\n"))
-    with pytest.raises(ProfileError, match=rf"mk3s.yaml:{line_of(path, f'    {key}:')}: slicer.overrides.{key}: {expect}"):
+    line = line_of(path, f"    {key}:")
+    with pytest.raises(ProfileError, match=rf"mk3s.yaml:{line}: slicer.overrides.{key}: {expect}"):
         load_printer(path)
