@@ -187,13 +187,14 @@ def cmd_build(args: argparse.Namespace) -> int:
 
 def cmd_stl(args: argparse.Namespace) -> int:
     """The main job: design + build, returning at once when nothing changed since the last run."""
-    from rigcad.export.manifest import inputs_key, up_to_date
+    from rigcad.export.atomic import stale_results
+    from rigcad.export.manifest import inputs_key, profile_digest, up_to_date
     from rigcad.profile import load_profile
 
     profile = load_profile(args.profile)
     out = Path(args.exports) / profile.name
     key = inputs_key(profile)
-    if up_to_date(out, key):
+    if up_to_date(out, key) and not stale_results(out, profile_digest(profile)):  # else a build removes them
         tidy(out, profile_lock(args.exports, profile.name))
         print(f"{profile.name}: up to date ({out}/manifest.json)")
         return 0
