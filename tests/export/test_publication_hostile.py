@@ -57,6 +57,7 @@ def _outside(tmp_path: Path) -> tuple[Path, dict]:
     (home / "notes").mkdir(parents=True)
     (home / "precious.txt").write_text("three years of measurements\n")
     (home / "notes" / "a.txt").write_text("a\n")
+    (home / "empty-flag").write_bytes(b"")  # empty: nothing in its text tells it from a fresh lock
     return home, _tree(home)
 
 
@@ -76,7 +77,7 @@ def _plant_dangling(lock: Path, home: Path) -> None:
 
 
 def _plant_hardlink(lock: Path, home: Path) -> None:
-    os.link(home / "precious.txt", lock)
+    os.link(home / "empty-flag", lock)
 
 
 def _plant_foreign(lock: Path, home: Path) -> None:
