@@ -28,7 +28,12 @@ def cmd_basis(args: argparse.Namespace) -> int:
 
     order = check_basis_order(_order(args.order))  # before any work: a bad order is one line, nothing written
     alpha = None if args.alpha_deg is None else math.radians(args.alpha_deg)
-    rig = load(args.profile)
+    from rigcad.export.atomic import check_exports
+    from rigcad.profile import load_profile
+
+    profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name, "basis")  # a planted link or lock: one line now, not after the work
+    rig = load(profile)
     out = Path(args.exports) / rig.name / "basis"
     # the one lock of everything under exports/<profile>: a design or build publishing the whole
     # folder meanwhile waits, instead of deleting this run's staging folder

@@ -508,6 +508,18 @@ def profile_lock(exports: Path, profile: str) -> Path:
     return Path(exports) / f".{profile}.lock"
 
 
+def check_exports(exports: Path, profile: str, folder: str | None = None) -> None:
+    """Refuse at once, before any work, what publishing into ``exports/<profile>[/<folder>]`` would
+    refuse at its end: a symbolic link on the way there, a lock file rigcad did not make. Creates
+    nothing; the publication checks again under its lock."""
+    exports = Path(exports)
+    target = exports / profile if folder is None else exports / profile / folder
+    refuse_links(target, exports)
+    lock = profile_lock(exports, profile)
+    if os.path.lexists(lock):
+        os.close(_open_lock(lock))
+
+
 class _Lock:
     def __init__(self, fd: int) -> None:
         self.fd = fd

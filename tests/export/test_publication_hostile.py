@@ -145,6 +145,31 @@ def test_the_cli_refuses_a_linked_lock_in_one_line(tmp_path, capsys):
     assert sorted(p.name for p in exports.iterdir()) == [".achutha2006.lock"]  # nothing published
 
 
+@pytest.mark.parametrize("planted", ["lock", "folder"])
+@pytest.mark.parametrize("command", ["design", "build", "stl", "basis"])
+def test_a_planted_link_is_refused_before_any_work(tmp_path, capsys, monkeypatch, command, planted):
+    """The refusal comes before the rig is built (the dome integrated, the basis computed): a command
+    that would only find the link when it publishes has done all its work for nothing."""
+    from rigcad.cli import main
+    from rigcad.rig import Rig
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("the command started its work before refusing the planted link")
+
+    monkeypatch.setattr(Rig, "from_profile", no_work)
+    home, before = _outside(tmp_path)
+    exports = tmp_path / "exports"
+    exports.mkdir()
+    if planted == "lock":
+        (exports / ".achutha2006.lock").symlink_to(home / "precious.txt")
+    else:
+        (exports / "achutha2006").symlink_to(home, target_is_directory=True)
+    code = main([command, "achutha2006", "--exports", str(exports)])
+    line = _one_line(capsys.readouterr().err)
+    assert code != 0 and "symbolic link" in line, line
+    assert _tree(home) == before
+
+
 # -- a staging folder that vanishes is an error, never re-made ------------------------------------------
 @pytest.mark.parametrize("then", ["write", "commit"])
 @pytest.mark.parametrize("replaced_by", ["nothing", "a link"])
@@ -241,7 +266,7 @@ def test_a_linked_profile_folder_is_refused_and_its_target_untouched(tmp_path, c
     line = _one_line(capsys.readouterr().err)
     assert code != 0 and "achutha2006 is a symbolic link" in line, line
     assert _tree(home) == before, "the folder the link names changed"
-    assert sorted(p.name for p in exports.iterdir()) == [".achutha2006.lock", "achutha2006"]  # no .old-* left
+    assert {p.name for p in exports.iterdir()} <= {".achutha2006.lock", "achutha2006"}  # no .old-* left
     assert (exports / "achutha2006").is_symlink()
 
 
@@ -273,10 +298,13 @@ def test_links_inside_the_exports_are_not_carried_through(tmp_path):
     (out / "secret.txt").symlink_to(home / "precious.txt")
     (out / "notes").symlink_to(home / "notes", target_is_directory=True)
     (out / ".x.tmp").symlink_to(home / "precious.txt")  # a leftover name: the link goes, not its target
+    old_tree = out.parent / ".rig.old-1234"  # what an old run left when it swapped a linked folder away
+    old_tree.symlink_to(home, target_is_directory=True)
     with Staging(out) as stage:
         stage.write_bytes(out / "new.txt", b"new")
         stage.commit()
     assert _tree(out) == {"kept.txt": b"kept", "new.txt": b"new"}
+    assert not os.path.lexists(old_tree)
     inodes = {os.stat(p).st_ino for p in home.rglob("*")}
     assert not any(os.lstat(p).st_ino in inodes for p in out.rglob("*")), "an outside file was linked in"
     assert _tree(home) == before
