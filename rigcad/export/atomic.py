@@ -112,6 +112,16 @@ class Staging:
     over (default: all); a run that owns a family of files (say ``*bit/z_*.png``) drops the stale
     ones of an earlier run by refusing them here.
 
+    ``made_from`` (a result folder: check/, fab/<printer>/, ...): the SHA-256 of the profile the
+    results were made from (export.manifest.profile_digest), recorded beside the folder at commit;
+    the previous folder's files are carried over only when it records the same profile.
+    ``results_of`` (a whole ``exports/<profile>`` folder): the SHA-256 of the profile it is now built
+    from; result folders inside that record another profile, or none, are not carried over
+    (:attr:`stale`, reported on ``say`` at commit and by :meth:`stale_report`).
+
+    The folder, and every folder between the lock's folder (the exports root) and it, must be a
+    real folder, not a symbolic link; the staging folder must stay the one this run made.
+
     I/O failures (no space, permission, read-only file system, a file vanished) raise WriteError
     naming the path; the previous outputs are untouched.
     """
