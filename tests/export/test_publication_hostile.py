@@ -393,3 +393,35 @@ def test_a_result_folder_does_not_carry_files_of_another_profile(tmp_path):
     assert (exports / "rig" / "check" / "theta_map.png").is_file()  # same profile: carried
     _result(exports, "check", "b" * 64, files=("raycheck.json",))
     assert sorted(p.name for p in (exports / "rig" / "check").iterdir()) == ["raycheck.json"]
+
+
+def test_stl_removes_results_of_an_older_profile_even_when_up_to_date(tmp_path, capsys):
+    """The reported case: after the profile changed, `rigcad stl` rebuilt, and the old check/ and
+    fab/ results moved into the new folder unmarked. Now they are removed; and a result of another
+    profile published after an up-to-date build makes the next `stl` publish again, without it."""
+    from rigcad.cli import main
+    from rigcad.export.manifest import profile_digest
+    from rigcad.profile import load_profile
+
+    exports = tmp_path / "exports"
+    out = exports / "rig"
+    a = _profile(tmp_path / "a")
+    b = _profile(tmp_path / "b", "beam:\n  width: 5 mm\n")  # rebuilds the beam only
+    da = profile_digest(load_profile(a))
+    assert main(["stl", str(a), "--exports", str(exports)]) == 0
+    _result(exports, "check", da)
+    _result(exports, "fab/mk4", da)
+    capsys.readouterr()
+    assert main(["stl", str(b), "--exports", str(exports)]) == 0
+    err = capsys.readouterr().err
+    assert "rigcad: removed check/" in err and "rigcad: removed fab/mk4/" in err, err
+    assert not (out / "check").exists() and not (out / "fab" / "mk4").exists()
+    assert [r["folder"] for r in json.loads((out / "manifest.json").read_text())["stale_results_removed"]] == [
+        "check", "fab/mk4"]
+    _result(exports, "tolerance", da)  # a run of the older profile, published after the build
+    assert main(["stl", str(b), "--exports", str(exports)]) == 0
+    text = capsys.readouterr()
+    assert "up to date" not in text.out and "rigcad: removed tolerance/" in text.err, text
+    assert not (out / "tolerance").exists()
+    assert main(["stl", str(b), "--exports", str(exports)]) == 0
+    assert "up to date" in capsys.readouterr().out
