@@ -12,7 +12,7 @@ from pathlib import Path
 
 from rigcad import __version__
 from rigcad.errors import RigcadError
-from rigcad.export.atomic import profile_lock, tidy
+from rigcad.export.atomic import check_exports, profile_lock, tidy
 from rigcad.units import DEG
 
 
@@ -144,10 +144,13 @@ def _part_lines(result, names) -> list[str]:
 
 def cmd_design(args: argparse.Namespace) -> int:
     from rigcad.export.design import write_design
+    from rigcad.profile import load_profile
     from rigcad.rig import load
 
+    profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name)  # a planted link or lock: one line now, not after the work
     with _progress(3, "design") as step:
-        rig = load(args.profile)
+        rig = load(profile)
         step("dome integrated")
         design = rig.design
         step("traced")
@@ -171,11 +174,14 @@ def cmd_design(args: argparse.Namespace) -> int:
 
 def cmd_build(args: argparse.Namespace) -> int:
     from rigcad.export.build import build_rig, select_parts
+    from rigcad.profile import load_profile
     from rigcad.rig import load
 
     names = select_parts(args.parts)
+    profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name)
     with _progress(len(names) + 2, "build") as step:
-        rig = load(args.profile)
+        rig = load(profile)
         step("dome integrated")
         out = Path(args.exports) / rig.name
         result = build_rig(rig, out, names, progress=step, lock=profile_lock(args.exports, rig.name))
@@ -187,13 +193,15 @@ def cmd_build(args: argparse.Namespace) -> int:
 
 def cmd_stl(args: argparse.Namespace) -> int:
     """The main job: design + build, returning at once when nothing changed since the last run."""
-    from rigcad.export.manifest import inputs_key, up_to_date
+    from rigcad.export.atomic import stale_results
+    from rigcad.export.manifest import inputs_key, profile_digest, up_to_date
     from rigcad.profile import load_profile
 
     profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name)
     out = Path(args.exports) / profile.name
     key = inputs_key(profile)
-    if up_to_date(out, key):
+    if up_to_date(out, key) and not stale_results(out, profile_digest(profile)):  # else a build removes them
         tidy(out, profile_lock(args.exports, profile.name))
         print(f"{profile.name}: up to date ({out}/manifest.json)")
         return 0

@@ -346,15 +346,16 @@ def simulation_steps(moved_count: int | None = None) -> int:
     return SIM_STEPS_FIXED - 1 + (2 if moved_count is None else moved_count)
 
 
-def write_simulation(sim: RigSimulation, out_dir) -> list:
-    """Write simulation.json and simulation.png into ``out_dir`` (atomically, together)."""
+def write_simulation(sim: RigSimulation, out_dir, lock=None, made_from: str | None = None) -> list:
+    """Write simulation.json and simulation.png into ``out_dir`` (atomically, together; ``lock`` and
+    ``made_from`` as for :func:`rigcad.basis.projector.write_basis`)."""
     from pathlib import Path
 
     from rigcad import plots
     from rigcad.export.atomic import Staging, json_bytes
 
     out = Path(out_dir)
-    with Staging(out) as st:
+    with Staging(out, lock, made_from=made_from) as st:
         st.write_bytes(out / "simulation.json", json_bytes(sim.report))
         st.write_bytes(out / "simulation.png", plots.basis_simulation(sim.report))
         return st.commit()

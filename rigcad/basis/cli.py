@@ -22,22 +22,33 @@ def cmd_basis(args: argparse.Namespace) -> int:
     from rigcad.basis.acquire import simulate_on_rig, simulation_steps, write_simulation
     from rigcad.basis.projector import BASIS_STEPS, check_basis_order, projector_basis, write_basis
     from rigcad.cli import _progress
+    from rigcad.export.atomic import profile_lock
+    from rigcad.export.manifest import profile_digest
     from rigcad.rig import load
 
     order = check_basis_order(_order(args.order))  # before any work: a bad order is one line, nothing written
     alpha = None if args.alpha_deg is None else math.radians(args.alpha_deg)
-    rig = load(args.profile)
+    from rigcad.export.atomic import check_exports
+    from rigcad.profile import load_profile
+
+    profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name, "basis")  # a planted link or lock: one line now, not after the work
+    rig = load(profile)
     out = Path(args.exports) / rig.name / "basis"
+    # the one lock of everything under exports/<profile>: a design or build publishing the whole
+    # folder meanwhile waits, instead of deleting this run's staging folder
+    lock = profile_lock(args.exports, rig.name)
+    made_from = profile_digest(rig.profile)
     total = BASIS_STEPS + (order + 1) ** 2 + 1 + (simulation_steps() if args.simulate else 0)
     t0 = time.perf_counter()
     with _progress(total, f"basis {rig.name}") as step:
         basis = projector_basis(rig, order, alpha_rad=alpha, progress=step)
-        paths = write_basis(basis, out, lowdin_images=args.lowdin, progress=step)
+        paths = write_basis(basis, out, lowdin_images=args.lowdin, progress=step, lock=lock, made_from=made_from)
         t_images = time.perf_counter() - t0
         sim = None
         if args.simulate:
             sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step)
-            paths += write_simulation(sim, out)
+            paths += write_simulation(sim, out, lock, made_from)
     rep = basis.report
     z, px, sa = rep["zone"], rep["projector"], rep["solid_angle"]
     print(f"{rig.name}: zonal basis to order {order} ({rep['functions']} functions) over "

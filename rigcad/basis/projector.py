@@ -655,13 +655,16 @@ def image_name(l: int, m: int, part: str) -> str:
 
 
 def write_basis(basis: ProjectorBasis, out_dir: str | Path, *, lowdin_images: bool = False,
-                progress: Progress = None) -> list[Path]:
+                progress: Progress = None, lock: Path | None = None, made_from: str | None = None) -> list[Path]:
     """Write ``basis`` into ``out_dir`` (exports/<profile>/basis): projector/{8bit,16bit}/ (the frames
     to project), latlong/{8bit,16bit}/ and latlong_float32.npy (the 4.2.1 maps), with
     ``lowdin_images`` projector_lowdin/{8bit,16bit}/ (the re-orthonormalised set), contact_sheet.png,
     latlong_sheet.png and basis.json (the report and the list of files). All published together
     (atomic); images of an earlier run that this one does not write are removed. ``progress(label)``
-    is called once per function and once at the end. Returns the written paths."""
+    is called once per function and once at the end. ``lock``: the lock every run writing under
+    exports/<profile> holds (export.atomic.profile_lock; default one beside ``out_dir``);
+    ``made_from``: the SHA-256 of the profile the basis was made from (export.manifest.profile_digest),
+    recorded beside the folder. Returns the written paths."""
     import io
 
     from rigcad import plots
@@ -675,7 +678,7 @@ def write_basis(basis: ProjectorBasis, out_dir: str | Path, *, lowdin_images: bo
     def carry(rel: Path) -> bool:  # images of an earlier run that this one does not write are dropped
         return not (rel.parts[0] in ("projector", "projector_lowdin", "latlong") and rel.match("*bit/z_*.png"))
 
-    with Staging(out, carry=carry) as st:
+    with Staging(out, lock, carry=carry, made_from=made_from) as st:
         for k, (l, m) in enumerate(basis.indices):
             for part in ("positive", "negative"):
                 name = image_name(int(l), int(m), part)

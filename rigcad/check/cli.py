@@ -28,6 +28,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     from rigcad.check.raycheck import run_raycheck, write_raycheck
     from rigcad.check.tolerances import raise_if_failed, table
     from rigcad.export.atomic import profile_lock
+    from rigcad.export.manifest import profile_digest
     from rigcad.rig import load
 
     rig = load(args.profile)
@@ -49,7 +50,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         with counting(bar):
             result = run_raycheck(rig, exports=exports, rays=args.rays, mode=args.mode,
                                   monte_carlo=not args.no_monte_carlo, builds=args.builds, progress=step)
-    paths = write_raycheck(result, exports / profile.name / "check", profile_lock(exports, profile.name))
+    paths = write_raycheck(result, exports / profile.name / "check", profile_lock(exports, profile.name),
+                           made_from=profile_digest(profile))
     rep = result.report
     main = rep["readings"][rep["mode"]]
     print(f"{profile.name}: mode {rep['mode']}, {rep['rays']} rays, backend {rep['backend']}")

@@ -307,9 +307,12 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
     return RayCheck(profile, report, rows, main, ddirs, theta_map, status_map, fan)
 
 
-def write_raycheck(result: RayCheck, out_dir: Path, lock: Path | None = None) -> list[Path]:
+def write_raycheck(result: RayCheck, out_dir: Path, lock: Path | None = None,
+                   made_from: str | None = None) -> list[Path]:
     """Write raycheck.json, spot.png, theta_map.png into ``out_dir``, published together
-    (export.atomic.Staging, under ``lock``); returns the paths."""
+    (export.atomic.Staging, under ``lock``); ``made_from``: the SHA-256 of the profile as given
+    (export.manifest.profile_digest; ``result.profile`` carries the run's overrides), recorded
+    beside the folder. Returns the paths."""
     from rigcad import plots
     from rigcad.export.atomic import Staging, json_bytes
 
@@ -317,7 +320,7 @@ def write_raycheck(result: RayCheck, out_dir: Path, lock: Path | None = None) ->
     files = {"raycheck.json": json_bytes(result.report), "spot.png": plots.spot_diagram(result)}
     if result.theta_map is not None:
         files["theta_map.png"] = plots.theta_map(result)
-    with Staging(out_dir, lock) as stage:
+    with Staging(out_dir, lock, made_from=made_from) as stage:
         for name, data in files.items():
             stage.write_bytes(out_dir / name, data)
         return stage.commit()

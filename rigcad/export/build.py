@@ -85,7 +85,8 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
     shapes: dict[str, object] = {}
     tol = profile.tessellation
 
-    with Staging(out, lock) as stage:
+    # results (check/, fab/<printer>/, ...) made from another profile are not carried into this build
+    with Staging(out, lock, results_of=profile_digest(profile)) as stage:
         old = _read_manifest(out / "manifest.json")
         old_parts = old.get("parts", {})
         entries = dict(old_parts)
@@ -142,6 +143,7 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
             "parts": {n: entries[n] for n in PARTS if n in entries},
             "mirrors": mirrors,
             "assembly": assembly,
+            "stale_results_removed": stage.stale_report(),
         }
         stage.write_bytes(out / "manifest.json", json_bytes(manifest))
         step("publishing")

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from rigcad.export.atomic import Staging, json_bytes
+from rigcad.export.manifest import profile_digest
 from rigcad.optics.design import Design
 
 
@@ -40,7 +41,8 @@ def write_design(design: Design, out_dir: Path, lock: Path | None = None) -> lis
     """Write the design files into ``out_dir``, published together with the folder's other files
     carried over (export.atomic.Staging, under ``lock``); returns the paths."""
     files = design_files(design)
-    with Staging(out_dir, lock) as stage:
+    # results (check/, fab/<printer>/, ...) made from another profile are not carried over
+    with Staging(out_dir, lock, results_of=profile_digest(design.profile)) as stage:
         for name, data in files.items():
             stage.write_bytes(out_dir / name, data)
         manifest = out_dir / "manifest.json"
@@ -50,9 +52,11 @@ def write_design(design: Design, out_dir: Path, lock: Path | None = None) -> lis
             except (OSError, ValueError):
                 m = None
             shas = {name: hashlib.sha256(data).hexdigest() for name, data in files.items()}
-            if isinstance(m, dict) and m.get("design_files") != shas:
-                m["design_files"] = shas
-                m["inputs_key"] = None  # the parts may no longer match this design: `rigcad stl` rebuilds
+            if isinstance(m, dict) and (m.get("design_files") != shas or stage.stale):
+                if m.get("design_files") != shas:
+                    m["design_files"] = shas
+                    m["inputs_key"] = None  # the parts may no longer match this design: `rigcad stl` rebuilds
+                m["stale_results_removed"] = stage.stale_report()
                 stage.write_bytes(manifest, json_bytes(m))
         return stage.commit()
 

@@ -30,6 +30,7 @@ import numpy as np
 from rigcad import __version__
 from rigcad.errors import FabricationError, RigcadError
 from rigcad.export.atomic import Staging, json_bytes
+from rigcad.export.manifest import profile_digest
 from rigcad import plots
 from rigcad.fab import estimate as E
 from rigcad.fab import outlines
@@ -147,7 +148,7 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
     stocks: dict[str, float] = {}  # mirror name -> stock printed in front of it (mm)
     meshes: dict[str, tuple] = {}  # piece -> (vertices in print position, faces, mirror face indices)
 
-    with Staging(out, lock) as stage:
+    with Staging(out, lock, made_from=profile_digest(rig.profile)) as stage:
         old_path = out / "fab.json"
         try:
             old = json.loads(old_path.read_text(encoding="utf-8")) if old_path.is_file() else {}

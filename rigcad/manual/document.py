@@ -410,7 +410,9 @@ def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = 
     doc, files, figures = build_manual(rig, printer, fab_report, progress)
     title = f"{rig.name}: assembly and calibration manual ({printer.name})"
     page = doc.html(title, files).encode("utf-8")
-    with Staging(out, lock, carry=lambda rel: False) as stage:
+    from rigcad.export.manifest import profile_digest
+
+    with Staging(out, lock, carry=lambda rel: False, made_from=profile_digest(rig.profile)) as stage:
         for rel, data in sorted(files.items()):
             stage.write_bytes(out / rel, data)
         stage.write_bytes(out / "manual.md", doc.markdown().encode("utf-8"))

@@ -287,7 +287,9 @@ def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays
     page = view_html(rig, meshes, traced)
     png = plots.rig_picture(meshes, traced, f"{rig.name}: the assembled rig")
     step("page and picture")
-    with Staging(out_dir, lock) as stage:
+    from rigcad.export.manifest import profile_digest
+
+    with Staging(out_dir, lock, made_from=profile_digest(rig.profile)) as stage:
         stage.write_bytes(out_dir / "rig.html", page)
         stage.write_bytes(out_dir / "rig.png", png)
         stage.commit()

@@ -100,7 +100,10 @@ def write_tolerance(out_dir: Path, profile, mc, limits, correlations, run_info: 
              "run.json": json_bytes(run_info)}
     if limits:
         files["sensitivity.png"] = plots.tolerance_sensitivity(profile, limits)
-    with Staging(out_dir, lock, carry=lambda rel: False) as stage:  # the run owns the whole folder
+    from rigcad.export.manifest import profile_digest
+
+    with Staging(out_dir, lock, carry=lambda rel: False,  # the run owns the whole folder
+                 made_from=profile_digest(profile)) as stage:
         for name, data in files.items():
             stage.write_bytes(out_dir / name, data)
         return stage.commit()
