@@ -99,5 +99,5 @@ class Paraboloid:
         with np.errstate(invalid="ignore", divide="ignore"):
             l_chord = (self.rim_z - origins[:, 1]) / dirs[:, 1]
             x_chord = origins[:, 0] + l_chord * dirs[:, 0] - self.dx
-        chord = (l_chord > 1e-9) & (l_chord < lengths) & (np.abs(x_chord) <= self.rim_radius)
+        chord = (l_chord > 1e-9) & (l_chord < lengths) & (np.abs(x_chord) <= self.rim_radius * (1 + RIM_RTOL))
         return crosses | chord
