@@ -12,7 +12,7 @@ SYSTEM_TOOLS := prusa-slicer chromium
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 EXPORTS ?= exports
 
-.PHONY: all stl design docs check gcode view manual tools test test-all test-slow bench stress clean distclean help
+.PHONY: all stl design docs check gcode view manual tools test test-all test-slow test-portable bench stress clean distclean help
 
 all: stl
 
@@ -25,6 +25,7 @@ help:
 	@echo "make test     - the fast test suite (default run, < 10 min)"
 	@echo "make test-slow - only the slow tests (the whole rig through PrusaSlicer)"
 	@echo "make test-all - every test, slow ones included"
+	@echo "make test-portable - the numerical tests as other CPUs compute them (BLAS kernels, numpy SIMD off, generic numba)"
 	@echo "make stress   - numerical stress suite: 500 random profiles (hypothesis)"
 	@echo "make bench    - run time against error for each accuracy knob -> bench/results/*.json, *.png"
 	@echo "make clean    - remove $(EXPORTS)/ ; make distclean also removes $(VENV)/"
@@ -66,6 +67,29 @@ docs: check view
 
 test: $(VENV)/.installed tools
 	$(PY) -m pytest -q -n auto --dist loadfile -m "not slow and not stress"
+
+# The numerical tests as other x86-64 CPUs compute them, on this one: OpenBLAS's kernel forced
+# (Prescott: SSE3 only; SkylakeX: AVX-512; Haswell: AVX2 + FMA), numpy's SIMD dispatch switched off
+# down to its baseline (numpy 2.4 refuses to disable the baseline X86_V2; names this CPU lacks are
+# ignored) and numba compiled for a generic x86-64. numba keys its cache by CPU name, and the generic
+# mode also keeps its own cache folder, so no machine code built for this CPU is reused there.
+# A kernel this CPU cannot run (SIGILL) is skipped with a line saying so.
+# The optimiser's tests (a design that must build) run in the combined mode only: they are long.
+PORTABLE_TESTS := tests/optics tests/check tests/fab/test_staircase.py tests/fab/test_split.py \
+	tests/fab/test_split_form3.py tests/basis
+NPY_SIMD_OFF := X86_V3 X86_V4 AVX512_ICL AVX512_SPR
+PORTABLE_PYTEST = $(PY) -m pytest -q -n 2 --dist loadfile -m "not slow and not stress" $(PORTABLE_TESTS)
+
+test-portable: $(VENV)/.installed
+	@echo "== test-portable: OpenBLAS Prescott, numpy SIMD off, numba generic"
+	OPENBLAS_CORETYPE=Prescott NPY_DISABLE_CPU_FEATURES="$(NPY_SIMD_OFF)" NUMBA_CPU_NAME=generic \
+	  NUMBA_CACHE_DIR=$(CURDIR)/build/numba-generic $(PORTABLE_PYTEST) tests/optimize
+	@for k in SkylakeX:avx512f Haswell:avx2; do \
+	  core=$${k%%:*}; flag=$${k##*:}; \
+	  if grep -qw $$flag /proc/cpuinfo; then \
+	    echo "== test-portable: OpenBLAS $$core"; OPENBLAS_CORETYPE=$$core $(PORTABLE_PYTEST) || exit 1; \
+	  else echo "== test-portable: OpenBLAS $$core SKIPPED: this CPU lacks $$flag"; fi; \
+	done
 
 test-slow: $(VENV)/.installed tools
 	$(PY) -m pytest -q -m slow

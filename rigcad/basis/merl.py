@@ -158,17 +158,34 @@ def directions_from_half_diff(theta_half: np.ndarray, theta_diff: np.ndarray, ph
     return wi, wo
 
 
+#: Cells (in units of one cell) within which a value counts as on a cell boundary: the directions the
+#: rig and the tests use put angles exactly on boundaries (in-plane pairs: phi_diff 0 or +-pi; whole
+#: degrees), and their last bits, which differ between CPUs (numpy's SIMD trigonometry, BLAS), would
+#: pick the cell. 1e-9 cell is ~2e-11 rad: far above rounding, far below any measured direction's error.
+CELL_SNAP = 1e-9
+
+
+def _cells(x: np.ndarray, n: int) -> np.ndarray:
+    """Cell index of cell coordinates ``x`` (trunc, clipped to 0..n-1), a value within CELL_SNAP of a
+    boundary taken as on it (the cell above, as the reference reader does for the exact value)."""
+    k = np.rint(x)
+    x = np.where(np.abs(x - k) <= CELL_SNAP, k, x)
+    return np.clip(np.trunc(x), 0, n - 1).astype(np.intp)
+
+
 def cell_indices(theta_half: np.ndarray, theta_diff: np.ndarray, phi_diff: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Integer cell indices (i_theta_half, i_theta_diff, i_phi_diff) as the reference reader computes them."""
+    """Integer cell indices (i_theta_half, i_theta_diff, i_phi_diff) as the reference reader computes them,
+    but for values within CELL_SNAP of a boundary (:func:`_cells`) and phi_diff = +-pi, which reciprocity
+    (phi_diff and phi_diff + pi are one cell) puts with 0 in cell 0 (the reader: -pi in 0, +pi in 179)."""
     th = np.asarray(theta_half, dtype=float)
     with np.errstate(invalid="ignore"):
         r = np.sqrt(np.maximum(th, 0.0) / (math.pi / 2.0) * N_THETA_HALF * N_THETA_HALF)
-    i_th = np.where(th <= 0.0, 0, np.clip(np.trunc(r), 0, N_THETA_HALF - 1)).astype(np.intp)
-    i_td = np.clip(np.trunc(np.asarray(theta_diff, dtype=float) / (math.pi * 0.5) * N_THETA_DIFF),
-                   0, N_THETA_DIFF - 1).astype(np.intp)
-    pd = np.asarray(phi_diff, dtype=float)
-    pd = np.where(pd < 0.0, pd + math.pi, pd)
-    i_pd = np.clip(np.trunc(pd / math.pi * N_PHI_DIFF), 0, N_PHI_DIFF - 1).astype(np.intp)
+    i_th = np.where(th <= 0.0, 0, _cells(r, N_THETA_HALF)).astype(np.intp)
+    i_td = _cells(np.asarray(theta_diff, dtype=float) / (math.pi * 0.5) * N_THETA_DIFF, N_THETA_DIFF)
+    x = np.asarray(phi_diff, dtype=float) / math.pi * N_PHI_DIFF
+    k = np.rint(x)
+    x = np.mod(np.where(np.abs(x - k) <= CELL_SNAP, k, x), N_PHI_DIFF)  # [-180, 180] -> [0, 180): +pi rule
+    i_pd = _cells(x, N_PHI_DIFF)
     return i_th, i_td, i_pd
 
 

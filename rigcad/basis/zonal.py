@@ -73,9 +73,11 @@ class Zone:
         return 2.0 * math.pi * (self.x_high - self.x_low)
 
     def contains(self, theta_rad: np.ndarray) -> np.ndarray:
-        """Boolean mask of polar angles (radians) inside the zone, edges included."""
+        """Boolean mask of polar angles (radians) inside the zone, edges included, with the
+        ZONE_EDGE_SLACK_RAD that :meth:`shifted_cosine` accepts: a direction the rig puts on an edge
+        (the design's theta range ends on it) is in on every CPU, whichever way its acos rounded."""
         th = np.asarray(theta_rad, dtype=float)
-        return (th >= self.alpha_rad) & (th <= self.beta_rad)
+        return (th >= self.alpha_rad - ZONE_EDGE_SLACK_RAD) & (th <= self.beta_rad + ZONE_EDGE_SLACK_RAD)
 
     def shifted_cosine(self, theta_rad: np.ndarray) -> np.ndarray:
         """t = (2 cos(theta) - a - b) / (b - a) in [-1, 1] (eq. 3.1's shift), same shape as ``theta_rad``.

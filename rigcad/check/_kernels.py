@@ -41,6 +41,9 @@ OK, MISSED_PARABOLOID, OCCLUDED_BY_MOUNT, OCCLUDED_BY_BEAM, OCCLUDED_BY_PARABOLO
 
 #: Distance (mm) a ray must travel before it can hit the paraboloid (rays.ExactParaboloid's eps).
 PARABOLOID_EPS = 1e-9
+#: optics.paraboloid.RIM_RTOL (a hit within 1e-12 of the rim radius counts), restated here because
+#: numba's cache keeps a value read from another file; tests/check assert that the two are equal.
+RIM_RTOL = 1e-12
 
 
 @nb.njit(**_JIT)
@@ -151,7 +154,7 @@ def _paraboloid(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax):
         if math.isfinite(r) and r > PARABOLOID_EPS:
             px = ox + r * dx
             py = oy + r * dy
-            if px * px + py * py <= rim * rim and r < best:
+            if px * px + py * py <= (rim * (1.0 + RIM_RTOL)) * (rim * (1.0 + RIM_RTOL)) and r < best:
                 best = r
     return best if best <= tmax else np.inf
 
@@ -159,10 +162,12 @@ def _paraboloid(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax):
 @nb.njit(**_JIT)
 def _paraboloid_bounded(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax):
     """:func:`_paraboloid`, skipped when the ray cannot reach the mirror's bounding sphere (centre
-    on the axis halfway between vertex and rim plane)."""
+    on the axis halfway between vertex and rim plane). The rim lies ON that sphere, so its radius
+    gets the occluder rows' margin (1e-6 relative + 1e-9 mm): rounding never skips a ray that
+    :func:`_paraboloid` would find at the rim."""
     sag = rim * rim / (4.0 * f)
-    if not _reaches_sphere(0.0, 0.0, zv - 0.5 * sag, math.sqrt(rim * rim + 0.25 * sag * sag), ox, oy, oz, dx, dy, dz,
-                           tmax):
+    radius = math.sqrt(rim * rim + 0.25 * sag * sag) * (1.0 + 1e-6) + 1e-9
+    if not _reaches_sphere(0.0, 0.0, zv - 0.5 * sag, radius, ox, oy, oz, dx, dy, dz, tmax):
         return np.inf
     return _paraboloid(ox, oy, oz, dx, dy, dz, f, zv, rim, tmax)
 

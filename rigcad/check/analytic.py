@@ -339,7 +339,8 @@ def _body_sphere(geo, para_occ: np.ndarray) -> np.ndarray:
 def _mount_shadowed(geo, para_occ: np.ndarray) -> bool:
     """Does every mount solid lie under the mirror surface within its rim (in the convex solid
     r <= rim, z <= vertex_z - r^2 / (4 f)), so that a ray from above that hits the mirror cannot
-    meet the mount first? Checked at the solids' outermost corners / top rims."""
+    meet the mount first? Checked at the solids' outermost corners / top rims, with a margin
+    (1e-9 of the rig's size) so that a mount touching the mirror takes the exact tests on every CPU."""
     f, zv, rim = geo.focal_length, geo.vertex_z, geo.rim_radius
     for row in para_occ:
         if row[0] == 0.0:
@@ -350,7 +351,8 @@ def _mount_shadowed(geo, para_occ: np.ndarray) -> bool:
             r = [np.hypot(row[4], row[5]) + row[1]]
             top = row[3]
         rmax = max(r)
-        if rmax > rim or top > zv - rmax * rmax / (4 * f):
+        tol = 1e-9 * max(rim, abs(zv), 1.0)
+        if rmax > rim - tol or top > zv - rmax * rmax / (4 * f) - tol:
             return False
     return True
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigcad.errors import CheckError
+from rigcad.optics.paraboloid import RIM_RTOL
 from rigcad.optics.solids import slab, z_cylinder
 from rigcad.optics.surfaces import Meridian
 
@@ -407,7 +408,7 @@ class ExactParaboloid:
         best = np.full(len(o), np.inf)
         for r in (r1, r2):
             p = o + np.nan_to_num(r)[:, None] * d
-            ok = np.isfinite(r) & (r > eps) & (p[:, 0] ** 2 + p[:, 1] ** 2 <= self.rim ** 2)
+            ok = np.isfinite(r) & (r > eps) & (p[:, 0] ** 2 + p[:, 1] ** 2 <= (self.rim * (1 + RIM_RTOL)) ** 2)
             best = np.where(ok & (r < best), r, best)
         if tmax is not None:
             best = np.where(best <= tmax, best, np.inf)

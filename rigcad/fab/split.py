@@ -193,7 +193,8 @@ def plan_grid(man: m3d.Manifold, fits) -> GridPlan:
     every cell ``fits(cell_manifold, plan, i, j)``; raises if none."""
     bb = np.asarray(man.bounding_box(), dtype=float)
     x0, y0, x1, y1 = bb[0], bb[1], bb[3], bb[4]
-    long_x = (x1 - x0) >= (y1 - y0)
+    # the long side, a square's (equal to rounding: 1e-9 of the size) counted as x on every CPU
+    long_x = (x1 - x0) >= (y1 - y0) - 1e-9 * max(x1 - x0, y1 - y0)
     options = sorted(((a, b) for a in GRID_COUNTS for b in GRID_COUNTS),
                      key=lambda ab: (ab[0] * ab[1], -ab[0] if long_x else -ab[1]))
     for nx, ny in options:
@@ -559,7 +560,10 @@ def _farthest(pts: np.ndarray, want: int, valid) -> list[np.ndarray]:
     attempts = 0
     while len(chosen) < want and alive.any() and attempts < 200:  # a boolean per attempt: bounded
         attempts += 1
-        k = int(np.argmax(np.where(alive, dist, -1.0)))
+        # the farthest, ties (distances equal to rounding, 1e-9 relative: a symmetric face's
+        # mirror-image points) to the first in ``pts``' order, so the choice is the same on every CPU
+        d = np.where(alive, dist, -1.0)
+        k = int(np.argmax(d >= d.max() * (1.0 - 1e-9)))
         alive[k] = False
         if not valid(pts[k]):
             continue

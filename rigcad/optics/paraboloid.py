@@ -11,6 +11,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+#: Relative margin (of the rim radius) within which a hit at the rim counts: a ray the design aims
+#: at the rim meets it at |x| = rim up to rounding, which differs between CPUs (numpy's SIMD loops,
+#: BLAS); 1e-12 is ~5000 ulps, 1e-10 mm at a 100 mm rim. The 3D tracers use the same (check.rays,
+#: check._kernels.RIM_RTOL).
+RIM_RTOL = 1e-12
+
 
 def unit(v: np.ndarray) -> np.ndarray:
     """Rows of ``v`` (n, 2) scaled to length 1."""
@@ -78,7 +84,7 @@ class Paraboloid:
             eps = 1e-9
             cand = np.stack([r1, r2], axis=-1)
             hit_x = X[:, None] + cand * dirs[:, :1]
-            ok = (cand > eps) & (np.abs(hit_x) <= self.rim_radius * (1 + 1e-12))
+            ok = (cand > eps) & (np.abs(hit_x) <= self.rim_radius * (1 + RIM_RTOL))
             cand = np.where(ok, cand, np.inf)
             best = cand.min(axis=-1)
         return np.where(np.isfinite(best), best, np.nan)
@@ -93,5 +99,5 @@ class Paraboloid:
         with np.errstate(invalid="ignore", divide="ignore"):
             l_chord = (self.rim_z - origins[:, 1]) / dirs[:, 1]
             x_chord = origins[:, 0] + l_chord * dirs[:, 0] - self.dx
-        chord = (l_chord > 1e-9) & (l_chord < lengths) & (np.abs(x_chord) <= self.rim_radius)
+        chord = (l_chord > 1e-9) & (l_chord < lengths) & (np.abs(x_chord) <= self.rim_radius * (1 + RIM_RTOL))
         return crosses | chord

@@ -23,6 +23,16 @@ STATUS_NAMES = {OK: "ok", MISSED_PARABOLOID: "missed_paraboloid", MISSED_DOME: "
 _CHUNK = 2_000_000  # rays x segments per block in the vectorised crossing search (memory bound)
 
 
+def _side(p: np.ndarray, o: np.ndarray, d: np.ndarray, eps: float) -> tuple[np.ndarray, np.ndarray]:
+    """cross(p - o, d) for (k, 2) points, origins and directions, and whether it lies within its own
+    rounding of zero: |error| <= 3 u (|p_x - o_x| |d_y| + |p_y - o_y| |d_x|) + u (|p| + |o|) |d|
+    (u = eps / 2, one rounding per operation), bounded here by 8 eps (|p| + |o|) . |d|, a margin scaled
+    to the operands so that no hit at a node rests on the last bits of the products."""
+    c = (p[:, 0] - o[:, 0]) * d[:, 1] - (p[:, 1] - o[:, 1]) * d[:, 0]
+    scale = (np.abs(p[:, 0]) + np.abs(o[:, 0])) * np.abs(d[:, 1]) + (np.abs(p[:, 1]) + np.abs(o[:, 1])) * np.abs(d[:, 0])
+    return c, np.abs(c) <= 8 * eps * scale
+
+
 @dataclass(frozen=True)
 class DomeCurve:
     """Right half of the dome section (mm), shifted sideways by ``dx``; parameter: the design's s."""
@@ -57,23 +67,30 @@ class DomeCurve:
         # Screen every (ray, node) pair with one matrix product, cross(P - o, d) = P x d - o x d, then
         # evaluate the exact crossing only on the segments where that sign changes or comes within its
         # rounding (|error| < 64 eps (|P| + |o|) for unit d): the same numbers as testing every segment.
+        # The matrix product runs in BLAS, whose kernel (and so the last bits) the CPU chooses: only the
+        # per-segment numbers below decide, and the screen's margin covers both roundings.
+        eps = np.finfo(float).eps
         reach = np.abs(P).max() if len(P) else 0.0
         block = max(1, _CHUNK // max(len(P), 1))
         for a in range(0, n, block):
             oo, dd = o[a:a + block], d[a:a + block]
             screen = P @ np.stack([dd[:, 1], -dd[:, 0]]) - (oo[:, 0] * dd[:, 1] - oo[:, 1] * dd[:, 0])
-            near = np.abs(screen) <= 64 * np.finfo(float).eps * (reach + np.abs(oo).max(axis=1))
+            near = np.abs(screen) <= 64 * eps * (reach + np.abs(oo).max(axis=1)) * np.abs(dd).sum(axis=1)
             pos = screen > 0
             cand = (pos[:-1] != pos[1:]) | near[:-1] | near[1:]
             j, i = np.nonzero(cand)  # segment, ray within the block
-            rel0, rel1 = P[j] - oo[i], P[j + 1] - oo[i]
-            c0 = rel0[:, 0] * dd[i, 1] - rel0[:, 1] * dd[i, 0]
-            c1 = rel1[:, 0] * dd[i, 1] - rel1[:, 1] * dd[i, 0]
-            change = (c0 == 0) | (np.sign(c0) != np.sign(c1))
+            c0, on0 = _side(P[j], oo[i], dd[i], eps)
+            c1, on1 = _side(P[j + 1], oo[i], dd[i], eps)
+            # A crossing within rounding of a node is a crossing AT that node (f exactly 0 or 1, the
+            # node's own coordinates): the node ending the polyline counts whichever side its cross
+            # product rounded to, and the two segments sharing an inner node give bit-identical
+            # candidates, so the lower segment wins the tie on every machine. c1 of segment j and c0
+            # of segment j + 1 are the same floating-point operations, so both segments agree on it.
+            change = on0 | on1 | ((c0 > 0) & (c1 < 0)) | ((c0 < 0) & (c1 > 0))
             with np.errstate(invalid="ignore", divide="ignore"):
-                f = c0 / (c0 - c1)
-            f = np.where(np.isfinite(f), f, 0.0)
-            hit = P[j] + f[:, None] * (P[j + 1] - P[j])
+                f = np.clip(c0 / (c0 - c1), 0.0, 1.0)
+            f = np.where(on0, 0.0, np.where(on1, 1.0, np.where(np.isfinite(f), f, 0.0)))
+            hit = np.where(on0[:, None], P[j], np.where(on1[:, None], P[j + 1], P[j] + f[:, None] * (P[j + 1] - P[j])))
             along = np.sum((hit - oo[i]) * dd[i], axis=-1)
             ok = change & (along > 1e-9)
             i, j, f, along = i[ok], j[ok], f[ok], along[ok]

@@ -28,6 +28,13 @@ from rigcad.units import DEG
 #: model's outline is sampled (its extents err by < 0.05 mm, measured) and the fabrication stage
 #: cuts a meshed part; a design exactly at the edge of the bed is not one to print.
 PRINT_RESERVE = 0.5
+#: Room (mm) each geometric constraint (``design.*``) keeps beyond the refusal it mirrors in the
+#: certified layout (parts.layout and parts.tower compare the same quantities, strictly). The search
+#: drives an active constraint to g = 0, where the fast path's error (its dome top agrees with the
+#: certified layout's to 4e-11 mm, measured on four designs; the certified dome's own tolerance is
+#: <= 1e-7 mm) and the last bits of the sums (~1e-13 mm at 300 mm, which differ between CPUs) would
+#: otherwise decide whether the written design builds. 1 um: 1e4 times those, nothing a print resolves.
+GEOMETRY_RESERVE = 1e-3
 #: Scale of one unit of violation, per unit, for the penalty merit (a constraint's g / scale).
 UNIT_SCALE = {"mm": 1.0, "deg": 0.1, "px/deg": 0.01, "": 0.001}
 
@@ -126,6 +133,8 @@ def evaluate(problem: Problem, x) -> dict:
         # parts.tower: the projector's shelf must clear the dome's top (tower_layout refuses it otherwise)
         dome_top = float(max(fd.outline.outer[:, 1].max(), fd.outline.inner[:, 1].max()))
         g["design.tower_above_dome"] = dome_top + profile.tower.clearance - shelf_bottom_z(profile, geo.cop_z)
+    for key in g:
+        g[key] += GEOMETRY_RESERVE
     pr = problem.printer
     density = pr.density_g_cm3 if pr is not None else 1.24  # PLA when no printer is named
     fig["dome_mass_g"] = fig["dome_volume_mm3"] / 1000.0 * density
@@ -174,6 +183,7 @@ CONSTRAINT_KEYS = {
     "design.holder_inside_base": "sample_holder.stop_radius must lie inside the dome's base",
     "design.tower_above_dome": "the COP tower's projector shelf must clear the dome's top by tower.clearance "
                                "(raise the COP or lower tower.splitter_distance)",
+    # every design.* value includes GEOMETRY_RESERVE mm
     "printer.pieces": "optimize.constraints.printer / max_pieces: the dome must print in at most max_pieces pieces "
                       "with PRINT_RESERVE mm to spare (value: how many mm too large the best split is)",
     "min_feature.dome_wall": "optimize.constraints.min_feature_nozzles: dome_shell.wall against the nozzle",

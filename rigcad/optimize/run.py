@@ -135,7 +135,14 @@ def certified_rig(problem: Problem, row: dict):
 def certify(problem: Problem, row: dict) -> dict:
     """The chosen design on the certified path (converged DOP853 dome, the 2D design's report) beside
     the fast path's figures: the differences say how far the optimiser's evaluation can be trusted."""
+    from rigcad.parts.tower import shelf_bottom_z
+
     rig, tol = certified_rig(problem, row)
+    # the refusals `rigcad build` makes, on the certified dome (GeometryError: the next design is tried):
+    # the layout (beam over the flange, holder inside the base, the tower's shelf over the dome's top)
+    # and every part's recipe; the search's constraints hold GEOMETRY_RESERVE mm short of them
+    layout = rig.layout
+    rig.recipes
     row["dome_tolerance_mm"] = tol
     r = rig.design.report
     f = row["figures"]
@@ -148,7 +155,10 @@ def certify(problem: Problem, row: dict) -> dict:
             "note": "px_per_deg_min of the certified design: np.gradient over its 2001+ rows (second order); the fast "
                     "path's is exact at its nodes", "dome_rows": int(len(rig.dome.s)),
             "dome_error_estimate_mm": rig.dome.error_estimate, "dome_tolerance_mm": rig.dome.tolerance,
-            "dome_tolerance_loosened": tol is not None}
+            "dome_tolerance_loosened": tol is not None,
+            # room left between the projector's shelf and the dome's top beyond tower.clearance (mm)
+            "tower_room_mm": None if rig.geometry.cop_at_infinity else
+            shelf_bottom_z(rig.profile, rig.geometry.cop_z) - layout.dome_top_z - rig.profile.tower.clearance}
 
 
 def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine | None = None, overrides=None,

@@ -150,3 +150,21 @@ def test_bad_files_are_refused(tmp_path):
         read_merl(tmp_path / "missing.binary")
     with pytest.raises(BasisError, match="shape"):
         write_merl(tmp_path / "x.binary", np.zeros((3, 90, 90, 90)))
+
+
+def test_in_plane_pairs_land_in_one_cell_on_every_cpu():
+    """In-plane pairs (phi_diff 0 or +-pi) turned about the normal by phi_half: the difference
+    vector's y is 0 up to rounding, either sign, so arctan2 gives 0 or -0 (+-pi) by the last bits,
+    which differ between CPUs. Reciprocity makes phi_diff and phi_diff + pi one cell: cell 0 for all,
+    and whole-degree theta_diff (a cell boundary) in its upper cell whichever way it rounded."""
+    r = math.radians
+    k_seen, j_seen = set(), set()
+    for ph in np.linspace(0.0, 2 * np.pi, 37)[:-1]:
+        for swap in (False, True):
+            wi, wo = directions_from_half_diff(r(30.0), r(20.0), np.pi if swap else 0.0, ph)
+            th, _, td, pd = half_diff_angles(wi, wo)
+            i, j, k = cell_indices(th, td, pd)
+            k_seen.add(int(k))
+            j_seen.add(int(j))
+    assert k_seen == {0}, k_seen
+    assert j_seen == {20}, j_seen  # theta_diff exactly 20 deg: the boundary goes to the cell above

@@ -155,3 +155,17 @@ def test_zone_and_order_validation():
     with pytest.raises(BasisError, match="order = -1"):
         zonal_basis(np.array([0.5]), np.array([0.0]), -1, THESIS_ZONE)
     assert issubclass(BasisError, RigcadError)
+
+
+def test_a_direction_on_a_zone_edge_is_inside_whichever_way_it_rounded():
+    """The rig puts directions on the zone's edges (its theta range ends there); acos of a unit
+    vector's z rounds them a few ulps either way, differently on different CPUs (numpy's SIMD
+    loops, BLAS). Inside within ZONE_EDGE_SLACK_RAD (1e-9 rad), outside beyond it."""
+    zone = THESIS_ZONE
+    for edge, outward in ((zone.alpha_rad, -np.inf), (zone.beta_rad, np.inf)):
+        near = [edge]
+        for _ in range(4):  # 1-4 ulps outside the edge
+            near.append(np.nextafter(near[-1], outward))
+        assert zone.contains(np.array(near)).all()
+        assert not zone.contains(np.array([edge + np.sign(outward) * 1e-8])).any()  # 10x the slack: outside
+        zone.shifted_cosine(np.array(near))  # and the basis evaluates there (no BasisError)

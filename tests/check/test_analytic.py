@@ -174,3 +174,34 @@ def test_the_aligned_table_converges_at_fourth_order_and_a_coarse_one_is_not_use
     assert np.array_equal(a.status, b.status)
     ok = a.ok
     assert np.max(np.linalg.norm(a.p2[ok] - b.p2[ok], axis=1)) < 1e-9
+
+
+def test_a_ray_through_the_rim_is_found_by_both_paraboloid_tracers_on_every_cpu(rig):
+    """Rays through the mirror's rim, each at an angle in the rim's plane, along the direction that is
+    tangent to the kernel's bounding sphere there (the rim lies on that sphere), the point nudged
+    0-3 ulps outwards: the hit sits on the rim up to rounding, which differs between CPUs. Both the
+    numba kernel (sphere skip + quadratic) and rays.ExactParaboloid count it, within RIM_RTOL."""
+    from rigcad.optics import paraboloid as P
+
+    assert K.RIM_RTOL == P.RIM_RTOL  # the kernel restates the optics' margin (numba's cache)
+    geo = rig.geometry
+    f, zv, rim = geo.focal_length, geo.vertex_z, geo.rim_radius
+    sag = rim * rim / (4 * f)
+    origins, dirs = [], []
+    for a in np.linspace(0.0, 2 * np.pi, 13)[:-1]:
+        c, s = np.cos(a), np.sin(a)
+        w = np.array([rim * c, rim * s, -0.5 * sag])  # rim point minus the sphere's centre
+        d = np.array([0.5 * sag * c, 0.5 * sag * s, rim])  # in the meridian plane, normal to w
+        d /= np.linalg.norm(d)
+        for k in range(4):
+            p = np.array([rim * c, rim * s, zv - sag])
+            for _ in range(k):
+                p[:2] = np.nextafter(p[:2], 2 * p[:2])  # outwards (a zero component stays)
+            origins.append(p - 50.0 * d)
+            dirs.append(d)
+    o, d = np.array(origins), np.array(dirs)
+    kernel = np.array([K._paraboloid_bounded(*o[i], *d[i], f, zv, rim, np.inf) for i in range(len(o))])
+    exact = R.ExactParaboloid(f, zv, rim).intersect(o, d).t
+    # 50 mm to the rim; 1e-9 mm: the quadratic's rounding at |o| ~ 300 mm (~1e-13 relative)
+    assert np.all(np.abs(kernel - 50.0) < 1e-9), kernel
+    assert np.all(np.abs(exact - 50.0) < 1e-9), exact

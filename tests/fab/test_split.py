@@ -79,3 +79,19 @@ def test_mirror_faces_cover_the_dome_mirror(table31, layout):
     ds = np.linalg.norm(np.diff(p, axis=0), axis=1)
     exact = float(np.sum(2 * np.pi * 0.5 * (p[1:, 0] + p[:-1, 0]) * ds))
     assert 0.97 * exact < mf.area <= exact * (1 + 1e-6)  # slots take < 3 %; facets are inscribed
+
+
+def test_pin_points_tied_to_rounding_are_chosen_in_their_order_on_every_cpu():
+    """_farthest picks the farthest point; mirror-image points of a symmetric face are equally far
+    but for the last bits of their sums (which differ between CPUs): the tie goes to the first."""
+    r = 40.0
+    pts = np.array([[r, 0.0, 5.0], [0.0, r, 5.0], [-r, 0.0, 5.0], [0.0, -r, 5.0]])
+    for k in (0, 2):  # make either of the opposite points the farther by one ulp
+        p = pts.copy()
+        p[k, 0] = np.nextafter(p[k, 0], np.sign(p[k, 0]) * np.inf)
+        first = SP._farthest(p, 1, lambda q: True)[0]
+        assert np.array_equal(first, p[0]), (k, first)
+    # a real difference (1e-6 relative, 1000 x the tie window) still decides
+    p = pts.copy()
+    p[2, 0] *= 1 + 1e-6
+    assert np.array_equal(SP._farthest(p, 1, lambda q: True)[0], p[2])

@@ -53,3 +53,28 @@ def test_parallel_rays_reflect_through_the_focus():
     rel = p.focus - P
     miss = np.abs(rel[:, 0] * u[:, 1] - rel[:, 1] * u[:, 0])
     assert miss.max() < 1e-12 * 100  # float64 round-off on 100 mm coordinates
+
+
+def test_rays_through_the_rim_count_whichever_way_they_rounded():
+    """The design's rays pass exactly through the rim (the dome's occlusion end is defined by the
+    ray that grazes it; the outermost COP ray hits it): their crossing with the rim chord or the
+    surface rounds a few ulps either way, differently on different CPUs. Within RIM_RTOL of the rim
+    both intersect (a hit) and blocks (the surface or the rim chord) count them."""
+    corner = np.array([PARA.dx + PARA.rim_radius, PARA.rim_z])
+    src = np.array([PARA.dx, PARA.rim_z + 200.0])  # above, inside: down through the rim corner
+    u = unit((corner - src)[None])[0]
+    dirs = [u]
+    for k in range(1, 4):  # turned k ulps outwards (the crossing falls just beyond the rim)
+        dirs.append(np.array([np.nextafter(dirs[-1][0], np.inf), dirs[-1][1]]))
+    dirs = np.array(dirs)
+    origins = np.tile(src, (len(dirs), 1))
+    lam = PARA.intersect(origins, dirs)
+    assert np.all(np.isfinite(lam)) and np.all(np.abs(lam - np.linalg.norm(corner - src)) < 1e-9), lam
+    # from below the chord, up and outwards through the corner
+    below = np.array([PARA.dx + PARA.rim_radius - 10.0, PARA.rim_z - 10.0])
+    v = unit((corner - below)[None])[0]
+    vs = [v]
+    for k in range(1, 4):
+        vs.append(np.array([np.nextafter(vs[-1][0], np.inf), vs[-1][1]]))
+    vs = np.array(vs)
+    assert PARA.blocks(np.tile(below, (len(vs), 1)), vs, np.full(len(vs), 100.0)).all()
