@@ -593,6 +593,16 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
     return out
 
 
+def check_override(section: str, key: str, value: Any, flag: str) -> Any:
+    """A command-line value that replaces profile key ``section.key`` (``--rays`` for raycheck.rays),
+    checked against that key's Spec: the same range as in a profile, the message naming ``flag``."""
+    s = next(f.metadata["spec"] for f in fields(SECTIONS[section]) if f.name == key)
+    try:
+        return convert_value(s, value, f"{flag} (as {section}.{key})", None)
+    except ProfileError as err:
+        raise ProfileError(err.message, param=flag) from None
+
+
 def read_section(raw: RawProfile, name: str, cls: type) -> Any:
     """Validate section ``name`` of ``raw`` into the frozen dataclass ``cls`` (whose fields carry
     Specs): unknown keys, missing values, bad units and out-of-range values are refused with
