@@ -151,3 +151,42 @@ def test_optimize_never_replaces_a_file_it_did_not_write(tmp_path, capsys):
     # an earlier run's own design file may be replaced (it starts with rigcad's mark)
     precious.write_bytes(DESIGN_MARK + b"mine` (...)\n")
     refuse_foreign_design(str(profile), "mine", tmp_path / "X" / "mine" / "optimize")
+
+
+PRINTER = """process: fdm
+build_volume: {x: 200 mm, y: 200 mm, z: 200 mm}
+nozzle: 0.4 mm
+filament_diameter: 1.75 mm
+material_density_g_cm3: 1.24
+deposition_rate_mm3_s: 8
+layer_height: 1e-9 mm
+"""
+
+
+def test_a_layer_below_a_printers_resolution_is_refused_with_its_line(tmp_path, monkeypatch, capsys):
+    import rigcad.rig
+
+    printer = tmp_path / "tiny.yaml"
+    printer.write_text(PRINTER)
+    monkeypatch.setattr(rigcad.rig, "load", lambda *a: (_ for _ in ()).throw(AssertionError("rig built first")))
+    code = main(["fab", "achutha2006", "--printer", str(printer), "--exports", str(tmp_path / "x")])
+    err = capsys.readouterr().err
+    assert code == 2 and f"{printer}:7" in err and "layer_height" in err and ">= 0.01 mm" in err, err
+    assert err.count("\n") == 1
+
+
+@pytest.mark.parametrize("section,line,valid", [
+    ("projector:\n  resolution: [100000, 100000]\n", 2, "16384"),
+    ("tessellation:\n  mirror_chord_error: 1e-9 mm\n", 2, ">= 0.0001 mm"),
+    ("tessellation:\n  mirror_normal_error: 1e-9 rad\n", 2, ">= 0.0572958 deg"),  # 1 mrad
+    ("coating:\n  layers:\n    - {name: paint, thickness: 5 m}\n", 2, "0..1 mm"),
+])
+def test_profile_quantities_out_of_their_range_are_refused_with_their_line(section, line, valid, tmp_path):
+    from rigcad.errors import ProfileError
+    from rigcad.profile import load_profile
+
+    path = tmp_path / "p.yaml"
+    path.write_text("extends: achutha2006\n" + section)
+    with pytest.raises(ProfileError) as err:
+        load_profile(path)
+    assert f"{path}:{line + 1}" in str(err.value) and valid in str(err.value), str(err.value)

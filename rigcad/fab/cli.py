@@ -21,9 +21,9 @@ def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.export.atomic import profile_lock
     from rigcad.rig import load
 
+    printer = load_printer(args.printer)  # a bad printer file is refused before the dome is integrated
     rig = load(args.profile)
     profile = rig.profile
-    printer = load_printer(args.printer)
     out = Path(args.exports) / profile.name / "fab" / printer.name
     names = select_parts(args.parts)
     with _progress(len(names), f"fab {profile.name}") as step:
