@@ -57,14 +57,6 @@ def _engine_progress(update):
 
 
 def cmd_tolerance(args: argparse.Namespace) -> int:
-    from rigcad.cli import progress_bar
-    from rigcad.errors import CheckError
-    from rigcad.export.atomic import profile_lock
-    from rigcad.rig import load
-    from rigcad.tolerance.limits import run_limits
-    from rigcad.tolerance.montecarlo import Job, rank_correlations, run_monte_carlo
-    from rigcad.tolerance.report import write_tolerance
-
     from rigcad.profile import load_profile
     from rigcad.profile.schema import check_override
 
@@ -76,6 +68,15 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
     # --samples may pass tolerancing.builds' bound (at scale, on Dask): memory is its limit
     checked_tolerance(samples, rays, engine, "--samples" if args.samples else "tolerancing.builds",
                       "--rays" if args.rays else "tolerancing.rays")
+    # the stages' modules (and their libraries) only once the counts are known to be sane
+    from rigcad.cli import progress_bar
+    from rigcad.errors import CheckError
+    from rigcad.export.atomic import profile_lock
+    from rigcad.rig import load
+    from rigcad.tolerance.limits import run_limits
+    from rigcad.tolerance.montecarlo import Job, rank_correlations, run_monte_carlo
+    from rigcad.tolerance.report import write_tolerance
+
     rig = load(profile)
     t0 = time.perf_counter()
     with progress_bar(samples, f"tolerance {profile.name} ({engine.name})", "sample") as update:
@@ -116,17 +117,17 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
+    from rigcad.profile.schema import check_override
+    from rigcad.tolerance.sweep import finite_or_none, parse_set, run_sweep, sweep_csv
+
+    check_override("raycheck", "rays", args.rays, "--rays")
+    spec = parse_set(args.set)
     from rigcad import plots
     from rigcad.cli import progress_bar
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
     from rigcad.fab.printers import load_printer
     from rigcad.profile.loader import load_raw
-    from rigcad.tolerance.sweep import finite_or_none, parse_set, run_sweep, sweep_csv
 
-    from rigcad.profile.schema import check_override
-
-    check_override("raycheck", "rays", args.rays, "--rays")
-    spec = parse_set(args.set)
     raw = load_raw(args.profile)
     printer = None if args.printer == "none" else load_printer(args.printer)
     engine = _engine(args)

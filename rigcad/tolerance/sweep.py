@@ -81,8 +81,8 @@ def parse_set(text: str) -> SweepSpec:
     if m:
         n = int(m["n"])
         if n < 2 or n > MAX_POINTS:
-            raise ProfileError(f"--set {name}: {m['n']} points; a range needs 2..{MAX_POINTS} (A..B:N): each point is "
-                               "a design built and traced", param="--set")
+            raise ProfileError(f"--set {name}: {m['n']} points; a range needs at least 2 and at most {MAX_POINTS} "
+                               "(A..B:N): each point is a design built and traced", param="--set")
         a, b = value(m["a"]), value(m["b"])
         values = np.linspace(a, b, n)
         if s.kind == "int":
