@@ -103,14 +103,17 @@ def machine_memory() -> int:
 
 
 def require_memory(param: str, value: int, per_item: float, fixed: float = 0.0, what: str = "",
-                   memory: int | None = None) -> None:
+                   memory: int | None = None, most: float | None = None) -> None:
     """Refuse ``param = value`` when ``fixed + per_item * value`` bytes (an estimate, made before
-    anything is allocated) exceed this machine's memory; the message names the largest value that fits."""
+    anything is allocated) exceed this machine's memory; the message names the largest value that
+    fits (and is at most ``most``, the parameter's own bound)."""
     memory = machine_memory() if memory is None else memory
     need = fixed + per_item * float(value)
     if need <= memory:
         return
     largest = int(max(0.0, memory - fixed) // per_item)
+    if most is not None:
+        largest = min(largest, int(most))
     raise ResourceError(f"{param} {value}: {what + ' ' if what else ''}would need about {need / 2**30:.3g} GiB of "
                         f"memory, more than this machine's {memory / 2**30:.3g} GiB; the largest {param} that fits "
                         f"is {largest}", param=param)

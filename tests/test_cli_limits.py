@@ -58,14 +58,20 @@ def test_a_bad_count_is_one_line_before_any_work(argv, names, monkeypatch, capsy
     assert not any(tmp_path.iterdir()), "a refused command wrote something"
 
 
-def _peak_rss_kb(argv: list[str], env: dict | None = None) -> tuple[int, str, int]:
-    """Run ``python -m rigcad argv`` and return (exit code, stderr, the child's peak RSS in kB)."""
-    proc = subprocess.Popen([sys.executable, "-c", "import sys; from rigcad.cli import main; sys.exit(main())", *argv],
-                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, env=env, cwd=env and env.get("HOME"))
-    err = proc.stderr.read().decode()
-    _, status, usage = os.wait4(proc.pid, 0)
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    return proc.returncode, err, usage.ru_maxrss
+#: Starts the command and reports its peak RSS (wait4). A small launcher, because Linux carries a
+#: forked child's high-water mark over exec: forked from a large pytest, the child would report
+#: pytest's size.
+LAUNCHER = ("import os, subprocess, sys; p = subprocess.Popen(sys.argv[1:], stdout=subprocess.DEVNULL); "
+            "_, status, usage = os.wait4(p.pid, 0); print(os.waitstatus_to_exitcode(status), usage.ru_maxrss)")
+
+
+def _peak_rss_kb(argv: list[str], env: dict) -> tuple[int, str, int]:
+    """Run ``rigcad argv`` and return (exit code, stderr, its peak RSS in kB)."""
+    proc = subprocess.run([sys.executable, "-c", LAUNCHER, sys.executable, "-c",
+                           "import sys; from rigcad.cli import main; sys.exit(main())", *argv],
+                          capture_output=True, text=True, env=env, cwd=env["HOME"], timeout=300)
+    code, peak = proc.stdout.split()
+    return int(code), proc.stderr, int(peak)
 
 
 @pytest.mark.parametrize("argv", [

@@ -39,18 +39,23 @@ CHECK_BYTES_PER_BUILD = 600
 def checked_counts(profile, rays: int | None, builds: int | None) -> None:
     """Refuse, before any work, ``--rays``/``--builds`` outside their profile keys' ranges
     (raycheck.rays, tolerancing.builds) or beyond this machine's memory."""
-    from rigcad.engine import require_memory
-    from rigcad.profile.schema import check_override
+    from rigcad.engine import ResourceError, require_memory
+    from rigcad.profile.schema import bound, check_override
 
+    n_rays = profile.raycheck.rays if rays is None else rays
+    try:  # memory first: its message names the largest count this machine can take
+        require_memory("--rays" if rays is not None else "raycheck.rays", n_rays, CHECK_BYTES_PER_RAY,
+                       CHECK_FIXED_BYTES, "tracing the check's rays", most=bound("raycheck", "rays"))
+        if builds is not None:
+            per_build = max(n_rays, profile.tolerancing.rays) * CHECK_BYTES_PER_RAY + CHECK_FIXED_BYTES
+            require_memory("--builds", builds, CHECK_BYTES_PER_BUILD, per_build, "keeping every build's figures",
+                           most=bound("tolerancing", "builds"))
+    except ResourceError as err:
+        raise err.located(profile.marks) from None
     if rays is not None:
         check_override("raycheck", "rays", rays, "--rays")
     if builds is not None:
         check_override("tolerancing", "builds", builds, "--builds")
-    n_rays = profile.raycheck.rays if rays is None else rays
-    require_memory("--rays" if rays is not None else "raycheck.rays", n_rays, CHECK_BYTES_PER_RAY, CHECK_FIXED_BYTES, "tracing the check's rays")
-    if builds is not None:
-        per_build = max(n_rays, profile.tolerancing.rays) * CHECK_BYTES_PER_RAY + CHECK_FIXED_BYTES
-        require_memory("--builds", builds, CHECK_BYTES_PER_BUILD, per_build, "keeping every build's figures")
 
 
 def cmd_check(args: argparse.Namespace) -> int:

@@ -603,6 +603,11 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
     return out
 
 
+def bound(section: str, key: str) -> float | None:
+    """The upper bound of profile key ``section.key`` (internal units), or None."""
+    return next(f.metadata["spec"] for f in fields(SECTIONS[section]) if f.name == key).hi
+
+
 def check_override(section: str, key: str, value: Any, flag: str) -> Any:
     """A command-line value that replaces profile key ``section.key`` (``--rays`` for raycheck.rays),
     checked against that key's Spec: the same range as in a profile, the message naming ``flag``."""

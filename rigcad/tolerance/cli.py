@@ -39,14 +39,16 @@ def _local_workers(engine) -> int:
     return engine.n_workers if engine.scheduler in (None, LOCAL_DASK) else 1
 
 
-def checked_tolerance(samples: int, rays: int, engine, samples_flag: str, rays_flag: str) -> None:
+def checked_tolerance(samples: int, rays: int, engine, samples_flag: str, rays_flag: str,
+                      rays_key: tuple[str, str] = ("tolerancing", "rays")) -> None:
     """Refuse, before any work, a sample count whose table or a ray count whose traces (one light
     path per local worker at once) would not fit in this machine's memory."""
     from rigcad.engine import require_memory
+    from rigcad.profile.schema import bound
 
     workers = _local_workers(engine)
     require_memory(rays_flag, rays, TOLERANCE_BYTES_PER_RAY * workers, TOLERANCE_FIXED_BYTES * (workers + 1),
-                   f"tracing one light path in each of {workers} worker(s)")
+                   f"tracing one light path in each of {workers} worker(s)", most=bound(*rays_key))
     require_memory(samples_flag, samples, TOLERANCE_BYTES_PER_SAMPLE,
                    TOLERANCE_FIXED_BYTES * (workers + 1) + rays * TOLERANCE_BYTES_PER_RAY * workers,
                    "keeping every sample's row")
@@ -64,10 +66,12 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
     tol = profile.tolerancing
     engine = _engine(args)
     samples = tol.builds if args.samples is None else args.samples
-    rays = tol.rays if args.rays is None else check_override("tolerancing", "rays", args.rays, "--rays")
+    rays = tol.rays if args.rays is None else args.rays
     # --samples may pass tolerancing.builds' bound (at scale, on Dask): memory is its limit
     checked_tolerance(samples, rays, engine, "--samples" if args.samples else "tolerancing.builds",
                       "--rays" if args.rays else "tolerancing.rays")
+    if args.rays is not None:
+        check_override("tolerancing", "rays", args.rays, "--rays")
     # the stages' modules (and their libraries) only once the counts are known to be sane
     from rigcad.cli import progress_bar
     from rigcad.errors import CheckError
@@ -120,8 +124,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from rigcad.profile.schema import check_override
     from rigcad.tolerance.sweep import finite_or_none, parse_set, run_sweep, sweep_csv
 
-    check_override("raycheck", "rays", args.rays, "--rays")
     spec = parse_set(args.set)
+    engine = _engine(args)
+    checked_tolerance(len(spec.values), args.rays, engine, "--set (points)", "--rays", ("raycheck", "rays"))
+    check_override("raycheck", "rays", args.rays, "--rays")
     from rigcad import plots
     from rigcad.cli import progress_bar
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
@@ -130,8 +136,6 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     raw = load_raw(args.profile)
     printer = None if args.printer == "none" else load_printer(args.printer)
-    engine = _engine(args)
-    checked_tolerance(len(spec.values), args.rays, engine, "--set (points)", "--rays")
     t0 = time.perf_counter()
     with progress_bar(len(spec.values), f"sweep {spec.name} ({engine.name})", "design") as update:
         rows = run_sweep(raw, spec, args.rays, 2006, printer, engine, progress=_engine_progress(update))
