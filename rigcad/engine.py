@@ -254,7 +254,8 @@ PR_SET_PDEATHSIG = 1
 def die_with_parent(parent_pid: int) -> None:
     """In a worker process: be killed (SIGKILL) when the process that started it ends, however it
     ends (SIGKILL included, where no clean-up of the parent runs). Linux only (prctl); elsewhere a
-    worker still ends when its pool's pipe closes. Used as the loky workers' initializer."""
+    worker still ends when its pool's pipe closes. Used as the loky workers' initializer. Linux
+    sends the signal when the *thread* that started the worker ends: see :func:`run`."""
     if sys.platform.startswith("linux"):
         import ctypes
 
@@ -317,10 +318,14 @@ def run(func: Callable[[Any, Any], Any], shared: Any, tasks: Sequence[Any], engi
     if engine.name == "loky":
         from joblib import Parallel, delayed
 
+        # the death signal follows the thread that started a worker: only the main thread, which
+        # lives as long as the process, may arm it (a pool started from a passing thread would
+        # lose its workers with that thread)
+        arm = threading.current_thread() is threading.main_thread()
         par = Parallel(n_jobs=min(engine.n_workers, max(1, len(tasks))), backend="loky",
                        return_as="generator", batch_size=1, pre_dispatch="2*n_jobs",
                        temp_folder=tempfile.gettempdir(),
-                       initializer=die_with_parent, initargs=(os.getpid(),))
+                       **(dict(initializer=die_with_parent, initargs=(os.getpid(),)) if arm else {}))
         for i, r in enumerate(par(delayed(_run_one)(func, digest, blob, t) for t in tasks)):
             out[i] = r
             done_items += sizes[i]
