@@ -230,7 +230,9 @@ class DomeParams:
     # 100..1000 mm; below 1e-10 mm the error estimate is rounding (the integrator refuses, after long work)
     euler_steps: int = spec("int", "euler: rays evenly spaced in radius from the rim to the vertex; the polyline "
                             "stops before the first one whose return to O is occluded",
-                            2000, lo=2, hi=50_000_000)
+                            2000, lo=2, hi=2_000_000)
+    # <= 2 M: the polyline's error falls as 1/steps (1000x the default is far past any print), and
+    # it costs ~600 bytes a step (peak RSS 1.27 GB at 2 M, measured; 50 M would need ~30 GB)
     table_rows: int = spec("int", "rows of the profile table (CSV) and points of the smooth curve (at least: doubled "
                            "until the curve returns every chief ray to O within 1e-9 of the optical path)", 2001,
                            lo=11, hi=1_000_000)
