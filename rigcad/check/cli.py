@@ -24,9 +24,9 @@ def _rays_bar(desc: str):
         bar.close()
 
 
-#: Peak memory of a check per pinhole ray (bytes): 1.5 kB measured (peak RSS 0.40 GB at 20,000
-#: rays, 1.91 GB at 1,000,000, smooth mode: /usr/bin/time -f %M rigcad check achutha2006 --rays N
-#: --no-monte-carlo), with a third more for the other modes and the figures.
+#: Peak memory of a check per pinhole ray (bytes): at most 1.5 kB measured (peak RSS 0.40 GB at
+#: 20,000 rays, 1.91 GB at 1,000,000, 4.03 GB at 3,000,000, smooth mode: /usr/bin/time -f %M
+#: rigcad check achutha2006 --rays N --no-monte-carlo), with a third more for the other modes.
 CHECK_BYTES_PER_RAY = 2000
 #: Memory of a check before its rays (bytes): the interpreter, the kernels, the mirror meshes (0.40 GB
 #: measured at 20,000 rays).
