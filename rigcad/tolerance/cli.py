@@ -169,7 +169,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _engine_args(p: argparse.ArgumentParser) -> None:
-    from rigcad.cli import exports_root, worker_count
+    from rigcad.cli import worker_count
 
     p.add_argument("--workers", type=worker_count, default=0,
                    help="worker processes (default 0: every core; 1: in this process)")
@@ -181,7 +181,7 @@ def _engine_args(p: argparse.ArgumentParser) -> None:
 
 def register(subparsers) -> None:
     """Add ``tolerance`` and ``sweep`` to rigcad's subcommands."""
-    from rigcad.cli import positive_int, worker_count
+    from rigcad.cli import positive_int
 
     p = subparsers.add_parser(
         "tolerance", help="Monte Carlo tolerancing at scale: per-sample table, sensitivity, inverse limits",
