@@ -177,11 +177,20 @@ def _owner_alive(pid: int, made: float) -> bool:
         return False
     except PermissionError:  # another user's process: alive
         return True
+    started = _process_start(pid)
+    return started is None or started <= made + 1.0
+
+
+def _process_start(pid: int) -> float | None:
+    """When process ``pid`` started (s since the epoch; Linux /proc), or None when unknown: its
+    ``starttime`` (field 22 of /proc/<pid>/stat, clock ticks since boot) plus the boot time."""
     try:
-        started = os.stat(f"/proc/{pid}").st_ctime  # Linux: when the process started
-    except OSError:
-        return True
-    return started <= made + 1.0
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()  # fields 3.. (comm may hold spaces)
+        with open("/proc/stat") as fh:
+            boot = next(int(line.split()[1]) for line in fh if line.startswith("btime"))
+        return boot + int(fields[19]) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError, StopIteration):
+        return None
 
 
 def sweep_stale_runs(base: Path) -> list[Path]:

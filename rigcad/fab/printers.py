@@ -37,7 +37,6 @@ from rigcad.profile.schema import REQUIRED, Spec, convert_value, read_section, s
 #: Printer files live in this folder under each folder of the profile search path.
 PRINTERS_SUBDIR = "printers"
 
-_POS = dict(lo=0, lo_open=True)
 #: Thinnest layer a printer file may give (mm): a printer's resolution. The finest commercial
 #: layers (SLA, material jetting) are 0.014..0.025 mm; thinner is a unit slip, and every layer of
 #: every piece is sliced in memory (1e-9 mm reached 21 GB in two minutes).

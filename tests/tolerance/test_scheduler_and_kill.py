@@ -239,5 +239,19 @@ def test_the_sweep_spares_live_runs_and_other_files(tmp_path):
     for d in (live, other_live, dead):
         (d / "sub").mkdir(parents=True)
     mine.write_text("not a folder")
-    removed = E.sweep_stale_runs(tmp_path)
-    assert removed == [dead] and live.exists() and other_live.exists() and mine.exists()
+    # a live process that started after its folder was made has reused a dead run's pid
+    before = time.time()
+    reused = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        # its start time is read from the kernel (boot time has whole seconds: 1 s of slack)
+        assert before - 1 <= E._process_start(reused.pid) <= time.time() + 1
+        stale = tmp_path / f"{E.RUN_TEMP_PREFIX}{reused.pid}-abc"
+        (stale / "sub").mkdir(parents=True)
+        past = time.time() - 3600
+        os.utime(stale, (past, past))
+        removed = E.sweep_stale_runs(tmp_path)
+    finally:
+        reused.kill()
+        reused.wait()
+    assert sorted(removed) == sorted([dead, stale]) and live.exists() and other_live.exists() and mine.exists()
+    assert E._process_start(os.getppid()) <= E._process_start(os.getpid())  # a parent starts first
