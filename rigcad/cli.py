@@ -224,6 +224,43 @@ def cmd_stl(args: argparse.Namespace) -> int:
     return 0
 
 
+def positive_int(text: str) -> int:
+    """An argparse type: a whole number >= 1, written plainly or as ``1e6``; anything else is
+    refused by argparse on one line, before any work."""
+    try:
+        value = int(text)
+    except ValueError:
+        try:
+            f = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+        if not (math.isfinite(f) and f == int(f)):
+            raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+        value = int(f)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return value
+
+
+def worker_count(text: str) -> int:
+    """An argparse type: a worker count, 0 for every core, else >= 1 (clamped to the cores by
+    rigcad.engine.Engine unless a remote Dask scheduler runs the tasks)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0 (0: every core), got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0 (0: every core), got {text!r}")
+    return value
+
+
+def exports_root(text: str) -> str:
+    """An argparse type: an output root, not empty (an empty one would write into the current folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("expected a folder, got an empty path (the default is 'exports')")
+    return text
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="rigcad",
@@ -294,14 +331,28 @@ def build_parser() -> argparse.ArgumentParser:
     from rigcad.tolerance.cli import register as register_tolerance
 
     register_tolerance(sub)
+    _require_exports_root(parser)
     return parser
 
 
+def _require_exports_root(parser: argparse.ArgumentParser) -> None:
+    """Every command's ``--exports`` takes :func:`exports_root` (one rule, whichever module added it)."""
+    for action in parser._actions:
+        if action.dest == "exports":
+            action.type = exports_root
+        if isinstance(action, argparse._SubParsersAction):
+            for child in action.choices.values():
+                _require_exports_root(child)
+
+
 def main(argv: list[str] | None = None) -> int:
+    from rigcad.engine import run_temp_dir
+
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return args.func(args)
+        with run_temp_dir():
+            return args.func(args)
     except RigcadError as err:
         print(f"rigcad: error: {err}", file=sys.stderr)
         return err.exit_code
@@ -316,6 +367,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("rigcad: interrupted", file=sys.stderr)
         return 130
+    except MemoryError as err:  # an allocation the estimates before it did not foresee
+        print(f"rigcad: error: out of memory{': ' + str(err) if str(err) else ''}; ask for fewer rays, builds or "
+              "samples, or run on a machine with more memory", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

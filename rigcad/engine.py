@@ -13,6 +13,13 @@ Engines: ``serial`` (in this process), ``loky`` (joblib's process pool, the defa
 ``workers > 1``), ``dask`` (a ``dask.distributed`` scheduler at an address, or ``local-dask``: a
 ``LocalCluster`` of ``workers`` single-threaded processes started for the run). Dask is the optional
 ``rigcad[dask]`` extra; without it ``--scheduler`` says what to install.
+
+Resources: worker processes on this machine are at most its cores (:func:`cores`; a remote Dask
+scheduler may have more), and each one dies with the process that started it (Linux
+``PR_SET_PDEATHSIG``), so a run killed with SIGKILL leaves no worker behind. A count a user gives
+(rays, builds, samples) is checked against the machine's memory (:func:`machine_memory`) before
+anything is allocated (:func:`require_memory`). Temporary files of a run go into one folder,
+``rigcad-run-<pid>-*`` (:func:`run_temp_dir`), removed at the end and, after a kill, by the next run.
 """
 
 from __future__ import annotations
@@ -20,9 +27,17 @@ from __future__ import annotations
 import hashlib
 import os
 import pickle
+import shutil
+import signal
 import socket
+import struct
+import sys
+import tempfile
+import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -31,8 +46,18 @@ from rigcad.errors import RigcadError
 
 #: Scheduler value that starts a Dask LocalCluster for the run.
 LOCAL_DASK = "local-dask"
-#: Seconds to reach a Dask scheduler given by address before the run is refused.
+#: Seconds to reach a Dask scheduler given by address and hear its first message (the whole
+#: handshake, not only the TCP connect) before the run is refused.
 CONNECT_TIMEOUT_S = 10
+#: Largest first message (bytes) a Dask scheduler sends: its handshake is a small dict (versions,
+#: compression and pickle protocol; ~100 bytes); a server whose first 8 bytes read as more is not
+#: speaking Dask's protocol (an HTTP "HTTP/1.1" read as a length is 3.5e18).
+MAX_HANDSHAKE_BYTES = 1 << 20
+#: Workers a remote Dask scheduler may be asked to balance the tasks over (only the batch sizes
+#: depend on it): a large cluster, not a typo.
+MAX_DASK_WORKERS = 4096
+#: Prefix of a run's temporary folder in the system temp folder; the pid of the run follows.
+RUN_TEMP_PREFIX = "rigcad-run-"
 
 #: Called after each finished task with (tasks done, tasks in all, items done, items in all).
 Progress = Callable[[int, int, int, int], None] | None
@@ -40,6 +65,58 @@ Progress = Callable[[int, int, int, int], None] | None
 
 class EngineError(RigcadError):
     """A parallel run could not be started or a worker failed."""
+
+
+class ResourceError(RigcadError):
+    """A count asks for more memory than this machine has: the message names the argument and the
+    largest value that would fit."""
+
+
+def cores() -> int:
+    """Cores this process may run on (its CPU affinity where the OS has one)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def machine_memory() -> int:
+    """Physical memory of this machine in bytes, or the cgroup's limit when it is lower (a container)."""
+    total = 0
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        try:
+            import psutil
+
+            total = int(psutil.virtual_memory().total)
+        except ImportError:
+            total = 0
+    for limit_file in ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"):
+        try:
+            text = Path(limit_file).read_text().strip()
+        except OSError:
+            continue
+        if text.isdigit() and 0 < int(text) < (total or int(text) + 1):
+            total = int(text)
+    return total or 8 << 30  # unknown: assume a small 8 GB machine rather than none
+
+
+def require_memory(param: str, value: int, per_item: float, fixed: float = 0.0, what: str = "",
+                   memory: int | None = None, most: float | None = None) -> None:
+    """Refuse ``param = value`` when ``fixed + per_item * value`` bytes (an estimate, made before
+    anything is allocated) exceed this machine's memory; the message names the largest value that
+    fits (and is at most ``most``, the parameter's own bound)."""
+    memory = machine_memory() if memory is None else memory
+    need = fixed + per_item * float(value)
+    if need <= memory:
+        return
+    largest = int(max(0.0, memory - fixed) // per_item)
+    if most is not None:
+        largest = min(largest, int(most))
+    raise ResourceError(f"{param} {value}: {what + ' ' if what else ''}would need about {need / 2**30:.3g} GiB of "
+                        f"memory, more than this machine's {memory / 2**30:.3g} GiB; the largest {param} that fits "
+                        f"is {largest}", param=param)
 
 
 @dataclass(frozen=True)
@@ -52,12 +129,16 @@ class Engine:
 
     @property
     def n_workers(self) -> int:
+        """Processes the run uses: at most this machine's cores (more only on a remote Dask
+        scheduler, up to MAX_DASK_WORKERS): a process per task beyond the cores only adds memory."""
         if self.workers is None or self.workers == 0:
-            return os.cpu_count() or 1
+            return cores()
         if self.workers < 0:
             raise EngineError(f"workers = {self.workers}: need a positive count, or 0 for every core",
                               param="--workers")
-        return int(self.workers)
+        if self.scheduler is not None and self.scheduler != LOCAL_DASK:
+            return min(int(self.workers), MAX_DASK_WORKERS)
+        return min(int(self.workers), cores())
 
     @property
     def name(self) -> str:
@@ -80,7 +161,120 @@ def split(count: int, size: int) -> list[range]:
     return [range(a, min(a + size, count)) for a in range(0, count, size)]
 
 
+# -- a run's temporary folder ---------------------------------------------------------------------------
+#: Folders earlier rigcad versions made directly in the temp folder (one per slicer run or key
+#: listing); a kill left them for good. Removed when older than this (s): no run lasts a day.
+_LEGACY_TEMP = ("rigcad-keys-", "rigcad-slice-", "rigcad-check-")
+LEGACY_TEMP_AGE_S = 24 * 3600
+
+
+def _owner_alive(pid: int, made: float) -> bool:
+    """Whether process ``pid`` may still own a folder made at time ``made`` (s since the epoch): it
+    exists and started before the folder (a pid reused by a later process does not count)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process: alive
+        return True
+    started = _process_start(pid)
+    return started is None or started <= made + 1.0
+
+
+def _process_start(pid: int) -> float | None:
+    """When process ``pid`` started (s since the epoch; Linux /proc), or None when unknown: its
+    ``starttime`` (field 22 of /proc/<pid>/stat, clock ticks since boot) plus the boot time."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()  # fields 3.. (comm may hold spaces)
+        with open("/proc/stat") as fh:
+            boot = next(int(line.split()[1]) for line in fh if line.startswith("btime"))
+        return boot + int(fields[19]) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError, StopIteration):
+        return None
+
+
+def sweep_stale_runs(base: Path) -> list[Path]:
+    """Remove the temporary folders of rigcad runs that ended without their clean-up (killed):
+    ``rigcad-run-<pid>-*`` whose process is gone, and the folders older versions left (see
+    _LEGACY_TEMP). Only this user's real folders (never through a link). Returns what was removed."""
+    removed = []
+    try:
+        entries = list(os.scandir(base))
+    except OSError:
+        return removed
+    now = time.time()
+    for e in entries:
+        name = e.name
+        if name.startswith(RUN_TEMP_PREFIX):
+            pid_text = name[len(RUN_TEMP_PREFIX):].split("-", 1)[0]
+            if not pid_text.isdigit() or int(pid_text) == os.getpid():
+                continue
+        elif not name.startswith(_LEGACY_TEMP):
+            continue
+        try:
+            st = e.stat(follow_symlinks=False)
+        except OSError:
+            continue
+        if not e.is_dir(follow_symlinks=False) or st.st_uid != os.getuid():
+            continue
+        if name.startswith(RUN_TEMP_PREFIX):
+            if _owner_alive(int(pid_text), st.st_mtime if st.st_mtime < st.st_ctime else st.st_ctime):
+                continue
+        elif now - st.st_mtime < LEGACY_TEMP_AGE_S:
+            continue
+        shutil.rmtree(e.path, ignore_errors=True)
+        removed.append(Path(e.path))
+    return removed
+
+
+@contextmanager
+def run_temp_dir():
+    """One temporary folder for everything a command and its children write to a temp folder
+    (slicer runs, key listings, joblib's memory maps, Dask's worker scratch): ``tempfile`` and
+    ``TMPDIR`` point into it while the command runs; it is removed at the end, and by the next
+    run (:func:`sweep_stale_runs`) when this one was killed. The pool of loky workers started in
+    it is shut down with it. Yields the folder."""
+    base = Path(tempfile.gettempdir())
+    sweep_stale_runs(base)
+    path = Path(tempfile.mkdtemp(prefix=f"{RUN_TEMP_PREFIX}{os.getpid()}-", dir=base))
+    saved = tempfile.tempdir, os.environ.get("TMPDIR")
+    tempfile.tempdir = str(path)
+    os.environ["TMPDIR"] = str(path)
+    try:
+        yield path
+    finally:
+        loky = sys.modules.get("joblib.externals.loky.reusable_executor")
+        executor = getattr(loky, "_executor", None) if loky else None
+        if executor is not None:
+            executor.shutdown(wait=True, kill_workers=True)
+        tempfile.tempdir = saved[0]
+        if saved[1] is None:
+            os.environ.pop("TMPDIR", None)
+        else:
+            os.environ["TMPDIR"] = saved[1]
+        shutil.rmtree(path, ignore_errors=True)
+
+
 # -- worker side --------------------------------------------------------------------------------------
+#: prctl option: the signal this process gets when the thread that started it ends (linux/prctl.h).
+PR_SET_PDEATHSIG = 1
+
+
+def die_with_parent(parent_pid: int) -> None:
+    """In a worker process: be killed (SIGKILL) when the process that started it ends, however it
+    ends (SIGKILL included, where no clean-up of the parent runs). Linux only (prctl); elsewhere a
+    worker still ends when its pool's pipe closes. Used as the loky workers' initializer. Linux
+    sends the signal when the *thread* that started the worker ends: see :func:`run`."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) != 0:  # pragma: no cover - a kernel without it
+            return
+    if os.getppid() != parent_pid:  # the parent ended before the line above: nothing would signal us
+        os._exit(1)
+
+
 _SHARED: dict[str, Any] = {}
 _CACHE: dict[tuple, Any] = {}
 
@@ -133,8 +327,14 @@ def run(func: Callable[[Any, Any], Any], shared: Any, tasks: Sequence[Any], engi
     if engine.name == "loky":
         from joblib import Parallel, delayed
 
+        # the death signal follows the thread that started a worker: only the main thread, which
+        # lives as long as the process, may arm it (a pool started from a passing thread would
+        # lose its workers with that thread)
+        arm = threading.current_thread() is threading.main_thread()
         par = Parallel(n_jobs=min(engine.n_workers, max(1, len(tasks))), backend="loky",
-                       return_as="generator", batch_size=1, pre_dispatch="2*n_jobs")
+                       return_as="generator", batch_size=1, pre_dispatch="2*n_jobs",
+                       temp_folder=tempfile.gettempdir(),
+                       **(dict(initializer=die_with_parent, initargs=(os.getpid(),)) if arm else {}))
         for i, r in enumerate(par(delayed(_run_one)(func, digest, blob, t) for t in tasks)):
             out[i] = r
             done_items += sizes[i]
@@ -143,16 +343,64 @@ def run(func: Callable[[Any, Any], Any], shared: Any, tasks: Sequence[Any], engi
     return _run_on_dask(func, shared, tasks, engine, report, sizes, total_items, out)
 
 
-def _listening(address: str) -> None:
-    """Raise OSError at once when nothing listens at a tcp/tls scheduler address: distributed's
-    Client would retry a refused connection for its whole timeout before saying so."""
+def _handshake(address: str, timeout: float = None) -> None:
+    """Raise OSError unless a Dask scheduler answers at a tcp/tls address within ``timeout`` s:
+    the TCP connect AND its first message (a scheduler speaks first, its handshake), whose length
+    must be a handshake's. distributed's Client bounds only the connect: a server that accepts and
+    says nothing would hang it for good, and one that speaks HTTP has its "HTTP/1.1" read as a
+    3-exabyte length."""
     from distributed.comm import parse_address
     from distributed.comm.addressing import parse_host_port
 
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
     protocol, location = parse_address(address)
-    if protocol in ("tcp", "tls"):
-        with socket.create_connection(parse_host_port(location), timeout=CONNECT_TIMEOUT_S):
-            pass
+    if protocol not in ("tcp", "tls"):
+        return
+    deadline = time.monotonic() + timeout
+    with socket.create_connection(parse_host_port(location), timeout=timeout) as sock:
+        if protocol == "tls":  # the TLS handshake comes first and needs the certificates: Client's timeout covers it
+            return
+        head = b""
+        while len(head) < 8:
+            sock.settimeout(max(0.01, deadline - time.monotonic()))
+            try:
+                chunk = sock.recv(8 - len(head))
+            except socket.timeout:
+                raise TimeoutError(f"it accepted the connection but sent nothing in {timeout:g} s "
+                                   "(a Dask scheduler greets at once)") from None
+            if not chunk:
+                raise ConnectionError("it closed the connection without a Dask handshake")
+            head += chunk
+        if head.startswith(b"HTTP") or struct.unpack("<Q", head)[0] > MAX_HANDSHAKE_BYTES:
+            what = "an HTTP server (the dashboard? the scheduler listens on port 8786)" if head.startswith(b"HTTP") \
+                else "a server that does not speak Dask's protocol"
+            raise ConnectionError(f"it answered as {what}")
+
+
+def _client_within(address: str, timeout: float):
+    """``Client(address)`` made in a daemon thread and given up after ``timeout`` s: a server that
+    passed the greeting check and then stalls must not hang the run."""
+    from distributed import Client
+
+    box: dict[str, Any] = {}
+
+    def make() -> None:
+        try:
+            box["client"] = Client(address, timeout=f"{timeout}s")
+        except BaseException as err:  # handed to the caller, which turns it into one line
+            box["error"] = err
+
+    t = threading.Thread(target=make, daemon=True, name="rigcad-dask-connect")
+    t.start()
+    t.join(timeout + 1.0)
+    if t.is_alive():
+        raise TimeoutError(f"no Dask handshake in {timeout:g} s")
+    if "error" in box:
+        err = box["error"]
+        if isinstance(err, (OSError, TimeoutError, ValueError, MemoryError, OverflowError)):
+            raise OSError(str(err) or type(err).__name__) from err
+        raise err
+    return box["client"]
 
 
 def _run_on_dask(func, shared, tasks, engine, report, sizes, total_items, out) -> list:
@@ -164,12 +412,14 @@ def _run_on_dask(func, shared, tasks, engine, report, sizes, total_items, out) -
     cluster = None
     try:
         if engine.scheduler == LOCAL_DASK:
+            # the workers' scratch folders go in the run's temporary folder (run_temp_dir), which
+            # the next run removes when this one is killed
             cluster = LocalCluster(n_workers=engine.n_workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, host="127.0.0.1")
+                                   dashboard_address=None, host="127.0.0.1", local_directory=tempfile.gettempdir())
             client = Client(cluster)
         else:
-            _listening(engine.scheduler)
-            client = Client(engine.scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
+            _handshake(engine.scheduler)
+            client = _client_within(engine.scheduler, CONNECT_TIMEOUT_S)
     except (OSError, TimeoutError, ValueError) as err:  # ValueError: an address Dask cannot read
         if cluster is not None:
             cluster.close()

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-SCRIPTS = ("ray_count", "float32", "tessellation", "make_stl", "basis", "optimize")
+SCRIPTS = ("ray_count", "float32", "tessellation", "make_stl", "basis", "optimize", "refusals")
 
 
 @pytest.mark.parametrize("name", SCRIPTS)

@@ -23,6 +23,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.export.atomic import profile_lock
     from rigcad.rig import load
 
+    printer = load_printer(args.printer)  # a bad printer file is refused before the dome is integrated
     rig = load(args.profile)
     profile = rig.profile
     out = Path(args.exports) / profile.name / "fab" / printer.name
@@ -78,6 +79,8 @@ def cmd_fab(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add the `fab` command to rigcad's subparsers (rigcad.cli.build_parser)."""
+    from rigcad.cli import positive_int
+
     from rigcad.fab.printers import available_printers
 
     p = subparsers.add_parser(
@@ -93,7 +96,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--gcode", action="store_true", help="also slice with PrusaSlicer (printers with slicer: prusa-slicer)")
     p.add_argument("--parts", nargs="+", metavar="PART", help="only these parts (default: all)")
-    p.add_argument("--jobs", type=int, default=None, help="slicer processes at once (default: cores, at most 4)")
+    p.add_argument("--jobs", type=positive_int, default=None, help="slicer processes at once (default: cores, at most 4)")
     p.add_argument("--timings", action="store_true", help="print the time of each stage and slicer run")
     p.add_argument("-v", "--verbose", action="store_true", help="name each part as it is processed")
     p.set_defaults(func=cmd_fab)

@@ -38,25 +38,31 @@ from rigcad.profile.schema import REQUIRED, Spec, convert_value, read_section, s
 #: Printer files live in this folder under each folder of the profile search path.
 PRINTERS_SUBDIR = "printers"
 
-_POS = dict(lo=0, lo_open=True)
+#: Thinnest layer a printer file may give (mm): a printer's resolution. The finest commercial
+#: layers (SLA, material jetting) are 0.014..0.025 mm; thinner is a unit slip, and every layer of
+#: every piece is sliced in memory (1e-9 mm reached 21 GB in two minutes).
+MIN_LAYER_MM = 0.01
 
 
 @dataclass(frozen=True)
 class BuildVolume:
     """The printable box (mm): x, y the bed, z the height."""
 
-    x: float = spec("length", "bed width", **_POS)
-    y: float = spec("length", "bed depth", **_POS)
-    z: float = spec("length", "largest print height", **_POS)
+    # 10 mm to 2 m: below, no part of a rig fits; above, larger than any gantry printer made
+    x: float = spec("length", "bed width", lo=10, hi=2000)
+    y: float = spec("length", "bed depth", lo=10, hi=2000)
+    z: float = spec("length", "largest print height", lo=10, hi=2000)
 
 
 @dataclass(frozen=True)
 class AlignmentPin:
     """Dowel pins that align split pieces: a hole of diameter + clearance, depth into each piece."""
 
-    diameter: float = spec("length", "pin diameter", "1.75 mm", **_POS)
-    clearance: float = spec("length", "added to the hole diameter", "0.15 mm", lo=0)
-    depth: float = spec("length", "hole depth into each piece", "6 mm", **_POS)
+    # a pin is a stock dowel or filament: 0.5..20 mm; a clearance past 1 mm no longer aligns; a hole
+    # deeper than 100 mm is deeper than the pieces are thick
+    diameter: float = spec("length", "pin diameter", "1.75 mm", lo=0.5, hi=20)
+    clearance: float = spec("length", "added to the hole diameter", "0.15 mm", lo=0, hi=1)
+    depth: float = spec("length", "hole depth into each piece", "6 mm", lo=0.5, hi=100)
 
     @property
     def hole_radius(self) -> float:
@@ -124,18 +130,24 @@ class Printer:
 _TOP: dict[str, Spec] = {
     "description": Spec("str", "one line saying what machine this is", ""),
     "process": Spec("choice", "printing process", choices=("fdm", "sla")),
-    "bed_margin": Spec("length", "kept free on each side of the bed", "0 mm", lo=0),
-    "layer_height": Spec("length", "layer height", lo=0, lo_open=True, hi=1.0),
-    "first_layer_height": Spec("length", "first layer height (default: the layer height)", None, lo=0, lo_open=True,
+    "bed_margin": Spec("length", "kept free on each side of the bed", "0 mm", lo=0, hi=500),
+    # layers: at least MIN_LAYER_MM (a printer's resolution), at most 1 mm (the coarsest FDM layers)
+    "layer_height": Spec("length", "layer height", lo=MIN_LAYER_MM, hi=1.0),
+    "first_layer_height": Spec("length", "first layer height (default: the layer height)", None, lo=MIN_LAYER_MM,
                                hi=1.0),
-    "nozzle": Spec("length", "FDM nozzle (or tip) diameter", None, lo=0, lo_open=True),
-    "pixel": Spec("length", "SLA pixel or laser spot size", None, lo=0, lo_open=True),
-    "filament_diameter": Spec("length", "FDM filament diameter", None, lo=0, lo_open=True),
+    # FDM nozzles are made 0.1..1.2 mm, large-format ones up to ~3 mm
+    "nozzle": Spec("length", "FDM nozzle (or tip) diameter", None, lo=0.05, hi=3.0),
+    # SLA/DLP/LCD pixels and laser spots are ~0.02..0.15 mm
+    "pixel": Spec("length", "SLA pixel or laser spot size", None, lo=0.005, hi=1.0),
+    # filament is sold at 1.75, 2.85 and 3 mm
+    "filament_diameter": Spec("length", "FDM filament diameter", None, lo=1.0, hi=3.5),
     "material": Spec("str", "material name", "unspecified"),
-    "material_density_g_cm3": Spec("float", "material density in g/cm3", lo=0, lo_open=True, hi=25),
+    # from foams (~0.1) to the densest printable metals (tungsten, 19.3)
+    "material_density_g_cm3": Spec("float", "material density in g/cm3", lo=0.1, hi=25),
+    # the fastest pellet extruders deposit a few hundred mm3/s; a layer never waits an hour
     "deposition_rate_mm3_s": Spec("float", "volume deposited per second, for estimates without a slicer "
-                                  "(mm3/s; 0 for SLA)", 0.0, lo=0),
-    "layer_time_s": Spec("float", "time per layer beyond the deposition, for estimates (s)", 0.0, lo=0),
+                                  "(mm3/s; 0 for SLA)", 0.0, lo=0, hi=2000),
+    "layer_time_s": Spec("float", "time per layer beyond the deposition, for estimates (s)", 0.0, lo=0, hi=3600),
     "slicer": Spec("choice", "slicer rigcad runs for G-code (or a mapping of PrusaSlicer presets)", "none",
                    choices=("none", "prusa-slicer")),
     "sanding_stock": Spec("str", "material printed in front of every mirror surface, sanded off down to the "

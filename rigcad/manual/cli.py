@@ -7,12 +7,22 @@ import argparse
 from pathlib import Path
 
 
+#: Most rays ``rigcad view`` draws: the page carries each ray's segments inline (~100 bytes of
+#: base64 a ray) and a browser draws them all at once; 100,000 rays is ~10 MB of page and already
+#: a solid colour over the dome (the default 300 shows the fan).
+VIEW_MAX_RAYS = 100_000
+
+
 def cmd_view(args: argparse.Namespace) -> int:
     from rigcad.cli import _progress
+    from rigcad.errors import ProfileError
     from rigcad.export.atomic import profile_lock
     from rigcad.manual.view import write_view
     from rigcad.rig import load
 
+    if args.rays > VIEW_MAX_RAYS:
+        raise ProfileError(f"--rays {args.rays}: the page draws at most {VIEW_MAX_RAYS} rays (each travels inside the "
+                           f"HTML file and is drawn at once); valid: 1..{VIEW_MAX_RAYS}", param="--rays")
     with _progress(5, "view") as step:
         rig = load(args.profile)
         step("dome integrated")
@@ -33,6 +43,8 @@ def cmd_manual(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Add ``view`` and ``manual`` to rigcad's subcommands."""
+    from rigcad.cli import positive_int
+
     p = subparsers.add_parser(
         "view", help="the assembled rig in 3D: one self-contained HTML file (three.js inline, no network)",
         description="Write exports/<profile>/view/rig.html: the assembled rig (parts toggled by name), a few hundred "
@@ -41,7 +53,7 @@ def register(subparsers) -> None:
                     "exports/<profile>/view/rig.png, a picture of the assembled rig.")
     p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--exports", default="exports", help="output root (default: exports)")
-    p.add_argument("--rays", type=int, default=300, help="rays traced from the COP (default: 300)")
+    p.add_argument("--rays", type=positive_int, default=300, help="rays traced from the COP (default: 300)")
     p.set_defaults(func=cmd_view)
 
     m = subparsers.add_parser(

@@ -3,8 +3,42 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
+
+
+#: First line of a design profile rigcad optimize writes (rigcad.optimize.run.design_yaml): a file
+#: that starts otherwise was not written by rigcad and is never replaced.
+DESIGN_MARK = b"# Chosen by `rigcad optimize "
+
+
+def refuse_foreign_design(profile_spec, name: str, out: Path) -> None:
+    """The chosen design is written beside the profile's file when the profile is given by a path off
+    the search path (there its ``extends: name`` resolves; under the exports it would not, and an
+    absolute ``extends`` would tie the file to this machine). Such a file is replaced only when an
+    earlier run of rigcad optimize wrote it: a file of the user's of that name is refused before the
+    search, naming it."""
+    from rigcad.errors import ProfileError
+    from rigcad.optimize.run import _design_home
+
+    home = _design_home(profile_spec, name, out)
+    if home == out:
+        return
+    path = home / f"{name}_design.yaml"
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(len(DESIGN_MARK))
+    except FileNotFoundError:
+        return
+    except OSError as err:
+        raise ProfileError(f"{path}: cannot read it to check who wrote it ({err.strerror}); rigcad optimize writes "
+                           "its chosen design there", param="--exports") from err
+    if os.path.islink(path) or head != DESIGN_MARK:
+        raise ProfileError(f"{path} exists and was not written by rigcad optimize: it would be replaced by the chosen "
+                           f"design (written beside {name}'s file, where its extends: {name} resolves); rename or "
+                           "move that file, or put the profile on the search path (./profiles or $RIGCAD_PROFILES) "
+                           "so the design goes under the exports")
 
 
 def cmd_optimize(args: argparse.Namespace) -> int:
@@ -15,6 +49,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
 
     overrides = {"seed": args.seed, "evaluations": args.evaluations, "workers": args.workers}
     problem = load_problem(args.profile, overrides)  # refuses a bad optimize section before any work
+    refuse_foreign_design(args.profile, problem.base.name, Path(args.exports) / problem.base.name / "optimize")
     spec = problem.spec
     engine = Engine(workers=spec.workers, scheduler=args.scheduler)
     bar = tqdm(total=spec.evaluations, desc=f"optimize {problem.base.name}", unit="design", disable=None,
@@ -56,6 +91,8 @@ def cmd_optimize(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``optimize`` to rigcad's subcommands."""
+    from rigcad.cli import positive_int, worker_count
+
     p = subparsers.add_parser(
         "optimize", help="inverse design: search the profile's optimize: section for the rig that meets its targets",
         description="Seeded global search (differential evolution for one objective, NSGA-II for two or more) "
@@ -66,8 +103,8 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("profile", help="profile name (under profiles/) or path, with an optimize: section")
     p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--seed", type=int, help="seed (default: optimize.seed)")
-    p.add_argument("--evaluations", type=int, help="evaluation budget (default: optimize.evaluations)")
-    p.add_argument("--workers", type=int, help="worker processes, 0 = every core (default: optimize.workers)")
+    p.add_argument("--evaluations", type=positive_int, help="evaluation budget (default: optimize.evaluations)")
+    p.add_argument("--workers", type=worker_count, help="worker processes, 0 = every core (default: optimize.workers)")
     p.add_argument("--scheduler", help="a Dask scheduler address, or local-dask (default: loky / serial)")
     p.set_defaults(func=cmd_optimize)
     return p

@@ -24,8 +24,12 @@ REQUIRED = object()
 MAX_LENGTH_MM = 10_000.0
 #: Largest seed (numpy's SeedSequence takes any int; this keeps seeds portable as int64).
 MAX_SEED = 2**63 - 1
-#: Largest projector or camera side (pixels).
-MAX_PIXELS = 100_000
+#: Largest projector or camera side (pixels): 16K, past any projector (8K UHD is 7680 x 4320) or
+#: machine-vision camera (150 MP: 14204 x 10652) of the rig's kind; the calibration image has a
+#: byte per projector pixel (268 MB at 16384 x 16384, 10 GB at the 100,000 once allowed).
+MAX_PIXELS = 16_384
+#: Thickest coating layer (mm): paint films are 0.01..0.1 mm; a millimetre is a unit slip.
+MAX_COATING_LAYER_MM = 1.0
 #: Mounting threads an instrument may name, with their major diameters (mm): ISO metric coarse, and
 #: the unified 1/4-20 and 3/8-16 UNC of camera tripod sockets (ISO 1222).
 MOUNT_THREADS: dict[str, float] = {"M3": 3.0, "M4": 4.0, "M5": 5.0, "M6": 6.0, "1/4-20 UNC": 6.35,
@@ -222,10 +226,13 @@ class DomeParams:
                        "equal_path (closed form)", "dop853", choices=("dop853", "rk45", "euler", "equal_path"))
     tolerance: float | None = spec(
         "length", "adaptive integrators: certified global error in the distance along each reflected ray "
-        "(default: 1e-11 of the optical path)", None, lo=0, lo_open=True, hi=1e-3)
+        "(default: 1e-11 of the optical path)", None, lo=1e-10, hi=1e-3)  # float64 resolves ~1e-13 mm on a path of
+    # 100..1000 mm; below 1e-10 mm the error estimate is rounding (the integrator refuses, after long work)
     euler_steps: int = spec("int", "euler: rays evenly spaced in radius from the rim to the vertex; the polyline "
                             "stops before the first one whose return to O is occluded",
-                            2000, lo=2, hi=50_000_000)
+                            2000, lo=2, hi=2_000_000)
+    # <= 2 M: the polyline's error falls as 1/steps (1000x the default is far past any print), and
+    # it costs ~600 bytes a step (peak RSS 1.27 GB at 2 M, measured; 50 M would need ~30 GB)
     table_rows: int = spec("int", "rows of the profile table (CSV) and points of the smooth curve (at least: doubled "
                            "until the curve returns every chief ray to O within 1e-9 of the optical path)", 2001,
                            lo=11, hi=1_000_000)
@@ -361,13 +368,17 @@ class TessellationParams:
 
     chord_error: float = spec("length", "printed parts (STL): max distance from the exact surface; default a "
                               "tenth of the thesis printer's 0.007 in layer (above 0.03 mm the small parts' STL "
-                              "volumes drift past the 0.5 % STL/STEP check)", "0.018 mm", lo=0, lo_open=True, hi=0.03)
+                              "volumes drift past the 0.5 % STL/STEP check)", "0.018 mm", lo=0.002, hi=0.03)  # >= 2 um: a fifth of the
+    # finest printer layer (0.01 mm); triangles grow as 1/chord error (9x the default's at the bound)
     mirror_chord_error: float = spec("length", "mirror meshes for the ray checker: max distance from the "
-                                     "exact surface", "0.001 mm", **_POS)
+                                     "exact surface", "0.001 mm", lo=1e-4)  # >= 0.1 um: triangles grow as
+    # 1/chord error: 0.8 M on the dome at the default, 7.9 M at the bound (export.mirror_mesh._plan)
     mirror_normal_error: float = spec("angle", "mirror meshes: max facet-normal error (the flat-facet reading; "
-                                      "smooth traces use the exact vertex normals)", "0.01 rad", **_POS)
+                                      "smooth traces use the exact vertex normals)", "0.01 rad", lo=1e-3)
+    # >= 1 mrad: triangles grow as 1/error^2: 12 M on the dome at the bound (export.mirror_mesh._plan)
     fit_tolerance: float = spec("length", "B-spline fit of the mirror profiles in the STEP solids (<= 1 um)",
-                                "0.1 um", lo=0, lo_open=True, hi=0.001)
+                                "0.1 um", lo=1e-6, hi=0.001)  # >= 1 nm: ten times OpenCascade's
+    # Precision::Confusion (1e-7 mm), below which the kernel takes two points for one
 
 
 @dataclass(frozen=True)
@@ -571,8 +582,9 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
                 t = parse_quantity(layer["thickness"], "length")
             except UnitError as err:
                 raise fail(f"layer {i + 1} ({layer['name']}): {err}") from err
-            if not (math.isfinite(t) and 0 <= t <= MAX_LENGTH_MM):
-                raise fail(f"layer {i + 1} ({layer['name']}): thickness must be finite and >= 0, got {_r(layer['thickness'])}")
+            if not (math.isfinite(t) and 0 <= t <= MAX_COATING_LAYER_MM):
+                raise fail(f"layer {i + 1} ({layer['name']}): thickness must be 0..{MAX_COATING_LAYER_MM:g} mm (a paint "
+                           f"film), got {_r(layer['thickness'])}")
             layers.append((layer["name"], t))
         names = [n for n, _ in layers]
         if len(set(names)) != len(names):
@@ -591,6 +603,21 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
     if too_low or too_high:
         raise fail(f"{_r(value)} is out of range; valid: {s.describe_range()}")
     return out
+
+
+def bound(section: str, key: str) -> float | None:
+    """The upper bound of profile key ``section.key`` (internal units), or None."""
+    return next(f.metadata["spec"] for f in fields(SECTIONS[section]) if f.name == key).hi
+
+
+def check_override(section: str, key: str, value: Any, flag: str) -> Any:
+    """A command-line value that replaces profile key ``section.key`` (``--rays`` for raycheck.rays),
+    checked against that key's Spec: the same range as in a profile, the message naming ``flag``."""
+    s = next(f.metadata["spec"] for f in fields(SECTIONS[section]) if f.name == key)
+    try:
+        return convert_value(s, value, f"{flag} (as {section}.{key})", None)
+    except ProfileError as err:
+        raise ProfileError(err.message, param=flag) from None
 
 
 def read_section(raw: RawProfile, name: str, cls: type) -> Any:

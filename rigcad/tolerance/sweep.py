@@ -21,6 +21,10 @@ from rigcad.errors import ProfileError, RigcadError
 #: Chord error (mm) of the meshes the printer fit is judged on: the fit has centimetre margins or
 #: none, 0.3 mm does not change the verdict and meshes every part in about a second.
 FIT_CHORD_MM = 0.3
+#: Most designs one sweep builds: each is a dome integrated, traced and meshed (about a second
+#: each on one core), so 10,000 is a day of a workstation; more is a slip of the keyboard, and
+#: ``--set ...:100000000`` would hold a hundred million values before the first design.
+MAX_POINTS = 10_000
 _RANGE = re.compile(r"^\s*(?P<a>[^.][^:]*?)\s*\.\.\s*(?P<b>[^:]+?)\s*:\s*(?P<n>\d+)\s*$")
 
 
@@ -76,15 +80,20 @@ def parse_set(text: str) -> SweepSpec:
     m = _RANGE.match(spec)
     if m:
         n = int(m["n"])
-        if n < 2:
-            raise ProfileError(f"--set {name}: {n} points; a range needs at least 2 (A..B:N)", param="--set")
+        if n < 2 or n > MAX_POINTS:
+            raise ProfileError(f"--set {name}: {m['n']} points; a range needs at least 2 and at most {MAX_POINTS} "
+                               "(A..B:N): each point is a design built and traced", param="--set")
         a, b = value(m["a"]), value(m["b"])
         values = np.linspace(a, b, n)
         if s.kind == "int":
             values = np.unique(np.round(values).astype(int))
         vals = tuple(int(v) if s.kind == "int" else float(v) for v in values)
     else:
-        vals = tuple(value(v) for v in spec.split(",") if v.strip())
+        items = [v for v in spec.split(",") if v.strip()]
+        if len(items) > MAX_POINTS:
+            raise ProfileError(f"--set {name}: {len(items)} values; a sweep builds at most {MAX_POINTS} designs",
+                               param="--set")
+        vals = tuple(value(v) for v in items)
         if not vals:
             raise ProfileError(f"--set {name}: no values; expected A..B:N or v1,v2,...", param="--set")
     for v in vals:  # every value must be valid for the key (the ends were; integers rounded stay so)

@@ -1,0 +1,257 @@
+"""A Dask scheduler address that is not one (silent, HTTP) is one line within the handshake's
+bound; a run killed with SIGKILL leaves no process and, after the next run, no temporary folder."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+import rigcad.engine as E
+from rigcad.engine import Engine, EngineError, run
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _task(shared, t):
+    return t
+
+
+class _Server:
+    """A TCP server on 127.0.0.1 that accepts and then does ``behave(conn)``."""
+
+    def __init__(self, behave):
+        self.sock = socket.create_server(("127.0.0.1", 0))
+        self.port = self.sock.getsockname()[1]
+        self.conns: list[socket.socket] = []
+        self.behave = behave
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self):
+        while True:
+            try:
+                conn, _ = self.sock.accept()
+            except OSError:
+                return
+            self.conns.append(conn)
+            threading.Thread(target=self.behave, args=(conn,), daemon=True).start()
+
+    def close(self):
+        self.sock.close()
+        for c in self.conns:
+            c.close()
+
+
+def _silent(conn):
+    """Accept and say nothing, ever."""
+
+
+def _http_replying(conn):
+    """An HTTP server: waits for a request, answers 400 to anything."""
+    try:
+        conn.recv(65536)
+        conn.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n")
+    except OSError:  # the test closed the server first
+        pass
+
+
+def _http_first(conn):
+    """A server that speaks first, in HTTP (a banner or a proxy's error page)."""
+    conn.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n")
+
+
+def _refusal_within(address: str, bound_s: float) -> str:
+    """Run two tasks on ``address`` in a thread; the run must end (an EngineError) within ``bound_s``:
+    a hang bound, not a speed figure (the old code waited past 115 s)."""
+    box = {}
+
+    def go():
+        try:
+            run(_task, None, [1, 2], Engine(1, address))
+            box["result"] = "ran"
+        except BaseException as err:  # recorded and judged below
+            box["error"] = err
+
+    t = threading.Thread(target=go, daemon=True)
+    t.start()
+    t.join(bound_s)
+    assert not t.is_alive(), f"the run on {address} still waits after {bound_s} s"
+    err = box.get("error")
+    assert isinstance(err, EngineError), repr(err)
+    return str(err)
+
+
+@pytest.mark.parametrize("behave,says", [(_silent, "sent nothing"), (_http_replying, "sent nothing"),
+                                         (_http_first, "HTTP server")])
+def test_a_server_that_is_not_a_scheduler_is_refused_within_the_handshake_bound(behave, says, monkeypatch):
+    pytest.importorskip("distributed")
+    monkeypatch.setattr(E, "CONNECT_TIMEOUT_S", 2)
+    server = _Server(behave)
+    try:
+        # bound: the 2 s handshake timeout plus the Client's own bounded attempt, with room for a
+        # loaded machine; the old code had no bound at all for the silent server
+        msg = _refusal_within(f"tcp://127.0.0.1:{server.port}", 60)
+    finally:
+        server.close()
+    assert "cannot reach the Dask scheduler" in msg and says in msg and "\n" not in msg, msg
+
+
+def test_a_real_scheduler_passes_the_handshake_check():
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None, protocol="tcp://",
+                                  host="127.0.0.1") as cluster:
+        assert run(_task, None, [3, 1, 2], Engine(1, cluster.scheduler_address)) == [3, 1, 2]
+
+
+def test_the_http_scheduler_on_the_command_line_is_one_line(tmp_path):
+    pytest.importorskip("distributed")
+    server = _Server(_http_first)
+    try:
+        env = dict(os.environ, PYTHONPATH=str(ROOT), TMPDIR=str(tmp_path))
+        proc = subprocess.run([sys.executable, "-c", "import sys; from rigcad.cli import main; sys.exit(main())",
+                               "tolerance", "achutha2006", "--samples", "4", "--rays", "100", "--no-limits",
+                               "--scheduler", f"tcp://127.0.0.1:{server.port}", "--exports", str(tmp_path / "x")],
+                              capture_output=True, text=True, env=env, timeout=300)
+    finally:
+        server.close()
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+    assert proc.stderr.count("\n") == 1 and "HTTP server" in proc.stderr, proc.stderr
+
+
+# -- kill -9 ------------------------------------------------------------------------------------------
+def _children(pid: int) -> set[int]:
+    """Every live descendant of ``pid`` (from /proc)."""
+    parent_of = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if fields[0] != "Z":
+                parent_of[int(entry.name)] = int(fields[1])
+    out, frontier = set(), {pid}
+    while frontier:
+        frontier = {c for c, p in parent_of.items() if p in frontier} - out
+        out |= frontier
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"  # a zombie has ended; only its exit status waits for a reaper
+
+
+def _poll(condition, bound_s: float, step_s: float = 0.05):
+    """``condition()`` until it is truthy or ``bound_s`` passes; returns its last value."""
+    end = time.monotonic() + bound_s
+    while True:
+        value = condition()
+        if value or time.monotonic() > end:
+            return value
+        time.sleep(step_s)
+
+
+def _start(argv: list[str], tmp: Path) -> subprocess.Popen:
+    env = dict(os.environ, PYTHONPATH=str(ROOT), TMPDIR=str(tmp), RIGCAD_EVENTS="1")
+    return subprocess.Popen([sys.executable, "-c", "import sys; from rigcad.cli import main; sys.exit(main())",
+                             *argv, "--exports", str(tmp / "exports")],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+
+
+def _kill_and_check(proc: subprocess.Popen, tmp: Path) -> None:
+    """SIGKILL ``proc``; every process it started must end (bounded wait), and the next rigcad run
+    must leave no temporary folder of it behind."""
+    kids = _children(proc.pid)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=30)
+    # bound: the kernel delivers the death signal at once; 30 s leaves room for a loaded machine
+    survivors = _poll(lambda: not [k for k in kids if _alive(k)], 30) or [k for k in kids if _alive(k)]
+    try:
+        assert survivors is True, f"still alive after the parent's SIGKILL: {survivors}"
+    finally:
+        for k in kids:  # never leave them running, whatever the verdict
+            if _alive(k):
+                os.kill(k, signal.SIGKILL)
+    env = dict(os.environ, PYTHONPATH=str(ROOT), TMPDIR=str(tmp))
+    subprocess.run([sys.executable, "-c", "import sys; from rigcad.cli import main; sys.exit(main())",
+                    "profile", "show", "achutha2006"], env=env, capture_output=True, timeout=300, check=True)
+    left = sorted(p.name for p in tmp.iterdir() if p.name != "exports")
+    assert left == [], f"left in the temp folder after the next run: {left}"
+
+
+def test_a_killed_tolerance_run_leaves_no_worker_and_no_temp(tmp_path):
+    proc = _start(["tolerance", "achutha2006", "--workers", "2", "--samples", "20000", "--rays", "2000",
+                   "--no-limits"], tmp_path)
+    try:
+        # wait (bounded) until the loky pool runs: two workers and the resource tracker
+        assert _poll(lambda: len(_children(proc.pid)) >= 3, 300, 0.2), "the pool never started"
+        _kill_and_check(proc, tmp_path)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+
+
+def test_a_killed_local_dask_run_leaves_no_worker_and_no_scratch(tmp_path):
+    pytest.importorskip("distributed")
+    proc = _start(["tolerance", "achutha2006", "--workers", "2", "--scheduler", "local-dask", "--samples", "20000",
+                   "--rays", "2000", "--no-limits"], tmp_path)
+    try:
+        scratch = lambda: list(tmp_path.rglob("dask-scratch-space/worker-*"))  # noqa: E731
+        assert _poll(scratch, 300, 0.2), "the Dask workers never started"
+        _kill_and_check(proc, tmp_path)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+
+
+def test_a_killed_fab_leaves_no_slicer_temp(tmp_path):
+    if shutil.which("prusa-slicer") is None:
+        pytest.skip("PrusaSlicer is not installed")
+    proc = _start(["fab", "achutha2006", "--printer", "prusa_mk3s", "--gcode", "--parts", "beam"], tmp_path)
+    try:
+        slicing = lambda: list(tmp_path.rglob("rigcad-slice-*")) or list(tmp_path.rglob("rigcad-keys-*"))  # noqa: E731
+        assert _poll(slicing, 300, 0.01), "fab never made its slicer folder"
+        _kill_and_check(proc, tmp_path)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+
+
+def test_the_sweep_spares_live_runs_and_other_files(tmp_path):
+    live = tmp_path / f"{E.RUN_TEMP_PREFIX}{os.getpid()}-abc"
+    other_live = tmp_path / f"{E.RUN_TEMP_PREFIX}1-abc"  # pid 1 runs for as long as the machine
+    dead_pid = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead_pid.wait()
+    dead = tmp_path / f"{E.RUN_TEMP_PREFIX}{dead_pid.pid}-abc"
+    mine = tmp_path / "rigcad-run-notes.txt"
+    for d in (live, other_live, dead):
+        (d / "sub").mkdir(parents=True)
+    mine.write_text("not a folder")
+    # a live process that started after its folder was made has reused a dead run's pid
+    before = time.time()
+    reused = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        # its start time is read from the kernel (boot time has whole seconds: 1 s of slack)
+        assert before - 1 <= E._process_start(reused.pid) <= time.time() + 1
+        stale = tmp_path / f"{E.RUN_TEMP_PREFIX}{reused.pid}-abc"
+        (stale / "sub").mkdir(parents=True)
+        past = time.time() - 3600
+        os.utime(stale, (past, past))
+        removed = E.sweep_stale_runs(tmp_path)
+    finally:
+        reused.kill()
+        reused.wait()
+    assert sorted(removed) == sorted([dead, stale]) and live.exists() and other_live.exists() and mine.exists()
+    assert E._process_start(os.getppid()) <= E._process_start(os.getpid())  # a parent starts first
