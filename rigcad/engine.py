@@ -227,32 +227,53 @@ def sweep_stale_runs(base: Path) -> list[Path]:
     return removed
 
 
+#: The run folder of this process while one or more commands run in it (commands run in threads of
+#: one process share it: ``tempfile.tempdir`` is process-wide), and how many are running.
+_RUN_TEMP = {"path": None, "users": 0, "saved": (None, None)}
+_RUN_TEMP_LOCK = threading.Lock()
+
+
 @contextmanager
 def run_temp_dir():
     """One temporary folder for everything a command and its children write to a temp folder
     (slicer runs, key listings, joblib's memory maps, Dask's worker scratch): ``tempfile`` and
     ``TMPDIR`` point into it while the command runs; it is removed at the end, and by the next
     run (:func:`sweep_stale_runs`) when this one was killed. The pool of loky workers started in
-    it is shut down with it. Yields the folder."""
-    base = Path(tempfile.gettempdir())
-    sweep_stale_runs(base)
-    path = Path(tempfile.mkdtemp(prefix=f"{RUN_TEMP_PREFIX}{os.getpid()}-", dir=base))
-    saved = tempfile.tempdir, os.environ.get("TMPDIR")
-    tempfile.tempdir = str(path)
-    os.environ["TMPDIR"] = str(path)
+    it is shut down with it. Commands running at once in one process (threads) share one folder,
+    made by the first and removed by the last, so none removes another's files or leaves
+    ``tempfile`` pointing at a removed folder. Yields the folder."""
+    with _RUN_TEMP_LOCK:
+        if _RUN_TEMP["users"] == 0:
+            base = Path(tempfile.gettempdir())
+            sweep_stale_runs(base)
+            path = Path(tempfile.mkdtemp(prefix=f"{RUN_TEMP_PREFIX}{os.getpid()}-", dir=base))
+            _RUN_TEMP.update(path=path, saved=(tempfile.tempdir, os.environ.get("TMPDIR")))
+            tempfile.tempdir = str(path)
+            os.environ["TMPDIR"] = str(path)
+        _RUN_TEMP["users"] += 1
+        path = _RUN_TEMP["path"]
     try:
         yield path
     finally:
-        loky = sys.modules.get("joblib.externals.loky.reusable_executor")
-        executor = getattr(loky, "_executor", None) if loky else None
-        if executor is not None:
-            executor.shutdown(wait=True, kill_workers=True)
-        tempfile.tempdir = saved[0]
-        if saved[1] is None:
-            os.environ.pop("TMPDIR", None)
-        else:
-            os.environ["TMPDIR"] = saved[1]
-        shutil.rmtree(path, ignore_errors=True)
+        with _RUN_TEMP_LOCK:
+            _RUN_TEMP["users"] -= 1
+            if _RUN_TEMP["users"] == 0:
+                _end_run_temp(path, _RUN_TEMP["saved"])
+                _RUN_TEMP.update(path=None, saved=(None, None))
+
+
+def _end_run_temp(path: Path, saved: tuple[str | None, str | None]) -> None:
+    """Shut down the loky pool started in the run folder, point ``tempfile`` back, remove the folder."""
+    loky = sys.modules.get("joblib.externals.loky.reusable_executor")
+    executor = getattr(loky, "_executor", None) if loky else None
+    if executor is not None:
+        executor.shutdown(wait=True, kill_workers=True)
+    tempfile.tempdir = saved[0]
+    if saved[1] is None:
+        os.environ.pop("TMPDIR", None)
+    else:
+        os.environ["TMPDIR"] = saved[1]
+    shutil.rmtree(path, ignore_errors=True)
 
 
 # -- worker side --------------------------------------------------------------------------------------

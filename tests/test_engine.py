@@ -63,3 +63,36 @@ def test_unreachable_scheduler_is_one_clear_error(address):
 def test_negative_workers_refused():
     with pytest.raises(EngineError, match="workers = -1"):
         Engine(-1).n_workers
+
+
+def test_commands_running_at_once_in_one_process_share_one_run_folder():
+    """Two commands in threads of one process, the first ending before the second (the order that
+    left ``tempfile`` pointing at the first's removed folder when each saved and restored it): both
+    see one live folder while they run, and afterwards ``tempfile`` is back where it was."""
+    import tempfile
+    import threading
+
+    from rigcad.engine import run_temp_dir
+
+    before = tempfile.gettempdir()
+    first_in, second_in, first_out = threading.Event(), threading.Event(), threading.Event()
+    seen = {}
+
+    def second():
+        first_in.wait(60)
+        with run_temp_dir() as path:
+            seen["second"] = path
+            second_in.set()
+            first_out.wait(60)
+            seen["alive_after_first"] = path.is_dir() and tempfile.gettempdir() == str(path)
+
+    t = threading.Thread(target=second)
+    t.start()
+    with run_temp_dir() as path:
+        seen["first"] = path
+        first_in.set()
+        assert second_in.wait(60), "the second command never started"
+    first_out.set()
+    t.join(60)
+    assert seen["first"] == seen["second"] and seen["alive_after_first"], seen
+    assert tempfile.gettempdir() == before and not seen["first"].exists()
