@@ -61,13 +61,14 @@ def checked_counts(profile, rays: int | None, builds: int | None) -> None:
 def cmd_check(args: argparse.Namespace) -> int:
     from rigcad.check.raycheck import run_raycheck, write_raycheck
     from rigcad.check.tolerances import raise_if_failed, table
-    from rigcad.export.atomic import profile_lock
+    from rigcad.export.atomic import check_exports, profile_lock
     from rigcad.export.manifest import profile_digest
     from rigcad.profile import load_profile
     from rigcad.rig import load
 
     profile = load_profile(args.profile)
     checked_counts(profile, args.rays, args.builds)
+    check_exports(args.exports, profile.name, "check")  # a planted link or lock: one line now, not after the work
     rig = load(profile)
     profile = rig.profile
     from rigcad.check.trace3d import counting

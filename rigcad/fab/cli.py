@@ -20,12 +20,13 @@ def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.cli import _progress
     from rigcad.export.build import select_parts
     from rigcad.fab.stage import run_fab
-    from rigcad.export.atomic import profile_lock
+    from rigcad.export.atomic import check_exports, profile_lock
+    from rigcad.profile import load_profile
     from rigcad.rig import load
 
-    printer = load_printer(args.printer)  # a bad printer file is refused before the dome is integrated
-    rig = load(args.profile)
-    profile = rig.profile
+    profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name, "fab")  # a planted link or lock: one line now, not after the work
+    rig = load(profile)
     out = Path(args.exports) / profile.name / "fab" / printer.name
     names = select_parts(args.parts)
     with _progress(len(names), f"fab {profile.name}") as step:

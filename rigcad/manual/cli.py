@@ -16,15 +16,18 @@ VIEW_MAX_RAYS = 100_000
 def cmd_view(args: argparse.Namespace) -> int:
     from rigcad.cli import _progress
     from rigcad.errors import ProfileError
-    from rigcad.export.atomic import profile_lock
+    from rigcad.export.atomic import check_exports, profile_lock
     from rigcad.manual.view import write_view
+    from rigcad.profile import load_profile
     from rigcad.rig import load
 
     if args.rays > VIEW_MAX_RAYS:
         raise ProfileError(f"--rays {args.rays}: the page draws at most {VIEW_MAX_RAYS} rays (each travels inside the "
                            f"HTML file and is drawn at once); valid: 1..{VIEW_MAX_RAYS}", param="--rays")
+    profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name, "view")  # a planted link or lock: one line now, not after the work
     with _progress(5, "view") as step:
-        rig = load(args.profile)
+        rig = load(profile)
         step("dome integrated")
         out = Path(args.exports) / rig.name / "view"
         r = write_view(rig, out, profile_lock(args.exports, rig.name), progress=step, rays=args.rays)

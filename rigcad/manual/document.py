@@ -423,13 +423,16 @@ def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = 
 
 def cmd_manual(args) -> int:
     from rigcad.cli import _progress
-    from rigcad.export.atomic import profile_lock
+    from rigcad.export.atomic import check_exports, profile_lock
     from rigcad.fab.printers import load_printer
     from rigcad.fab.stage import run_fab
+    from rigcad.profile import load_profile
     from rigcad.rig import load
 
-    rig = load(args.profile)
-    printer = load_printer(args.printer)
+    printer = load_printer(args.printer)  # a refused printer file costs no rig
+    profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name, "manual")  # a planted link or lock: one line now, not after the work
+    rig = load(profile)
     root = Path(args.exports) / rig.name
     total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
     with _progress(total, f"manual {rig.name} ({printer.name})") as step:

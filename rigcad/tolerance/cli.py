@@ -62,7 +62,10 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
     from rigcad.profile import load_profile
     from rigcad.profile.schema import check_override
 
+    from rigcad.export.atomic import check_exports
+
     profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name, "tolerance")  # a planted link or lock: one line now, not after the work
     tol = profile.tolerancing
     engine = _engine(args)
     samples = tol.builds if args.samples is None else args.samples
@@ -135,6 +138,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from rigcad.profile.loader import load_raw
 
     raw = load_raw(args.profile)
+    from rigcad.export.atomic import check_exports
+
+    check_exports(args.exports, raw.name, "sweep")  # a planted link or lock: one line now, not after the work
     printer = None if args.printer == "none" else load_printer(args.printer)
     t0 = time.perf_counter()
     with progress_bar(len(spec.values), f"sweep {spec.name} ({engine.name})", "design") as update:

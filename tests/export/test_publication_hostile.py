@@ -146,7 +146,9 @@ def test_the_cli_refuses_a_linked_lock_in_one_line(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("planted", ["lock", "folder"])
-@pytest.mark.parametrize("command", ["design", "build", "stl", "basis"])
+@pytest.mark.parametrize("command", ["design", "build", "stl", "basis", "check", "view", "tolerance",
+                                     "fab --printer prusa_mk3s", "manual --printer prusa_mk3s",
+                                     "sweep --set paraboloid.tangent_angle=19deg..21deg:2 --printer none"])
 def test_a_planted_link_is_refused_before_any_work(tmp_path, capsys, monkeypatch, command, planted):
     """The refusal comes before the rig is built (the dome integrated, the basis computed): a command
     that would only find the link when it publishes has done all its work for nothing."""
@@ -164,7 +166,8 @@ def test_a_planted_link_is_refused_before_any_work(tmp_path, capsys, monkeypatch
         (exports / ".achutha2006.lock").symlink_to(home / "precious.txt")
     else:
         (exports / "achutha2006").symlink_to(home, target_is_directory=True)
-    code = main([command, "achutha2006", "--exports", str(exports)])
+    name, *options = command.split()
+    code = main([name, "achutha2006", *options, "--exports", str(exports)])
     line = _one_line(capsys.readouterr().err)
     assert code != 0 and "symbolic link" in line, line
     assert _tree(home) == before
