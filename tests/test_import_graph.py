@@ -57,13 +57,13 @@ def test_the_rig_module_loads_no_scipy():
     assert not _loaded(modules, HEAVY + ("scipy",))
 
 
-def test_loading_a_profile_loads_no_integrator_or_kernel():
-    """What an up-to-date `rigcad stl` does (read the profile, hash it, compare the manifest) needs
-    numpy for the schema but not the dome integrator, the kernel or the plots."""
-    modules = _modules_after("from rigcad.profile import load_profile\nload_profile('achutha2006')\n"
-                             "import rigcad.export.manifest")
-    assert "rigcad.profile.schema" in modules
-    assert not _loaded(modules, HEAVY)
+def test_an_up_to_date_stl_loads_nothing_heavy():
+    """What an up-to-date `rigcad stl` does before it returns (read and validate the profile, hash
+    it and the code, compare the manifest) needs YAML, not numpy, the integrator, kernel or plots."""
+    modules = _modules_after("from rigcad.profile import load_profile\nfrom rigcad.export.manifest import inputs_key\n"
+                             "inputs_key(load_profile('achutha2006'))\nimport rigcad.export.atomic")
+    assert "rigcad.profile.schema" in modules and "yaml" in modules
+    assert not _loaded(modules, HEAVY + LIGHT_START)
 
 
 @pytest.mark.parametrize("name", ["Rig", "load", "__version__"])
