@@ -109,6 +109,7 @@ bench: $(VENV)/.installed stl
 	$(PY) bench/make_stl.py
 	$(PY) bench/basis.py
 	$(PY) bench/optimize.py
+	$(PY) bench/startup.py
 
 stress: $(VENV)/.installed
 	$(PY) -m pytest -q -m stress --hypothesis-show-statistics

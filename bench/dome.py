@@ -140,7 +140,7 @@ def plot(cases: list[dict]) -> bytes:
 
 
 def main() -> None:
-    profile = load_profile(ROOT / "rigcad" / "profiles" / "achutha2006.yaml")
+    profile = load_profile(ROOT / "profiles" / "achutha2006.yaml")
     g = derive(profile)
     from dataclasses import replace
 

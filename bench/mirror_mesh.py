@@ -31,7 +31,7 @@ from rigcad.optics.surfaces import dome_meridian, paraboloid_meridian
 from rigcad.profile import derive, load_profile
 
 ROOT = Path(__file__).resolve().parents[1]
-PROFILE = ROOT / "rigcad" / "profiles" / "achutha2006.yaml"
+PROFILE = ROOT / "profiles" / "achutha2006.yaml"
 RESULTS = ROOT / "bench" / "results"
 CHORD_ERRORS_MM = (0.1, 0.03, 0.01, 0.003, 0.001)
 NORMAL_PER_CHORD_RAD_PER_MM = 1.0

@@ -15,8 +15,29 @@ check, fabrication. Internally everything is millimetres and radians in float64.
 See docs/api.md.
 """
 
-__version__ = "0.1.0"
+from typing import TYPE_CHECKING
 
-from rigcad.rig import Rig, load  # noqa: E402  (after __version__, which the manifest reads)
+from rigcad._version import __version__
+
+if TYPE_CHECKING:
+    from rigcad.rig import Rig, load
 
 __all__ = ["Rig", "__version__", "load"]
+
+#: Public names imported on first use: ``import rigcad`` (and so every ``rigcad`` command, ``--help``
+#: included) loads no numpy or scipy until a rig is asked for.
+_LAZY = {"Rig": "rigcad.rig", "load": "rigcad.rig"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        from importlib import import_module
+
+        value = getattr(import_module(_LAZY[name]), name)
+        globals()[name] = value  # later lookups skip this function
+        return value
+    raise AttributeError(f"module 'rigcad' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

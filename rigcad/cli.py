@@ -10,7 +10,7 @@ from contextlib import contextmanager
 from dataclasses import fields
 from pathlib import Path
 
-from rigcad import __version__
+from rigcad._version import __version__
 from rigcad.errors import RigcadError
 from rigcad.export.atomic import check_exports, profile_lock, tidy
 from rigcad.units import DEG

@@ -10,7 +10,7 @@ import pytest
 from rigcad.profile import derive, load_profile
 
 ROOT = Path(__file__).resolve().parents[1]
-PROFILES = ROOT / "rigcad" / "profiles"
+PROFILES = ROOT / "profiles"
 
 TABLE31 = """
 paraboloid:

@@ -18,7 +18,7 @@ def run(*args, cwd=ROOT):
 
 
 def test_design_writes_report_table_and_figures(tmp_path, capsys):
-    assert main(["design", str(ROOT / "rigcad/profiles/achutha2006.yaml"), "--exports", str(tmp_path)]) == 0
+    assert main(["design", str(ROOT / "profiles/achutha2006.yaml"), "--exports", str(tmp_path)]) == 0
     out = tmp_path / "achutha2006"
     assert sorted(p.name for p in out.iterdir()) == ["design.json", "dome_profile.csv", "incidence.png", "rays.png"]
     report = json.loads((out / "design.json").read_text())
@@ -53,7 +53,7 @@ def test_bad_profile_is_one_line_with_file_and_line_and_writes_nothing(tmp_path)
 
 def test_impossible_geometry_keeps_previous_exports_intact(tmp_path):
     good = tmp_path / "rig.yaml"
-    good.write_text((ROOT / "rigcad/profiles/achutha2006.yaml").read_text())
+    good.write_text((ROOT / "profiles/achutha2006.yaml").read_text())
     exports = tmp_path / "exports"
     assert main(["design", str(good), "--exports", str(exports)]) == 0
     before = {p.name: p.read_bytes() for p in (exports / "rig").iterdir()}

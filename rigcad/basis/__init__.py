@@ -10,3 +10,8 @@
 
 Angles in radians, solid angles in steradians, local frame: normal +z, tangent +x. See docs/basis.md.
 """
+
+#: Every 32nd camera pixel in both directions: ~50 exitant directions over the zone, ~10 deg apart
+#: (the simulated acquisition's default, :mod:`rigcad.basis.acquire`; here so that ``rigcad basis --help``
+#: shows it without importing the simulation).
+CAMERA_STRIDE_PX = 32

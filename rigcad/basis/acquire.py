@@ -41,6 +41,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from rigcad.basis import CAMERA_STRIDE_PX
 from rigcad.basis.brdf import AshikhminShirleyMicrofacet, AshikhminShirleyPhong, CookTorrance, Lambert, Ward
 from rigcad.basis.gram import gram, quantise_images
 from rigcad.basis.projector import (ProjectorBasis, Progress, check_basis_order, illumination, progress_step,
@@ -52,8 +53,6 @@ from rigcad.errors import BasisError
 
 #: Orders reported (thesis 3.3.1: 4 suffices for matte materials, up to 6 for specular ones).
 ORDERS = (2, 4, 6)
-#: Every 32nd camera pixel in both directions: ~50 exitant directions over the zone, ~10 deg apart.
-CAMERA_STRIDE_PX = 32
 #: The lobe-width study (docs/basis.md): order, Ward roughnesses, exitant directions (theta, phi deg)
 #: whose mirror lobes lie away from the beam's shadow (phi near 0 and 180 deg).
 LOBE_ORDER = 4

@@ -93,7 +93,7 @@ def cmd_basis(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``basis`` to rigcad's subcommands."""
-    from rigcad.basis.acquire import CAMERA_STRIDE_PX
+    from rigcad.basis import CAMERA_STRIDE_PX
 
     p = subparsers.add_parser(
         "basis", help="zonal basis images for the projector, Gram matrices, simulated acquisition",

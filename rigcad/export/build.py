@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigcad import __version__
+from rigcad._version import __version__
 from rigcad.errors import ExportError, ProfileError
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import code_version, file_sha, profile_digest

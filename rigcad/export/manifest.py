@@ -8,7 +8,7 @@ import hashlib
 import json
 from pathlib import Path
 
-from rigcad import __version__
+from rigcad._version import __version__
 
 PACKAGE = Path(__file__).resolve().parents[1]
 

@@ -81,8 +81,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
 def register(subparsers) -> argparse.ArgumentParser:
     """Add the `fab` command to rigcad's subparsers (rigcad.cli.build_parser)."""
     from rigcad.cli import positive_int
-
-    from rigcad.fab.printers import available_printers
+    from rigcad.profile.paths import PRINTERS_SUBDIR, names_on_search_path  # not fab.printers: no numpy for --help
 
     p = subparsers.add_parser(
         "fab", help="fabrication: fit/split, print orientation, staircase, G-code, cutting outlines, report",
@@ -91,7 +90,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "polishing allowance, optical effect), write STL in print position, G-code through PrusaSlicer "
                     "(--gcode), DXF/SVG outlines of the templates, fab.json and fab.md into "
                     "exports/<profile>/fab/<printer>/.",
-        epilog="printers: " + ", ".join(available_printers()) + "; parts: as for `rigcad build --help`")
+        epilog="printers: " + ", ".join(names_on_search_path(PRINTERS_SUBDIR)) + "; parts: as for `rigcad build --help`")
     p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--printer", required=True, help="printer name (under profiles/printers/) or path")
     p.add_argument("--exports", default="exports", help="output root (default: exports)")

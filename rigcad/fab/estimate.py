@@ -28,7 +28,7 @@ import numpy as np
 
 #: Largest error (relative to PrusaSlicer) the fit is held to on every piece of the default profile.
 MAX_REL_ERROR = 0.25
-#: The calibration printer's figures the time scales against (rigcad/profiles/printers/prusa_mk3s.yaml).
+#: The calibration printer's figures the time scales against (profiles/printers/prusa_mk3s.yaml).
 CALIBRATION = {"printer": "prusa_mk3s", "deposition_rate_mm3_s": 8.0, "layer_time_s": 1.0}
 
 

@@ -31,12 +31,10 @@ from typing import Any
 
 from rigcad.errors import FabricationError, ProfileError
 from rigcad.fab import vendor as V
-from rigcad.profile.loader import RawProfile, find_file, load_raw, search_path
+from rigcad.profile.loader import RawProfile, find_file, load_raw
+from rigcad.profile.paths import PRINTERS_SUBDIR, display, names_on_search_path, search_path
 # The schema's own readers, so printer files follow the same unit, range and error rules.
 from rigcad.profile.schema import REQUIRED, Spec, convert_value, read_section, spec, suggest
-
-#: Printer files live in this folder under each folder of the profile search path.
-PRINTERS_SUBDIR = "printers"
 
 #: Thinnest layer a printer file may give (mm): a printer's resolution. The finest commercial
 #: layers (SLA, material jetting) are 0.014..0.025 mm; thinner is a unit slip, and every layer of
@@ -178,7 +176,7 @@ def printer_path(name: str | Path) -> Path:
     spec = Path(name)
     if spec.suffix not in ("", ".yaml", ".yml"):
         raise ProfileError(f"printer {str(name)[:200]!r} is not a printer file: printer files are YAML (.yaml), "
-                           f"found by name in {', '.join(str(d) + '/' for d in search_path(PRINTERS_SUBDIR))}")
+                           f"found by name in {', '.join(display(d) + '/' for d in search_path(PRINTERS_SUBDIR))}")
     if not spec.suffix:
         spec = spec.with_suffix(".yaml")
     refused = ProfileError(f"printer {str(name)[:200]!r} leads to a system folder or to a file that is not YAML, "
@@ -194,7 +192,7 @@ def printer_path(name: str | Path) -> Path:
 
 def available_printers() -> list[str]:
     """Printer names on the search path (first folder wins for a name)."""
-    return sorted({p.stem for d in search_path(PRINTERS_SUBDIR) if d.is_dir() for p in d.glob("*.yaml")})
+    return names_on_search_path(PRINTERS_SUBDIR)
 
 
 def load_printer(name: str | Path) -> Printer:

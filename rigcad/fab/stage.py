@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigcad import __version__
+from rigcad._version import __version__
 from rigcad.errors import FabricationError, RigcadError
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import profile_digest

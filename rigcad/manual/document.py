@@ -20,7 +20,7 @@ import re
 import sys
 from pathlib import Path
 
-from rigcad import __version__
+from rigcad._version import __version__
 from rigcad.manual import bom as B
 from rigcad.manual import calibration as C
 

@@ -24,9 +24,6 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.interpolate import make_interp_spline
-from scipy.optimize import brentq
 
 from rigcad.errors import GeometryError, IntegrationError
 from rigcad.profile.derived import Derived
@@ -204,6 +201,8 @@ class DomeProfile:
         if self.kind != "smooth":
             raise GeometryError(f"the {self.method} dome is a polyline of flat mirror segments: it has no smooth "
                                 "curve (use dome.method dop853, rk45 or equal_path)", param="dome.method")
+        from scipy.interpolate import make_interp_spline  # scipy is imported when a dome is read, not with rigcad
+
         order = np.argsort(self.s)[::-1]  # s decreases from the rim (bottom) to the top
         return make_interp_spline(-self.s[order], self.points[order], k=5)
 
@@ -237,6 +236,8 @@ def scalar_theta(geo: Derived, path_length: float):
 
 def occlusion_s(geo: Derived, path_length: float) -> float:
     """Parabola radius whose dome point is seen from O exactly at the rim (closed form + brentq)."""
+    from scipy.optimize import brentq
+
     theta = scalar_theta(geo, path_length)
 
     def g(s: float) -> float:
@@ -329,6 +330,8 @@ def build_euler(geo: Derived, steps: int) -> DomeProfile:
 
 def _solve(geo: Derived, method: str, tol: float, st: Start, s_end: float):
     """One solve_ivp run from the rim to s_end; raises IntegrationError when scipy reports failure."""
+    from scipy.integrate import solve_ivp
+
     rtol = max(tol / (2.0 * st.t), 100 * np.finfo(float).eps)  # |t| <= 2 t_rim: allowance <= 2 tol
 
     rhs = scalar_rhs(geo)

@@ -99,7 +99,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "and a local polish over the free parameters of the profile's optimize: section, under its "
                     "constraints; writes exports/<profile>/optimize/{<profile>_design.yaml, optimize.json, "
                     "history.png, pareto.png}. Exit 1 naming the constraint that could not be met.",
-        epilog="Example: rigcad optimize achutha2006_optimize (rigcad/profiles/achutha2006_optimize.yaml)")
+        epilog="Example: rigcad optimize achutha2006_optimize (profiles/achutha2006_optimize.yaml)")
     p.add_argument("profile", help="profile name (under profiles/) or path, with an optimize: section")
     p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--seed", type=int, help="seed (default: optimize.seed)")

@@ -165,7 +165,8 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
                  progress=None) -> OptimizeRun:
     """Search and publish (module docstring). Raises OptimizeError (after publishing the record of
     every evaluation) when no design meets the constraints."""
-    from rigcad import __version__, plots
+    from rigcad import plots
+    from rigcad._version import __version__
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
 
     problem = load_problem(profile_spec, overrides)

@@ -152,7 +152,7 @@ def read_optimize(raw: RawProfile, profile: Profile) -> OptimizeSpec:
     data = raw.data.get("optimize")
     if not isinstance(data, dict):
         raise ProfileError(f"profile {profile.name} has no 'optimize:' section (free parameters, objectives, "
-                           "constraints); see rigcad/profiles/achutha2006_optimize.yaml",
+                           "constraints); see profiles/achutha2006_optimize.yaml",
                            where=where(("optimize",)) or (str(raw.sources[0]) if raw.sources else None))
     for key in data:
         if key not in _SEARCH:

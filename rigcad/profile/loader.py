@@ -1,8 +1,8 @@
 """The only YAML reader in rigcad: files -> nested dicts with a file:line mark per key.
 
-Profiles are found by name on a search path (:func:`search_path`): the working directory's
-``profiles/``, the folders in ``$RIGCAD_PROFILES`` (``os.pathsep``-separated) and the profiles
-shipped inside the package (``rigcad/profiles/``), in that order; or given as a path. A profile may
+Profiles are found by name on a search path (:func:`rigcad.profile.paths.search_path`): the working
+directory's ``profiles/``, the folders in ``$RIGCAD_PROFILES`` (``os.pathsep``-separated) and the
+profiles shipped with rigcad (the repository's ``profiles/``), in that order; or given as a path. A profile may
 say ``extends: other`` (a name looked up first beside it, then on the search path, or a file) and
 override a few keys; mappings merge key by key, anything else is replaced. Each value keeps the mark of
 the file and line that set it, so validation errors point at the line to edit.
@@ -18,7 +18,6 @@ file is never opened, so its content is never echoed.
 
 from __future__ import annotations
 
-import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +26,7 @@ from typing import Any
 import yaml
 
 from rigcad.errors import ProfileError
+from rigcad.profile.paths import PROFILES_ENV, display as _display, is_shipped, search_path
 
 Key = tuple[str, ...]
 
@@ -70,21 +70,6 @@ class RawProfile:
 def _mark(shown: str, node: yaml.Node) -> str:
     """``file:line`` of a node; ``shown`` is the file as :func:`_display` names it."""
     return f"{shown}:{node.start_mark.line + 1}"
-
-
-def _display(path: Path) -> str:
-    """How a file is named in messages and outputs: a shipped profile as ``rigcad/profiles/...``
-    wherever rigcad is installed (outputs do not depend on the install folder), others relative to
-    the working directory when under it."""
-    resolved = path.resolve()
-    try:
-        return str(Path("rigcad") / "profiles" / resolved.relative_to(PACKAGE_PROFILES.resolve()))
-    except ValueError:
-        pass
-    try:
-        return str(resolved.relative_to(Path.cwd().resolve()))
-    except ValueError:
-        return str(path)
 
 
 def _build(loader: yaml.SafeLoader, node: yaml.Node, shown: str, key: Key, marks: dict[Key, str]) -> Any:
@@ -225,21 +210,6 @@ def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-#: The profiles shipped with rigcad (rig profiles; printers under ``printers/``).
-PACKAGE_PROFILES = Path(__file__).resolve().parents[1] / "profiles"
-#: Environment variable naming extra profile folders, ``os.pathsep``-separated.
-PROFILES_ENV = "RIGCAD_PROFILES"
-
-
-def search_path(sub: str = "") -> list[Path]:
-    """Folders searched for a profile given by name, first match wins: ``./profiles``, each folder
-    of ``$RIGCAD_PROFILES``, the package's profiles; ``sub`` (e.g. ``printers``) is appended to each."""
-    dirs = [Path("profiles")]
-    dirs += [Path(p) for p in os.environ.get(PROFILES_ENV, "").split(os.pathsep) if p]
-    dirs.append(PACKAGE_PROFILES)
-    return [d / sub if sub else d for d in dirs]
-
-
 def find_file(spec: str | Path, kind: str, sub: str = "", near: Path | None = None,
               as_path: bool = True) -> Path:
     """A ``kind`` file ("profile", "printer") by path (unless ``as_path`` is False), or by name in
@@ -258,9 +228,13 @@ def find_file(spec: str | Path, kind: str, sub: str = "", near: Path | None = No
             if candidate.is_file():
                 return candidate
     looked = []
-    for folder in dict.fromkeys(folders):
+    unique: dict[Path, Path] = {}
+    for folder in folders:
+        unique.setdefault(folder.resolve(), folder)  # each folder once (./profiles may be the shipped one)
+    for folder in unique.values():
         names = sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
-        looked.append(f"{_display(folder)}/ ({', '.join(names) if names else 'none'})")
+        shipped = "shipped with rigcad: " if is_shipped(folder) else ""
+        looked.append(f"{_display(folder)}/ ({shipped}{', '.join(names) if names else 'none'})")
     raise ProfileError(f"no {kind} {str(spec)!r}: looked for {candidates[-1].name} in " + "; ".join(looked)
                        + f" (set ${PROFILES_ENV} to add folders)")
 

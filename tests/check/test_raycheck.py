@@ -18,7 +18,7 @@ from rigcad.rig import Rig
 
 ROOT = Path(__file__).resolve().parents[2]
 #: rig profiles (profiles/printers/ holds printer definitions, not rigs)
-PROFILES = sorted((ROOT / "rigcad" / "profiles").glob("*.yaml"))
+PROFILES = sorted((ROOT / "profiles").glob("*.yaml"))
 
 
 def test_there_are_profiles():
@@ -73,7 +73,7 @@ def test_cli_writes_the_report_and_figures(tmp_path, capsys):
 
 def test_cli_exits_nonzero_with_a_table_on_failure(tmp_path, write_profile, capsys):
     path = write_profile(f"""
-        extends: {ROOT / "rigcad" / "profiles" / "achutha2006.yaml"}
+        extends: {ROOT / "profiles" / "achutha2006.yaml"}
         raycheck:
           mode: analytic
           max_lost_fraction: 0.01

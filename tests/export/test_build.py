@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     out = tmp_path_factory.mktemp("build") / "achutha2006"
-    profile = load_profile(ROOT / "rigcad/profiles/achutha2006.yaml")
+    profile = load_profile(ROOT / "profiles/achutha2006.yaml")
     rig = Rig.from_profile(profile)
     result = build_rig(rig, out)
     return rig, out, result
@@ -111,7 +111,7 @@ def test_changed_key_rebuilds_only_dependent_parts(built, tmp_path, write_profil
 
     work = tmp_path / "rig"
     shutil.copytree(out, work)
-    text = (ROOT / "rigcad/profiles/achutha2006.yaml").read_text() + "beam:\n  width: 5 mm\n"
+    text = (ROOT / "profiles/achutha2006.yaml").read_text() + "beam:\n  width: 5 mm\n"
     changed = load_profile(write_profile(text, name="achutha2006"))
     result = build_rig(Rig.from_profile(changed), work)
     # the beam's width shapes the beam, the dome's slots and both clamps; nothing else
@@ -128,7 +128,7 @@ def test_failed_run_leaves_the_last_good_exports(built, tmp_path, monkeypatch):
     work = tmp_path / "rig"
     shutil.copytree(out, work)
     before = {p: p.read_bytes() for p in work.rglob("*") if p.is_file()}
-    changed = load_profile(ROOT / "rigcad/profiles/achutha2006.yaml")
+    changed = load_profile(ROOT / "profiles/achutha2006.yaml")
     changed = type(changed)(**{**changed.__dict__, "tessellation": type(changed.tessellation)(
         **{**changed.tessellation.__dict__, "chord_error": 0.02})})
 

@@ -31,12 +31,12 @@ def layout(table31_rig):
 
 @pytest.fixture(scope="session")
 def prusa():
-    return load_printer(ROOT / "rigcad" / "profiles" / "printers" / "prusa_mk3s.yaml")
+    return load_printer(ROOT / "profiles" / "printers" / "prusa_mk3s.yaml")
 
 
 @pytest.fixture(scope="session")
 def vantage():
-    return load_printer(ROOT / "rigcad" / "profiles" / "printers" / "vantage_i.yaml")
+    return load_printer(ROOT / "profiles" / "printers" / "vantage_i.yaml")
 
 
 @pytest.fixture(scope="session")

@@ -22,7 +22,7 @@ from .conftest import ROOT
 
 @pytest.fixture(scope="module")
 def form3():
-    return load_printer(ROOT / "rigcad" / "profiles" / "printers" / "form3.yaml")
+    return load_printer(ROOT / "profiles" / "printers" / "form3.yaml")
 
 
 def _fits(piece, plan, printer, mirror) -> bool:

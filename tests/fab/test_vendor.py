@@ -39,7 +39,7 @@ needs_slicer = pytest.mark.skipif(not (have_slicer() and have_bundle()), reason=
 
 def printer_yaml(tmp_path: Path, slicer: str, drop: tuple[str, ...] = (), edit: dict[str, str] | None = None) -> Path:
     """The shipped MK3S printer file with its slicer section replaced (and keys dropped or edited)."""
-    text = (ROOT / "rigcad" / "profiles" / "printers" / "prusa_mk3s.yaml").read_text()
+    text = (ROOT / "profiles" / "printers" / "prusa_mk3s.yaml").read_text()
     head, _, tail = text.partition("slicer:\n")
     tail = tail[tail.index("alignment_pin:"):]
     lines = [ln for ln in head.splitlines() if not any(ln.startswith(k + ":") for k in drop)]

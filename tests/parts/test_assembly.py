@@ -22,7 +22,7 @@ RIG = ["dome", "paraboloid", "beam", "base_plate", "sample_holder"]
 
 @pytest.fixture(scope="module")
 def rig():
-    r = Rig.from_profile(load_profile(ROOT / "rigcad/profiles/achutha2006.yaml"))
+    r = Rig.from_profile(load_profile(ROOT / "profiles/achutha2006.yaml"))
     shapes = {n: K.single_solid(K.build(r.recipe(n).solid, 1e-4, K.FitReport())) for n in RIG}
     return r, shapes
 

@@ -41,7 +41,7 @@ def _utf8(text: str) -> bytes:
 
 
 def _encoding_cases(rng: random.Random, scale: int):
-    good = (Path(__file__).resolve().parents[2] / "rigcad" / "profiles" / "achutha2006.yaml").read_text()
+    good = (Path(__file__).resolve().parents[2] / "profiles" / "achutha2006.yaml").read_text()
     text = BASE + "description: caf\u00e9 \u00fcber na\u00efve\n"
     yield "latin-1", text.encode("latin-1")
     yield "cp1252", (BASE + "description: \u201cquoted\u201d\n").encode("cp1252")
@@ -242,7 +242,9 @@ def run_case(arena: Path, payload, capsys, command: str = "design") -> tuple[int
     assert "Traceback" not in err
     assert SECRET not in err and "root:" not in err, err
     assert not out.exists() or not any(p.is_file() for p in out.rglob("*")), "files written for a refused profile"
-    forbidden = [p for p in _opened if "secret" in p or p.startswith(("/etc/", "/proc/", "/dev/"))]
+    secret_dir = (arena / "secret").resolve()  # by path: the standard library's secrets.py is not the secret
+    forbidden = [p for p in _opened if Path(p).resolve().is_relative_to(secret_dir)
+                 or p.startswith(("/etc/", "/proc/", "/dev/"))]
     assert not forbidden, f"opened {forbidden}"
     assert not Path("PWNED").exists() and not (work / "PWNED").exists()
     assert elapsed < 2.0, f"{elapsed:.2f} s"

@@ -69,8 +69,8 @@ def test_shipped_profile_loads_by_name_from_any_folder(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     monkeypatch.delenv("RIGCAD_PROFILES", raising=False)
     raw = load_raw("achutha2006")
-    assert str(raw.sources[0]) == "rigcad/profiles/achutha2006.yaml"
-    assert raw.marks[("layout", "cop_to_vertex")].startswith("rigcad/profiles/achutha2006.yaml:")
+    assert str(raw.sources[0]) == "profiles/achutha2006.yaml"  # the file to edit, as the repository has it
+    assert raw.marks[("layout", "cop_to_vertex")].startswith("profiles/achutha2006.yaml:")
 
 
 def test_extends_a_shipped_profile_by_name_from_elsewhere(tmp_path, monkeypatch):
@@ -100,4 +100,5 @@ def test_missing_name_says_where_it_looked(tmp_path, monkeypatch):
     with pytest.raises(ProfileError) as err:
         load_raw("nope")
     msg = str(err.value)
-    assert "profiles/ (none)" in msg and "lab/ (none)" in msg and "rigcad/profiles/ (achutha2006" in msg and "RIGCAD_PROFILES" in msg
+    assert "profiles/ (none)" in msg and "lab/ (none)" in msg and "RIGCAD_PROFILES" in msg
+    assert "profiles/ (shipped with rigcad: achutha2006" in msg
