@@ -24,6 +24,7 @@ anything is allocated (:func:`require_memory`). Temporary files of a run go into
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import os
 import pickle
@@ -168,34 +169,47 @@ _LEGACY_TEMP = ("rigcad-keys-", "rigcad-slice-", "rigcad-check-")
 LEGACY_TEMP_AGE_S = 24 * 3600
 
 
-def _owner_alive(pid: int, made: float) -> bool:
-    """Whether process ``pid`` may still own a folder made at time ``made`` (s since the epoch): it
-    exists and started before the folder (a pid reused by a later process does not count)."""
+#: The file in a run folder that its process holds an exclusive ``flock`` on while it runs: the
+#: kernel drops the lock when the process (and every child that inherited it) has ended, however it
+#: ended, so a sweep tells a live run from a killed one without reading /proc or trusting a pid.
+RUN_OWNER_FILE = ".owner"
+
+
+def _hold_owner(path: Path) -> int:
+    """Create ``path/.owner`` and hold an exclusive lock on it; returns the descriptor to close."""
+    fd = os.open(path / RUN_OWNER_FILE, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+    fcntl.flock(fd, fcntl.LOCK_EX)
+    return fd
+
+
+def _run_alive(folder: str, pid: int) -> bool:
+    """Whether the run that made ``folder`` may still be running: its owner file is locked, or (no
+    owner file yet: the moment between making the folder and locking it) process ``pid`` exists.
+    Anything that is not rigcad's plain owner file counts as alive: the sweep leaves it alone."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's process: alive
+        fd = os.open(os.path.join(folder, RUN_OWNER_FILE), os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC | os.O_NONBLOCK)
+    except FileNotFoundError:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        except PermissionError:  # another user's process
+            return True
         return True
-    started = _process_start(pid)
-    return started is None or started <= made + 1.0
-
-
-def _process_start(pid: int) -> float | None:
-    """When process ``pid`` started (s since the epoch; Linux /proc), or None when unknown: its
-    ``starttime`` (field 22 of /proc/<pid>/stat, clock ticks since boot) plus the boot time."""
+    except OSError:  # a link or something else planted there
+        return True
     try:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()  # fields 3.. (comm may hold spaces)
-        with open("/proc/stat") as fh:
-            boot = next(int(line.split()[1]) for line in fh if line.startswith("btime"))
-        return boot + int(fields[19]) / os.sysconf("SC_CLK_TCK")
-    except (OSError, ValueError, IndexError, StopIteration):
-        return None
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return True
+    finally:
+        os.close(fd)
+    return False
 
 
 def sweep_stale_runs(base: Path) -> list[Path]:
     """Remove the temporary folders of rigcad runs that ended without their clean-up (killed):
-    ``rigcad-run-<pid>-*`` whose process is gone, and the folders older versions left (see
+    ``rigcad-run-<pid>-*`` whose owner lock is free (the run ended without its clean-up), and the folders older versions left (see
     _LEGACY_TEMP). Only this user's real folders (never through a link). Returns what was removed."""
     removed = []
     try:
@@ -218,7 +232,7 @@ def sweep_stale_runs(base: Path) -> list[Path]:
         if not e.is_dir(follow_symlinks=False) or st.st_uid != os.getuid():
             continue
         if name.startswith(RUN_TEMP_PREFIX):
-            if _owner_alive(int(pid_text), st.st_mtime if st.st_mtime < st.st_ctime else st.st_ctime):
+            if _run_alive(e.path, int(pid_text)):
                 continue
         elif now - st.st_mtime < LEGACY_TEMP_AGE_S:
             continue
@@ -229,7 +243,7 @@ def sweep_stale_runs(base: Path) -> list[Path]:
 
 #: The run folder of this process while one or more commands run in it (commands run in threads of
 #: one process share it: ``tempfile.tempdir`` is process-wide), and how many are running.
-_RUN_TEMP = {"path": None, "users": 0, "saved": (None, None)}
+_RUN_TEMP = {"path": None, "owner": None, "users": 0, "saved": (None, None)}
 _RUN_TEMP_LOCK = threading.Lock()
 
 
@@ -247,7 +261,8 @@ def run_temp_dir():
             base = Path(tempfile.gettempdir())
             sweep_stale_runs(base)
             path = Path(tempfile.mkdtemp(prefix=f"{RUN_TEMP_PREFIX}{os.getpid()}-", dir=base))
-            _RUN_TEMP.update(path=path, saved=(tempfile.tempdir, os.environ.get("TMPDIR")))
+            owner = _hold_owner(path)
+            _RUN_TEMP.update(path=path, owner=owner, saved=(tempfile.tempdir, os.environ.get("TMPDIR")))
             tempfile.tempdir = str(path)
             os.environ["TMPDIR"] = str(path)
         _RUN_TEMP["users"] += 1
@@ -259,7 +274,8 @@ def run_temp_dir():
             _RUN_TEMP["users"] -= 1
             if _RUN_TEMP["users"] == 0:
                 _end_run_temp(path, _RUN_TEMP["saved"])
-                _RUN_TEMP.update(path=None, saved=(None, None))
+                os.close(_RUN_TEMP["owner"])
+                _RUN_TEMP.update(path=None, owner=None, saved=(None, None))
 
 
 def _end_run_temp(path: Path, saved: tuple[str | None, str | None]) -> None:

@@ -143,7 +143,7 @@ def test_a_memory_error_is_one_line(monkeypatch, capsys):
 def test_optimize_never_replaces_a_file_it_did_not_write(tmp_path, capsys):
     from rigcad.optimize.cli import DESIGN_MARK, refuse_foreign_design
 
-    src = (ROOT / "rigcad" / "profiles" / "achutha2006_optimize.yaml").read_text()
+    src = (ROOT / "profiles" / "achutha2006_optimize.yaml").read_text()
     (tmp_path / "lab").mkdir()
     profile = tmp_path / "lab" / "mine.yaml"
     profile.write_text(src)

@@ -230,28 +230,34 @@ def test_a_killed_fab_leaves_no_slicer_temp(tmp_path):
 
 
 def test_the_sweep_spares_live_runs_and_other_files(tmp_path):
-    live = tmp_path / f"{E.RUN_TEMP_PREFIX}{os.getpid()}-abc"
-    other_live = tmp_path / f"{E.RUN_TEMP_PREFIX}1-abc"  # pid 1 runs for as long as the machine
-    dead_pid = subprocess.Popen([sys.executable, "-c", "pass"])
-    dead_pid.wait()
-    dead = tmp_path / f"{E.RUN_TEMP_PREFIX}{dead_pid.pid}-abc"
-    mine = tmp_path / "rigcad-run-notes.txt"
-    for d in (live, other_live, dead):
+    """A run folder is live while its owner file is locked (by whatever process, whatever its pid),
+    or, before it has an owner file, while its pid exists; the rest of the temp folder is not
+    rigcad's to touch."""
+    import fcntl
+
+    def folder(pid, owner):
+        d = tmp_path / f"{E.RUN_TEMP_PREFIX}{pid}-{len(list(tmp_path.iterdir()))}"
         (d / "sub").mkdir(parents=True)
+        if owner:
+            (d / E.RUN_OWNER_FILE).write_text("")
+        return d
+
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    locked = folder(gone.pid, owner=True)  # a pid that ended, but the lock is held: live
+    fd = os.open(locked / E.RUN_OWNER_FILE, os.O_RDONLY)
+    fcntl.flock(fd, fcntl.LOCK_EX)
+    unlocked = folder(1, owner=True)  # pid 1 lives (a reused pid), but nobody holds the lock: killed
+    new_live = folder(1, owner=False)  # no owner file yet, its pid lives: being made right now
+    new_dead = folder(gone.pid, owner=False)  # no owner file and its pid is gone: killed while made
+    planted = folder(gone.pid, owner=False)
+    (planted / E.RUN_OWNER_FILE).symlink_to(tmp_path / "elsewhere")  # not rigcad's: left alone
+    mine = tmp_path / "rigcad-run-notes.txt"
     mine.write_text("not a folder")
-    # a live process that started after its folder was made has reused a dead run's pid
-    before = time.time()
-    reused = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
     try:
-        # its start time is read from the kernel (boot time has whole seconds: 1 s of slack)
-        assert before - 1 <= E._process_start(reused.pid) <= time.time() + 1
-        stale = tmp_path / f"{E.RUN_TEMP_PREFIX}{reused.pid}-abc"
-        (stale / "sub").mkdir(parents=True)
-        past = time.time() - 3600
-        os.utime(stale, (past, past))
         removed = E.sweep_stale_runs(tmp_path)
     finally:
-        reused.kill()
-        reused.wait()
-    assert sorted(removed) == sorted([dead, stale]) and live.exists() and other_live.exists() and mine.exists()
-    assert E._process_start(os.getppid()) <= E._process_start(os.getpid())  # a parent starts first
+        os.close(fd)
+    assert sorted(removed) == sorted([unlocked, new_dead]), removed
+    assert locked.exists() and new_live.exists() and planted.exists() and mine.exists()
+    assert E.sweep_stale_runs(tmp_path) == [locked]  # its lock released: swept by the next run
