@@ -1,10 +1,18 @@
-"""Shared fixtures: the repository's profiles and small profiles written to tmp_path."""
+"""Shared fixtures: the repository's profiles, small profiles written to tmp_path, and the costly
+outputs (the default profile's exports, a fab run) built once per session and shared by the xdist
+workers."""
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
+import io
 import os
+import pickle
+import shutil
 import textwrap
 from pathlib import Path
+from typing import NamedTuple
 
 import pytest
 
@@ -64,6 +72,56 @@ def table31_rig(table31):
     from rigcad.rig import Rig
 
     return Rig.from_profile(table31)
+
+
+def shared_build(tmp_path_factory, name: str, build):
+    """``build(folder)`` run once per session, by whichever xdist worker asks first; the others wait
+    on a file lock (fcntl.flock) and read what it returned (pickled) and wrote under ``folder``.
+    The folder lives in the session's temporary root (the workers' base temps' parent, or the base
+    temp itself without xdist), so no session reuses another's. Consumers only read it."""
+    base = tmp_path_factory.getbasetemp()
+    root = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "shared"
+    root.mkdir(exist_ok=True)
+    folder, done = root / name, root / f"{name}.pickle"
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes, or by the OS if the worker dies
+        if not done.is_file():
+            shutil.rmtree(folder, ignore_errors=True)  # a worker that failed half-way
+            result = build(folder)
+            tmp = done.with_suffix(".tmp")
+            tmp.write_bytes(pickle.dumps(result))
+            tmp.replace(done)
+        return pickle.loads(done.read_bytes())
+
+
+class Exports(NamedTuple):
+    """The default profile's exports, as `rigcad stl achutha2006 --exports root` wrote them."""
+
+    root: Path  #: the --exports folder
+    out: Path  #: root / achutha2006
+    stdout: str  #: what the command printed
+
+
+@pytest.fixture(scope="session")
+def default_exports(tmp_path_factory) -> Exports:
+    """`rigcad stl achutha2006` once per session (in-process), shared by every worker. Read only: a
+    test that writes into an export tree works on a copy (copy_exports)."""
+    from rigcad.cli import main
+
+    def build(root: Path) -> Exports:
+        out, err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = main(["stl", "achutha2006", "--exports", str(root)])
+        assert code == 0, err.getvalue()[-2000:]
+        return Exports(root, root / "achutha2006", out.getvalue())
+
+    return shared_build(tmp_path_factory, "default_exports", build)
+
+
+def copy_exports(exports: Exports, dest: Path) -> Path:
+    """A private copy of the shared exports (dest becomes the --exports folder): for tests that write."""
+    shutil.copytree(exports.root, dest, ignore=shutil.ignore_patterns("*.lock"))
+    return dest
 
 
 @pytest.fixture
