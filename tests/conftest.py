@@ -36,6 +36,37 @@ def in_ci() -> bool:
     return os.environ.get("CI") == "true"
 
 
+def warm_numba() -> None:
+    """Compile (or load from numba's on-disk cache) every kernel of the analytic and the mesh ray
+    tracers: a few rays through the default rig, aligned (the table kernel) and misaligned (the
+    Newton kernel), through the analytic surfaces and through coarse meshes (each mode)."""
+    import numpy as np
+
+    from rigcad.check import trace3d
+    from rigcad.check.scene import analytic_optics, mesh_optics, rig_meshes
+    from rigcad.optics.frames import Pose
+    from rigcad.rig import Rig
+
+    rig = Rig.from_profile(load_profile(PROFILES / "achutha2006.yaml"))
+    s = np.linspace(-0.3, 0.3, 16)
+    dirs = np.column_stack([s, s[::-1] / 2, -np.sqrt(1 - s * s - s[::-1] ** 2 / 4)])
+    origins = np.tile([0.0, 0.0, rig.geometry.cop_z], (len(s), 1))
+    tilted = Pose.misaligned((0.3, -0.2, 0.4), 0.004, (1.0, 1.0, 0.0), (0, 0, rig.geometry.vertex_z))
+    meshes = rig_meshes(rig, None, 0.05, 0.05)
+    for optics in (analytic_optics(rig), *(mesh_optics(meshes, mode) for mode in ("mesh", "smooth", "exact_normals"))):
+        trace3d.trace(optics, origins, dirs)
+        trace3d.trace(optics.placed(tilted, tilted), origins, dirs)
+
+
+def pytest_sessionstart(session):
+    """Before the xdist workers start (on the controller, when -n is given), warm numba's cache
+    once: on a fresh clone each worker would otherwise compile the same kernels (~20 s each)."""
+    config = session.config
+    if hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None):
+        return
+    warm_numba()
+
+
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item, call):
     """In CI a skip is a failure: the skip helpers (no PrusaSlicer, no vendor bundle, no Chromium,
@@ -74,7 +105,7 @@ def table31_rig(table31):
     return Rig.from_profile(table31)
 
 
-def shared_build(tmp_path_factory, name: str, build):
+def _shared_build(tmp_path_factory, name: str, build):
     """``build(folder)`` run once per session, by whichever xdist worker asks first; the others wait
     on a file lock (fcntl.flock) and read what it returned (pickled) and wrote under ``folder``.
     The folder lives in the session's temporary root (the workers' base temps' parent, or the base
@@ -94,6 +125,12 @@ def shared_build(tmp_path_factory, name: str, build):
         return pickle.loads(done.read_bytes())
 
 
+@pytest.fixture(scope="session")
+def shared_build(tmp_path_factory):
+    """``shared_build(name, build)``: build(folder) once per session for every worker (_shared_build)."""
+    return lambda name, build: _shared_build(tmp_path_factory, name, build)
+
+
 class Exports(NamedTuple):
     """The default profile's exports, as `rigcad stl achutha2006 --exports root` wrote them."""
 
@@ -105,7 +142,7 @@ class Exports(NamedTuple):
 @pytest.fixture(scope="session")
 def default_exports(tmp_path_factory) -> Exports:
     """`rigcad stl achutha2006` once per session (in-process), shared by every worker. Read only: a
-    test that writes into an export tree works on a copy (copy_exports)."""
+    test that writes into an export tree works on a copy (exports_copy)."""
     from rigcad.cli import main
 
     def build(root: Path) -> Exports:
@@ -115,12 +152,14 @@ def default_exports(tmp_path_factory) -> Exports:
         assert code == 0, err.getvalue()[-2000:]
         return Exports(root, root / "achutha2006", out.getvalue())
 
-    return shared_build(tmp_path_factory, "default_exports", build)
+    return _shared_build(tmp_path_factory, "default_exports", build)
 
 
-def copy_exports(exports: Exports, dest: Path) -> Path:
-    """A private copy of the shared exports (dest becomes the --exports folder): for tests that write."""
-    shutil.copytree(exports.root, dest, ignore=shutil.ignore_patterns("*.lock"))
+@pytest.fixture
+def exports_copy(default_exports, tmp_path) -> Path:
+    """A private copy of the shared exports (the --exports folder), for a test that writes into it."""
+    dest = tmp_path / "exports_copy"
+    shutil.copytree(default_exports.root, dest, ignore=shutil.ignore_patterns("*.lock"))
     return dest
 
 
