@@ -63,6 +63,7 @@ def _stl(profile: Path, exports: Path, env=None, **kw):
 KILL_AT = ("dome integrated", "paraboloid", "tower_column", "publishing")
 
 
+@pytest.mark.slow  # six `rigcad stl` processes (already at the coarsest tessellation): the default run's longest test
 def test_a_killed_stl_never_publishes_half_a_run(tmp_path):
     """A good build of one profile, then builds of a changed one (every mirror part rebuilds)
     killed with SIGKILL at its progress events, the last one just as it starts publishing. After
