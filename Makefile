@@ -22,7 +22,7 @@ help:
 	@echo "make gcode    - print files + G-code (PrusaSlicer) for PRINTER=$(PRINTER) -> $(EXPORTS)/$(PROFILE)/fab/$(PRINTER)/"
 	@echo "make view     - the assembled rig in 3D: $(EXPORTS)/$(PROFILE)/view/rig.html (one self-contained file)"
 	@echo "make manual   - assembly and calibration manual for PRINTER=$(PRINTER) -> $(EXPORTS)/$(PROFILE)/manual/$(PRINTER)/"
-	@echo "make test     - the fast test suite (default run, < 10 min)"
+	@echo "make test     - the fast test suite (default run, < 5 min on 2 cores)"
 	@echo "make test-slow - only the slow tests (the whole rig through PrusaSlicer)"
 	@echo "make test-all - every test, slow ones included"
 	@echo "make test-portable - the numerical tests as other CPUs compute them (BLAS kernels, numpy SIMD off, generic numba)"
@@ -65,8 +65,10 @@ docs: check view
 	cp $(EXPORTS)/achutha2006/check/spot.png $(EXPORTS)/achutha2006/check/theta_map.png docs/
 	mkdir -p docs/parts && cp $(EXPORTS)/achutha2006/renders/*.png docs/parts/
 
+# --durations=15: the slowest tests on every run; --timeout (pytest-timeout): a hung test fails after
+# 10 min (the slow ones, the whole rig through PrusaSlicer, after an hour) instead of stalling the run
 test: $(VENV)/.installed tools
-	$(PY) -m pytest -q -n auto --dist loadfile -m "not slow and not stress"
+	$(PY) -m pytest -q -n auto --dist loadfile -m "not slow and not stress" --durations=15 --timeout=600
 
 # The numerical tests as other x86-64 CPUs compute them, on this one: OpenBLAS's kernel forced
 # (Prescott: SSE3 only; SkylakeX: AVX-512; Haswell: AVX2 + FMA), numpy's SIMD dispatch switched off
@@ -92,7 +94,7 @@ test-portable: $(VENV)/.installed
 	done
 
 test-slow: $(VENV)/.installed tools
-	$(PY) -m pytest -q -m slow
+	$(PY) -m pytest -q -m slow --durations=15 --timeout=3600
 
 gcode: $(VENV)/.installed tools
 	$(VENV)/bin/rigcad fab $(PROFILE) --printer $(PRINTER) --exports $(EXPORTS) --gcode

@@ -4,20 +4,24 @@ PrusaSlicer's own figures on this rig's pieces (``bench/fab_stages.py --estimate
 A piece is read as the slicer builds it: a shell of ``perimeters`` beads around every surface
 (``shell_mm`` thick: perimeters x extrusion width), the core inside it at the infill's share,
 support under its overhangs (the columns from each overhang down to what it stands on, and the
-overhang's area for the dense interface layers: rigcad.fab.orientation.support_contact), and a
-fixed cost per piece (the vendor's start G-code: heating, mesh bed levelling, purge line, skirt).
-Material and time are linear in those, with non-negative coefficients (scipy's NNLS, each piece's
-relative error weighing alike):
+overhang's area for the dense interface layers: rigcad.fab.orientation.support_contact), and the
+island-layers: each island of each layer (a closed outline of the slice) is one loop the slicer
+travels to, retracts for, starts a seam on and closes. A tall, thin piece (a tower column: 513
+layers of thin walls, several islands each) spends much of its time there, which no volume term
+sees. Material and time are linear in those, with non-negative coefficients (scipy's NNLS, each
+piece's relative error weighing alike):
 
-    material (mm3) = m_shell V_shell + m_core V_core + m_support V_support + m_piece
+    material (mm3) = m_shell V_shell + m_core V_core + m_support V_support + m_island N_island
     time (s)       = t_shell V_shell + t_core V_core + t_support V_support + t_overhang A_overhang
-                     + t_layer layers + t_piece
+                     + t_island N_island + t_piece
 
-Where V_shell = min(V, surface area x shell_mm), V_core = V - V_shell. The coefficients below were
-fitted on the Prusa MK3S (0.15 mm QUALITY, 3 perimeters, 20 % infill, PrusaSlicer 2.5) and hold
-there within MAX_REL_ERROR on every piece (bench table, README); another printer scales the
-volume terms by its own deposition rate and the layer term by its layer time against the MK3S
-file's (8 mm3/s, 1 s): a first-order transfer, not a calibration.
+Where V_shell = min(V, surface area x shell_mm), V_core = V - V_shell, N_island = the islands
+summed over the layers. The coefficients below were fitted on the Prusa MK3S (0.15 mm QUALITY, 3
+perimeters, 20 % gyroid infill, Prusament PLA, PrusaSlicer 2.5) and hold there within
+MAX_REL_ERROR on every piece; left out of the fit one part at a time, each part's pieces are
+predicted within the leave-one-out errors in bench/results/fab_estimates.json. Another printer
+scales the volume terms by its own deposition rate and the island term by its layer time against
+the MK3S file's (8 mm3/s, 1 s): a first-order transfer, not a calibration.
 """
 
 from __future__ import annotations
@@ -35,32 +39,34 @@ CALIBRATION = {"printer": "prusa_mk3s", "deposition_rate_mm3_s": 8.0, "layer_tim
 @dataclass(frozen=True)
 class Fit:
     """Coefficients of the model (see the module docstring): material per mm3 of shell, core and
-    support envelope (mm3/mm3) and per piece (mm3); time per mm3 (s/mm3), per mm2 of overhang
-    (s/mm2), per layer (s) and per piece (s)."""
+    support envelope (mm3/mm3) and per island-layer (mm3); time per mm3 (s/mm3), per mm2 of
+    overhang (s/mm2), per island-layer (s) and per piece (s)."""
 
     m_shell: float
     m_core: float
     m_support: float
-    m_piece: float
+    m_island: float
     t_shell: float
     t_core: float
     t_support: float
     t_overhang: float
-    t_layer: float
+    t_island: float
     t_piece: float
     source: str
 
 
-#: Fitted by `bench/fab_stages.py --estimates --fit` on achutha2006 / prusa_mk3s (16 pieces,
-#: PrusaSlicer 2.5.0); bench/results/fab_estimates.json holds the table and the leave-one-out errors.
-FIT = Fit(m_shell=0.827627, m_core=0.158985, m_support=0.246222, m_piece=844.977,
-          t_shell=0.336918, t_core=0.0551712, t_support=0.141063, t_overhang=0.334485, t_layer=3.58497,
-          t_piece=621.682, source="fitted to PrusaSlicer 2.5.0 on achutha2006 / prusa_mk3s")
+#: Fitted by `bench/fab_stages.py --estimates --fit` on achutha2006 / prusa_mk3s (28 pieces of 17
+#: parts, PrusaSlicer 2.5.0): worst error 20.6 % in the fit, 28.9 % on a part left out of it;
+#: bench/results/fab_estimates.json holds the table and the leave-one-part-out errors.
+FIT = Fit(m_shell=0.922548, m_core=0.13058, m_support=0.217561, m_island=1.93945,
+          t_shell=0.387839, t_core=0.0404128, t_support=0.0, t_overhang=2.88925, t_island=5.06252,
+          t_piece=67.704, source="fitted to PrusaSlicer 2.5.0 on achutha2006 / prusa_mk3s")
 
 
 @dataclass(frozen=True)
 class Features:
-    """What the model reads of a piece (mm, mm2, mm3)."""
+    """What the model reads of a piece (mm, mm2, mm3; island_layers: the islands of every layer,
+    summed: island_layers(layers))."""
 
     volume_mm3: float
     surface_mm2: float
@@ -68,6 +74,7 @@ class Features:
     support_envelope_mm3: float
     overhang_mm2: float
     shell_mm: float
+    island_layers: int
 
     @property
     def shell_volume_mm3(self) -> float:
@@ -78,11 +85,24 @@ class Features:
         return self.volume_mm3 - self.shell_volume_mm3
 
     def material_row(self) -> np.ndarray:
-        return np.array([self.shell_volume_mm3, self.core_volume_mm3, self.support_envelope_mm3, 1.0])
+        return np.array([self.shell_volume_mm3, self.core_volume_mm3, self.support_envelope_mm3,
+                         float(self.island_layers)])
 
     def time_row(self) -> np.ndarray:
         return np.array([self.shell_volume_mm3, self.core_volume_mm3, self.support_envelope_mm3, self.overhang_mm2,
-                         float(self.layers), 1.0])
+                         float(self.island_layers), 1.0])
+
+
+def island_layers(layers) -> int:
+    """The islands of every layer, summed: the outlines that enclose material (positive signed
+    area, counter-clockwise as manifold3d returns a slice's outer boundaries; holes are clockwise)
+    of ``layers`` (rigcad.fab.staircase.Layers, printer frame)."""
+    count = 0
+    for polys in layers.contours:
+        for p in polys:
+            x, y = p[:, 0], p[:, 1]
+            count += int(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) > 0.0)
+    return count
 
 
 def shell_thickness(printer) -> float:
@@ -103,7 +123,7 @@ def shell_thickness(printer) -> float:
 
 def estimate(features: Features, printer, fit: Fit = FIT) -> dict:
     """Time (s) and material (cm3, g) of one piece on ``printer`` by the fitted model."""
-    mat = float(features.material_row() @ np.array([fit.m_shell, fit.m_core, fit.m_support, fit.m_piece]))
+    mat = float(features.material_row() @ np.array([fit.m_shell, fit.m_core, fit.m_support, fit.m_island]))
     if printer.process != "fdm":
         mat = features.volume_mm3  # resin: the part itself (no infill; supports not modelled)
     rate = printer.deposition_rate_mm3_s or CALIBRATION["deposition_rate_mm3_s"]
@@ -111,7 +131,7 @@ def estimate(features: Features, printer, fit: Fit = FIT) -> dict:
     scale_l = (printer.layer_time_s / CALIBRATION["layer_time_s"]) if printer.layer_time_s > 0 else 1.0
     row = features.time_row()
     t = float(row[:4] @ np.array([fit.t_shell, fit.t_core, fit.t_support, fit.t_overhang])) * scale_v
-    t += row[4] * fit.t_layer * scale_l + fit.t_piece
+    t += row[4] * fit.t_island * scale_l + fit.t_piece
     if printer.process != "fdm":  # resin: a whole layer is exposed at once, the time is per layer
         t = features.layers * printer.layer_time_s
     return {"method": f"rigcad model fitted to PrusaSlicer (rigcad.fab.estimate; {fit.source})",
@@ -119,7 +139,8 @@ def estimate(features: Features, printer, fit: Fit = FIT) -> dict:
             "material_g": mat / 1000.0 * printer.material_density_g_cm3,
             "features": {"volume_mm3": features.volume_mm3, "surface_mm2": features.surface_mm2,
                          "layers": features.layers, "support_envelope_mm3": features.support_envelope_mm3,
-                         "overhang_mm2": features.overhang_mm2, "shell_mm": features.shell_mm}}
+                         "overhang_mm2": features.overhang_mm2, "shell_mm": features.shell_mm,
+                         "island_layers": features.island_layers}}
 
 
 def fit(rows: list[tuple[Features, float, float]], density_g_cm3: float, source: str) -> Fit:

@@ -461,7 +461,7 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
                                                  rows[k]["support_model"]["support_envelope_mm3"],
                                                  rows[k]["support_model"]["mirror_under_mm2"]
                                                  + rows[k]["support_model"]["other_under_mm2"],
-                                                 E.shell_thickness(printer)), printer)}
+                                                 E.shell_thickness(printer), E.island_layers(layers)), printer)}
         if mf is not None and len(mf.index):
             steps = ST.step_map(layers, rot, shift, mirror, tol_mirror)
             row["mirror_area_mm2"] = mf.area

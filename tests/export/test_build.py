@@ -2,7 +2,9 @@
 reader, trimesh's STL reader, manifold3d's validity check."""
 
 import json
+import shutil
 from pathlib import Path
+from types import SimpleNamespace
 
 import manifold3d as m3d
 import numpy as np
@@ -18,12 +20,21 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    out = tmp_path_factory.mktemp("build") / "achutha2006"
-    profile = load_profile(ROOT / "profiles/achutha2006.yaml")
-    rig = Rig.from_profile(profile)
-    result = build_rig(rig, out)
-    return rig, out, result
+def built(default_exports, table31_rig):
+    """The session's `rigcad stl achutha2006` (tests/conftest.py, built once for every worker; read
+    only): the rig, its export folder, and what the run built (from its output) and its manifest."""
+    rebuilt = [ln.split()[0] for ln in default_exports.stdout.splitlines() if ln.startswith("  ") and " built " in ln]
+    manifest = json.loads((default_exports.out / "manifest.json").read_text())
+    return table31_rig, default_exports.out, SimpleNamespace(rebuilt=rebuilt, manifest=manifest)
+
+
+def _stl_inputs(rig) -> dict:
+    """What `rigcad stl` hands build_rig besides the rig (rigcad.cli.cmd_stl): the design files and
+    the inputs key, so a build here writes the same tree as the shared one."""
+    from rigcad.export.design import design_files
+    from rigcad.export.manifest import inputs_key
+
+    return {"design": design_files(rig.design), "inputs_key": inputs_key(rig.profile)}
 
 
 def _read_step(path):
@@ -88,17 +99,20 @@ def test_mirror_fits_within_one_micrometre(built):
     assert max(f["end_gap_mm"] for f in fits) <= 1e-9  # ends are exact, so the sections close
 
 
-def test_second_run_rebuilds_nothing_and_changes_nothing(built):
-    rig, out, _ = built
+def test_second_run_rebuilds_nothing_and_changes_nothing(built, tmp_path):
+    rig, shared, _ = built
+    out = tmp_path / "achutha2006"
+    shutil.copytree(shared, out)  # the shared tree stays read-only
     before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
-    again = build_rig(rig, out)
+    again = build_rig(rig, out, **_stl_inputs(rig))
     assert again.rebuilt == [] and sorted(again.reused) == sorted(PARTS)
     assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
 
 
 def test_clean_rebuild_is_byte_identical(built, tmp_path):
     rig, out, _ = built
-    build_rig(Rig.from_profile(rig.profile), tmp_path / "again")
+    # a fresh rig in this process; the shared tree was built by `rigcad stl` in whichever worker ran first
+    build_rig(Rig.from_profile(rig.profile), tmp_path / "again", **_stl_inputs(rig))
     for path in out.rglob("*"):
         if path.is_file():
             twin = tmp_path / "again" / path.relative_to(out)

@@ -13,7 +13,6 @@ import signal
 import subprocess
 import sys
 import threading
-import time
 from pathlib import Path
 
 import pytest
@@ -64,6 +63,7 @@ def _stl(profile: Path, exports: Path, env=None, **kw):
 KILL_AT = ("dome integrated", "paraboloid", "tower_column", "publishing")
 
 
+@pytest.mark.slow  # six `rigcad stl` processes (already at the coarsest tessellation): the default run's longest test
 def test_a_killed_stl_never_publishes_half_a_run(tmp_path):
     """A good build of one profile, then builds of a changed one (every mirror part rebuilds)
     killed with SIGKILL at its progress events, the last one just as it starts publishing. After
@@ -189,17 +189,24 @@ def test_an_up_to_date_run_removes_what_a_run_killed_while_publishing_left(tmp_p
 def test_a_second_run_waits_for_the_first_and_says_who_holds_the_lock(tmp_path):
     lock = tmp_path / ".rig.lock"
     held = hold_lock(lock)
-    said, done = [], threading.Event()
+    said, reported, done = [], threading.Event(), threading.Event()
+
+    def say(msg):
+        said.append(msg)
+        reported.set()
 
     def second():
-        h = hold_lock(lock, say=said.append)
+        h = hold_lock(lock, say=say)
         done.set()
         h.release()
 
     t = threading.Thread(target=second)
     t.start()
-    time.sleep(0.5)
-    assert not done.is_set(), "the second run went ahead while the first held the lock"
+    # the second run says who holds the lock before it blocks; 60 s is a hang guard, not a timing
+    assert reported.wait(timeout=60), "the second run never said it was waiting"
+    # while the first holds the lock the second cannot go ahead, however long we look: a correct lock
+    # never fails this; a lock that does not block fails it (0.5 s for the thread to get there)
+    assert not done.wait(timeout=0.5), "the second run went ahead while the first held the lock"
     assert said and f"pid {os.getpid()}" in said[0] and str(lock) in said[0], said
     held.release()
     t.join(timeout=10)

@@ -40,14 +40,17 @@ def vantage():
 
 
 @pytest.fixture(scope="session")
-def prusa_run(table31_rig, prusa, tmp_path_factory):
-    """One fab run of the small parts and the dome on the desktop printer, without G-code."""
+def prusa_run(table31_rig, prusa, shared_build):
+    """One fab run of the small parts and the dome on the desktop printer, without G-code: run once
+    per session for every xdist worker (tests/conftest.py); its readers only read it."""
     from rigcad.fab.stage import run_fab
 
-    out = tmp_path_factory.mktemp("fab") / "prusa_mk3s"
-    res = run_fab(table31_rig, prusa, out, parts=["dome", "paraboloid", "beam", "sample_holder", "camera_cross_hung",
-                                              "dome_template", "paraboloid_template"])
-    return out, res
+    def build(folder):
+        out = folder / "prusa_mk3s"
+        return out, run_fab(table31_rig, prusa, out, parts=["dome", "paraboloid", "beam", "sample_holder",
+                                                            "camera_cross_hung", "dome_template", "paraboloid_template"])
+
+    return shared_build("prusa_run", build)
 
 
 def have_slicer() -> bool:

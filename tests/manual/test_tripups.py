@@ -19,28 +19,32 @@ def _rigcad(*args, timeout=600):
     return subprocess.run([sys.executable, "-m", "rigcad.cli", *args], capture_output=True, text=True, timeout=timeout)
 
 
-@pytest.fixture(scope="module")
-def stl_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("exports")
-    run = _rigcad("stl", "achutha2006", "--exports", str(out))
-    assert run.returncode == 0, run.stderr
-    return out, run
-
-
-def test_stl_names_every_part_it_built_in_aligned_columns(stl_run):
-    _, run = stl_run
-    lines = [ln for ln in run.stdout.splitlines() if ln.startswith("  ")]
+def test_stl_names_every_part_it_built_in_aligned_columns(default_exports):
+    stdout = default_exports.stdout  # the session's `rigcad stl achutha2006` (tests/conftest.py)
+    lines = [ln for ln in stdout.splitlines() if ln.startswith("  ")]
     named = [ln.split()[0] for ln in lines]
-    assert named == list(PARTS), run.stdout
+    assert named == list(PARTS), stdout
     # the state column starts at the same place on every line, the longest name included
     starts = {re.search(r" (built|unchanged) ", ln).start() for ln in lines}
     assert len(starts) == 1, lines
 
 
-def test_check_says_when_it_meshes_from_the_profile(tmp_path, stl_run):
-    run = _rigcad("check", "achutha2006", "--exports", str(tmp_path), "--rays", "2000", "--no-monte-carlo")
-    assert "meshing the mirrors from the profile" in run.stderr and "rigcad stl achutha2006" in run.stderr
-    exported = _rigcad("check", "achutha2006", "--exports", str(stl_run[0]), "--rays", "2000", "--no-monte-carlo")
+#: The default profile meshed coarsely: the message is the claim here, not the meshes' accuracy.
+COARSE = """extends: achutha2006
+tessellation:
+  chord_error: 0.03 mm
+  mirror_chord_error: 0.02 mm
+  mirror_normal_error: 0.05 rad
+"""
+
+
+def test_check_says_when_it_meshes_from_the_profile(tmp_path, exports_copy):
+    coarse = tmp_path / "coarse.yaml"
+    coarse.write_text(COARSE)
+    run = _rigcad("check", str(coarse), "--exports", str(tmp_path / "none"), "--rays", "2000", "--no-monte-carlo")
+    assert "meshing the mirrors from the profile" in run.stderr and f"rigcad stl {coarse}" in run.stderr, run.stderr
+    # the session's exports, copied: check writes its report beside the meshes
+    exported = _rigcad("check", "achutha2006", "--exports", str(exports_copy), "--rays", "2000", "--no-monte-carlo")
     assert "from the profile" not in exported.stderr, exported.stderr
     # the theta rows compare the traced end of the range itself (positive degrees) with the target
     # widened by the tolerance: no negative 'measured' value to puzzle over

@@ -84,6 +84,13 @@ def _browser_available() -> None:
         pytest.fail(f"{CHROMIUM} is missing: `make tools` installs Debian's chromium (apt-get)")
 
 
+def _next_frame(page) -> None:
+    """Return once the browser has drawn a frame after the last change: the page renders on change
+    (setVisible, setExplode call render() at once), and the second requestAnimationFrame callback
+    runs only after the frame holding that render has been produced; no fixed wait."""
+    page.evaluate("() => new Promise(done => requestAnimationFrame(() => requestAnimationFrame(done)))")
+
+
 def _screenshot(page) -> np.ndarray:
     from PIL import Image
 
@@ -131,7 +138,7 @@ def test_in_chromium_no_request_leaves_the_page_and_the_canvas_draws_the_rig(vie
             solid = "projector_body" if "projector_body" in names else "base_plate"
             for name, floor in ((solid, 0.02), ("dome", 0.005)):
                 page.click(f"#part-{name}")  # the check box, as a user toggles it
-                page.wait_for_timeout(200)
+                _next_frame(page)
                 hidden = _screenshot(page)
                 assert not page.evaluate(f"document.getElementById('part-{name}').checked")
                 changed = (np.abs(hidden - assembled).sum(axis=2) > PIXEL_DIFF).mean()
@@ -141,7 +148,7 @@ def test_in_chromium_no_request_leaves_the_page_and_the_canvas_draws_the_rig(vie
                 assert changed > floor, f"hiding {name} changed only {changed:.3%} of the pixels"
                 page.click(f"#part-{name}")
             page.evaluate("window.rigcad.setExplode(1)")
-            page.wait_for_timeout(200)
+            _next_frame(page)
             exploded = _screenshot(page)
             assert (np.abs(exploded - assembled).sum(axis=2) > PIXEL_DIFF).mean() > 0.02
         finally:
