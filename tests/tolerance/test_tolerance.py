@@ -43,8 +43,41 @@ def test_monte_carlo_is_not_vacuous(serial_mc, table31_rig):
     assert np.all(np.hypot(c["dome_dx_mm"], c["dome_dy_mm"]) <= tol.dome_offset)
     assert np.all(c["paraboloid_tilt_rad"] <= tol.paraboloid_tilt)
     assert len(set(c["max_spot_radius_mm"].tolist())) == SAMPLES
-    # sub-millimetre placement errors move the spot by ~0.1-3 mm (the sensitivity table's scale)
-    assert 0.05 < serial_mc.summary["figures"]["max_spot_radius_mm"]["p50"] < 3
+    # the summary's percentiles are those of the column (numpy's median, not the summary's code)
+    fig = serial_mc.summary["figures"]["max_spot_radius_mm"]
+    assert fig["p50"] == pytest.approx(float(np.median(c["max_spot_radius_mm"])), rel=1e-12)
+    assert fig["max"] == float(np.max(c["max_spot_radius_mm"]))
+
+
+def test_monte_carlo_spots_match_an_independent_retrace(serial_mc, table31_rig):
+    """Each sample's projector spot radius, re-traced from the perturbation the table records
+    (offsets, tilt, tilt axis) through the vectorised exact path (numpy passes, not the compiled
+    kernel the Monte Carlo runs) and measured here as max |miss| of the rays that return.
+    Replaces a 60x window (0.05 < p50 < 3 mm) around the median."""
+    from rigcad.check.sources import annulus_rays
+    from rigcad.optics.frames import Misalignment
+
+    rig, c = table31_rig, serial_mc.columns
+    tol = rig.profile.tolerancing
+    optics, design = analytic_optics(rig), rig.incidence
+    ray_seed = int(tol.seed) + 1  # the Monte Carlo's ray seed: tolerancing.seed + 1 (run_monte_carlo)
+    spots = []
+    for i in range(SAMPLES):
+        mis = Misalignment.none()
+        for comp in ("projector", "camera", "paraboloid", "dome"):
+            az = c[f"{comp}_tilt_axis_azimuth_rad"][i]
+            mis = mis.with_(comp, offset=(c[f"{comp}_dx_mm"][i], c[f"{comp}_dy_mm"][i], c[f"{comp}_dz_mm"][i]),
+                            tilt=c[f"{comp}_tilt_rad"][i], axis=(math.cos(az), math.sin(az), 0.0))
+        rays_ = annulus_rays(design, RAYS, ray_seed, mis.pose("projector", rig.geometry))
+        placed = optics.placed(mis.pose("paraboloid", rig.geometry), mis.pose("dome", rig.geometry))
+        tr = trace(placed, rays_.origins, rays_.dirs, vectorised=True)
+        spots.append(float(np.max(np.abs(tr.miss[tr.ok]))))
+    # the two paths solve the same float64 intersections with different operation orders (and the
+    # tilt axis passes through atan2 and back): agreement to rounding at ~300 mm, 1e-9 mm
+    assert np.max(np.abs(np.array(spots) - c["projector_max_spot_radius_mm"])) < 1e-9
+    # the build is the spot's cause: the aligned rig's spot is under 1e-6 mm (tests/check), these
+    # are 1e5x that, and differ from sample to sample
+    assert min(spots) > 1e-3 and len(set(spots)) == SAMPLES
 
 
 def test_workers_and_batching_give_the_same_bits(serial_mc, table31_rig):
