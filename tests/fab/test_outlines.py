@@ -7,6 +7,7 @@ import xml.etree.ElementTree as ET
 
 import ezdxf
 import numpy as np
+import pytest
 
 from rigcad.fab.outlines import dxf_bytes, outline, svg_bytes
 from rigcad.parts import PARTS
@@ -121,23 +122,65 @@ def test_dxf_rereads_at_true_scale(table31, table31_rig, layout, tmp_path):
         assert worst <= chord, (name, worst, chord)
 
 
+def test_dxf_layers_units_and_note(table31, layout, tmp_path):
+    """What the DXF's docstring promises besides the geometry: R2010, millimetres (metric), the
+    three layers with their entities, the note naming the part and plate thickness below the
+    outline, flat (z = 0) splines."""
+    part = PARTS["paraboloid_template"](table31, layout)
+    o = outline(part, table31.tessellation.chord_error)
+    assert o.name == part.name and o.thickness == part.solid.thickness
+    path = tmp_path / "t.dxf"
+    path.write_bytes(dxf_bytes(o))
+    doc = ezdxf.readfile(path)
+    assert doc.dxfversion == "AC1024"  # R2010
+    assert doc.header["$MEASUREMENT"] == 1 and doc.header["$INSUNITS"] == 4  # metric, mm
+    # CAM reads the layer table: CUT red (1), CURVES green (3), NOTE white (7), ezdxf's ACI numbers
+    assert {la.dxf.name: la.dxf.color for la in doc.layers if la.dxf.name in ("CUT", "CURVES", "NOTE")} == \
+        {"CUT": 1, "CURVES": 3, "NOTE": 7}
+    msp = doc.modelspace()
+    assert sorted(e.dxf.layer for e in msp) == ["CURVES", "CURVES", "CUT", "NOTE"]
+    [text] = [e for e in msp if e.dxftype() == "TEXT"]
+    assert text.dxf.layer == "NOTE" and text.dxf.text == f"paraboloid_template t={o.thickness:g} mm"
+    lo = o.polygon.min(axis=0)
+    # the note sits under the outline's lower-left corner, clear of the cut (6 mm below, 3 mm high)
+    assert tuple(text.dxf.insert)[:2] == pytest.approx((lo[0], lo[1] - 6.0), abs=1e-9)
+    assert text.dxf.height == 3.0
+    for sp in (e for e in msp if e.dxftype() == "SPLINE"):
+        assert np.all(np.array(sp.fit_points)[:, 2] == 0.0)  # a 2D drawing
+
+
+def test_outline_refuses_a_part_that_is_not_flat(table31, layout):
+    part = PARTS["beam"](table31, layout)
+    with pytest.raises(TypeError, match="beam is not a flat"):
+        outline(part, 0.018)
+
+
 def test_svg_is_true_scale_in_mm(table31, layout):
     part = PARTS["dome_template"](table31, layout)
     o = outline(part, table31.tessellation.chord_error)
     root = ET.fromstring(svg_bytes(o))
     w, h = (float(root.get(k).removesuffix("mm")) for k in ("width", "height"))
     vb = [float(v) for v in root.get("viewBox").split()]
-    assert vb[2:] == [w, h]  # one user unit = one mm
+    assert vb[:2] == [0.0, 0.0] and vb[2:] == [w, h]  # one user unit = one mm
+    # the document is the outline plus the 2 mm margin on each side (5 decimals: 1e-5 mm)
+    assert np.allclose([w, h], np.ptp(o.polygon, axis=0) + 4.0, atol=2e-5)
     path = root.find("{http://www.w3.org/2000/svg}path")
-    xy = np.array([[float(a), float(b)] for a, b in re.findall(r"([-\d.]+),([-\d.]+)", path.get("d"))])
-    # 5 decimals in the file: 1e-5 mm
-    assert np.allclose(np.ptp(xy, axis=0), np.ptp(o.polygon, axis=0), atol=2e-5)
+    d = path.get("d")
+    # absolute commands: one moveto, a lineto per further vertex, closed
+    assert d.startswith("M ") and d.endswith(" Z") and d.count(" L ") == len(o.polygon) - 1
+    assert not re.search(r"[a-z]", d)  # no relative (lower-case) command
+    xy = np.array([[float(a), float(b)] for a, b in re.findall(r"([-\d.]+),([-\d.]+)", d)])
+    # each vertex where the drawing puts it: x from the left margin, y flipped from the top margin
+    lo, hi = o.polygon.min(axis=0), o.polygon.max(axis=0)
+    expect = np.column_stack([o.polygon[:, 0] - lo[0] + 2.0, hi[1] + 2.0 - o.polygon[:, 1]])
+    assert np.allclose(xy, expect, atol=2e-5)
 
 
 def test_dxf_is_the_same_in_every_process():
     """Python salts string hashes per process; the DXF must not depend on it (ezdxf collects its
     CLASS entries in a set). Two interpreters with different PYTHONHASHSEED write the same bytes,
     DXF and SVG (two processes, not two calls in one: a call cannot be its own reference)."""
+    import hashlib
     import os
     import subprocess
     import sys
@@ -146,7 +189,9 @@ def test_dxf_is_the_same_in_every_process():
             "rig = rigcad.load('achutha2006'); "
             "o = outline(rig.recipe('paraboloid_template'), 0.018); "
             "print(hashlib.sha256(dxf_bytes(o) + b'|' + svg_bytes(o)).hexdigest())")
-    digests = set()
+    # this process's bytes too (so mutation testing sees this test call the writers)
+    o = outline(PARTS["paraboloid_template"](*_table31_and_layout()), 0.018)
+    digests = {hashlib.sha256(dxf_bytes(o) + b"|" + svg_bytes(o)).hexdigest()}
     for seed in ("0", "4"):  # two seeds known to order the classes differently without the fix
         env = {**os.environ, "PYTHONHASHSEED": seed}
         res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
@@ -154,3 +199,10 @@ def test_dxf_is_the_same_in_every_process():
         digests.add(res.stdout.strip())
     assert len(digests) == 1, digests
     assert len(next(iter(digests))) == 64  # a sha256 hex digest, not an empty line
+
+
+def _table31_and_layout():
+    import rigcad
+
+    rig = rigcad.load("achutha2006")
+    return rig.profile, rig.layout
