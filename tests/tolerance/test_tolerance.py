@@ -179,3 +179,30 @@ def test_scheduler_without_dask_says_what_to_install(table31_rig, monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
     with pytest.raises(EngineError, match=r"pip install 'rigcad\[dask\]'"):
         run_monte_carlo(table31_rig, 2, 100, Engine(1, LOCAL_DASK))
+
+
+def test_limit_search_at_its_two_ends(table31_rig):
+    """The inverse-limit search where the doubling never brackets the target (SEARCH_CAP: no limit
+    there) and where the very first move already exceeds it (the limit lies between 0 and the
+    start), and the light path each component's move is traced on."""
+    from rigcad.tolerance.limits import LimitJob, _search, worst_figures
+    from rigcad.tolerance.params import SEARCH_CAP
+
+    rig, rays = table31_rig, 200
+    job = LimitJob(rig, rays, int(rig.profile.tolerancing.seed) + 1, Job(rig, rays, 0, 0).key)
+    p = next(q for q in PARAMETERS if q.name == "dome_offset")
+    # an unreachable target: the search stops at the cap and says so, with the error there
+    capped = _search(job, p, "max_spot_radius_mm", math.inf, 0.1)
+    assert capped["limit"] == SEARCH_CAP["offset"] and capped["reached"] is False
+    at_cap = worst_figures(job, p, SEARCH_CAP["offset"])["max_spot_radius_mm"]
+    assert capped["error_at_limit"] == at_cap and at_cap > 1.0  # a 50 mm move misses by far more
+    # a target the first move (0.1 mm) already exceeds: 1e-4 mm, above the aligned rig's own spot
+    # (~1.5e-8 mm): the bracket is [0, start] and the limit lies inside it, meeting the target
+    tight = _search(job, p, "max_spot_radius_mm", 1e-4, 0.1)
+    assert tight["reached"] is True and 0.0 < tight["limit"] < 0.1
+    assert tight["error_at_limit"] <= 1e-4
+    # the camera's move is seen on the camera's path only; the dome's on the projector's
+    cam = worst_figures(job, next(q for q in PARAMETERS if q.name == "camera_offset"), 0.1)
+    assert any(k.startswith("camera_") for k in cam) and not any(k.startswith("projector_") for k in cam)
+    dome = worst_figures(job, p, 0.1)
+    assert any(k.startswith("projector_") for k in dome) and not any(k.startswith("camera_") for k in dome)
