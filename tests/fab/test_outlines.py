@@ -130,7 +130,10 @@ def test_dxf_layers_units_and_note(table31, layout, tmp_path):
     o = outline(part, table31.tessellation.chord_error)
     assert o.name == part.name and o.thickness == part.solid.thickness
     path = tmp_path / "t.dxf"
+    before = ezdxf.options.write_fixed_meta_data_for_testing
     path.write_bytes(dxf_bytes(o))
+    # the writer fixes ezdxf's dates and GUIDs for its own call only: the global option is restored
+    assert ezdxf.options.write_fixed_meta_data_for_testing == before
     doc = ezdxf.readfile(path)
     assert doc.dxfversion == "AC1024"  # R2010
     assert doc.header["$MEASUREMENT"] == 1 and doc.header["$INSUNITS"] == 4  # metric, mm
