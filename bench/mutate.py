@@ -116,6 +116,41 @@ def run(group: str, max_children: int) -> dict:
     return collect(group, work, seconds)
 
 
+def retest_survivors(group: str, max_children: int) -> dict:
+    """Test again, against the committed tests (HEAD), only the mutants of ``group`` that survived
+    its last run (kept in build/mutate/<group>/): how the tests added for them are checked without
+    re-running every mutant. The modules must be unchanged since that run."""
+    work = ROOT / "build" / "mutate" / group
+    modules, tests = GROUPS[group]
+    names = []
+    for module in modules:
+        meta = json.loads((work / "mutants" / (module + ".meta")).read_text())
+        names += [k for k, v in meta["exit_code_by_key"].items() if v in SURVIVED or v is None]
+        old = subprocess.run(["git", "-C", str(ROOT), "show", f"{_commit_of(work)}:{module}"], capture_output=True,
+                             text=True).stdout
+        if old != (ROOT / module).read_text():
+            raise SystemExit(f"{module} changed since {group}'s run: run the group again")
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", "HEAD", "tests"], capture_output=True,
+                             check=True).stdout
+    for dest in (work, work / "mutants"):
+        shutil.rmtree(dest / "tests")
+        subprocess.run(["tar", "-x", "-C", str(dest)], input=archive, check=True)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(work / "mutants")
+    t0 = time.monotonic()
+    with (work / "mutmut-retest.log").open("w") as out:
+        subprocess.run([sys.executable, "-m", "mutmut", "run", "--max-children", str(max_children), *names],
+                       cwd=work, env=env, stdout=out, stderr=subprocess.STDOUT)
+    (work / "commit.txt").write_text(f"{_commit_of(work)}, survivors retested with the tests of {_head()}\n")
+    done = work / "seconds.txt"
+    total = (float(done.read_text()) if done.exists() else 0.0) + time.monotonic() - t0
+    return collect(group, work, total)
+
+
+def _commit_of(work: Path) -> str:
+    return (work / "commit.txt").read_text().split()[0]
+
+
 def collect(group: str, work: Path, seconds: float | None) -> dict:
     modules, tests = GROUPS[group]
     per_module = {}
@@ -209,6 +244,8 @@ def main() -> None:
     p.add_argument("groups", nargs="*", help="groups to run (default: all, smallest first)")
     p.add_argument("--max-children", type=int, default=1, help="mutants tested at once (default 1)")
     p.add_argument("--list", action="store_true", help="name the groups and their modules, then stop")
+    p.add_argument("--retest-survivors", action="store_true",
+                   help="test the survivors of the groups' last runs again with the committed tests")
     p.add_argument("--collect-only", action="store_true",
                    help="re-read the results of groups already run in build/mutate/ (no mutmut run)")
     args = p.parse_args()
@@ -220,7 +257,10 @@ def main() -> None:
     if unknown:
         raise SystemExit(f"unknown group(s) {unknown}; valid: {', '.join(GROUPS)}")
     for group in args.groups or list(GROUPS):
-        if args.collect_only:
+        if args.retest_survivors:
+            print(f"retesting the survivors of {group} ...", flush=True)
+            res = retest_survivors(group, args.max_children)
+        elif args.collect_only:
             work = ROOT / "build" / "mutate" / group
             done = work / "seconds.txt"  # absent when the run was stopped: its results are partial
             res = collect(group, work, float(done.read_text()) if done.exists() else None)
