@@ -125,6 +125,11 @@ def test_inverse_limit_holds_at_the_limit_and_fails_at_twice_it(table31_rig, nam
             out = max(out, MC.figures(tr, design.direction(rays_.chief), None, mdirs)["max_mirror_angle_error_rad"])
         return out
 
+    # the figures at the profile's tolerance, and the share of the target they use, against the
+    # same independent trace (compiled kernel against numpy passes: rounding, 1e-9 relative)
+    at_tol = worst(p.tolerance(tol))
+    assert row["max_mirror_angle_error_rad_at_tolerance"] == pytest.approx(at_tol, rel=1e-9)
+    assert row["angle_budget_used"] == pytest.approx(at_tol / tol.max_angle_error, rel=1e-9)
     at = worst(limit)
     # within 5 % of the declared error at the limit (the bound; bisection stops at 1e-3 of the move)
     assert 0.95 * tol.max_angle_error <= at <= tol.max_angle_error, (at, tol.max_angle_error)
