@@ -159,3 +159,30 @@ def test_evaluate_sh_refuses_a_wrong_shape():
     for bad in (np.zeros(10), np.zeros((1, 9))):  # K not a square; a 2D array with a square K
         with pytest.raises(BasisError, match=rf"shape \({bad.shape[0]},"):
             evaluate_sh(bad, th, ph)
+
+
+def test_zone_gram_and_condition_against_the_tests_own_quadrature():
+    """M = the SH Gram matrix over the zone and cond(M), against M built here on the test's rule
+    (Gauss-Legendre in theta): products of SH of order 4 are polynomials of degree 8 in cos and
+    sin, integrated to round-off by both rules (1e-12); cond(M) = 1.6e5 amplifies that to ~1e-7
+    relative in the condition number, 1e-6 allowed. The dual (M^-1) times M is the identity."""
+    conv = zonal_to_sh_matrix(ZONE, 4)
+    th, ph, w = rule(ZONE)
+    Y = sh_basis(th, ph, 4)
+    M = (Y * w[:, None]).T @ Y
+    assert np.max(np.abs(conv.zone_gram - M)) < 1e-12
+    assert conv.condition == pytest.approx(np.linalg.cond(M), rel=1e-6)
+    assert np.max(np.abs(conv.dual @ M - np.eye(len(M)))) < 1e-6  # cond(M) x 1e-12
+
+
+def test_zonal_to_sh_refuses_a_wrong_length():
+    conv = zonal_to_sh_matrix(ZONE, 2)
+    with pytest.raises(BasisError, match=r"have 10 entries on the last axis: need 9 \(order 2\)"):
+        zonal_to_sh(np.zeros(10), conv)
+
+
+def test_an_explicit_polar_node_count_is_used():
+    # 8 polar nodes are too few for order 4: C moves by far more than the default's round-off
+    coarse = zonal_to_sh_matrix(ZONE, 4, n_polar=8)
+    fine = zonal_to_sh_matrix(ZONE, 4)
+    assert np.max(np.abs(coarse.matrix - fine.matrix)) > 1e-6
