@@ -172,6 +172,7 @@ def test_svg_is_true_scale_in_mm(table31, layout):
     # absolute commands: one moveto, a lineto per further vertex, closed
     assert d.startswith("M ") and d.endswith(" Z") and d.count(" L ") == len(o.polygon) - 1
     assert not re.search(r"[a-z]", d)  # no relative (lower-case) command
+    assert re.fullmatch(r"M [-\d.]+,[-\d.]+( L [-\d.]+,[-\d.]+)* Z", d), d[:80]  # nothing else in the path
     xy = np.array([[float(a), float(b)] for a, b in re.findall(r"([-\d.]+),([-\d.]+)", d)])
     # each vertex where the drawing puts it: x from the left margin, y flipped from the top margin
     lo, hi = o.polygon.min(axis=0), o.polygon.max(axis=0)
