@@ -148,7 +148,7 @@ def retest_survivors(group: str, max_children: int) -> dict:
 
 
 def _commit_of(work: Path) -> str:
-    return (work / "commit.txt").read_text().split()[0]
+    return (work / "commit.txt").read_text().split()[0].rstrip(",")
 
 
 def collect(group: str, work: Path, seconds: float | None) -> dict:
