@@ -227,6 +227,13 @@ def _markdown(doc: dict) -> str:
         score = "-" if m["score"] is None else f"{100 * m['score']:.1f} %"
         out.append(f"| {name} | {', '.join(Path(t).name for t in m['tests'])} | {m['killed']} | {m['timeout']} "
                    f"| {m['survived']} | {m['no_tests']} | {m['not_checked']} | {score} |")
+    missing = [m for mods, _ in GROUPS.values() for m in mods if m not in doc["modules"]]
+    if missing:
+        out += ["", "Not run yet (no entry above): " + ", ".join(f"`{m}`" for m in missing) + "."]
+    partial = [n for n, m in doc["modules"].items() if m["not_checked"]]
+    if partial:
+        out += ["", "Stopped before the end (their score counts only the mutants tried): "
+                + ", ".join(f"`{n}`" for n in partial) + "."]
     overall = doc["overall_score"]
     out += ["", f"Overall: {'-' if overall is None else f'{100 * overall:.1f} %'} of the mutants tried killed.", "",
             "## Survivors", "",
