@@ -124,3 +124,18 @@ def test_write_raycheck_is_deterministic_apart_from_timings(tmp_path, table31):
     run_in(tmp_path / "b", "7")
     pb = [tmp_path / "b" / p.name for p in pa]
     assert [p.read_bytes() for p in pa] == [p.read_bytes() for p in pb]
+
+
+def test_the_table_is_fixed_width_with_a_verdict_per_row():
+    """The printed check table: a header, one line per row, columns at fixed offsets (the CLI prints
+    it and people read it against the report), ok or FAIL at the end."""
+    from rigcad.check.tolerances import Row
+
+    rows = [Row("spot radius", "raycheck.max_spot_radius", 1.5e-8, 0.05, "<=", "mm", None),
+            Row("pixels per degree", "raycheck.min_px_per_deg", 0.5, 1.0, ">=", "px/deg", "p.yaml:3")]
+    lines = table(rows).split("\n")
+    assert lines == [
+        "check" + " " * 45 + "     measured" + "    " + "     limit" + " unit   " + "     ",
+        "spot radius" + " " * 39 + "      1.5e-08 <=       0.05 mm      ok",
+        "pixels per degree" + " " * 33 + "          0.5 >=          1 px/deg  FAIL",
+    ]
