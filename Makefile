@@ -12,7 +12,7 @@ SYSTEM_TOOLS := prusa-slicer chromium
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 EXPORTS ?= exports
 
-.PHONY: all stl design docs check gcode view manual tools test test-all test-slow test-portable bench stress clean distclean help
+.PHONY: all stl design docs check gcode view manual tools test test-all test-slow test-portable bench stress mutate clean distclean help
 
 all: stl
 
@@ -28,6 +28,8 @@ help:
 	@echo "make test-portable - the numerical tests as other CPUs compute them (BLAS kernels, numpy SIMD off, generic numba)"
 	@echo "make stress   - numerical stress suite: 500 random profiles (hypothesis)"
 	@echo "make bench    - run time against error for each accuracy knob -> bench/results/*.json, *.png"
+	@echo "make mutate   - mutation testing (mutmut) of the numerical core, each module against its own tests"
+	@echo "               -> bench/results/mutation.json, mutation.md (MUTATE='group ...' runs some; --list names them)"
 	@echo "make clean    - remove $(EXPORTS)/ ; make distclean also removes $(VENV)/"
 
 $(VENV)/.installed: pyproject.toml requirements.lock
@@ -115,6 +117,12 @@ bench: $(VENV)/.installed stl
 
 stress: $(VENV)/.installed
 	$(PY) -m pytest -q -m stress --hypothesis-show-statistics
+
+# Long (an hour or more on 2 cores): each group mutates a few modules of the numerical core and runs only
+# their own test files, in a copy of the committed tree under build/mutate/. MUTATE picks groups.
+MUTATE ?=
+mutate: $(VENV)/.installed
+	$(PY) bench/mutate.py $(MUTATE)
 
 test-all: $(VENV)/.installed tools
 	$(PY) -m pytest -q

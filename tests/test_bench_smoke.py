@@ -1,6 +1,7 @@
 """Smoke test of the issue-7 bench scripts (and issue 16's basis.py): each runs in its --quick mode into tmp_path and writes
-its JSON (units in keys, the run's load recorded) and PNG. Nothing here is timed or compared with
-a number: the benchmarks' figures are in bench/results/, produced by `make bench`."""
+its JSON (units in keys, the run's load recorded) and PNG, and one accuracy figure of each JSON
+matches its reference (CHECKS). Nothing here is timed: the benchmarks' figures are in
+bench/results/, produced by `make bench`."""
 
 from __future__ import annotations
 
@@ -15,6 +16,56 @@ ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = ("ray_count", "float32", "tessellation", "make_stl", "basis", "optimize", "refusals")
 
 
+def _ray_count(data: dict) -> None:
+    # each row's mean lost fraction against the pooled reference (all rays of the largest N), within
+    # 4 standard errors of a mean of `seeds` binomial runs (the row's own predicted_std)
+    ref = data["reference_all_rays_of_largest_n"]["lost_fraction"]
+    for row in data["rows"]:
+        se = row["predicted_std"]["lost_fraction"] / row["seeds"] ** 0.5
+        assert abs(row["mean"]["lost_fraction"] - ref) < 4 * se, (row["rays"], row["mean"]["lost_fraction"], ref)
+
+
+def _float32(data: dict) -> None:
+    # the exact (float64) path converges on O: the 2D design's chief rays miss by <= 1.5e-8 mm
+    assert data["analytic"]["max_spot_radius_mm"] < 1e-6
+
+
+def _tessellation(data: dict) -> None:
+    rows = sorted(data["stl"], key=lambda r: r["chord_error_mm"])
+    for row in rows:
+        # the beam is a box: flat faces, so its mesh has the B-rep's volume to rounding
+        assert abs(row["parts"]["beam"]["volume_rel_error"]) < 1e-12
+    # an inscribed mesh loses ~ (2/3) chord x area of volume: first order in the chord error. The
+    # worst part's error scales with the chord ratio, within 2x either way (measured 1.2x)
+    fine, coarse = rows[0], rows[-1]
+    worst = [max(abs(p["volume_rel_error"]) for p in r["parts"].values()) for r in (fine, coarse)]
+    ratio = (worst[0] / worst[1]) / (fine["chord_error_mm"] / coarse["chord_error_mm"])
+    assert 0.5 < ratio < 2.0, (worst, ratio)
+
+
+def _make_stl(data: dict) -> None:
+    # timings only (never asserted); every timed command succeeded
+    assert all(set(c["exit_codes"]) == {0} for c in data["commands"].values() if "exit_codes" in c)
+
+
+def _basis(data: dict) -> None:
+    # after Loewdin orthonormalisation the 8-bit images' Gram matrix is the identity up to the
+    # quantisation: under one 8-bit step (1/255) in every entry
+    for order, g in data["gram"].items():
+        assert g["lowdin_8bit_max_abs"] < 1 / 255, (order, g)
+
+
+def _optimize(data: dict) -> None:
+    # the fast design path's mean pixels per degree is the certified path's to rounding (same
+    # formula on the same converged profile), whatever the node count
+    for row in data["nodes"]:
+        assert row["px_per_deg_mean_rel_error_vs_certified"] < 1e-12, row
+
+
+CHECKS = {"ray_count": _ray_count, "float32": _float32, "tessellation": _tessellation, "make_stl": _make_stl,
+          "basis": _basis, "optimize": _optimize}
+
+
 @pytest.mark.parametrize("name", SCRIPTS)
 def test_bench_script_quick_run_writes_json_and_png(name: str, tmp_path: Path) -> None:
     cmd = [sys.executable, str(ROOT / "bench" / f"{name}.py"), "--quick", "--out", str(tmp_path)]
@@ -27,3 +78,4 @@ def test_bench_script_quick_run_writes_json_and_png(name: str, tmp_path: Path) -
     png = (tmp_path / f"{name}.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
     assert b"Software" not in png, "PNG written without the Software metadata (same bytes every run)"
+    CHECKS[name](data)

@@ -139,3 +139,50 @@ def test_ill_conditioning_is_reported_and_refused():
     assert conds[0] < conds[1] < conds[2] and conds[2] > 1e7, conds
     with pytest.raises(BasisError, match="order_sh = 12 is numerically unidentifiable"):
         zonal_to_sh_matrix(Zone(1.2, 1.4), 2, 12)
+
+
+def test_conversion_residual_against_the_tests_own_quadrature():
+    """Each residual ||Z_k - sum_p C[p, k] Y_p||_zone against the same norm on this file's rule
+    (Gauss-Legendre in theta, 400 x 64 nodes): the integrand is a trigonometric polynomial in phi
+    of degree 2 (order_zonal + order_sh) = 16 < 64, so both rules are exact in phi and differ by
+    the polar rules' error: measured 2.7e-7 (rigcad's 200 nodes against 400 here), bound 1e-6.
+    An azimuthal grid too coarse for degree 16 aliases by far more."""
+    conv = zonal_to_sh_matrix(ZONE, 4)
+    th, ph, w = rule(ZONE)
+    Z = zonal_basis(th, ph, conv.order_zonal, ZONE)
+    ref = np.sqrt(np.sum((Z - sh_basis(th, ph, conv.order_sh) @ conv.matrix) ** 2 * w[:, None], axis=0))
+    assert np.max(np.abs(conversion_residual(conv) - ref)) < 1e-6
+
+
+def test_evaluate_sh_refuses_a_wrong_shape():
+    th, ph = np.array([0.3]), np.array([0.1])
+    for bad in (np.zeros(10), np.zeros((1, 9))):  # K not a square; a 2D array with a square K
+        with pytest.raises(BasisError, match=rf"shape \({bad.shape[0]},"):
+            evaluate_sh(bad, th, ph)
+
+
+def test_zone_gram_and_condition_against_the_tests_own_quadrature():
+    """M = the SH Gram matrix over the zone and cond(M), against M built here on the test's rule
+    (Gauss-Legendre in theta): products of SH of order 4 are polynomials of degree 8 in cos and
+    sin, integrated to round-off by both rules (1e-12); cond(M) = 1.6e5 amplifies that to ~1e-7
+    relative in the condition number, 1e-6 allowed. The dual (M^-1) times M is the identity."""
+    conv = zonal_to_sh_matrix(ZONE, 4)
+    th, ph, w = rule(ZONE)
+    Y = sh_basis(th, ph, 4)
+    M = (Y * w[:, None]).T @ Y
+    assert np.max(np.abs(conv.zone_gram - M)) < 1e-12
+    assert conv.condition == pytest.approx(np.linalg.cond(M), rel=1e-6)
+    assert np.max(np.abs(conv.dual @ M - np.eye(len(M)))) < 1e-6  # cond(M) x 1e-12
+
+
+def test_zonal_to_sh_refuses_a_wrong_length():
+    conv = zonal_to_sh_matrix(ZONE, 2)
+    with pytest.raises(BasisError, match=r"have 10 entries on the last axis: need 9 \(order 2\)"):
+        zonal_to_sh(np.zeros(10), conv)
+
+
+def test_an_explicit_polar_node_count_is_used():
+    # 8 polar nodes are too few for order 4: C moves by far more than the default's round-off
+    coarse = zonal_to_sh_matrix(ZONE, 4, n_polar=8)
+    fine = zonal_to_sh_matrix(ZONE, 4)
+    assert np.max(np.abs(coarse.matrix - fine.matrix)) > 1e-6

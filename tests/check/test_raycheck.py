@@ -67,6 +67,19 @@ def test_cli_writes_the_report_and_figures(tmp_path, capsys):
     out = tmp_path / "achutha2006" / "check"
     rep = json.loads((out / "raycheck.json").read_text())
     assert rep["passed"] and rep["backend"].startswith("analytic")
+    a = rep["readings"]["analytic"]
+    assert a["rays"] == 3000 and a["rays_ok"] == round(3000 * (1 - a["lost_fraction"]))
+    # the exact surfaces converge on O: the 2D design's chief rays miss by <= 1.5e-8 mm
+    # (tests/optics, 1e-6 bound there too); float64 rounding at ~300 mm is ~1e-13 mm
+    assert a["max_spot_radius_mm"] < 1e-6 and a["max_angle_error_rad"] < 1e-8
+    # the beam's shadow, two independent samplings of it: the 3000 random rays of the reading and the
+    # whole pixel grid (every pixel that lands on the paraboloid). The rays' fraction is binomial:
+    # 4 sigma = 4 sqrt(p (1 - p) / 3000) ~ 0.015 at p ~ 0.045 (a beam twice as wide doubles both)
+    grid = rep["pixel_grid"]
+    p_grid = grid["pixels_lost"]["occluded_by_beam"] / grid["pixels_on_paraboloid"]
+    p_rays = a["losses"]["occluded_by_beam"]["fraction"]
+    assert 0.01 < p_grid < 0.2, p_grid  # a shadow at all, and not the whole annulus
+    assert abs(p_rays - p_grid) < 4 * (p_grid * (1 - p_grid) / 3000) ** 0.5, (p_rays, p_grid)
     assert (out / "spot.png").stat().st_size > 1000 and (out / "theta_map.png").stat().st_size > 1000
     assert "spot radius" in capsys.readouterr().out
 
@@ -89,10 +102,40 @@ def test_cli_exits_nonzero_with_a_table_on_failure(tmp_path, write_profile, caps
 
 
 def test_write_raycheck_is_deterministic_apart_from_timings(tmp_path, table31):
+    """The same files from two interpreters (one with another PYTHONHASHSEED), not two calls in one
+    process: a second call could share the first one's caches and state."""
+    import os
+    import subprocess
+    import sys
+
+    def run_in(folder: Path, seed: str) -> None:
+        code = ("import sys; from pathlib import Path; from rigcad.profile import load_profile; "
+                "from rigcad.rig import Rig; from rigcad.check.raycheck import run_raycheck, write_raycheck; "
+                "r = run_raycheck(Rig.from_profile(load_profile(sys.argv[1])), mode='analytic', rays=2000, "
+                "monte_carlo=False); r.report.pop('timings_s'); write_raycheck(r, Path(sys.argv[2]))")
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        res = subprocess.run([sys.executable, "-c", code, str(table31.sources[0]), str(folder)], env=env,
+                             capture_output=True, text=True, timeout=600)
+        assert res.returncode == 0, res.stderr[-2000:]
+
     a = run_raycheck(Rig.from_profile(table31), mode="analytic", rays=2000, monte_carlo=False)
-    b = run_raycheck(Rig.from_profile(table31), mode="analytic", rays=2000, monte_carlo=False)
-    for r in (a, b):
-        r.report.pop("timings_s")
+    a.report.pop("timings_s")
     pa = write_raycheck(a, tmp_path / "a")
-    pb = write_raycheck(b, tmp_path / "b")
+    run_in(tmp_path / "b", "7")
+    pb = [tmp_path / "b" / p.name for p in pa]
     assert [p.read_bytes() for p in pa] == [p.read_bytes() for p in pb]
+
+
+def test_the_table_is_fixed_width_with_a_verdict_per_row():
+    """The printed check table: a header, one line per row, columns at fixed offsets (the CLI prints
+    it and people read it against the report), ok or FAIL at the end."""
+    from rigcad.check.tolerances import Row
+
+    rows = [Row("spot radius", "raycheck.max_spot_radius", 1.5e-8, 0.05, "<=", "mm", None),
+            Row("pixels per degree", "raycheck.min_px_per_deg", 0.5, 1.0, ">=", "px/deg", "p.yaml:3")]
+    lines = table(rows).split("\n")
+    assert lines == [
+        "check" + " " * 45 + "     measured" + "    " + "     limit" + " unit   " + "     ",
+        "spot radius" + " " * 39 + "      1.5e-08 <=       0.05 mm      ok",
+        "pixels per degree" + " " * 33 + "          0.5 >=          1 px/deg  FAIL",
+    ]

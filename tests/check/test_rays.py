@@ -34,9 +34,12 @@ def test_embree_is_the_backend_and_agrees_with_the_float64_reference_hit_for_hit
     # both re-intersect the same triangle in float64 (or, on an edge, its neighbour: same plane
     # to within the facet angle x the float32 edge error): distances agree to 1e-9 mm
     assert np.max(np.abs(emb.t[hit] - ref.t[hit])) < 1e-9
-    cosang = np.clip(np.sum(emb.normal[hit] * ref.normal[hit], axis=1), -1, 1)
-    # interpolated normals: same barycentrics up to rounding, 1e-9 rad
-    assert np.max(np.arccos(cosang)) < 1e-6
+    # interpolated normals: same barycentrics up to rounding, 1e-9 rad. The angle between unit
+    # vectors as atan2(|a x b|, a . b): well conditioned at 0, where arccos(a . b) cannot resolve
+    # below sqrt(2 eps) ~ 1.5e-8 rad
+    a, b = emb.normal[hit], ref.normal[hit]
+    angle = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.sum(a * b, axis=1))
+    assert np.max(angle) < 1e-9, np.max(angle)
 
 
 def test_float64_refinement_beats_embrees_float32_hit(coarse_meshes, design_map):

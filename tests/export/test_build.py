@@ -164,9 +164,21 @@ def test_manifest_reports_each_part(built):
     _, out, _ = built
     m = json.loads((out / "manifest.json").read_text())
     assert m["tolerances"]["stl_chord_error_mm"] == pytest.approx(0.018)
+    from rigcad.parts._kernel import volume
+
     for name, e in m["parts"].items():
-        assert e["volume_mm3"] > 0 and e["triangles"] > 0, name
         assert len(e["bbox_min_mm"]) == 3 and all(len(h) == 64 for h in e["files"].values())
+        # each figure against the written files, read back by other readers: the STEP by
+        # OpenCascade's reader (the same solid: its volume to OCCT's integration, 1e-9), the STL by
+        # trimesh (float32 vertices: ~1e-7 relative, 1e-6 allowed; its bounds to float32 at
+        # <= 400 mm, 1e-4 mm)
+        v_step = volume(_read_step(out / "step" / f"{name}.step"))
+        assert e["volume_mm3"] == pytest.approx(v_step, rel=1e-9), name
+        mesh = trimesh.load(out / "stl" / f"{name}.stl")
+        assert e["stl_volume_mm3"] == pytest.approx(mesh.volume, rel=1e-6), name
+        assert e["triangles"] == len(mesh.faces), name
+        assert np.allclose(e["bbox_min_mm"], mesh.bounds[0], atol=1e-4), name
+        assert np.allclose(e["bbox_max_mm"], mesh.bounds[1], atol=1e-4), name
 
 
 def _pixels(path: Path) -> np.ndarray:

@@ -55,14 +55,50 @@ def test_the_page_names_no_url_and_carries_every_in_rig_part(view, table31_rig):
     assert sorted(names) == sorted(expected) and len(set(names)) == len(names)
     for n in names:
         assert f'"name":"{n}"' in text
-    # a few hundred rays, nearly all reaching the sample (the beam hides ~5 %: raycheck's figure)
-    assert rays["traced"] == 300 and 0.85 * 300 < rays["reached"] <= 300
+    assert rays["traced"] == 300
+    _check_the_rays(rays, table31_rig)
     assert len(page) < 5e6, f"the view is {len(page) / 1e6:.2f} MB; the issue asks for under 5 MB"
 
 
+def _check_the_rays(rays: dict, rig) -> None:
+    """The drawn rays against references outside rigcad.manual.view."""
+    from rigcad.check.scene import analytic_optics
+    from rigcad.check.sources import annulus_rays
+    from rigcad.check.trace3d import trace
+
+    lines = rays["lines"]
+    # every drawn ray ends at the sample point O: the exact surfaces converge there (the 2D chief
+    # rays miss by <= 1.5e-8 mm, tests/optics)
+    assert np.max(np.linalg.norm(lines[:, -1], axis=1)) < 1e-6
+    # its incidence angle is the angle of its last segment to the sample's normal +z (atan2 of the
+    # horizontal and vertical parts: well conditioned at 0 and 90 deg), to rounding
+    v = lines[:, -2] - lines[:, -1]
+    theta = np.arctan2(np.hypot(v[:, 0], v[:, 1]), v[:, 2])
+    assert np.max(np.abs(theta - rays["theta"])) < 1e-9
+    # the share that reaches the sample (the beam's shadow) against an independent draw of 3000
+    # rays (another seed) through the vectorised exact path: binomial, 4 sigma of the difference
+    src = annulus_rays(rig.incidence, 3000, 12345, rig.pose("projector"))
+    p_ref = float(np.mean(trace(analytic_optics(rig), src.origins, src.dirs, vectorised=True).ok))
+    p_view = rays["reached"] / rays["traced"]
+    sigma = (p_ref * (1 - p_ref) * (1 / 300 + 1 / 3000)) ** 0.5
+    assert abs(p_view - p_ref) < 4 * sigma, (p_view, p_ref, sigma)
+    assert 0 < 1 - p_ref < 0.2, p_ref  # the beam hides a few percent (raycheck's 4-5 %), not nothing
+
+
 def test_the_page_is_deterministic(view, table31_rig):
+    """The same page from another interpreter (another PYTHONHASHSEED): two processes, not two
+    calls in one, which could share caches and state."""
+    import hashlib
+    import os
+
     path, page, meshes, rays = view
-    assert view_html(table31_rig, meshes, traced_rays(table31_rig)) == page
+    code = ("import hashlib, rigcad; from rigcad.manual.assembly import rig_meshes; "
+            "from rigcad.manual.view import traced_rays, view_html; rig = rigcad.load('achutha2006'); "
+            "print(hashlib.sha256(view_html(rig, rig_meshes(rig), traced_rays(rig))).hexdigest())")
+    res = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONHASHSEED": "3"},
+                         capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert res.stdout.strip() == hashlib.sha256(page).hexdigest()
 
 
 def test_exploded_offsets_stack_parts_without_overlap():

@@ -1,0 +1,284 @@
+"""Mutation testing of the numerical core with mutmut 3: does each module's own test file fail
+when one line of the module is changed?
+
+Run from the repository root: ``.venv/bin/python bench/mutate.py [GROUP ...] [--max-children N]``
+(``make mutate`` runs every group; ``--list`` names them, smallest first). Each group is a few
+modules mutated against only their own test files (the table below), so a group finishes in
+minutes rather than running the whole suite once per mutant. A group runs in its own copy of the
+tree as committed (git archive HEAD), build/mutate/<group>/ (mutmut writes its mutants/ folder there), configured by a setup.cfg
+written beside it, so groups never share mutmut's state.
+
+Writes bench/results/mutation.json: per module the mutants killed, survived, timed out and with no
+test reaching them, and the score, killed (timeouts included: a mutant that hangs the test is
+caught) over all mutants tried. Groups not run keep their last entry. And bench/results/mutation.md:
+every survivor's diff, with its explanation from bench/mutation_survivors.toml (an equivalent mutant,
+or a claim no one makes) where it has one. mutmut's "no tests" and "survived" both count against the
+score; a mutant left "not checked" (a run stopped early) is listed and counted apart.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+import tomllib
+from datetime import datetime, timezone
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "bench" / "results"
+EXPLAINED = ROOT / "bench" / "mutation_survivors.toml"
+
+# group -> (modules mutated, their own test files). Smallest first: `make mutate` runs them in order.
+GROUPS: dict[str, tuple[list[str], list[str]]] = {
+    "fab.outlines": (["rigcad/fab/outlines.py"], ["tests/fab/test_outlines.py"]),
+    "tolerance.limits": (["rigcad/tolerance/limits.py"], ["tests/tolerance/test_tolerance.py"]),
+    "check.tolerances": (["rigcad/check/tolerances.py"], ["tests/check/test_raycheck.py"]),
+    "fab.estimate": (["rigcad/fab/estimate.py"], ["tests/fab/test_estimate.py"]),
+    "basis.sh": (["rigcad/basis/sh.py"], ["tests/basis/test_sh.py"]),
+    "tolerance.montecarlo": (["rigcad/tolerance/montecarlo.py"], ["tests/tolerance/test_tolerance.py"]),
+    "optics.small": (
+        ["rigcad/optics/paraboloid.py", "rigcad/optics/thin_lens.py", "rigcad/optics/misalignment.py",
+         "rigcad/optics/frames.py", "rigcad/optics/solids.py", "rigcad/optics/incidence.py"],
+        ["tests/optics/test_paraboloid.py", "tests/optics/test_design.py"],
+    ),
+    "optics.trace2d": (["rigcad/optics/trace2d.py"], ["tests/optics/test_trace2d.py"]),
+    "optics.splitter": (["rigcad/optics/splitter.py"], ["tests/optics/test_splitter.py"]),
+    "fab.staircase": (["rigcad/fab/staircase.py"], ["tests/fab/test_staircase.py"]),
+    "optics.surfaces": (["rigcad/optics/surfaces.py"], ["tests/optics/test_surfaces.py"]),
+    "basis.gram": (["rigcad/basis/gram.py"], ["tests/basis/test_gram.py"]),
+    "basis.zonal": (["rigcad/basis/zonal.py"], ["tests/basis/test_zonal.py"]),
+    "optics.design": (["rigcad/optics/design.py"], ["tests/optics/test_design.py"]),
+    "check.raycheck": (["rigcad/check/raycheck.py"], ["tests/check/test_raycheck.py"]),
+    "manual.bom": (["rigcad/manual/bom.py"], ["tests/manual/test_manual.py"]),
+    "optics.dome": (["rigcad/optics/dome.py"], ["tests/optics/test_dome.py"]),
+    "fab.split": (["rigcad/fab/split.py"], ["tests/fab/test_split.py", "tests/fab/test_split_form3.py"]),
+}
+
+# mutmut's exit codes (mutmut.stats.status_by_exit_code), folded into the four figures reported
+KILLED = {1, 3}
+TIMEOUT = {36, -24, 24, 152, 255}
+SURVIVED = {0}
+NO_TESTS = {5, 33}
+
+
+def _setup_cfg(modules: list[str], tests: list[str]) -> str:
+    """mutmut's configuration for one group (mutmut reads setup.cfg when pyproject.toml has no
+    [tool.mutmut]). The tests run as in `make test`, less the slow and stress marks."""
+    lines = ["[mutmut]", "source_paths = rigcad", "only_mutate ="]
+    lines += [f"    {m}" for m in modules]
+    lines += ["pytest_add_cli_args_test_selection ="] + [f"    {t}" for t in tests]
+    lines += ["pytest_add_cli_args =", "    -p", "    no:cacheprovider", "    -m",
+              "    not slow and not stress", "    -x"]
+    # a mutant that makes its tests 15x slower than the clean run is a timeout (mutmut's default);
+    # the constant covers the fixtures' import and build time
+    lines += ["timeout_multiplier = 15.0", "timeout_constant = 5.0", ""]
+    return "\n".join(lines)
+
+
+def prepare(group: str) -> Path:
+    modules, tests = GROUPS[group]
+    work = ROOT / "build" / "mutate" / group
+    if work.exists():
+        shutil.rmtree(work)
+    work.mkdir(parents=True)
+    # the committed tree (HEAD), not the working files: a result names the commit it measured, and
+    # an edit in progress cannot leak into a run
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", "HEAD", "rigcad", "tests", "pyproject.toml"],
+                             capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(work)], input=archive, check=True)
+    (work / "commit.txt").write_text(_head() + "\n")
+    (work / "setup.cfg").write_text(_setup_cfg(modules, tests))
+    return work
+
+
+def run(group: str, max_children: int) -> dict:
+    work = prepare(group)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    # tests that start a Python subprocess import the mutated tree too. The folder must exist before
+    # mutmut starts: Python caches a missing sys.path entry as dead for the whole process, and the
+    # tests would then import the installed (unmutated) rigcad and every mutant would survive.
+    (work / "mutants").mkdir()
+    env["PYTHONPATH"] = str(work / "mutants")
+    t0 = time.monotonic()
+    log = work / "mutmut.log"
+    with log.open("w") as out:
+        res = subprocess.run([sys.executable, "-m", "mutmut", "run", "--max-children", str(max_children)],
+                             cwd=work, env=env, stdout=out, stderr=subprocess.STDOUT)
+    seconds = time.monotonic() - t0
+    (work / "seconds.txt").write_text(f"{seconds:.1f}\n")
+    if res.returncode != 0:
+        raise SystemExit(f"mutmut failed on {group} (exit {res.returncode}); see {log}")
+    return collect(group, work, seconds)
+
+
+def retest_survivors(group: str, max_children: int) -> dict:
+    """Test again, against the committed tests (HEAD), only the mutants of ``group`` that survived
+    its last run (kept in build/mutate/<group>/): how the tests added for them are checked without
+    re-running every mutant. The modules must be unchanged since that run."""
+    work = ROOT / "build" / "mutate" / group
+    modules, tests = GROUPS[group]
+    names = []
+    for module in modules:
+        meta = json.loads((work / "mutants" / (module + ".meta")).read_text())
+        names += [k for k, v in meta["exit_code_by_key"].items() if v in SURVIVED]
+        old = subprocess.run(["git", "-C", str(ROOT), "show", f"{_commit_of(work)}:{module}"], capture_output=True,
+                             text=True).stdout
+        if old != (ROOT / module).read_text():
+            raise SystemExit(f"{module} changed since {group}'s run: run the group again")
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", "HEAD", "tests"], capture_output=True,
+                             check=True).stdout
+    for dest in (work, work / "mutants"):
+        shutil.rmtree(dest / "tests")
+        subprocess.run(["tar", "-x", "-C", str(dest)], input=archive, check=True)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(work / "mutants")
+    t0 = time.monotonic()
+    with (work / "mutmut-retest.log").open("w") as out:
+        subprocess.run([sys.executable, "-m", "mutmut", "run", "--max-children", str(max_children), *names],
+                       cwd=work, env=env, stdout=out, stderr=subprocess.STDOUT)
+    (work / "commit.txt").write_text(f"{_commit_of(work)}, survivors retested with the tests of {_head()}\n")
+    done = work / "seconds.txt"
+    total = (float(done.read_text()) if done.exists() else 0.0) + time.monotonic() - t0
+    return collect(group, work, total)
+
+
+def _commit_of(work: Path) -> str:
+    return (work / "commit.txt").read_text().split()[0].rstrip(",")
+
+
+def collect(group: str, work: Path, seconds: float | None) -> dict:
+    modules, tests = GROUPS[group]
+    per_module = {}
+    survivors = []
+    for module in modules:
+        meta = json.loads((work / "mutants" / (module + ".meta")).read_text())
+        codes = meta["exit_code_by_key"]
+        counts = {"killed": 0, "survived": 0, "timeout": 0, "no_tests": 0, "not_checked": 0, "other": 0}
+        for name, code in codes.items():
+            if code in KILLED:
+                counts["killed"] += 1
+            elif code in TIMEOUT:
+                counts["timeout"] += 1
+            elif code in SURVIVED or code in NO_TESTS:
+                counts["survived" if code in SURVIVED else "no_tests"] += 1
+                diff = subprocess.run([sys.executable, "-m", "mutmut", "show", name], cwd=work,
+                                      capture_output=True, text=True).stdout
+                survivors.append({"module": module, "mutant": name,
+                                  "status": "survived" if code in SURVIVED else "no tests", "diff": diff})
+            elif code is None:
+                counts["not_checked"] += 1
+            else:
+                counts["other"] += 1
+        tried = sum(counts.values()) - counts["not_checked"]
+        caught = counts["killed"] + counts["timeout"]
+        per_module[module] = {
+            **counts, "total": len(codes),
+            "score": round(caught / tried, 4) if tried else None,
+            "tests": tests, "group": group, "group_seconds": None if seconds is None else round(seconds, 1), "commit": (work / "commit.txt").read_text().strip(),
+            "run_utc": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        }
+    return {"modules": per_module, "survivors": survivors}
+
+
+def write(results: dict) -> None:
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    jpath = RESULTS / "mutation.json"
+    old = json.loads(jpath.read_text()) if jpath.exists() else {"modules": {}, "survivors": []}
+    rerun = set(results["modules"])
+    modules = {**old["modules"], **results["modules"]}
+    survivors = [s for s in old["survivors"] if s["module"] not in rerun] + results["survivors"]
+    survivors.sort(key=lambda s: (s["module"], s["mutant"]))
+    killed = sum(m["killed"] + m["timeout"] for m in modules.values())
+    tried = sum(m["total"] - m["not_checked"] for m in modules.values())
+    doc = {
+        "tool": "mutmut " + _version(),
+        "score_definition": "(killed + timeout) / mutants tried; survived and no-tests count against",
+        "overall_score": round(killed / tried, 4) if tried else None,
+        "modules": dict(sorted(modules.items())),
+        "survivors": survivors,
+    }
+    jpath.write_text(json.dumps(doc, indent=1) + "\n")
+    (RESULTS / "mutation.md").write_text(_markdown(doc))
+
+
+def _head() -> str:
+    return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                          text=True, check=True).stdout.strip()
+
+
+def _version() -> str:
+    from importlib.metadata import version
+
+    return version("mutmut")
+
+
+def _markdown(doc: dict) -> str:
+    explained = tomllib.loads(EXPLAINED.read_text()) if EXPLAINED.exists() else {}
+    out = ["# Mutation testing of the numerical core", "",
+           f"Written by `bench/mutate.py` ({doc['tool']}); score = {doc['score_definition']}.", "",
+           "| module | tests | killed | timeout | survived | no tests | not checked | score |",
+           "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    for name, m in doc["modules"].items():
+        score = "-" if m["score"] is None else f"{100 * m['score']:.1f} %"
+        out.append(f"| {name} | {', '.join(Path(t).name for t in m['tests'])} | {m['killed']} | {m['timeout']} "
+                   f"| {m['survived']} | {m['no_tests']} | {m['not_checked']} | {score} |")
+    missing = [m for mods, _ in GROUPS.values() for m in mods if m not in doc["modules"]]
+    if missing:
+        out += ["", "Not run yet (no entry above): " + ", ".join(f"`{m}`" for m in missing) + "."]
+    partial = [n for n, m in doc["modules"].items() if m["not_checked"]]
+    if partial:
+        out += ["", "Stopped before the end (their score counts only the mutants tried): "
+                + ", ".join(f"`{n}`" for n in partial) + "."]
+    overall = doc["overall_score"]
+    out += ["", f"Overall: {'-' if overall is None else f'{100 * overall:.1f} %'} of the mutants tried killed.", "",
+            "## Survivors", "",
+            "Each is either explained here (an equivalent mutant, or a claim no one makes) or open: a test "
+            "that should fail on it is still missing.", ""]
+    for s in doc["survivors"]:
+        reason = explained.get(s["mutant"], {}).get("reason", "OPEN: no test kills it yet")
+        out += [f"### `{s['mutant']}` ({s['status']})", "", f"{reason}", "", "```diff",
+                s["diff"].strip(), "```", ""]
+    return "\n".join(out)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("groups", nargs="*", help="groups to run (default: all, smallest first)")
+    p.add_argument("--max-children", type=int, default=1, help="mutants tested at once (default 1)")
+    p.add_argument("--list", action="store_true", help="name the groups and their modules, then stop")
+    p.add_argument("--retest-survivors", action="store_true",
+                   help="test the survivors of the groups' last runs again with the committed tests")
+    p.add_argument("--collect-only", action="store_true",
+                   help="re-read the results of groups already run in build/mutate/ (no mutmut run)")
+    args = p.parse_args()
+    if args.list:
+        for g, (mods, tests) in GROUPS.items():
+            print(f"{g}: {' '.join(mods)}  <-  {' '.join(tests)}")
+        return
+    unknown = [g for g in args.groups if g not in GROUPS]
+    if unknown:
+        raise SystemExit(f"unknown group(s) {unknown}; valid: {', '.join(GROUPS)}")
+    for group in args.groups or list(GROUPS):
+        if args.retest_survivors:
+            print(f"retesting the survivors of {group} ...", flush=True)
+            res = retest_survivors(group, args.max_children)
+        elif args.collect_only:
+            work = ROOT / "build" / "mutate" / group
+            done = work / "seconds.txt"  # absent when the run was stopped: its results are partial
+            res = collect(group, work, float(done.read_text()) if done.exists() else None)
+        else:
+            print(f"mutating {group} ...", flush=True)
+            res = run(group, args.max_children)
+        write(res)
+        for mod, m in res["modules"].items():
+            print(f"  {mod}: killed {m['killed']}, timeout {m['timeout']}, survived {m['survived']}, "
+                  f"no tests {m['no_tests']}, score {m['score']}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
