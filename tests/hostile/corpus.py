@@ -306,11 +306,45 @@ def argument_cases():
                    lambda sb, i=i: ["tolerance", "fast.yaml", "--no-limits", "--samples", "1", "--scheduler",
                                     f"tcp://127.0.0.1:1/{sb.injected()[i]}", "--exports", str(sb.exports)],
                    expect_refusal=True, timed=False, stress=i > 1)
+    for behaviour in ("http", "silent"):  # a server that is not a scheduler: refused once the handshake's bound is over
+        yield Case("args", f"tolerance --scheduler an {behaviour} server",
+                   lambda sb, behaviour=behaviour: ["tolerance", "fast.yaml", "--no-limits", "--samples", "1",
+                                                    "--scheduler", f"tcp://127.0.0.1:{fake_scheduler(behaviour)}",
+                                                    "--exports", str(sb.exports)],
+                   expect_refusal=True, timed=False, timeout=90, stress=behaviour == "silent")
     for value in ("", "file:///etc/passwd", "tcp://127.0.0.1:1", "tcp://[::1", "inproc://x", "tcp://127.0.0.1:99999"):
         yield Case("args", f"tolerance --scheduler {value!r}",
                    lambda sb, value=value: ["tolerance", "fast.yaml", "--no-limits", "--samples", "1", "--scheduler",
                                             value, "--exports", str(sb.exports)],
                    expect_refusal=True, timed=False, stress=value not in ("", "tcp://127.0.0.1:1"))
+
+
+_servers: dict[str, int] = {}
+
+
+def fake_scheduler(behaviour: str) -> int:
+    """The port of a server in this (the test) process that accepts and then never says a word
+    ("silent") or answers as a web server does ("http"): what a mistyped --scheduler reaches."""
+    import socket
+    import threading
+
+    if behaviour in _servers:
+        return _servers[behaviour]
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(16)
+    held = []
+
+    def serve() -> None:
+        while True:
+            conn, _ = listener.accept()
+            held.append(conn)  # silent: kept open, never answered
+            if behaviour == "http":
+                conn.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\nConnection: close\r\n\r\n")
+
+    threading.Thread(target=serve, daemon=True, name=f"fake-scheduler-{behaviour}").start()
+    _servers[behaviour] = listener.getsockname()[1]
+    return _servers[behaviour]
 
 
 # -- links and files planted in the exports --------------------------------------------------------

@@ -109,12 +109,13 @@ class Sandbox:
         (self.work / "fast.yaml").write_text(FAST_PROFILE)
         self.profile = "fast"
         self.guarded: list[Path] = []  # files in the exports that are not the case's to change
-        self._before = self.snapshot()
+        self.rebase()
 
     def rebase(self) -> None:
         """Take the decoy's state as it is now (after planting hard links to it, or after a case
-        whose change was already reported)."""
+        whose change was already reported); files now in the exports are the planted ones."""
         self._before = self.snapshot()
+        self._planted = {str(p): p.lstat().st_ino for p in self.exports.rglob("*")}
 
     def injected(self) -> list[str]:
         """Commands in the forms a value could smuggle one: each creates the marker if it ever runs."""
@@ -168,8 +169,8 @@ class Sandbox:
                 p = Path(dirpath) / name
                 try:
                     st = p.lstat()
-                    if not stat.S_ISREG(st.st_mode) or st.st_size > 20_000_000:
-                        continue
+                    if not stat.S_ISREG(st.st_mode) or st.st_size > 20_000_000 or self._planted.get(str(p)) == st.st_ino:
+                        continue  # a planted hard link to a decoy file holds its text: only a new copy is a leak
                     data = p.read_bytes()
                 except OSError:
                     continue
@@ -451,7 +452,8 @@ class Child:
     def finish(self, timeout: float, grace: float = 10.0) -> Outcome:
         """Wait for the case to end (kill -9 of its group after ``timeout`` s: a hang), then collect
         its outcome and the processes it left behind (after ``grace`` s for them to go)."""
-        end = self.t0 + timeout
+        # from the fork; for a case the test already killed, from now (it only has to be reaped)
+        end = (time.perf_counter() if self.outcome.killed else self.t0) + timeout
         last_scan = 0.0
         while not self.poll():
             now = time.perf_counter()
