@@ -253,6 +253,8 @@ INT_OPTIONS = {"--rays", "--builds", "--samples", "--workers", "--jobs", "--seed
 
 
 def argument_cases():
+    covered = {(command, option) for command, _, option, _ in _argument_table()}
+    covered |= {(c, "profile") for c in ("design", "stl", "check")} | {("design", "--exports"), ("stl", "--exports")}
     for command, before, option, values in _argument_table():
         for value in values:
             def argv(sb, command=command, before=before, option=option, value=value):
@@ -306,6 +308,7 @@ def argument_cases():
                    lambda sb, i=i: ["tolerance", "fast.yaml", "--no-limits", "--samples", "1", "--scheduler",
                                     f"tcp://127.0.0.1:1/{sb.injected()[i]}", "--exports", str(sb.exports)],
                    expect_refusal=True, timed=False, stress=i > 1)
+    yield from generic_cases(covered)
     for behaviour in ("http", "silent"):  # a server that is not a scheduler: refused once the handshake's bound is over
         yield Case("args", f"tolerance --scheduler an {behaviour} server",
                    lambda sb, behaviour=behaviour: ["tolerance", "fast.yaml", "--no-limits", "--samples", "1",
@@ -345,6 +348,56 @@ def fake_scheduler(behaviour: str) -> int:
     threading.Thread(target=serve, daemon=True, name=f"fake-scheduler-{behaviour}").start()
     _servers[behaviour] = listener.getsockname()[1]
     return _servers[behaviour]
+
+
+def parser_options() -> list[tuple[list[str], str]]:
+    """Every (command words, option) `rigcad --help` lists that takes a value ("profile" for the
+    positional), read from the parser itself: a new option is a gap in the corpus until it has cases."""
+    from rigcad.cli import build_parser
+
+    found = []
+
+    def walk(parser, words):
+        for action in parser._actions:
+            choices = getattr(action, "choices", None)
+            if isinstance(choices, dict):  # sub-commands
+                for name, sub in choices.items():
+                    walk(sub, [*words, name])
+            elif action.dest != "help" and action.nargs != 0:
+                found.append((words, action.option_strings[-1] if action.option_strings else action.dest))
+
+    walk(build_parser(), [])
+    return [(w, o) for w, o in found if w]
+
+
+#: Values tried on an option the table above does not cover: empty, a path out, a huge text, a
+#: right-to-left override, a line break.
+GENERIC = ["", "../../decoy/x", "x" * 5000, "\u202ex", "a\nb"]
+#: Arguments a command cannot run without (the option under test replaces its own).
+REQUIRED = {"fab": ["--printer", "prusa_mk3s"], "manual": ["--printer", "prusa_mk3s"],
+            "sweep": ["--set", "layout.cop_to_vertex=25cm..35cm:2"]}
+
+
+def generic_cases(covered: set[tuple[str, str]]):
+    """The GENERIC values on every option of every command the table leaves out."""
+    for words, option in parser_options():
+        command = " ".join(words)
+        if (command, option) in covered:
+            continue
+        for value in GENERIC:
+            def argv(sb, words=words, option=option, value=value):
+                profile = OPTIMIZE_PROFILE if words[0] == "optimize" else "fast.yaml"
+                fixed = [a for k, v in zip(REQUIRED.get(words[0], [])[::2], REQUIRED.get(words[0], [])[1::2])
+                         if k != option for a in (k, v)]
+                if words[0] in ("design", "build", "stl", "check", "fab", "basis", "optimize", "view", "manual",
+                                "tolerance", "sweep") and option != "--exports":
+                    fixed += ["--exports", str(sb.exports)]
+                if option == "profile":
+                    return [*words, value, *fixed]
+                return [*words, profile, *fixed, option, value]
+            # an empty or mistyped value has no valid reading, except as a path to a folder to create
+            yield Case("args", f"{command} {option} {value[:12]!r} (generic)", argv,
+                       expect_refusal=option != "--exports" or value in ("", "x" * 5000), stress=True, timeout=120)
 
 
 # -- links and files planted in the exports --------------------------------------------------------
