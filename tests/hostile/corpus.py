@@ -161,6 +161,8 @@ def printer_cases():
 HUGE = ["1000000000000", str(10 ** 30), str(2 ** 63)]
 NEGATIVE = ["-1", "-5", "-9223372036854775809"]
 NOT_INTS = ["nan", "inf", "1e12", "", " ", "0x10", "12abc", "\u0660x", "--1"]
+#: A worker count past the cores is clamped to them (a valid reading): only what is no count at all.
+NOT_WORKERS = [v for v in NOT_INTS if v != "1e12"]
 UNICODE_ZERO = "\u0660"  # ARABIC-INDIC DIGIT ZERO: int() reads it as 0
 UNICODE_MINUS_ONE = "-\uff11"  # FULLWIDTH DIGIT ONE: int() reads it as -1
 
@@ -184,11 +186,11 @@ def _argument_table(sb_free: bool = True):
         ("view", ["fast.yaml", "--exports", E], "--rays", _count_values()),
         ("tolerance", ["fast.yaml", "--no-limits", "--exports", E], "--samples", _count_values()),
         ("tolerance", ["fast.yaml", "--no-limits", "--exports", E], "--rays", _count_values()),
-        ("tolerance", ["fast.yaml", "--no-limits", "--exports", E], "--workers", NEGATIVE + NOT_INTS),
+        ("tolerance", ["fast.yaml", "--no-limits", "--exports", E], "--workers", NEGATIVE + NOT_WORKERS),
         ("sweep", ["fast.yaml", "--set", "layout.cop_to_vertex=25cm..35cm:2", "--exports", E], "--rays",
          _count_values()),
         ("sweep", ["fast.yaml", "--set", "layout.cop_to_vertex=25cm..35cm:2", "--exports", E], "--workers",
-         NEGATIVE + NOT_INTS),
+         NEGATIVE + NOT_WORKERS),
         ("sweep", ["fast.yaml", "--exports", E], "--set", [
             "layout.cop_to_vertex=25cm..35cm:100000000", "layout.cop_to_vertex=25cm..35cm:0",
             "layout.cop_to_vertex=25cm..35cm:-1", "layout.cop_to_vertex=25cm..35cm:nan",
@@ -206,7 +208,7 @@ def _argument_table(sb_free: bool = True):
         ("fab", ["fast.yaml", "--printer", "prusa_mk3s", "--exports", E], "--parts", [
             "", "../../decoy/x", "dome/../../../x", "nosuch", "beam\nx", "*", "\u202ebeam"]),
         ("fab", ["fast.yaml", "--printer", "prusa_mk3s", "--parts", "beam", "--exports", E], "--jobs",
-         NEGATIVE + NOT_INTS),
+         NEGATIVE + NOT_WORKERS),
         ("manual", ["fast.yaml", "--exports", E], "--printer", ["/etc/shadow", "/proc/self/environ", "", "{FIFO}",
                                                                 "../decoy/precious.yaml"]),
         ("basis", ["fast.yaml", "--exports", E], "--order", [
@@ -217,7 +219,7 @@ def _argument_table(sb_free: bool = True):
          ["0", "-1", UNICODE_ZERO] + NOT_INTS[:3] + HUGE[1:]),
         ("optimize", [OPTIMIZE_PROFILE, "--exports", E], "--seed", NEGATIVE + NOT_INTS[:5]),
         ("optimize", [OPTIMIZE_PROFILE, "--exports", E], "--evaluations", _count_values()),
-        ("optimize", [OPTIMIZE_PROFILE, "--exports", E], "--workers", NEGATIVE + NOT_INTS[:5]),
+        ("optimize", [OPTIMIZE_PROFILE, "--exports", E], "--workers", NEGATIVE + NOT_WORKERS[:4]),
         ("build", ["fast.yaml", "--exports", E], "--parts", ["", "../../decoy/x", "nosuch", "*", "beam\x7f"]),
     ]
 
@@ -283,19 +285,19 @@ def argument_cases():
                    stress=name not in ("...yaml", "..yaml", "x" * 250 + ".yaml"))
     # the exports root
     exports = {"": "design", " ": "design", "/dev/null": "design", "/proc/self": "design", "{FILE}": "design",
-               "x" * 300: "design", "{DECOYLINK}": "stl"}
+               "x" * 300: "design", "{LINK}": "stl"}
     for value, command in exports.items():
         def argv(sb, value=value, command=command):
             if value == "{FILE}":
                 (sb.work / "a-file").write_text("x")
                 value = str(sb.work / "a-file")
-            elif value == "{DECOYLINK}":
+            elif value == "{LINK}":  # exports on another disk, through a link: the user's choice
                 value = str(sb.work / "exports-link")
+                (sb.root / "elsewhere").mkdir(exist_ok=True)
                 if not os.path.islink(value):
-                    os.symlink(sb.decoy / "folder", value)
+                    os.symlink(sb.root / "elsewhere", value)
             return [command, "fast.yaml", "--exports", value]
-        # '' and ' ' are refusals (--exports "" wrote into the working folder); a link is the user's choice
-        # of folder only if the user made it: here it is planted, and its target is the decoy
+        # '' and ' ' are refusals (--exports "" wrote into the working folder)
         yield Case("args", f"{command} --exports {value[:30]!r}", argv,
                    expect_refusal=value in ("", " ", "/dev/null", "/proc/self", "{FILE}"),
                    stress=value not in ("", "/dev/null"))
@@ -373,6 +375,8 @@ def parser_options() -> list[tuple[list[str], str]]:
 #: Values tried on an option the table above does not cover: empty, a path out, a huge text, a
 #: right-to-left override, a line break.
 GENERIC = ["", "../../decoy/x", "x" * 5000, "\u202ex", "a\nb"]
+#: The same for an exports root: a folder beside the working one is the user's to choose.
+GENERIC_EXPORTS = ["", "x" * 5000, "\u202ex", "a\nb", "../elsewhere"]
 #: Arguments a command cannot run without (the option under test replaces its own).
 REQUIRED = {"fab": ["--printer", "prusa_mk3s"], "manual": ["--printer", "prusa_mk3s"],
             "sweep": ["--set", "layout.cop_to_vertex=25cm..35cm:2"]}
@@ -384,7 +388,7 @@ def generic_cases(covered: set[tuple[str, str]]):
         command = " ".join(words)
         if (command, option) in covered:
             continue
-        for value in GENERIC:
+        for value in (GENERIC_EXPORTS if option == "--exports" else GENERIC):
             def argv(sb, words=words, option=option, value=value):
                 profile = OPTIMIZE_PROFILE if words[0] == "optimize" else "fast.yaml"
                 fixed = [a for k, v in zip(REQUIRED.get(words[0], [])[::2], REQUIRED.get(words[0], [])[1::2])

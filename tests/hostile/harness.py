@@ -528,6 +528,9 @@ def violations(o: Outcome, sandbox: Sandbox, *, expect_refusal: bool = False, ti
         sandbox.marker.unlink()
     allowed, package = _allowed_outside()
     roots = [str(sandbox.exports), str(sandbox.tmp)]
+    if "--exports" in o.argv[:-1] and o.argv[o.argv.index("--exports") + 1]:  # the root the user named
+        given = sandbox.work / o.argv[o.argv.index("--exports") + 1]
+        roots += [os.path.abspath(given), os.path.realpath(given)]
     outside = [p for p in o.writes if not any(p == r or p.startswith(r + os.sep) for r in roots)
                and not p.startswith(allowed) and not (p.startswith(package) and "__pycache__" in p)]
     if outside:
