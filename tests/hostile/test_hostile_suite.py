@@ -9,6 +9,7 @@ whole corpus."""
 from __future__ import annotations
 
 import json
+import os
 import signal
 
 import pytest
@@ -18,6 +19,22 @@ from .harness import Child, Sandbox, _cmdline, _family, run, violations
 
 CASES = corpus.all_cases()
 STRESS_CASES = [c for c in corpus.all_cases(stress=True) if c.stress]
+#: Set to a path to have every case's figures (exit, CPU, wall, peak memory) written there as JSON.
+SUMMARY_ENV = "RIGCAD_HOSTILE_SUMMARY"
+_figures: list[dict] = []
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _summary():
+    yield
+    path = os.environ.get(SUMMARY_ENV)
+    if path and _figures:
+        refused = [f for f in _figures if f["refused"]]
+        json.dump({"cases": _figures,
+                   "refused": len(refused),
+                   "max_refusal_cpu_s": max((f["cpu_s"] or 0 for f in refused), default=None),
+                   "max_refusal_peak_mb": max((f["peak_mb"] for f in refused), default=None)},
+                  open(path, "w"), indent=1)
 
 
 def _check(case: corpus.Case, sandbox: Sandbox) -> None:
@@ -26,6 +43,8 @@ def _check(case: corpus.Case, sandbox: Sandbox) -> None:
     argv = case.argv(sandbox)
     o = run(argv, sandbox, timeout=case.timeout, name=case.kind)
     v = violations(o, sandbox, expect_refusal=case.expect_refusal, timed=case.timed)
+    _figures.append({"case": case.id, "exit": o.rc, "killed": o.killed, "refused": o.refused, "cpu_s": o.cpu_s,
+                     "wall_s": round(o.wall_s, 3), "peak_mb": round(o.maxrss_mb, 1), "violations": v})
     assert not v, f"{case.id}: {'; '.join(v)}\n  {o.describe()}"
 
 
