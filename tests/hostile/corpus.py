@@ -34,6 +34,8 @@ class Case:
     timed: bool = True  # False: the refusal waits on something outside rigcad by design
     timeout: float = 60.0
     stress: bool = False
+    #: A finding that is someone else's open work: the case is expected to fail (strictly) until it is fixed.
+    xfail: str | None = None
 
     @property
     def id(self) -> str:
@@ -249,6 +251,18 @@ _DEFAULT_VALUES = {"-1", "1000000000000", "", "/etc/shadow", "{FIFO}", "../../de
                    "layout.cop_to_vertex=" + ",".join(["30cm"] * 100_000), "{DECOYLINK}"}
 
 
+#: Findings in the argument limits' own scope (branch limits-sec), still open when this suite was run
+#: against it: the stride is checked only when the simulation starts, after the basis images.
+OPEN_WORK = {("basis", "--camera-stride-px"): "limits-sec: --camera-stride-px is checked after the basis images "
+                                              "are computed (20 s of CPU before the refusal), not before any work"}
+def _reads_as_int(value: str) -> bool:
+    try:
+        int(value)
+    except ValueError:
+        return False
+    return True
+
+
 #: Options argparse reads as int: text that is not an integer is argparse's refusal, one sample is enough.
 INT_OPTIONS = {"--rays", "--builds", "--samples", "--workers", "--jobs", "--seed", "--evaluations",
                "--camera-stride-px"}
@@ -263,7 +277,7 @@ def argument_cases():
                 return [command, *[_resolve(t, sb) for t in before], option, _resolve(value, sb)]
             sample = value in _DEFAULT_VALUES and (option not in INT_OPTIONS or value in ("-1", "1000000000000"))
             yield Case("args", f"{command} {option} {value[:40]!r}", argv, expect_refusal=True, stress=not sample,
-                       timeout=60)
+                       timeout=60, xfail=OPEN_WORK.get((command, option)) if _reads_as_int(value) else None)
     # the profile itself: a name that is a path, a special file, or a file whose name becomes a folder
     positional = {
         "": None, " ": None, "/dev/zero": None, "/dev/stdin": None, "{FIFO}": None, "{DIR}": None,
