@@ -345,6 +345,13 @@ def _require_exports_root(parser: argparse.ArgumentParser) -> None:
                 _require_exports_root(child)
 
 
+def _error_line(message: object) -> str:
+    """``rigcad: error: <message>`` on one line: a newline or other control character that a name,
+    a path or a value brought into the message is shown escaped (``\\n``), never printed."""
+    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in str(message))
+    return f"rigcad: error: {text}"
+
+
 def main(argv: list[str] | None = None) -> int:
     from rigcad.engine import run_temp_dir
 
@@ -354,7 +361,7 @@ def main(argv: list[str] | None = None) -> int:
         with run_temp_dir():
             return args.func(args)
     except RigcadError as err:
-        print(f"rigcad: error: {err}", file=sys.stderr)
+        print(_error_line(err), file=sys.stderr)
         return err.exit_code
     except BrokenPipeError:  # output piped into head & co.
         return 0
@@ -362,14 +369,14 @@ def main(argv: list[str] | None = None) -> int:
         from rigcad.export.atomic import write_error
 
         failure = write_error(Path(err.filename or "."), err)
-        print(f"rigcad: error: {failure}", file=sys.stderr)
+        print(_error_line(failure), file=sys.stderr)
         return failure.exit_code
     except KeyboardInterrupt:
         print("rigcad: interrupted", file=sys.stderr)
         return 130
     except MemoryError as err:  # an allocation the estimates before it did not foresee
-        print(f"rigcad: error: out of memory{': ' + str(err) if str(err) else ''}; ask for fewer rays, builds or "
-              "samples, or run on a machine with more memory", file=sys.stderr)
+        print(_error_line(f"out of memory{': ' + str(err) if str(err) else ''}; ask for fewer rays, builds or "
+                          "samples, or run on a machine with more memory"), file=sys.stderr)
         return 1
 
 

@@ -62,8 +62,20 @@ def _optimize(data: dict) -> None:
         assert row["px_per_deg_mean_rel_error_vs_certified"] < 1e-12, row
 
 
+def _refusals(data: dict) -> None:
+    # every hostile count is refused (exit 2, one error line naming its argument) far under the
+    # 2 GB that the refusals promise: a refusal allocates nothing of what it was asked for
+    for row in data["rows"]:
+        option = next(w for w in row["command"].split() if w.startswith("--"))
+        assert row["exit_code"] == 2 and row["message"].startswith("rigcad: error: ") and option in row["message"], row
+        assert "\n" not in row["message"], row
+        assert row["peak_rss_kb"] < 2 * 1024 * 1024, row
+    assert data["max_peak_rss_kb"] == max(r["peak_rss_kb"] for r in data["rows"])
+
+
 CHECKS = {"ray_count": _ray_count, "float32": _float32, "tessellation": _tessellation, "make_stl": _make_stl,
-          "basis": _basis, "optimize": _optimize}
+          "basis": _basis, "optimize": _optimize,
+          "refusals": _refusals}
 
 
 @pytest.mark.parametrize("name", SCRIPTS)

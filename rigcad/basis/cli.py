@@ -33,6 +33,14 @@ def cmd_basis(args: argparse.Namespace) -> int:
 
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "basis")  # a planted link or lock: one line now, not after the work
+    if args.simulate:  # before the images: a stride that samples no 2 x 2 camera pixels is refused now
+        largest = min(profile.camera.resolution) // 2
+        if args.camera_stride_px > largest:
+            from rigcad.errors import BasisError
+
+            raise BasisError(f"--camera-stride-px {args.camera_stride_px}: the {profile.camera.resolution[0]} x "
+                             f"{profile.camera.resolution[1]} px camera would be sampled at fewer than 2 x 2 pixels; "
+                             f"valid: 1..{largest}")
     rig = load(profile)
     out = Path(args.exports) / rig.name / "basis"
     # the one lock of everything under exports/<profile>: a design or build publishing the whole
@@ -94,6 +102,7 @@ def cmd_basis(args: argparse.Namespace) -> int:
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``basis`` to rigcad's subcommands."""
     from rigcad.basis import CAMERA_STRIDE_PX
+    from rigcad.cli import positive_int
 
     p = subparsers.add_parser(
         "basis", help="zonal basis images for the projector, Gram matrices, simulated acquisition",
@@ -113,7 +122,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--lowdin", action="store_true", help="also write the re-orthonormalised (Loewdin) images")
     p.add_argument("--simulate", action="store_true", help="simulated acquisition: five analytic BRDFs, the rig "
                                                            "as designed and moved by its tolerances")
-    p.add_argument("--camera-stride-px", type=int, default=CAMERA_STRIDE_PX,
+    p.add_argument("--camera-stride-px", type=positive_int, default=CAMERA_STRIDE_PX,
                    help=f"simulate every N-th camera pixel in both directions (default {CAMERA_STRIDE_PX}: ~50 "
                         "exitant directions)")
     p.set_defaults(func=cmd_basis)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import ctypes
 import errno
 import fcntl
+import glob
 import json
 import math
 import os
@@ -475,7 +476,8 @@ def _stale_siblings(folder: Path) -> list[Path]:
     parent = folder.parent
     if not parent.is_dir():
         return []
-    return [*parent.glob(f".{folder.name}.new-*"), *parent.glob(f".{folder.name}.old-*")]
+    name = glob.escape(folder.name)  # a name with [ ] * ? matches itself only, never another's trees
+    return [*parent.glob(f".{name}.new-*"), *parent.glob(f".{name}.old-*")]
 
 
 def clean_leftovers(folder: Path) -> list[Path]:

@@ -173,6 +173,8 @@ def printer_path(name: str | Path) -> Path:
     YAML file (``.yaml``/``.yml``, its link target too) outside the system folders
     (rigcad.fab.vendor.SYSTEM_DIRS) is read: ``--printer /etc/shadow`` is refused before the file
     is opened, so its content is never shown."""
+    if not str(name).strip() or "\x00" in str(name):
+        raise ProfileError(f"printer {str(name)!r}: name a printer (e.g. prusa_mk3s) or give the path of its .yaml file")
     spec = Path(name)
     if spec.suffix not in ("", ".yaml", ".yml"):
         raise ProfileError(f"printer {str(name)[:200]!r} is not a printer file: printer files are YAML (.yaml), "

@@ -215,6 +215,8 @@ def find_file(spec: str | Path, kind: str, sub: str = "", near: Path | None = No
     """A ``kind`` file ("profile", "printer") by path (unless ``as_path`` is False), or by name in
     ``near`` and then on :func:`search_path` (``sub`` below each folder); a missing name lists where
     it looked and the names found there. Raises ProfileError."""
+    if not str(spec).strip() or "\x00" in str(spec):
+        raise ProfileError(f"a {kind} is named by its name or the path of its .yaml file; got {str(spec)!r}")
     path = Path(spec)
     named = path.suffix == ""
     candidates = [path, path.with_suffix(".yaml")] if named else [path]
@@ -278,9 +280,26 @@ def _resolve_extends(parent: Any, child: Path, where: str | None) -> Path:
     return candidate
 
 
+#: A profile's name is its file's name without ``.yaml``, and names its folder under the exports
+#: (``exports/<name>/``, staged beside it as ``.<name>.new-*``): letters, digits, ``_ + - .`` and
+#: spaces, not starting with a dot or a space, at most 100 characters. A name such as ``.`` (from
+#: ``..yaml``), one with a newline or one with glob characters would name another folder.
+PROFILE_NAME = re.compile(r"[^\W][\w .+-]{0,99}")
+
+
+def check_profile_name(name: str, path: Path) -> str:
+    """``name`` when it is a valid profile name (:data:`PROFILE_NAME`), else a ProfileError."""
+    if not PROFILE_NAME.fullmatch(name) or name.rstrip(" .") != name:
+        raise ProfileError(f"profile file {_display(path)!r}: its name {name!r} cannot name a folder under the exports; "
+                           "rename the file to letters, digits, '_', '+', '-', '.' and spaces (not first or last), "
+                           "at most 100 characters, e.g. my_rig.yaml")
+    return name
+
+
 def load_raw(spec: str | Path) -> RawProfile:
     """Read a profile and everything it extends, child keys overriding parent keys."""
     path = resolve_profile_path(spec)
+    check_profile_name(path.stem, path)
     chain: list[Path] = []
     layers: list[tuple[dict[str, Any], dict[Key, str]]] = []
     current: Path | None = path
