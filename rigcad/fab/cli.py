@@ -17,7 +17,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.fab.printers import load_printer
 
     printer = load_printer(args.printer)  # first: a refused printer file costs no rig and no CAD kernel import
-    from rigcad.cli import _progress
+    from rigcad.progress import stages
     from rigcad.export.build import select_parts
     from rigcad.fab.stage import run_fab
     from rigcad.export.atomic import check_exports, profile_lock
@@ -29,7 +29,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
     rig = load(profile)
     out = Path(args.exports) / profile.name / "fab" / printer.name
     names = select_parts(args.parts)
-    with _progress(len(names), f"fab {profile.name}") as step:
+    with stages(len(names), f"fab {profile.name}") as step:
         def progress(msg: str) -> None:
             step(msg)
             if args.verbose:
@@ -37,7 +37,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
 
         res = run_fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs,
                       lock=profile_lock(args.exports, profile.name), progress=progress,
-                      slicing=lambda total: _progress(total, f"slicing ({printer.slicer})"))
+                      slicing=lambda total: stages(total, f"slicing ({printer.slicer})"))
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")
     for name, e in res.report["parts"].items():
@@ -80,7 +80,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add the `fab` command to rigcad's subparsers (rigcad.cli.build_parser)."""
-    from rigcad.cli import positive_int
+    from rigcad.arguments import positive_int
     from rigcad.profile.paths import PRINTERS_SUBDIR, names_on_search_path  # not fab.printers: no numpy for --help
 
     p = subparsers.add_parser(

@@ -422,7 +422,7 @@ def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = 
 
 
 def cmd_manual(args) -> int:
-    from rigcad.cli import _progress
+    from rigcad.progress import stages
     from rigcad.export.atomic import check_exports, profile_lock
     from rigcad.fab.printers import load_printer
     from rigcad.fab.stage import run_fab
@@ -435,7 +435,7 @@ def cmd_manual(args) -> int:
     rig = load(profile)
     root = Path(args.exports) / rig.name
     total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
-    with _progress(total, f"manual {rig.name} ({printer.name})") as step:
+    with stages(total, f"manual {rig.name} ({printer.name})") as step:
         fab = run_fab(rig, printer, root / "fab" / printer.name, gcode=args.gcode,
                       lock=profile_lock(args.exports, rig.name), progress=step)
         for problem in fab.problems:
