@@ -107,10 +107,3 @@ def parse_quantity(text: object, kind: str) -> float:
 def mm_to_in(value_mm: float) -> float:
     """Millimetres to inches."""
     return value_mm / 25.4
-
-
-def format_length(value_mm: float) -> str:
-    """A length for people: millimetres with inches beside it."""
-    if math.isinf(value_mm):
-        return "inf"
-    return f"{value_mm:.4g} mm ({mm_to_in(value_mm):.4g} in)"

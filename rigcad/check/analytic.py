@@ -32,6 +32,7 @@ import numpy as np
 from scipy.interpolate import PPoly
 
 from rigcad.check import rays as R
+from rigcad.check.result import Trace3D
 from rigcad.optics.frames import Pose
 
 #: Uniform cells of x (the sine of a COP ray's angle from the axis) of the aligned kernel's table.
@@ -196,7 +197,6 @@ class AnalyticTracer:
         """PINHOLE_COLUMNS of the exact trace of the COP rays at sines ``x`` (m,) in the x-z plane
         (no occluders), and how many of them do not reach the dome."""
         from rigcad.check import _kernels as K
-        from rigcad.check.trace3d import Trace3D
 
         m = len(x)
         origins = np.tile([0.0, 0.0, self.cop_z], (m, 1))
@@ -221,7 +221,6 @@ class AnalyticTracer:
         """Trace rays (n, 3) through ``optics`` (its poses) with the kernels: a Trace3D with
         ``kernels`` = rays per kernel."""
         from rigcad.check import _kernels as K
-        from rigcad.check.trace3d import Trace3D
 
         origins = np.ascontiguousarray(origins, float)
         dirs = np.ascontiguousarray(dirs, float)

@@ -27,6 +27,7 @@ import numpy as np
 
 from rigcad.check import _mesh_kernels as K
 from rigcad.check.rays import EmbreeMesh
+from rigcad.check.result import Trace3D
 
 
 def supports(optics) -> bool:
@@ -73,9 +74,8 @@ def _scratch(m: int) -> dict:
 
 def trace(optics, origins: np.ndarray, dirs: np.ndarray):
     """Trace rays (origins, dirs: (n, 3), global frame; dirs need not be unit) through Embree
-    ``optics`` (:func:`supports`), in blocks of :data:`BLOCK` rays: a trace3d.Trace3D with
+    ``optics`` (:func:`supports`), in blocks of :data:`BLOCK` rays: a result.Trace3D with
     ``kernels = {"mesh_compiled": n}``."""
-    from rigcad.check.trace3d import Trace3D
 
     origins = np.ascontiguousarray(origins, float)
     dirs = np.ascontiguousarray(dirs, float)

@@ -23,7 +23,8 @@ from rigcad.check import tolerances as T
 from rigcad.check.scene import Optics, analytic_optics, mesh_optics, mixed, placed_as, rig_meshes, share_scenes
 from rigcad.check.sources import annulus_rays, pixel_grid, pixel_rays, thin_lens_rays
 from rigcad.optics.incidence import DesignMap
-from rigcad.check.trace3d import STATUS_NAMES, Trace3D, trace
+from rigcad.check.result import STATUS_NAMES, Trace3D
+from rigcad.check.trace3d import trace
 from rigcad.profile.schema import Profile
 
 #: Rays of the exact-normal reading (its foot points cost ~10 us a ray): enough for its maximum
