@@ -179,7 +179,9 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     bill = B.bill(rig, fab_report, printer)
     files: dict[str, bytes] = {}
     meshes = rig_meshes(rig)
-    files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig")
+    cut_away = A.encloses(meshes)
+    files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
+                                                cut_away=cut_away)
     step("rig picture")
 
     d = Doc()
@@ -340,7 +342,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         d.p(text)
         path = f"images/step_{k + 1:02d}_{re.sub(r'_[0-9]+$', '', first.name)}.png"
         files[path] = plots.assembly_step(meshes, done, members, A.step_offsets(meshes, done, members),
-                                          f"step {k + 1}: {label}")
+                                          f"step {k + 1}: {label}", cut_away=cut_away)
         d.img(path, f"Step {k + 1}: the {label.replace('_', ' ')} (orange) goes where the dashed line points")
         done += members
         step(f"step {k + 1}")
