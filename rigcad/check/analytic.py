@@ -33,7 +33,7 @@ from scipy.interpolate import PPoly
 
 from rigcad.check import rays as R
 from rigcad.check.result import Trace3D
-from rigcad.optics.frames import Pose
+from rigcad.optics.vec import pose_arrays
 
 #: Uniform cells of x (the sine of a COP ray's angle from the axis) of the aligned kernel's table.
 #: The cubic spline's error falls as h^4 (bench/raycheck.py's table sweep on Table 3.1:
@@ -85,11 +85,6 @@ def _occluder_rows(members) -> np.ndarray:
         else:  # pragma: no cover - analytic_optics builds only these
             raise TypeError(f"not an occluder: {m!r}")
     return np.array(rows, float).reshape(-1, 11)
-
-
-def _pose(p: Pose) -> tuple[np.ndarray, np.ndarray, bool]:
-    return (np.ascontiguousarray(p.rotation, float), np.ascontiguousarray(p.translation, float),
-            bool(p.is_identity))
 
 
 @dataclass
@@ -248,8 +243,8 @@ class AnalyticTracer:
         return result
 
     def _general(self, K, idx, origins, dirs, pp, dp, out) -> int:
-        R1, T1, id1 = _pose(pp)
-        R2, T2, id2 = _pose(dp)
+        R1, T1, id1 = pose_arrays(pp)
+        R2, T2, id2 = pose_arrays(dp)
         return int(K.general(idx, origins, dirs, R1, T1, id1, R2, T2, id2, self.focal_length, self.vertex_z,
                              self.rim_radius, self.para_occ, self.mount_shadowed, self.body_sphere, self.beam_occ,
                              self.breaks, self.coef_r, self.coef_z, self.u_lo, self.u_hi, self.piece_of,

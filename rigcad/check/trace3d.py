@@ -16,17 +16,12 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from rigcad.check.rays import _cross, _dot, unit
 # the result type and status codes live in check.result (every tracer returns them); named here too,
 # beside trace(), for its callers
 from rigcad.check.result import (ESCAPED_AFTER_DOME, ESCAPED_TOP, MISSED_DOME, MISSED_PARABOLOID, OCCLUDED_BY_BEAM,  # noqa: F401
                                  OCCLUDED_BY_MOUNT, OCCLUDED_BY_PARABOLOID, OK, STATUS_NAMES, Trace3D)
 from rigcad.check.scene import Optics
-
-
-def reflect(d: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """Mirror reflection of directions d (n, 3) about unit normals n (n, 3)."""
-    return d - (2.0 * _dot(d, n))[:, None] * n
+from rigcad.optics.vec import cross, dot, reflect_rows, unit
 
 
 #: Called with the ray count after every trace inside :func:`counting` (a progress bar's feed).
@@ -85,7 +80,7 @@ def _trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     q1 = pp.globalize_points(lo[i1] + t1[:, None] * ld[i1])
     n1 = pp.globalize_dirs(h1.normal[i1])
     p1[i1] = q1
-    u = reflect(dirs[i1], n1)
+    u = reflect_rows(dirs[i1], n1)
 
     # 2: paraboloid -> dome (part 0), the beam (part 1) in between
     dp = optics.dome_pose
@@ -102,7 +97,7 @@ def _trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     q2 = dp.globalize_points(lo2[keep] + t2[:, None] * ld2[keep])
     n2 = dp.globalize_dirs(h2.normal[keep])
     p2[i2] = q2
-    w = reflect(u[keep], n2)
+    w = reflect_rows(u[keep], n2)
 
     # 3: dome -> plane z = 0, the paraboloid (mirror, mount) and the beam in between
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -125,7 +120,7 @@ def _trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     landing[i3] = q2[ok] + t3[ok, None] * w[ok]
     path[i3] = t1[keep][ok] + t2[ok] + t3[ok]
     miss = np.full(n, np.nan)
-    miss[i3] = np.linalg.norm(_cross(q2[ok], w[ok]), axis=1)  # |O - line|, O at the origin
+    miss[i3] = np.linalg.norm(cross(q2[ok], w[ok]), axis=1)  # |O - line|, O at the origin
     return Trace3D(status, segment, p1, p2, v, landing, path, miss, {"vectorised": n})
 
 
@@ -139,5 +134,5 @@ def convergence_point(tr: Trace3D) -> np.ndarray:
     # threaded reductions may round differently with the thread count (tolerancing promises the
     # same bits on any number of workers)
     a = len(w) * np.eye(3) - np.einsum("ij,ik->jk", w, w)
-    b = p.sum(axis=0) - np.einsum("ij,i->j", w, _dot(w, p))
+    b = p.sum(axis=0) - np.einsum("ij,i->j", w, dot(w, p))
     return np.linalg.solve(a, b)
