@@ -107,3 +107,9 @@ def parse_quantity(text: object, kind: str) -> float:
 def mm_to_in(value_mm: float) -> float:
     """Millimetres to inches."""
     return value_mm / 25.4
+
+
+def hours_minutes(seconds: float) -> str:
+    """A duration for people, to the nearest minute: ``3h05m`` (seconds rounded to whole first)."""
+    s = int(round(seconds))
+    return f"{s // 3600}h{(s % 3600) // 60:02d}m"

@@ -47,7 +47,8 @@ PINHOLE_CELLS = 8192
 PINHOLE_COLUMNS = ("s_mm", "z1_mm", "t1_mm", "r2_mm", "z2_mm", "t2_mm", "wr", "wz", "miss_signed_mm")
 #: The aligned kernel runs only if the table lands within this of the exact path at every cell's
 #: midpoint (mm: points and distances; rad: the return direction). Measured on Table 3.1: ~3e-13
-#: mm, ~3e-15 rad (the issue's bounds: 1e-9 mm, 1e-12 rad).
+#: mm, ~3e-15 rad (the required agreement of the compiled kernels with the exact path: 1e-9 mm,
+#: 1e-12 rad).
 PINHOLE_POINT_TOL = 1e-11
 PINHOLE_DIRECTION_TOL = 1e-13
 #: Uniform cells of the dome parameter that seed the spline-piece search (~4 per piece).

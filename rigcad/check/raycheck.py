@@ -1,4 +1,4 @@
-"""The 3D ray check stage (issue 5): a Rig -> meshes and exact surfaces -> traces -> figures ->
+"""The 3D ray check stage: a Rig -> meshes and exact surfaces -> traces -> figures ->
 tolerance table; ``exports/<profile>/check/{raycheck.json, spot.png, theta_map.png}``.
 
 Readings traced on the same rays (seeded, uniform in projector-image area over the paraboloid's

@@ -202,14 +202,14 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
             rows.append([f"`{r['part']}`", r["use"], r["quantity"] or "-", "cut" if r["quantity"] else "-",
                          r["process"], "-", "-", r["note"]])
         else:
-            rows.append([f"`{r['part']}`", r["use"], r["quantity"], r["pieces"], r["process"], B._hms(r["time_s"]),
+            rows.append([f"`{r['part']}`", r["use"], r["quantity"], r["pieces"], r["process"], hours_minutes(r["time_s"]),
                          f"{r['material_g']:.0f} g", f"{r['note']} ({r['source']})"])
     d.table(["part", "use", "qty", "pieces", "process", "print time (with qty)", "material", "orientation"], rows)
     timed = [r for r in bill["printed"] if r.get("time_s") is not None]
     total_t = sum(r["time_s"] for r in timed)
     total_g = sum(r["material_g"] for r in timed)
     pieces = sum(r["pieces"] * r["quantity"] for r in timed)
-    d.p(f"In all: **{pieces} printed pieces, {B._hms(total_t)} of printing and {total_g:.0f} g of "
+    d.p(f"In all: **{pieces} printed pieces, {hours_minutes(total_t)} of printing and {total_g:.0f} g of "
         f"{printer.material}**" + ("" if all(r["source"] == "slicer" for r in timed) else
                                    " (rigcad's estimate where no G-code was sliced"
                                    + (": `rigcad manual ... --gcode` uses PrusaSlicer's own figures)"
