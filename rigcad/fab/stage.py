@@ -40,6 +40,7 @@ from rigcad.fab import staircase
 from rigcad.fab.mirror import MirrorSurface, mirror_faces
 from rigcad.fab.printers import Printer
 from rigcad.parts.recipe import Prism
+from rigcad.units import hours_minutes
 
 #: Parts cut from plate rather than printed.
 CUT_PARTS = ("dome_template", "paraboloid_template")
