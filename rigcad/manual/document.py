@@ -23,6 +23,7 @@ from pathlib import Path
 from rigcad._version import __version__
 from rigcad.manual import bom as B
 from rigcad.manual import calibration as C
+from rigcad.units import hours_minutes
 
 MIL = 0.0254  # mm
 
