@@ -6,60 +6,15 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from contextlib import contextmanager
 from dataclasses import fields
 from pathlib import Path
 
 from rigcad._version import __version__
+from rigcad.arguments import exports_root
 from rigcad.errors import RigcadError
 from rigcad.export.atomic import check_exports, profile_lock, tidy
+from rigcad.progress import stages
 from rigcad.units import DEG
-
-
-#: Set (to anything) to have every progress step also printed as a line ``rigcad-event: <label>``
-#: on stderr: a machine-readable trace of where a run is (the fault tests kill runs at these).
-EVENTS_ENV = "RIGCAD_EVENTS"
-
-
-@contextmanager
-def _progress(total: int, desc: str):
-    """A progress bar on stderr when it is a terminal (tqdm); silent otherwise."""
-    import os
-
-    from tqdm import tqdm
-
-    bar = tqdm(total=total, desc=desc, unit="stage", disable=None, leave=False, file=sys.stderr)
-    events = bool(os.environ.get(EVENTS_ENV))
-
-    def step(label: str) -> None:
-        bar.set_postfix_str(label)
-        bar.update(1)
-        if events:
-            print(f"rigcad-event: {label}", file=sys.stderr, flush=True)
-
-    try:
-        yield step
-    finally:
-        bar.close()
-
-
-@contextmanager
-def progress_bar(total: int, desc: str, unit: str):
-    """A counting progress bar on stderr (tqdm: count, rate in ``unit``/s, ETA), refreshed at
-    least once a second while it advances; silent when stderr is not a terminal. Yields
-    ``update(done)`` taking the absolute count (engine callbacks pass totals, not increments)."""
-    from tqdm import tqdm
-
-    bar = tqdm(total=total, desc=desc, unit=unit, disable=None, leave=False, file=sys.stderr,
-               mininterval=0.25, maxinterval=1.0, smoothing=0.1)
-
-    def update(done: int) -> None:
-        bar.update(done - bar.n)
-
-    try:
-        yield update
-    finally:
-        bar.close()
 
 
 def _fmt(spec, value) -> str:
@@ -149,7 +104,7 @@ def cmd_design(args: argparse.Namespace) -> int:
 
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name)  # a planted link or lock: one line now, not after the work
-    with _progress(3, "design") as step:
+    with stages(3, "design") as step:
         rig = load(profile)
         step("dome integrated")
         design = rig.design
@@ -180,7 +135,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     names = select_parts(args.parts)
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name)
-    with _progress(len(names) + 2, "build") as step:
+    with stages(len(names) + 2, "build") as step:
         rig = load(profile)
         step("dome integrated")
         out = Path(args.exports) / rig.name
@@ -210,7 +165,7 @@ def cmd_stl(args: argparse.Namespace) -> int:
     from rigcad.parts import PARTS
     from rigcad.rig import Rig
 
-    with _progress(len(PARTS) + 6, f"stl {profile.name}") as step:
+    with stages(len(PARTS) + 6, f"stl {profile.name}") as step:
         rig = Rig.from_profile(profile)
         step("dome integrated")
         files = design_files(rig.design)
@@ -222,43 +177,6 @@ def cmd_stl(args: argparse.Namespace) -> int:
           f"{len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
     print("\n".join(_part_lines(result, list(PARTS))))
     return 0
-
-
-def positive_int(text: str) -> int:
-    """An argparse type: a whole number >= 1, written plainly or as ``1e6``; anything else is
-    refused by argparse on one line, before any work."""
-    try:
-        value = int(text)
-    except ValueError:
-        try:
-            f = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
-        if not (math.isfinite(f) and f == int(f)):
-            raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
-        value = int(f)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
-    return value
-
-
-def worker_count(text: str) -> int:
-    """An argparse type: a worker count, 0 for every core, else >= 1 (clamped to the cores by
-    rigcad.engine.Engine unless a remote Dask scheduler runs the tasks)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0 (0: every core), got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0 (0: every core), got {text!r}")
-    return value
-
-
-def exports_root(text: str) -> str:
-    """An argparse type: an output root, not empty (an empty one would write into the current folder)."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("expected a folder, got an empty path (the default is 'exports')")
-    return text
 
 
 def build_parser() -> argparse.ArgumentParser:

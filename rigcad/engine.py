@@ -478,15 +478,3 @@ def _run_on_dask(func, shared, tasks, engine, report, sizes, total_items, out) -
         client.close()
         if cluster is not None:
             cluster.close()
-
-
-class Rate:
-    """Items per second and ETA for a progress line, from the wall clock."""
-
-    def __init__(self) -> None:
-        self.t0 = time.perf_counter()
-
-    def __call__(self, done: int, total: int) -> tuple[float, float]:
-        dt = max(time.perf_counter() - self.t0, 1e-9)
-        rate = done / dt
-        return rate, (total - done) / rate if rate > 0 else float("inf")

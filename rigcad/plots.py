@@ -215,17 +215,13 @@ def _cut_front(tri: np.ndarray) -> np.ndarray:
     return tri[(tri[:, :, 1] > -1e-9).all(axis=1)]
 
 
-def _encloses(meshes) -> set[str]:
-    from rigcad.manual.view import encloses
-
-    return encloses(meshes)
-
-
-def rig_picture(meshes, rays: dict | None, title: str, elev: float = 18.0, azim: float = -118.0) -> bytes:
+def rig_picture(meshes, rays: dict | None, title: str, elev: float = 18.0, azim: float = -118.0, *,
+                cut_away: set[str]) -> bytes:
     """The assembled rig: every part (``rigcad.manual.assembly.PartMesh``) in its working position,
-    the parts that enclose others (the dome) cut away in front, and ``rays`` (view.traced_rays: COP ->
-    paraboloid -> dome -> sample polylines, mm) coloured by incidence angle."""
-    cut = _encloses(meshes)
+    the parts named in ``cut_away`` (those that enclose others, the dome: assembly.encloses) cut away
+    in front, and ``rays`` (view.traced_rays: COP -> paraboloid -> dome -> sample polylines, mm)
+    coloured by incidence angle."""
+    cut = cut_away
     fig = plt.figure(figsize=(7, 8))
     ax = fig.add_axes((0, 0, 1, 0.93), projection="3d")
     lo = np.min([m.lo for m in meshes], axis=0)
@@ -246,12 +242,12 @@ def rig_picture(meshes, rays: dict | None, title: str, elev: float = 18.0, azim:
 
 
 def assembly_step(meshes, done: list[int], new: list[int], offsets: dict, title: str, elev: float = 18.0,
-                  azim: float = -118.0) -> bytes:
+                  azim: float = -118.0, *, cut_away: set[str]) -> bytes:
     """Exploded picture of one assembly step: the parts ``done`` (indices into ``meshes``,
     ``rigcad.manual.assembly.PartMesh``) in place (grey), the parts ``new`` highlighted (orange)
-    moved by ``offsets`` (index -> (3,) mm), with a dashed line to where they go; enclosing parts
-    cut away in front. Parts that go in from below are seen from below."""
-    cut = _encloses(meshes)
+    moved by ``offsets`` (index -> (3,) mm), with a dashed line to where they go; the parts named in
+    ``cut_away`` (assembly.encloses) cut away in front. Parts that go in from below are seen from below."""
+    cut = cut_away
     fig = plt.figure(figsize=(6, 6.5))
     ax = fig.add_axes((0, 0, 1, 0.92), projection="3d")
     shown = [*done, *new]

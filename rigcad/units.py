@@ -109,8 +109,7 @@ def mm_to_in(value_mm: float) -> float:
     return value_mm / 25.4
 
 
-def format_length(value_mm: float) -> str:
-    """A length for people: millimetres with inches beside it."""
-    if math.isinf(value_mm):
-        return "inf"
-    return f"{value_mm:.4g} mm ({mm_to_in(value_mm):.4g} in)"
+def hours_minutes(seconds: float) -> str:
+    """A duration for people, to the nearest minute: ``3h05m`` (seconds rounded to whole first)."""
+    s = int(round(seconds))
+    return f"{s // 3600}h{(s % 3600) // 60:02d}m"

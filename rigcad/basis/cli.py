@@ -21,7 +21,7 @@ def _order(text: str):
 def cmd_basis(args: argparse.Namespace) -> int:
     from rigcad.basis.acquire import simulate_on_rig, simulation_steps, write_simulation
     from rigcad.basis.projector import BASIS_STEPS, check_basis_order, projector_basis, write_basis
-    from rigcad.cli import _progress
+    from rigcad.progress import stages
     from rigcad.export.atomic import profile_lock
     from rigcad.export.manifest import profile_digest
     from rigcad.rig import load
@@ -49,7 +49,7 @@ def cmd_basis(args: argparse.Namespace) -> int:
     made_from = profile_digest(rig.profile)
     total = BASIS_STEPS + (order + 1) ** 2 + 1 + (simulation_steps() if args.simulate else 0)
     t0 = time.perf_counter()
-    with _progress(total, f"basis {rig.name}") as step:
+    with stages(total, f"basis {rig.name}") as step:
         basis = projector_basis(rig, order, alpha_rad=alpha, progress=step)
         paths = write_basis(basis, out, lowdin_images=args.lowdin, progress=step, lock=lock, made_from=made_from)
         t_images = time.perf_counter() - t0
@@ -102,7 +102,7 @@ def cmd_basis(args: argparse.Namespace) -> int:
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``basis`` to rigcad's subcommands."""
     from rigcad.basis import CAMERA_STRIDE_PX
-    from rigcad.cli import positive_int
+    from rigcad.arguments import positive_int
 
     p = subparsers.add_parser(
         "basis", help="zonal basis images for the projector, Gram matrices, simulated acquisition",

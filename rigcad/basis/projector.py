@@ -179,7 +179,7 @@ class PixelMap:
     @property
     def ok(self) -> np.ndarray:
         """Centre rays that reach O."""
-        from rigcad.check.trace3d import OK
+        from rigcad.check.result import OK
 
         return self.status == OK
 
@@ -195,7 +195,7 @@ class PixelMap:
 
     def border_all_missed(self) -> bool:
         """Every pixel on the traced window's border misses the paraboloid (the window is big enough)."""
-        from rigcad.check.trace3d import MISSED_PARABOLOID
+        from rigcad.check.result import MISSED_PARABOLOID
 
         s = self.status.reshape(self.shape)
         border = np.concatenate([s[0], s[-1], s[:, 0], s[:, -1]])
@@ -554,7 +554,7 @@ def projector_basis(rig, order: int = 6, *, alpha_rad: float | None = None,
     docstring), their Gram matrices over the lit pixels and the latitude-longitude maps.
     ``alpha_rad``: the zone's lower edge (default: the rig's occlusion limit). ``progress(label)`` is
     called after each of BASIS_STEPS stages."""
-    from rigcad.check.trace3d import STATUS_NAMES
+    from rigcad.check.result import STATUS_NAMES
 
     L = check_basis_order(order)
     step = progress_step(progress)

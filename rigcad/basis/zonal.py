@@ -188,12 +188,6 @@ def zonal_basis(theta_rad: np.ndarray, phi_rad: np.ndarray, order: int, zone: Zo
     return real_basis(t, phi_rad, L, math.sqrt(2.0 / (zone.x_high - zone.x_low)))
 
 
-def zonal_basis_directions(directions: np.ndarray, order: int, zone: Zone) -> np.ndarray:
-    """:func:`zonal_basis` at unit vectors ``directions`` (n, 3) in the local frame: (n, K)."""
-    theta, phi = direction_angles(directions)
-    return zonal_basis(theta, phi, order, zone)
-
-
 def direction_angles(directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(theta_rad, phi_rad) of unit vectors (..., 3) in the local frame (normal +z, tangent +x)."""
     d = np.asarray(directions, dtype=float)

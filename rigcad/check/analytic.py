@@ -32,7 +32,8 @@ import numpy as np
 from scipy.interpolate import PPoly
 
 from rigcad.check import rays as R
-from rigcad.optics.frames import Pose
+from rigcad.check.result import Trace3D
+from rigcad.optics.vec import pose_arrays
 
 #: Uniform cells of x (the sine of a COP ray's angle from the axis) of the aligned kernel's table.
 #: The cubic spline's error falls as h^4 (bench/raycheck.py's table sweep on Table 3.1:
@@ -46,7 +47,8 @@ PINHOLE_CELLS = 8192
 PINHOLE_COLUMNS = ("s_mm", "z1_mm", "t1_mm", "r2_mm", "z2_mm", "t2_mm", "wr", "wz", "miss_signed_mm")
 #: The aligned kernel runs only if the table lands within this of the exact path at every cell's
 #: midpoint (mm: points and distances; rad: the return direction). Measured on Table 3.1: ~3e-13
-#: mm, ~3e-15 rad (the issue's bounds: 1e-9 mm, 1e-12 rad).
+#: mm, ~3e-15 rad (the required agreement of the compiled kernels with the exact path: 1e-9 mm,
+#: 1e-12 rad).
 PINHOLE_POINT_TOL = 1e-11
 PINHOLE_DIRECTION_TOL = 1e-13
 #: Uniform cells of the dome parameter that seed the spline-piece search (~4 per piece).
@@ -84,11 +86,6 @@ def _occluder_rows(members) -> np.ndarray:
         else:  # pragma: no cover - analytic_optics builds only these
             raise TypeError(f"not an occluder: {m!r}")
     return np.array(rows, float).reshape(-1, 11)
-
-
-def _pose(p: Pose) -> tuple[np.ndarray, np.ndarray, bool]:
-    return (np.ascontiguousarray(p.rotation, float), np.ascontiguousarray(p.translation, float),
-            bool(p.is_identity))
 
 
 @dataclass
@@ -196,7 +193,6 @@ class AnalyticTracer:
         """PINHOLE_COLUMNS of the exact trace of the COP rays at sines ``x`` (m,) in the x-z plane
         (no occluders), and how many of them do not reach the dome."""
         from rigcad.check import _kernels as K
-        from rigcad.check.trace3d import Trace3D
 
         m = len(x)
         origins = np.tile([0.0, 0.0, self.cop_z], (m, 1))
@@ -221,7 +217,6 @@ class AnalyticTracer:
         """Trace rays (n, 3) through ``optics`` (its poses) with the kernels: a Trace3D with
         ``kernels`` = rays per kernel."""
         from rigcad.check import _kernels as K
-        from rigcad.check.trace3d import Trace3D
 
         origins = np.ascontiguousarray(origins, float)
         dirs = np.ascontiguousarray(dirs, float)
@@ -249,8 +244,8 @@ class AnalyticTracer:
         return result
 
     def _general(self, K, idx, origins, dirs, pp, dp, out) -> int:
-        R1, T1, id1 = _pose(pp)
-        R2, T2, id2 = _pose(dp)
+        R1, T1, id1 = pose_arrays(pp)
+        R2, T2, id2 = pose_arrays(dp)
         return int(K.general(idx, origins, dirs, R1, T1, id1, R2, T2, id2, self.focal_length, self.vertex_z,
                              self.rim_radius, self.para_occ, self.mount_shadowed, self.body_sphere, self.beam_occ,
                              self.breaks, self.coef_r, self.coef_z, self.u_lo, self.u_hi, self.piece_of,

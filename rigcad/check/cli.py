@@ -108,7 +108,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``check`` to rigcad's subcommands."""
-    from rigcad.cli import positive_int
+    from rigcad.arguments import positive_int
 
     p = subparsers.add_parser(
         "check", help="3D ray check: trace the mirror meshes, compare with the exact surfaces and the targets",

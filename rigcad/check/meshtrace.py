@@ -27,6 +27,8 @@ import numpy as np
 
 from rigcad.check import _mesh_kernels as K
 from rigcad.check.rays import EmbreeMesh
+from rigcad.check.result import Trace3D
+from rigcad.optics.vec import pose_arrays
 
 
 def supports(optics) -> bool:
@@ -35,12 +37,6 @@ def supports(optics) -> bool:
     take the numpy passes)."""
     members = (optics.paraboloid, optics.dome, optics.beam)
     return all(isinstance(m, EmbreeMesh) and m.refine and m.normal_model in ("facet", "vertex") for m in members)
-
-
-def _pose(pose):
-    """(R, T, identity) of a Pose as the kernels take it."""
-    return (np.ascontiguousarray(pose.rotation, float), np.ascontiguousarray(pose.translation, float),
-            bool(pose.is_identity))
 
 
 def _scene(mesh: EmbreeMesh):
@@ -73,16 +69,15 @@ def _scratch(m: int) -> dict:
 
 def trace(optics, origins: np.ndarray, dirs: np.ndarray):
     """Trace rays (origins, dirs: (n, 3), global frame; dirs need not be unit) through Embree
-    ``optics`` (:func:`supports`), in blocks of :data:`BLOCK` rays: a trace3d.Trace3D with
+    ``optics`` (:func:`supports`), in blocks of :data:`BLOCK` rays: a result.Trace3D with
     ``kernels = {"mesh_compiled": n}``."""
-    from rigcad.check.trace3d import Trace3D
 
     origins = np.ascontiguousarray(origins, float)
     dirs = np.ascontiguousarray(dirs, float)
     n = len(origins)
     out = Trace3D.allocate(n, {"mesh_compiled": n})
     status, segment, p1, p2, v, landing, path, miss = out.arrays
-    poses = _pose(optics.paraboloid_pose) + _pose(optics.dome_pose)
+    poses = pose_arrays(optics.paraboloid_pose) + pose_arrays(optics.dome_pose)
     work = _scratch(min(n, BLOCK))
     for a in range(0, n, BLOCK):
         b = min(a + BLOCK, n)

@@ -1,4 +1,4 @@
-"""The 3D ray check stage (issue 5): a Rig -> meshes and exact surfaces -> traces -> figures ->
+"""The 3D ray check stage: a Rig -> meshes and exact surfaces -> traces -> figures ->
 tolerance table; ``exports/<profile>/check/{raycheck.json, spot.png, theta_map.png}``.
 
 Readings traced on the same rays (seeded, uniform in projector-image area over the paraboloid's
@@ -23,7 +23,8 @@ from rigcad.check import tolerances as T
 from rigcad.check.scene import Optics, analytic_optics, mesh_optics, mixed, placed_as, rig_meshes, share_scenes
 from rigcad.check.sources import annulus_rays, pixel_grid, pixel_rays, thin_lens_rays
 from rigcad.optics.incidence import DesignMap
-from rigcad.check.trace3d import STATUS_NAMES, Trace3D, trace
+from rigcad.check.result import STATUS_NAMES, Trace3D
+from rigcad.check.trace3d import trace
 from rigcad.profile.schema import Profile
 
 #: Rays of the exact-normal reading (its foot points cost ~10 us a ray): enough for its maximum

@@ -33,6 +33,8 @@ from rigcad.errors import CheckError
 from rigcad.optics.paraboloid import RIM_RTOL
 from rigcad.optics.solids import slab, z_cylinder
 from rigcad.optics.surfaces import Meridian
+# unit: also read as rays.unit by the tracers' callers; _cross, _dot: the names the check modules use
+from rigcad.optics.vec import cross as _cross, dot as _dot, unit  # noqa: F401
 
 #: Dense meridian samples that bracket the dome intersection (as mirror_mesh).
 DENSE_SAMPLES = 20001
@@ -48,11 +50,6 @@ FAST_PATH_RESIDUAL = 1e-9
 #: Newton steps from the design correspondence: it starts within ~1e-3 mm on an aligned rig and
 #: converges quadratically (1e-3 -> 1e-6 -> 1e-12); a ray that needs more takes the general path.
 FAST_PATH_NEWTON_STEPS = 3
-
-
-def unit(v: np.ndarray) -> np.ndarray:
-    """Rows of ``v`` (n, 3) scaled to length 1."""
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
 @dataclass
@@ -117,19 +114,6 @@ class TriMesh:
     normals: np.ndarray | None = None
     meridian: Meridian | None = None
     source: str = ""
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross product of (n, 3) arrays (np.cross is ~3x slower on (n, 3) rows)."""
-    out = np.empty_like(a)
-    np.subtract(a[:, 1] * b[:, 2], a[:, 2] * b[:, 1], out=out[:, 0])
-    np.subtract(a[:, 2] * b[:, 0], a[:, 0] * b[:, 2], out=out[:, 1])
-    np.subtract(a[:, 0] * b[:, 1], a[:, 1] * b[:, 0], out=out[:, 2])
-    return out
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
 
 
 def _moller_trumbore(o: np.ndarray, d: np.ndarray, tri: np.ndarray):

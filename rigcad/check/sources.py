@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigcad.check.rays import unit
+from rigcad.optics.vec import unit
 from rigcad.optics.frames import Pose
 from rigcad.optics.incidence import DesignMap
 

@@ -17,7 +17,8 @@ import numpy as np
 
 from rigcad.check import montecarlo as MC
 from rigcad.check.sources import Rays, pixel_rays, thin_lens_rays
-from rigcad.check.trace3d import Trace3D, trace
+from rigcad.check.result import Trace3D
+from rigcad.check.trace3d import trace
 from rigcad.optics.splitter import mirror_point, transmit
 
 #: Chief rays around the rim of the useful bundle, and aperture-edge rays per chief ray, of the

@@ -13,84 +13,15 @@ from __future__ import annotations
 
 import contextvars
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from rigcad.check.rays import _cross, _dot, unit
+# the result type and status codes live in check.result (every tracer returns them); named here too,
+# beside trace(), for its callers
+from rigcad.check.result import (ESCAPED_AFTER_DOME, ESCAPED_TOP, MISSED_DOME, MISSED_PARABOLOID, OCCLUDED_BY_BEAM,  # noqa: F401
+                                 OCCLUDED_BY_MOUNT, OCCLUDED_BY_PARABOLOID, OK, STATUS_NAMES, Trace3D)
 from rigcad.check.scene import Optics
-
-OK, MISSED_PARABOLOID, OCCLUDED_BY_MOUNT, OCCLUDED_BY_BEAM, OCCLUDED_BY_PARABOLOID, ESCAPED_TOP, \
-    MISSED_DOME, ESCAPED_AFTER_DOME = range(8)
-STATUS_NAMES = {
-    OK: "ok",
-    MISSED_PARABOLOID: "missed_paraboloid",
-    OCCLUDED_BY_MOUNT: "hit_paraboloid_mount_from_the_source",
-    OCCLUDED_BY_BEAM: "occluded_by_beam",
-    OCCLUDED_BY_PARABOLOID: "occluded_by_paraboloid_on_return",
-    ESCAPED_TOP: "escaped_through_dome_top",
-    MISSED_DOME: "missed_dome_below_its_base",
-    ESCAPED_AFTER_DOME: "escaped_after_dome",
-}
-
-
-def reflect(d: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """Mirror reflection of directions d (n, 3) about unit normals n (n, 3)."""
-    return d - (2.0 * _dot(d, n))[:, None] * n
-
-
-@dataclass
-class Trace3D:
-    """Per ray (n,): ``status`` (STATUS_NAMES), ``segment`` where it was lost (0 = not lost),
-    paraboloid and dome hit points ``p1``, ``p2`` (n, 3) mm (NaN where not reached), the final
-    direction ``v`` (n, 3), ``landing`` (n, 3) on z = 0, total ``path_length`` mm, and ``miss``: the
-    distance from O to the returning ray's line (mm; the convergence error, well conditioned even
-    at grazing incidence, where the landing point is not). ``kernels``: rays per kernel of the
-    analytic tracer (rigcad.check.analytic), ``{"mesh_compiled": n}`` for the compiled mesh reading
-    (rigcad.check.meshtrace), or ``{"vectorised": n}`` for the numpy path."""
-
-    status: np.ndarray
-    segment: np.ndarray
-    p1: np.ndarray
-    p2: np.ndarray
-    v: np.ndarray
-    landing: np.ndarray
-    path_length: np.ndarray
-    miss: np.ndarray
-    kernels: dict = field(default_factory=dict)
-
-    @classmethod
-    def allocate(cls, n: int, kernels: dict | None = None) -> "Trace3D":
-        """Uninitialised arrays for n rays, for a compiled kernel to fill (every entry written)."""
-        return cls(np.empty(n, np.int64), np.empty(n, np.int8), *(np.empty((n, 3)) for _ in range(4)), np.empty(n),
-                   np.empty(n), dict(kernels or {}))
-
-    @property
-    def arrays(self) -> tuple:
-        """The per-ray arrays in the kernels' argument order (status, segment, p1, p2, v, landing,
-        path_length, miss)."""
-        return (self.status, self.segment, self.p1, self.p2, self.v, self.landing, self.path_length, self.miss)
-
-    @property
-    def ok(self) -> np.ndarray:
-        return self.status == OK
-
-    @property
-    def arrival(self) -> np.ndarray:
-        """Unit directions (n, 3) from O towards where each ray comes from (-v)."""
-        return -self.v
-
-    @property
-    def theta(self) -> np.ndarray:
-        """Incidence angle (rad) from +z of each arriving ray (NaN where lost)."""
-        a = self.arrival
-        return np.where(self.ok, np.arctan2(np.hypot(a[:, 0], a[:, 1]), a[:, 2]), np.nan)
-
-    @property
-    def phi(self) -> np.ndarray:
-        """Azimuth (rad, from +x towards +y) of each arriving ray (NaN where lost)."""
-        a = self.arrival
-        return np.where(self.ok, np.arctan2(a[:, 1], a[:, 0]), np.nan)
+from rigcad.optics.vec import cross, dot, reflect_rows, unit
 
 
 #: Called with the ray count after every trace inside :func:`counting` (a progress bar's feed).
@@ -149,7 +80,7 @@ def _trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     q1 = pp.globalize_points(lo[i1] + t1[:, None] * ld[i1])
     n1 = pp.globalize_dirs(h1.normal[i1])
     p1[i1] = q1
-    u = reflect(dirs[i1], n1)
+    u = reflect_rows(dirs[i1], n1)
 
     # 2: paraboloid -> dome (part 0), the beam (part 1) in between
     dp = optics.dome_pose
@@ -166,7 +97,7 @@ def _trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     q2 = dp.globalize_points(lo2[keep] + t2[:, None] * ld2[keep])
     n2 = dp.globalize_dirs(h2.normal[keep])
     p2[i2] = q2
-    w = reflect(u[keep], n2)
+    w = reflect_rows(u[keep], n2)
 
     # 3: dome -> plane z = 0, the paraboloid (mirror, mount) and the beam in between
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -189,7 +120,7 @@ def _trace(optics: Optics, origins: np.ndarray, dirs: np.ndarray) -> Trace3D:
     landing[i3] = q2[ok] + t3[ok, None] * w[ok]
     path[i3] = t1[keep][ok] + t2[ok] + t3[ok]
     miss = np.full(n, np.nan)
-    miss[i3] = np.linalg.norm(_cross(q2[ok], w[ok]), axis=1)  # |O - line|, O at the origin
+    miss[i3] = np.linalg.norm(cross(q2[ok], w[ok]), axis=1)  # |O - line|, O at the origin
     return Trace3D(status, segment, p1, p2, v, landing, path, miss, {"vectorised": n})
 
 
@@ -203,13 +134,5 @@ def convergence_point(tr: Trace3D) -> np.ndarray:
     # threaded reductions may round differently with the thread count (tolerancing promises the
     # same bits on any number of workers)
     a = len(w) * np.eye(3) - np.einsum("ij,ik->jk", w, w)
-    b = p.sum(axis=0) - np.einsum("ij,i->j", w, _dot(w, p))
+    b = p.sum(axis=0) - np.einsum("ij,i->j", w, dot(w, p))
     return np.linalg.solve(a, b)
-
-
-def distances_to(tr: Trace3D, point: np.ndarray) -> np.ndarray:
-    """Distance (n,) mm from ``point`` (3,) to each returning ray's line (NaN where lost)."""
-    d = np.full(len(tr.status), np.nan)
-    ok = tr.ok
-    d[ok] = np.linalg.norm(_cross(tr.p2[ok] - point, tr.v[ok]), axis=1)
-    return d

@@ -19,12 +19,14 @@ from rigcad._version import __version__
 from rigcad.errors import ExportError, ProfileError
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import code_version, file_sha, profile_digest
+from rigcad.export.manifest import sha256_hex as _sha
 from rigcad.parts import PARTS
 from rigcad.parts.recipe import Part
 from rigcad.profile.schema import Profile
 
-#: STL and STEP volumes must agree within this fraction (the issue's 0.5 %): the mesh is
-#: inscribed in the exact surface at the chord error, so it is slightly smaller.
+#: STL and STEP volumes must agree within this fraction (the requirement: a re-imported STEP's
+#: volume matches the STL's within 0.5 %): the mesh is inscribed in the exact surface at the chord
+#: error, so it is slightly smaller.
 MESH_VOLUME_RTOL = 5e-3
 #: Chord error of the meshes drawn for the renders (mm): only for looking at.
 RENDER_CHORD_ERROR = 0.3
@@ -38,10 +40,6 @@ class BuildResult:
     rebuilt: list[str]
     reused: list[str]
     written: list[Path]
-
-
-def _sha(data: bytes) -> str:
-    return hashlib.sha256(data).hexdigest()
 
 
 def part_key(part: Part, profile: Profile) -> str:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
 import io
 import json
 from pathlib import Path
@@ -10,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from rigcad.export.atomic import Staging, json_bytes
-from rigcad.export.manifest import profile_digest
+from rigcad.export.manifest import profile_digest, sha256_hex
 from rigcad.optics.design import Design
 
 
@@ -51,7 +50,7 @@ def write_design(design: Design, out_dir: Path, lock: Path | None = None) -> lis
                 m = json.loads(manifest.read_text(encoding="utf-8"))
             except (OSError, ValueError):
                 m = None
-            shas = {name: hashlib.sha256(data).hexdigest() for name, data in files.items()}
+            shas = {name: sha256_hex(data) for name, data in files.items()}
             if isinstance(m, dict) and (m.get("design_files") != shas or stage.stale):
                 if m.get("design_files") != shas:
                     m["design_files"] = shas

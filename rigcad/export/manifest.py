@@ -34,8 +34,14 @@ def inputs_key(profile) -> str:
     return hashlib.sha256(f"{profile_digest(profile)}|{code_version('**/*.py')}".encode()).hexdigest()
 
 
+def sha256_hex(data: bytes) -> str:
+    """SHA-256 of ``data``, hexadecimal: how every written file is recorded in a report."""
+    return hashlib.sha256(data).hexdigest()
+
+
 def file_sha(path: Path) -> str | None:
-    return hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else None
+    """:func:`sha256_hex` of the file at ``path``; None if there is none."""
+    return sha256_hex(path.read_bytes()) if path.is_file() else None
 
 
 def listed_files(manifest: dict) -> dict[str, str]:

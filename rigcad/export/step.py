@@ -13,7 +13,6 @@ import re
 from pathlib import Path
 
 from rigcad.errors import ExportError
-from rigcad.export.atomic import write_with
 
 #: The fixed header timestamp (STEP requires one; a clock time would change every file).
 TIMESTAMP = "2000-01-01T00:00:00"
@@ -48,11 +47,6 @@ def step_writer(parts: list[tuple[str, object, tuple[float, float, float]]], lab
             tmp.write_text(canonical_step(text), encoding="latin-1", newline="\n")
 
     return writer
-
-
-def write_step(path: Path, parts: list[tuple[str, object, tuple[float, float, float]]], label: str) -> Path:
-    """Write parts to one STEP file, atomically; returns the path."""
-    return write_with(path, step_writer(parts, label))
 
 
 def reimport_check(path: Path, expected_volume: float, expected_solids: int) -> dict:

@@ -1,4 +1,4 @@
-"""Fabrication (project issues 6, 14): printer profiles, fit and split, print orientation (no
+"""Fabrication: printer profiles, fit and split, print orientation (no
 support on a mirror), sanding stock printed in front of every mirror, in-process slicing and the
 staircase on mirror surfaces, G-code through PrusaSlicer with its vendor presets and the support
 contact read from it (support.py), time and material estimates fitted to PrusaSlicer

@@ -7,17 +7,14 @@ import argparse
 import sys
 from pathlib import Path
 
-
-def _hm(seconds: float) -> str:
-    s = int(round(seconds))
-    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
+from rigcad.units import hours_minutes
 
 
 def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.fab.printers import load_printer
 
     printer = load_printer(args.printer)  # first: a refused printer file costs no rig and no CAD kernel import
-    from rigcad.cli import _progress
+    from rigcad.progress import stages
     from rigcad.export.build import select_parts
     from rigcad.fab.stage import run_fab
     from rigcad.export.atomic import check_exports, profile_lock
@@ -29,7 +26,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
     rig = load(profile)
     out = Path(args.exports) / profile.name / "fab" / printer.name
     names = select_parts(args.parts)
-    with _progress(len(names), f"fab {profile.name}") as step:
+    with stages(len(names), f"fab {profile.name}") as step:
         def progress(msg: str) -> None:
             step(msg)
             if args.verbose:
@@ -37,7 +34,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
 
         res = run_fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs,
                       lock=profile_lock(args.exports, profile.name), progress=progress,
-                      slicing=lambda total: _progress(total, f"slicing ({printer.slicer})"))
+                      slicing=lambda total: stages(total, f"slicing ({printer.slicer})"))
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")
     for name, e in res.report["parts"].items():
@@ -51,22 +48,22 @@ def cmd_fab(args: argparse.Namespace) -> int:
             if sliced and len(sliced) == len(e["pieces"]):
                 t = sum(g["estimates"].get("print_time_s", 0) for g in sliced)
                 g_ = sum(g["estimates"].get("filament_g", 0) for g in sliced)
-                extra += f"; slicer {_hm(t)}, {g_:.0f} g"
+                extra += f"; slicer {hours_minutes(t)}, {g_:.0f} g"
                 sc = [g["support_contact"] for g in sliced if "support_contact" in g]
                 if sc and (e.get("mirror") or any(c["other_mm2"] for c in sc)):
                     extra += (f"; support contact mirror {sum(c['mirror_mm2'] for c in sc):.0f} mm2, "
                               f"other {sum(c['other_mm2'] for c in sc):.0f} mm2")
             else:
                 est = sum(pc["estimate"]["print_time_s"] for pc in e["pieces"])
-                extra += f"; est. {_hm(est)}, {sum(pc['estimate']['material_g'] for pc in e['pieces']):.0f} g"
+                extra += f"; est. {hours_minutes(est)}, {sum(pc['estimate']['material_g'] for pc in e['pieces']):.0f} g"
             print(f"  {name}: {len(e['pieces'])} piece(s), {orient}, {e['layers_total']} layers{extra}")
         elif "error" not in e:
             print(f"  {name}: outlines/{name}.dxf, .svg" + (" (+ _printed, _sanded stages)" if "stages" in e else ""))
     if "slicer_print_time_s" in tot:
-        print(f"  total ({printer.slicer}, with quantities): {_hm(tot['slicer_print_time_s'])}, "
+        print(f"  total ({printer.slicer}, with quantities): {hours_minutes(tot['slicer_print_time_s'])}, "
               f"{tot['slicer_filament_g']:.0f} g filament")
     else:
-        print(f"  total (rigcad estimate, with quantities): {_hm(tot['estimate_print_time_s'])}, "
+        print(f"  total (rigcad estimate, with quantities): {hours_minutes(tot['estimate_print_time_s'])}, "
               f"{tot['estimate_material_g']:.0f} g")
     if args.timings:
         for k, v in sorted(res.timings_s.items()):
@@ -80,7 +77,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add the `fab` command to rigcad's subparsers (rigcad.cli.build_parser)."""
-    from rigcad.cli import positive_int
+    from rigcad.arguments import positive_int
     from rigcad.profile.paths import PRINTERS_SUBDIR, names_on_search_path  # not fab.printers: no numpy for --help
 
     p = subparsers.add_parser(

@@ -175,10 +175,6 @@ def grid_cell(man: m3d.Manifold, plan: GridPlan, i: int, j: int) -> m3d.Manifold
     return out
 
 
-def any_cell(man: m3d.Manifold, plan, i: int, j: int) -> m3d.Manifold:
-    return grid_cell(man, plan, i, j) if isinstance(plan, GridPlan) else cell(man, plan, i, j)
-
-
 def is_off_axis(man: m3d.Manifold, rtol: float = 0.05) -> bool:
     """A part not centred on the optical axis (its bounding box's centre off z by more than
     ``rtol`` of its size): it is split by a grid in its own bounding box, not into sectors."""

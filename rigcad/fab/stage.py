@@ -18,7 +18,6 @@ staircase/<part>.png, support/<piece>.png, fab.json, fab.md. Timings are returne
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import time
@@ -30,17 +29,18 @@ import numpy as np
 from rigcad._version import __version__
 from rigcad.errors import FabricationError, RigcadError
 from rigcad.export.atomic import Staging, json_bytes
-from rigcad.export.manifest import profile_digest
+from rigcad.export.manifest import profile_digest, sha256_hex
 from rigcad import plots
-from rigcad.fab import estimate as E
+from rigcad.fab import estimate
 from rigcad.fab import outlines
-from rigcad.fab import orientation as O
-from rigcad.fab import slicer as S
-from rigcad.fab import split as SP
-from rigcad.fab import staircase as ST
+from rigcad.fab import orientation
+from rigcad.fab import slicer
+from rigcad.fab import split
+from rigcad.fab import staircase
 from rigcad.fab.mirror import MirrorSurface, mirror_faces
 from rigcad.fab.printers import Printer
 from rigcad.parts.recipe import Prism
+from rigcad.units import hours_minutes
 
 #: Parts cut from plate rather than printed.
 CUT_PARTS = ("dome_template", "paraboloid_template")
@@ -56,10 +56,6 @@ class FabResult:
     timings_s: dict[str, float] = field(default_factory=dict)
     slicer_s: dict[str, float] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
-
-
-def _sha(b: bytes) -> str:
-    return hashlib.sha256(b).hexdigest()
 
 
 def _mirror(part, layout) -> MirrorSurface | None:
@@ -81,20 +77,20 @@ def sanding_stock(printer: Printer, needed: float) -> tuple[float, str]:
     return needed, "auto: the staircase's bound in the chosen orientations (stock_bound)"
 
 
-def evaluate(vertices, faces, orient: O.Orientation, printer: Printer, mirror_f) -> dict:
+def evaluate(vertices, faces, orient: orientation.Orientation, printer: Printer, mirror_f) -> dict:
     """One candidate orientation of one piece: fit, staircase (closed form), supports."""
-    spin, extents = O.fit_spin(vertices, orient.direction, printer.usable)
+    spin, extents = orientation.fit_spin(vertices, orient.direction, printer.usable)
     row = {"orientation": orient.name, "build_direction": [round(float(v), 12) for v in orient.direction],
            "fits": spin is not None, "spin_deg": None if spin is None else math.degrees(spin),
-           "extents_mm": extents, "overhang_area_mm2": O.overhang_area(vertices, faces, orient.direction)}
+           "extents_mm": extents, "overhang_area_mm2": orientation.overhang_area(vertices, faces, orient.direction)}
     mask = None
     if mirror_f is not None and len(mirror_f.index):
         mask = np.zeros(len(faces), bool)
         mask[mirror_f.index] = True
-        row["mirror_overhang_area_mm2"] = O.overhang_area(vertices, faces, orient.direction, mask)
-        row["staircase_closed_form"] = ST.surface_staircase(mirror_f, orient.direction, printer.layer_height)
+        row["mirror_overhang_area_mm2"] = orientation.overhang_area(vertices, faces, orient.direction, mask)
+        row["staircase_closed_form"] = staircase.surface_staircase(mirror_f, orient.direction, printer.layer_height)
     if spin is not None:
-        row["support_model"] = O.support_contact(vertices, faces, orient.direction, mask)
+        row["support_model"] = orientation.support_contact(vertices, faces, orient.direction, mask)
     return row
 
 
@@ -143,7 +139,7 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
     bed_c = (printer.build_volume.x / 2, printer.build_volume.y / 2)
     report_parts: dict[str, dict] = {}
     problems: list[str] = []
-    jobs: list[S.SliceJob] = []
+    jobs: list[slicer.SliceJob] = []
     job_part: dict[str, str] = {}
     stocks: dict[str, float] = {}  # mirror name -> stock printed in front of it (mm)
     meshes: dict[str, tuple] = {}  # piece -> (vertices in print position, faces, mirror face indices)
@@ -165,7 +161,7 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                 report_parts[name] = {"process": "cut from plate (laser / water-jet)", "quantity": part.quantity,
                                       "plate_thickness_mm": o.thickness, "outline_size_mm": list(o.size),
                                       "outline_points": len(o.polygon), "chord_error_mm": chord,
-                                      "files": {f"outlines/{name}.dxf": _sha(dxf), f"outlines/{name}.svg": _sha(svg)}}
+                                      "files": {f"outlines/{name}.dxf": sha256_hex(dxf), f"outlines/{name}.svg": sha256_hex(svg)}}
                 report_parts[name]["stages"] = _stage_templates(rig, name, printer, stocks, chord, stage, out)
                 timings[f"outline:{name}"] = time.perf_counter() - t
                 say(name)
@@ -200,14 +196,14 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                     g = pc.get("gcode") or {}
                     path = out / "gcode" / f"{pc['name']}.gcode"
                     proj = out / "3mf" / f"{pc['name']}.3mf"
-                    if (g.get("key") and path.is_file() and _sha(path.read_bytes()) == g.get("sha256")
-                            and proj.is_file() and _sha(proj.read_bytes()) == g.get("project_sha256")):
+                    if (g.get("key") and path.is_file() and sha256_hex(path.read_bytes()) == g.get("sha256")
+                            and proj.is_file() and sha256_hex(proj.read_bytes()) == g.get("project_sha256")):
                         cached[pc["name"]] = (g["key"], path.read_bytes(), proj.read_bytes())
             from contextlib import nullcontext
 
             try:
                 with (slicing(len(jobs)) if slicing else nullcontext(None)) as step:
-                    results, version = S.slice_all(jobs, cached, workers,
+                    results, version = slicer.slice_all(jobs, cached, workers,
                                                    on_done=(lambda r: step(f"sliced {r.name}")) if step else None)
             except FabricationError as err:
                 problems.append(str(err))
@@ -219,16 +215,16 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                 stage.write_bytes(out / "3mf" / f"{job.name}.3mf", res.project)
                 slicer_s[job.name] = res.seconds
                 pc = next(p for p in report_parts[job_part[job.name]]["pieces"] if p["name"] == job.name)
-                pc["gcode"] = {"key": job.key(version), "sha256": _sha(res.gcode), "estimates": res.estimates,
+                pc["gcode"] = {"key": job.key(version), "sha256": sha256_hex(res.gcode), "estimates": res.estimates,
                                "slicer_warnings": list(res.warnings), "project": f"3mf/{job.name}.3mf",
-                               "project_sha256": _sha(res.project), "placement": res.placement}
+                               "project_sha256": sha256_hex(res.project), "placement": res.placement}
                 if res.warnings:
                     problems.append(f"{job.name}: slicer warnings: {'; '.join(res.warnings)}")
                 if job.name in meshes:
                     pc["gcode"]["support_contact"] = _support_contact(job.name, res.gcode, meshes[job.name], printer,
                                                                       stage, out)
             timings["gcode"] = time.perf_counter() - t
-            ini = S.printer_ini(printer, support=False)
+            ini = slicer.printer_ini(printer, support=False)
         elif gcode and printer.slicer != "prusa-slicer":
             report_gcode["note"] = (f"printer '{printer.name}' has no slicer rigcad can run (slicer: {printer.slicer}); "
                                     "time and material are rigcad's estimates")
@@ -243,9 +239,9 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
             "frame": "part frame: mm, sample point at the origin, optical axis +z, working position; print "
                      "frame: build direction +z, bed at z = 0",
             "tolerances": {"stl_chord_error_mm": chord, "mirror_face_tolerance_mm": tol_mirror,
-                           "pin_min_wall_mm": SP.MIN_WALL, "pin_mirror_clearance_mm": SP.MIRROR_CLEARANCE,
+                           "pin_min_wall_mm": split.MIN_WALL, "pin_mirror_clearance_mm": split.MIRROR_CLEARANCE,
                            "orientation_cusp_tie_rtol": CUSP_TIE_RTOL,
-                           "overhang_angle_deg": math.degrees(O.OVERHANG_ANGLE)},
+                           "overhang_angle_deg": math.degrees(orientation.OVERHANG_ANGLE)},
             "gcode": report_gcode,
             "totals": _totals(report_parts),
             "parts": report_parts,
@@ -261,12 +257,12 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
 def _support_contact(name: str, gcode: bytes, mesh: tuple, printer: Printer, stage: Staging, out: Path) -> dict:
     """Support contact of one piece from its G-code's support extrusions (rigcad.fab.support), mm2
     on its mirror and its other faces; a picture (support/<piece>.png) for pieces with a mirror."""
-    from rigcad.fab import support as SU
+    from rigcad.fab import support
 
     vertices, faces, mirror_index = mesh
     settings = printer.slicer_config.effective() if printer.slicer_config else {}
-    beads = SU.support_beads(gcode)
-    areas = SU.contact_areas(vertices, faces, mirror_index, beads, SU.contact_reach(settings, printer.layer_height))
+    beads = support.support_beads(gcode)
+    areas = support.contact_areas(vertices, faces, mirror_index, beads, support.contact_reach(settings, printer.layer_height))
     pts, touched, on_m = areas.pop("_points"), areas.pop("_touched"), areas.pop("_mirror")
     areas["method"] = ("surface samples within reach_mm of the G-code's ;TYPE:Support material / Support material "
                        "interface extrusions (rigcad.fab.support)")
@@ -276,7 +272,7 @@ def _support_contact(name: str, gcode: bytes, mesh: tuple, printer: Printer, sta
                                     f"other faces {areas['other_mm2']:.0f} mm2")
         stage.write_bytes(out / "support" / f"{name}.png", png)
         areas["png"] = f"support/{name}.png"
-        areas["png_sha256"] = _sha(png)
+        areas["png_sha256"] = sha256_hex(png)
     return areas
 
 
@@ -292,14 +288,14 @@ def _stage_templates(rig, name: str, printer: Printer, stocks: dict, chord: floa
     ``coated`` (the profile's gauged layer: ``outlines/<template>.dxf``). Depths in mm behind the
     design surface; the printed stage needs the stock, known when the mirror's part is in the
     same run or the printer file states it."""
-    from rigcad.parts import templates as T
+    from rigcad.parts import templates
 
-    make = {"dome_template": T.dome_template, "paraboloid_template": T.paraboloid_template}[name]
+    make = {"dome_template": templates.dome_template, "paraboloid_template": templates.paraboloid_template}[name]
     mirror = TEMPLATE_MIRROR[name]
     coating = rig.layout.coating
     stock = stocks.get(mirror, printer.sanding_stock)
     rows = {"coated": {"gauges": f"the {rig.profile.templates.gauged_layer} surface",
-                       "depth_behind_design_mm": T.gauged_depth(rig.profile),
+                       "depth_behind_design_mm": templates.gauged_depth(rig.profile),
                        "files": [f"outlines/{name}.dxf", f"outlines/{name}.svg"]}}
     depths = {"sanded": ("the sanded surface, under the whole coating", coating)}
     if stock is not None:
@@ -314,7 +310,7 @@ def _stage_templates(rig, name: str, printer: Printer, stocks: dict, chord: floa
         for ext, data in (("dxf", outlines.dxf_bytes(o)), ("svg", outlines.svg_bytes(o))):
             path = f"outlines/{name}_{label}.{ext}"
             stage.write_bytes(out / path, data)
-            files[path] = _sha(data)
+            files[path] = sha256_hex(data)
         rows[label] = {"gauges": what, "depth_behind_design_mm": depth, "files": files}
     return rows
 
@@ -373,46 +369,46 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
     """One printed part: mesh, fit or split (``plan``: a split decided before, or None to find the
     fewest pieces), orient every piece, slice it, its STL and slicing job; ``orient_only`` stops
     after choosing the orientations (what the sanding stock needs to know, :func:`_with_stock`)."""
-    from rigcad.export import mesh as M
+    from rigcad.export import mesh
 
     name = part.name
     t = time.perf_counter()
-    man = M.build(part.solid, chord)
+    man = mesh.build(part.solid, chord)
     mirror = _mirror(part, layout)
     timings[f"{name}:mesh"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    v, f = M.mesh_arrays(man)
-    plate = None if mirror else O.plate_axis(v)
+    v, f = mesh.mesh_arrays(man)
+    plate = None if mirror else orientation.plate_axis(v)
 
-    def candidates(sector=None, sectors: bool = False) -> list[O.Orientation]:
+    def candidates(sector=None, sectors: bool = False) -> list[orientation.Orientation]:
         if mirror:
-            return O.mirror_candidates(sector if sectors else None)
-        return O.flat_candidates(plate) if plate is not None else O.generic_candidates()
+            return orientation.mirror_candidates(sector if sectors else None)
+        return orientation.flat_candidates(plate) if plate is not None else orientation.generic_candidates()
 
-    whole_fits = plan is None and any(O.fit_spin(v, o.direction, printer.usable)[0] is not None for o in candidates())
+    whole_fits = plan is None and any(orientation.fit_spin(v, o.direction, printer.usable)[0] is not None for o in candidates())
     if plan is not None:
         pass
     elif whole_fits:
-        plan = SP.SplitPlan(1, 1, 0.0, (float(v[:, 2].min()), float(v[:, 2].max())))
+        plan = split.SplitPlan(1, 1, 0.0, (float(v[:, 2].min()), float(v[:, 2].max())))
     else:
         def fits(cell, plan, i, j):
             if cell.is_empty():
                 return True
-            cv, _ = M.mesh_arrays(cell)
+            cv, _ = mesh.mesh_arrays(cell)
             rng = plan.sector_range(i) if plan.sectors > 1 else None
-            cands = candidates(rng, isinstance(plan, SP.SplitPlan))
-            return any(O.fit_spin(cv, o.direction, printer.usable)[0] is not None for o in cands)
+            cands = candidates(rng, isinstance(plan, split.SplitPlan))
+            return any(orientation.fit_spin(cv, o.direction, printer.usable)[0] is not None for o in cands)
 
-        if SP.is_off_axis(man):  # flat / off-axis parts: a grid in their own bounding box
-            plan = SP.plan_grid(man, fits)
+        if split.is_off_axis(man):  # flat / off-axis parts: a grid in their own bounding box
+            plan = split.plan_grid(man, fits)
         else:
             try:
-                plan = SP.plan_split(man, fits)
+                plan = split.plan_split(man, fits)
             except FabricationError:
-                plan = SP.plan_grid(man, fits)
+                plan = split.plan_grid(man, fits)
     tongues: list = []
-    pieces, pins, drilled = SP.split_part(man, name, plan, printer.alignment_pin, mirror, tongues)
+    pieces, pins, drilled = split.split_part(man, name, plan, printer.alignment_pin, mirror, tongues)
     timings[f"{name}:fit_split"] = time.perf_counter() - t
 
     entry = {"process": printer.process, "quantity": part.quantity, "description": part.description,
@@ -428,52 +424,52 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
     map_pts, map_cusp = [], []
     t = time.perf_counter()
     for pc in pieces:
-        pv, pf = M.mesh_arrays(pc.manifold)
+        pv, pf = mesh.mesh_arrays(pc.manifold)
         mf = mirror_faces(pv, pf, mirror, tol_mirror) if mirror else None
-        cands = candidates(pc.sector_range, isinstance(plan, SP.SplitPlan))
+        cands = candidates(pc.sector_range, isinstance(plan, split.SplitPlan))
         rows = [evaluate(pv, pf, o, printer, mf) for o in cands]
         k = choose(rows)
         if not rows[k]["fits"]:
             raise FabricationError(f"piece {pc.name} fits the printer in no orientation")
-        best = O.Orientation(cands[k].name, cands[k].direction, math.radians(rows[k]["spin_deg"]))
+        best = orientation.Orientation(cands[k].name, cands[k].direction, math.radians(rows[k]["spin_deg"]))
         rot = best.rotation()
         steep = float(np.abs(mf.normals @ np.asarray(best.direction)).max()) if mf is not None and len(mf.index) else None
         if orient_only:
             piece_rows.append({"name": pc.name, "orientation": best.name, "mirror_area_mm2": mf.area if mf else 0.0,
                                "mirror_max_abs_normal_along_build": steep})
             continue
-        layers, shift = ST.slice_layers(pc.manifold, rot, printer.layer_height, printer.first_layer_height)
-        placed = O.place(pv, best, bed_c)
+        layers, shift = staircase.slice_layers(pc.manifold, rot, printer.layer_height, printer.first_layer_height)
+        placed = orientation.place(pv, best, bed_c)
         if meshes is not None:
             meshes[pc.name] = (placed, pf, mf.index if mf is not None else np.zeros(0, int))
-        stl = M.stl_bytes(placed, pf, pc.name)
+        stl = mesh.stl_bytes(placed, pf, pc.name)
         stage.write_bytes(out / "stl" / f"{pc.name}.stl", stl)
         volume = pc.manifold.volume()
-        # print position = rotation @ part frame + translation (what O.place did), for readers of the STL
+        # print position = rotation @ part frame + translation (what orientation.place did), for readers of the STL
         translation = (placed - pv @ rot.T).mean(axis=0)
         row = {"name": pc.name, "orientation": best.name, "build_direction": rows[k]["build_direction"],
                "spin_deg": rows[k]["spin_deg"], "extents_mm": rows[k]["extents_mm"], "layers": layers.count,
                "print_transform": {"rotation": rot.tolist(), "translation_mm": translation.tolist()},
                "volume_mm3": volume, "needs_support": rows[k]["overhang_area_mm2"] > 0,
-               "candidates": rows, "stl_sha256": _sha(stl),
+               "candidates": rows, "stl_sha256": sha256_hex(stl),
                "support_model": rows[k]["support_model"],
-               "estimate": E.estimate(E.Features(volume, pc.manifold.surface_area(), layers.count,
+               "estimate": estimate.estimate(estimate.Features(volume, pc.manifold.surface_area(), layers.count,
                                                  rows[k]["support_model"]["support_envelope_mm3"],
                                                  rows[k]["support_model"]["mirror_under_mm2"]
                                                  + rows[k]["support_model"]["other_under_mm2"],
-                                                 E.shell_thickness(printer), E.island_layers(layers)), printer)}
+                                                 estimate.shell_thickness(printer), estimate.island_layers(layers)), printer)}
         if mf is not None and len(mf.index):
-            steps = ST.step_map(layers, rot, shift, mirror, tol_mirror)
+            steps = staircase.step_map(layers, rot, shift, mirror, tol_mirror)
             row["mirror_area_mm2"] = mf.area
             row["mirror_max_abs_normal_along_build"] = steep
             row["staircase_from_slices"] = steps.summary()
-            row["polishing"] = ST.polishing_allowance(steps)
-            row["optical_effect_as_printed"] = ST.optical_effect(mf, best.direction, mirror.name)
+            row["polishing"] = staircase.polishing_allowance(steps)
+            row["optical_effect_as_printed"] = staircase.optical_effect(mf, best.direction, mirror.name)
             map_pts.append(steps.points)
             map_cusp.append(steps.cusp_slices)
         piece_rows.append(row)
         if printer.slicer == "prusa-slicer":
-            jobs.append(S.slice_job(printer, pc.name, stl, row["needs_support"], bed_c))
+            jobs.append(slicer.slice_job(printer, pc.name, stl, row["needs_support"], bed_c))
     timings[f"{name}:orient_slice"] = time.perf_counter() - t
     entry["pieces"] = piece_rows
     if orient_only:
@@ -487,7 +483,7 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
                                   f"{', '.join(orients)}")
         stage.write_bytes(out / "staircase" / f"{name}.png", png)
         ok = np.isfinite(cusp)
-        entry["staircase_map"] = {"png": f"staircase/{name}.png", "png_sha256": _sha(png),
+        entry["staircase_map"] = {"png": f"staircase/{name}.png", "png_sha256": sha256_hex(png),
                                   "cusp_mean_mm": float(cusp[ok].mean()), "cusp_max_mm": float(cusp[ok].max()),
                                   "cusp_p95_mm": float(np.percentile(cusp[ok], 95))}
         entry["polishing"] = {"sanding_depth_mm": max(r["polishing"]["sanding_depth_mm"] for r in piece_rows if "polishing" in r),
@@ -500,7 +496,7 @@ def reassembly(man, drilled, pieces, mirror, tol, pins, printer) -> dict:
     from the exact surface, the pins' distance from the mirror."""
     import manifold3d as m3d
 
-    from rigcad.export import mesh as M
+    from rigcad.export import mesh
 
     union = m3d.Manifold.batch_boolean([p.manifold for p in pieces], m3d.OpType.Add)
     out = {"part_volume_mm3": man.volume(), "drilled_volume_mm3": drilled.volume(),
@@ -508,11 +504,11 @@ def reassembly(man, drilled, pieces, mirror, tol, pins, printer) -> dict:
            "union_volume_mm3": union.volume(), "pin_holes": len(pins),
            "symmetric_difference_mm3": (union - drilled).volume() + (drilled - union).volume()}
     if mirror is not None:
-        v, f = M.mesh_arrays(man)
+        v, f = mesh.mesh_arrays(man)
         whole = mirror_faces(v, f, mirror, tol)
         area, dmax = 0.0, 0.0
         for p in pieces:
-            pv, pf = M.mesh_arrays(p.manifold)
+            pv, pf = mesh.mesh_arrays(p.manifold)
             mf = mirror_faces(pv, pf, mirror, tol)
             area += mf.area
             if len(mf.index):
@@ -542,11 +538,6 @@ def _totals(parts: dict) -> dict:
     return out
 
 
-def _hms(s: float) -> str:
-    s = int(round(s))
-    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
-
-
 def markdown(report: dict) -> str:
     """fab.md: one page a fabricator reads, with the staircase maps."""
     pr = report["printer"]
@@ -572,12 +563,12 @@ def markdown(report: dict) -> str:
         cusp = f"{sm['cusp_mean_mm']:.3f} / {sm['cusp_max_mm']:.3f}" if sm else "-"
         stock = e["sanding_stock"]["stock_mm"] if e.get("sanding_stock") else e.get("polishing", {}).get("stock_to_add_mm")
         pol = f"{e['polishing']['sanding_depth_mm']:.3f} / {stock:.3f}" if "polishing" in e else "-"
-        lines.append(f"| {name} | {e['quantity']} | {len(pcs)} | {orient} | {e['layers_total']} | {_hms(t)} ({src}) | "
+        lines.append(f"| {name} | {e['quantity']} | {len(pcs)} | {orient} | {e['layers_total']} | {hours_minutes(t)} ({src}) | "
                      f"{g:.0f} g | {cusp} | {pol} |")
     tot = report["totals"]
-    lines += ["", f"Totals (with quantities): {tot['pieces']} pieces, {_hms(tot['estimate_print_time_s'])} and "
+    lines += ["", f"Totals (with quantities): {tot['pieces']} pieces, {hours_minutes(tot['estimate_print_time_s'])} and "
               f"{tot['estimate_material_g']:.0f} g by rigcad's estimate (rigcad.fab.estimate, fitted to PrusaSlicer)"
-              + (f"; slicer: {_hms(tot['slicer_print_time_s'])}, {tot['slicer_filament_g']:.0f} g" if "slicer_print_time_s" in tot else "")
+              + (f"; slicer: {hours_minutes(tot['slicer_print_time_s'])}, {tot['slicer_filament_g']:.0f} g" if "slicer_print_time_s" in tot else "")
               + ".", ""]
     stocked = [(n, e) for n, e in report["parts"].items() if e.get("sanding_stock")]
     if stocked:

@@ -167,4 +167,16 @@ def step_offsets(meshes: list[PartMesh], done: list[int], new: list[int]) -> dic
     return {i: np.array([0.0, 0.0, dz]) for i in new}
 
 
-__all__ = ["PartMesh", "VIEW_CHORD_ERROR_MM", "assembly_order", "explode_offsets", "rig_meshes", "step_offsets", "steps"]
+def encloses(meshes: list[PartMesh]) -> set[str]:
+    """Parts whose bounding box holds another part's whole bounding box (the dome holds the
+    paraboloid): drawn see-through in the view, cut away in the pictures."""
+    out = set()
+    for a in meshes:
+        for b in meshes:
+            if a is not b and np.all(a.lo <= b.lo) and np.all(b.hi <= a.hi):
+                out.add(a.name)
+    return out
+
+
+__all__ = ["PartMesh", "VIEW_CHORD_ERROR_MM", "assembly_order", "encloses", "explode_offsets", "rig_meshes", "step_offsets",
+           "steps"]

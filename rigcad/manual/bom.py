@@ -255,11 +255,6 @@ def dowel_pins(fab_report: dict, printer) -> dict | None:
                      + ("; cut from the printer's own filament" if filament else ""))}
 
 
-def _hms(seconds: float) -> str:
-    s = int(round(seconds))
-    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
-
-
 def printed(rig, fab_report: dict) -> list[dict]:
     """One row per part of the fab report: printed pieces with time and material (the slicer's when
     G-code was made, else rigcad's estimate), or the plate a template is cut from."""

@@ -14,7 +14,7 @@ VIEW_MAX_RAYS = 100_000
 
 
 def cmd_view(args: argparse.Namespace) -> int:
-    from rigcad.cli import _progress
+    from rigcad.progress import stages
     from rigcad.errors import ProfileError
     from rigcad.export.atomic import check_exports, profile_lock
     from rigcad.manual.view import write_view
@@ -26,7 +26,7 @@ def cmd_view(args: argparse.Namespace) -> int:
                            f"HTML file and is drawn at once); valid: 1..{VIEW_MAX_RAYS}", param="--rays")
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "view")  # a planted link or lock: one line now, not after the work
-    with _progress(5, "view") as step:
+    with stages(5, "view") as step:
         rig = load(profile)
         step("dome integrated")
         out = Path(args.exports) / rig.name / "view"
@@ -46,7 +46,7 @@ def cmd_manual(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Add ``view`` and ``manual`` to rigcad's subcommands."""
-    from rigcad.cli import positive_int
+    from rigcad.arguments import positive_int
 
     p = subparsers.add_parser(
         "view", help="the assembled rig in 3D: one self-contained HTML file (three.js inline, no network)",

@@ -23,6 +23,7 @@ from pathlib import Path
 from rigcad._version import __version__
 from rigcad.manual import bom as B
 from rigcad.manual import calibration as C
+from rigcad.units import hours_minutes
 
 MIL = 0.0254  # mm
 
@@ -179,7 +180,9 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     bill = B.bill(rig, fab_report, printer)
     files: dict[str, bytes] = {}
     meshes = rig_meshes(rig)
-    files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig")
+    cut_away = A.encloses(meshes)
+    files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
+                                                cut_away=cut_away)
     step("rig picture")
 
     d = Doc()
@@ -200,14 +203,14 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
             rows.append([f"`{r['part']}`", r["use"], r["quantity"] or "-", "cut" if r["quantity"] else "-",
                          r["process"], "-", "-", r["note"]])
         else:
-            rows.append([f"`{r['part']}`", r["use"], r["quantity"], r["pieces"], r["process"], B._hms(r["time_s"]),
+            rows.append([f"`{r['part']}`", r["use"], r["quantity"], r["pieces"], r["process"], hours_minutes(r["time_s"]),
                          f"{r['material_g']:.0f} g", f"{r['note']} ({r['source']})"])
     d.table(["part", "use", "qty", "pieces", "process", "print time (with qty)", "material", "orientation"], rows)
     timed = [r for r in bill["printed"] if r.get("time_s") is not None]
     total_t = sum(r["time_s"] for r in timed)
     total_g = sum(r["material_g"] for r in timed)
     pieces = sum(r["pieces"] * r["quantity"] for r in timed)
-    d.p(f"In all: **{pieces} printed pieces, {B._hms(total_t)} of printing and {total_g:.0f} g of "
+    d.p(f"In all: **{pieces} printed pieces, {hours_minutes(total_t)} of printing and {total_g:.0f} g of "
         f"{printer.material}**" + ("" if all(r["source"] == "slicer" for r in timed) else
                                    " (rigcad's estimate where no G-code was sliced"
                                    + (": `rigcad manual ... --gcode` uses PrusaSlicer's own figures)"
@@ -340,7 +343,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         d.p(text)
         path = f"images/step_{k + 1:02d}_{re.sub(r'_[0-9]+$', '', first.name)}.png"
         files[path] = plots.assembly_step(meshes, done, members, A.step_offsets(meshes, done, members),
-                                          f"step {k + 1}: {label}")
+                                          f"step {k + 1}: {label}", cut_away=cut_away)
         d.img(path, f"Step {k + 1}: the {label.replace('_', ' ')} (orange) goes where the dashed line points")
         done += members
         step(f"step {k + 1}")
@@ -422,7 +425,7 @@ def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = 
 
 
 def cmd_manual(args) -> int:
-    from rigcad.cli import _progress
+    from rigcad.progress import stages
     from rigcad.export.atomic import check_exports, profile_lock
     from rigcad.fab.printers import load_printer
     from rigcad.fab.stage import run_fab
@@ -435,7 +438,7 @@ def cmd_manual(args) -> int:
     rig = load(profile)
     root = Path(args.exports) / rig.name
     total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
-    with _progress(total, f"manual {rig.name} ({printer.name})") as step:
+    with stages(total, f"manual {rig.name} ({printer.name})") as step:
         fab = run_fab(rig, printer, root / "fab" / printer.name, gcode=args.gcode,
                       lock=profile_lock(args.exports, rig.name), progress=step)
         for problem in fab.problems:

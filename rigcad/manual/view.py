@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from rigcad.errors import ExportError
-from rigcad.manual.assembly import PartMesh
+from rigcad.manual.assembly import PartMesh, encloses
 
 #: Rays drawn in the view: enough to show the fan from the COP over the paraboloid's annulus to the
 #: sample, few enough to tell them apart.
@@ -93,17 +93,6 @@ def _b64(a: np.ndarray, dtype) -> str:
 
 def _hex(color) -> str:
     return "#" + "".join(f"{int(round(255 * min(max(c, 0.0), 1.0))):02x}" for c in color)
-
-
-def encloses(meshes: list[PartMesh]) -> set[str]:
-    """Parts whose bounding box holds another part's whole bounding box (the dome holds the
-    paraboloid): drawn see-through in the view, cut away in the pictures."""
-    out = set()
-    for a in meshes:
-        for b in meshes:
-            if a is not b and np.all(a.lo <= b.lo) and np.all(b.hi <= a.hi):
-                out.add(a.name)
-    return out
 
 
 def view_html(rig, meshes: list[PartMesh], rays: dict) -> bytes:
@@ -285,7 +274,7 @@ def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays
     traced = traced_rays(rig, rays)
     step("rays traced")
     page = view_html(rig, meshes, traced)
-    png = plots.rig_picture(meshes, traced, f"{rig.name}: the assembled rig")
+    png = plots.rig_picture(meshes, traced, f"{rig.name}: the assembled rig", cut_away=encloses(meshes))
     step("page and picture")
     from rigcad.export.manifest import profile_digest
 

@@ -13,7 +13,8 @@ import numpy as np
 from rigcad.errors import GeometryError, ProfileError, RigcadError
 from rigcad.optics.dome import DomeProfile, build_dome, reflected_rays, start
 from rigcad.optics.misalignment import COMPONENT_OFFSETS, Offsets, convergence_error, misaligned_trace, offsets_for
-from rigcad.optics.paraboloid import Paraboloid, unit
+from rigcad.optics.paraboloid import Paraboloid
+from rigcad.optics.vec import unit
 from rigcad.optics.thin_lens import ThinLensResult, thin_lens_check
 from rigcad.optics.trace2d import STATUS_NAMES, DomeCurve, Trace, parallel_rays, trace
 from rigcad.profile.derived import Derived

@@ -11,21 +11,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rigcad.optics.vec import unit
+
 #: Relative margin (of the rim radius) within which a hit at the rim counts: a ray the design aims
 #: at the rim meets it at |x| = rim up to rounding, which differs between CPUs (numpy's SIMD loops,
 #: BLAS); 1e-12 is ~5000 ulps, 1e-10 mm at a 100 mm rim. The 3D tracers use the same (check.rays,
 #: check._kernels.RIM_RTOL).
 RIM_RTOL = 1e-12
-
-
-def unit(v: np.ndarray) -> np.ndarray:
-    """Rows of ``v`` (n, 2) scaled to length 1."""
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
-
-
-def reflect(d: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """Mirror reflection of directions ``d`` (n, 2) about unit normals ``n`` (n, 2)."""
-    return d - 2.0 * np.sum(d * n, axis=-1, keepdims=True) * n
 
 
 @dataclass(frozen=True)

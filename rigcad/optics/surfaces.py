@@ -17,6 +17,7 @@ from scipy.spatial import cKDTree
 
 from rigcad.errors import GeometryError
 from rigcad.optics.dome import DomeProfile
+from rigcad.optics.vec import unit
 from rigcad.profile.derived import Derived
 
 
@@ -46,10 +47,6 @@ class _FootTable:
     dsdu: np.ndarray
     tangent_sign: float
     tree: cKDTree
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
 @dataclass(frozen=True)
@@ -92,7 +89,7 @@ class Meridian:
     def normals(self, u: np.ndarray) -> np.ndarray:
         """Unit normals (n, 2) pointing to the reflecting side: up/out for the convex paraboloid,
         towards the axis (inside) for the dome. The same for every offset (parallel curves)."""
-        t = _unit(self._design_tangents(u))
+        t = unit(self._design_tangents(u))
         # u runs bottom -> top; the left normal (-t_z, t_r) points inwards for the dome's wall and
         # down into the body for the paraboloid, whose reflecting side is the other one.
         left = np.stack([-t[:, 1], t[:, 0]], axis=-1)

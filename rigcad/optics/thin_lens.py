@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigcad.optics.paraboloid import Paraboloid, unit
+from rigcad.optics.paraboloid import Paraboloid
+from rigcad.optics.vec import unit
 from rigcad.optics.trace2d import DomeCurve, trace
 
 

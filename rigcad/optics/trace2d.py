@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigcad.optics.dome import DomeProfile
-from rigcad.optics.paraboloid import Paraboloid, reflect, unit
+from rigcad.optics.paraboloid import Paraboloid
+from rigcad.optics.vec import reflect, unit
 
 #: Ray status codes in :class:`Trace`.
 OK, MISSED_PARABOLOID, MISSED_DOME, OCCLUDED, ESCAPED = 0, 1, 2, 3, 4

@@ -91,7 +91,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``optimize`` to rigcad's subcommands."""
-    from rigcad.cli import positive_int, worker_count
+    from rigcad.arguments import positive_int, worker_count
 
     p = subparsers.add_parser(
         "optimize", help="inverse design: search the profile's optimize: section for the rig that meets its targets",

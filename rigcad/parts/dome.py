@@ -54,8 +54,3 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
     return Part("dome", Difference(Revolve(section), (slot, *holes)), (0.82, 0.82, 0.86),
                 "dome: mirror surface inside (paint it), wall, base flange bolted to the base plate, beam slots",
                 mirrors=(("dome", layout.design_dome),))
-
-
-def wall_radius_at(layout: RigLayout, z: float) -> float:
-    """Outer radius of the dome's wall at height z (mm)."""
-    return _pt(layout.dome_outer, u_at_height(layout.dome_outer, z))[0]

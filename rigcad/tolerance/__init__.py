@@ -1,4 +1,4 @@
-"""Tolerancing at scale (issue 12): the seeded Monte Carlo of perturbed rigs on rigcad.engine
+"""Tolerancing at scale: the seeded Monte Carlo of perturbed rigs on rigcad.engine
 (joblib loky by default, Dask with a scheduler), the sensitivity ranking, inverse limits by
 bisection on the analytic tracer, and parameter sweeps of whole designs.
 

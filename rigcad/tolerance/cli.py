@@ -76,7 +76,7 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
     if args.rays is not None:
         check_override("tolerancing", "rays", args.rays, "--rays")
     # the stages' modules (and their libraries) only once the counts are known to be sane
-    from rigcad.cli import progress_bar
+    from rigcad.progress import progress_bar
     from rigcad.errors import CheckError
     from rigcad.export.atomic import profile_lock
     from rigcad.rig import load
@@ -132,7 +132,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     checked_tolerance(len(spec.values), args.rays, engine, "--set (points)", "--rays", ("raycheck", "rays"))
     check_override("raycheck", "rays", args.rays, "--rays")
     from rigcad import plots
-    from rigcad.cli import progress_bar
+    from rigcad.progress import progress_bar
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
     from rigcad.fab.printers import load_printer
     from rigcad.profile.loader import load_raw
@@ -175,7 +175,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _engine_args(p: argparse.ArgumentParser) -> None:
-    from rigcad.cli import worker_count
+    from rigcad.arguments import worker_count
 
     p.add_argument("--workers", type=worker_count, default=0,
                    help="worker processes (default 0: every core; 1: in this process)")
@@ -187,7 +187,7 @@ def _engine_args(p: argparse.ArgumentParser) -> None:
 
 def register(subparsers) -> None:
     """Add ``tolerance`` and ``sweep`` to rigcad's subcommands."""
-    from rigcad.cli import positive_int
+    from rigcad.arguments import positive_int
 
     p = subparsers.add_parser(
         "tolerance", help="Monte Carlo tolerancing at scale: per-sample table, sensitivity, inverse limits",

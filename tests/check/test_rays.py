@@ -112,7 +112,7 @@ def test_axisymmetric_fast_path_agrees_with_the_general_dome_intersection(rig, a
     """The exact dome first tries Newton from the design's own correspondence (exact when aligned);
     the general bracketing path must give the same hits, and an aligned rig must never need it."""
     from rigcad.check.sources import annulus_rays
-    from rigcad.check.trace3d import reflect
+    from rigcad.optics.vec import reflect_rows as reflect
 
     dome = analytic.dome.members[0]
     src = annulus_rays(design_map, 5000, 3)

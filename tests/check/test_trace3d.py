@@ -12,7 +12,8 @@ from rigcad.optics.frames import Pose
 from rigcad.check.sources import annulus_rays, pixel_rays
 from rigcad.check.trace3d import OCCLUDED_BY_BEAM, convergence_point, trace
 from rigcad.optics.misalignment import Offsets, misaligned_trace
-from rigcad.optics.paraboloid import Paraboloid, unit as unit2
+from rigcad.optics.paraboloid import Paraboloid
+from rigcad.optics.vec import unit as unit2
 from rigcad.optics.trace2d import DomeCurve
 
 

@@ -201,13 +201,13 @@ def test_basis_paused_while_design_publishes_loses_nothing(tmp_path, monkeypatch
     """The reproduction: `basis` paused inside its publication (its images staged, basis.json not
     yet), `design` run meanwhile, then `basis` resumed. Both publish everything they report: design
     waits for basis's lock instead of swapping the folder under it."""
-    from rigcad import cli
+    from rigcad import cli, progress
     from rigcad.export import atomic
 
     exports = tmp_path / "exports"
     paused, resume, design_moved = threading.Event(), threading.Event(), threading.Event()
     waits: list[str] = []
-    real_progress = cli._progress
+    real_progress = progress.stages
 
     @contextmanager
     def pausing_progress(total, desc):
@@ -223,7 +223,7 @@ def test_basis_paused_while_design_publishes_loses_nothing(tmp_path, monkeypatch
         waits.append(message)
         design_moved.set()
 
-    monkeypatch.setattr(cli, "_progress", pausing_progress)
+    monkeypatch.setattr(progress, "stages", pausing_progress)
     monkeypatch.setattr(atomic, "_say_waiting", waiting, raising=False)
     codes: dict[str, int] = {}
 

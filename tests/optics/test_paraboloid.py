@@ -1,6 +1,7 @@
 import numpy as np
 
-from rigcad.optics.paraboloid import Paraboloid, reflect, unit
+from rigcad.optics.paraboloid import Paraboloid
+from rigcad.optics.vec import reflect, unit
 
 PARA = Paraboloid(focal_length=2.98, vertex_z=157.5, rim_radius=16.38, dx=0.7)
 

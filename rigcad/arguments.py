@@ -1,0 +1,44 @@
+"""argparse types shared by the commands' parsers: each refuses a bad value on one line, before
+any work. A ground-floor leaf: it imports no other part of rigcad."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+
+def positive_int(text: str) -> int:
+    """An argparse type: a whole number >= 1, written plainly or as ``1e6``; anything else is
+    refused by argparse on one line, before any work."""
+    try:
+        value = int(text)
+    except ValueError:
+        try:
+            f = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+        if not (math.isfinite(f) and f == int(f)):
+            raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+        value = int(f)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return value
+
+
+def worker_count(text: str) -> int:
+    """An argparse type: a worker count, 0 for every core, else >= 1 (clamped to the cores by
+    rigcad.engine.Engine unless a remote Dask scheduler runs the tasks)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0 (0: every core), got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0 (0: every core), got {text!r}")
+    return value
+
+
+def exports_root(text: str) -> str:
+    """An argparse type: an output root, not empty (an empty one would write into the current folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("expected a folder, got an empty path (the default is 'exports')")
+    return text
