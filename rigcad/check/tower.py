@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rigcad.check import montecarlo as MC
+from rigcad.check.figures import figures
 from rigcad.check.sources import Rays, pixel_rays, thin_lens_rays
 from rigcad.check.trace3d import Trace3D, trace
 from rigcad.optics.splitter import mirror_point, transmit
@@ -55,14 +55,14 @@ def camera_rays(rig, design, count: int, seed: int, compensate: bool = True) -> 
 
 def camera_view(optics, rig, design, count: int, seed: int, compensate: bool = True) -> tuple[Trace3D, dict]:
     """Trace the camera through the splitter (module docstring); returns the trace and its figures
-    (MC.figures, units in keys): the spot at O, the angle error against each pixel's design
+    (check.figures.figures, units in keys): the spot at O, the angle error against each pixel's design
     direction (uncalibrated) and against the design direction of the paraboloid point each ray hit
     (after the camera calibration of thesis 4.1.1, which maps camera pixels to paraboloid points)."""
     rays, inside, _ = camera_rays(rig, design, count, seed, compensate)
     tr = trace(optics, rays.origins, rays.dirs)
     pp = rig.pose("paraboloid")
     local, _ = pp.localize(tr.p1, tr.p1)
-    f = MC.figures(tr, design.direction(rays.chief), None, pp.globalize_dirs(design.direction_at(local)))
+    f = figures(tr, design.direction(rays.chief), None, pp.globalize_dirs(design.direction_at(local)))
     f["rays_outside_the_plate"] = int(np.count_nonzero(~inside))
     f["compensated"] = compensate
     return tr, f
