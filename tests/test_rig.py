@@ -128,6 +128,29 @@ def test_a_moved_rig_is_traced_where_its_paraboloid_stands(table31_rig):
     assert spot > 100 * aligned["readings"]["analytic"]["max_spot_radius_mm"]  # it did move
 
 
+def test_a_part_is_meshed_once_per_rig_and_chord(table31_rig, monkeypatch):
+    """rig.mesh is the one meshing call: a (recipe, chord error) is meshed once for a rig and its
+    moved copies (a counter on manifold3d's mesher), by name or by recipe, and what a caller gets
+    is its own copy."""
+    from rigcad.export import mesh as M
+
+    calls = []
+    real = M.build
+    monkeypatch.setattr(M, "build", lambda solid, chord: calls.append(chord) or real(solid, chord))
+    chord = 0.4321  # a chord no other test asks for: the session's rig has not meshed it yet
+    rig = table31_rig
+    first = rig.mesh("beam", chord)
+    first.vertices[0] += 100.0  # the caller's copy: changing it changes nothing shared
+    again = rig.moved("dome", offset=(1.0, 0.0, 0.0)).mesh(rig.recipe("beam"), chord)
+    assert calls == [chord], calls
+    # the cached mesh is what manifold3d makes of the recipe, vertex for vertex
+    v, f = M.mesh_arrays(real(rig.recipe("beam").solid, chord))
+    assert np.array_equal(again.vertices, v) and np.array_equal(again.faces, f)
+    rig.mesh("beam", 2 * chord)  # another chord is another mesh
+    assert calls == [chord, 2 * chord]
+    assert "_meshes" not in pickle.loads(pickle.dumps(rig)).__dict__  # workers are not sent the meshes
+
+
 def test_part_is_a_build123d_part_with_cadquery_and_mesh(table31_rig):
     import build123d
     import cadquery as cq

@@ -102,17 +102,10 @@ def _camera_bundle(rig, design) -> tuple[np.ndarray, np.ndarray]:
 
 def _obstacles(rig) -> dict[str, object]:
     """Trimesh meshes of the tower's parts in the rig and of the instruments, by name."""
-    import trimesh
-
-    from rigcad.export import mesh as M
     from rigcad.parts.tower import TOWER_PARTS
 
     parts = [rig.recipe(n) for n in TOWER_PARTS if rig.recipe(n).in_rig] + list(rig.instruments)
-    out = {}
-    for part in parts:
-        v, f = M.mesh_arrays(M.build(part.solid, CLEARANCE_CHORD_ERROR))
-        out[part.name] = trimesh.Trimesh(v, f, process=False)
-    return out
+    return {part.name: rig.mesh(part, CLEARANCE_CHORD_ERROR) for part in parts}
 
 
 def _blocked(segments: tuple[np.ndarray, np.ndarray], meshes: dict) -> dict[str, int]:

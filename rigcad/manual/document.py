@@ -167,10 +167,12 @@ def _mil(mm: float) -> str:
 def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, dict[str, bytes], dict]:
     """The document, its files (relative path -> bytes: pictures and the calibration image) and the
     figures (for manual.json)."""
+    import numpy as np
+
     from rigcad import plots
     from rigcad.export import mesh as M
     from rigcad.manual import assembly as A
-    from rigcad.manual.assembly import VIEW_CHORD_ERROR_MM, rig_meshes
+    from rigcad.manual.assembly import rig_meshes
     from rigcad.manual.view import traced_rays
     from rigcad.parts.templates import gauged_depth
 
@@ -276,8 +278,9 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     for name in ("dome_template", "paraboloid_template"):
         if name in rig.recipes:
             part = rig.recipes[name]
-            v, f = M.mesh_arrays(M.build(part.solid, VIEW_CHORD_ERROR_MM))
-            files[f"images/{name}.png"] = plots.render_mesh(v, f, name, part.color)
+            mesh = rig.mesh(part, M.PICTURE_CHORD_ERROR)
+            files[f"images/{name}.png"] = plots.render_mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), name,
+                                                            part.color)
     for name in ("dome_template", "paraboloid_template"):
         if f"images/{name}.png" in files:
             d.img(f"images/{name}.png", f"`{name}`: {rig.recipes[name].description}")
@@ -389,8 +392,9 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     for name in ("projector_cross", "camera_cross_hung"):
         if name in rig.recipes:
             part = rig.recipes[name]
-            v, f = M.mesh_arrays(M.build(part.solid, VIEW_CHORD_ERROR_MM))
-            files[f"images/{name}.png"] = plots.render_mesh(v, f, name, part.color)
+            mesh = rig.mesh(part, M.PICTURE_CHORD_ERROR)
+            files[f"images/{name}.png"] = plots.render_mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), name,
+                                                            part.color)
             d.img(f"images/{name}.png", f"`{name}`: {part.description}")
     d.p("Then the camera's pixel-to-paraboloid correspondence as in the thesis: a checkerboard on the base "
         "plate, the calibrated circle projected, and the paraboloid's image located in the camera's picture.")
