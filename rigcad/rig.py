@@ -204,18 +204,16 @@ class Rig:
 
     def export(self, folder: str | Path | None = None, parts: list[str] | None = None, progress=None):
         """Write the design files and the parts (STEP, STL, 3MF, PLY mirrors, renders, rig.step,
-        manifest.json) into ``folder`` (default ``exports/<profile>``), all published together.
-        Returns the build's :class:`rigcad.export.build.BuildResult`."""
+        manifest.json) into ``folder`` (default ``exports/<profile>``), all published together
+        under :func:`writer_lock`. Returns the build's :class:`rigcad.export.build.BuildResult`."""
         from rigcad.export.build import build_rig
         from rigcad.export.design import design_files
         from rigcad.export.manifest import inputs_key
 
-        from rigcad.export.atomic import profile_lock
-
         out = Path(folder) if folder is not None else Path("exports") / self.name
         key = inputs_key(self.profile) if parts is None and self.misalignment == Misalignment.none() else None
         return build_rig(self, out, parts, progress=progress, design=design_files(self.design), inputs_key=key,
-                         lock=profile_lock(out.parent, out.name))
+                         lock=writer_lock(out, self.name))
 
     def check(self, rays: int | None = None, mode: str | None = None, exports: str | Path | None = None, **options):
         """The 3D ray check (``rigcad.check.raycheck.run_raycheck``): returns a RayCheck whose
@@ -234,18 +232,33 @@ class Rig:
         return projector_basis(self, order, alpha_rad=alpha)
 
     def fab(self, printer, folder: str | Path | None = None, gcode: bool = False, parts: list[str] | None = None,
-            progress=None):
+            progress=None, workers: int | None = None, slicing=None):
         """Fabrication for ``printer`` (a name on the profile search path, a path, or a Printer):
-        fit, split, orient, slice, report into ``folder`` (default ``exports/<profile>/fab/<printer>``)."""
+        fit, split, orient, slice, report into ``folder`` (default ``exports/<profile>/fab/<printer>``),
+        published under :func:`writer_lock`. ``workers``/``slicing``: see
+        :func:`rigcad.fab.stage.run_fab`."""
         from rigcad.fab.printers import Printer, load_printer
         from rigcad.fab.stage import run_fab
 
-        from rigcad.export.atomic import profile_lock
-
         p = printer if isinstance(printer, Printer) else load_printer(printer)
-        lock = profile_lock("exports", self.name) if folder is None else None  # default: beside the folder
         out = Path(folder) if folder is not None else Path("exports") / self.name / "fab" / p.name
-        return run_fab(self, p, out, gcode=gcode, parts=parts, progress=progress, lock=lock)
+        return run_fab(self, p, out, gcode=gcode, parts=parts, progress=progress, workers=workers,
+                       lock=writer_lock(out, self.name, ("fab", p.name)), slicing=slicing)
+
+
+def writer_lock(folder: str | Path, profile: str, inside: tuple[str, ...] = ()) -> Path:
+    """The lock a writer into ``folder`` holds while it publishes. ``inside``: where the writer's
+    folder lies in ``<root>/<profile>`` (``()`` for that folder itself, ``("fab", printer)`` for a
+    fab run). When ``folder`` is ``<root>/<profile>/<inside...>``: the profile's one lock
+    (export.atomic.profile_lock(root, profile), what every command writing there holds); anywhere
+    else: a lock of its own beside the folder."""
+    from rigcad.export.atomic import profile_lock
+
+    folder = Path(folder)
+    tail = (profile, *inside)
+    if folder.parts[-len(tail):] == tail:
+        return profile_lock(folder.parents[len(inside)], profile)
+    return profile_lock(folder.parent, folder.name)
 
 
 @contextmanager

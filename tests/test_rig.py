@@ -151,6 +151,50 @@ def test_a_part_is_meshed_once_per_rig_and_chord(table31_rig, monkeypatch):
     assert "_meshes" not in pickle.loads(pickle.dumps(rig)).__dict__  # workers are not sent the meshes
 
 
+def test_every_writer_under_exports_holds_the_profile_lock(table31_rig, tmp_path, monkeypatch):
+    """Rig.export, Rig.fab given a folder, `rigcad stl`, `rigcad fab` and `rigcad manual` hand their
+    writers one lock:
+    exports/.<profile>.lock for a folder under exports/<profile>, the one every command writing
+    there holds; a folder elsewhere gets a lock of its own beside it."""
+    import rigcad.export.build as EB
+    import rigcad.fab.stage as FS
+    from rigcad.cli import main
+    from rigcad.rig import writer_lock
+
+    root = tmp_path / "exports"
+    lock = root / ".achutha2006.lock"
+    assert writer_lock(root / "achutha2006", "achutha2006") == lock
+    assert writer_lock(root / "achutha2006" / "check", "achutha2006", ("check",)) == lock
+    assert writer_lock(root / "achutha2006" / "fab" / "vantage_i", "achutha2006", ("fab", "vantage_i")) == lock
+    # a profile named like a subfolder still locks at the exports root, not at the subfolder
+    assert writer_lock(root / "fab" / "fab" / "vantage_i", "fab", ("fab", "vantage_i")) == root / ".fab.lock"
+    assert writer_lock(tmp_path / "mine", "achutha2006") == tmp_path / ".mine.lock"
+    assert writer_lock(tmp_path / "fab" / "vantage_i", "achutha2006", ("fab", "vantage_i")) == \
+        tmp_path / "fab" / ".vantage_i.lock"
+
+    class Stop(Exception):
+        """Raised by the writers' stand-ins once they have seen their lock: nothing is written."""
+
+    seen = []
+
+    def stand_in(kind):
+        def record(*args, **kwargs):
+            seen.append((kind, kwargs["lock"]))
+            raise Stop
+        return record
+
+    monkeypatch.setattr(FS, "run_fab", stand_in("fab"))
+    monkeypatch.setattr(EB, "build_rig", stand_in("stl"))
+    for call in (lambda: table31_rig.fab("vantage_i", root / "achutha2006" / "fab" / "vantage_i"),
+                 lambda: table31_rig.export(root / "achutha2006"),
+                 lambda: main(["fab", "achutha2006", "--printer", "vantage_i", "--exports", str(root)]),
+                 lambda: main(["stl", "achutha2006", "--exports", str(root)]),
+                 lambda: main(["manual", "achutha2006", "--printer", "vantage_i", "--exports", str(root)])):
+        with pytest.raises(Stop):
+            call()
+    assert seen == [("fab", lock), ("stl", lock), ("fab", lock), ("stl", lock), ("fab", lock)], seen
+
+
 def test_part_is_a_build123d_part_with_cadquery_and_mesh(table31_rig):
     import build123d
     import cadquery as cq

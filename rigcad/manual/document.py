@@ -429,7 +429,6 @@ def cmd_manual(args) -> int:
     from rigcad.cli import _progress
     from rigcad.export.atomic import check_exports, profile_lock
     from rigcad.fab.printers import load_printer
-    from rigcad.fab.stage import run_fab
     from rigcad.profile import load_profile
     from rigcad.rig import load
 
@@ -440,8 +439,7 @@ def cmd_manual(args) -> int:
     root = Path(args.exports) / rig.name
     total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
     with _progress(total, f"manual {rig.name} ({printer.name})") as step:
-        fab = run_fab(rig, printer, root / "fab" / printer.name, gcode=args.gcode,
-                      lock=profile_lock(args.exports, rig.name), progress=step)
+        fab = rig.fab(printer, root / "fab" / printer.name, gcode=args.gcode, progress=step)
         for problem in fab.problems:
             print(f"rigcad: fab: {problem}", file=sys.stderr)
         out = root / "manual" / printer.name
