@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 from _common import arguments, png, pyplot, run_info
 
-from rigcad.check.montecarlo import _angles
+from rigcad.check.figures import _angles
 from rigcad.check.scene import analytic_optics, mesh_optics, rig_meshes, share_scenes
 from rigcad.check.sources import annulus_rays
 from rigcad.check.trace3d import trace

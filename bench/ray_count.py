@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from _common import arguments, loglog_slope, png, pyplot, run_info
 
-from rigcad.check.montecarlo import _angles
+from rigcad.check.figures import _angles
 from rigcad.check.scene import mesh_optics, rig_meshes
 from rigcad.check.sources import annulus_rays
 from rigcad.check.trace3d import trace

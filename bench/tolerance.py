@@ -23,7 +23,7 @@ from _common import arguments, png, pyplot, run_info  # noqa: E402
 from rigcad.engine import LOCAL_DASK, Engine  # noqa: E402
 from rigcad.export.atomic import write_bytes, write_json  # noqa: E402
 from rigcad.rig import load  # noqa: E402
-from rigcad.tolerance.montecarlo import run_monte_carlo  # noqa: E402
+from rigcad.check.montecarlo import run_monte_carlo  # noqa: E402
 
 
 def main() -> None:

@@ -42,21 +42,9 @@ class RigPart(Part):
 
     def mesh(self, chord_error: float | None = None):
         """The printable mesh as a ``trimesh.Trimesh`` (mm): the recipe meshed by manifold3d at
-        ``chord_error`` mm (default the profile's ``tessellation.chord_error``), as in the STL."""
+        ``chord_error`` mm (default the profile's ``tessellation.chord_error``), as in the STL
+        (:meth:`rigcad.rig.Rig.mesh`)."""
         if self._rig is None:
             raise ExportError("mesh() needs a part made by Rig.part(); for another build123d shape use "
                               "its tessellate() method")
-        return part_mesh(self._rig, self._name, chord_error)
-
-
-def part_mesh(rig, name: str, chord_error: float | None = None):
-    """``rig``'s part ``name`` as a ``trimesh.Trimesh`` (mm), meshed from its recipe by manifold3d."""
-    import trimesh
-
-    from rigcad.export import mesh as M
-
-    chord = rig.profile.tessellation.chord_error if chord_error is None else float(chord_error)
-    if not chord > 0:
-        raise ExportError(f"chord_error must be > 0 mm, got {chord_error!r}")
-    vertices, faces = M.mesh_arrays(M.build(rig.recipe(name).solid, chord))
-    return trimesh.Trimesh(vertices, faces, process=False)
+        return self._rig.mesh(self._name, chord_error)

@@ -160,18 +160,15 @@ def cmd_stl(args: argparse.Namespace) -> int:
         tidy(out, profile_lock(args.exports, profile.name))
         print(f"{profile.name}: up to date ({out}/manifest.json)")
         return 0
-    from rigcad.export.build import build_rig
-    from rigcad.export.design import design_files
     from rigcad.parts import PARTS
     from rigcad.rig import Rig
 
     with stages(len(PARTS) + 6, f"stl {profile.name}") as step:
         rig = Rig.from_profile(profile)
         step("dome integrated")
-        files = design_files(rig.design)
+        rig.design  # traced here, for the progress bar; the export reuses it
         step("design traced")
-        result = build_rig(rig, out, progress=step, design=files, inputs_key=key,
-                           lock=profile_lock(args.exports, profile.name))
+        result = rig.export(out, progress=step)  # the Python API's path: the same lock and cache key
     env = rig.design.report["envelope"]
     print(f"{profile.name}: dome mirror {env['width_in']:.2f} x {env['height_in']:.2f} in; "
           f"{len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")

@@ -23,7 +23,7 @@ from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from rigcad.errors import ProfileError, RigcadError
+from rigcad.errors import ExportError, ProfileError, RigcadError
 from rigcad.optics.dome import DomeProfile
 from rigcad.optics.frames import COMPONENTS, Misalignment, Pose
 from rigcad.profile.derived import Derived
@@ -38,7 +38,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from rigcad.parts.recipe import Part
 
 #: Geometry a move does not change: carried over by :meth:`Rig.moved` instead of recomputed.
-_SHARED = ("paraboloid", "curve", "design", "layout", "recipes", "instruments", "incidence", "occluders")
+_SHARED = ("paraboloid", "curve", "design", "layout", "recipes", "instruments", "incidence", "occluders",
+           "_meshes")
 
 
 @dataclass(frozen=True)
@@ -129,10 +130,15 @@ class Rig:
         (``Part.occluders``): part name -> ((name, recipe Box or Cylinder), ...)."""
         return {name: part.occluders for name, part in self.recipes.items() if part.occluders}
 
-    def recipe(self, name: str) -> "Part":
-        """One part's recipe; an unknown name lists the parts."""
+    def recipe(self, name: str, layout: "RigLayout | None" = None) -> "Part":
+        """One part's recipe; an unknown name lists the parts. ``layout``: a variant of this rig's
+        layout (``rig.layout.with_sanding_stock(...)``) to make the part on instead (not kept)."""
         if name not in self.recipes:
             raise ProfileError(f"unknown part {name!r}; parts: {', '.join(self.recipes)}")
+        if layout is not None and layout is not self.layout:
+            from rigcad.parts import make_recipe
+
+            return make_recipe(self.profile, layout, name)
         return self.recipes[name]
 
     def pose(self, component: str) -> Pose:
@@ -147,10 +153,17 @@ class Rig:
         if component not in COMPONENTS:
             raise ProfileError(f"cannot move {component!r}: components are {', '.join(COMPONENTS)}")
         moved = dataclasses.replace(self, misalignment=self.misalignment.with_(component, offset, tilt, axis))
+        self._meshes  # made now, so that this rig and the copy fill one mesh cache
         for key in _SHARED:
             if key in self.__dict__:
                 moved.__dict__[key] = self.__dict__[key]  # a cached_property's value, shared read-only
         return moved
+
+    def __getstate__(self) -> dict:
+        """Pickled without the mesh cache (a worker meshes what it needs; the pickle stays small)."""
+        state = dict(self.__dict__)
+        state.pop("_meshes", None)
+        return state
 
     # -- the stages, as a Python API ---------------------------------------------------------------
     def part(self, name: str):
@@ -160,27 +173,47 @@ class Rig:
 
         return RigPart.build(self, name)
 
-    def mesh(self, name: str, chord_error: float | None = None):
-        """The part's printable mesh as a ``trimesh.Trimesh`` (the STL's mesh; ``chord_error`` mm,
-        default the profile's ``tessellation.chord_error``)."""
-        from rigcad.api import part_mesh
+    @cached_property
+    def _meshes(self) -> dict:
+        """(recipe content hash, chord error) -> (vertices, faces), read-only: see :meth:`mesh`."""
+        return {}
 
-        return part_mesh(self, name, chord_error)
+    def mesh(self, part: "str | Part", chord_error: float | None = None):
+        """A part's mesh as a ``trimesh.Trimesh`` (mm, working position): its recipe (a part name, or
+        a recipe ``Part`` such as an instrument or a part re-made on another layout) meshed by
+        manifold3d with every surface within ``chord_error`` mm of the exact one (default the
+        profile's ``tessellation.chord_error``: the STL's mesh; ``export.mesh.PICTURE_CHORD_ERROR``
+        for pictures). The one place a recipe is meshed: each (recipe, chord error) is meshed once
+        per rig and its moved copies; the Trimesh returned is a fresh copy, changing it changes
+        nothing shared."""
+        import trimesh
+
+        from rigcad.export import mesh as M
+
+        chord = self.profile.tessellation.chord_error if chord_error is None else float(chord_error)
+        if not chord > 0:
+            raise ExportError(f"chord_error must be > 0 mm, got {chord_error!r}")
+        recipe = self.recipe(part) if isinstance(part, str) else part
+        key = (recipe.content_hash(), chord)
+        if key not in self._meshes:
+            vertices, faces = M.mesh_arrays(M.build(recipe.solid, chord))
+            vertices.flags.writeable = faces.flags.writeable = False
+            self._meshes[key] = (vertices, faces)
+        vertices, faces = self._meshes[key]
+        return trimesh.Trimesh(vertices.copy(), faces.copy(), process=False)
 
     def export(self, folder: str | Path | None = None, parts: list[str] | None = None, progress=None):
         """Write the design files and the parts (STEP, STL, 3MF, PLY mirrors, renders, rig.step,
-        manifest.json) into ``folder`` (default ``exports/<profile>``), all published together.
-        Returns the build's :class:`rigcad.export.build.BuildResult`."""
+        manifest.json) into ``folder`` (default ``exports/<profile>``), all published together
+        under :func:`writer_lock`. Returns the build's :class:`rigcad.export.build.BuildResult`."""
         from rigcad.export.build import build_rig
         from rigcad.export.design import design_files
         from rigcad.export.manifest import inputs_key
 
-        from rigcad.export.atomic import profile_lock
-
         out = Path(folder) if folder is not None else Path("exports") / self.name
         key = inputs_key(self.profile) if parts is None and self.misalignment == Misalignment.none() else None
         return build_rig(self, out, parts, progress=progress, design=design_files(self.design), inputs_key=key,
-                         lock=profile_lock(out.parent, out.name))
+                         lock=writer_lock(out, self.name))
 
     def check(self, rays: int | None = None, mode: str | None = None, exports: str | Path | None = None, **options):
         """The 3D ray check (``rigcad.check.raycheck.run_raycheck``): returns a RayCheck whose
@@ -199,18 +232,33 @@ class Rig:
         return projector_basis(self, order, alpha_rad=alpha)
 
     def fab(self, printer, folder: str | Path | None = None, gcode: bool = False, parts: list[str] | None = None,
-            progress=None):
+            progress=None, workers: int | None = None, slicing=None):
         """Fabrication for ``printer`` (a name on the profile search path, a path, or a Printer):
-        fit, split, orient, slice, report into ``folder`` (default ``exports/<profile>/fab/<printer>``)."""
+        fit, split, orient, slice, report into ``folder`` (default ``exports/<profile>/fab/<printer>``),
+        published under :func:`writer_lock`. ``workers``/``slicing``: see
+        :func:`rigcad.fab.stage.run_fab`."""
         from rigcad.fab.printers import Printer, load_printer
         from rigcad.fab.stage import run_fab
 
-        from rigcad.export.atomic import profile_lock
-
         p = printer if isinstance(printer, Printer) else load_printer(printer)
-        lock = profile_lock("exports", self.name) if folder is None else None  # default: beside the folder
         out = Path(folder) if folder is not None else Path("exports") / self.name / "fab" / p.name
-        return run_fab(self, p, out, gcode=gcode, parts=parts, progress=progress, lock=lock)
+        return run_fab(self, p, out, gcode=gcode, parts=parts, progress=progress, workers=workers,
+                       lock=writer_lock(out, self.name, ("fab", p.name)), slicing=slicing)
+
+
+def writer_lock(folder: str | Path, profile: str, inside: tuple[str, ...] = ()) -> Path:
+    """The lock a writer into ``folder`` holds while it publishes. ``inside``: where the writer's
+    folder lies in ``<root>/<profile>`` (``()`` for that folder itself, ``("fab", printer)`` for a
+    fab run). When ``folder`` is ``<root>/<profile>/<inside...>``: the profile's one lock
+    (export.atomic.profile_lock(root, profile), what every command writing there holds); anywhere
+    else: a lock of its own beside the folder."""
+    from rigcad.export.atomic import profile_lock
+
+    folder = Path(folder)
+    tail = (profile, *inside)
+    if folder.parts[-len(tail):] == tail:
+        return profile_lock(folder.parents[len(inside)], profile)
+    return profile_lock(folder.parent, folder.name)
 
 
 @contextmanager

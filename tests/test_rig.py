@@ -128,6 +128,73 @@ def test_a_moved_rig_is_traced_where_its_paraboloid_stands(table31_rig):
     assert spot > 100 * aligned["readings"]["analytic"]["max_spot_radius_mm"]  # it did move
 
 
+def test_a_part_is_meshed_once_per_rig_and_chord(table31_rig, monkeypatch):
+    """rig.mesh is the one meshing call: a (recipe, chord error) is meshed once for a rig and its
+    moved copies (a counter on manifold3d's mesher), by name or by recipe, and what a caller gets
+    is its own copy."""
+    from rigcad.export import mesh as M
+
+    calls = []
+    real = M.build
+    monkeypatch.setattr(M, "build", lambda solid, chord: calls.append(chord) or real(solid, chord))
+    chord = 0.4321  # a chord no other test asks for: the session's rig has not meshed it yet
+    rig = table31_rig
+    first = rig.mesh("beam", chord)
+    first.vertices[0] += 100.0  # the caller's copy: changing it changes nothing shared
+    again = rig.moved("dome", offset=(1.0, 0.0, 0.0)).mesh(rig.recipe("beam"), chord)
+    assert calls == [chord], calls
+    # the cached mesh is what manifold3d makes of the recipe, vertex for vertex
+    v, f = M.mesh_arrays(real(rig.recipe("beam").solid, chord))
+    assert np.array_equal(again.vertices, v) and np.array_equal(again.faces, f)
+    rig.mesh("beam", 2 * chord)  # another chord is another mesh
+    assert calls == [chord, 2 * chord]
+    assert "_meshes" not in pickle.loads(pickle.dumps(rig)).__dict__  # workers are not sent the meshes
+
+
+def test_every_writer_under_exports_holds_the_profile_lock(table31_rig, tmp_path, monkeypatch):
+    """Rig.export, Rig.fab given a folder, `rigcad stl`, `rigcad fab` and `rigcad manual` hand their
+    writers one lock:
+    exports/.<profile>.lock for a folder under exports/<profile>, the one every command writing
+    there holds; a folder elsewhere gets a lock of its own beside it."""
+    import rigcad.export.build as EB
+    import rigcad.fab.stage as FS
+    from rigcad.cli import main
+    from rigcad.rig import writer_lock
+
+    root = tmp_path / "exports"
+    lock = root / ".achutha2006.lock"
+    assert writer_lock(root / "achutha2006", "achutha2006") == lock
+    assert writer_lock(root / "achutha2006" / "check", "achutha2006", ("check",)) == lock
+    assert writer_lock(root / "achutha2006" / "fab" / "vantage_i", "achutha2006", ("fab", "vantage_i")) == lock
+    # a profile named like a subfolder still locks at the exports root, not at the subfolder
+    assert writer_lock(root / "fab" / "fab" / "vantage_i", "fab", ("fab", "vantage_i")) == root / ".fab.lock"
+    assert writer_lock(tmp_path / "mine", "achutha2006") == tmp_path / ".mine.lock"
+    assert writer_lock(tmp_path / "fab" / "vantage_i", "achutha2006", ("fab", "vantage_i")) == \
+        tmp_path / "fab" / ".vantage_i.lock"
+
+    class Stop(Exception):
+        """Raised by the writers' stand-ins once they have seen their lock: nothing is written."""
+
+    seen = []
+
+    def stand_in(kind):
+        def record(*args, **kwargs):
+            seen.append((kind, kwargs["lock"]))
+            raise Stop
+        return record
+
+    monkeypatch.setattr(FS, "run_fab", stand_in("fab"))
+    monkeypatch.setattr(EB, "build_rig", stand_in("stl"))
+    for call in (lambda: table31_rig.fab("vantage_i", root / "achutha2006" / "fab" / "vantage_i"),
+                 lambda: table31_rig.export(root / "achutha2006"),
+                 lambda: main(["fab", "achutha2006", "--printer", "vantage_i", "--exports", str(root)]),
+                 lambda: main(["stl", "achutha2006", "--exports", str(root)]),
+                 lambda: main(["manual", "achutha2006", "--printer", "vantage_i", "--exports", str(root)])):
+        with pytest.raises(Stop):
+            call()
+    assert seen == [("fab", lock), ("stl", lock), ("fab", lock), ("stl", lock), ("fab", lock)], seen
+
+
 def test_part_is_a_build123d_part_with_cadquery_and_mesh(table31_rig):
     import build123d
     import cadquery as cq

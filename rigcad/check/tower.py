@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from rigcad.check import montecarlo as MC
+from rigcad.check.figures import figures
 from rigcad.check.sources import Rays, pixel_rays, thin_lens_rays
 from rigcad.check.result import Trace3D
 from rigcad.check.trace3d import trace
-from rigcad.optics.splitter import mirror_point, transmit
+from rigcad.optics.splitter import transmit
 
 #: Chief rays around the rim of the useful bundle, and aperture-edge rays per chief ray, of the
 #: clearance check: 256 x 32 rays step 1.4 deg around the rim and 11 deg around the aperture, where a
@@ -56,14 +56,14 @@ def camera_rays(rig, design, count: int, seed: int, compensate: bool = True) -> 
 
 def camera_view(optics, rig, design, count: int, seed: int, compensate: bool = True) -> tuple[Trace3D, dict]:
     """Trace the camera through the splitter (module docstring); returns the trace and its figures
-    (MC.figures, units in keys): the spot at O, the angle error against each pixel's design
+    (check.figures.figures, units in keys): the spot at O, the angle error against each pixel's design
     direction (uncalibrated) and against the design direction of the paraboloid point each ray hit
     (after the camera calibration of thesis 4.1.1, which maps camera pixels to paraboloid points)."""
     rays, inside, _ = camera_rays(rig, design, count, seed, compensate)
     tr = trace(optics, rays.origins, rays.dirs)
     pp = rig.pose("paraboloid")
     local, _ = pp.localize(tr.p1, tr.p1)
-    f = MC.figures(tr, design.direction(rays.chief), None, pp.globalize_dirs(design.direction_at(local)))
+    f = figures(tr, design.direction(rays.chief), None, pp.globalize_dirs(design.direction_at(local)))
     f["rays_outside_the_plate"] = int(np.count_nonzero(~inside))
     f["compensated"] = compensate
     return tr, f
@@ -103,17 +103,10 @@ def _camera_bundle(rig, design) -> tuple[np.ndarray, np.ndarray]:
 
 def _obstacles(rig) -> dict[str, object]:
     """Trimesh meshes of the tower's parts in the rig and of the instruments, by name."""
-    import trimesh
-
-    from rigcad.export import mesh as M
     from rigcad.parts.tower import TOWER_PARTS
 
     parts = [rig.recipe(n) for n in TOWER_PARTS if rig.recipe(n).in_rig] + list(rig.instruments)
-    out = {}
-    for part in parts:
-        v, f = M.mesh_arrays(M.build(part.solid, CLEARANCE_CHORD_ERROR))
-        out[part.name] = trimesh.Trimesh(v, f, process=False)
-    return out
+    return {part.name: rig.mesh(part, CLEARANCE_CHORD_ERROR) for part in parts}
 
 
 def _blocked(segments: tuple[np.ndarray, np.ndarray], meshes: dict) -> dict[str, int]:

@@ -28,8 +28,6 @@ from rigcad.profile.schema import Profile
 #: volume matches the STL's within 0.5 %): the mesh is inscribed in the exact surface at the chord
 #: error, so it is slightly smaller.
 MESH_VOLUME_RTOL = 5e-3
-#: Chord error of the meshes drawn for the renders (mm): only for looking at.
-RENDER_CHORD_ERROR = 0.3
 #: The code that shapes the files (parts, export, plots, surfaces): a change rebuilds what it wrote.
 CACHE_VERSION = code_version("parts/*.py", "export/*.py", "plots.py", "optics/surfaces.py")
 
@@ -100,7 +98,7 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
                 step(f"{name} (unchanged)")
                 continue
             step(name)
-            entries[name] = _build_part(part, key, profile, out, stage, shapes)
+            entries[name] = _build_part(part, key, rig, out, stage, shapes)
             rebuilt.append(name)
 
         mirrors = dict(old.get("mirrors", {}))
@@ -197,11 +195,12 @@ def _occlusion(rig, previous: dict | None) -> dict:
     return {**blocked_solid_angle(rig.occluders, profile_table(rig.geometry, rig.dome)), "key": key}
 
 
-def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Staging, shapes: dict) -> dict:
+def _build_part(part: Part, key: str, rig, out: Path, stage: Staging, shapes: dict) -> dict:
     from rigcad.export import mesh as M
     from rigcad.export.step import reimport_check, step_writer
     from rigcad.parts import _kernel as K
 
+    profile = rig.profile
     tol = profile.tessellation
     fits = K.FitReport()
     shape = K.part_solid(part, tol.fit_tolerance, fits, profile)
@@ -214,8 +213,8 @@ def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Stagin
     stage.write_with(step_path, step_writer([(part.name, shape, part.color)], part.name))
     check = reimport_check(stage.temp_path(step_path), volume, 1)
 
-    man = M.build(part.solid, tol.chord_error)
-    vertices, faces = M.mesh_arrays(man)
+    mesh = rig.mesh(part, tol.chord_error)
+    vertices, faces = np.asarray(mesh.vertices), np.asarray(mesh.faces)
     mesh_vol = M.mesh_volume(vertices, faces)
     if abs(mesh_vol - volume) > MESH_VOLUME_RTOL * volume:
         raise ExportError(f"{part.name}: STL volume {mesh_vol:.6g} differs from the STEP's {volume:.6g} mm^3 "
@@ -231,7 +230,8 @@ def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Stagin
     from rigcad import plots
 
     # The picture needs no print accuracy: a coarse mesh of the same recipe renders in a second.
-    pv, pf = M.mesh_arrays(M.build(part.solid, RENDER_CHORD_ERROR))
+    picture = rig.mesh(part, M.PICTURE_CHORD_ERROR)
+    pv, pf = np.asarray(picture.vertices), np.asarray(picture.faces)
     png = plots.render_mesh(pv, pf, part.name, part.color, cutaway=part.name == "dome")
     stage.write_bytes(out / "renders" / f"{part.name}.png", png)
     files = {f"step/{part.name}.step": _sha(stage.temp_path(step_path).read_bytes()), f"stl/{part.name}.stl": _sha(stl),
@@ -248,7 +248,7 @@ def _build_part(part: Part, key: str, profile: Profile, out: Path, stage: Stagin
         "bbox_min_mm": lo.tolist(),
         "bbox_max_mm": hi.tolist(),
         "triangles": int(len(faces)),
-        "genus": int(man.genus()),
+        "genus": M.genus(vertices, faces),
         "stl_mirror_surface": mirror_report,
         "step_reimport": check,
         "bspline_fits": fits.fits,

@@ -16,8 +16,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
     printer = load_printer(args.printer)  # first: a refused printer file costs no rig and no CAD kernel import
     from rigcad.progress import stages
     from rigcad.export.build import select_parts
-    from rigcad.fab.stage import run_fab
-    from rigcad.export.atomic import check_exports, profile_lock
+    from rigcad.export.atomic import check_exports
     from rigcad.profile import load_profile
     from rigcad.rig import load
 
@@ -32,8 +31,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
             if args.verbose:
                 print(f"  {msg}", file=sys.stderr)
 
-        res = run_fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs,
-                      lock=profile_lock(args.exports, profile.name), progress=progress,
+        res = rig.fab(printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs, progress=progress,
                       slicing=lambda total: stages(total, f"slicing ({printer.slicer})"))
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")

@@ -321,8 +321,6 @@ def _with_stock(rig, part, printer: Printer, chord: float, tol_mirror: float, be
     the part as designed (0.1 mm changes neither), the stock follows (:func:`sanding_stock`), then
     the part with its mirror moved forward by the stock is split the same way and fabricated.
     Records the stock in ``stocks`` and in the entry."""
-    from rigcad.parts import PARTS
-
     name = part.name
     mirror = part.mirrors[0][0]
     t = time.perf_counter()
@@ -338,7 +336,7 @@ def _with_stock(rig, part, printer: Printer, chord: float, tol_mirror: float, be
               "mirror_area_without_stock_mm2": sum(pc["mirror_area_mm2"] for pc in first["pieces"])}
     timings[f"{name}:orient_for_stock"] = time.perf_counter() - t
     layout = rig.layout.with_sanding_stock(**{mirror: stock, ("paraboloid" if mirror == "dome" else "dome"): 0.0})
-    stocked = replace(part, solid=PARTS[name](rig.profile, layout).solid)  # the same part, its mirror moved
+    stocked = replace(part, solid=rig.recipe(name, layout).solid)  # the same part, its mirror moved
     new, new_jobs = _fab_part(stocked, layout, printer, chord, tol_mirror, bed_c, stage, out, timings, meshes,
                               plan=first["_plan"])
     record["volume_added_mm3"] = new["volume_mm3"] - first["volume_mm3"]

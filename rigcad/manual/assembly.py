@@ -23,10 +23,6 @@ import numpy as np
 
 from rigcad.errors import GeometryError
 
-#: Chord error (mm) of the picture meshes: the view and the manual's pictures need no print
-#: accuracy; 0.3 mm is what the part renders use (export.build.RENDER_CHORD_ERROR), ~0.1 % of the
-#: dome's size, and keeps the whole rig at a few ten thousand triangles.
-VIEW_CHORD_ERROR_MM = 0.3
 #: Gap between exploded parts, as a fraction of the assembled rig's height.
 EXPLODE_GAP = 0.08
 #: The order the thesis's rig goes together (parts known today); parts not listed follow, by height.
@@ -57,18 +53,20 @@ class PartMesh:
         return self.vertices.max(axis=0)
 
 
-def rig_meshes(rig, chord_error: float = VIEW_CHORD_ERROR_MM) -> list[PartMesh]:
-    """Every in-rig part of ``rig`` (a :class:`rigcad.rig.Rig`) as a PartMesh, in assembly order."""
-    from rigcad.export import mesh as M
+def rig_meshes(rig, chord_error: float | None = None) -> list[PartMesh]:
+    """Every in-rig part of ``rig`` (a :class:`rigcad.rig.Rig`) as a PartMesh, in assembly order,
+    meshed at ``chord_error`` mm (default the picture chord, export.mesh.PICTURE_CHORD_ERROR)."""
+    from rigcad.export.mesh import PICTURE_CHORD_ERROR
 
+    chord_error = PICTURE_CHORD_ERROR if chord_error is None else chord_error
     raw = []
     # the instruments are bought, but for the shim stacks: those are the printed tower_shim
     bought = {p.name for p in getattr(rig, "instruments", ()) if "shim" not in p.name}
     for part in [*rig.recipes.values(), *getattr(rig, "instruments", ())]:
         if not part.in_rig:
             continue
-        v, f = M.mesh_arrays(M.build(part.solid, chord_error))
-        raw.append((part, np.asarray(v, float), np.asarray(f, np.int64)))
+        mesh = rig.mesh(part, chord_error)
+        raw.append((part, np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64)))
     if not raw:
         raise GeometryError(f"{rig.name}: no part stands in the rig (every recipe has in_rig = False)")
     markers = {p.name for p, _, _ in raw if p.name.endswith("_marker")}
@@ -178,5 +176,4 @@ def encloses(meshes: list[PartMesh]) -> set[str]:
     return out
 
 
-__all__ = ["PartMesh", "VIEW_CHORD_ERROR_MM", "assembly_order", "encloses", "explode_offsets", "rig_meshes", "step_offsets",
-           "steps"]
+__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "rig_meshes", "step_offsets", "steps"]

@@ -168,10 +168,12 @@ def _mil(mm: float) -> str:
 def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, dict[str, bytes], dict]:
     """The document, its files (relative path -> bytes: pictures and the calibration image) and the
     figures (for manual.json)."""
+    import numpy as np
+
     from rigcad import plots
     from rigcad.export import mesh as M
     from rigcad.manual import assembly as A
-    from rigcad.manual.assembly import VIEW_CHORD_ERROR_MM, rig_meshes
+    from rigcad.manual.assembly import rig_meshes
     from rigcad.manual.view import traced_rays
     from rigcad.parts.templates import gauged_depth
 
@@ -279,8 +281,9 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     for name in ("dome_template", "paraboloid_template"):
         if name in rig.recipes:
             part = rig.recipes[name]
-            v, f = M.mesh_arrays(M.build(part.solid, VIEW_CHORD_ERROR_MM))
-            files[f"images/{name}.png"] = plots.render_mesh(v, f, name, part.color)
+            mesh = rig.mesh(part, M.PICTURE_CHORD_ERROR)
+            files[f"images/{name}.png"] = plots.render_mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), name,
+                                                            part.color)
     for name in ("dome_template", "paraboloid_template"):
         if f"images/{name}.png" in files:
             d.img(f"images/{name}.png", f"`{name}`: {rig.recipes[name].description}")
@@ -392,8 +395,9 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     for name in ("projector_cross", "camera_cross_hung"):
         if name in rig.recipes:
             part = rig.recipes[name]
-            v, f = M.mesh_arrays(M.build(part.solid, VIEW_CHORD_ERROR_MM))
-            files[f"images/{name}.png"] = plots.render_mesh(v, f, name, part.color)
+            mesh = rig.mesh(part, M.PICTURE_CHORD_ERROR)
+            files[f"images/{name}.png"] = plots.render_mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), name,
+                                                            part.color)
             d.img(f"images/{name}.png", f"`{name}`: {part.description}")
     d.p("Then the camera's pixel-to-paraboloid correspondence as in the thesis: a checkerboard on the base "
         "plate, the calibrated circle projected, and the paraboloid's image located in the camera's picture.")
@@ -428,7 +432,6 @@ def cmd_manual(args) -> int:
     from rigcad.progress import stages
     from rigcad.export.atomic import check_exports, profile_lock
     from rigcad.fab.printers import load_printer
-    from rigcad.fab.stage import run_fab
     from rigcad.profile import load_profile
     from rigcad.rig import load
 
@@ -439,8 +442,7 @@ def cmd_manual(args) -> int:
     root = Path(args.exports) / rig.name
     total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
     with stages(total, f"manual {rig.name} ({printer.name})") as step:
-        fab = run_fab(rig, printer, root / "fab" / printer.name, gcode=args.gcode,
-                      lock=profile_lock(args.exports, rig.name), progress=step)
+        fab = rig.fab(printer, root / "fab" / printer.name, gcode=args.gcode, progress=step)
         for problem in fab.problems:
             print(f"rigcad: fab: {problem}", file=sys.stderr)
         out = root / "manual" / printer.name

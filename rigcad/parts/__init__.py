@@ -38,7 +38,7 @@ PARTS: dict[str, Callable[[Profile, RigLayout], Part]] = {
     "tower_shim": tower_shim,
 }
 
-__all__ = ["PARTS", "Part", "RigLayout", "make_recipes", "rig_layout"]
+__all__ = ["PARTS", "Part", "RigLayout", "make_recipe", "make_recipes", "rig_layout"]
 
 
 class _Reads:
@@ -62,12 +62,14 @@ class _SectionReads:
         return getattr(self._values, key)
 
 
+def make_recipe(profile: Profile, layout: RigLayout, name: str) -> Part:
+    """One part's recipe on ``layout``, with the profile keys its function read (``Part.shaped_by``:
+    what an error names when the kernel cannot build it)."""
+    reads = _Reads(profile)
+    part = PARTS[name](reads, layout)  # type: ignore[arg-type]  # reads every attribute through to the profile
+    return replace(part, shaped_by=tuple(dict.fromkeys(reads.keys)))
+
+
 def make_recipes(profile: Profile, layout: RigLayout) -> dict[str, Part]:
-    """Every part's recipe, in build order, each with the profile keys its function read
-    (``Part.shaped_by``: what an error names when the kernel cannot build it)."""
-    out = {}
-    for name, make in PARTS.items():
-        reads = _Reads(profile)
-        part = make(reads, layout)  # type: ignore[arg-type]  # reads every attribute through to the profile
-        out[name] = replace(part, shaped_by=tuple(dict.fromkeys(reads.keys)))
-    return out
+    """Every part's recipe, in build order (:func:`make_recipe`)."""
+    return {name: make_recipe(profile, layout, name) for name in PARTS}

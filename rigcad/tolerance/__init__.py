@@ -3,8 +3,9 @@
 bisection on the analytic tracer, and parameter sweeps of whole designs.
 
 Modules: ``params`` (the toleranced parameters: which component, which degree of freedom, unit,
-profile key), ``montecarlo`` (per-sample perturbations from their own SeedSequence children and
-figures; the summary), ``limits`` (one-at-a-time sensitivity and inverse limits), ``sweep``
+profile key), ``montecarlo`` (the rank correlations of the
+parameters with the figures; the Monte Carlo itself is rigcad.check.montecarlo, shared with the
+ray check), ``limits`` (one-at-a-time sensitivity and inverse limits), ``sweep``
 (designs over a parameter range), ``report`` (Parquet, CSV, JSON, tolerance.md and the figures
 from rigcad.plots), ``cli`` (``rigcad tolerance`` and ``rigcad sweep``).
 

@@ -81,7 +81,8 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
     from rigcad.export.atomic import profile_lock
     from rigcad.rig import load
     from rigcad.tolerance.limits import run_limits
-    from rigcad.tolerance.montecarlo import Job, rank_correlations, run_monte_carlo
+    from rigcad.check.montecarlo import Job, run_monte_carlo
+    from rigcad.tolerance.montecarlo import rank_correlations
     from rigcad.tolerance.report import write_tolerance
 
     rig = load(profile)

@@ -16,8 +16,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from rigcad.check.montecarlo import build_figures, worker_optics
 from rigcad.engine import Engine, run
-from rigcad.tolerance.montecarlo import build_figures, worker_optics
 from rigcad.tolerance.params import DEFAULT_PROBE, PARAMETERS, SEARCH_CAP, Parameter
 
 #: Bisection stops when the bracket is this fraction of the move: the error is smooth in the move

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigcad.tolerance.montecarlo import PATH_FIGURES, meets
+from rigcad.check.montecarlo import PATH_FIGURES, meets
 from rigcad.units import DEG
 
 

@@ -16,7 +16,7 @@ from rigcad.check.trace3d import trace
 from rigcad.engine import LOCAL_DASK, Engine, EngineError
 from rigcad.errors import ProfileError
 from rigcad.tolerance.limits import run_limits
-from rigcad.tolerance.montecarlo import Job, run_monte_carlo
+from rigcad.check.montecarlo import Job, run_monte_carlo
 from rigcad.tolerance.params import PARAMETERS
 
 #: A small run for the engine comparisons: 12 builds x 300 rays per path, batched 3 to a task
@@ -97,6 +97,29 @@ def test_a_sample_does_not_depend_on_the_run_size(serial_mc, table31_rig):
     few = run_monte_carlo(table31_rig, 5, RAYS, Engine(1))
     for k in ("dome_dx_mm", "max_spot_radius_mm", "max_mirror_angle_error_rad"):
         assert np.array_equal(few.columns[k], serial_mc.columns[k][:5])
+
+
+def test_the_check_and_tolerance_report_one_monte_carlo(table31_rig):
+    # `rigcad check` runs the Monte Carlo in-process on its small sample, `rigcad tolerance` on the
+    # engine's process pool at scale: the same seed and sample count must give the same builds,
+    # so the same per-build figures bit for bit and the same yield (a user compares the two)
+    from rigcad.check.raycheck import run_raycheck
+
+    tol = table31_rig.profile.tolerancing
+    check = run_raycheck(table31_rig, mode="analytic", rays=2000, grid=False, builds=SAMPLES).report["monte_carlo"]
+    scale = run_monte_carlo(table31_rig, SAMPLES, tol.rays, Engine(2))
+    assert (check["builds"], check["seed"], check["rays_per_build_and_path"]) == (SAMPLES, tol.seed, tol.rays)
+    for k in ("max_spot_radius_mm", "max_mirror_angle_error_rad"):
+        assert check["per_build"][k] == scale.columns[k].tolist(), k
+        assert check[k] == scale.summary["figures"][k], k
+    assert check["max_pixel_angle_error_rad_uncalibrated"] == scale.summary["figures"]["max_angle_error_rad"]
+    assert check["yield"] == scale.summary["yield"]
+    # not vacuous: every build differs, and the yield is the share of the listed builds that meet
+    # both targets, counted here from the per-build figures themselves
+    spot, angle = check["per_build"]["max_spot_radius_mm"], check["per_build"]["max_mirror_angle_error_rad"]
+    assert len(set(spot)) == SAMPLES
+    met = sum(s <= tol.max_spot_radius and a <= tol.max_angle_error for s, a in zip(spot, angle))
+    assert check["yield"] == met / SAMPLES
 
 
 @pytest.mark.parametrize("name", ["dome_offset", "paraboloid_tilt"])
