@@ -8,10 +8,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from rigcad.check import montecarlo as MC
 from rigcad.check.sources import annulus_rays
 from rigcad.check.tower import bundle_clearance, camera_view
-from rigcad.check.trace3d import trace
+from rigcad.check.trace3d import convergence_point, trace
 from rigcad.optics.splitter import lateral_shift
 from rigcad.profile import load_profile
 from rigcad.rig import Rig
@@ -36,7 +35,7 @@ def test_without_compensation_the_spot_moves_by_the_predicted_amount(rig, analyt
     d = lateral_shift(bs.thickness, bs.index, math.pi / 4)
     moved = rig.moved("camera", offset=(d, 0.0, 0.0))
     rays = annulus_rays(design_map, RAYS, 3, moved.pose("camera"))
-    predicted = MC.convergence_point(trace(analytic, rays.origins, rays.dirs))
+    predicted = convergence_point(trace(analytic, rays.origins, rays.dirs))
     _, raw = camera_view(analytic, rig, design_map, RAYS, 3, compensate=False)
     _, comp = camera_view(analytic, rig, design_map, RAYS, 3, compensate=True)
     moved_by = np.array(raw["convergence_point_mm"])
