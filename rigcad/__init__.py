@@ -17,6 +17,7 @@ See docs/api.md.
 
 from typing import TYPE_CHECKING
 
+from rigcad._lazy import lazy_names
 from rigcad._version import __version__
 
 if TYPE_CHECKING:
@@ -29,15 +30,4 @@ __all__ = ["Rig", "__version__", "load"]
 _LAZY = {"Rig": "rigcad.rig", "load": "rigcad.rig"}
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        from importlib import import_module
-
-        value = getattr(import_module(_LAZY[name]), name)
-        globals()[name] = value  # later lookups skip this function
-        return value
-    raise AttributeError(f"module 'rigcad' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_names("rigcad", _LAZY, globals(), __all__)

@@ -2,6 +2,8 @@
 
 from typing import TYPE_CHECKING
 
+from rigcad._lazy import lazy_names
+
 if TYPE_CHECKING:
     from rigcad.profile.derived import Derived, derive
     from rigcad.profile.schema import Profile, load_profile
@@ -14,15 +16,4 @@ _LAZY = {"Derived": "rigcad.profile.derived", "derive": "rigcad.profile.derived"
          "Profile": "rigcad.profile.schema", "load_profile": "rigcad.profile.schema"}
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        from importlib import import_module
-
-        value = getattr(import_module(_LAZY[name]), name)
-        globals()[name] = value  # later lookups skip this function
-        return value
-    raise AttributeError(f"module 'rigcad.profile' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_names("rigcad.profile", _LAZY, globals(), __all__)
