@@ -194,7 +194,7 @@ def test_sampling_stores_float_angles_and_a_boolean_mask():
     assert s.pitch_rad() == math.sqrt(6.5)
     one = IlluminationSampling([0.5, 0.5], [0.0, 0.0], [2.0, 3.0], [False, True])
     assert one.pitch_rad() == math.sqrt(3.0)
-    with pytest.raises(BasisError, match="has no valid sample: nothing illuminates the zone"):
+    with pytest.raises(BasisError, match="^sampling has no valid sample: nothing illuminates the zone$"):
         IlluminationSampling([0.5], [0.0], [2.0], [False]).pitch_rad()
 
 
@@ -241,6 +241,7 @@ def test_loewdin_and_cholesky_of_two_unit_functions_at_angle():
     assert np.allclose(ch.transform, np.array([[1.0, -c / r], [0.0, 1.0 / r]]), rtol=0, atol=1e-14)
     # without a reference there is no deviation to report
     assert lo.deviation is None and ch.deviation is None
+    assert (lo.method, ch.method) == ("lowdin", "cholesky")
 
 
 def test_deviation_is_relative_to_each_reference_function_under_the_weights():
@@ -274,3 +275,36 @@ def test_ill_conditioned_sets_are_refused_with_their_eigenvalues():
         reorthonormalise(np.zeros((3, 2)), s)
     with pytest.raises(BasisError, match=r"method = 'qr': need 'lowdin' or 'cholesky'"):
         reorthonormalise(V, s, "qr")
+
+
+def test_gram_and_off_identity_on_hand_made_matrices():
+    s = _diag_sampling([0.5, 2.0, 1.0])
+    # G = V^T W V by hand: columns (1, 1, 1) and (1, -1, 2) under weights (0.5, 2, 1)
+    V = np.array([[1.0, 1.0], [1.0, -1.0], [1.0, 2.0]])
+    assert np.array_equal(gram(V, s), np.array([[3.5, 0.5], [0.5, 6.5]]))
+    for bad in (np.ones(3), np.ones((2, 1))):
+        with pytest.raises(BasisError, match=rf"values have shape \({bad.shape[0]},.*need \(n, K\) with n = 3 samples"):
+            gram(bad, s)
+    d = off_identity(np.array([[1.0, 0.3], [-0.4, 1.1]]))
+    # largest |off-diagonal| 0.4, largest |diagonal - 1| 0.1 (to round-off of 1.1 - 1)
+    assert d.max_offdiag == 0.4 and abs(d.max_diag_deviation - 0.1) < 1e-15 and d.max_abs == 0.4
+    one = off_identity(np.array([[1.5]]))
+    assert (one.max_offdiag, one.max_diag_deviation) == (0.0, 0.5)
+    with pytest.raises(BasisError, match=r"Gram matrix has shape \(2, 3\): need a square \(K, K\) array"):
+        off_identity(np.ones((2, 3)))
+
+
+def test_quantisation_levels_and_refusals_on_a_hand_made_image():
+    # largest |value| exactly 1: scale 1, levels value * 255 rounded half to even (127.5 -> 128)
+    V = np.array([[1.0, -0.5], [0.0, 0.25]])
+    q = quantise_images(V, 8)
+    assert q.scale == 1.0 and q.levels == 255
+    assert q.positive.tolist() == [[255, 0], [0, 64]] and q.negative.tolist() == [[0, 0], [128, 0]]
+    with pytest.raises(BasisError, match=r"^basis images are all zero: nothing to quantise \(no valid sample\?\)$"):
+        quantise_images(np.zeros((2, 2)), 8)
+    with pytest.raises(BasisError, match=r"basis images have shape \(3,\) or non-finite values: need finite \(n, K\)"):
+        quantise_images(np.ones(3), 8)
+    with pytest.raises(BasisError, match="non-finite"):
+        quantise_images(np.array([[1.0, np.inf]]), 8)
+    with pytest.raises(BasisError, match=r"rounding = 'up': need 'nearest' or 'truncate'"):
+        quantise_images(V, 8, rounding="up")
