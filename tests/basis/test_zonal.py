@@ -263,3 +263,15 @@ def test_moments_with_an_azimuth_rule_per_polar_row():
         zonal_moments(theta, phi[:6], values[:, :6], 6, zone)  # phi rows do not match theta
     with pytest.raises(BasisError, match=msg):
         zonal_moments(theta, phi[None], values, 6, zone)  # a 3-D phi
+
+
+def test_directions_and_angles_keep_the_grid_shape():
+    # a (2, 4) grid of angles gives (2, 4, 3) unit vectors, and back: the last axis holds x, y, z
+    th, ph = np.meshgrid([0.4, 1.0], [0.0, 1.0, 2.0, 3.0], indexing="ij")
+    d = angles_to_directions(th, ph)
+    assert d.shape == (2, 4, 3)
+    assert np.allclose(d[1, 2], [math.sin(1.0) * math.cos(2.0), math.sin(1.0) * math.sin(2.0), math.cos(1.0)],
+                       rtol=0, atol=1e-15)
+    th2, ph2 = direction_angles(d)
+    # arctan2 of the components: round-off of O(1) angles
+    assert np.allclose(th2, th, rtol=0, atol=1e-15) and np.allclose(ph2, ph, rtol=0, atol=1e-15)
