@@ -59,6 +59,9 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
     "fab.split": (["rigcad/fab/split.py"], ["tests/fab/test_split.py", "tests/fab/test_split_form3.py"]),
 }
 
+# folders the tests read, copied into each group's tree and into mutmut's mutants/ beside the code
+DATA = ["profiles", "bench/results"]
+
 # mutmut's exit codes (mutmut.stats.status_by_exit_code), folded into the four figures reported
 KILLED = {1, 3}
 TIMEOUT = {36, -24, 24, 152, 255}
@@ -72,6 +75,9 @@ def _setup_cfg(modules: list[str], tests: list[str]) -> str:
     lines = ["[mutmut]", "source_paths = rigcad", "only_mutate ="]
     lines += [f"    {m}" for m in modules]
     lines += ["pytest_add_cli_args_test_selection ="] + [f"    {t}" for t in tests]
+    # data the tests read beside the code: the shipped profiles and the recorded bench figures
+    # (test_estimate compares with PrusaSlicer's figures in bench/results/fab_estimates.json)
+    lines += ["also_copy ="] + [f"    {d}" for d in DATA]
     lines += ["pytest_add_cli_args =", "    -p", "    no:cacheprovider", "    -m",
               "    not slow and not stress", "    -x"]
     # a mutant that makes its tests 15x slower than the clean run is a timeout (mutmut's default);
@@ -88,7 +94,7 @@ def prepare(group: str) -> Path:
     work.mkdir(parents=True)
     # the committed tree (HEAD), not the working files: a result names the commit it measured, and
     # an edit in progress cannot leak into a run
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", "HEAD", "rigcad", "tests", "pyproject.toml"],
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", "HEAD", "rigcad", "tests", "pyproject.toml", *DATA],
                              capture_output=True, check=True).stdout
     subprocess.run(["tar", "-x", "-C", str(work)], input=archive, check=True)
     (work / "commit.txt").write_text(_head() + "\n")
@@ -125,7 +131,9 @@ def retest_survivors(group: str, max_children: int) -> dict:
     names = []
     for module in modules:
         meta = json.loads((work / "mutants" / (module + ".meta")).read_text())
-        names += [k for k, v in meta["exit_code_by_key"].items() if v in SURVIVED]
+        # "no tests" too: new tests may reach a function none reached before (mutmut collects the
+        # coverage of the new tests before it runs the mutants)
+        names += [k for k, v in meta["exit_code_by_key"].items() if v in SURVIVED or v in NO_TESTS]
         old = subprocess.run(["git", "-C", str(ROOT), "show", f"{_commit_of(work)}:{module}"], capture_output=True,
                              text=True).stdout
         if old != (ROOT / module).read_text():

@@ -169,3 +169,109 @@ def test_a_direction_on_a_zone_edge_is_inside_whichever_way_it_rounded():
         assert zone.contains(np.array(near)).all()
         assert not zone.contains(np.array([edge + np.sign(outward) * 1e-8])).any()  # 10x the slack: outside
         zone.shifted_cosine(np.array(near))  # and the basis evaluates there (no BasisError)
+
+
+# --- small cases with closed forms --------------------------------------------------------------
+
+from rigcad.basis.zonal import (ZONE_EDGE_SLACK_RAD, angles_to_directions, check_order,  # noqa: E402
+                                direction_angles, zonal_basis_directions)
+
+UPPER = Zone(0.3, 1.2)  # cos(beta) != 0: b - a and b + a differ
+
+
+def test_directions_and_angles_by_hand():
+    s = math.sqrt(0.5)
+    d = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.5, s], [0.0, -s, -s]])
+    # theta from the normal +z, phi from the tangent +x towards +y, written down for each vector
+    th_ref = [math.pi / 2, math.pi / 2, 0.0, math.pi / 4, 3 * math.pi / 4]
+    ph_ref = [0.0, math.pi / 2, 0.0, math.pi / 4, -math.pi / 2]
+    th, ph = direction_angles(d)
+    assert np.allclose(th, th_ref, rtol=0, atol=1e-15) and np.allclose(ph, ph_ref, rtol=0, atol=1e-15)
+    # back to unit vectors: round-off of sin/cos of O(1) angles
+    assert np.allclose(angles_to_directions(th_ref, ph_ref), d, rtol=0, atol=1e-15)
+    # a scalar theta broadcasts against many phi
+    ring = angles_to_directions(math.pi / 2, np.array([0.0, math.pi]))
+    assert ring.shape == (2, 3) and np.allclose(ring, [[1, 0, 0], [-1, 0, 0]], atol=1e-15)
+    with pytest.raises(BasisError, match=r"directions have shape \(2, 2\): need \(\.\.\., 3\) unit vectors"):
+        direction_angles(np.ones((2, 2)))
+    v = angles_to_directions([0.4, 0.9, 1.1], [0.2, -2.0, 3.0])
+    # the basis at unit vectors is the basis at their angles (angles taken back by arctan2: round-off)
+    assert np.allclose(zonal_basis_directions(v, 3, UPPER), zonal_basis(np.array([0.4, 0.9, 1.1]),
+                       np.array([0.2, -2.0, 3.0]), 3, UPPER), rtol=0, atol=1e-13)
+
+
+def test_one_node_rule_and_zone_rule_weights_on_an_upper_zone():
+    th, wt, ph, wp = zone_rule(UPPER, 1, 1)
+    a, b = math.cos(1.2), math.cos(0.3)
+    # one Gauss node at u = pi/2: x = (a + b)/2, weight (b - a)/2 * sin(pi/2) * pi/2 * 2; phi 0, weight 2 pi
+    assert np.allclose(np.cos(th), [(a + b) / 2], atol=1e-15) and np.allclose(wt, [(b - a) * math.pi / 2], atol=1e-15)
+    assert ph.tolist() == [0.0] and np.allclose(wp, [2 * math.pi], atol=1e-15)
+    th, wt, ph, wp = zone_rule(UPPER, 9, 4)
+    # the weights integrate 1 and cos(theta) over the zone: 2 pi (b - a) and pi (b^2 - a^2) sr
+    assert math.isclose(wt.sum() * wp.sum(), 2 * math.pi * (b - a), rel_tol=1e-13)
+    assert math.isclose((wt * np.cos(th)).sum() * wp.sum(), math.pi * (b * b - a * a), rel_tol=1e-12)
+    for n_p, n_a in ((0, 3), (3, 0)):
+        with pytest.raises(BasisError, match=rf"quadrature sizes n_polar = {n_p}, n_azimuth = {n_a}: need >= 1 each"):
+            zone_rule(UPPER, n_p, n_a)
+
+
+def test_zone_edges_within_the_slack_are_inside_and_clipped():
+    lo, hi = UPPER.alpha_rad - ZONE_EDGE_SLACK_RAD, UPPER.beta_rad + ZONE_EDGE_SLACK_RAD
+    # the slack's own ends are inside (edges included), and one ulp beyond them is not
+    assert UPPER.contains(np.array([lo, hi])).all()
+    assert not UPPER.contains(np.array([np.nextafter(lo, -1.0), np.nextafter(hi, 4.0)])).any()
+    # just outside the geometric edge, t = (2 cos theta - a - b)/(b - a) leaves [-1, 1] by ~1e-9: clipped,
+    # so the Legendre recurrences see a valid argument
+    t = UPPER.shifted_cosine(np.array([lo, hi, 0.75]))
+    assert t[0] == 1.0 and t[1] == -1.0 and abs(t[2]) < 1.0
+    with pytest.raises(BasisError, match=r"\(2 value\(s\)\) outside the zone .* before evaluating the zonal basis$"):
+        UPPER.shifted_cosine(np.array([0.1, 0.5, 1.5]))
+
+
+def test_zone_and_order_refusals_name_the_parameter():
+    with pytest.raises(BasisError, match=r"need 0 <= alpha_rad < beta_rad <= pi \(polar angles from the sample "
+                                         r"normal, in radians\)$") as e:
+        Zone(0.5, 0.5)  # an empty zone
+    assert e.value.param == "basis.zone"
+    assert check_order(np.int64(3)) == 3
+    for bad in (True, 2.0, -1):
+        with pytest.raises(BasisError, match=rf"basis order = {bad!r}: need an integer >= 0") as e:
+            check_order(bad)
+        assert e.value.param == "basis.order"
+    with pytest.raises(BasisError, match=r"\(l, m\) = \(1, 2\): need l >= 0 and -l <= m <= l"):
+        basis_index(1, 2)
+
+
+def test_normalised_legendre_shape():
+    # (order + 1) x (order + 1) per argument: l down, m across
+    assert normalized_legendre(np.zeros((4, 2)), 3).shape == (4, 2, 4, 4)
+
+
+def test_moments_with_an_azimuth_rule_per_polar_row():
+    zone = UPPER
+    rng = np.random.default_rng(11)
+    theta = np.sort(rng.uniform(zone.alpha_rad, zone.beta_rad, 7))
+    phi = rng.uniform(0, 2 * math.pi, (7, 5))  # each polar row its own azimuths
+    values = rng.normal(size=(3, 7, 5))
+    T = np.repeat(theta[:, None], 5, axis=1)
+    dense = values.reshape(3, -1) @ zonal_basis(T.ravel(), phi.ravel(), 6, zone)
+    sep = zonal_moments(theta, phi, values, 6, zone)
+    # two summation orders of 35 terms of O(1): round-off
+    assert np.max(np.abs(sep - dense)) < 1e-12 * max(1.0, np.max(np.abs(dense))), np.max(np.abs(sep - dense))
+    msg = r"need values \(\.\.\., 7, n_phi\) \(theta x phi\) and phi \(n_phi,\) or \(n_theta, n_phi\)$"
+    with pytest.raises(BasisError, match=msg):
+        zonal_moments(theta, phi[:6], values[:, :6], 6, zone)  # phi rows do not match theta
+    with pytest.raises(BasisError, match=msg):
+        zonal_moments(theta, phi[None], values, 6, zone)  # a 3-D phi
+
+
+def test_directions_and_angles_keep_the_grid_shape():
+    # a (2, 4) grid of angles gives (2, 4, 3) unit vectors, and back: the last axis holds x, y, z
+    th, ph = np.meshgrid([0.4, 1.0], [0.0, 1.0, 2.0, 3.0], indexing="ij")
+    d = angles_to_directions(th, ph)
+    assert d.shape == (2, 4, 3)
+    assert np.allclose(d[1, 2], [math.sin(1.0) * math.cos(2.0), math.sin(1.0) * math.sin(2.0), math.cos(1.0)],
+                       rtol=0, atol=1e-15)
+    th2, ph2 = direction_angles(d)
+    # arctan2 of the components: round-off of O(1) angles
+    assert np.allclose(th2, th, rtol=0, atol=1e-15) and np.allclose(ph2, ph, rtol=0, atol=1e-15)

@@ -6,6 +6,7 @@ piece sliced live agrees (the whole rig sliced live: tests/fab/test_fab_run.py, 
 from __future__ import annotations
 
 import dataclasses
+import math
 import json
 from pathlib import Path
 
@@ -109,3 +110,93 @@ def test_the_time_scales_with_a_slower_printer(prusa):
     fixed = f.island_layers * E.FIT.t_island + E.FIT.t_piece  # the terms that do not scale with the rate
     assert abs((b["print_time_s"] - fixed) / (a["print_time_s"] - fixed) - 2.0) < 1e-12  # half the rate
     assert a["material_g"] == b["material_g"]
+
+
+# --- the model written out by hand (module docstring), on printers other than the calibration one ----
+
+FEATURES = E.Features(volume_mm3=2e4, surface_mm2=1e4, layers=300, support_envelope_mm3=5e3, overhang_mm2=400.0,
+                      shell_mm=1.35, island_layers=450)
+
+
+def _by_hand(f, rate, layer_time, density):
+    """The docstring's formulas: V_shell = min(V, surface x shell), time's volume terms scaled by
+    8 mm3/s over the printer's rate, the island term by its layer time over the MK3S's 1 s."""
+    c = E.FIT
+    vs = min(f.volume_mm3, f.surface_mm2 * f.shell_mm)
+    vc = f.volume_mm3 - vs
+    mat = c.m_shell * vs + c.m_core * vc + c.m_support * f.support_envelope_mm3 + c.m_island * f.island_layers
+    t = ((c.t_shell * vs + c.t_core * vc + c.t_support * f.support_envelope_mm3 + c.t_overhang * f.overhang_mm2)
+         * 8.0 / rate + c.t_island * f.island_layers * layer_time / 1.0 + c.t_piece)
+    return t, mat / 1000.0, mat / 1000.0 * density
+
+
+@pytest.mark.parametrize("rate, layer_time", [(14.9, 2.0), (8.0, 0.5), (0.0, 3.0)])
+def test_the_estimate_is_the_documented_model(prusa, vantage, rate, layer_time):
+    """The Vantage file as shipped (14.9 mm3/s, 2 s a layer), then a printer with a short layer time,
+    then one with no deposition rate (the calibration's 8 mm3/s is used)."""
+    printer = dataclasses.replace(vantage, deposition_rate_mm3_s=rate, layer_time_s=layer_time)
+    e = E.estimate(FEATURES, printer)
+    t, cm3, g = _by_hand(FEATURES, rate or 8.0, layer_time, vantage.material_density_g_cm3)
+    # the same sums in another order: round-off of ~1e5 s sums
+    assert math.isclose(e["print_time_s"], t, rel_tol=1e-12), (e["print_time_s"], t)
+    assert math.isclose(e["material_cm3"], cm3, rel_tol=1e-12) and math.isclose(e["material_g"], g, rel_tol=1e-12)
+    assert e["method"] == f"rigcad model fitted to PrusaSlicer (rigcad.fab.estimate; {E.FIT.source})"
+    assert e["features"] == dataclasses.asdict(FEATURES)
+
+
+def test_a_printer_without_a_layer_time_has_no_island_scaling(prusa):
+    # layer_time_s = 0 (allowed by the printer schema): the island term keeps the MK3S's time
+    e = E.estimate(FEATURES, dataclasses.replace(prusa, layer_time_s=0.0))
+    t, _, _ = _by_hand(FEATURES, 8.0, 1.0, prusa.material_density_g_cm3)
+    assert math.isclose(e["print_time_s"], t, rel_tol=1e-12), (e["print_time_s"], t)
+
+
+def test_a_resin_print_is_its_volume_and_its_layers():
+    from rigcad.fab.printers import load_printer
+
+    form3 = load_printer(ROOT / "profiles" / "printers" / "form3.yaml")
+    e = E.estimate(FEATURES, form3)
+    # SLA: the part's own volume (no infill, supports not modelled), 9 s per layer (form3.yaml)
+    assert e["material_cm3"] == 20.0 and math.isclose(e["material_g"], 20.0 * 1.18, rel_tol=1e-15)
+    assert e["print_time_s"] == 300 * 9.0
+    assert E.shell_thickness(form3) == math.inf  # solid: all shell
+
+
+class _Config:
+    """A slicer configuration as printers.py gives it: effective() is the merged preset (strings)."""
+
+    def __init__(self, **settings):
+        self.settings = settings
+
+    def effective(self):
+        return dict(self.settings)
+
+
+@pytest.mark.parametrize("settings, nozzle, shell", [
+    ({"perimeters": "2", "perimeter_extrusion_width": "0.6", "extrusion_width": "0.5"}, 0.4, 2 * 0.6),
+    ({"extrusion_width": "0.5"}, 0.4, 3 * 0.5),            # no perimeter width: the general width
+    ({"perimeter_extrusion_width": "110%"}, 0.4, 3 * 0.44),  # a percentage of the nozzle
+    ({"perimeters": "2"}, 0.4, 2 * 1.125 * 0.4),            # no width at all: PrusaSlicer's default
+    ({"perimeter_extrusion_width": ""}, 0.4, 3 * 1.125 * 0.4),
+    ({"perimeter_extrusion_width": "0"}, 0.6, 3 * 1.125 * 0.6),  # 0 = auto
+    ({"perimeters": "abc", "extrusion_width": "0.5"}, 0.4, 3 * 1.125 * 0.4),  # unreadable: the defaults
+    ({"perimeters": "1"}, None, 1 * 1.125 * 0.4),           # no nozzle in the file: 0.4 mm
+])
+def test_the_shell_follows_the_slicer_settings(prusa, settings, nozzle, shell):
+    # perimeters x width, as PrusaSlicer reads its settings: a width in mm or in % of the nozzle, 0 or
+    # empty for its automatic width (1.125 x nozzle), perimeters a count
+    printer = dataclasses.replace(prusa, nozzle=nozzle, slicer_config=_Config(**settings))
+    assert math.isclose(E.shell_thickness(printer), shell, rel_tol=1e-15), (settings, E.shell_thickness(printer))
+
+
+def test_thin_triangles_and_tiny_islands_count_and_flat_outlines_do_not():
+    tri = np.array([[0.0, 0.0], [4.0, 0.0], [0.0, 3.0]])  # counter-clockwise: encloses material
+    tiny = _square(10, 10, 0.5)                            # 0.25 mm2: a thin wall's slice is an island too
+    flat = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])  # zero area: encloses nothing
+    layers = Layers(0.15, np.array([0.075, 0.225]), [[tri, tiny], [flat, tri[::-1]]])
+    assert E.island_layers(layers) == 2
+
+
+def test_a_refit_carries_its_source(recorded, prusa):
+    _, rows = recorded
+    assert E.fit([r[:3] for r in rows], prusa.material_density_g_cm3, "refit here").source == "refit here"

@@ -92,3 +92,72 @@ def test_closed_form_is_layer_times_cosine():
     n = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.6, 0.0, 0.8], [0.0, 0.6, -0.8]])
     c = closed_form_cusp(n, (0, 0, 1), 0.2)
     assert np.allclose(c, [0.2, 0.0, 0.16, 0.16], atol=1e-15)  # exact arithmetic up to rounding
+
+
+# --- the summaries over faces and maps, on hand-made faces (closed forms) ------------------------
+
+from rigcad.fab.mirror import MirrorFaces  # noqa: E402
+from rigcad.fab.staircase import StepMap, optical_effect, polishing_allowance, surface_staircase  # noqa: E402
+
+
+def _faces(normals, areas, centroids):
+    n = len(areas)
+    return MirrorFaces(np.arange(n), np.asarray(centroids, float), np.asarray(areas, float), np.asarray(normals, float))
+
+
+def test_surface_staircase_is_the_area_weighted_closed_form():
+    # a face facing the build direction (cusp t) of 1 mm2 and a wall along it (cusp 0) of 3 mm2
+    f = _faces([[0, 0, 1], [1, 0, 0]], [1.0, 3.0], np.zeros((2, 3)))
+    s = surface_staircase(f, (0.0, 0.0, 2.0), 0.2)  # the direction need not be a unit vector
+    # mean 0.2/4, rms sqrt(0.04/4) = 0.1, max 0.2; 75 % of the area has cusp 0, so the 95th percentile is 0.2
+    assert math.isclose(s["cusp_mean_mm"], 0.05, rel_tol=1e-15) and math.isclose(s["cusp_rms_mm"], 0.1, rel_tol=1e-15)
+    assert s["cusp_max_mm"] == 0.2 and s["cusp_p95_mm"] == 0.2
+
+
+def test_optical_effect_of_ideal_steps_on_two_faces():
+    th = 0.3
+    # face A normal to the build direction z, face B tilted by 0.3 rad; both 1 mm2, both 100 mm from O
+    f = _faces([[0, 0, 1], [math.sin(th), 0, math.cos(th)]], [1.0, 1.0], [[0, 0, 100.0], [100.0, 0, 0]])
+    e = optical_effect(f, (0.0, 0.0, 5.0), "dome")
+    # treads: A error 0 (area 1), B error 0.3 (area cos 0.3); risers: B error pi/2 - 0.3 (area sin 0.3),
+    # A's riser has no area. Area fractions of the total 1 + cos 0.3 + sin 0.3:
+    tot = 1 + math.cos(th) + math.sin(th)
+    fa, fb, fr = 1 / tot, math.cos(th) / tot, math.sin(th) / tot  # 0.444, 0.424, 0.131
+    assert math.isclose(e["normal_error_median_deg"], math.degrees(th), rel_tol=1e-12)  # cdf 0.444, 0.869
+    assert math.isclose(e["normal_error_p90_deg"], 90 - math.degrees(th), rel_tol=1e-12)
+    assert math.isclose(e["ray_angle_error_median_deg"], 2 * math.degrees(th), rel_tol=1e-12)  # reflection doubles
+    assert math.isclose(e["ray_angle_error_p90_deg"], 2 * (90 - math.degrees(th)), rel_tol=1e-12)
+    assert math.isclose(e["area_fraction_within_1mrad"], fa, rel_tol=1e-12)
+    h = e["histogram_normal_error_deg"]
+    assert h["edges"] == list(range(0, 91, 10))
+    # 0 deg in [0, 10), 17.2 deg in [10, 20), 72.8 deg in [70, 80)
+    assert np.allclose(h["area_fraction"], [fa, fb, 0, 0, 0, 0, 0, fr, 0], rtol=1e-12, atol=0)
+    # the median ray misses O by L tan(2 x 0.3 rad)
+    assert math.isclose(e["miss_at_sample_median_mm"], 100 * math.tan(2 * th), rel_tol=1e-12)
+    assert "miss_at_sample_median_mm" not in optical_effect(f, (0.0, 0.0, 1.0), "paraboloid")
+
+
+def _map(cusp_slices, cusp_closed, peak, valley):
+    n = len(peak)
+    return StepMap((0.0, 0.0, 1.0), 0.2, np.zeros((n, 3)), np.asarray(cusp_slices, float), np.asarray(cusp_closed, float),
+                   np.asarray(peak, float), np.asarray(valley, float))
+
+
+def test_step_map_summary_and_polishing_allowance_by_hand():
+    m = _map([0.1, np.nan, 0.3], [0.1, 0.2, 0.2], [0.1, 0.05, 0.02], [-0.05, -0.12, 0.01])
+    s = m.summary()
+    # the top layer's NaN is left out: slices (0.1, 0.3), closed form (0.1, 0.2) at the same points
+    assert s["contour_points"] == 3
+    assert math.isclose(s["cusp_from_slices_mean_mm"], 0.2) and s["cusp_from_slices_max_mm"] == 0.3
+    assert math.isclose(s["cusp_closed_form_mean_mm"], 0.15)
+    assert math.isclose(s["slices_vs_closed_form_mean_rel_diff"], 1 / 3)
+    assert math.isclose(s["slices_vs_closed_form_max_abs_diff_mm"], 0.1)
+    assert math.isclose(s["slices_vs_closed_form_p95_abs_diff_mm"], 0.095)  # linear between 0 and 0.1
+    assert s["stepped_surface_peak_mm"] == 0.1 and s["stepped_surface_valley_mm"] == -0.12
+    p = polishing_allowance(m)
+    # sand peak to valley where it is deepest (0.05 + 0.12), add the deepest valley's 0.12 mm of stock
+    assert math.isclose(p["sanding_depth_mm"], 0.17) and p["stock_to_add_mm"] == 0.12
+    assert polishing_allowance(_map([0.1], [0.1], [0.3], [0.1]))["stock_to_add_mm"] == 0.0  # no valley below
+    empty = _map([], [], [], [])
+    assert polishing_allowance(empty) == {"sanding_depth_mm": 0.0, "stock_to_add_mm": 0.0}
+    assert empty.summary()["cusp_from_slices_mean_mm"] is None and empty.summary()["stepped_surface_peak_mm"] is None
