@@ -232,7 +232,7 @@ def optical_effect(faces: MirrorFaces, direction, mirror_kind: str) -> dict:
     if mirror_kind == "dome":
         # each dome point reflects straight to O at distance L; the ray error 2 delta misses O by
         # L tan(2 delta) (clipped at 89 deg: beyond that the ray never comes near the sample)
-        L = np.linalg.norm(np.repeat(faces.centroids, 2, axis=0)[keep][order], axis=1)
+        L = np.linalg.norm(np.concatenate([faces.centroids, faces.centroids])[keep][order], axis=1)  # treads, then risers, as err
         miss = L * np.tan(np.minimum(2 * err, np.radians(89.0)))
         o = np.argsort(miss)
         mc = np.cumsum(w[o])

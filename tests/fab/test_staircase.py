@@ -137,6 +137,15 @@ def test_optical_effect_of_ideal_steps_on_two_faces():
     assert "miss_at_sample_median_mm" not in optical_effect(f, (0.0, 0.0, 1.0), "paraboloid")
 
 
+def test_the_miss_at_the_sample_pairs_each_face_with_its_own_distance():
+    # face A (normal to z) 100 mm from O, face B (tilted 0.3 rad) 50 mm from O: the median error is
+    # B's tread, so the median miss is B's distance times tan(2 x 0.3 rad), not A's
+    th = 0.3
+    f = _faces([[0, 0, 1], [math.sin(th), 0, math.cos(th)]], [1.0, 1.0], [[0, 0, 100.0], [50.0, 0, 0]])
+    e = optical_effect(f, (0.0, 0.0, 1.0), "dome")
+    assert math.isclose(e["miss_at_sample_median_mm"], 50 * math.tan(2 * th), rel_tol=1e-12), e
+
+
 def _map(cusp_slices, cusp_closed, peak, valley):
     n = len(peak)
     return StepMap((0.0, 0.0, 1.0), 0.2, np.zeros((n, 3)), np.asarray(cusp_slices, float), np.asarray(cusp_closed, float),
