@@ -38,7 +38,11 @@ def worker_count(text: str) -> int:
 
 
 def exports_root(text: str) -> str:
-    """An argparse type: an output root, not empty (an empty one would write into the current folder)."""
+    """An argparse type: an output root, not empty (an empty one would write into the current folder)
+    and without control or formatting characters (a newline or a right-to-left override in a folder
+    name breaks every line that names it)."""
     if not text.strip():
         raise argparse.ArgumentTypeError("expected a folder, got an empty path (the default is 'exports')")
+    if not text.isprintable():
+        raise argparse.ArgumentTypeError(f"expected a folder name of printable characters, got {ascii(text)[:80]}")
     return text

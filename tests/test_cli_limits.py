@@ -196,3 +196,14 @@ def test_profile_quantities_out_of_their_range_are_refused_with_their_line(secti
     with pytest.raises(ProfileError) as err:
         load_profile(path)
     assert f"{path}:{line + 1}" in str(err.value) and valid in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize("folder", ["a\nb", "\u202ex", "tab\there"])
+def test_an_exports_folder_with_control_characters_is_refused_at_once(folder, capsys):
+    """A newline or a right-to-left override in the output root would break every line naming it."""
+    from rigcad.cli import main
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["design", "achutha2006", "--exports", folder])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and "printable characters" in err and "\n" not in err.strip().splitlines()[-1]

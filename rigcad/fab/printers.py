@@ -34,7 +34,7 @@ from rigcad.fab import vendor as V
 from rigcad.profile.loader import RawProfile, find_file, load_raw
 from rigcad.profile.paths import PRINTERS_SUBDIR, display, names_on_search_path, search_path
 # The schema's own readers, so printer files follow the same unit, range and error rules.
-from rigcad.profile.schema import REQUIRED, Spec, convert_value, read_section, spec, suggest
+from rigcad.profile.schema import REQUIRED, Spec, convert_value, read_section, spec, suggest, unknown_key
 
 #: Thinnest layer a printer file may give (mm): a printer's resolution. The finest commercial
 #: layers (SLA, material jetting) are 0.014..0.025 mm; thinner is a unit slip, and every layer of
@@ -204,7 +204,8 @@ def load_printer(name: str | Path) -> Printer:
     valid = sorted([*_TOP, *_SECTIONS])
     for key in raw.data:
         if key not in valid:
-            raise ProfileError(f"unknown printer key {key!r}{suggest(key, valid)}; valid: {', '.join(valid)}",
+            raise ProfileError(f"unknown printer key {unknown_key(key)}{suggest(str(key), valid)}; valid: "
+                               f"{', '.join(valid)}",
                                where=raw.where((key,)))
     slicer_cfg, unavailable = None, None
     if isinstance(raw.data.get("slicer"), dict):

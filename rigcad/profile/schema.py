@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -526,6 +527,17 @@ def _r(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 4] + " ..."
 
 
+#: What an unknown key may look like for an error to quote it: a setting's name, maybe mistyped.
+#: Anything else (a line of a file that is not a profile, such as a password or key file given by
+#: path) is never echoed: the error says where it is, not what it says.
+_KEY_LIKE = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,39}")
+
+
+def unknown_key(key: Any) -> str:
+    """An unknown key as an error shows it: quoted when it looks like a setting's name, else not shown."""
+    return repr(key) if isinstance(key, str) and _KEY_LIKE.fullmatch(key) else "(not a setting's name; not shown)"
+
+
 def suggest(name: str, valid: list[str]) -> str:
     close = difflib.get_close_matches(name, valid, n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
@@ -633,7 +645,8 @@ def read_section(raw: RawProfile, name: str, cls: type) -> Any:
     for key in data:
         if key not in valid:
             raise ProfileError(
-                f"unknown key {name}.{key}{suggest(key, valid)}; valid keys in {name}: {', '.join(valid)}",
+                f"unknown key {name}.{key if _KEY_LIKE.fullmatch(str(key)) else unknown_key(key)}"
+                f"{suggest(str(key), valid)}; valid keys in {name}: {', '.join(valid)}",
                 where=raw.where((name, key)))
     values = {}
     for f in fields(cls):
@@ -655,7 +668,8 @@ def validate(raw: RawProfile) -> Profile:
     valid_top = sorted(set(SECTIONS) | TOP_LEVEL)
     for key in raw.data:
         if key not in valid_top:
-            raise ProfileError(f"unknown section {_r(key)}{suggest(key, valid_top)}; valid: {', '.join(valid_top)}",
+            raise ProfileError(f"unknown section {unknown_key(key)}{suggest(str(key), valid_top)}; valid: "
+                               f"{', '.join(valid_top)}",
                                where=raw.where((key,)))
     sections = {name: read_section(raw, name, cls) for name, cls in SECTIONS.items()}
     par: ParaboloidParams = sections["paraboloid"]

@@ -109,3 +109,23 @@ def test_allowed_places_still_work(tmp_path, monkeypatch):
     monkeypatch.delenv("RIGCAD_PROFILES")
     msg, _ = refusal(printer_yaml(elsewhere, f"slicer:\n  vendor_bundle: {lab / 'mk3s.ini'}\n"))
     assert "leads outside the printer file's folder and the profile search path" in msg
+
+
+@pytest.mark.parametrize("first_line", ["DECOY-SECRET-not-for-the-exports: 1", "root:x:0:0:root:/root:/bin/bash: 1",
+                                        "AKIA0123456789SECRET/xyz: 1"])
+def test_a_yaml_file_that_is_not_a_printer_is_refused_without_quoting_it(tmp_path, first_line):
+    """--printer names a YAML file that is not a printer (a credentials or notes file): the error says
+    where it is and what would be valid, never what its first key says."""
+    path = tmp_path / "notes.yaml"
+    path.write_text(first_line + "\n")
+    with pytest.raises(ProfileError) as err:
+        load_printer(path)
+    secret = first_line.rsplit(":", 1)[0]
+    assert secret not in str(err.value) and "not shown" in str(err.value) and "notes.yaml:1" in str(err.value)
+
+
+def test_a_mistyped_printer_key_is_still_named(tmp_path):
+    path = tmp_path / "typo.yaml"
+    path.write_text("layer_heigth: 0.2 mm\n")
+    with pytest.raises(ProfileError, match=r"unknown printer key 'layer_heigth' \(did you mean 'layer_height'\?\)"):
+        load_printer(path)
