@@ -191,42 +191,39 @@ def _kill_and_check(proc: subprocess.Popen, tmp: Path) -> None:
     assert left == [], f"left in the temp folder after the next run: {left}"
 
 
-def test_a_killed_tolerance_run_leaves_no_worker_and_no_temp(tmp_path):
-    proc = _start(["tolerance", "achutha2006", "--workers", "2", "--samples", "20000", "--rays", "2000",
-                   "--no-limits"], tmp_path)
+def _kill_once_running(argv: list[str], tmp: Path, running, what: str, step_s: float) -> None:
+    """Start rigcad with ``argv``, wait (bounded: 300 s on a loaded machine) until ``running(proc)``
+    is truthy, then SIGKILL it and check what it leaves (:func:`_kill_and_check`); never leaves it running."""
+    proc = _start(argv, tmp)
     try:
-        # wait (bounded) until the loky pool runs: two workers and the resource tracker
-        assert _poll(lambda: len(_children(proc.pid)) >= 3, 300, 0.2), "the pool never started"
-        _kill_and_check(proc, tmp_path)
+        assert _poll(lambda: running(proc), 300, step_s), what
+        _kill_and_check(proc, tmp)
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+def test_a_killed_tolerance_run_leaves_no_worker_and_no_temp(tmp_path):
+    # running: the loky pool's two workers and its resource tracker
+    _kill_once_running(["tolerance", "achutha2006", "--workers", "2", "--samples", "20000", "--rays", "2000",
+                        "--no-limits"], tmp_path, lambda proc: len(_children(proc.pid)) >= 3,
+                       "the pool never started", 0.2)
 
 
 def test_a_killed_local_dask_run_leaves_no_worker_and_no_scratch(tmp_path):
     pytest.importorskip("distributed")
-    proc = _start(["tolerance", "achutha2006", "--workers", "2", "--scheduler", "local-dask", "--samples", "20000",
-                   "--rays", "2000", "--no-limits"], tmp_path)
-    try:
-        scratch = lambda: list(tmp_path.rglob("dask-scratch-space/worker-*"))  # noqa: E731
-        assert _poll(scratch, 300, 0.2), "the Dask workers never started"
-        _kill_and_check(proc, tmp_path)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+    _kill_once_running(["tolerance", "achutha2006", "--workers", "2", "--scheduler", "local-dask", "--samples",
+                        "20000", "--rays", "2000", "--no-limits"], tmp_path,
+                       lambda proc: list(tmp_path.rglob("dask-scratch-space/worker-*")), "the Dask workers never started",
+                       0.2)
 
 
 def test_a_killed_fab_leaves_no_slicer_temp(tmp_path):
     if shutil.which("prusa-slicer") is None:
         pytest.skip("PrusaSlicer is not installed")
-    proc = _start(["fab", "achutha2006", "--printer", "prusa_mk3s", "--gcode", "--parts", "beam"], tmp_path)
-    try:
-        slicing = lambda: list(tmp_path.rglob("rigcad-slice-*")) or list(tmp_path.rglob("rigcad-keys-*"))  # noqa: E731
-        assert _poll(slicing, 300, 0.01), "fab never made its slicer folder"
-        _kill_and_check(proc, tmp_path)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+    _kill_once_running(["fab", "achutha2006", "--printer", "prusa_mk3s", "--gcode", "--parts", "beam"], tmp_path,
+                       lambda proc: list(tmp_path.rglob("rigcad-slice-*")) or list(tmp_path.rglob("rigcad-keys-*")),
+                       "fab never made its slicer folder", 0.01)
 
 
 def test_the_sweep_spares_live_runs_and_other_files(tmp_path):
