@@ -35,7 +35,7 @@ help:
 $(VENV)/.installed: pyproject.toml requirements.lock
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c requirements.lock -e ".[cad,dev,dask]"
+	$(PY) -m pip install --quiet -c requirements.lock -e ".[cad,dev,dask,ocp]"
 	touch $@
 
 venv: $(VENV)/.installed
