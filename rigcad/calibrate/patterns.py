@@ -24,21 +24,25 @@ AXES = ("x", "y")
 MIN_WIDTH_PX = 0.02
 
 
-def _second_antiderivative(prof: np.ndarray):
-    """G with G'' = the staircase ``prof`` (value prof[i] on [i, i + 1), 0 outside), exact: a
-    piecewise quadratic through the cumulative sums."""
-    first = np.concatenate([[0.0], np.cumsum(prof)])  # F at the integers
-    second = np.concatenate([[0.0], np.cumsum(first[:-1] + prof / 2)])  # G at the integers
-    n = len(prof)
+def _cell(c: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Continuous coordinates c -> (pixel index clipped to [0, n], offset in it, beyond the end)."""
+    c = np.asarray(c, float)
+    i = np.clip(np.floor(c), 0, n).astype(np.int64)
+    return i, np.clip(c, 0, n) - i, np.maximum(c - n, 0.0)
 
-    def g(c: np.ndarray) -> np.ndarray:
-        c = np.asarray(c, float)
-        i = np.clip(np.floor(c), 0, n).astype(np.int64)
-        t = np.clip(c, 0, n) - i
-        val = np.where(i < n, prof[np.minimum(i, n - 1)], 0.0)
-        inside = second[i] + first[i] * t + val * t * t / 2
-        return inside + first[-1] * np.maximum(c - n, 0.0)  # beyond the end: F is constant
-    return g
+
+class _Staircase:
+    """G with G'' = the staircase ``prof`` (value prof[i] on [i, i + 1), 0 outside), exact: a
+    piecewise quadratic through the cumulative sums, evaluated at :func:`_cell` cells."""
+
+    def __init__(self, prof: np.ndarray) -> None:
+        self.first = np.concatenate([[0.0], np.cumsum(prof)])  # F at the integers
+        self.second = np.concatenate([[0.0], np.cumsum(self.first[:-1] + prof / 2)])  # G at the integers
+        self.value = np.append(prof, 0.0)
+
+    def __call__(self, cell) -> np.ndarray:
+        i, t, beyond = cell
+        return self.second[i] + self.first[i] * t + self.value[i] * t * t / 2 + self.first[-1] * beyond
 
 
 @dataclass(frozen=True)
@@ -114,22 +118,34 @@ class Sequence:
 
     def footprint_mean(self, name: str, cx: np.ndarray, cy: np.ndarray, edges: np.ndarray) -> np.ndarray:
         """The frame's mean value in [0, 1] over parallelograms on the screen: centres (cx, cy) px
-        and edge vectors ``edges`` (..., 2, 2) px (edges[..., k, :] the k-th edge's (x, y)). A frame
-        varies along one axis only, so the mean is the staircase of screen pixels integrated against
-        the parallelogram's projection on that axis (a trapezoid: two boxes convolved), exactly, by
+        and edge vectors ``edges`` (..., 2, 2) px (edges[..., k, :] the k-th edge's (x, y)); see
+        :meth:`footprint_means`."""
+        return self.footprint_means([name], cx, cy, edges)[name]
+
+    def footprint_means(self, names: list[str], cx: np.ndarray, cy: np.ndarray, edges: np.ndarray) -> dict:
+        """:meth:`footprint_mean` of several frames, sharing the footprints' cells. A frame varies
+        along one axis only, so its mean is the staircase of screen pixels integrated against the
+        parallelogram's projection on that axis (a trapezoid: two boxes convolved), exactly, by
         second antiderivatives. Off the screen (centre outside) 0; white and black by the centre."""
         w, h = self.resolution
         on = (cx >= 0) & (cx < w) & (cy >= 0) & (cy < h)
-        if name in ("white", "black"):
-            return np.where(on, 1.0 if name == "white" else 0.0, 0.0)
-        k = 0 if name.startswith("x") else 1
-        c = cx if k == 0 else cy
-        prof = self.profile(name).astype(float) / 255.0
-        a = np.maximum(np.abs(edges[..., 0, k]), MIN_WIDTH_PX)
-        b = np.maximum(np.abs(edges[..., 1, k]), MIN_WIDTH_PX)
-        g = _second_antiderivative(prof)
-        total = g(c + (a + b) / 2) - g(c + (a - b) / 2) - g(c - (a - b) / 2) + g(c - (a + b) / 2)
-        return np.where(on, total / (a * b), 0.0)
+        out, cells = {}, {}
+        for name in names:
+            if name in ("white", "black"):
+                out[name] = np.where(on, 1.0 if name == "white" else 0.0, 0.0)
+                continue
+            k = 0 if name.startswith("x") else 1
+            if k not in cells:
+                c = cx if k == 0 else cy
+                a = np.maximum(np.abs(edges[..., 0, k]), MIN_WIDTH_PX)
+                b = np.maximum(np.abs(edges[..., 1, k]), MIN_WIDTH_PX)
+                points = [c + (a + b) / 2, c + (a - b) / 2, c - (a - b) / 2, c - (a + b) / 2]
+                cells[k] = ([_cell(p, self.length("x" if k == 0 else "y")) for p in points], a * b)
+            parts, area = cells[k]
+            g = _Staircase(self.profile(name).astype(float) / 255.0)
+            total = g(parts[0]) - g(parts[1]) - g(parts[2]) + g(parts[3])
+            out[name] = np.where(on, total / area, 0.0)
+        return out
 
     def to_mm(self, axis: str, c: np.ndarray) -> np.ndarray:
         """Screen coordinate (px, continuous) along ``axis`` -> mm in the screen's frame (module docstring)."""
