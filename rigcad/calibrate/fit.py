@@ -31,8 +31,9 @@ from rigcad.calibrate import model as M
 #: Forward-difference steps of the Jacobian, as a fraction of each parameter's tolerance: 1e-3 of
 #: 0.1 mm is 0.1 um, far above the tracer's Newton tolerance and far below the curvature scale.
 JAC_STEP = 1e-3
-#: The robust first solve's scale (mm on the screen): soft L1 above it.
-ROBUST_SCALE_MM = 0.5
+#: The robust first solve's scale (mm on the screen): soft L1 above it; ~15 x the decoding noise
+#: (3 um median on Table 3.1's simulated capture).
+ROBUST_SCALE_MM = 0.05
 #: Outliers: residuals past this many robust sigmas are dropped before the second solve.
 OUTLIER_SIGMAS = 5.0
 

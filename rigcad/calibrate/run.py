@@ -16,6 +16,10 @@ from rigcad.calibrate.fit import FitData, fit
 from rigcad.calibrate.patterns import Sequence
 
 
+#: Pixels within this many of an undecoded pixel are left out of the fit (not of the maps).
+EDGE_PX = 2
+
+
 @dataclass
 class Calibration:
     """Everything one calibration computed (window arrays (n,) or (n, 3) row-major over ``cam.shape``)."""
@@ -76,7 +80,11 @@ def _fit_data(cam: M.Camera, decoded: list, stride: int) -> FitData:
     """Every ``stride``-th row and column of the window that decoded at every height."""
     rows, cols = np.meshgrid(np.arange(cam.shape[0]), np.arange(cam.shape[1]), indexing="ij")
     pick = ((rows % stride == 0) & (cols % stride == 0)).ravel()
-    ok = pick & np.all([d.valid.ravel() for d in decoded], axis=0)
+    from scipy.ndimage import binary_erosion
+
+    # pixels next to an undecoded one see a screen edge or a shadow's edge in part of their footprint
+    inner = [binary_erosion(d.valid, iterations=EDGE_PX).ravel() for d in decoded]
+    ok = pick & np.all(inner, axis=0)
     idx = np.nonzero(ok)[0]
     uv = np.stack([np.stack([d.u.ravel()[idx], d.v.ravel()[idx]], axis=-1) for d in decoded], axis=1)
     return FitData(idx, uv)

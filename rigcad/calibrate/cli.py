@@ -1,0 +1,117 @@
+"""``rigcad calibrate PROFILE (--images DIR | --simulate) [--seed N] [--exports DIR]``: decode the
+capture, fit the misalignment, write the residual slope map and the corrected pixel -> incidence
+map into ``<exports>/<profile>/calibrate/`` (published atomically: a refused capture writes
+nothing). Wired into the command line by :func:`register`."""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+
+def cmd_calibrate(args: argparse.Namespace) -> int:
+    from rigcad.calibrate import model as M
+    from rigcad.calibrate.images import check_decoded, read_capture
+    from rigcad.calibrate.patterns import Sequence
+    from rigcad.calibrate.run import calibrate, compare
+    from rigcad.check.scene import analytic_optics
+    from rigcad.export.atomic import Staging, json_bytes, profile_lock
+    from rigcad.export.manifest import profile_digest
+    from rigcad.progress import stages
+    from rigcad.rig import load
+
+    rig = load(args.profile)
+    seq = Sequence.from_profile(rig.profile.calibration)
+    heights = M.nominal_heights(rig.profile)
+    with stages(4, "calibrate") as step:
+        step("tracer")
+        optics = analytic_optics(rig)
+        truth = None
+        if args.simulate:
+            from rigcad.calibrate import simulate as S
+
+            step("simulated capture")
+            rng = np.random.default_rng(args.seed)
+            theta = S.random_misalignment(rig, len(heights), rng)
+            surface = S.planted_surface(rig, rng)
+            images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, heights, rng)
+            images = [{n: im.astype(float) / 255.0 for n, im in f.items()} for f in images]
+            truth = (theta, surface)
+            folder = Path("<simulated>")
+        else:
+            step("reading the capture")
+            folder = Path(args.images)
+            images = read_capture(folder, seq, len(heights), rig.profile.camera.resolution)
+        step("decode, fit, maps")
+        result = calibrate(optics, rig, images, say=print)
+        if not args.simulate:
+            for k, d in enumerate(result.decoded):
+                check_decoded(folder, k, seq, d)
+    _check_heights(result, folder)
+    report = _report(result)
+    if truth is not None:
+        report["simulation"] = {"seed": args.seed, **compare(optics, rig, result, *truth)}
+    out = Path(args.exports) / rig.name / "calibrate"
+    with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
+        st.write_bytes(out / "calibration.json", json_bytes(report))
+        st.write_bytes(out / "corrected_map.npz", _npz(result))
+        st.commit()
+    f = report["fit"]
+    print(f"calibrate {rig.name}: fit RMS {f['rms_residual_mm'] * 1e3:.2f} um over {f['residuals_used']} residuals; "
+          f"dome residual slope RMS {report['residual_slopes']['residual_slope_rms_mrad']:.3f} mrad, worst "
+          f"{report['residual_slopes']['residual_slope_worst_mrad']:.3f} mrad; wrote {out}")
+    return 0
+
+
+#: A fitted screen height further than this (mm) from its spacer's is a height the images contradict.
+HEIGHT_TOLERANCE_MM = 1.0
+
+
+def _check_heights(result, folder: Path) -> None:
+    from rigcad.calibrate import model as M
+    from rigcad.calibrate.images import CaptureError, capture_path
+
+    for k in range(len(result.heights)):
+        dz = float(result.fit.theta[len(M.RIG_NAMES) + 3 * k])
+        if abs(dz) > HEIGHT_TOLERANCE_MM:
+            raise CaptureError(f"{capture_path(folder, k, 'white')}: the images put the screen {dz:+.2f} mm from "
+                               f"its spacer's height ({result.heights[k]:g} mm above O): wrong spacer or order")
+
+
+def _report(result) -> dict:
+    return {"fit": result.fit.as_dict(), "residual_slopes": result.slope_figures(),
+            "residual_attribution": "the dome (sanded by hand); a paraboloid slope error at the paired point, "
+                                    "and low-order figure errors that a fitted tilt or offset mimics, are not "
+                                    "separable from it",
+            "decoding": [d.stats() for d in result.decoded], "screen_heights_mm": result.heights.tolist(),
+            "timings_s": result.timings_s, "camera_window": {"row0": result.cam.row0, "col0": result.cam.col0,
+                                                             "shape": list(result.cam.shape)}}
+
+
+def _npz(result) -> bytes:
+    buf = io.BytesIO()
+    c = result.corrected
+    shape = result.cam.shape + (3,)
+    np.savez_compressed(buf, direction=c["direction"].reshape(shape), uncertainty_rad=c["uncertainty_rad"].reshape(
+        result.cam.shape), source=c["source"].reshape(result.cam.shape), design=result.design.reshape(shape),
+        row0=result.cam.row0, col0=result.cam.col0, resolution=np.array(result.cam.resolution),
+        residual_slope=result.slopes.reshape(shape), about=json.dumps(
+            {"frame": "mm, O at the origin, +z up; unit directions from O towards the light",
+             "source": "0 none, 1 measured, 2 filled, 3 model only"}))
+    return buf.getvalue()
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser("calibrate", help="deflectometric calibration of the as-built rig")
+    p.add_argument("profile")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif)")
+    src.add_argument("--simulate", action="store_true", help="render a seeded simulated capture and calibrate it")
+    p.add_argument("--seed", type=int, default=2006, help="seed of the simulated misalignment and noise")
+    p.add_argument("--exports", default="exports", help="exports root (default exports)")
+    p.set_defaults(func=cmd_calibrate)
+    return p
