@@ -31,9 +31,17 @@ from rigcad.calibrate import model as M
 #: Forward-difference steps of the Jacobian, as a fraction of each parameter's tolerance: 1e-3 of
 #: 0.1 mm is 0.1 um, far above the tracer's Newton tolerance and far below the curvature scale.
 JAC_STEP = 1e-3
-#: The robust first solve's scale (mm on the screen): soft L1 above it; ~15 x the decoding noise
-#: (3 um median on Table 3.1's simulated capture).
-ROBUST_SCALE_MM = 0.05
+#: The robust first solve's scale (mm on the screen): soft L1 above it. The dome's slope errors
+#: move the screen points by ~0.2 mm (1 mrad over the ~200 mm from the dome): they stay quadratic.
+ROBUST_SCALE_MM = 0.5
+#: The tolerances as a Gaussian prior (each parameter ~ N(0, tolerance)), one residual row per
+#: parameter of this weight (mm): a ridge that holds the near-null combinations (the camera's and
+#: the paraboloid's lateral offsets with the camera's tilt: they move the rays alike) at their prior
+#: instead of letting the surface error push them millimetres away; along every well-seen direction
+#: the tens of thousands of data rows outweigh it.
+PRIOR_MM = 0.2
+#: Iterations of each solve (each costs a Jacobian: one trace per rig parameter).
+MAX_ITERATIONS = 40
 #: Outliers: residuals past this many robust sigmas are dropped before the second solve.
 OUTLIER_SIGMAS = 5.0
 
@@ -108,7 +116,7 @@ class Problem:
     def fun(self, z: np.ndarray) -> np.ndarray:
         theta = self.full(z) * self.scale
         r = self.residual_of(self.trace(theta), theta)
-        return np.where(np.isfinite(r), r, 0.0)
+        return np.concatenate([np.where(np.isfinite(r), r, 0.0), PRIOR_MM * z])
 
     def jac(self, z: np.ndarray) -> np.ndarray:
         theta = self.full(z) * self.scale
@@ -121,7 +129,7 @@ class Problem:
             tr = self.trace(t) if i < self.n_rig else base_tr
             diff = (self.residual_of(tr, t) - base) / JAC_STEP
             J[:, i] = np.where(np.isfinite(diff), diff, 0.0)  # a ray lost on either side: no slope
-        return J[:, self.free]
+        return np.vstack([J[:, self.free], PRIOR_MM * np.eye(int(self.free.sum()))])
 
 
 def fit(optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData, say=None) -> FitResult:
@@ -134,8 +142,8 @@ def fit(optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData, say=None
     # and rays near grazing meet the screen far away; soft L1 at ROBUST_SCALE_MM keeps them from
     # steering the fit
     res = least_squares(prob.fun, z0, jac=prob.jac, method="trf", loss="soft_l1", f_scale=ROBUST_SCALE_MM,
-                        xtol=1e-10, ftol=1e-10)
-    r = res.fun
+                        xtol=1e-10, ftol=1e-10, max_nfev=MAX_ITERATIONS)
+    r = res.fun[:int(prob.keep.sum())]
     sigma = 1.4826 * np.median(np.abs(r - np.median(r)))
     full = np.zeros(len(prob.keep))
     full[prob.keep] = r
@@ -145,7 +153,8 @@ def fit(optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData, say=None
         if say:
             say(f"dropping {outliers} outlying residuals (> {OUTLIER_SIGMAS:g} robust sigmas); refitting")
         prob.keep &= ~drop
-        res = least_squares(prob.fun, res.x, jac=prob.jac, method="trf", xtol=1e-10, ftol=1e-10)
+        res = least_squares(prob.fun, res.x, jac=prob.jac, method="trf", xtol=1e-10, ftol=1e-10,
+                            max_nfev=MAX_ITERATIONS)
     J = res.jac
     m, p = J.shape
     s2 = float(res.fun @ res.fun) / max(m - p, 1)
@@ -155,5 +164,6 @@ def fit(optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData, say=None
     se = np.sqrt(np.diag(cov))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
+    data = res.fun[:int(prob.keep.sum())]
     return FitResult(prob.full(res.x) * prob.scale, M.parameter_names(len(heights)), se, np.nan_to_num(corr),
-                     float(np.sqrt(np.mean(res.fun ** 2))), int(m), outliers, prob.evaluations, cov)
+                     float(np.sqrt(np.mean(data ** 2))), int(len(data)), outliers, prob.evaluations, cov)
