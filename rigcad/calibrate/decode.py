@@ -83,6 +83,9 @@ class AxisDecode:
     level: np.ndarray
     gray_failures: np.ndarray
     fringes: list[Fringes] = field(repr=False)
+    #: per finer period (levels 1..): (pixels modulated enough to refine, of which disagreed with
+    #: the coarser level)
+    disagreements: list[tuple[int, int]] = field(default_factory=list)
 
 
 def decode_axis(seq: Sequence, axis: str, images: dict[str, np.ndarray], white: np.ndarray, black: np.ndarray,
@@ -100,29 +103,33 @@ def decode_axis(seq: Sequence, axis: str, images: dict[str, np.ndarray], white: 
     ok &= ~gray_fail
     level = np.where(ok, 0, -1)
     active = ok.copy()
+    disagreements = []
     for k, p in enumerate(seq.periods[1:], start=1):
         xf = p * fr[k].phase / (2 * np.pi)
         turns = (x - xf) / p
         xf = xf + p * np.round(turns)
         agree = np.abs(turns - np.round(turns)) < PERIOD_MARGIN
-        active &= (fr[k].modulation >= min_modulation) & agree
+        active &= fr[k].modulation >= min_modulation
+        disagreements.append((int(active.sum()), int((active & ~agree).sum())))
+        active &= agree
         x = np.where(active, xf, x)
         level = np.where(active, k, level)
-    return AxisDecode(np.where(ok, x, np.nan), level, gray_fail, fr)
+    return AxisDecode(np.where(ok, x, np.nan), level, gray_fail, fr, disagreements)
 
 
 def jump_fraction(coordinate: np.ndarray, limit: float) -> float:
-    """Fraction of pairs of neighbouring decoded pixels (rows and columns) whose coordinates differ by
-    more than ``limit`` (screen px): ~0 for a capture in order (a smooth map but at the screen's
-    and the shadows' edges); a Gray bit or a period out of order tears the map into whole-period jumps
-    that no per-pixel check sees."""
+    """Fraction of runs of three neighbouring decoded pixels (along rows and columns) whose second
+    difference exceeds ``limit`` (screen px): ~0 for a capture in order, where the map is smooth
+    however steep (near grazing, neighbours see points millimetres apart) but at the screen's and the
+    shadows' edges; a Gray bit or a period out of order tears the map into whole-period steps that no
+    per-pixel check sees."""
     c = np.asarray(coordinate, float)
-    pairs = jumps = 0
-    for a, b in ((c[1:, :], c[:-1, :]), (c[:, 1:], c[:, :-1])):
-        both = np.isfinite(a) & np.isfinite(b)
-        pairs += int(both.sum())
-        jumps += int((np.abs(a - b)[both] > limit).sum())
-    return jumps / pairs if pairs else 0.0
+    runs = tears = 0
+    for second in (c[2:, :] - 2 * c[1:-1, :] + c[:-2, :], c[:, 2:] - 2 * c[:, 1:-1] + c[:, :-2]):
+        ok = np.isfinite(second)
+        runs += int(ok.sum())
+        tears += int((np.abs(second[ok]) > limit).sum())
+    return tears / runs if runs else 0.0
 
 
 @dataclass
@@ -137,7 +144,7 @@ class Decoded:
     axes: dict[str, AxisDecode]
 
     def jumps(self, stripe: float) -> dict[str, float]:
-        """Per axis, :func:`jump_fraction` at one Gray stripe (screen px)."""
+        """Per axis, :func:`jump_fraction` at one Gray stripe (screen px, half the coarsest period)."""
         return {a: jump_fraction(d.coordinate, stripe) for a, d in self.axes.items()}
 
     def stats(self) -> dict:
@@ -145,7 +152,8 @@ class Decoded:
         return {"lit_pixels": lit, "decoded_pixels": int(self.valid.sum()),
                 "gray_unwrapping_failures": {a: int(d.gray_failures.sum()) for a, d in self.axes.items()},
                 "finest_level_pixels": {a: [int((d.level == k).sum()) for k in range(len(d.fringes))]
-                                        for a, d in self.axes.items()}}
+                                        for a, d in self.axes.items()},
+                "finer_period_disagreements": {a: [list(t) for t in d.disagreements] for a, d in self.axes.items()}}
 
 
 def decode(seq: Sequence, images: dict[str, np.ndarray], min_modulation: float) -> Decoded:

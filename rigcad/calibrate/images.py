@@ -22,8 +22,12 @@ DARK_LEVEL = 0.04
 SATURATED_FRACTION = 0.05
 #: Too little modulation: fewer than this fraction of the lit pixels decoded.
 MIN_DECODED_FRACTION = 0.3
-#: Out of order: more than this fraction of neighbouring decoded pixels a Gray stripe apart.
+#: Out of order: more than this fraction of runs of three neighbouring decoded pixels with a second
+#: difference over a Gray stripe.
 MAX_JUMP_FRACTION = 0.05
+#: Out of order: a finer period disagreeing with the coarser one at more than this fraction of the
+#: pixels it modulates (a reversed or shuffled step order still fits a sinusoid, at the wrong phase).
+MAX_DISAGREEMENT = 0.2
 #: Out of order (N >= 4): the median misfit of a period's frames to a sinusoid above this.
 MAX_MISFIT = 0.35
 
@@ -97,7 +101,13 @@ def check_decoded(folder: Path, k: int, seq: Sequence, decoded) -> None:
     for axis, frac in decoded.jumps(seq.stripe).items():
         if frac > MAX_JUMP_FRACTION:
             raise CaptureError(f"{capture_path(folder, k, f'{axis}_gray0')}: the {axis} frames decode to a torn map "
-                               f"({frac:.0%} of neighbours a stripe apart): Gray or phase frames in the wrong order")
+                               f"({frac:.0%} of neighbouring pixels step by a stripe or more): Gray or phase frames in the wrong order")
+    for axis, d in decoded.axes.items():
+        for p, (tried, failed) in zip(seq.periods[1:], d.disagreements):
+            if tried and failed > MAX_DISAGREEMENT * tried:
+                raise CaptureError(f"{capture_path(folder, k, f'{axis}_p{p}_s0')}: period {p} disagrees with the "
+                                   f"coarser one at {failed / tried:.0%} of the pixels it modulates: phase frames "
+                                   "in the wrong order")
     if seq.steps > 3:
         for axis, d in decoded.axes.items():
             for p, fr in zip(seq.periods, d.fringes):
