@@ -25,6 +25,13 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from rigcad.rig import load
 
     rig = load(args.profile)
+    if getattr(args, "kit", False):
+        from rigcad.calibrate.kit import write_kit
+
+        out = Path(args.exports) / rig.name / "calibrate_kit"
+        manifest = write_kit(rig, out, say=print)
+        print(f"calibration kit for {rig.name}: {len(manifest['files'])} files in {out}")
+        return 0
     seq = Sequence.from_profile(rig.profile.calibration)
     heights = M.nominal_heights(rig.profile)
     with stages(4, "calibrate") as step:
@@ -111,6 +118,8 @@ def register(subparsers) -> argparse.ArgumentParser:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif)")
     src.add_argument("--simulate", action="store_true", help="render a seeded simulated capture and calibrate it")
+    src.add_argument("--kit", action="store_true", help="write the calibration kit: screen patterns, spacers "
+                     "(STL, STEP, manifest), the manual's page, into <exports>/<profile>/calibrate_kit")
     p.add_argument("--seed", type=int, default=2006, help="seed of the simulated misalignment and noise")
     p.add_argument("--exports", default="exports", help="exports root (default exports)")
     p.set_defaults(func=cmd_calibrate)

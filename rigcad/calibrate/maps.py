@@ -17,6 +17,8 @@ from rigcad.calibrate.raxel import rays, to_global
 from rigcad.check.figures import _angles as angle_between  # noqa: F401  (the one home of the angle between rows)
 
 SMOOTH_PX = 1.0
+#: Decoded pixels within this many of an undecoded one are filled, not measured.
+EDGE_PX = 2
 FILL_PX = 6.0
 #: A pixel counts as measured when the smoothing's weight there is at least this (of a fully
 #: decoded neighbourhood); as filled when the fill's weight is.
@@ -69,8 +71,13 @@ def corrected_map(model_tr: M.Traced, measured: np.ndarray, shape: tuple[int, in
                   cov_rig: np.ndarray) -> dict:
     """The corrected map (module docstring): ``direction`` (n, 3), ``uncertainty_rad`` (n,),
     ``source`` (n,: 0 none, 1 measured, 2 filled, 3 model only)."""
+    from scipy.ndimage import binary_erosion
+
     model = -model_tr.v
     seen = np.all(np.isfinite(measured), axis=1) & model_tr.ok
+    # a pixel next to an undecoded one sees the screen's or a shadow's edge in part of its footprint
+    # (its decoded point is pulled towards the lit part): filled from the inner ones instead
+    seen &= binary_erosion(seen.reshape(shape), iterations=EDGE_PX).ravel()
     resid = np.where(seen[:, None], measured - model, 0.0)
     sm, w1 = _smooth(resid, seen, shape, SMOOTH_PX)
     fill, w2 = _smooth(resid, seen, shape, FILL_PX)

@@ -16,7 +16,7 @@ from rigcad.calibrate.fit import FitData, fit
 from rigcad.calibrate.patterns import Sequence
 
 
-#: Pixels within this many of an undecoded pixel are left out of the fit (not of the maps).
+#: Pixels within this many of an undecoded pixel are left out of the fit (the maps fill them).
 EDGE_PX = 2
 
 
@@ -120,6 +120,9 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
         "parameters_met": int(np.sum(np.abs(err) <= target)), "parameters_total": len(names),
         "lit_pixels": int(lit.sum()),
         "corrected_incidence_error_deg": _stats(err_c), "design_incidence_error_deg": _stats(err_d),
+        "corrected_incidence_error_deg_by_source": {
+            name: _stats(err_c[result.corrected["source"][lit] == code])
+            for code, name in ((1, "measured"), (2, "filled"), (3, "model_only"))},
         "slope_pixels": int(seen.sum()), "planted_slope_rms_mrad": rms(g_p), "recovered_slope_rms_mrad": rms(g_r),
         "slope_difference_rms_mrad": rms(g_r - g_p),
     }
@@ -127,6 +130,6 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
 
 def _stats(e: np.ndarray) -> dict:
     if not e.size:
-        return {}
-    return {"p50": float(np.percentile(e, 50)), "p99": float(np.percentile(e, 99)), "max": float(e.max()),
+        return {"pixels": 0}
+    return {"pixels": int(e.size), "p50": float(np.percentile(e, 50)), "p99": float(np.percentile(e, 99)), "max": float(e.max()),
             "rms": float(np.sqrt(np.mean(e ** 2)))}

@@ -135,3 +135,28 @@ def test_a_good_capture_is_written(tmp_path, small):
     data = np.load(out / "corrected_map.npz")
     assert data["direction"].shape == small["cam"].shape + (3,)
     assert (out / "calibration.json").is_file()
+
+
+def test_kit_patterns_spacers_and_page(tmp_path, small):
+    from rigcad.calibrate.kit import write_kit
+
+    out = tmp_path / "exports" / "small" / "calibrate_kit"
+    manifest = write_kit(small["rig"], out)
+    seq = small["seq"]
+    assert manifest["frames_in_capture_order"] == seq.names()
+    with Image.open(out / "patterns" / "x_p16_s1.png") as im:
+        assert im.size == tuple(small["rig"].profile.calibration.screen_resolution) and im.mode == "L"
+        assert np.array_equal(np.asarray(im), seq.image("x_p16_s1"))
+    # the spacer's top: the holder's seat (-sample thickness) + its height; the plug's volume by hand
+    import trimesh
+
+    p = small["rig"].profile
+    for k, h in enumerate(p.calibration.spacer_heights):
+        mesh = trimesh.load_mesh(out / "stl" / f"calibration_spacer_{k}.stl")
+        assert mesh.bounds[1][2] == pytest.approx(-p.sample_holder.sample_thickness + h, abs=1e-6)
+        hs = p.sample_holder
+        vol = np.pi * (hs.radius ** 2 * (p.base_plate.thickness - hs.sample_thickness + h)
+                       + hs.stop_radius ** 2 * hs.stop_thickness)
+        assert manifest["parts"][f"calibration_spacer_{k}"]["volume_mm3"] == pytest.approx(vol, rel=1e-6)
+    page = (out / "calibration.md").read_text()
+    assert "h1_<frame>.png" in page and "Exposure" in page
