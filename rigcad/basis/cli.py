@@ -55,7 +55,12 @@ def cmd_basis(args: argparse.Namespace) -> int:
         t_images = time.perf_counter() - t0
         sim = None
         if args.simulate:
-            sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step)
+            from rigcad.calibrate import load_corrected_map
+
+            corrected = load_corrected_map(args.exports, rig.name)
+            print(f"  camera exitant directions: {'the corrected map ' + str(corrected.path) if corrected else 'the design map (no corrected map: rigcad calibrate)'}")
+            sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step,
+                                  corrected=corrected)
             paths += write_simulation(sim, out, lock, made_from)
     rep = basis.report
     z, px, sa = rep["zone"], rep["projector"], rep["solid_angle"]

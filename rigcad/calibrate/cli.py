@@ -10,10 +10,10 @@ import io
 import json
 from pathlib import Path
 
-import numpy as np
-
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from rigcad.calibrate import model as M
     from rigcad.calibrate.images import check_decoded, read_capture
     from rigcad.calibrate.patterns import Sequence
@@ -100,6 +100,8 @@ def _report(result) -> dict:
 
 
 def _npz(result) -> bytes:
+    import numpy as np
+
     buf = io.BytesIO()
     c = result.corrected
     shape = result.cam.shape + (3,)
