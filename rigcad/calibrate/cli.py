@@ -60,12 +60,18 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
                 check_decoded(folder, k, seq, d)
     _check_heights(result, folder)
     report = _report(result)
+    extra = None
     if truth is not None:
+        from rigcad.calibrate.run import truth_maps
+
         report["simulation"] = {"seed": args.seed, **compare(optics, rig, result, *truth)}
+        extra = truth_maps(optics, rig, result, *truth)
+    picture = _picture(rig.name, result, extra)
     out = Path(args.exports) / rig.name / "calibrate"
     with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
         st.write_bytes(out / "calibration.json", json_bytes(report))
         st.write_bytes(out / "corrected_map.npz", _npz(result))
+        st.write_bytes(out / "maps.png", picture)
         st.commit()
     f = report["fit"]
     print(f"calibrate {rig.name}: fit RMS {f['rms_residual_mm'] * 1e3:.2f} um over {f['residuals_used']} residuals; "
@@ -97,6 +103,23 @@ def _report(result) -> dict:
             "decoding": [d.stats() for d in result.decoded], "screen_heights_mm": result.heights.tolist(),
             "timings_s": result.timings_s, "camera_window": {"row0": result.cam.row0, "col0": result.cam.col0,
                                                              "shape": list(result.cam.shape)}}
+
+
+def _picture(name: str, result, extra) -> bytes:
+    """maps.png: decoded phase, residual slopes (and, simulated, the planted ones and both maps' errors)."""
+    import numpy as np
+
+    from rigcad import plots
+
+    shape = result.cam.shape
+    phase = result.decoded[0].axes["x"].fringes[-1].phase
+    phase = np.where(result.decoded[0].valid, phase, np.nan)
+    slope = (np.linalg.norm(result.slopes, axis=1) * 1e3).reshape(shape)
+    if extra is None:
+        return plots.calibration_maps(phase, slope, None, None, None, f"{name}: calibration")
+    return plots.calibration_maps(phase, slope, extra["planted_slope_mrad"].reshape(shape),
+                                  extra["corrected_error_deg"].reshape(shape), extra["design_error_deg"].reshape(shape),
+                                  f"{name}: simulated calibration")
 
 
 def _npz(result) -> bytes:

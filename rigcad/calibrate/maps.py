@@ -16,7 +16,7 @@ from rigcad.calibrate import model as M
 from rigcad.calibrate.raxel import rays, to_global
 from rigcad.check.figures import _angles as angle_between  # noqa: F401  (the one home of the angle between rows)
 
-SMOOTH_PX = 1.0
+SMOOTH_PX = 1.5
 #: Decoded pixels within this many of an undecoded one are filled, not measured.
 EDGE_PX = 2
 FILL_PX = 6.0

@@ -63,11 +63,13 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     fitted = M.moved(rig, result.theta)
     model_tr = M.trace_camera(optics, fitted, cam.x_px, cam.y_px, cam.design)
     measured = maps.measured_rays(decoded, poses)
-    slopes = np.where(np.isfinite(measured[:, :1]) & model_tr.ok[:, None], maps.residual_slopes(model_tr, measured),
-                      np.nan)
     n_rig = len(M.RIG_NAMES)
     jac = maps.direction_jacobian(optics, rig, cam, result.theta)
     corrected = maps.corrected_map(model_tr, measured, cam.shape, jac, result.covariance[:n_rig, :n_rig])
+    # the slopes from the smoothed measurement (the raw rays' noise, divided by 2 cos of the dome's
+    # angle of incidence, would swamp them), where measured
+    seen = (corrected["source"] == 1)[:, None]
+    slopes = np.where(seen, maps.residual_slopes(model_tr, np.where(seen, corrected["direction"], np.nan)), np.nan)
     t3 = time.perf_counter()
     from rigcad.check.sources import pixel_rays
 
@@ -126,6 +128,21 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
         "slope_pixels": int(seen.sum()), "planted_slope_rms_mrad": rms(g_p), "recovered_slope_rms_mrad": rms(g_r),
         "slope_difference_rms_mrad": rms(g_r - g_p),
     }
+
+
+def truth_maps(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -> dict:
+    """Per window pixel, for a simulation's pictures: the planted slope magnitude (mrad, where the
+    calibration measured slopes) and both maps' incidence errors (deg)."""
+    from rigcad.calibrate.simulate import surface_slopes, with_surface
+
+    cam = result.cam
+    true_rig = M.moved(rig, theta_true)
+    base = M.trace_camera(optics, true_rig, cam.x_px, cam.y_px, cam.design)
+    up = -with_surface(true_rig, surface, base).v
+    planted = np.linalg.norm(surface_slopes(true_rig, surface, base), axis=1) * 1e3
+    return {"planted_slope_mrad": np.where(np.isfinite(result.slopes[:, 0]), planted, np.nan),
+            "corrected_error_deg": np.degrees(maps.angle_between(result.corrected["direction"], up)),
+            "design_error_deg": np.degrees(maps.angle_between(result.design, up))}
 
 
 def _stats(e: np.ndarray) -> dict:
