@@ -106,6 +106,7 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
     up = -truth.v
     err_c = np.degrees(maps.angle_between(result.corrected["direction"][lit], up[lit]))
     err_d = np.degrees(maps.angle_between(result.design[lit], up[lit]))
+    err_m = np.degrees(maps.angle_between(-result.model.v[lit], up[lit]))  # the fitted model alone
     planted = surface_slopes(true_rig, surface, base)
     seen = np.isfinite(result.slopes[:, 0]) & np.isfinite(planted[:, 0])
     g_p, g_r = planted[seen], result.slopes[seen]
@@ -122,6 +123,7 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
         "parameters_met": int(np.sum(np.abs(err) <= target)), "parameters_total": len(names),
         "lit_pixels": int(lit.sum()),
         "corrected_incidence_error_deg": _stats(err_c), "design_incidence_error_deg": _stats(err_d),
+        "fitted_model_incidence_error_deg": _stats(err_m),
         "corrected_incidence_error_deg_by_source": {
             name: _stats(err_c[result.corrected["source"][lit] == code])
             for code, name in ((1, "measured"), (2, "filled"), (3, "model_only"))},
