@@ -6,9 +6,10 @@ pixel -> incidence map come from those rays (docs/calibrate.md).
 
 Modules: ``patterns`` (what the screen shows), ``decode`` (camera images -> screen points),
 ``raxel`` (screen points -> rays), ``model`` (the rig's tracer as the forward model), ``simulate``
-(the images a capture would give), ``fit`` (least squares, residual slopes, corrected map),
-``images`` (reading and checking a capture), ``run`` (the command's stages), ``kit`` (screen PNGs,
-spacers, the manual's page)."""
+(the images a capture would give), ``fit`` (the misalignment by least squares), ``maps`` (measured
+rays, residual slopes, the corrected map), ``images`` (reading and checking a capture), ``run`` (the
+stages, and a simulation's comparison with what was planted), ``kit`` (screen PNGs, spacers, the
+manual's page), ``cli`` (the command)."""
 
 from __future__ import annotations
 
