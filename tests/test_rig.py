@@ -34,8 +34,8 @@ def _calls(path: Path, names: set[str]) -> set[str]:
 
 def test_no_stage_derives_the_geometry_or_integrates_a_dome_itself():
     """Only the Rig builds the geometry and the dome (rigcad/rig.py); `profile show` prints a
-    profile's derived figures without a dome (cli.py, derive only). The stages take a Rig."""
-    allowed = {"rig.py": {"derive", "converged_dome"}, "cli.py": {"derive"},
+    profile's derived figures without a dome (cli/profile.py, derive only). The stages take a Rig."""
+    allowed = {"rig.py": {"derive", "converged_dome"}, "cli/profile.py": {"derive"},
                # the definitions themselves, and the integrator that converged_dome drives
                "profile/derived.py": set(), "optics/design.py": {"build_dome"},
                # the optimiser derives each candidate design's closed-form geometry (never a dome: its
@@ -216,7 +216,7 @@ def test_part_is_a_build123d_part_with_cadquery_and_mesh(table31_rig):
 
 
 def _run(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "rigcad.cli", *args], cwd=cwd, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "rigcad", *args], cwd=cwd, capture_output=True, text=True,
                           timeout=600)
 
 

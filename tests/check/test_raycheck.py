@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rigcad.check import cli as check_cli
+from rigcad.cli import check as check_cli
 from rigcad.check.raycheck import run_raycheck, write_raycheck
 from rigcad.check.tolerances import raise_if_failed, table
 from rigcad.errors import CheckError, RigcadError

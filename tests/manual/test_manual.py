@@ -194,7 +194,7 @@ def test_the_manual_is_deterministic(table31_rig, fab_reports, written):
 
 
 def test_rigcad_manual_refuses_an_unknown_printer_in_one_line(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "rigcad.cli", "manual", "achutha2006", "--printer", "nosuch",
+    run = subprocess.run([sys.executable, "-m", "rigcad", "manual", "achutha2006", "--printer", "nosuch",
                           "--exports", str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert run.returncode != 0 and run.stderr.startswith("rigcad: error:") and len(run.stderr.splitlines()) == 1
     assert "nosuch" in run.stderr and not any(tmp_path.iterdir())

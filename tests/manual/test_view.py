@@ -195,7 +195,7 @@ def test_in_chromium_no_request_leaves_the_page_and_the_canvas_draws_the_rig(vie
 
 
 def test_rigcad_view_writes_the_page_and_the_picture(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "rigcad.cli", "view", "achutha2006", "--exports", str(tmp_path),
+    run = subprocess.run([sys.executable, "-m", "rigcad", "view", "achutha2006", "--exports", str(tmp_path),
                           "--rays", "60"], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     out = tmp_path / "achutha2006" / "view"

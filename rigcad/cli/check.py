@@ -1,4 +1,4 @@
-"""``rigcad check PROFILE``: the 3D ray check from the command line (wired by rigcad.cli)."""
+"""``rigcad check PROFILE``: the 3D ray check from the command line."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """``rigcad basis PROFILE [--order N] [--exports DIR] [--alpha-deg A] [--lowdin] [--simulate]``: the
 projector images of the zonal basis, their Gram matrices and (``--simulate``) the simulated
-acquisition on the rig, from the command line (wired into rigcad.cli by :func:`register`)."""
+acquisition on the rig, from the command line."""
 
 from __future__ import annotations
 

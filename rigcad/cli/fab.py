@@ -1,5 +1,5 @@
 """`rigcad fab PROFILE --printer NAME [--exports DIR] [--gcode] [--parts ...] [--jobs N]`:
-the fabrication stage from the command line. Wired into rigcad.cli by :func:`register`."""
+the fabrication stage from the command line."""
 
 from __future__ import annotations
 
@@ -74,7 +74,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
 
 
 def register(subparsers) -> argparse.ArgumentParser:
-    """Add the `fab` command to rigcad's subparsers (rigcad.cli.build_parser)."""
+    """Add the `fab` command to rigcad's subparsers (rigcad.cli.main.build_parser)."""
     from rigcad.arguments import positive_int
     from rigcad.profile.paths import PRINTERS_SUBDIR, names_on_search_path  # not fab.printers: no numpy for --help
 

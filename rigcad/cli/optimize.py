@@ -1,4 +1,4 @@
-"""``rigcad optimize PROFILE``: inverse design from the command line (wired by rigcad.cli)."""
+"""``rigcad optimize PROFILE``: inverse design from the command line."""
 
 from __future__ import annotations
 
