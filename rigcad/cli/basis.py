@@ -7,7 +7,6 @@ from __future__ import annotations
 import argparse
 import math
 import time
-from pathlib import Path
 
 
 def _order(text: str):
@@ -19,11 +18,10 @@ def _order(text: str):
 
 
 def cmd_basis(args: argparse.Namespace) -> int:
-    from rigcad.basis.acquire import simulate_on_rig, simulation_steps, write_simulation
-    from rigcad.basis.projector import BASIS_STEPS, check_basis_order, projector_basis, write_basis
+    from rigcad import api
+    from rigcad.basis.acquire import simulate_on_rig, simulation_steps
+    from rigcad.basis.projector import BASIS_STEPS, check_basis_order
     from rigcad.progress import stages
-    from rigcad.export.atomic import profile_lock
-    from rigcad.export.manifest import profile_digest
     from rigcad.rig import load
 
     order = check_basis_order(_order(args.order))  # before any work: a bad order is one line, nothing written
@@ -42,21 +40,19 @@ def cmd_basis(args: argparse.Namespace) -> int:
                              f"{profile.camera.resolution[1]} px camera would be sampled at fewer than 2 x 2 pixels; "
                              f"valid: 1..{largest}")
     rig = load(profile)
-    out = Path(args.exports) / rig.name / "basis"
-    # the one lock of everything under exports/<profile>: a design or build publishing the whole
-    # folder meanwhile waits, instead of deleting this run's staging folder
-    lock = profile_lock(args.exports, rig.name)
-    made_from = profile_digest(rig.profile)
+    # written under the one lock of everything under exports/<profile>: a design or build publishing
+    # the whole folder meanwhile waits, instead of deleting this run's staging folder
+    out = api.default_folder(rig.name, "basis", root=args.exports)
     total = BASIS_STEPS + (order + 1) ** 2 + 1 + (simulation_steps() if args.simulate else 0)
     t0 = time.perf_counter()
     with stages(total, f"basis {rig.name}") as step:
-        basis = projector_basis(rig, order, alpha_rad=alpha, progress=step)
-        paths = write_basis(basis, out, lowdin_images=args.lowdin, progress=step, lock=lock, made_from=made_from)
+        basis = api.basis(rig, order, alpha, progress=step)
+        paths = api.write_basis(rig, basis, out, lowdin_images=args.lowdin, progress=step)
         t_images = time.perf_counter() - t0
         sim = None
         if args.simulate:
             sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step)
-            paths += write_simulation(sim, out, lock, made_from)
+            paths += api.write_simulation(rig, sim, out)
     rep = basis.report
     z, px, sa = rep["zone"], rep["projector"], rep["solid_angle"]
     print(f"{rig.name}: zonal basis to order {order} ({rep['functions']} functions) over "

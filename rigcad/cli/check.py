@@ -59,10 +59,9 @@ def checked_counts(profile, rays: int | None, builds: int | None) -> None:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from rigcad.check.raycheck import run_raycheck, write_raycheck
+    from rigcad import api
     from rigcad.check.tolerances import raise_if_failed, table
-    from rigcad.export.atomic import check_exports, profile_lock
-    from rigcad.export.manifest import profile_digest
+    from rigcad.export.atomic import check_exports
     from rigcad.profile import load_profile
     from rigcad.rig import load
 
@@ -74,7 +73,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     from rigcad.check.trace3d import counting
 
     exports = Path(args.exports)
-    mirrors = exports / profile.name / "mirrors"
+    mirrors = api.default_folder(profile.name, "mirrors", root=exports)
     missing = [n for n in ("paraboloid", "dome") if not (mirrors / f"{n}.ply").is_file()]
     if missing and (args.mode or profile.raycheck.mode) != "analytic":
         print(f"note: no exported {' and '.join(missing)} mesh in {mirrors}/ (run `rigcad stl {args.profile}`): "
@@ -86,10 +85,9 @@ def cmd_check(args: argparse.Namespace) -> int:
                 print(f"  {label} ...", file=sys.stderr)
 
         with counting(bar):
-            result = run_raycheck(rig, exports=exports, rays=args.rays, mode=args.mode,
-                                  monte_carlo=not args.no_monte_carlo, builds=args.builds, progress=step)
-    paths = write_raycheck(result, exports / profile.name / "check", profile_lock(exports, profile.name),
-                           made_from=profile_digest(profile))
+            result = api.check(rig, args.rays, args.mode, exports, monte_carlo=not args.no_monte_carlo,
+                               builds=args.builds, progress=step)
+    paths = api.write_check(rig, result, api.default_folder(profile.name, "check", root=exports))
     rep = result.report
     main = rep["readings"][rep["mode"]]
     print(f"{profile.name}: mode {rep['mode']}, {rep['rays']} rays, backend {rep['backend']}")

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from rigcad.units import hours_minutes
 
@@ -14,8 +13,9 @@ def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.fab.printers import load_printer
 
     printer = load_printer(args.printer)  # first: a refused printer file costs no rig and no CAD kernel import
-    from rigcad.progress import stages
+    from rigcad import api
     from rigcad.export.build import select_parts
+    from rigcad.progress import stages
     from rigcad.export.atomic import check_exports
     from rigcad.profile import load_profile
     from rigcad.rig import load
@@ -23,7 +23,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "fab")  # a planted link or lock: one line now, not after the work
     rig = load(profile)
-    out = Path(args.exports) / profile.name / "fab" / printer.name
+    out = api.default_folder(profile.name, "fab", printer.name, root=args.exports)
     names = select_parts(args.parts)
     with stages(len(names), f"fab {profile.name}") as step:
         def progress(msg: str) -> None:
@@ -31,7 +31,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
             if args.verbose:
                 print(f"  {msg}", file=sys.stderr)
 
-        res = rig.fab(printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs, progress=progress,
+        res = api.fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs, progress=progress,
                       slicing=lambda total: stages(total, f"slicing ({printer.slicer})"))
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")

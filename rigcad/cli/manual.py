@@ -9,11 +9,12 @@ from pathlib import Path
 
 
 def cmd_manual(args: argparse.Namespace) -> int:
-    from rigcad.progress import stages
+    from rigcad import api
     from rigcad.export.atomic import check_exports, profile_lock
     from rigcad.fab.printers import load_printer
     from rigcad.manual.document import write_manual
     from rigcad.profile import load_profile
+    from rigcad.progress import stages
     from rigcad.rig import load
 
     printer = load_printer(args.printer)  # a refused printer file costs no rig
@@ -23,7 +24,7 @@ def cmd_manual(args: argparse.Namespace) -> int:
     root = Path(args.exports) / rig.name
     total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
     with stages(total, f"manual {rig.name} ({printer.name})") as step:
-        fab = rig.fab(printer, root / "fab" / printer.name, gcode=args.gcode, progress=step)
+        fab = api.fab(rig, printer, root / "fab" / printer.name, gcode=args.gcode, progress=step)
         for problem in fab.problems:
             print(f"rigcad: fab: {problem}", file=sys.stderr)
         out = root / "manual" / printer.name

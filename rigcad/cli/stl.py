@@ -3,25 +3,20 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
-
+from rigcad import api
 from rigcad.cli.build import part_lines
-from rigcad.export.atomic import check_exports, profile_lock, tidy
+from rigcad.export.atomic import check_exports
 from rigcad.progress import stages
 
 
 def cmd_stl(args: argparse.Namespace) -> int:
     """The main job: design + build, returning at once when nothing changed since the last run."""
-    from rigcad.export.atomic import stale_results
-    from rigcad.export.manifest import inputs_key, profile_digest, up_to_date
     from rigcad.profile import load_profile
 
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name)
-    out = Path(args.exports) / profile.name
-    key = inputs_key(profile)
-    if up_to_date(out, key) and not stale_results(out, profile_digest(profile)):  # else a build removes them
-        tidy(out, profile_lock(args.exports, profile.name))
+    out = api.default_folder(profile.name, root=args.exports)
+    if api.export_up_to_date(profile, out):
         print(f"{profile.name}: up to date ({out}/manifest.json)")
         return 0
     from rigcad.parts import PARTS
@@ -32,7 +27,7 @@ def cmd_stl(args: argparse.Namespace) -> int:
         step("dome integrated")
         rig.design  # traced here, for the progress bar; the export reuses it
         step("design traced")
-        result = rig.export(out, progress=step)  # the Python API's path: the same lock and cache key
+        result = api.export(rig, out, progress=step)
     env = rig.design.report["envelope"]
     print(f"{profile.name}: dome mirror {env['width_in']:.2f} x {env['height_in']:.2f} in; "
           f"{len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
