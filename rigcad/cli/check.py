@@ -98,6 +98,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     if meshed and not missing:
         print(f"  note: meshed from the profile, not the exports: {', '.join(meshed)}", file=sys.stderr)
     print(table(result.rows))
+    if args.verbose:  # the run's times: not in raycheck.json, which is the same bytes on every run
+        for stage, seconds in result.timings_s.items():
+            print(f"  time {stage}: {seconds:.2f} s", file=sys.stderr)
     for p in paths:
         print(f"  wrote {p}")
     raise_if_failed(result.rows, profile.name)
@@ -120,6 +123,6 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--mode", choices=("mesh", "smooth", "analytic"), help="reading checked (default: raycheck.mode)")
     p.add_argument("--builds", type=positive_int, help="Monte Carlo builds (default: tolerancing.builds)")
     p.add_argument("--no-monte-carlo", action="store_true", help="skip the Monte Carlo tolerance analysis")
-    p.add_argument("-v", "--verbose", action="store_true", help="print stages on stderr")
+    p.add_argument("-v", "--verbose", action="store_true", help="print stages and their times on stderr")
     p.set_defaults(func=cmd_check)
     return p

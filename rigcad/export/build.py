@@ -77,49 +77,19 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
     step = progress or (lambda label: None)
     profile, layout = rig.profile, rig.layout
     names = select_parts(parts)
-    rebuilt, reused = [], []
-    shapes: dict[str, object] = {}
+    shapes: dict[str, object] = {}  # part -> its solid, built once for its files and the assembly
     tol = profile.tessellation
 
     # results (check/, fab/<printer>/, ...) made from another profile are not carried into this build
     with Staging(out, lock, results_of=profile_digest(profile)) as stage:
         old = _read_manifest(out / "manifest.json")
-        old_parts = old.get("parts", {})
-        entries = dict(old_parts)
         design_shas = {}
         for name, data in (design or {}).items():
             stage.write_bytes(out / name, data)
             design_shas[name] = _sha(data)
-        for name in names:
-            part = rig.recipe(name)
-            key = part_key(part, profile)
-            if _cached(old_parts.get(name), key, out):
-                reused.append(name)
-                step(f"{name} (unchanged)")
-                continue
-            step(name)
-            entries[name] = _build_part(part, key, rig, out, stage, shapes)
-            rebuilt.append(name)
-
-        mirrors = dict(old.get("mirrors", {}))
-        for name in names:
-            for mirror, meridian in rig.recipe(name).mirrors:
-                key = _mirror_key(meridian, profile)
-                if _cached(mirrors.get(mirror), key, out):
-                    continue
-                step(f"{mirror} mirror mesh")
-                mirrors[mirror] = _build_mirror(mirror, meridian, key, profile, out, stage)
-
-        rig_parts = [n for n in PARTS if n in entries and entries[n].get("in_rig")]
-        # the instruments and COP markers (parts.tower.instruments) join the printed parts in rig.step
-        asm_key = hashlib.sha256("|".join([entries[n]["key"] for n in rig_parts]
-                                          + [f"{p.name}:{p.content_hash()}" for p in rig.instruments]).encode()).hexdigest()
-        asm_old = old.get("assembly")
-        if rig_parts and not _cached(asm_old, asm_key, out):
-            step("assembly")
-            assembly = _build_assembly(rig_parts, rig, out, stage, shapes, asm_key)
-        else:
-            assembly = asm_old
+        entries, rebuilt, reused = _build_parts(rig, names, old.get("parts", {}), out, stage, shapes, step)
+        mirrors = _build_mirrors(rig, names, old.get("mirrors", {}), out, stage, step)
+        assembly = _assembly(rig, entries, old.get("assembly"), out, stage, shapes, step)
         manifest = {
             "rigcad_version": __version__,
             "profile": {"name": profile.name, "sources": list(profile.sources), "sha256": profile_digest(profile)},
@@ -145,6 +115,51 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
         step("publishing")
         written = stage.commit()
     return BuildResult(manifest, rebuilt, reused, written)
+
+
+def _build_parts(rig, names: list[str], old_parts: dict, out: Path, stage: Staging, shapes: dict,
+                 step) -> tuple[dict, list[str], list[str]]:
+    """Build each part of ``names`` whose key changed since the previous manifest (``old_parts``) or
+    whose files are not intact; the manifest's part entries (the others carried over), and the
+    parts rebuilt and reused."""
+    entries, rebuilt, reused = dict(old_parts), [], []
+    for name in names:
+        part = rig.recipe(name)
+        key = part_key(part, rig.profile)
+        if _cached(old_parts.get(name), key, out):
+            reused.append(name)
+            step(f"{name} (unchanged)")
+            continue
+        step(name)
+        entries[name] = _build_part(part, key, rig, out, stage, shapes)
+        rebuilt.append(name)
+    return entries, rebuilt, reused
+
+
+def _build_mirrors(rig, names: list[str], old_mirrors: dict, out: Path, stage: Staging, step) -> dict:
+    """The mirror meshes (PLY) of the parts ``names``, each rebuilt when its key changed or its file
+    is not intact; the manifest's mirror entries."""
+    mirrors = dict(old_mirrors)
+    for name in names:
+        for mirror, meridian in rig.recipe(name).mirrors:
+            key = _mirror_key(meridian, rig.profile)
+            if _cached(mirrors.get(mirror), key, out):
+                continue
+            step(f"{mirror} mirror mesh")
+            mirrors[mirror] = _build_mirror(mirror, meridian, key, rig.profile, out, stage)
+    return mirrors
+
+
+def _assembly(rig, entries: dict, previous: dict | None, out: Path, stage: Staging, shapes: dict, step) -> dict | None:
+    """rig.step, the assembly of the in-rig parts with the instruments and COP markers
+    (parts.tower.instruments), rebuilt when any of them changed; the manifest's entry."""
+    rig_parts = [n for n in PARTS if n in entries and entries[n].get("in_rig")]
+    key = hashlib.sha256("|".join([entries[n]["key"] for n in rig_parts]
+                                  + [f"{p.name}:{p.content_hash()}" for p in rig.instruments]).encode()).hexdigest()
+    if rig_parts and not _cached(previous, key, out):
+        step("assembly")
+        return _build_assembly(rig_parts, rig, out, stage, shapes, key)
+    return previous
 
 
 def _tower_hardware(rig) -> list[dict]:

@@ -172,7 +172,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     from rigcad import plots
     from rigcad.export import mesh as M
     from rigcad.manual import assembly as A
-    from rigcad.manual.assembly import rig_meshes
+    from rigcad.manual.assembly import picture_meshes
     from rigcad.manual.view import traced_rays
     from rigcad.parts.templates import gauged_depth
 
@@ -180,7 +180,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     p = rig.profile
     bill = B.bill(rig, fab_report, printer)
     files: dict[str, bytes] = {}
-    meshes = rig_meshes(rig)
+    meshes = picture_meshes(rig)
     cut_away = A.encloses(meshes)
     files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
                                                 cut_away=cut_away)

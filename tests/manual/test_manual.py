@@ -177,10 +177,10 @@ def test_the_manual_is_written_with_its_pictures_and_one_self_contained_page(wri
     assert f"| {pins['item']} | {pins['quantity']} |" in md
     assert "M4 x 25 mm socket-head bolt" in md
     assert (out / "calibration" / "circle.png").is_file()
-    from rigcad.manual.assembly import rig_meshes, steps
+    from rigcad.manual.assembly import picture_meshes, steps
 
     shots = sorted(p.name for p in (out / "images").glob("step_*.png"))
-    assert len(shots) == len(steps(rig_meshes(table31_rig))) and "step_05_dome.png" in shots
+    assert len(shots) == len(steps(picture_meshes(table31_rig))) and "step_05_dome.png" in shots
     assert md.count("### Step ") == len(shots)
 
 
