@@ -98,10 +98,11 @@ def cmd_basis(args: argparse.Namespace) -> int:
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``basis`` to rigcad's subcommands."""
     from rigcad.basis import CAMERA_STRIDE_PX
-    from rigcad.arguments import positive_int
+    from rigcad.arguments import positive_int, profile_command
 
-    p = subparsers.add_parser(
-        "basis", help="zonal basis images for the projector, Gram matrices, simulated acquisition",
+    p = profile_command(
+        subparsers, "basis", cmd_basis,
+        help="zonal basis images for the projector, Gram matrices, simulated acquisition",
         description="Compute the zonal basis functions (thesis 3.3) at every projector pixel's incidence "
                     "direction (the rig's own map; pixels that do not reach the sample black), preprocess them as "
                     "thesis 4.2.1 (one scale, positive and negative parts, 8 and 16 bit) and write "
@@ -110,9 +111,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "matrices over the lit pixels, the re-orthonormalised set). --simulate adds the thesis's "
                     "basis validation (3.3.1) on the rig as designed and moved within its tolerances: "
                     "simulation.json and simulation.png.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--order", default="6", help="largest l, 0..12 (default 6: thesis 3.3.1, specular materials)")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--alpha-deg", type=float, help="the zone's lower edge in degrees (default: the rig's occlusion "
                                                    "limit, its lowest measurable incidence angle)")
     p.add_argument("--lowdin", action="store_true", help="also write the re-orthonormalised (Loewdin) images")
@@ -121,5 +120,4 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--camera-stride-px", type=positive_int, default=CAMERA_STRIDE_PX,
                    help=f"simulate every N-th camera pixel in both directions (default {CAMERA_STRIDE_PX}: ~50 "
                         "exitant directions)")
-    p.set_defaults(func=cmd_basis)
     return p

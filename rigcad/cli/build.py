@@ -44,15 +44,15 @@ def cmd_build(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Add ``build`` to rigcad's subcommands."""
-    p = subparsers.add_parser(
-        "build", help="3D parts: STEP and STL per part, rig assembly, manifest",
+    from rigcad.arguments import profile_command
+
+    p = profile_command(
+        subparsers, "build", cmd_build,
+        help="3D parts: STEP and STL per part, rig assembly, manifest",
         description="Build the rig's parts into exports/<profile>/: step/<part>.step (exact B-rep, re-imported "
                     "and checked), stl/<part>.stl (at tessellation.chord_error), rig.step (the assembly, named "
                     "and coloured parts) and manifest.json. Unchanged parts are not rebuilt.",
         epilog="parts: dome, paraboloid, beam, base_plate, sample_holder, projector_cross, projector_backplate, "
                "projector_mounting_plate, camera_cross_hung, camera_cross_base, dome_template, paraboloid_template, "
                "tower_column, tower_shelf, splitter_holder, lens_mount, tower_shim")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--parts", nargs="+", metavar="PART", help="build only these parts (default: all)")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
-    p.set_defaults(func=cmd_build)

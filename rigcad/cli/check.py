@@ -109,20 +109,18 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``check`` to rigcad's subcommands."""
-    from rigcad.arguments import positive_int
+    from rigcad.arguments import positive_int, profile_command
 
-    p = subparsers.add_parser(
-        "check", help="3D ray check: trace the mirror meshes, compare with the exact surfaces and the targets",
+    p = profile_command(
+        subparsers, "check", cmd_check,
+        help="3D ray check: trace the mirror meshes, compare with the exact surfaces and the targets",
         description="Trace rays from the COP through the mirror meshes (Embree; exported PLYs when present, "
                     "else meshed from the profile), the exact surfaces and the occluders; write "
                     "exports/<profile>/check/{raycheck.json, spot.png, theta_map.png}; exit 1 with a table when "
                     "a tolerance declared in the profile (raycheck.*, tolerancing.*) is not met.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
-    p.add_argument("--exports", default="exports", help="exports root (default: exports)")
     p.add_argument("--rays", type=positive_int, help="pinhole rays (default: raycheck.rays)")
     p.add_argument("--mode", choices=("mesh", "smooth", "analytic"), help="reading checked (default: raycheck.mode)")
     p.add_argument("--builds", type=positive_int, help="Monte Carlo builds (default: tolerancing.builds)")
     p.add_argument("--no-monte-carlo", action="store_true", help="skip the Monte Carlo tolerance analysis")
     p.add_argument("-v", "--verbose", action="store_true", help="print stages and their times on stderr")
-    p.set_defaults(func=cmd_check)
     return p

@@ -11,12 +11,13 @@ from rigcad.progress import stages
 
 
 def cmd_design(args: argparse.Namespace) -> int:
-    from rigcad.export.design import write_design
     from rigcad.profile import load_profile
+
+    profile = load_profile(args.profile)  # first: a refused profile is one line, before numpy is imported
+    check_exports(args.exports, profile.name)  # a planted link or lock: one line now, not after the work
+    from rigcad.export.design import write_design
     from rigcad.rig import load
 
-    profile = load_profile(args.profile)
-    check_exports(args.exports, profile.name)  # a planted link or lock: one line now, not after the work
     with stages(3, "design") as step:
         rig = load(profile)
         step("dome integrated")
@@ -42,10 +43,10 @@ def cmd_design(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Add ``design`` to rigcad's subcommands."""
-    p = subparsers.add_parser(
-        "design", help="2D optical design: dome profile, ray diagram, derived figures",
+    from rigcad.arguments import profile_command
+
+    p = profile_command(
+        subparsers, "design", cmd_design,
+        help="2D optical design: dome profile, ray diagram, derived figures",
         description="Integrate the dome profile, trace the design in 2D (pinhole, thin lens, misalignment) "
                     "and write exports/<profile>/design.json, dome_profile.csv, rays.png and incidence.png.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
-    p.set_defaults(func=cmd_design)

@@ -75,24 +75,22 @@ def cmd_fab(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add the `fab` command to rigcad's subparsers (rigcad.cli.main.build_parser)."""
-    from rigcad.arguments import positive_int
+    from rigcad.arguments import positive_int, profile_command
     from rigcad.profile.paths import PRINTERS_SUBDIR, names_on_search_path  # not fab.printers: no numpy for --help
 
-    p = subparsers.add_parser(
-        "fab", help="fabrication: fit/split, print orientation, staircase, G-code, cutting outlines, report",
+    p = profile_command(
+        subparsers, "fab", cmd_fab,
+        help="fabrication: fit/split, print orientation, staircase, G-code, cutting outlines, report",
         description="Fit every part to a printer (splitting it into pinned pieces when it does not fit), orient "
                     "each piece for the least staircase on its mirror, slice it in-process (layers, staircase map, "
                     "polishing allowance, optical effect), write STL in print position, G-code through PrusaSlicer "
                     "(--gcode), DXF/SVG outlines of the templates, fab.json and fab.md into "
                     "exports/<profile>/fab/<printer>/.",
         epilog="printers: " + ", ".join(names_on_search_path(PRINTERS_SUBDIR)) + "; parts: as for `rigcad build --help`")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--printer", required=True, help="printer name (under profiles/printers/) or path")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--gcode", action="store_true", help="also slice with PrusaSlicer (printers with slicer: prusa-slicer)")
     p.add_argument("--parts", nargs="+", metavar="PART", help="only these parts (default: all)")
     p.add_argument("--jobs", type=positive_int, default=None, help="slicer processes at once (default: cores, at most 4)")
     p.add_argument("--timings", action="store_true", help="print the time of each stage and slicer run")
     p.add_argument("-v", "--verbose", action="store_true", help="name each part as it is processed")
-    p.set_defaults(func=cmd_fab)
     return p

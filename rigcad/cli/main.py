@@ -55,10 +55,9 @@ def _error_line(message: object) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)  # --help and a bad argument end here: no engine, no numpy
     from rigcad.engine import run_temp_dir
 
-    parser = build_parser()
-    args = parser.parse_args(argv)
     try:
         with run_temp_dir():
             return args.func(args)

@@ -37,17 +37,17 @@ def cmd_manual(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Add ``manual`` to rigcad's subcommands."""
-    m = subparsers.add_parser(
-        "manual", help="assembly and calibration manual with the bill of materials, for a profile and a printer",
+    from rigcad.arguments import profile_command
+
+    m = profile_command(
+        subparsers, "manual", cmd_manual,
+        help="assembly and calibration manual with the bill of materials, for a profile and a printer",
         description="Write exports/<profile>/manual/<printer>/: manual.md and manual.html (printable, self-contained) "
                     "with the bill of materials (printed pieces with time and filament from `rigcad fab`, bolts, "
                     "nuts, dowel pins, optics, paint and clearcoat volumes), the steps (print, sand, coat, "
                     "assemble with exploded views, calibrate as thesis 4.1.1) and the calibration image at the "
                     "projector's resolution. Runs `rigcad fab` for the printer when its report is missing or stale.")
-    m.add_argument("profile", help="profile name (under profiles/) or path")
     m.add_argument("--printer", required=True, help="printer name (under printers/ on the profile search path) or path")
-    m.add_argument("--exports", default="exports", help="output root (default: exports)")
     m.add_argument("--gcode", action="store_true",
                    help="slice the pieces with PrusaSlicer so that times and filament are the slicer's (cached "
                         "per piece); default: rigcad's estimate")
-    m.set_defaults(func=cmd_manual)

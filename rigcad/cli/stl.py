@@ -37,11 +37,11 @@ def cmd_stl(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Add ``stl`` to rigcad's subcommands."""
-    p = subparsers.add_parser(
-        "stl", help="the main job (make stl): design + build, skipped when nothing changed",
+    from rigcad.arguments import profile_command
+
+    p = profile_command(
+        subparsers, "stl", cmd_stl,
+        help="the main job (make stl): design + build, skipped when nothing changed",
         description="Run `design` then `build` for every part, recording the inputs' hash in manifest.json; "
                     "when the profile and rigcad's code are unchanged and every listed file is intact, "
                     "return at once.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
-    p.set_defaults(func=cmd_stl)

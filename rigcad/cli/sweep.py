@@ -64,16 +64,15 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Add ``sweep`` to rigcad's subcommands."""
-    from rigcad.arguments import positive_int
+    from rigcad.arguments import positive_int, profile_command
 
-    s = subparsers.add_parser(
-        "sweep", help="parameter sweep: one row per design (design, check and printer-fit figures)",
+    s = profile_command(
+        subparsers, "sweep", cmd_sweep,
+        help="parameter sweep: one row per design (design, check and printer-fit figures)",
         description="Build one design per value of --set section.key=A..B:N (or v1,v2,...; units as in a "
                     "profile, e.g. layout.cop_to_vertex=25cm..35cm:21) on the same engine as tolerance; write "
                     "exports/<profile>/sweep/<key>/{sweep.csv, sweep.json, sweep.png}.")
-    s.add_argument("profile", help="profile name (under profiles/) or path")
     s.add_argument("--set", required=True, metavar="SECTION.KEY=A..B:N", help="the swept key and its values")
     s.add_argument("--rays", type=positive_int, default=20000, help="pinhole rays of each design's check (default 20000)")
     s.add_argument("--printer", default="prusa_mk3s", help="printer for the fit column, or 'none' (default prusa_mk3s)")
     engine_args(s)
-    s.set_defaults(func=cmd_sweep)

@@ -128,7 +128,7 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
 
 
 def engine_args(p: argparse.ArgumentParser) -> None:
-    """``--workers``, ``--scheduler`` and ``--exports``, shared by ``tolerance`` and ``sweep``."""
+    """``--workers`` and ``--scheduler``, shared by ``tolerance`` and ``sweep``."""
     from rigcad.arguments import worker_count
 
     p.add_argument("--workers", type=worker_count, default=0,
@@ -136,22 +136,20 @@ def engine_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scheduler", metavar="ADDR",
                    help="run the tasks on Dask: a dask.distributed scheduler address (tcp://host:8786) or "
                         "'local-dask' (a LocalCluster of --workers processes); needs pip install 'rigcad[dask]'")
-    p.add_argument("--exports", default="exports", help="exports root (default: exports)")
 
 
 def register(subparsers) -> None:
     """Add ``tolerance`` to rigcad's subcommands."""
-    from rigcad.arguments import positive_int
+    from rigcad.arguments import positive_int, profile_command
 
-    p = subparsers.add_parser(
-        "tolerance", help="Monte Carlo tolerancing at scale: per-sample table, sensitivity, inverse limits",
+    p = profile_command(
+        subparsers, "tolerance", cmd_tolerance,
+        help="Monte Carlo tolerancing at scale: per-sample table, sensitivity, inverse limits",
         description="Trace --samples random builds (tolerancing.*) through the analytic tracer on this machine's "
                     "cores (joblib) or Dask; write exports/<profile>/tolerance/{samples.parquet, samples.csv, "
                     "summary.json, tolerance.md, histograms.png, sensitivity.png, run.json}. Exit 1 when the "
                     "yield is below tolerancing.min_yield.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--samples", type=positive_int, help="random builds (default: tolerancing.builds)")
     p.add_argument("--rays", type=positive_int, help="pinhole rays per light path (default: tolerancing.rays)")
     p.add_argument("--no-limits", action="store_true", help="skip the sensitivity ranking and inverse limits")
     engine_args(p)
-    p.set_defaults(func=cmd_tolerance)

@@ -39,15 +39,13 @@ def cmd_view(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Add ``view`` to rigcad's subcommands."""
-    from rigcad.arguments import positive_int
+    from rigcad.arguments import positive_int, profile_command
 
-    p = subparsers.add_parser(
-        "view", help="the assembled rig in 3D: one self-contained HTML file (three.js inline, no network)",
+    p = profile_command(
+        subparsers, "view", cmd_view,
+        help="the assembled rig in 3D: one self-contained HTML file (three.js inline, no network)",
         description="Write exports/<profile>/view/rig.html: the assembled rig (parts toggled by name), a few hundred "
                     "rays traced through the exact surfaces and coloured by incidence angle, an exploded view; one "
                     "file with three.js and the geometry inside, nothing loaded from the network. Also "
                     "exports/<profile>/view/rig.png, a picture of the assembled rig.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--rays", type=positive_int, default=300, help="rays traced from the COP (default: 300)")
-    p.set_defaults(func=cmd_view)
