@@ -115,113 +115,130 @@ def shelf_bottom_z(profile: Profile, cop_z: float) -> float:
             - shims_nominal(profile) * tw.shim_thickness - 2 * tw.wall)
 
 
-def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z: float) -> TowerLayout:
-    """Place the tower; raise GeometryError naming the parameter when something does not fit."""
-    tw, bs, pj, cm, ln = profile.tower, profile.beam_splitter, profile.projector, profile.camera, profile.lens
-    if geometry.cop_at_infinity:
-        raise GeometryError("the COP tower needs a finite COP (layout.cop_to_vertex is inf)",
-                            where=profile.where("layout", "cop_to_vertex"))
-    cop_z = geometry.cop_z
-    L = tw.splitter_distance
-    z_s = cop_z - L
-    plate = splitter_plate(cop_z, L, bs.width, bs.length, bs.thickness, bs.index)
-    camera = camera_cop(plate, cop_z, geometry.rim_angle_at_cop)
-    p_cop = mirror_point(plate, (0.0, 0.0, cop_z))  # = (L, 0, z_s): the projector's real COP
+def _bundle_radius(profile: Profile, geometry: Derived, distance: float) -> float:
+    """Radius (mm) of the projector's ray bundle ``distance`` mm from its COP: the pinhole cone to the
+    paraboloid's rim plus the thin-lens aperture."""
+    return profile.projector.aperture / 2 + distance * math.tan(geometry.rim_angle_at_cop)
 
-    # the plate's extent in x-z (both faces)
-    n = np.asarray(plate.normal)
-    corners = np.vstack([plate.corners(), plate.corners() - plate.thickness * n])
-    px0, px1 = float(corners[:, 0].min()), float(corners[:, 0].max())
-    pz0, pz1 = float(corners[:, 2].min()), float(corners[:, 2].max())
-    # the ray bundle: pinhole cone to the paraboloid's rim plus the thin-lens aperture
-    tan_a = math.tan(geometry.rim_angle_at_cop)
-    half_ap = pj.aperture / 2
 
-    def bundle_r(distance: float) -> float:
-        return half_ap + distance * tan_a
-
-    need = bundle_r(L) * math.sqrt(2.0) + tw.clearance
-    if bs.length / 2 < need or bs.width / 2 < bundle_r(L) + tw.clearance:
+def _check_splitter_size(profile: Profile, geometry: Derived) -> None:
+    tw, bs = profile.tower, profile.beam_splitter
+    r = _bundle_radius(profile, geometry, tw.splitter_distance)
+    need = r * math.sqrt(2.0) + tw.clearance
+    if bs.length / 2 < need or bs.width / 2 < r + tw.clearance:
         raise GeometryError(
             f"the beam splitter ({bs.width:g} x {bs.length:g} mm) does not cover the ray bundle with "
             f"tower.clearance: at 45 deg it must be at least {2 * need:.1f} mm long and "
-            f"{2 * (bundle_r(L) + tw.clearance):.1f} mm wide; enlarge beam_splitter.length and width",
+            f"{2 * (r + tw.clearance):.1f} mm wide; enlarge beam_splitter.length and width",
             where=profile.where("beam_splitter", "length"))
 
-    # camera: looking down; lens front above the plate's top with clearance
+
+def _plate_extent(plate: Plate) -> tuple[float, float, float, float]:
+    """x0, x1, z0, z1 (mm) of the splitter plate (both faces) in the x-z plane."""
+    n = np.asarray(plate.normal)
+    corners = np.vstack([plate.corners(), plate.corners() - plate.thickness * n])
+    return (float(corners[:, 0].min()), float(corners[:, 0].max()),
+            float(corners[:, 2].min()), float(corners[:, 2].max()))
+
+
+def _camera_boxes(profile: Profile, camera: CameraPlacement, plate_top_z: float, L: float):
+    """The camera body's and lens's boxes (looking down; lens front above the plate with clearance)."""
+    tw, cm = profile.tower, profile.camera
     cx, cy, cz = camera.cop
-    c_lens_front = cz - cm.pupil_depth
-    if c_lens_front < pz1 + tw.clearance:
+    front = cz - cm.pupil_depth
+    if front < plate_top_z + tw.clearance:
         raise GeometryError(
-            f"the camera's lens front (z = {c_lens_front:.1f} mm) would be within tower.clearance of the "
-            f"splitter's top edge (z = {pz1:.1f} mm): raise tower.splitter_distance (now {L:g} mm) or shorten "
-            "camera.pupil_depth", where=profile.where("tower", "splitter_distance"))
-    c_body0 = c_lens_front + cm.lens_length
-    face_y = cy - cm.pupil_height
-    camera_box = _box((cx - cm.body_width / 2, face_y, c_body0),
-                      (cx + cm.body_width / 2, face_y + cm.body_height, c_body0 + cm.body_depth))
-    camera_lens_box = _box((cx - cm.lens_diameter / 2, cy - cm.lens_diameter / 2, c_lens_front),
-                           (cx + cm.lens_diameter / 2, cy + cm.lens_diameter / 2, c_body0))
+            f"the camera's lens front (z = {front:.1f} mm) would be within tower.clearance of the "
+            f"splitter's top edge (z = {plate_top_z:.1f} mm): raise tower.splitter_distance (now {L:g} mm) or "
+            "shorten camera.pupil_depth", where=profile.where("tower", "splitter_distance"))
     if cm.lens_diameter / 2 > cm.pupil_height:
         raise GeometryError(f"camera.lens_diameter ({cm.lens_diameter:g} mm) reaches past the mounting face "
                             f"(camera.pupil_height {cm.pupil_height:g} mm)", where=profile.where("camera", "lens_diameter"))
+    body0 = front + cm.lens_length
+    face_y = cy - cm.pupil_height
+    body = _box((cx - cm.body_width / 2, face_y, body0), (cx + cm.body_width / 2, face_y + cm.body_height,
+                                                           body0 + cm.body_depth))
+    lens = _box((cx - cm.lens_diameter / 2, cy - cm.lens_diameter / 2, front),
+                (cx + cm.lens_diameter / 2, cy + cm.lens_diameter / 2, body0))
+    return body, lens, face_y
 
-    # projector: looking -x at the splitter
-    p_lens_front = p_cop[0] - pj.pupil_depth
+
+def _projector_boxes(profile: Profile, p_cop, plate_x1: float):
+    """The focusing lens's x and the projector body's and lens's boxes (looking -x at the splitter)."""
+    tw, pj, ln = profile.tower, profile.projector, profile.lens
+    z_s = p_cop[2]
+    front = p_cop[0] - pj.pupil_depth
     lens_x = float(p_cop[0] - ln.distance)
-    lens_half_x = ln.thickness / 2 + tw.wall / 2  # the lens's pocket and its lips
-    if lens_x - lens_half_x < px1 + tw.clearance or lens_x + lens_half_x > p_lens_front - tw.clearance:
+    half = ln.thickness / 2 + tw.wall / 2  # the lens's pocket and its lips
+    if lens_x - half < plate_x1 + tw.clearance or lens_x + half > front - tw.clearance:
         raise GeometryError(
-            f"the focusing lens's mount (x = {lens_x - lens_half_x:.1f}..{lens_x + lens_half_x:.1f} mm) does not "
-            f"fit between the splitter (x <= {px1:.1f} mm) and the projector's lens front (x = {p_lens_front:.1f} mm) "
+            f"the focusing lens's mount (x = {lens_x - half:.1f}..{lens_x + half:.1f} mm) does not "
+            f"fit between the splitter (x <= {plate_x1:.1f} mm) and the projector's lens front (x = {front:.1f} mm) "
             f"with tower.clearance: change lens.distance (now {ln.distance:g} mm) or raise tower.splitter_distance",
             where=profile.where("lens", "distance"))
-    p_body0 = p_lens_front + pj.lens_length
-    body_y0 = -pj.pupil_lateral - pj.body_width / 2
-    shims = shims_nominal(profile)
-    shims_per_stack = 2 * shims
-    body_z0 = z_s - pj.pupil_height
-    projector_box = _box((p_body0, body_y0, body_z0),
-                         (p_body0 + pj.body_depth, body_y0 + pj.body_width, body_z0 + pj.body_height))
     if pj.lens_diameter / 2 > pj.pupil_height:
         raise GeometryError(f"projector.lens_diameter ({pj.lens_diameter:g} mm) reaches below the body "
                             f"(projector.pupil_height {pj.pupil_height:g} mm)",
                             where=profile.where("projector", "lens_diameter"))
-    projector_lens_box = _box((p_lens_front, -pj.lens_diameter / 2, z_s - pj.lens_diameter / 2),
-                              (p_body0, pj.lens_diameter / 2, z_s + pj.lens_diameter / 2))
+    body0 = front + pj.lens_length
+    y0, z0 = -pj.pupil_lateral - pj.body_width / 2, z_s - pj.pupil_height
+    body = _box((body0, y0, z0), (body0 + pj.body_depth, y0 + pj.body_width, z0 + pj.body_height))
+    lens = _box((front, -pj.lens_diameter / 2, z_s - pj.lens_diameter / 2),
+                (body0, pj.lens_diameter / 2, z_s + pj.lens_diameter / 2))
+    return lens_x, body, lens
 
+
+def _shelf_top(profile: Profile, cop_z: float, plate_z0: float, dome_top_z: float) -> float:
+    """Height (mm) of the shelf's top; raise when it meets the splitter or comes near the dome."""
+    tw = profile.tower
     shelf_t = 2 * tw.wall
-    shelf_top = shelf_bottom_z(profile, cop_z) + shelf_t
-    if shelf_top > pz0 - tw.clearance:
+    top = shelf_bottom_z(profile, cop_z) + shelf_t
+    if top > plate_z0 - tw.clearance:
         raise GeometryError(
-            f"the shelf (top z = {shelf_top:.1f} mm) would reach the splitter's lower edge (z = {pz0:.1f} mm): "
+            f"the shelf (top z = {top:.1f} mm) would reach the splitter's lower edge (z = {plate_z0:.1f} mm): "
             "raise projector.pupil_height or shorten beam_splitter.length", where=profile.where("projector", "pupil_height"))
-    if shelf_top - shelf_t < dome_top_z + tw.clearance:
+    if top - shelf_t < dome_top_z + tw.clearance:
         raise GeometryError(
-            f"the shelf under the projector (bottom z = {shelf_top - shelf_t:.1f} mm) would be within tower.clearance "
-            f"of the dome's top (z = {dome_top_z:.1f} mm): lower tower.splitter_distance (now {L:g} mm) or "
-            "projector.pupil_height", where=profile.where("tower", "splitter_distance"))
+            f"the shelf under the projector (bottom z = {top - shelf_t:.1f} mm) would be within tower.clearance "
+            f"of the dome's top (z = {dome_top_z:.1f} mm): lower tower.splitter_distance (now "
+            f"{tw.splitter_distance:g} mm) or projector.pupil_height", where=profile.where("tower", "splitter_distance"))
+    return top
 
-    wall_in = bs.width / 2 - GROOVE_DEPTH
+
+def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z: float) -> TowerLayout:
+    """Place the tower; raise GeometryError naming the parameter when something does not fit."""
+    tw, bs, cm = profile.tower, profile.beam_splitter, profile.camera
+    if geometry.cop_at_infinity:
+        raise GeometryError("the COP tower needs a finite COP (layout.cop_to_vertex is inf)",
+                            where=profile.where("layout", "cop_to_vertex"))
+    cop_z, L = geometry.cop_z, tw.splitter_distance
+    plate = splitter_plate(cop_z, L, bs.width, bs.length, bs.thickness, bs.index)
+    camera = camera_cop(plate, cop_z, geometry.rim_angle_at_cop)
+    p_cop = mirror_point(plate, (0.0, 0.0, cop_z))  # = (L, 0, cop_z - L): the projector's real COP
+    px0, px1, pz0, pz1 = _plate_extent(plate)
+    _check_splitter_size(profile, geometry)
+    camera_box, camera_lens_box, face_y = _camera_boxes(profile, camera, pz1, L)
+    lens_x, projector_box, projector_lens_box = _projector_boxes(profile, p_cop, px1)
+    shims = shims_nominal(profile)
+    shelf_t = 2 * tw.wall
+    shelf_top = _shelf_top(profile, cop_z, pz0, dome_top_z)
     wall_out = bs.width / 2 + GROOVE_GAP + tw.wall
-    holder_x = (px0 - GROOVE_GAP - 1.0 - tw.wall, px1 + tw.wall)
-    holder_top = pz1 + tw.wall
     bracket_y = face_y - shims * tw.shim_thickness
     if bracket_y < -wall_out + tw.wall:
         raise GeometryError(f"the camera bracket would stand outside the splitter holder's wall: camera.pupil_height "
                             f"({cm.pupil_height:g} mm) is larger than the splitter's half width allows",
                             where=profile.where("camera", "pupil_height"))
     foot_half = tw.column_width / 2 + 3 * tw.bolt_diameter
-    column_x = plate_r + tw.clearance + foot_half
-    bench_z = -(profile.base_plate.thickness + profile.sample_holder.stop_thickness)
     return TowerLayout(
         plate=plate, camera=camera, projector_cop=tuple(float(v) for v in p_cop), cop=(0.0, 0.0, cop_z),
-        bench_z=bench_z, shelf_top_z=shelf_top, shelf_thickness=shelf_t, holder_x=holder_x, holder_top_z=holder_top,
-        wall_y=(wall_in, wall_out), bracket_y=bracket_y, column_x=column_x,
+        bench_z=-(profile.base_plate.thickness + profile.sample_holder.stop_thickness), shelf_top_z=shelf_top,
+        shelf_thickness=shelf_t, holder_x=(px0 - GROOVE_GAP - 1.0 - tw.wall, px1 + tw.wall), holder_top_z=pz1 + tw.wall,
+        wall_y=(bs.width / 2 - GROOVE_DEPTH, wall_out), bracket_y=bracket_y,
+        column_x=plate_r + tw.clearance + foot_half,
         projector_box=projector_box, projector_lens_box=projector_lens_box, camera_box=camera_box,
         camera_lens_box=camera_lens_box, lens_x=lens_x,
-        bundle_radius_at_shelf=bundle_r(cop_z - (shelf_top - shelf_t)),
-        shims_nominal=shims, shims_per_stack=shims_per_stack)
+        bundle_radius_at_shelf=_bundle_radius(profile, geometry, cop_z - (shelf_top - shelf_t)),
+        shims_nominal=shims, shims_per_stack=2 * shims)
 
 
 # -- the printed parts -----------------------------------------------------------------------------
