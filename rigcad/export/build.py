@@ -136,7 +136,7 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
             "layout": layout.describe(),
             "tower_hardware": _tower_hardware(rig),
             "occlusion": _occlusion(rig, old.get("occlusion")),
-            "parts": {n: entries[n] for n in PARTS if n in entries},
+            "parts": {n: _with_stock(entries[n], rig.recipe(n)) for n in PARTS if n in entries},
             "mirrors": mirrors,
             "assembly": assembly,
             "stale_results_removed": stage.stale_report(),
@@ -193,6 +193,13 @@ def _occlusion(rig, previous: dict | None) -> dict:
     if previous and previous.get("key") == key:
         return previous
     return {**blocked_solid_angle(rig.occluders, profile_table(rig.geometry, rig.dome)), "key": key}
+
+
+def _with_stock(entry: dict, part) -> dict:
+    """A part's manifest entry with its ``bought`` stock (profile's ``buy``): set apart from the cached
+    entry, whose key is the solid's alone (a plate cut from stock has the printed shelf's solid)."""
+    out = {k: v for k, v in entry.items() if k != "bought"}
+    return {**out, "bought": part.bought} if part.bought else out
 
 
 def _build_part(part: Part, key: str, rig, out: Path, stage: Staging, shapes: dict) -> dict:

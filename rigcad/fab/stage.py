@@ -152,6 +152,10 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
             old = {}  # unreadable: nothing is reused
         for name in names:
             part = rig.recipe(name)
+            if part.bought:  # the profile's buy: standard stock, never printed
+                report_parts[name] = {"process": "bought", "stock": part.bought, "quantity": part.quantity}
+                say(name)
+                continue
             if name in CUT_PARTS and isinstance(part.solid, Prism):
                 t = time.perf_counter()
                 o = outlines.outline(part, chord)
@@ -547,6 +551,9 @@ def markdown(report: dict) -> str:
     for name, e in report["parts"].items():
         if "error" in e:
             lines.append(f"| {name} | | | **not printable:** {e['error']} | | | | | |")
+            continue
+        if e.get("process") == "bought":
+            lines.append(f"| {name} | {e['quantity']} | bought | {e['stock']} | | | | | |")
             continue
         if "pieces" not in e:
             lines.append(f"| {name} | {e['quantity']} | cut | {e['process']}: `outlines/{name}.dxf`, `.svg` "
