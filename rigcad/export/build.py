@@ -135,6 +135,7 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
             },
             "layout": layout.describe(),
             "tower_hardware": _tower_hardware(rig),
+            "alignment": _alignment(rig),
             "occlusion": _occlusion(rig, old.get("occlusion")),
             "parts": {n: _with_stock(entries[n], rig.recipe(n)) for n in PARTS if n in entries},
             "mirrors": mirrors,
@@ -152,6 +153,25 @@ def _tower_hardware(rig) -> list[dict]:
     from rigcad.parts.tower import hardware
 
     return hardware(rig.profile, rig.layout)
+
+
+def _alignment(rig) -> dict:
+    """What holds and what adjusts the tower's optics (mm, deg in the keys): the datum chain from the
+    base plate (parts.datum), every adjuster's range and resolution against its tolerance
+    (parts.adjusters), the focusing lens (optics.focus), and the sizes to measure before printing
+    (profile.instruments)."""
+    from dataclasses import asdict
+
+    from rigcad.optics.focus import focusing_lens
+    from rigcad.parts.adjusters import adjusters
+    from rigcad.parts.datum import check_datum_chain, datum_chain
+    from rigcad.profile.instruments import measurements
+
+    p, layout = rig.profile, rig.layout
+    return {"datum_chain": {**datum_chain(p, layout).describe(), "checks": check_datum_chain(p, layout)},
+            "adjusters": [a.describe() for a in adjusters(p, layout)],
+            "focusing_lens": focusing_lens(p, layout.geometry).describe(),
+            "measure_first": [asdict(m) for m in measurements(p)]}
 
 
 def _read_manifest(path: Path) -> dict:
