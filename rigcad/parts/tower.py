@@ -12,16 +12,19 @@ Layout (mm, rig frame: O at the origin, optical axis +z; every number from the p
   N-BK7) so that it sees the rig from the design COP;
 * the focusing lens on the projector's axis between its lens and the splitter, in a square pocket;
 * a shelf under the projector reaching over the axis (a hole lets the bundle down), on a square
-  column that stands on the bench beside the base plate (the bench is level with the rig's lowest
-  point, the sample holder's stop collar);
-* the splitter holder on the shelf: two side walls with 45 deg grooves the plate rests in (it slides
-  in through the +y wall), a back
-  wall (a light dump for the half of the projector's light the plate transmits), and the camera
-  bracket above, with a slot for the camera's tripod screw;
-* adjustment, each way from the nominal placement: the camera slides in its bracket's slot along the
-  axis (``tower.travel_along``) and across it in x (``tower.travel_across``), and on slotted shims
-  in y; the projector slides in the shelf's slots along its own axis (its virtual COP moves along
-  the optical axis) and across it, and on shims in height (its virtual COP moves across, in x).
+  column that stands on the base plate's datum tongue (two dowels and four bolts at each end of the
+  column: the datum chain, ``rigcad.parts.datum``), or a bought extrusion in square pockets;
+* the splitter holder on a kinematic seat over the shelf (three push screws on balls in a cone, a
+  vee and a flat; two spring bolts): two side walls with 45 deg grooves the plate rests in (it
+  slides in through the +y wall; the grooves follow its catalogue thickness), a back wall (a light
+  dump for the half of the projector's light the plate transmits), and the camera bracket above,
+  with one slot for the camera's two screws (in line along the axis: it cannot pivot);
+* adjustment, each way from the nominal placement (``rigcad.parts.adjusters`` states each range and
+  resolution against its tolerance): the splitter tips and tilts on its seat; the camera slides in
+  its bracket's slot along the axis (``tower.travel_along``) and across it in x
+  (``tower.travel_across``), and on slotted shims in y; the projector slides in the shelf's slots
+  along its own axis (its virtual COP moves along the optical axis) and across it, and on shims in
+  height (its virtual COP moves across, in x), held by screws sized per shim stack.
 
 Instruments are not printed: :func:`instruments` gives them as simple named solids for rig.step.
 """

@@ -215,7 +215,7 @@ class BeamSplitterParams:
 
 @dataclass(frozen=True)
 class TowerParams:
-    """The COP tower (rigcad.parts.tower): a column on the bench beside the rig, a shelf for the
+    """The COP tower (rigcad.parts.tower): a column on the base plate's datum tongue, a shelf for the
     projector at 90 deg that reaches over the optical axis, where the splitter holder (with the camera
     bracket above the splitter) and the lens mount stand. Adjustment travel is each way from the
     nominal position."""
