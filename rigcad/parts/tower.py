@@ -293,6 +293,25 @@ def column_joint_cuts(t: TowerLayout, profile: Profile, z0: float, height: float
     return (pocket, *_holes([(t.column_x, 0.0)], CORE_BOLT_HOLE, z0, height))
 
 
+#: Square nut traps under the tongue (mm): an M4 nut (7 mm across flats, 3.2 mm thick) drops in and
+#: cannot turn (its corners, 8.1 mm across, meet the sides); the tongue then stands on the bench.
+NUT_TRAP = 7.2
+NUT_TRAP_DEPTH = 3.6
+#: Counterbore under the tongue for the extrusion's M8 socket head (13 mm, 8 mm tall; ISO 4762).
+CORE_HEAD_BORE = (14.0, 8.5)
+
+
+def tongue_underside_cuts(t: TowerLayout, profile: Profile, z_bottom: float) -> tuple:
+    """What the column joint cuts into the tongue's underside (z_bottom: the bench): a square nut
+    trap under each of the printed column's bolts, or a counterbore for the extrusion's M8 head."""
+    if profile.buy.column != "print":
+        d, depth = CORE_HEAD_BORE
+        return (Cylinder((t.column_x, 0.0, z_bottom - 1.0), d / 2, depth + 1.0),)
+    h = NUT_TRAP / 2
+    return tuple(Box((x - h, y - h, z_bottom - 1.0), (x + h, y + h, z_bottom + NUT_TRAP_DEPTH))
+                 for x, y in _column_flange_points(t, profile))
+
+
 def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: float) -> tuple[Cylinder, ...]:
     """The bolt and dowel holes of a column joint through z0..z0+height: the column's foot on the
     base plate's tongue, its top flange under the shelf (the same pattern at both)."""
@@ -558,16 +577,18 @@ def _length(grip: float, extra: float) -> float:
 def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
     """The column's joints to the base plate's tongue and to the shelf: four bolts and two dowels at
     each end of a printed column; one M8 bolt into the core at each end of a bought extrusion."""
-    tw, base = profile.tower, profile.base_plate.thickness
+    tw, tongue = profile.tower, -t.bench_z  # the tongue reaches down to the bench
     if profile.buy.column != "print":
-        return [{"item": "bolt and washer, ISO 4762", "thread": "M8", "length_mm": float(_length(max(base, t.shelf_thickness) + 1.0, 16.0)),
-                 "quantity": 2, "joins": "up through the base plate's tongue, and down through the shelf, into the "
-                                         "extrusion's tapped core (16 mm engaged)"}]
+        grip = max(tongue - CORE_HEAD_BORE[1], t.shelf_thickness)
+        return [{"item": "bolt and washer, ISO 4762", "thread": "M8", "length_mm": float(_length(grip + 1.0, 16.0)),
+                 "quantity": 2, "joins": "up through the base plate's tongue (its head in the counterbore underneath), "
+                                         "and down through the shelf, into the extrusion's tapped core (16 mm engaged)"}]
     return [
         {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + t.shelf_thickness, nut),
          "quantity": 4, "joins": "the column's top flange to the shelf"},
-        {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + base, nut),
-         "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (nuts under the tongue)"},
+        {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + tongue - NUT_TRAP_DEPTH, nut),
+         "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (the nuts in the square traps "
+                                 "under the tongue, put in before it stands on the bench)"},
         {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
          "length_mm": _length(min(tw.wall, t.shelf_thickness) + tw.wall, 0.0), "quantity": 4,
          "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf "

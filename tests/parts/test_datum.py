@@ -57,3 +57,21 @@ def test_a_bought_extrusion_and_plate_change_the_chain(write_profile, table31_te
     assert links["column"].lateral == pytest.approx(EXTRUSION_END_SQUARENESS / 40.0 * height, rel=1e-12)
     assert links["pocket, tongue to column"].lateral == POCKET_GAP
     assert links["shelf"].lateral == PLATE_HOLE_POSITION
+
+
+def test_the_tongue_stands_on_the_bench_with_nut_traps(table31_rig):
+    # the tower's weight goes into the bench: the tongue's underside is the bench level, and a 7 mm
+    # (across flats) M4 nut fits each trap under a column bolt, 0.1 mm clear each side
+    import manifold3d as m3d
+
+    from rigcad.export import mesh as M
+    from rigcad.parts.recipe import Box
+    from rigcad.parts.tower import NUT_TRAP_DEPTH, _column_flange_points
+
+    t = table31_rig.layout.tower
+    plate = M.build(table31_rig.recipe("base_plate").solid, 0.05)
+    assert plate.bounding_box()[2] == pytest.approx(t.bench_z, abs=1e-9)
+    for x, y in _column_flange_points(t, table31_rig.profile):
+        nut = M.build(Box((x - 3.5, y - 3.5, t.bench_z + 0.01), (x + 3.5, y + 3.5, t.bench_z + NUT_TRAP_DEPTH - 0.01)), 0.05)
+        assert (plate ^ nut).volume() < 1e-9
+        assert (plate ^ nut).status() == m3d.Error.NoError
