@@ -55,6 +55,8 @@ def cmd_fab(args: argparse.Namespace) -> int:
                 est = sum(pc["estimate"]["print_time_s"] for pc in e["pieces"])
                 extra += f"; est. {hours_minutes(est)}, {sum(pc['estimate']['material_g'] for pc in e['pieces']):.0f} g"
             print(f"  {name}: {len(e['pieces'])} piece(s), {orient}, {e['layers_total']} layers{extra}")
+        elif e.get("process") == "bought":
+            print(f"  {name}: bought, not printed ({e['stock']})")
         elif "error" not in e:
             print(f"  {name}: outlines/{name}.dxf, .svg" + (" (+ _printed, _sanded stages)" if "stages" in e else ""))
     if "slicer_print_time_s" in tot:

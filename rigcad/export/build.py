@@ -105,8 +105,9 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
             },
             "layout": layout.describe(),
             "tower_hardware": _tower_hardware(rig),
+            "alignment": _alignment(rig),
             "occlusion": _occlusion(rig, old.get("occlusion")),
-            "parts": {n: entries[n] for n in PARTS if n in entries},
+            "parts": {n: _with_stock(entries[n], rig.recipe(n)) for n in PARTS if n in entries},
             "mirrors": mirrors,
             "assembly": assembly,
             "stale_results_removed": stage.stale_report(),
@@ -169,6 +170,25 @@ def _tower_hardware(rig) -> list[dict]:
     return hardware(rig.profile, rig.layout)
 
 
+def _alignment(rig) -> dict:
+    """What holds and what adjusts the tower's optics (mm, deg in the keys): the datum chain from the
+    base plate (parts.datum), every adjuster's range and resolution against its tolerance
+    (parts.adjusters), the focusing lens (optics.focus), and the sizes to measure before printing
+    (profile.instruments)."""
+    from dataclasses import asdict
+
+    from rigcad.optics.focus import focusing_lens
+    from rigcad.parts.adjusters import adjusters
+    from rigcad.parts.datum import check_datum_chain, datum_chain
+    from rigcad.profile.instruments import measurements
+
+    p, layout = rig.profile, rig.layout
+    return {"datum_chain": {**datum_chain(p, layout).describe(), "checks": check_datum_chain(p, layout)},
+            "adjusters": [a.describe() for a in adjusters(p, layout)],
+            "focusing_lens": focusing_lens(p, layout.geometry).describe(),
+            "measure_first": [asdict(m) for m in measurements(p)]}
+
+
 def _read_manifest(path: Path) -> dict:
     """The previous manifest, or {} when there is none or it is unreadable (then nothing is reused)."""
     try:
@@ -208,6 +228,13 @@ def _occlusion(rig, previous: dict | None) -> dict:
     if previous and previous.get("key") == key:
         return previous
     return {**blocked_solid_angle(rig.occluders, profile_table(rig.geometry, rig.dome)), "key": key}
+
+
+def _with_stock(entry: dict, part) -> dict:
+    """A part's manifest entry with its ``bought`` stock (profile's ``buy``): set apart from the cached
+    entry, whose key is the solid's alone (a plate cut from stock has the printed shelf's solid)."""
+    out = {k: v for k, v in entry.items() if k != "bought"}
+    return {**out, "bought": part.bought} if part.bought else out
 
 
 def _build_part(part: Part, key: str, rig, out: Path, stage: Staging, shapes: dict) -> dict:

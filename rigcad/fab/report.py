@@ -72,6 +72,9 @@ def _parts_table(report: dict) -> list[str]:
         if "error" in e:
             lines.append(f"| {name} | | | **not printable:** {e['error']} | | | | | |")
             continue
+        if e.get("process") == "bought":
+            lines.append(f"| {name} | {e['quantity']} | bought | {e['stock']} | | | | | |")
+            continue
         if "pieces" not in e:
             lines.append(f"| {name} | {e['quantity']} | cut | {e['process']}: `outlines/{name}.dxf`, `.svg` "
                          f"({e['outline_size_mm'][0]:.1f} x {e['outline_size_mm'][1]:.1f} mm, plate {e['plate_thickness_mm']:g} mm) | | | | | |")

@@ -126,6 +126,10 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
         old = _previous_report(out)  # read before anything is published over it
         for name in select_parts(parts):
             part = rig.recipe(name)
+            if part.bought:  # the profile's buy: standard stock, never printed
+                report_parts[name] = {"process": "bought", "stock": part.bought, "quantity": part.quantity}
+                say(name)
+                continue
             if name in CUT_PARTS and isinstance(part.solid, Prism):
                 done[name] = _cut_part(rig, part, run, stocks)
             else:
