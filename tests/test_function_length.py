@@ -1,5 +1,5 @@
-"""No function in rigcad/ runs over 80 lines (STYLE: "Functions at most 80 lines"; from its ``def``
-to its last line, docstring and comments included): a longer one is split by meaning. Numba kernels are exempt (a function decorated
+"""No function in rigcad/ runs over 80 lines (from its ``def`` to its last line, docstring and
+comments included): a longer one is split by meaning. Numba kernels are exempt (a function decorated
 with numba's ``njit``/``jit``: the compiler sees one function, and splitting a kernel costs calls in
 its inner loop). The scan reads the source (ast), it imports nothing."""
 
@@ -10,9 +10,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 MAX_LINES = 80
-#: Functions still over the limit, by (file under rigcad/, name): the manual's document, being
-#: rewritten in its own work (the COP tower's tower_layout, the other one, is split now). Nothing
-#: else may join this list.
+#: Functions still over the limit, by (file under rigcad/, name). It is being rewritten in its
+#: own work (the manual's document); nothing else may join this list.
 ALLOWED = {("manual/document.py", "build_manual")}
 
 
