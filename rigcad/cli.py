@@ -246,6 +246,9 @@ def build_parser() -> argparse.ArgumentParser:
     from rigcad.tolerance.cli import register as register_tolerance
 
     register_tolerance(sub)
+    from rigcad.live.cli import register as register_watch
+
+    register_watch(sub)
     _require_exports_root(parser)
     return parser
 

@@ -246,6 +246,15 @@ class Rig:
                        lock=writer_lock(out, self.name, ("fab", p.name)), slicing=slicing)
 
 
+    def show(self, port: int = 3939, rays: int | None = None):
+        """Push the named, coloured parts, ``rays`` traced rays (default: as many as ``rigcad view``
+        draws) as polylines and the COP markers to an OCP CAD Viewer running on ``port``; a
+        ViewerError saying how to start one when none runs. See :mod:`rigcad.live.ocp`."""
+        from rigcad.live.ocp import show
+
+        return show(self, port, rays)
+
+
 def writer_lock(folder: str | Path, profile: str, inside: tuple[str, ...] = ()) -> Path:
     """The lock a writer into ``folder`` holds while it publishes. ``inside``: where the writer's
     folder lies in ``<root>/<profile>`` (``()`` for that folder itself, ``("fab", printer)`` for a

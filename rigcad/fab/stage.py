@@ -384,7 +384,7 @@ def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, b
             return orientation.mirror_candidates(sector if sectors else None)
         return orientation.flat_candidates(plate) if plate is not None else orientation.generic_candidates()
 
-    whole_fits = plan is None and any(orientation.fit_spin(v, o.direction, printer.usable)[0] is not None for o in candidates())
+    whole_fits = plan is None and orientation.fits_whole(v, bool(mirror), printer.usable)
     if plan is not None:
         pass
     elif whole_fits:
