@@ -78,10 +78,14 @@ class OcpPush:
         missing = viewer_missing(self.port, self.host)
         if missing is not None:
             raise ViewerError(missing)
+        import warnings
+
         from ocp_vscode import show
 
         shapes, names, colours = self.objects(rig, rays)
-        show(*shapes, names=names, colors=colours, port=self.port, progress="", reset_camera=False)
+        with warnings.catch_warnings():  # the camera is kept on purpose: the user's view survives an edit
+            warnings.simplefilter("ignore")
+            show(*shapes, names=names, colors=colours, port=self.port, progress="")
         self.pushed += 1
 
 

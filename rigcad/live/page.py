@@ -44,7 +44,7 @@ _PAGE = r"""<!DOCTYPE html>
   .box { position: absolute; background: rgba(255,255,255,0.92); padding: 8px 10px; border-radius: 6px;
          box-shadow: 0 1px 4px rgba(0,0,0,0.25); overflow: auto; }
   #panel { top: 8px; left: 8px; max-height: calc(100% - 40px); }
-  #report { top: 8px; right: 8px; max-width: 46%; max-height: calc(100% - 40px); }
+  #report { top: 8px; right: 8px; max-width: 52%; max-height: calc(100% - 40px); }
   h1 { font-size: 14px; margin: 0 0 6px; }
   label { display: block; white-space: nowrap; cursor: pointer; }
   .swatch { display: inline-block; width: 10px; height: 10px; margin: 0 4px; border: 1px solid #555; }

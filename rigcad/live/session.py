@@ -293,7 +293,7 @@ class LiveSession:
 
         old = self.good.printers if self.good is not None else {}
         out = {}
-        printed = {m.name: m for m in meshes if not m.bought and not m.marker}
+        printed = {m.name: m for m in meshes if m.name in rig.recipes}  # the instruments are bought
         for name, printer in self._printers.items():
             key = key_of(printer, sorted((n, keys[n]) for n in printed))
             if old.get(name, {}).get("key") == key:
