@@ -260,9 +260,11 @@ _PAGE = r"""<!DOCTYPE html>
 """
 
 
-def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays: int = VIEW_RAYS) -> dict:
+def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays: int = VIEW_RAYS,
+               glb: bool = False) -> dict:
     """Write ``out_dir/rig.html`` (the 3D view) and ``out_dir/rig.png`` (the assembled rig for the
-    README), published together (export.atomic.Staging). Returns a summary (paths, sizes)."""
+    README), and with ``glb`` ``out_dir/rig.glb`` (manual.glb), published together
+    (export.atomic.Staging). Returns a summary (paths, sizes)."""
     from rigcad import plots
     from rigcad.export.atomic import Staging
     from rigcad.manual.assembly import rig_meshes
@@ -280,11 +282,16 @@ def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays
     with Staging(out_dir, lock, made_from=profile_digest(rig.profile)) as stage:
         stage.write_bytes(out_dir / "rig.html", page)
         stage.write_bytes(out_dir / "rig.png", png)
+        if glb:
+            from rigcad.manual.glb import glb_bytes
+
+            stage.write_bytes(out_dir / "rig.glb", glb_bytes(rig, meshes, traced))
         stage.commit()
     step("written")
     return {"html": out_dir / "rig.html", "png": out_dir / "rig.png", "html_bytes": len(page),
             "parts": [m.name for m in meshes], "triangles": sum(len(m.faces) for m in meshes),
-            "rays": int(len(traced["lines"])), "rays_traced": traced["traced"]}
+            "rays": int(len(traced["lines"])), "rays_traced": traced["traced"],
+            **({"glb": out_dir / "rig.glb"} if glb else {})}
 
 
 __all__ = ["VIEW_RAYS", "three_js", "traced_rays", "view_html", "write_view"]
