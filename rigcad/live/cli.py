@@ -38,7 +38,7 @@ def cmd_watch(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``watch`` to rigcad's subcommands."""
-    from rigcad.arguments import positive_int
+    from rigcad.arguments import port_number
 
     p = subparsers.add_parser(
         "watch", help="edit the YAML, see the rig: a live 3D view rebuilt on every save",
@@ -52,7 +52,8 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--host", default="127.0.0.1", help="address the live view is served on (default: 127.0.0.1, "
                                                         "this machine only)")
-    p.add_argument("--port", type=int, default=8765, help="port of the live view (default 8765; taken: the next free)")
+    p.add_argument("--port", type=port_number, default=8765,
+                   help="port of the live view (default 8765; taken: the next free one; 0: any free port)")
     p.add_argument("--printer", action="append", metavar="NAME",
                    help="a printer (name under printers/ or path) whose files are watched too; the view lists the "
                         "printed parts that must be split for it (repeatable)")
@@ -61,7 +62,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--exports", default="exports", help="output root for --write (default: exports)")
     p.add_argument("--ocp", action="store_true", help="also push the parts, rays and COP markers to a running OCP CAD "
                                                       "Viewer (the optional ocp_vscode)")
-    p.add_argument("--ocp-port", type=positive_int, default=3939, help="the OCP CAD Viewer's port (default 3939)")
+    p.add_argument("--ocp-port", type=port_number, default=3939, help="the OCP CAD Viewer's port (default 3939)")
     p.set_defaults(func=cmd_watch)
     return p
 

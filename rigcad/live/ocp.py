@@ -25,10 +25,6 @@ class ViewerError(RigcadError):
     """No OCP CAD Viewer to show the rig in (none running, or ocp_vscode not installed)."""
 
 
-def _hex(color) -> str:
-    return "#" + "".join(f"{int(round(255 * min(max(c, 0.0), 1.0))):02x}" for c in color)
-
-
 def viewer_missing(port: int = DEFAULT_PORT, host: str = "127.0.0.1") -> str | None:
     """Why the rig cannot be shown in an OCP CAD Viewer on ``host:port`` (one line), or None."""
     try:
@@ -50,6 +46,7 @@ class OcpPush:
 
     def objects(self, rig, rays: dict | None) -> tuple[list, list[str], list[str]]:
         """(shapes, names, colours) of ``rig``: its in-rig parts and instruments, and the rays."""
+        from rigcad.manual.assembly import hex_color
         from rigcad.parts import _kernel as K
 
         shapes, names, colours, used = [], [], [], set()
@@ -63,7 +60,7 @@ class OcpPush:
             used.add(key)
             shapes.append(self._solids[key])
             names.append(part.name)
-            colours.append(_hex(part.color))
+            colours.append(hex_color(part.color))
         for stale in [k for k in self._solids if k not in used]:
             del self._solids[stale]
         if rays is not None and len(rays["lines"]):

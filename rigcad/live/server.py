@@ -11,7 +11,6 @@ a page applies. Python's standard library only (http.server), threads: one per c
 
 from __future__ import annotations
 
-import base64
 import errno
 import json
 import threading
@@ -38,30 +37,15 @@ class ServerError(RigcadError):
     """The live view's server could not start (no free port, an address that cannot be bound)."""
 
 
-def _b64(a: np.ndarray, dtype) -> str:
-    return base64.b64encode(np.ascontiguousarray(a, dtype=dtype).tobytes()).decode("ascii")
-
-
-def _hex(color) -> str:
-    return "#" + "".join(f"{int(round(255 * min(max(c, 0.0), 1.0))):02x}" for c in color)
-
-
 def _rays_message(rays: dict | None) -> dict | None:
-    """The rays as line segments (positions, colours: viridis of theta / 90 deg), float32 base64."""
+    """The rays as line segments with their colours (manual.view.ray_segments), float32 base64."""
     if rays is None:
         return None
-    from matplotlib import colormaps
+    from rigcad.manual.view import b64, ray_segments
 
-    lines = rays["lines"]
-    cmap = colormaps["viridis"]
-    if len(lines):
-        seg = np.concatenate([lines[:, :-1], lines[:, 1:]], axis=2).reshape(-1, 3)
-        rgb = cmap(np.degrees(rays["theta"]) / 90.0)[:, :3]
-        colours = np.repeat(rgb, 2 * (lines.shape[1] - 1), axis=0)
-    else:
-        seg = colours = np.zeros((0, 3))
-    return {"key": rays.get("key"), "positions": _b64(seg, "<f4"), "colors": _b64(colours, "<f4"),
-            "count": int(len(lines)), "traced": int(rays["traced"])}
+    seg, colours = ray_segments(rays)
+    return {"key": rays.get("key"), "positions": b64(seg, "<f4"), "colors": b64(colours, "<f4"),
+            "count": int(len(rays["lines"])), "traced": int(rays["traced"])}
 
 
 def _finite(value):
@@ -77,7 +61,9 @@ def _finite(value):
 
 def mesh_message(mesh) -> dict:
     """A part's picture mesh (assembly.PartMesh) for the page: base64 float32 positions, uint32 indices."""
-    return {"positions": _b64(mesh.vertices, "<f4"), "indices": _b64(mesh.faces, "<u4")}
+    from rigcad.manual.view import b64
+
+    return {"positions": b64(mesh.vertices, "<f4"), "indices": b64(mesh.faces, "<u4")}
 
 
 def frame_message(frame, meshes_for, rays: bool, encode=mesh_message) -> dict:
@@ -85,13 +71,13 @@ def frame_message(frame, meshes_for, rays: bool, encode=mesh_message) -> dict:
     ``meshes_for`` (``encode``: mesh_message or a cache of it), the rays when ``rays``, figures with
     their change, rows, timings and the error."""
     from rigcad.live.session import HEADLINE
-    from rigcad.manual.assembly import encloses
+    from rigcad.manual.assembly import SEE_THROUGH_OPACITY, encloses, hex_color
 
     see_through = encloses(frame.parts) if frame.parts else set()
     parts, meshes = [], {}
     for m in frame.parts:
-        parts.append({"name": m.name, "key": frame.keys.get(m.name), "color": _hex(m.color), "quantity": m.quantity,
-                      "description": m.description, "opacity": 0.3 if m.name in see_through else 1.0})
+        parts.append({"name": m.name, "key": frame.keys.get(m.name), "color": hex_color(m.color), "quantity": m.quantity,
+                      "description": m.description, "opacity": SEE_THROUGH_OPACITY if m.name in see_through else 1.0})
         if m.name in meshes_for:
             meshes[m.name] = encode(m)
     figures = [{"key": k, "label": label, "unit": unit, "value": frame.figures.get(k), "delta": frame.deltas.get(k)}

@@ -14,11 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rigcad.manual.assembly import PartMesh, encloses
-
-#: Opacity of a part drawn see-through (the dome), as in the HTML view.
-SEE_THROUGH = 0.3
-
+from rigcad.manual.assembly import SEE_THROUGH_OPACITY, PartMesh, encloses, ray_colors
 
 def _rgba(color, alpha: float) -> list[int]:
     return [int(round(255 * min(max(c, 0.0), 1.0))) for c in color] + [int(round(255 * alpha))]
@@ -27,12 +23,11 @@ def _rgba(color, alpha: float) -> list[int]:
 def rig_scene(rig, meshes: list[PartMesh], rays: dict):
     """A trimesh Scene of ``meshes`` (assembly.rig_meshes) and ``rays`` (view.traced_rays)."""
     import trimesh
-    from matplotlib import colormaps
 
     scene = trimesh.Scene()
     see_through = encloses(meshes)
     for m in meshes:
-        alpha = SEE_THROUGH if m.name in see_through else 1.0
+        alpha = SEE_THROUGH_OPACITY if m.name in see_through else 1.0
         material = trimesh.visual.material.PBRMaterial(
             name=m.name, baseColorFactor=_rgba(m.color, alpha), metallicFactor=0.0, roughnessFactor=0.8,
             alphaMode="BLEND" if alpha < 1 else "OPAQUE", doubleSided=True)
@@ -43,7 +38,8 @@ def rig_scene(rig, meshes: list[PartMesh], rays: dict):
     if len(lines):
         k, n = lines.shape[:2]
         entities = [trimesh.path.entities.Line(np.arange(i * n, (i + 1) * n)) for i in range(k)]
-        rgba = (colormaps["viridis"](np.degrees(rays["theta"]) / 90.0) * 255).round().astype(np.uint8)
+        rgb = (ray_colors(rays["theta"]) * 255).round()
+        rgba = np.column_stack([rgb, np.full(len(rgb), 255.0)]).astype(np.uint8)
         path = trimesh.path.Path3D(entities=entities, vertices=lines.reshape(-1, 3), colors=rgba, process=False)
         scene.add_geometry(path, node_name="rays", geom_name="rays")
     scene.metadata.update({"profile": rig.name, "frame": "mm; sample point O at the origin; optical axis +z",

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from rigcad.errors import ExportError
-from rigcad.manual.assembly import PartMesh, encloses
+from rigcad.manual.assembly import SEE_THROUGH_OPACITY, PartMesh, encloses, hex_color, ray_colors
 
 #: Rays drawn in the view: enough to show the fan from the COP over the paraboloid's annulus to the
 #: sample, few enough to tell them apart.
@@ -86,12 +86,19 @@ def _folded(lines: np.ndarray, tower) -> np.ndarray:
     return np.concatenate([start[:, None], hit[:, None], lines[:, 1:]], axis=1)
 
 
-def _b64(a: np.ndarray, dtype) -> str:
+def b64(a: np.ndarray, dtype) -> str:
+    """``a`` as ``dtype`` (e.g. ``"<f4"``), its bytes in base64: how a page carries an array."""
     return base64.b64encode(np.ascontiguousarray(a, dtype=dtype).tobytes()).decode("ascii")
 
 
-def _hex(color) -> str:
-    return "#" + "".join(f"{int(round(255 * min(max(c, 0.0), 1.0))):02x}" for c in color)
+def ray_segments(rays: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The polylines of ``rays`` (traced_rays) as line segments: both ends of every segment (2 s, 3)
+    mm and their colours (2 s, 3) (ray_colors)."""
+    lines = rays["lines"]
+    if not len(lines):
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    seg = np.concatenate([lines[:, :-1], lines[:, 1:]], axis=2).reshape(-1, 3)
+    return seg, np.repeat(ray_colors(rays["theta"]), 2 * (lines.shape[1] - 1), axis=0)  # 2 ends per segment
 
 
 def view_html(rig, meshes: list[PartMesh], rays: dict) -> bytes:
@@ -101,26 +108,24 @@ def view_html(rig, meshes: list[PartMesh], rays: dict) -> bytes:
 
     cmap = colormaps["viridis"]
     see_through = encloses(meshes)
-    parts = [{"name": m.name, "color": _hex(m.color), "quantity": m.quantity, "description": m.description,
-              "opacity": 0.3 if m.name in see_through else 1.0,
+    parts = [{"name": m.name, "color": hex_color(m.color), "quantity": m.quantity, "description": m.description,
+              "opacity": SEE_THROUGH_OPACITY if m.name in see_through else 1.0,
               "explode_mm": [round(float(x), 6) for x in m.explode],
-              "positions": _b64(m.vertices, "<f4"), "indices": _b64(m.faces, "<u4"), "triangles": int(len(m.faces))}
+              "positions": b64(m.vertices, "<f4"), "indices": b64(m.faces, "<u4"), "triangles": int(len(m.faces))}
              for m in meshes]
     lines = rays["lines"]
-    seg = np.concatenate([lines[:, :-1], lines[:, 1:]], axis=2).reshape(-1, 3) if len(lines) else np.zeros((0, 3))
+    seg, colours = ray_segments(rays)
     theta_deg = np.degrees(rays["theta"])
-    rgb = np.asarray([cmap(t / 90.0)[:3] for t in theta_deg]).reshape(-1, 3) if len(lines) else np.zeros((0, 3))
-    colours = np.repeat(rgb, 2 * (lines.shape[1] - 1) if len(lines) else 0, axis=0)  # 2 ends per segment
     g = rig.geometry
     data = {
         "profile": rig.name,
         "frame": "mm; sample point O at the origin; optical axis +z",
         "cop_z_mm": None if g.cop_at_infinity else float(g.cop_z),
         "parts": parts,
-        "rays": {"positions": _b64(seg, "<f4"), "colors": _b64(colours, "<f4"), "count": int(len(lines)),
+        "rays": {"positions": b64(seg, "<f4"), "colors": b64(colours, "<f4"), "count": int(len(lines)),
                  "traced": rays["traced"], "theta_min_deg": float(theta_deg.min()) if len(lines) else None,
                  "theta_max_deg": float(theta_deg.max()) if len(lines) else None},
-        "colorbar": [_hex(cmap(k / 8)[:3]) for k in range(9)],
+        "colorbar": [hex_color(cmap(k / 8)[:3]) for k in range(9)],
     }
     payload = json.dumps(data, sort_keys=True, separators=(",", ":")).replace("</", "<\\/")
     page = (_PAGE.replace("@@TITLE@@", html.escape(f"{rig.name}: the rig in 3D (rigcad view)"))
@@ -294,4 +299,5 @@ def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays
             **({"glb": out_dir / "rig.glb"} if glb else {})}
 
 
-__all__ = ["VIEW_RAYS", "three_js", "traced_rays", "view_html", "write_view"]
+__all__ = ["VIEW_RAYS", "b64", "ray_segments", "three_js", "traced_rays", "view_html",
+           "write_view"]

@@ -56,6 +56,7 @@ def test_ocp_without_a_viewer_says_one_line_and_the_browser_view_runs(tmp_path):
     assert "browser view" in said[0]
     assert any(re.match(r"\[1\] rig: rebuilt", line) for line in lines), lines
     assert proc.returncode == 0 and "Traceback" not in stderr, stderr
+    assert not (tmp_path / "exports").exists()  # without --write nothing is published
 
 
 def test_rig_show_without_a_viewer_is_one_clear_error():

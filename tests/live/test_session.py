@@ -94,6 +94,19 @@ def test_the_design_carried_over_equals_a_fresh_one(live):
     assert session.good.rig.design.report == _from_scratch(path).design.report
 
 
+def test_a_design_input_alone_retraces_the_design_not_the_dome(live):
+    """targets.* is read by the design, not by the dome or the parts: the design is traced again
+    (its report then equals a fresh one) and nothing else is."""
+    session, path = live
+    before = session.builds.copy()
+    _write(path, "beam:\n  width: 9 mm\n  height: 12 mm\ntargets:\n  theta_min: 10 deg\n")
+    frame = session.update()
+    assert frame.error is None, frame.error
+    assert session.builds["design"] == before["design"] + 1 and session.builds["dome"] == before["dome"]
+    assert frame.changed == ()
+    assert session.good.rig.design.report == _from_scratch(path).design.report
+
+
 def test_unknown_key_keeps_the_last_good_rig_and_a_fix_brings_the_new_one(live):
     session, path = live
     good = session.good
