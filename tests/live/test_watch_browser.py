@@ -150,6 +150,7 @@ def _scenario(page, profile: Path, watch: Watch) -> None:
     beam_key = page.evaluate("window.rigcad.key('beam')")
     profile.write_text("extends: achutha2006\nbeam:\n  widht: 10 mm\n", encoding="utf-8")
     page.wait_for_function("window.rigcad.state.error !== null", timeout=60_000)
+    assert page.is_visible("#error")
     shown = page.inner_text("#error")
     assert f"{profile.name}:3" in shown and "widht" in shown and "last good rig" in shown, shown
     assert page.evaluate("window.rigcad.key('beam')") == beam_key and page.evaluate("window.rigcad.parts()") == names
