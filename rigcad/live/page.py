@@ -21,10 +21,10 @@ HIGHLIGHT_MS = 4000
 
 def live_html(title: str) -> bytes:
     """The page, UTF-8; ``title`` is escaped. Deterministic (same title, same bytes)."""
-    from rigcad.manual.view import three_js
+    from rigcad.manual.view import SCENE_JS, three_js
 
     page = (_PAGE.replace("@@TITLE@@", html.escape(title)).replace("@@HIGHLIGHT_MS@@", str(HIGHLIGHT_MS))
-            .replace("@@THREE@@", three_js()))
+            .replace("@@THREE@@", three_js()).replace("@@SCENE@@", SCENE_JS))
     return page.encode("utf-8")
 
 
@@ -85,25 +85,8 @@ _PAGE = r"""<!DOCTYPE html>
 "use strict";
 (function () {
   const HIGHLIGHT_MS = @@HIGHLIGHT_MS@@;
-  function decode(b64, Type) {
-    const bin = atob(b64), bytes = new Uint8Array(bin.length);
-    for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
-    return new Type(bytes.buffer);
-  }
-  function el(tag, text, cls) { const e = document.createElement(tag); if (text !== undefined) e.textContent = text;
+@@SCENE@@  function el(tag, text, cls) { const e = document.createElement(tag); if (text !== undefined) e.textContent = text;
     if (cls) e.className = cls; return e; }
-  const host = document.getElementById("view");
-  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-  renderer.setPixelRatio(window.devicePixelRatio || 1);
-  renderer.setSize(host.clientWidth, host.clientHeight);
-  host.appendChild(renderer.domElement);
-  const scene = new THREE.Scene();
-  scene.background = new THREE.Color(0xf4f4f4);
-  scene.add(new THREE.AmbientLight(0xffffff, 0.45));
-  const light = new THREE.DirectionalLight(0xffffff, 0.75);
-  scene.add(light);
-  const camera = new THREE.PerspectiveCamera(30, host.clientWidth / host.clientHeight, 1, 1e6);
-  camera.up.set(0, 0, 1);
   const controls = new THREE.TrackballControls(camera, renderer.domElement);
   controls.rotateSpeed = 2.0; controls.zoomSpeed = 1.2; controls.panSpeed = 0.8; controls.staticMoving = true;
 
@@ -116,13 +99,7 @@ _PAGE = r"""<!DOCTYPE html>
   function setPart(p, m) {
     const old = parts[p.name];
     if (old) { scene.remove(old.mesh); old.mesh.geometry.dispose(); old.mesh.material.dispose(); }
-    const geom = new THREE.BufferGeometry();
-    geom.setAttribute("position", new THREE.BufferAttribute(decode(m.positions, Float32Array), 3));
-    geom.setIndex(new THREE.BufferAttribute(decode(m.indices, Uint32Array), 1));
-    const mat = new THREE.MeshPhongMaterial({ color: new THREE.Color(p.color), flatShading: true,
-      side: THREE.DoubleSide, transparent: p.opacity < 1, opacity: p.opacity, depthWrite: p.opacity >= 1 });
-    const mesh = new THREE.Mesh(geom, mat);
-    mesh.name = p.name;
+    const mesh = partMesh(p, m);
     mesh.visible = !hidden[p.name];
     scene.add(mesh);
     parts[p.name] = { mesh: mesh, key: p.key, color: p.color };
@@ -199,12 +176,7 @@ _PAGE = r"""<!DOCTYPE html>
     if (framed || Object.keys(parts).length === 0) return;
     const box = new THREE.Box3();
     for (const n in parts) box.expandByObject(parts[n].mesh);
-    const sphere = box.getBoundingSphere(new THREE.Sphere());
-    const dir = new THREE.Vector3(1.0, -1.7, 0.75).normalize();
-    const dist = sphere.radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.8;
-    camera.position.copy(sphere.center).addScaledVector(dir, dist);
-    camera.lookAt(sphere.center);
-    controls.target.copy(sphere.center);
+    fitCamera(box, controls);
     framed = true;   // once: later frames keep the user's view
   }
   function setStatus(s, text) {

@@ -129,9 +129,50 @@ def view_html(rig, meshes: list[PartMesh], rays: dict) -> bytes:
     }
     payload = json.dumps(data, sort_keys=True, separators=(",", ":")).replace("</", "<\\/")
     page = (_PAGE.replace("@@TITLE@@", html.escape(f"{rig.name}: the rig in 3D (rigcad view)"))
-            .replace("@@THREE@@", three_js()).replace("@@DATA@@", payload))
+            .replace("@@THREE@@", three_js()).replace("@@SCENE@@", SCENE_JS).replace("@@DATA@@", payload))
     return page.encode("utf-8")
 
+
+#: The script both 3D pages (this one and ``rigcad watch``'s, rigcad.live.page) start with: base64
+#: decoding, the renderer, scene, lights and camera (mm, +z up), a part's mesh from its data
+#: (``partMesh``: colour, opacity, base64 positions and indices) and the first view of a box
+#: (``fitCamera``).
+SCENE_JS = r"""  function decode(b64, Type) {
+    const bin = atob(b64), bytes = new Uint8Array(bin.length);
+    for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+    return new Type(bytes.buffer);
+  }
+  const host = document.getElementById("view");
+  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+  renderer.setPixelRatio(window.devicePixelRatio || 1);
+  renderer.setSize(host.clientWidth, host.clientHeight);
+  host.appendChild(renderer.domElement);
+  const scene = new THREE.Scene();
+  scene.background = new THREE.Color(0xf4f4f4);
+  scene.add(new THREE.AmbientLight(0xffffff, 0.45));
+  const light = new THREE.DirectionalLight(0xffffff, 0.75);
+  scene.add(light);
+  const camera = new THREE.PerspectiveCamera(30, host.clientWidth / host.clientHeight, 1, 1e6);
+  camera.up.set(0, 0, 1);
+  function partMesh(p, data) {
+    const geom = new THREE.BufferGeometry();
+    geom.setAttribute("position", new THREE.BufferAttribute(decode(data.positions, Float32Array), 3));
+    geom.setIndex(new THREE.BufferAttribute(decode(data.indices, Uint32Array), 1));
+    const mat = new THREE.MeshPhongMaterial({ color: new THREE.Color(p.color), flatShading: true,
+      side: THREE.DoubleSide, transparent: p.opacity < 1, opacity: p.opacity, depthWrite: p.opacity >= 1 });
+    const mesh = new THREE.Mesh(geom, mat);
+    mesh.name = p.name;
+    return mesh;
+  }
+  function fitCamera(box, controls) {
+    const sphere = box.getBoundingSphere(new THREE.Sphere());
+    const dir = new THREE.Vector3(1.0, -1.7, 0.75).normalize();
+    const dist = sphere.radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.8;
+    camera.position.copy(sphere.center).addScaledVector(dir, dist);
+    camera.lookAt(sphere.center);
+    controls.target.copy(sphere.center);
+  }
+"""
 
 _PAGE = r"""<!DOCTYPE html>
 <html lang="en">
@@ -170,35 +211,12 @@ _PAGE = r"""<!DOCTYPE html>
 "use strict";
 (function () {
   const DATA = JSON.parse(document.getElementById("rig-data").textContent);
-  function decode(b64, Type) {
-    const bin = atob(b64), bytes = new Uint8Array(bin.length);
-    for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
-    return new Type(bytes.buffer);
-  }
-  const host = document.getElementById("view");
-  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-  renderer.setPixelRatio(window.devicePixelRatio || 1);
-  renderer.setSize(host.clientWidth, host.clientHeight);
-  host.appendChild(renderer.domElement);
-  const scene = new THREE.Scene();
-  scene.background = new THREE.Color(0xf4f4f4);
-  scene.add(new THREE.AmbientLight(0xffffff, 0.45));
-  const light = new THREE.DirectionalLight(0xffffff, 0.75);
-  scene.add(light);
-  const camera = new THREE.PerspectiveCamera(30, host.clientWidth / host.clientHeight, 1, 1e6);
-  camera.up.set(0, 0, 1);
-
+@@SCENE@@
   const parts = {};
   const list = document.getElementById("parts");
   document.getElementById("title").textContent = DATA.profile + ": the rig";
   for (const p of DATA.parts) {
-    const geom = new THREE.BufferGeometry();
-    geom.setAttribute("position", new THREE.BufferAttribute(decode(p.positions, Float32Array), 3));
-    geom.setIndex(new THREE.BufferAttribute(decode(p.indices, Uint32Array), 1));
-    const mat = new THREE.MeshPhongMaterial({ color: new THREE.Color(p.color), flatShading: true,
-      side: THREE.DoubleSide, transparent: p.opacity < 1, opacity: p.opacity, depthWrite: p.opacity >= 1 });
-    const mesh = new THREE.Mesh(geom, mat);
-    mesh.name = p.name;
+    const mesh = partMesh(p, p);
     scene.add(mesh);
     parts[p.name] = { mesh: mesh, explode: p.explode_mm };
     const label = document.createElement("label");
@@ -219,15 +237,9 @@ _PAGE = r"""<!DOCTYPE html>
     " traced rays reach the sample; colour: theta 0..90 deg (traced " +
     (DATA.rays.count ? DATA.rays.theta_min_deg.toFixed(1) + ".." + DATA.rays.theta_max_deg.toFixed(1) : "-") + " deg)";
 
-  const box = new THREE.Box3().setFromObject(scene);
-  const sphere = box.getBoundingSphere(new THREE.Sphere());
-  const dir = new THREE.Vector3(1.0, -1.7, 0.75).normalize();
-  const dist = sphere.radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.8;
-  camera.position.copy(sphere.center).addScaledVector(dir, dist);
-  camera.lookAt(sphere.center);
   const controls = new THREE.TrackballControls(camera, renderer.domElement);
-  controls.target.copy(sphere.center);
   controls.rotateSpeed = 2.0; controls.zoomSpeed = 1.2; controls.panSpeed = 0.8; controls.staticMoving = true;
+  fitCamera(new THREE.Box3().setFromObject(scene), controls);
 
   let frames = 0;
   function render() { light.position.copy(camera.position); renderer.render(scene, camera); frames++; }
@@ -299,5 +311,5 @@ def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays
             **({"glb": out_dir / "rig.glb"} if glb else {})}
 
 
-__all__ = ["VIEW_RAYS", "b64", "ray_segments", "three_js", "traced_rays", "view_html",
+__all__ = ["SCENE_JS", "VIEW_RAYS", "b64", "ray_segments", "three_js", "traced_rays", "view_html",
            "write_view"]
