@@ -42,7 +42,7 @@ def _yaml(width_mm: float, cop_cm: float) -> str:
 
 class Watcher:
     def __init__(self, profile: Path) -> None:
-        self.proc = subprocess.Popen([sys.executable, "-m", "rigcad.cli", "watch", str(profile), "--port", "0"],
+        self.proc = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), "--port", "0"],
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
                                      env={**os.environ, "PYTHONPATH": str(ROOT)}, cwd=profile.parent)
         self.lines: list[str] = []

@@ -218,17 +218,6 @@ def _subdivide(tri: np.ndarray, area: np.ndarray, cell: float) -> tuple[np.ndarr
     return np.concatenate(pts), np.concatenate(owner), np.concatenate(share)
 
 
-def fits_whole(vertices: np.ndarray, has_mirror: bool, usable: tuple[float, float, float]) -> bool:
-    """Whether the whole part (vertices (n, 3) mm) fits the usable box (x, y, z mm) in one of its
-    candidate build directions (a mirror part's, a plate's flat ones, or the six axis directions)."""
-    if has_mirror:
-        candidates = mirror_candidates(None)
-    else:
-        plate = plate_axis(vertices)
-        candidates = flat_candidates(plate) if plate is not None else generic_candidates()
-    return any(fit_spin(vertices, o.direction, usable)[0] is not None for o in candidates)
-
-
 def generic_candidates() -> list[Orientation]:
     """Six axis-aligned build directions for parts without a mirror."""
     return [Orientation(n, d) for n, d in (("+z up (working position)", (0, 0, 1)), ("-z up", (0, 0, -1)),

@@ -226,16 +226,16 @@ class LiveSession:
         return rig, dome_key, design_key
 
     def _meshes(self, rig, parts, keys: dict, ran: list) -> list:
-        """Every in-rig part's picture mesh (manual.assembly.rig_meshes): only the parts whose key
+        """Every in-rig part's picture mesh (manual.assembly.picture_meshes): only the parts whose key
         is not cached are meshed; the cache is then pruned to this rig's parts."""
         from rigcad.export.mesh import PICTURE_CHORD_ERROR
-        from rigcad.manual.assembly import rig_meshes
+        from rigcad.manual.assembly import picture_meshes
 
         for p in parts:
             if (keys[p.name], PICTURE_CHORD_ERROR) not in self._mesh_cache:
                 self.builds[f"mesh:{p.name}"] += 1
                 ran.append(f"mesh:{p.name}")
-        meshes = rig_meshes(rig, PICTURE_CHORD_ERROR)
+        meshes = picture_meshes(rig, PICTURE_CHORD_ERROR)
         used = {(k, PICTURE_CHORD_ERROR) for k in keys.values()}
         for stale in [k for k in self._mesh_cache if k not in used]:  # memory stays one rig's meshes
             del self._mesh_cache[stale]
@@ -285,11 +285,16 @@ class LiveSession:
             self._printers[printer.name] = printer
 
     def _printer_fits(self, rig, meshes, keys: dict, ran: list) -> dict[str, dict]:
-        """Per printer: the printed parts that fit its usable volume whole
-        (fab.orientation.fits_whole on the picture meshes) and those that must be split."""
+        """Per printer: the printed parts that fit its usable volume whole (fab.choice's orientations
+        and fit, on the picture meshes) and those that must be split."""
         if not self._printers:
             return {}
-        from rigcad.fab.orientation import fits_whole
+        from rigcad.fab import choice
+        from rigcad.fab.orientation import plate_axis
+
+        def whole(name: str, vertices, printer) -> bool:  # as rigcad fab decides it (fab.choice.split_plan)
+            mirror = bool(rig.recipe(name).mirrors)
+            return choice.fits(vertices, choice.candidates(mirror, None if mirror else plate_axis(vertices)), printer)
 
         old = self.good.printers if self.good is not None else {}
         out = {}
@@ -301,8 +306,7 @@ class LiveSession:
                 continue
             self.builds[f"fit:{name}"] += 1
             ran.append(f"fit:{name}")
-            split = sorted(n for n, m in printed.items()
-                           if not fits_whole(m.vertices, bool(rig.recipe(n).mirrors), printer.usable))
+            split = sorted(n for n, m in printed.items() if not whole(n, m.vertices, printer))
             out[name] = {"key": key, "parts": len(printed), "split": split, "usable_mm": list(printer.usable)}
         return out
 

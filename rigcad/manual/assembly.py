@@ -55,7 +55,7 @@ class PartMesh:
         return self.vertices.max(axis=0)
 
 
-def rig_meshes(rig, chord_error: float | None = None) -> list[PartMesh]:
+def picture_meshes(rig, chord_error: float | None = None) -> list[PartMesh]:
     """Every in-rig part of ``rig`` (a :class:`rigcad.rig.Rig`) as a PartMesh, in assembly order,
     meshed at ``chord_error`` mm (default the picture chord, export.mesh.PICTURE_CHORD_ERROR)."""
     from rigcad.export.mesh import PICTURE_CHORD_ERROR
@@ -193,5 +193,5 @@ def encloses(meshes: list[PartMesh]) -> set[str]:
     return out
 
 
-__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "hex_color", "ray_colors", "rig_meshes",
-           "step_offsets", "steps"]
+__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "hex_color", "picture_meshes", "ray_colors",
+           "rig_meshes", "step_offsets", "steps"]

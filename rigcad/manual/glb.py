@@ -1,7 +1,7 @@
 """``rigcad view --glb``: the assembled rig as one binary glTF 2.0 file (``rig.glb``) for Blender,
 YACV or any glTF viewer.
 
-One node per in-rig part (``manual.assembly.rig_meshes``: the picture meshes the HTML view draws,
+One node per in-rig part (``manual.assembly.picture_meshes``: the picture meshes the HTML view draws,
 in their working positions), named after the part, with a PBR material of the part's colour (the
 see-through dome at the view's 30 % opacity); and one node ``rays``: the traced rays
 (``manual.view.traced_rays``) as line strips, one per ray, coloured by their incidence angle at the
@@ -21,7 +21,7 @@ def _rgba(color, alpha: float) -> list[int]:
 
 
 def rig_scene(rig, meshes: list[PartMesh], rays: dict):
-    """A trimesh Scene of ``meshes`` (assembly.rig_meshes) and ``rays`` (view.traced_rays)."""
+    """A trimesh Scene of ``meshes`` (assembly.picture_meshes) and ``rays`` (view.traced_rays)."""
     import trimesh
 
     scene = trimesh.Scene()

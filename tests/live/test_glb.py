@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope="module")
 def written(tmp_path_factory):
     out = tmp_path_factory.mktemp("glb")
-    run = subprocess.run([sys.executable, "-m", "rigcad.cli", "view", "achutha2006", "--exports", str(out),
+    run = subprocess.run([sys.executable, "-m", "rigcad", "view", "achutha2006", "--exports", str(out),
                           "--rays", "40", "--glb"], capture_output=True, text=True, timeout=600, cwd=ROOT)
     assert run.returncode == 0, run.stderr
     return out / "achutha2006" / "view" / "rig.glb", run.stdout
@@ -39,7 +39,7 @@ def _chunks(data: bytes) -> tuple[dict, bytes]:
 
 
 def test_the_glb_holds_every_part_by_name_and_the_rays_as_lines(written):
-    from rigcad.manual.assembly import rig_meshes
+    from rigcad.manual.assembly import picture_meshes
     from rigcad.manual.view import traced_rays
     from rigcad.rig import load
 
@@ -47,7 +47,7 @@ def test_the_glb_holds_every_part_by_name_and_the_rays_as_lines(written):
     assert "rig.glb" in stdout
     data = path.read_bytes()
     rig = load("achutha2006")
-    meshes = rig_meshes(rig)
+    meshes = picture_meshes(rig)
     rays = traced_rays(rig, 40)
     doc, _ = _chunks(data)
     nodes = {n["name"]: n for n in doc["nodes"] if "name" in n}
@@ -71,10 +71,10 @@ def test_the_glb_holds_every_part_by_name_and_the_rays_as_lines(written):
 
 
 def test_same_profile_same_bytes(written):
-    from rigcad.manual.assembly import rig_meshes
+    from rigcad.manual.assembly import picture_meshes
     from rigcad.manual.glb import glb_bytes
     from rigcad.manual.view import traced_rays
     from rigcad.rig import load
 
     rig = load("achutha2006")
-    assert glb_bytes(rig, rig_meshes(rig), traced_rays(rig, 40)) == written[0].read_bytes()
+    assert glb_bytes(rig, picture_meshes(rig), traced_rays(rig, 40)) == written[0].read_bytes()

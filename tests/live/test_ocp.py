@@ -37,7 +37,7 @@ def test_ocp_without_a_viewer_says_one_line_and_the_browser_view_runs(tmp_path):
     profile = tmp_path / "rig.yaml"
     profile.write_text("extends: achutha2006\n", encoding="utf-8")
     port = _closed_port()
-    proc = subprocess.Popen([sys.executable, "-m", "rigcad.cli", "watch", str(profile), "--port", "0", "--ocp",
+    proc = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), "--port", "0", "--ocp",
                              "--ocp-port", str(port), "--no-check"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, cwd=tmp_path)
     lines: list[str] = []

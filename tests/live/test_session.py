@@ -1,5 +1,5 @@
 """The live session rebuilds only what an edit touches, and what it rebuilds equals a rig built
-from scratch (the non-incremental path: Rig.from_profile, run_design, rig_meshes, run_raycheck):
+from scratch (the non-incremental path: Rig.from_profile, run_design, picture_meshes, run_raycheck):
 an edit of beam.width re-meshes exactly the in-rig parts whose recipes declare that they read
 beam.width (Part.shaped_by, the parts' own statement, not the session's keys), integrates no dome
 and traces no design; an edit of layout.cop_to_vertex does both; an unknown key gives file:line

@@ -38,7 +38,7 @@ class Watch:
 
     def __init__(self, profile: Path, *args: str) -> None:
         env = {**os.environ, "PYTHONPATH": str(ROOT)}
-        self.proc = subprocess.Popen([sys.executable, "-m", "rigcad.cli", "watch", str(profile), *args],
+        self.proc = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), *args],
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
                                      cwd=profile.parent)
         self.lines: list[str] = []

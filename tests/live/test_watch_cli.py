@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_a_missing_profile_is_one_line(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "rigcad.cli", "watch", "no_such_rig", "--port", "0"],
+    run = subprocess.run([sys.executable, "-m", "rigcad", "watch", "no_such_rig", "--port", "0"],
                          capture_output=True, text=True, timeout=120, cwd=tmp_path,
                          env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert run.returncode != 0
@@ -34,7 +34,7 @@ def test_write_publishes_the_exports_and_rebuilds_only_what_changed(tmp_path):
     profile = tmp_path / "rig.yaml"
     profile.write_text("extends: achutha2006\nbeam:\n  width: 6 mm\n", encoding="utf-8")
     exports = tmp_path / "out"
-    proc = subprocess.Popen([sys.executable, "-m", "rigcad.cli", "watch", str(profile), "--port", "0", "--write",
+    proc = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), "--port", "0", "--write",
                              "--no-check", "--exports", str(exports)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)})
     lines: list[str] = []

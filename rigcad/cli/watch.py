@@ -1,4 +1,4 @@
-"""``rigcad watch PROFILE`` from the command line (wired into rigcad's subcommands by :func:`register`)."""
+"""``rigcad watch PROFILE``: the live edit loop (rigcad.live) with its view served on 127.0.0.1."""
 
 from __future__ import annotations
 
@@ -38,18 +38,18 @@ def cmd_watch(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``watch`` to rigcad's subcommands."""
-    from rigcad.arguments import port_number
+    from rigcad.arguments import port_number, profile_command
 
-    p = subparsers.add_parser(
-        "watch", help="edit the YAML, see the rig: a live 3D view rebuilt on every save",
+    p = profile_command(
+        subparsers, "watch", cmd_watch,
+        help="edit the YAML, see the rig: a live 3D view rebuilt on every save",
         description="Watch the profile, every file its extends: chain reads and the printer files given, and on "
                     "each save rebuild only what the change touches (the parts whose recipe changed; the dome, "
                     "design and check only when their inputs did), re-run the design-level check rows on the "
                     "analytic tracer and push the result to a live view in the browser (served on 127.0.0.1). "
                     "A profile with an error shows it, with file:line, and keeps the last good rig. Ctrl-C stops.",
         epilog="By default nothing under the exports changes; --write publishes them after each good rebuild, "
-               "as `rigcad stl` does. --ocp also shows the rig in a running OCP CAD Viewer.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
+               "as `rigcad stl` does. --ocp also shows the rig in a running OCP CAD Viewer. See docs/watch.md.")
     p.add_argument("--host", default="127.0.0.1", help="address the live view is served on (default: 127.0.0.1, "
                                                         "this machine only)")
     p.add_argument("--port", type=port_number, default=8765,
@@ -58,12 +58,10 @@ def register(subparsers) -> argparse.ArgumentParser:
                    help="a printer (name under printers/ or path) whose files are watched too; the view lists the "
                         "printed parts that must be split for it (repeatable)")
     p.add_argument("--no-check", action="store_true", help="skip the check rows (parts and design only)")
-    p.add_argument("--write", action="store_true", help="also publish exports/<profile>/ after each good rebuild")
-    p.add_argument("--exports", default="exports", help="output root for --write (default: exports)")
+    p.add_argument("--write", action="store_true", help="also publish <exports>/<profile>/ after each good rebuild")
     p.add_argument("--ocp", action="store_true", help="also push the parts, rays and COP markers to a running OCP CAD "
                                                       "Viewer (the optional ocp_vscode)")
     p.add_argument("--ocp-port", type=port_number, default=3939, help="the OCP CAD Viewer's port (default 3939)")
-    p.set_defaults(func=cmd_watch)
     return p
 
 
