@@ -14,11 +14,11 @@ import sys
 from pathlib import Path
 
 from rigcad._version import __version__
-from rigcad.cli import basis, build, check, design, fab, manual, optimize, profile, stl, sweep, tolerance, view
-from rigcad.errors import RigcadError
+from rigcad.cli import basis, build, check, design, fab, manual, optimize, profile, stl, sweep, tolerance, view, watch
+from rigcad.errors import RigcadError, one_line
 
 #: The commands, in the order of ``rigcad --help``: each a module with ``register(subparsers)``.
-COMMANDS = (profile, design, build, stl, check, fab, basis, optimize, view, manual, tolerance, sweep)
+COMMANDS = (profile, design, build, stl, check, fab, basis, optimize, view, watch, manual, tolerance, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -38,8 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
 def _error_line(message: object) -> str:
     """``rigcad: error: <message>`` on one line: a newline or other control character that a name,
     a path or a value brought into the message is shown escaped (``\\n``), never printed."""
-    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in str(message))
-    return f"rigcad: error: {text}"
+    return f"rigcad: error: {one_line(message)}"
 
 
 def main(argv: list[str] | None = None) -> int:
