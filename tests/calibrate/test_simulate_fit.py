@@ -12,7 +12,7 @@ from PIL import Image
 from scipy.ndimage import binary_erosion
 
 from rigcad.calibrate import maps, model as M, simulate as S
-from rigcad.calibrate.cli import cmd_calibrate
+from rigcad.cli.calibrate import cmd_calibrate
 from rigcad.calibrate.decode import decode
 from rigcad.calibrate.images import CaptureError
 from rigcad.calibrate.patterns import Sequence

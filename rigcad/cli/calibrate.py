@@ -1,7 +1,7 @@
 """``rigcad calibrate PROFILE (--images DIR | --simulate) [--seed N] [--exports DIR]``: decode the
 capture, fit the misalignment, write the residual slope map and the corrected pixel -> incidence
 map into ``<exports>/<profile>/calibrate/`` (published atomically: a refused capture writes
-nothing). Wired into the command line by :func:`register`."""
+nothing). ``--kit`` writes the calibration kit instead (rigcad.calibrate.kit)."""
 
 from __future__ import annotations
 
@@ -138,14 +138,22 @@ def _npz(result) -> bytes:
 
 
 def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser("calibrate", help="deflectometric calibration of the as-built rig")
-    p.add_argument("profile")
+    """Add ``calibrate`` to rigcad's subcommands."""
+    from rigcad.arguments import profile_command
+
+    p = profile_command(
+        subparsers, "calibrate", cmd_calibrate,
+        help="deflectometric calibration of the as-built rig (a screen at the sample)",
+        description="Decode a capture of the calibration screen at two or more spacer heights (images "
+                    "h<spacer>_<frame>.png|tif, docs/calibrate.md), fit the rig's misalignment with its own "
+                    "tracer, map the dome's residual slopes and write exports/<profile>/calibrate/: "
+                    "calibration.json, corrected_map.npz (read by rigcad basis --simulate), maps.png. "
+                    "--simulate renders a seeded capture of a moved rig with a planted dome error instead and "
+                    "compares; --kit writes the screen patterns, the spacers and the manual's page.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif)")
     src.add_argument("--simulate", action="store_true", help="render a seeded simulated capture and calibrate it")
     src.add_argument("--kit", action="store_true", help="write the calibration kit: screen patterns, spacers "
                      "(STL, STEP, manifest), the manual's page, into <exports>/<profile>/calibrate_kit")
     p.add_argument("--seed", type=int, default=2006, help="seed of the simulated misalignment and noise")
-    p.add_argument("--exports", default="exports", help="exports root (default exports)")
-    p.set_defaults(func=cmd_calibrate)
     return p
