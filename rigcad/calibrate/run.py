@@ -44,8 +44,9 @@ class Calibration:
                 "pixels": int(g.size)}
 
 
-def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: None) -> Calibration:
-    """Calibrate from ``images`` (per spacer, frame name -> full camera image as float, checked)."""
+def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: None, check=None) -> Calibration:
+    """Calibrate from ``images`` (per spacer, frame name -> full camera image as float, checked).
+    ``check(decoded)``: called with the decoded captures before the fit (it raises to refuse them)."""
     cal = rig.profile.calibration
     seq = Sequence.from_profile(cal)
     cam = M.Camera.of(rig)
@@ -53,6 +54,8 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     t0 = time.perf_counter()
     decoded = [decode(seq, {n: cam.crop(im) for n, im in frames.items()}, cal.min_modulation) for frames in images]
     t1 = time.perf_counter()
+    if check is not None:
+        check(decoded)
     say(f"decoded {', '.join(str(d.stats()['decoded_pixels']) for d in decoded)} camera pixels per height")
     data = _fit_data(cam, decoded, cal.fit_stride)
     result = fit(optics, rig, cam, heights, data, say)

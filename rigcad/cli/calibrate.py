@@ -34,10 +34,13 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         return 0
     seq = Sequence.from_profile(rig.profile.calibration)
     heights = M.nominal_heights(rig.profile)
-    with stages(4, "calibrate") as step:
+    folder, images, truth = Path("<simulated>"), None, None
+    if not args.simulate:  # a capture that is missing or the wrong size is refused before any work
+        folder = Path(args.images)
+        images = read_capture(folder, seq, len(heights), rig.profile.camera.resolution)
+    with stages(3, "calibrate") as step:
         step("tracer")
         optics = analytic_optics(rig)
-        truth = None
         if args.simulate:
             from rigcad.calibrate import simulate as S
 
@@ -48,16 +51,10 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, heights, rng)
             images = [{n: im.astype(float) / 255.0 for n, im in f.items()} for f in images]
             truth = (theta, surface)
-            folder = Path("<simulated>")
-        else:
-            step("reading the capture")
-            folder = Path(args.images)
-            images = read_capture(folder, seq, len(heights), rig.profile.camera.resolution)
         step("decode, fit, maps")
-        result = calibrate(optics, rig, images, say=print)
-        if not args.simulate:
-            for k, d in enumerate(result.decoded):
-                check_decoded(folder, k, seq, d)
+        check = None if args.simulate else (
+            lambda decoded: [check_decoded(folder, k, seq, d) for k, d in enumerate(decoded)])
+        result = calibrate(optics, rig, images, say=print, check=check)
     _check_heights(result, folder)
     report = _report(result)
     extra = None
