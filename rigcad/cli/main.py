@@ -14,7 +14,6 @@ import sys
 from pathlib import Path
 
 from rigcad._version import __version__
-from rigcad.arguments import exports_root
 from rigcad.cli import basis, build, check, design, fab, manual, optimize, profile, stl, sweep, tolerance, view, watch
 from rigcad.errors import RigcadError, one_line
 
@@ -33,18 +32,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for command in COMMANDS:
         command.register(sub)
-    _require_exports_root(parser)
     return parser
-
-
-def _require_exports_root(parser: argparse.ArgumentParser) -> None:
-    """Every command's ``--exports`` takes :func:`exports_root` (one rule, whichever module added it)."""
-    for action in parser._actions:
-        if action.dest == "exports":
-            action.type = exports_root
-        if isinstance(action, argparse._SubParsersAction):
-            for child in action.choices.values():
-                _require_exports_root(child)
 
 
 def _error_line(message: object) -> str:
