@@ -142,4 +142,4 @@ def summary(frame, push: float) -> str:
     return f"{head} rebuilt {what} ({times} push {push:.2f} s){'; checking' if frame.check_pending else ''}"
 
 
-__all__ = ["DEBOUNCE_MS", "Watcher", "summary"]
+__all__ = ["DEBOUNCE_MS", "STEP_MS", "Watcher", "summary"]

@@ -13,7 +13,7 @@ import pytest
 
 from rigcad.live.server import Hub
 from rigcad.live.session import LiveSession
-from rigcad.live.watch import Watcher
+from rigcad.live.watch import STEP_MS, Watcher
 
 
 @pytest.fixture
@@ -66,12 +66,17 @@ def test_saves_in_place_by_rename_and_by_backup_each_rebuild(loop):
 def test_a_burst_of_writes_is_one_rebuild(loop):
     watcher, path = loop
     before = len(watcher.frames)
-    for width in (7.1, 7.2, 7.3, 7.4, 7.5):  # an editor writing in chunks, ~5 ms apart
+    t0 = time.perf_counter()
+    for width in (7.1, 7.2, 7.3, 7.4, 7.5):  # an editor writing in chunks, back to back
         path.write_text(f"extends: achutha2006\nbeam:\n  width: {width} mm\n", encoding="utf-8")
-        time.sleep(0.005)
+    span = time.perf_counter() - t0
     _wait(lambda: len(watcher.frames) > before and abs(_beam(watcher) - 7.5) < 1e-9, "the last write")
     time.sleep(1.0)  # anything the burst would still trigger
-    assert len(watcher.frames) == before + 1, watcher.frames[before:]
+    rebuilds = len(watcher.frames) - before
+    if span < STEP_MS / 1000:  # the writes came closer together than the quiet time that ends a burst
+        assert rebuilds == 1, watcher.frames[before:]
+    else:  # a loaded machine spread the writes out (measured span in the message): still grouped
+        assert rebuilds < 5, (span, watcher.frames[before:])
 
 
 def test_the_extends_chain_is_followed(loop):
