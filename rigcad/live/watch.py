@@ -68,12 +68,19 @@ class Watcher:
         self.say(summary(frame, push))
 
     def _write(self) -> None:
+        """Publish the exports of the good rig; a failure (a planted link, a full disk) is one line
+        and the watch goes on (the previous exports stay whole: the publication is atomic)."""
+        from rigcad.errors import RigcadError
         from rigcad.export.atomic import check_exports
 
         rig = self.session.good.rig
-        check_exports(self.write, rig.name)
         t0 = time.perf_counter()
-        result = rig.export(Path(self.write) / rig.name)
+        try:
+            check_exports(self.write, rig.name)
+            result = rig.export(Path(self.write) / rig.name)
+        except RigcadError as err:
+            self.say(f"  not written: {one_line(err)}")
+            return
         self.say(f"  wrote {Path(self.write) / rig.name}/: {len(result.rebuilt)} part(s) built, "
                  f"{len(result.reused)} unchanged ({time.perf_counter() - t0:.1f} s)")
 
