@@ -89,3 +89,20 @@ def test_the_extends_chain_is_followed(loop):
     # written at once, maybe before the watch has restarted on the new chain: still seen
     parent.write_text("extends: achutha2006\nbeam:\n  width: 11 mm\n", encoding="utf-8")  # only the parent changes
     _wait(lambda: abs(_beam(watcher) - 11) < 1e-9, "an edit of the parent")
+
+
+def test_a_refused_write_is_one_line_and_the_watch_goes_on(tmp_path):
+    """--write into an exports folder where the profile's folder is a planted symbolic link: the
+    publication refuses (export.atomic), the watcher says so in one line and keeps the rig."""
+    path = tmp_path / "rig.yaml"
+    path.write_text("extends: achutha2006\n", encoding="utf-8")
+    out = tmp_path / "out"
+    out.mkdir()
+    (tmp_path / "elsewhere").mkdir()
+    (out / "rig").symlink_to(tmp_path / "elsewhere")
+    lines: list[str] = []
+    watcher = Watcher(LiveSession(path, check=False), Hub(), say=lines.append, write=out)
+    watcher.rebuild()
+    refused = [line for line in lines if line.startswith("  not written: ")]
+    assert len(refused) == 1 and "link" in refused[0], lines
+    assert watcher.session.good is not None and list((tmp_path / "elsewhere").iterdir()) == []
