@@ -63,7 +63,8 @@ def test_rig_show_without_a_viewer_is_one_clear_error():
     from rigcad.rig import load
 
     port = _closed_port()
-    with pytest.raises(ViewerError, match=f"no OCP CAD Viewer on 127.0.0.1:{port}: .*python -m ocp_viewer --port {port}"):
+    hint = f"no OCP CAD Viewer on 127.0.0.1:{port}: .*python -m ocp_viewer --port {port}"
+    with pytest.raises(ViewerError, match=hint):
         load("achutha2006").show(port=port)
 
 
