@@ -12,7 +12,6 @@ import json
 import os
 import re
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -21,21 +20,15 @@ from pathlib import Path
 
 import pytest
 
+from .conftest import closed_port
+
 ROOT = Path(__file__).resolve().parents[2]
-
-
-def _closed_port() -> int:
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()  # nothing listens there now
-    return port
 
 
 def test_ocp_without_a_viewer_says_one_line_and_the_browser_view_runs(tmp_path):
     profile = tmp_path / "rig.yaml"
     profile.write_text("extends: achutha2006\n", encoding="utf-8")
-    port = _closed_port()
+    port = closed_port()
     proc = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), "--port", "0", "--ocp",
                              "--ocp-port", str(port), "--no-check"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, cwd=tmp_path)
@@ -62,7 +55,7 @@ def test_rig_show_without_a_viewer_is_one_clear_error():
     from rigcad.live.ocp import ViewerError
     from rigcad.rig import load
 
-    port = _closed_port()
+    port = closed_port()
     hint = f"no OCP CAD Viewer on 127.0.0.1:{port}: .*python -m ocp_viewer --port {port}"
     with pytest.raises(ViewerError, match=hint):
         load("achutha2006").show(port=port)

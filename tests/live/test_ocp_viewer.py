@@ -15,7 +15,6 @@ from __future__ import annotations
 import os
 import re
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -25,10 +24,8 @@ from pathlib import Path
 
 import pytest
 
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
-                 "--enable-unsafe-swiftshader", "--disable-background-networking", "--disable-component-update",
-                 "--disable-default-apps", "--disable-sync", "--no-first-run"]
+from .conftest import CHROMIUM, CHROMIUM_ARGS, closed_port
+
 ROOT = Path(__file__).resolve().parents[2]
 MARKERS = {"cop_marker", "projector_cop_marker", "camera_cop_marker"}
 #: The tree's nodes as the page shows them: path, faces state, edges state, colour of the name's dot.
@@ -48,14 +45,6 @@ TREE_JS = """async () => {
 }"""
 
 pytestmark = pytest.mark.slow
-
-
-def _free_port() -> int:
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 class Lines:
@@ -110,7 +99,7 @@ def viewer(tmp_path):
         pytest.fail(f"{CHROMIUM} is missing: `make tools` installs Debian's chromium (apt-get)")
     from playwright.sync_api import sync_playwright
 
-    port = _free_port()
+    port = closed_port()
     home = tmp_path / "home"
     home.mkdir()
     proc = subprocess.Popen([sys.executable, "-m", "ocp_viewer", "--host", "127.0.0.1", "--port", str(port)],
