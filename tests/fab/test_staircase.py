@@ -320,3 +320,43 @@ def test_step_map_with_no_point_on_the_mirror_is_empty():
     for a in (s.cusp_slices, s.cusp_closed, s.peak, s.valley):
         assert isinstance(a, np.ndarray) and a.shape == (0,)
     assert s.summary()["contour_points"] == 0 and polishing_allowance(s)["sanding_depth_mm"] == 0.0
+
+
+def test_optical_effect_p90_below_the_largest_error():
+    # A facing z, B tilted 0.1 rad, 1 mm2 each: area fractions (1, cos 0.1, sin 0.1) / total = 0.477, 0.475,
+    # 0.048 for errors 0, 0.1 and pi/2 - 0.1 rad: the 90th percentile is B's tread, not the largest error
+    th = 0.1
+    f = _faces([[0, 0, 1], [math.sin(th), 0, math.cos(th)]], [1.0, 1.0], [[0, 0, 100.0], [100.0, 0, 0]])
+    e = optical_effect(f, (0.0, 0.0, 1.0), "paraboloid")
+    assert math.isclose(e["normal_error_p90_deg"], math.degrees(th), rel_tol=1e-12)
+    assert math.isclose(e["ray_angle_error_p90_deg"], 2 * math.degrees(th), rel_tol=1e-12)
+
+
+def test_faces_facing_the_build_direction_have_no_error():
+    # unit normals along the unit build direction: |n . D| is 1 up to rounding, and may round above 1
+    # (for (1, 1, 1) / sqrt(3) it does on x86-64 with numpy's dot); the error is 0, never NaN
+    dirs = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, 2.0], [2.0, 1.0, 3.0], [1.0, 4.0, 4.0]])
+    for d in dirs:
+        n = d / np.linalg.norm(d)
+        e = optical_effect(_faces([n], [1.0], [[0.0, 0.0, 100.0]]), tuple(d), "dome")
+        assert e["normal_error_median_deg"] == 0.0 and e["area_fraction_within_1mrad"] == 1.0, (d, e)
+        assert e["histogram_normal_error_deg"]["area_fraction"][0] == 1.0 and e["miss_at_sample_median_mm"] == 0.0
+
+
+def test_a_ray_turned_past_89_degrees_misses_by_l_tan_89():
+    # one face at 44.6 deg to z: its tread (error 44.6 deg) holds the larger area cos 44.6 > sin 44.6, so
+    # it is the median; the reflected ray turns by 89.2 deg, clipped at 89 deg: miss L tan(89 deg)
+    th = math.radians(44.6)
+    f = _faces([[math.sin(th), 0, math.cos(th)]], [1.0], [[0.0, 0.0, 100.0]])
+    e = optical_effect(f, (0.0, 0.0, 1.0), "dome")
+    assert math.isclose(e["normal_error_median_deg"], 44.6, rel_tol=1e-12)
+    assert math.isclose(e["miss_at_sample_median_mm"], 100 * math.tan(math.radians(89.0)), rel_tol=1e-12)
+
+
+def test_step_map_summary_without_a_closed_form_cusp():
+    # walls along the build direction: closed-form cusp 0, so the relative difference is undefined (None);
+    # an empty map has no figure at all
+    s = _map([0.01, 0.02], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]).summary()
+    assert s["slices_vs_closed_form_mean_rel_diff"] is None and s["cusp_closed_form_mean_mm"] == 0.0
+    empty = _map([], [], [], []).summary()
+    assert empty["contour_points"] == 0 and all(v is None for k, v in empty.items() if k != "contour_points"), empty
