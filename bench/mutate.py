@@ -140,7 +140,8 @@ def retest_survivors(group: str, max_children: int) -> dict:
                              text=True).stdout
         if old != (ROOT / module).read_text():
             raise SystemExit(f"{module} changed since {group}'s run: run the group again")
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", "HEAD", "tests"], capture_output=True,
+    head = _head()  # the tests' commit, named before a commit made during the run can move HEAD
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", head, "tests"], capture_output=True,
                              check=True).stdout
     for dest in (work, work / "mutants"):
         shutil.rmtree(dest / "tests")
@@ -151,7 +152,7 @@ def retest_survivors(group: str, max_children: int) -> dict:
     with (work / "mutmut-retest.log").open("w") as out:
         subprocess.run([sys.executable, "-m", "mutmut", "run", "--max-children", str(max_children), *names],
                        cwd=work, env=env, stdout=out, stderr=subprocess.STDOUT)
-    (work / "commit.txt").write_text(f"{_commit_of(work)}, survivors retested with the tests of {_head()}\n")
+    (work / "commit.txt").write_text(f"{_commit_of(work)}, survivors retested with the tests of {head}\n")
     done = work / "seconds.txt"
     total = (float(done.read_text()) if done.exists() else 0.0) + time.monotonic() - t0
     return collect(group, work, total)
