@@ -138,6 +138,34 @@ def run(group: str, max_children: int) -> dict:
     return collect(group, work, seconds)
 
 
+def resume(group: str, max_children: int) -> dict:
+    """Go on with a run of ``group`` that was stopped (build/mutate/<group>/ kept): mutmut lets the
+    results it has stand and tests the mutants left unchecked. The modules must be unchanged."""
+    work = ROOT / "build" / "mutate" / group
+    _check_unchanged(group, work)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(work / "mutants")
+    t0 = time.monotonic()
+    with (work / "mutmut.log").open("a") as out:
+        res = subprocess.run([sys.executable, "-m", "mutmut", "run", "--max-children", str(max_children)],
+                             cwd=work, env=env, stdout=out, stderr=subprocess.STDOUT)
+    if res.returncode != 0:
+        raise SystemExit(f"mutmut failed on {group} (exit {res.returncode}); see {work / 'mutmut.log'}")
+    done = work / "seconds.txt"
+    # a stopped run wrote no time of its own: the figure is then this part's only
+    total = (float(done.read_text()) if done.exists() else 0.0) + time.monotonic() - t0
+    done.write_text(f"{total:.1f}\n")
+    return collect(group, work, total)
+
+
+def _check_unchanged(group: str, work: Path) -> None:
+    for module in GROUPS[group][0]:
+        old = subprocess.run(["git", "-C", str(ROOT), "show", f"{_commit_of(work)}:{module}"], capture_output=True,
+                             text=True).stdout
+        if old != (ROOT / module).read_text():
+            raise SystemExit(f"{module} changed since {group}'s run: run the group again")
+
+
 def retest_survivors(group: str, max_children: int) -> dict:
     """Test again, against the committed tests (HEAD), only the mutants of ``group`` that survived
     its last run (kept in build/mutate/<group>/): how the tests added for them are checked without
@@ -150,10 +178,7 @@ def retest_survivors(group: str, max_children: int) -> dict:
         # "no tests" too: new tests may reach a function none reached before (mutmut collects the
         # coverage of the new tests before it runs the mutants)
         names += [k for k, v in meta["exit_code_by_key"].items() if v in SURVIVED or v in NO_TESTS]
-        old = subprocess.run(["git", "-C", str(ROOT), "show", f"{_commit_of(work)}:{module}"], capture_output=True,
-                             text=True).stdout
-        if old != (ROOT / module).read_text():
-            raise SystemExit(f"{module} changed since {group}'s run: run the group again")
+    _check_unchanged(group, work)
     head = _head()  # the tests' commit, named before a commit made during the run can move HEAD
     archive = subprocess.run(["git", "-C", str(ROOT), "archive", head, "tests"], capture_output=True,
                              check=True).stdout
@@ -289,6 +314,8 @@ def main() -> None:
     p.add_argument("--list", action="store_true", help="name the groups and their modules, then stop")
     p.add_argument("--retest-survivors", action="store_true",
                    help="test the survivors of the groups' last runs again with the committed tests")
+    p.add_argument("--resume", action="store_true",
+                   help="go on with the groups' stopped runs (build/mutate/<group>/), testing only the mutants left")
     p.add_argument("--collect-only", action="store_true",
                    help="re-read the results of groups already run in build/mutate/ (no mutmut run)")
     args = p.parse_args()
@@ -303,6 +330,9 @@ def main() -> None:
         if args.retest_survivors:
             print(f"retesting the survivors of {group} ...", flush=True)
             res = retest_survivors(group, args.max_children)
+        elif args.resume:
+            print(f"resuming {group} ...", flush=True)
+            res = resume(group, args.max_children)
         elif args.collect_only:
             work = ROOT / "build" / "mutate" / group
             done = work / "seconds.txt"  # absent when the run was stopped: its results are partial
