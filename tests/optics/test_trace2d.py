@@ -104,3 +104,72 @@ def test_screened_crossing_search_finds_every_first_crossing(system):
     # 1e-9 mm: both sides solve the same 2x2 system in float64 at |P| ~ 300 mm (rounding ~1e-13 mm);
     # the bound is the self-hit threshold along the ray, far above rounding, far below a facet
     assert np.max(np.abs(lam[hit] - ref[hit])) < 1e-9
+
+
+def _cross(a, b):
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+
+
+def test_trace_fields_are_the_geometry_of_each_ray(system):
+    """Each returning ray's recorded points and angle, checked by the geometry they must satisfy
+    (not by the trace's own sums): the paraboloid point on the parabola z = z_v - x^2 / 4f and on
+    the ray from the COP; the arrival angle that of the line from the dome point to O; the landing
+    point where that line meets z = 0; the path COP -> P -> D -> O the same for every ray (Fermat).
+    A ray off the paraboloid is reported as missing it, the first cause, with no figure."""
+    from rigcad.optics.trace2d import MISSED_PARABOLOID
+
+    g, para, dome = system
+    curve = DomeCurve.from_profile(dome)
+    rng = np.random.default_rng(5)
+    x = rng.uniform(dome.occlusion_s, g.rim_radius, 400) * rng.choice([-1.0, 1.0], 400)
+    cop = np.array([0.0, g.cop_z])
+    origins, dirs = cop_rays(cop, np.append(x, g.rim_radius * 1.5), para)
+    tr = trace(para, curve, origins, dirs)
+    ok = tr.ok
+    assert ok[:-1].all() and tr.status[-1] == MISSED_PARABOLOID
+    P, D = tr.paraboloid_point[ok], tr.dome_point[ok]
+    assert np.max(np.abs(P[:, 1] - (g.vertex_z - P[:, 0] ** 2 / (4 * g.focal_length)))) < 1e-9
+    assert np.max(np.abs(_cross(P - cop, dirs[ok]))) < 1e-9  # on the ray (|P - COP| ~ 300 mm)
+    # O is within |miss| < 1e-6 mm of the returning line, so the line's angle is that of D seen from O
+    # to |miss| / |D| < 1e-8 rad, and it meets z = 0 at -miss / cos(theta) (|landing| ~ 1e-6 mm)
+    assert np.max(np.abs(tr.theta[ok] - np.arctan2(D[:, 0], D[:, 1]))) < 1e-8
+    assert np.max(np.abs(tr.landing_x[ok] + tr.miss[ok] / np.cos(tr.theta[ok]))) < 1e-9
+    fermat = np.linalg.norm(P - cop, axis=1) + np.linalg.norm(D - P, axis=1) + np.linalg.norm(D, axis=1)
+    assert np.ptp(fermat) < 1e-5  # the bound of test_table31_rays_converge_on_the_sample_point
+    for field in (tr.paraboloid_point, tr.dome_point, tr.miss, tr.landing_x, tr.theta, tr.path_length):
+        assert field.dtype == float and np.all(np.isnan(field[-1])), field[-1]
+
+
+def test_a_shifted_dome_is_the_same_curve_moved_sideways(system):
+    g, _, dome = system
+    curve = DomeCurve.from_profile(dome)
+    src = np.array([0.0, g.cop_z / 3])
+    nodes = curve.points[::50]
+    v = np.vstack([nodes, nodes * [-1.0, 1.0]]) - src  # dome nodes on both halves
+    d = v / np.linalg.norm(v, axis=1)[:, None]
+    o = np.tile(src, (len(d), 1))
+    lam0, n0 = curve.intersect(o, d)
+    moved = curve.shifted(1.5).shifted(-0.25)  # 1.25 mm to +x in all
+    lam1, n1 = moved.intersect(o + [1.25, 0.0], d)
+    hit = np.isfinite(lam0)
+    assert hit.sum() > 10 and np.array_equal(np.isfinite(lam1), hit) and moved.kind == curve.kind
+    # the same crossing, found in a frame moved by 1.25 mm: rounding of the shift at ~300 mm
+    assert np.max(np.abs(lam1[hit] - lam0[hit])) < 1e-9 and np.max(np.abs(n1[hit] - n0[hit])) < 1e-9
+
+
+def test_rays_parallel_to_the_axis_reflect_through_the_focus(system):
+    from rigcad.optics.trace2d import parallel_rays
+
+    g, para, dome = system
+    x = np.linspace(dome.occlusion_s + 1.0, g.rim_radius - 1.0, 50)
+    o, d = parallel_rays(list(np.concatenate([x, -x])), g.vertex_z + 1.0)
+    assert np.array_equal(o[:, 1], np.full(100, g.vertex_z + 1.0)) and np.array_equal(d, np.tile([0.0, -1.0], (100, 1)))
+    tr = trace(para, DomeCurve.from_profile(dome), o, d)
+    P, D = tr.paraboloid_point, tr.dome_point
+    assert np.array_equal(P[:, 0], np.concatenate([x, -x]))  # straight down
+    # the parabola's focal property: every reflected ray passes through the focus (0, z_v - f), so the
+    # dome point lies on the line from P through it
+    hit = np.isfinite(D[:, 0])
+    F = np.array([0.0, g.vertex_z - g.focal_length])
+    assert hit.sum() > 50
+    assert np.max(np.abs(_cross(D[hit] - P[hit], F - P[hit])) / np.linalg.norm(D[hit] - P[hit], axis=1)) < 1e-9
