@@ -173,3 +173,27 @@ def test_rays_parallel_to_the_axis_reflect_through_the_focus(system):
     F = np.array([0.0, g.vertex_z - g.focal_length])
     assert hit.sum() > 50
     assert np.max(np.abs(_cross(D[hit] - P[hit], F - P[hit])) / np.linalg.norm(D[hit] - P[hit], axis=1)) < 1e-9
+
+
+def test_side_flags_points_on_the_line_within_their_rounding_and_no_others():
+    """_side's margin: a point built on the ray's line (o + t d, rounded) is within the rounding of
+    cross(p - o, d) and flagged; a point 1e-6 mm off the line never is, whatever the ray's direction
+    (near horizontal or vertical, where one of the two products vanishes) or the operands' sizes."""
+    from rigcad.optics.trace2d import _side
+
+    rng = np.random.default_rng(9)
+    n, eps = 20000, np.finfo(float).eps
+    o = rng.uniform(-300, 300, (n, 2))
+    o[: n // 4, 1] *= 1e-3  # origins far out along x only
+    o[n // 4: n // 2, 0] *= 1e-3  # and along z only
+    a = rng.uniform(0, 2 * np.pi, n)
+    a[: n // 8] = rng.choice([0.0, np.pi], n // 8) + rng.uniform(-1e-9, 1e-9, n // 8)  # near horizontal
+    a[n // 8: n // 4] = np.pi / 2 + rng.uniform(-1e-9, 1e-9, n // 8)  # near vertical
+    d = np.stack([np.cos(a), np.sin(a)], axis=1)
+    p = o + rng.uniform(-400, 400, n)[:, None] * d
+    _, on = _side(p, o, d, eps)
+    assert on.all(), np.count_nonzero(~on)
+    _, off = _side(p + 1e-6 * np.stack([-d[:, 1], d[:, 0]], axis=1), o, d, eps)
+    assert not off.any(), np.count_nonzero(off)
+    # the ray's own origin: the cross product is exactly 0, and so is its scale
+    assert _side(np.zeros((1, 2)), np.zeros((1, 2)), np.array([[1.0, 0.0]]), eps)[1].all()
