@@ -155,6 +155,9 @@ def test_a_shifted_dome_is_the_same_curve_moved_sideways(system):
     assert hit.sum() > 10 and np.array_equal(np.isfinite(lam1), hit) and moved.kind == curve.kind
     # the same crossing, found in a frame moved by 1.25 mm: rounding of the shift at ~300 mm
     assert np.max(np.abs(lam1[hit] - lam0[hit])) < 1e-9 and np.max(np.abs(n1[hit] - n0[hit])) < 1e-9
+    # built shifted from the profile: the same curve
+    lam2, _ = DomeCurve.from_profile(dome, 1.25).intersect(o + [1.25, 0.0], d)
+    assert np.max(np.abs(lam2[hit] - lam0[hit])) < 1e-9
 
 
 def test_rays_parallel_to_the_axis_reflect_through_the_focus(system):
@@ -197,3 +200,34 @@ def test_side_flags_points_on_the_line_within_their_rounding_and_no_others():
     assert not off.any(), np.count_nonzero(off)
     # the ray's own origin: the cross product is exactly 0, and so is its scale
     assert _side(np.zeros((1, 2)), np.zeros((1, 2)), np.array([[1.0, 0.0]]), eps)[1].all()
+
+
+def test_a_moved_dome_sends_rays_up_or_back_through_the_paraboloid(system):
+    """With the dome 5 mm off the axis some rays leave it going up (ESCAPED: they never reach the
+    sample plane) and some go down through the paraboloid (OCCLUDED). The classification is checked
+    against the outgoing direction rebuilt here from the parabola's closed-form normal and the dome
+    normal at the hit; both kinds record where they left the dome and no figure."""
+    from rigcad.optics.trace2d import ESCAPED, OCCLUDED
+    from rigcad.optics.vec import reflect
+
+    g, para, dome = system
+    curve = DomeCurve.from_profile(dome).shifted(5.0)
+    x = np.linspace(-g.rim_radius, g.rim_radius, 2001)
+    o, d = cop_rays(np.array([0.0, g.cop_z]), x, para)
+    tr = trace(para, curve, o, d)
+    esc, occ = tr.status == ESCAPED, tr.status == OCCLUDED
+    assert esc.sum() > 5 and occ.sum() > 5 and tr.ok.sum() > 1000, np.bincount(tr.status)
+    P = tr.paraboloid_point
+    n_p = np.stack([P[:, 0] / (2 * g.focal_length), np.ones(len(P))], axis=1)  # z = z_v - x^2/4f: (x/2f, 1)
+    u = reflect(d, n_p / np.linalg.norm(n_p, axis=1)[:, None])
+    lam, n_d = curve.intersect(P, u)
+    v = reflect(u, np.nan_to_num(n_d))
+    assert np.all(v[esc, 1] > 0) and np.all(v[tr.ok | occ, 1] < 0)  # up, or down towards z = 0
+    D = P + lam[:, None] * u
+    for k in (esc, occ):
+        assert np.allclose(tr.dome_point[k], D[k], rtol=0, atol=1e-9)
+        for field in (tr.miss, tr.landing_x, tr.theta, tr.path_length):
+            assert np.all(np.isnan(field[k]))
+    # an occluded ray meets the paraboloid on its way down, before the sample plane
+    back = para.intersect(D[occ], v[occ])
+    assert np.all(np.isfinite(back) & (back < -D[occ, 1] / v[occ, 1]))
