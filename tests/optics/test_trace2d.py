@@ -86,20 +86,22 @@ def test_screened_crossing_search_finds_every_first_crossing(system):
     # and rays aimed at the polyline's two end nodes (no segment beyond them), each direction turned
     # by 0-3 ulps either way: the crossing stays within the reference's f window, the end node's cross
     # product takes both signs, so a search that needs a strict sign change loses some on any CPU (on
-    # some BLAS kernels it lost the unturned one too)
-    src = np.array([0.0, g.cop_z / 3])
-    for end in (P[0], P[-1]):
-        u = (end - src) / np.linalg.norm(end - src)
-        for k in range(-3, 4):
-            turned = u.copy()
-            for _ in range(abs(k)):
-                turned = np.nextafter(turned, turned + np.sign(k) * np.array([1.0, -1.0]))
-            o = np.vstack([o, src])
-            d = np.vstack([d, turned])
+    # some BLAS kernels it lost the unturned one too) -- from above, and from 1 um above O, an origin
+    # far smaller than the nodes
+    # (the screen's margin must scale with the nodes too, not only with the origin)
+    for src in (np.array([0.0, g.cop_z / 3]), np.array([0.0, 1e-3])):
+        for end in (P[0], P[-1]):
+            u = (end - src) / np.linalg.norm(end - src)
+            for k in range(-3, 4):
+                turned = u.copy()
+                for _ in range(abs(k)):
+                    turned = np.nextafter(turned, turned + np.sign(k) * np.array([1.0, -1.0]))
+                o = np.vstack([o, src])
+                d = np.vstack([d, turned])
     ref = np.fmin(_first_crossing_every_segment(P, o, d), _first_crossing_every_segment(P * [-1, 1], o, d))  # both halves
     lam, _ = flat.intersect(o, d)
     hit = np.isfinite(ref)
-    assert np.all(hit[-14:]), "the reference finds every end-aimed ray"
+    assert np.all(hit[-28:]), "the reference finds every end-aimed ray"
     assert 100 < hit.sum() < len(o) and np.array_equal(np.isfinite(lam), hit), np.nonzero(np.isfinite(lam) != hit)
     # 1e-9 mm: both sides solve the same 2x2 system in float64 at |P| ~ 300 mm (rounding ~1e-13 mm);
     # the bound is the self-hit threshold along the ray, far above rounding, far below a facet
