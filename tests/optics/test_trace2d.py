@@ -233,3 +233,38 @@ def test_a_moved_dome_sends_rays_up_or_back_through_the_paraboloid(system):
     # an occluded ray meets the paraboloid on its way down, before the sample plane
     back = para.intersect(D[occ], v[occ])
     assert np.all(np.isfinite(back) & (back < -D[occ, 1] / v[occ, 1]))
+
+
+def test_the_first_of_two_crossings_and_a_hit_close_to_the_start(system):
+    """A chord of the (convex) polyline through the midpoints A and B of two of its segments crosses it
+    at A and at B only: from 10 mm before A the first crossing is A, at 10 mm, not B. From 0.5 mm in
+    front of a segment's midpoint, along its normal, the hit is at 0.5 mm (the self-hit threshold
+    along the ray is 1e-9 mm, not more). Each hit's normal is the unit normal of the segment hit."""
+    _, _, dome = system
+    curve = DomeCurve.from_profile(dome)
+    flat = DomeCurve("polyline", curve.s, curve.points, None)
+    P = curve.points
+    mid = 0.5 * (P[:-1] + P[1:])
+    a, b = np.arange(100, 1500, 200), np.arange(300, 1700, 200)
+    u = (mid[b] - mid[a]) / np.linalg.norm(mid[b] - mid[a], axis=1)[:, None]
+    lam, normal = flat.intersect(mid[a] - 10.0 * u, u)
+    assert np.allclose(lam, 10.0, rtol=0, atol=1e-9), lam  # rounding at ~300 mm
+    t = P[a + 1] - P[a]
+    n_seg = np.stack([-t[:, 1], t[:, 0]], axis=1) / np.linalg.norm(t, axis=1)[:, None]
+    assert np.allclose(np.abs(np.sum(normal * n_seg, axis=1)), 1.0, rtol=0, atol=1e-12)
+    # 0.5 mm in front of each midpoint, aimed back at it along the segment's normal
+    lam2, normal2 = flat.intersect(mid[a] + 0.5 * n_seg, -n_seg)
+    assert np.allclose(lam2, 0.5, rtol=0, atol=1e-9), lam2
+    assert np.allclose(np.abs(np.sum(normal2 * n_seg, axis=1)), 1.0, rtol=0, atol=1e-12)
+    # the first segment too (a hit there is a hit like any other, with its normal), on the polyline and
+    # on the smooth curve (which passes within far less than 1 um of the polyline's midpoint there)
+    n0 = _unit_normal(P, 0)
+    lam3, normal3 = flat.intersect(mid[:1] + 0.5 * n0, -n0)
+    assert np.allclose(lam3, 0.5, rtol=0, atol=1e-9) and np.allclose(np.abs(normal3 @ n0[0]), 1.0, atol=1e-12)
+    lam4, normal4 = curve.intersect(mid[:1] + 0.5 * n0, -n0)
+    assert abs(lam4[0] - 0.5) < 1e-3 and np.allclose(np.abs(normal4 @ n0[0]), 1.0, atol=1e-6), (lam4, normal4)
+
+
+def _unit_normal(P, j):
+    t = P[j + 1] - P[j]
+    return (np.array([-t[1], t[0]]) / np.linalg.norm(t))[None, :]
