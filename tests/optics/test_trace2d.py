@@ -172,6 +172,8 @@ def test_rays_parallel_to_the_axis_reflect_through_the_focus(system):
     tr = trace(para, DomeCurve.from_profile(dome), o, d)
     P, D = tr.paraboloid_point, tr.dome_point
     assert np.array_equal(P[:, 0], np.concatenate([x, -x]))  # straight down
+    # integer abscissae are positions like any other: the start height is not rounded to an integer
+    assert np.array_equal(parallel_rays([0, 5], 10.5)[0], [[0.0, 10.5], [5.0, 10.5]])
     # the parabola's focal property: every reflected ray passes through the focus (0, z_v - f), so the
     # dome point lies on the line from P through it
     hit = np.isfinite(D[:, 0])
