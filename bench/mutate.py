@@ -300,9 +300,15 @@ def _markdown(doc: dict) -> str:
             "## Survivors", "",
             "Each is either explained here (an equivalent mutant, or a claim no one makes) or open: a test "
             "that should fail on it is still missing.", ""]
+    module = None
     for s in doc["survivors"]:
+        if s["module"] != module:  # survivors grouped by module, the open ones counted in its heading
+            module = s["module"]
+            mine = [x for x in doc["survivors"] if x["module"] == module]
+            still_open = sum(x["mutant"] not in explained for x in mine)
+            out += [f"### {module}: {len(mine)} survivors, {still_open} open", ""]
         reason = explained.get(s["mutant"], {}).get("reason", "OPEN: no test kills it yet")
-        out += [f"### `{s['mutant']}` ({s['status']})", "", f"{reason}", "", "```diff",
+        out += [f"#### `{s['mutant']}` ({s['status']})", "", f"{reason}", "", "```diff",
                 s["diff"].strip(), "```", ""]
     return "\n".join(out)
 
