@@ -72,6 +72,7 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
     "check.raycheck": (["rigcad/check/raycheck.py"], ["tests/check/test_raycheck.py"]),
     "manual.bom": (["rigcad/manual/bom.py"], ["tests/manual/test_manual.py"]),
     "optics.dome": (["rigcad/optics/dome.py"], ["tests/optics/test_dome.py"]),
+    "optics.focus": (["rigcad/optics/focus.py"], ["tests/optics/test_focus.py"]),
     "fab.split": (["rigcad/fab/split.py"], ["tests/fab/test_split.py", "tests/fab/test_split_form3.py"]),
 }
 
