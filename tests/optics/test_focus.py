@@ -55,3 +55,47 @@ def test_a_given_focal_length_out_of_range_is_refused(write_profile, table31_tex
     with pytest.raises(GeometryError) as info:
         focusing_lens(p, derive(p))
     assert "lens.focal_length" in str(info.value)
+
+
+def test_a_given_reachable_focal_length_is_used_as_given(write_profile, table31_text, table31, table31_geometry):
+    import json
+
+    chosen = focusing_lens(table31, table31_geometry)
+    p = load_profile(write_profile(table31_text + f"lens:\n  focal_length: {chosen.focal_length:g} mm\n"))
+    lens = focusing_lens(p, derive(p))
+    s = p.lens.distance
+    assert (lens.focal_length, lens.lens_distance, lens.from_catalogue) == (chosen.focal_length, s, False)
+    for focus, image in ((lens.focus_near, lens.image_near), (lens.focus_far, lens.image_far)):
+        # D = s + 1 / (1/u - 1/f), the lens equation written out here
+        assert focus == pytest.approx(s + 1.0 / (1.0 / image - 1.0 / lens.focal_length), rel=1e-12)
+    # what the manifest records is strict JSON, with an infinite range end written "inf"
+    d = json.loads(json.dumps(_by_hand(1.0, 2.0, 3.0, math.inf).describe(), allow_nan=False))
+    assert d["projector_focus_range_mm"] == [3.0, "inf"] and d["projector_focus_mm"] == [1.0, 2.0]
+
+
+def _by_hand(near, far, lo, hi):
+    from rigcad.optics.focus import FocusingLens
+
+    return FocusingLens(200.0, 25.0, 250.0, 270.0, near, far, lo, hi, True)
+
+
+def test_a_focus_setting_at_the_end_of_the_range_is_reachable():
+    from rigcad.optics.focus import _reachable
+
+    lo, hi = 1000.0, 3000.0
+    assert _reachable(_by_hand(lo, hi, lo, hi))  # both ends exactly at the range's ends
+    assert _reachable(_by_hand(lo * (1 - 1e-12), hi * (1 + 1e-12), lo, hi))  # within rounding of them
+    for near, far in ((lo * (1 - 1e-6), hi), (lo, hi * (1 + 1e-6)), (0.5 * lo, hi), (lo, 2 * hi)):
+        assert not _reachable(_by_hand(near, far, lo, hi)), (near, far)
+    assert _reachable(_by_hand(lo, math.inf, lo, math.inf))  # a projector focusing out to infinity
+
+
+def test_a_focus_range_that_starts_at_the_lens_is_refused_naming_the_key(write_profile, table31_text, table31):
+    s = table31.lens.distance
+    for text in (f"projector:\n  focus_min: {s:g} mm\n", "projector:\n  focus_min: 2 m\n  focus_max: 1 m\n"):
+        path = write_profile(table31_text + text)
+        p = load_profile(path)
+        with pytest.raises(GeometryError) as info:
+            focusing_lens(p, derive(p))
+        msg = str(info.value)
+        assert "projector.focus_min" in msg and "lens.distance" in msg and path.name in msg, msg
