@@ -100,3 +100,22 @@ def test_camera_placement_as_dict_names_its_figures():
                  "chief_ray_shift_closed_form_mm": cam.chief_shift_mm, "bundle_rms_distance_from_cop_mm": cam.residual_mm}
     # the offset is the COP's move from the design COP (0, 0, cop_z)
     assert np.allclose(np.array(d["camera_cop_mm"]) - [0.0, 0.0, 300.0], d["compensation_offset_mm"], atol=1e-12)
+
+
+def test_transmit_knows_the_plate_edges():
+    """Rays at normal incidence from behind the rig's splitter leave the front face where they aim
+    (no bend at normal incidence); ``inside`` holds exactly for exits within the face's
+    2 hw x 2 hl rectangle, each edge on its own."""
+    from rigcad.optics.splitter import transmit
+
+    hw, hl = 30.0, 40.0
+    plate = splitter_plate(300.0, 50.0, 2 * hw, 2 * hl, 3.0, 1.5)
+    c, n = np.array(plate.center), np.array(plate.normal)
+    w, l_ = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 1.0]) / math.sqrt(2)
+    # exits at (u, v) in the face's (width, length) coordinates: inside, and just past each edge alone
+    uv = np.array([[0.0, 0.0], [29.0, 39.0], [-29.0, -39.0], [31.0, 0.0], [0.0, 41.0], [-31.0, 0.0], [0.0, -41.0]])
+    targets = c + uv[:, :1] * w + uv[:, 1:] * l_
+    origins = targets - 20.0 * n  # behind the plate, aimed along the normal
+    p_out, d_out, inside = transmit(plate, origins, np.tile(n, (len(uv), 1)))
+    assert np.allclose(p_out, targets, rtol=0, atol=1e-12) and np.allclose(d_out, n, atol=1e-15)
+    assert inside.tolist() == [True, True, True, False, False, False, False]
