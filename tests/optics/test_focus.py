@@ -99,3 +99,17 @@ def test_a_focus_range_that_starts_at_the_lens_is_refused_naming_the_key(write_p
             focusing_lens(p, derive(p))
         msg = str(info.value)
         assert "projector.focus_min" in msg and "lens.distance" in msg and path.name in msg, msg
+
+
+@pytest.mark.parametrize("extra, key", [
+    ("projector:\n  focus_min: 2 m\n  focus_max: 1 m\n", "focus_min"),  # a range ending before it starts
+    ("projector:\n  focus_min: 9 m\n  focus_max: 9.001 m\n", "focus_min"),  # no catalogue lens reaches
+    ("lens:\n  focal_length: 100 mm\n", "focal_length"),  # the given lens does not reach
+])
+def test_each_refusal_points_at_the_line_of_its_key(write_profile, table31_text, extra, key):
+    path = write_profile(table31_text + extra)
+    line = 1 + max(i for i, t in enumerate(path.read_text().splitlines()) if t.strip().startswith(key + ":"))
+    p = load_profile(path)
+    with pytest.raises(GeometryError) as info:
+        focusing_lens(p, derive(p))
+    assert str(info.value).startswith(f"{path}:{line}: "), (str(info.value), line)
