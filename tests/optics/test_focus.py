@@ -24,7 +24,7 @@ def test_image_distance_is_the_gaussian_lens_equation():
 def test_the_default_lens_brings_the_paraboloid_into_the_projector_range(table31, table31_geometry):
     lens = focusing_lens(table31, table31_geometry)
     g = table31_geometry
-    assert lens.focal_length in CATALOGUE_FOCAL_LENGTHS
+    assert lens.focal_length in CATALOGUE_FOCAL_LENGTHS and lens.from_catalogue is True
     # the paraboloid from the lens: vertex d_cp - s, rim from the COP by Pythagoras
     s = table31.lens.distance
     assert lens.image_near == pytest.approx(g.cop_z - g.vertex_z - s, rel=1e-12)
@@ -88,6 +88,9 @@ def test_a_focus_setting_at_the_end_of_the_range_is_reachable():
     for near, far in ((lo * (1 - 1e-6), hi), (lo, hi * (1 + 1e-6)), (0.5 * lo, hi), (lo, 2 * hi)):
         assert not _reachable(_by_hand(near, far, lo, hi)), (near, far)
     assert _reachable(_by_hand(lo, math.inf, lo, math.inf))  # a projector focusing out to infinity
+    from rigcad.optics.focus import _dioptres
+
+    assert _dioptres(math.inf) == 0.0 and _dioptres(250.0) == 1 / 250.0  # focus at infinity: 0 dioptres
 
 
 def test_a_focus_range_that_starts_at_the_lens_is_refused_naming_the_key(write_profile, table31_text, table31):
