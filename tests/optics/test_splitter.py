@@ -119,3 +119,21 @@ def test_transmit_knows_the_plate_edges():
     p_out, d_out, inside = transmit(plate, origins, np.tile(n, (len(uv), 1)))
     assert np.allclose(p_out, targets, rtol=0, atol=1e-12) and np.allclose(d_out, n, atol=1e-15)
     assert inside.tolist() == [True, True, True, False, False, False, False]
+
+
+def test_the_cone_and_the_bundle_residual():
+    """cone_dirs: unit directions, the chief ray -z first, none wider than the half angle. The camera
+    placement's residual is the RMS distance of the bundle's transmitted lines from the design COP,
+    measured here with |(COP - p) x d| (not the module's projection)."""
+    from rigcad.optics.splitter import transmit
+
+    half = 0.05
+    dirs = cone_dirs(half)
+    assert np.allclose(np.linalg.norm(dirs, axis=1), 1.0, atol=1e-15) and np.array_equal(dirs[0], [0.0, 0.0, -1.0])
+    assert np.max(np.arccos(np.clip(-dirs[:, 2], -1, 1))) <= half * (1 + 1e-12)
+    plate = splitter_plate(300.0, 50.0, 60.0, 80.0, 3.0, 1.5)
+    cam = camera_cop(plate, 300.0, half)
+    p, d, _ = transmit(plate, np.tile(cam.cop, (len(dirs), 1)), dirs)
+    dist = np.linalg.norm(np.cross(np.array([0.0, 0.0, 300.0]) - p, d), axis=1)
+    assert cam.residual_mm == pytest.approx(float(np.sqrt(np.mean(dist ** 2))), rel=1e-9)
+    assert cam.residual_mm > 0  # a tilted plate is astigmatic: no single point sees every ray straight
