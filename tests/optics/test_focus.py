@@ -116,3 +116,15 @@ def test_each_refusal_points_at_the_line_of_its_key(write_profile, table31_text,
     with pytest.raises(GeometryError) as info:
         focusing_lens(p, derive(p))
     assert str(info.value).startswith(f"{path}:{line}: "), (str(info.value), line)
+
+
+def test_no_real_image_is_inf_and_describe_names_every_figure():
+    # the projector's image behind the projector (focus - s = -f / 2, or exactly -f): the lens forms no
+    # real image (1/u = 1/f + 1/(D - s) <= 0), reported as inf, not a negative distance or an error
+    assert math.isinf(image_distance(200.0, 25.0, 25.0 - 100.0)) and math.isinf(image_distance(200.0, 25.0, 25.0 - 200.0))
+    from rigcad.optics.focus import FocusingLens
+
+    lens = FocusingLens(200.0, 25.0, 250.0, 270.0, 1500.0, 2500.0, 1000.0, 3000.0, True)
+    assert lens.describe() == {"focal_length_mm": 200.0, "lens_distance_mm": 25.0,
+                               "paraboloid_from_lens_mm": [250.0, 270.0], "projector_focus_mm": [1500.0, 2500.0],
+                               "projector_focus_range_mm": [1000.0, 3000.0], "from_catalogue": True}
