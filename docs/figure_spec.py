@@ -225,8 +225,10 @@ def bench_figures(root: Path) -> dict[str, dict]:
         if not count:
             value = float(value) * (scale[0] if scale else 1)
         run = data.get("run") or data.get("machine") or {}
-        machine = (f"{run.get('machine', 'x86_64')}, {run.get('cpus', '?')} cores, load average "
-                   f"{run.get('loadavg_1min', '?')}") if isinstance(run, dict) else str(run)
+        if isinstance(run, dict) and run.get("cpus"):
+            machine = f"{run.get('machine', 'x86_64')}, {run['cpus']} cores, load average {run.get('loadavg_1min', '?')}"
+        else:  # the older bench files do not record it
+            machine = str(run) if run and not isinstance(run, dict) else "the project's shared 2-core machine (not recorded in the result)"
         date = subprocess.run(["git", "log", "-1", "--format=%cs", "--", str(file)], cwd=root, capture_output=True,
                               text=True).stdout.strip() or "uncommitted"
         out[name] = {"value": int(value) if count else value, "unit": unit, "format": fmt,
@@ -314,13 +316,12 @@ def _optimize() -> list[Figure]:
             o(f"{which}.dome_sectors", f"{f}.dome_sectors", "sectors", "d", True),
             o(f"{which}.dome_bands", f"{f}.dome_bands", "bands", "d", True),
         ]
-    p = "chosen.parameters"
     return out + [
         o("chosen.cop_to_vertex_cm", lambda j: j["chosen"]["parameters"]["layout.cop_to_vertex_mm"] / 10, "cm", ".2f"),
         o("chosen.sample_to_rim_cm", lambda j: j["chosen"]["parameters"]["layout.sample_to_rim_mm"] / 10, "cm", ".2f"),
         o("chosen.vertical_extent_cm", lambda j: j["chosen"]["parameters"]["paraboloid.vertical_extent_mm"] / 10,
           "cm", ".3f"),
-        o("chosen.tangent_angle_deg", f"{p}.paraboloid.tangent_angle_deg", "deg", ".0f"),
+        o("chosen.tangent_angle_deg", lambda j: j["chosen"]["parameters"]["paraboloid.tangent_angle_deg"], "deg", ".0f"),
         o("fast_minus_certified.theta_min_deg", lambda j: abs(j["certified_check"]["fast_minus_certified"]["theta_min_deg"]),
           "deg", ".0e"),
         o("fast_minus_certified.dome_width_mm", lambda j: abs(j["certified_check"]["fast_minus_certified"]["dome_width_mm"]),

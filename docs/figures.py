@@ -38,10 +38,12 @@ ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 FILE = DOCS / "figures.json"
 PROFILE = "achutha2006"
+#: The wall times of the last `run`, beside its outputs (so that `collect` can be re-run alone).
+TIMES = "make_docs_times.json"
 
 #: A number as the docs write it (thousands commas, a decimal part, an exponent), or several joined by
 #: " x " (a size), followed by the marker naming its figure.
-NUMBER = r"-?\d[\d,]*(?:\.\d+)?(?:e[-+]?\d+)?"
+NUMBER = r"(?:(?<![\w>])-)?\d[\d,]*(?:\.\d+)?(?:e[-+]?\d+)?"  # a "-" after a marker is a range's dash
 MARKED = re.compile(rf"(?P<num>{NUMBER}(?: x {NUMBER})*)<!--fig:(?P<name>[\w.\-]+)-->")
 
 
@@ -153,6 +155,7 @@ def run_commands(runs, root: Path) -> dict[str, dict]:
             raise SystemExit(f"make docs: `{run.command}` failed (exit {done.returncode})")
         print(f"make docs: {run.command}: {seconds:.1f} s", flush=True)
         times[run.id] = {"seconds": seconds, "machine": machine(), "date": today()}
+        (root / TIMES).write_text(json.dumps(times, indent=1) + "\n")  # `collect` reads them again
     return times
 
 
@@ -230,6 +233,18 @@ def formatted(entry: dict) -> str:
     return format(value, fmt)
 
 
+def shown_numbers(num: str, entry: dict) -> str:
+    """The part of a marked match that is the figure: its last number, or its last k for a size of k
+    numbers ("1.75 x 11.5<!--fig:length-->" marks only 11.5)."""
+    k = len(entry["value"]) if isinstance(entry["value"], list) else 1
+    return " x ".join(num.split(" x ")[-k:])
+
+
+def shown_prefix(num: str, entry: dict) -> str:
+    """What precedes the figure's own numbers in a marked match (kept as written)."""
+    return num[: len(num) - len(shown_numbers(num, entry))]
+
+
 def pages() -> list[Path]:
     return [ROOT / "README.md", *sorted(DOCS.glob("*.md"))]
 
@@ -245,7 +260,7 @@ def render(figures: dict[str, dict]) -> list[str]:
             if entry is None:
                 missing.append(f"{page.name}: {m['name']}")
                 return m[0]
-            return f"{formatted(entry)}<!--fig:{m['name']}-->"
+            return f"{shown_prefix(m['num'], entry)}{formatted(entry)}<!--fig:{m['name']}-->"
 
         new = MARKED.sub(sub, text)
         if new != text:
@@ -269,7 +284,10 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     root = args.exports.resolve()
     if args.action != "render":
-        times = run_commands(spec.RUNS, root) if args.action == "run" else None
+        if args.action == "run":
+            times = run_commands(spec.RUNS, root)
+        else:
+            times = json.loads((root / TIMES).read_text()) if (root / TIMES).is_file() else None
         copy_pictures(spec, root)
         write_file(collect(spec, root, times))
     missing = render(json.loads(FILE.read_text())["figures"])
