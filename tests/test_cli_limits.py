@@ -108,7 +108,7 @@ def test_check_rays_beyond_memory_names_the_largest_that_fits(monkeypatch, capsy
     err = capsys.readouterr().err
     assert code == 2 and "Traceback" not in err
     largest = int(err.strip().rsplit(" ", 1)[-1])
-    from rigcad.check.cli import CHECK_BYTES_PER_RAY, CHECK_FIXED_BYTES
+    from rigcad.cli.check import CHECK_BYTES_PER_RAY, CHECK_FIXED_BYTES
 
     assert largest == int((4 << 30) - CHECK_FIXED_BYTES) // CHECK_BYTES_PER_RAY, err
 
@@ -129,19 +129,19 @@ def test_workers_are_clamped_to_the_cores():
 
 
 def test_a_memory_error_is_one_line(monkeypatch, capsys):
-    import rigcad.cli as C
+    from rigcad.cli import profile as command
 
     def boom(args):
         raise MemoryError("Unable to allocate 3.07 EiB for an array")
 
-    monkeypatch.setattr(C, "cmd_profile_show", boom)
+    monkeypatch.setattr(command, "cmd_show", boom)
     code = main(["profile", "show", "achutha2006"])
     err = capsys.readouterr().err
     assert code == 1 and err.count("\n") == 1 and "out of memory" in err and "Traceback" not in err, err
 
 
 def test_optimize_never_replaces_a_file_it_did_not_write(tmp_path, capsys):
-    from rigcad.optimize.cli import DESIGN_MARK, refuse_foreign_design
+    from rigcad.cli.optimize import DESIGN_MARK, refuse_foreign_design
 
     src = (ROOT / "profiles" / "achutha2006_optimize.yaml").read_text()
     (tmp_path / "lab").mkdir()

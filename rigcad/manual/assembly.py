@@ -53,7 +53,7 @@ class PartMesh:
         return self.vertices.max(axis=0)
 
 
-def rig_meshes(rig, chord_error: float | None = None) -> list[PartMesh]:
+def picture_meshes(rig, chord_error: float | None = None) -> list[PartMesh]:
     """Every in-rig part of ``rig`` (a :class:`rigcad.rig.Rig`) as a PartMesh, in assembly order,
     meshed at ``chord_error`` mm (default the picture chord, export.mesh.PICTURE_CHORD_ERROR)."""
     from rigcad.export.mesh import PICTURE_CHORD_ERROR
@@ -176,4 +176,4 @@ def encloses(meshes: list[PartMesh]) -> set[str]:
     return out
 
 
-__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "rig_meshes", "step_offsets", "steps"]
+__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "picture_meshes", "step_offsets", "steps"]

@@ -95,7 +95,7 @@ def _hex(color) -> str:
 
 
 def view_html(rig, meshes: list[PartMesh], rays: dict) -> bytes:
-    """The page for ``rig`` with its assembly ``meshes`` (assembly.rig_meshes) and ``rays``
+    """The page for ``rig`` with its assembly ``meshes`` (assembly.picture_meshes) and ``rays``
     (traced_rays), as UTF-8 bytes; deterministic (same inputs, same bytes)."""
     from matplotlib import colormaps
 
@@ -265,10 +265,10 @@ def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays
     README), published together (export.atomic.Staging). Returns a summary (paths, sizes)."""
     from rigcad import plots
     from rigcad.export.atomic import Staging
-    from rigcad.manual.assembly import rig_meshes
+    from rigcad.manual.assembly import picture_meshes
 
     step = progress or (lambda label: None)
-    meshes = rig_meshes(rig)
+    meshes = picture_meshes(rig)
     step("parts meshed")
     traced = traced_rays(rig, rays)
     step("rays traced")
