@@ -78,6 +78,8 @@ def _design() -> list[Figure]:
         d("cop_z_mm", "paraboloid.cop_z_mm", "mm", ".1f"),
         d("max_miss_mm", "convergence.max_miss_mm", "mm", ".1e"),
         d("dome_vs_equal_path_mm", "dome.error_vs_equal_path_mm", "mm", ".1e"),
+        d("splitter_thickness_mm", "profile.parameters.beam_splitter.thickness_mm", "mm", ".1f"),
+        d("splitter_index", "profile.parameters.beam_splitter.index", "", ".4f"),
     ]
 
 
