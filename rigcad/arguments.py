@@ -37,6 +37,17 @@ def worker_count(text: str) -> int:
     return value
 
 
+def port_number(text: str) -> int:
+    """An argparse type: a TCP port, 1..65535, or 0 for any free port."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port 0..65535 (0: any free port), got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port 0..65535 (0: any free port), got {text!r}")
+    return value
+
+
 def exports_root(text: str) -> str:
     """An argparse type: an output root, not empty (an empty one would write into the current folder)
     and without control or formatting characters (a newline or a right-to-left override in a folder

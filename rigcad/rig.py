@@ -230,6 +230,14 @@ class Rig:
 
         return api.fab(self, printer, folder, gcode, parts, progress, workers, slicing)
 
+    def show(self, port: int = 3939, rays: int | None = None):
+        """Push the named, coloured parts, ``rays`` traced rays (default: as many as ``rigcad view``
+        draws) as polylines and the COP markers to an OCP CAD Viewer running on ``port``; a
+        ViewerError saying how to start one when none runs. See :mod:`rigcad.live.ocp`."""
+        from rigcad.live.ocp import show
+
+        return show(self, port, rays)
+
 
 @contextmanager
 def _located(profile: Profile):

@@ -36,6 +36,31 @@ REFUSED = [
 ]
 
 
+def test_every_commands_exports_is_an_exports_root():
+    """Every command's ``--exports`` refuses an empty or unprintable root (arguments.exports_root):
+    the commands take it from arguments.profile_command; one that added its own would show here."""
+    import argparse
+
+    from rigcad.arguments import exports_root
+    from rigcad.cli import build_parser
+
+    types = {}
+
+    def walk(parser, name):
+        for action in parser._actions:
+            if action.dest == "exports":
+                types[name] = action.type
+            if isinstance(action, argparse._SubParsersAction):
+                for command, child in action.choices.items():
+                    walk(child, command)
+
+    parser = build_parser()
+    walk(parser, "rigcad")
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+    assert set(types) == set(commands) - {"profile"}, sorted(types)  # `profile show` writes nothing
+    assert all(t is exports_root for t in types.values()), types
+
+
 @pytest.mark.parametrize("argv,names", REFUSED, ids=[" ".join(a[2:]) or a[0] for a, _ in REFUSED])
 def test_a_bad_count_is_one_line_before_any_work(argv, names, monkeypatch, capsys, tmp_path):
     import rigcad.rig

@@ -14,12 +14,11 @@ import sys
 from pathlib import Path
 
 from rigcad._version import __version__
-from rigcad.arguments import exports_root
-from rigcad.cli import basis, build, check, design, fab, manual, optimize, profile, stl, sweep, tolerance, view
-from rigcad.errors import RigcadError
+from rigcad.cli import basis, build, check, design, fab, manual, optimize, profile, stl, sweep, tolerance, view, watch
+from rigcad.errors import RigcadError, one_line
 
 #: The commands, in the order of ``rigcad --help``: each a module with ``register(subparsers)``.
-COMMANDS = (profile, design, build, stl, check, fab, basis, optimize, view, manual, tolerance, sweep)
+COMMANDS = (profile, design, build, stl, check, fab, basis, optimize, view, watch, manual, tolerance, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -33,25 +32,13 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for command in COMMANDS:
         command.register(sub)
-    _require_exports_root(parser)
     return parser
-
-
-def _require_exports_root(parser: argparse.ArgumentParser) -> None:
-    """Every command's ``--exports`` takes :func:`exports_root` (one rule, whichever module added it)."""
-    for action in parser._actions:
-        if action.dest == "exports":
-            action.type = exports_root
-        if isinstance(action, argparse._SubParsersAction):
-            for child in action.choices.values():
-                _require_exports_root(child)
 
 
 def _error_line(message: object) -> str:
     """``rigcad: error: <message>`` on one line: a newline or other control character that a name,
     a path or a value brought into the message is shown escaped (``\\n``), never printed."""
-    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in str(message))
-    return f"rigcad: error: {text}"
+    return f"rigcad: error: {one_line(message)}"
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -29,11 +29,13 @@ def cmd_view(args: argparse.Namespace) -> int:
         rig = load(profile)
         step("dome integrated")
         out = Path(args.exports) / rig.name / "view"
-        r = write_view(rig, out, profile_lock(args.exports, rig.name), progress=step, rays=args.rays)
+        r = write_view(rig, out, profile_lock(args.exports, rig.name), progress=step, rays=args.rays, glb=args.glb)
     print(f"{rig.name}: 3D view of {len(r['parts'])} part(s) ({', '.join(r['parts'])}), {r['triangles']} triangles, "
           f"{r['rays']} of {r['rays_traced']} rays reach the sample")
     print(f"  wrote {r['html']} ({r['html_bytes'] / 1e6:.2f} MB, self-contained: open it in a browser, offline)")
     print(f"  wrote {r['png']}")
+    if args.glb:
+        print(f"  wrote {r['glb']} (binary glTF: a named node per part, the rays as lines; mm, +z up)")
     return 0
 
 
@@ -49,3 +51,6 @@ def register(subparsers) -> None:
                     "file with three.js and the geometry inside, nothing loaded from the network. Also "
                     "exports/<profile>/view/rig.png, a picture of the assembled rig.")
     p.add_argument("--rays", type=positive_int, default=300, help="rays traced from the COP (default: 300)")
+    p.add_argument("--glb", action="store_true", help="also write rig.glb: the assembled rig as one binary glTF "
+                                                      "(named nodes, colours, the rays as lines) for Blender, YACV "
+                                                      "or any glTF viewer")

@@ -157,6 +157,11 @@ def converged_dome(profile: Profile, geo: Derived) -> DomeProfile:
         rows = min(2 * rows - 1, MAX_ROWS)
 
 
+def profile_entry(profile: Profile) -> dict:
+    """The report's ``profile`` entry: its name, the files it came from and every resolved parameter."""
+    return {"name": profile.name, "sources": list(profile.sources), "parameters": profile.as_dict()}
+
+
 def run_design(rig, progress=None) -> Design:
     """Trace and check the 2D design of ``rig`` (a :class:`rigcad.rig.Rig`: its geometry, converged
     dome and curve). Raises GeometryError for an impossible rig."""
@@ -183,7 +188,7 @@ def run_design(rig, progress=None) -> Design:
     misalignment = _misalignment(profile, para, curve, origins, dirs, aligned)
     table = profile_table(geo, dome)
     report = {
-        "profile": {"name": profile.name, "sources": list(profile.sources), "parameters": profile.as_dict()},
+        "profile": profile_entry(profile),
         "frame": "meridional plane; sample point O at the origin; optical axis +z; lengths mm",
         "paraboloid": geo.as_dict(),
         "dome": {

@@ -714,10 +714,19 @@ def _marker(name: str, p, color) -> Part:
                 f"marker: {name.replace('_', ' ')} at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) mm")
 
 
+def _seat_balls(profile: Profile, t: TowerLayout) -> tuple[Part, ...]:
+    """The splitter seat's three steel balls, each drawn as the cylinder it fills from the shelf's top
+    to its own top (0.8 of its diameter: it sinks 0.2 into its seat), under the holder's push screws."""
+    b = profile.adjusters.seat_ball
+    return tuple(Part(f"seat_ball_{i + 1}", Cylinder((x, y, t.shelf_top_z), b / 2, 0.8 * b), (0.8, 0.8, 0.85),
+                      f"{b:g} mm steel ball (DIN 5401) in the shelf's {kind}, under the holder's push screw")
+                 for i, (kind, (x, y)) in enumerate(seat_points(t, profile).items()))
+
+
 def instruments(profile: Profile, layout) -> tuple[Part, ...]:
     """The bought items as simple named solids in their working positions (not printed): projector
     and camera bodies and lenses, the beam splitter plate, the focusing lens, the nominal shim
-    stacks; and markers at the design COP and at the projector's and camera's real COPs."""
+    stacks, the splitter seat's balls; and markers at the design COP and at the projector's and camera's real COPs."""
     t = layout.tower
     tw, ln = profile.tower, profile.lens
     p = t.plate
@@ -753,6 +762,7 @@ def instruments(profile: Profile, layout) -> tuple[Part, ...]:
         Part("focusing_lens", Box((t.lens_x - ln.thickness / 2, -r, zc - r), (t.lens_x + ln.thickness / 2, r, zc + r)),
              glass, f"focusing lens {ln.diameter:g} mm (its square bounding box)"),
         *shims,
+        *_seat_balls(profile, t),
         Part("camera_shims", cam_shims, (0.9, 0.8, 0.3), f"{t.shims_nominal} shims behind the camera"),
         _marker("cop_marker", t.cop, (1.0, 0.1, 0.1)),
         _marker("projector_cop_marker", t.projector_cop, (1.0, 0.6, 0.1)),
