@@ -102,7 +102,11 @@ def test_a_stale_number_is_caught():
 #: triangles, steps): a number before one of them is a figure, never an input of the profile.
 OUTPUT_UNITS = r"(?:h|min|g|kg|MB|MiB|KB|s|ms|pieces|pins|triangles|steps)\b"
 #: Words that make a number a bound or a target rather than a measured figure.
-BOUND = re.compile(r"(<|<=|>=|>|under|within|target|limit|at most|up to|timeout)\W*[\d.,x ]*$", re.I)
+BOUND = re.compile(r"(<|<=|>=|>|under|within|targets?|limit|at most|up to|timeout)\W*[\d.,x ]*$", re.I)
+#: A sentence that names its numbers as targets ("Targets: 1.5 s for an edit, 10 s for ...").
+TARGETS = re.compile(r"\btargets?\b(?:(?!\.\s).)*$", re.I | re.S)
+#: Words after a number that make it a bound ("400 ms at most").
+BOUND_AFTER = re.compile(r"^\s*(at most|or less|or more|at least)", re.I)
 
 
 def unmarked_figures(text: str) -> list[str]:
@@ -114,15 +118,17 @@ def unmarked_figures(text: str) -> list[str]:
     for block in re.split(r"\n\s*\n|\n(?=\|)", text):
         if "one-off" in block:
             continue
-        for m in re.finditer(rf"(?<![\w.\-/])(\d[\d,]*(?:\.\d+)?)(?!<!--fig)\s?{OUTPUT_UNITS}", block):
-            if not BOUND.search(block[max(0, m.start() - 30):m.start()]):
+        # <!--given--> after a number: a setting or a constant the page states, not a measurement
+        for m in re.finditer(rf"(?<![\w.\-/])(\d[\d,]*(?:\.\d+)?)(?!<!--fig|<!--given-->)\s?{OUTPUT_UNITS}", block):
+            before, after = block[:m.start()], block[m.end():]
+            if not (BOUND.search(before[-30:]) or TARGETS.search(before) or BOUND_AFTER.search(after)):
                 found.append(" ".join(block[max(0, m.start() - 40):m.end()].split()))
     return found
 
 
 def test_no_unmarked_figure(tools):
     """Every time, mass, file size and count the pages state is marked (and so checked), or is said to
-    be a one-off measurement, or is a bound."""
+    be a one-off measurement, or is a bound or a target, or is marked <!--given--> (a setting)."""
     wrong = [f"{page.name}: ...{hit}" for page in _pages() for hit in unmarked_figures(page.read_text(encoding="utf-8"))]
     assert not wrong, "mark these figures (docs/figures.md) or say they are one-off:\n" + "\n".join(wrong)
 
@@ -132,6 +138,10 @@ def test_an_unmarked_figure_is_caught():
     assert unmarked_figures("The dome prints in 53.1<!--fig:x--> h.") == []
     assert unmarked_figures("The dome prints in 53.1 h (one-off, `rigcad fab --gcode`).") == []
     assert unmarked_figures("A run takes under 2 s.") == []
+    assert unmarked_figures("Targets: 1.5 s for one edit, 10 s for another.") == []
+    assert unmarked_figures("Edits are grouped (400 ms at most).") == []
+    assert unmarked_figures("ended by 30<!--given--> ms of quiet") == []
+    assert unmarked_figures("Targets: 1.5 s. It took 3.2 s.") == ["Targets: 1.5 s. It took 3.2 s"]
 
 
 def test_every_figure_states_unit_source_and_tolerance(data):
