@@ -141,26 +141,27 @@ def _holes(solid, offset=(0.0, 0.0, 0.0), cut=False):
             yield ((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2], hi[2], min(w[0], w[1]), False)
 
 
-def bolt_joints(rig) -> list[dict]:
-    """Every bolted joint of the rig outside the COP tower (whose joints the tower module computes:
-    tower_hardware), found in the recipes: vertical holes of the in-rig printed parts
-    that share an axis (x, y within 0.05 mm) and touch in z are one bolt through those parts; a round
-    hole of one part alone is a bolt into what it stands on (the bench). Grouped by (parts joined,
-    thread, length): count, grip, the bolt, its nut and washers."""
+def bolt_axes(rig, tower: bool = False) -> list[dict]:
+    """Every bolt of the rig, found in the recipes: vertical holes of the in-rig printed parts that
+    share an axis (x, y within 0.05 mm) and touch in z are one bolt through those parts; a round hole
+    of one part alone is a bolt into what it stands on (the bench). One dict per bolt: the parts it
+    joins (sorted), x and y, the z of its top and bottom faces, its grip and the narrowest hole (mm).
+    The COP tower's parts are left out unless ``tower`` (their counts have their own home:
+    tower_hardware)."""
     try:
         from rigcad.parts.tower import TOWER_PARTS
     except ImportError:  # pragma: no cover - a rig without the tower module
         TOWER_PARTS = ()
     holes = []
     for name, part in rig.recipes.items():
-        if part.in_rig and name not in TOWER_PARTS:  # the tower's own joints: tower_hardware
+        if part.in_rig and (tower or name not in TOWER_PARTS):
             holes += [(name, *h) for h in _holes(part.solid)]
     axes: dict[tuple, list] = {}
     for h in holes:
         axes.setdefault((round(h[1] / 0.05), round(h[2] / 0.05)), []).append(h)
-    groups: dict[tuple, dict] = {}
-    for stack in axes.values():
-        stack.sort(key=lambda h: h[3])
+    out = []
+    for key in sorted(axes):
+        stack = sorted(axes[key], key=lambda h: (h[3], h[0]))
         runs, run = [], [stack[0]]
         for h in stack[1:]:
             if h[3] <= max(r[4] for r in run) + 1e-6:
@@ -173,10 +174,24 @@ def bolt_joints(rig) -> list[dict]:
             parts = tuple(sorted({h[0] for h in run}))
             if len(parts) == 1 and not all(h[6] for h in run):
                 continue  # a slot or channel of one part alone (a clamp, the projector's slots): no bolt of its own
-            grip = max(h[4] for h in run) - min(h[3] for h in run) - 2 * HOLE_OVERSHOOT_MM
-            hole = min(h[5] for h in run)
-            key = (parts, round(grip, 3), round(hole, 3))
-            groups.setdefault(key, {"parts": parts, "grip_mm": grip, "hole_mm": hole, "count": 0})["count"] += 1
+            top, bottom = max(h[4] for h in run) - HOLE_OVERSHOOT_MM, min(h[3] for h in run) + HOLE_OVERSHOOT_MM
+            upper = max(run, key=lambda h: (h[4], h[0]))[0]
+            spans = {n: (min(h[3] for h in run if h[0] == n) + HOLE_OVERSHOOT_MM,
+                         max(h[4] for h in run if h[0] == n) - HOLE_OVERSHOOT_MM) for n in parts}
+            out.append({"parts": parts, "upper": upper, "spans": spans, "x": run[0][1], "y": run[0][2], "top_z": top,
+                        "bottom_z": bottom, "grip_mm": top - bottom, "hole_mm": min(h[5] for h in run)})
+    return out
+
+
+def bolt_joints(rig) -> list[dict]:
+    """Every bolted joint of the rig outside the COP tower (whose joints the tower module computes:
+    tower_hardware), from :func:`bolt_axes`. Grouped by (parts joined, thread, length): count, grip,
+    the bolt, its nut and washers."""
+    groups: dict[tuple, dict] = {}
+    for b in bolt_axes(rig):
+        key = (b["parts"], round(b["grip_mm"], 3), round(b["hole_mm"], 3))
+        groups.setdefault(key, {"parts": b["parts"], "grip_mm": b["grip_mm"], "hole_mm": b["hole_mm"],
+                                "count": 0})["count"] += 1
     rows = []
     for g in sorted(groups.values(), key=lambda g: (-len(g["parts"]), g["parts"], g["grip_mm"])):
         thread, _, pitch, nut, washer = thread_for_hole(g["hole_mm"])
@@ -351,5 +366,5 @@ def bill(rig, fab_report: dict, printer) -> dict:
             "totals": fab_report.get("totals", {})}
 
 
-__all__ = ["bill", "bolt_joints", "bolt_length", "coating_rows", "dowel_pins", "fasteners", "printed", "purchased",
+__all__ = ["bill", "bolt_axes", "bolt_joints", "bolt_length", "coating_rows", "dowel_pins", "fasteners", "printed", "purchased",
            "revolved_area", "thread_for_hole", "tower_hardware"]
