@@ -24,8 +24,9 @@ finds a feasible order when there is one and says which steps are stuck when the
 Penetration is measured as the thickness of the overlap solid, 2 V / A (V its volume, A its area:
 a thin slab's thickness), so parts that touch (a beam on its slot floor, a plate on its collar)
 pass while a part pushed through a wall does not; no decision hangs on the last bits of a
-coincident face. The sweep is sampled every SWEEP_STEP_MM along the path (a wall thinner than
-that could be jumped: see SWEEP_STEP_MM). Frame: mm, rig frame (O at the origin, +z up).
+coincident face. A convex part's sweep is exact (the hull of its start and end); any other part's
+is sampled every SWEEP_STEP_MM along the path (a wall thinner than that could be jumped: see
+SWEEP_STEP_MM). Frame: mm, rig frame (O at the origin, +z up).
 """
 
 from __future__ import annotations
@@ -55,6 +56,19 @@ class Tool:
     name: str
     length_mm: float
     radius_mm: float
+    #: An L-shaped hex key: its long arm (mm) leaves the short one's end at right angles, along
+    #: ``arm_dir`` (unit), the way a hand turns it a little at a time under an overhang.
+    arm_mm: float = 0.0
+    arm_dir: tuple[float, float, float] | None = None
+
+    def path(self, start, axis):
+        """The tool's straight path from ``start`` (the head's top, (3,) mm) out along ``-axis``."""
+        a = np.asarray(axis, float)
+        end = np.asarray(start, float) - a * self.length_mm
+        shaft = cylinder(end, a, self.length_mm, self.radius_mm)
+        if not self.arm_mm:
+            return shaft
+        return _union([shaft, cylinder(end, self.arm_dir, self.arm_mm, self.radius_mm)])
 
 
 @dataclass(frozen=True)
@@ -72,7 +86,7 @@ class Fastener:
     shank_radius_mm: float
     head_radius_mm: float
     head_height_mm: float
-    tool: Tool
+    tools: tuple[Tool, ...]  #: any one of them will do, best first
     thread_in: str = "nut"
     nut_size_mm: tuple[float, float] = (0.0, 0.0)  #: across corners / 2 (mm), height (mm)
     nut_tool: Tool | None = None
@@ -91,16 +105,20 @@ class Fastener:
 
     def paths(self) -> list[tuple[str, object]]:
         """The straight paths that must be clear: the head's approach along the axis (the bolt goes
-        in from outside), the tool's, and the nut's spanner (named, as solids)."""
+        in from outside) and the nut's spanner (named, as solids); the tools' in :meth:`tool_paths`."""
         a, h = np.asarray(self.axis, float), np.asarray(self.head, float)
         top = h - a * self.head_height_mm
-        out = [("the head's way in", cylinder(top - a * self.length_mm, a, self.length_mm, self.head_radius_mm)),
-               (self.tool.name, cylinder(top - a * self.tool.length_mm, a, self.tool.length_mm, self.tool.radius_mm))]
+        out = [("the head's way in", cylinder(top - a * self.length_mm, a, self.length_mm, self.head_radius_mm))]
         if self.thread_in == "nut" and self.nut_tool is not None:
             n = np.asarray(self.nut_dir, float)
             start = h + a * (self.grip_mm + 0.5 * self.nut_size_mm[1])
             out.append((self.nut_tool.name, cylinder(start, n, self.nut_tool.length_mm, self.nut_tool.radius_mm)))
         return out
+
+    def tool_paths(self) -> list[tuple[Tool, object]]:
+        """Each tool with its path from the head's top."""
+        a, h = np.asarray(self.axis, float), np.asarray(self.head, float)
+        return [(t, t.path(h - a * self.head_height_mm, a)) for t in self.tools]
 
 
 @dataclass(frozen=True)
@@ -182,7 +200,12 @@ def swept(solid, direction, travel: float, near=None):
     """The union of ``solid`` moved back along ``direction`` by 0 .. ``travel`` mm, every SWEEP_STEP_MM;
     with ``near`` (boxes (k, 6): lo, hi), only where its bounding box meets one of them (elsewhere it
     meets nothing, so leaving those positions out changes no penetration)."""
+    import manifold3d as m3
+
     d = np.asarray(direction, float)
+    hull = solid.hull()
+    if hull.volume() <= solid.volume() * (1 + 1e-9) + 1e-9:  # convex: the exact sweep is one hull
+        return m3.Manifold.batch_hull([solid, solid.translate(tuple(-d * travel))])
     n = max(1, int(np.ceil(travel / SWEEP_STEP_MM)))
     s = np.linspace(0.0, travel, n + 1)
     if near is not None and len(near):
@@ -292,6 +315,14 @@ class Assembly:
                 if pen > CLEARANCE_MM:
                     out.append(f"{f.item} #{k + 1} at {_at(f.head)}: {what} is blocked by {_worst(path, fitted)} "
                                f"({pen:.2f} mm)")
+            tried = []
+            for tool, path in f.tool_paths():
+                pen = penetration(path, everything)
+                if pen <= CLEARANCE_MM:
+                    break
+                tried.append(f"the {tool.name}'s path is blocked by {_worst(path, fitted)} ({pen:.2f} mm)")
+            else:
+                out.append(f"{f.item} #{k + 1} at {_at(f.head)}: " + "; ".join(tried or ["no tool declared"]))
             fitted.append((f"{f.item} #{k + 1}", body))
         return out
 
@@ -338,6 +369,7 @@ def find_order(assembly: Assembly) -> list[Placed]:
     leads nowhere: parts only ever add obstacles. GeometryError when there is no order, naming the
     steps left and why each cannot go next."""
     _refuse_cycles(assembly)
+    _refuse_blocked_at_first(assembly)
     dead: set[frozenset[str]] = set()
     total = len(assembly.steps)
 
@@ -384,6 +416,33 @@ def _refuse_cycles(assembly: Assembly) -> None:
     for s in assembly.steps:
         if s.name not in state:
             visit(s.name, [s.name])
+
+
+def _before(assembly: Assembly) -> dict[str, frozenset[str]]:
+    """The steps each step must come after in any order: what it needs, transitively."""
+    owner = {m: s.name for s in assembly.steps for m in s.members}
+    direct = {s.name: {owner[n] for n in (*s.needs, *(p for f in s.fasteners for p in f.passes))
+                       if n in owner and owner[n] != s.name} for s in assembly.steps}
+    out: dict[str, frozenset[str]] = {}
+
+    def close(name: str) -> frozenset[str]:
+        if name not in out:
+            out[name] = frozenset(direct[name]).union(*(close(n) for n in direct[name]))
+        return out[name]
+
+    for s in assembly.steps:
+        close(s.name)
+    return out
+
+
+def _refuse_blocked_at_first(assembly: Assembly) -> None:
+    """GeometryError when a step is blocked with only what it must come after in place: parts only
+    ever add obstacles, so it is blocked in every order (the exact answer, found without a search)."""
+    for step in assembly.steps:
+        r = assembly.attempt(step, _before(assembly)[step.name])
+        if isinstance(r, Refusal) and r.blocked:
+            raise GeometryError(f"no feasible assembly order: {step.name} cannot go in even with only what it "
+                                f"needs in place: {r}")
 
 
 def _stuck(assembly: Assembly) -> str:

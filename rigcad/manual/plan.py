@@ -54,10 +54,21 @@ SPANNER_MM = 80.0
 INSERT = {"M3": (4.5, 5.7), "M4": (5.6, 8.1), "M5": (6.4, 9.5), "M6": (8.0, 12.7)}
 
 
-def driver(thread: str) -> Tool:
+#: ISO 2936 hex keys: key (mm across flats) -> long arm, short arm (mm).
+L_KEY = {1.5: (45.0, 14.0), 2.0: (50.0, 16.0), 2.5: (56.0, 18.0), 3.0: (63.0, 20.0), 4.0: (70.0, 25.0),
+         4.7625: (80.0, 28.0), 5.0: (80.0, 28.0), 6.0: (90.0, 32.0), 7.9375: (100.0, 36.0), 8.0: (100.0, 36.0),
+         10.0: (112.0, 40.0)}
+
+
+def driver(thread: str, out_dir=(1.0, 0.0, 0.0)) -> tuple[Tool, ...]:
+    """A hex screwdriver with a DRIVER_BLADE_MM blade; else an L hex key (ISO 2936) with its short
+    arm in the socket and its long arm out along ``out_dir`` (away from the rig's axis)."""
     key = HEX_KEY[thread]
-    return Tool(f"{key:g} mm hex screwdriver (ISO 2936 hex), {DRIVER_BLADE_MM:g} mm blade", DRIVER_BLADE_MM,
-                key / np.sqrt(3.0) + 0.5)
+    r = key / np.sqrt(3.0) + 0.5  # the key's corners, and a little play for the hand
+    long, short = L_KEY[key]
+    return (Tool(f"{key:g} mm hex screwdriver (ISO 2936 hex), {DRIVER_BLADE_MM:g} mm blade", DRIVER_BLADE_MM, r),
+            Tool(f"{key:g} mm L hex key (ISO 2936, {long:g} x {short:g} mm), short arm in", short, r, long,
+                 tuple(float(v) for v in out_dir)))
 
 
 def spanner(thread: str, nut_height: float) -> Tool:
@@ -88,7 +99,12 @@ def _metric(thread: str):
 
 
 def _socket_head(item: str, head, axis, length: float, d: float, thread: str, **kw) -> Fastener:
-    return Fastener(item, tuple(float(v) for v in head), axis, float(length), d / 2, 0.75 * d, d, driver(thread), **kw)
+    h = np.array([head[0], head[1], 0.0])
+    out = tuple(h / np.linalg.norm(h)) if np.linalg.norm(h) > 1e-9 else (1.0, 0.0, 0.0)
+    if abs(np.dot(out, axis)) > 0.9:
+        out = (0.0, 0.0, -1.0)
+    return Fastener(item, tuple(float(v) for v in head), axis, float(length), d / 2, 0.75 * d, d,
+                    driver(thread, out), **kw)
 
 
 def bolt_fasteners(bolt: dict) -> tuple[Fastener, ...]:
