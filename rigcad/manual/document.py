@@ -168,26 +168,71 @@ def _mil(mm: float) -> str:
 def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, dict[str, bytes], dict]:
     """The document, its files (relative path -> bytes: pictures and the calibration image) and the
     figures (for manual.json)."""
-    import numpy as np
+    from types import SimpleNamespace
 
     from rigcad import plots
-    from rigcad.export import mesh as M
     from rigcad.manual import assembly as A
-    from rigcad.manual.assembly import rig_meshes
     from rigcad.manual.view import traced_rays
-    from rigcad.parts.templates import gauged_depth
 
     step = progress or (lambda label: None)
-    p = rig.profile
-    bill = B.bill(rig, fab_report, printer)
-    files: dict[str, bytes] = {}
-    meshes = rig_meshes(rig)
-    cut_away = A.encloses(meshes)
-    files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
-                                                cut_away=cut_away)
+    meshes = A.rig_meshes(rig)
+    c = SimpleNamespace(rig=rig, printer=printer, fab_report=fab_report, p=rig.profile, files={}, meshes=meshes,
+                        bill=B.bill(rig, fab_report, printer), cut_away=A.encloses(meshes), step=step)
+    c.files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
+                                                  cut_away=c.cut_away)
     step("rig picture")
-
     d = Doc()
+    _introduction(d, c)
+    for section in (_section_bill, _section_print, _section_sand, _section_coat, _section_assemble,
+                    _section_calibrate):
+        section(d, c)
+    figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
+               "bill": c.bill, "calibration": c.calibration,
+               "coating_gauged_layer": c.gauged, "coating_total_mm": c.total,
+               "assembly_order": [m.name for m in meshes]}
+    return d, c.files, figures
+
+
+def assumed_sizes(profile) -> list[dict]:
+    """The profile's instrument and optics sizes that its schema marks as assumed (not from a
+    maker's drawing): section, key, value as the manual shows it, and where the profile set it."""
+    from dataclasses import fields
+
+    out = []
+    for section in ("projector", "camera", "beam_splitter", "lens"):
+        obj = getattr(profile, section, None)
+        if obj is None:
+            continue
+        for f in fields(obj):
+            spec = f.metadata.get("spec")
+            doc = getattr(spec, "doc", "") or ""
+            if "assumed" not in doc.lower() or getattr(obj, f.name) is None:
+                continue
+            value = getattr(obj, f.name)
+            text = f"{value:.4g} mm" if getattr(spec, "kind", "") == "length" else str(value)
+            out.append({"key": f"{section}.{f.name}", "value": text, "doc": doc,
+                        "set_in": profile.where(section, f.name) or "default"})
+    return out
+
+
+def measure_first(d: Doc, c) -> None:
+    """What must be measured or chosen before anything is printed: the assumed sizes."""
+    rows = assumed_sizes(c.p)
+    d.h(2, "0. Before printing: measure or choose")
+    if not rows:
+        d.p("Every instrument size in this profile is given, none assumed: nothing to measure first.")
+        return
+    d.p(f"The parts are shaped around these **{len(rows)} sizes, which the profile only assumes**. Measure each on "
+        "your own instrument (a caliper; a lens's pupil from the maker's data sheet), write it into the profile "
+        "under its key and build again before you print: a wrong size puts the centre of projection in the wrong "
+        "place.")
+    d.table(["key", "assumed", "what it is", "set in"],
+            [[f"`{r['key']}`", r["value"], r["doc"], f"`{r['set_in']}`"] for r in rows])
+
+
+def _introduction(d: Doc, c) -> None:
+    """The title, what the manual is made from, and the assembled rig."""
+    rig, printer, p = c.rig, c.printer, c.p
     d.h(1, f"{rig.name}: assembly and calibration manual ({printer.name})")
     d.p(f"The rig of profile `{rig.name}` ({' <- '.join(p.sources)}), printed on **{printer.description}** "
         f"(`{printer.source}`). Every figure below is computed by rigcad {__version__} from the profile, the "
@@ -195,8 +240,19 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         "parts (STEP, STL) in `step/` and `stl/`, the 3D view in `view/rig.html` (`rigcad view`).")
     d.img("images/rig.png", "The assembled rig (front of the dome cut away) with rays traced from the centre of "
                             "projection, coloured by their incidence angle at the sample")
+    measure_first(d, c)
 
-    # -- 1 bill of materials
+
+def _section_bill(d: Doc, c) -> None:
+    """The manual's section: 1 bill of materials."""
+    import numpy as np
+
+    from rigcad import plots
+    from rigcad.export import mesh as M
+    from rigcad.manual import assembly as A
+    from rigcad.parts.templates import gauged_depth
+
+    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
     d.h(2, "1. Bill of materials")
     d.h(3, "Printed and cut parts")
     rows = []
@@ -238,7 +294,17 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
             [[c["layer"], f"{_mil(c['thickness_mm'])} ({c['thickness_mm']:.4f} mm)", f"{c['area_mm2'] / 100:.1f} cm²",
               f"{c['film_cm3']:.2f} ml", f"**{c['to_buy_cm3']:.1f} ml**"] for c in bill["coating"]])
 
-    # -- 2 print
+
+def _section_print(d: Doc, c) -> None:
+    """The manual's section: 2 print."""
+    import numpy as np
+
+    from rigcad import plots
+    from rigcad.export import mesh as M
+    from rigcad.manual import assembly as A
+    from rigcad.parts.templates import gauged_depth
+
+    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
     d.h(2, "2. Print")
     items = []
     for name, e in fab_report["parts"].items():
@@ -262,7 +328,17 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
             f"{bill['pins']['diameter_mm']:g} mm rod (or filament), push them into one piece's holes, join the "
             "next piece on them and glue the cut faces.")
 
-    # -- 3 sand
+
+def _section_sand(d: Doc, c) -> None:
+    """The manual's section: 3 sand."""
+    import numpy as np
+
+    from rigcad import plots
+    from rigcad.export import mesh as M
+    from rigcad.manual import assembly as A
+    from rigcad.parts.templates import gauged_depth
+
+    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
     gd = gauged_depth(p)
     total = float(sum(t for _, t in p.coating.layers))
     gauged = p.templates.gauged_layer
@@ -288,7 +364,20 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         if f"images/{name}.png" in files:
             d.img(f"images/{name}.png", f"`{name}`: {rig.recipes[name].description}")
 
-    # -- 4 coat
+    c.gauged, c.total, c.gd = gauged, total, gd
+
+
+def _section_coat(d: Doc, c) -> None:
+    """The manual's section: 4 coat."""
+    import numpy as np
+
+    from rigcad import plots
+    from rigcad.export import mesh as M
+    from rigcad.manual import assembly as A
+    from rigcad.parts.templates import gauged_depth
+
+    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
+    gauged, total, gd = c.gauged, c.total, c.gd
     d.h(2, "4. Coat, layer by layer, checking with the template")
     layers = p.coating.layers
     rows, cum = [], 0.0
@@ -308,7 +397,17 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         "(`coating.layers`), the dome outwards, the paraboloid inwards.")
     step("bill and steps")
 
-    # -- 5 assemble
+
+def _section_assemble(d: Doc, c) -> None:
+    """The manual's section: 5 assemble."""
+    import numpy as np
+
+    from rigcad import plots
+    from rigcad.export import mesh as M
+    from rigcad.manual import assembly as A
+    from rigcad.parts.templates import gauged_depth
+
+    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
     d.h(2, "5. Assemble")
     d.p("Each step shows what is already in place (grey) and what goes in (orange), drawn clear of it with "
         "a dashed line to its place. Bought items (instruments, optics) are marked so.")
@@ -351,9 +450,20 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         done += members
         step(f"step {k + 1}")
 
-    # -- 6 calibrate
+
+def _section_calibrate(d: Doc, c) -> None:
+    """The manual's section: 6 calibrate."""
+    import numpy as np
+
+    from rigcad import plots
+    from rigcad.export import mesh as M
+    from rigcad.manual import assembly as A
+    from rigcad.parts.templates import gauged_depth
+
+    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
     circle, info = C.circle_image(rig)
     files["calibration/circle.png"] = circle
+    files["calibration/circle.html"] = C.circle_page(rig, info)
     film = C.film_shadows(rig)
     pshadow = C.projector_shadows(rig)
     cam = C.camera_crosses(rig)
@@ -371,7 +481,11 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     d.p(f"(Arms of {pshadow['arm_length_mm']:g} mm, `crosses.arm_length`; the closer the projector, the finer the "
         f"check. The profile allows `tolerancing.projector_offset` = {p.tolerancing.projector_offset:g} mm.)")
     d.h(3, "Projector: the circle on the paraboloid")
-    d.p(f"Project `calibration/circle.png` ({info['resolution_px'][0]} x {info['resolution_px'][1]} px, the "
+    d.p("Take the focusing lens out of its mount first: the circle is set with the projector's own optics. Open "
+        "`calibration/circle.html` in a browser on the projector's screen and press f (full screen): arrow keys "
+        "move the circle (Shift: 10 px), + and - change its radius, 0 restores the design's circle, and its centre "
+        "and radius in pixels are shown at the top left (h hides them). The same circle as a fixed image:")
+    d.p(f"`calibration/circle.png` ({info['resolution_px'][0]} x {info['resolution_px'][1]} px, the "
         f"projector's resolution): a bright disc of radius **{info['radius_px']:.1f} px** centred on pixel "
         f"({info['centre_px_from_top_left'][0]:g}, {info['centre_px_from_top_left'][1]:g}) from the top left, the "
         f"paraboloid's rim as the design maps it (the rim ray leaves the COP at {info['rim_angle_at_cop_deg']:.3f} "
@@ -402,12 +516,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     d.p("Then the camera's pixel-to-paraboloid correspondence as in the thesis: a checkerboard on the base "
         "plate, the calibrated circle projected, and the paraboloid's image located in the camera's picture.")
     step("calibration")
-    figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
-               "bill": bill, "calibration": {"circle": info, "film": film, "projector_crosses": pshadow,
-                                             "camera_crosses": cam},
-               "coating_gauged_layer": gauged, "coating_total_mm": total,
-               "assembly_order": [m.name for m in meshes]}
-    return d, files, figures
+    c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam}
 
 
 def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = None, progress=None) -> list[Path]:
