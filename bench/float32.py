@@ -28,7 +28,7 @@ import numpy as np
 from _common import arguments, png, pyplot, run_info
 
 from rigcad.check.figures import _angles
-from rigcad.check.scene import analytic_optics, mesh_optics, rig_meshes, share_scenes
+from rigcad.check.scene import analytic_optics, mesh_optics, mirror_meshes, share_scenes
 from rigcad.check.sources import annulus_rays
 from rigcad.check.trace3d import trace
 from rigcad.export.atomic import write_bytes, write_json
@@ -85,9 +85,9 @@ def main() -> None:
               "levels": [], "run": run}
     for name, chord, normal in levels:
         if chord is None:
-            meshes = rig_meshes(rig, Path(args.exports))
+            meshes = mirror_meshes(rig, Path(args.exports))
         else:
-            meshes = rig_meshes(rig, None, chord, normal)
+            meshes = mirror_meshes(rig, None, chord, normal)
         base = mesh_optics(meshes, "smooth")
         level = {"level": name, "tessellation": meshes.tolerances,
                  "triangles": {"paraboloid": len(meshes.paraboloid.faces), "dome": len(meshes.dome.faces)},

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from rigcad.check import _kernels, _mesh_kernels, rays
-from rigcad.check.scene import mesh_optics, rig_meshes, share_scenes
+from rigcad.check.scene import mesh_optics, mirror_meshes, share_scenes
 from rigcad.check.sources import annulus_rays
 from rigcad.check.trace3d import trace
 from rigcad.profile import load_profile
@@ -37,7 +37,7 @@ def main() -> None:
     ap.add_argument("--exports", default="exports")
     args = ap.parse_args()
     rig = Rig.from_profile(load_profile(args.profile))
-    base = mesh_optics(rig_meshes(rig, Path(args.exports)), "smooth")
+    base = mesh_optics(mirror_meshes(rig, Path(args.exports)), "smooth")
     src = annulus_rays(rig.incidence, args.rays, 1)
     spent = defaultdict(float)
 

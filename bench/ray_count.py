@@ -27,7 +27,7 @@ import numpy as np
 from _common import arguments, loglog_slope, png, pyplot, run_info
 
 from rigcad.check.figures import _angles
-from rigcad.check.scene import mesh_optics, rig_meshes
+from rigcad.check.scene import mesh_optics, mirror_meshes
 from rigcad.check.sources import annulus_rays
 from rigcad.check.trace3d import trace
 from rigcad.export.atomic import write_bytes, write_json
@@ -82,7 +82,7 @@ def main() -> None:
     profile = load_profile(args.profile)
     rig = Rig.from_profile(profile)
     design = rig.incidence
-    meshes = rig_meshes(rig, Path(args.exports))
+    meshes = mirror_meshes(rig, Path(args.exports))
     optics = mesh_optics(meshes, "smooth")
     rng = np.random.default_rng(7)
     rows = []

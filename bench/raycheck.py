@@ -43,7 +43,7 @@ from _common import run_info  # noqa: E402
 
 from rigcad.check import montecarlo as MC  # noqa: E402
 from rigcad.check.rays import Timer, embree_version  # noqa: E402
-from rigcad.check.scene import analytic_optics, mesh_optics, rig_meshes, share_scenes  # noqa: E402
+from rigcad.check.scene import analytic_optics, mesh_optics, mirror_meshes, share_scenes  # noqa: E402
 from rigcad.check.sources import annulus_rays  # noqa: E402
 from rigcad.check.trace3d import trace  # noqa: E402
 from rigcad.export.atomic import write_bytes, write_json  # noqa: E402
@@ -132,7 +132,7 @@ def main() -> None:
     design = rig.incidence
     geo = rig.geometry
     t0 = time.perf_counter()
-    meshes = rig_meshes(rig, Path(args.exports))
+    meshes = mirror_meshes(rig, Path(args.exports))
     mesh_s = time.perf_counter() - t0
     timer = Timer()
     base = mesh_optics(meshes, "smooth", timer=timer)

@@ -38,7 +38,7 @@ COMMANDS = [
 CHILD = """
 import json, sys, time
 t0 = time.perf_counter()
-import rigcad.cli, rigcad.engine, rigcad.profile, rigcad.check.cli, rigcad.tolerance.cli, rigcad.manual.cli
+import rigcad.cli, rigcad.engine, rigcad.profile, rigcad.cli.check, rigcad.cli.tolerance, rigcad.cli.manual
 t1 = time.perf_counter()
 try:
     code = rigcad.cli.main(sys.argv[1:])

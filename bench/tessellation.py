@@ -89,7 +89,7 @@ def stl_row(profile, layout, chord: float, volumes: dict, repeats: int, scratch:
 
 
 def mirror_row(rig, design, rays, exact, sweep: str, chord, normal) -> dict:
-    """One mirror-tessellation row: both mirrors meshed as rigcad.check.scene.rig_meshes does
+    """One mirror-tessellation row: both mirrors meshed as rigcad.check.scene.mirror_meshes does
     without exports (occluders from the layout), traced in the smooth and facet readings."""
     tess = rig.profile.tessellation
     c = tess.mirror_chord_error if chord is None else chord

@@ -37,6 +37,17 @@ def worker_count(text: str) -> int:
     return value
 
 
+def port_number(text: str) -> int:
+    """An argparse type: a TCP port, 1..65535, or 0 for any free port."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port 0..65535 (0: any free port), got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port 0..65535 (0: any free port), got {text!r}")
+    return value
+
+
 def exports_root(text: str) -> str:
     """An argparse type: an output root, not empty (an empty one would write into the current folder)
     and without control or formatting characters (a newline or a right-to-left override in a folder
@@ -46,3 +57,20 @@ def exports_root(text: str) -> str:
     if not text.isprintable():
         raise argparse.ArgumentTypeError(f"expected a folder name of printable characters, got {ascii(text)[:80]}")
     return text
+
+
+#: What every command that reads a profile says of its first argument.
+PROFILE_HELP = "profile name (under profiles/) or path"
+
+
+def profile_command(subparsers, name: str, func, *, profile_help: str = PROFILE_HELP, exports: bool = True,
+                    **parser_options) -> argparse.ArgumentParser:
+    """A command ``name`` that reads a profile (its first argument) and writes under ``--exports``
+    (an :func:`exports_root`, default ``exports``; ``exports=False`` for one that writes nothing),
+    run by ``func(args)``. ``parser_options``: ``help``, ``description``, ``epilog`` of its parser."""
+    p = subparsers.add_parser(name, **parser_options)
+    p.add_argument("profile", help=profile_help)
+    if exports:
+        p.add_argument("--exports", default="exports", type=exports_root, help="output root (default: exports)")
+    p.set_defaults(func=func)
+    return p

@@ -39,11 +39,12 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Sequence
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from rigcad.errors import RigcadError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 #: Scheduler value that starts a Dask LocalCluster for the run.
 LOCAL_DASK = "local-dask"
@@ -149,10 +150,12 @@ class Engine:
         return "loky" if self.n_workers > 1 else "serial"
 
 
-def child_seed(seed: int, i: int) -> np.random.SeedSequence:
+def child_seed(seed: int, i: int) -> "np.random.SeedSequence":
     """Child i of ``SeedSequence(seed)``, the one ``.spawn`` would give as its i-th (same entropy,
     spawn key (i,)), made alone: sample i draws from it whatever batch or worker it lands in, and
     a task builds only its own samples' seeds (spawning all 10,000 took 0.13 s per task)."""
+    import numpy as np
+
     return np.random.SeedSequence(int(seed), spawn_key=(int(i),))
 
 

@@ -71,3 +71,9 @@ class FabricationError(RigcadError):
 
 class BasisError(RigcadError):
     """Basis-illumination maths refused its input: a bad zone, order, sampling, BRDF parameter or BRDF file."""
+
+
+def one_line(message: object) -> str:
+    """``message`` on one line: a newline or other control character that a name, a path or a value
+    brought into it is shown escaped (``\\n``), never printed."""
+    return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in str(message))

@@ -168,8 +168,8 @@ class Rig:
     # -- the stages, as a Python API ---------------------------------------------------------------
     def part(self, name: str):
         """The part's exact solid as a build123d ``Part`` (mm, working position), with
-        ``.to_cadquery()`` and ``.mesh()``; see :class:`rigcad.api.RigPart`."""
-        from rigcad.api import RigPart
+        ``.to_cadquery()`` and ``.mesh()``; see :class:`rigcad.parts.cad.RigPart`."""
+        from rigcad.parts.cad import RigPart
 
         return RigPart.build(self, name)
 
@@ -202,63 +202,41 @@ class Rig:
         vertices, faces = self._meshes[key]
         return trimesh.Trimesh(vertices.copy(), faces.copy(), process=False)
 
+    # the operations on a rig: rigcad.api holds them, with their folders, locks and cache keys
     def export(self, folder: str | Path | None = None, parts: list[str] | None = None, progress=None):
-        """Write the design files and the parts (STEP, STL, 3MF, PLY mirrors, renders, rig.step,
-        manifest.json) into ``folder`` (default ``exports/<profile>``), all published together
-        under :func:`writer_lock`. Returns the build's :class:`rigcad.export.build.BuildResult`."""
-        from rigcad.export.build import build_rig
-        from rigcad.export.design import design_files
-        from rigcad.export.manifest import inputs_key
+        """Write the design files and the parts into ``folder`` (default ``exports/<profile>``):
+        :func:`rigcad.api.export`."""
+        from rigcad import api
 
-        out = Path(folder) if folder is not None else Path("exports") / self.name
-        key = inputs_key(self.profile) if parts is None and self.misalignment == Misalignment.none() else None
-        return build_rig(self, out, parts, progress=progress, design=design_files(self.design), inputs_key=key,
-                         lock=writer_lock(out, self.name))
+        return api.export(self, folder, parts, progress)
 
     def check(self, rays: int | None = None, mode: str | None = None, exports: str | Path | None = None, **options):
-        """The 3D ray check (``rigcad.check.raycheck.run_raycheck``): returns a RayCheck whose
-        ``report`` holds every figure and ``rows`` the declared tolerances with pass/fail."""
-        from rigcad.check.raycheck import run_raycheck
+        """The 3D ray check, in memory: :func:`rigcad.api.check`."""
+        from rigcad import api
 
-        return run_raycheck(self, exports=Path(exports) if exports is not None else None, rays=rays, mode=mode,
-                            **options)
+        return api.check(self, rays, mode, exports, **options)
 
     def basis(self, order: int = 6, alpha: float | None = None):
-        """The zonal basis up to ``order`` as this rig's projector shows it (thesis 3.3, 4.2.1): images,
-        Gram matrices over the lit pixels, latitude-longitude maps; ``alpha`` rad the zone's lower
-        edge (default: the occlusion limit). See :func:`rigcad.basis.projector.projector_basis`."""
-        from rigcad.basis.projector import projector_basis
+        """The zonal basis up to ``order`` as this rig's projector shows it: :func:`rigcad.api.basis`."""
+        from rigcad import api
 
-        return projector_basis(self, order, alpha_rad=alpha)
+        return api.basis(self, order, alpha)
 
     def fab(self, printer, folder: str | Path | None = None, gcode: bool = False, parts: list[str] | None = None,
             progress=None, workers: int | None = None, slicing=None):
-        """Fabrication for ``printer`` (a name on the profile search path, a path, or a Printer):
-        fit, split, orient, slice, report into ``folder`` (default ``exports/<profile>/fab/<printer>``),
-        published under :func:`writer_lock`. ``workers``/``slicing``: see
-        :func:`rigcad.fab.stage.run_fab`."""
-        from rigcad.fab.printers import Printer, load_printer
-        from rigcad.fab.stage import run_fab
+        """Fabrication for ``printer`` into ``folder`` (default ``exports/<profile>/fab/<printer>``):
+        :func:`rigcad.api.fab`."""
+        from rigcad import api
 
-        p = printer if isinstance(printer, Printer) else load_printer(printer)
-        out = Path(folder) if folder is not None else Path("exports") / self.name / "fab" / p.name
-        return run_fab(self, p, out, gcode=gcode, parts=parts, progress=progress, workers=workers,
-                       lock=writer_lock(out, self.name, ("fab", p.name)), slicing=slicing)
+        return api.fab(self, printer, folder, gcode, parts, progress, workers, slicing)
 
+    def show(self, port: int = 3939, rays: int | None = None):
+        """Push the named, coloured parts, ``rays`` traced rays (default: as many as ``rigcad view``
+        draws) as polylines and the COP markers to an OCP CAD Viewer running on ``port``; a
+        ViewerError saying how to start one when none runs. See :mod:`rigcad.live.ocp`."""
+        from rigcad.live.ocp import show
 
-def writer_lock(folder: str | Path, profile: str, inside: tuple[str, ...] = ()) -> Path:
-    """The lock a writer into ``folder`` holds while it publishes. ``inside``: where the writer's
-    folder lies in ``<root>/<profile>`` (``()`` for that folder itself, ``("fab", printer)`` for a
-    fab run). When ``folder`` is ``<root>/<profile>/<inside...>``: the profile's one lock
-    (export.atomic.profile_lock(root, profile), what every command writing there holds); anywhere
-    else: a lock of its own beside the folder."""
-    from rigcad.export.atomic import profile_lock
-
-    folder = Path(folder)
-    tail = (profile, *inside)
-    if folder.parts[-len(tail):] == tail:
-        return profile_lock(folder.parents[len(inside)], profile)
-    return profile_lock(folder.parent, folder.name)
+        return show(self, port, rays)
 
 
 @contextmanager

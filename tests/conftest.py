@@ -43,7 +43,7 @@ def warm_numba() -> None:
     import numpy as np
 
     from rigcad.check import trace3d
-    from rigcad.check.scene import analytic_optics, mesh_optics, rig_meshes
+    from rigcad.check.scene import analytic_optics, mesh_optics, mirror_meshes
     from rigcad.optics.frames import Pose
     from rigcad.rig import Rig
 
@@ -52,7 +52,7 @@ def warm_numba() -> None:
     dirs = np.column_stack([s, s[::-1] / 2, -np.sqrt(1 - s * s - s[::-1] ** 2 / 4)])
     origins = np.tile([0.0, 0.0, rig.geometry.cop_z], (len(s), 1))
     tilted = Pose.misaligned((0.3, -0.2, 0.4), 0.004, (1.0, 1.0, 0.0), (0, 0, rig.geometry.vertex_z))
-    meshes = rig_meshes(rig, None, 0.05, 0.05)
+    meshes = mirror_meshes(rig, None, 0.05, 0.05)
     for optics in (analytic_optics(rig), *(mesh_optics(meshes, mode) for mode in ("mesh", "smooth", "exact_normals"))):
         trace3d.trace(optics, origins, dirs)
         trace3d.trace(optics.placed(tilted, tilted), origins, dirs)

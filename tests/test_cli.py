@@ -14,7 +14,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def run(*args, cwd=ROOT):
-    return subprocess.run([sys.executable, "-m", "rigcad.cli", *args], cwd=cwd, capture_output=True, text=True)
+    return subprocess.run([sys.executable, "-m", "rigcad", *args], cwd=cwd, capture_output=True, text=True)
 
 
 def test_design_writes_report_table_and_figures(tmp_path, capsys):

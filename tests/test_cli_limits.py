@@ -36,6 +36,31 @@ REFUSED = [
 ]
 
 
+def test_every_commands_exports_is_an_exports_root():
+    """Every command's ``--exports`` refuses an empty or unprintable root (arguments.exports_root):
+    the commands take it from arguments.profile_command; one that added its own would show here."""
+    import argparse
+
+    from rigcad.arguments import exports_root
+    from rigcad.cli import build_parser
+
+    types = {}
+
+    def walk(parser, name):
+        for action in parser._actions:
+            if action.dest == "exports":
+                types[name] = action.type
+            if isinstance(action, argparse._SubParsersAction):
+                for command, child in action.choices.items():
+                    walk(child, command)
+
+    parser = build_parser()
+    walk(parser, "rigcad")
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+    assert set(types) == set(commands) - {"profile"}, sorted(types)  # `profile show` writes nothing
+    assert all(t is exports_root for t in types.values()), types
+
+
 @pytest.mark.parametrize("argv,names", REFUSED, ids=[" ".join(a[2:]) or a[0] for a, _ in REFUSED])
 def test_a_bad_count_is_one_line_before_any_work(argv, names, monkeypatch, capsys, tmp_path):
     import rigcad.rig
@@ -108,7 +133,7 @@ def test_check_rays_beyond_memory_names_the_largest_that_fits(monkeypatch, capsy
     err = capsys.readouterr().err
     assert code == 2 and "Traceback" not in err
     largest = int(err.strip().rsplit(" ", 1)[-1])
-    from rigcad.check.cli import CHECK_BYTES_PER_RAY, CHECK_FIXED_BYTES
+    from rigcad.cli.check import CHECK_BYTES_PER_RAY, CHECK_FIXED_BYTES
 
     assert largest == int((4 << 30) - CHECK_FIXED_BYTES) // CHECK_BYTES_PER_RAY, err
 
@@ -129,19 +154,19 @@ def test_workers_are_clamped_to_the_cores():
 
 
 def test_a_memory_error_is_one_line(monkeypatch, capsys):
-    import rigcad.cli as C
+    from rigcad.cli import profile as command
 
     def boom(args):
         raise MemoryError("Unable to allocate 3.07 EiB for an array")
 
-    monkeypatch.setattr(C, "cmd_profile_show", boom)
+    monkeypatch.setattr(command, "cmd_show", boom)
     code = main(["profile", "show", "achutha2006"])
     err = capsys.readouterr().err
     assert code == 1 and err.count("\n") == 1 and "out of memory" in err and "Traceback" not in err, err
 
 
 def test_optimize_never_replaces_a_file_it_did_not_write(tmp_path, capsys):
-    from rigcad.optimize.cli import DESIGN_MARK, refuse_foreign_design
+    from rigcad.cli.optimize import DESIGN_MARK, refuse_foreign_design
 
     src = (ROOT / "profiles" / "achutha2006_optimize.yaml").read_text()
     (tmp_path / "lab").mkdir()

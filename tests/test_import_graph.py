@@ -45,7 +45,7 @@ def test_import_rigcad_loads_nothing_heavy():
 
 def test_cli_parser_loads_nothing_heavy():
     modules = _modules_after("import rigcad.cli\nrigcad.cli.build_parser()")
-    assert "rigcad.cli" in modules and "rigcad.fab.cli" in modules  # every sub-command registered
+    assert "rigcad.cli" in modules and "rigcad.cli.fab" in modules  # every sub-command registered
     assert not _loaded(modules, HEAVY + LIGHT_START)
 
 

@@ -34,8 +34,8 @@ def _calls(path: Path, names: set[str]) -> set[str]:
 
 def test_no_stage_derives_the_geometry_or_integrates_a_dome_itself():
     """Only the Rig builds the geometry and the dome (rigcad/rig.py); `profile show` prints a
-    profile's derived figures without a dome (cli.py, derive only). The stages take a Rig."""
-    allowed = {"rig.py": {"derive", "converged_dome"}, "cli.py": {"derive"},
+    profile's derived figures without a dome (cli/profile.py, derive only). The stages take a Rig."""
+    allowed = {"rig.py": {"derive", "converged_dome"}, "cli/profile.py": {"derive"},
                # the definitions themselves, and the integrator that converged_dome drives
                "profile/derived.py": set(), "optics/design.py": {"build_dome"},
                # the optimiser derives each candidate design's closed-form geometry (never a dome: its
@@ -152,14 +152,14 @@ def test_a_part_is_meshed_once_per_rig_and_chord(table31_rig, monkeypatch):
 
 
 def test_every_writer_under_exports_holds_the_profile_lock(table31_rig, tmp_path, monkeypatch):
-    """Rig.export, Rig.fab given a folder, `rigcad stl`, `rigcad fab` and `rigcad manual` hand their
-    writers one lock:
+    """Rig.export, Rig.fab given a folder, `rigcad stl`, `rigcad fab`, `rigcad manual` and the writers
+    of `rigcad check` and `rigcad basis` (rigcad.api) hand their writers one lock:
     exports/.<profile>.lock for a folder under exports/<profile>, the one every command writing
     there holds; a folder elsewhere gets a lock of its own beside it."""
     import rigcad.export.build as EB
     import rigcad.fab.stage as FS
     from rigcad.cli import main
-    from rigcad.rig import writer_lock
+    from rigcad.api import writer_lock
 
     root = tmp_path / "exports"
     lock = root / ".achutha2006.lock"
@@ -177,22 +177,36 @@ def test_every_writer_under_exports_holds_the_profile_lock(table31_rig, tmp_path
 
     seen = []
 
-    def stand_in(kind):
+    def stand_in(kind, position=None):
         def record(*args, **kwargs):
-            seen.append((kind, kwargs["lock"]))
+            seen.append((kind, kwargs["lock"] if position is None else args[position]))
             raise Stop
         return record
 
+    import rigcad.basis.acquire as BA
+    import rigcad.basis.projector as BP
+    import rigcad.check.raycheck as CR
+    from rigcad import api
+
     monkeypatch.setattr(FS, "run_fab", stand_in("fab"))
     monkeypatch.setattr(EB, "build_rig", stand_in("stl"))
+    monkeypatch.setattr(CR, "write_raycheck", stand_in("check", 2))
+    monkeypatch.setattr(BP, "write_basis", stand_in("basis"))
+    monkeypatch.setattr(BA, "write_simulation", stand_in("simulation", 2))
     for call in (lambda: table31_rig.fab("vantage_i", root / "achutha2006" / "fab" / "vantage_i"),
                  lambda: table31_rig.export(root / "achutha2006"),
                  lambda: main(["fab", "achutha2006", "--printer", "vantage_i", "--exports", str(root)]),
                  lambda: main(["stl", "achutha2006", "--exports", str(root)]),
-                 lambda: main(["manual", "achutha2006", "--printer", "vantage_i", "--exports", str(root)])):
+                 lambda: main(["manual", "achutha2006", "--printer", "vantage_i", "--exports", str(root)]),
+                 # what `rigcad check` and `rigcad basis` write their computed results with
+                 lambda: api.write_check(table31_rig, None, root / "achutha2006" / "check"),
+                 lambda: api.write_basis(table31_rig, None, root / "achutha2006" / "basis"),
+                 lambda: api.write_simulation(table31_rig, None, root / "achutha2006" / "basis"),
+                 lambda: api.write_check(table31_rig, None, tmp_path / "mine")):
         with pytest.raises(Stop):
             call()
-    assert seen == [("fab", lock), ("stl", lock), ("fab", lock), ("stl", lock), ("fab", lock)], seen
+    assert seen == [("fab", lock), ("stl", lock), ("fab", lock), ("stl", lock), ("fab", lock), ("check", lock),
+                    ("basis", lock), ("simulation", lock), ("check", tmp_path / ".mine.lock")], seen
 
 
 def test_part_is_a_build123d_part_with_cadquery_and_mesh(table31_rig):
@@ -216,7 +230,7 @@ def test_part_is_a_build123d_part_with_cadquery_and_mesh(table31_rig):
 
 
 def _run(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "rigcad.cli", *args], cwd=cwd, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "rigcad", *args], cwd=cwd, capture_output=True, text=True,
                           timeout=600)
 
 

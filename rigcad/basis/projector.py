@@ -554,8 +554,6 @@ def projector_basis(rig, order: int = 6, *, alpha_rad: float | None = None,
     docstring), their Gram matrices over the lit pixels and the latitude-longitude maps.
     ``alpha_rad``: the zone's lower edge (default: the rig's occlusion limit). ``progress(label)`` is
     called after each of BASIS_STEPS stages."""
-    from rigcad.check.result import STATUS_NAMES
-
     L = check_basis_order(order)
     step = progress_step(progress)
     zone = zone_of(rig, alpha_rad)
@@ -569,14 +567,7 @@ def projector_basis(rig, order: int = 6, *, alpha_rad: float | None = None,
     lowdin = reorthonormalise(values, s, "lowdin", reference=values)
     lowdin_images = {b: quantise_images(lowdin.functions, b) for b in BITS}
     step("images")
-    inside = design.in_zone(zone)
-    theta, phi = design.design_angles()
-    free = IlluminationSampling(np.where(inside, theta, 0.0), np.where(inside, phi, 0.0),
-                                np.where(inside, design.jacobian_sr, 0.0), inside)
-    free_values = basis_images(free, L, zone)
-    orders = sorted({o for o in GRAM_ORDERS if o <= L} | {L})
-    grams = {f"order_{o}": _gram_figures(values[:, :(o + 1) ** 2], s, free, free_values[:, :(o + 1) ** 2])
-             for o in orders}
+    grams = _gram_orders(design, zone, s, values, L)
     step("Gram matrices")
     th, ph = latlong_grid(zone, latlong_step_deg)
     TH, PH = np.meshgrid(th, ph, indexing="ij")
@@ -584,10 +575,6 @@ def projector_basis(rig, order: int = 6, *, alpha_rad: float | None = None,
     latlong_images = {b: quantise_images(ll, b) for b in BITS}
     latlong = np.ascontiguousarray(ll.T.reshape(-1, len(th), len(ph)).astype(np.float32))
     step("latitude-longitude maps")
-
-    width, height = design.resolution
-    r0, c0, h, w = design.window
-    pitch = s.pitch_rad()
     report = {
         "profile": rig.name,
         "order": L,
@@ -599,20 +586,7 @@ def projector_basis(rig, order: int = 6, *, alpha_rad: float | None = None,
                  "solid_angle_sr": zone.solid_angle_sr,
                  "alpha_from": "the incidence map's inner edge (occlusion limit)" if alpha_rad is None else "given",
                  "design_report_theta_min_deg": rig.design.report["measurable_range"]["theta_min_deg"]},
-        "projector": {
-            "resolution_px": [width, height], "focal_length_px": design.focal_px,
-            "traced_window_row_col_rows_cols": [r0, c0, h, w],
-            "window_border_all_missed": design.border_all_missed(),
-            "pixels_traced": design.size,
-            "pixels_by_status": {STATUS_NAMES[k]: int(np.sum(design.status == k)) for k in STATUS_NAMES},
-            "pixels_in_zone": int(inside.sum()),
-            "pixels_lit": int(illum.lit.sum()),
-            "edge_pixels_supersampled": illum.edge_pixels, "supersample_per_side": SUPERSAMPLE,
-            "lit_solid_angle_sr": float(illum.weight_sr.sum()),
-            "lit_fraction_of_zone": float(illum.weight_sr.sum() / zone.solid_angle_sr),
-            "pitch_deg": math.degrees(pitch),
-            "pitch_note": "side of a square of the median lit pixel's solid angle",
-        },
+        "projector": _projector_figures(design, illum, zone),
         "solid_angle": solid_angle_check(rig, design, zone),
         "preprocessing": {
             "thesis": "4.2.1: one scale for all images of the set, positive and negative parts as separate "
@@ -636,16 +610,56 @@ def projector_basis(rig, order: int = 6, *, alpha_rad: float | None = None,
         "lowdin_transform": lowdin.transform.tolist(),
         "lowdin_note": "the re-orthonormalised set is values @ lowdin_transform; responses to the analytic "
                        "images times lowdin_transform are coefficients in that set",
-        "latlong": {"step_deg": math.degrees(th[1] - th[0]) if len(th) > 1 else math.degrees(zone.beta_rad -
-                                                                                             zone.alpha_rad),
-                    "rows_theta": len(th), "columns_phi": len(ph),
-                    "theta_first_deg": math.degrees(th[0]), "theta_last_deg": math.degrees(th[-1]),
-                    "phi_first_deg": math.degrees(ph[0]),
-                    "layout": "row 0 next to the normal (theta = alpha), columns from phi = 0 towards +y"},
+        "latlong": _latlong_figures(zone, th, ph),
         "functions_index": [{"k": k, "l": int(l), "m": int(m)} for k, (l, m) in enumerate(basis_indices(L))],
     }
     return ProjectorBasis(rig.name, L, zone, illum, values, images, lowdin, lowdin_images, latlong, th, ph,
                           latlong_images, report)
+
+
+def _gram_orders(design, zone, sampling, values, order: int) -> dict:
+    """The Gram figures (:func:`_gram_figures`) of the basis truncated at each order of GRAM_ORDERS up
+    to ``order`` and at ``order``, against the pixels whose centre lies in the zone without occluders."""
+    inside = design.in_zone(zone)
+    theta, phi = design.design_angles()
+    free = IlluminationSampling(np.where(inside, theta, 0.0), np.where(inside, phi, 0.0),
+                                np.where(inside, design.jacobian_sr, 0.0), inside)
+    free_values = basis_images(free, order, zone)
+    orders = sorted({o for o in GRAM_ORDERS if o <= order} | {order})
+    return {f"order_{o}": _gram_figures(values[:, :(o + 1) ** 2], sampling, free, free_values[:, :(o + 1) ** 2])
+            for o in orders}
+
+
+def _projector_figures(design, illum, zone) -> dict:
+    """The projector's pixels: traced window, status counts, in the zone, lit, supersampled at the
+    edge, the lit solid angle (sr) and the pitch (deg)."""
+    from rigcad.check.result import STATUS_NAMES
+
+    width, height = design.resolution
+    r0, c0, h, w = design.window
+    return {
+        "resolution_px": [width, height], "focal_length_px": design.focal_px,
+        "traced_window_row_col_rows_cols": [r0, c0, h, w],
+        "window_border_all_missed": design.border_all_missed(),
+        "pixels_traced": design.size,
+        "pixels_by_status": {STATUS_NAMES[k]: int(np.sum(design.status == k)) for k in STATUS_NAMES},
+        "pixels_in_zone": int(design.in_zone(zone).sum()),
+        "pixels_lit": int(illum.lit.sum()),
+        "edge_pixels_supersampled": illum.edge_pixels, "supersample_per_side": SUPERSAMPLE,
+        "lit_solid_angle_sr": float(illum.weight_sr.sum()),
+        "lit_fraction_of_zone": float(illum.weight_sr.sum() / zone.solid_angle_sr),
+        "pitch_deg": math.degrees(illum.sampling.pitch_rad()),
+        "pitch_note": "side of a square of the median lit pixel's solid angle",
+    }
+
+
+def _latlong_figures(zone, th, ph) -> dict:
+    """The latitude-longitude maps' grid: step, rows and columns, first cells (deg)."""
+    step = th[1] - th[0] if len(th) > 1 else zone.beta_rad - zone.alpha_rad
+    return {"step_deg": math.degrees(step), "rows_theta": len(th), "columns_phi": len(ph),
+            "theta_first_deg": math.degrees(th[0]), "theta_last_deg": math.degrees(th[-1]),
+            "phi_first_deg": math.degrees(ph[0]),
+            "layout": "row 0 next to the normal (theta = alpha), columns from phi = 0 towards +y"}
 
 
 # -- files ---------------------------------------------------------------------------------------------

@@ -13,14 +13,14 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from rigcad.check import montecarlo as MC
-from rigcad.check import tolerances as T
-from rigcad.check.scene import Optics, analytic_optics, mesh_optics, mixed, placed_as, rig_meshes, share_scenes
+from rigcad.check import montecarlo, tolerances
+from rigcad.check.scene import Optics, analytic_optics, mesh_optics, mirror_meshes, mixed, placed_as, share_scenes
 from rigcad.check.sources import annulus_rays, pixel_grid, pixel_rays, thin_lens_rays
 from rigcad.optics.incidence import DesignMap
 from rigcad.check.result import STATUS_NAMES, Trace3D
@@ -40,7 +40,8 @@ FAN_STEP_PX = 0.05
 @dataclass
 class RayCheck:
     """Everything the check computed; ``report`` is JSON-ready (units in keys), ``rows`` the
-    tolerance table; arrays kept for the figures."""
+    tolerance table; arrays kept for the figures; ``timings_s`` the wall time of each stage (s),
+    kept apart from the report so that raycheck.json is the same bytes on every run."""
 
     profile: Profile
     report: dict
@@ -50,6 +51,7 @@ class RayCheck:
     theta_map: np.ndarray | None
     status_map: np.ndarray | None
     fan: dict
+    timings_s: dict = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
@@ -83,7 +85,7 @@ def _losses(tr: Trace3D, rays_chief: np.ndarray, design_dirs: np.ndarray) -> dic
 def reading(tr: Trace3D, design_dirs: np.ndarray, exact: Trace3D | None, chief: np.ndarray) -> dict:
     """Figures of one reading (units in keys)."""
     ok = tr.ok
-    f = MC.figures(tr, design_dirs, exact)
+    f = montecarlo.figures(tr, design_dirs, exact)
     th = tr.theta[ok]
     f["theta_min_deg"] = float(np.degrees(th.min())) if th.size else float("nan")
     f["theta_max_deg"] = float(np.degrees(th.max())) if th.size else float("nan")
@@ -132,155 +134,41 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
     reused across calls (tests) to keep BVHs. A moved rig (``rig.moved``) is traced where its
     components stand; the sensitivity table and the Monte Carlo perturb the design's alignment."""
     step = progress or (lambda label: None)
-    profile = rig.profile
-    rc = profile.raycheck
-    if rays is not None:
-        profile = replace(profile, raycheck=replace(rc, rays=rays))
-    if mode is not None:
-        profile = replace(profile, raycheck=replace(profile.raycheck, mode=mode))
+    profile = _overridden(rig.profile, rays, mode, chord_error, normal_error, builds)
     override_tess = chord_error is not None or normal_error is not None
-    if override_tess:
-        tess = profile.tessellation
-        profile = replace(profile, tessellation=replace(
-            tess, mirror_chord_error=tess.mirror_chord_error if chord_error is None else chord_error,
-            mirror_normal_error=tess.mirror_normal_error if normal_error is None else normal_error))
-    if builds is not None:
-        profile = replace(profile, tolerancing=replace(profile.tolerancing, builds=builds))
     rc, tol = profile.raycheck, profile.tolerancing
     timings = {}
-    t0 = time.perf_counter()
-    step("design")
-    design = rig.incidence
-    analytic = analytic_optics(rig)
-    timings["design_s"] = time.perf_counter() - t0
-
-    meshes = None
-    meshed = None
+    with _timed(timings, "design_s", step, "design"):
+        design = rig.incidence
+        analytic = analytic_optics(rig)
+    meshes = meshed = None
     if rc.mode != "analytic":
         step("meshes")
-        t0 = time.perf_counter()
-        key = (profile.name, profile.tessellation.mirror_chord_error, profile.tessellation.mirror_normal_error,
-               str(exports))
-        cache = optics_cache if optics_cache is not None else {}
-        if key not in cache:
-            tess = profile.tessellation
-            meshes = rig_meshes(rig, exports, tess.mirror_chord_error, tess.mirror_normal_error) \
-                if exports is None or override_tess else rig_meshes(rig, exports)
-            t1 = time.perf_counter()
-            cache[key] = (meshes, mesh_optics(meshes, "smooth"), t1 - t0, time.perf_counter() - t1)
-        meshes, meshed, timings["meshes_s"], timings["embree_build_s"] = cache[key]
-        meshed = placed_as(meshed, rig)
+        meshes, meshed, timings["meshes_s"], timings["embree_build_s"] = _mesh_optics(
+            rig, profile, exports, override_tess, optics_cache)
     check_optics = analytic if meshed is None else share_scenes(meshed, rc.mode)
-
-    step("pinhole")
-    t0 = time.perf_counter()
     projector = rig.pose("projector")
-    src = annulus_rays(design, rc.rays, rc.seed, projector)
-    ddirs = design.direction(src.chief)
-    exact = trace(analytic, src.origins, src.dirs)
-    readings = {"analytic": reading(exact, ddirs, None, src.chief)}
-    readings["analytic"]["kernels"] = exact.kernels  # which analytic kernel traced how many rays
-    main = exact
-    if meshed is not None:
-        for name in ("mesh", "smooth"):
-            tr = trace(share_scenes(meshed, name), src.origins, src.dirs)
-            readings[name] = reading(tr, ddirs, exact, src.chief)
-            readings[name]["kernels"] = tr.kernels  # the compiled mesh passes or the numpy ones
-            if name == rc.mode:
-                main = tr
-        k = min(EXACT_NORMAL_RAYS, rc.rays)
-        sub = exact.__class__(*(v[:k] if isinstance(v, np.ndarray) else v
-                                for v in (getattr(exact, f) for f in exact.__dataclass_fields__)))
-        for name, optics in (("exact_normals", share_scenes(meshed, "exact_normals")),
-                             ("mesh_float32", share_scenes(meshed, "mesh", refine=False)),
-                             ("smooth_float32", share_scenes(meshed, "smooth", refine=False))):
-            tr = trace(optics, src.origins[:k], src.dirs[:k])
-            readings[name] = reading(tr, ddirs[:k], sub, src.chief[:k])
-            readings[name]["rays_traced"] = k
-        for part in ("paraboloid", "dome"):  # which mirror's mesh causes the error
-            for name in ("mesh", "smooth"):
-                tr = trace(mixed(analytic, share_scenes(meshed, name), part), src.origins, src.dirs)
-                r = reading(tr, ddirs, exact, src.chief)
-                readings[f"{name}_{part}_mesh_only"] = {k2: r[k2] for k2 in (
-                    "max_spot_radius_mm", "rms_spot_radius_mm", "mesh_minus_exact_angle_rad")}
-    timings["pinhole_s"] = time.perf_counter() - t0
+    with _timed(timings, "pinhole_s", step, "pinhole"):
+        src = annulus_rays(design, rc.rays, rc.seed, projector)
+        ddirs = design.direction(src.chief)
+        exact = trace(analytic, src.origins, src.dirs)
+        readings, main = _pinhole_readings(analytic, meshed, src, ddirs, exact, rc.mode, rc.rays)
+    with _timed(timings, "tower_s", step, "tower"):
+        from rigcad.check.tower import tower_report  # the camera through the beam splitter; bundle clearance
 
-    step("tower")
-    t0 = time.perf_counter()
-    from rigcad.check.tower import tower_report  # the camera through the beam splitter; bundle clearance
-
-    tower = tower_report(check_optics, rig, design, rc.rays, rc.seed + 17)
-    timings["tower_s"] = time.perf_counter() - t0
-
-    step("pixels")
-    t0 = time.perf_counter()
-    fan = pixels_per_degree(check_optics, design, pose=projector)
-    theta_map = status_map = None
-    grid_report = None
-    if grid:
-        r_out = float(design.pixel_radius(np.array([design.alpha_max]))[0])
-        window = 2 * int(math.ceil(r_out)) + 8  # the paraboloid's image and a 4 px margin
-        g, (h, w), (r0, c0) = pixel_grid(design, profile.projector.resolution, projector, window=window)
-        gt = trace(check_optics, g.origins, g.dirs)
-        theta_map = np.degrees(gt.theta).reshape(h, w)
-        status_map = gt.status.reshape(h, w)
-        gd = design.direction(g.chief)
-        err = _angles(gt.arrival[gt.ok], gd[gt.ok])
-        border = np.concatenate([status_map[0], status_map[-1], status_map[:, 0], status_map[:, -1]])
-        width, height = profile.projector.resolution
-        grid_report = {
-            "resolution": [width, height], "traced_window_px": [w, h], "window_origin_row_col": [r0, c0],
-            "window_border_all_missed": bool(np.all(border == 1)),
-            "pixels_total": width * height,
-            "pixels_on_paraboloid": int(np.sum(gt.status != 1)),
-            "pixels_reaching_sample": int(gt.ok.sum()),
-            "pixels_lost": {STATUS_NAMES[k]: int(np.sum(gt.status == k)) for k in STATUS_NAMES if k > 1},
-            "max_angle_error_rad": float(err.max()) if err.size else float("nan"),
-            "theta_min_deg": float(np.nanmin(theta_map)), "theta_max_deg": float(np.nanmax(theta_map)),
-            "max_spot_radius_mm": float(np.nanmax(gt.miss)),
-        }
-    timings["pixels_s"] = time.perf_counter() - t0
-
-    step("thin lens")
-    t0 = time.perf_counter()
-    k = min(THIN_LENS_RAYS, rc.rays)
-    chief = annulus_rays(design, k, rc.seed + 7, projector)
-    ctr = trace(check_optics, chief.origins, chief.dirs)
-    focal = float(np.nanmean(exact.path_length))  # thesis 3.2.2: mean source-to-sample path
-    edge = thin_lens_rays(chief, focal, profile.projector.aperture, rc.lens_azimuths)
-    etr = trace(check_optics, edge.origins, edge.dirs)
-    c_arr = np.repeat(ctr.arrival, rc.lens_azimuths, axis=0)
-    both = etr.ok & np.repeat(ctr.ok, rc.lens_azimuths)
-    off = _angles(etr.arrival[both], c_arr[both])
-    lens = {
-        "aperture_mm": profile.projector.aperture, "focal_distance_mm": focal, "chief_rays": k,
-        "edge_rays_per_chief": rc.lens_azimuths,
-        "mean_abs_angular_offset_rad": float(off.mean()), "max_abs_angular_offset_rad": float(off.max()),
-        "mean_miss_mm": float(np.nanmean(etr.miss)), "max_miss_mm": float(np.nanmax(etr.miss)),
-        "edge_rays_lost_fraction": float(1 - etr.ok.mean()),
-    }
-    timings["thin_lens_s"] = time.perf_counter() - t0
-
-    step("misalignment")
-    t0 = time.perf_counter()
-    mis = profile.misalignment
-    mis_optics = check_optics
-    sens = MC.sensitivity(mis_optics, rig, design, mis.probe, mis.probe_tilt, tol.rays, rc.seed + 11)
-    decl = MC.declared(profile)
-    declared_report = None
-    if decl != MC.Misalignment.none():
-        declared_report = {}
-        for device in ("projector", "camera"):
-            tr, dd, md = MC.trace_path(mis_optics, rig, design, decl, device, tol.rays, rc.seed + 13)
-            declared_report[device + "_path"] = MC.figures(tr, dd, None, md)
-    timings["misalignment_s"] = time.perf_counter() - t0
+        tower = tower_report(check_optics, rig, design, rc.rays, rc.seed + 17)
+    with _timed(timings, "pixels_s", step, "pixels"):
+        fan = pixels_per_degree(check_optics, design, pose=projector)
+        theta_map, status_map, grid_report = _pixel_grid(check_optics, design, profile, projector) if grid \
+            else (None, None, None)
+    with _timed(timings, "thin_lens_s", step, "thin lens"):
+        lens = _thin_lens(check_optics, design, profile, projector, exact)
+    with _timed(timings, "misalignment_s", step, "misalignment"):
+        misalignment = _misalignment(check_optics, rig, design, profile)
     mc = None
     if monte_carlo:
-        step("monte carlo")
-        t0 = time.perf_counter()
-        mc = MC.check_report(rig, tol.builds, tol.rays)  # the exact surfaces, as rigcad tolerance traces
-        timings["monte_carlo_s"] = time.perf_counter() - t0
-
+        with _timed(timings, "monte_carlo_s", step, "monte carlo"):
+            mc = montecarlo.check_report(rig, tol.builds, tol.rays)  # the exact surfaces, as rigcad tolerance traces
     report = {
         "profile": {"name": profile.name, "sources": list(profile.sources)},
         "frame": "mm; sample point O at the origin; optical axis +z; projector pixel x to +x, rows to -y",
@@ -288,24 +176,168 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
         "backend": check_optics.backend,
         "backends": {"analytic": analytic.backend, **({"mesh": meshed.backend} if meshed else {})},
         "rays": rc.rays, "seed": rc.seed,
-        "meshes": None if meshes is None else {
-            "sources": meshes.sources(), "tolerances": meshes.tolerances,
-            "triangles": {"paraboloid": len(meshes.paraboloid.faces), "dome": len(meshes.dome.faces),
-                          "paraboloid_mount": len(meshes.mount.faces), "beam": len(meshes.beam.faces)}},
+        "meshes": None if meshes is None else _mesh_figures(meshes),
         "readings": readings,
         "pixels_per_degree": fan["summary"],
         "pixel_grid": grid_report,
         "thin_lens": lens,
         "tower": tower,
-        "misalignment": {"probe_mm": mis.probe, "probe_tilt_rad": mis.probe_tilt, "sensitivity": sens,
-                         "declared": declared_report},
+        "misalignment": misalignment,
         "monte_carlo": mc,
-        "timings_s": timings,
     }
-    rows = T.evaluate(profile, report)
+    rows = tolerances.evaluate(profile, report)
     report["checks"] = [r.as_dict() for r in rows]
     report["passed"] = all(r.ok for r in rows)
-    return RayCheck(profile, report, rows, main, ddirs, theta_map, status_map, fan)
+    return RayCheck(profile, report, rows, main, ddirs, theta_map, status_map, fan, timings)
+
+
+@contextmanager
+def _timed(timings: dict, key: str, step, label: str):
+    """One stage of the check: ``step(label)`` first, its wall time (s) in ``timings[key]`` after."""
+    step(label)
+    t0 = time.perf_counter()
+    yield
+    timings[key] = time.perf_counter() - t0
+
+
+def _overridden(profile: Profile, rays, mode, chord_error, normal_error, builds) -> Profile:
+    """The profile with the run's overrides of raycheck.rays and .mode, the mirrors' tessellation
+    (chord error mm, normal error rad) and tolerancing.builds (None: the profile's own)."""
+    if rays is not None:
+        profile = replace(profile, raycheck=replace(profile.raycheck, rays=rays))
+    if mode is not None:
+        profile = replace(profile, raycheck=replace(profile.raycheck, mode=mode))
+    if chord_error is not None or normal_error is not None:
+        tess = profile.tessellation
+        profile = replace(profile, tessellation=replace(
+            tess, mirror_chord_error=tess.mirror_chord_error if chord_error is None else chord_error,
+            mirror_normal_error=tess.mirror_normal_error if normal_error is None else normal_error))
+    if builds is not None:
+        profile = replace(profile, tolerancing=replace(profile.tolerancing, builds=builds))
+    return profile
+
+
+def _mesh_optics(rig, profile: Profile, exports: Path | None, override_tess: bool, optics_cache: dict | None):
+    """The mirror meshes (the exported PLYs under ``exports``, else meshed at the profile's
+    tolerances) and their smooth-normal optics placed as ``rig`` stands, with the seconds spent
+    meshing and building the BVHs; kept in ``optics_cache`` by profile, tolerances and exports."""
+    key = (profile.name, profile.tessellation.mirror_chord_error, profile.tessellation.mirror_normal_error,
+           str(exports))
+    cache = optics_cache if optics_cache is not None else {}
+    if key not in cache:
+        t0 = time.perf_counter()
+        tess = profile.tessellation
+        meshes = mirror_meshes(rig, exports, tess.mirror_chord_error, tess.mirror_normal_error) \
+            if exports is None or override_tess else mirror_meshes(rig, exports)
+        t1 = time.perf_counter()
+        cache[key] = (meshes, mesh_optics(meshes, "smooth"), t1 - t0, time.perf_counter() - t1)
+    meshes, meshed, meshes_s, embree_s = cache[key]
+    return meshes, placed_as(meshed, rig), meshes_s, embree_s
+
+
+def _mesh_figures(meshes) -> dict:
+    """Where each mirror mesh came from, its tolerances and triangle counts."""
+    return {"sources": meshes.sources(), "tolerances": meshes.tolerances,
+            "triangles": {"paraboloid": len(meshes.paraboloid.faces), "dome": len(meshes.dome.faces),
+                          "paraboloid_mount": len(meshes.mount.faces), "beam": len(meshes.beam.faces)}}
+
+
+def _pinhole_readings(analytic: Optics, meshed: Optics | None, src, ddirs, exact: Trace3D, mode: str,
+                      rays: int) -> tuple[dict, Trace3D]:
+    """Every reading of the pinhole rays ``src`` (see the module docstring), against the exact
+    trace ``exact``; and the trace of the reading checked (``mode``). With meshes: the float32 and
+    exact-normal readings on the first EXACT_NORMAL_RAYS rays, and each mirror's mesh alone."""
+    readings = {"analytic": reading(exact, ddirs, None, src.chief)}
+    readings["analytic"]["kernels"] = exact.kernels  # which analytic kernel traced how many rays
+    if meshed is None:
+        return readings, exact
+    main = exact
+    for name in ("mesh", "smooth"):
+        tr = trace(share_scenes(meshed, name), src.origins, src.dirs)
+        readings[name] = reading(tr, ddirs, exact, src.chief)
+        readings[name]["kernels"] = tr.kernels  # the compiled mesh passes or the numpy ones
+        if name == mode:
+            main = tr
+    k = min(EXACT_NORMAL_RAYS, rays)
+    sub = exact.__class__(*(v[:k] if isinstance(v, np.ndarray) else v
+                            for v in (getattr(exact, f) for f in exact.__dataclass_fields__)))
+    for name, optics in (("exact_normals", share_scenes(meshed, "exact_normals")),
+                         ("mesh_float32", share_scenes(meshed, "mesh", refine=False)),
+                         ("smooth_float32", share_scenes(meshed, "smooth", refine=False))):
+        tr = trace(optics, src.origins[:k], src.dirs[:k])
+        readings[name] = reading(tr, ddirs[:k], sub, src.chief[:k])
+        readings[name]["rays_traced"] = k
+    for part in ("paraboloid", "dome"):  # which mirror's mesh causes the error
+        for name in ("mesh", "smooth"):
+            tr = trace(mixed(analytic, share_scenes(meshed, name), part), src.origins, src.dirs)
+            r = reading(tr, ddirs, exact, src.chief)
+            readings[f"{name}_{part}_mesh_only"] = {k2: r[k2] for k2 in (
+                "max_spot_radius_mm", "rms_spot_radius_mm", "mesh_minus_exact_angle_rad")}
+    return readings, main
+
+
+def _pixel_grid(optics: Optics, design: DesignMap, profile: Profile, projector) -> tuple:
+    """Every projector pixel of the window around the paraboloid's image traced: the theta map
+    (deg) and status map (rows x columns), and their figures."""
+    r_out = float(design.pixel_radius(np.array([design.alpha_max]))[0])
+    window = 2 * int(math.ceil(r_out)) + 8  # the paraboloid's image and a 4 px margin
+    g, (h, w), (r0, c0) = pixel_grid(design, profile.projector.resolution, projector, window=window)
+    gt = trace(optics, g.origins, g.dirs)
+    theta_map = np.degrees(gt.theta).reshape(h, w)
+    status_map = gt.status.reshape(h, w)
+    gd = design.direction(g.chief)
+    err = _angles(gt.arrival[gt.ok], gd[gt.ok])
+    border = np.concatenate([status_map[0], status_map[-1], status_map[:, 0], status_map[:, -1]])
+    width, height = profile.projector.resolution
+    return theta_map, status_map, {
+        "resolution": [width, height], "traced_window_px": [w, h], "window_origin_row_col": [r0, c0],
+        "window_border_all_missed": bool(np.all(border == 1)),
+        "pixels_total": width * height,
+        "pixels_on_paraboloid": int(np.sum(gt.status != 1)),
+        "pixels_reaching_sample": int(gt.ok.sum()),
+        "pixels_lost": {STATUS_NAMES[k]: int(np.sum(gt.status == k)) for k in STATUS_NAMES if k > 1},
+        "max_angle_error_rad": float(err.max()) if err.size else float("nan"),
+        "theta_min_deg": float(np.nanmin(theta_map)), "theta_max_deg": float(np.nanmax(theta_map)),
+        "max_spot_radius_mm": float(np.nanmax(gt.miss)),
+    }
+
+
+def _thin_lens(optics: Optics, design: DesignMap, profile: Profile, projector, exact: Trace3D) -> dict:
+    """The projector as a thin lens (thesis 3.2.2) focused at the mean source-to-sample path of the
+    exact trace: edge rays around THIN_LENS_RAYS chief rays, their offset from the chief (rad) and
+    their miss (mm)."""
+    rc = profile.raycheck
+    k = min(THIN_LENS_RAYS, rc.rays)
+    chief = annulus_rays(design, k, rc.seed + 7, projector)
+    ctr = trace(optics, chief.origins, chief.dirs)
+    focal = float(np.nanmean(exact.path_length))  # thesis 3.2.2: mean source-to-sample path
+    edge = thin_lens_rays(chief, focal, profile.projector.aperture, rc.lens_azimuths)
+    etr = trace(optics, edge.origins, edge.dirs)
+    c_arr = np.repeat(ctr.arrival, rc.lens_azimuths, axis=0)
+    both = etr.ok & np.repeat(ctr.ok, rc.lens_azimuths)
+    off = _angles(etr.arrival[both], c_arr[both])
+    return {
+        "aperture_mm": profile.projector.aperture, "focal_distance_mm": focal, "chief_rays": k,
+        "edge_rays_per_chief": rc.lens_azimuths,
+        "mean_abs_angular_offset_rad": float(off.mean()), "max_abs_angular_offset_rad": float(off.max()),
+        "mean_miss_mm": float(np.nanmean(etr.miss)), "max_miss_mm": float(np.nanmax(etr.miss)),
+        "edge_rays_lost_fraction": float(1 - etr.ok.mean()),
+    }
+
+
+def _misalignment(optics: Optics, rig, design: DesignMap, profile: Profile) -> dict:
+    """The sensitivity of each component's alignment (the profile's probe move and tilt), and the
+    figures of each light path under the misalignment the profile declares (None: none declared)."""
+    mis, rc, tol = profile.misalignment, profile.raycheck, profile.tolerancing
+    sens = montecarlo.sensitivity(optics, rig, design, mis.probe, mis.probe_tilt, tol.rays, rc.seed + 11)
+    decl = montecarlo.declared(profile)
+    declared_report = None
+    if decl != montecarlo.Misalignment.none():
+        declared_report = {}
+        for device in ("projector", "camera"):
+            tr, dd, md = montecarlo.trace_path(optics, rig, design, decl, device, tol.rays, rc.seed + 13)
+            declared_report[device + "_path"] = montecarlo.figures(tr, dd, None, md)
+    return {"probe_mm": mis.probe, "probe_tilt_rad": mis.probe_tilt, "sensitivity": sens, "declared": declared_report}
 
 
 def write_raycheck(result: RayCheck, out_dir: Path, lock: Path | None = None,

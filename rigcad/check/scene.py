@@ -4,7 +4,7 @@ Frame: mm, sample point O at the origin, optical axis +z. Three rigid bodies can
 (misalignment): the paraboloid (its mirror with its back, stem and clamp), the dome, and the two
 sources (camera, projector; see sources.py). The beam rests in the dome's slots and moves with the dome.
 
-:func:`rig_meshes` is the one place that obtains the meshes: the exported files when present
+:func:`mirror_meshes` is the one place that obtains the meshes: the exported files when present
 (``exports/<profile>/mirrors/{dome,paraboloid}.ply`` written by ``rigcad build``, and
 ``stl/paraboloid.stl``, ``stl/beam.stl``), else built from the profile (``mirror_mesh`` at the
 profile's ``tessellation.mirror_*`` tolerances; the occluders from the boxes and cylinders the
@@ -87,8 +87,8 @@ def _read_stl(path: Path, name: str) -> R.TriMesh:
     return R.TriMesh(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64), source=str(path))
 
 
-def rig_meshes(rig, exports: Path | None = None, chord_error: float | None = None,
-               normal_error: float | None = None) -> RigMeshes:
+def mirror_meshes(rig, exports: Path | None = None, chord_error: float | None = None,
+                  normal_error: float | None = None) -> RigMeshes:
     """The meshes the checker traces (see the module docstring). ``chord_error`` (mm) and
     ``normal_error`` (rad) override the profile's ``tessellation.mirror_*`` (then the exported
     PLYs, made at the profile's values, are not used)."""

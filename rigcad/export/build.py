@@ -77,49 +77,19 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
     step = progress or (lambda label: None)
     profile, layout = rig.profile, rig.layout
     names = select_parts(parts)
-    rebuilt, reused = [], []
-    shapes: dict[str, object] = {}
+    shapes: dict[str, object] = {}  # part -> its solid, built once for its files and the assembly
     tol = profile.tessellation
 
     # results (check/, fab/<printer>/, ...) made from another profile are not carried into this build
     with Staging(out, lock, results_of=profile_digest(profile)) as stage:
         old = _read_manifest(out / "manifest.json")
-        old_parts = old.get("parts", {})
-        entries = dict(old_parts)
         design_shas = {}
         for name, data in (design or {}).items():
             stage.write_bytes(out / name, data)
             design_shas[name] = _sha(data)
-        for name in names:
-            part = rig.recipe(name)
-            key = part_key(part, profile)
-            if _cached(old_parts.get(name), key, out):
-                reused.append(name)
-                step(f"{name} (unchanged)")
-                continue
-            step(name)
-            entries[name] = _build_part(part, key, rig, out, stage, shapes)
-            rebuilt.append(name)
-
-        mirrors = dict(old.get("mirrors", {}))
-        for name in names:
-            for mirror, meridian in rig.recipe(name).mirrors:
-                key = _mirror_key(meridian, profile)
-                if _cached(mirrors.get(mirror), key, out):
-                    continue
-                step(f"{mirror} mirror mesh")
-                mirrors[mirror] = _build_mirror(mirror, meridian, key, profile, out, stage)
-
-        rig_parts = [n for n in PARTS if n in entries and entries[n].get("in_rig")]
-        # the instruments and COP markers (parts.tower.instruments) join the printed parts in rig.step
-        asm_key = hashlib.sha256("|".join([entries[n]["key"] for n in rig_parts]
-                                          + [f"{p.name}:{p.content_hash()}" for p in rig.instruments]).encode()).hexdigest()
-        asm_old = old.get("assembly")
-        if rig_parts and not _cached(asm_old, asm_key, out):
-            step("assembly")
-            assembly = _build_assembly(rig_parts, rig, out, stage, shapes, asm_key)
-        else:
-            assembly = asm_old
+        entries, rebuilt, reused = _build_parts(rig, names, old.get("parts", {}), out, stage, shapes, step)
+        mirrors = _build_mirrors(rig, names, old.get("mirrors", {}), out, stage, step)
+        assembly = _assembly(rig, entries, old.get("assembly"), out, stage, shapes, step)
         manifest = {
             "rigcad_version": __version__,
             "profile": {"name": profile.name, "sources": list(profile.sources), "sha256": profile_digest(profile)},
@@ -135,8 +105,9 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
             },
             "layout": layout.describe(),
             "tower_hardware": _tower_hardware(rig),
+            "alignment": _alignment(rig),
             "occlusion": _occlusion(rig, old.get("occlusion")),
-            "parts": {n: entries[n] for n in PARTS if n in entries},
+            "parts": {n: _with_stock(entries[n], rig.recipe(n)) for n in PARTS if n in entries},
             "mirrors": mirrors,
             "assembly": assembly,
             "stale_results_removed": stage.stale_report(),
@@ -147,11 +118,75 @@ def build_rig(rig, out: Path, parts: list[str] | None = None, progress=None,
     return BuildResult(manifest, rebuilt, reused, written)
 
 
+def _build_parts(rig, names: list[str], old_parts: dict, out: Path, stage: Staging, shapes: dict,
+                 step) -> tuple[dict, list[str], list[str]]:
+    """Build each part of ``names`` whose key changed since the previous manifest (``old_parts``) or
+    whose files are not intact; the manifest's part entries (the others carried over), and the
+    parts rebuilt and reused."""
+    entries, rebuilt, reused = dict(old_parts), [], []
+    for name in names:
+        part = rig.recipe(name)
+        key = part_key(part, rig.profile)
+        if _cached(old_parts.get(name), key, out):
+            reused.append(name)
+            step(f"{name} (unchanged)")
+            continue
+        step(name)
+        entries[name] = _build_part(part, key, rig, out, stage, shapes)
+        rebuilt.append(name)
+    return entries, rebuilt, reused
+
+
+def _build_mirrors(rig, names: list[str], old_mirrors: dict, out: Path, stage: Staging, step) -> dict:
+    """The mirror meshes (PLY) of the parts ``names``, each rebuilt when its key changed or its file
+    is not intact; the manifest's mirror entries."""
+    mirrors = dict(old_mirrors)
+    for name in names:
+        for mirror, meridian in rig.recipe(name).mirrors:
+            key = _mirror_key(meridian, rig.profile)
+            if _cached(mirrors.get(mirror), key, out):
+                continue
+            step(f"{mirror} mirror mesh")
+            mirrors[mirror] = _build_mirror(mirror, meridian, key, rig.profile, out, stage)
+    return mirrors
+
+
+def _assembly(rig, entries: dict, previous: dict | None, out: Path, stage: Staging, shapes: dict, step) -> dict | None:
+    """rig.step, the assembly of the in-rig parts with the instruments and COP markers
+    (parts.tower.instruments), rebuilt when any of them changed; the manifest's entry."""
+    rig_parts = [n for n in PARTS if n in entries and entries[n].get("in_rig")]
+    key = hashlib.sha256("|".join([entries[n]["key"] for n in rig_parts]
+                                  + [f"{p.name}:{p.content_hash()}" for p in rig.instruments]).encode()).hexdigest()
+    if rig_parts and not _cached(previous, key, out):
+        step("assembly")
+        return _build_assembly(rig_parts, rig, out, stage, shapes, key)
+    return previous
+
+
 def _tower_hardware(rig) -> list[dict]:
     """The COP tower's bought hardware, computed from its parts (parts.tower.hardware)."""
     from rigcad.parts.tower import hardware
 
     return hardware(rig.profile, rig.layout)
+
+
+def _alignment(rig) -> dict:
+    """What holds and what adjusts the tower's optics (mm, deg in the keys): the datum chain from the
+    base plate (parts.datum), every adjuster's range and resolution against its tolerance
+    (parts.adjusters), the focusing lens (optics.focus), and the sizes to measure before printing
+    (profile.instruments)."""
+    from dataclasses import asdict
+
+    from rigcad.optics.focus import focusing_lens
+    from rigcad.parts.adjusters import adjusters
+    from rigcad.parts.datum import check_datum_chain, datum_chain
+    from rigcad.profile.instruments import measurements
+
+    p, layout = rig.profile, rig.layout
+    return {"datum_chain": {**datum_chain(p, layout).describe(), "checks": check_datum_chain(p, layout)},
+            "adjusters": [a.describe() for a in adjusters(p, layout)],
+            "focusing_lens": focusing_lens(p, layout.geometry).describe(),
+            "measure_first": [asdict(m) for m in measurements(p)]}
 
 
 def _read_manifest(path: Path) -> dict:
@@ -193,6 +228,13 @@ def _occlusion(rig, previous: dict | None) -> dict:
     if previous and previous.get("key") == key:
         return previous
     return {**blocked_solid_angle(rig.occluders, profile_table(rig.geometry, rig.dome)), "key": key}
+
+
+def _with_stock(entry: dict, part) -> dict:
+    """A part's manifest entry with its ``bought`` stock (profile's ``buy``): set apart from the cached
+    entry, whose key is the solid's alone (a plate cut from stock has the printed shelf's solid)."""
+    out = {k: v for k, v in entry.items() if k != "bought"}
+    return {**out, "bought": part.bought} if part.bought else out
 
 
 def _build_part(part: Part, key: str, rig, out: Path, stage: Staging, shapes: dict) -> dict:

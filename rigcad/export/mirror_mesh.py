@@ -407,26 +407,93 @@ def mirror_mesh(meridian: Meridian, name: str, chord_error: float, normal_error:
     bound sets the density), measured_on, triangles, vertices, rings, sectors, apex_vertices,
     azimuth_share, sector_angle_rad, ring_spacing_min_mm / _max_mm, bytes (PLY size), builds,
     hausdorff_mm (+ its two directions and hausdorff_sampling)."""
+    chord_error, normal_error = _checked_bounds(name, chord_error, normal_error)
+    d = _dense(meridian)
+    ends_on_axis = int(d.points[0, 0] <= AXIS_MM) + int(d.points[-1, 0] <= AXIS_MM)
+    b = _build_within(meridian, d, name, chord_error, normal_error, ends_on_axis, every_facet)
+    grid, ring_u, sectors = b.grid, b.ring_u, b.sectors
+    vertices, normals, faces = grid.vertices, grid.normals, grid.faces
+    spacing = np.linalg.norm(np.diff(meridian.points(ring_u), axis=0), axis=1)  # chords between rings, mm
+    ratio_c, ratio_n = b.measured_chord / chord_error, b.measured_normal / normal_error
+    report = {
+        "name": name,
+        "meridian_kind": meridian.kind,
+        "meridian_offset_mm": float(meridian.offset),
+        "frame": PLY_FRAME,
+        "chord_error_mm": float(chord_error),
+        "facet_normal_error_rad": float(normal_error),
+        "measured_chord_error_mm": b.measured_chord,
+        "measured_facet_normal_error_rad": b.measured_normal,
+        "model_chord_error_mm": b.model_chord,
+        "model_facet_normal_error_rad": b.model_normal,
+        "binding": "chord" if ratio_c >= ratio_n else "facet_normal",
+        "measured_on": (f"{b.measured_facets} facets" + ("" if every_facet else
+                        f" of sector 0 (every sector is this strip rotated by a multiple of 2 pi/{sectors})"))
+                       + f", {len(barycentric_lattice(MEASURE_ORDER))} barycentric samples each, foot points on "
+                       "the exact meridian by Newton",
+        "triangles": int(len(faces)),
+        "vertices": int(len(vertices)),
+        "rings": int(len(ring_u)),
+        "sectors": int(sectors),
+        "apex_vertices": ends_on_axis,
+        "azimuth_share": b.share,
+        "sector_angle_rad": 2.0 * np.pi / sectors,
+        "ring_spacing_min_mm": float(spacing.min()),
+        "ring_spacing_max_mm": float(spacing.max()),
+        "bytes": len(_ply_header(name, len(vertices), len(faces), chord_error, normal_error, len(ring_u), sectors))
+        + len(vertices) * 8 * len(_VERTEX_PROPS) + len(faces) * _FACE_DTYPE.itemsize,
+        "builds": b.builds,
+    }
+    report.update(_hausdorff(meridian, ring_u, sectors, d.tangent_sign, grid))
+    _readonly(vertices, normals, faces, ring_u)
+    return MirrorMesh(name, vertices, faces, normals, len(ring_u), sectors, ring_u, report)
+
+
+def _checked_bounds(name: str, chord_error, normal_error) -> tuple[float, float]:
+    """The declared bounds as floats (one repr in report and PLY header); ExportError for a bound
+    that is not a positive number, or a facet-normal bound too coarse for the error model."""
     _check_name(name)
     for label, value, unit in (("chord_error", chord_error, "mm"), ("normal_error", normal_error, "rad")):
         if isinstance(value, bool) or not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
             raise ExportError(f"mirror mesh {name!r}: {label} must be a positive number of {unit}, got {value!r}")
-    chord_error, normal_error = float(chord_error), float(normal_error)  # one repr in report and PLY header
+    chord_error, normal_error = float(chord_error), float(normal_error)
     # the error model linearises angles (tan x ~ x to 1 % below 0.17 rad); a coarser facet-normal
     # bound is not a mesh anyone should trace rays on
     if normal_error > 0.17:
         raise ExportError(f"mirror mesh {name!r}: normal_error {normal_error} rad is too coarse for the "
                           "small-angle model; use at most 0.17 rad (about 10 deg)")
-    d = _dense(meridian)
-    ends_on_axis = int(d.points[0, 0] <= AXIS_MM) + int(d.points[-1, 0] <= AXIS_MM)
+    return chord_error, normal_error
+
+
+@dataclass(frozen=True)
+class _Built:
+    """The last build of :func:`_build_within`: the grid, its rings (meridian parameters) and
+    sectors, the azimuth share and the model's errors of its plan, the errors measured on it (mm,
+    rad) over ``measured_facets`` facets, and how many builds it took."""
+    grid: object
+    ring_u: np.ndarray
+    sectors: int
+    share: float
+    model_chord: float
+    model_normal: float
+    measured_chord: float
+    measured_normal: float
+    measured_facets: int
+    builds: int
+
+
+def _build_within(meridian: Meridian, d, name: str, chord_error: float, normal_error: float, ends_on_axis: int,
+                  every_facet: bool) -> _Built:
+    """Plan, build and measure the mesh, tightening the model's targets by the measured misses,
+    until both bounds hold (at most MAX_BUILDS builds). CheckError when they still do not, or are
+    missed by more than MODEL_MISS times (not a model error: no retry)."""
     target_chord, target_normal = TARGET_FRACTION * chord_error, TARGET_FRACTION * normal_error
     for build in range(1, MAX_BUILDS + 1):
         ring_u, sectors, share, model_chord, model_normal = _plan(d, target_chord, target_normal, ends_on_axis)
         angles = 2.0 * np.pi * np.arange(sectors) / sectors
         grid = _grid(meridian, ring_u, angles, True, d.tangent_sign)
-        vertices, normals, faces = grid.vertices, grid.normals, grid.faces
-        measured = faces if every_facet else faces[grid.sector_faces(1)]
-        chord, normal = facet_errors(vertices, measured, meridian)
+        measured = grid.faces if every_facet else grid.faces[grid.sector_faces(1)]
+        chord, normal = facet_errors(grid.vertices, measured, meridian)
         measured_chord, measured_normal = float(chord.max()), float(normal.max())
         if measured_chord <= chord_error and measured_normal <= normal_error:
             break
@@ -441,41 +508,8 @@ def mirror_mesh(meridian: Meridian, name: str, chord_error: float, normal_error:
             f"mirror mesh {name!r}: after {build} build(s) the measured chord error {measured_chord:.4g} mm / "
             f"facet-normal error {measured_normal:.4g} rad exceed the declared {chord_error} mm / {normal_error} rad; "
             "the meridian's curvature or normals may not describe its points (a kink, a wrong normal side)")
-
-    spacing = np.linalg.norm(np.diff(meridian.points(ring_u), axis=0), axis=1)  # chords between rings, mm
-    ratio_c, ratio_n = measured_chord / chord_error, measured_normal / normal_error
-    report = {
-        "name": name,
-        "meridian_kind": meridian.kind,
-        "meridian_offset_mm": float(meridian.offset),
-        "frame": PLY_FRAME,
-        "chord_error_mm": float(chord_error),
-        "facet_normal_error_rad": float(normal_error),
-        "measured_chord_error_mm": measured_chord,
-        "measured_facet_normal_error_rad": measured_normal,
-        "model_chord_error_mm": model_chord,
-        "model_facet_normal_error_rad": model_normal,
-        "binding": "chord" if ratio_c >= ratio_n else "facet_normal",
-        "measured_on": (f"{len(measured)} facets" + ("" if every_facet else
-                        f" of sector 0 (every sector is this strip rotated by a multiple of 2 pi/{sectors})"))
-                       + f", {len(barycentric_lattice(MEASURE_ORDER))} barycentric samples each, foot points on "
-                       "the exact meridian by Newton",
-        "triangles": int(len(faces)),
-        "vertices": int(len(vertices)),
-        "rings": int(len(ring_u)),
-        "sectors": int(sectors),
-        "apex_vertices": ends_on_axis,
-        "azimuth_share": share,
-        "sector_angle_rad": 2.0 * np.pi / sectors,
-        "ring_spacing_min_mm": float(spacing.min()),
-        "ring_spacing_max_mm": float(spacing.max()),
-        "bytes": len(_ply_header(name, len(vertices), len(faces), chord_error, normal_error, len(ring_u), sectors))
-        + len(vertices) * 8 * len(_VERTEX_PROPS) + len(faces) * _FACE_DTYPE.itemsize,
-        "builds": build,
-    }
-    report.update(_hausdorff(meridian, ring_u, sectors, d.tangent_sign, grid))
-    _readonly(vertices, normals, faces, ring_u)
-    return MirrorMesh(name, vertices, faces, normals, len(ring_u), sectors, ring_u, report)
+    return _Built(grid, ring_u, sectors, share, model_chord, model_normal, measured_chord, measured_normal,
+                  len(measured), build)
 
 
 # -- PLY ------------------------------------------------------------------------------------------

@@ -19,34 +19,25 @@ staircase/<part>.png, support/<piece>.png, fab.json, fab.md. Timings are returne
 from __future__ import annotations
 
 import json
-import math
 import time
+from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from rigcad._version import __version__
+from rigcad import plots
 from rigcad.errors import FabricationError, RigcadError
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import profile_digest, sha256_hex
-from rigcad import plots
-from rigcad.fab import estimate
-from rigcad.fab import outlines
-from rigcad.fab import orientation
-from rigcad.fab import slicer
-from rigcad.fab import split
-from rigcad.fab import staircase
+from rigcad.fab import choice, estimate, orientation, outlines, slicer, split, staircase
 from rigcad.fab.mirror import MirrorSurface, mirror_faces
 from rigcad.fab.printers import Printer
+from rigcad.fab.report import fab_report, markdown
 from rigcad.parts.recipe import Prism
-from rigcad.units import hours_minutes
 
 #: Parts cut from plate rather than printed.
 CUT_PARTS = ("dome_template", "paraboloid_template")
-#: Two orientations whose mean cusp differs by less than this fraction tie (upright and upside
-#: down give the same |n . D| everywhere); the tie goes to less support on the mirror.
-CUSP_TIE_RTOL = 1e-3
 
 
 @dataclass
@@ -56,6 +47,41 @@ class FabResult:
     timings_s: dict[str, float] = field(default_factory=dict)
     slicer_s: dict[str, float] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _Run:
+    """What every part of one run shares: the printer, the STL's chord error (mm), how far from the
+    exact mirror a facet still counts as mirror (mm), the bed's centre (mm), and where files go."""
+    printer: Printer
+    chord: float
+    tol_mirror: float
+    bed_centre: tuple[float, float]
+    stage: Staging
+    out: Path
+
+
+@dataclass
+class PartFab:
+    """One part through the stage: its fab.json entry, its slicing jobs, the split plan it was cut by
+    (a mirror part is cut again by the same plan once its sanding stock is known), its pieces'
+    meshes in print position (vertices, faces, mirror face indices: for the support contact read
+    from the G-code) and the time of each step (s)."""
+    entry: dict
+    jobs: list = field(default_factory=list)
+    plan: object = None
+    meshes: dict[str, tuple] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class _Sliced:
+    """The run's pieces through the slicer: fab.json's ``gcode`` figures of the run, each piece's
+    G-code record, each piece's slicing time (s) and the problems met."""
+    report: dict
+    records: dict[str, dict]
+    seconds: dict[str, float]
+    problems: list[str]
 
 
 def _mirror(part, layout) -> MirrorSurface | None:
@@ -77,49 +103,6 @@ def sanding_stock(printer: Printer, needed: float) -> tuple[float, str]:
     return needed, "auto: the staircase's bound in the chosen orientations (stock_bound)"
 
 
-def evaluate(vertices, faces, orient: orientation.Orientation, printer: Printer, mirror_f) -> dict:
-    """One candidate orientation of one piece: fit, staircase (closed form), supports."""
-    spin, extents = orientation.fit_spin(vertices, orient.direction, printer.usable)
-    row = {"orientation": orient.name, "build_direction": [round(float(v), 12) for v in orient.direction],
-           "fits": spin is not None, "spin_deg": None if spin is None else math.degrees(spin),
-           "extents_mm": extents, "overhang_area_mm2": orientation.overhang_area(vertices, faces, orient.direction)}
-    mask = None
-    if mirror_f is not None and len(mirror_f.index):
-        mask = np.zeros(len(faces), bool)
-        mask[mirror_f.index] = True
-        row["mirror_overhang_area_mm2"] = orientation.overhang_area(vertices, faces, orient.direction, mask)
-        row["staircase_closed_form"] = staircase.surface_staircase(mirror_f, orient.direction, printer.layer_height)
-    if spin is not None:
-        row["support_model"] = orientation.support_contact(vertices, faces, orient.direction, mask)
-    return row
-
-
-#: Support contact on a mirror (mm2, the model's estimate) below this counts as none: a few
-#: facets at a sector's edge, far under one support line's footprint.
-MIRROR_SUPPORT_TIE_MM2 = 1.0
-
-
-def choose(rows: list[dict]) -> int:
-    """Index of the best candidate: among those that fit, the least support contact on the mirror
-    (the model's estimate; below MIRROR_SUPPORT_TIE_MM2 counts as none), then the least mean cusp
-    on the mirror (ties within CUSP_TIE_RTOL), then the least overhang, then the lowest height;
-    without a mirror, the least overhang, then the lowest height."""
-    ok = [i for i, r in enumerate(rows) if r["fits"]]
-    if not ok:
-        return 0
-    if all("staircase_closed_form" in rows[i] for i in ok):
-        def on_mirror(i):
-            a = rows[i]["support_model"]["mirror_mm2"]
-            return 0.0 if a < MIRROR_SUPPORT_TIE_MM2 else round(a, 0)
-
-        least = min(on_mirror(i) for i in ok)
-        ok = [i for i in ok if on_mirror(i) == least]
-        best = min(rows[i]["staircase_closed_form"]["cusp_mean_mm"] for i in ok)
-        ok = [i for i in ok if rows[i]["staircase_closed_form"]["cusp_mean_mm"] <= best * (1 + CUSP_TIE_RTOL)]
-        return min(ok, key=lambda i: (round(rows[i]["overhang_area_mm2"], 3), rows[i]["extents_mm"]["z_mm"], i))
-    return min(ok, key=lambda i: (round(rows[i]["overhang_area_mm2"], 3), rows[i]["extents_mm"]["z_mm"], i))
-
-
 def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: list[str] | None = None,
             progress=None, workers: int | None = None, lock: Path | None = None, slicing=None) -> FabResult:
     """Run the stage for ``rig`` (a :class:`rigcad.rig.Rig`: the same converged dome, layout and
@@ -129,124 +112,59 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
     from rigcad.export.build import select_parts
 
     say = progress or (lambda msg: None)
-    timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    profile, layout = rig.profile, rig.layout
-    timings["design_and_layout"] = time.perf_counter() - t0
+    profile = rig.profile
+    timings: dict[str, float] = {"design_and_layout": time.perf_counter() - t0}
     chord = profile.tessellation.chord_error
-    tol_mirror = chord + 2e-3  # mesh vertices lie on the surface; facets within the chord error
-    names = select_parts(parts)
-    bed_c = (printer.build_volume.x / 2, printer.build_volume.y / 2)
     report_parts: dict[str, dict] = {}
     problems: list[str] = []
-    jobs: list[slicer.SliceJob] = []
-    job_part: dict[str, str] = {}
+    done: dict[str, PartFab] = {}
     stocks: dict[str, float] = {}  # mirror name -> stock printed in front of it (mm)
-    meshes: dict[str, tuple] = {}  # piece -> (vertices in print position, faces, mirror face indices)
-
     with Staging(out, lock, made_from=profile_digest(rig.profile)) as stage:
-        old_path = out / "fab.json"
-        try:
-            old = json.loads(old_path.read_text(encoding="utf-8")) if old_path.is_file() else {}
-        except (OSError, ValueError):
-            old = {}  # unreadable: nothing is reused
-        for name in names:
+        # mesh vertices lie on the surface; facets within the chord error
+        run = _Run(printer, chord, chord + 2e-3, (printer.build_volume.x / 2, printer.build_volume.y / 2), stage, out)
+        old = _previous_report(out)  # read before anything is published over it
+        for name in select_parts(parts):
             part = rig.recipe(name)
+            if part.bought:  # the profile's buy: standard stock, never printed
+                report_parts[name] = {"process": "bought", "stock": part.bought, "quantity": part.quantity}
+                say(name)
+                continue
             if name in CUT_PARTS and isinstance(part.solid, Prism):
-                t = time.perf_counter()
-                o = outlines.outline(part, chord)
-                dxf, svg = outlines.dxf_bytes(o), outlines.svg_bytes(o)
-                stage.write_bytes(out / "outlines" / f"{name}.dxf", dxf)
-                stage.write_bytes(out / "outlines" / f"{name}.svg", svg)
-                report_parts[name] = {"process": "cut from plate (laser / water-jet)", "quantity": part.quantity,
-                                      "plate_thickness_mm": o.thickness, "outline_size_mm": list(o.size),
-                                      "outline_points": len(o.polygon), "chord_error_mm": chord,
-                                      "files": {f"outlines/{name}.dxf": sha256_hex(dxf), f"outlines/{name}.svg": sha256_hex(svg)}}
-                report_parts[name]["stages"] = _stage_templates(rig, name, printer, stocks, chord, stage, out)
-                timings[f"outline:{name}"] = time.perf_counter() - t
-                say(name)
-                continue
-            try:
-                if part.mirrors:
-                    entry, part_jobs = _with_stock(rig, part, printer, chord, tol_mirror, bed_c, stage, out, timings,
-                                                   stocks, meshes)
-                else:
-                    entry, part_jobs = _fab_part(part, layout, printer, chord, tol_mirror, bed_c, stage, out, timings,
-                                                 meshes)
-                entry.pop("_plan", None)
-            except RigcadError as err:
-                problems.append(f"{name}: {err}")
-                report_parts[name] = {"error": str(err)}
-                say(name)
-                continue
+                done[name] = _cut_part(rig, part, run, stocks)
+            else:
+                try:
+                    if part.mirrors:
+                        done[name], stocks[part.mirrors[0][0]] = _with_stock(rig, part, run)
+                    else:
+                        done[name] = _fab_part(part, rig.layout, run)
+                except RigcadError as err:
+                    problems.append(f"{name}: {err}")
+                    done[name] = PartFab({"error": str(err)})
+            report_parts[name] = done[name].entry
+            timings.update(done[name].timings)
             say(name)
-            report_parts[name] = entry
-            for job in part_jobs:
-                jobs.append(job)
-                job_part[job.name] = name
-
-        slicer_s: dict[str, float] = {}
+        jobs = [job for d in done.values() for job in d.jobs]
         report_gcode = {"requested": gcode, "slicer": printer.slicer}
-        ini = None
+        slicer_s: dict[str, float] = {}
         if gcode and printer.slicer == "prusa-slicer" and jobs:
             t = time.perf_counter()
-            cached = {}
-            for pname, entry in old.get("parts", {}).items():
-                for pc in entry.get("pieces", []):
-                    g = pc.get("gcode") or {}
-                    path = out / "gcode" / f"{pc['name']}.gcode"
-                    proj = out / "3mf" / f"{pc['name']}.3mf"
-                    if (g.get("key") and path.is_file() and sha256_hex(path.read_bytes()) == g.get("sha256")
-                            and proj.is_file() and sha256_hex(proj.read_bytes()) == g.get("project_sha256")):
-                        cached[pc["name"]] = (g["key"], path.read_bytes(), proj.read_bytes())
-            from contextlib import nullcontext
-
-            try:
-                with (slicing(len(jobs)) if slicing else nullcontext(None)) as step:
-                    results, version = slicer.slice_all(jobs, cached, workers,
-                                                   on_done=(lambda r: step(f"sliced {r.name}")) if step else None)
-            except FabricationError as err:
-                problems.append(str(err))
-                report_gcode["error"] = str(err)
-                results, version = [], None
-            report_gcode["slicer_version"] = version
-            for job, res in zip(jobs, results):
-                stage.write_bytes(out / "gcode" / f"{job.name}.gcode", res.gcode)
-                stage.write_bytes(out / "3mf" / f"{job.name}.3mf", res.project)
-                slicer_s[job.name] = res.seconds
-                pc = next(p for p in report_parts[job_part[job.name]]["pieces"] if p["name"] == job.name)
-                pc["gcode"] = {"key": job.key(version), "sha256": sha256_hex(res.gcode), "estimates": res.estimates,
-                               "slicer_warnings": list(res.warnings), "project": f"3mf/{job.name}.3mf",
-                               "project_sha256": sha256_hex(res.project), "placement": res.placement}
-                if res.warnings:
-                    problems.append(f"{job.name}: slicer warnings: {'; '.join(res.warnings)}")
-                if job.name in meshes:
-                    pc["gcode"]["support_contact"] = _support_contact(job.name, res.gcode, meshes[job.name], printer,
-                                                                      stage, out)
+            meshes = {piece: m for d in done.values() for piece, m in d.meshes.items()}
+            sliced = _slice(jobs, meshes, _cached_gcode(old, out), run, workers, slicing)
+            report_gcode.update(sliced.report)
+            problems += sliced.problems
+            slicer_s = sliced.seconds
+            for name, d in done.items():
+                for pc in d.entry.get("pieces", []):
+                    if pc["name"] in sliced.records:
+                        pc["gcode"] = sliced.records[pc["name"]]
             timings["gcode"] = time.perf_counter() - t
-            ini = slicer.printer_ini(printer, support=False)
+            stage.write_bytes(out / "printer.ini", slicer.printer_ini(printer, support=False).encode())
         elif gcode and printer.slicer != "prusa-slicer":
             report_gcode["note"] = (f"printer '{printer.name}' has no slicer rigcad can run (slicer: {printer.slicer}); "
                                     "time and material are rigcad's estimates")
-        if ini is not None:
-            stage.write_bytes(out / "printer.ini", ini.encode())
-
         t = time.perf_counter()
-        report = {
-            "rigcad_version": __version__,
-            "profile": profile.name,
-            "printer": printer.describe(),
-            "frame": "part frame: mm, sample point at the origin, optical axis +z, working position; print "
-                     "frame: build direction +z, bed at z = 0",
-            "tolerances": {"stl_chord_error_mm": chord, "mirror_face_tolerance_mm": tol_mirror,
-                           "pin_min_wall_mm": split.MIN_WALL, "pin_mirror_clearance_mm": split.MIRROR_CLEARANCE,
-                           "orientation_cusp_tie_rtol": CUSP_TIE_RTOL,
-                           "overhang_angle_deg": math.degrees(orientation.OVERHANG_ANGLE)},
-            "gcode": report_gcode,
-            "totals": _totals(report_parts),
-            "parts": report_parts,
-            "problems": problems,
-        }
+        report = fab_report(profile.name, printer, chord, run.tol_mirror, report_gcode, report_parts, problems)
         stage.write_bytes(out / "fab.json", json_bytes(report))
         stage.write_bytes(out / "fab.md", markdown(report).encode())
         timings["report"] = time.perf_counter() - t
@@ -254,11 +172,81 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
     return FabResult(report, written, timings, slicer_s, problems)
 
 
-def _support_contact(name: str, gcode: bytes, mesh: tuple, printer: Printer, stage: Staging, out: Path) -> dict:
+def _previous_report(out: Path) -> dict:
+    """The fab.json of an earlier run in ``out`` ({} when there is none or it cannot be read)."""
+    path = out / "fab.json"
+    try:
+        return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+    except (OSError, ValueError):
+        return {}  # unreadable: nothing is reused
+
+
+def _cached_gcode(old: dict, out: Path) -> dict[str, tuple]:
+    """The G-code and PrusaSlicer projects of the earlier run whose report is ``old``, still in
+    ``out`` as it recorded them: piece -> (slicing key, G-code, project)."""
+    cached = {}
+    for entry in old.get("parts", {}).values():
+        for pc in entry.get("pieces", []):
+            g = pc.get("gcode") or {}
+            gcode, project = out / "gcode" / f"{pc['name']}.gcode", out / "3mf" / f"{pc['name']}.3mf"
+            if (g.get("key") and gcode.is_file() and sha256_hex(gcode.read_bytes()) == g.get("sha256")
+                    and project.is_file() and sha256_hex(project.read_bytes()) == g.get("project_sha256")):
+                cached[pc["name"]] = (g["key"], gcode.read_bytes(), project.read_bytes())
+    return cached
+
+
+def _slice(jobs: list, meshes: dict, cached: dict, run: _Run, workers: int | None, slicing) -> _Sliced:
+    """Slice every piece with PrusaSlicer (``cached``: an earlier run's results by key), write each
+    G-code and project, and read each piece's support contact from its G-code."""
+    problems: list[str] = []
+    report: dict = {}
+    try:
+        with (slicing(len(jobs)) if slicing else nullcontext(None)) as step:
+            results, version = slicer.slice_all(jobs, cached, workers,
+                                                on_done=(lambda r: step(f"sliced {r.name}")) if step else None)
+    except FabricationError as err:
+        problems.append(str(err))
+        report["error"] = str(err)
+        results, version = [], None
+    report["slicer_version"] = version
+    records, seconds = {}, {}
+    for job, res in zip(jobs, results):
+        run.stage.write_bytes(run.out / "gcode" / f"{job.name}.gcode", res.gcode)
+        run.stage.write_bytes(run.out / "3mf" / f"{job.name}.3mf", res.project)
+        seconds[job.name] = res.seconds
+        records[job.name] = {"key": job.key(version), "sha256": sha256_hex(res.gcode), "estimates": res.estimates,
+                             "slicer_warnings": list(res.warnings), "project": f"3mf/{job.name}.3mf",
+                             "project_sha256": sha256_hex(res.project), "placement": res.placement}
+        if res.warnings:
+            problems.append(f"{job.name}: slicer warnings: {'; '.join(res.warnings)}")
+        if job.name in meshes:
+            records[job.name]["support_contact"] = _support_contact(job.name, res.gcode, meshes[job.name], run)
+    return _Sliced(report, records, seconds, problems)
+
+
+def _cut_part(rig, part, run: _Run, stocks: dict) -> PartFab:
+    """A template cut from plate: its DXF and SVG outlines, and one per finishing stage of the
+    mirror it gauges (``stocks``: the sanding stock of the mirrors fabricated so far in this run)."""
+    name, chord = part.name, run.chord
+    t = time.perf_counter()
+    o = outlines.outline(part, chord)
+    dxf, svg = outlines.dxf_bytes(o), outlines.svg_bytes(o)
+    run.stage.write_bytes(run.out / "outlines" / f"{name}.dxf", dxf)
+    run.stage.write_bytes(run.out / "outlines" / f"{name}.svg", svg)
+    entry = {"process": "cut from plate (laser / water-jet)", "quantity": part.quantity,
+             "plate_thickness_mm": o.thickness, "outline_size_mm": list(o.size),
+             "outline_points": len(o.polygon), "chord_error_mm": chord,
+             "files": {f"outlines/{name}.dxf": sha256_hex(dxf), f"outlines/{name}.svg": sha256_hex(svg)}}
+    entry["stages"] = _stage_templates(rig, name, run, stocks)
+    return PartFab(entry, timings={f"outline:{name}": time.perf_counter() - t})
+
+
+def _support_contact(name: str, gcode: bytes, mesh: tuple, run: "_Run") -> dict:
     """Support contact of one piece from its G-code's support extrusions (rigcad.fab.support), mm2
     on its mirror and its other faces; a picture (support/<piece>.png) for pieces with a mirror."""
     from rigcad.fab import support
 
+    printer, stage, out = run.printer, run.stage, run.out
     vertices, faces, mirror_index = mesh
     settings = printer.slicer_config.effective() if printer.slicer_config else {}
     beads = support.support_beads(gcode)
@@ -280,8 +268,7 @@ def _support_contact(name: str, gcode: bytes, mesh: tuple, printer: Printer, sta
 TEMPLATE_MIRROR = {"dome_template": "dome", "paraboloid_template": "paraboloid"}
 
 
-def _stage_templates(rig, name: str, printer: Printer, stocks: dict, chord: float, stage: Staging,
-                     out: Path) -> dict:
+def _stage_templates(rig, name: str, run: "_Run", stocks: dict) -> dict:
     """Templates that gauge the mirror at each stage of its finishing (thesis 3.4, Figure 3.11):
     ``printed`` (the surface the printer makes: the stock in front of the sanded one), ``sanded``
     (the surface the coating goes on: the design surface behind by the whole coating) and
@@ -290,6 +277,7 @@ def _stage_templates(rig, name: str, printer: Printer, stocks: dict, chord: floa
     same run or the printer file states it."""
     from rigcad.parts import templates
 
+    printer, chord, stage, out = run.printer, run.chord, run.stage, run.out
     make = {"dome_template": templates.dome_template, "paraboloid_template": templates.paraboloid_template}[name]
     mirror = TEMPLATE_MIRROR[name]
     coating = rig.layout.coating
@@ -315,35 +303,33 @@ def _stage_templates(rig, name: str, printer: Printer, stocks: dict, chord: floa
     return rows
 
 
-def _with_stock(rig, part, printer: Printer, chord: float, tol_mirror: float, bed_c, stage: Staging, out: Path,
-                timings: dict, stocks: dict, meshes: dict) -> tuple[dict, list]:
+def _with_stock(rig, part, run: _Run) -> tuple[PartFab, float]:
     """A mirror part printed with its sanding stock: the split and the orientations are chosen on
     the part as designed (0.1 mm changes neither), the stock follows (:func:`sanding_stock`), then
     the part with its mirror moved forward by the stock is split the same way and fabricated.
-    Records the stock in ``stocks`` and in the entry."""
+    Returns it with the stock (mm), which its entry records too."""
     name = part.name
     mirror = part.mirrors[0][0]
     t = time.perf_counter()
-    first, _ = _fab_part(part, rig.layout, printer, chord, tol_mirror, bed_c, stage, out, timings, orient_only=True)
-    steep = [pc["mirror_max_abs_normal_along_build"] for pc in first["pieces"]
-             if pc["mirror_max_abs_normal_along_build"] is not None]
-    bound = stock_bound(printer.layer_height, max(steep, default=0.0), chord)
-    stock, source = sanding_stock(printer, bound)
-    stocks[mirror] = stock
+    first = _fab_part(part, rig.layout, run, orient_only=True)
+    pieces = first.entry["pieces"]
+    steep = [pc["mirror_max_abs_normal_along_build"] for pc in pieces if pc["mirror_max_abs_normal_along_build"] is not None]
+    bound = stock_bound(run.printer.layer_height, max(steep, default=0.0), run.chord)
+    stock, source = sanding_stock(run.printer, bound)
     record = {"stock_mm": stock, "source": source, "needed_bound_mm": bound,
               "needed_bound_formula": "layer/2 x max |n . D| over the mirror + STL chord error",
-              "part_volume_without_stock_mm3": first["volume_mm3"],
-              "mirror_area_without_stock_mm2": sum(pc["mirror_area_mm2"] for pc in first["pieces"])}
-    timings[f"{name}:orient_for_stock"] = time.perf_counter() - t
+              "part_volume_without_stock_mm3": first.entry["volume_mm3"],
+              "mirror_area_without_stock_mm2": sum(pc["mirror_area_mm2"] for pc in pieces)}
+    stock_s = time.perf_counter() - t
     layout = rig.layout.with_sanding_stock(**{mirror: stock, ("paraboloid" if mirror == "dome" else "dome"): 0.0})
     stocked = replace(part, solid=rig.recipe(name, layout).solid)  # the same part, its mirror moved
-    new, new_jobs = _fab_part(stocked, layout, printer, chord, tol_mirror, bed_c, stage, out, timings, meshes,
-                              plan=first["_plan"])
-    record["volume_added_mm3"] = new["volume_mm3"] - first["volume_mm3"]
+    done = _fab_part(stocked, layout, run, plan=first.plan)
+    new = done.entry
+    record["volume_added_mm3"] = new["volume_mm3"] - first.entry["volume_mm3"]
     record["mirror_area_times_stock_mm3"] = record["mirror_area_without_stock_mm2"] * stock
     record["volume_added_over_area_times_stock"] = (record["volume_added_mm3"] / record["mirror_area_times_stock_mm3"]
                                                     if record["mirror_area_times_stock_mm3"] > 0 else None)
-    changed = [pc["name"] for pc, q in zip(first["pieces"], new["pieces"]) if pc["orientation"] != q["orientation"]]
+    changed = [pc["name"] for pc, q in zip(pieces, new["pieces"]) if pc["orientation"] != q["orientation"]]
     if changed:
         record["orientation_changed_by_stock"] = changed
     # the stepped surface measured on the slices of the stocked mesh: any valley behind the sanded
@@ -351,7 +337,8 @@ def _with_stock(rig, part, printer: Printer, chord: float, tol_mirror: float, be
     if "polishing" in new:
         record["valley_behind_sanded_surface_mm"] = max(0.0, new["polishing"]["stock_to_add_mm"] - stock)
     new["sanding_stock"] = record
-    return new, new_jobs
+    done.timings = {**first.timings, f"{name}:orient_for_stock": stock_s, **done.timings}
+    return done, stock
 
 
 def stock_bound(layer: float, steepest: float, chord: float) -> float:
@@ -362,131 +349,141 @@ def stock_bound(layer: float, steepest: float, chord: float) -> float:
     return 0.5 * layer * steepest + chord
 
 
-def _fab_part(part, layout, printer: Printer, chord: float, tol_mirror: float, bed_c, stage: Staging, out: Path,
-              timings: dict, meshes: dict | None = None, plan=None, orient_only: bool = False) -> tuple[dict, list]:
+@dataclass
+class _Oriented:
+    """A piece in its chosen print orientation: its mesh in the part frame, its mirror's faces
+    (None without a mirror), the orientation with its spin, every candidate's row and the chosen
+    one, and the steepest |n . D| over its mirror (None without one)."""
+    vertices: np.ndarray
+    faces: np.ndarray
+    mirror_f: object
+    best: orientation.Orientation
+    rows: list[dict]
+    chosen: dict
+    steepest: float | None
+
+
+def _fab_part(part, layout, run: _Run, plan=None, orient_only: bool = False) -> PartFab:
     """One printed part: mesh, fit or split (``plan``: a split decided before, or None to find the
     fewest pieces), orient every piece, slice it, its STL and slicing job; ``orient_only`` stops
     after choosing the orientations (what the sanding stock needs to know, :func:`_with_stock`)."""
     from rigcad.export import mesh
 
     name = part.name
+    timings = {}
     t = time.perf_counter()
-    man = mesh.build(part.solid, chord)
+    man = mesh.build(part.solid, run.chord)
     mirror = _mirror(part, layout)
     timings[f"{name}:mesh"] = time.perf_counter() - t
-
     t = time.perf_counter()
-    v, f = mesh.mesh_arrays(man)
+    v, _ = mesh.mesh_arrays(man)
     plate = None if mirror else orientation.plate_axis(v)
-
-    def candidates(sector=None, sectors: bool = False) -> list[orientation.Orientation]:
-        if mirror:
-            return orientation.mirror_candidates(sector if sectors else None)
-        return orientation.flat_candidates(plate) if plate is not None else orientation.generic_candidates()
-
-    whole_fits = plan is None and any(orientation.fit_spin(v, o.direction, printer.usable)[0] is not None for o in candidates())
-    if plan is not None:
-        pass
-    elif whole_fits:
-        plan = split.SplitPlan(1, 1, 0.0, (float(v[:, 2].min()), float(v[:, 2].max())))
-    else:
-        def fits(cell, plan, i, j):
-            if cell.is_empty():
-                return True
-            cv, _ = mesh.mesh_arrays(cell)
-            rng = plan.sector_range(i) if plan.sectors > 1 else None
-            cands = candidates(rng, isinstance(plan, split.SplitPlan))
-            return any(orientation.fit_spin(cv, o.direction, printer.usable)[0] is not None for o in cands)
-
-        if split.is_off_axis(man):  # flat / off-axis parts: a grid in their own bounding box
-            plan = split.plan_grid(man, fits)
-        else:
-            try:
-                plan = split.plan_split(man, fits)
-            except FabricationError:
-                plan = split.plan_grid(man, fits)
+    if plan is None:
+        plan = choice.split_plan(man, v, mirror is not None, plate, run.printer)
     tongues: list = []
-    pieces, pins, drilled = split.split_part(man, name, plan, printer.alignment_pin, mirror, tongues)
+    pieces, pins, drilled = split.split_part(man, name, plan, run.printer.alignment_pin, mirror, tongues)
     timings[f"{name}:fit_split"] = time.perf_counter() - t
-
-    entry = {"process": printer.process, "quantity": part.quantity, "description": part.description,
-             "volume_mm3": man.volume(), "split": plan.describe(),
-             "mirror": mirror.name if mirror else None, "_plan": plan}
+    entry = {"process": run.printer.process, "quantity": part.quantity, "description": part.description,
+             "volume_mm3": man.volume(), "split": plan.describe(), "mirror": mirror.name if mirror else None}
     if plan.count > 1 and not orient_only:
         entry["pins"] = [{"centre_mm": list(p.centre), "axis": list(p.axis), "face": p.face} for p in pins]
         if tongues:
             entry["tongues"] = [t.describe() for t in tongues]
-        entry["reassembly"] = reassembly(man, drilled, pieces, mirror, tol_mirror, pins, printer)
-    piece_rows = []
-    jobs = []
-    map_pts, map_cusp = [], []
+        entry["reassembly"] = reassembly(man, drilled, pieces, mirror, run.tol_mirror, pins, run.printer)
     t = time.perf_counter()
-    for pc in pieces:
-        pv, pf = mesh.mesh_arrays(pc.manifold)
-        mf = mirror_faces(pv, pf, mirror, tol_mirror) if mirror else None
-        cands = candidates(pc.sector_range, isinstance(plan, split.SplitPlan))
-        rows = [evaluate(pv, pf, o, printer, mf) for o in cands]
-        k = choose(rows)
-        if not rows[k]["fits"]:
-            raise FabricationError(f"piece {pc.name} fits the printer in no orientation")
-        best = orientation.Orientation(cands[k].name, cands[k].direction, math.radians(rows[k]["spin_deg"]))
-        rot = best.rotation()
-        steep = float(np.abs(mf.normals @ np.asarray(best.direction)).max()) if mf is not None and len(mf.index) else None
-        if orient_only:
-            piece_rows.append({"name": pc.name, "orientation": best.name, "mirror_area_mm2": mf.area if mf else 0.0,
-                               "mirror_max_abs_normal_along_build": steep})
-            continue
-        layers, shift = staircase.slice_layers(pc.manifold, rot, printer.layer_height, printer.first_layer_height)
-        placed = orientation.place(pv, best, bed_c)
-        if meshes is not None:
-            meshes[pc.name] = (placed, pf, mf.index if mf is not None else np.zeros(0, int))
-        stl = mesh.stl_bytes(placed, pf, pc.name)
-        stage.write_bytes(out / "stl" / f"{pc.name}.stl", stl)
-        volume = pc.manifold.volume()
-        # print position = rotation @ part frame + translation (what orientation.place did), for readers of the STL
-        translation = (placed - pv @ rot.T).mean(axis=0)
-        row = {"name": pc.name, "orientation": best.name, "build_direction": rows[k]["build_direction"],
-               "spin_deg": rows[k]["spin_deg"], "extents_mm": rows[k]["extents_mm"], "layers": layers.count,
-               "print_transform": {"rotation": rot.tolist(), "translation_mm": translation.tolist()},
-               "volume_mm3": volume, "needs_support": rows[k]["overhang_area_mm2"] > 0,
-               "candidates": rows, "stl_sha256": sha256_hex(stl),
-               "support_model": rows[k]["support_model"],
-               "estimate": estimate.estimate(estimate.Features(volume, pc.manifold.surface_area(), layers.count,
-                                                 rows[k]["support_model"]["support_envelope_mm3"],
-                                                 rows[k]["support_model"]["mirror_under_mm2"]
-                                                 + rows[k]["support_model"]["other_under_mm2"],
-                                                 estimate.shell_thickness(printer), estimate.island_layers(layers)), printer)}
-        if mf is not None and len(mf.index):
-            steps = staircase.step_map(layers, rot, shift, mirror, tol_mirror)
-            row["mirror_area_mm2"] = mf.area
-            row["mirror_max_abs_normal_along_build"] = steep
-            row["staircase_from_slices"] = steps.summary()
-            row["polishing"] = staircase.polishing_allowance(steps)
-            row["optical_effect_as_printed"] = staircase.optical_effect(mf, best.direction, mirror.name)
-            map_pts.append(steps.points)
-            map_cusp.append(steps.cusp_slices)
-        piece_rows.append(row)
-        if printer.slicer == "prusa-slicer":
-            jobs.append(slicer.slice_job(printer, pc.name, stl, row["needs_support"], bed_c))
-    timings[f"{name}:orient_slice"] = time.perf_counter() - t
-    entry["pieces"] = piece_rows
+    sectors = isinstance(plan, split.SplitPlan)
+    oriented = [_orient(pc, mirror, plate, sectors, run) for pc in pieces]
     if orient_only:
-        return entry, []
-    entry["layers_total"] = sum(r["layers"] for r in piece_rows)
-    if map_pts:
-        pts, cusp = np.concatenate(map_pts), np.concatenate(map_cusp)
-        orients = sorted({r["orientation"] for r in piece_rows})
-        png = plots.staircase_map(pts, cusp, printer.layer_height,
-                                  f"{name} on {printer.name}: cusp from slices, {printer.layer_height:.4g} mm layers, "
-                                  f"{', '.join(orients)}")
-        stage.write_bytes(out / "staircase" / f"{name}.png", png)
-        ok = np.isfinite(cusp)
-        entry["staircase_map"] = {"png": f"staircase/{name}.png", "png_sha256": sha256_hex(png),
-                                  "cusp_mean_mm": float(cusp[ok].mean()), "cusp_max_mm": float(cusp[ok].max()),
-                                  "cusp_p95_mm": float(np.percentile(cusp[ok], 95))}
-        entry["polishing"] = {"sanding_depth_mm": max(r["polishing"]["sanding_depth_mm"] for r in piece_rows if "polishing" in r),
-                              "stock_to_add_mm": max(r["polishing"]["stock_to_add_mm"] for r in piece_rows if "polishing" in r)}
-    return entry, jobs
+        entry["pieces"] = [{"name": pc.name, "orientation": o.best.name,
+                            "mirror_area_mm2": o.mirror_f.area if o.mirror_f else 0.0,
+                            "mirror_max_abs_normal_along_build": o.steepest} for pc, o in zip(pieces, oriented)]
+        timings[f"{name}:orient_slice"] = time.perf_counter() - t
+        return PartFab(entry, plan=plan, timings=timings)
+    done = PartFab(entry, plan=plan, timings=timings)
+    entry["pieces"], maps = [], []
+    for pc, o in zip(pieces, oriented):
+        row, done.meshes[pc.name], job, staircase_map = _print_piece(pc, o, mirror, run)
+        entry["pieces"].append(row)
+        done.jobs += [job] if job is not None else []
+        maps += [staircase_map] if staircase_map is not None else []
+    timings[f"{name}:orient_slice"] = time.perf_counter() - t
+    entry["layers_total"] = sum(r["layers"] for r in entry["pieces"])
+    if maps:
+        entry.update(_staircase_map(name, entry["pieces"], maps, run))
+    return done
+
+
+def _orient(pc, mirror, plate, sectors: bool, run: _Run) -> _Oriented:
+    """Piece ``pc`` in its best print orientation (rigcad.fab.choice) among its part's candidates
+    (``sectors``: the part is split in sectors about its axis, each with its own candidates)."""
+    from rigcad.export import mesh
+
+    pv, pf = mesh.mesh_arrays(pc.manifold)
+    mf = mirror_faces(pv, pf, mirror, run.tol_mirror) if mirror else None
+    cands = choice.candidates(mirror is not None, plate, pc.sector_range if sectors else None)
+    best, rows, chosen = choice.best_orientation(pv, pf, mf, cands, run.printer, pc.name)
+    steep = float(np.abs(mf.normals @ np.asarray(best.direction)).max()) if mf is not None and len(mf.index) else None
+    return _Oriented(pv, pf, mf, best, rows, chosen, steep)
+
+
+def _print_piece(pc, o: _Oriented, mirror, run: _Run) -> tuple[dict, tuple, object, tuple | None]:
+    """Slice piece ``pc`` in its orientation and write its STL in print position. Returns its
+    fab.json row, its mesh in print position (vertices, faces, mirror face indices), its slicing
+    job (None for a printer rigcad cannot slice for) and its mirror's staircase map (points, cusp
+    from the slices; None without a mirror)."""
+    from rigcad.export import mesh
+
+    printer = run.printer
+    rot = o.best.rotation()
+    layers, shift = staircase.slice_layers(pc.manifold, rot, printer.layer_height, printer.first_layer_height)
+    placed = orientation.place(o.vertices, o.best, run.bed_centre)
+    stl = mesh.stl_bytes(placed, o.faces, pc.name)
+    run.stage.write_bytes(run.out / "stl" / f"{pc.name}.stl", stl)
+    volume = pc.manifold.volume()
+    # print position = rotation @ part frame + translation (what orientation.place did), for readers of the STL
+    translation = (placed - o.vertices @ rot.T).mean(axis=0)
+    support_model = o.chosen["support_model"]
+    row = {"name": pc.name, "orientation": o.best.name, "build_direction": o.chosen["build_direction"],
+           "spin_deg": o.chosen["spin_deg"], "extents_mm": o.chosen["extents_mm"], "layers": layers.count,
+           "print_transform": {"rotation": rot.tolist(), "translation_mm": translation.tolist()},
+           "volume_mm3": volume, "needs_support": o.chosen["overhang_area_mm2"] > 0,
+           "candidates": o.rows, "stl_sha256": sha256_hex(stl), "support_model": support_model,
+           "estimate": estimate.estimate(estimate.Features(
+               volume, pc.manifold.surface_area(), layers.count, support_model["support_envelope_mm3"],
+               support_model["mirror_under_mm2"] + support_model["other_under_mm2"],
+               estimate.shell_thickness(printer), estimate.island_layers(layers)), printer)}
+    staircase_map = None
+    if o.mirror_f is not None and len(o.mirror_f.index):
+        steps = staircase.step_map(layers, rot, shift, mirror, run.tol_mirror)
+        row["mirror_area_mm2"] = o.mirror_f.area
+        row["mirror_max_abs_normal_along_build"] = o.steepest
+        row["staircase_from_slices"] = steps.summary()
+        row["polishing"] = staircase.polishing_allowance(steps)
+        row["optical_effect_as_printed"] = staircase.optical_effect(o.mirror_f, o.best.direction, mirror.name)
+        staircase_map = (steps.points, steps.cusp_slices)
+    job = slicer.slice_job(printer, pc.name, stl, row["needs_support"], run.bed_centre) \
+        if printer.slicer == "prusa-slicer" else None
+    piece_mesh = (placed, o.faces, o.mirror_f.index if o.mirror_f is not None else np.zeros(0, int))
+    return row, piece_mesh, job, staircase_map
+
+
+def _staircase_map(name: str, rows: list[dict], maps: list[tuple], run: _Run) -> dict:
+    """A mirror part's staircase over all its pieces: the map's picture (staircase/<part>.png), its
+    cusp statistics, and the deepest sanding and stock any piece needs."""
+    pts, cusp = np.concatenate([m[0] for m in maps]), np.concatenate([m[1] for m in maps])
+    orients = sorted({r["orientation"] for r in rows})
+    printer = run.printer
+    png = plots.staircase_map(pts, cusp, printer.layer_height,
+                              f"{name} on {printer.name}: cusp from slices, {printer.layer_height:.4g} mm layers, "
+                              f"{', '.join(orients)}")
+    run.stage.write_bytes(run.out / "staircase" / f"{name}.png", png)
+    ok = np.isfinite(cusp)
+    polished = [r["polishing"] for r in rows if "polishing" in r]
+    return {"staircase_map": {"png": f"staircase/{name}.png", "png_sha256": sha256_hex(png),
+                              "cusp_mean_mm": float(cusp[ok].mean()), "cusp_max_mm": float(cusp[ok].max()),
+                              "cusp_p95_mm": float(np.percentile(cusp[ok], 95))},
+            "polishing": {"sanding_depth_mm": max(p["sanding_depth_mm"] for p in polished),
+                          "stock_to_add_mm": max(p["stock_to_add_mm"] for p in polished)}}
 
 
 def reassembly(man, drilled, pieces, mirror, tol, pins, printer) -> dict:
@@ -521,111 +518,3 @@ def reassembly(man, drilled, pieces, mirror, tol, pins, printer) -> dict:
             out["pin_hole_min_clearance_to_mirror_mm"] = float(-mirror.signed_distance(c).max()
                                                                - printer.alignment_pin.hole_radius)
     return out
-
-
-def _totals(parts: dict) -> dict:
-    pieces = [pc for e in parts.values() for pc in e.get("pieces", [])]
-    qty = {pc["name"]: e.get("quantity", 1) for e in parts.values() for pc in e.get("pieces", [])}
-    est_t = sum(pc["estimate"]["print_time_s"] * qty[pc["name"]] for pc in pieces)
-    est_g = sum(pc["estimate"]["material_g"] * qty[pc["name"]] for pc in pieces)
-    out = {"pieces": sum(qty.values()), "estimate_print_time_s": est_t, "estimate_material_g": est_g}
-    sl = [pc for pc in pieces if "gcode" in pc]
-    if sl and len(sl) == len(pieces):
-        out["slicer_print_time_s"] = sum(pc["gcode"]["estimates"].get("print_time_s", 0) * qty[pc["name"]] for pc in sl)
-        out["slicer_filament_g"] = sum(pc["gcode"]["estimates"].get("filament_g", 0) * qty[pc["name"]] for pc in sl)
-    return out
-
-
-def markdown(report: dict) -> str:
-    """fab.md: one page a fabricator reads, with the staircase maps."""
-    pr = report["printer"]
-    lines = [f"# Fabrication: {report['profile']} on {pr['name']}", "",
-             f"{pr['description']} ({pr['process']}); build volume {' x '.join(f'{v:g}' for v in pr['build_volume_mm'])} mm; "
-             f"layer {pr['layer_height_mm']:.4g} mm; material {pr['material']}. Source: `{pr['source']}`.", "",
-             "| part | qty | pieces | orientation | layers | time | material | mirror cusp mean / max (mm) | sanding depth / stock printed (mm) |",
-             "|---|---|---|---|---|---|---|---|---|"]
-    for name, e in report["parts"].items():
-        if "error" in e:
-            lines.append(f"| {name} | | | **not printable:** {e['error']} | | | | | |")
-            continue
-        if "pieces" not in e:
-            lines.append(f"| {name} | {e['quantity']} | cut | {e['process']}: `outlines/{name}.dxf`, `.svg` "
-                         f"({e['outline_size_mm'][0]:.1f} x {e['outline_size_mm'][1]:.1f} mm, plate {e['plate_thickness_mm']:g} mm) | | | | | |")
-            continue
-        pcs = e["pieces"]
-        t = sum((pc.get("gcode", {}).get("estimates", {}).get("print_time_s") or pc["estimate"]["print_time_s"]) for pc in pcs)
-        g = sum((pc.get("gcode", {}).get("estimates", {}).get("filament_g") or pc["estimate"]["material_g"]) for pc in pcs)
-        src = "slicer" if all("gcode" in pc for pc in pcs) else "est."
-        orient = ", ".join(sorted({pc["orientation"] for pc in pcs}))
-        sm = e.get("staircase_map")
-        cusp = f"{sm['cusp_mean_mm']:.3f} / {sm['cusp_max_mm']:.3f}" if sm else "-"
-        stock = e["sanding_stock"]["stock_mm"] if e.get("sanding_stock") else e.get("polishing", {}).get("stock_to_add_mm")
-        pol = f"{e['polishing']['sanding_depth_mm']:.3f} / {stock:.3f}" if "polishing" in e else "-"
-        lines.append(f"| {name} | {e['quantity']} | {len(pcs)} | {orient} | {e['layers_total']} | {hours_minutes(t)} ({src}) | "
-                     f"{g:.0f} g | {cusp} | {pol} |")
-    tot = report["totals"]
-    lines += ["", f"Totals (with quantities): {tot['pieces']} pieces, {hours_minutes(tot['estimate_print_time_s'])} and "
-              f"{tot['estimate_material_g']:.0f} g by rigcad's estimate (rigcad.fab.estimate, fitted to PrusaSlicer)"
-              + (f"; slicer: {hours_minutes(tot['slicer_print_time_s'])}, {tot['slicer_filament_g']:.0f} g" if "slicer_print_time_s" in tot else "")
-              + ".", ""]
-    stocked = [(n, e) for n, e in report["parts"].items() if e.get("sanding_stock")]
-    if stocked:
-        lines += ["## Sanding stock", "",
-                  "Every mirror is printed forward, into the light, by the stock: sand down to the `_sanded` template "
-                  "(the steps' valleys then lie in front of it), coat, and the coating brings the surface to the design "
-                  "surface. Templates: `outlines/<mirror>_template_printed` gauges the print, `_sanded` the sanded "
-                  "surface, `<mirror>_template` the coating layer the profile names.", "",
-                  "| part | stock (mm) | from | volume added (cm3) | / (mirror area x stock) | valley left behind the sanded surface (mm) |",
-                  "|---|---|---|---|---|---|"]
-        for n, e in stocked:
-            st = e["sanding_stock"]
-            ratio = st.get("volume_added_over_area_times_stock")
-            lines.append(f"| {n} | {st['stock_mm']:.3f} | {st['source']} | {st.get('volume_added_mm3', 0) / 1000:.2f} | "
-                         f"{'-' if ratio is None else f'{ratio:.4f}'} | {st.get('valley_behind_sanded_surface_mm', 0):.4f} |")
-        lines.append("")
-    contact = [(pc, e) for e in report["parts"].values() for pc in e.get("pieces", [])
-               if pc.get("gcode", {}).get("support_contact")]
-    if contact:
-        lines += ["## Support contact (from the G-code's support extrusions)", "",
-                  "| piece | orientation | on the mirror (mm2) | on other faces (mm2) | model: mirror / other (mm2) | picture |",
-                  "|---|---|---|---|---|---|"]
-        for pc, e in contact:
-            sc, sm = pc["gcode"]["support_contact"], pc.get("support_model", {})
-            pic = f"![{pc['name']}]({sc['png']})" if "png" in sc else ""
-            lines.append(f"| {pc['name']} | {pc['orientation']} | {sc['mirror_mm2']:.0f} | {sc['other_mm2']:.0f} | "
-                         f"{sm.get('mirror_mm2', 0):.0f} / {sm.get('other_mm2', 0):.0f} | {pic} |")
-        lines.append("")
-    for name, e in report["parts"].items():
-        if not e.get("staircase_map"):
-            continue
-        lines += [f"## {name}: staircase on the mirror", ""]
-        if e["split"]["pieces"] > 1:
-            s = e["split"]
-            r = e.get("reassembly", {})
-            lines.append(f"Split into {s['pieces']} pieces ({s['sectors']} sectors at "
-                         f"{', '.join(f'{a:.1f}' for a in s['sector_planes_deg'])} deg"
-                         + (f", bands cut at z = {', '.join(f'{z:.1f}' for z in s['band_cuts_z_mm'])} mm" if s["band_cuts_z_mm"] else "")
-                         + f"), {r.get('pin_holes', 0)} pin holes of {pr['alignment_pin']['diameter_mm']:g} mm "
-                         f"(at least {r.get('pin_hole_min_clearance_to_mirror_mm', float('nan')):.2f} mm behind the mirror)"
-                         + "".join(f"; band cut z = {t['z_mm']:.1f} mm joined by a tongue and groove {t['depth_mm']:g} mm deep "
-                                   f"({t['min_clearance_to_mirror_mm']:.2f} mm behind the mirror)" for t in e.get("tongues", []))
-                         + ".")
-            lines.append("")
-        lines += ["| piece | orientation | closed-form cusp mean (mm) | from slices mean / max (mm) | ray error median (deg, as printed) |",
-                  "|---|---|---|---|---|"]
-        for pc in e["pieces"]:
-            if "staircase_from_slices" not in pc:
-                continue
-            cand = {c["orientation"]: c for c in pc["candidates"]}
-            cf = ", ".join(f"{o}: {c['staircase_closed_form']['cusp_mean_mm']:.4f}" + ("" if c["fits"] else " (no fit)")
-                           for o, c in cand.items())
-            s = pc["staircase_from_slices"]
-            lines.append(f"| {pc['name']} | **{pc['orientation']}** | {cf} | {s['cusp_from_slices_mean_mm']:.4f} / "
-                         f"{s['cusp_from_slices_max_mm']:.4f} | {pc['optical_effect_as_printed']['ray_angle_error_median_deg']:.1f} |")
-        lines += ["", f"![staircase map of {name}]({e['staircase_map']['png']})", "",
-                  "As printed, the steps' treads and risers tilt the surface normal by tens of degrees (ideal steps), "
-                  "so every reflected ray is lost: the steps must be sanded away (depth above) before the coating. "
-                  "The mirror is printed forward by the sanding stock (above), so that every valley lies in front of the sanded surface.", ""]
-    if report["problems"]:
-        lines += ["## Problems", ""] + [f"- {p}" for p in report["problems"]] + [""]
-    return "\n".join(lines)

@@ -27,6 +27,8 @@ from rigcad.errors import GeometryError
 EXPLODE_GAP = 0.08
 #: The order the thesis's rig goes together (parts known today); parts not listed follow, by height.
 KNOWN_ORDER = ("base_plate", "sample_holder", "beam", "paraboloid", "dome")
+#: Opacity of a part that encloses others (:func:`encloses`: the dome) in the 3D views.
+SEE_THROUGH_OPACITY = 0.3
 
 
 @dataclass(frozen=True)
@@ -53,7 +55,7 @@ class PartMesh:
         return self.vertices.max(axis=0)
 
 
-def rig_meshes(rig, chord_error: float | None = None) -> list[PartMesh]:
+def picture_meshes(rig, chord_error: float | None = None) -> list[PartMesh]:
     """Every in-rig part of ``rig`` (a :class:`rigcad.rig.Rig`) as a PartMesh, in assembly order,
     meshed at ``chord_error`` mm (default the picture chord, export.mesh.PICTURE_CHORD_ERROR)."""
     from rigcad.export.mesh import PICTURE_CHORD_ERROR
@@ -76,6 +78,21 @@ def rig_meshes(rig, chord_error: float | None = None) -> list[PartMesh]:
               for p, v, f in raw}
     order = assembly_order({n: (m.lo, m.hi) for n, m in meshes.items() if not m.marker}, bought)
     return [meshes[n] for n in order] + [meshes[n] for n in sorted(markers)]
+
+
+def hex_color(color) -> str:
+    """An RGB colour (3 floats in 0..1, clipped) as ``#rrggbb``: how a part's colour is shown."""
+    return "#" + "".join(f"{int(round(255 * min(max(c, 0.0), 1.0))):02x}" for c in color)
+
+
+def ray_colors(theta: np.ndarray) -> np.ndarray:
+    """The colour (k, 3) of rays arriving at incidence angles ``theta`` (k,) rad, as every view of
+    the assembled rig draws them: viridis of theta / 90 deg."""
+    from matplotlib import colormaps
+
+    if not len(theta):
+        return np.zeros((0, 3))
+    return np.asarray(colormaps["viridis"](np.degrees(np.asarray(theta, float)) / 90.0))[:, :3]
 
 
 def _base(boxes: dict[str, tuple[np.ndarray, np.ndarray]]) -> str:
@@ -176,4 +193,5 @@ def encloses(meshes: list[PartMesh]) -> set[str]:
     return out
 
 
-__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "rig_meshes", "step_offsets", "steps"]
+__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "hex_color", "picture_meshes", "ray_colors",
+           "step_offsets", "steps"]

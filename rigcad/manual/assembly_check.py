@@ -304,7 +304,9 @@ class Assembly:
         out = []
         fitted = list(obstacles)
         for k, f in enumerate(step.fasteners):
-            into = [(n, s) for n, s in fitted if not (f.thread_in == "bench" and n == "the bench")]
+            # a screw's thread runs into the bench or into the instrument's socket by design
+            into = [(n, s) for n, s in fitted if not (f.thread_in == "bench" and n == "the bench")
+                    and not (f.thread_in == "instrument" and n in step.members)]
             everything = _union([s for _, s in fitted])
             body = f.solids()
             pen = penetration(body, _union([s for _, s in into]))

@@ -17,7 +17,6 @@ from __future__ import annotations
 import base64
 import html
 import re
-import sys
 from pathlib import Path
 
 from rigcad._version import __version__
@@ -175,7 +174,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     from rigcad.manual.view import traced_rays
 
     step = progress or (lambda label: None)
-    meshes = A.rig_meshes(rig)
+    meshes = A.picture_meshes(rig)
     c = SimpleNamespace(rig=rig, printer=printer, fab_report=fab_report, p=rig.profile, files={}, meshes=meshes,
                         bill=B.bill(rig, fab_report, printer), cut_away=A.encloses(meshes), step=step)
     c.files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
@@ -537,29 +536,4 @@ def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = 
         return stage.commit()
 
 
-def cmd_manual(args) -> int:
-    from rigcad.progress import stages
-    from rigcad.export.atomic import check_exports, profile_lock
-    from rigcad.fab.printers import load_printer
-    from rigcad.profile import load_profile
-    from rigcad.rig import load
-
-    printer = load_printer(args.printer)  # a refused printer file costs no rig
-    profile = load_profile(args.profile)
-    check_exports(args.exports, profile.name, "manual")  # a planted link or lock: one line now, not after the work
-    rig = load(profile)
-    root = Path(args.exports) / rig.name
-    total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
-    with stages(total, f"manual {rig.name} ({printer.name})") as step:
-        fab = rig.fab(printer, root / "fab" / printer.name, gcode=args.gcode, progress=step)
-        for problem in fab.problems:
-            print(f"rigcad: fab: {problem}", file=sys.stderr)
-        out = root / "manual" / printer.name
-        written = write_manual(rig, printer, fab.report, out, profile_lock(args.exports, rig.name), progress=step)
-    html_path = out / "manual.html"
-    print(f"{rig.name}: manual for {printer.name} -> {out}/ (manual.md, manual.html "
-          f"{html_path.stat().st_size / 1e6:.1f} MB, {len(written)} files)")
-    return 0
-
-
-__all__ = ["Doc", "build_manual", "cmd_manual", "write_manual"]
+__all__ = ["Doc", "build_manual", "write_manual"]

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from rigcad.errors import ExportError
-from rigcad.manual.assembly import PartMesh, encloses
+from rigcad.manual.assembly import SEE_THROUGH_OPACITY, PartMesh, encloses, hex_color, ray_colors
 
 #: Rays drawn in the view: enough to show the fan from the COP over the paraboloid's annulus to the
 #: sample, few enough to tell them apart.
@@ -86,47 +86,93 @@ def _folded(lines: np.ndarray, tower) -> np.ndarray:
     return np.concatenate([start[:, None], hit[:, None], lines[:, 1:]], axis=1)
 
 
-def _b64(a: np.ndarray, dtype) -> str:
+def b64(a: np.ndarray, dtype) -> str:
+    """``a`` as ``dtype`` (e.g. ``"<f4"``), its bytes in base64: how a page carries an array."""
     return base64.b64encode(np.ascontiguousarray(a, dtype=dtype).tobytes()).decode("ascii")
 
 
-def _hex(color) -> str:
-    return "#" + "".join(f"{int(round(255 * min(max(c, 0.0), 1.0))):02x}" for c in color)
+def ray_segments(rays: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The polylines of ``rays`` (traced_rays) as line segments: both ends of every segment (2 s, 3)
+    mm and their colours (2 s, 3) (ray_colors)."""
+    lines = rays["lines"]
+    if not len(lines):
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    seg = np.concatenate([lines[:, :-1], lines[:, 1:]], axis=2).reshape(-1, 3)
+    return seg, np.repeat(ray_colors(rays["theta"]), 2 * (lines.shape[1] - 1), axis=0)  # 2 ends per segment
 
 
 def view_html(rig, meshes: list[PartMesh], rays: dict) -> bytes:
-    """The page for ``rig`` with its assembly ``meshes`` (assembly.rig_meshes) and ``rays``
+    """The page for ``rig`` with its assembly ``meshes`` (assembly.picture_meshes) and ``rays``
     (traced_rays), as UTF-8 bytes; deterministic (same inputs, same bytes)."""
     from matplotlib import colormaps
 
     cmap = colormaps["viridis"]
     see_through = encloses(meshes)
-    parts = [{"name": m.name, "color": _hex(m.color), "quantity": m.quantity, "description": m.description,
-              "opacity": 0.3 if m.name in see_through else 1.0,
+    parts = [{"name": m.name, "color": hex_color(m.color), "quantity": m.quantity, "description": m.description,
+              "opacity": SEE_THROUGH_OPACITY if m.name in see_through else 1.0,
               "explode_mm": [round(float(x), 6) for x in m.explode],
-              "positions": _b64(m.vertices, "<f4"), "indices": _b64(m.faces, "<u4"), "triangles": int(len(m.faces))}
+              "positions": b64(m.vertices, "<f4"), "indices": b64(m.faces, "<u4"), "triangles": int(len(m.faces))}
              for m in meshes]
     lines = rays["lines"]
-    seg = np.concatenate([lines[:, :-1], lines[:, 1:]], axis=2).reshape(-1, 3) if len(lines) else np.zeros((0, 3))
+    seg, colours = ray_segments(rays)
     theta_deg = np.degrees(rays["theta"])
-    rgb = np.asarray([cmap(t / 90.0)[:3] for t in theta_deg]).reshape(-1, 3) if len(lines) else np.zeros((0, 3))
-    colours = np.repeat(rgb, 2 * (lines.shape[1] - 1) if len(lines) else 0, axis=0)  # 2 ends per segment
     g = rig.geometry
     data = {
         "profile": rig.name,
         "frame": "mm; sample point O at the origin; optical axis +z",
         "cop_z_mm": None if g.cop_at_infinity else float(g.cop_z),
         "parts": parts,
-        "rays": {"positions": _b64(seg, "<f4"), "colors": _b64(colours, "<f4"), "count": int(len(lines)),
+        "rays": {"positions": b64(seg, "<f4"), "colors": b64(colours, "<f4"), "count": int(len(lines)),
                  "traced": rays["traced"], "theta_min_deg": float(theta_deg.min()) if len(lines) else None,
                  "theta_max_deg": float(theta_deg.max()) if len(lines) else None},
-        "colorbar": [_hex(cmap(k / 8)[:3]) for k in range(9)],
+        "colorbar": [hex_color(cmap(k / 8)[:3]) for k in range(9)],
     }
     payload = json.dumps(data, sort_keys=True, separators=(",", ":")).replace("</", "<\\/")
     page = (_PAGE.replace("@@TITLE@@", html.escape(f"{rig.name}: the rig in 3D (rigcad view)"))
-            .replace("@@THREE@@", three_js()).replace("@@DATA@@", payload))
+            .replace("@@THREE@@", three_js()).replace("@@SCENE@@", SCENE_JS).replace("@@DATA@@", payload))
     return page.encode("utf-8")
 
+
+#: The script both 3D pages (this one and ``rigcad watch``'s, rigcad.live.page) start with: base64
+#: decoding, the renderer, scene, lights and camera (mm, +z up), a part's mesh from its data
+#: (``partMesh``: colour, opacity, base64 positions and indices) and the first view of a box
+#: (``fitCamera``).
+SCENE_JS = r"""  function decode(b64, Type) {
+    const bin = atob(b64), bytes = new Uint8Array(bin.length);
+    for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+    return new Type(bytes.buffer);
+  }
+  const host = document.getElementById("view");
+  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+  renderer.setPixelRatio(window.devicePixelRatio || 1);
+  renderer.setSize(host.clientWidth, host.clientHeight);
+  host.appendChild(renderer.domElement);
+  const scene = new THREE.Scene();
+  scene.background = new THREE.Color(0xf4f4f4);
+  scene.add(new THREE.AmbientLight(0xffffff, 0.45));
+  const light = new THREE.DirectionalLight(0xffffff, 0.75);
+  scene.add(light);
+  const camera = new THREE.PerspectiveCamera(30, host.clientWidth / host.clientHeight, 1, 1e6);
+  camera.up.set(0, 0, 1);
+  function partMesh(p, data) {
+    const geom = new THREE.BufferGeometry();
+    geom.setAttribute("position", new THREE.BufferAttribute(decode(data.positions, Float32Array), 3));
+    geom.setIndex(new THREE.BufferAttribute(decode(data.indices, Uint32Array), 1));
+    const mat = new THREE.MeshPhongMaterial({ color: new THREE.Color(p.color), flatShading: true,
+      side: THREE.DoubleSide, transparent: p.opacity < 1, opacity: p.opacity, depthWrite: p.opacity >= 1 });
+    const mesh = new THREE.Mesh(geom, mat);
+    mesh.name = p.name;
+    return mesh;
+  }
+  function fitCamera(box, controls) {
+    const sphere = box.getBoundingSphere(new THREE.Sphere());
+    const dir = new THREE.Vector3(1.0, -1.7, 0.75).normalize();
+    const dist = sphere.radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.8;
+    camera.position.copy(sphere.center).addScaledVector(dir, dist);
+    camera.lookAt(sphere.center);
+    controls.target.copy(sphere.center);
+  }
+"""
 
 _PAGE = r"""<!DOCTYPE html>
 <html lang="en">
@@ -165,35 +211,12 @@ _PAGE = r"""<!DOCTYPE html>
 "use strict";
 (function () {
   const DATA = JSON.parse(document.getElementById("rig-data").textContent);
-  function decode(b64, Type) {
-    const bin = atob(b64), bytes = new Uint8Array(bin.length);
-    for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
-    return new Type(bytes.buffer);
-  }
-  const host = document.getElementById("view");
-  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-  renderer.setPixelRatio(window.devicePixelRatio || 1);
-  renderer.setSize(host.clientWidth, host.clientHeight);
-  host.appendChild(renderer.domElement);
-  const scene = new THREE.Scene();
-  scene.background = new THREE.Color(0xf4f4f4);
-  scene.add(new THREE.AmbientLight(0xffffff, 0.45));
-  const light = new THREE.DirectionalLight(0xffffff, 0.75);
-  scene.add(light);
-  const camera = new THREE.PerspectiveCamera(30, host.clientWidth / host.clientHeight, 1, 1e6);
-  camera.up.set(0, 0, 1);
-
+@@SCENE@@
   const parts = {};
   const list = document.getElementById("parts");
   document.getElementById("title").textContent = DATA.profile + ": the rig";
   for (const p of DATA.parts) {
-    const geom = new THREE.BufferGeometry();
-    geom.setAttribute("position", new THREE.BufferAttribute(decode(p.positions, Float32Array), 3));
-    geom.setIndex(new THREE.BufferAttribute(decode(p.indices, Uint32Array), 1));
-    const mat = new THREE.MeshPhongMaterial({ color: new THREE.Color(p.color), flatShading: true,
-      side: THREE.DoubleSide, transparent: p.opacity < 1, opacity: p.opacity, depthWrite: p.opacity >= 1 });
-    const mesh = new THREE.Mesh(geom, mat);
-    mesh.name = p.name;
+    const mesh = partMesh(p, p);
     scene.add(mesh);
     parts[p.name] = { mesh: mesh, explode: p.explode_mm };
     const label = document.createElement("label");
@@ -214,15 +237,9 @@ _PAGE = r"""<!DOCTYPE html>
     " traced rays reach the sample; colour: theta 0..90 deg (traced " +
     (DATA.rays.count ? DATA.rays.theta_min_deg.toFixed(1) + ".." + DATA.rays.theta_max_deg.toFixed(1) : "-") + " deg)";
 
-  const box = new THREE.Box3().setFromObject(scene);
-  const sphere = box.getBoundingSphere(new THREE.Sphere());
-  const dir = new THREE.Vector3(1.0, -1.7, 0.75).normalize();
-  const dist = sphere.radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.8;
-  camera.position.copy(sphere.center).addScaledVector(dir, dist);
-  camera.lookAt(sphere.center);
   const controls = new THREE.TrackballControls(camera, renderer.domElement);
-  controls.target.copy(sphere.center);
   controls.rotateSpeed = 2.0; controls.zoomSpeed = 1.2; controls.panSpeed = 0.8; controls.staticMoving = true;
+  fitCamera(new THREE.Box3().setFromObject(scene), controls);
 
   let frames = 0;
   function render() { light.position.copy(camera.position); renderer.render(scene, camera); frames++; }
@@ -260,15 +277,17 @@ _PAGE = r"""<!DOCTYPE html>
 """
 
 
-def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays: int = VIEW_RAYS) -> dict:
+def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays: int = VIEW_RAYS,
+               glb: bool = False) -> dict:
     """Write ``out_dir/rig.html`` (the 3D view) and ``out_dir/rig.png`` (the assembled rig for the
-    README), published together (export.atomic.Staging). Returns a summary (paths, sizes)."""
+    README), and with ``glb`` ``out_dir/rig.glb`` (manual.glb), published together
+    (export.atomic.Staging). Returns a summary (paths, sizes)."""
     from rigcad import plots
     from rigcad.export.atomic import Staging
-    from rigcad.manual.assembly import rig_meshes
+    from rigcad.manual.assembly import picture_meshes
 
     step = progress or (lambda label: None)
-    meshes = rig_meshes(rig)
+    meshes = picture_meshes(rig)
     step("parts meshed")
     traced = traced_rays(rig, rays)
     step("rays traced")
@@ -280,11 +299,17 @@ def write_view(rig, out_dir: Path, lock: Path | None = None, progress=None, rays
     with Staging(out_dir, lock, made_from=profile_digest(rig.profile)) as stage:
         stage.write_bytes(out_dir / "rig.html", page)
         stage.write_bytes(out_dir / "rig.png", png)
+        if glb:
+            from rigcad.manual.glb import glb_bytes
+
+            stage.write_bytes(out_dir / "rig.glb", glb_bytes(rig, meshes, traced))
         stage.commit()
     step("written")
     return {"html": out_dir / "rig.html", "png": out_dir / "rig.png", "html_bytes": len(page),
             "parts": [m.name for m in meshes], "triangles": sum(len(m.faces) for m in meshes),
-            "rays": int(len(traced["lines"])), "rays_traced": traced["traced"]}
+            "rays": int(len(traced["lines"])), "rays_traced": traced["traced"],
+            **({"glb": out_dir / "rig.glb"} if glb else {})}
 
 
-__all__ = ["VIEW_RAYS", "three_js", "traced_rays", "view_html", "write_view"]
+__all__ = ["SCENE_JS", "VIEW_RAYS", "b64", "ray_segments", "three_js", "traced_rays", "view_html",
+           "write_view"]

@@ -157,33 +157,23 @@ def converged_dome(profile: Profile, geo: Derived) -> DomeProfile:
         rows = min(2 * rows - 1, MAX_ROWS)
 
 
+def profile_entry(profile: Profile) -> dict:
+    """The report's ``profile`` entry: its name, the files it came from and every resolved parameter."""
+    return {"name": profile.name, "sources": list(profile.sources), "parameters": profile.as_dict()}
+
+
 def run_design(rig, progress=None) -> Design:
     """Trace and check the 2D design of ``rig`` (a :class:`rigcad.rig.Rig`: its geometry, converged
     dome and curve). Raises GeometryError for an impossible rig."""
     step = progress or (lambda label: None)
     profile, geo, para, dome, curve = rig.profile, rig.geometry, rig.paraboloid, rig.dome, rig.curve
     aperture = profile.projector.aperture
-
-    # Top aperture: the dome ends at the occlusion limit; the projector's bundle must pass inside it.
-    top = dome.points[np.argmax(dome.points[:, 1])]
-    end = dome.points[-1]
-    bundle = cop_bundle_radius(geo, float(end[1]), aperture)
-    clearance = float(end[0] - bundle)
-    if clearance <= 0:
-        raise GeometryError(
-            f"the dome's top opening (radius {end[0]:.2f} mm at z = {end[1]:.1f} mm) would cut the projector's "
-            f"ray bundle (radius {bundle:.2f} mm there): increase layout.cop_to_vertex",
-            where=profile.where("layout", "cop_to_vertex"))
-    if not geo.cop_at_infinity and geo.cop_z <= top[1]:
-        raise GeometryError(
-            f"the centre of projection (z = {geo.cop_z:.1f} mm) lies inside the dome (top at {top[1]:.1f} mm): "
-            "increase layout.cop_to_vertex", where=profile.where("layout", "cop_to_vertex"))
+    top_aperture = _top_aperture(profile, geo, dome)
 
     step("chief rays")
     origins, dirs = chief_rays(geo, para, dome, profile.misalignment.rays)
     aligned = trace(para, curve, origins, dirs)
-    ok = aligned.ok
-    if not ok.any():
+    if not aligned.ok.any():
         lost = {STATUS_NAMES[k]: int(np.sum(aligned.status == k)) for k in STATUS_NAMES if k}
         raise GeometryError(f"no chief ray of the design returns to the sample point ({lost}): check the layout "
                             "(layout.sample_to_rim, layout.cop_to_vertex) and the paraboloid's size",
@@ -195,6 +185,66 @@ def run_design(rig, progress=None) -> Design:
         lens = thin_lens_check(para, curve, np.array([0.0, geo.cop_z]), dirs, aperture)
 
     step("misalignment")
+    misalignment = _misalignment(profile, para, curve, origins, dirs, aligned)
+    table = profile_table(geo, dome)
+    report = {
+        "profile": profile_entry(profile),
+        "frame": "meridional plane; sample point O at the origin; optical axis +z; lengths mm",
+        "paraboloid": geo.as_dict(),
+        "dome": {
+            "method": dome.method,
+            "kind": dome.kind,
+            "tolerance_mm": dome.tolerance,
+            "points": int(len(dome.s)),
+            "error_estimate_mm": dome.error_estimate,
+            "error_vs_equal_path_mm": dome.error_vs_equal_path,
+            "stats": dome.stats,
+            "start_r_mm": float(dome.points[0, 0]),
+            "end_paraboloid_r_mm": dome.occlusion_s,
+        },
+        "measurable_range": _measurable_range(profile, geo, dome),
+        "envelope": {
+            "width_mm": float(2 * dome.points[:, 0].max()),
+            "height_mm": float(dome.points[:, 1].max()),
+            "base_radius_mm": float(dome.points[0, 0]),
+            "width_in": float(2 * dome.points[:, 0].max() / 25.4),
+            "height_in": float(dome.points[:, 1].max() / 25.4),
+            "note": "mirror (design) surface; the printed part adds coating and wall",
+        },
+        "top_aperture": top_aperture,
+        "paths": _paths(dome, table, aligned),
+        "pixels": _pixels(profile, geo, dome, table),
+        "convergence": _convergence(aligned),
+        "thin_lens": None if lens is None else lens.summary(),
+        "misalignment": misalignment,
+    }
+    return Design(profile, geo, para, dome, curve, origins, dirs, aligned, lens, table, report)
+
+
+def _top_aperture(profile: Profile, geo: Derived, dome: DomeProfile) -> dict:
+    """The dome's top opening (it ends at the occlusion limit) and its clearance (mm) around the
+    projector's ray bundle there. Raises GeometryError when the bundle would be cut or the centre
+    of projection lies inside the dome."""
+    top = dome.points[np.argmax(dome.points[:, 1])]
+    end = dome.points[-1]
+    bundle = cop_bundle_radius(geo, float(end[1]), profile.projector.aperture)
+    clearance = float(end[0] - bundle)
+    if clearance <= 0:
+        raise GeometryError(
+            f"the dome's top opening (radius {end[0]:.2f} mm at z = {end[1]:.1f} mm) would cut the projector's "
+            f"ray bundle (radius {bundle:.2f} mm there): increase layout.cop_to_vertex",
+            where=profile.where("layout", "cop_to_vertex"))
+    if not geo.cop_at_infinity and geo.cop_z <= top[1]:
+        raise GeometryError(
+            f"the centre of projection (z = {geo.cop_z:.1f} mm) lies inside the dome (top at {top[1]:.1f} mm): "
+            "increase layout.cop_to_vertex", where=profile.where("layout", "cop_to_vertex"))
+    return {"radius_mm": float(end[0]), "z_mm": float(end[1]), "projector_bundle_radius_mm": bundle,
+            "clearance_mm": clearance}
+
+
+def _misalignment(profile: Profile, para: Paraboloid, curve: DomeCurve, origins, dirs, aligned: Trace) -> dict:
+    """How far the chief rays miss O when each component moves by the profile's probe offset, and
+    under the offsets the profile declares for each light path (mm)."""
     mis = profile.misalignment
     cache: dict[Offsets, dict] = {}
 
@@ -210,83 +260,62 @@ def run_design(rig, progress=None) -> Design:
                       paraboloid_dx=mis.paraboloid_dx, dome_dx=mis.dome_dx)
         if off != Offsets():
             declared[device + "_path"] = case(off)
+    return {"probe_mm": mis.probe,
+            "note": "camera and projector share the COP: a pinhole offset of either moves the same rays",
+            "sensitivity": sensitivity, "declared": declared}
 
-    table = profile_table(geo, dome)
-    theta = dome.theta
-    theta_min, theta_max = float(theta.min()), float(theta.max())
+
+def _measurable_range(profile: Profile, geo: Derived, dome: DomeProfile) -> dict:
+    """The incidence angles the dome covers against the profile's targets (deg)."""
+    theta_min, theta_max = float(dome.theta.min()), float(dome.theta.max())
     tg = profile.targets
     # A design "reaches" 90 deg when its first ray is grazing to float precision.
     covers = theta_min <= tg.theta_min + 1e-12 and theta_max >= tg.theta_max - 1e-9
-    pixels = table["projector_pixel"]
-    dpix = np.abs(np.gradient(pixels, theta / DEG)) if not geo.cop_at_infinity else np.full_like(theta, np.nan)
-
-    report = {
-        "profile": {"name": profile.name, "sources": list(profile.sources), "parameters": profile.as_dict()},
-        "frame": "meridional plane; sample point O at the origin; optical axis +z; lengths mm",
-        "paraboloid": geo.as_dict(),
-        "dome": {
-            "method": dome.method,
-            "kind": dome.kind,
-            "tolerance_mm": dome.tolerance,
-            "points": int(len(dome.s)),
-            "error_estimate_mm": dome.error_estimate,
-            "error_vs_equal_path_mm": dome.error_vs_equal_path,
-            "stats": dome.stats,
-            "start_r_mm": float(dome.points[0, 0]),
-            "end_paraboloid_r_mm": dome.occlusion_s,
-        },
-        "measurable_range": {
-            "theta_min_deg": theta_min / DEG,
-            "theta_max_deg": theta_max / DEG,
+    return {"theta_min_deg": theta_min / DEG, "theta_max_deg": theta_max / DEG,
             "occlusion_theta_deg": geo.occlusion_theta / DEG,
-            "target_theta_min_deg": tg.theta_min / DEG,
-            "target_theta_max_deg": tg.theta_max / DEG,
-            "targets_met": bool(covers),
-        },
-        "envelope": {
-            "width_mm": float(2 * dome.points[:, 0].max()),
-            "height_mm": float(dome.points[:, 1].max()),
-            "base_radius_mm": float(dome.points[0, 0]),
-            "width_in": float(2 * dome.points[:, 0].max() / 25.4),
-            "height_in": float(dome.points[:, 1].max() / 25.4),
-            "note": "mirror (design) surface; the printed part adds coating and wall",
-        },
-        "top_aperture": {
-            "radius_mm": float(end[0]),
-            "z_mm": float(end[1]),
-            "projector_bundle_radius_mm": bundle,
-            "clearance_mm": clearance,
-        },
-        "paths": {
-            "optical_path_mm": dome.path_length,
-            "chief_ray_path_spread_mm": float(np.ptp(aligned.path_length[ok])) if ok.any() else None,
-            "cop_to_paraboloid_mm": _stat(table["optical_path_mm"] - dome.t - np.linalg.norm(dome.points, axis=-1)),
-            "paraboloid_to_dome_mm": _stat(dome.t),
-            "dome_to_sample_mm": _stat(np.linalg.norm(dome.points, axis=-1)),
-        },
-        "pixels": {
-            "projector_resolution": list(profile.projector.resolution),
-            "projector_focal_px": geo.projector_focal_px,
-            "vertex_to_rim_px": None if geo.cop_at_infinity else geo.pixels_vertex_to_rim,
-            "useful_px": None if geo.cop_at_infinity else float(pixels.max() - pixels.min()),
-            "px_per_deg_mean": None if geo.cop_at_infinity else float((pixels.max() - pixels.min()) / ((theta_max - theta_min) / DEG)),
-            "px_per_deg_min": None if geo.cop_at_infinity else float(dpix.min()),
-            "px_per_deg_max": None if geo.cop_at_infinity else float(dpix.max()),
-        },
-        "convergence": {
-            "rays": int(len(dirs)),
-            "rays_ok": int(ok.sum()),
-            "rays_lost": {STATUS_NAMES[k]: int(np.sum(aligned.status == k)) for k in STATUS_NAMES if k},
-            "rms_miss_mm": float(np.sqrt(np.mean(aligned.miss[ok] ** 2))) if ok.any() else None,
-            "max_miss_mm": float(np.abs(aligned.miss[ok]).max()) if ok.any() else None,
-            "note": "miss = distance from O to each returning ray (2D trace against the smooth curve or polyline)",
-        },
-        "thin_lens": None if lens is None else lens.summary(),
-        "misalignment": {
-            "probe_mm": mis.probe,
-            "note": "camera and projector share the COP: a pinhole offset of either moves the same rays",
-            "sensitivity": sensitivity,
-            "declared": declared,
-        },
+            "target_theta_min_deg": tg.theta_min / DEG, "target_theta_max_deg": tg.theta_max / DEG,
+            "targets_met": bool(covers)}
+
+
+def _paths(dome: DomeProfile, table: dict, aligned: Trace) -> dict:
+    """The optical path (mm): the design's, the chief rays' spread, and its three legs."""
+    ok = aligned.ok
+    return {
+        "optical_path_mm": dome.path_length,
+        "chief_ray_path_spread_mm": float(np.ptp(aligned.path_length[ok])) if ok.any() else None,
+        "cop_to_paraboloid_mm": _stat(table["optical_path_mm"] - dome.t - np.linalg.norm(dome.points, axis=-1)),
+        "paraboloid_to_dome_mm": _stat(dome.t),
+        "dome_to_sample_mm": _stat(np.linalg.norm(dome.points, axis=-1)),
     }
-    return Design(profile, geo, para, dome, curve, origins, dirs, aligned, lens, table, report)
+
+
+def _pixels(profile: Profile, geo: Derived, dome: DomeProfile, table: dict) -> dict:
+    """The projector's pixels over the measurable range: useful pixels and pixels per degree of
+    incidence angle (None with the centre of projection at infinity)."""
+    theta = dome.theta
+    pixels = table["projector_pixel"]
+    far = geo.cop_at_infinity
+    dpix = np.abs(np.gradient(pixels, theta / DEG)) if not far else np.full_like(theta, np.nan)
+    span_deg = (float(theta.max()) - float(theta.min())) / DEG
+    return {
+        "projector_resolution": list(profile.projector.resolution),
+        "projector_focal_px": geo.projector_focal_px,
+        "vertex_to_rim_px": None if far else geo.pixels_vertex_to_rim,
+        "useful_px": None if far else float(pixels.max() - pixels.min()),
+        "px_per_deg_mean": None if far else float((pixels.max() - pixels.min()) / span_deg),
+        "px_per_deg_min": None if far else float(dpix.min()),
+        "px_per_deg_max": None if far else float(dpix.max()),
+    }
+
+
+def _convergence(aligned: Trace) -> dict:
+    """How the chief rays return to O: counts, losses by cause, and the miss (mm)."""
+    ok = aligned.ok
+    return {
+        "rays": int(len(aligned.status)),
+        "rays_ok": int(ok.sum()),
+        "rays_lost": {STATUS_NAMES[k]: int(np.sum(aligned.status == k)) for k in STATUS_NAMES if k},
+        "rms_miss_mm": float(np.sqrt(np.mean(aligned.miss[ok] ** 2))) if ok.any() else None,
+        "max_miss_mm": float(np.abs(aligned.miss[ok]).max()) if ok.any() else None,
+        "note": "miss = distance from O to each returning ray (2D trace against the smooth curve or polyline)",
+    }

@@ -164,6 +164,41 @@ def mount_boxes(profile: Profile, geo: Derived) -> tuple[dict, list[tuple[float,
     return {"beam_bottom_z_mm": beam_bottom, "beam_top_z_mm": beam_top, "paraboloid_back_z_mm": back_z}, boxes
 
 
+def _pixel_radius(geo: Derived, rays, dtheta, n: int):
+    """The projector pixel radius rho(s) = f_px s / (cop_z - Pz(s)) at the ``n`` nodes and the two
+    ends (px), its derivative d rho / ds (px/mm), and the pixels per degree of theta there."""
+    deg = math.pi / 180.0
+    sq = rays.s[: n + 2]
+    h = geo.cop_z - rays.P[: n + 2, 1]
+    rho = geo.projector_focal_px * sq / h
+    drho = geo.projector_focal_px * (h - sq * sq / (2 * geo.focal_length)) / (h * h)
+    dps = np.abs(drho) / (np.abs(dtheta[: n + 2]) / deg)  # px per degree of theta, at each node
+    return rho, drho, dps
+
+
+def _printed_outline(profile: Profile, Do, u):
+    """The printed dome's outline from the design surface ``Do`` (its rays' directions ``u``): the
+    surface behind the coating, then the wall, and the flange; with the outer and inner curves, the
+    flange's outer radius (mm) and the dome's material volume (mm3: Pappus on the thin wall, plus
+    the flange ring)."""
+    shell = profile.dome_shell
+    coating = float(sum(t for _, t in profile.coating.layers))
+    normal = _outward(Do, u)
+    inner = Do + coating * normal
+    outer = inner + shell.wall * normal
+    fl_in = float(np.interp(shell.flange_thickness, outer[:, 1], outer[:, 0])) if outer[0, 1] < shell.flange_thickness \
+        else float(outer[0, 0])
+    fl_out = fl_in + shell.flange_width
+    outline = Outline(outer=outer[outer[:, 1] >= shell.flange_thickness], inner=inner[inner[:, 1] >= 0.0],
+                      flange=np.array([[fl_out, 0.0], [fl_out, shell.flange_thickness], [fl_in, shell.flange_thickness],
+                                       [float(np.interp(0.0, inner[:, 1], inner[:, 0])), 0.0]]))
+    seg = np.linalg.norm(np.diff(inner, axis=0), axis=-1)
+    r_mid = 0.5 * (inner[1:, 0] + inner[:-1, 0]) + 0.5 * shell.wall * 0.5 * (normal[1:, 0] + normal[:-1, 0])
+    volume = float(np.sum(2 * math.pi * r_mid * seg * shell.wall)) \
+        + math.pi * (fl_out ** 2 - fl_in ** 2) * shell.flange_thickness
+    return outline, outer, inner, fl_out, volume
+
+
 def fast_design(profile: Profile, geo: Derived, nodes: int = DEFAULT_NODES) -> FastDesign:
     """The figures of ``profile`` (geometry ``geo`` from ``derive``); raises GeometryError for the
     impossible rigs ``Rig.from_profile`` and ``run_design`` refuse (a test checks they agree)."""
@@ -188,35 +223,13 @@ def fast_design(profile: Profile, geo: Derived, nodes: int = DEFAULT_NODES) -> F
     if span_deg < MIN_THETA_SPAN_DEG:
         raise GeometryError(f"the design measures only {span_deg:.3g} deg of incidence angle",
                             where=profile.where("layout", "sample_to_rim"))
-    # projector pixel radius rho(s) = f_px s / (cop_z - Pz(s)) and its derivative
-    sq = rays.s[: n + 2]
-    h = geo.cop_z - rays.P[: n + 2, 1]
-    rho = geo.projector_focal_px * sq / h
-    drho = geo.projector_focal_px * (h - sq * sq / (2 * geo.focal_length)) / (h * h)
-    dps = np.abs(drho) / (np.abs(dtheta[: n + 2]) / deg)  # px per degree of theta, at each node
+    rho, drho, dps = _pixel_radius(geo, rays, dtheta, n)
     span_px = float(rho[-1] - rho[-2])
     mean = span_px / span_deg  # = the theta-uniform mean of dps (its integral over theta is the pixel span)
     second = float(np.sum(w * dps[:n] ** 2 * np.abs(dtheta[:n]) / deg)) / span_deg
     cv = math.sqrt(max(second - mean * mean, 0.0)) / mean
-
-    # the printed outline: design surface behind the coating, then the wall
-    shell = profile.dome_shell
-    coating = float(sum(t for _, t in profile.coating.layers))
     Do = D_all[n + 2:]
-    normal = _outward(Do, rays.u[n + 2:])
-    inner = Do + coating * normal
-    outer = inner + shell.wall * normal
-    fl_in = float(np.interp(shell.flange_thickness, outer[:, 1], outer[:, 0])) if outer[0, 1] < shell.flange_thickness \
-        else float(outer[0, 0])
-    fl_out = fl_in + shell.flange_width
-    outline = Outline(outer=outer[outer[:, 1] >= shell.flange_thickness], inner=inner[inner[:, 1] >= 0.0],
-                      flange=np.array([[fl_out, 0.0], [fl_out, shell.flange_thickness], [fl_in, shell.flange_thickness],
-                                       [float(np.interp(0.0, inner[:, 1], inner[:, 0])), 0.0]]))
-    # wall volume (Pappus on the thin wall) + flange ring: the dome's material
-    seg = np.linalg.norm(np.diff(inner, axis=0), axis=-1)
-    r_mid = 0.5 * (inner[1:, 0] + inner[:-1, 0]) + 0.5 * shell.wall * 0.5 * (normal[1:, 0] + normal[:-1, 0])
-    volume = float(np.sum(2 * math.pi * r_mid * seg * shell.wall)) \
-        + math.pi * (fl_out ** 2 - fl_in ** 2) * shell.flange_thickness
+    outline, outer, inner, fl_out, volume = _printed_outline(profile, Do, rays.u[n + 2:])
 
     # the mirror envelope (maxima refined between samples) and the top opening
     width = 2.0 * _peak(np.concatenate([Do[:, 0]]), so)
@@ -231,6 +244,7 @@ def fast_design(profile: Profile, geo: Derived, nodes: int = DEFAULT_NODES) -> F
     occluded = float(np.sum(area_w * blocked) / np.sum(area_w))
     solid_w = w * np.sin(theta[:n]) * np.abs(dtheta[:n])
     occluded_sr = float(np.sum(solid_w * blocked) * 2 * math.pi)
+    shell = profile.dome_shell
 
     figures = {
         "theta_min_deg": theta_lo / deg,

@@ -166,7 +166,6 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
     """Search and publish (module docstring). Raises OptimizeError (after publishing the record of
     every evaluation) when no design meets the constraints."""
     from rigcad import plots
-    from rigcad._version import __version__
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
 
     problem = load_problem(profile_spec, overrides)
@@ -175,45 +174,10 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
     result = optimize(problem, engine, progress)
     name = problem.base.name
     out = Path(exports) / name / "optimize"
-    report = {
-        "rigcad_version": __version__,
-        "profile": name, "sources": list(problem.base.sources),
-        "method": result.method, "engine": engine.name, "workers": engine.n_workers,
-        "spec": spec.describe(),
-        "units": {"parameters": "keys end in _mm, _deg or nothing (a number)", "constraints": {
-            k: v or "fraction" for k, v in CONSTRAINT_UNITS.items()},
-            "constraint_sign": "value <= 0 when met", "merit": "first objective / its scale (minimised); infeasible "
-            f"designs {1e6:g} x (1 + scaled violation) above; refused designs 1e12"},
-        "objective_scales": {n: OBJECTIVES[n][2] for n, _ in spec.objectives},
-        "status": "ok" if result.chosen is not None else "infeasible",
-        "reason": result.reason,
-        "base": _row_json(problem, result.base),
-        "chosen": _row_json(problem, result.chosen) if result.chosen else None,
-        "pareto": [_row_json(problem, r) for r in result.front],
-        "timings_s": result.timings,
-        "evaluation_time_s": _time_stats(result.history),
-        "evaluations": [_row_json(problem, r) for r in result.history],
-    }
+    report = _report(problem, result, engine)
     files: dict[str, bytes] = {}
     profile_path = None
-    rejected = []
-    if result.chosen is not None:
-        # the certified path (converged DOP853 dome at the profile's dome.tolerance) has the last word:
-        # a design it refuses (e.g. a tolerance float64 cannot certify there) gives way to the next
-        for row, why in preference(problem, result)[:MAX_CERTIFY]:
-            try:
-                report["certified_check"] = certify(problem, row)
-            except RigcadError as err:
-                rejected.append({"index": row["index"], "error": str(err)})
-                continue
-            result.chosen, result.reason = row, why
-            break
-        else:
-            result.chosen = None
-        report["rejected_by_certified_path"] = rejected
-        report["chosen"] = _row_json(problem, result.chosen) if result.chosen else None
-        report["reason"] = result.reason
-        report["status"] = "ok" if result.chosen is not None else "infeasible"
+    rejected = _certify_choice(problem, result, report) if result.chosen is not None else []
     if result.chosen is not None:
         note = f"seed {spec.seed}, {len(result.history)} evaluations, {result.method}; {result.reason}"
         stem = f"{name}_design"
@@ -242,6 +206,57 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
     if result.chosen is None:
         raise OptimizeError(f"{name}: {report['infeasible']} (every evaluation in {out / 'optimize.json'})")
     return OptimizeRun(report, written, profile_path, result)
+
+
+def _report(problem, result, engine: Engine) -> dict:
+    """optimize.json before the certified path has spoken: the search, its spec and units, the base,
+    chosen and Pareto designs and every evaluation."""
+    from rigcad._version import __version__
+
+    spec = problem.spec
+    name = problem.base.name
+    return {
+        "rigcad_version": __version__,
+        "profile": name, "sources": list(problem.base.sources),
+        "method": result.method, "engine": engine.name, "workers": engine.n_workers,
+        "spec": spec.describe(),
+        "units": {"parameters": "keys end in _mm, _deg or nothing (a number)", "constraints": {
+            k: v or "fraction" for k, v in CONSTRAINT_UNITS.items()},
+            "constraint_sign": "value <= 0 when met", "merit": "first objective / its scale (minimised); infeasible "
+            f"designs {1e6:g} x (1 + scaled violation) above; refused designs 1e12"},
+        "objective_scales": {n: OBJECTIVES[n][2] for n, _ in spec.objectives},
+        "status": "ok" if result.chosen is not None else "infeasible",
+        "reason": result.reason,
+        "base": _row_json(problem, result.base),
+        "chosen": _row_json(problem, result.chosen) if result.chosen else None,
+        "pareto": [_row_json(problem, r) for r in result.front],
+        "timings_s": result.timings,
+        "evaluation_time_s": _time_stats(result.history),
+        "evaluations": [_row_json(problem, r) for r in result.history],
+    }
+
+
+def _certify_choice(problem, result, report: dict) -> list[dict]:
+    """Certify the search's choice: the certified path (converged DOP853 dome at the profile's
+    dome.tolerance) has the last word, and a design it refuses (e.g. a tolerance float64 cannot
+    certify there) gives way to the next in preference, up to MAX_CERTIFY. Sets ``result.chosen``
+    and ``.reason`` (None: every one refused) and the report's verdict; returns the refused designs."""
+    rejected = []
+    for row, why in preference(problem, result)[:MAX_CERTIFY]:
+        try:
+            report["certified_check"] = certify(problem, row)
+        except RigcadError as err:
+            rejected.append({"index": row["index"], "error": str(err)})
+            continue
+        result.chosen, result.reason = row, why
+        break
+    else:
+        result.chosen = None
+    report["rejected_by_certified_path"] = rejected
+    report["chosen"] = _row_json(problem, result.chosen) if result.chosen else None
+    report["reason"] = result.reason
+    report["status"] = "ok" if result.chosen is not None else "infeasible"
+    return rejected
 
 
 def _design_home(profile_spec, name: str, out: Path) -> Path:

@@ -211,3 +211,22 @@ def kernel_error(part: Part, what: str, profile=None) -> KernelError:
                        "(and the mirrors' layout): look for a size near zero, a clearance or offset that cuts it "
                        f"apart, or features that no longer overlap; change {keys[0] if keys else 'the profile'} "
                        "and build again", where=where, param=keys[0] if keys else None)
+
+
+def polylines(lines) -> TopoDS_Shape:
+    """Polylines (k, m, 3) mm (k rays of m points each) as one compound of k wires of straight edges,
+    for a viewer that shows B-rep shapes (an OCP CAD Viewer); consecutive equal points are skipped."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakePolygon
+    from OCP.TopoDS import TopoDS_Compound
+
+    builder = BRep_Builder()
+    compound = TopoDS_Compound()
+    builder.MakeCompound(compound)
+    for line in lines:
+        polygon = BRepBuilderAPI_MakePolygon()
+        for x, y, z in line:
+            polygon.Add(gp_Pnt(float(x), float(y), float(z)))
+        if polygon.IsDone():
+            builder.Add(compound, polygon.Wire())
+    return compound

@@ -3,20 +3,35 @@ sample holder that slides into its bore so the sample's top surface lands on z =
 
 from __future__ import annotations
 
+import math
+
 from rigcad.parts.dome import bolt_holes
 from rigcad.parts.layout import RigLayout
 from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Union_
+from rigcad.parts.tower import column_joint_cuts, tongue_underside_cuts
 from rigcad.profile.schema import Profile
 
 
 def base_plate(profile: Profile, layout: RigLayout) -> Part:
+    """The rig's datum: a disc bolted to the dome's flange, bored for the sample holder, with a tongue
+    out to the COP tower's column, whose foot it locates by two dowels and holds by four bolts (nuts
+    in square traps underneath). The tongue reaches down to the bench (the sample holder's stop
+    collar's level): the tower's weight goes into the bench, not through the disc."""
     t = profile.base_plate.thickness
     holder = profile.sample_holder
     plate = Cylinder((0.0, 0.0, -t), layout.plate_r, t)
+    tw = layout.tower
+    half = tw.column_foot_half
+    x0 = math.sqrt(layout.plate_r ** 2 - half ** 2) - 1.0  # 1 mm inside the disc's rim: one solid
+    tongue = Box((x0, -half, tw.bench_z), (tw.column_x + half, half, 0.0))  # down to the bench: the tower's weight
     bore = Cylinder((0.0, 0.0, -t - 1.0), holder.radius + holder.clearance, t + 2.0)
     holes = bolt_holes(layout, profile.dome_shell.bolt_diameter, -t - 1.0, t + 2.0)
-    return Part("base_plate", Difference(plate, (bore, *holes)), (0.55, 0.57, 0.6),
-                "base plate: bolts to the dome flange; the sample holder slides into its bore")
+    joint = (*column_joint_cuts(tw, profile, tw.bench_z, -tw.bench_z, "top"), *tongue_underside_cuts(tw, profile, tw.bench_z))
+    return Part("base_plate", Difference(Union_((plate, tongue)), (bore, *holes, *joint)),
+                (0.55, 0.57, 0.6), "base plate, the rig's datum: bolts to the dome flange; the sample holder slides "
+                "into its bore; its tongue locates the tower's column " + (
+                    f"by two {profile.datum.dowel_diameter:g} mm dowels (reamed H7) and four bolts"
+                    if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core"))
 
 
 def holder_body(profile: Profile, top_z: float) -> Cylinder | Union_:

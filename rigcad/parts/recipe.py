@@ -173,6 +173,9 @@ class Part:
     description: str
     quantity: int = 1
     in_rig: bool = True
+    #: Empty: the part is made (printed, or cut from plate). Else the stock to buy instead, as one
+    #: would order it: a bought part is drawn in the rig and listed in the bill, never printed.
+    bought: str = ""
     mirrors: tuple[tuple[str, Meridian], ...] = field(default=(), compare=False)
     occluders: tuple[tuple[str, Box | Cylinder], ...] = field(default=(), compare=False)
     #: The profile keys ("section.key") this part's function read: named when the kernel fails.

@@ -12,16 +12,19 @@ Layout (mm, rig frame: O at the origin, optical axis +z; every number from the p
   N-BK7) so that it sees the rig from the design COP;
 * the focusing lens on the projector's axis between its lens and the splitter, in a square pocket;
 * a shelf under the projector reaching over the axis (a hole lets the bundle down), on a square
-  column that stands on the bench beside the base plate (the bench is level with the rig's lowest
-  point, the sample holder's stop collar);
-* the splitter holder on the shelf: two side walls with 45 deg grooves the plate rests in (it slides
-  in through the +y wall), a back
-  wall (a light dump for the half of the projector's light the plate transmits), and the camera
-  bracket above, with a slot for the camera's tripod screw;
-* adjustment, each way from the nominal placement: the camera slides in its bracket's slot along the
-  axis (``tower.travel_along``) and across it in x (``tower.travel_across``), and on slotted shims
-  in y; the projector slides in the shelf's slots along its own axis (its virtual COP moves along
-  the optical axis) and across it, and on shims in height (its virtual COP moves across, in x).
+  column that stands on the base plate's datum tongue (two dowels and four bolts at each end of the
+  column: the datum chain, ``rigcad.parts.datum``), or a bought extrusion in square pockets;
+* the splitter holder on a kinematic seat over the shelf (three push screws on balls in a cone, a
+  vee and a flat; two spring bolts): two side walls with 45 deg grooves the plate rests in (it
+  slides in through the +y wall; the grooves follow its catalogue thickness), a back wall (a light
+  dump for the half of the projector's light the plate transmits), and the camera bracket above,
+  with one slot for the camera's two screws (in line along the axis: it cannot pivot);
+* adjustment, each way from the nominal placement (``rigcad.parts.adjusters`` states each range and
+  resolution against its tolerance): the splitter tips and tilts on its seat; the camera slides in
+  its bracket's slot along the axis (``tower.travel_along``) and across it in x
+  (``tower.travel_across``), and on slotted shims in y; the projector slides in the shelf's slots
+  along its own axis (its virtual COP moves along the optical axis) and across it, and on shims in
+  height (its virtual COP moves across, in x), held by screws sized per shim stack.
 
 Instruments are not printed: :func:`instruments` gives them as simple named solids for rig.step.
 """
@@ -34,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigcad.errors import GeometryError
+from rigcad.optics.focus import focusing_lens
 from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_point, splitter_plate
 from rigcad.parts.recipe import Box, Cylinder, Difference, Line, Part, Prism, Section, Translate, Union_
 from rigcad.profile.derived import Derived
@@ -71,9 +75,12 @@ class TowerLayout:
     shelf_thickness: float
     holder_x: tuple[float, float]  #: back, front of the splitter holder
     holder_top_z: float
+    plate_bottom_z: float  #: the splitter plate's lowest point
     wall_y: tuple[float, float]  #: inner, outer |y| of the holder's side walls
     bracket_y: float  #: the camera bracket's face (y), under the camera's shims
     column_x: float  #: the column's centre (x; y = 0)
+    column_base_z: float  #: the column foot's underside: the base plate's datum tongue (z = 0)
+    column_foot_half: float  #: half the side of the column's square foot and top flange
     projector_box: tuple[tuple[float, float, float], tuple[float, float, float]]
     projector_lens_box: tuple[tuple[float, float, float], tuple[float, float, float]]
     camera_box: tuple[tuple[float, float, float], tuple[float, float, float]]
@@ -115,113 +122,131 @@ def shelf_bottom_z(profile: Profile, cop_z: float) -> float:
             - shims_nominal(profile) * tw.shim_thickness - 2 * tw.wall)
 
 
-def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z: float) -> TowerLayout:
-    """Place the tower; raise GeometryError naming the parameter when something does not fit."""
-    tw, bs, pj, cm, ln = profile.tower, profile.beam_splitter, profile.projector, profile.camera, profile.lens
-    if geometry.cop_at_infinity:
-        raise GeometryError("the COP tower needs a finite COP (layout.cop_to_vertex is inf)",
-                            where=profile.where("layout", "cop_to_vertex"))
-    cop_z = geometry.cop_z
-    L = tw.splitter_distance
-    z_s = cop_z - L
-    plate = splitter_plate(cop_z, L, bs.width, bs.length, bs.thickness, bs.index)
-    camera = camera_cop(plate, cop_z, geometry.rim_angle_at_cop)
-    p_cop = mirror_point(plate, (0.0, 0.0, cop_z))  # = (L, 0, z_s): the projector's real COP
+def _bundle_radius(profile: Profile, geometry: Derived, distance: float) -> float:
+    """Radius (mm) of the projector's ray bundle ``distance`` mm from its COP: the pinhole cone to the
+    paraboloid's rim plus the thin-lens aperture."""
+    return profile.projector.aperture / 2 + distance * math.tan(geometry.rim_angle_at_cop)
 
-    # the plate's extent in x-z (both faces)
-    n = np.asarray(plate.normal)
-    corners = np.vstack([plate.corners(), plate.corners() - plate.thickness * n])
-    px0, px1 = float(corners[:, 0].min()), float(corners[:, 0].max())
-    pz0, pz1 = float(corners[:, 2].min()), float(corners[:, 2].max())
-    # the ray bundle: pinhole cone to the paraboloid's rim plus the thin-lens aperture
-    tan_a = math.tan(geometry.rim_angle_at_cop)
-    half_ap = pj.aperture / 2
 
-    def bundle_r(distance: float) -> float:
-        return half_ap + distance * tan_a
-
-    need = bundle_r(L) * math.sqrt(2.0) + tw.clearance
-    if bs.length / 2 < need or bs.width / 2 < bundle_r(L) + tw.clearance:
+def _check_splitter_size(profile: Profile, geometry: Derived) -> None:
+    tw, bs = profile.tower, profile.beam_splitter
+    r = _bundle_radius(profile, geometry, tw.splitter_distance)
+    need = r * math.sqrt(2.0) + tw.clearance
+    if bs.length / 2 < need or bs.width / 2 < r + tw.clearance:
         raise GeometryError(
             f"the beam splitter ({bs.width:g} x {bs.length:g} mm) does not cover the ray bundle with "
             f"tower.clearance: at 45 deg it must be at least {2 * need:.1f} mm long and "
-            f"{2 * (bundle_r(L) + tw.clearance):.1f} mm wide; enlarge beam_splitter.length and width",
+            f"{2 * (r + tw.clearance):.1f} mm wide; enlarge beam_splitter.length and width",
             where=profile.where("beam_splitter", "length"))
 
-    # camera: looking down; lens front above the plate's top with clearance
+
+def _plate_extent(plate: Plate) -> tuple[float, float, float, float]:
+    """x0, x1, z0, z1 (mm) of the splitter plate (both faces) in the x-z plane."""
+    n = np.asarray(plate.normal)
+    corners = np.vstack([plate.corners(), plate.corners() - plate.thickness * n])
+    return (float(corners[:, 0].min()), float(corners[:, 0].max()),
+            float(corners[:, 2].min()), float(corners[:, 2].max()))
+
+
+def _camera_boxes(profile: Profile, camera: CameraPlacement, plate_top_z: float, L: float):
+    """The camera body's and lens's boxes (looking down; lens front above the plate with clearance)."""
+    tw, cm = profile.tower, profile.camera
     cx, cy, cz = camera.cop
-    c_lens_front = cz - cm.pupil_depth
-    if c_lens_front < pz1 + tw.clearance:
+    front = cz - cm.pupil_depth
+    if front < plate_top_z + tw.clearance:
         raise GeometryError(
-            f"the camera's lens front (z = {c_lens_front:.1f} mm) would be within tower.clearance of the "
-            f"splitter's top edge (z = {pz1:.1f} mm): raise tower.splitter_distance (now {L:g} mm) or shorten "
-            "camera.pupil_depth", where=profile.where("tower", "splitter_distance"))
-    c_body0 = c_lens_front + cm.lens_length
-    face_y = cy - cm.pupil_height
-    camera_box = _box((cx - cm.body_width / 2, face_y, c_body0),
-                      (cx + cm.body_width / 2, face_y + cm.body_height, c_body0 + cm.body_depth))
-    camera_lens_box = _box((cx - cm.lens_diameter / 2, cy - cm.lens_diameter / 2, c_lens_front),
-                           (cx + cm.lens_diameter / 2, cy + cm.lens_diameter / 2, c_body0))
+            f"the camera's lens front (z = {front:.1f} mm) would be within tower.clearance of the "
+            f"splitter's top edge (z = {plate_top_z:.1f} mm): raise tower.splitter_distance (now {L:g} mm) or "
+            "shorten camera.pupil_depth", where=profile.where("tower", "splitter_distance"))
     if cm.lens_diameter / 2 > cm.pupil_height:
         raise GeometryError(f"camera.lens_diameter ({cm.lens_diameter:g} mm) reaches past the mounting face "
                             f"(camera.pupil_height {cm.pupil_height:g} mm)", where=profile.where("camera", "lens_diameter"))
+    body0 = front + cm.lens_length
+    face_y = cy - cm.pupil_height
+    body = _box((cx - cm.body_width / 2, face_y, body0), (cx + cm.body_width / 2, face_y + cm.body_height,
+                                                           body0 + cm.body_depth))
+    lens = _box((cx - cm.lens_diameter / 2, cy - cm.lens_diameter / 2, front),
+                (cx + cm.lens_diameter / 2, cy + cm.lens_diameter / 2, body0))
+    return body, lens, face_y
 
-    # projector: looking -x at the splitter
-    p_lens_front = p_cop[0] - pj.pupil_depth
+
+def _projector_boxes(profile: Profile, p_cop, plate_x1: float):
+    """The focusing lens's x and the projector body's and lens's boxes (looking -x at the splitter)."""
+    tw, pj, ln = profile.tower, profile.projector, profile.lens
+    z_s = p_cop[2]
+    front = p_cop[0] - pj.pupil_depth
     lens_x = float(p_cop[0] - ln.distance)
-    lens_half_x = ln.thickness / 2 + tw.wall / 2  # the lens's pocket and its lips
-    if lens_x - lens_half_x < px1 + tw.clearance or lens_x + lens_half_x > p_lens_front - tw.clearance:
+    half = ln.thickness / 2 + tw.wall / 2  # the lens's pocket and its lips
+    if lens_x - half < plate_x1 + tw.clearance or lens_x + half > front - tw.clearance:
         raise GeometryError(
-            f"the focusing lens's mount (x = {lens_x - lens_half_x:.1f}..{lens_x + lens_half_x:.1f} mm) does not "
-            f"fit between the splitter (x <= {px1:.1f} mm) and the projector's lens front (x = {p_lens_front:.1f} mm) "
+            f"the focusing lens's mount (x = {lens_x - half:.1f}..{lens_x + half:.1f} mm) does not "
+            f"fit between the splitter (x <= {plate_x1:.1f} mm) and the projector's lens front (x = {front:.1f} mm) "
             f"with tower.clearance: change lens.distance (now {ln.distance:g} mm) or raise tower.splitter_distance",
             where=profile.where("lens", "distance"))
-    p_body0 = p_lens_front + pj.lens_length
-    body_y0 = -pj.pupil_lateral - pj.body_width / 2
-    shims = shims_nominal(profile)
-    shims_per_stack = 2 * shims
-    body_z0 = z_s - pj.pupil_height
-    projector_box = _box((p_body0, body_y0, body_z0),
-                         (p_body0 + pj.body_depth, body_y0 + pj.body_width, body_z0 + pj.body_height))
     if pj.lens_diameter / 2 > pj.pupil_height:
         raise GeometryError(f"projector.lens_diameter ({pj.lens_diameter:g} mm) reaches below the body "
                             f"(projector.pupil_height {pj.pupil_height:g} mm)",
                             where=profile.where("projector", "lens_diameter"))
-    projector_lens_box = _box((p_lens_front, -pj.lens_diameter / 2, z_s - pj.lens_diameter / 2),
-                              (p_body0, pj.lens_diameter / 2, z_s + pj.lens_diameter / 2))
+    body0 = front + pj.lens_length
+    y0, z0 = -pj.pupil_lateral - pj.body_width / 2, z_s - pj.pupil_height
+    body = _box((body0, y0, z0), (body0 + pj.body_depth, y0 + pj.body_width, z0 + pj.body_height))
+    lens = _box((front, -pj.lens_diameter / 2, z_s - pj.lens_diameter / 2),
+                (body0, pj.lens_diameter / 2, z_s + pj.lens_diameter / 2))
+    return lens_x, body, lens
 
+
+def _shelf_top(profile: Profile, cop_z: float, plate_z0: float, dome_top_z: float) -> float:
+    """Height (mm) of the shelf's top; raise when it meets the splitter or comes near the dome."""
+    tw = profile.tower
     shelf_t = 2 * tw.wall
-    shelf_top = shelf_bottom_z(profile, cop_z) + shelf_t
-    if shelf_top > pz0 - tw.clearance:
+    top = shelf_bottom_z(profile, cop_z) + shelf_t
+    if top > plate_z0 - tw.clearance:
         raise GeometryError(
-            f"the shelf (top z = {shelf_top:.1f} mm) would reach the splitter's lower edge (z = {pz0:.1f} mm): "
+            f"the shelf (top z = {top:.1f} mm) would reach the splitter's lower edge (z = {plate_z0:.1f} mm): "
             "raise projector.pupil_height or shorten beam_splitter.length", where=profile.where("projector", "pupil_height"))
-    if shelf_top - shelf_t < dome_top_z + tw.clearance:
+    if top - shelf_t < dome_top_z + tw.clearance:
         raise GeometryError(
-            f"the shelf under the projector (bottom z = {shelf_top - shelf_t:.1f} mm) would be within tower.clearance "
-            f"of the dome's top (z = {dome_top_z:.1f} mm): lower tower.splitter_distance (now {L:g} mm) or "
-            "projector.pupil_height", where=profile.where("tower", "splitter_distance"))
+            f"the shelf under the projector (bottom z = {top - shelf_t:.1f} mm) would be within tower.clearance "
+            f"of the dome's top (z = {dome_top_z:.1f} mm): lower tower.splitter_distance (now "
+            f"{tw.splitter_distance:g} mm) or projector.pupil_height", where=profile.where("tower", "splitter_distance"))
+    return top
 
-    wall_in = bs.width / 2 - GROOVE_DEPTH
+
+def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z: float) -> TowerLayout:
+    """Place the tower; raise GeometryError naming the parameter when something does not fit."""
+    tw, bs, cm = profile.tower, profile.beam_splitter, profile.camera
+    if geometry.cop_at_infinity:
+        raise GeometryError("the COP tower needs a finite COP (layout.cop_to_vertex is inf)",
+                            where=profile.where("layout", "cop_to_vertex"))
+    cop_z, L = geometry.cop_z, tw.splitter_distance
+    plate = splitter_plate(cop_z, L, bs.width, bs.length, bs.thickness, bs.index)
+    camera = camera_cop(plate, cop_z, geometry.rim_angle_at_cop)
+    p_cop = mirror_point(plate, (0.0, 0.0, cop_z))  # = (L, 0, cop_z - L): the projector's real COP
+    px0, px1, pz0, pz1 = _plate_extent(plate)
+    _check_splitter_size(profile, geometry)
+    camera_box, camera_lens_box, face_y = _camera_boxes(profile, camera, pz1, L)
+    lens_x, projector_box, projector_lens_box = _projector_boxes(profile, p_cop, px1)
+    shims = shims_nominal(profile)
+    shelf_t = 2 * tw.wall
+    shelf_top = _shelf_top(profile, cop_z, pz0, dome_top_z)
     wall_out = bs.width / 2 + GROOVE_GAP + tw.wall
-    holder_x = (px0 - GROOVE_GAP - 1.0 - tw.wall, px1 + tw.wall)
-    holder_top = pz1 + tw.wall
     bracket_y = face_y - shims * tw.shim_thickness
     if bracket_y < -wall_out + tw.wall:
         raise GeometryError(f"the camera bracket would stand outside the splitter holder's wall: camera.pupil_height "
                             f"({cm.pupil_height:g} mm) is larger than the splitter's half width allows",
                             where=profile.where("camera", "pupil_height"))
     foot_half = tw.column_width / 2 + 3 * tw.bolt_diameter
-    column_x = plate_r + tw.clearance + foot_half
-    bench_z = -(profile.base_plate.thickness + profile.sample_holder.stop_thickness)
     return TowerLayout(
         plate=plate, camera=camera, projector_cop=tuple(float(v) for v in p_cop), cop=(0.0, 0.0, cop_z),
-        bench_z=bench_z, shelf_top_z=shelf_top, shelf_thickness=shelf_t, holder_x=holder_x, holder_top_z=holder_top,
-        wall_y=(wall_in, wall_out), bracket_y=bracket_y, column_x=column_x,
+        bench_z=-(profile.base_plate.thickness + profile.sample_holder.stop_thickness), shelf_top_z=shelf_top,
+        shelf_thickness=shelf_t, holder_x=(px0 - GROOVE_GAP - 1.0 - tw.wall, px1 + tw.wall), holder_top_z=pz1 + tw.wall,
+        plate_bottom_z=pz0,
+        wall_y=(bs.width / 2 - GROOVE_DEPTH, wall_out), bracket_y=bracket_y,
+        column_x=plate_r + tw.clearance + foot_half, column_base_z=0.0, column_foot_half=foot_half,
         projector_box=projector_box, projector_lens_box=projector_lens_box, camera_box=camera_box,
         camera_lens_box=camera_lens_box, lens_x=lens_x,
-        bundle_radius_at_shelf=bundle_r(cop_z - (shelf_top - shelf_t)),
-        shims_nominal=shims, shims_per_stack=shims_per_stack)
+        bundle_radius_at_shelf=_bundle_radius(profile, geometry, cop_z - (shelf_top - shelf_t)),
+        shims_nominal=shims, shims_per_stack=2 * shims)
 
 
 # -- the printed parts -----------------------------------------------------------------------------
@@ -239,10 +264,101 @@ def _column_flange_points(t: TowerLayout, profile: Profile):
     return [(t.column_x + a * h, b * h) for a in (-1, 1) for b in (-1, 1)]
 
 
+def column_dowel_points(t: TowerLayout, profile: Profile):
+    """The two dowel pins of each column joint (x, y; mm): on the x axis either side of the tube,
+    between the bolts, as far apart as the foot allows (the joint's angle error is fit / spacing)."""
+    h = profile.tower.column_width / 2 + 1.5 * profile.tower.bolt_diameter
+    return [(t.column_x - h, 0.0), (t.column_x + h, 0.0)]
+
+
+#: A bought column: 40 x 40 mm aluminium extrusion (slot 8) whose ends stand in square pockets in the
+#: base plate's tongue and under the shelf (POCKET_DEPTH deep, POCKET_GAP wider each side than the
+#: extrusion's nominal 40 mm, whose tolerance is about +-0.2 mm: ream or file the pocket to a slide
+#: fit), held by an M8 bolt into the extrusion's tapped core at each end.
+EXTRUSION = 40.0
+POCKET_DEPTH = 1.5
+POCKET_GAP = 0.1
+CORE_BOLT_HOLE = 9.0  #: M8 clearance (ISO 273 medium)
+
+
+def column_joint_cuts(t: TowerLayout, profile: Profile, z0: float, height: float, face: str) -> tuple:
+    """What a column joint cuts into the plate it stands on (``face`` "top": the base plate's tongue)
+    or hangs under ("bottom": the shelf), through z0..z0+height: the printed column's bolt and dowel
+    holes, or the bought extrusion's square pocket and core bolt hole."""
+    if profile.buy.column == "print":
+        return column_joint_holes(t, profile, z0, height)
+    h = EXTRUSION / 2 + POCKET_GAP
+    zp = z0 + height - POCKET_DEPTH if face == "top" else z0 - 1.0
+    pocket = Box((t.column_x - h, -h, zp), (t.column_x + h, h, zp + POCKET_DEPTH + 1.0))
+    return (pocket, *_holes([(t.column_x, 0.0)], CORE_BOLT_HOLE, z0, height))
+
+
+#: Square nut traps under the tongue (mm): an M4 nut (7 mm across flats, 3.2 mm thick) drops in and
+#: cannot turn (its corners, 8.1 mm across, meet the sides); the tongue then stands on the bench.
+NUT_TRAP = 7.2
+NUT_TRAP_DEPTH = 3.6
+#: Counterbore under the tongue for the extrusion's M8 socket head (13 mm, 8 mm tall; ISO 4762).
+CORE_HEAD_BORE = (14.0, 8.5)
+
+
+def tongue_underside_cuts(t: TowerLayout, profile: Profile, z_bottom: float) -> tuple:
+    """What the column joint cuts into the tongue's underside (z_bottom: the bench): a square nut
+    trap under each of the printed column's bolts, or a counterbore for the extrusion's M8 head."""
+    if profile.buy.column != "print":
+        d, depth = CORE_HEAD_BORE
+        return (Cylinder((t.column_x, 0.0, z_bottom - 1.0), d / 2, depth + 1.0),)
+    h = NUT_TRAP / 2
+    return tuple(Box((x - h, y - h, z_bottom - 1.0), (x + h, y + h, z_bottom + NUT_TRAP_DEPTH))
+                 for x, y in _column_flange_points(t, profile))
+
+
+def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: float) -> tuple[Cylinder, ...]:
+    """The bolt and dowel holes of a column joint through z0..z0+height: the column's foot on the
+    base plate's tongue, its top flange under the shelf (the same pattern at both)."""
+    return (_holes(_column_flange_points(t, profile), profile.tower.bolt_diameter, z0, height)
+            + _holes(column_dowel_points(t, profile), profile.datum.dowel_diameter, z0, height))
+
+
 def _holder_flange_points(t: TowerLayout, profile: Profile):
+    """The two spring bolts that hold the splitter holder down on its seat (x, y; mm)."""
     y = t.wall_y[1] + 1.5 * profile.tower.bolt_diameter
+    return [(t.holder_x[0] + 8.0, s * y) for s in (-1, 1)]
+
+
+#: Heat-set insert holes (mm) for the seat's push screws: the insert makers' hole for each thread.
+INSERT_HOLE = {"M3": 4.0, "M4": 5.6, "M5": 6.4, "M6": 8.0}
+#: Clearance (mm) of the spring bolts in the holder's flanges: room to tilt by the seat's travel.
+SPRING_HOLE = 6.0
+
+
+def seat_points(t: TowerLayout, profile: Profile) -> dict[str, tuple[float, float]]:
+    """The splitter holder's kinematic seat (x, y; mm): a cone and a vee on the side flanges at its
+    +x end, a flat on its back flange (y = 0): each a push screw in the holder over a steel ball in
+    the shelf. The vee's slot points at the cone."""
+    tw = profile.tower
+    y = t.wall_y[1] + 1.5 * tw.bolt_diameter
     x0, x1 = t.holder_x
-    return [(x, s * y) for x in (x0 + 8.0, x1 - 8.0) for s in (-1, 1)]
+    return {"cone": (x1 - 8.0, -y), "vee": (x1 - 8.0, y), "flat": (x0 - 1.5 * tw.bolt_diameter, 0.0)}
+
+
+def seat_gap(profile: Profile) -> float:
+    """Gap (mm) between the shelf's top and the holder's underside with the screws at their nominal
+    setting: the ball's top (it sinks 0.2 of its diameter into a cone hole 0.8 of it wide) plus the
+    screws' travel plus 0.5 mm, so the holder never lands on a ball."""
+    a = profile.adjusters
+    return 0.8 * a.seat_ball + a.seat_travel + 0.5
+
+
+def _seat_cuts(t: TowerLayout, profile: Profile) -> tuple:
+    """The shelf's seats for the three balls: a cone (a hole 0.8 ball wide), a vee (a slot 0.8 ball
+    wide along y, towards the cone) and a flat (a 0.3 mm pocket 2.5 balls wide, the ball free in it)."""
+    b = profile.adjusters.seat_ball
+    top = t.shelf_top_z
+    pts = seat_points(t, profile)
+    (cx, cy), (vx, vy), (fx, fy) = pts["cone"], pts["vee"], pts["flat"]
+    return (Cylinder((cx, cy, top - 0.6 * b), 0.4 * b, 0.6 * b + 1.0),
+            Box((vx - 0.4 * b, vy - b, top - 0.6 * b), (vx + 0.4 * b, vy + b, top + 1.0)),
+            Cylinder((fx, fy, top - 0.3), 1.25 * b, 1.3))
 
 
 def _lens_foot(t: TowerLayout, profile: Profile):
@@ -265,7 +381,7 @@ def _shelf_extent(t: TowerLayout, profile: Profile):
     hy = t.wall_y[1] + 3 * tw.bolt_diameter
     _, _, lens_hy, _ = _lens_foot(t, profile)
     flange = tw.column_width / 2 + 3 * tw.bolt_diameter
-    x0 = t.holder_x[0] - tw.wall
+    x0 = t.holder_x[0] - 3 * tw.bolt_diameter - tw.wall  # under the holder's back flange
     x1 = max(bx1 + tw.wall, t.column_x + flange)
     y0 = min(by0 - tw.wall, -hy - tw.wall, -lens_hy - tw.wall, -flange)
     y1 = max(by1 + tw.wall, hy + tw.wall, lens_hy + tw.wall, flange)
@@ -273,25 +389,35 @@ def _shelf_extent(t: TowerLayout, profile: Profile):
 
 
 def tower_column(profile: Profile, layout) -> Part:
-    """Square hollow column on the bench beside the base plate, under the projector's shelf: a foot
-    with four bolt holes (to the bench), a top flange with four (to the shelf)."""
+    """Square hollow column on the base plate's datum tongue, under the projector's shelf: a foot and
+    a top flange, each with four bolt holes and two dowel holes (the datum chain, rigcad.parts.datum)."""
     t, tw = layout.tower, profile.tower
+    if profile.buy.column != "print":
+        return _extrusion_column(profile, t)
     w = tw.column_width / 2
     top = t.shelf_top_z - t.shelf_thickness
-    xc = t.column_x
-    foot_h = w + 3 * tw.bolt_diameter
-    foot = Box((xc - foot_h, -foot_h, t.bench_z), (xc + foot_h, foot_h, t.bench_z + tw.wall))
-    tube = Difference(Box((xc - w, -w, t.bench_z), (xc + w, w, top)),
-                      (Box((xc - w + tw.wall, -w + tw.wall, t.bench_z + tw.wall), (xc + w - tw.wall, w - tw.wall,
-                                                                                    top - tw.wall)),))
+    xc, z0 = t.column_x, t.column_base_z
+    foot_h = t.column_foot_half
+    foot = Box((xc - foot_h, -foot_h, z0), (xc + foot_h, foot_h, z0 + tw.wall))
+    tube = Difference(Box((xc - w, -w, z0), (xc + w, w, top)),
+                      (Box((xc - w + tw.wall, -w + tw.wall, z0 + tw.wall), (xc + w - tw.wall, w - tw.wall,
+                                                                             top - tw.wall)),))
     flange = Box((xc - foot_h, -foot_h, top - tw.wall), (xc + foot_h, foot_h, top))
-    h = w + 1.5 * tw.bolt_diameter
-    feet_holes = [(xc + a * h, b * h) for a in (-1, 1) for b in (-1, 1)]
-    holes = _holes(feet_holes, tw.bolt_diameter, t.bench_z, tw.wall) + \
-        _holes(_column_flange_points(t, profile), tw.bolt_diameter, top - tw.wall, tw.wall)
+    holes = tuple(h for z in (z0, top - tw.wall) for h in column_joint_holes(t, profile, z, tw.wall))
     return Part("tower_column", Difference(Union_((foot, tube, flange)), holes), (0.55, 0.57, 0.6),
-                f"COP tower: hollow {tw.column_width:g} mm column on the bench beside the base plate, "
-                "under the projector's shelf; bolts to the bench and to the shelf")
+                f"COP tower: hollow {tw.column_width:g} mm column on the base plate's datum tongue, under the "
+                f"projector's shelf; two {profile.datum.dowel_diameter:g} mm dowels and four bolts at each end")
+
+
+def _extrusion_column(profile: Profile, t: TowerLayout) -> Part:
+    """The bought column: the extrusion from the tongue's pocket to the shelf's."""
+    h = EXTRUSION / 2
+    z0, z1 = t.column_base_z - POCKET_DEPTH, t.shelf_top_z - t.shelf_thickness + POCKET_DEPTH
+    return Part("tower_column", Box((t.column_x - h, -h, z0), (t.column_x + h, h, z1)), (0.75, 0.77, 0.8),
+                f"COP tower: bought {EXTRUSION:g} x {EXTRUSION:g} mm aluminium extrusion column, standing in square "
+                "pockets in the base plate's tongue and under the shelf, an M8 bolt into its core at each end",
+                bought=f"aluminium extrusion {EXTRUSION:g} x {EXTRUSION:g} mm, slot 8, cut to {z1 - z0:.1f} mm, "
+                       "ends sawn square (0.1 mm across 40 mm), core tapped M8 x 20 mm at both ends")
 
 
 def tower_shelf(profile: Profile, layout) -> Part:
@@ -306,12 +432,16 @@ def tower_shelf(profile: Profile, layout) -> Part:
     slots = tuple(_slot(x, y, d / 2 + tw.travel_along, d / 2 + tw.travel_across, z0, t.shelf_thickness)
                   for x, y in _projector_feet(t))
     _, _, _, lens_pts = _lens_foot(t, profile)
-    holes = _holes(_column_flange_points(t, profile) + _holder_flange_points(t, profile) + lens_pts,
-                   tw.bolt_diameter, z0, t.shelf_thickness)
+    holes = column_joint_cuts(t, profile, z0, t.shelf_thickness, "bottom") + _holes(
+        _holder_flange_points(t, profile) + lens_pts, tw.bolt_diameter, z0, t.shelf_thickness) + _seat_cuts(t, profile)
+    bought = "" if profile.buy.shelf == "print" else (
+        f"aluminium plate EN AW-5083, {t.shelf_thickness:g} mm, cut to {x1 - x0:.1f} x {y1 - y0:.1f} mm; drill and "
+        "mill its holes, slots and the seat's cone, vee and flat as drawn (print the shelf at 0.2 mm layers as a "
+        "drilling template)")
     return Part("tower_shelf", Difference(plate, (hole, *slots, *holes)), (0.55, 0.57, 0.6),
                 f"COP tower: shelf under the projector; {pj.mount_thread} screws through its four slots "
                 f"(+-{tw.travel_along:g} mm along the projector's axis, +-{tw.travel_across:g} mm across) hold it "
-                "on its shim stacks; a hole passes the ray bundle")
+                "on its shim stacks; a hole passes the ray bundle", bought=bought)
 
 
 def _groove(t: TowerLayout) -> Translate:
@@ -331,34 +461,64 @@ def _groove(t: TowerLayout) -> Translate:
     return Translate(slab, (0.0, 0.5 * (y0 + y1), 0.0))
 
 
-def splitter_holder(profile: Profile, layout) -> Part:
-    """The beam splitter's holder on the shelf: side walls with 45 deg grooves (the plate slides in
-    through the +y wall and rests on their lower faces), a back wall, bolt flanges, and the camera bracket above with a slot for the
-    camera's tripod screw (+-travel_along along the axis, +-travel_across across)."""
-    t, tw, cm = layout.tower, profile.tower, profile.camera
+def camera_screws(t: TowerLayout, profile: Profile) -> list[tuple[float, float]]:
+    """The camera's two screws (x, z; mm) at the nominal placement: in line along the optical axis,
+    ``camera.mount_spacing`` apart, about the body's middle (two points: the camera cannot pivot)."""
+    (cx0, _, cz0), (cx1, _, cz1) = t.camera_box
+    cx, cz, s = 0.5 * (cx0 + cx1), 0.5 * (cz0 + cz1), profile.camera.mount_spacing
+    return [(cx, cz - s / 2), (cx, cz + s / 2)]
+
+
+def _camera_bracket(t: TowerLayout, profile: Profile) -> tuple[tuple[Box, Box], Box]:
+    """The camera bracket on the holder's -y wall (a ledge into the wall's top and an upright) and its
+    slot: both camera screws slide in it by travel_along along the axis and travel_across across."""
+    tw, cm = profile.tower, profile.camera
     x0, x1 = t.holder_x
     yi, yo = t.wall_y
-    z0, z1 = t.shelf_top_z, t.holder_top_z
+    z1 = t.holder_top_z
+    (cx0, _, _), (cx1, _, cz1) = t.camera_box
+    (cx, s0), (_, s1) = camera_screws(t, profile)
+    d = clearance_hole(cm.mount_thread)
+    if s1 + d / 2 > cz1 or s0 - d / 2 < t.camera_box[0][2]:
+        raise GeometryError(f"the camera's screws ({cm.mount_spacing:g} mm apart) do not fit its body "
+                            f"({cm.body_depth:g} mm deep along its axis): check camera.mount_spacing",
+                            where=profile.where("camera", "mount_spacing"))
+    half_w = max((cx1 - cx0) / 2, d / 2 + tw.travel_across + tw.wall)
+    bx0, bx1 = max(cx - half_w, x0), min(cx + half_w, x1)
+    ledge = Box((bx0, -yo, z1 - tw.wall), (bx1, -yi, z1))  # sits into the -y wall's top
+    upright = Box((bx0, -yo, z1 - tw.wall), (bx1, t.bracket_y, cz1))
+    slot = Box((cx - d / 2 - tw.travel_across, -yo - 1.0, s0 - d / 2 - tw.travel_along),
+               (cx + d / 2 + tw.travel_across, t.bracket_y + 1.0, s1 + d / 2 + tw.travel_along))
+    return (ledge, upright), slot
+
+
+def splitter_holder(profile: Profile, layout) -> Part:
+    """The beam splitter's holder: side walls with 45 deg grooves (the plate slides in through the +y
+    wall and rests on their lower faces), a back wall, and flanges on a kinematic seat over the shelf
+    (three push screws in heat-set inserts, on balls in the shelf's cone, vee and flat; two spring
+    bolts hold it down): tip and tilt. Above, the camera bracket with its slot for two screws."""
+    t, tw, cm, a = layout.tower, profile.tower, profile.camera, profile.adjusters
+    x0, x1 = t.holder_x
+    yi, yo = t.wall_y
+    z0, z1 = t.shelf_top_z + seat_gap(profile), t.holder_top_z
+    if z0 > t.plate_bottom_z - GROOVE_GAP:
+        raise GeometryError(f"the splitter holder, raised {seat_gap(profile):.1f} mm on its seat, would start above "
+                            f"the plate's lower edge (z = {t.plate_bottom_z:.1f} mm): lower adjusters.seat_travel "
+                            "or adjusters.seat_ball", where=profile.where("adjusters", "seat_travel"))
     walls = [Box((x0, s0, z0), (x1, s1, z1)) for s0, s1 in ((-yo, -yi), (yi, yo))]
     back = Box((x0, -yo, z0), (x0 + tw.wall, yo, z1))
     fl = 3 * tw.bolt_diameter
-    flanges = [Box((x0, -yo - fl, z0), (x1, -yo, z0 + tw.wall)), Box((x0, yo, z0), (x1, yo + fl, z0 + tw.wall))]
-    (cx0, _, cz0), (cx1, _, cz1) = t.camera_box
-    cx = 0.5 * (cx0 + cx1)
-    d = clearance_hole(cm.mount_thread)
-    half_w = max((cx1 - cx0) / 2, d / 2 + tw.travel_across + tw.wall)
-    bx0, bx1 = max(cx - half_w, x0), min(cx + half_w, x1)
-    bracket = Box((bx0, -yo, z1 - tw.wall), (bx1, -yi, z1))  # sits into the -y wall's top
-    upright = Box((bx0, -yo, z1 - tw.wall), (bx1, t.bracket_y, cz1))
-    screw_z = 0.5 * (cz0 + cz1)
-    slot = Box((cx - d / 2 - tw.travel_across, -yo - 1.0, screw_z - d / 2 - tw.travel_along),
-               (cx + d / 2 + tw.travel_across, t.bracket_y + 1.0, screw_z + d / 2 + tw.travel_along))
-    holes = _holes(_holder_flange_points(t, profile), tw.bolt_diameter, z0, tw.wall)
-    solid = Difference(Union_((*walls, back, *flanges, bracket, upright)), (_groove(t), slot, *holes))
+    flanges = [Box((x0, -yo - fl, z0), (x1, -yo, z0 + tw.wall)), Box((x0, yo, z0), (x1, yo + fl, z0 + tw.wall)),
+               Box((x0 - fl, -yo, z0), (x0, yo, z0 + tw.wall))]
+    bracket, slot = _camera_bracket(t, profile)
+    holes = (_holes(seat_points(t, profile).values(), INSERT_HOLE[a.seat_thread], z0, tw.wall)
+             + _holes(_holder_flange_points(t, profile), SPRING_HOLE, z0, tw.wall))
+    solid = Difference(Union_((*walls, back, *flanges, *bracket)), (_groove(t), slot, *holes))
     return Part("splitter_holder", solid, (0.3, 0.5, 0.75),
                 f"COP tower: holds the {profile.beam_splitter.thickness:g} mm plate beam splitter at 45 deg in its "
-                f"grooves (slide it in through the +y wall) and the camera on its bracket above "
-                f"({cm.mount_thread} screw in the slot; shims between camera and bracket)")
+                f"grooves (slide it in through the +y wall) on a kinematic seat (three {a.seat_thread} push screws "
+                f"in heat-set inserts on {a.seat_ball:g} mm balls, two spring bolts), and the camera on its bracket "
+                f"above (two {cm.mount_thread} screws in the slot; shims between camera and bracket)")
 
 
 def lens_mount(profile: Profile, layout) -> Part:
@@ -414,39 +574,133 @@ def _length(grip: float, extra: float) -> float:
     return LENGTH_STEP * math.ceil((grip + extra) / LENGTH_STEP - 1e-9)
 
 
+def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
+    """The column's joints to the base plate's tongue and to the shelf: four bolts and two dowels at
+    each end of a printed column; one M8 bolt into the core at each end of a bought extrusion."""
+    tw, tongue = profile.tower, -t.bench_z  # the tongue reaches down to the bench
+    if profile.buy.column != "print":
+        grip = max(tongue - CORE_HEAD_BORE[1], t.shelf_thickness)
+        return [{"item": "bolt and washer, ISO 4762", "thread": "M8", "length_mm": float(_length(grip + 1.0, 16.0)),
+                 "quantity": 2, "joins": "up through the base plate's tongue (its head in the counterbore underneath), "
+                                         "and down through the shelf, into the extrusion's tapped core (16 mm engaged)"}]
+    return [
+        {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + t.shelf_thickness, nut),
+         "quantity": 4, "joins": "the column's top flange to the shelf"},
+        {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + tongue - NUT_TRAP_DEPTH, nut),
+         "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (the nuts in the square traps "
+                                 "under the tongue, put in before it stands on the bench)"},
+        {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
+         "length_mm": _length(min(tw.wall, t.shelf_thickness) + tw.wall, 0.0), "quantity": 4,
+         "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf "
+                  f"(ream the printed holes {profile.datum.dowel_diameter:g} H7)"},
+    ]
+
+
+def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
+    """The splitter seat's push screws, inserts, balls, spring bolts and springs."""
+    a, tw = profile.adjusters, profile.tower
+    gap = seat_gap(profile)
+    spring = 10.0  # free length (mm) of the compression spring under the nut (assumed stock: 10 mm)
+    return [
+        {"item": "set screw, ISO 4026 (flat point)", "thread": a.seat_thread,
+         "length_mm": _length(tw.wall + a.seat_travel + 1.0, 0.0), "quantity": 3,
+         "joins": "the splitter holder's seat: pushes on a ball, turned from above (tip/tilt)"},
+        {"item": "heat-set insert", "thread": a.seat_thread, "length_mm": None, "quantity": 3,
+         "hole_mm": INSERT_HOLE[a.seat_thread], "joins": "pressed into the holder's three seat holes from above"},
+        {"item": "steel ball, DIN 5401", "thread": None, "length_mm": None, "quantity": 3, "diameter_mm": a.seat_ball,
+         "joins": "in the shelf's cone, vee and flat, under the push screws"},
+        {"item": "bolt, two washers, nut and compression spring", "thread": "M4",
+         "length_mm": _length(t.shelf_thickness + gap + tw.wall + spring, nut), "quantity": 2,
+         "spring_mm": {"inner_diameter": 4.5, "free_length": spring},
+         "joins": "from under the shelf up through the holder's flange; the spring under the nut holds the holder "
+                  "on its three balls"},
+    ]
+
+
+#: ISO 4762 socket head cap screw lengths (mm) stocked for M3..M6 (the standard's preferred series).
+ISO_4762_LENGTHS = (6, 8, 10, 12, 16, 20, 25, 30, 35, 40, 45, 50, 55, 60, 65, 70, 80)
+#: Washers (1 mm, ISO 7089 for M4 is 0.8 mm: rounded up) a screw may carry under its head to reach
+#: the right depth: more and the joint loses stiffness.
+MAX_EXTRA_WASHERS = 3
+
+
+def projector_screws(profile, layout) -> list[dict]:
+    """The projector's screws for each shim stack (0..shims_per_stack shims; mm): the shortest ISO 4762
+    length, with the fewest extra washers under its head (at most MAX_EXTRA_WASHERS), that engages the
+    projector's thread by SOCKET_ENGAGEMENT to ``projector.mount_depth``, through a washer, the shelf
+    and the stack. ``ok`` False: no stocked length fits that stack."""
+    t, tw, pj = layout.tower, profile.tower, profile.projector
+    rows = []
+    for n in range(t.shims_per_stack + 1):
+        grip = WASHER + t.shelf_thickness + n * tw.shim_thickness
+        fits = [(L, w, L - grip - w * WASHER) for L in ISO_4762_LENGTHS for w in range(MAX_EXTRA_WASHERS + 1)
+                if SOCKET_ENGAGEMENT - 1e-9 <= L - grip - w * WASHER <= pj.mount_depth + 1e-9]
+        length, washers, reach = fits[0] if fits else (None, None, None)
+        rows.append({"shims": n, "grip_mm": grip, "length_mm": length, "extra_washers": washers,
+                     "engagement_mm": reach, "ok": bool(fits)})
+    return rows
+
+
+def _projector_screw_rows(profile: Profile, layout) -> list[dict]:
+    """The projector's screws: one row per length the shim stacks need (:func:`projector_screws`)."""
+    rows = projector_screws(profile, layout)
+    bad = [r["shims"] for r in rows if not r["ok"]]
+    if bad:
+        raise GeometryError(f"no stocked {profile.projector.mount_thread} screw suits a stack of {bad[0]} shims with "
+                            f"projector.mount_depth {profile.projector.mount_depth:g} mm: check it",
+                            where=profile.where("projector", "mount_depth"))
+    stacks: dict[float, list[int]] = {}
+    for r in rows:
+        stacks.setdefault(r["length_mm"], []).append(r["shims"])
+    return [{"item": "screw and washer", "thread": profile.projector.mount_thread, "length_mm": float(L),
+             "quantity": len(_projector_feet(layout.tower)), "for_stacks_of_shims": ns,
+             "joins": "the projector's mounting holes, through the shelf's slots and a stack of "
+                      f"{ns[0]}..{ns[-1]} shims (extra washers per stack: rigcad.parts.tower.projector_screws)"}
+            for L, ns in stacks.items()]
+
+
 def hardware(profile: Profile, layout) -> list[dict]:
     """The tower's bought hardware, computed from the parts (mm; units in keys): each item's name,
     quantity, thread and length (grip plus nut or socket engagement, rounded up to LENGTH_STEP), and
-    what it joins. The bench bolts are the user's (their length depends on the bench)."""
-    t, tw, pj, cm, bs, ln = layout.tower, profile.tower, profile.projector, profile.camera, \
-        profile.beam_splitter, profile.lens
+    what it joins: the datum chain's dowels and bolts, the splitter seat's parts, the projector's
+    screws per shim stack, the camera's two screws, the splitter and the focusing lens (bought to
+    the catalogue specification: ``splitter_spec``, ``rigcad.optics.focus``)."""
+    t, tw, cm, bs, ln = layout.tower, profile.tower, profile.camera, profile.beam_splitter, profile.lens
     m4 = "M4"
     nut = NUT_FACTOR * MOUNT_THREADS[m4] + WASHER + 1.0  # + two threads of 0.7 mm pitch, rounded
-    through = _length(tw.wall + t.shelf_thickness, nut)
+    through = _length(tw.wall + t.shelf_thickness, nut)  # the lens mount's foot on the shelf
     shim_max = t.shims_per_stack * tw.shim_thickness
     bracket = t.bracket_y + t.wall_y[1]  # the camera bracket's thickness (y)
     _, _, _, lens_pts = _lens_foot(t, profile)
+    focus = focusing_lens(profile, layout.geometry)
     return [
-        {"item": "bolt, washer and nut", "thread": m4, "length_mm": through, "quantity": 4,
-         "joins": "the column's top flange to the shelf"},
-        {"item": "bolt, washer and nut", "thread": m4, "length_mm": through, "quantity": len(_holder_flange_points(t, profile)),
-         "joins": "the splitter holder's flanges to the shelf"},
+        *_column_hardware(profile, t, nut),
+        *_seat_hardware(profile, t, nut),
         {"item": "bolt, washer and nut", "thread": m4, "length_mm": through, "quantity": len(lens_pts),
          "joins": "the lens mount's slotted foot to the shelf"},
-        {"item": "bench bolt or screw", "thread": f"{tw.bolt_diameter:g} mm clearance holes", "length_mm": None,
-         "quantity": 4, "joins": "the column's foot to the bench (length: the bench's)"},
-        {"item": "screw and washer", "thread": pj.mount_thread,
-         "length_mm": _length(t.shelf_thickness + shim_max, SOCKET_ENGAGEMENT), "quantity": len(_projector_feet(t)),
-         "joins": "the projector's mounting holes, through the shelf's slots and its shim stacks"},
+        *_projector_screw_rows(profile, layout),
         {"item": "screw and washer", "thread": cm.mount_thread,
-         "length_mm": _length(bracket + shim_max, SOCKET_ENGAGEMENT), "quantity": 1,
-         "joins": "the camera's tripod socket, through the bracket's slot and its shim stack"},
+         "length_mm": _length(bracket + shim_max, SOCKET_ENGAGEMENT), "quantity": 2,
+         "joins": f"the camera's two mounting holes ({cm.mount_spacing:g} mm apart along its axis), through the "
+                  "bracket's slot and its shim stack"},
         {"item": "plate beam splitter", "thread": None, "length_mm": None, "quantity": 1,
-         "size_mm": [bs.width, bs.length, bs.thickness], "index": bs.index,
+         "size_mm": [bs.width, bs.length, bs.thickness], "index": bs.index, "spec": splitter_spec(profile),
          "joins": "slides into the splitter holder's grooves through its +y wall, coated face towards the projector"},
         {"item": "focusing lens", "thread": None, "length_mm": None, "quantity": 1,
-         "size_mm": [ln.diameter, ln.thickness], "joins": "drops into the lens mount's pocket"},
+         "size_mm": [ln.diameter, ln.thickness], "focal_length_mm": focus.focal_length,
+         "spec": f"plano-convex singlet, {ln.diameter:g} mm diameter, f = {focus.focal_length:g} mm, N-BK7, "
+                 "AR coated 400-700 nm; its flat side towards the projector",
+         "joins": "drops into the lens mount's pocket"},
     ]
+
+
+def splitter_spec(profile: Profile) -> str:
+    """The beam splitter as a catalogue would list it (size, ratio at 45 deg, coating, thickness)."""
+    bs = profile.beam_splitter
+    r = round(100 * bs.reflectance)
+    return (f"plate beam splitter, {bs.width:g} x {bs.length:g} mm, {bs.thickness:g} mm thick, {r}R/{100 - r}T at "
+            f"45 deg (400-700 nm), {bs.coating} coating on the front face, AR-coated back; the holder's grooves are "
+            f"cut for {bs.thickness:g} mm + {2 * GROOVE_GAP:g} mm")
 
 
 # -- the instruments and markers in rig.step -------------------------------------------------------
@@ -460,10 +714,19 @@ def _marker(name: str, p, color) -> Part:
                 f"marker: {name.replace('_', ' ')} at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) mm")
 
 
+def _seat_balls(profile: Profile, t: TowerLayout) -> tuple[Part, ...]:
+    """The splitter seat's three steel balls, each drawn as the cylinder it fills from the shelf's top
+    to its own top (0.8 of its diameter: it sinks 0.2 into its seat), under the holder's push screws."""
+    b = profile.adjusters.seat_ball
+    return tuple(Part(f"seat_ball_{i + 1}", Cylinder((x, y, t.shelf_top_z), b / 2, 0.8 * b), (0.8, 0.8, 0.85),
+                      f"{b:g} mm steel ball (DIN 5401) in the shelf's {kind}, under the holder's push screw")
+                 for i, (kind, (x, y)) in enumerate(seat_points(t, profile).items()))
+
+
 def instruments(profile: Profile, layout) -> tuple[Part, ...]:
     """The bought items as simple named solids in their working positions (not printed): projector
     and camera bodies and lenses, the beam splitter plate, the focusing lens, the nominal shim
-    stacks; and markers at the design COP and at the projector's and camera's real COPs."""
+    stacks, the splitter seat's balls; and markers at the design COP and at the projector's and camera's real COPs."""
     t = layout.tower
     tw, ln = profile.tower, profile.lens
     p = t.plate
@@ -499,6 +762,7 @@ def instruments(profile: Profile, layout) -> tuple[Part, ...]:
         Part("focusing_lens", Box((t.lens_x - ln.thickness / 2, -r, zc - r), (t.lens_x + ln.thickness / 2, r, zc + r)),
              glass, f"focusing lens {ln.diameter:g} mm (its square bounding box)"),
         *shims,
+        *_seat_balls(profile, t),
         Part("camera_shims", cam_shims, (0.9, 0.8, 0.3), f"{t.shims_nominal} shims behind the camera"),
         _marker("cop_marker", t.cop, (1.0, 0.1, 0.1)),
         _marker("projector_cop_marker", t.projector_cop, (1.0, 0.6, 0.1)),

@@ -57,6 +57,8 @@ class RawProfile:
     data: dict[str, Any]
     marks: dict[Key, str]
     sources: tuple[Path, ...]
+    #: The same files, resolved (child first): what a watcher of the profile watches.
+    files: tuple[Path, ...] = ()
 
     def where(self, key: Key) -> str | None:
         """The file:line that set ``key`` or, failing that, its nearest parent; None if unknown."""
@@ -321,4 +323,5 @@ def load_raw(spec: str | Path) -> RawProfile:
     for layer_data, layer_marks in reversed(layers):
         data = _merge(data, layer_data)
         marks.update({k: v for k, v in layer_marks.items() if k != ("extends",)})
-    return RawProfile(name=path.stem, data=data, marks=marks, sources=tuple(Path(_display(p)) for p in chain))
+    return RawProfile(name=path.stem, data=data, marks=marks, sources=tuple(Path(_display(p)) for p in chain),
+                      files=tuple(chain))

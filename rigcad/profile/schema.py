@@ -15,6 +15,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 from rigcad.errors import ProfileError
+from rigcad.profile import instruments as instrument_library
 from rigcad.profile.loader import Key, RawProfile
 from rigcad.units import DEG, UnitError, parse_quantity
 
@@ -35,6 +36,10 @@ MAX_COATING_LAYER_MM = 1.0
 #: the unified 1/4-20 and 3/8-16 UNC of camera tripod sockets (ISO 1222).
 MOUNT_THREADS: dict[str, float] = {"M3": 3.0, "M4": 4.0, "M5": 5.0, "M6": 6.0, "1/4-20 UNC": 6.35,
                                    "3/8-16 UNC": 9.525}
+
+#: Thread pitches (mm) of the same threads: ISO 261 coarse; UNC 20 and 16 threads per inch.
+THREAD_PITCH: dict[str, float] = {"M3": 0.5, "M4": 0.7, "M5": 0.8, "M6": 1.0, "1/4-20 UNC": 25.4 / 20,
+                                  "3/8-16 UNC": 25.4 / 16}
 
 _POS = {"lo": 0, "lo_open": True}
 
@@ -113,8 +118,12 @@ class LayoutParams:
 
 @dataclass(frozen=True)
 class ProjectorParams:
-    """The projector at the COP, looking down the optical axis."""
+    """The projector at the COP, looking down the optical axis. ``model`` picks an entry of the
+    instrument library (rigcad.profile.instruments): its sourced sizes replace the defaults below,
+    which stay ASSUMED otherwise (``rigcad.profile.instruments.measurements`` lists them)."""
 
+    model: str = spec("choice", "instrument library entry (rigcad.profile.instruments)", "benq_pb6210",
+                      choices=instrument_library.names("projector"))
     resolution: tuple[int, int] = spec("pixels", "[width, height] in pixels", [1024, 768])
     throw_ratio: float = spec("float", "throw distance / image width (sets the field of view)", 1.75,
                               lo=0, lo_open=True, hi=100)
@@ -134,13 +143,21 @@ class ProjectorParams:
                                 "0 mm")
     mount_thread: str = spec("choice", "thread of the body's mounting holes (ceiling mount; assumed)", "M4",
                              choices=tuple(MOUNT_THREADS))
+    mount_depth: float = spec("length", "depth of thread in the body's mounting holes (assumed: 8 mm, a ceiling "
+                              "mount's brass insert)", "8 mm", **_POS)
+    focus_min: float = spec("length", "nearest distance the projector's own lens focuses, from its COP (assumed: "
+                            "1 m, a business projector's)", "1 m", **_POS)
+    focus_max: float = spec("length", "farthest distance it focuses, from its COP (assumed: 10 m)", "10 m", **_POS,
+                            allow_inf=True)
 
 
 @dataclass(frozen=True)
 class CameraParams:
     """The camera, sharing the COP through the beam splitter: behind it on the optical axis, looking
-    down through the plate (thesis Figure 3.4, right)."""
+    down through the plate (thesis Figure 3.4, right). ``model``: as for the projector."""
 
+    model: str = spec("choice", "instrument library entry (rigcad.profile.instruments)", "prosilica_ec1350c",
+                      choices=instrument_library.names("camera"))
     resolution: tuple[int, int] = spec("pixels", "[width, height] in pixels", [1360, 1024])
     # The Prosilica EC 1350C of thesis 3.1: resolution from the thesis; the sizes are ASSUMED
     # (a C-mount FireWire machine-vision camera of its class), no datasheet at hand.
@@ -156,6 +173,8 @@ class CameraParams:
                                "16.5 mm", **_POS)
     mount_thread: str = spec("choice", "thread of the tripod hole in the mounting face (assumed)", "1/4-20 UNC",
                              choices=tuple(MOUNT_THREADS))
+    mount_spacing: float = spec("length", "between the two screws that hold the camera (its mounting holes, or a "
+                                "two-hole tripod adapter), along its optical axis (assumed)", "20 mm", **_POS)
 
 
 @dataclass(frozen=True)
@@ -167,6 +186,9 @@ class LensParams:
     thickness: float = spec("length", "edge thickness held by the mount (assumed)", "6 mm", **_POS)
     distance: float = spec("length", "from the projector's COP to the lens's centre, along the projector's axis",
                            "25 mm", **_POS)
+    focal_length: float | None = spec("length", "the lens's focal length; default: computed from the projector's "
+                                      "focus range and the path to the paraboloid, rounded to a catalogue value "
+                                      "(rigcad.optics.focus)", None, **_POS)
     rim: float = spec("length", "radial seat of the mount under the lens's edge (the clear aperture is the "
                       "diameter less twice this)", "2 mm", **_POS)
 
@@ -179,14 +201,21 @@ class BeamSplitterParams:
 
     width: float = spec("length", "plate width across the plane of incidence (assumed)", "50 mm", **_POS)
     length: float = spec("length", "plate length along the 45 deg slope (assumed)", "50 mm", **_POS)
-    thickness: float = spec("length", "plate thickness (assumed: a common 1 mm plate splitter)", "1 mm", **_POS)
+    thickness: float = spec("length", "plate thickness (catalogue plate beam splitters are 1.1 mm soda-lime or "
+                            "B270 float glass, or 1 / 3 mm N-BK7)", "1.1 mm", **_POS)
+    reflectance: float = spec("float", "fraction of the light the coated face reflects (to the projector's side); "
+                              "the camera gets the rest: 0.5 for a 50R/50T splitter", 0.5, lo=0, hi=1, lo_open=True,
+                              hi_open=True)
+    coating: str = spec("choice", "the front face's coating: dielectric (low absorption) or metallic (inconel, "
+                        "~ 20 % absorbed, little polarisation); the back face is anti-reflection coated",
+                        "dielectric", choices=("dielectric", "metallic"))
     index: float = spec("float", "refractive index of the plate (N-BK7 at 587.6 nm, 1.5168; the glass is assumed)",
                         1.5168, lo=1.0, hi=4.0)
 
 
 @dataclass(frozen=True)
 class TowerParams:
-    """The COP tower (rigcad.parts.tower): a column on the bench beside the rig, a shelf for the
+    """The COP tower (rigcad.parts.tower): a column on the base plate's datum tongue, a shelf for the
     projector at 90 deg that reaches over the optical axis, where the splitter holder (with the camera
     bracket above the splitter) and the lens mount stand. Adjustment travel is each way from the
     nominal position."""
@@ -207,6 +236,52 @@ class TowerParams:
                             "and the ray bundle", "5 mm", **_POS)
     bolt_diameter: float = spec("length", "clearance hole of the bolts joining the tower's parts (M4)", "4.5 mm",
                                 **_POS)
+
+
+@dataclass(frozen=True)
+class DatumParams:
+    """The rig's one reference (rigcad.parts.datum): the base plate. The tower's column stands on the
+    base plate's datum tongue, located by two dowel pins in reamed printed holes and held by bolts;
+    the shelf sits on the column the same way. The assumed print accuracy sets the error the chain
+    can hold (``rigcad.parts.datum.datum_chain``)."""
+
+    dowel_diameter: float = spec("length", "dowel pins locating each joint of the chain (ISO 8734, m6; the printed "
+                                 "holes are reamed to H7)", "4 mm", **_POS)
+    print_position: float = spec("length", "a printed feature's position error, fixed part (assumed: a calibrated "
+                                 "FDM printer, about half a 0.4 mm nozzle's width)", "0.1 mm", lo=0)
+    print_scale: float = spec("float", "a printed length's relative error (shrinkage, steps per mm; assumed 0.2 %)",
+                              0.002, lo=0, hi=0.05)
+    foot_flatness: float = spec("length", "out-of-flat of a printed foot or flange across its width (warp; "
+                                "assumed)", "0.1 mm", lo=0)
+
+
+@dataclass(frozen=True)
+class AdjusterParams:
+    """The adjusters (rigcad.parts.adjusters): what a hand can set, and the splitter's kinematic seat
+    (three screws on three balls in a cone, a vee and a flat, two springs holding it down)."""
+
+    turn_fraction: float = spec("float", "finest fraction of a turn a hand sets on a screw with a hex key "
+                                "(assumed: 1/8 turn, 45 deg)", 0.125, lo=0, hi=1, lo_open=True)
+    hand_slide: float = spec("length", "finest a hand sets a slide in a slot, against a caliper or a feeler gauge "
+                             "(assumed)", "0.1 mm", **_POS)
+    seat_thread: str = spec("choice", "thread of the splitter seat's push screws (set screws in heat-set inserts "
+                            "in the holder's flanges)", "M3", choices=tuple(MOUNT_THREADS))
+    seat_travel: float = spec("length", "travel of each seat screw, each way from its nominal setting", "1.5 mm",
+                              **_POS)
+    seat_ball: float = spec("length", "steel balls (DIN 5401) under the seat screws' tips", "3 mm", **_POS)
+
+
+@dataclass(frozen=True)
+class BuyParams:
+    """Print or buy each structural part (rigcad.parts.stock): a bought part is standard stock cut to
+    length; it is drawn in the rig, listed in the bill with its stock, and not printed."""
+
+    column: str = spec("choice", "the tower's column: print it, or buy a 40 x 40 mm aluminium extrusion (slot 8, "
+                       "M8 core tapped at both ends) with printed end plates", "print",
+                       choices=("print", "extrusion_40x40"))
+    shelf: str = spec("choice", "the tower's shelf: print it, or cut and drill it from aluminium plate (EN AW-5083) "
+                      "as thick as the printed one, with the same outline, holes and seats", "print",
+                      choices=("print", "aluminium_plate"))
 
 
 @dataclass(frozen=True)
@@ -450,6 +525,9 @@ SECTIONS: dict[str, type] = {
     "lens": LensParams,
     "beam_splitter": BeamSplitterParams,
     "tower": TowerParams,
+    "datum": DatumParams,
+    "adjusters": AdjusterParams,
+    "buy": BuyParams,
     "targets": TargetParams,
     "dome": DomeParams,
     "misalignment": MisalignmentParams,
@@ -482,6 +560,9 @@ class Profile:
     lens: LensParams
     beam_splitter: BeamSplitterParams
     tower: TowerParams
+    datum: DatumParams
+    adjusters: AdjusterParams
+    buy: BuyParams
     targets: TargetParams
     dome: DomeParams
     misalignment: MisalignmentParams
@@ -663,6 +744,19 @@ def read_section(raw: RawProfile, name: str, cls: type) -> Any:
     return cls(**values)
 
 
+def _with_model(raw: RawProfile, section: str, params: Any) -> Any:
+    """``params`` with its library entry's sourced sizes and resolution (``params.model``), but for the
+    keys the profile gives itself (a lab's measurement wins over the library)."""
+    from dataclasses import replace
+
+    entry = instrument_library.LIBRARY[params.model]
+    given = raw.data.get(section) or {}
+    updates = {k: v for k, v in entry.sizes.items() if k not in given}
+    if "resolution" not in given:
+        updates["resolution"] = entry.resolution
+    return replace(params, **updates)
+
+
 def validate(raw: RawProfile) -> Profile:
     """Check every key of ``raw`` and return the frozen :class:`Profile`."""
     valid_top = sorted(set(SECTIONS) | TOP_LEVEL)
@@ -672,6 +766,8 @@ def validate(raw: RawProfile) -> Profile:
                                f"{', '.join(valid_top)}",
                                where=raw.where((key,)))
     sections = {name: read_section(raw, name, cls) for name, cls in SECTIONS.items()}
+    for name in ("projector", "camera"):
+        sections[name] = _with_model(raw, name, sections[name])
     par: ParaboloidParams = sections["paraboloid"]
     pair_a = (par.vertical_extent, par.tangent_angle)
     pair_b = (par.focal_length, par.rim_radius)

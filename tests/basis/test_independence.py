@@ -1,6 +1,6 @@
 """rigcad.basis keeps its mathematical core pure: the modules that do the maths work on plain arrays
 and never reach into the rig's geometry, parts, exports or checks; the modules that wire the core to
-a Rig (projector images, simulated acquisition on the rig, the CLI) are named here, and the pure
+a Rig (projector images, simulated acquisition on the rig) are named here, and the pure
 ones may not import them either."""
 
 import ast
@@ -12,11 +12,11 @@ PKG = Path(rigcad.__file__).parent
 #: The mathematical core: numpy/scipy and each other only.
 PURE = {"__init__.py", "zonal.py", "gram.py", "brdf.py", "merl.py", "sh.py", "simulate.py"}
 #: The wiring to the rig: may import the Rig's stages (optics, check, parts, export, plots).
-WIRED = {"projector.py", "acquire.py", "cli.py"}
+WIRED = {"projector.py", "acquire.py"}
 #: What the pure modules must not import: the rig's stages, the wiring, and CAD kernels.
 FORBIDDEN = ("rigcad.check", "rigcad.parts", "rigcad.export", "rigcad.fab", "rigcad.profile", "rigcad.optics",
              "rigcad.cli", "rigcad.plots", "rigcad.rig", "rigcad.basis.projector", "rigcad.basis.acquire",
-             "rigcad.basis.cli", "build123d", "OCP", "cadquery", "manifold3d", "trimesh")
+             "build123d", "OCP", "cadquery", "manifold3d", "trimesh")
 
 
 def _imports(path: Path) -> list[str]:

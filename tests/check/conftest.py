@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from rigcad.check.scene import analytic_optics, mesh_optics, rig_meshes
+from rigcad.check.scene import analytic_optics, mesh_optics, mirror_meshes
 
 #: A coarse tessellation for fast tests: 66k + 121k triangles, built in ~0.5 s.
 COARSE = (0.01, 0.01)
@@ -29,7 +29,7 @@ def analytic(rig):
 
 @pytest.fixture(scope="session")
 def coarse_meshes(rig):
-    return rig_meshes(rig, None, *COARSE)
+    return mirror_meshes(rig, None, *COARSE)
 
 
 @pytest.fixture(scope="session")
@@ -39,7 +39,7 @@ def coarse(coarse_meshes):
 
 @pytest.fixture(scope="session")
 def fine(rig):
-    return mesh_optics(rig_meshes(rig, None, *FINE), "smooth")
+    return mesh_optics(mirror_meshes(rig, None, *FINE), "smooth")
 
 
 @pytest.fixture(scope="session")

@@ -10,7 +10,7 @@ import pytest
 
 from rigcad.check import meshtrace
 from rigcad.check import trace3d as T
-from rigcad.check.scene import mesh_optics, rig_meshes, share_scenes
+from rigcad.check.scene import mesh_optics, mirror_meshes, share_scenes
 from rigcad.check.sources import annulus_rays, pixel_rays
 from rigcad.optics.frames import Pose
 
@@ -18,7 +18,7 @@ from rigcad.optics.frames import Pose
 @pytest.fixture(scope="module")
 def default_meshes(rig):
     """The default profile's mirror meshes at its own tessellation tolerances (~0.8 M triangles)."""
-    return mesh_optics(rig_meshes(rig, None), "smooth")
+    return mesh_optics(mirror_meshes(rig, None), "smooth")
 
 
 def _rays(rig, seed):

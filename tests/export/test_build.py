@@ -29,7 +29,7 @@ def built(default_exports, table31_rig):
 
 
 def _stl_inputs(rig) -> dict:
-    """What `rigcad stl` hands build_rig besides the rig (rigcad.cli.cmd_stl): the design files and
+    """What `rigcad stl` hands build_rig besides the rig (rigcad.cli.stl.cmd_stl): the design files and
     the inputs key, so a build here writes the same tree as the shared one."""
     from rigcad.export.design import design_files
     from rigcad.export.manifest import inputs_key

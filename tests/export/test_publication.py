@@ -54,7 +54,7 @@ def _leftovers(exports: Path) -> list[Path]:
 
 
 def _stl(profile: Path, exports: Path, env=None, **kw):
-    return subprocess.Popen([sys.executable, "-m", "rigcad.cli", "stl", str(profile), "--exports", str(exports)],
+    return subprocess.Popen([sys.executable, "-m", "rigcad", "stl", str(profile), "--exports", str(exports)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, **kw)
 
 

@@ -121,13 +121,18 @@ def test_a_planted_lock_is_refused_and_what_it_names_is_untouched(tmp_path, kind
 
 
 def test_a_lock_rigcad_made_is_taken_again(tmp_path):
-    """The checks let rigcad's own lock through: empty (a run killed at once) or holding a holder line."""
+    """The checks let rigcad's own lock through: empty (released, or a run killed at once) or holding
+    a holder line (a run killed while it held the lock). Held, it names its holder for a run that
+    waits; released, it names no one, so the exports are the same bytes after every run."""
     lock = tmp_path / ".rig.lock"
-    hold_lock(lock).release()
+    held = hold_lock(lock)
     assert lock.read_text().startswith(f"pid {os.getpid()}: ")
+    held.release()
+    assert lock.read_bytes() == b""
+    lock.write_text("pid 1: rigcad stl achutha2006, since 12:00:00")  # killed while holding it
     hold_lock(lock).release()
-    lock.write_text("")
     hold_lock(lock).release()
+    assert lock.read_bytes() == b""
 
 
 def test_the_cli_refuses_a_linked_lock_in_one_line(tmp_path, capsys):

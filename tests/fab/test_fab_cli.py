@@ -14,7 +14,7 @@ from .conftest import ROOT, have_slicer
 
 def _fab(tmp_path, *args):
     env = dict(os.environ, RIGCAD_EVENTS="1", PYTHONPATH=str(ROOT))
-    return subprocess.run([sys.executable, "-m", "rigcad.cli", "fab", "achutha2006", "--exports", str(tmp_path), *args],
+    return subprocess.run([sys.executable, "-m", "rigcad", "fab", "achutha2006", "--exports", str(tmp_path), *args],
                           cwd=tmp_path, capture_output=True, text=True, env=env, timeout=600)
 
 

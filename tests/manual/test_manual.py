@@ -177,10 +177,10 @@ def test_the_manual_is_written_with_its_pictures_and_one_self_contained_page(wri
     assert f"| {pins['item']} | {pins['quantity']} |" in md
     assert "M4 x 25 mm socket-head bolt" in md
     assert (out / "calibration" / "circle.png").is_file()
-    from rigcad.manual.assembly import rig_meshes, steps
+    from rigcad.manual.assembly import picture_meshes, steps
 
     shots = sorted(p.name for p in (out / "images").glob("step_*.png"))
-    assert len(shots) == len(steps(rig_meshes(table31_rig))) and "step_05_dome.png" in shots
+    assert len(shots) == len(steps(picture_meshes(table31_rig))) and "step_05_dome.png" in shots
     assert md.count("### Step ") == len(shots)
 
 
@@ -194,7 +194,7 @@ def test_the_manual_is_deterministic(table31_rig, fab_reports, written):
 
 
 def test_rigcad_manual_refuses_an_unknown_printer_in_one_line(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "rigcad.cli", "manual", "achutha2006", "--printer", "nosuch",
+    run = subprocess.run([sys.executable, "-m", "rigcad", "manual", "achutha2006", "--printer", "nosuch",
                           "--exports", str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert run.returncode != 0 and run.stderr.startswith("rigcad: error:") and len(run.stderr.splitlines()) == 1
     assert "nosuch" in run.stderr and not any(tmp_path.iterdir())

@@ -16,7 +16,7 @@ from rigcad.parts import PARTS
 
 
 def _rigcad(*args, timeout=600):
-    return subprocess.run([sys.executable, "-m", "rigcad.cli", *args], capture_output=True, text=True, timeout=timeout)
+    return subprocess.run([sys.executable, "-m", "rigcad", *args], capture_output=True, text=True, timeout=timeout)
 
 
 def test_stl_names_every_part_it_built_in_aligned_columns(default_exports):

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from rigcad.manual import calibration as C
-from rigcad.manual.assembly import explode_offsets, rig_meshes
+from rigcad.manual.assembly import explode_offsets, picture_meshes
 from rigcad.manual.view import traced_rays, view_html
 
 CHROMIUM = Path("/usr/bin/chromium")
@@ -34,7 +34,7 @@ PIXEL_DIFF = 30
 
 @pytest.fixture(scope="module")
 def view(table31_rig, tmp_path_factory):
-    meshes = rig_meshes(table31_rig)
+    meshes = picture_meshes(table31_rig)
     rays = traced_rays(table31_rig)
     page = view_html(table31_rig, meshes, rays)
     path = tmp_path_factory.mktemp("view") / "rig.html"
@@ -93,9 +93,9 @@ def test_the_page_is_deterministic(view, table31_rig):
     import os
 
     path, page, meshes, rays = view
-    code = ("import hashlib, rigcad; from rigcad.manual.assembly import rig_meshes; "
+    code = ("import hashlib, rigcad; from rigcad.manual.assembly import picture_meshes; "
             "from rigcad.manual.view import traced_rays, view_html; rig = rigcad.load('achutha2006'); "
-            "print(hashlib.sha256(view_html(rig, rig_meshes(rig), traced_rays(rig))).hexdigest())")
+            "print(hashlib.sha256(view_html(rig, picture_meshes(rig), traced_rays(rig))).hexdigest())")
     res = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONHASHSEED": "3"},
                          capture_output=True, text=True, timeout=600)
     assert res.returncode == 0, res.stderr[-2000:]
@@ -196,7 +196,7 @@ def test_in_chromium_no_request_leaves_the_page_and_the_canvas_draws_the_rig(vie
 
 
 def test_rigcad_view_writes_the_page_and_the_picture(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "rigcad.cli", "view", "achutha2006", "--exports", str(tmp_path),
+    run = subprocess.run([sys.executable, "-m", "rigcad", "view", "achutha2006", "--exports", str(tmp_path),
                           "--rays", "60"], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     out = tmp_path / "achutha2006" / "view"

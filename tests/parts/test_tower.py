@@ -119,25 +119,28 @@ def test_projector_slots_travel_covers_the_tolerances(rig, shapes):
 
 
 def test_camera_slot_travel_covers_the_tolerances(rig, shapes):
-    # the camera's tripod screw moves in the bracket's slot by travel_along (z) and travel_across (x)
+    # both camera screws (two points, camera.mount_spacing apart along the axis) move in the bracket's
+    # slot by travel_along (z) and travel_across (x); 0.55 mm further along, the upper one meets it
     from rigcad.parts.recipe import Box
+    from rigcad.parts.tower import camera_screws
 
     t, tw, tol = rig.layout.tower, rig.profile.tower, rig.profile.tolerancing
     assert tw.travel_along >= tol.camera_height and tw.travel_across >= tol.camera_offset
     d = clearance_hole(rig.profile.camera.mount_thread) - 0.5
-    (cx0, _, cz0), (cx1, _, cz1) = t.camera_box
-    cx, cz = (cx0 + cx1) / 2, (cz0 + cz1) / 2
     holder = shapes["splitter_holder"]
     yo = t.wall_y[1]
+    screws = camera_screws(t, rig.profile)
+    assert screws[1][1] - screws[0][1] == pytest.approx(rig.profile.camera.mount_spacing)
 
     def fits(x, z):  # a square screw of side d along y through the bracket
         screw = _solid(Part("screw", Box((x - d / 2 + 0.05, -yo - 2, z - d / 2 + 0.05),
                                          (x + d / 2 - 0.05, t.bracket_y + 0.5, z + d / 2 - 0.05)), (0, 0, 0), ""))
         return _common(holder, screw) < CONTACT_MM3
 
-    for dx, dz in ((tw.travel_across, 0), (-tw.travel_across, 0), (0, tw.travel_along), (0, -tw.travel_along)):
-        assert fits(cx + dx, cz + dz), (dx, dz)
-    assert not fits(cx, cz + tw.travel_along + 0.55)
+    for cx, cz in screws:
+        for dx, dz in ((tw.travel_across, 0), (-tw.travel_across, 0), (0, tw.travel_along), (0, -tw.travel_along)):
+            assert fits(cx + dx, cz + dz), (dx, dz)
+    assert not fits(screws[1][0], screws[1][1] + tw.travel_along + 0.55)
     # shims across y: travel_across each way from the nominal stack
     assert t.shims_nominal * tw.shim_thickness >= tw.travel_across
     assert t.shims_per_stack * tw.shim_thickness >= 2 * tw.travel_across
@@ -171,12 +174,17 @@ def test_hardware_is_computed_from_the_parts(rig, write_profile, table31_text):
 
     items = hardware(rig.profile, rig.layout)
     m4 = [i for i in items if i["item"] == "bolt, washer and nut"]
-    assert sum(i["quantity"] for i in m4) == 4 + 4 + 2  # column, holder flanges, lens foot
-    assert all(i["length_mm"] == 25.0 for i in m4)  # 5 mm flange + 10 mm shelf + washer, nut, threads = 20.2 mm
-    screw = next(i for i in items if i["thread"] == rig.profile.projector.mount_thread and i["item"].startswith("screw"))
-    # more travel: more shims in each stack, a longer screw through them
+    assert sum(i["quantity"] for i in m4) == 4 + 2 + 4  # column top, lens foot, column foot on the tongue
+    # 5 mm flange + 10 mm shelf (or 10 mm base plate tongue) + washer, nut, threads = 20.2 mm
+    assert all(i["length_mm"] == 25.0 for i in m4)
+    springs = next(i for i in items if "spring" in i["item"])
+    assert springs["quantity"] == 2
+    screws = [i for i in items if i["thread"] == rig.profile.projector.mount_thread and i["item"].startswith("screw")]
+    # every stack from 0 to shims_per_stack has its screw, four of each length (one per foot)
+    assert sorted(n for i in screws for n in i["for_stacks_of_shims"]) == list(range(rig.layout.tower.shims_per_stack + 1))
+    # more travel: more shims in each stack, longer screws through the thickest
     more = Rig.from_profile(load_profile(write_profile(table31_text + "tower:\n  travel_across: 6 mm\n")))
-    screw2 = next(i for i in hardware(more.profile, more.layout) if i["item"].startswith("screw")
-                  and i["thread"] == more.profile.projector.mount_thread)
-    assert screw2["length_mm"] > screw["length_mm"]
+    screws2 = [i for i in hardware(more.profile, more.layout) if i["item"].startswith("screw")
+               and i["thread"] == more.profile.projector.mount_thread]
+    assert max(i["length_mm"] for i in screws2) > max(i["length_mm"] for i in screws)
     assert more.recipe("tower_shim").quantity == 5 * 24  # 12 mm of 0.5 mm shims per stack

@@ -1,4 +1,5 @@
-"""``rigcad tolerance`` and ``rigcad sweep`` (wired by rigcad.cli)."""
+"""``rigcad tolerance PROFILE``: the Monte Carlo tolerancing at scale (per-sample table, sensitivity,
+inverse limits), and the engine arguments and memory guard ``rigcad sweep`` shares."""
 
 from __future__ import annotations
 
@@ -21,7 +22,8 @@ TOLERANCE_BYTES_PER_RAY = 1000
 TOLERANCE_FIXED_BYTES = 400e6
 
 
-def _engine(args):
+def engine_from(args):
+    """The engine ``--workers`` and ``--scheduler`` ask for; a note on stderr when it has fewer workers."""
     from rigcad.engine import LOCAL_DASK, Engine, cores
 
     engine = Engine(workers=args.workers, scheduler=args.scheduler)
@@ -54,7 +56,8 @@ def checked_tolerance(samples: int, rays: int, engine, samples_flag: str, rays_f
                    "keeping every sample's row")
 
 
-def _engine_progress(update):
+def engine_progress(update):
+    """The engine's progress callback, feeding a progress bar's ``update(done)``."""
     return lambda tasks_done, tasks, done, total: update(done)
 
 
@@ -67,7 +70,7 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "tolerance")  # a planted link or lock: one line now, not after the work
     tol = profile.tolerancing
-    engine = _engine(args)
+    engine = engine_from(args)
     samples = tol.builds if args.samples is None else args.samples
     rays = tol.rays if args.rays is None else args.rays
     # --samples may pass tolerancing.builds' bound (at scale, on Dask): memory is its limit
@@ -88,7 +91,7 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
     rig = load(profile)
     t0 = time.perf_counter()
     with progress_bar(samples, f"tolerance {profile.name} ({engine.name})", "sample") as update:
-        mc = run_monte_carlo(rig, samples, rays, engine, progress=_engine_progress(update))
+        mc = run_monte_carlo(rig, samples, rays, engine, progress=engine_progress(update))
     mc_s = time.perf_counter() - t0
     limits = None
     limits_s = 0.0
@@ -98,7 +101,7 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
         t1 = time.perf_counter()
         with progress_bar(len(PARAMETERS), "inverse limits", "parameter") as update:
             limits = run_limits(rig, Job(rig, rays, 0, 0).key, rays, int(tol.seed) + 1, engine,
-                                progress=_engine_progress(update))
+                                progress=engine_progress(update))
         limits_s = time.perf_counter() - t1
     corr = rank_correlations(mc.columns) if samples > 2 else None
     run_info = {"engine": engine.name, "workers": engine.n_workers, "scheduler": args.scheduler,
@@ -124,58 +127,8 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_sweep(args: argparse.Namespace) -> int:
-    from rigcad.profile.schema import check_override
-    from rigcad.tolerance.sweep import finite_or_none, parse_set, run_sweep, sweep_csv
-
-    spec = parse_set(args.set)
-    engine = _engine(args)
-    checked_tolerance(len(spec.values), args.rays, engine, "--set (points)", "--rays", ("raycheck", "rays"))
-    check_override("raycheck", "rays", args.rays, "--rays")
-    from rigcad import plots
-    from rigcad.progress import progress_bar
-    from rigcad.export.atomic import Staging, json_bytes, profile_lock
-    from rigcad.fab.printers import load_printer
-    from rigcad.profile.loader import load_raw
-
-    raw = load_raw(args.profile)
-    from rigcad.export.atomic import check_exports
-
-    check_exports(args.exports, raw.name, "sweep")  # a planted link or lock: one line now, not after the work
-    printer = None if args.printer == "none" else load_printer(args.printer)
-    t0 = time.perf_counter()
-    with progress_bar(len(spec.values), f"sweep {spec.name} ({engine.name})", "design") as update:
-        rows = run_sweep(raw, spec, args.rays, 2006, printer, engine, progress=_engine_progress(update))
-    wall = time.perf_counter() - t0
-    out = Path(args.exports) / raw.name / "sweep" / spec.name
-    scale = 1.0
-    unit = spec.unit or "-"
-    cols = [("dome_width_mm", "dome width (mm)"), ("check_max_spot_radius_mm", "max spot radius (mm)"),
-            ("check_theta_min_deg", "traced theta min (deg)"), ("check_px_per_deg_min", "min px/deg")]
-    if printer is not None:
-        cols.append(("parts_to_split_count", f"parts to split ({printer.name})"))
-    plot_rows = [dict(r, value=r["value"] * scale) for r in rows]
-    files = {"sweep.csv": sweep_csv(spec, rows),
-             "sweep.json": json_bytes({"key": spec.name, "unit": spec.unit, "values": list(spec.values),
-                                       "rays": args.rays,
-                                       "rows": [{k: finite_or_none(v) for k, v in r.items()} for r in rows]}),
-             "sweep.png": plots.sweep_plot(spec.name, unit, plot_rows, cols)}
-    with Staging(out, profile_lock(Path(args.exports), raw.name), carry=lambda rel: False) as stage:
-        for name, data in files.items():
-            stage.write_bytes(out / name, data)
-        paths = stage.commit()
-    good = [r for r in rows if r["ok"]]
-    print(f"{raw.name}: {len(rows)} designs of {spec.name} on {engine.name} in {wall:.1f} s; "
-          f"{len(good)} built, {len(rows) - len(good)} refused")
-    for r in rows:
-        if not r["ok"]:
-            print(f"  {spec.name} = {r['value']:.6g} {spec.unit}: {r['error']}", file=sys.stderr)
-    for p in paths:
-        print(f"  wrote {p}")
-    return 0
-
-
-def _engine_args(p: argparse.ArgumentParser) -> None:
+def engine_args(p: argparse.ArgumentParser) -> None:
+    """``--workers`` and ``--scheduler``, shared by ``tolerance`` and ``sweep``."""
     from rigcad.arguments import worker_count
 
     p.add_argument("--workers", type=worker_count, default=0,
@@ -183,34 +136,20 @@ def _engine_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scheduler", metavar="ADDR",
                    help="run the tasks on Dask: a dask.distributed scheduler address (tcp://host:8786) or "
                         "'local-dask' (a LocalCluster of --workers processes); needs pip install 'rigcad[dask]'")
-    p.add_argument("--exports", default="exports", help="exports root (default: exports)")
 
 
 def register(subparsers) -> None:
-    """Add ``tolerance`` and ``sweep`` to rigcad's subcommands."""
-    from rigcad.arguments import positive_int
+    """Add ``tolerance`` to rigcad's subcommands."""
+    from rigcad.arguments import positive_int, profile_command
 
-    p = subparsers.add_parser(
-        "tolerance", help="Monte Carlo tolerancing at scale: per-sample table, sensitivity, inverse limits",
+    p = profile_command(
+        subparsers, "tolerance", cmd_tolerance,
+        help="Monte Carlo tolerancing at scale: per-sample table, sensitivity, inverse limits",
         description="Trace --samples random builds (tolerancing.*) through the analytic tracer on this machine's "
                     "cores (joblib) or Dask; write exports/<profile>/tolerance/{samples.parquet, samples.csv, "
                     "summary.json, tolerance.md, histograms.png, sensitivity.png, run.json}. Exit 1 when the "
                     "yield is below tolerancing.min_yield.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--samples", type=positive_int, help="random builds (default: tolerancing.builds)")
     p.add_argument("--rays", type=positive_int, help="pinhole rays per light path (default: tolerancing.rays)")
     p.add_argument("--no-limits", action="store_true", help="skip the sensitivity ranking and inverse limits")
-    _engine_args(p)
-    p.set_defaults(func=cmd_tolerance)
-
-    s = subparsers.add_parser(
-        "sweep", help="parameter sweep: one row per design (design, check and printer-fit figures)",
-        description="Build one design per value of --set section.key=A..B:N (or v1,v2,...; units as in a "
-                    "profile, e.g. layout.cop_to_vertex=25cm..35cm:21) on the same engine as tolerance; write "
-                    "exports/<profile>/sweep/<key>/{sweep.csv, sweep.json, sweep.png}.")
-    s.add_argument("profile", help="profile name (under profiles/) or path")
-    s.add_argument("--set", required=True, metavar="SECTION.KEY=A..B:N", help="the swept key and its values")
-    s.add_argument("--rays", type=positive_int, default=20000, help="pinhole rays of each design's check (default 20000)")
-    s.add_argument("--printer", default="prusa_mk3s", help="printer for the fit column, or 'none' (default prusa_mk3s)")
-    _engine_args(s)
-    s.set_defaults(func=cmd_sweep)
+    engine_args(p)

@@ -1,4 +1,4 @@
-"""``rigcad check PROFILE``: the 3D ray check from the command line (wired by rigcad.cli)."""
+"""``rigcad check PROFILE``: the 3D ray check from the command line."""
 
 from __future__ import annotations
 
@@ -59,10 +59,9 @@ def checked_counts(profile, rays: int | None, builds: int | None) -> None:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from rigcad.check.raycheck import run_raycheck, write_raycheck
+    from rigcad import api
     from rigcad.check.tolerances import raise_if_failed, table
-    from rigcad.export.atomic import check_exports, profile_lock
-    from rigcad.export.manifest import profile_digest
+    from rigcad.export.atomic import check_exports
     from rigcad.profile import load_profile
     from rigcad.rig import load
 
@@ -74,7 +73,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     from rigcad.check.trace3d import counting
 
     exports = Path(args.exports)
-    mirrors = exports / profile.name / "mirrors"
+    mirrors = api.default_folder(profile.name, "mirrors", root=exports)
     missing = [n for n in ("paraboloid", "dome") if not (mirrors / f"{n}.ply").is_file()]
     if missing and (args.mode or profile.raycheck.mode) != "analytic":
         print(f"note: no exported {' and '.join(missing)} mesh in {mirrors}/ (run `rigcad stl {args.profile}`): "
@@ -86,10 +85,9 @@ def cmd_check(args: argparse.Namespace) -> int:
                 print(f"  {label} ...", file=sys.stderr)
 
         with counting(bar):
-            result = run_raycheck(rig, exports=exports, rays=args.rays, mode=args.mode,
-                                  monte_carlo=not args.no_monte_carlo, builds=args.builds, progress=step)
-    paths = write_raycheck(result, exports / profile.name / "check", profile_lock(exports, profile.name),
-                           made_from=profile_digest(profile))
+            result = api.check(rig, args.rays, args.mode, exports, monte_carlo=not args.no_monte_carlo,
+                               builds=args.builds, progress=step)
+    paths = api.write_check(rig, result, api.default_folder(profile.name, "check", root=exports))
     rep = result.report
     main = rep["readings"][rep["mode"]]
     print(f"{profile.name}: mode {rep['mode']}, {rep['rays']} rays, backend {rep['backend']}")
@@ -100,6 +98,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     if meshed and not missing:
         print(f"  note: meshed from the profile, not the exports: {', '.join(meshed)}", file=sys.stderr)
     print(table(result.rows))
+    if args.verbose:  # the run's times: not in raycheck.json, which is the same bytes on every run
+        for stage, seconds in result.timings_s.items():
+            print(f"  time {stage}: {seconds:.2f} s", file=sys.stderr)
     for p in paths:
         print(f"  wrote {p}")
     raise_if_failed(result.rows, profile.name)
@@ -108,20 +109,18 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``check`` to rigcad's subcommands."""
-    from rigcad.arguments import positive_int
+    from rigcad.arguments import positive_int, profile_command
 
-    p = subparsers.add_parser(
-        "check", help="3D ray check: trace the mirror meshes, compare with the exact surfaces and the targets",
+    p = profile_command(
+        subparsers, "check", cmd_check,
+        help="3D ray check: trace the mirror meshes, compare with the exact surfaces and the targets",
         description="Trace rays from the COP through the mirror meshes (Embree; exported PLYs when present, "
                     "else meshed from the profile), the exact surfaces and the occluders; write "
                     "exports/<profile>/check/{raycheck.json, spot.png, theta_map.png}; exit 1 with a table when "
                     "a tolerance declared in the profile (raycheck.*, tolerancing.*) is not met.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
-    p.add_argument("--exports", default="exports", help="exports root (default: exports)")
     p.add_argument("--rays", type=positive_int, help="pinhole rays (default: raycheck.rays)")
     p.add_argument("--mode", choices=("mesh", "smooth", "analytic"), help="reading checked (default: raycheck.mode)")
     p.add_argument("--builds", type=positive_int, help="Monte Carlo builds (default: tolerancing.builds)")
     p.add_argument("--no-monte-carlo", action="store_true", help="skip the Monte Carlo tolerance analysis")
-    p.add_argument("-v", "--verbose", action="store_true", help="print stages on stderr")
-    p.set_defaults(func=cmd_check)
+    p.add_argument("-v", "--verbose", action="store_true", help="print stages and their times on stderr")
     return p

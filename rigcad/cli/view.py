@@ -1,5 +1,4 @@
-"""``rigcad view PROFILE`` and ``rigcad manual PROFILE --printer NAME`` from the command line (wired
-into rigcad.cli by :func:`register`)."""
+"""``rigcad view PROFILE``: the assembled rig in 3D, one self-contained HTML file."""
 
 from __future__ import annotations
 
@@ -30,46 +29,28 @@ def cmd_view(args: argparse.Namespace) -> int:
         rig = load(profile)
         step("dome integrated")
         out = Path(args.exports) / rig.name / "view"
-        r = write_view(rig, out, profile_lock(args.exports, rig.name), progress=step, rays=args.rays)
+        r = write_view(rig, out, profile_lock(args.exports, rig.name), progress=step, rays=args.rays, glb=args.glb)
     print(f"{rig.name}: 3D view of {len(r['parts'])} part(s) ({', '.join(r['parts'])}), {r['triangles']} triangles, "
           f"{r['rays']} of {r['rays_traced']} rays reach the sample")
     print(f"  wrote {r['html']} ({r['html_bytes'] / 1e6:.2f} MB, self-contained: open it in a browser, offline)")
     print(f"  wrote {r['png']}")
+    if args.glb:
+        print(f"  wrote {r['glb']} (binary glTF: a named node per part, the rays as lines; mm, +z up)")
     return 0
 
 
-def cmd_manual(args: argparse.Namespace) -> int:
-    from rigcad.manual.document import cmd_manual as run
-
-    return run(args)
-
-
 def register(subparsers) -> None:
-    """Add ``view`` and ``manual`` to rigcad's subcommands."""
-    from rigcad.arguments import positive_int
+    """Add ``view`` to rigcad's subcommands."""
+    from rigcad.arguments import positive_int, profile_command
 
-    p = subparsers.add_parser(
-        "view", help="the assembled rig in 3D: one self-contained HTML file (three.js inline, no network)",
+    p = profile_command(
+        subparsers, "view", cmd_view,
+        help="the assembled rig in 3D: one self-contained HTML file (three.js inline, no network)",
         description="Write exports/<profile>/view/rig.html: the assembled rig (parts toggled by name), a few hundred "
                     "rays traced through the exact surfaces and coloured by incidence angle, an exploded view; one "
                     "file with three.js and the geometry inside, nothing loaded from the network. Also "
                     "exports/<profile>/view/rig.png, a picture of the assembled rig.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--rays", type=positive_int, default=300, help="rays traced from the COP (default: 300)")
-    p.set_defaults(func=cmd_view)
-
-    m = subparsers.add_parser(
-        "manual", help="assembly and calibration manual with the bill of materials, for a profile and a printer",
-        description="Write exports/<profile>/manual/<printer>/: manual.md and manual.html (printable, self-contained) "
-                    "with the bill of materials (printed pieces with time and filament from `rigcad fab`, bolts, "
-                    "nuts, dowel pins, optics, paint and clearcoat volumes), the steps (print, sand, coat, "
-                    "assemble with exploded views, calibrate as thesis 4.1.1) and the calibration image at the "
-                    "projector's resolution. Runs `rigcad fab` for the printer when its report is missing or stale.")
-    m.add_argument("profile", help="profile name (under profiles/) or path")
-    m.add_argument("--printer", required=True, help="printer name (under printers/ on the profile search path) or path")
-    m.add_argument("--exports", default="exports", help="output root (default: exports)")
-    m.add_argument("--gcode", action="store_true",
-                   help="slice the pieces with PrusaSlicer so that times and filament are the slicer's (cached "
-                        "per piece); default: rigcad's estimate")
-    m.set_defaults(func=cmd_manual)
+    p.add_argument("--glb", action="store_true", help="also write rig.glb: the assembled rig as one binary glTF "
+                                                      "(named nodes, colours, the rays as lines) for Blender, YACV "
+                                                      "or any glTF viewer")

@@ -1,13 +1,12 @@
 """``rigcad basis PROFILE [--order N] [--exports DIR] [--alpha-deg A] [--lowdin] [--simulate]``: the
 projector images of the zonal basis, their Gram matrices and (``--simulate``) the simulated
-acquisition on the rig, from the command line (wired into rigcad.cli by :func:`register`)."""
+acquisition on the rig, from the command line."""
 
 from __future__ import annotations
 
 import argparse
 import math
 import time
-from pathlib import Path
 
 
 def _order(text: str):
@@ -19,11 +18,10 @@ def _order(text: str):
 
 
 def cmd_basis(args: argparse.Namespace) -> int:
-    from rigcad.basis.acquire import simulate_on_rig, simulation_steps, write_simulation
-    from rigcad.basis.projector import BASIS_STEPS, check_basis_order, projector_basis, write_basis
+    from rigcad import api
+    from rigcad.basis.acquire import simulate_on_rig, simulation_steps
+    from rigcad.basis.projector import BASIS_STEPS, check_basis_order
     from rigcad.progress import stages
-    from rigcad.export.atomic import profile_lock
-    from rigcad.export.manifest import profile_digest
     from rigcad.rig import load
 
     order = check_basis_order(_order(args.order))  # before any work: a bad order is one line, nothing written
@@ -42,21 +40,19 @@ def cmd_basis(args: argparse.Namespace) -> int:
                              f"{profile.camera.resolution[1]} px camera would be sampled at fewer than 2 x 2 pixels; "
                              f"valid: 1..{largest}")
     rig = load(profile)
-    out = Path(args.exports) / rig.name / "basis"
-    # the one lock of everything under exports/<profile>: a design or build publishing the whole
-    # folder meanwhile waits, instead of deleting this run's staging folder
-    lock = profile_lock(args.exports, rig.name)
-    made_from = profile_digest(rig.profile)
+    # written under the one lock of everything under exports/<profile>: a design or build publishing
+    # the whole folder meanwhile waits, instead of deleting this run's staging folder
+    out = api.default_folder(rig.name, "basis", root=args.exports)
     total = BASIS_STEPS + (order + 1) ** 2 + 1 + (simulation_steps() if args.simulate else 0)
     t0 = time.perf_counter()
     with stages(total, f"basis {rig.name}") as step:
-        basis = projector_basis(rig, order, alpha_rad=alpha, progress=step)
-        paths = write_basis(basis, out, lowdin_images=args.lowdin, progress=step, lock=lock, made_from=made_from)
+        basis = api.basis(rig, order, alpha, progress=step)
+        paths = api.write_basis(rig, basis, out, lowdin_images=args.lowdin, progress=step)
         t_images = time.perf_counter() - t0
         sim = None
         if args.simulate:
             sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step)
-            paths += write_simulation(sim, out, lock, made_from)
+            paths += api.write_simulation(rig, sim, out)
     rep = basis.report
     z, px, sa = rep["zone"], rep["projector"], rep["solid_angle"]
     print(f"{rig.name}: zonal basis to order {order} ({rep['functions']} functions) over "
@@ -102,10 +98,11 @@ def cmd_basis(args: argparse.Namespace) -> int:
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``basis`` to rigcad's subcommands."""
     from rigcad.basis import CAMERA_STRIDE_PX
-    from rigcad.arguments import positive_int
+    from rigcad.arguments import positive_int, profile_command
 
-    p = subparsers.add_parser(
-        "basis", help="zonal basis images for the projector, Gram matrices, simulated acquisition",
+    p = profile_command(
+        subparsers, "basis", cmd_basis,
+        help="zonal basis images for the projector, Gram matrices, simulated acquisition",
         description="Compute the zonal basis functions (thesis 3.3) at every projector pixel's incidence "
                     "direction (the rig's own map; pixels that do not reach the sample black), preprocess them as "
                     "thesis 4.2.1 (one scale, positive and negative parts, 8 and 16 bit) and write "
@@ -114,9 +111,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "matrices over the lit pixels, the re-orthonormalised set). --simulate adds the thesis's "
                     "basis validation (3.3.1) on the rig as designed and moved within its tolerances: "
                     "simulation.json and simulation.png.")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--order", default="6", help="largest l, 0..12 (default 6: thesis 3.3.1, specular materials)")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--alpha-deg", type=float, help="the zone's lower edge in degrees (default: the rig's occlusion "
                                                    "limit, its lowest measurable incidence angle)")
     p.add_argument("--lowdin", action="store_true", help="also write the re-orthonormalised (Loewdin) images")
@@ -125,5 +120,4 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--camera-stride-px", type=positive_int, default=CAMERA_STRIDE_PX,
                    help=f"simulate every N-th camera pixel in both directions (default {CAMERA_STRIDE_PX}: ~50 "
                         "exitant directions)")
-    p.set_defaults(func=cmd_basis)
     return p

@@ -1,11 +1,10 @@
 """`rigcad fab PROFILE --printer NAME [--exports DIR] [--gcode] [--parts ...] [--jobs N]`:
-the fabrication stage from the command line. Wired into rigcad.cli by :func:`register`."""
+the fabrication stage from the command line."""
 
 from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from rigcad.units import hours_minutes
 
@@ -14,8 +13,9 @@ def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.fab.printers import load_printer
 
     printer = load_printer(args.printer)  # first: a refused printer file costs no rig and no CAD kernel import
-    from rigcad.progress import stages
+    from rigcad import api
     from rigcad.export.build import select_parts
+    from rigcad.progress import stages
     from rigcad.export.atomic import check_exports
     from rigcad.profile import load_profile
     from rigcad.rig import load
@@ -23,7 +23,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "fab")  # a planted link or lock: one line now, not after the work
     rig = load(profile)
-    out = Path(args.exports) / profile.name / "fab" / printer.name
+    out = api.default_folder(profile.name, "fab", printer.name, root=args.exports)
     names = select_parts(args.parts)
     with stages(len(names), f"fab {profile.name}") as step:
         def progress(msg: str) -> None:
@@ -31,7 +31,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
             if args.verbose:
                 print(f"  {msg}", file=sys.stderr)
 
-        res = rig.fab(printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs, progress=progress,
+        res = api.fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs, progress=progress,
                       slicing=lambda total: stages(total, f"slicing ({printer.slicer})"))
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")
@@ -55,6 +55,8 @@ def cmd_fab(args: argparse.Namespace) -> int:
                 est = sum(pc["estimate"]["print_time_s"] for pc in e["pieces"])
                 extra += f"; est. {hours_minutes(est)}, {sum(pc['estimate']['material_g'] for pc in e['pieces']):.0f} g"
             print(f"  {name}: {len(e['pieces'])} piece(s), {orient}, {e['layers_total']} layers{extra}")
+        elif e.get("process") == "bought":
+            print(f"  {name}: bought, not printed ({e['stock']})")
         elif "error" not in e:
             print(f"  {name}: outlines/{name}.dxf, .svg" + (" (+ _printed, _sanded stages)" if "stages" in e else ""))
     if "slicer_print_time_s" in tot:
@@ -74,25 +76,23 @@ def cmd_fab(args: argparse.Namespace) -> int:
 
 
 def register(subparsers) -> argparse.ArgumentParser:
-    """Add the `fab` command to rigcad's subparsers (rigcad.cli.build_parser)."""
-    from rigcad.arguments import positive_int
+    """Add the `fab` command to rigcad's subparsers (rigcad.cli.main.build_parser)."""
+    from rigcad.arguments import positive_int, profile_command
     from rigcad.profile.paths import PRINTERS_SUBDIR, names_on_search_path  # not fab.printers: no numpy for --help
 
-    p = subparsers.add_parser(
-        "fab", help="fabrication: fit/split, print orientation, staircase, G-code, cutting outlines, report",
+    p = profile_command(
+        subparsers, "fab", cmd_fab,
+        help="fabrication: fit/split, print orientation, staircase, G-code, cutting outlines, report",
         description="Fit every part to a printer (splitting it into pinned pieces when it does not fit), orient "
                     "each piece for the least staircase on its mirror, slice it in-process (layers, staircase map, "
                     "polishing allowance, optical effect), write STL in print position, G-code through PrusaSlicer "
                     "(--gcode), DXF/SVG outlines of the templates, fab.json and fab.md into "
                     "exports/<profile>/fab/<printer>/.",
         epilog="printers: " + ", ".join(names_on_search_path(PRINTERS_SUBDIR)) + "; parts: as for `rigcad build --help`")
-    p.add_argument("profile", help="profile name (under profiles/) or path")
     p.add_argument("--printer", required=True, help="printer name (under profiles/printers/) or path")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--gcode", action="store_true", help="also slice with PrusaSlicer (printers with slicer: prusa-slicer)")
     p.add_argument("--parts", nargs="+", metavar="PART", help="only these parts (default: all)")
     p.add_argument("--jobs", type=positive_int, default=None, help="slicer processes at once (default: cores, at most 4)")
     p.add_argument("--timings", action="store_true", help="print the time of each stage and slicer run")
     p.add_argument("-v", "--verbose", action="store_true", help="name each part as it is processed")
-    p.set_defaults(func=cmd_fab)
     return p

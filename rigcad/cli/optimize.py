@@ -1,4 +1,4 @@
-"""``rigcad optimize PROFILE``: inverse design from the command line (wired by rigcad.cli)."""
+"""``rigcad optimize PROFILE``: inverse design from the command line."""
 
 from __future__ import annotations
 
@@ -91,20 +91,19 @@ def cmd_optimize(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``optimize`` to rigcad's subcommands."""
-    from rigcad.arguments import positive_int, worker_count
+    from rigcad.arguments import positive_int, profile_command, worker_count
 
-    p = subparsers.add_parser(
-        "optimize", help="inverse design: search the profile's optimize: section for the rig that meets its targets",
+    p = profile_command(
+        subparsers, "optimize", cmd_optimize,
+        profile_help="profile name (under profiles/) or path, with an optimize: section",
+        help="inverse design: search the profile's optimize: section for the rig that meets its targets",
         description="Seeded global search (differential evolution for one objective, NSGA-II for two or more) "
                     "and a local polish over the free parameters of the profile's optimize: section, under its "
                     "constraints; writes exports/<profile>/optimize/{<profile>_design.yaml, optimize.json, "
                     "history.png, pareto.png}. Exit 1 naming the constraint that could not be met.",
         epilog="Example: rigcad optimize achutha2006_optimize (profiles/achutha2006_optimize.yaml)")
-    p.add_argument("profile", help="profile name (under profiles/) or path, with an optimize: section")
-    p.add_argument("--exports", default="exports", help="output root (default: exports)")
     p.add_argument("--seed", type=int, help="seed (default: optimize.seed)")
     p.add_argument("--evaluations", type=positive_int, help="evaluation budget (default: optimize.evaluations)")
     p.add_argument("--workers", type=worker_count, help="worker processes, 0 = every core (default: optimize.workers)")
     p.add_argument("--scheduler", help="a Dask scheduler address, or local-dask (default: loky / serial)")
-    p.set_defaults(func=cmd_optimize)
     return p

@@ -1,0 +1,52 @@
+"""``rigcad design PROFILE``: the 2D optical design (dome profile, ray diagram, derived figures)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from rigcad.export.atomic import check_exports, profile_lock
+from rigcad.progress import stages
+
+
+def cmd_design(args: argparse.Namespace) -> int:
+    from rigcad.profile import load_profile
+
+    profile = load_profile(args.profile)  # first: a refused profile is one line, before numpy is imported
+    check_exports(args.exports, profile.name)  # a planted link or lock: one line now, not after the work
+    from rigcad.export.design import write_design
+    from rigcad.rig import load
+
+    with stages(3, "design") as step:
+        rig = load(profile)
+        step("dome integrated")
+        design = rig.design
+        step("traced")
+        out_dir = Path(args.exports) / rig.name
+        paths = write_design(design, out_dir, profile_lock(args.exports, rig.name))
+        step("written")
+    r = design.report
+    env, rng, px = r["envelope"], r["measurable_range"], r["pixels"]
+    print(f"{rig.name}: dome {env['width_mm']:.1f} x {env['height_mm']:.1f} mm "
+          f"({env['width_in']:.2f} x {env['height_in']:.2f} in), theta {rng['theta_min_deg']:.2f}..{rng['theta_max_deg']:.1f} deg, "
+          f"dome by {r['dome']['method']} (error vs closed form {r['dome']['error_vs_equal_path_mm']:.2g} mm), "
+          f"max miss at O {r['convergence']['max_miss_mm']:.2g} mm"
+          + (f", {px['vertex_to_rim_px']:.0f} px vertex to rim" if px["vertex_to_rim_px"] else ""))
+    if not rng["targets_met"]:
+        print(f"warning: the design covers theta {rng['theta_min_deg']:.2f}..{rng['theta_max_deg']:.2f} deg, "
+              f"not the target {rng['target_theta_min_deg']:g}..{rng['target_theta_max_deg']:g} deg", file=sys.stderr)
+    for p in paths:
+        print(f"  wrote {p}")
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``design`` to rigcad's subcommands."""
+    from rigcad.arguments import profile_command
+
+    p = profile_command(
+        subparsers, "design", cmd_design,
+        help="2D optical design: dome profile, ray diagram, derived figures",
+        description="Integrate the dome profile, trace the design in 2D (pinhole, thin lens, misalignment) "
+                    "and write exports/<profile>/design.json, dome_profile.csv, rays.png and incidence.png.")

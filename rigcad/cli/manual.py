@@ -1,0 +1,53 @@
+"""``rigcad manual PROFILE --printer NAME``: the assembly and calibration manual, after ``rigcad fab``
+for that printer (run again when its report is missing or stale)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+
+def cmd_manual(args: argparse.Namespace) -> int:
+    from rigcad import api
+    from rigcad.export.atomic import check_exports, profile_lock
+    from rigcad.fab.printers import load_printer
+    from rigcad.manual.document import write_manual
+    from rigcad.profile import load_profile
+    from rigcad.progress import stages
+    from rigcad.rig import load
+
+    printer = load_printer(args.printer)  # a refused printer file costs no rig
+    profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name, "manual")  # a planted link or lock: one line now, not after the work
+    rig = load(profile)
+    root = Path(args.exports) / rig.name
+    total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
+    with stages(total, f"manual {rig.name} ({printer.name})") as step:
+        fab = api.fab(rig, printer, root / "fab" / printer.name, gcode=args.gcode, progress=step)
+        for problem in fab.problems:
+            print(f"rigcad: fab: {problem}", file=sys.stderr)
+        out = root / "manual" / printer.name
+        written = write_manual(rig, printer, fab.report, out, profile_lock(args.exports, rig.name), progress=step)
+    html_path = out / "manual.html"
+    print(f"{rig.name}: manual for {printer.name} -> {out}/ (manual.md, manual.html "
+          f"{html_path.stat().st_size / 1e6:.1f} MB, {len(written)} files)")
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``manual`` to rigcad's subcommands."""
+    from rigcad.arguments import profile_command
+
+    m = profile_command(
+        subparsers, "manual", cmd_manual,
+        help="assembly and calibration manual with the bill of materials, for a profile and a printer",
+        description="Write exports/<profile>/manual/<printer>/: manual.md and manual.html (printable, self-contained) "
+                    "with the bill of materials (printed pieces with time and filament from `rigcad fab`, bolts, "
+                    "nuts, dowel pins, optics, paint and clearcoat volumes), the steps (print, sand, coat, "
+                    "assemble with exploded views, calibrate as thesis 4.1.1) and the calibration image at the "
+                    "projector's resolution. Runs `rigcad fab` for the printer when its report is missing or stale.")
+    m.add_argument("--printer", required=True, help="printer name (under printers/ on the profile search path) or path")
+    m.add_argument("--gcode", action="store_true",
+                   help="slice the pieces with PrusaSlicer so that times and filament are the slicer's (cached "
+                        "per piece); default: rigcad's estimate")

@@ -1,0 +1,89 @@
+"""``rigcad profile show PROFILE [--json]``: every resolved parameter with the file:line that set it,
+and the derived geometry (closed forms: no dome is integrated to show them)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from dataclasses import fields
+
+from rigcad.units import DEG
+
+
+def _fmt(spec, value) -> str:
+    if value is None:
+        return "-"
+    if spec.kind == "length":
+        return "inf" if math.isinf(value) else f"{value:.6g} mm"
+    if spec.kind == "angle":
+        return f"{value / DEG:.6g} deg"
+    if spec.kind == "layers":
+        return "; ".join(f"{name} {t / 0.0254:.4g} mil" for name, t in value) + f" (total {sum(t for _, t in value) / 0.0254:.4g} mil)"
+    return str(list(value) if isinstance(value, tuple) else value)
+
+
+def _columns(row, widths) -> str:
+    """One line of a table: each cell padded to its column's width (the widest cell), the last free."""
+    return " ".join(f"{cell:<{w}}" for cell, w in zip(row, widths)) + " " + " ".join(row[len(widths):])
+
+
+def cmd_show(args: argparse.Namespace) -> int:
+    from rigcad.export.atomic import json_bytes
+    from rigcad.profile import derive, load_profile
+    from rigcad.profile.schema import SECTIONS
+
+    profile = load_profile(args.profile)
+    geo = derive(profile)  # the profile's own figures; no dome is integrated to show them
+    if args.json:
+        sys.stdout.write(json_bytes({"parameters": profile.as_dict(), "derived": geo.as_dict()}).decode())
+        return 0
+    print(f"profile {profile.name}  ({' <- '.join(profile.sources)})")
+    if profile.description:
+        print(f"  {profile.description}")
+    table = {section: [(f.name, _fmt(f.metadata["spec"], getattr(getattr(profile, section), f.name)),
+                        profile.marks.get((section, f.name)) or "default", f.metadata["spec"].doc)
+                       for f in fields(getattr(profile, section))] for section in SECTIONS}
+    # a value wider than this (the coating's layer list) goes on its own line under its row, so that
+    # one long cell does not push every other row's columns to the right
+    cap = 32
+    widths = [max(len(row[i]) for rows in table.values() for row in rows if i != 1 or len(row[1]) <= cap)
+              for i in range(3)]
+    for section, rows in table.items():
+        print(f"\n[{section}]")
+        for name, value, origin, doc in rows:
+            long = len(value) > cap
+            print("  " + _columns((name, "(below)" if long else value, origin, doc), widths))
+            if long:
+                print("  " + " " * (widths[0] + 1) + value)
+    print("\n[derived]")
+    rows = [
+        ("focal_length", f"{geo.focal_length:.6g} mm"),
+        ("rim_radius", f"{geo.rim_radius:.6g} mm"),
+        ("vertical_extent", f"{geo.vertical_extent:.6g} mm"),
+        ("tangent_angle", f"{geo.tangent_angle / DEG:.6g} deg"),
+        ("vertex_radius_of_curvature", f"{geo.vertex_radius_of_curvature:.6g} mm"),
+        ("vertex_z", f"{geo.vertex_z:.6g} mm"),
+        ("rim_z", f"{geo.rim_z:.6g} mm"),
+        ("focus_z", f"{geo.focus_z:.6g} mm"),
+        ("cop_z", "inf" if geo.cop_at_infinity else f"{geo.cop_z:.6g} mm"),
+        ("occlusion_theta", f"{geo.occlusion_theta / DEG:.6g} deg"),
+        ("rim_angle_at_cop", f"{geo.rim_angle_at_cop / DEG:.6g} deg"),
+        ("pixels_vertex_to_rim", "-" if geo.cop_at_infinity else f"{geo.pixels_vertex_to_rim:.4g} px"),
+    ]
+    width = max(len(name) for name, _ in rows)
+    for name, value in rows:
+        print(f"  {name:<{width}} {value}")
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``profile show`` to rigcad's subcommands."""
+    p_profile = subparsers.add_parser("profile", help="inspect profiles", description="Inspect profiles.")
+    psub = p_profile.add_subparsers(dest="profile_command", metavar="ACTION", required=True)
+    p_show = psub.add_parser("show", help="print resolved and derived parameters, with where each came from",
+                             description="Print every resolved parameter (with the file:line that set it, "
+                                         "or 'default') and the derived geometry.")
+    p_show.add_argument("profile", help="profile name (under profiles/) or path")
+    p_show.add_argument("--json", action="store_true", help="machine-readable output, units in the keys")
+    p_show.set_defaults(func=cmd_show)

@@ -1,0 +1,133 @@
+"""The tower's adjusters, sized from the tolerance analysis (kernel-free; mm and rad).
+
+Each adjuster moves one thing along one direction; its *range* is how far it moves each way from
+the nominal placement and its *resolution* the smallest step a hand sets reliably:
+
+* a screw: its pitch times the fraction of a turn a hand sets with a hex key
+  (``adjusters.turn_fraction``, assumed 1/8 turn), over the lever arm it acts on;
+* a slot: how finely a hand slides a part against a caliper or a feeler gauge
+  (``adjusters.hand_slide``, assumed 0.1 mm);
+* a shim stack: one shim.
+
+Each serves a tolerance of ``tolerancing`` (the Monte Carlo's placement limits): a setting can be
+brought within one step of its target, so the resolution must not exceed the tolerance; and the
+range must cover what the datum chain (rigcad.parts.datum) can leave out of place, so that every
+rig built within the assumed print accuracy can be aligned.
+
+The splitter's seat is kinematic (Kelvin's cone, vee and flat, rigcad.parts.tower.seat_points):
+turning one screw rotates the holder about the line through the other two balls. A tilt delta of
+the plate turns the reflected (projector's) axis by 2 delta (the law of reflection), so the
+splitter's adjusters serve ``tolerancing.projector_tilt`` through that factor of two.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rigcad.parts.datum import datum_chain
+from rigcad.parts.tower import projector_screws, seat_points
+from rigcad.profile.schema import THREAD_PITCH
+
+
+
+@dataclass(frozen=True)
+class Adjuster:
+    """One adjuster: what it moves and how, the tolerance it serves (``tolerance_key``, value and
+    unit, mm or rad), its range each way and its resolution (same unit), and the range it needs
+    (the datum chain's error, or the printed part's)."""
+
+    name: str
+    how: str
+    tolerance_key: str
+    tolerance: float
+    unit: str
+    range: float
+    resolution: float
+    needed_range: float
+
+    @property
+    def ok(self) -> bool:
+        return self.resolution <= self.tolerance and self.range >= self.needed_range
+
+    def describe(self) -> dict:
+        scale, unit = (180 / math.pi, "deg") if self.unit == "rad" else (1.0, "mm")
+        return {"name": self.name, "how": self.how, "serves": self.tolerance_key,
+                f"tolerance_{unit}": self.tolerance * scale, f"range_each_way_{unit}": self.range * scale,
+                f"resolution_{unit}": self.resolution * scale, f"needed_range_{unit}": self.needed_range * scale,
+                "ok": self.ok}
+
+
+def _lever(p, a, b) -> float:
+    """Distance (mm) from point ``p`` to the line through ``a`` and ``b`` (x, y)."""
+    (px, py), (ax, ay), (bx, by) = p, a, b
+    return abs((bx - ax) * (ay - py) - (ax - px) * (by - ay)) / math.hypot(bx - ax, by - ay)
+
+
+def splitter_adjusters(profile, layout) -> list[Adjuster]:
+    """The seat's three screws: the flat's screw tilts the plate in the plane of incidence (its 45 deg),
+    the vee's screw about the other axis; the cone's screw, with both, sets its height."""
+    t, a, tol = layout.tower, profile.adjusters, profile.tolerancing
+    pts = seat_points(t, profile)
+    step = THREAD_PITCH[a.seat_thread] * a.turn_fraction
+    # the printed grooves' angle error: each face print_position off across the plate's length
+    groove = 2 * profile.datum.print_position / profile.beam_splitter.length
+    out = []
+    for screw, (o1, o2), what in (("flat", ("cone", "vee"), "in the plane of incidence (its 45 deg)"),
+                                  ("vee", ("cone", "flat"), "across the plane of incidence")):
+        arm = _lever(pts[screw], pts[o1], pts[o2])
+        out.append(Adjuster(
+            f"splitter tilt {what}",
+            f"{a.seat_thread} x {THREAD_PITCH[a.seat_thread]:g} mm push screw over the {screw} ball, "
+            f"{a.turn_fraction:g} turn, on a {arm:.1f} mm lever; the reflected axis turns twice the plate",
+            "tolerancing.projector_tilt", tol.projector_tilt, "rad",
+            2 * a.seat_travel / arm, 2 * step / arm, 2 * groove))
+    return out
+
+
+def _slot(name, how, key, tol, travel, need, hand) -> Adjuster:
+    return Adjuster(name, how, key, tol, "mm", travel, hand, need)
+
+
+def slot_adjusters(profile, layout) -> list[Adjuster]:
+    """The camera's and projector's slots and shim stacks, against their placement tolerances and
+    the datum chain's lateral and vertical errors."""
+    t, tw, tol, a = layout.tower, profile.tower, profile.tolerancing, profile.adjusters
+    chain = datum_chain(profile, layout)
+    lat, vert = chain.lateral_worst, chain.vertical_worst
+    shims = t.shims_nominal * tw.shim_thickness
+    slot = f"in a slot, set against a caliper or feeler gauge ({a.hand_slide:g} mm)"
+    stack = f"{tw.shim_thickness:g} mm shims"
+    return [
+        _slot("camera along the axis", "two screws " + slot, "tolerancing.camera_height", tol.camera_height,
+              tw.travel_along, vert, a.hand_slide),
+        _slot("camera across (x)", "two screws " + slot, "tolerancing.camera_offset", tol.camera_offset,
+              tw.travel_across, lat, a.hand_slide),
+        _slot("camera across (y)", stack + " between camera and bracket", "tolerancing.camera_offset",
+              tol.camera_offset, shims, lat, tw.shim_thickness),
+        _slot("projector along its axis (its COP along the optical axis)", "four screws " + slot,
+              "tolerancing.projector_height", tol.projector_height, tw.travel_along, vert, a.hand_slide),
+        _slot("projector across (y)", "four screws " + slot, "tolerancing.projector_offset", tol.projector_offset,
+              tw.travel_across, lat, a.hand_slide),
+        _slot("projector height (its COP across, x)", stack + " under its four feet", "tolerancing.projector_offset",
+              tol.projector_offset, shims, lat, tw.shim_thickness),
+    ]
+
+
+def camera_mount_tilt(profile) -> Adjuster:
+    """The two-point camera mount: the camera's axis stays within the hand's setting error across the
+    two screws' spacing (no pivot); against ``tolerancing.camera_tilt``. Its range is not a travel:
+    0 needed, 0 given."""
+    cm, a, tol = profile.camera, profile.adjusters, profile.tolerancing
+    return Adjuster("camera tilt held by its two screws",
+                    f"two {cm.mount_thread} screws {cm.mount_spacing:g} mm apart in one slot, each set to "
+                    f"{a.hand_slide:g} mm", "tolerancing.camera_tilt", tol.camera_tilt, "rad", 0.0,
+                    a.hand_slide / cm.mount_spacing, 0.0)
+
+
+def adjusters(profile, layout) -> list[Adjuster]:
+    """Every adjuster of the tower, with its range and resolution against the tolerance it serves."""
+    return [*splitter_adjusters(profile, layout), *slot_adjusters(profile, layout), camera_mount_tilt(profile)]
+
+
+__all__ = ["Adjuster", "adjusters", "camera_mount_tilt", "projector_screws", "slot_adjusters", "splitter_adjusters"]

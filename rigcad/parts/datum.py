@@ -1,0 +1,139 @@
+"""The rig's one datum chain: how far the tower's optics can sit from the design COP before any
+adjustment, and whether the adjusters can take that up (kernel-free; mm).
+
+The reference is the base plate: its bore holds the sample holder (the sample point O on the
+optical axis). The chain runs, link by link, to the splitter (whose front face makes the
+projector's virtual COP and whose plate the camera looks through):
+
+1. the base plate's datum tongue: the bore to the tongue's dowel holes (a printed length);
+2. dowel pins, tongue to column foot (ISO 8734 m6 pins in printed holes reamed H7), or, for a
+   bought extrusion, the square pocket it stands in;
+3. the column: foot to top flange, and its lean (the foot's out-of-flat over its width, times the
+   column's height), or, bought, the extrusion's saw-cut end squareness;
+4. dowel pins (or the pocket), column to shelf;
+5. the shelf: its dowel holes to the splitter seat's cone (a printed, or a cut and drilled, length);
+6. the splitter holder: the seat's balls to the grooves the plate rests on (printed).
+
+Each link's error is its worst case; the chain's worst case is their sum and its likely value
+their root sum of squares (independent links). Links 1-5 move the whole tower (projector, camera
+and splitter together): the COPs move as much. Link 6 moves the splitter alone: its virtual image
+of the projector's COP moves by twice the plate's shift along its normal, whose lateral part, at
+45 deg, equals the shift (2 cos^2 45 deg = 1); so every link counts once.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from rigcad.parts.tower import EXTRUSION, POCKET_GAP
+
+#: Worst-case diametral clearance (mm) of an ISO 8734 dowel (m6: +0.004..+0.012 mm for 3..6 mm) in a
+#: hole reamed H7 (0..+0.012 mm): 0.012 - 0.004. A joint of two such fits (one in each part)
+#: may shift by half of it twice: 0.008 mm.
+DOWEL_FIT = 0.008
+#: A 40 x 40 mm extrusion cut on a saw with a stop (assumed): its ends square to 0.1 mm across 40 mm,
+#: and its length to 0.1 mm.
+EXTRUSION_END_SQUARENESS = 0.1
+#: Holes in a cut-and-drilled aluminium plate (assumed: drilled through a printed template, 0.05 mm).
+PLATE_HOLE_POSITION = 0.05
+
+
+@dataclass(frozen=True)
+class Link:
+    """One link of the chain: its name, what the error comes from, its lateral (x-y) and vertical
+    (z) worst-case error (mm)."""
+
+    name: str
+    source: str
+    lateral: float
+    vertical: float
+
+
+@dataclass(frozen=True)
+class DatumChain:
+    """The chain's links and totals (mm)."""
+
+    links: tuple[Link, ...]
+
+    @property
+    def lateral_worst(self) -> float:
+        return sum(k.lateral for k in self.links)
+
+    @property
+    def lateral_rss(self) -> float:
+        return math.sqrt(sum(k.lateral ** 2 for k in self.links))
+
+    @property
+    def vertical_worst(self) -> float:
+        return sum(k.vertical for k in self.links)
+
+    def describe(self) -> dict:
+        return {"links": [{"name": k.name, "source": k.source, "lateral_mm": k.lateral, "vertical_mm": k.vertical}
+                          for k in self.links],
+                "lateral_worst_mm": self.lateral_worst, "lateral_rss_mm": self.lateral_rss,
+                "vertical_worst_mm": self.vertical_worst}
+
+
+def _printed(profile, span: float) -> float:
+    """Position error (mm) of a printed feature ``span`` mm from the part's datum feature."""
+    d = profile.datum
+    return d.print_position + d.print_scale * abs(span)
+
+
+def _column_links(profile, t) -> tuple[Link, Link, Link]:
+    """The column and its two joints: a printed column on dowels, or a bought extrusion in pockets."""
+    d = profile.datum
+    height = t.shelf_top_z - t.shelf_thickness - t.column_base_z
+    if profile.buy.column == "print":
+        foot = 2 * t.column_foot_half
+        dowels = Link("dowels", f"ISO 8734 m6 in H7: {DOWEL_FIT:g} mm", DOWEL_FIT, 0.0)
+        return (dowels, Link("column", f"printed: dowel pattern {_printed(profile, 0):.2f} mm; lean: the foot's "
+                             f"{d.foot_flatness:g} mm out-of-flat over {foot:.0f} mm, times {height:.0f} mm",
+                             _printed(profile, 0) + d.foot_flatness / foot * height, _printed(profile, height)), dowels)
+    pocket = Link("pocket", f"square pocket, a slide fit: {POCKET_GAP:g} mm each side", POCKET_GAP, 0.0)
+    return (pocket, Link("column", f"extrusion: saw-cut ends square to {EXTRUSION_END_SQUARENESS:g} mm over "
+                         f"{EXTRUSION:g} mm, times {height:.0f} mm; cut length to {EXTRUSION_END_SQUARENESS:g} mm",
+                         EXTRUSION_END_SQUARENESS / EXTRUSION * height, EXTRUSION_END_SQUARENESS), pocket)
+
+
+def datum_chain(profile, layout) -> DatumChain:
+    """The chain from the base plate's bore to the splitter for ``profile`` and ``layout`` (RigLayout)."""
+    t = layout.tower
+    low, column, high = _column_links(profile, t)
+    span = t.column_x - t.holder_x[1]
+    shelf = (Link("shelf", f"printed: {span:.0f} mm from its column joint to the seat", _printed(profile, span),
+                  _printed(profile, t.shelf_thickness)) if profile.buy.shelf == "print" else
+             Link("shelf", f"aluminium plate drilled through a printed template ({PLATE_HOLE_POSITION:g} mm)",
+                  PLATE_HOLE_POSITION, 0.0))
+    holder_span = t.holder_top_z - t.shelf_top_z
+    return DatumChain((
+        Link("base plate", f"printed: {t.column_x:.0f} mm from its bore to the tongue's column joint",
+             _printed(profile, t.column_x), _printed(profile, profile.base_plate.thickness)),
+        replace(low, name=f"{low.name}, tongue to column"),
+        column,
+        replace(high, name=f"{high.name}, column to shelf"),
+        shelf,
+        Link("splitter holder", f"printed: {holder_span:.0f} mm from its seat to the grooves",
+             _printed(profile, holder_span), _printed(profile, holder_span)),
+    ))
+
+
+def check_datum_chain(profile, layout) -> list[dict]:
+    """The chain against the tolerances and the adjusters (mm): one row per claim, with ``ok``.
+
+    * ``needs_adjustment``: whether the chain alone holds ``tolerancing.projector_offset`` (then the
+      adjusters only refine) or not (then the calibration must use them);
+    * ``lateral_within_travel``: the chain's worst lateral error is within the adjusters' travel
+      across (``tower.travel_across``): the adjusters can always bring the COP back;
+    * ``vertical_within_travel``: the same along the axis (``tower.travel_along``)."""
+    chain = datum_chain(profile, layout)
+    tol, tw = profile.tolerancing, profile.tower
+    return [
+        {"claim": "needs_adjustment", "value_mm": chain.lateral_worst, "limit_mm": tol.projector_offset,
+         "ok": True, "adjust": chain.lateral_worst > tol.projector_offset},
+        {"claim": "lateral_within_travel", "value_mm": chain.lateral_worst, "limit_mm": tw.travel_across,
+         "ok": chain.lateral_worst <= tw.travel_across},
+        {"claim": "vertical_within_travel", "value_mm": chain.vertical_worst, "limit_mm": tw.travel_along,
+         "ok": chain.vertical_worst <= tw.travel_along},
+    ]

@@ -1,0 +1,77 @@
+"""The datum chain from the base plate to the splitter: its sum against a hand computation, and its
+checks against the tolerances and the adjusters' travel."""
+
+import math
+
+import pytest
+
+from rigcad.parts.datum import DOWEL_FIT, check_datum_chain, datum_chain
+from rigcad.profile import load_profile
+from rigcad.rig import Rig
+
+
+def test_the_chain_adds_its_links_as_stated(table31_rig):
+    p, t = table31_rig.profile, table31_rig.layout.tower
+    chain = datum_chain(p, table31_rig.layout)
+    d = p.datum
+    # hand computation of the default (printed) chain, link by link, from the module's docstring
+    height = t.shelf_top_z - t.shelf_thickness - t.column_base_z
+    expect = [
+        d.print_position + d.print_scale * t.column_x,  # bore to tongue dowels
+        DOWEL_FIT,
+        d.print_position + d.foot_flatness / (2 * t.column_foot_half) * height,  # column: pattern and lean
+        DOWEL_FIT,
+        d.print_position + d.print_scale * (t.column_x - t.holder_x[1]),  # shelf
+        d.print_position + d.print_scale * (t.holder_top_z - t.shelf_top_z),  # holder
+    ]
+    assert [k.lateral for k in chain.links] == pytest.approx(expect, rel=1e-12)
+    assert chain.lateral_worst == pytest.approx(sum(expect), rel=1e-12)
+    assert chain.lateral_rss == pytest.approx(math.sqrt(sum(e * e for e in expect)), rel=1e-12)
+
+
+def test_the_default_chain_needs_the_adjusters_and_they_reach(table31_rig):
+    rows = {r["claim"]: r for r in check_datum_chain(table31_rig.profile, table31_rig.layout)}
+    # a printed chain (0.2 % over ~200 mm spans) cannot hold 0.5 mm alone: the adjusters must take it up
+    assert rows["needs_adjustment"]["adjust"]
+    assert rows["lateral_within_travel"]["ok"] and rows["vertical_within_travel"]["ok"]
+
+
+def test_a_poor_printer_breaks_the_chain(write_profile, table31_text):
+    # 1 % scale error (an uncalibrated printer): ~2 mm on the base plate alone, beyond the 2 mm travel
+    rig = Rig.from_profile(load_profile(write_profile(table31_text + "datum:\n  print_scale: 0.01\n")))
+    rows = {r["claim"]: r for r in check_datum_chain(rig.profile, rig.layout)}
+    assert not rows["lateral_within_travel"]["ok"]
+
+
+def test_a_bought_extrusion_and_plate_change_the_chain(write_profile, table31_text):
+    # the extrusion leans by its end squareness (0.1 mm over 40 mm) times its height; the plate's holes
+    # are drilled through a template (0.05 mm) instead of printed over ~170 mm
+    from rigcad.parts.datum import EXTRUSION_END_SQUARENESS, PLATE_HOLE_POSITION
+    from rigcad.parts.tower import POCKET_GAP
+
+    rig = Rig.from_profile(load_profile(write_profile(
+        table31_text + "buy:\n  column: extrusion_40x40\n  shelf: aluminium_plate\n")))
+    t = rig.layout.tower
+    links = {k.name: k for k in datum_chain(rig.profile, rig.layout).links}
+    height = t.shelf_top_z - t.shelf_thickness - t.column_base_z
+    assert links["column"].lateral == pytest.approx(EXTRUSION_END_SQUARENESS / 40.0 * height, rel=1e-12)
+    assert links["pocket, tongue to column"].lateral == POCKET_GAP
+    assert links["shelf"].lateral == PLATE_HOLE_POSITION
+
+
+def test_the_tongue_stands_on_the_bench_with_nut_traps(table31_rig):
+    # the tower's weight goes into the bench: the tongue's underside is the bench level, and a 7 mm
+    # (across flats) M4 nut fits each trap under a column bolt, 0.1 mm clear each side
+    import manifold3d as m3d
+
+    from rigcad.export import mesh as M
+    from rigcad.parts.recipe import Box
+    from rigcad.parts.tower import NUT_TRAP_DEPTH, _column_flange_points
+
+    t = table31_rig.layout.tower
+    plate = M.build(table31_rig.recipe("base_plate").solid, 0.05)
+    assert plate.bounding_box()[2] == pytest.approx(t.bench_z, abs=1e-9)
+    for x, y in _column_flange_points(t, table31_rig.profile):
+        nut = M.build(Box((x - 3.5, y - 3.5, t.bench_z + 0.01), (x + 3.5, y + 3.5, t.bench_z + NUT_TRAP_DEPTH - 0.01)), 0.05)
+        assert (plate ^ nut).volume() < 1e-9
+        assert (plate ^ nut).status() == m3d.Error.NoError
