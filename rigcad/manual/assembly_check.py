@@ -93,6 +93,9 @@ class Fastener:
     nut_dir: tuple[float, float, float] | None = None
     passes: tuple[str, ...] = ()  #: parts the shank goes through (they must be in place)
     grip_mm: float = 0.0  #: head's bearing face to the nut's (mm): washers included
+    #: Parts drawn without the hole it goes through (an instrument's or a shim stack's plain box):
+    #: its body may run through them.
+    pierces: tuple[str, ...] = ()
 
     def solids(self):
         """The fastener in place: its shank and head, and its nut when it has one."""
@@ -284,10 +287,9 @@ class Assembly:
         obstacles = self._obstacles(done)
         everything = _union([s for _, s in obstacles])
         near = [s.bounding_box() for _, s in obstacles]
-        moving = _union([self.solids[m] for m in step.members])
         direction, reasons = None, []
         for d in step.directions:
-            sweep = swept(moving, d, step.travel_mm, near)
+            sweep = _union([swept(self.solids[m], d, step.travel_mm, near) for m in step.members])
             pen = penetration(sweep, everything)
             if pen <= CLEARANCE_MM:
                 direction = d
@@ -306,7 +308,7 @@ class Assembly:
         for k, f in enumerate(step.fasteners):
             # a screw's thread runs into the bench or into the instrument's socket by design
             into = [(n, s) for n, s in fitted if not (f.thread_in == "bench" and n == "the bench")
-                    and not (f.thread_in == "instrument" and n in step.members)]
+                    and not (f.thread_in == "instrument" and n in step.members) and n not in f.pierces]
             everything = _union([s for _, s in fitted])
             body = f.solids()
             pen = penetration(body, _union([s for _, s in into]))

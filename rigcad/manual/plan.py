@@ -40,7 +40,7 @@ SIDEWAYS = ((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1.0, 0.0)
 #: A part that touches nothing below within REST_PROBE_MM sits in a pocket or a groove with a gap: the
 #: parts under it within REST_SEARCH_MM (mm) hold it.
 REST_SEARCH_MM = 5.0
-REST_PROBE_MM = 0.15
+REST_PROBE_MM = 0.08
 #: Hex key (mm across flats, ISO 4762 socket) per thread; 1/4-20 and 3/8-16 socket heads take 3/16 in and 5/16 in.
 HEX_KEY = {"M2": 1.5, "M2.5": 2.0, "M3": 2.5, "M4": 3.0, "M5": 4.0, "M6": 5.0, "M8": 6.0, "M10": 8.0, "M12": 10.0,
            "1/4-20 UNC": 4.7625, "3/8-16 UNC": 7.9375}
@@ -164,13 +164,24 @@ def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener,
             shims = sorted(n for n in meshes_by_name if n.startswith("projector_shims_"))
             out["projector_body"] = tuple(
                 _socket_head(item, (*_centre(meshes_by_name[n])[:2], z), UP, h["length_mm"], d, h["thread"],
-                             thread_in="instrument", passes=("tower_shelf", n)) for n in shims)
+                             thread_in="instrument", passes=("tower_shelf", n), pierces=(n,)) for n in shims)
         elif "camera" in h["joins"] and "camera_shims" in meshes_by_name:
-            c = _centre(meshes_by_name["camera_shims"])
-            out["camera_body"] = (_socket_head(item, (c[0], -t.wall_y[1] - 1.0, c[2]), (0.0, 1.0, 0.0),
-                                               h["length_mm"], d, h["thread"], thread_in="instrument",
-                                               passes=("splitter_holder", "camera_shims")),)
+            out["camera_body"] = tuple(
+                _socket_head(item, (x, -t.wall_y[1] - 1.0, z), (0.0, 1.0, 0.0), h["length_mm"], d, h["thread"],
+                             thread_in="instrument", passes=("splitter_holder", "camera_shims"),
+                             pierces=("camera_shims",))
+                for x, z in _camera_points(rig, meshes_by_name))
     return out
+
+
+def _camera_points(rig, meshes_by_name) -> list[tuple[float, float]]:
+    """The camera's screws (x, z; mm): the tower's two when it has them, else one at its shims' centre."""
+    try:
+        from rigcad.parts.tower import camera_screws
+    except ImportError:
+        c = _centre(meshes_by_name["camera_shims"])
+        return [(float(c[0]), float(c[2]))]
+    return [(float(x), float(z)) for x, z in camera_screws(rig.layout.tower, rig.profile)]
 
 
 def _centre(mesh) -> np.ndarray:
@@ -183,11 +194,14 @@ def _rests_on(name: str, solids: dict, members: tuple[str, ...], floor: float) -
     gap); () when it stands on the bench (its bottom at ``floor``) or on nothing below (it hangs)."""
     from rigcad.manual.assembly_check import CLEARANCE_MM
 
-    if solids[name].bounding_box()[2] <= floor + REST_PROBE_MM:
+    bottom = solids[name].bounding_box()[2]
+    if bottom <= floor + REST_PROBE_MM:
         return ()
+    # only a part that reaches lower can hold it up (a plate in a holder's grooves does not hold the holder)
+    lower = {n: s for n, s in solids.items() if n not in members and s.bounding_box()[2] < bottom + REST_PROBE_MM}
     for drop in (REST_PROBE_MM, REST_SEARCH_MM):
         probe = solids[name].translate((0.0, 0.0, -drop))
-        hit = tuple(n for n, s in solids.items() if n not in members and penetration(probe, s) > CLEARANCE_MM)
+        hit = tuple(n for n, s in lower.items() if penetration(probe, s) > CLEARANCE_MM)
         if hit:
             return hit
     return ()
@@ -219,7 +233,9 @@ def steps(rig, meshes) -> tuple[list[Step], dict]:
     from rigcad.manual.bom import bolt_axes
 
     bolts: dict[str, list[Fastener]] = {}
-    for b in bolt_axes(rig, tower=True):
+    for b in bolt_axes(rig):  # the through bolts outside the COP tower (its joints: see the module docstring)
+        if len(b["parts"]) < 2 or not set(b["parts"]) <= set(solids):
+            continue
         options = bolt_fasteners(b)
         fits = [f for f in options if penetration(f.solids(), whole) <= _clearance()]
         bolts.setdefault(b["upper"], []).append((fits or options)[0])
