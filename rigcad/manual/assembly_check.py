@@ -21,8 +21,9 @@ A step's feasibility depends only on the set in place (not on the order that set
 finds a feasible order when there is one and says which steps are stuck when there is none.
 :func:`check_order` refuses a given order at its first infeasible step, with the reason.
 
-Penetration is measured as the thickness of the overlap solid, 2 V / A (V its volume, A its area:
-a thin slab's thickness), so parts that touch (a beam on its slot floor, a plate on its collar)
+Penetration is measured against each solid in place in turn (each pair once: a solid in place is
+the same whatever came before it), as the thickness of the overlap solid, 2 V / A (V its volume, A
+its area: a thin slab's thickness), so parts that touch (a beam on its slot floor, a plate on its collar)
 pass while a part pushed through a wall does not; no decision hangs on the last bits of a
 coincident face. A convex part's sweep is exact (the hull of its start and end); any other part's
 is sampled every SWEEP_STEP_MM along the path (a wall thinner than that could be jumped: see
@@ -209,18 +210,42 @@ def swept(solid, direction, travel: float, near=None):
     hull = solid.hull()
     if hull.volume() <= solid.volume() * (1 + 1e-9) + 1e-9:  # convex: the exact sweep is one hull
         return m3.Manifold.batch_hull([solid, solid.translate(tuple(-d * travel))])
+    s = _near_positions(solid, d, travel, near)
+    return _union([solid.translate(tuple(-d * v)) for v in s])
+
+
+#: A sweep is first tried at every COARSE-th sampled position, one copy at a time: a collision found
+#: there refuses the step (its depth a lower bound) without building the whole sweep.
+COARSE = 32
+
+
+def sweep_penetration(solid, direction, travel: float, other) -> float:
+    """Penetration (mm) of ``solid`` swept along ``direction`` (see :func:`swept`) into ``other``."""
+    d = np.asarray(direction, float)
+    hull = solid.hull()
+    if hull.volume() <= solid.volume() * (1 + 1e-9) + 1e-9:
+        return penetration(swept(solid, d, travel), other)
+    for s in _near_positions(solid, d, travel, [other.bounding_box()])[::COARSE]:
+        pen = penetration(solid.translate(tuple(-d * s)), other)
+        if pen > CLEARANCE_MM:
+            return pen
+    return penetration(swept(solid, d, travel, [other.bounding_box()]), other)
+
+
+def _near_positions(solid, d: np.ndarray, travel: float, near) -> np.ndarray:
+    """Sampled positions (mm back along ``d``) where the moved solid's box meets one of ``near``."""
     n = max(1, int(np.ceil(travel / SWEEP_STEP_MM)))
     s = np.linspace(0.0, travel, n + 1)
-    if near is not None and len(near):
-        box = np.asarray(solid.bounding_box(), float)
-        lo = box[None, :3] - d[None, :] * s[:, None]  # (n + 1, 3) the moved box at each position
-        hi = box[None, 3:] - d[None, :] * s[:, None]
-        near = np.asarray(near, float)
-        pad = SWEEP_STEP_MM  # a position whose box is within one step of an obstacle is kept
-        meets = np.any(np.all((lo[:, None, :] < near[None, :, 3:] + pad) & (hi[:, None, :] > near[None, :, :3] - pad),
-                              axis=2), axis=1)
-        s = s[meets]
-    return _union([solid.translate(tuple(-d * v)) for v in s])
+    if near is None or not len(near):
+        return s
+    box = np.asarray(solid.bounding_box(), float)
+    lo = box[None, :3] - d[None, :] * s[:, None]  # (n + 1, 3) the moved box at each position
+    hi = box[None, 3:] - d[None, :] * s[:, None]
+    near = np.asarray(near, float)
+    pad = SWEEP_STEP_MM  # a position whose box is within one step of an obstacle is kept
+    meets = np.any(np.all((lo[:, None, :] < near[None, :, 3:] + pad) & (hi[:, None, :] > near[None, :, :3] - pad),
+                          axis=2), axis=1)
+    return s[meets]
 
 
 @dataclass(frozen=True)
@@ -252,24 +277,37 @@ class Assembly:
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
             raise GeometryError(f"parts {dup} are placed by more than one assembly step")
-        if with_bench:
-            boxes = [s.bounding_box() for s in solids.values()]
-            lo = np.min([b[:3] for b in boxes], axis=0)
-            hi = np.max([b[3:] for b in boxes], axis=0)
-            self.bench = bench(lo, hi)
-        else:
-            self.bench = None
+        #: The bench's top (mm): the plane under the lowest part; None: no bench. A half-space, so its
+        #: penetration is a depth below that plane, computed from bounding boxes (exact for a plane).
+        self.bench_top = float(min(s.bounding_box()[2] for s in solids.values())) if with_bench else None
         self._memo: dict = {}
+        self._pairs: dict = {}
 
     def _obstacles(self, done: frozenset[str], extra: tuple[str, ...] = ()) -> list[tuple[str, object]]:
         """Named solids in place once the steps ``done`` are: parts, fitted fasteners, the bench."""
-        out = [] if self.bench is None else [("the bench", self.bench)]
-        for name in done:
+        out = []
+        for name in sorted(done):
             step = self.by_name[name]
             out += [(m, self.solids[m]) for m in step.members]
-            out += [(f"{f.item} of step {step.name}", f.solids()) for f in step.fasteners]
+            out += [(_fastener_name(step, k), f.solids()) for k, f in enumerate(step.fasteners)]
         out += [(m, self.solids[m]) for m in extra]
         return out
+
+    def _into(self, key: tuple, make, named: list[tuple[str, object]], low: float | None = None) -> tuple[float, str]:
+        """The deepest penetration (mm) of a solid into the named solids (``make(other)`` measures it,
+        remembered under ``key``) and the bench (``low``: the solid's lowest point, None: the bench is not in
+        its way), and the name of the one it runs into deepest. Each pair is computed once: a solid
+        in place is the same whatever came before it."""
+        worst = (0.0, "nothing")
+        if low is not None and self.bench_top is not None and self.bench_top - low > 0:
+            worst = (self.bench_top - low, "the bench")
+        for name, other in named:
+            pair = (key, name)
+            if pair not in self._pairs:
+                self._pairs[pair] = make(other)
+            if self._pairs[pair] > worst[0]:
+                worst = (self._pairs[pair], name)
+        return worst
 
     def attempt(self, step: Step, done: frozenset[str]) -> Placed | Refusal:
         """The step placed after ``done`` (a Placed), or why it cannot be (a sentence)."""
@@ -285,16 +323,17 @@ class Assembly:
         if missing:
             return Refusal(f"needs {', '.join(missing)} in place first", False)
         obstacles = self._obstacles(done)
-        everything = _union([s for _, s in obstacles])
-        near = [s.bounding_box() for _, s in obstacles]
         direction, reasons = None, []
         for d in step.directions:
-            sweep = _union([swept(self.solids[m], d, step.travel_mm, near) for m in step.members])
-            pen = penetration(sweep, everything)
-            if pen <= CLEARANCE_MM:
+            worst = max((self._into(("sweep", m, d, step.travel_mm),
+                                    lambda other, m=m, d=d: sweep_penetration(self.solids[m], d, step.travel_mm,
+                                                                              other), obstacles,
+                                    self.solids[m].bounding_box()[2] - max(0.0, d[2]) * step.travel_mm)
+                         for m in step.members), key=lambda t: t[0])
+            if worst[0] <= CLEARANCE_MM:
                 direction = d
                 break
-            reasons.append(f"moved in along {_dir_name(d)} it runs {pen:.2f} mm into {_worst(sweep, obstacles)}")
+            reasons.append(f"moved in along {_dir_name(d)} it runs {worst[0]:.2f} mm into {worst[1]}")
         if direction is None:
             return Refusal("; ".join(reasons) or "no direction declared", True)
         blocked = self._fastener_problems(step, self._obstacles(done, step.members))
@@ -306,36 +345,35 @@ class Assembly:
         out = []
         fitted = list(obstacles)
         for k, f in enumerate(step.fasteners):
+            name = _fastener_name(step, k)
             # a screw's thread runs into the bench or into the instrument's socket by design
-            into = [(n, s) for n, s in fitted if not (f.thread_in == "bench" and n == "the bench")
-                    and not (f.thread_in == "instrument" and n in step.members) and n not in f.pierces]
-            everything = _union([s for _, s in fitted])
+            into = [(n, s) for n, s in fitted
+                    if not (f.thread_in == "instrument" and n in step.members) and n not in f.pierces]
             body = f.solids()
-            pen = penetration(body, _union([s for _, s in into]))
+            pen, what_in = self._into(("body", name), lambda other: penetration(body, other), into,
+                                      None if f.thread_in == "bench" else body.bounding_box()[2])
             if pen > CLEARANCE_MM:
-                out.append(f"{f.item} #{k + 1} at {_at(f.head)} runs {pen:.2f} mm into {_worst(body, into)}")
+                out.append(f"{f.item} #{k + 1} at {_at(f.head)} runs {pen:.2f} mm into {what_in}")
             for what, path in f.paths():
-                pen = penetration(path, everything)
+                pen, by = self._into(("path", name, what), lambda other, path=path: penetration(path, other), fitted,
+                                     path.bounding_box()[2])
                 if pen > CLEARANCE_MM:
-                    out.append(f"{f.item} #{k + 1} at {_at(f.head)}: {what} is blocked by {_worst(path, fitted)} "
-                               f"({pen:.2f} mm)")
+                    out.append(f"{f.item} #{k + 1} at {_at(f.head)}: {what} is blocked by {by} ({pen:.2f} mm)")
             tried = []
             for tool, path in f.tool_paths():
-                pen = penetration(path, everything)
+                pen, by = self._into(("tool", name, tool.name), lambda other, path=path: penetration(path, other), fitted,
+                                     path.bounding_box()[2])
                 if pen <= CLEARANCE_MM:
                     break
-                tried.append(f"the {tool.name}'s path is blocked by {_worst(path, fitted)} ({pen:.2f} mm)")
+                tried.append(f"the {tool.name}'s path is blocked by {by} ({pen:.2f} mm)")
             else:
                 out.append(f"{f.item} #{k + 1} at {_at(f.head)}: " + "; ".join(tried or ["no tool declared"]))
-            fitted.append((f"{f.item} #{k + 1}", body))
+            fitted.append((name, body))
         return out
 
 
-def _worst(solid, named: list) -> str:
-    """The name of the solid in ``named`` that ``solid`` penetrates deepest."""
-    pens = [(penetration(solid, s), n) for n, s in named]
-    pen, name = max(pens, key=lambda t: t[0]) if pens else (0.0, "nothing")
-    return name
+def _fastener_name(step: Step, k: int) -> str:
+    return f"{step.fasteners[k].item} #{k + 1} of step {step.name}"
 
 
 def _at(p) -> str:

@@ -188,7 +188,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
                "bill": c.bill, "calibration": c.calibration,
                "coating_gauged_layer": c.gauged, "coating_total_mm": c.total,
-               "assembly_order": [m.name for m in meshes]}
+               "assembly_order": getattr(c, "assembly_order", None)}
     return d, c.files, figures
 
 
@@ -397,57 +397,119 @@ def _section_coat(d: Doc, c) -> None:
     step("bill and steps")
 
 
+#: How a step's direction reads (rig frame: +z up, the projector on the +x side).
+MOVES = {"-z (down)": "lower it from above", "+z (up)": "push it up from below",
+         "-x": "slide it in level along -x, from the +x side", "+x": "slide it in level along +x, from the -x side",
+         "-y": "slide it in level along -y, from the +y side", "+y": "slide it in level along +y, from the -y side"}
+#: Fastenings by what takes the thread: what the step says after the bolt.
+THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut with the spanner, tighten crosswise by "
+                    "hand", "insert": "screwed into the insert (melt it in flush first: soldering iron at the "
+                                      "insert maker's temperature)",
+             "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
+             "bench": "into the bench"}
+
+
+def assembly_order(rig, meshes):
+    """The order rigcad's assembly check finds (rigcad.manual.assembly_check.find_order over
+    rigcad.manual.plan's steps), or the check's refusal (a GeometryError's message)."""
+    from rigcad.errors import GeometryError
+    from rigcad.manual import assembly_check, plan
+
+    try:
+        return assembly_check.find_order(plan.assembly(rig, meshes)), None
+    except GeometryError as err:
+        return None, str(err)
+
+
+def step_text(placed, meshes_by_name: dict) -> str:
+    """What a found step says: what goes in, how (its direction), on what, and each group of like
+    fasteners with its tool and what takes its thread."""
+    from collections import Counter
+
+    from rigcad.manual.assembly_check import _dir_name
+
+    st = placed.step
+    parts = " and ".join(n.replace("_", " ") for n in st.members)
+    bought = " (bought)" if st.bought else ""
+    text = f"Take the {parts}{bought}: {meshes_by_name[st.members[0]].description}. "
+    text += MOVES.get(_dir_name(placed.direction), f"move it in along {_dir_name(placed.direction)}").capitalize()
+    text += (f" until it rests on the {', '.join(n.replace('_', ' ') for n in st.needs)}." if st.needs
+             else " onto the bench.")
+    groups = Counter((f.item, f.tools[0].name, f.thread_in) for f in st.fasteners)
+    for (item, tool, thread_in), n in groups.items():
+        text += f" Fix it with {n} x {item}, {THREAD_IN[thread_in]} (tool: {tool} or an L key)."
+    return text
+
+
 def _section_assemble(d: Doc, c) -> None:
-    """The manual's section: 5 assemble."""
-    import numpy as np
-
+    """The manual's section 5: the assembly steps in the order the assembly check finds."""
     from rigcad import plots
-    from rigcad.export import mesh as M
     from rigcad.manual import assembly as A
-    from rigcad.parts.templates import gauged_depth
 
-    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
     d.h(2, "5. Assemble")
-    d.p("Each step shows what is already in place (grey) and what goes in (orange), drawn clear of it with "
-        "a dashed line to its place. Bought items (instruments, optics) are marked so.")
-    joints = B.bolt_joints(rig)
-    tower_rows = B.tower_hardware(rig)
-    order = [meshes[i].name for st in A.steps(meshes) for i in st]
-
-    def keys(name: str) -> set[str]:
-        words = name.replace("tower_", "").replace("_body", "").replace("_", " ")
-        return {name.replace("_", " "), words}
-
-    # each tower item goes with the last step (in assembly order) whose part its "joins" text names
-    tower_at = {}
-    for h in tower_rows:
-        named = [n for n in order if any(re.search(rf"\b{re.escape(k)}'?s?\b", h["joins"]) for k in keys(n))]
-        if named:
-            tower_at.setdefault(named[-1], []).append(h)
+    order, refusal = assembly_order(c.rig, c.meshes)
+    if order is None:
+        d.p(f"**rigcad's assembly check finds no order in which this rig can be put together:** {refusal}")
+        return
+    d.p("The order below is the one rigcad's assembly check found: each part, swept along the direction the "
+        "step names, clears everything already in place; each bolt's head, nut and tool have a straight way "
+        "in. Each picture shows what is in place (grey) and what goes in (orange), drawn before its place "
+        "along the direction it moves in, with a dashed line to where it goes.")
+    index = {m.name: i for i, m in enumerate(c.meshes)}
+    by_name = {m.name: m for m in c.meshes}
+    tower_at = _tower_rows_by_step(c.rig, [p.step for p in order])
     done: list[int] = []
-    for k, members in enumerate(A.steps(meshes)):
-        first = meshes[members[0]]
-        label = first.name if len(members) == 1 else re.sub(r"_\d+$", "", first.name) + f" (x{len(members)})"
-        text = STEP_TEXT.get(first.name)
-        if text is None:
-            text = (f"Place the {label.replace('_', ' ')}" + (" (bought)" if first.bought else "")
-                    + f": {first.description}.")
-        for j in joints:
-            if first.name in j["parts"] and all(n in [meshes[i].name for i in done + members] for n in j["parts"]):
-                text += (f" Bolt it ({j['joins']}) with {j['count']} {j['short']}"
-                         + (", a washer under each head and each nut; tighten crosswise, by hand." if j["nuts"]
-                            else " into what it stands on."))
-        for h in tower_at.get(first.name, []):
+    for k, placed in enumerate(order):
+        st = placed.step
+        members = [index[n] for n in st.members]
+        label = st.name.replace("_", " ") + (f" (x{len(members)})" if len(members) > 1 and st.name not in
+                                             st.members else "")
+        text = step_text(placed, by_name)
+        for h in tower_at.get(st.name, []):
             size = f"{h['thread']} x {h['length_mm']:g} mm" if h.get("length_mm") else h["thread"]
             text += f" Fix it with {h['quantity']} x {h['item']} ({size}): {h['joins']}."
-        d.h(3, f"Step {k + 1}: {label}" + (f" (x{first.quantity})" if first.quantity > 1 else ""))
+        d.h(3, f"Step {k + 1}: {label}")
         d.p(text)
-        path = f"images/step_{k + 1:02d}_{re.sub(r'_[0-9]+$', '', first.name)}.png"
-        files[path] = plots.assembly_step(meshes, done, members, A.step_offsets(meshes, done, members),
-                                          f"step {k + 1}: {label}", cut_away=cut_away)
-        d.img(path, f"Step {k + 1}: the {label.replace('_', ' ')} (orange) goes where the dashed line points")
+        path = f"images/step_{k + 1:02d}_{st.name}.png"
+        c.files[path] = plots.assembly_step(c.meshes, done, members, _approach(c.meshes, done, members,
+                                                                                placed.direction),
+                                            f"step {k + 1}: {label}", cut_away=c.cut_away)
+        d.img(path, f"Step {k + 1}: the {label} (orange) moves along the dashed line to its place")
         done += members
-        step(f"step {k + 1}")
+        c.step(f"step {k + 1}")
+    c.assembly_order = [{"step": p.step.name, "parts": list(p.step.members), "direction": list(p.direction),
+                         "fasteners": [f.item for f in p.step.fasteners]} for p in order]
+
+
+def _approach(meshes, done: list[int], new: list[int], direction) -> dict:
+    """Where a step's parts are drawn before they go in: moved back against their direction until
+    their bounding box clears the parts in place (and by a gap)."""
+    import numpy as np
+
+    from rigcad.manual.assembly import EXPLODE_GAP
+
+    d = np.asarray(direction, float)
+    lo = np.min([meshes[i].lo for i in new], axis=0)
+    hi = np.max([meshes[i].hi for i in new], axis=0)
+    size = float(np.max(hi - lo))
+    back = size + EXPLODE_GAP * size if done else 0.0
+    return {i: -d * back for i in new}
+
+
+def _tower_rows_by_step(rig, steps) -> dict:
+    """The tower's hardware rows (rigcad.parts.tower.hardware) that the plan does not place itself
+    (the tower's own joints), each with the last step whose part its "joins" text names."""
+    names = [(s.name, m) for s in steps for m in s.members]
+    out: dict = {}
+    for h in B.tower_hardware(rig):
+        if "mounting holes" in h["joins"]:
+            continue  # the instruments' screws: the plan's
+        named = [s for s, m in names
+                 if any(re.search(rf"\b{re.escape(k)}'?s?\b", h["joins"])
+                        for k in {m.replace("_", " "), m.replace("tower_", "").replace("_body", "").replace("_", " ")})]
+        if named:
+            out.setdefault(named[-1], []).append(h)
+    return out
 
 
 def _section_calibrate(d: Doc, c) -> None:
