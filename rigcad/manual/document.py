@@ -403,8 +403,9 @@ MOVES = {"-z (down)": "lower it from above", "+z (up)": "push it up from below",
          "-y": "slide it in level along -y, from the +y side", "+y": "slide it in level along +y, from the -y side"}
 #: Fastenings by what takes the thread: what the step says after the bolt.
 THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut with the spanner, tighten crosswise by "
-                    "hand", "insert": "screwed into the insert (melt it in flush first: soldering iron at the "
-                                      "insert maker's temperature)",
+                    "hand", "insert": "screwed into the insert (first drill the part's hole out to the "
+                                      "insert's outer diameter and melt the insert in flush with a soldering iron at "
+                                      "its maker's temperature)",
              "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
              "bench": "into the bench"}
 
@@ -429,9 +430,12 @@ def step_text(placed, meshes_by_name: dict) -> str:
     from rigcad.manual.assembly_check import _dir_name
 
     st = placed.step
-    parts = " and ".join(n.replace("_", " ") for n in st.members)
+    stems = {re.sub(r"_\d+$", "", n) for n in st.members}
+    parts = (f"{len(st.members)} {stems.pop().replace('_', ' ')}" if len(stems) == 1 and len(st.members) > 1
+             else " with the ".join(n.replace("_", " ") for n in sorted(st.members, key=lambda n: n != st.name)))
     bought = " (bought)" if st.bought else ""
-    text = f"Take the {parts}{bought}: {meshes_by_name[st.members[0]].description}. "
+    lead = st.name if st.name in st.members else st.members[0]
+    text = f"Take the {parts}{bought}: {meshes_by_name[lead].description}. "
     text += MOVES.get(_dir_name(placed.direction), f"move it in along {_dir_name(placed.direction)}").capitalize()
     text += (f" until it rests on the {', '.join(n.replace('_', ' ') for n in st.needs)}." if st.needs
              else " onto the bench.")
@@ -443,6 +447,8 @@ def step_text(placed, meshes_by_name: dict) -> str:
 
 def _section_assemble(d: Doc, c) -> None:
     """The manual's section 5: the assembly steps in the order the assembly check finds."""
+    import numpy as np
+
     from rigcad import plots
     from rigcad.manual import assembly as A
 
@@ -471,9 +477,12 @@ def _section_assemble(d: Doc, c) -> None:
         d.h(3, f"Step {k + 1}: {label}")
         d.p(text)
         path = f"images/step_{k + 1:02d}_{st.name}.png"
-        c.files[path] = plots.assembly_step(c.meshes, done, members, _approach(c.meshes, done, members,
-                                                                                placed.direction),
-                                            f"step {k + 1}: {label}", cut_away=c.cut_away)
+        offsets = _approach(c.meshes, done, members, placed.direction)
+        shift = offsets[members[0]] if members else 0.0
+        bolts = [(np.asarray(f.head) + shift - np.asarray(f.axis) * f.head_height_mm,
+                  np.asarray(f.head) + shift + np.asarray(f.axis) * f.length_mm) for f in st.fasteners]
+        c.files[path] = plots.assembly_step(c.meshes, done, members, offsets, f"step {k + 1}: {label}",
+                                            cut_away=c.cut_away, fasteners=bolts)
         d.img(path, f"Step {k + 1}: the {label} (orange) moves along the dashed line to its place")
         done += members
         c.step(f"step {k + 1}")
