@@ -368,3 +368,52 @@ def bill(rig, fab_report: dict, printer) -> dict:
 
 __all__ = ["bill", "bolt_axes", "bolt_joints", "bolt_length", "coating_rows", "dowel_pins", "fasteners", "printed", "purchased",
            "revolved_area", "thread_for_hole", "tower_hardware"]
+
+
+# -- consumables and tools ------------------------------------------------------------------------
+#: Consumables with an orderable spec (standard or product class); the paint itself is the profile's.
+CONSUMABLES = (
+    ("Wet-or-dry silicon carbide paper, P120 P240 P400 P600 P800 P1000 P1500 P2000 P3000 (ISO 6344), 230 x 280 mm "
+     "sheets", "2 sheets of each"),
+    ("Dry guide coat powder (black, e.g. 3M 05861) with its applicator", "1"),
+    ("Filler primer: 1K acrylic high-build aerosol, 400 ml (or 2K epoxy primer with hardener)", "2"),
+    ("Cutting compound and finishing polish (automotive, e.g. 3M 06085 + 06068 class), 250 ml each", "1 each"),
+    ("Foam polishing pads, 75 mm, cutting and finishing", "2 each"),
+    ("Cyanoacrylate glue, medium viscosity, 20 g, for the split pieces' cut faces", "1"),
+    ("Two-part epoxy, 5 min, 25 ml (pins into holes)", "1"),
+    ("Isopropyl alcohol 99 %, 500 ml, and lint-free wipes (degreasing before each coat)", "1"),
+    ("Tack cloths", "5"),
+)
+#: Tools with an orderable spec.
+TOOLS = (
+    ("Digital caliper 150 mm, 0.01 mm (DIN 862)", "1"),
+    ("Engineer's square 100 mm (DIN 875, grade 1)", "1"),
+    ("Spirit level 200 mm, 0.3 mm/m", "1"),
+    ("Hex screwdrivers 2.5, 3, 4 mm and 3/16 in, 100 mm blades; L hex key set (ISO 2936)", "1 set"),
+    ("Open-end spanners 5.5, 7, 8 mm (DIN 3110)", "1 set"),
+    ("Soldering iron with a heat-set insert tip (M3, M4)", "1"),
+    ("HVLP spray gun 1.3-1.4 mm nozzle and a compressor (or aerosol cans only)", "1"),
+    ("Respirator, half mask with A2P3 filters (EN 14387); supplied-air hood for 2K isocyanate coats", "1"),
+    ("Nitrile gloves and safety glasses (EN 166)", "1 box / 1"),
+    ("Sanding blocks: flat rubber block and blocks curved to the mirrors' radii (section 3)", "see section 3"),
+)
+
+
+def feeler_gauge(gaps_mm: list[float]) -> tuple[str, str]:
+    """A feeler gauge set (DIN 2275 / ISO 2768 leaves) with the leaves the template checks need: the
+    gaps rounded to the set's 0.01 mm steps; a gap under 0.02 mm (the thinnest leaf) is checked
+    against the light instead."""
+    leaves = sorted({round(g, 2) for g in gaps_mm if g >= 0.02})
+    return (f"Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: "
+            + (", ".join(f"{v:.2f}" for v in leaves) + " mm" if leaves else "none (check against the light)"),
+            "1")
+
+
+def dowel_drills(printer) -> tuple[str, str]:
+    """The drill for the split pieces' pin holes (the printer's alignment pin plus its clearance)."""
+    pin = printer.alignment_pin
+    return (f"HSS twist drill {pin.diameter + pin.clearance:g} mm (DIN 338) for the pin holes; 4 mm H7 reamer "
+            "for the column's dowel holes", "1 each")
+
+
+__all__ += ["CONSUMABLES", "TOOLS", "dowel_drills", "feeler_gauge"]

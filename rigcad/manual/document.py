@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import base64
 import html
+import math
 import re
 from pathlib import Path
 
@@ -182,11 +183,11 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     step("rig picture")
     d = Doc()
     _introduction(d, c)
-    for section in (_section_bill, _section_print, _section_sand, _section_coat, _section_assemble,
-                    _section_calibrate):
+    for section in (_section_bill, _bill_consumables, _section_print, _section_sand, _section_finish, _section_coat,
+                    _section_assemble, _section_calibrate):
         section(d, c)
     figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
-               "bill": c.bill, "calibration": c.calibration,
+               "bill": c.bill, "calibration": c.calibration, "finishing": c.finishing,
                "coating_gauged_layer": c.gauged, "coating_total_mm": c.total,
                "assembly_order": getattr(c, "assembly_order", None)}
     return d, c.files, figures
@@ -244,14 +245,7 @@ def _introduction(d: Doc, c) -> None:
 
 def _section_bill(d: Doc, c) -> None:
     """The manual's section: 1 bill of materials."""
-    import numpy as np
-
-    from rigcad import plots
-    from rigcad.export import mesh as M
-    from rigcad.manual import assembly as A
-    from rigcad.parts.templates import gauged_depth
-
-    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
+    printer, p, bill = c.printer, c.p, c.bill
     d.h(2, "1. Bill of materials")
     d.h(3, "Printed and cut parts")
     rows = []
@@ -294,16 +288,26 @@ def _section_bill(d: Doc, c) -> None:
               f"{c['film_cm3']:.2f} ml", f"**{c['to_buy_cm3']:.1f} ml**"] for c in bill["coating"]])
 
 
-def _section_print(d: Doc, c) -> None:
-    """The manual's section: 2 print."""
-    import numpy as np
-
-    from rigcad import plots
-    from rigcad.export import mesh as M
-    from rigcad.manual import assembly as A
+def _bill_consumables(d: Doc, c) -> None:
+    """The consumables and tools lists, the feeler leaves from the template gaps."""
     from rigcad.parts.templates import gauged_depth
 
-    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
+    total = float(sum(t for _, t in c.p.coating.layers))
+    gap, gaps = total - gauged_depth(c.p), []
+    for _, t in c.p.coating.layers:
+        gap -= t
+        if gap > 1e-9:
+            gaps.append(gap)
+    d.h(3, "Consumables")
+    d.table(["item", "qty"], [list(r) for r in B.CONSUMABLES])
+    d.h(3, "Tools")
+    d.table(["item", "qty"], [list(r) for r in (*B.TOOLS, B.feeler_gauge([total - gauged_depth(c.p), *gaps]),
+                                                B.dowel_drills(c.printer))])
+
+
+def _section_print(d: Doc, c) -> None:
+    """The manual's section: 2 print."""
+    printer, fab_report, p, bill, files = c.printer, c.fab_report, c.p, c.bill, c.files
     d.h(2, "2. Print")
     items = []
     for name, e in fab_report["parts"].items():
@@ -334,10 +338,9 @@ def _section_sand(d: Doc, c) -> None:
 
     from rigcad import plots
     from rigcad.export import mesh as M
-    from rigcad.manual import assembly as A
     from rigcad.parts.templates import gauged_depth
 
-    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
+    rig, fab_report, p, files = c.rig, c.fab_report, c.p, c.files
     gd = gauged_depth(p)
     total = float(sum(t for _, t in p.coating.layers))
     gauged = p.templates.gauged_layer
@@ -368,14 +371,7 @@ def _section_sand(d: Doc, c) -> None:
 
 def _section_coat(d: Doc, c) -> None:
     """The manual's section: 4 coat."""
-    import numpy as np
-
-    from rigcad import plots
-    from rigcad.export import mesh as M
-    from rigcad.manual import assembly as A
-    from rigcad.parts.templates import gauged_depth
-
-    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
+    rig, p, bill, step = c.rig, c.p, c.bill, c.step
     gauged, total, gd = c.gauged, c.total, c.gd
     d.h(2, "4. Coat, layer by layer, checking with the template")
     layers = p.coating.layers
@@ -521,6 +517,86 @@ def _tower_rows_by_step(rig, steps) -> dict:
     return out
 
 
+def _section_finish(d: Doc, c) -> None:
+    """The finishing recipe, the blocks from the mirrors' curvature, the templates' cutting, and the
+    optical acceptance test (rigcad.manual.finishing)."""
+    from rigcad.manual import finishing as F
+
+    d.h(3, "Finishing recipe, stage by stage")
+    d.table(["stage", "what", "how", "cure / wait", "check"], [list(r) for r in F.RECIPE])
+    blocks = F.sanding_blocks(c.rig)
+    d.p(f"Sanding blocks, from the mirrors' curvature: a flat block of length L stands off a curve of radius R by "
+        f"L²/(8R); keep that under {F.BLOCK_SAG_MM:g} mm (1 mil, the thinnest coat). Longer blocks must be curved "
+        "to the radius given (convex for the concave dome, concave for the convex paraboloid).")
+    d.table(["mirror", "smallest radius along the meridian", "smallest radius across", "longest flat block",
+             "curved block radius"],
+            [[b["mirror"], f"{b['meridional_mm']:.1f} mm", f"{b['sagittal_mm']:.1f} mm",
+              f"{b['flat_block_max_mm']:.1f} mm", f"{b['smallest_radius_mm']:.1f} mm"] for b in blocks])
+    d.p("The templates: cut them with the cutter's path half a kerf outside the outline (" +
+        ", ".join(f"{k} {v:g} mm" for k, v in F.KERF_MM.items()) + " kerf), so the edge lands on the outline; "
+        "mark the datum on each (the edge that sits on the base plate's top, z = 0, and the axis line) and hold "
+        "the template in a jig: a square block clamped to the base plate with the template's datum edge on the "
+        "plate and its axis line on the plate's centre mark, so it swings about the axis and checks every "
+        "meridian the same way.")
+    acc = F.slope_acceptance(c.rig)
+    d.h(3, "Optical acceptance test")
+    d.p(f"The mirrors' slope must be right, not only their form: each may err by at most "
+        f"**{acc['slope_tolerance_mrad']:.2f} mrad** (a quarter of `tolerancing.max_angle_error` = "
+        f"{acc['angle_target_deg']:g} deg: two reflections, each turning a ray by twice the slope error). Lay a "
+        "target of straight black lines 5 mm apart on white card on the base plate, light it, and take the "
+        "camera's picture through the splitter (the rig assembled). Fit each line's image with a smooth curve "
+        "(a low-order polynomial along it: the mirrors' designed distortion); the residual ripple must stay "
+        f"within **{acc['pass_limit_px']:.1f} px** (2 x slope tolerance x the camera's focal length, "
+        f"{acc['camera_focal_px']:.0f} px with its lens chosen so the paraboloid's rim fills the image's short "
+        "side). A ripple above the limit marks the area to block and polish again.")
+    c.finishing = {"blocks": blocks, "acceptance": acc}
+
+
+#: The checkerboard's square (mm): 5 mm prints sharply on a laser printer and spans several camera
+#: pixels in the paraboloid's image of the base plate.
+CHECKER_SQUARE_MM = 5.0
+
+
+def _calibration_more(d: Doc, c, cam: dict) -> None:
+    """The steps after the crosses: where the projector crosses' plate goes, the turned camera crosses,
+    the checkerboard and the gray card (thesis 4.1.1, 4.1.2)."""
+    import numpy as np
+
+    rig = c.rig
+    t = getattr(rig.layout, "tower", None)
+    if t is not None and "projector_mounting_plate" in rig.recipes:
+        plate = rig.mesh(rig.recipes["projector_mounting_plate"])
+        base = -float(np.asarray(plate.vertices)[:, 2].min())  # the plate's thickness under its top face (z = 0)
+        above = t.projector_cop[2] - t.shelf_top_z
+        want = base + c.p.crosses.projector_axis_height
+        d.p(f"Where the crosses' plate goes: lift the splitter holder off its three balls (its kinematic seat puts it "
+            f"back in the same place) and take the focusing lens out of its mount. Stand the "
+            f"`projector_mounting_plate` on the shelf in front of the projector, its fences' line on the shelf's "
+            f"centre line y = 0 (square it from the shelf's two long edges, measure the centre with the caliper). "
+            f"The projector's axis is {above:.1f} mm above the shelf; the crosses' centres stand {want:.1f} mm above "
+            f"it ({base:.1f} mm of plate + `crosses.projector_axis_height`)"
+            + (f": put {above - want:.1f} mm of shims under the plate." if above - want > 0.05 else
+               f": the crosses stand {want - above:.1f} mm too high; lower `crosses.projector_axis_height` by that "
+               "and print them again." if want - above > 0.05 else "."))
+    hidden = cam["base_cross_arm_mrad"] < cam["hung_cross_arm_mrad"]
+    d.p("Turn the base cross 45 degrees to the hung one (it turns freely in the holder's bore)"
+        + (f": seen from the COP its arms span {cam['base_cross_arm_mrad']:.1f} mrad, less than the hung cross's "
+           f"{cam['hung_cross_arm_mrad']:.1f} mrad, so aligned it would hide behind it; turned, its arms show in the "
+           "gaps between the hung cross's arms." if hidden else ": its arms then show between the hung cross's."))
+    r = rig.layout.plate_r
+    d.p(f"Camera pixels to paraboloid points: paste a checkerboard of {CHECKER_SQUARE_MM:g} mm black and white "
+        f"squares ({math.ceil(2 * r / CHECKER_SQUARE_MM)} x {math.ceil(2 * r / CHECKER_SQUARE_MM)} squares, a "
+        f"{2 * r:.0f} mm disc: matte paper, laser-printed at 600 dpi, checked with the caliper over ten squares) on the "
+        "base plate, project the calibrated circle and locate the paraboloid's image in the camera's picture: its "
+        "centre and radius in pixels are the camera's correspondence.")
+    d.h(3, "Reflectance (thesis 4.1.2)")
+    d.p("Put an 18 % diffuse gray card (photographic, e.g. a Kodak R-27 class card cut to the sample holder's "
+        "diameter) in the sample holder, its face at z = 0. Project the zonal harmonic basis images up to order 2 "
+        "(`rigcad basis`), capture each at three exposures (thesis: 62.5, 125 and 250 ms), and recover the card's "
+        "hemispherical reflectance; the scale factor for each direction is (0.18 / pi) cos(theta) divided by the "
+        "measured value (thesis eq. 4.2). Keep the card dry and out of the light between uses.")
+
+
 def _section_calibrate(d: Doc, c) -> None:
     """The manual's section: 6 calibrate."""
     import numpy as np
@@ -528,9 +604,8 @@ def _section_calibrate(d: Doc, c) -> None:
     from rigcad import plots
     from rigcad.export import mesh as M
     from rigcad.manual import assembly as A
-    from rigcad.parts.templates import gauged_depth
 
-    rig, printer, fab_report, p, bill, files, meshes, cut_away, step = (c.rig, c.printer, c.fab_report, c.p, c.bill, c.files, c.meshes, c.cut_away, c.step)
+    rig, p, files, step = c.rig, c.p, c.files, c.step
     circle, info = C.circle_image(rig)
     files["calibration/circle.png"] = circle
     files["calibration/circle.html"] = C.circle_page(rig, info)
@@ -583,8 +658,7 @@ def _section_calibrate(d: Doc, c) -> None:
             files[f"images/{name}.png"] = plots.render_mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), name,
                                                             part.color)
             d.img(f"images/{name}.png", f"`{name}`: {part.description}")
-    d.p("Then the camera's pixel-to-paraboloid correspondence as in the thesis: a checkerboard on the base "
-        "plate, the calibrated circle projected, and the paraboloid's image located in the camera's picture.")
+    _calibration_more(d, c, cam)
     step("calibration")
     c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam}
 
