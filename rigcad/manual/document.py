@@ -540,15 +540,15 @@ def _section_finish(d: Doc, c) -> None:
         "meridian the same way.")
     acc = F.slope_acceptance(c.rig)
     d.h(3, "Optical acceptance test")
-    d.p(f"The mirrors' slope must be right, not only their form: each may err by at most "
-        f"**{acc['slope_tolerance_mrad']:.2f} mrad** (a quarter of `tolerancing.max_angle_error` = "
-        f"{acc['angle_target_deg']:g} deg: two reflections, each turning a ray by twice the slope error). Lay a "
-        "target of straight black lines 5 mm apart on white card on the base plate, light it, and take the "
-        "camera's picture through the splitter (the rig assembled). Fit each line's image with a smooth curve "
-        "(a low-order polynomial along it: the mirrors' designed distortion); the residual ripple must stay "
-        f"within **{acc['pass_limit_px']:.1f} px** (2 x slope tolerance x the camera's focal length, "
-        f"{acc['camera_focal_px']:.0f} px with its lens chosen so the paraboloid's rim fills the image's short "
-        "side). A ripple above the limit marks the area to block and polish again.")
+    d.p("The mirrors' slope must be right, not only their form: in a right rig every ray the camera sees lands on "
+        f"the sample point O. Print a white disc of **{acc['disc_radius_mm']:g} mm radius** "
+        "(`tolerancing.max_spot_radius`) on matte black card, put it in the sample holder centred on O, light it "
+        "from the side through a beam slot, and take the camera's picture through the splitter with the rig "
+        "assembled. **Pass:** the paraboloid's image is white (outside the occlusion disc of the calibration "
+        f"circle) over at least {100 * acc['pass_fraction']:g} % of its pixels (`tolerancing.min_yield`); black "
+        "patches mark the mirror areas to block and polish again. This holds the dome's slope to "
+        f"{acc['dome_slope_tolerance_mrad']:.1f} mrad at its farthest point from O "
+        f"({acc['dome_farthest_from_o_mm']:.0f} mm): a slope error e turns a ray by 2 e.")
     c.finishing = {"blocks": blocks, "acceptance": acc}
 
 

@@ -8,11 +8,10 @@ target.
   distance along the normal to the axis). A flat block of length L on a curve of radius R stands
   off by the sagitta L^2 / (8 R): the longest block that keeps it under BLOCK_SAG_MM is
   sqrt(8 R BLOCK_SAG_MM); a longer block must be curved to R (convex for a concave mirror).
-- Slope: a mirror tilted by e turns a reflected ray by 2 e. The rays meet two mirrors (paraboloid,
-  dome), so the angle target ``tolerancing.max_angle_error`` is split evenly: each mirror's slope
-  error at most max_angle_error / 4. Seen from the camera at the COP, a slope error e bends the
-  image of a straight edge by 2 e rad, i.e. 2 e f_px pixels, f_px the camera's focal length in pixels
-  when the paraboloid's rim fills the short side of its image (its lens chosen so).
+- Slope: every ray of a right rig lands on O (the sample point); a mirror tilted by e turns a
+  reflected ray by 2 e, and it lands off O. The acceptance test looks at that directly: a white disc
+  of radius ``tolerancing.max_spot_radius`` on black at O, seen by the camera through the rig, is
+  white over the paraboloid's whole image when every ray lands inside it (slope_acceptance).
 
 Units: mm and rad inside; the figures carry their unit in their keys.
 """
@@ -63,14 +62,17 @@ def sanding_blocks(rig) -> list[dict]:
 
 
 def slope_acceptance(rig) -> dict:
-    """The slope tolerance of each mirror (rad) and the acceptance test's pass limit (px): how far
-    the camera's image of a straight edge may wander from its smooth fit."""
-    tol = rig.profile.tolerancing.max_angle_error / 4.0
-    design = rig.incidence
-    short = min(rig.profile.camera.resolution) / 2.0
-    f_px = short / math.tan(design.alpha_max)
-    return {"slope_tolerance_mrad": 1e3 * tol, "camera_focal_px": f_px, "pass_limit_px": 2.0 * tol * f_px,
-            "angle_target_deg": math.degrees(rig.profile.tolerancing.max_angle_error)}
+    """The optical acceptance test's figures: every camera pixel's ray lands on the sample plane within
+    ``tolerancing.max_spot_radius`` of O when the mirrors are right, so a white disc of that radius on
+    black, centred on O, fills the paraboloid's whole image white; a pixel that sees black marks a
+    mirror area whose slope is off. The dome's slope tolerance that this test holds: a slope error e
+    turns the ray by 2 e, which lands 2 e D off O, D the dome's farthest point from O (mm)."""
+    p = rig.profile
+    pts = rig.layout.design_dome.points(rig.layout.design_dome.sample(2001))
+    far = float(np.max(np.hypot(pts[:, 0], pts[:, 1])))
+    limit = p.tolerancing.max_spot_radius
+    return {"disc_radius_mm": limit, "dome_farthest_from_o_mm": far,
+            "dome_slope_tolerance_mrad": 1e3 * limit / (2.0 * far), "pass_fraction": p.tolerancing.min_yield}
 
 
 #: The finishing recipe, stage by stage: (stage, what, how, cure / wait, check). A 2K (isocyanate)

@@ -32,8 +32,12 @@ def test_flat_block_length_keeps_the_sagitta(table31_rig):
         assert L * L / (8 * R) == pytest.approx(F.BLOCK_SAG_MM, rel=1e-12)
 
 
-def test_pass_limit_is_twice_the_slope_tolerance_in_camera_pixels(table31_rig):
+def test_the_dome_slope_held_by_the_disc_test(table31_rig):
+    """A ray turned by 2 e at the dome's farthest point (distance D from O) lands 2 e D off O: the disc's
+    radius over 2 D; D checked against the dome's rim point (r, z) from the layout directly."""
     acc = F.slope_acceptance(table31_rig)
     p = table31_rig.profile
-    f_px = min(p.camera.resolution) / 2 / math.tan(table31_rig.incidence.alpha_max)
-    assert acc["pass_limit_px"] == pytest.approx(2 * p.tolerancing.max_angle_error / 4 * f_px, rel=1e-12)
+    rim = table31_rig.layout.design_dome.points(np.array(table31_rig.layout.design_dome.u_range))
+    assert acc["dome_farthest_from_o_mm"] >= float(np.max(np.hypot(rim[:, 0], rim[:, 1]))) - 1e-9
+    e = acc["dome_slope_tolerance_mrad"] / 1e3
+    assert 2 * e * acc["dome_farthest_from_o_mm"] == pytest.approx(p.tolerancing.max_spot_radius, rel=1e-12)
