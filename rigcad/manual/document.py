@@ -194,24 +194,18 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
 
 
 def assumed_sizes(profile) -> list[dict]:
-    """The profile's instrument and optics sizes that its schema marks as assumed (not from a
-    maker's drawing): section, key, value as the manual shows it, and where the profile set it."""
-    from dataclasses import fields
+    """What must be measured before printing: the instrument sizes that neither the chosen library
+    entry sources nor the profile gives (rigcad.profile.instruments.measurements, the one home of
+    that list), each with how to measure it (the view and the two features it runs between)."""
+    from rigcad.profile.instruments import measurements
 
     out = []
-    for section in ("projector", "camera", "beam_splitter", "lens"):
-        obj = getattr(profile, section, None)
-        if obj is None:
-            continue
-        for f in fields(obj):
-            spec = f.metadata.get("spec")
-            doc = getattr(spec, "doc", "") or ""
-            if "assumed" not in doc.lower() or getattr(obj, f.name) is None:
-                continue
-            value = getattr(obj, f.name)
-            text = f"{value:.4g} mm" if getattr(spec, "kind", "") == "length" else str(value)
-            out.append({"key": f"{section}.{f.name}", "value": text, "doc": doc,
-                        "set_in": profile.where(section, f.name) or "default"})
+    for m in measurements(profile):
+        section, key = m.key.split(".", 1) if "." in m.key else ("", m.key)
+        value = f"{m.assumed:g} {m.unit}" if isinstance(m.assumed, (int, float)) else f"{m.assumed} {m.unit}".strip()
+        out.append({"key": m.key, "value": value,
+                    "doc": f"{m.what} ({m.view} view: from the {m.between[0]} to the {m.between[1]})",
+                    "set_in": (profile.where(section, key) if section else None) or "default"})
     return out
 
 
@@ -245,7 +239,7 @@ def _introduction(d: Doc, c) -> None:
 
 def _section_bill(d: Doc, c) -> None:
     """The manual's section: 1 bill of materials."""
-    printer, p, bill = c.printer, c.p, c.bill
+    rig, printer, p, bill = c.rig, c.printer, c.p, c.bill
     d.h(2, "1. Bill of materials")
     d.h(3, "Printed and cut parts")
     rows = []
@@ -267,7 +261,13 @@ def _section_bill(d: Doc, c) -> None:
                                    + (": `rigcad manual ... --gcode` uses PrusaSlicer's own figures)"
                                       if printer.slicer == "prusa-slicer" else ")")) + ".")
     d.h(3, "Hardware")
-    hw = [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"]]
+    from rigcad.manual import plan
+
+    steps, _ = plan.steps(rig, c.meshes)
+    hw = [[r["item"], r["quantity"], f"assembly steps: {r['steps']}", "as the assembly check fitted it"]
+          for r in plan.hardware(steps)]
+    hw += [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"] if f.get("tower")
+           and "mounting holes" not in f["use"]]
     if bill["pins"]:
         pin = bill["pins"]
         hw.append([pin["item"], pin["quantity"], f"aligning split pieces ({pin['use']})", pin["note"]])

@@ -280,3 +280,31 @@ def assembly(rig, meshes) -> Assembly:
 
 
 __all__ = ["assembly", "bolt_fasteners", "driver", "groups", "instrument_fasteners", "spanner", "steps"]
+
+
+def hardware(steps: list[Step]) -> list[dict]:
+    """The plan's fasteners as one list: each bolt or screw item with its count and the steps that use
+    it, then the nuts, washers and heat-set inserts they need (counted from the items)."""
+    rows: dict[str, dict] = {}
+    extra: dict[str, int] = {}
+    for st in steps:
+        for f in st.fasteners:
+            row = rows.setdefault(f.item, {"item": f.item, "quantity": 0, "steps": []})
+            row["quantity"] += 1
+            if st.name not in row["steps"]:
+                row["steps"].append(st.name)
+            thread = f.item.split(" x ")[0]
+            if f.thread_in == "nut":
+                extra[f"{thread} hex nut (ISO 4032)"] = extra.get(f"{thread} hex nut (ISO 4032)", 0) + 1
+                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 2
+            else:
+                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 1
+            if f.thread_in == "insert":
+                dia, long = INSERT[thread]
+                name = f"{thread} heat-set insert for printed parts, {dia:g} x {long:g} mm"
+                extra[name] = extra.get(name, 0) + 1
+    out = [{**r, "steps": ", ".join(r["steps"])} for r in rows.values()]
+    return out + [{"item": k, "quantity": v, "steps": "with the bolts above"} for k, v in extra.items()]
+
+
+__all__ += ["hardware"]

@@ -116,3 +116,27 @@ def test_steps_that_need_each_other_are_refused_at_once():
     steps = [AC.Step("a", ("a",), (DOWN,), 10.0, needs=("b",)), AC.Step("b", ("b",), (DOWN,), 10.0, needs=("a",))]
     with pytest.raises(GeometryError, match="loop"):
         AC.find_order(AC.Assembly(solids, steps))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("buy", [None, "buy:\n  column: extrusion_40x40\n  shelf: aluminium_plate\n"])
+def test_the_default_rig_has_a_feasible_order_printed_or_bought(tmp_path, buy):
+    """The default profile, its tower printed or bought, goes together in an order the check finds
+    (~15 s each); the plan takes no printer (a split piece is joined before assembly), so this holds
+    for every printer. On the same rig, the planted wrong orders are refused: the dome before the
+    plate it rests on, the paraboloid before the beam it clamps to."""
+    import rigcad
+    from rigcad.manual.assembly import picture_meshes
+
+    path = tmp_path / "p.yaml"
+    path.write_text("extends: achutha2006\n" + (buy or ""), encoding="utf-8")
+    rig = rigcad.load(path)
+    a = plan.assembly(rig, picture_meshes(rig))
+    order = [p.step.name for p in AC.find_order(a)]
+    assert order.index("base_plate") < order.index("dome") < order.index("beam") < order.index("paraboloid")
+    assert order.index("camera_shims") < order.index("camera_body")  # the shims before the screws through them
+    assert "projector_lens" not in [s.name for s in a.steps]  # the projector's lens goes with its body
+    wrong = [n for n in order if n != "base_plate"]
+    wrong.insert(wrong.index("dome") + 1, "base_plate")
+    with pytest.raises(GeometryError, match=r"\(dome\).*needs base_plate"):
+        AC.check_order(a, wrong)
