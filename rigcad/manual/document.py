@@ -651,7 +651,8 @@ def _section_calibrate(d: Doc, c) -> None:
         "camera until the two overlap symmetrically in its image, then focus on the hung cross. A camera off the "
         f"axis by 1 mm shows them {cam['separation_mrad_per_mm_offset']:.2f} mrad apart "
         f"(`tolerancing.camera_offset` = {p.tolerancing.camera_offset:g} mm).")
-    for name in ("projector_cross", "camera_cross_hung"):
+    for name in ("projector_cross", "projector_backplate", "projector_mounting_plate", "camera_cross_hung",
+                 "camera_cross_base"):
         if name in rig.recipes:
             part = rig.recipes[name]
             mesh = rig.mesh(part, M.PICTURE_CHORD_ERROR)
