@@ -657,3 +657,31 @@ def sweep_plot(key: str, unit: str, rows: list[dict], columns: list[tuple[str, s
         ax.grid(alpha=0.3)
     fig.tight_layout()
     return _png(fig)
+
+
+def calibration_maps(phase: np.ndarray, slope_mrad: np.ndarray, planted_mrad: np.ndarray | None,
+                     corrected_deg: np.ndarray | None, design_deg: np.ndarray | None, title: str) -> bytes:
+    """Deflectometric calibration (rigcad calibrate), over the camera window: the decoded phase of the
+    finest x period (rad), the dome's residual slope magnitude (mrad) and, for a simulation, the
+    planted one, and the corrected and design maps' incidence errors (deg). Arrays (rows, cols), NaN
+    where there is nothing to show."""
+    panels = [("decoded x phase, finest period (rad)", phase, "twilight"),
+              ("residual slope |grad h| (mrad)", slope_mrad, "magma")]
+    if planted_mrad is not None:
+        panels.append(("planted slope |grad h| (mrad)", planted_mrad, "magma"))
+    if corrected_deg is not None and design_deg is not None:
+        panels += [("corrected map: incidence error (deg)", corrected_deg, "viridis"),
+                   ("design map: incidence error (deg)", design_deg, "viridis")]
+    fig, axes = plt.subplots(1, len(panels), figsize=(3.4 * len(panels), 3.4))
+    slope_top = np.nanpercentile(np.concatenate([slope_mrad[np.isfinite(slope_mrad)]] + (
+        [planted_mrad[np.isfinite(planted_mrad)]] if planted_mrad is not None else [])), 99)
+    for ax, (name, data, cmap) in zip(np.atleast_1d(axes), panels):
+        top = slope_top if "slope" in name else (np.nanpercentile(data, 99) if np.isfinite(data).any() else 1.0)
+        im = ax.imshow(data, cmap=cmap, vmin=0, vmax=top, interpolation="nearest")
+        ax.set_title(name, fontsize=8)
+        ax.set_xticks([])
+        ax.set_yticks([])
+        fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    return _png(fig)

@@ -110,8 +110,11 @@ class CameraView:
     wo: np.ndarray
 
 
-def camera_view(rig, zone: Zone, stride: int = CAMERA_STRIDE_PX, focal_px: float | None = None) -> CameraView:
-    """Camera pixels every ``stride`` px traced through the rig as designed (see the module docstring)."""
+def camera_view(rig, zone: Zone, stride: int = CAMERA_STRIDE_PX, focal_px: float | None = None,
+                corrected=None) -> CameraView:
+    """Camera pixels every ``stride`` px traced through the rig as designed (see the module docstring).
+    ``corrected``: a :class:`rigcad.calibrate.CorrectedMap`; the exitant direction the software
+    assigns a pixel is then the corrected map's (the design's where the map has none)."""
     px = trace_pixels(rig, "camera", stride=stride, focal_px=focal_px)
     keep = px.ok & px.in_zone(zone)
     theta, _ = px.design_angles()
@@ -119,7 +122,11 @@ def camera_view(rig, zone: Zone, stride: int = CAMERA_STRIDE_PX, focal_px: float
     if keep.sum() < 2:
         raise BasisError(f"camera stride = {stride} px leaves {int(keep.sum())} camera pixels on the sample: "
                          "use a smaller stride")
-    return CameraView(px, keep, px.design_dirs[keep])
+    wo = px.design_dirs[keep]
+    if corrected is not None:
+        measured = corrected.at(px.row[keep], px.col[keep])
+        wo = np.where(np.isfinite(measured[:, :1]), measured, wo)
+    return CameraView(px, keep, wo)
 
 
 def _angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -185,7 +192,7 @@ def _slice_figures(coeffs: dict, brdf, wo: np.ndarray, zone: Zone, rules, conver
 
 def simulate_on_rig(rig, order: int = 6, *, basis: ProjectorBasis | None = None, moved: Sequence | None = None,
                     brdfs: dict | None = None, bits: int = 8, camera_stride_px: int = CAMERA_STRIDE_PX,
-                    lobe_study: bool = True, progress: Progress = None) -> RigSimulation:
+                    lobe_study: bool = True, progress: Progress = None, corrected=None) -> RigSimulation:
     """Simulate basis-illumination acquisition on ``rig`` (as designed) and on each rig of ``moved``
     (default: :func:`default_moves`, made with ``rig.moved``), for the orders in ORDERS up to
     ``order``; see the module docstring. ``basis``: the rig's :class:`ProjectorBasis` of ``order``
@@ -199,7 +206,9 @@ def simulate_on_rig(rig, order: int = 6, *, basis: ProjectorBasis | None = None,
     squares over the rest of the zone), and for ``gram`` the slice, cap and albedo errors; ``exact`` gives the same
     slice figures from the exact zonal coefficients (the order's own truncation). Also the gray card
     of 4.1.2 (order 1), the reference quadrature's own error, the geometry of each moved rig (how
-    far its pixels' directions moved), and the lobe-width study on the rig's pixels."""
+    far its pixels' directions moved), and the lobe-width study on the rig's pixels. ``corrected``: the
+    camera's corrected map (:func:`rigcad.calibrate.load_corrected_map`), read for the exitant
+    directions instead of the design map's."""
     L = check_basis_order(order)
     if bits not in (8, 16):
         raise BasisError(f"bits = {bits!r}: need 8 or 16 (projector image depth)")
@@ -211,7 +220,7 @@ def simulate_on_rig(rig, order: int = 6, *, basis: ProjectorBasis | None = None,
     brdfs = brdfs if brdfs is not None else models()
     moved = list(moved) if moved is not None else [rig.moved(c, offset=o) for c, o in default_moves(rig)]
     orders = sorted({o for o in ORDERS if o <= L} | {L})
-    cam = camera_view(rig, zone, camera_stride_px)
+    cam = camera_view(rig, zone, camera_stride_px, corrected=corrected)
 
     # truths: eq. 4.3 over the zone and over the lit part, on shared nodes (graded to the narrowest lobe)
     widths = [w for _, w in brdfs.values() if w is not None]
@@ -239,7 +248,7 @@ def simulate_on_rig(rig, order: int = 6, *, basis: ProjectorBasis | None = None,
         "bits": bits,
         "thesis": "3.3.1 and Figure 3.10 (basis validation), eq. 4.3, 4.1.2 (gray card), eqs. 3.5-3.7 (SH)",
         "zone": {"alpha_deg": math.degrees(zone.alpha_rad), "beta_deg": math.degrees(zone.beta_rad)},
-        "camera": _camera_figures(cam, camera_stride_px),
+        "camera": _camera_figures(cam, camera_stride_px, corrected),
         "models": {name: {"brdf": repr(f), "lobe_width_rad": w} for name, (f, w) in brdfs.items()},
         "reference": {
             "method": "eq. 4.3 by product Gauss quadrature graded towards each mirror direction "
@@ -263,14 +272,16 @@ def simulate_on_rig(rig, order: int = 6, *, basis: ProjectorBasis | None = None,
     return RigSimulation(report, lobe_rows)
 
 
-def _camera_figures(cam, stride_px: int) -> dict:
-    """The simulated camera: its pixels, model, stride and the exitant directions it samples."""
+def _camera_figures(cam, stride_px: int, corrected=None) -> dict:
+    """The simulated camera: its pixels, model, stride and the exitant directions it samples (and the
+    map they were read from: ``corrected``, a :class:`rigcad.calibrate.CorrectedMap`, or the design's)."""
     theta_o, _ = direction_angles(cam.wo)
     return {
         "resolution_px": list(cam.pixels.resolution), "focal_length_px": cam.pixels.focal_px,
         "model": "same COP as the projector; pinhole pixels through the same optics; a pixel samples the "
                  "radiance leaving O along its traced arrival direction (footprint not integrated); the "
                  "software reads its exitant direction from the design map",
+        "exitant_directions_from": str(corrected.path) if corrected is not None else "the design map",
         "stride_px": stride_px, "exitant_directions": int(len(cam.wo)),
         "theta_o_deg_range": [float(np.degrees(theta_o.min())), float(np.degrees(theta_o.max()))],
     }

@@ -60,6 +60,7 @@ from rigcad.basis.gram import (IlluminationSampling, QuantisedImages, Reorthonor
                                off_identity, quantise_images, reorthonormalise)
 from rigcad.basis.zonal import Zone, basis_indices, check_order, direction_angles, zonal_basis
 from rigcad.errors import BasisError
+from rigcad.optics.incidence import camera_focal_px  # noqa: F401  (named here too: the basis's callers import it from here)
 
 #: Sub-points per side of a pixel on an edge (its lit part in steps of 1/16): the error of the lit
 #: part's solid angle is then ~1/8 of a pixel row along the edges.
@@ -103,15 +104,6 @@ def zone_of(rig, alpha_rad: float | None = None) -> Zone:
                          f"alpha_rad < pi/2 ({math.degrees(lowest):.4g} deg is the rig's occlusion limit, the "
                          "lowest incidence angle its pixels reach)", param="basis.alpha")
     return Zone(max(a, lowest), math.pi / 2)
-
-
-def camera_focal_px(rig) -> float:
-    """The camera's focal length in its own pixels. The profile gives only the camera's resolution;
-    rigcad assumes the camera, behind the beam splitter at the projector's COP (thesis 3.1,
-    Figure 3.4), frames the paraboloid as the projector does: the same field of view across the
-    sensor's height, f_camera = f_projector x camera height / projector height (2389 px for
-    Table 3.1: the rim at 134 px from the image centre, 1.5 camera pixels per degree on average)."""
-    return rig.incidence.focal_px * rig.profile.camera.resolution[1] / rig.profile.projector.resolution[1]
 
 
 def device_map(rig, device: str, focal_px: float | None = None):

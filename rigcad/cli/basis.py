@@ -51,7 +51,13 @@ def cmd_basis(args: argparse.Namespace) -> int:
         t_images = time.perf_counter() - t0
         sim = None
         if args.simulate:
-            sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step)
+            from rigcad.calibrate import load_corrected_map
+
+            corrected = load_corrected_map(args.exports, rig.name)
+            print("  camera exitant directions: " + (f"the corrected map {corrected.path}" if corrected else
+                                                     "the design map (no corrected map: rigcad calibrate)"))
+            sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step,
+                                  corrected=corrected)
             paths += api.write_simulation(rig, sim, out)
     rep = basis.report
     z, px, sa = rep["zone"], rep["projector"], rep["solid_angle"]

@@ -14,11 +14,12 @@ import sys
 from pathlib import Path
 
 from rigcad._version import __version__
-from rigcad.cli import basis, build, check, design, fab, manual, optimize, profile, stl, sweep, tolerance, view, watch
+from rigcad.cli import (basis, build, calibrate, check, design, fab, manual, optimize, profile, stl, sweep, tolerance,
+                        view, watch)
 from rigcad.errors import RigcadError, one_line
 
 #: The commands, in the order of ``rigcad --help``: each a module with ``register(subparsers)``.
-COMMANDS = (profile, design, build, stl, check, fab, basis, optimize, view, watch, manual, tolerance, sweep)
+COMMANDS = (profile, design, build, stl, check, fab, basis, calibrate, optimize, view, watch, manual, tolerance, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -105,3 +105,13 @@ class DesignMap:
 
     def pixel_radius(self, alpha: np.ndarray) -> np.ndarray:
         return self.focal_px * np.tan(alpha)
+
+
+def camera_focal_px(rig) -> float:
+    """The camera's focal length in its own pixels. The profile gives only the camera's resolution;
+    rigcad assumes the camera, behind the beam splitter at the projector's COP (thesis 3.1,
+    Figure 3.4), frames the paraboloid as the projector does: the same field of view across the
+    sensor's height, f_camera = f_projector x camera height / projector height (2389 px for
+    Table 3.1: the rim at 134 px from the image centre, 1.5 camera pixels per degree on average).
+    ``rig``: a :class:`rigcad.rig.Rig` (its design map and profile)."""
+    return rig.incidence.focal_px * rig.profile.camera.resolution[1] / rig.profile.projector.resolution[1]

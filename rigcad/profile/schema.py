@@ -49,7 +49,9 @@ class Spec:
     """How one profile key is read and checked.
 
     ``kind`` is ``length`` (mm), ``angle`` (rad), ``int``, ``float``, ``choice``, ``pixels``
-    (a ``[width, height]`` pair of positive integers) or ``layers`` (a list of named thicknesses).
+    (a ``[width, height]`` pair of positive integers), ``layers`` (a list of named thicknesses),
+    ``lengths`` (a list of lengths, mm, each within the bounds) or ``ints`` (a list of whole numbers,
+    each within the bounds).
     Bounds are in internal units.
     """
 
@@ -517,6 +519,45 @@ class TolerancingParams:
     min_yield: float = spec("float", "fewest builds (fraction) that must meet both targets", 0.9, lo=0, hi=1)
 
 
+@dataclass(frozen=True)
+class CalibrationParams:
+    """Deflectometric calibration of the as-built rig (rigcad calibrate): a flat screen at the
+    sample, shown phase-shifted sinusoids and Gray codes, seen by the camera through the mirrors at
+    two or more heights. The screen's emitting surface stands at z = spacer + screen_thickness -
+    sample_holder.sample_thickness (the spacer on the holder's seat). The ``sim_*`` keys shape the
+    simulated capture (``--simulate``): the planted dome error and the camera's noise."""
+
+    screen_pitch: float = spec("length", "screen pixel pitch (a tablet: 0.05-0.1 mm)", "0.085 mm",
+                               lo=0.005, hi=2.0)
+    screen_resolution: tuple[int, int] = spec("pixels", "screen [width, height] in pixels", [2560, 1600])
+    screen_thickness: float = spec("length", "screen: from its back (on the spacer) to its emitting surface",
+                                   "6 mm", lo=0, hi=100.0)
+    spacer_heights: tuple[float, ...] = spec("lengths", "printed spacers under the screen, one capture per "
+                                             "spacer (two or more, distinct)", ["2 mm", "10 mm"], lo=0, hi=200.0)
+    phase_steps: int = spec("int", "phase shifts per sinusoid period (>= 3)", 4, lo=3, hi=64)
+    periods: tuple[int, ...] = spec("ints", "sinusoid periods in screen pixels, coarse to fine unwrapping "
+                                    "(the coarsest is unwrapped by the Gray code)", [128, 16], lo=4, hi=MAX_PIXELS)
+    gray_bits: int = spec("int", "Gray-code bits per axis; the finest stripe is half the coarsest period",
+                          6, lo=1, hi=16)
+    min_modulation: float = spec("float", "least fringe modulation (amplitude / mean) a camera pixel must show to "
+                                 "be decoded", 0.1, lo=0, hi=1, lo_open=True)
+    fit_stride: int = spec("int", "camera pixels used by the misalignment fit: every n-th row and column", 2,
+                           lo=1, hi=64)
+    sim_bump_amplitude: float = spec("length", "simulation: the dome's low-order bump, peak height", "20 um",
+                                     lo=0, hi=1.0)
+    sim_bump_width: float = spec("length", "simulation: the bump's Gaussian width (sigma) along the dome", "25 mm",
+                                 lo=0, lo_open=True, hi=1000.0)
+    sim_ripple_amplitude: float = spec("length", "simulation: the sanding ripple across the print layers, "
+                                       "amplitude", "2 um", lo=0, hi=1.0)
+    sim_ripple_period: float = spec("length", "simulation: the ripple's period along the print's z", "12 mm",
+                                    lo=0, lo_open=True, hi=1000.0)
+    sim_supersample: int = spec("int", "simulation: sub-pixel rays per camera pixel side", 3, lo=1, hi=16)
+    sim_blur: float = spec("float", "simulation: defocus blur, Gaussian sigma in camera pixels", 0.5, lo=0, hi=20)
+    sim_full_well: float = spec("float", "simulation: electrons at a white screen pixel's full exposure", 10000.0,
+                                lo=1, hi=1e7)
+    sim_read_noise: float = spec("float", "simulation: read noise, electrons RMS", 10.0, lo=0, hi=1e5)
+
+
 SECTIONS: dict[str, type] = {
     "paraboloid": ParaboloidParams,
     "layout": LayoutParams,
@@ -542,6 +583,7 @@ SECTIONS: dict[str, type] = {
     "tessellation": TessellationParams,
     "raycheck": RayCheckParams,
     "tolerancing": TolerancingParams,
+    "calibration": CalibrationParams,
 }
 #: ``optimize`` is read and validated by rigcad.optimize.spec (rigcad optimize), ignored by the other stages.
 TOP_LEVEL = {"description", "optimize"}
@@ -577,6 +619,7 @@ class Profile:
     tessellation: TessellationParams
     raycheck: RayCheckParams
     tolerancing: TolerancingParams
+    calibration: CalibrationParams
     sources: tuple[str, ...]
     marks: dict[Key, str] = field(compare=False, repr=False)
 
@@ -593,7 +636,7 @@ class Profile:
             for f in fields(obj):
                 s: Spec = f.metadata["spec"]
                 value = getattr(obj, f.name)
-                suffix = {"length": "_mm", "angle": "_rad"}.get(s.kind, "")
+                suffix = {"length": "_mm", "lengths": "_mm", "angle": "_rad"}.get(s.kind, "")
                 if isinstance(value, float) and math.isinf(value):
                     value = "inf"
                 if s.kind == "layers":
@@ -683,6 +726,13 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
         if len(set(names)) != len(names):
             raise fail(f"layer names must be distinct, got {names}")
         return tuple(layers)
+    elif s.kind in ("lengths", "ints"):
+        one = Spec("length" if s.kind == "lengths" else "int", s.doc, lo=s.lo, hi=s.hi, lo_open=s.lo_open,
+                   hi_open=s.hi_open)
+        if not isinstance(value, list) or not value:
+            raise fail(f"expected a list of {'lengths' if s.kind == 'lengths' else 'whole numbers'} "
+                       f"({one.describe_range()}), got {_r(value)}")
+        return tuple(convert_value(one, v, f"{key}[{i}]", where) for i, v in enumerate(value))
     elif s.kind == "pixels":
         ok = (isinstance(value, list) and len(value) == 2
               and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= MAX_PIXELS for v in value))
@@ -798,11 +848,31 @@ def validate(raw: RawProfile) -> Profile:
                 f"tower.{key} ({getattr(tower, key):g} mm) does not cover tolerancing.{worst} "
                 f"({getattr(tol, worst):g} mm): the adjustment must reach every placement the tolerances allow; "
                 f"raise tower.{key} to at least {getattr(tol, worst):g} mm", where=raw.where(("tower", key)))
+    _check_calibration(sections["calibration"], raw)
     description = raw.data.get("description", "")
     if not isinstance(description, str):
         raise ProfileError("description must be text", where=raw.where(("description",)))
     return Profile(name=raw.name, description=description, sources=tuple(str(p) for p in raw.sources),
                    marks=dict(raw.marks), **sections)
+
+
+def _check_calibration(cal: CalibrationParams, raw: RawProfile) -> None:
+    """The calibration keys that depend on each other: two or more distinct spacers, periods from
+    coarse to fine, and Gray codes that number every coarsest half-period across the screen."""
+    heights = sorted(cal.spacer_heights)
+    if len(heights) < 2 or min(b - a for a, b in zip(heights, heights[1:])) <= 0:
+        raise ProfileError(f"calibration.spacer_heights {[f'{h:g} mm' for h in cal.spacer_heights]}: a ray needs "
+                           "two or more distinct heights", where=raw.where(("calibration", "spacer_heights")))
+    if any(b >= a for a, b in zip(cal.periods, cal.periods[1:])):
+        raise ProfileError(f"calibration.periods {list(cal.periods)}: list them coarse to fine, each shorter than "
+                           "the one before", where=raw.where(("calibration", "periods")))
+    stripes = 2 ** cal.gray_bits
+    need = max(cal.screen_resolution)
+    if stripes * (cal.periods[0] / 2) < need:
+        bits = math.ceil(math.log2(need / (cal.periods[0] / 2)))
+        raise ProfileError(f"calibration.gray_bits {cal.gray_bits}: {stripes} stripes of {cal.periods[0] / 2:g} px "
+                           f"(half the coarsest period) do not span the screen's {need} px; need >= {bits}",
+                           where=raw.where(("calibration", "gray_bits")))
 
 
 def load_profile(spec_or_path: Any) -> Profile:

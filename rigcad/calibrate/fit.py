@@ -1,0 +1,169 @@
+"""The misalignment fit, the dome's residual slope map and the corrected pixel -> incidence map.
+
+Fit: scipy.optimize.least_squares (trust-region reflective) over the parameters of
+:mod:`rigcad.calibrate.model`, scaled by their tolerances; residuals are the decoded screen points
+minus the forward model's (mm, both screen axes, every height) over every ``fit_stride``-th camera
+pixel that decoded at every height. The Jacobian is by forward differences with one trace per rig
+parameter (the screens' columns reuse it: each touches its own height's rows only). After a first
+solve, residuals beyond 5 robust sigmas (1.4826 MAD) are dropped and the fit repeated. Standard
+errors: s^2 (J^T J)^-1 with s^2 the residual variance; the residual is dominated by the surface
+error, which is correlated between neighbouring pixels, so they understate the true spread
+(the bench compares them with the errors).
+
+Residual slopes: where the measured ray d (up, the raxel) differs from the fitted model's, the
+difference is read as a tilt of the dome's normal at the model ray's dome point: for the
+reflection v = u - 2 (u.n) n, a normal tilt dn in the tangent plane changes v by
+-2 [(u.dn) n + (u.n) dn], whose tangential part gives grad_s h = dv_t / (2 u.n). Each camera ray
+meets the paraboloid at one point and the dome at one point: the paraboloid's slope error at its
+point and the dome's at the paired point make the same ray error, so they cannot be told apart, and
+neither can a low-order figure error that a misalignment parameter mimics (a tilt, a shift); the
+residual is attributed to the dome, the mirror sanded by hand."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigcad.calibrate import model as M
+
+#: Forward-difference steps of the Jacobian, as a fraction of each parameter's tolerance: 1e-3 of
+#: 0.1 mm is 0.1 um, far above the tracer's Newton tolerance and far below the curvature scale.
+JAC_STEP = 1e-3
+#: The robust first solve's scale (mm on the screen): soft L1 above it. The dome's slope errors
+#: move the screen points by ~0.2 mm (1 mrad over the ~200 mm from the dome): they stay quadratic.
+ROBUST_SCALE_MM = 0.5
+#: The tolerances as a Gaussian prior (each parameter ~ N(0, tolerance)), one residual row per
+#: parameter of this weight (mm): a ridge that holds the near-null combinations (the camera's and
+#: the paraboloid's lateral offsets with the camera's tilt: they move the rays alike) at their prior
+#: instead of letting the surface error push them millimetres away; along every well-seen direction
+#: the tens of thousands of data rows outweigh it.
+PRIOR_MM = 0.2
+#: Iterations of each solve (each costs a Jacobian: one trace per rig parameter).
+MAX_ITERATIONS = 40
+#: Outliers: residuals past this many robust sigmas are dropped before the second solve.
+OUTLIER_SIGMAS = 5.0
+
+
+@dataclass
+class FitData:
+    """What the fit reads: pixel indices (into the camera window) and the decoded screen points
+    (n, heights, 2) mm."""
+
+    pixels: np.ndarray
+    screen_uv: np.ndarray
+
+
+@dataclass
+class FitResult:
+    theta: np.ndarray
+    names: tuple[str, ...]
+    standard_error: np.ndarray
+    correlation: np.ndarray
+    rms_residual_mm: float
+    residuals_used: int
+    outliers: int
+    evaluations: int
+    covariance: np.ndarray
+
+    def as_dict(self) -> dict:
+        out = {}
+        for n, v, s in zip(self.names, self.theta, self.standard_error):
+            scale = 180 / math.pi if n.endswith("_rad") else 1.0
+            key = n.replace("_rad", "_deg")
+            out[key] = {"value": float(v * scale), "standard_error": float(s * scale)}
+        strong = [(self.names[i], self.names[j], float(self.correlation[i, j]))
+                  for i in range(len(self.names)) for j in range(i + 1, len(self.names))
+                  if abs(self.correlation[i, j]) > 0.9]
+        return {"parameters": out, "rms_residual_mm": self.rms_residual_mm, "residuals_used": self.residuals_used,
+                "outliers_dropped": self.outliers, "evaluations": self.evaluations,
+                "strong_correlations_over_0.9": [{"a": a, "b": b, "correlation": c} for a, b, c in strong],
+                "correlation_order": list(self.names), "correlation": self.correlation.tolist()}
+
+
+class Problem:
+    """The residual function and its Jacobian (module docstring)."""
+
+    def __init__(self, optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData) -> None:
+        self.optics, self.rig, self.cam, self.heights, self.data = optics, rig, cam, heights, data
+        self.x, self.y = cam.x_px[data.pixels], cam.y_px[data.pixels]
+        self.scale = M.tolerance_scale(rig, len(heights))
+        self.n_rig = len(M.RIG_NAMES)
+        self.keep = np.ones(len(data.pixels) * len(heights) * 2, bool)
+        self.evaluations = 0
+        #: the fitted parameters: all but the first screen's height, the gauge (moving the rig and
+        #: every screen up together changes no image): the first spacer's screen defines z
+        self.free = np.array([i != self.n_rig for i in range(len(self.scale))])
+
+    def trace(self, theta: np.ndarray) -> M.Traced:
+        self.evaluations += 1
+        return M.trace_camera(self.optics, M.moved(self.rig, theta), self.x, self.y, self.cam.design)
+
+    def residual_of(self, tr: M.Traced, theta: np.ndarray) -> np.ndarray:
+        out = np.empty((len(self.x), len(self.heights), 2))
+        for k, pose in enumerate(M.screens(self.heights, theta)):
+            su, sv = tr.screen(pose)
+            out[:, k, 0], out[:, k, 1] = su, sv
+        return (out - self.data.screen_uv).ravel()[self.keep]
+
+    def full(self, z: np.ndarray) -> np.ndarray:
+        """The parameter vector (scaled) from the free ones (the gauge at 0)."""
+        out = np.zeros(len(self.scale))
+        out[self.free] = z
+        return out
+
+    def fun(self, z: np.ndarray) -> np.ndarray:
+        theta = self.full(z) * self.scale
+        r = self.residual_of(self.trace(theta), theta)
+        return np.concatenate([np.where(np.isfinite(r), r, 0.0), PRIOR_MM * z])
+
+    def jac(self, z: np.ndarray) -> np.ndarray:
+        theta = self.full(z) * self.scale
+        base_tr = self.trace(theta)
+        base = self.residual_of(base_tr, theta)
+        J = np.zeros((len(base), len(self.scale)))
+        for i in np.nonzero(self.free)[0]:
+            t = theta.copy()
+            t[i] += JAC_STEP * self.scale[i]
+            tr = self.trace(t) if i < self.n_rig else base_tr
+            diff = (self.residual_of(tr, t) - base) / JAC_STEP
+            J[:, i] = np.where(np.isfinite(diff), diff, 0.0)  # a ray lost on either side: no slope
+        return np.vstack([J[:, self.free], PRIOR_MM * np.eye(int(self.free.sum()))])
+
+
+def fit(optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData, say=None) -> FitResult:
+    """Fit the misalignment (module docstring); ``say``: a callable told each stage."""
+    from scipy.optimize import least_squares
+
+    prob = Problem(optics, rig, cam, heights, data)
+    z0 = np.zeros(int(prob.free.sum()))
+    # robust first solve from the design: pixels near the screen's edges or the shadows decode wrong,
+    # and rays near grazing meet the screen far away; soft L1 at ROBUST_SCALE_MM keeps them from
+    # steering the fit
+    res = least_squares(prob.fun, z0, jac=prob.jac, method="trf", loss="soft_l1", f_scale=ROBUST_SCALE_MM,
+                        xtol=1e-10, ftol=1e-10, max_nfev=MAX_ITERATIONS)
+    r = res.fun[:int(prob.keep.sum())]
+    sigma = 1.4826 * np.median(np.abs(r - np.median(r)))
+    full = np.zeros(len(prob.keep))
+    full[prob.keep] = r
+    drop = np.abs(full) > OUTLIER_SIGMAS * max(sigma, 1e-12)
+    outliers = int(drop.sum())
+    if outliers:
+        if say:
+            say(f"dropping {outliers} outlying residuals (> {OUTLIER_SIGMAS:g} robust sigmas); refitting")
+        prob.keep &= ~drop
+        res = least_squares(prob.fun, res.x, jac=prob.jac, method="trf", xtol=1e-10, ftol=1e-10,
+                            max_nfev=MAX_ITERATIONS)
+    J = res.jac
+    m, p = J.shape
+    s2 = float(res.fun @ res.fun) / max(m - p, 1)
+    cov_z = np.zeros((len(prob.scale), len(prob.scale)))
+    cov_z[np.ix_(prob.free, prob.free)] = s2 * np.linalg.pinv(J.T @ J)
+    cov = cov_z * np.outer(prob.scale, prob.scale)
+    se = np.sqrt(np.diag(cov))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(se, se)
+    data = res.fun[:int(prob.keep.sum())]
+    return FitResult(prob.full(res.x) * prob.scale, M.parameter_names(len(heights)), se, np.nan_to_num(corr),
+                     float(np.sqrt(np.mean(data ** 2))), int(len(data)), outliers, prob.evaluations, cov)

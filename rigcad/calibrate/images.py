@@ -1,0 +1,118 @@
+"""Reading a capture, and refusing a bad one with one line that names the file.
+
+Naming scheme: a folder with one image per spacer and frame, ``h{k}_{frame}.{png|tif|tiff}``:
+k the spacer's index in ``calibration.spacer_heights`` (0 first), frame a name of
+:meth:`rigcad.calibrate.patterns.Sequence.names` (white, black, x_gray0.., x_p128_s0.., y_...),
+e.g. ``h1_y_p16_s3.png``. Grey 8- or 16-bit PNG or TIFF (colour is averaged to grey), every image at
+the camera's resolution. Values are scaled to [0, 1] by the format's full scale."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from rigcad.calibrate.patterns import Sequence
+from rigcad.errors import RigcadError
+
+SUFFIXES = (".png", ".tif", ".tiff")
+#: All dark: the white frame's 99th percentile under this fraction of full scale.
+DARK_LEVEL = 0.04
+#: Saturated: more than this fraction of the lit pixels at full scale in the white frame.
+SATURATED_FRACTION = 0.05
+#: Too little modulation: fewer than this fraction of the lit pixels decoded.
+MIN_DECODED_FRACTION = 0.3
+#: Out of order: more than this fraction of runs of three neighbouring decoded pixels with a second
+#: difference over a Gray stripe.
+MAX_JUMP_FRACTION = 0.05
+#: Out of order: a finer period disagreeing with the coarser one at more than this fraction of the
+#: pixels it modulates (a reversed or shuffled step order still fits a sinusoid, at the wrong phase).
+MAX_DISAGREEMENT = 0.2
+#: Out of order (N >= 4): the median misfit of a period's frames to a sinusoid above this.
+MAX_MISFIT = 0.35
+
+
+class CaptureError(RigcadError):
+    """A capture that cannot be calibrated from: the message names the file and what is wrong."""
+
+
+def capture_path(folder: Path, k: int, name: str) -> Path:
+    """The capture's file for spacer ``k`` and frame ``name`` (any of SUFFIXES), or the .png expected."""
+    for suffix in SUFFIXES:
+        p = folder / f"h{k}_{name}{suffix}"
+        if p.is_file():
+            return p
+    return folder / f"h{k}_{name}.png"
+
+
+def read_image(path: Path, resolution: tuple[int, int]) -> np.ndarray:
+    """One image as float in [0, 1] (rows, cols), checked for existence and size."""
+    from PIL import Image, UnidentifiedImageError
+
+    if not path.is_file():
+        raise CaptureError(f"{path}: missing (naming scheme h<spacer>_<frame>.png|tif, see docs/calibrate.md)")
+    try:
+        with Image.open(path) as im:
+            im.load()
+            arr = np.asarray(im)
+    except (OSError, UnidentifiedImageError, ValueError) as err:
+        raise CaptureError(f"{path}: not a readable PNG or TIFF ({err})") from err
+    if arr.ndim == 3:
+        arr = arr[..., :3].mean(axis=2) if arr.shape[2] >= 3 else arr[..., 0]
+    width, height = resolution
+    if arr.shape[:2] != (height, width):
+        raise CaptureError(f"{path}: {arr.shape[1]} x {arr.shape[0]} px, the camera's is {width} x {height}")
+    full = 65535.0 if np.asarray(arr).dtype == np.uint16 or arr.max() > 255 else 255.0
+    return arr.astype(float) / full
+
+
+def read_capture(folder: Path, seq: Sequence, heights: int, resolution: tuple[int, int]) -> list[dict]:
+    """Every frame of every spacer (module docstring), exposure-checked."""
+    out = []
+    for k in range(heights):
+        frames = {n: read_image(capture_path(folder, k, n), resolution) for n in seq.names()}
+        check_exposure(folder, k, frames)
+        out.append(frames)
+    return out
+
+
+def check_exposure(folder: Path, k: int, frames: dict) -> None:
+    """All dark, saturated, or white and black swapped."""
+    white, black = frames["white"], frames["black"]
+    path = capture_path(folder, k, "white")
+    if np.percentile(white, 99) < DARK_LEVEL:
+        raise CaptureError(f"{path}: all dark (99th percentile {np.percentile(white, 99):.3f} of full scale): "
+                           "is the screen on and the lens cap off?")
+    if white.mean() < black.mean():
+        raise CaptureError(f"{path}: darker than {capture_path(folder, k, 'black').name}: frames in the wrong order")
+    lit = white - black > 0.05 * np.percentile(white - black, 99)
+    sat = float(np.mean(white[lit] >= 1.0)) if lit.any() else 0.0
+    if sat > SATURATED_FRACTION:
+        raise CaptureError(f"{path}: saturated ({sat:.0%} of the lit pixels at full scale): shorten the exposure")
+
+
+def check_decoded(folder: Path, k: int, seq: Sequence, decoded) -> None:
+    """Too little modulation, or frames out of order (torn map, misfit to a sinusoid)."""
+    lit = int(decoded.lit.sum())
+    if lit == 0 or decoded.valid.sum() < MIN_DECODED_FRACTION * lit:
+        raise CaptureError(f"{capture_path(folder, k, f'x_p{seq.periods[0]}_s0')}: too little modulation: "
+                           f"{int(decoded.valid.sum())} of {lit} lit pixels decoded (focus on the screen, "
+                           "raise the exposure or the screen's brightness)")
+    for axis, frac in decoded.jumps(seq.stripe).items():
+        if frac > MAX_JUMP_FRACTION:
+            raise CaptureError(f"{capture_path(folder, k, f'{axis}_gray0')}: the {axis} frames decode to a torn map "
+                               f"({frac:.0%} of neighbouring pixels step by a stripe or more): Gray or phase frames in the wrong order")
+    for axis, d in decoded.axes.items():
+        for p, (tried, failed) in zip(seq.periods[1:], d.disagreements):
+            if tried and failed > MAX_DISAGREEMENT * tried:
+                raise CaptureError(f"{capture_path(folder, k, f'{axis}_p{p}_s0')}: period {p} disagrees with the "
+                                   f"coarser one at {failed / tried:.0%} of the pixels it modulates: phase frames "
+                                   "in the wrong order")
+    if seq.steps > 3:
+        for axis, d in decoded.axes.items():
+            for p, fr in zip(seq.periods, d.fringes):
+                mis = float(np.nanmedian(fr.misfit[decoded.valid])) if decoded.valid.any() else 0.0
+                if mis > MAX_MISFIT:
+                    raise CaptureError(f"{capture_path(folder, k, f'{axis}_p{p}_s0')}: the {seq.steps} phase "
+                                       f"steps of period {p} do not fit a sinusoid (misfit {mis:.2f}): "
+                                       "frames in the wrong order")

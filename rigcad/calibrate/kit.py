@@ -1,0 +1,123 @@
+"""The calibration kit from the profile: the screen's patterns as PNGs at its resolution, the
+spacers as printed parts (the sample holder's recipe, :func:`rigcad.parts.base.holder_body`, cut
+to each spacer's height: the same recipe objects, meshed and written by the same exporters as every
+part, with a manifest), and the manual's page (:func:`manual_page`: placing the screen, the
+capture order and the naming scheme, exposure advice)."""
+
+from __future__ import annotations
+
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+
+from rigcad.calibrate import model as M
+from rigcad.calibrate.patterns import Sequence
+
+
+def pattern_png(seq: Sequence, name: str) -> bytes:
+    """One frame as an 8-bit grey PNG at the screen's resolution."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(seq.image(name), mode="L").save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def spacer(profile, k: int):
+    """Spacer ``k`` as a recipe Part: the holder's plug (stop collar under the plate) whose top, where
+    the screen's back rests, stands ``spacer_heights[k]`` above the holder's seat."""
+    from rigcad.parts.base import holder_body
+    from rigcad.parts.recipe import Part
+
+    h = profile.calibration.spacer_heights[k]
+    top = -profile.sample_holder.sample_thickness + h
+    return Part(f"calibration_spacer_{k}", holder_body(profile, top), (0.3, 0.6, 0.3),
+                f"calibration spacer {k}: replaces the sample holder; the screen's back rests {h:g} mm above "
+                "the holder's seat", in_rig=False)
+
+
+def manual_page(rig) -> str:
+    """The manual's page on the calibration (Markdown)."""
+    p = rig.profile
+    cal = p.calibration
+    seq = Sequence.from_profile(cal)
+    heights = M.nominal_heights(p)
+    w, h = cal.screen_resolution
+    frames = seq.names()
+    spacers = "\n".join(f"{k + 1}. spacer {k} ({cal.spacer_heights[k]:g} mm): screen surface {z:g} mm above the "
+                        f"sample point; files `h{k}_<frame>.png`" for k, z in enumerate(heights))
+    reach = math.degrees(math.atan((min(w, h) * cal.screen_pitch / 2) / max(heights)))
+    return f"""# Calibrating the as-built rig (deflectometry)
+
+What it measures: each camera pixel's incidence direction at the sample, through the paraboloid and
+the dome as they were built and placed; the fit of the misalignment; the dome's residual slopes.
+
+## The kit
+- A flat screen (a tablet): {w} x {h} px at {cal.screen_pitch:g} mm pitch, {cal.screen_thickness:g} mm from its
+  back to its emitting surface. Set it to its full brightness, no night shift, no auto-brightness, and a
+  linear (gamma 1) response if it offers one; show each PNG of `patterns/` full screen, unscaled.
+- The spacers (`stl/calibration_spacer_<k>.stl`): each replaces the sample holder in the base plate's bore;
+  lay the screen face up, centred on the axis, on its top.
+
+## Capture order
+For each spacer in turn:
+{spacers}
+
+and for each, the {len(frames)} frames in this order (the names of `patterns/`): {', '.join(frames[:4])}, ...,
+{frames[-1]}. Name each camera image `h<spacer>_<frame>.png` (or .tif, 8 or 16 bit, grey or colour) at the
+camera's full resolution, {p.camera.resolution[0]} x {p.camera.resolution[1]} px, all in one folder; then
+`rigcad calibrate {p.name} --images <folder>`.
+
+## Exposure
+- One exposure for every frame of a spacer: set it on the white frame so the brightest lit pixels sit at
+  80-90 % of full scale (a saturated white is refused; so is an all-dark one).
+- Keep the room dark: stray light lowers the fringes' modulation (pixels under
+  {cal.min_modulation:g} modulation are not decoded).
+- Focus between the two screen heights; a little defocus is harmless.
+- The screen reaches rays up to {reach:.0f} deg from the axis at the highest spacer: beyond that the
+  corrected map is filled from the fit.
+"""
+
+
+def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
+    """Write the kit into ``out`` (published atomically): patterns/<frame>.png, stl/ and step/
+    calibration_spacer_<k>, calibration.md, manifest.json (each file's SHA-256, the spacers' volumes)."""
+    from rigcad.export import mesh as EM
+    from rigcad.export.atomic import Staging, json_bytes, profile_lock
+    from rigcad.export.manifest import profile_digest, sha256_hex
+    from rigcad.export.step import reimport_check, step_writer
+    from rigcad.parts import _kernel as K
+
+    p = rig.profile
+    seq = Sequence.from_profile(p.calibration)
+    files, parts = {}, {}
+    with Staging(out, lock=profile_lock(out.parent.parent, p.name) if out.parent.name == p.name else None,
+                 made_from=profile_digest(p)) as st:
+        for name in seq.names():
+            data = pattern_png(seq, name)
+            st.write_bytes(out / "patterns" / f"{name}.png", data)
+            files[f"patterns/{name}.png"] = sha256_hex(data)
+        for k in range(len(p.calibration.spacer_heights)):
+            part = spacer(p, k)
+            say(part.name)
+            shape = K.part_solid(part, p.tessellation.fit_tolerance, K.FitReport(), p)
+            step_path = out / "step" / f"{part.name}.step"
+            st.write_with(step_path, step_writer([(part.name, shape, part.color)], part.name))
+            check = reimport_check(st.temp_path(step_path), K.volume(shape), 1)
+            mesh = rig.mesh(part)
+            stl = EM.stl_bytes(np.asarray(mesh.vertices), np.asarray(mesh.faces), part.name)
+            st.write_bytes(out / "stl" / f"{part.name}.stl", stl)
+            files[f"stl/{part.name}.stl"] = sha256_hex(stl)
+            files[f"step/{part.name}.step"] = sha256_hex(st.temp_path(step_path).read_bytes())
+            parts[part.name] = {"description": part.description, "volume_mm3": K.volume(shape),
+                                "step_reimport": check}
+        page = manual_page(rig).encode()
+        st.write_bytes(out / "calibration.md", page)
+        files["calibration.md"] = sha256_hex(page)
+        manifest = {"profile": p.name, "screen_resolution_px": list(p.calibration.screen_resolution),
+                    "frames_in_capture_order": seq.names(), "parts": parts, "files": files}
+        st.write_bytes(out / "manifest.json", json_bytes(manifest))
+        st.commit()
+    return manifest

@@ -1,0 +1,99 @@
+"""From the fit to the maps: each camera pixel's measured ray (the raxel through its decoded points
+on the fitted screens), the dome's residual slopes (:mod:`rigcad.calibrate.fit`'s docstring) and
+the corrected pixel -> incidence map: the fitted model's direction plus the measured residual,
+smoothed (normalised Gaussian convolution over the decoded pixels, sigma SMOOTH_PX) and filled
+where no screen point was seen (the same at FILL_PX; beyond that reach, the model alone). Its
+uncertainty per pixel (rad): the fit's covariance carried through the model's direction, with the
+decoding noise (the measured residual's local scatter about its smoothed value, divided by the
+smoothing's effective count) where measured, or the residual's RMS over the decoded pixels where
+filled (the surface there is not seen). Directions are unit vectors from O towards the light (+z)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rigcad.calibrate import model as M
+from rigcad.calibrate.raxel import rays, to_global
+from rigcad.check.figures import _angles as angle_between  # noqa: F401  (the one home of the angle between rows)
+
+#: The smoothing of the measured residual (camera px): the sanding ripple's rings are ~7 px apart on
+#: Table 3.1's camera, which sigma 1.5 px would attenuate to 40 %, sigma 0.6 to 87 %.
+SMOOTH_PX = 0.6
+#: Decoded pixels within this many of an undecoded one are filled, not measured.
+EDGE_PX = 2
+FILL_PX = 6.0
+#: A pixel counts as measured when the smoothing's weight there is at least this (of a fully
+#: decoded neighbourhood); as filled when the fill's weight is.
+MEASURED_WEIGHT = 0.5
+FILLED_WEIGHT = 0.02
+
+
+def measured_rays(decoded: list, poses: list) -> np.ndarray:
+    """Unit directions (n, 3), up, of each window pixel's raxel (NaN where < 2 heights decoded)."""
+    pts = [to_global(pose, d.u, d.v).reshape(-1, 3) for d, pose in zip(decoded, poses)]
+    _, direction = rays(pts)
+    return direction
+
+
+def residual_slopes(tr: M.Traced, measured: np.ndarray) -> np.ndarray:
+    """grad_s h (n, 3) rad at the model rays' dome points from the measured directions (up)."""
+    n = tr.v - tr.u
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    dv = -measured - tr.v
+    dv_t = dv - np.sum(dv * n, axis=1)[:, None] * n
+    return dv_t / (2 * np.sum(tr.u * n, axis=1))[:, None]
+
+
+def _smooth(values: np.ndarray, weight: np.ndarray, shape: tuple[int, int], sigma: float):
+    from scipy.ndimage import gaussian_filter
+
+    w = gaussian_filter(weight.reshape(shape).astype(float), sigma)
+    out = np.stack([gaussian_filter(np.where(weight, values[:, k], 0.0).reshape(shape), sigma)
+                    for k in range(values.shape[1])], axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return (out / w[..., None]).reshape(-1, values.shape[1]), w.ravel()
+
+
+def direction_jacobian(optics, rig, cam: M.Camera, theta: np.ndarray) -> np.ndarray:
+    """d(model direction)/d(rig parameter) (n, 3, 15) over the window, forward differences."""
+    from rigcad.calibrate.fit import JAC_STEP
+
+    scale = M.tolerance_scale(rig, 0)
+    base = -M.trace_camera(optics, M.moved(rig, theta), cam.x_px, cam.y_px, cam.design).v
+    out = np.empty(base.shape + (len(M.RIG_NAMES),))
+    for i in range(len(M.RIG_NAMES)):
+        t = theta.copy()
+        t[i] += JAC_STEP * scale[i]
+        out[:, :, i] = (-M.trace_camera(optics, M.moved(rig, t), cam.x_px, cam.y_px, cam.design).v - base) / (
+            JAC_STEP * scale[i])
+    return out
+
+
+def corrected_map(model_tr: M.Traced, measured: np.ndarray, shape: tuple[int, int], dir_jac: np.ndarray,
+                  cov_rig: np.ndarray) -> dict:
+    """The corrected map (module docstring): ``direction`` (n, 3), ``uncertainty_rad`` (n,),
+    ``source`` (n,: 0 none, 1 measured, 2 filled, 3 model only)."""
+    from scipy.ndimage import binary_erosion
+
+    model = -model_tr.v
+    seen = np.all(np.isfinite(measured), axis=1) & model_tr.ok
+    # a pixel next to an undecoded one sees the screen's or a shadow's edge in part of its footprint
+    # (its decoded point is pulled towards the lit part): filled from the inner ones instead
+    seen &= binary_erosion(seen.reshape(shape), iterations=EDGE_PX).ravel()
+    resid = np.where(seen[:, None], measured - model, 0.0)
+    sm, w1 = _smooth(resid, seen, shape, SMOOTH_PX)
+    fill, w2 = _smooth(resid, seen, shape, FILL_PX)
+    measured_px = model_tr.ok & (w1 >= MEASURED_WEIGHT)
+    filled_px = model_tr.ok & ~measured_px & (w2 >= FILLED_WEIGHT)
+    delta = np.where(measured_px[:, None], sm, np.where(filled_px[:, None], fill, 0.0))
+    d = model + np.nan_to_num(delta)
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    var_model = np.einsum("nki,ij,nkj->n", np.nan_to_num(dir_jac), cov_rig, np.nan_to_num(dir_jac))
+    scatter, _ = _smooth(np.sum((resid - np.nan_to_num(sm)) ** 2, axis=1)[:, None], seen, shape, 2.0)
+    n_eff = 4 * np.pi * SMOOTH_PX ** 2  # the Gaussian's effective pixel count
+    var_meas = np.nan_to_num(scatter[:, 0]) / n_eff
+    surface_rms2 = float(np.mean(np.sum(resid[seen] ** 2, axis=1))) if seen.any() else 0.0
+    var = var_model + np.where(measured_px, var_meas, surface_rms2)
+    source = np.where(measured_px, 1, np.where(filled_px, 2, np.where(model_tr.ok, 3, 0)))
+    return {"direction": np.where(model_tr.ok[:, None], d, np.nan), "uncertainty_rad": np.where(
+        model_tr.ok, np.sqrt(var), np.nan), "source": source.astype(np.int8)}

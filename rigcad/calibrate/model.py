@@ -1,0 +1,135 @@
+"""The rig's own analytic tracer as the calibration's forward model: a camera pixel's ray from the
+camera's COP (as placed by its pose), through the beam splitter's plate (as the ray check traces
+the camera), off the paraboloid and the dome (``Rig.moved`` poses), to the screen.
+
+Parameters (mm, rad): the paraboloid's, the dome's and the camera's offsets (x, y, z) and tilts
+(the rotation vector's x and y; pivots as :meth:`rigcad.optics.frames.Misalignment.pose`), then per
+screen height its height offset and tilt (x, y). Frame: mm, O at the origin, +z up."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigcad.calibrate.raxel import on_screen, screen_pose
+
+COMPONENTS = ("paraboloid", "dome", "camera")
+RIG_NAMES = tuple(f"{c}_{k}" for c in COMPONENTS for k in ("dx_mm", "dy_mm", "dz_mm", "tilt_x_rad", "tilt_y_rad"))
+#: Pixels of margin around the paraboloid's design image in the camera window: a camera tilted by the
+#: largest tolerance the profile accepts moves the image ~ f tan(tilt) (21 px at 0.5 deg on Table 3.1).
+WINDOW_MARGIN_PX = 40
+
+
+def screen_names(k: int) -> tuple[str, ...]:
+    return (f"screen{k}_dz_mm", f"screen{k}_tilt_x_rad", f"screen{k}_tilt_y_rad")
+
+
+def parameter_names(heights: int) -> tuple[str, ...]:
+    return RIG_NAMES + tuple(n for k in range(heights) for n in screen_names(k))
+
+
+def tolerance_scale(rig, heights: int) -> np.ndarray:
+    """Each parameter's tolerance (``tolerancing``; the screen's: 0.5 mm and 0.5 deg): the fit's
+    scale and the recovery targets' reference."""
+    t = rig.profile.tolerancing
+    out = []
+    for c in COMPONENTS:
+        off, hgt, tilt = getattr(t, f"{c}_offset"), getattr(t, f"{c}_height"), getattr(t, f"{c}_tilt")
+        out += [off, off, hgt, tilt, tilt]
+    out += [0.5, math.radians(0.5), math.radians(0.5)] * heights
+    return np.array(out)
+
+
+def moved(rig, theta: np.ndarray):
+    """``rig`` moved by the rig parameters ``theta[:15]`` (module docstring)."""
+    out = rig
+    for i, c in enumerate(COMPONENTS):
+        dx, dy, dz, tx, ty = (float(v) for v in theta[5 * i: 5 * i + 5])
+        angle = math.hypot(tx, ty)
+        axis = (tx / angle, ty / angle, 0.0) if angle > 0 else (0.0, 1.0, 0.0)
+        out = out.moved(c, (dx, dy, dz), angle, axis)
+    return out
+
+
+def screens(heights: np.ndarray, theta: np.ndarray) -> list:
+    """The screens' poses: nominal heights (mm) plus the per-height parameters of ``theta``."""
+    s = np.asarray(theta[len(RIG_NAMES):]).reshape(-1, 3)
+    return [screen_pose(float(h + p[0]), float(p[1]), float(p[2])) for h, p in zip(heights, s)]
+
+
+@dataclass(frozen=True)
+class Camera:
+    """The camera's pixels in a window around the paraboloid's image: ``shape`` (rows, cols), the
+    window's first ``row0``/``col0``, image coordinates x_px, y_px (n,) row-major (pixel centre
+    x = col + 0.5 - W / 2, y = H / 2 - row - 0.5) and the design map in the camera's pixels."""
+
+    resolution: tuple[int, int]
+    shape: tuple[int, int]
+    row0: int
+    col0: int
+    x_px: np.ndarray
+    y_px: np.ndarray
+    design: object
+
+    @classmethod
+    def of(cls, rig, stride: int = 1) -> "Camera":
+        import dataclasses
+
+        from rigcad.optics.incidence import camera_focal_px
+
+        design = dataclasses.replace(rig.incidence, focal_px=camera_focal_px(rig))
+        width, height = rig.profile.camera.resolution
+        r = float(design.pixel_radius(np.array([design.alpha_max]))[0])
+        side = 2 * math.ceil(r) + 2 * WINDOW_MARGIN_PX
+        w, h = min(width, side), min(height, side)
+        c0, r0 = (width - w) // 2, (height - h) // 2
+        rows, cols = np.arange(r0, r0 + h, stride), np.arange(c0, c0 + w, stride)
+        jj, ii = np.meshgrid(rows, cols, indexing="ij")
+        return cls((width, height), (len(rows), len(cols)), int(r0), int(c0), ii.ravel() + 0.5 - width / 2,
+                   height / 2 - jj.ravel() - 0.5, design)
+
+    def crop(self, image: np.ndarray) -> np.ndarray:
+        """The window of a full camera image (rows, cols)."""
+        return image[self.row0: self.row0 + self.shape[0], self.col0: self.col0 + self.shape[1]]
+
+
+@dataclass
+class Traced:
+    """Per pixel: the ray leaving the dome (point ``p2`` and unit direction ``v``, going down), the
+    direction ``u`` from the paraboloid to the dome, and ``ok`` (reached the sample plane)."""
+
+    p2: np.ndarray
+    v: np.ndarray
+    u: np.ndarray
+    ok: np.ndarray
+
+    def screen(self, pose) -> tuple[np.ndarray, np.ndarray]:
+        """Where each ray meets a screen: (u, v) mm in its frame, NaN where lost."""
+        su, sv = on_screen(pose, np.nan_to_num(self.p2), np.nan_to_num(self.v, nan=1.0))
+        return np.where(self.ok, su, np.nan), np.where(self.ok, sv, np.nan)
+
+
+def trace_camera(optics, rig, x_px: np.ndarray, y_px: np.ndarray, design) -> Traced:
+    """Trace camera image points (x, y) px through ``rig`` (moved copy of the rig ``optics`` was
+    built for): from the camera's pose, through the splitter (compensated, as built), to the dome."""
+    from rigcad.check.scene import placed_as
+    from rigcad.check.sources import pixel_rays
+    from rigcad.check.tower import through_splitter
+    from rigcad.check.trace3d import trace
+
+    rays = pixel_rays(design, x_px, y_px, rig.pose("camera"))
+    p, d, _ = through_splitter(rig, rays.origins, rays.dirs)
+    tr = trace(placed_as(optics, rig), p, d)
+    with np.errstate(invalid="ignore"):
+        u = tr.p2 - tr.p1
+        u /= np.linalg.norm(u, axis=1)[:, None]
+    return Traced(tr.p2, tr.v, u, tr.ok)
+
+
+def nominal_heights(profile) -> np.ndarray:
+    """The screen's emitting surface at each spacer (mm above O): spacer + screen thickness - the
+    sample's thickness (the spacer stands on the holder's seat, where a sample's underside rests)."""
+    cal = profile.calibration
+    return np.array(cal.spacer_heights) + cal.screen_thickness - profile.sample_holder.sample_thickness

@@ -1,0 +1,157 @@
+"""The calibration's stages on captured (or simulated) images: decode each height, fit the
+misalignment, the measured rays on the fitted screens, the dome's residual slopes, the corrected map;
+and, for a simulation, the comparison with what was planted."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rigcad.calibrate import maps, model as M
+from rigcad.calibrate.decode import decode
+from rigcad.calibrate.fit import FitData, fit
+from rigcad.calibrate.patterns import Sequence
+
+
+#: Pixels within this many of an undecoded pixel are left out of the fit (the maps fill them).
+EDGE_PX = 2
+
+
+@dataclass
+class Calibration:
+    """Everything one calibration computed (window arrays (n,) or (n, 3) row-major over ``cam.shape``)."""
+
+    cam: M.Camera
+    heights: np.ndarray
+    decoded: list
+    fit: object
+    model: M.Traced
+    measured: np.ndarray
+    slopes: np.ndarray
+    corrected: dict
+    design: np.ndarray
+    timings_s: dict = field(default_factory=dict)
+
+    def slope_figures(self) -> dict:
+        """Residual slope RMS and worst (mrad) over the decoded pixels."""
+        g = np.linalg.norm(self.slopes, axis=1)
+        g = g[np.isfinite(g)]
+        return {"residual_slope_rms_mrad": float(np.sqrt(np.mean(g ** 2)) * 1e3) if g.size else math.nan,
+                "residual_slope_worst_mrad": float(g.max() * 1e3) if g.size else math.nan,
+                "pixels": int(g.size)}
+
+
+def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: None, check=None) -> Calibration:
+    """Calibrate from ``images`` (per spacer, frame name -> full camera image as float, checked).
+    ``check(decoded)``: called with the decoded captures before the fit (it raises to refuse them)."""
+    cal = rig.profile.calibration
+    seq = Sequence.from_profile(cal)
+    cam = M.Camera.of(rig)
+    heights = M.nominal_heights(rig.profile)
+    t0 = time.perf_counter()
+    decoded = [decode(seq, {n: cam.crop(im) for n, im in frames.items()}, cal.min_modulation) for frames in images]
+    t1 = time.perf_counter()
+    if check is not None:
+        check(decoded)
+    say(f"decoded {', '.join(str(d.stats()['decoded_pixels']) for d in decoded)} camera pixels per height")
+    data = _fit_data(cam, decoded, cal.fit_stride)
+    result = fit(optics, rig, cam, heights, data, say)
+    t2 = time.perf_counter()
+    say(f"fitted {len(result.theta)} parameters to {result.residuals_used} residuals "
+        f"(RMS {result.rms_residual_mm * 1e3:.2f} um)")
+    poses = M.screens(heights, result.theta)
+    fitted = M.moved(rig, result.theta)
+    model_tr = M.trace_camera(optics, fitted, cam.x_px, cam.y_px, cam.design)
+    measured = maps.measured_rays(decoded, poses)
+    n_rig = len(M.RIG_NAMES)
+    jac = maps.direction_jacobian(optics, rig, cam, result.theta)
+    corrected = maps.corrected_map(model_tr, measured, cam.shape, jac, result.covariance[:n_rig, :n_rig])
+    # the slopes from the smoothed measurement (the raw rays' noise, divided by 2 cos of the dome's
+    # angle of incidence, would swamp them), where measured
+    seen = (corrected["source"] == 1)[:, None]
+    slopes = np.where(seen, maps.residual_slopes(model_tr, np.where(seen, corrected["direction"], np.nan)), np.nan)
+    t3 = time.perf_counter()
+    from rigcad.check.sources import pixel_rays
+
+    design = cam.design.direction(pixel_rays(cam.design, cam.x_px, cam.y_px).dirs)
+    return Calibration(cam, heights, decoded, result, model_tr, measured, slopes, corrected, design,
+                       {"decode_s": t1 - t0, "fit_s": t2 - t1, "maps_s": t3 - t2})
+
+
+def _fit_data(cam: M.Camera, decoded: list, stride: int) -> FitData:
+    """Every ``stride``-th row and column of the window that decoded at every height."""
+    rows, cols = np.meshgrid(np.arange(cam.shape[0]), np.arange(cam.shape[1]), indexing="ij")
+    pick = ((rows % stride == 0) & (cols % stride == 0)).ravel()
+    from scipy.ndimage import binary_erosion
+
+    # pixels next to an undecoded one see a screen edge or a shadow's edge in part of their footprint
+    inner = [binary_erosion(d.valid, iterations=EDGE_PX).ravel() for d in decoded]
+    ok = pick & np.all(inner, axis=0)
+    idx = np.nonzero(ok)[0]
+    uv = np.stack([np.stack([d.u.ravel()[idx], d.v.ravel()[idx]], axis=-1) for d in decoded], axis=1)
+    return FitData(idx, uv)
+
+
+def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -> dict:
+    """A simulation's figures against what was planted: each parameter's error against its
+    tolerance, the corrected and the design (uncorrected) map's incidence error (deg, p99 and more
+    over the lit pixels), the residual slopes against the planted ones (mrad)."""
+    from rigcad.calibrate.simulate import surface_slopes, with_surface
+
+    cam = result.cam
+    true_rig = M.moved(rig, theta_true)
+    base = M.trace_camera(optics, true_rig, cam.x_px, cam.y_px, cam.design)
+    truth = with_surface(true_rig, surface, base)
+    lit = truth.ok & np.isfinite(result.design[:, 0]) & np.isfinite(result.corrected["direction"][:, 0])
+    up = -truth.v
+    err_c = np.degrees(maps.angle_between(result.corrected["direction"][lit], up[lit]))
+    err_d = np.degrees(maps.angle_between(result.design[lit], up[lit]))
+    err_m = np.degrees(maps.angle_between(-result.model.v[lit], up[lit]))  # the fitted model alone
+    planted = surface_slopes(true_rig, surface, base)
+    seen = np.isfinite(result.slopes[:, 0]) & np.isfinite(planted[:, 0])
+    g_p, g_r = planted[seen], result.slopes[seen]
+    rms = lambda a: float(np.sqrt(np.mean(np.sum(a * a, axis=1))) * 1e3) if len(a) else math.nan  # noqa: E731
+    tol = M.tolerance_scale(rig, len(result.heights))
+    err = result.fit.theta - theta_true
+    names = M.parameter_names(len(result.heights))
+    target = np.maximum(0.1 * tol, [math.radians(0.01) if n.endswith("_rad") else 0.02 for n in names])
+    z = np.abs(err) / np.maximum(result.fit.standard_error, 1e-300)
+    return {
+        "parameters": {n: {"planted": float(t), "fitted": float(f), "error": float(e), "target": float(g),
+                           "met": bool(abs(e) <= g), "error_over_standard_error": float(zz)}
+                       for n, t, f, e, g, zz in zip(names, theta_true, result.fit.theta, err, target, z)},
+        "parameters_met": int(np.sum(np.abs(err) <= target)), "parameters_total": len(names),
+        "lit_pixels": int(lit.sum()),
+        "corrected_incidence_error_deg": _stats(err_c), "design_incidence_error_deg": _stats(err_d),
+        "fitted_model_incidence_error_deg": _stats(err_m),
+        "corrected_incidence_error_deg_by_source": {
+            name: _stats(err_c[result.corrected["source"][lit] == code])
+            for code, name in ((1, "measured"), (2, "filled"), (3, "model_only"))},
+        "slope_pixels": int(seen.sum()), "planted_slope_rms_mrad": rms(g_p), "recovered_slope_rms_mrad": rms(g_r),
+        "slope_difference_rms_mrad": rms(g_r - g_p),
+    }
+
+
+def truth_maps(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -> dict:
+    """Per window pixel, for a simulation's pictures: the planted slope magnitude (mrad, where the
+    calibration measured slopes) and both maps' incidence errors (deg)."""
+    from rigcad.calibrate.simulate import surface_slopes, with_surface
+
+    cam = result.cam
+    true_rig = M.moved(rig, theta_true)
+    base = M.trace_camera(optics, true_rig, cam.x_px, cam.y_px, cam.design)
+    up = -with_surface(true_rig, surface, base).v
+    planted = np.linalg.norm(surface_slopes(true_rig, surface, base), axis=1) * 1e3
+    return {"planted_slope_mrad": np.where(np.isfinite(result.slopes[:, 0]), planted, np.nan),
+            "corrected_error_deg": np.degrees(maps.angle_between(result.corrected["direction"], up)),
+            "design_error_deg": np.degrees(maps.angle_between(result.design, up))}
+
+
+def _stats(e: np.ndarray) -> dict:
+    if not e.size:
+        return {"pixels": 0}
+    return {"pixels": int(e.size), "p50": float(np.percentile(e, 50)), "p99": float(np.percentile(e, 99)), "max": float(e.max()),
+            "rms": float(np.sqrt(np.mean(e ** 2)))}

@@ -1,0 +1,172 @@
+"""The camera images a calibration capture would give, without hardware (``rigcad calibrate
+--simulate``): the rig moved by a seeded random misalignment within ``tolerancing``, a planted
+surface error on the dome, each camera pixel's sub-rays traced to the screen with the pattern
+integrated over each sub-ray's footprint, defocus blur, photon and read noise, 8-bit quantisation.
+
+The dome's surface error h (mm, along the reflecting side's normal, in the dome's own frame): a
+Gaussian bump of ``calibration.sim_bump_amplitude`` and width ``sim_bump_width`` centred on a
+seeded point of the dome, plus the ripple that sanding across the print's layers leaves,
+``sim_ripple_amplitude`` x sin(2 pi z / ``sim_ripple_period``) (layers are planes of constant z).
+To first order it tilts the normal by its tangential gradient: n' = unit(n - grad_s h) (slopes in
+rad; the ~um height change moves the hit point negligibly). The screen emits uniformly in angle
+and linearly in its 8-bit values (a calibrated display)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigcad.calibrate import model as M
+from rigcad.calibrate.patterns import Sequence
+
+#: Fraction of full exposure the screen's black (and the room) gives: a display's contrast ~1000:1
+#: and some stray light.
+BLACK_LEVEL = 0.01
+#: Fraction of the camera's full well a white screen pixel fills (exposure advice: just short of saturation).
+WHITE_LEVEL = 0.85
+
+
+@dataclass(frozen=True)
+class SurfaceError:
+    """The planted dome error (module docstring): bump centre (3,) mm in the dome's frame."""
+
+    bump_centre: np.ndarray
+    bump_amplitude: float
+    bump_width: float
+    ripple_amplitude: float
+    ripple_period: float
+
+    def gradient(self, p: np.ndarray) -> np.ndarray:
+        """grad h (n, 3) at points p (n, 3) (dome frame), before projection on the surface."""
+        d = p - self.bump_centre
+        bump = self.bump_amplitude * np.exp(-np.sum(d * d, axis=1) / (2 * self.bump_width ** 2))
+        g = -bump[:, None] * d / self.bump_width ** 2
+        k = 2 * math.pi / self.ripple_period
+        g[:, 2] += self.ripple_amplitude * k * np.cos(k * p[:, 2])
+        return g
+
+
+def planted_surface(rig, rng: np.random.Generator) -> SurfaceError:
+    """A seeded bump centre on the dome (parameter in the middle 60 % of its meridian, any azimuth)."""
+    cal = rig.profile.calibration
+    mer = rig.layout.design_dome
+    lo, hi = mer.u_range
+    u = rng.uniform(lo + 0.2 * (hi - lo), hi - 0.2 * (hi - lo))
+    r, z = mer.points(np.array([u]))[0]
+    phi = rng.uniform(0, 2 * math.pi)
+    return SurfaceError(np.array([r * math.cos(phi), r * math.sin(phi), z]), cal.sim_bump_amplitude,
+                        cal.sim_bump_width, cal.sim_ripple_amplitude, cal.sim_ripple_period)
+
+
+def surface_slopes(rig, surface: SurfaceError | None, tr: M.Traced) -> np.ndarray:
+    """The planted error's tangential gradient grad_s h (n, 3) (global frame, rad) at each ray's
+    dome point (0 without a surface error; NaN where lost)."""
+    out = np.where(tr.ok[:, None], 0.0, np.nan)
+    if surface is None:
+        return out
+    pose = rig.pose("dome")
+    local, _ = pose.localize(np.nan_to_num(tr.p2), np.nan_to_num(tr.p2))
+    g = pose.globalize_dirs(surface.gradient(local))
+    n = tr.v - tr.u
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    g = g - np.sum(g * n, axis=1)[:, None] * n
+    return np.where(tr.ok[:, None], g, np.nan)
+
+
+def with_surface(rig, surface: SurfaceError | None, tr: M.Traced) -> M.Traced:
+    """The traced rays re-reflected off the dome with the planted error: v' = reflect(u, n')."""
+    if surface is None:
+        return tr
+    g = np.nan_to_num(surface_slopes(rig, surface, tr))
+    n = tr.v - tr.u
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    n2 = n - g
+    n2 /= np.linalg.norm(n2, axis=1)[:, None]
+    v = tr.u - 2 * np.sum(tr.u * n2, axis=1)[:, None] * n2
+    return M.Traced(tr.p2, np.where(tr.ok[:, None], v, np.nan), tr.u, tr.ok)
+
+
+def random_misalignment(rig, heights: int, rng: np.random.Generator) -> np.ndarray:
+    """A seeded build: each offset uniform within +- its tolerance, each tilt's rotation vector
+    uniform in magnitude (0..tolerance) and direction; the screens' heights +-0.2 mm and tilts
+    within 0.2 deg (a printed spacer, the screen laid on it), but the first screen's height: it
+    defines z (the fit's gauge, :mod:`rigcad.calibrate.fit`)."""
+    tol = M.tolerance_scale(rig, heights)
+    theta = np.zeros(len(tol))
+    for i in range(len(M.COMPONENTS)):
+        j = 5 * i
+        theta[j: j + 3] = rng.uniform(-1, 1, 3) * tol[j: j + 3]
+        mag, ang = rng.uniform(0, tol[j + 3]), rng.uniform(0, 2 * math.pi)
+        theta[j + 3: j + 5] = mag * math.cos(ang), mag * math.sin(ang)
+    for k in range(heights):
+        j = len(M.RIG_NAMES) + 3 * k
+        mag, ang = rng.uniform(0, math.radians(0.2)), rng.uniform(0, 2 * math.pi)
+        theta[j: j + 3] = rng.uniform(-0.2, 0.2) if k else 0.0, mag * math.cos(ang), mag * math.sin(ang)
+    return theta
+
+
+def _sub_offsets(s: int) -> np.ndarray:
+    return (np.arange(s) + 0.5) / s - 0.5
+
+
+def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.Camera, seq: Sequence,
+           heights: np.ndarray, rng: np.random.Generator) -> list[dict[str, np.ndarray]]:
+    """Per screen height, every frame of ``seq`` as the camera records it: full-resolution uint8
+    images (rows, cols) (module docstring). ``theta``: the true misalignment (model parameters)."""
+    from scipy.ndimage import gaussian_filter
+
+    cal = rig.profile.calibration
+    s = cal.sim_supersample
+    true_rig = M.moved(rig, theta)
+    off = _sub_offsets(s)
+    ox, oy = [a.ravel() for a in np.meshgrid(off, off)]
+    n = len(cam.x_px)
+    x = (cam.x_px[:, None] + ox[None, :]).ravel()
+    y = (cam.y_px[:, None] - oy[None, :]).ravel()
+    tr = with_surface(true_rig, surface, M.trace_camera(optics, true_rig, x, y, cam.design))
+    width, height = cam.resolution
+    out = []
+    for pose in M.screens(heights, theta):
+        su, sv = tr.screen(pose)
+        cx, cy = seq.from_mm(su, sv)
+        edges = _sub_edges(cx.reshape(n, s, s), cy.reshape(n, s, s), cam.shape)
+        frames = {}
+        lit = np.repeat(tr.ok.reshape(n, s * s).any(axis=1), s * s)  # pixels with a sub-ray on a screen's side
+        means = seq.footprint_means(seq.names(), np.nan_to_num(cx[lit], nan=-1e9), np.nan_to_num(cy[lit], nan=-1e9),
+                                    edges[lit])
+        for name in seq.names():
+            val = np.zeros(n * s * s)
+            val[lit] = means[name]
+            expected = (BLACK_LEVEL + (WHITE_LEVEL - BLACK_LEVEL) * val.reshape(n, s * s).mean(axis=1))
+            expected = gaussian_filter(expected.reshape(cam.shape), cal.sim_blur) if cal.sim_blur > 0 else \
+                expected.reshape(cam.shape)
+            frames[name] = _expose(expected, cam, (height, width), cal, rng)
+        out.append(frames)
+    return out
+
+
+def _sub_edges(cx: np.ndarray, cy: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """Each sub-ray's footprint edges on the screen (n * s * s, 2, 2) px: the landing point's change
+    over one sub-pixel step along the camera's columns and rows, from neighbouring pixels' centre
+    sub-rays (central differences over the window; NaN neighbours give a point sample)."""
+    n, s, _ = cx.shape
+    mid = s // 2
+    cxm, cym = cx[:, mid, mid].reshape(shape), cy[:, mid, mid].reshape(shape)
+    e = np.zeros((n, 2, 2))
+    for k, c in enumerate((cxm, cym)):
+        with np.errstate(invalid="ignore"):
+            e[:, 0, k] = np.nan_to_num(np.gradient(c, axis=1).ravel()) / s
+            e[:, 1, k] = np.nan_to_num(np.gradient(c, axis=0).ravel()) / s
+    return np.repeat(e, s * s, axis=0)
+
+
+def _expose(expected: np.ndarray, cam: M.Camera, size: tuple[int, int], cal, rng) -> np.ndarray:
+    """Photon (Poisson) and read (Gaussian) noise on the window's expected exposure (fractions of
+    the full well), read noise elsewhere, quantised to 8 bits (255 = the full well)."""
+    full = cal.sim_full_well
+    image = rng.normal(0.0, cal.sim_read_noise, size)
+    win = image[cam.row0: cam.row0 + cam.shape[0], cam.col0: cam.col0 + cam.shape[1]]
+    win += rng.poisson(np.clip(expected, 0, None) * full)
+    return np.clip(np.round(image * 255.0 / full), 0, 255).astype(np.uint8)

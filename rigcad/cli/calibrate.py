@@ -1,0 +1,156 @@
+"""``rigcad calibrate PROFILE (--images DIR | --simulate) [--seed N] [--exports DIR]``: decode the
+capture, fit the misalignment, write the residual slope map and the corrected pixel -> incidence
+map into ``<exports>/<profile>/calibrate/`` (published atomically: a refused capture writes
+nothing). ``--kit`` writes the calibration kit instead (rigcad.calibrate.kit)."""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+from pathlib import Path
+
+
+def cmd_calibrate(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from rigcad.calibrate import model as M
+    from rigcad.calibrate.images import check_decoded, read_capture
+    from rigcad.calibrate.patterns import Sequence
+    from rigcad.calibrate.run import calibrate, compare
+    from rigcad.check.scene import analytic_optics
+    from rigcad.export.atomic import Staging, json_bytes, profile_lock
+    from rigcad.export.manifest import profile_digest
+    from rigcad.progress import stages
+    from rigcad.rig import load
+
+    rig = load(args.profile)
+    if getattr(args, "kit", False):
+        from rigcad.calibrate.kit import write_kit
+
+        out = Path(args.exports) / rig.name / "calibrate_kit"
+        manifest = write_kit(rig, out, say=print)
+        print(f"calibration kit for {rig.name}: {len(manifest['files'])} files in {out}")
+        return 0
+    seq = Sequence.from_profile(rig.profile.calibration)
+    heights = M.nominal_heights(rig.profile)
+    folder, images, truth = Path("<simulated>"), None, None
+    if not args.simulate:  # a capture that is missing or the wrong size is refused before any work
+        folder = Path(args.images)
+        images = read_capture(folder, seq, len(heights), rig.profile.camera.resolution)
+    with stages(3, "calibrate") as step:
+        step("tracer")
+        optics = analytic_optics(rig)
+        if args.simulate:
+            from rigcad.calibrate import simulate as S
+
+            step("simulated capture")
+            rng = np.random.default_rng(args.seed)
+            theta = S.random_misalignment(rig, len(heights), rng)
+            surface = S.planted_surface(rig, rng)
+            images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, heights, rng)
+            images = [{n: im.astype(float) / 255.0 for n, im in f.items()} for f in images]
+            truth = (theta, surface)
+        step("decode, fit, maps")
+        check = None if args.simulate else (
+            lambda decoded: [check_decoded(folder, k, seq, d) for k, d in enumerate(decoded)])
+        result = calibrate(optics, rig, images, say=print, check=check)
+    _check_heights(result, folder)
+    report = _report(result)
+    extra = None
+    if truth is not None:
+        from rigcad.calibrate.run import truth_maps
+
+        report["simulation"] = {"seed": args.seed, **compare(optics, rig, result, *truth)}
+        extra = truth_maps(optics, rig, result, *truth)
+    picture = _picture(rig.name, result, extra)
+    out = Path(args.exports) / rig.name / "calibrate"
+    with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
+        st.write_bytes(out / "calibration.json", json_bytes(report))
+        st.write_bytes(out / "corrected_map.npz", _npz(result))
+        st.write_bytes(out / "maps.png", picture)
+        st.commit()
+    f = report["fit"]
+    print(f"calibrate {rig.name}: fit RMS {f['rms_residual_mm'] * 1e3:.2f} um over {f['residuals_used']} residuals; "
+          f"dome residual slope RMS {report['residual_slopes']['residual_slope_rms_mrad']:.3f} mrad, worst "
+          f"{report['residual_slopes']['residual_slope_worst_mrad']:.3f} mrad; wrote {out}")
+    return 0
+
+
+#: A fitted screen height further than this (mm) from its spacer's is a height the images contradict.
+HEIGHT_TOLERANCE_MM = 1.0
+
+
+def _check_heights(result, folder: Path) -> None:
+    from rigcad.calibrate import model as M
+    from rigcad.calibrate.images import CaptureError, capture_path
+
+    for k in range(len(result.heights)):
+        dz = float(result.fit.theta[len(M.RIG_NAMES) + 3 * k])
+        if abs(dz) > HEIGHT_TOLERANCE_MM:
+            raise CaptureError(f"{capture_path(folder, k, 'white')}: the images put the screen {dz:+.2f} mm from "
+                               f"its spacer's height ({result.heights[k]:g} mm above O): wrong spacer or order")
+
+
+def _report(result) -> dict:
+    return {"fit": result.fit.as_dict(), "residual_slopes": result.slope_figures(),
+            "residual_attribution": "the dome (sanded by hand); a paraboloid slope error at the paired point, "
+                                    "and low-order figure errors that a fitted tilt or offset mimics, are not "
+                                    "separable from it",
+            "decoding": [d.stats() for d in result.decoded], "screen_heights_mm": result.heights.tolist(),
+            "timings_s": result.timings_s, "camera_window": {"row0": result.cam.row0, "col0": result.cam.col0,
+                                                             "shape": list(result.cam.shape)}}
+
+
+def _picture(name: str, result, extra) -> bytes:
+    """maps.png: decoded phase, residual slopes (and, simulated, the planted ones and both maps' errors)."""
+    import numpy as np
+
+    from rigcad import plots
+
+    shape = result.cam.shape
+    phase = result.decoded[0].axes["x"].fringes[-1].phase
+    phase = np.where(result.decoded[0].valid, phase, np.nan)
+    slope = (np.linalg.norm(result.slopes, axis=1) * 1e3).reshape(shape)
+    if extra is None:
+        return plots.calibration_maps(phase, slope, None, None, None, f"{name}: calibration")
+    return plots.calibration_maps(phase, slope, extra["planted_slope_mrad"].reshape(shape),
+                                  extra["corrected_error_deg"].reshape(shape), extra["design_error_deg"].reshape(shape),
+                                  f"{name}: simulated calibration")
+
+
+def _npz(result) -> bytes:
+    import numpy as np
+
+    buf = io.BytesIO()
+    c = result.corrected
+    shape = result.cam.shape + (3,)
+    np.savez_compressed(buf, direction=c["direction"].reshape(shape), uncertainty_rad=c["uncertainty_rad"].reshape(
+        result.cam.shape), source=c["source"].reshape(result.cam.shape), design=result.design.reshape(shape),
+        row0=result.cam.row0, col0=result.cam.col0, resolution=np.array(result.cam.resolution),
+        residual_slope=result.slopes.reshape(shape), about=json.dumps(
+            {"frame": "mm, O at the origin, +z up; unit directions from O towards the light",
+             "source": "0 none, 1 measured, 2 filled, 3 model only"}))
+    return buf.getvalue()
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add ``calibrate`` to rigcad's subcommands."""
+    from rigcad.arguments import profile_command
+
+    p = profile_command(
+        subparsers, "calibrate", cmd_calibrate,
+        help="deflectometric calibration of the as-built rig (a screen at the sample)",
+        description="Decode a capture of the calibration screen at two or more spacer heights (images "
+                    "h<spacer>_<frame>.png|tif, docs/calibrate.md), fit the rig's misalignment with its own "
+                    "tracer, map the dome's residual slopes and write exports/<profile>/calibrate/: "
+                    "calibration.json, corrected_map.npz (read by rigcad basis --simulate), maps.png. "
+                    "--simulate renders a seeded capture of a moved rig with a planted dome error instead and "
+                    "compares; --kit writes the screen patterns, the spacers and the manual's page.")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif)")
+    src.add_argument("--simulate", action="store_true", help="render a seeded simulated capture and calibrate it")
+    src.add_argument("--kit", action="store_true", help="write the calibration kit: screen patterns, spacers "
+                     "(STL, STEP, manifest), the manual's page, into <exports>/<profile>/calibrate_kit")
+    p.add_argument("--seed", type=int, default=2006, help="seed of the simulated misalignment and noise")
+    return p
