@@ -55,6 +55,43 @@ class Doc:
     def img(self, path: str, caption: str) -> None:
         self.blocks.append(("img", path, caption))
 
+    def page(self, text: str, shift: int = 1) -> None:
+        """Blocks from a Markdown page of headings (their level moved down by ``shift``), lists (``-`` or
+        ``1.``; an indented line continues the item) and paragraphs, as another module writes one."""
+        kind, items, para = None, [], []
+
+        def flush() -> None:
+            nonlocal kind, items, para
+            if para:
+                self.p(" ".join(para))
+            if items:
+                (self.ol if kind == "ol" else self.ul)(items)
+            kind, items, para = None, [], []
+
+        for line in text.splitlines():
+            head = re.match(r"(#+) (.*)", line)
+            item = re.match(r"(?:- |\d+\. )(.*)", line)
+            if head:
+                flush()
+                self.h(min(len(head.group(1)) + shift, 6), head.group(2))
+            elif item:
+                if para:
+                    flush()
+                new = "ol" if line[0].isdigit() else "ul"
+                if kind not in (None, new):
+                    flush()
+                kind = new
+                items.append(item.group(1))
+            elif line.startswith("  ") and items:
+                items[-1] += " " + line.strip()
+            elif line.strip():
+                if items:
+                    flush()
+                para.append(line.strip())
+            else:
+                flush()
+        flush()
+
     def markdown(self) -> str:
         out = []
         for b in self.blocks:
@@ -597,6 +634,16 @@ def _calibration_more(d: Doc, c, cam: dict) -> None:
         "measured value (thesis eq. 4.2). Keep the card dry and out of the light between uses.")
 
 
+def _as_built(d: Doc, c) -> None:
+    """The deflectometric calibration of the rig as built (rigcad.calibrate.kit's page), when the
+    profile has a calibration section."""
+    if getattr(c.p, "calibration", None) is None:
+        return
+    from rigcad.calibrate.kit import manual_page
+
+    d.page(manual_page(c.rig), shift=2)
+
+
 def _section_calibrate(d: Doc, c) -> None:
     """The manual's section: 6 calibrate."""
     import numpy as np
@@ -660,6 +707,7 @@ def _section_calibrate(d: Doc, c) -> None:
                                                             part.color)
             d.img(f"images/{name}.png", f"`{name}`: {part.description}")
     _calibration_more(d, c, cam)
+    _as_built(d, c)
     step("calibration")
     c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam}
 
