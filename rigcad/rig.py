@@ -40,6 +40,9 @@ if TYPE_CHECKING:  # pragma: no cover
 #: Geometry a move does not change: carried over by :meth:`Rig.moved` instead of recomputed.
 _SHARED = ("paraboloid", "curve", "design", "layout", "recipes", "instruments", "incidence", "occluders",
            "_meshes")
+#: What depends on the geometry and the dome alone: carried over by :meth:`Rig.from_profile` from a
+#: previous rig with the same dome inputs.
+_DOME_ONLY = ("paraboloid", "curve", "incidence")
 
 
 @dataclass(frozen=True)
@@ -54,13 +57,22 @@ class Rig:
 
     # -- construction ------------------------------------------------------------------------------
     @classmethod
-    def from_profile(cls, profile: Profile) -> "Rig":
+    def from_profile(cls, profile: Profile, previous: "Rig | None" = None) -> "Rig":
         """Derive the geometry and integrate the dome, once. Raises GeometryError (naming the
-        profile key and its file:line) for an impossible rig."""
+        profile key and its file:line) for an impossible rig. ``previous``: the rig of an earlier
+        version of the profile (the live edit loop, rigcad.live): when the dome's inputs (the
+        ``dome`` section and the derived geometry) are equal, its dome and what was computed from
+        the dome alone (_DOME_ONLY) are carried over instead of integrated again."""
         from rigcad.optics.design import converged_dome
         from rigcad.profile.derived import derive
 
         geometry = derive(profile)
+        if previous is not None and previous.profile.dome == profile.dome and previous.geometry == geometry:
+            rig = cls(profile, geometry, previous.dome)
+            for key in _DOME_ONLY:
+                if key in previous.__dict__:
+                    rig.__dict__[key] = previous.__dict__[key]  # a cached value of the same inputs
+            return rig
         return cls(profile, geometry, converged_dome(profile, geometry))
 
     @property

@@ -224,9 +224,11 @@ def test_profile_quantities_out_of_their_range_are_refused_with_their_line(secti
 
 
 @pytest.mark.parametrize("folder", ["a\nb", "\u202ex", "tab\there"])
-def test_an_exports_folder_with_control_characters_is_refused_at_once(folder, capsys):
+def test_an_exports_folder_with_control_characters_is_refused_at_once(folder, capsys, tmp_path, monkeypatch):
     """A newline or a right-to-left override in the output root would break every line naming it."""
     from rigcad.cli import main
+
+    monkeypatch.chdir(tmp_path)  # should the refusal break, the folder lands in tmp, not in the checkout
 
     with pytest.raises(SystemExit) as exit_:
         main(["design", "achutha2006", "--exports", folder])

@@ -240,14 +240,15 @@ def zonal_moments(theta_rad: np.ndarray, phi_rad: np.ndarray, values: np.ndarray
     """sum_ij values[..., i, j] Z_k(theta_i, phi_j) for every k (shape values.shape[:-2] + (K,)): the
     zonal coefficients of a function sampled on a product grid theta (n_t,) x phi (n_p,) with its
     quadrature weights already multiplied in; ``phi_rad`` (n_t, n_p) gives each polar row its own
-    azimuths instead. Separable (Legendre factors on theta, cos/sin(m phi)
+    azimuths instead, and a scalar ``phi_rad`` is a single azimuth (values (..., n_t, 1)). Separable (Legendre factors on theta, cos/sin(m phi)
     on phi, as :func:`real_basis`), so it costs O(n_t n_p order) instead of O(n_t n_p K) for the
     dense ``values.ravel() @ zonal_basis(...)``, which it equals to round-off (tested)."""
     L = check_order(order)
     g = np.asarray(values, dtype=float)
-    th, ph = np.asarray(theta_rad, dtype=float), np.asarray(phi_rad, dtype=float)
+    th = np.asarray(theta_rad, dtype=float)
+    ph = np.atleast_1d(np.asarray(phi_rad, dtype=float))  # a scalar phi is a rule of one azimuth
     rows = ph.ndim == 2  # an azimuth rule of its own per polar row
-    n_p = ph.shape[-1] if ph.ndim else 1
+    n_p = ph.shape[-1]
     if g.shape[-2:] != (th.size, n_p) or (rows and ph.shape != (th.size, n_p)) or ph.ndim > 2:
         raise BasisError(f"values have shape {g.shape}, phi {ph.shape}: need values (..., {th.size}, n_phi) "
                          "(theta x phi) and phi (n_phi,) or (n_theta, n_phi)")

@@ -135,11 +135,11 @@ class LiveSession:
 
     def _update(self, timings: dict, ran: list) -> Frame:
         t0 = time.perf_counter()
-        profile, geometry = self._reload()
+        profile = self._reload()
         timings["reload"] = time.perf_counter() - t0
 
         t0 = time.perf_counter()
-        rig, dome_key, design_key = self._rig(profile, geometry, ran)
+        rig, dome_key, design_key = self._rig(profile, ran)
         figures = headline(rig.design.report)
         timings["design"] = time.perf_counter() - t0
 
@@ -180,8 +180,7 @@ class LiveSession:
 
     # -- stages ----------------------------------------------------------------------------------
     def _reload(self):
-        """The profile and its geometry; the files to watch (profile chain, printers) kept current."""
-        from rigcad.profile.derived import derive
+        """The profile; the files to watch (its extends: chain, the printers) kept current."""
         from rigcad.profile.loader import load_raw
         from rigcad.profile.schema import validate
 
@@ -193,26 +192,21 @@ class LiveSession:
             self.files = tuple(dict.fromkeys([*files, *self._printer_files()]))
         profile = validate(raw)
         self._load_printers()
-        return profile, derive(profile)
+        return profile
 
-    def _rig(self, profile, geometry, ran: list):
-        """The rig of ``profile``: the dome, its maps and the design carried over from the last
-        good rig when their keys are unchanged, else computed (and counted)."""
-        from rigcad.optics.design import converged_dome, profile_entry
+    def _rig(self, profile, ran: list):
+        """The rig of ``profile``: the dome (Rig.from_profile with the last good rig) and the design
+        carried over when their inputs are unchanged, else computed (and counted)."""
+        from rigcad.optics.design import profile_entry
         from rigcad.rig import Rig
 
         old = self.good
-        dome_key = key_of(profile.dome, geometry)
-        design_key = key_of(dome_key, *(getattr(profile, s) for s in DESIGN_SECTIONS))
-        if old is not None and old.dome_key == dome_key:
-            rig = Rig(profile, geometry, old.rig.dome)
-            for name in ("paraboloid", "curve", "incidence"):
-                if name in old.rig.__dict__:
-                    rig.__dict__[name] = old.rig.__dict__[name]  # a cached value of the same inputs
-        else:
-            rig = Rig(profile, geometry, converged_dome(profile, geometry))
+        rig = Rig.from_profile(profile, previous=old.rig if old is not None else None)
+        if old is None or rig.dome is not old.rig.dome:
             self.builds["dome"] += 1
             ran.append("dome")
+        dome_key = key_of(profile.dome, rig.geometry)
+        design_key = key_of(dome_key, *(getattr(profile, s) for s in DESIGN_SECTIONS))
         if old is not None and old.design_key == design_key:
             design = old.rig.design
             rig.__dict__["design"] = dataclasses.replace(

@@ -20,7 +20,8 @@ from rigcad.errors import ProfileError, one_line
 #: burst (ms): an editor's save is a few writes within ~10 ms; a rebuild waits at most this long.
 DEBOUNCE_MS = 400
 STEP_MS = 30
-#: How long the watch blocks in Rust before checking for Ctrl-C or the stop event (ms).
+#: How long the watch blocks in Rust before checking for Ctrl-C, the stop event and the files'
+#: signatures (ms).
 RUST_TIMEOUT_MS = 500
 
 
@@ -32,9 +33,11 @@ class Watcher:
     def __init__(self, session, hub, say=print, write: Path | None = None, ocp=None) -> None:
         self.session, self.hub, self.say, self.write, self.ocp = session, hub, say, write, ocp
         self.frames: list[dict] = []  # per frame: seq, timings (s), push (s), error: for the bench
+        self._seen: tuple = ()
 
     def rebuild(self) -> None:
         """One update: parts first (published at once), then the check rows, then the extras."""
+        self._seen = self._signature()
         frame = self.session.update()
         self._publish(frame)
         if frame.error is not None:
@@ -65,14 +68,32 @@ class Watcher:
         self.say(summary(frame, push))
 
     def _write(self) -> None:
+        """Publish the exports of the good rig; a failure (a planted link, a full disk) is one line
+        and the watch goes on (the previous exports stay whole: the publication is atomic)."""
+        from rigcad.errors import RigcadError
         from rigcad.export.atomic import check_exports
 
         rig = self.session.good.rig
-        check_exports(self.write, rig.name)
         t0 = time.perf_counter()
-        result = rig.export(Path(self.write) / rig.name)
+        try:
+            check_exports(self.write, rig.name)
+            result = rig.export(Path(self.write) / rig.name)
+        except RigcadError as err:
+            self.say(f"  not written: {one_line(err)}")
+            return
         self.say(f"  wrote {Path(self.write) / rig.name}/: {len(result.rebuilt)} part(s) built, "
                  f"{len(result.reused)} unchanged ({time.perf_counter() - t0:.1f} s)")
+
+    def _signature(self) -> tuple:
+        """(file, modification time, size) of every watched file: what a rebuild has seen."""
+        out = []
+        for path in sorted(self.watched()):
+            try:
+                st = path.stat()
+                out.append((path, st.st_mtime_ns, st.st_size))
+            except OSError:
+                out.append((path, None, None))
+        return tuple(out)
 
     def watched(self) -> frozenset[Path]:
         spec = Path(str(self.session.spec))
@@ -92,9 +113,13 @@ class Watcher:
             names = {str(f) for f in files}
             folders = sorted({str(f.parent) for f in files})
             restarted = False
-            for _changes in watchfiles.watch(*folders, watch_filter=lambda _c, path: path in names,
-                                             debounce=DEBOUNCE_MS, step=STEP_MS, stop_event=stop,
-                                             rust_timeout=RUST_TIMEOUT_MS, recursive=False):
+            for changes in watchfiles.watch(*folders, watch_filter=lambda _c, path: path in names,
+                                            debounce=DEBOUNCE_MS, step=STEP_MS, stop_event=stop,
+                                            rust_timeout=RUST_TIMEOUT_MS, yield_on_timeout=True, recursive=False):
+                # an empty set: a quiet RUST_TIMEOUT_MS; a file changed while the watch was not yet
+                # armed (restarted for a new extends: chain) is caught by its signature
+                if not changes and self._signature() == self._seen:
+                    continue
                 self.rebuild()
                 if self.watched() != files:  # the extends: chain changed: watch the new files
                     restarted = True
@@ -124,4 +149,4 @@ def summary(frame, push: float) -> str:
     return f"{head} rebuilt {what} ({times} push {push:.2f} s){'; checking' if frame.check_pending else ''}"
 
 
-__all__ = ["DEBOUNCE_MS", "Watcher", "summary"]
+__all__ = ["DEBOUNCE_MS", "STEP_MS", "Watcher", "summary"]

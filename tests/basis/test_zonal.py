@@ -127,6 +127,20 @@ def test_separable_moments_equal_the_dense_sum(zone):
         zonal_moments(theta, phi, values[..., :5], 8, zone)
 
 
+@pytest.mark.parametrize("order", [0, 1, 3])
+def test_a_scalar_phi_is_one_azimuth(order):
+    # values on a theta x one-azimuth grid: the same dense sum over zonal_basis at that azimuth, at every
+    # order (order >= 1 reaches the cos/sin(m phi) factors, where a 0-d phi once failed)
+    zone = THESIS_ZONE
+    theta = np.linspace(zone.alpha_rad, zone.beta_rad, 9)
+    values = np.random.default_rng(5).normal(size=(2, 9, 1))
+    dense = values.reshape(2, -1) @ zonal_basis(theta, np.full(9, 0.7), order, zone)
+    for phi in (0.7, np.float64(0.7), np.array(0.7), np.array([0.7])):
+        sep = zonal_moments(theta, phi, values, order, zone)
+        # two summation orders of 9 terms of O(1): round-off
+        assert np.max(np.abs(sep - dense)) < 1e-12, (phi, np.max(np.abs(sep - dense)))
+
+
 def test_zone_rule_is_the_factor_of_zone_quadrature():
     th, wt, ph, wp = zone_rule(THESIS_ZONE, 7, 5)
     t2, p2, w2 = zone_quadrature(THESIS_ZONE, 7, 5)

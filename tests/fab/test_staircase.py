@@ -7,6 +7,7 @@ import math
 
 import manifold3d as m3d
 import numpy as np
+import pytest
 
 from rigcad.fab.orientation import Orientation
 from rigcad.fab.staircase import closed_form_cusp, slice_layers, step_map
@@ -170,3 +171,192 @@ def test_step_map_summary_and_polishing_allowance_by_hand():
     empty = _map([], [], [], [])
     assert polishing_allowance(empty) == {"sanding_depth_mm": 0.0, "stock_to_add_mm": 0.0}
     assert empty.summary()["cusp_from_slices_mean_mm"] is None and empty.summary()["stepped_surface_peak_mm"] is None
+
+
+# --- slicing, the segment search and the step map on hand-made geometry (exact expectations) -----
+
+from rigcad.fab.staircase import Layers, _segment_distance  # noqa: E402
+
+
+def test_slice_layers_of_a_tetrahedron_off_the_origin():
+    # a right-corner tetrahedron: base triangle (legs 4 and 3 mm) at z = 2 with its corner at (5, 7), apex
+    # 1.1 mm above the corner. At height h the section is the base scaled by s = 1 - h / 1.1 about the
+    # corner: a triangle of three vertices (a contour of three is a polygon). The part is lifted to the
+    # bed by z only, and the layer tops are the first layer then one layer each up to the part's top.
+    tet = m3d.Manifold.hull_points([(5.0, 7.0, 2.0), (9.0, 7.0, 2.0), (5.0, 10.0, 2.0), (5.0, 7.0, 3.1)])
+    layers, shift = slice_layers(tet, np.eye(3), 0.2, first_layer=0.3)
+    assert np.array_equal(shift, [0.0, 0.0, -2.0])  # printer = part + (0, 0, -2): on the bed, x and y kept
+    # tops 0.3, 0.5, 0.7, 0.9, 1.1: mid-planes half a layer below each top (the first: half the first layer)
+    assert np.allclose(layers.heights, [0.15, 0.4, 0.6, 0.8, 1.0], rtol=0, atol=1e-12)
+    assert layers.layer == 0.2 and layers.count == 5
+    for h, polys in zip(layers.heights, layers.contours):
+        s = 1 - h / 1.1
+        assert len(polys) == 1 and polys[0].shape == (3, 2)
+        want = np.array([(5.0, 7.0), (5.0 + 4 * s, 7.0), (5.0, 7.0 + 3 * s)])
+        got = polys[0][np.lexsort(polys[0].T[::-1])]
+        # manifold3d intersects the edges to ~1e-9 mm here (measured 3e-9): 1e-6 mm is far below the 0.1 mm scale
+        assert np.allclose(got, want[np.lexsort(want.T[::-1])], rtol=0, atol=1e-6), (got, want)
+    # a part thinner than its first layer is one layer, whose mid-plane is half its first layer up
+    slab = m3d.Manifold.cube((4.0, 3.0, 0.25))
+    thin, _ = slice_layers(slab, np.eye(3), 0.2, first_layer=0.3)
+    assert thin.count == 1 and np.allclose(thin.heights, [0.15], rtol=0, atol=1e-12)
+    # without a first layer of its own, every layer is 0.2 mm: 1.1 mm is 6 layers (the last ends at 1.2)
+    even, _ = slice_layers(tet, np.eye(3), 0.2)
+    assert np.allclose(even.heights, 0.1 + 0.2 * np.arange(6), rtol=0, atol=1e-12)
+
+
+def _brute_segment_distance(points, a, b):
+    """Distance from each point to each segment by the closed form (projection inside the segment:
+    perpendicular distance, else the nearer end), minimum over all segments."""
+    out = []
+    for p in points:
+        best = math.inf
+        for s, e in zip(a, b):
+            d = e - s
+            u = float((p - s) @ d) / float(d @ d)
+            if 0.0 <= u <= 1.0:
+                dist = abs(d[0] * (p - s)[1] - d[1] * (p - s)[0]) / math.hypot(*d)
+            else:
+                dist = min(math.hypot(*(p - s)), math.hypot(*(p - e)))
+            best = min(best, dist)
+        out.append(best)
+    return np.array(out)
+
+
+def test_segment_distance_equals_the_distance_to_the_polygon():
+    # a 60-gon of radius 10 mm (edges 1.05 mm) and points up to 0.5 mm either side of it: the nearest
+    # point is sometimes inside an edge and sometimes a vertex (points beyond an edge's ends)
+    ang = 2 * math.pi * np.arange(60) / 60
+    a = 10.0 * np.column_stack([np.cos(ang), np.sin(ang)])
+    b = np.roll(a, -1, axis=0)
+    rng = np.random.default_rng(11)
+    phi, rho = rng.uniform(0, 2 * math.pi, 400), rng.uniform(9.5, 10.5, 400)
+    pts = np.column_stack([rho * np.cos(phi), rho * np.sin(phi)])
+    got, ref = _segment_distance(pts, a, b), _brute_segment_distance(pts, a, b)
+    # the same distances by two formulas: round-off of products of O(10) mm
+    assert np.max(np.abs(got - ref)) < 1e-12, np.max(np.abs(got - ref))
+
+
+class _ConeInPrinter:
+    """A cone around the printer's z axis, radius R0 - (z - z0) delta / t, as a 'mirror' seen in
+    the part frame (part -> printer: rotation @ p + shift); + side outward."""
+
+    def __init__(self, rotation, shift, r0, z0, delta, t):
+        self.rot, self.shift, self.r0, self.z0, self.slope = rotation, shift, r0, z0, delta / t
+        self.norm = math.sqrt(1 + self.slope ** 2)
+
+    def signed_distance(self, p):
+        q = p @ self.rot.T + self.shift
+        rho = np.hypot(q[:, 0], q[:, 1])
+        return (rho - (self.r0 - (q[:, 2] - self.z0) * self.slope)) / self.norm  # distance to the meridian line
+
+    def normals(self, p):
+        q = p @ self.rot.T + self.shift
+        phi = np.arctan2(q[:, 1], q[:, 0])
+        n = np.column_stack([np.cos(phi), np.sin(phi), np.full(len(q), self.slope)]) / self.norm
+        return n @ self.rot  # printer -> part
+
+
+def _cone_layers(n_gon, count, t, r0, delta, gap=None):
+    """Layer k: a regular n-gon of circumradius r0 - k delta turned by k half-steps (slicers' vertices
+    do not line up layer to layer), plus a small square at the centre that is not on the mirror;
+    layer ``gap`` is empty (a layer with no contour). Mid-planes (k + 1/2) t."""
+    contours = []
+    for k in range(count):
+        ang = 2 * math.pi * np.arange(n_gon) / n_gon + k * math.pi / n_gon
+        gon = (r0 - k * delta) * np.column_stack([np.cos(ang), np.sin(ang)])
+        square = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+        contours.append([] if k == gap else [gon, square])
+    return Layers(t, (np.arange(count) + 0.5) * t, contours)
+
+
+def test_step_map_of_a_stepped_cone_by_hand():
+    n_gon, count, t, r0, delta = 12, 6, 0.2, 10.0, 0.1
+    rot = Orientation("t", (1.0, 0.0, 1.0), spin=0.4).rotation()
+    shift = np.array([3.0, -2.0, 5.0])
+    cone = _ConeInPrinter(rot, shift, r0, 0.5 * t, delta, t)
+    layers = _cone_layers(n_gon, count, t, r0, delta)
+    s = step_map(layers, rot, shift, cone, 1e-9)
+    # every polygon vertex is on the cone, no vertex of the centre squares is
+    assert s.points.shape == (count * n_gon, 3) and np.max(np.abs(cone.signed_distance(s.points))) < 1e-12
+    assert s.direction == pytest.approx(tuple(rot.T @ [0.0, 0.0, 1.0]), abs=1e-15) and s.layer == t
+    # a vertex of layer k is r_k from the axis on the bisector of an edge of layer k + 1 (turned by half
+    # a step): the horizontal step is r_k - r_(k+1) cos(pi / n), the cusp t D / sqrt(t^2 + D^2)
+    r = r0 - delta * np.arange(count)
+    step = r[:-1] - r[1:] * math.cos(math.pi / n_gon)
+    cusp = np.repeat(t * step / np.sqrt(t * t + step * step), n_gon)
+    assert np.allclose(s.cusp_slices[:-n_gon], cusp, rtol=1e-12, atol=0)
+    assert np.all(np.isnan(s.cusp_slices[-n_gon:]))  # the top layer has no next layer
+    # closed form t |n . D|: the cone's normal makes cos theta = (delta/t) / sqrt(1 + (delta/t)^2) with z
+    assert np.allclose(s.cusp_closed, t * delta / math.hypot(t, delta), rtol=1e-12, atol=0)
+    # the step's corners half a layer above and below: +- (delta / 2) / sqrt(1 + (delta/t)^2)
+    half = 0.5 * delta / math.hypot(1.0, delta / t)
+    assert np.allclose(s.peak, half, rtol=1e-9, atol=0) and np.allclose(s.valley, -half, rtol=1e-9, atol=0)
+
+
+def test_step_map_keeps_every_kth_vertex_and_skips_an_empty_layer():
+    n_gon, count, t, r0, delta = 12, 6, 0.2, 10.0, 0.1
+    rot, shift = np.eye(3), np.zeros(3)
+    cone = _ConeInPrinter(rot, shift, r0, 0.5 * t, delta, t)
+    # 96 contour vertices (12-gon and square per layer): at most 32 points -> every 3rd vertex of each
+    # layer's 16: 0, 3, 6, 9 on the 12-gon, 12 and 15 on the square (not on the mirror)
+    few = step_map(_cone_layers(n_gon, count, t, r0, delta), rot, shift, cone, 1e-9, max_points=32)
+    assert len(few.points) == 4 * count
+    # at most 6: every 16th vertex, the first of each layer: one point per layer
+    one = step_map(_cone_layers(n_gon, count, t, r0, delta), rot, shift, cone, 1e-9, max_points=6)
+    assert len(one.points) == count and np.sum(np.isfinite(one.cusp_slices)) == count - 1
+    # layer 3 empty: layers 0, 1 and 4 have a next layer; 2 (below the gap) and 5 (the top) do not
+    gap = step_map(_cone_layers(n_gon, count, t, r0, delta, gap=3), rot, shift, cone, 1e-9)
+    assert len(gap.points) == (count - 1) * n_gon
+    finite = np.isfinite(gap.cusp_slices).reshape(count - 1, n_gon).all(axis=1)
+    assert finite.tolist() == [True, True, False, True, False]
+
+
+def test_step_map_with_no_point_on_the_mirror_is_empty():
+    t = 0.2
+    far = _ConeInPrinter(np.eye(3), np.zeros(3), 50.0, 0.0, 0.1, t)  # 40 mm outside every contour
+    s = step_map(_cone_layers(12, 4, t, 10.0, 0.1), np.eye(3), np.zeros(3), far, 1e-3)
+    assert s.direction == (0.0, 0.0, 1.0) and s.layer == t and s.points.shape == (0, 3)
+    for a in (s.cusp_slices, s.cusp_closed, s.peak, s.valley):
+        assert isinstance(a, np.ndarray) and a.shape == (0,)
+    assert s.summary()["contour_points"] == 0 and polishing_allowance(s)["sanding_depth_mm"] == 0.0
+
+
+def test_optical_effect_p90_below_the_largest_error():
+    # A facing z, B tilted 0.1 rad, 1 mm2 each: area fractions (1, cos 0.1, sin 0.1) / total = 0.477, 0.475,
+    # 0.048 for errors 0, 0.1 and pi/2 - 0.1 rad: the 90th percentile is B's tread, not the largest error
+    th = 0.1
+    f = _faces([[0, 0, 1], [math.sin(th), 0, math.cos(th)]], [1.0, 1.0], [[0, 0, 100.0], [100.0, 0, 0]])
+    e = optical_effect(f, (0.0, 0.0, 1.0), "paraboloid")
+    assert math.isclose(e["normal_error_p90_deg"], math.degrees(th), rel_tol=1e-12)
+    assert math.isclose(e["ray_angle_error_p90_deg"], 2 * math.degrees(th), rel_tol=1e-12)
+
+
+def test_faces_facing_the_build_direction_have_no_error():
+    # unit normals along the unit build direction: |n . D| is 1 up to rounding, and may round above 1
+    # (for (1, 1, 1) / sqrt(3) it does on x86-64 with numpy's dot); the error is 0, never NaN
+    dirs = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, 2.0], [2.0, 1.0, 3.0], [1.0, 4.0, 4.0]])
+    for d in dirs:
+        n = d / np.linalg.norm(d)
+        e = optical_effect(_faces([n], [1.0], [[0.0, 0.0, 100.0]]), tuple(d), "dome")
+        assert e["normal_error_median_deg"] == 0.0 and e["area_fraction_within_1mrad"] == 1.0, (d, e)
+        assert e["histogram_normal_error_deg"]["area_fraction"][0] == 1.0 and e["miss_at_sample_median_mm"] == 0.0
+
+
+def test_a_ray_turned_past_89_degrees_misses_by_l_tan_89():
+    # one face at 44.6 deg to z: its tread (error 44.6 deg) holds the larger area cos 44.6 > sin 44.6, so
+    # it is the median; the reflected ray turns by 89.2 deg, clipped at 89 deg: miss L tan(89 deg)
+    th = math.radians(44.6)
+    f = _faces([[math.sin(th), 0, math.cos(th)]], [1.0], [[0.0, 0.0, 100.0]])
+    e = optical_effect(f, (0.0, 0.0, 1.0), "dome")
+    assert math.isclose(e["normal_error_median_deg"], 44.6, rel_tol=1e-12)
+    assert math.isclose(e["miss_at_sample_median_mm"], 100 * math.tan(math.radians(89.0)), rel_tol=1e-12)
+
+
+def test_step_map_summary_without_a_closed_form_cusp():
+    # walls along the build direction: closed-form cusp 0, so the relative difference is undefined (None);
+    # an empty map has no figure at all
+    s = _map([0.01, 0.02], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]).summary()
+    assert s["slices_vs_closed_form_mean_rel_diff"] is None and s["cusp_closed_form_mean_mm"] == 0.0
+    empty = _map([], [], [], []).summary()
+    assert empty["contour_points"] == 0 and all(v is None for k, v in empty.items() if k != "contour_points"), empty

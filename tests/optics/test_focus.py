@@ -24,7 +24,7 @@ def test_image_distance_is_the_gaussian_lens_equation():
 def test_the_default_lens_brings_the_paraboloid_into_the_projector_range(table31, table31_geometry):
     lens = focusing_lens(table31, table31_geometry)
     g = table31_geometry
-    assert lens.focal_length in CATALOGUE_FOCAL_LENGTHS
+    assert lens.focal_length in CATALOGUE_FOCAL_LENGTHS and lens.from_catalogue is True
     # the paraboloid from the lens: vertex d_cp - s, rim from the COP by Pythagoras
     s = table31.lens.distance
     assert lens.image_near == pytest.approx(g.cop_z - g.vertex_z - s, rel=1e-12)
@@ -55,3 +55,76 @@ def test_a_given_focal_length_out_of_range_is_refused(write_profile, table31_tex
     with pytest.raises(GeometryError) as info:
         focusing_lens(p, derive(p))
     assert "lens.focal_length" in str(info.value)
+
+
+def test_a_given_reachable_focal_length_is_used_as_given(write_profile, table31_text, table31, table31_geometry):
+    import json
+
+    chosen = focusing_lens(table31, table31_geometry)
+    p = load_profile(write_profile(table31_text + f"lens:\n  focal_length: {chosen.focal_length:g} mm\n"))
+    lens = focusing_lens(p, derive(p))
+    s = p.lens.distance
+    assert (lens.focal_length, lens.lens_distance, lens.from_catalogue) == (chosen.focal_length, s, False)
+    for focus, image in ((lens.focus_near, lens.image_near), (lens.focus_far, lens.image_far)):
+        # D = s + 1 / (1/u - 1/f), the lens equation written out here
+        assert focus == pytest.approx(s + 1.0 / (1.0 / image - 1.0 / lens.focal_length), rel=1e-12)
+    # what the manifest records is strict JSON, with an infinite range end written "inf"
+    d = json.loads(json.dumps(_by_hand(1.0, 2.0, 3.0, math.inf).describe(), allow_nan=False))
+    assert d["projector_focus_range_mm"] == [3.0, "inf"] and d["projector_focus_mm"] == [1.0, 2.0]
+
+
+def _by_hand(near, far, lo, hi):
+    from rigcad.optics.focus import FocusingLens
+
+    return FocusingLens(200.0, 25.0, 250.0, 270.0, near, far, lo, hi, True)
+
+
+def test_a_focus_setting_at_the_end_of_the_range_is_reachable():
+    from rigcad.optics.focus import _reachable
+
+    lo, hi = 1000.0, 3000.0
+    assert _reachable(_by_hand(lo, hi, lo, hi))  # both ends exactly at the range's ends
+    assert _reachable(_by_hand(lo * (1 - 1e-12), hi * (1 + 1e-12), lo, hi))  # within rounding of them
+    for near, far in ((lo * (1 - 1e-6), hi), (lo, hi * (1 + 1e-6)), (0.5 * lo, hi), (lo, 2 * hi)):
+        assert not _reachable(_by_hand(near, far, lo, hi)), (near, far)
+    assert _reachable(_by_hand(lo, math.inf, lo, math.inf))  # a projector focusing out to infinity
+    from rigcad.optics.focus import _dioptres
+
+    assert _dioptres(math.inf) == 0.0 and _dioptres(250.0) == 1 / 250.0  # focus at infinity: 0 dioptres
+
+
+def test_a_focus_range_that_starts_at_the_lens_is_refused_naming_the_key(write_profile, table31_text, table31):
+    s = table31.lens.distance
+    for text in (f"projector:\n  focus_min: {s:g} mm\n", "projector:\n  focus_min: 2 m\n  focus_max: 1 m\n"):
+        path = write_profile(table31_text + text)
+        p = load_profile(path)
+        with pytest.raises(GeometryError) as info:
+            focusing_lens(p, derive(p))
+        msg = str(info.value)
+        assert "projector.focus_min" in msg and "lens.distance" in msg and path.name in msg, msg
+
+
+@pytest.mark.parametrize("extra, key", [
+    ("projector:\n  focus_min: 2 m\n  focus_max: 1 m\n", "focus_min"),  # a range ending before it starts
+    ("projector:\n  focus_min: 9 m\n  focus_max: 9.001 m\n", "focus_min"),  # no catalogue lens reaches
+    ("lens:\n  focal_length: 100 mm\n", "focal_length"),  # the given lens does not reach
+])
+def test_each_refusal_points_at_the_line_of_its_key(write_profile, table31_text, extra, key):
+    path = write_profile(table31_text + extra)
+    line = 1 + max(i for i, t in enumerate(path.read_text().splitlines()) if t.strip().startswith(key + ":"))
+    p = load_profile(path)
+    with pytest.raises(GeometryError) as info:
+        focusing_lens(p, derive(p))
+    assert str(info.value).startswith(f"{path}:{line}: "), (str(info.value), line)
+
+
+def test_no_real_image_is_inf_and_describe_names_every_figure():
+    # the projector's image behind the projector (focus - s = -f / 2, or exactly -f): the lens forms no
+    # real image (1/u = 1/f + 1/(D - s) <= 0), reported as inf, not a negative distance or an error
+    assert math.isinf(image_distance(200.0, 25.0, 25.0 - 100.0)) and math.isinf(image_distance(200.0, 25.0, 25.0 - 200.0))
+    from rigcad.optics.focus import FocusingLens
+
+    lens = FocusingLens(200.0, 25.0, 250.0, 270.0, 1500.0, 2500.0, 1000.0, 3000.0, True)
+    assert lens.describe() == {"focal_length_mm": 200.0, "lens_distance_mm": 25.0,
+                               "paraboloid_from_lens_mm": [250.0, 270.0], "projector_focus_mm": [1500.0, 2500.0],
+                               "projector_focus_range_mm": [1000.0, 3000.0], "from_catalogue": True}

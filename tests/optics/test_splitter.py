@@ -75,3 +75,65 @@ def test_compensated_camera_sees_from_the_design_cop():
     # thinner plate, proportionally smaller everything (all terms are linear in t)
     thin = camera_cop(splitter_plate(427.5, 70.0, 50.0, 50.0, 0.5, 1.5168), 427.5, math.atan2(16.3787, 292.5))
     assert np.allclose(np.array(thin.offset) * 2, cam.offset, rtol=1e-9, atol=1e-12)
+
+
+def test_the_plate_corners_span_its_front_face():
+    """The rig's splitter at 45 deg: its front face is a rectangle of 2 hw (along y) by 2 hl (along
+    the face, (1, 0, 1)/sqrt 2), centred on the plate's centre, in the plane of its normal."""
+    hw, hl = 30.0, 40.0
+    plate = splitter_plate(300.0, 50.0, 2 * hw, 2 * hl, 3.0, 1.5)
+    c = np.array([0.0, 0.0, 250.0])
+    r = 1 / math.sqrt(2)
+    k = plate.corners()
+    want = [c + a * hw * np.array([0, 1, 0]) + b * hl * np.array([r, 0, r]) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    assert np.allclose(k, want, rtol=0, atol=1e-12)
+    assert np.allclose((k - c) @ np.array([r, 0, -r]), 0.0, atol=1e-12)  # in the face's plane
+    edges = np.linalg.norm(np.roll(k, -1, axis=0) - k, axis=1)  # around the rectangle, in order
+    assert np.allclose(edges, [2 * hw, 2 * hl, 2 * hw, 2 * hl], rtol=1e-15)
+
+
+def test_camera_placement_as_dict_names_its_figures():
+    plate = splitter_plate(300.0, 50.0, 60.0, 80.0, 3.0, 1.5)
+    cam = camera_cop(plate, 300.0, 0.05)
+    d = cam.as_dict()
+    assert d == {"camera_cop_mm": list(cam.cop), "compensation_offset_mm": list(cam.offset),
+                 "chief_ray_shift_closed_form_mm": cam.chief_shift_mm, "bundle_rms_distance_from_cop_mm": cam.residual_mm}
+    # the offset is the COP's move from the design COP (0, 0, cop_z)
+    assert np.allclose(np.array(d["camera_cop_mm"]) - [0.0, 0.0, 300.0], d["compensation_offset_mm"], atol=1e-12)
+
+
+def test_transmit_knows_the_plate_edges():
+    """Rays at normal incidence from behind the rig's splitter leave the front face where they aim
+    (no bend at normal incidence); ``inside`` holds exactly for exits within the face's
+    2 hw x 2 hl rectangle, each edge on its own."""
+    from rigcad.optics.splitter import transmit
+
+    hw, hl = 30.0, 40.0
+    plate = splitter_plate(300.0, 50.0, 2 * hw, 2 * hl, 3.0, 1.5)
+    c, n = np.array(plate.center), np.array(plate.normal)
+    w, l_ = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 1.0]) / math.sqrt(2)
+    # exits at (u, v) in the face's (width, length) coordinates: inside, and just past each edge alone
+    uv = np.array([[0.0, 0.0], [29.0, 39.0], [-29.0, -39.0], [31.0, 0.0], [0.0, 41.0], [-31.0, 0.0], [0.0, -41.0]])
+    targets = c + uv[:, :1] * w + uv[:, 1:] * l_
+    origins = targets - 20.0 * n  # behind the plate, aimed along the normal
+    p_out, d_out, inside = transmit(plate, origins, np.tile(n, (len(uv), 1)))
+    assert np.allclose(p_out, targets, rtol=0, atol=1e-12) and np.allclose(d_out, n, atol=1e-15)
+    assert inside.tolist() == [True, True, True, False, False, False, False]
+
+
+def test_the_cone_and_the_bundle_residual():
+    """cone_dirs: unit directions, the chief ray -z first, none wider than the half angle. The camera
+    placement's residual is the RMS distance of the bundle's transmitted lines from the design COP,
+    measured here with |(COP - p) x d| (not the module's projection)."""
+    from rigcad.optics.splitter import transmit
+
+    half = 0.05
+    dirs = cone_dirs(half)
+    assert np.allclose(np.linalg.norm(dirs, axis=1), 1.0, atol=1e-15) and np.array_equal(dirs[0], [0.0, 0.0, -1.0])
+    assert np.max(np.arccos(np.clip(-dirs[:, 2], -1, 1))) <= half * (1 + 1e-12)
+    plate = splitter_plate(300.0, 50.0, 60.0, 80.0, 3.0, 1.5)
+    cam = camera_cop(plate, 300.0, half)
+    p, d, _ = transmit(plate, np.tile(cam.cop, (len(dirs), 1)), dirs)
+    dist = np.linalg.norm(np.cross(np.array([0.0, 0.0, 300.0]) - p, d), axis=1)
+    assert cam.residual_mm == pytest.approx(float(np.sqrt(np.mean(dist ** 2))), rel=1e-9)
+    assert cam.residual_mm > 0  # a tilted plate is astigmatic: no single point sees every ray straight

@@ -234,3 +234,61 @@ def test_limit_search_at_its_two_ends(table31_rig):
     assert any(k.startswith("camera_") for k in cam) and not any(k.startswith("projector_") for k in cam)
     dome = worst_figures(job, p, 0.1)
     assert any(k.startswith("projector_") for k in dome) and not any(k.startswith("camera_") for k in dome)
+
+
+def test_limit_rows_ranked_by_budget_and_a_zero_tolerance(table31_rig, monkeypatch):
+    """run_limits' rows: the share of each target a parameter uses at its tolerance (its figures there
+    over the target), the limit over the tolerance, the ranking by the larger share; a parameter
+    toleranced at 0 has no figures at its tolerance, uses none of the budget, and its limit is still
+    searched (from the default probe) and found. The row's keys are those tolerance.md and the
+    command line read."""
+    import dataclasses
+
+    from rigcad.tolerance.limits import LimitJob, worst_figures
+    from rigcad.tolerance.params import SEARCH_CAP
+
+    tol = dataclasses.replace(table31_rig.profile.tolerancing, dome_height=0.0)
+    rig = dataclasses.replace(table31_rig, profile=dataclasses.replace(table31_rig.profile, tolerancing=tol))
+    rays, seed = 200, int(tol.seed) + 1
+    key = Job(rig, rays, 0, 0).key
+    params = [next(q for q in PARAMETERS if q.name == n) for n in ("dome_height", "dome_offset", "paraboloid_tilt")]
+    seen = []
+    rows = run_limits(rig, key, rays, seed, Engine(1), progress=lambda *a: seen.append(a), parameters=params)
+    assert seen == [(1, 3, 1, 3), (2, 3, 2, 3), (3, 3, 3, 3)]  # one task per parameter
+    job = LimitJob(rig, rays, seed, key)
+    by = {r["parameter"]: r for r in rows}
+    common = {"parameter", "profile_key", "unit", "limit_found", "max_mirror_angle_error_rad_at_limit",
+              "spot_limit_found", "max_spot_radius_mm_at_spot_limit", "spot_budget_used", "angle_budget_used",
+              "limit_over_tolerance", "rank"}
+    at_tolerance = {"max_spot_radius_mm_at_tolerance", "max_mirror_angle_error_rad_at_tolerance",
+                    "lost_fraction_at_tolerance"}
+    for p in params[1:]:
+        r, u, value = by[p.name], p.unit, p.tolerance(tol)
+        assert set(r) == common | at_tolerance | {f"tolerance_{u}", f"limit_{u}", f"spot_limit_{u}"}, set(r)
+        assert (r["profile_key"], r["unit"], r[f"tolerance_{u}"]) == (f"tolerancing.{p.name}", u, value)
+        f = worst_figures(job, p, value)  # the same rays and operations in this process: the same bits
+        assert r["max_spot_radius_mm_at_tolerance"] == f["max_spot_radius_mm"]
+        assert r["lost_fraction_at_tolerance"] == f["lost_fraction"]
+        assert r["spot_budget_used"] == f["max_spot_radius_mm"] / tol.max_spot_radius
+        assert r["angle_budget_used"] == f["max_mirror_angle_error_rad"] / tol.max_angle_error
+        assert r["limit_over_tolerance"] == r[f"limit_{u}"] / value
+        # each limit meets its target; a spot limit not found below the search cap is the cap
+        assert r["limit_found"] and r["max_mirror_angle_error_rad_at_limit"] <= tol.max_angle_error
+        if r["spot_limit_found"]:
+            assert r["max_spot_radius_mm_at_spot_limit"] <= tol.max_spot_radius
+        else:
+            assert r[f"spot_limit_{u}"] == SEARCH_CAP[p.kind]
+    zero = by["dome_height"]
+    assert set(zero) == common | {"tolerance_mm", "limit_mm", "spot_limit_mm"}, set(zero)
+    assert zero["spot_budget_used"] == 0.0 and zero["angle_budget_used"] == 0.0
+    assert zero["limit_over_tolerance"] == math.inf
+    assert zero["limit_found"] and 0.0 < zero["limit_mm"] < 50.0, zero  # SEARCH_CAP["height"]
+    assert worst_figures(job, params[0], zero["limit_mm"])["max_mirror_angle_error_rad"] <= tol.max_angle_error
+    # ranked by the larger share, largest first, ranks from 1; the zero tolerance uses nothing: last
+    share = [max(r["spot_budget_used"], r["angle_budget_used"]) for r in rows]
+    assert [r["rank"] for r in rows] == [1, 2, 3] and share == sorted(share, reverse=True) and share[0] > share[1]
+    assert rows[-1]["parameter"] == "dome_height"
+    # and the limits run on the engine they are given: a dask engine without dask says so
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    with pytest.raises(EngineError, match="dask"):
+        run_limits(rig, key, 50, seed, Engine(1, LOCAL_DASK), parameters=params[1:2])
