@@ -22,6 +22,7 @@ help:
 	@echo "make gcode    - print files + G-code (PrusaSlicer) for PRINTER=$(PRINTER) -> $(EXPORTS)/$(PROFILE)/fab/$(PRINTER)/"
 	@echo "make view     - the assembled rig in 3D: $(EXPORTS)/$(PROFILE)/view/rig.html (one self-contained file)"
 	@echo "make manual   - assembly and calibration manual for PRINTER=$(PRINTER) -> $(EXPORTS)/$(PROFILE)/manual/$(PRINTER)/"
+	@echo "make docs     - run the documented commands on $(PROFILE); every figure and picture of README.md and docs/"
 	@echo "make test     - the fast test suite (default run, < 5 min on 2 cores)"
 	@echo "make test-slow - only the slow tests (the whole rig through PrusaSlicer)"
 	@echo "make test-all - every test, slow ones included"
@@ -61,11 +62,11 @@ view: $(VENV)/.installed
 manual: $(VENV)/.installed stl
 	$(VENV)/bin/rigcad manual $(PROFILE) --printer $(PRINTER) --exports $(EXPORTS)
 
-docs: check view
-	cp $(EXPORTS)/achutha2006/view/rig.png docs/rig.png
-	cp $(EXPORTS)/achutha2006/rays.png docs/rays.png
-	cp $(EXPORTS)/achutha2006/check/spot.png $(EXPORTS)/achutha2006/check/theta_map.png docs/
-	mkdir -p docs/parts && cp $(EXPORTS)/achutha2006/renders/*.png docs/parts/
+# Every figure and picture README.md and docs/*.md show, from the documented commands run on the
+# default profile (docs/figures.md): docs/figures.json, the pictures, the numbers in the pages.
+# About 10 minutes on 2 cores; niced, as it shares the machine.
+docs: $(VENV)/.installed tools
+	nice -n 10 $(PY) docs/figures.py run --exports $(EXPORTS)
 
 # --durations=15: the slowest tests on every run; --timeout (pytest-timeout): a hung test fails after
 # 10 min (the slow ones, the whole rig through PrusaSlicer, after an hour) instead of stalling the run

@@ -242,11 +242,13 @@ def rig_picture(meshes, rays: dict | None, title: str, elev: float = 18.0, azim:
 
 
 def assembly_step(meshes, done: list[int], new: list[int], offsets: dict, title: str, elev: float = 18.0,
-                  azim: float = -118.0, *, cut_away: set[str]) -> bytes:
+                  azim: float = -118.0, *, cut_away: set[str], fasteners=()) -> bytes:
     """Exploded picture of one assembly step: the parts ``done`` (indices into ``meshes``,
     ``rigcad.manual.assembly.PartMesh``) in place (grey), the parts ``new`` highlighted (orange)
     moved by ``offsets`` (index -> (3,) mm), with a dashed line to where they go; the parts named in
-    ``cut_away`` (assembly.encloses) cut away in front. Parts that go in from below are seen from below."""
+    ``cut_away`` (assembly.encloses) cut away in front. Parts that go in from below are seen from below.
+    ``fasteners``: (start (3,), end (3,)) mm of each bolt or screw of the step, drawn as thick dark
+    lines from head to tip; an x, y, z axis triad in the corner of every picture."""
     cut = cut_away
     fig = plt.figure(figsize=(6, 6.5))
     ax = fig.add_axes((0, 0, 1, 0.92), projection="3d")
@@ -270,9 +272,23 @@ def assembly_step(meshes, done: list[int], new: list[int], offsets: dict, title:
             a = c + lift
             ax.plot([a[0], c[0]], [a[1], c[1]], [a[2], c[2]], "--", color="tab:red", lw=1.4, zorder=5)
             ax.scatter([c[0]], [c[1]], [c[2]], color="tab:red", s=16, marker="v" if lift[2] > 0 else "^", zorder=6)
+    for a, b in fasteners:
+        ax.plot([a[0], b[0]], [a[1], b[1]], [a[2], b[2]], "-", color="black", lw=2.2, zorder=7)
+        ax.scatter([a[0]], [a[1]], [a[2]], color="black", s=10, zorder=7)
+    _triad(ax, lo, hi)
     _fit_axes(ax, lo, hi)
     ax.view_init(elev=-elev if lift[2] < 0 else elev, azim=azim)
     return _trimmed_png(fig, title)
+
+
+def _triad(ax, lo: np.ndarray, hi: np.ndarray) -> None:
+    """x (red), y (green), z (blue) arrows, a tenth of the picture's size, at its low corner."""
+    size = 0.12 * float(np.max(hi - lo))
+    for k, (name, color) in enumerate((("x", "tab:red"), ("y", "tab:green"), ("z", "tab:blue"))):
+        d = np.zeros(3)
+        d[k] = size
+        ax.quiver(lo[0], lo[1], lo[2], d[0], d[1], d[2], color=color, lw=1.5, arrow_length_ratio=0.25)
+        ax.text(lo[0] + 1.15 * d[0], lo[1] + 1.15 * d[1], lo[2] + 1.15 * d[2], name, color=color, fontsize=9)
 
 
 # -- the 3D ray check (rigcad check) -----------------------------------------------------------

@@ -89,7 +89,7 @@ def test_unknown_profile_names_the_known_ones():
 
 
 def test_readme_ray_diagram_is_current(tmp_path):
-    # docs/rays.png is shown in the README; regenerate it with `make stl && cp exports/achutha2006/rays.png docs/`
+    # docs/rays.png is shown in docs/design.md; `make docs` regenerates it
     assert main(["design", "achutha2006", "--exports", str(tmp_path)]) == 0
     assert (tmp_path / "achutha2006" / "rays.png").read_bytes() == (ROOT / "docs" / "rays.png").read_bytes()
 

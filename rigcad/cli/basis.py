@@ -59,6 +59,15 @@ def cmd_basis(args: argparse.Namespace) -> int:
             sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step,
                                   corrected=corrected)
             paths += api.write_simulation(rig, sim, out)
+    _print_basis(rig, basis, order)
+    print(f"  {len(paths)} files in {out}/ ({t_images:.1f} s)")
+    if sim is not None:
+        _print_simulation(sim, time.perf_counter() - t0 - t_images)
+    return 0
+
+
+def _print_basis(rig, basis, order: int) -> None:
+    """The basis's summary: zone, lit pixels, solid angles and the Gram matrices' deviations."""
     rep = basis.report
     z, px, sa = rep["zone"], rep["projector"], rep["solid_angle"]
     print(f"{rig.name}: zonal basis to order {order} ({rep['functions']} functions) over "
@@ -74,31 +83,32 @@ def cmd_basis(args: argparse.Namespace) -> int:
             print(f"    {key[6:]:>5}  {g['analytic']['max_abs']:.2e}  {g['analytic_8bit']['max_abs']:.2e}  "
                   f"{g['analytic_16bit']['max_abs']:.2e}  {g['analytic_without_occluders']['max_abs']:.2e}      "
                   f"{g['lowdin_8bit']['max_abs']:.2e} ({g['lowdin_deviation_from_analytic']['max']:.3f})")
-    print(f"  {len(paths)} files in {out}/ ({t_images:.1f} s)")
-    if sim is not None:
-        r = sim.report
-        print(f"  simulated acquisition ({r['camera']['exitant_directions']} exitant directions, {r['bits']}-bit "
-              f"images; relative L2 of the zonal coefficients; {time.perf_counter() - t0 - t_images:.1f} s):")
-        print("    model          order  lit zone (none)  zone (none)  zone (gram)   " +
-              "  ".join(f"moved {i}: lit zone (none)" for i in range(1, len(r["rigs"]))))
-        for name in r["models"]:
-            for o in r["orders"]:
-                cells = []
-                for rv in r["rigs"].values():
-                    f = rv["models"][name][f"order_{o}"]
-                    cells.append(f)
-                a = cells[0]
-                print(f"    {name:<14} {o:>5}  {a['coefficients_vs_lit_zone_rel_l2']['none']:15.2e}  "
-                      f"{a['coefficients_vs_zone_rel_l2']['none']:11.2e}  {a['coefficients_vs_zone_rel_l2']['gram']:11.2e}   "
-                      + "  ".join(f"{c['coefficients_vs_lit_zone_rel_l2']['none']:24.2e}" for c in cells[1:]))
-        for i, (key, rv) in enumerate(r["rigs"].items()):
-            if i:
-                print(f"    moved {i}: {rv['rig']}")
-        for rv in r["rigs"].values():
-            card = rv["gray_card_order_1"]
-            print(f"    gray card (4.1.2, orders 0-1), {rv['rig']}: albedo error {card['gram']['albedo_max_rel_error']:.2e} "
-                  f"(Gram), {card['none']['albedo_max_rel_error']:.2e} (none)")
-    return 0
+
+
+def _print_simulation(sim, seconds: float) -> None:
+    """The simulated acquisition's table: coefficient errors per model and order, moved rigs, gray card."""
+    r = sim.report
+    print(f"  simulated acquisition ({r['camera']['exitant_directions']} exitant directions, {r['bits']}-bit "
+          f"images; relative L2 of the zonal coefficients; {seconds:.1f} s):")
+    print("    model          order  lit zone (none)  zone (none)  zone (gram)   " +
+          "  ".join(f"moved {i}: lit zone (none)" for i in range(1, len(r["rigs"]))))
+    for name in r["models"]:
+        for o in r["orders"]:
+            cells = []
+            for rv in r["rigs"].values():
+                f = rv["models"][name][f"order_{o}"]
+                cells.append(f)
+            a = cells[0]
+            print(f"    {name:<14} {o:>5}  {a['coefficients_vs_lit_zone_rel_l2']['none']:15.2e}  "
+                  f"{a['coefficients_vs_zone_rel_l2']['none']:11.2e}  {a['coefficients_vs_zone_rel_l2']['gram']:11.2e}   "
+                  + "  ".join(f"{c['coefficients_vs_lit_zone_rel_l2']['none']:24.2e}" for c in cells[1:]))
+    for i, (key, rv) in enumerate(r["rigs"].items()):
+        if i:
+            print(f"    moved {i}: {rv['rig']}")
+    for rv in r["rigs"].values():
+        card = rv["gray_card_order_1"]
+        print(f"    gray card (4.1.2, orders 0-1), {rv['rig']}: albedo error {card['gram']['albedo_max_rel_error']:.2e} "
+              f"(Gram), {card['none']['albedo_max_rel_error']:.2e} (none)")
 
 
 def register(subparsers) -> argparse.ArgumentParser:

@@ -60,7 +60,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--no-check", action="store_true", help="skip the check rows (parts and design only)")
     p.add_argument("--write", action="store_true", help="also publish <exports>/<profile>/ after each good rebuild")
     p.add_argument("--ocp", action="store_true", help="also push the parts, rays and COP markers to a running OCP CAD "
-                                                      "Viewer (the optional ocp_vscode)")
+                                                      "Viewer (rigcad[ocp]; start one with `python -m ocp_viewer`)")
     p.add_argument("--ocp-port", type=port_number, default=3939, help="the OCP CAD Viewer's port (default 3939)")
     return p
 

@@ -6,8 +6,8 @@ projection markers (instruments named ``*_marker``), sent to a viewer already ru
 ``ocp_vscode`` is the optional ``rigcad[ocp]`` extra. When it is missing, or no viewer listens on
 the port, :func:`connect` says so in one line (how to start a viewer) and returns None; the
 watcher then shows the browser view only. ``ocp_vscode`` 4.2 no longer starts a standalone viewer
-itself (``python -m ocp_vscode`` says it moved to the ``ocp_viewer`` package), so the line names
-both ways to get one.
+itself (``python -m ocp_vscode`` says it moved to the ``ocp_viewer`` package, also in the extra), so
+the line names ``python -m ocp_viewer --port P`` and the VS Code extension.
 """
 
 from __future__ import annotations
@@ -16,9 +16,12 @@ from rigcad.errors import RigcadError
 
 #: The port OCP CAD Viewer listens on by default (ocp_vscode's DEFAULT_PORT).
 DEFAULT_PORT = 3939
-#: How to start a viewer, for the one line said when none runs.
-START_HINT = ("open one in VS Code (the OCP CAD Viewer extension) or run `python -m ocp_viewer` (pip install ocp_viewer; "
-              "`python -m ocp_vscode` starts one only before ocp_vscode 4.2)")
+
+
+def start_hint(port: int) -> str:
+    """How to start a viewer on ``port``, for the one line said when none runs."""
+    return (f"run `python -m ocp_viewer --port {port}` (the standalone viewer, in rigcad[ocp]; `python -m ocp_vscode` "
+            "no longer starts one) or open the OCP CAD Viewer extension in VS Code")
 
 
 class ViewerError(RigcadError):
@@ -32,7 +35,7 @@ def viewer_missing(port: int = DEFAULT_PORT, host: str = "127.0.0.1") -> str | N
     except ImportError:
         return "ocp_vscode is not installed (pip install 'rigcad[ocp]')"
     if not port_check(int(port), host):
-        return f"no OCP CAD Viewer on {host}:{port}: {START_HINT}"
+        return f"no OCP CAD Viewer on {host}:{port}: {start_hint(port)}"
     return None
 
 
@@ -108,4 +111,4 @@ def show(rig, port: int = DEFAULT_PORT, rays: int | None = None) -> OcpPush:
     return push
 
 
-__all__ = ["DEFAULT_PORT", "OcpPush", "ViewerError", "connect", "show", "viewer_missing"]
+__all__ = ["DEFAULT_PORT", "OcpPush", "ViewerError", "connect", "show", "start_hint", "viewer_missing"]

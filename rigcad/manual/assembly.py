@@ -194,4 +194,4 @@ def encloses(meshes: list[PartMesh]) -> set[str]:
 
 
 __all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "hex_color", "picture_meshes", "ray_colors",
-           "rig_meshes", "step_offsets", "steps"]
+           "step_offsets", "steps"]

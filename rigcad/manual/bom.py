@@ -141,26 +141,27 @@ def _holes(solid, offset=(0.0, 0.0, 0.0), cut=False):
             yield ((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2], hi[2], min(w[0], w[1]), False)
 
 
-def bolt_joints(rig) -> list[dict]:
-    """Every bolted joint of the rig outside the COP tower (whose joints the tower module computes:
-    tower_hardware), found in the recipes: vertical holes of the in-rig printed parts
-    that share an axis (x, y within 0.05 mm) and touch in z are one bolt through those parts; a round
-    hole of one part alone is a bolt into what it stands on (the bench). Grouped by (parts joined,
-    thread, length): count, grip, the bolt, its nut and washers."""
+def bolt_axes(rig, tower: bool = False) -> list[dict]:
+    """Every bolt of the rig, found in the recipes: vertical holes of the in-rig printed parts that
+    share an axis (x, y within 0.05 mm) and touch in z are one bolt through those parts; a round hole
+    of one part alone is a bolt into what it stands on (the bench). One dict per bolt: the parts it
+    joins (sorted), x and y, the z of its top and bottom faces, its grip and the narrowest hole (mm).
+    The COP tower's parts are left out unless ``tower`` (their counts have their own home:
+    tower_hardware)."""
     try:
         from rigcad.parts.tower import TOWER_PARTS
     except ImportError:  # pragma: no cover - a rig without the tower module
         TOWER_PARTS = ()
     holes = []
     for name, part in rig.recipes.items():
-        if part.in_rig and name not in TOWER_PARTS:  # the tower's own joints: tower_hardware
+        if part.in_rig and (tower or name not in TOWER_PARTS):
             holes += [(name, *h) for h in _holes(part.solid)]
     axes: dict[tuple, list] = {}
     for h in holes:
         axes.setdefault((round(h[1] / 0.05), round(h[2] / 0.05)), []).append(h)
-    groups: dict[tuple, dict] = {}
-    for stack in axes.values():
-        stack.sort(key=lambda h: h[3])
+    out = []
+    for key in sorted(axes):
+        stack = sorted(axes[key], key=lambda h: (h[3], h[0]))
         runs, run = [], [stack[0]]
         for h in stack[1:]:
             if h[3] <= max(r[4] for r in run) + 1e-6:
@@ -173,10 +174,24 @@ def bolt_joints(rig) -> list[dict]:
             parts = tuple(sorted({h[0] for h in run}))
             if len(parts) == 1 and not all(h[6] for h in run):
                 continue  # a slot or channel of one part alone (a clamp, the projector's slots): no bolt of its own
-            grip = max(h[4] for h in run) - min(h[3] for h in run) - 2 * HOLE_OVERSHOOT_MM
-            hole = min(h[5] for h in run)
-            key = (parts, round(grip, 3), round(hole, 3))
-            groups.setdefault(key, {"parts": parts, "grip_mm": grip, "hole_mm": hole, "count": 0})["count"] += 1
+            top, bottom = max(h[4] for h in run) - HOLE_OVERSHOOT_MM, min(h[3] for h in run) + HOLE_OVERSHOOT_MM
+            upper = max(run, key=lambda h: (h[4], h[0]))[0]
+            spans = {n: (min(h[3] for h in run if h[0] == n) + HOLE_OVERSHOOT_MM,
+                         max(h[4] for h in run if h[0] == n) - HOLE_OVERSHOOT_MM) for n in parts}
+            out.append({"parts": parts, "upper": upper, "spans": spans, "x": run[0][1], "y": run[0][2], "top_z": top,
+                        "bottom_z": bottom, "grip_mm": top - bottom, "hole_mm": min(h[5] for h in run)})
+    return out
+
+
+def bolt_joints(rig) -> list[dict]:
+    """Every bolted joint of the rig outside the COP tower (whose joints the tower module computes:
+    tower_hardware), from :func:`bolt_axes`. Grouped by (parts joined, thread, length): count, grip,
+    the bolt, its nut and washers."""
+    groups: dict[tuple, dict] = {}
+    for b in bolt_axes(rig):
+        key = (b["parts"], round(b["grip_mm"], 3), round(b["hole_mm"], 3))
+        groups.setdefault(key, {"parts": b["parts"], "grip_mm": b["grip_mm"], "hole_mm": b["hole_mm"],
+                                "count": 0})["count"] += 1
     rows = []
     for g in sorted(groups.values(), key=lambda g: (-len(g["parts"]), g["parts"], g["grip_mm"])):
         thread, _, pitch, nut, washer = thread_for_hole(g["hole_mm"])
@@ -351,5 +366,54 @@ def bill(rig, fab_report: dict, printer) -> dict:
             "totals": fab_report.get("totals", {})}
 
 
-__all__ = ["bill", "bolt_joints", "bolt_length", "coating_rows", "dowel_pins", "fasteners", "printed", "purchased",
+__all__ = ["bill", "bolt_axes", "bolt_joints", "bolt_length", "coating_rows", "dowel_pins", "fasteners", "printed", "purchased",
            "revolved_area", "thread_for_hole", "tower_hardware"]
+
+
+# -- consumables and tools ------------------------------------------------------------------------
+#: Consumables with an orderable spec (standard or product class); the paint itself is the profile's.
+CONSUMABLES = (
+    ("Wet-or-dry silicon carbide paper, P120 P240 P400 P600 P800 P1000 P1500 P2000 P3000 (ISO 6344), 230 x 280 mm "
+     "sheets", "2 sheets of each"),
+    ("Dry guide coat powder (black, e.g. 3M 05861) with its applicator", "1"),
+    ("Filler primer: 1K acrylic high-build aerosol, 400 ml (or 2K epoxy primer with hardener)", "2"),
+    ("Cutting compound and finishing polish (automotive, e.g. 3M 06085 + 06068 class), 250 ml each", "1 each"),
+    ("Foam polishing pads, 75 mm, cutting and finishing", "2 each"),
+    ("Cyanoacrylate glue, medium viscosity, 20 g, for the split pieces' cut faces", "1"),
+    ("Two-part epoxy, 5 min, 25 ml (pins into holes)", "1"),
+    ("Isopropyl alcohol 99 %, 500 ml, and lint-free wipes (degreasing before each coat)", "1"),
+    ("Tack cloths", "5"),
+)
+#: Tools with an orderable spec.
+TOOLS = (
+    ("Digital caliper 150 mm, 0.01 mm (DIN 862)", "1"),
+    ("Engineer's square 100 mm (DIN 875, grade 1)", "1"),
+    ("Spirit level 200 mm, 0.3 mm/m", "1"),
+    ("Hex screwdrivers 2.5, 3, 4 mm and 3/16 in, 100 mm blades; L hex key set (ISO 2936)", "1 set"),
+    ("Open-end spanners 5.5, 7, 8 mm (DIN 3110)", "1 set"),
+    ("Soldering iron with a heat-set insert tip (M3, M4)", "1"),
+    ("HVLP spray gun 1.3-1.4 mm nozzle and a compressor (or aerosol cans only)", "1"),
+    ("Respirator, half mask with A2P3 filters (EN 14387); supplied-air hood for 2K isocyanate coats", "1"),
+    ("Nitrile gloves and safety glasses (EN 166)", "1 box / 1"),
+    ("Sanding blocks: flat rubber block and blocks curved to the mirrors' radii (section 3)", "see section 3"),
+)
+
+
+def feeler_gauge(gaps_mm: list[float]) -> tuple[str, str]:
+    """A feeler gauge set (DIN 2275 / ISO 2768 leaves) with the leaves the template checks need: the
+    gaps rounded to the set's 0.01 mm steps; a gap under 0.02 mm (the thinnest leaf) is checked
+    against the light instead."""
+    leaves = sorted({round(g, 2) for g in gaps_mm if g >= 0.02})
+    return (f"Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: "
+            + (", ".join(f"{v:.2f}" for v in leaves) + " mm" if leaves else "none (check against the light)"),
+            "1")
+
+
+def dowel_drills(printer) -> tuple[str, str]:
+    """The drill for the split pieces' pin holes (the printer's alignment pin plus its clearance)."""
+    pin = printer.alignment_pin
+    return (f"HSS twist drill {pin.diameter + pin.clearance:g} mm (DIN 338) for the pin holes; 4 mm H7 reamer "
+            "for the column's dowel holes", "1 each")
+
+
+__all__ += ["CONSUMABLES", "TOOLS", "dowel_drills", "feeler_gauge"]

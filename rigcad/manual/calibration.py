@@ -94,4 +94,65 @@ def camera_crosses(rig) -> dict:
             "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
 
 
-__all__ = ["camera_crosses", "circle_image", "film_shadows", "projector_shadows"]
+__all__ = ["camera_crosses", "circle_image", "circle_page", "film_shadows", "projector_shadows"]
+
+
+#: The adjustable circle page: a full-screen canvas, the disc drawn in device pixels (the projector's
+#: own pixels when the page fills its screen). Keys: arrows move by 1 px (Shift: 10 px), + and - change
+#: the radius by 1 px (Shift: 10 px), 0 restores the design's circle, f toggles full screen, h hides
+#: the read-out. window.rigcadCircle exposes the state to scripts (the browser test reads it).
+_CIRCLE_PAGE = """<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>@@TITLE@@</title>
+<meta http-equiv="Content-Security-Policy" content="default-src 'none'; style-src 'unsafe-inline'; script-src 'unsafe-inline'">
+<style>html,body{margin:0;height:100%;background:#000;overflow:hidden}canvas{display:block;width:100vw;height:100vh}
+#info{position:fixed;left:8px;top:6px;color:#f80;font:14px monospace;white-space:pre}</style></head>
+<body><canvas id="c"></canvas><div id="info"></div>
+<script>
+"use strict";
+const DESIGN = @@DESIGN@@;
+const state = {cx: DESIGN.cx, cy: DESIGN.cy, r: DESIGN.r, info: true};
+const canvas = document.getElementById("c"), info = document.getElementById("info");
+function draw() {
+  const dpr = window.devicePixelRatio || 1;
+  const w = Math.round(window.innerWidth * dpr), h = Math.round(window.innerHeight * dpr);
+  canvas.width = w; canvas.height = h;
+  const g = canvas.getContext("2d");
+  g.fillStyle = "#000"; g.fillRect(0, 0, w, h);
+  g.fillStyle = "#fff"; g.beginPath(); g.arc(state.cx, state.cy, Math.max(state.r, 0), 0, 2 * Math.PI); g.fill();
+  const off = (w !== DESIGN.width || h !== DESIGN.height) ?
+    "\\nscreen " + w + " x " + h + " px: not the projector's " + DESIGN.width + " x " + DESIGN.height + " px" : "";
+  info.style.display = state.info ? "block" : "none";
+  info.textContent = "centre (" + state.cx.toFixed(1) + ", " + state.cy.toFixed(1) + ") px from the top left\\n" +
+    "radius " + state.r.toFixed(1) + " px (design " + DESIGN.r.toFixed(1) + " px)\\n" +
+    "arrows: move, + -: radius (Shift: x10), 0: design, f: full screen, h: hide this" + off;
+  window.rigcadCircle = {cx: state.cx, cy: state.cy, r: state.r, width: w, height: h};
+}
+window.addEventListener("keydown", (e) => {
+  const step = e.shiftKey ? 10 : 1;
+  const k = e.key;
+  if (k === "ArrowLeft") state.cx -= step; else if (k === "ArrowRight") state.cx += step;
+  else if (k === "ArrowUp") state.cy -= step; else if (k === "ArrowDown") state.cy += step;
+  else if (k === "+" || k === "=") state.r += step; else if (k === "-" || k === "_") state.r = Math.max(0, state.r - step);
+  else if (k === "0") { state.cx = DESIGN.cx; state.cy = DESIGN.cy; state.r = DESIGN.r; }
+  else if (k === "h") state.info = !state.info;
+  else if (k === "f") { if (document.fullscreenElement) document.exitFullscreen(); else document.documentElement.requestFullscreen(); }
+  else return;
+  e.preventDefault(); draw();
+});
+window.addEventListener("resize", draw);
+draw();
+</script></body></html>
+"""
+
+
+def circle_page(rig, info: dict) -> bytes:
+    """The calibration circle as an adjustable full-screen page (see _CIRCLE_PAGE), starting at the
+    design's circle (``info`` from :func:`circle_image`): self-contained, no request leaves it."""
+    import html
+    import json
+
+    w, h = info["resolution_px"]
+    design = {"cx": info["centre_px_from_top_left"][0], "cy": info["centre_px_from_top_left"][1],
+              "r": round(info["radius_px"], 3), "width": w, "height": h}
+    title = html.escape(f"{rig.name}: calibration circle ({w} x {h} px)")
+    return _CIRCLE_PAGE.replace("@@TITLE@@", title).replace("@@DESIGN@@", json.dumps(design)).encode("utf-8")

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import base64
 import html
+import math
 import re
 from pathlib import Path
 
@@ -53,6 +54,43 @@ class Doc:
 
     def img(self, path: str, caption: str) -> None:
         self.blocks.append(("img", path, caption))
+
+    def page(self, text: str, shift: int = 1) -> None:
+        """Blocks from a Markdown page of headings (their level moved down by ``shift``), lists (``-`` or
+        ``1.``; an indented line continues the item) and paragraphs, as another module writes one."""
+        kind, items, para = None, [], []
+
+        def flush() -> None:
+            nonlocal kind, items, para
+            if para:
+                self.p(" ".join(para))
+            if items:
+                (self.ol if kind == "ol" else self.ul)(items)
+            kind, items, para = None, [], []
+
+        for line in text.splitlines():
+            head = re.match(r"(#+) (.*)", line)
+            item = re.match(r"(?:- |\d+\. )(.*)", line)
+            if head:
+                flush()
+                self.h(min(len(head.group(1)) + shift, 6), head.group(2))
+            elif item:
+                if para:
+                    flush()
+                new = "ol" if line[0].isdigit() else "ul"
+                if kind not in (None, new):
+                    flush()
+                kind = new
+                items.append(item.group(1))
+            elif line.startswith("  ") and items:
+                items[-1] += " " + line.strip()
+            elif line.strip():
+                if items:
+                    flush()
+                para.append(line.strip())
+            else:
+                flush()
+        flush()
 
     def markdown(self) -> str:
         out = []
@@ -167,26 +205,65 @@ def _mil(mm: float) -> str:
 def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, dict[str, bytes], dict]:
     """The document, its files (relative path -> bytes: pictures and the calibration image) and the
     figures (for manual.json)."""
-    import numpy as np
+    from types import SimpleNamespace
 
     from rigcad import plots
-    from rigcad.export import mesh as M
     from rigcad.manual import assembly as A
-    from rigcad.manual.assembly import picture_meshes
     from rigcad.manual.view import traced_rays
-    from rigcad.parts.templates import gauged_depth
 
     step = progress or (lambda label: None)
-    p = rig.profile
-    bill = B.bill(rig, fab_report, printer)
-    files: dict[str, bytes] = {}
-    meshes = picture_meshes(rig)
-    cut_away = A.encloses(meshes)
-    files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
-                                                cut_away=cut_away)
+    meshes = A.picture_meshes(rig)
+    c = SimpleNamespace(rig=rig, printer=printer, fab_report=fab_report, p=rig.profile, files={}, meshes=meshes,
+                        bill=B.bill(rig, fab_report, printer), cut_away=A.encloses(meshes), step=step)
+    c.files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
+                                                  cut_away=c.cut_away)
     step("rig picture")
-
     d = Doc()
+    _introduction(d, c)
+    for section in (_section_bill, _bill_consumables, _section_print, _section_sand, _section_finish, _section_coat,
+                    _section_assemble, _section_calibrate):
+        section(d, c)
+    figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
+               "bill": c.bill, "calibration": c.calibration, "finishing": c.finishing,
+               "coating_gauged_layer": c.gauged, "coating_total_mm": c.total,
+               "assembly_order": getattr(c, "assembly_order", None)}
+    return d, c.files, figures
+
+
+def assumed_sizes(profile) -> list[dict]:
+    """What must be measured before printing: the instrument sizes that neither the chosen library
+    entry sources nor the profile gives (rigcad.profile.instruments.measurements, the one home of
+    that list), each with how to measure it (the view and the two features it runs between)."""
+    from rigcad.profile.instruments import measurements
+
+    out = []
+    for m in measurements(profile):
+        section, key = m.key.split(".", 1) if "." in m.key else ("", m.key)
+        value = f"{m.assumed:g} {m.unit}" if isinstance(m.assumed, (int, float)) else f"{m.assumed} {m.unit}".strip()
+        out.append({"key": m.key, "value": value,
+                    "doc": f"{m.what} ({m.view} view: from the {m.between[0]} to the {m.between[1]})",
+                    "set_in": (profile.where(section, key) if section else None) or "default"})
+    return out
+
+
+def measure_first(d: Doc, c) -> None:
+    """What must be measured or chosen before anything is printed: the assumed sizes."""
+    rows = assumed_sizes(c.p)
+    d.h(2, "0. Before printing: measure or choose")
+    if not rows:
+        d.p("Every instrument size in this profile is given, none assumed: nothing to measure first.")
+        return
+    d.p(f"The parts are shaped around these **{len(rows)} sizes, which the profile only assumes**. Measure each on "
+        "your own instrument (a caliper; a lens's pupil from the maker's data sheet), write it into the profile "
+        "under its key and build again before you print: a wrong size puts the centre of projection in the wrong "
+        "place.")
+    d.table(["key", "assumed", "what it is", "set in"],
+            [[f"`{r['key']}`", r["value"], r["doc"], f"`{r['set_in']}`"] for r in rows])
+
+
+def _introduction(d: Doc, c) -> None:
+    """The title, what the manual is made from, and the assembled rig."""
+    rig, printer, p = c.rig, c.printer, c.p
     d.h(1, f"{rig.name}: assembly and calibration manual ({printer.name})")
     d.p(f"The rig of profile `{rig.name}` ({' <- '.join(p.sources)}), printed on **{printer.description}** "
         f"(`{printer.source}`). Every figure below is computed by rigcad {__version__} from the profile, the "
@@ -194,8 +271,12 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         "parts (STEP, STL) in `step/` and `stl/`, the 3D view in `view/rig.html` (`rigcad view`).")
     d.img("images/rig.png", "The assembled rig (front of the dome cut away) with rays traced from the centre of "
                             "projection, coloured by their incidence angle at the sample")
+    measure_first(d, c)
 
-    # -- 1 bill of materials
+
+def _section_bill(d: Doc, c) -> None:
+    """The manual's section: 1 bill of materials."""
+    rig, printer, p, bill = c.rig, c.printer, c.p, c.bill
     d.h(2, "1. Bill of materials")
     d.h(3, "Printed and cut parts")
     rows = []
@@ -217,7 +298,13 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
                                    + (": `rigcad manual ... --gcode` uses PrusaSlicer's own figures)"
                                       if printer.slicer == "prusa-slicer" else ")")) + ".")
     d.h(3, "Hardware")
-    hw = [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"]]
+    from rigcad.manual import plan
+
+    steps, _ = plan.steps(rig, c.meshes)
+    hw = [[r["item"], r["quantity"], f"assembly steps: {r['steps']}", "as the assembly check fitted it"]
+          for r in plan.hardware(steps)]
+    hw += [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"] if f.get("tower")
+           and "mounting holes" not in f["use"]]
     if bill["pins"]:
         pin = bill["pins"]
         hw.append([pin["item"], pin["quantity"], f"aligning split pieces ({pin['use']})", pin["note"]])
@@ -237,7 +324,27 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
             [[c["layer"], f"{_mil(c['thickness_mm'])} ({c['thickness_mm']:.4f} mm)", f"{c['area_mm2'] / 100:.1f} cm²",
               f"{c['film_cm3']:.2f} ml", f"**{c['to_buy_cm3']:.1f} ml**"] for c in bill["coating"]])
 
-    # -- 2 print
+
+def _bill_consumables(d: Doc, c) -> None:
+    """The consumables and tools lists, the feeler leaves from the template gaps."""
+    from rigcad.parts.templates import gauged_depth
+
+    total = float(sum(t for _, t in c.p.coating.layers))
+    gap, gaps = total - gauged_depth(c.p), []
+    for _, t in c.p.coating.layers:
+        gap -= t
+        if gap > 1e-9:
+            gaps.append(gap)
+    d.h(3, "Consumables")
+    d.table(["item", "qty"], [list(r) for r in B.CONSUMABLES])
+    d.h(3, "Tools")
+    d.table(["item", "qty"], [list(r) for r in (*B.TOOLS, B.feeler_gauge([total - gauged_depth(c.p), *gaps]),
+                                                B.dowel_drills(c.printer))])
+
+
+def _section_print(d: Doc, c) -> None:
+    """The manual's section: 2 print."""
+    printer, fab_report, p, bill, files = c.printer, c.fab_report, c.p, c.bill, c.files
     d.h(2, "2. Print")
     items = []
     for name, e in fab_report["parts"].items():
@@ -261,7 +368,16 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
             f"{bill['pins']['diameter_mm']:g} mm rod (or filament), push them into one piece's holes, join the "
             "next piece on them and glue the cut faces.")
 
-    # -- 3 sand
+
+def _section_sand(d: Doc, c) -> None:
+    """The manual's section: 3 sand."""
+    import numpy as np
+
+    from rigcad import plots
+    from rigcad.export import mesh as M
+    from rigcad.parts.templates import gauged_depth
+
+    rig, fab_report, p, files = c.rig, c.fab_report, c.p, c.files
     gd = gauged_depth(p)
     total = float(sum(t for _, t in p.coating.layers))
     gauged = p.templates.gauged_layer
@@ -287,7 +403,13 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         if f"images/{name}.png" in files:
             d.img(f"images/{name}.png", f"`{name}`: {rig.recipes[name].description}")
 
-    # -- 4 coat
+    c.gauged, c.total, c.gd = gauged, total, gd
+
+
+def _section_coat(d: Doc, c) -> None:
+    """The manual's section: 4 coat."""
+    rig, p, bill, step = c.rig, c.p, c.bill, c.step
+    gauged, total, gd = c.gauged, c.total, c.gd
     d.h(2, "4. Coat, layer by layer, checking with the template")
     layers = p.coating.layers
     rows, cum = [], 0.0
@@ -307,52 +429,233 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         "(`coating.layers`), the dome outwards, the paraboloid inwards.")
     step("bill and steps")
 
-    # -- 5 assemble
+
+#: How a step's direction reads (rig frame: +z up, the projector on the +x side).
+MOVES = {"-z (down)": "lower it from above", "+z (up)": "push it up from below",
+         "-x": "slide it in level along -x, from the +x side", "+x": "slide it in level along +x, from the -x side",
+         "-y": "slide it in level along -y, from the +y side", "+y": "slide it in level along +y, from the -y side"}
+#: Fastenings by what takes the thread: what the step says after the bolt.
+THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut with the spanner, tighten crosswise by "
+                    "hand", "insert": "screwed into the insert (first drill the part's hole out to the "
+                                      "insert's outer diameter and melt the insert in flush with a soldering iron at "
+                                      "its maker's temperature)",
+             "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
+             "bench": "into the bench"}
+
+
+def assembly_order(rig, meshes):
+    """The order rigcad's assembly check finds (rigcad.manual.assembly_check.find_order over
+    rigcad.manual.plan's steps), or the check's refusal (a GeometryError's message)."""
+    from rigcad.errors import GeometryError
+    from rigcad.manual import assembly_check, plan
+
+    try:
+        return assembly_check.find_order(plan.assembly(rig, meshes)), None
+    except GeometryError as err:
+        return None, str(err)
+
+
+def step_text(placed, meshes_by_name: dict) -> str:
+    """What a found step says: what goes in, how (its direction), on what, and each group of like
+    fasteners with its tool and what takes its thread."""
+    from collections import Counter
+
+    from rigcad.manual.assembly_check import _dir_name
+
+    st = placed.step
+    stems = {re.sub(r"_\d+$", "", n) for n in st.members}
+    parts = (f"{len(st.members)} {stems.pop().replace('_', ' ')}" if len(stems) == 1 and len(st.members) > 1
+             else " with the ".join(n.replace("_", " ") for n in sorted(st.members, key=lambda n: n != st.name)))
+    bought = " (bought)" if st.bought else ""
+    lead = st.name if st.name in st.members else st.members[0]
+    text = f"Take the {parts}{bought}: {meshes_by_name[lead].description}. "
+    text += MOVES.get(_dir_name(placed.direction), f"move it in along {_dir_name(placed.direction)}").capitalize()
+    text += (f" until it rests on the {', '.join(n.replace('_', ' ') for n in st.needs)}." if st.needs
+             else " onto the bench.")
+    groups = Counter((f.item, f.tools[0].name, f.thread_in) for f in st.fasteners)
+    for (item, tool, thread_in), n in groups.items():
+        text += f" Fix it with {n} x {item}, {THREAD_IN[thread_in]} (tool: {tool} or an L key)."
+    return text
+
+
+def _section_assemble(d: Doc, c) -> None:
+    """The manual's section 5: the assembly steps in the order the assembly check finds."""
+    import numpy as np
+
+    from rigcad import plots
+    from rigcad.manual import assembly as A
+
     d.h(2, "5. Assemble")
-    d.p("Each step shows what is already in place (grey) and what goes in (orange), drawn clear of it with "
-        "a dashed line to its place. Bought items (instruments, optics) are marked so.")
-    joints = B.bolt_joints(rig)
-    tower_rows = B.tower_hardware(rig)
-    order = [meshes[i].name for st in A.steps(meshes) for i in st]
-
-    def keys(name: str) -> set[str]:
-        words = name.replace("tower_", "").replace("_body", "").replace("_", " ")
-        return {name.replace("_", " "), words}
-
-    # each tower item goes with the last step (in assembly order) whose part its "joins" text names
-    tower_at = {}
-    for h in tower_rows:
-        named = [n for n in order if any(re.search(rf"\b{re.escape(k)}'?s?\b", h["joins"]) for k in keys(n))]
-        if named:
-            tower_at.setdefault(named[-1], []).append(h)
+    order, refusal = assembly_order(c.rig, c.meshes)
+    if order is None:
+        d.p(f"**rigcad's assembly check finds no order in which this rig can be put together:** {refusal}")
+        return
+    d.p("The order below is the one rigcad's assembly check found: each part, swept along the direction the "
+        "step names, clears everything already in place; each bolt's head, nut and tool have a straight way "
+        "in. Each picture shows what is in place (grey) and what goes in (orange), drawn before its place "
+        "along the direction it moves in, with a dashed line to where it goes.")
+    index = {m.name: i for i, m in enumerate(c.meshes)}
+    by_name = {m.name: m for m in c.meshes}
+    tower_at = _tower_rows_by_step(c.rig, [p.step for p in order])
     done: list[int] = []
-    for k, members in enumerate(A.steps(meshes)):
-        first = meshes[members[0]]
-        label = first.name if len(members) == 1 else re.sub(r"_\d+$", "", first.name) + f" (x{len(members)})"
-        text = STEP_TEXT.get(first.name)
-        if text is None:
-            text = (f"Place the {label.replace('_', ' ')}" + (" (bought)" if first.bought else "")
-                    + f": {first.description}.")
-        for j in joints:
-            if first.name in j["parts"] and all(n in [meshes[i].name for i in done + members] for n in j["parts"]):
-                text += (f" Bolt it ({j['joins']}) with {j['count']} {j['short']}"
-                         + (", a washer under each head and each nut; tighten crosswise, by hand." if j["nuts"]
-                            else " into what it stands on."))
-        for h in tower_at.get(first.name, []):
+    for k, placed in enumerate(order):
+        st = placed.step
+        members = [index[n] for n in st.members]
+        label = st.name.replace("_", " ") + (f" (x{len(members)})" if len(members) > 1 and st.name not in
+                                             st.members else "")
+        text = step_text(placed, by_name)
+        for h in tower_at.get(st.name, []):
             size = f"{h['thread']} x {h['length_mm']:g} mm" if h.get("length_mm") else h["thread"]
             text += f" Fix it with {h['quantity']} x {h['item']} ({size}): {h['joins']}."
-        d.h(3, f"Step {k + 1}: {label}" + (f" (x{first.quantity})" if first.quantity > 1 else ""))
+        d.h(3, f"Step {k + 1}: {label}")
         d.p(text)
-        path = f"images/step_{k + 1:02d}_{re.sub(r'_[0-9]+$', '', first.name)}.png"
-        files[path] = plots.assembly_step(meshes, done, members, A.step_offsets(meshes, done, members),
-                                          f"step {k + 1}: {label}", cut_away=cut_away)
-        d.img(path, f"Step {k + 1}: the {label.replace('_', ' ')} (orange) goes where the dashed line points")
+        path = f"images/step_{k + 1:02d}_{st.name}.png"
+        offsets = _approach(c.meshes, done, members, placed.direction)
+        shift = offsets[members[0]] if members else 0.0
+        bolts = [(np.asarray(f.head) + shift - np.asarray(f.axis) * f.head_height_mm,
+                  np.asarray(f.head) + shift + np.asarray(f.axis) * f.length_mm) for f in st.fasteners]
+        c.files[path] = plots.assembly_step(c.meshes, done, members, offsets, f"step {k + 1}: {label}",
+                                            cut_away=c.cut_away, fasteners=bolts)
+        d.img(path, f"Step {k + 1}: the {label} (orange) moves along the dashed line to its place")
         done += members
-        step(f"step {k + 1}")
+        c.step(f"step {k + 1}")
+    c.assembly_order = [{"step": p.step.name, "parts": list(p.step.members), "direction": list(p.direction),
+                         "fasteners": [f.item for f in p.step.fasteners]} for p in order]
 
-    # -- 6 calibrate
+
+def _approach(meshes, done: list[int], new: list[int], direction) -> dict:
+    """Where a step's parts are drawn before they go in: moved back against their direction until
+    their bounding box clears the parts in place (and by a gap)."""
+    import numpy as np
+
+    from rigcad.manual.assembly import EXPLODE_GAP
+
+    d = np.asarray(direction, float)
+    lo = np.min([meshes[i].lo for i in new], axis=0)
+    hi = np.max([meshes[i].hi for i in new], axis=0)
+    size = float(np.max(hi - lo))
+    back = size + EXPLODE_GAP * size if done else 0.0
+    return {i: -d * back for i in new}
+
+
+def _tower_rows_by_step(rig, steps) -> dict:
+    """The tower's hardware rows (rigcad.parts.tower.hardware) that the plan does not place itself
+    (the tower's own joints), each with the last step whose part its "joins" text names."""
+    names = [(s.name, m) for s in steps for m in s.members]
+    out: dict = {}
+    for h in B.tower_hardware(rig):
+        if "mounting holes" in h["joins"]:
+            continue  # the instruments' screws: the plan's
+        named = [s for s, m in names
+                 if any(re.search(rf"\b{re.escape(k)}'?s?\b", h["joins"])
+                        for k in {m.replace("_", " "), m.replace("tower_", "").replace("_body", "").replace("_", " ")})]
+        if named:
+            out.setdefault(named[-1], []).append(h)
+    return out
+
+
+def _section_finish(d: Doc, c) -> None:
+    """The finishing recipe, the blocks from the mirrors' curvature, the templates' cutting, and the
+    optical acceptance test (rigcad.manual.finishing)."""
+    from rigcad.manual import finishing as F
+
+    d.h(3, "Finishing recipe, stage by stage")
+    d.table(["stage", "what", "how", "cure / wait", "check"], [list(r) for r in F.RECIPE])
+    blocks = F.sanding_blocks(c.rig)
+    d.p(f"Sanding blocks, from the mirrors' curvature: a flat block of length L stands off a curve of radius R by "
+        f"L²/(8R); keep that under {F.BLOCK_SAG_MM:g} mm (1 mil, the thinnest coat). Longer blocks must be curved "
+        "to the radius given (convex for the concave dome, concave for the convex paraboloid).")
+    d.table(["mirror", "smallest radius along the meridian", "smallest radius across", "longest flat block",
+             "curved block radius"],
+            [[b["mirror"], f"{b['meridional_mm']:.1f} mm", f"{b['sagittal_mm']:.1f} mm",
+              f"{b['flat_block_max_mm']:.1f} mm", f"{b['smallest_radius_mm']:.1f} mm"] for b in blocks])
+    d.p("The templates: cut them with the cutter's path half a kerf outside the outline (" +
+        ", ".join(f"{k} {v:g} mm" for k, v in F.KERF_MM.items()) + " kerf), so the edge lands on the outline; "
+        "mark the datum on each (the edge that sits on the base plate's top, z = 0, and the axis line) and hold "
+        "the template in a jig: a square block clamped to the base plate with the template's datum edge on the "
+        "plate and its axis line on the plate's centre mark, so it swings about the axis and checks every "
+        "meridian the same way.")
+    acc = F.slope_acceptance(c.rig)
+    d.h(3, "Optical acceptance test")
+    d.p("The mirrors' slope must be right, not only their form: in a right rig every ray the camera sees lands on "
+        f"the sample point O. Print a white disc of **{acc['disc_radius_mm']:g} mm radius** "
+        "(`tolerancing.max_spot_radius`) on matte black card, put it in the sample holder centred on O, light it "
+        "from the side through a beam slot, and take the camera's picture through the splitter with the rig "
+        "assembled. **Pass:** the paraboloid's image is white (outside the occlusion disc of the calibration "
+        f"circle) over at least {100 * acc['pass_fraction']:g} % of its pixels (`tolerancing.min_yield`); black "
+        "patches mark the mirror areas to block and polish again. This holds the dome's slope to "
+        f"{acc['dome_slope_tolerance_mrad']:.1f} mrad at its farthest point from O "
+        f"({acc['dome_farthest_from_o_mm']:.0f} mm): a slope error e turns a ray by 2 e.")
+    c.finishing = {"blocks": blocks, "acceptance": acc}
+
+
+#: The checkerboard's square (mm): 5 mm prints sharply on a laser printer and spans several camera
+#: pixels in the paraboloid's image of the base plate.
+CHECKER_SQUARE_MM = 5.0
+
+
+def _calibration_more(d: Doc, c, cam: dict) -> None:
+    """The steps after the crosses: where the projector crosses' plate goes, the turned camera crosses,
+    the checkerboard and the gray card (thesis 4.1.1, 4.1.2)."""
+    import numpy as np
+
+    rig = c.rig
+    t = getattr(rig.layout, "tower", None)
+    if t is not None and "projector_mounting_plate" in rig.recipes:
+        plate = rig.mesh(rig.recipes["projector_mounting_plate"])
+        base = -float(np.asarray(plate.vertices)[:, 2].min())  # the plate's thickness under its top face (z = 0)
+        above = t.projector_cop[2] - t.shelf_top_z
+        want = base + c.p.crosses.projector_axis_height
+        d.p(f"Where the crosses' plate goes: lift the splitter holder off its three balls (its kinematic seat puts it "
+            f"back in the same place) and take the focusing lens out of its mount. Stand the "
+            f"`projector_mounting_plate` on the shelf in front of the projector, its fences' line on the shelf's "
+            f"centre line y = 0 (square it from the shelf's two long edges, measure the centre with the caliper). "
+            f"The projector's axis is {above:.1f} mm above the shelf; the crosses' centres stand {want:.1f} mm above "
+            f"it ({base:.1f} mm of plate + `crosses.projector_axis_height`)"
+            + (f": put {above - want:.1f} mm of shims under the plate." if above - want > 0.05 else
+               f": the crosses stand {want - above:.1f} mm too high; lower `crosses.projector_axis_height` by that "
+               "and print them again." if want - above > 0.05 else "."))
+    hidden = cam["base_cross_arm_mrad"] < cam["hung_cross_arm_mrad"]
+    d.p("Turn the base cross 45 degrees to the hung one (it turns freely in the holder's bore)"
+        + (f": seen from the COP its arms span {cam['base_cross_arm_mrad']:.1f} mrad, less than the hung cross's "
+           f"{cam['hung_cross_arm_mrad']:.1f} mrad, so aligned it would hide behind it; turned, its arms show in the "
+           "gaps between the hung cross's arms." if hidden else ": its arms then show between the hung cross's."))
+    r = rig.layout.plate_r
+    d.p(f"Camera pixels to paraboloid points: paste a checkerboard of {CHECKER_SQUARE_MM:g} mm black and white "
+        f"squares ({math.ceil(2 * r / CHECKER_SQUARE_MM)} x {math.ceil(2 * r / CHECKER_SQUARE_MM)} squares, a "
+        f"{2 * r:.0f} mm disc: matte paper, laser-printed at 600 dpi, checked with the caliper over ten squares) on the "
+        "base plate, project the calibrated circle and locate the paraboloid's image in the camera's picture: its "
+        "centre and radius in pixels are the camera's correspondence.")
+    d.h(3, "Reflectance (thesis 4.1.2)")
+    d.p("Put an 18 % diffuse gray card (photographic, e.g. a Kodak R-27 class card cut to the sample holder's "
+        "diameter) in the sample holder, its face at z = 0. Project the zonal harmonic basis images up to order 2 "
+        "(`rigcad basis`), capture each at three exposures (thesis: 62.5, 125 and 250 ms), and recover the card's "
+        "hemispherical reflectance; the scale factor for each direction is (0.18 / pi) cos(theta) divided by the "
+        "measured value (thesis eq. 4.2). Keep the card dry and out of the light between uses.")
+
+
+def _as_built(d: Doc, c) -> None:
+    """The deflectometric calibration of the rig as built (rigcad.calibrate.kit's page), when the
+    profile has a calibration section."""
+    if getattr(c.p, "calibration", None) is None:
+        return
+    from rigcad.calibrate.kit import manual_page
+
+    d.page(manual_page(c.rig), shift=2)
+
+
+def _section_calibrate(d: Doc, c) -> None:
+    """The manual's section: 6 calibrate."""
+    import numpy as np
+
+    from rigcad import plots
+    from rigcad.export import mesh as M
+    from rigcad.manual import assembly as A
+
+    rig, p, files, step = c.rig, c.p, c.files, c.step
     circle, info = C.circle_image(rig)
     files["calibration/circle.png"] = circle
+    files["calibration/circle.html"] = C.circle_page(rig, info)
     film = C.film_shadows(rig)
     pshadow = C.projector_shadows(rig)
     cam = C.camera_crosses(rig)
@@ -370,7 +673,11 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     d.p(f"(Arms of {pshadow['arm_length_mm']:g} mm, `crosses.arm_length`; the closer the projector, the finer the "
         f"check. The profile allows `tolerancing.projector_offset` = {p.tolerancing.projector_offset:g} mm.)")
     d.h(3, "Projector: the circle on the paraboloid")
-    d.p(f"Project `calibration/circle.png` ({info['resolution_px'][0]} x {info['resolution_px'][1]} px, the "
+    d.p("Take the focusing lens out of its mount first: the circle is set with the projector's own optics. Open "
+        "`calibration/circle.html` in a browser on the projector's screen and press f (full screen): arrow keys "
+        "move the circle (Shift: 10 px), + and - change its radius, 0 restores the design's circle, and its centre "
+        "and radius in pixels are shown at the top left (h hides them). The same circle as a fixed image:")
+    d.p(f"`calibration/circle.png` ({info['resolution_px'][0]} x {info['resolution_px'][1]} px, the "
         f"projector's resolution): a bright disc of radius **{info['radius_px']:.1f} px** centred on pixel "
         f"({info['centre_px_from_top_left'][0]:g}, {info['centre_px_from_top_left'][1]:g}) from the top left, the "
         f"paraboloid's rim as the design maps it (the rim ray leaves the COP at {info['rim_angle_at_cop_deg']:.3f} "
@@ -391,22 +698,18 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
         "camera until the two overlap symmetrically in its image, then focus on the hung cross. A camera off the "
         f"axis by 1 mm shows them {cam['separation_mrad_per_mm_offset']:.2f} mrad apart "
         f"(`tolerancing.camera_offset` = {p.tolerancing.camera_offset:g} mm).")
-    for name in ("projector_cross", "camera_cross_hung"):
+    for name in ("projector_cross", "projector_backplate", "projector_mounting_plate", "camera_cross_hung",
+                 "camera_cross_base"):
         if name in rig.recipes:
             part = rig.recipes[name]
             mesh = rig.mesh(part, M.PICTURE_CHORD_ERROR)
             files[f"images/{name}.png"] = plots.render_mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), name,
                                                             part.color)
             d.img(f"images/{name}.png", f"`{name}`: {part.description}")
-    d.p("Then the camera's pixel-to-paraboloid correspondence as in the thesis: a checkerboard on the base "
-        "plate, the calibrated circle projected, and the paraboloid's image located in the camera's picture.")
+    _calibration_more(d, c, cam)
+    _as_built(d, c)
     step("calibration")
-    figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
-               "bill": bill, "calibration": {"circle": info, "film": film, "projector_crosses": pshadow,
-                                             "camera_crosses": cam},
-               "coating_gauged_layer": gauged, "coating_total_mm": total,
-               "assembly_order": [m.name for m in meshes]}
-    return d, files, figures
+    c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam}
 
 
 def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = None, progress=None) -> list[Path]:

@@ -1,3 +1,3 @@
 """Inverse design (``rigcad optimize``): the profile's ``optimize:`` section (spec), one design
 evaluated in milliseconds (fast, printfit, problem), the seeded search on rigcad.engine (search)
-and its outputs (run); the command is rigcad.cli.optimize. See README, "Inverse design"."""
+and its outputs (run); the command is rigcad.cli.optimize. See docs/optimize.md."""

@@ -53,7 +53,7 @@ _CONSTRAINTS = {"printer", "max_pieces", "max_cop_height", "min_feature_nozzles"
                 "raycheck", "raycheck_margin"}
 #: Default share of each raycheck limit kept in reserve (the 3D check measures on a finite fan of
 #: pixels and 1e5 seeded rays: its px/deg minimum and lost fraction differ from the exact ones by
-#: ~1e-3; see README).
+#: ~1e-3; see docs/optimize.md).
 RAYCHECK_MARGIN = 0.03
 #: Most free parameters and evaluations a run may ask for (a bench-top design space).
 MAX_PARAMETERS = 12

@@ -4,7 +4,7 @@ origin, optical axis +z, meridional plane x-z).
 The paraboloid is z(r) = vertex_z - r^2 / (4 f): convex, vertex up towards the COP, rim lowest.
 The tangent angle tau is measured between the rim's meridional tangent and the optical axis, so
 tan(tau) = 2 f / rim_radius and vertical_extent = rim_radius^2 / (4 f) (thesis Table 3.1, with the
-reading documented in the README: Figure 3.5 is lost).
+reading documented in docs/design.md: Figure 3.5 is lost).
 """
 
 from __future__ import annotations

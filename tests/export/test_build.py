@@ -188,7 +188,7 @@ def _pixels(path: Path) -> np.ndarray:
 
 
 def test_readme_part_pictures_are_current(built):
-    # docs/parts/*.png are shown in the README; `make docs` refreshes them. The same files on one
+    # docs/parts/*.png are shown in docs/parts.md; `make docs` refreshes them. The same files on one
     # machine are the same bytes (test_clean_rebuild_is_byte_identical); another CPU's last bits can
     # shade a few edge pixels differently (seen: up to 287 of 102 000 pixels, by at most 16/255),
     # while a part that moved or changed shape changes the frame or thousands of pixels.

@@ -1,11 +1,10 @@
 """`rigcad watch --ocp` and `rig.show()` with OCP CAD Viewer.
 
 Without a viewer: one line that says how to start one, no traceback, and the browser view runs on.
-With one: ocp_vscode 4.2.0's `python -m ocp_vscode` no longer starts a standalone viewer (it prints
-that the viewer moved to the `ocp_viewer` package, which is not installed here), so the test stands
-up a minimal viewer of its own speaking the same websocket protocol (ocp_viewer_core.websocket:
-``C:`` commands answered with JSON, ``B:`` answered with an ack, ``D:`` the model) and checks that
-the named, coloured parts, the rays and the COP markers arrive."""
+With one: a minimal viewer of the test's own speaking the viewer's websocket protocol
+(ocp_viewer_core.websocket: ``C:`` commands answered with JSON, ``B:`` answered with an ack, ``D:``
+the model) reads the model as sent (each part's name, colour and kind: solid, or edges for the
+rays). The real standalone viewer (`python -m ocp_viewer`) is tested in test_ocp_viewer.py."""
 
 from __future__ import annotations
 
@@ -13,7 +12,6 @@ import json
 import os
 import re
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -22,21 +20,15 @@ from pathlib import Path
 
 import pytest
 
+from .conftest import closed_port
+
 ROOT = Path(__file__).resolve().parents[2]
-
-
-def _closed_port() -> int:
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()  # nothing listens there now
-    return port
 
 
 def test_ocp_without_a_viewer_says_one_line_and_the_browser_view_runs(tmp_path):
     profile = tmp_path / "rig.yaml"
     profile.write_text("extends: achutha2006\n", encoding="utf-8")
-    port = _closed_port()
+    port = closed_port()
     proc = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), "--port", "0", "--ocp",
                              "--ocp-port", str(port), "--no-check"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, cwd=tmp_path)
@@ -52,7 +44,7 @@ def test_ocp_without_a_viewer_says_one_line_and_the_browser_view_runs(tmp_path):
         proc.wait(30)
     stderr = proc.stderr.read()
     said = [line for line in lines if "OCP CAD Viewer" in line]
-    assert len(said) == 1 and f":{port}" in said[0] and "python -m ocp_viewer" in said[0], lines
+    assert len(said) == 1 and f":{port}" in said[0] and f"python -m ocp_viewer --port {port}" in said[0], lines
     assert "browser view" in said[0]
     assert any(re.match(r"\[1\] rig: rebuilt", line) for line in lines), lines
     assert proc.returncode == 0 and "Traceback" not in stderr, stderr
@@ -63,8 +55,9 @@ def test_rig_show_without_a_viewer_is_one_clear_error():
     from rigcad.live.ocp import ViewerError
     from rigcad.rig import load
 
-    port = _closed_port()
-    with pytest.raises(ViewerError, match=f"no OCP CAD Viewer on 127.0.0.1:{port}: .*python -m ocp_viewer"):
+    port = closed_port()
+    hint = f"no OCP CAD Viewer on 127.0.0.1:{port}: .*python -m ocp_viewer --port {port}"
+    with pytest.raises(ViewerError, match=hint):
         load("achutha2006").show(port=port)
 
 

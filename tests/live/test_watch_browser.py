@@ -23,10 +23,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
-                 "--enable-unsafe-swiftshader", "--disable-background-networking", "--disable-component-update",
-                 "--disable-default-apps", "--disable-sync", "--no-first-run"]
+from .conftest import CHROMIUM, CHROMIUM_ARGS
+
 BACKGROUND = np.array([0xF4, 0xF4, 0xF4])
 #: A pixel is drawn (not background) when its RGB channels differ from it by more than this sum.
 PIXEL_DIFF = 30

@@ -175,12 +175,24 @@ def test_the_manual_is_written_with_its_pictures_and_one_self_contained_page(wri
         assert step in md
     pins = B.dowel_pins(fab_reports["prusa_mk3s"], load_printer("prusa_mk3s"))
     assert f"| {pins['item']} | {pins['quantity']} |" in md
-    assert "M4 x 25 mm socket-head bolt" in md
+    from rigcad.manual import plan
+    from rigcad.manual.assembly import picture_meshes
+
+    # the hardware table is the plan's fasteners as the assembly check fits them (one source with the steps)
+    for row in plan.hardware(plan.steps(table31_rig, picture_meshes(table31_rig))[0]):
+        assert f"| {row['item']} | {row['quantity']} |" in md, row
     assert (out / "calibration" / "circle.png").is_file()
-    from rigcad.manual.assembly import picture_meshes, steps
+    import json
+
+    from rigcad.manual import plan
+    from rigcad.manual.assembly import picture_meshes
 
     shots = sorted(p.name for p in (out / "images").glob("step_*.png"))
-    assert len(shots) == len(steps(picture_meshes(table31_rig))) and "step_05_dome.png" in shots
+    found = json.loads((out / "manual.json").read_text(encoding="utf-8"))["assembly_order"]
+    # one step, one picture for every step the plan declares, in the order the assembly check found
+    assert len(shots) == len(found) == len(plan.steps(table31_rig, picture_meshes(table31_rig))[0])
+    assert [s["step"] for s in found][:3] == ["sample_holder", "base_plate", "dome"], found
+    assert f"step_{[s['step'] for s in found].index('dome') + 1:02d}_dome.png" in shots
     assert md.count("### Step ") == len(shots)
 
 

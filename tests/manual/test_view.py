@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rigcad.manual import calibration as C
 from rigcad.manual.assembly import explode_offsets, picture_meshes
 from rigcad.manual.view import traced_rays, view_html
 
@@ -201,3 +202,69 @@ def test_rigcad_view_writes_the_page_and_the_picture(tmp_path):
     out = tmp_path / "achutha2006" / "view"
     assert (out / "rig.html").stat().st_size > 100_000 and (out / "rig.png").read_bytes()[:4] == b"\x89PNG"
     assert "MB, self-contained" in run.stdout and "dome" in run.stdout
+
+
+# -- the projector's calibration circle as an adjustable full-screen page -------------------------
+def _pixel(page, x: float, y: float) -> int:
+    from PIL import Image
+
+    img = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("L")).astype(int)
+    return int(img[int(round(y)), int(round(x))])
+
+
+@pytest.fixture(scope="module")
+def circle(table31_rig, tmp_path_factory):
+    _, info = C.circle_image(table31_rig)
+    path = tmp_path_factory.mktemp("circle") / "circle.html"
+    path.write_bytes(C.circle_page(table31_rig, info))
+    return path, info
+
+
+def test_the_page_is_self_contained(circle):
+    text = circle[0].read_text(encoding="utf-8")
+    assert "http" not in text.replace("http-equiv", ""), "the page names a URL"
+    assert "src=" not in text and "href=" not in text
+
+
+def test_in_chromium_the_circle_moves_and_resizes_with_the_keys(circle):
+    _browser_available()
+    from playwright.sync_api import sync_playwright
+
+    path, info = circle
+    w, h = info["resolution_px"]
+    r0 = info["radius_px"]
+    cx0, cy0 = info["centre_px_from_top_left"]
+    refused, errors = [], []
+    with sync_playwright() as p, tempfile.TemporaryDirectory() as profile_dir:
+        ctx = p.chromium.launch_persistent_context(profile_dir, executable_path=str(CHROMIUM), headless=True,
+                                                   args=CHROMIUM_ARGS, viewport={"width": w, "height": h},
+                                                   device_scale_factor=1)
+        try:
+            ctx.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file:")
+                      else (refused.append(r.request.url), r.abort()))
+            page = ctx.new_page()
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            page.goto(path.as_uri())
+            page.wait_for_function("window.rigcadCircle !== undefined")
+            s = page.evaluate("window.rigcadCircle")
+            assert (s["width"], s["height"]) == (w, h) and s["r"] == pytest.approx(r0, abs=1e-3)
+            page.keyboard.press("h")  # the read-out off: it would cover pixels near the top left
+            # 3 px inside and outside the rim (the edge pixel is anti-aliased): white, then black
+            assert _pixel(page, cx0 + r0 - 3, cy0) > 200 and _pixel(page, cx0 + r0 + 3, cy0) < 50
+            for key in ("Shift+ArrowRight", "Shift+ArrowRight", "ArrowDown", "+", "+", "Shift+Equal"):
+                page.keyboard.press(key)
+            s = page.evaluate("window.rigcadCircle")
+            assert (s["cx"], s["cy"]) == (cx0 + 20, cy0 + 1), s  # 2 x 10 px right, 1 px down
+            assert s["r"] == pytest.approx(r0 + 12, abs=1e-3), s  # +1, +1, Shift: +10
+            cx, cy, r = s["cx"], s["cy"], s["r"]
+            assert _pixel(page, cx + r - 3, cy) > 200 and _pixel(page, cx + r + 3, cy) < 50
+            assert _pixel(page, cx - r - 3, cy) < 50  # the old left edge's inside is dark now (moved right)
+            page.keyboard.press("h")
+            text = page.inner_text("#info")
+            assert f"centre ({cx:.1f}, {cy:.1f}) px" in text and f"radius {r:.1f} px" in text, text
+            page.keyboard.press("0")
+            s = page.evaluate("window.rigcadCircle")
+            assert (s["cx"], s["cy"], s["r"]) == (cx0, cy0, pytest.approx(r0, abs=1e-3))
+        finally:
+            ctx.close()
+    assert refused == [] and errors == [], (refused, errors)

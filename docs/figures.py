@@ -1,0 +1,307 @@
+"""Every figure the docs quote, generated: what `make docs` runs.
+
+    python docs/figures.py run [--exports DIR]   # the documented commands on the default profile, then
+                                                 #   collect, copy the pictures, write the Markdown
+    python docs/figures.py collect [--exports DIR]   # the same without running the commands
+    python docs/figures.py render                # only rewrite the Markdown from docs/figures.json
+
+A figure in README.md or docs/*.md is written as the number followed by its name in an HTML comment,
+``1,096<!--fig:optimize.base.dome_mass--> g``: GitHub shows ``1,096 g``. ``run`` writes every figure
+the spec below names into docs/figures.json (value, unit, the tolerance the docs test holds the text
+to, the command and file it comes from, and for a measured time or a bench figure the machine and the
+date), copies every picture the docs show (with the SHA-256 of its bytes and of the outputs it was
+drawn from) and rewrites each marked number from the file. tests/test_docs.py holds the Markdown to
+the file and the file to the current code's outputs.
+
+The spec (FIGURES, BENCH, PICTURES) lives in docs/figure_spec.py.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import math
+import os
+import platform
+import re
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Callable
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+FILE = DOCS / "figures.json"
+PROFILE = "achutha2006"
+#: The wall times of the last `run`, beside its outputs (so that `collect` can be re-run alone).
+TIMES = "make_docs_times.json"
+
+#: A number as the docs write it (thousands commas, a decimal part, an exponent), or several joined by
+#: " x " (a size), followed by the marker naming its figure.
+NUMBER = r"(?:(?<![\w>])-)?\d[\d,]*(?:\.\d+)?(?:e[-+]?\d+)?"  # a "-" after a marker is a range's dash
+MARKED = re.compile(rf"(?P<num>{NUMBER}(?: x {NUMBER})*)<!--fig:(?P<name>[\w.\-]+)-->")
+
+
+@dataclass(frozen=True)
+class Run:
+    """One documented command: ``rigcad <argv>`` with ``--exports <root>/<folder>``."""
+
+    id: str
+    argv: tuple[str, ...]
+    folder: str = ""  # a separate exports root under the docs' exports (a partial fab run would
+                      # overwrite the full one's report)
+
+    @property
+    def command(self) -> str:
+        return "rigcad " + " ".join(self.argv)
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A figure: ``get`` reads it from ``file`` (JSON, relative to the run's exports root)."""
+
+    name: str
+    run: str
+    file: str
+    get: str | Callable[[Any], Any]  # a dotted path (keys, list indices), a function of the JSON, or
+                                     # "@bytes": the file's size in MB
+    unit: str
+    fmt: str = ".3g"  # the format spec the Markdown shows it in (each number of a size)
+    count: bool = False  # an integer count: held exactly
+
+
+@dataclass(frozen=True)
+class Picture:
+    """A picture the docs show: ``docs/<doc>`` copied from ``<exports root>/<src>``; ``source`` names
+    what it was drawn from: ``file`` (bytes), ``file#a.b`` (a JSON section) or ``key:<part>`` (the
+    part's recipe hash in the manifest)."""
+
+    doc: str
+    run: str
+    src: str
+    source: str
+
+
+def dig(data: Any, path: str) -> Any:
+    """``data`` at a dotted path: dict keys, and integers as list indices."""
+    for key in path.split("."):
+        data = data[int(key)] if isinstance(data, list) else data[key]
+    return data
+
+
+def canonical_json(data: Any) -> bytes:
+    """JSON with sorted keys and every float to 9 significant digits: what a source digest hashes, so
+    that another CPU's last bits do not change it while any real change does."""
+    def norm(v: Any) -> Any:
+        if isinstance(v, float):
+            return float(f"{v:.9g}") if math.isfinite(v) else repr(v)
+        if isinstance(v, dict):
+            return {k: norm(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [norm(x) for x in v]
+        return v
+    return json.dumps(norm(data), sort_keys=True, separators=(",", ":")).encode()
+
+
+def sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def source_digest(root: Path, source: str) -> str:
+    """SHA-256 of what a picture was drawn from (see :class:`Picture`), under the exports root."""
+    if source.startswith("key:"):
+        manifest = json.loads((root / PROFILE / "manifest.json").read_text())
+        return sha256(manifest["parts"][source[4:]]["key"].encode())
+    file, _, section = source.partition("#")
+    path = root / PROFILE / file
+    if path.suffix != ".json":
+        return sha256(path.read_bytes())
+    data = json.loads(path.read_text())
+    return sha256(canonical_json(dig(data, section) if section else data))
+
+
+def machine() -> str:
+    """The CPU, its count and the load: what a measured time depends on."""
+    model = platform.machine()
+    with open("/proc/cpuinfo", encoding="utf-8") as f:
+        for line in f:
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    return f"{model}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}"
+
+
+def today() -> str:
+    return datetime.now(timezone.utc).strftime("%Y-%m-%d")
+
+
+def run_commands(runs, root: Path) -> dict[str, dict]:
+    """Each command in turn (`nice` is the caller's), timed; a failing one stops `make docs`."""
+    times = {}
+    for run in runs:
+        exports = root / run.folder if run.folder else root
+        argv = [sys.executable, "-c", "from rigcad.cli import main; raise SystemExit(main())", *run.argv,
+                "--exports", str(exports)]
+        print(f"make docs: {run.command}", flush=True)
+        t0 = time.perf_counter()
+        done = subprocess.run(argv, cwd=ROOT, stdout=subprocess.DEVNULL)
+        seconds = time.perf_counter() - t0
+        if done.returncode != 0:
+            raise SystemExit(f"make docs: `{run.command}` failed (exit {done.returncode})")
+        print(f"make docs: {run.command}: {seconds:.1f} s", flush=True)
+        times[run.id] = {"seconds": seconds, "machine": machine(), "date": today()}
+        (root / TIMES).write_text(json.dumps(times, indent=1) + "\n")  # `collect` reads them again
+    return times
+
+
+def _value(fig: Figure, root: Path, runs: dict[str, Run]) -> Any:
+    run = runs[fig.run]
+    path = (root / run.folder if run.folder else root) / fig.file
+    if fig.get == "@bytes":  # a file's size, in MB
+        value = path.stat().st_size / 1e6
+    else:  # JSON is parsed; any other file (Markdown) is given to ``get`` as text
+        data = json.loads(path.read_text()) if path.suffix == ".json" else path.read_text(encoding="utf-8")
+        value = fig.get(data) if callable(fig.get) else dig(data, fig.get)
+    if fig.count:
+        if value != int(value):
+            raise SystemExit(f"make docs: {fig.name} is a count but reads {value!r}")
+        return int(value)
+    if isinstance(value, (list, tuple)):
+        return [float(v) for v in value]
+    return float(value)
+
+
+def extract(figures, runs, root: Path) -> dict[str, Any]:
+    """Every figure's value read from the outputs under ``root`` (the test calls this on its own)."""
+    by_id = {r.id: r for r in runs}
+    return {f.name: _value(f, root, by_id) for f in figures}
+
+
+def collect(spec, root: Path, times: dict[str, dict] | None) -> dict:
+    """figures.json's content from the outputs under ``root``, the measured ``times`` (kept from the
+    old file when the commands were not run) and the bench results."""
+    old = json.loads(FILE.read_text()) if FILE.is_file() else {"figures": {}}
+    runs = {r.id: r for r in spec.RUNS}
+    figures: dict[str, dict] = {}
+    for fig in spec.FIGURES:
+        run = runs[fig.run]
+        figures[fig.name] = {
+            "value": _value(fig, root, runs), "unit": fig.unit, "format": fig.fmt,
+            "tolerance": "exact" if fig.count else "as printed",
+            "source": f"`{run.command}` -> {fig.file}" + ("" if callable(fig.get) else f" {fig.get}")}
+    for run in spec.RUNS:
+        name = f"time.{run.id}"
+        t = (times or {}).get(run.id) or {k: old["figures"].get(name, {}).get(k) for k in ("value", "machine", "date")}
+        seconds = t.get("seconds", t.get("value"))
+        if seconds is None:
+            continue
+        figures[name] = {"value": round(seconds, 1), "unit": "s", "format": ".0f", "tolerance": "5 %",
+                         "source": f"wall time of `{run.command}` in `make docs`", "kind": "measured",
+                         "machine": t["machine"], "date": t["date"]}
+    timed = [figures[f"time.{r.id}"] for r in spec.RUNS if f"time.{r.id}" in figures]
+    if len(timed) == len(spec.RUNS):
+        figures["time.make_docs"] = {**timed[-1], "value": round(sum(t["value"] for t in timed) / 60, 1), "unit": "min",
+                                     "source": "the wall times of every command in `make docs`, summed"}
+    figures.update(spec.bench_figures(ROOT))
+    pictures = {}
+    for pic in spec.PICTURES:
+        run = runs[pic.run]
+        exports = root / run.folder if run.folder else root
+        src = exports / PROFILE / pic.src
+        pictures[pic.doc] = {"sha256": sha256(src.read_bytes()), "from": f"`{run.command}` -> {pic.src}",
+                             "source": pic.source, "source_sha256": source_digest(exports, pic.source)}
+    return {"about": "every figure README.md and docs/*.md quote; written by `make docs` (docs/figures.py)",
+            "profile": PROFILE, "figures": dict(sorted(figures.items())), "pictures": dict(sorted(pictures.items()))}
+
+
+def copy_pictures(spec, root: Path) -> None:
+    runs = {r.id: r for r in spec.RUNS}
+    for pic in spec.PICTURES:
+        run = runs[pic.run]
+        exports = root / run.folder if run.folder else root
+        dest = DOCS / pic.doc
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(exports / PROFILE / pic.src, dest)
+
+
+def formatted(entry: dict) -> str:
+    """A figure as the Markdown writes it."""
+    value, fmt = entry["value"], entry.get("format", ".3g")
+    if isinstance(value, list):
+        return " x ".join(format(v, fmt) for v in value)
+    return format(value, fmt)
+
+
+def shown_numbers(num: str, entry: dict) -> str:
+    """The part of a marked match that is the figure: its last number, or its last k for a size of k
+    numbers ("1.75 x 11.5<!--fig:length-->" marks only 11.5)."""
+    k = len(entry["value"]) if isinstance(entry["value"], list) else 1
+    return " x ".join(num.split(" x ")[-k:])
+
+
+def shown_prefix(num: str, entry: dict) -> str:
+    """What precedes the figure's own numbers in a marked match (kept as written)."""
+    return num[: len(num) - len(shown_numbers(num, entry))]
+
+
+def pages() -> list[Path]:
+    return [ROOT / "README.md", *sorted(DOCS.glob("*.md"))]
+
+
+def render(figures: dict[str, dict]) -> list[str]:
+    """Rewrite every marked number of the pages from ``figures``; returns the names no figure has."""
+    missing = []
+    for page in pages():
+        text = page.read_text(encoding="utf-8")
+
+        def sub(m: re.Match) -> str:
+            entry = figures.get(m["name"])
+            if entry is None:
+                missing.append(f"{page.name}: {m['name']}")
+                return m[0]
+            return f"{shown_prefix(m['num'], entry)}{formatted(entry)}<!--fig:{m['name']}-->"
+
+        new = MARKED.sub(sub, text)
+        if new != text:
+            page.write_text(new, encoding="utf-8")
+    return missing
+
+
+def write_file(data: dict) -> None:
+    tmp = FILE.with_suffix(".tmp")
+    tmp.write_text(json.dumps(data, indent=1, sort_keys=False, ensure_ascii=False) + "\n", encoding="utf-8")
+    tmp.replace(FILE)
+
+
+def main(argv: list[str] | None = None) -> int:
+    sys.path.insert(0, str(DOCS))
+    import figure_spec as spec  # noqa: PLC0415 - beside this file
+
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("action", choices=["run", "collect", "render"])
+    ap.add_argument("--exports", type=Path, default=ROOT / "exports")
+    args = ap.parse_args(argv)
+    root = args.exports.resolve()
+    if args.action != "render":
+        if args.action == "run":
+            times = run_commands(spec.RUNS, root)
+        else:
+            times = json.loads((root / TIMES).read_text()) if (root / TIMES).is_file() else None
+        copy_pictures(spec, root)
+        write_file(collect(spec, root, times))
+    missing = render(json.loads(FILE.read_text())["figures"])
+    if missing:
+        print("make docs: no figure named " + "; ".join(missing), file=sys.stderr)
+        return 1
+    n = len(json.loads(FILE.read_text())["figures"])
+    print(f"make docs: {n} figures in {FILE.relative_to(ROOT)}; pages rewritten")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

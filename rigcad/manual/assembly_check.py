@@ -1,0 +1,505 @@
+"""Assembly feasibility: can the declared steps be done, in which order, with which tools.
+
+A plan is a list of :class:`Step`: each names the parts it puts in place (meshes of
+``rigcad.manual.assembly``), the directions it may go in along (unit vectors, rig frame: the part
+moves along one of them by ``travel_mm`` to reach its place), the parts it needs in place before
+(what it rests on or is held by) and its :class:`Fastener`s. A step is feasible, given the set of
+parts already in place, when
+
+1. everything it needs (and every part its fasteners pass through) is in place;
+2. its parts, swept along one of its directions from ``travel_mm`` out to their place, do not
+   penetrate anything in place (the parts, the fasteners already fitted, the bench) by more than
+   CLEARANCE_MM;
+3. every fastener fits: its body in place collides with nothing; its head's approach (the head's
+   cylinder from ``approach_mm`` out along the bolt's axis) and its tool (the driver's cylinder, of
+   the tool's stated length, straight out from the head) are clear; a nut, when it has one, sits
+   clear and its spanner's path is clear. A nut trap, a heat-set insert, an instrument's own
+   threaded socket or the bench's thread needs no path.
+
+A step's feasibility depends only on the set in place (not on the order that set came in), so
+:func:`find_order` is a depth-first search over sets, remembering the sets that lead nowhere: it
+finds a feasible order when there is one and says which steps are stuck when there is none.
+:func:`check_order` refuses a given order at its first infeasible step, with the reason.
+
+Penetration is measured against each solid in place in turn (each pair once: a solid in place is
+the same whatever came before it), as the thickness of the overlap solid, 2 V / A (V its volume, A
+its area: a thin slab's thickness), so parts that touch (a beam on its slot floor, a plate on its collar)
+pass while a part pushed through a wall does not; no decision hangs on the last bits of a
+coincident face. A convex part's sweep is exact (the hull of its start and end); any other part's
+is sampled every SWEEP_STEP_MM along the path (a wall thinner than that could be jumped: see
+SWEEP_STEP_MM). Frame: mm, rig frame (O at the origin, +z up).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rigcad.errors import GeometryError
+
+#: Overlap thickness (mm) above which two solids collide: a printed fit's gap is ~0.2 mm, so 0.05 mm
+#: is an interference no hand would push through, and well above the mesher's chord error in a contact.
+CLEARANCE_MM = 0.05
+#: Spacing (mm) of the sampled positions along an insertion path: half the thinnest solid a rig has
+#: (the 1 mm plate beam splitter), so no sampled step jumps over a wall.
+SWEEP_STEP_MM = 0.5
+#: A bench under the lowest part: this deep (mm) and this far beyond the rig each way.
+BENCH_DEPTH_MM = 50.0
+BENCH_MARGIN_MM = 1000.0
+
+
+@dataclass(frozen=True)
+class Tool:
+    """A hand tool on a straight path: its name with its standard and size, the length it reaches
+    (mm) and the radius (mm) of the cylinder its shaft and the hand's grip need around its axis."""
+
+    name: str
+    length_mm: float
+    radius_mm: float
+    #: An L-shaped hex key: its long arm (mm) leaves the short one's end at right angles, along
+    #: ``arm_dir`` (unit), the way a hand turns it a little at a time under an overhang.
+    arm_mm: float = 0.0
+    arm_dir: tuple[float, float, float] | None = None
+
+    def path(self, start, axis):
+        """The tool's straight path from ``start`` (the head's top, (3,) mm) out along ``-axis``."""
+        a = np.asarray(axis, float)
+        end = np.asarray(start, float) - a * self.length_mm
+        shaft = cylinder(end, a, self.length_mm, self.radius_mm)
+        if not self.arm_mm:
+            return shaft
+        return _union([shaft, cylinder(end, self.arm_dir, self.arm_mm, self.radius_mm)])
+
+
+@dataclass(frozen=True)
+class Fastener:
+    """One bolt or screw in place: its item (an orderable spec), the centre of its head's bearing
+    face ``head`` (3,) mm, its ``axis`` (unit, from the head into the joint), its length under the
+    head and shank radius, its head (radius, height), the tool that drives it, and what takes its
+    thread: "nut" (then ``nut_tool`` and ``nut_dir``, the spanner's way out), "insert" (a heat-set
+    insert or nut trap in the part), "instrument" (the instrument's threaded socket) or "bench"."""
+
+    item: str
+    head: tuple[float, float, float]
+    axis: tuple[float, float, float]
+    length_mm: float
+    shank_radius_mm: float
+    head_radius_mm: float
+    head_height_mm: float
+    tools: tuple[Tool, ...]  #: any one of them will do, best first
+    thread_in: str = "nut"
+    nut_size_mm: tuple[float, float] = (0.0, 0.0)  #: across corners / 2 (mm), height (mm)
+    nut_tool: Tool | None = None
+    nut_dir: tuple[float, float, float] | None = None
+    passes: tuple[str, ...] = ()  #: parts the shank goes through (they must be in place)
+    grip_mm: float = 0.0  #: head's bearing face to the nut's (mm): washers included
+    #: Parts drawn without the hole it goes through (an instrument's or a shim stack's plain box):
+    #: its body may run through them.
+    pierces: tuple[str, ...] = ()
+
+    def solids(self):
+        """The fastener in place: its shank and head, and its nut when it has one."""
+        a, h = np.asarray(self.axis, float), np.asarray(self.head, float)
+        body = [cylinder(h, a, self.length_mm, self.shank_radius_mm),
+                cylinder(h - a * self.head_height_mm, a, self.head_height_mm, self.head_radius_mm)]
+        if self.thread_in == "nut":
+            body.append(cylinder(h + a * self.grip_mm, a, self.nut_size_mm[1], self.nut_size_mm[0]))
+        return _union(body)
+
+    def paths(self) -> list[tuple[str, object]]:
+        """The straight paths that must be clear: the head's approach along the axis (the bolt goes
+        in from outside) and the nut's spanner (named, as solids); the tools' in :meth:`tool_paths`."""
+        a, h = np.asarray(self.axis, float), np.asarray(self.head, float)
+        top = h - a * self.head_height_mm
+        out = [("the head's way in", cylinder(top - a * self.length_mm, a, self.length_mm, self.head_radius_mm))]
+        if self.thread_in == "nut" and self.nut_tool is not None:
+            n = np.asarray(self.nut_dir, float)
+            start = h + a * (self.grip_mm + 0.5 * self.nut_size_mm[1])
+            out.append((self.nut_tool.name, cylinder(start, n, self.nut_tool.length_mm, self.nut_tool.radius_mm)))
+        return out
+
+    def tool_paths(self) -> list[tuple[Tool, object]]:
+        """Each tool with its path from the head's top."""
+        a, h = np.asarray(self.axis, float), np.asarray(self.head, float)
+        return [(t, t.path(h - a * self.head_height_mm, a)) for t in self.tools]
+
+
+@dataclass(frozen=True)
+class Step:
+    """One assembly step (see the module docstring)."""
+
+    name: str
+    members: tuple[str, ...]
+    directions: tuple[tuple[float, float, float], ...]
+    travel_mm: float
+    needs: tuple[str, ...] = ()
+    fasteners: tuple[Fastener, ...] = ()
+    text: str = ""
+    bought: bool = False
+
+
+@dataclass(frozen=True)
+class Placed:
+    """A step of a feasible order: the step and the direction it goes in along (unit, rig frame)."""
+
+    step: Step
+    direction: tuple[float, float, float]
+    notes: tuple[str, ...] = field(default=())
+
+
+# -- solids ----------------------------------------------------------------------------------------
+def manifold(vertices: np.ndarray, faces: np.ndarray):
+    """A manifold3d solid from a closed mesh (vertices (n, 3) mm, faces (m, 3))."""
+    import manifold3d as m3
+
+    mesh = m3.Mesh(vert_properties=np.asarray(vertices, np.float32), tri_verts=np.asarray(faces, np.uint32))
+    return m3.Manifold(mesh)
+
+
+def cylinder(start, axis, length: float, radius: float):
+    """A solid cylinder (32 sides, circumscribed: it covers the true one) from ``start`` (3,) mm
+    along the unit ``axis`` for ``length`` mm."""
+    import manifold3d as m3
+
+    a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(a, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(a, u)
+    r = radius / np.cos(np.pi / 32)
+    c = m3.Manifold.cylinder(length, r, r, 32)
+    m = np.column_stack([u, v, a, np.asarray(start, float)])
+    return c.transform(m)
+
+
+def penetration(a, b) -> float:
+    """Thickness (mm) of the overlap of two solids, 2 V / A of their intersection (0 when they only touch)."""
+    x = a ^ b
+    if x.is_empty():
+        return 0.0
+    area = x.surface_area()
+    return 2.0 * x.volume() / area if area > 0 else 0.0
+
+
+def _union(solids):
+    import manifold3d as m3
+
+    solids = [s for s in solids if s is not None]
+    if not solids:
+        return m3.Manifold()
+    return m3.Manifold.batch_boolean(solids, m3.OpType.Add)
+
+
+def bench(lo: np.ndarray, hi: np.ndarray):
+    """The bench: a slab under the lowest point ``lo`` (3,) of the rig, reaching well beyond it."""
+    import manifold3d as m3
+
+    size = (hi[0] - lo[0] + 2 * BENCH_MARGIN_MM, hi[1] - lo[1] + 2 * BENCH_MARGIN_MM, BENCH_DEPTH_MM)
+    return m3.Manifold.cube(size).translate((lo[0] - BENCH_MARGIN_MM, lo[1] - BENCH_MARGIN_MM, lo[2] - BENCH_DEPTH_MM))
+
+
+def swept(solid, direction, travel: float, near=None):
+    """The union of ``solid`` moved back along ``direction`` by 0 .. ``travel`` mm, every SWEEP_STEP_MM;
+    with ``near`` (boxes (k, 6): lo, hi), only where its bounding box meets one of them (elsewhere it
+    meets nothing, so leaving those positions out changes no penetration)."""
+    import manifold3d as m3
+
+    d = np.asarray(direction, float)
+    hull = solid.hull()
+    if hull.volume() <= solid.volume() * (1 + 1e-9) + 1e-9:  # convex: the exact sweep is one hull
+        return m3.Manifold.batch_hull([solid, solid.translate(tuple(-d * travel))])
+    s = _near_positions(solid, d, travel, near)
+    return _union([solid.translate(tuple(-d * v)) for v in s])
+
+
+#: A sweep is first tried at every COARSE-th sampled position, one copy at a time: a collision found
+#: there refuses the step (its depth a lower bound) without building the whole sweep.
+COARSE = 32
+
+
+def sweep_penetration(solid, direction, travel: float, other) -> float:
+    """Penetration (mm) of ``solid`` swept along ``direction`` (see :func:`swept`) into ``other``."""
+    d = np.asarray(direction, float)
+    hull = solid.hull()
+    if hull.volume() <= solid.volume() * (1 + 1e-9) + 1e-9:
+        return penetration(swept(solid, d, travel), other)
+    for s in _near_positions(solid, d, travel, [other.bounding_box()])[::COARSE]:
+        pen = penetration(solid.translate(tuple(-d * s)), other)
+        if pen > CLEARANCE_MM:
+            return pen
+    return penetration(swept(solid, d, travel, [other.bounding_box()]), other)
+
+
+def _near_positions(solid, d: np.ndarray, travel: float, near) -> np.ndarray:
+    """Sampled positions (mm back along ``d``) where the moved solid's box meets one of ``near``."""
+    n = max(1, int(np.ceil(travel / SWEEP_STEP_MM)))
+    s = np.linspace(0.0, travel, n + 1)
+    if near is None or not len(near):
+        return s
+    box = np.asarray(solid.bounding_box(), float)
+    lo = box[None, :3] - d[None, :] * s[:, None]  # (n + 1, 3) the moved box at each position
+    hi = box[None, 3:] - d[None, :] * s[:, None]
+    near = np.asarray(near, float)
+    pad = SWEEP_STEP_MM  # a position whose box is within one step of an obstacle is kept
+    meets = np.any(np.all((lo[:, None, :] < near[None, :, 3:] + pad) & (hi[:, None, :] > near[None, :, :3] - pad),
+                          axis=2), axis=1)
+    return s[meets]
+
+
+@dataclass(frozen=True)
+class Refusal:
+    """Why a step cannot go next: ``blocked`` when something in place is in the way (then it cannot
+    go after any more parts either), else it waits for a part it needs."""
+
+    reason: str
+    blocked: bool
+
+    def __str__(self) -> str:
+        return self.reason
+
+
+# -- the check -------------------------------------------------------------------------------------
+class Assembly:
+    """The parts' solids (name -> manifold3d solid) and the bench, with the feasibility test of a
+    step given the steps already done (see the module docstring). Results are remembered per
+    (step, set done): a step's feasibility depends on that set only."""
+
+    def __init__(self, solids: dict, steps: list[Step], with_bench: bool = True) -> None:
+        self.solids = solids
+        self.steps = list(steps)
+        self.by_name = {s.name: s for s in self.steps}
+        names = [n for s in self.steps for n in s.members]
+        missing = sorted(set(names) - set(solids))
+        if missing:
+            raise GeometryError(f"assembly steps place {missing}, which the rig has no solid for")
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise GeometryError(f"parts {dup} are placed by more than one assembly step")
+        #: The bench's top (mm): the plane under the lowest part; None: no bench. A half-space, so its
+        #: penetration is a depth below that plane, computed from bounding boxes (exact for a plane).
+        self.bench_top = float(min(s.bounding_box()[2] for s in solids.values())) if with_bench else None
+        self._memo: dict = {}
+        self._pairs: dict = {}
+
+    def _obstacles(self, done: frozenset[str], extra: tuple[str, ...] = ()) -> list[tuple[str, object]]:
+        """Named solids in place once the steps ``done`` are: parts, fitted fasteners, the bench."""
+        out = []
+        for name in sorted(done):
+            step = self.by_name[name]
+            out += [(m, self.solids[m]) for m in step.members]
+            out += [(_fastener_name(step, k), f.solids()) for k, f in enumerate(step.fasteners)]
+        out += [(m, self.solids[m]) for m in extra]
+        return out
+
+    def _into(self, key: tuple, make, named: list[tuple[str, object]], low: float | None = None) -> tuple[float, str]:
+        """The deepest penetration (mm) of a solid into the named solids (``make(other)`` measures it,
+        remembered under ``key``) and the bench (``low``: the solid's lowest point, None: the bench is not in
+        its way), and the name of the one it runs into deepest. Each pair is computed once: a solid
+        in place is the same whatever came before it."""
+        worst = (0.0, "nothing")
+        if low is not None and self.bench_top is not None and self.bench_top - low > 0:
+            worst = (self.bench_top - low, "the bench")
+        for name, other in named:
+            pair = (key, name)
+            if pair not in self._pairs:
+                self._pairs[pair] = make(other)
+            if self._pairs[pair] > worst[0]:
+                worst = (self._pairs[pair], name)
+        return worst
+
+    def attempt(self, step: Step, done: frozenset[str]) -> Placed | Refusal:
+        """The step placed after ``done`` (a Placed), or why it cannot be (a sentence)."""
+        key = (step.name, done)
+        if key not in self._memo:
+            self._memo[key] = self._attempt(step, done)
+        return self._memo[key]
+
+    def _attempt(self, step: Step, done: frozenset[str]) -> Placed | Refusal:
+        in_place = {m for n in done for m in self.by_name[n].members} | set(step.members)
+        wanted = [*step.needs, *(p for f in step.fasteners for p in f.passes)]
+        missing = sorted({n for n in wanted if n not in in_place})
+        if missing:
+            return Refusal(f"needs {', '.join(missing)} in place first", False)
+        obstacles = self._obstacles(done)
+        direction, reasons = None, []
+        for d in step.directions:
+            worst = max((self._into(("sweep", m, d, step.travel_mm),
+                                    lambda other, m=m, d=d: sweep_penetration(self.solids[m], d, step.travel_mm,
+                                                                              other), obstacles,
+                                    self.solids[m].bounding_box()[2] - max(0.0, d[2]) * step.travel_mm)
+                         for m in step.members), key=lambda t: t[0])
+            if worst[0] <= CLEARANCE_MM:
+                direction = d
+                break
+            reasons.append(f"moved in along {_dir_name(d)} it runs {worst[0]:.2f} mm into {worst[1]}")
+        if direction is None:
+            return Refusal("; ".join(reasons) or "no direction declared", True)
+        blocked = self._fastener_problems(step, self._obstacles(done, step.members))
+        if blocked:
+            return Refusal("; ".join(blocked), True)
+        return Placed(step, tuple(float(v) for v in direction))
+
+    def _fastener_problems(self, step: Step, obstacles: list) -> list[str]:
+        out = []
+        fitted = list(obstacles)
+        for k, f in enumerate(step.fasteners):
+            name = _fastener_name(step, k)
+            # a screw's thread runs into the bench or into the instrument's socket by design
+            into = [(n, s) for n, s in fitted
+                    if not (f.thread_in == "instrument" and n in step.members) and n not in f.pierces]
+            body = f.solids()
+            pen, what_in = self._into(("body", name), lambda other: penetration(body, other), into,
+                                      None if f.thread_in == "bench" else body.bounding_box()[2])
+            if pen > CLEARANCE_MM:
+                out.append(f"{f.item} #{k + 1} at {_at(f.head)} runs {pen:.2f} mm into {what_in}")
+            for what, path in f.paths():
+                pen, by = self._into(("path", name, what), lambda other, path=path: penetration(path, other), fitted,
+                                     path.bounding_box()[2])
+                if pen > CLEARANCE_MM:
+                    out.append(f"{f.item} #{k + 1} at {_at(f.head)}: {what} is blocked by {by} ({pen:.2f} mm)")
+            tried = []
+            for tool, path in f.tool_paths():
+                pen, by = self._into(("tool", name, tool.name), lambda other, path=path: penetration(path, other), fitted,
+                                     path.bounding_box()[2])
+                if pen <= CLEARANCE_MM:
+                    break
+                tried.append(f"the {tool.name}'s path is blocked by {by} ({pen:.2f} mm)")
+            else:
+                out.append(f"{f.item} #{k + 1} at {_at(f.head)}: " + "; ".join(tried or ["no tool declared"]))
+            fitted.append((name, body))
+        return out
+
+
+def _fastener_name(step: Step, k: int) -> str:
+    return f"{step.fasteners[k].item} #{k + 1} of step {step.name}"
+
+
+def _at(p) -> str:
+    return "(" + ", ".join(f"{v:.1f}" for v in p) + ") mm"
+
+
+_AXES = {(1, 0, 0): "+x", (-1, 0, 0): "-x", (0, 1, 0): "+y", (0, -1, 0): "-y", (0, 0, 1): "+z (up)",
+         (0, 0, -1): "-z (down)"}
+
+
+def _dir_name(d) -> str:
+    key = tuple(int(round(v)) for v in d)
+    if key in _AXES and np.allclose(d, key, atol=1e-9):
+        return _AXES[key]
+    return "(" + ", ".join(f"{v:+.3f}" for v in d) + ")"
+
+
+def check_order(assembly: Assembly, names: list[str]) -> list[Placed]:
+    """The steps named, in that order, each checked against those before it; GeometryError at the
+    first that cannot be done (a planted wrong order, a blocked bolt), naming it and why."""
+    done: frozenset[str] = frozenset()
+    out = []
+    for k, name in enumerate(names):
+        r = assembly.attempt(assembly.by_name[name], done)
+        if isinstance(r, Refusal):
+            raise GeometryError(f"assembly step {k + 1} ({name}) cannot be done: {r}")
+        out.append(r)
+        done = done | {name}
+    return out
+
+
+def find_order(assembly: Assembly) -> list[Placed]:
+    """A feasible order of every step (depth-first over the sets of steps done, the declared order
+    first at each choice; sets that lead nowhere are remembered). A set where a step left is blocked
+    leads nowhere: parts only ever add obstacles. GeometryError when there is no order, naming the
+    steps left and why each cannot go next."""
+    _refuse_cycles(assembly)
+    _refuse_blocked_at_first(assembly)
+    dead: set[frozenset[str]] = set()
+    total = len(assembly.steps)
+
+    def search(done: frozenset[str], path: list[Placed]) -> list[Placed] | None:
+        if len(path) == total:
+            return path
+        if done in dead:
+            return None
+        left = [(step, assembly.attempt(step, done)) for step in assembly.steps if step.name not in done]
+        if not any(isinstance(r, Refusal) and r.blocked for _, r in left):
+            for step, r in left:
+                if isinstance(r, Placed):
+                    found = search(done | {step.name}, [*path, r])
+                    if found is not None:
+                        return found
+        dead.add(done)
+        return None
+
+    order = search(frozenset(), [])
+    if order is None:
+        raise GeometryError("no feasible assembly order: " + _stuck(assembly))
+    return order
+
+
+def _refuse_cycles(assembly: Assembly) -> None:
+    """GeometryError when steps need each other (a cycle in what each needs in place): no order can
+    satisfy them, and the search would try every order of the rest before saying so."""
+    owner = {m: s.name for s in assembly.steps for m in s.members}
+    after = {s.name: {owner[n] for n in (*s.needs, *(p for f in s.fasteners for p in f.passes))
+                      if n in owner and owner[n] != s.name} for s in assembly.steps}
+    state: dict[str, int] = {}
+
+    def visit(name: str, trail: list[str]) -> None:
+        state[name] = 1
+        for nxt in sorted(after[name]):
+            if state.get(nxt) == 1:
+                loop = trail[trail.index(nxt):] + [nxt] if nxt in trail else [name, nxt]
+                raise GeometryError("no feasible assembly order: the steps need each other in a loop: "
+                                    + " needs ".join(loop))
+            if nxt not in state:
+                visit(nxt, [*trail, nxt])
+        state[name] = 2
+
+    for s in assembly.steps:
+        if s.name not in state:
+            visit(s.name, [s.name])
+
+
+def _before(assembly: Assembly) -> dict[str, frozenset[str]]:
+    """The steps each step must come after in any order: what it needs, transitively."""
+    owner = {m: s.name for s in assembly.steps for m in s.members}
+    direct = {s.name: {owner[n] for n in (*s.needs, *(p for f in s.fasteners for p in f.passes))
+                       if n in owner and owner[n] != s.name} for s in assembly.steps}
+    out: dict[str, frozenset[str]] = {}
+
+    def close(name: str) -> frozenset[str]:
+        if name not in out:
+            out[name] = frozenset(direct[name]).union(*(close(n) for n in direct[name]))
+        return out[name]
+
+    for s in assembly.steps:
+        close(s.name)
+    return out
+
+
+def _refuse_blocked_at_first(assembly: Assembly) -> None:
+    """GeometryError when a step is blocked with only what it must come after in place: parts only
+    ever add obstacles, so it is blocked in every order (the exact answer, found without a search)."""
+    for step in assembly.steps:
+        r = assembly.attempt(step, _before(assembly)[step.name])
+        if isinstance(r, Refusal) and r.blocked:
+            raise GeometryError(f"no feasible assembly order: {step.name} cannot go in even with only what it "
+                                f"needs in place: {r}")
+
+
+def _stuck(assembly: Assembly) -> str:
+    """The longest feasible prefix the declared order first allows, and why each step left fails."""
+    done: frozenset[str] = frozenset()
+    progress = True
+    while progress:
+        progress = False
+        for step in assembly.steps:
+            if step.name not in done and isinstance(assembly.attempt(step, done), Placed):
+                done, progress = done | {step.name}, True
+                break
+    left = [s for s in assembly.steps if s.name not in done]
+    return "; ".join(f"{s.name}: {assembly.attempt(s, done)}" for s in left)
+
+
+__all__ = ["Assembly", "CLEARANCE_MM", "Fastener", "Placed", "Refusal", "SWEEP_STEP_MM", "Step", "Tool", "check_order",
+           "cylinder", "find_order", "manifold", "penetration", "swept"]

@@ -1,0 +1,310 @@
+"""The rig's assembly steps as declarations for the feasibility check (rigcad.manual.assembly_check):
+each step's parts, the directions it may go in along, what it needs in place and its fasteners,
+all read from the rig (meshes, recipes' holes, the tower's hardware), none typed per rig.
+
+- Parts named alike but for a trailing number (projector_shims_1..4) go in one step; an instrument
+  and the lens built onto it (projector_body + projector_lens, camera_body + camera_lens) are one
+  unit: the lens is on the body before the body goes in.
+- A step needs the parts it rests on (the parts its solid, moved 1 mm down, runs into) and the parts
+  its fasteners pass through.
+- Directions: a part is lowered from above; failing that it slides in level from the side (+-x,
+  +-y); failing that it goes up from below. A beam or a plate that slides into slots or grooves
+  tries the sideways directions first (SIDEWAYS_FIRST). The travel is the rig's whole size: every
+  part comes from outside the assembly.
+- Fasteners: every bolt :func:`rigcad.manual.bom.bolt_axes` finds (the upper part's step fits it:
+  head on top, a hex screwdriver from above, a washer and a nut under the lower part held by an
+  open-end spanner from the side, or, where no nut fits under it, a heat-set insert melted into the
+  lower part); a bolt of one part alone goes into the bench; the instruments' screws
+  (``rigcad.parts.tower.hardware``) go up (projector) or across (camera) into their sockets.
+
+Frame: mm, rig frame. Screw sizes: ISO 4762 socket-head cap screws (head diameter 1.5 d, height d),
+ISO 4032 nuts, ISO 7089 washers, hex keys to ISO 2936.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from rigcad.manual.assembly_check import Assembly, Fastener, Step, Tool, manifold, penetration
+
+#: Units one step places together: an instrument with the lens built onto it.
+UNITS = (("projector_body", "projector_lens"), ("camera_body", "camera_lens"))
+#: Parts that slide in from the side into slots or grooves before anything is lowered onto them.
+SIDEWAYS_FIRST = ("beam", "beam_splitter")
+DOWN, UP = (0.0, 0.0, -1.0), (0.0, 0.0, 1.0)
+SIDEWAYS = ((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1.0, 0.0))
+#: How far (mm) a part is moved down to find what it rests on: above CLEARANCE_MM (a contact shows), below
+#: the printed fits' gaps (0.2 mm and up: a part in a slot is not taken to rest on the slot's ceiling).
+#: A part that touches nothing below within REST_PROBE_MM sits in a pocket or a groove with a gap: the
+#: parts under it within REST_SEARCH_MM (mm) hold it.
+REST_SEARCH_MM = 5.0
+REST_PROBE_MM = 0.08
+#: Hex key (mm across flats, ISO 4762 socket) per thread; 1/4-20 and 3/8-16 socket heads take 3/16 in and 5/16 in.
+HEX_KEY = {"M2": 1.5, "M2.5": 2.0, "M3": 2.5, "M4": 3.0, "M5": 4.0, "M6": 5.0, "M8": 6.0, "M10": 8.0, "M12": 10.0,
+           "1/4-20 UNC": 4.7625, "3/8-16 UNC": 7.9375}
+#: Nut width across flats (mm, ISO 4032) per metric thread: the open-end spanner's size.
+NUT_AF = {"M2": 4.0, "M2.5": 5.0, "M3": 5.5, "M4": 7.0, "M5": 8.0, "M6": 10.0, "M8": 13.0, "M10": 16.0, "M12": 18.0}
+#: The hex screwdriver's blade (mm): a hand needs this much straight room above a head.
+DRIVER_BLADE_MM = 100.0
+#: The open-end spanner's reach (mm, DIN 3110 for M3-M6 nuts: 90-120 mm long).
+SPANNER_MM = 80.0
+#: Heat-set insert (M thread -> outer diameter, length) as sold for printed parts (e.g. M4: 5.6 x 8.1 mm, hole 5.6 mm).
+INSERT = {"M3": (4.5, 5.7), "M4": (5.6, 8.1), "M5": (6.4, 9.5), "M6": (8.0, 12.7)}
+
+
+#: ISO 2936 hex keys: key (mm across flats) -> long arm, short arm (mm).
+L_KEY = {1.5: (45.0, 14.0), 2.0: (50.0, 16.0), 2.5: (56.0, 18.0), 3.0: (63.0, 20.0), 4.0: (70.0, 25.0),
+         4.7625: (80.0, 28.0), 5.0: (80.0, 28.0), 6.0: (90.0, 32.0), 7.9375: (100.0, 36.0), 8.0: (100.0, 36.0),
+         10.0: (112.0, 40.0)}
+
+
+def driver(thread: str, out_dir=(1.0, 0.0, 0.0)) -> tuple[Tool, ...]:
+    """A hex screwdriver with a DRIVER_BLADE_MM blade; else an L hex key (ISO 2936) with its short
+    arm in the socket and its long arm out along ``out_dir`` (away from the rig's axis)."""
+    key = HEX_KEY[thread]
+    r = key / np.sqrt(3.0) + 0.5  # the key's corners, and a little play for the hand
+    long, short = L_KEY[key]
+    return (Tool(f"{key:g} mm hex screwdriver (ISO 2936 hex), {DRIVER_BLADE_MM:g} mm blade", DRIVER_BLADE_MM, r),
+            Tool(f"{key:g} mm L hex key (ISO 2936, {long:g} x {short:g} mm), short arm in", short, r, long,
+                 tuple(float(v) for v in out_dir)))
+
+
+def spanner(thread: str, nut_height: float) -> Tool:
+    # its jaws are about as thick as the nut is high: a cylinder of that diameter along its way out
+    return Tool(f"{NUT_AF[thread]:g} mm open-end spanner (DIN 3110)", SPANNER_MM, nut_height / 2 + 0.5)
+
+
+def _stem(name: str) -> str:
+    return re.sub(r"_\d+$", "", name)
+
+
+def groups(meshes) -> list[tuple[str, tuple[str, ...]]]:
+    """Step names and the parts each places, in the meshes' order (markers left out)."""
+    out: dict[str, list[str]] = {}
+    unit_of = {m: u[0] for u in UNITS for m in u}
+    for m in meshes:
+        if m.marker:
+            continue
+        key = unit_of.get(m.name, _stem(m.name))
+        out.setdefault(key, []).append(m.name)
+    return [(k, tuple(v)) for k, v in out.items()]
+
+
+def _metric(thread: str):
+    from rigcad.manual.bom import METRIC
+
+    return next(r for r in METRIC if r[0] == thread)
+
+
+def _socket_head(item: str, head, axis, length: float, d: float, thread: str, **kw) -> Fastener:
+    h = np.array([head[0], head[1], 0.0])
+    out = tuple(h / np.linalg.norm(h)) if np.linalg.norm(h) > 1e-9 else (1.0, 0.0, 0.0)
+    if abs(np.dot(out, axis)) > 0.9:
+        out = (0.0, 0.0, -1.0)
+    return Fastener(item, tuple(float(v) for v in head), axis, float(length), d / 2, 0.75 * d, d,
+                    driver(thread, out), **kw)
+
+
+def bolt_fasteners(bolt: dict) -> tuple[Fastener, ...]:
+    """The ways to fit one bolt of :func:`rigcad.manual.bom.bolt_axes`, best first: through with a
+    washer and a nut under the lower part; into a heat-set insert in the lower part; into the bench
+    (a bolt of one part alone)."""
+    from rigcad.manual.bom import BOLT_LENGTHS, bolt_length, thread_for_hole
+
+    thread, _, pitch, nut_h, washer = thread_for_hole(bolt["hole_mm"])
+    d = float(re.sub(r"[^0-9.]", "", thread))
+    head = (bolt["x"], bolt["y"], bolt["top_z"] + washer)
+    if len(bolt["parts"]) == 1:
+        need = bolt["grip_mm"] + washer + 1.5 * d  # 1.5 d of thread into the bench (wood or a tapped plate)
+        length = next(n for n in BOLT_LENGTHS if n >= need - 1e-9)
+        return (_socket_head(f"{thread} x {length} mm socket-head screw (ISO 4762) into the bench", head, DOWN,
+                             length, d, thread, thread_in="bench", passes=bolt["parts"]),)
+    length, _ = bolt_length(bolt["grip_mm"], pitch, nut_h, washer)
+    out_dir = np.array([bolt["x"], bolt["y"], 0.0])
+    out_dir = tuple(out_dir / np.linalg.norm(out_dir)) if np.linalg.norm(out_dir) > 1e-9 else (1.0, 0.0, 0.0)
+    nut_r = NUT_AF[thread] / np.sqrt(3.0)
+    options = [_socket_head(f"{thread} x {length} mm socket-head bolt (ISO 4762) with 2 washers (ISO 7089) and a "
+                            f"nut (ISO 4032)", head, DOWN, length, d, thread, thread_in="nut",
+                            nut_size_mm=(nut_r, nut_h), nut_tool=spanner(thread, nut_h), nut_dir=out_dir,
+                            passes=bolt["parts"], grip_mm=bolt["grip_mm"] + 2 * washer)]
+    lower = min((n for n in bolt["parts"] if n != bolt["upper"]), key=lambda n: bolt["spans"][n][1])
+    lo, hi = bolt["spans"][lower]
+    if thread in INSERT and hi - lo >= INSERT[thread][1]:
+        need = (bolt["top_z"] - hi) + washer + INSERT[thread][1]
+        fits = [n for n in BOLT_LENGTHS if n <= need + 1e-9]
+        if fits:
+            dia, long = INSERT[thread]
+            options.append(_socket_head(
+                f"{thread} x {fits[-1]} mm socket-head bolt (ISO 4762) with a washer (ISO 7089) into a {thread} "
+                f"heat-set insert ({dia:g} x {long:g} mm) melted into {lower}", head, DOWN, fits[-1], d, thread,
+                thread_in="insert", passes=bolt["parts"]))
+    return tuple(options)
+
+
+def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]:
+    """The projector's and the camera's screws into their own sockets (thread and length from
+    ``rigcad.parts.tower.hardware``): the projector's up through the shelf's slots and its shim
+    stacks, the camera's across (+y) through the bracket's slot and its shims. Step name -> screws."""
+    t = getattr(rig.layout, "tower", None)
+    if t is None:
+        return {}
+    from rigcad.parts.tower import hardware
+    from rigcad.profile.schema import MOUNT_THREADS
+
+    rows = [h for h in hardware(rig.profile, rig.layout) if h.get("length_mm") and "socket" in h["joins"]
+            or h.get("length_mm") and "mounting holes" in h["joins"]]
+    out: dict[str, tuple[Fastener, ...]] = {}
+    for h in rows:
+        d = MOUNT_THREADS[h["thread"]]
+        item = f"{h['thread']} x {h['length_mm']:g} mm socket-head screw (ISO 4762 / ASME B18.3) with a washer"
+        if "projector" in h["joins"]:
+            z = t.shelf_top_z - t.shelf_thickness - 1.0
+            shims = sorted(n for n in meshes_by_name if n.startswith("projector_shims_"))
+            out["projector_body"] = tuple(
+                _socket_head(item, (*_centre(meshes_by_name[n])[:2], z), UP, h["length_mm"], d, h["thread"],
+                             thread_in="instrument", passes=("tower_shelf", n), pierces=(n,)) for n in shims)
+        elif "camera" in h["joins"] and "camera_shims" in meshes_by_name:
+            out["camera_body"] = tuple(
+                _socket_head(item, (x, -t.wall_y[1] - 1.0, z), (0.0, 1.0, 0.0), h["length_mm"], d, h["thread"],
+                             thread_in="instrument", passes=("splitter_holder", "camera_shims"),
+                             pierces=("camera_shims",))
+                for x, z in _camera_points(rig, meshes_by_name))
+    return out
+
+
+def _camera_points(rig, meshes_by_name) -> list[tuple[float, float]]:
+    """The camera's screws (x, z; mm): the tower's two when it has them, else one at its shims' centre."""
+    try:
+        from rigcad.parts.tower import camera_screws
+    except ImportError:
+        c = _centre(meshes_by_name["camera_shims"])
+        return [(float(c[0]), float(c[2]))]
+    return [(float(x), float(z)) for x, z in camera_screws(rig.layout.tower, rig.profile)]
+
+
+def _centre(mesh) -> np.ndarray:
+    return 0.5 * (mesh.lo + mesh.hi)
+
+
+def _rests_on(name: str, solids: dict, members: tuple[str, ...], floor: float) -> tuple[str, ...]:
+    """What the part ``name`` stands on: the parts it runs into when moved down, first within
+    REST_PROBE_MM (a contact), else within REST_SEARCH_MM (it sits in a pocket or groove with a fit's
+    gap); () when it stands on the bench (its bottom at ``floor``) or on nothing below (it hangs)."""
+    from rigcad.manual.assembly_check import CLEARANCE_MM
+
+    bottom = solids[name].bounding_box()[2]
+    if bottom <= floor + REST_PROBE_MM:
+        return ()
+    # only a part that reaches lower can hold it up (a plate in a holder's grooves does not hold the holder)
+    lower = {n: s for n, s in solids.items() if n not in members and s.bounding_box()[2] < bottom + REST_PROBE_MM}
+    for drop in (REST_PROBE_MM, REST_SEARCH_MM):
+        probe = solids[name].translate((0.0, 0.0, -drop))
+        hit = tuple(n for n, s in lower.items() if penetration(probe, s) > CLEARANCE_MM)
+        if hit:
+            return hit
+    return ()
+
+
+def _held_by(name: str, solids: dict, members: tuple[str, ...], later: set[str]) -> tuple[str, ...]:
+    """A part on nothing below (a shim between a bracket and a camera) needs what it touches from the
+    side, but for the parts whose screws pass through it (``later``: they hold it, so they come after)."""
+    from rigcad.manual.assembly_check import CLEARANCE_MM
+
+    out = set()
+    for d in SIDEWAYS:
+        probe = solids[name].translate(tuple(REST_PROBE_MM * np.asarray(d)))
+        out |= {n for n, s in solids.items() if n not in members and n not in later
+                and penetration(probe, s) > CLEARANCE_MM}
+    return tuple(sorted(out))
+
+
+def steps(rig, meshes) -> tuple[list[Step], dict]:
+    """The rig's assembly steps (see the module docstring) and the parts' solids (name -> manifold)."""
+    from rigcad.manual.assembly_check import _union, bench
+
+    by_name = {m.name: m for m in meshes if not m.marker}
+    solids = {n: manifold(m.vertices, m.faces) for n, m in by_name.items()}
+    lo = np.min([m.lo for m in by_name.values()], axis=0)
+    hi = np.max([m.hi for m in by_name.values()], axis=0)
+    travel = float(np.linalg.norm(hi - lo))
+    whole = _union([*solids.values(), bench(lo, hi)])
+    from rigcad.manual.bom import bolt_axes
+
+    bolts: dict[str, list[Fastener]] = {}
+    for b in bolt_axes(rig):  # the through bolts outside the COP tower (its joints: see the module docstring)
+        if len(b["parts"]) < 2 or not set(b["parts"]) <= set(solids):
+            continue
+        options = bolt_fasteners(b)
+        fits = [f for f in options if penetration(f.solids(), whole) <= _clearance()]
+        bolts.setdefault(b["upper"], []).append((fits or options)[0])
+    screws = instrument_fasteners(rig, by_name)
+    out = []
+    for name, members in groups(meshes):
+        fasteners = tuple(f for m in members for f in bolts.get(m, ())) + screws.get(name, ())
+        needs = set()
+        for m in members:
+            under = _rests_on(m, solids, members, float(lo[2]))
+            if not under and by_name[m].lo[2] > lo[2] + REST_PROBE_MM:
+                later = {p for fs in screws.values() for f in fs if m in f.passes
+                         for p in groups_of(meshes).get(_step_of(screws, f), ())}
+                under = _held_by(m, solids, members, later)
+            needs |= set(under)
+        needs = tuple(sorted(needs))
+        first = any(m in SIDEWAYS_FIRST for m in members)
+        directions = (*SIDEWAYS, DOWN, UP) if first else (DOWN, *SIDEWAYS, UP)
+        out.append(Step(name, members, directions, travel, needs, fasteners,
+                        bought=all(by_name[m].bought for m in members)))
+    return out, solids
+
+
+def groups_of(meshes) -> dict[str, tuple[str, ...]]:
+    return dict(groups(meshes))
+
+
+def _step_of(screws: dict, fastener) -> str:
+    return next(name for name, fs in screws.items() if fastener in fs)
+
+
+def _clearance() -> float:
+    from rigcad.manual.assembly_check import CLEARANCE_MM
+
+    return CLEARANCE_MM
+
+
+def assembly(rig, meshes) -> Assembly:
+    """The rig's steps and solids, ready for :func:`rigcad.manual.assembly_check.find_order`."""
+    declared, solids = steps(rig, meshes)
+    return Assembly(solids, declared)
+
+
+__all__ = ["assembly", "bolt_fasteners", "driver", "groups", "instrument_fasteners", "spanner", "steps"]
+
+
+def hardware(steps: list[Step]) -> list[dict]:
+    """The plan's fasteners as one list: each bolt or screw item with its count and the steps that use
+    it, then the nuts, washers and heat-set inserts they need (counted from the items)."""
+    rows: dict[str, dict] = {}
+    extra: dict[str, int] = {}
+    for st in steps:
+        for f in st.fasteners:
+            row = rows.setdefault(f.item, {"item": f.item, "quantity": 0, "steps": []})
+            row["quantity"] += 1
+            if st.name not in row["steps"]:
+                row["steps"].append(st.name)
+            thread = f.item.split(" x ")[0]
+            if f.thread_in == "nut":
+                extra[f"{thread} hex nut (ISO 4032)"] = extra.get(f"{thread} hex nut (ISO 4032)", 0) + 1
+                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 2
+            else:
+                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 1
+            if f.thread_in == "insert":
+                dia, long = INSERT[thread]
+                name = f"{thread} heat-set insert for printed parts, {dia:g} x {long:g} mm"
+                extra[name] = extra.get(name, 0) + 1
+    out = [{**r, "steps": ", ".join(r["steps"])} for r in rows.values()]
+    return out + [{"item": k, "quantity": v, "steps": "with the bolts above"} for k, v in extra.items()]
+
+
+__all__ += ["hardware"]

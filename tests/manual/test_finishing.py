@@ -1,0 +1,43 @@
+"""The finishing figures against closed forms: the paraboloid's principal radii, the block length
+from the sagitta, and the acceptance test's pass limit from the angle target."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rigcad.manual import finishing as F
+
+
+def test_paraboloid_radii_match_the_closed_form(table31_rig):
+    """z = z_v - r^2 / (4 f): meridional radius 2 f (1 + r^2 / 4 f^2)^(3/2), sagittal 2 f (1 + r^2 / 4 f^2)^(1/2),
+    both smallest at the smallest r of the mirror's annulus."""
+    g = table31_rig.geometry
+    f = g.focal_length
+    design = table31_rig.layout.design_paraboloid
+    r = np.abs(design.points(design.sample(4001))[2:-2, 0])
+    q = 1 + r * r / (4 * f * f)
+    exact_m, exact_s = float(np.min(2 * f * q ** 1.5)), float(np.min(2 * f * q ** 0.5))
+    got = F.principal_radii(design)
+    # second-order differences on 4001 points of a smooth curve: ~1e-6 relative; 1e-4 leaves room
+    assert got["meridional_mm"] == pytest.approx(exact_m, rel=1e-4)
+    assert got["sagittal_mm"] == pytest.approx(exact_s, rel=1e-4)
+
+
+def test_flat_block_length_keeps_the_sagitta(table31_rig):
+    for b in F.sanding_blocks(table31_rig):
+        L, R = b["flat_block_max_mm"], b["smallest_radius_mm"]
+        assert L * L / (8 * R) == pytest.approx(F.BLOCK_SAG_MM, rel=1e-12)
+
+
+def test_the_dome_slope_held_by_the_disc_test(table31_rig):
+    """A ray turned by 2 e at the dome's farthest point (distance D from O) lands 2 e D off O: the disc's
+    radius over 2 D; D checked against the dome's rim point (r, z) from the layout directly."""
+    acc = F.slope_acceptance(table31_rig)
+    p = table31_rig.profile
+    rim = table31_rig.layout.design_dome.points(np.array(table31_rig.layout.design_dome.u_range))
+    assert acc["dome_farthest_from_o_mm"] >= float(np.max(np.hypot(rim[:, 0], rim[:, 1]))) - 1e-9
+    e = acc["dome_slope_tolerance_mrad"] / 1e3
+    assert 2 * e * acc["dome_farthest_from_o_mm"] == pytest.approx(p.tolerancing.max_spot_radius, rel=1e-12)
