@@ -302,7 +302,7 @@ def _section_bill(d: Doc, c) -> None:
 
     steps, _ = plan.steps(rig, c.meshes)
     hw = [[r["item"], r["quantity"], f"assembly steps: {r['steps']}", "as the assembly check fitted it"]
-          for r in plan.hardware(steps)]
+          for r in plan.hardware(steps, rig)]
     hw += [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"] if f.get("tower")
            and "mounting holes" not in f["use"]]
     if bill["pins"]:
@@ -484,6 +484,7 @@ def _section_assemble(d: Doc, c) -> None:
 
     from rigcad import plots
     from rigcad.manual import assembly as A
+    from rigcad.manual import plan as plan_mod
 
     d.h(2, "5. Assemble")
     order, refusal = assembly_order(c.rig, c.meshes)
@@ -504,6 +505,8 @@ def _section_assemble(d: Doc, c) -> None:
         label = st.name.replace("_", " ") + (f" (x{len(members)})" if len(members) > 1 and st.name not in
                                              st.members else "")
         text = step_text(placed, by_name)
+        if st.name == "projector_body":
+            text += plan_mod.projector_screw_text(c.rig)
         for h in tower_at.get(st.name, []):
             size = f"{h['thread']} x {h['length_mm']:g} mm" if h.get("length_mm") else h["thread"]
             text += f" Fix it with {h['quantity']} x {h['item']} ({size}): {h['joins']}."

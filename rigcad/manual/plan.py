@@ -156,10 +156,11 @@ def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener,
     rows = [h for h in hardware(rig.profile, rig.layout) if h.get("length_mm") and "socket" in h["joins"]
             or h.get("length_mm") and "mounting holes" in h["joins"]]
     out: dict[str, tuple[Fastener, ...]] = {}
+    nominal = _projector_length(rig, t.shims_nominal)  # the stacks as drawn: shims_nominal shims each
     for h in rows:
         d = MOUNT_THREADS[h["thread"]]
-        item = f"{h['thread']} x {h['length_mm']:g} mm socket-head screw (ISO 4762 / ASME B18.3) with a washer"
-        if "projector" in h["joins"]:
+        item = _screw_item(h["thread"], h["length_mm"])
+        if "projector" in h["joins"] and h["length_mm"] == nominal:
             z = t.shelf_top_z - t.shelf_thickness - 1.0
             shims = sorted(n for n in meshes_by_name if n.startswith("projector_shims_"))
             out["projector_body"] = tuple(
@@ -172,6 +173,49 @@ def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener,
                              pierces=("camera_shims",))
                 for x, z in _camera_points(rig, meshes_by_name))
     return out
+
+
+def _screw_item(thread: str, length: float) -> str:
+    return f"{thread} x {length:g} mm socket-head screw (ISO 4762 / ASME B18.3) with a washer"
+
+
+def _projector_length(rig, shims: int) -> float:
+    """The projector screw's length (mm) for a stack of ``shims`` (rigcad.parts.tower.projector_screws)."""
+    from rigcad.parts.tower import projector_screws
+
+    return float(next(r["length_mm"] for r in projector_screws(rig.profile, rig.layout) if r["shims"] == shims))
+
+
+def projector_screw_rows(rig) -> list[dict]:
+    """The projector's screws, one row per length the shim stacks need (rigcad.parts.tower.hardware's
+    rows, sized by rigcad.parts.tower.projector_screws): item, quantity (one per foot: any stack may
+    end up at any count in the alignment), the stacks it serves and the extra washers per stack."""
+    from rigcad.parts.tower import hardware, projector_screws
+
+    extra = {r["shims"]: r["extra_washers"] for r in projector_screws(rig.profile, rig.layout)}
+    return [{"item": _screw_item(h["thread"], h["length_mm"]), "length_mm": h["length_mm"], "quantity": h["quantity"],
+             "stacks": list(h["for_stacks_of_shims"]),
+             "extra_washers": {n: extra[n] for n in h["for_stacks_of_shims"] if extra[n]}}
+            for h in hardware(rig.profile, rig.layout) if "for_stacks_of_shims" in h]
+
+
+def _stacks(ns: list[int]) -> str:
+    return f"{ns[0]} shims" if len(ns) == 1 else f"{ns[0]}..{ns[-1]} shims"
+
+
+def projector_screw_text(rig) -> str:
+    """What the projector's step says about its screws' lengths, stack by stack."""
+    rows = projector_screw_rows(rig)
+    if not rows:
+        return ""
+    parts = []
+    for r in rows:
+        washers = "".join(f"; with {w} extra washer{'s' * (w > 1)} under the head for {n} shims"
+                          for n, w in r["extra_washers"].items())
+        parts.append(f"{r['item'].split(' socket')[0]} for a stack of {_stacks(r['stacks'])}{washers}")
+    return (" Each screw's length follows its own stack: " + ", ".join(parts) + " (the shortest ISO 4762 length "
+            "that engages the projector's thread without bottoming in it). When the alignment adds or takes out "
+            "shims, change that foot's screw to the length of its new stack.")
 
 
 def _camera_points(rig, meshes_by_name) -> list[tuple[float, float]]:
@@ -282,13 +326,25 @@ def assembly(rig, meshes) -> Assembly:
 __all__ = ["assembly", "bolt_fasteners", "driver", "groups", "instrument_fasteners", "spanner", "steps"]
 
 
-def hardware(steps: list[Step]) -> list[dict]:
+def hardware(steps: list[Step], rig=None) -> list[dict]:
     """The plan's fasteners as one list: each bolt or screw item with its count and the steps that use
-    it, then the nuts, washers and heat-set inserts they need (counted from the items)."""
+    it, then the nuts, washers and heat-set inserts they need (counted from the items). With ``rig``,
+    the projector's screws are one row per length, for the stacks it serves (:func:`projector_screw_rows`)."""
     rows: dict[str, dict] = {}
     extra: dict[str, int] = {}
+    per_length = projector_screw_rows(rig) if rig is not None else []
+    for r in per_length:
+        rows[r["item"]] = {"item": r["item"], "quantity": r["quantity"],
+                           "steps": [f"projector_body (stacks of {_stacks(r['stacks'])})"]}
+        thread = r["item"].split(" x ")[0]
+        extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + max(
+            r["extra_washers"].values(), default=0) * r["quantity"]
     for st in steps:
         for f in st.fasteners:
+            if per_length and st.name == "projector_body" and f.thread_in == "instrument":
+                washer = f"{f.item.split(' x ')[0]} washer (ISO 7089)"  # the screw: a row per length above
+                extra[washer] = extra.get(washer, 0) + 1
+                continue
             row = rows.setdefault(f.item, {"item": f.item, "quantity": 0, "steps": []})
             row["quantity"] += 1
             if st.name not in row["steps"]:
@@ -307,4 +363,4 @@ def hardware(steps: list[Step]) -> list[dict]:
     return out + [{"item": k, "quantity": v, "steps": "with the bolts above"} for k, v in extra.items()]
 
 
-__all__ += ["hardware"]
+__all__ += ["hardware", "projector_screw_rows", "projector_screw_text"]
