@@ -23,6 +23,7 @@ from pathlib import Path
 from rigcad._version import __version__
 from rigcad.manual import bom as B
 from rigcad.manual import calibration as C
+from rigcad.manual import tower_joints
 from rigcad.units import hours_minutes
 
 MIL = 0.0254  # mm
@@ -304,7 +305,7 @@ def _section_bill(d: Doc, c) -> None:
     hw = [[r["item"], r["quantity"], f"assembly steps: {r['steps']}", "as the assembly check fitted it"]
           for r in plan.hardware(steps, rig)]
     hw += [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"] if f.get("tower")
-           and "mounting holes" not in f["use"]]
+           and "mounting holes" not in f["use"] and not tower_joints.placed({"joins": f["use"]})]
     if bill["pins"]:
         pin = bill["pins"]
         hw.append([pin["item"], pin["quantity"], f"aligning split pieces ({pin['use']})", pin["note"]])
@@ -440,7 +441,9 @@ THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut wit
                                       "insert's outer diameter and melt the insert in flush with a soldering iron at "
                                       "its maker's temperature)",
              "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
-             "bench": "into the bench"}
+             "bench": "into the bench",
+             "trap": "a washer under the head; its nut waits in the square trap printed for it (put it in before "
+                     "the part with the trap stands on the bench), tighten crosswise by hand"}
 
 
 def assembly_order(rig, meshes):
@@ -472,7 +475,8 @@ def step_text(placed, meshes_by_name: dict) -> str:
     text += MOVES.get(_dir_name(placed.direction), f"move it in along {_dir_name(placed.direction)}").capitalize()
     text += (f" until it rests on the {', '.join(n.replace('_', ' ') for n in st.needs)}." if st.needs
              else " onto the bench.")
-    groups = Counter((f.item, f.tools[0].name, f.thread_in) for f in st.fasteners)
+    groups = Counter((f.item, f.tools[0].name, "trap" if f.thread_in == "nut" and f.nut_tool is None else f.thread_in)
+                     for f in st.fasteners)
     for (item, tool, thread_in), n in groups.items():
         text += f" Fix it with {n} x {item}, {THREAD_IN[thread_in]} (tool: {tool} or an L key)."
     return text
@@ -547,8 +551,8 @@ def _tower_rows_by_step(rig, steps) -> dict:
     names = [(s.name, m) for s in steps for m in s.members]
     out: dict = {}
     for h in B.tower_hardware(rig):
-        if "mounting holes" in h["joins"]:
-            continue  # the instruments' screws: the plan's
+        if "mounting holes" in h["joins"] or tower_joints.placed(h):
+            continue  # the instruments' screws and the tower joints' bolts: the plan's
         named = [s for s, m in names
                  if any(re.search(rf"\b{re.escape(k)}'?s?\b", h["joins"])
                         for k in {m.replace("_", " "), m.replace("tower_", "").replace("_body", "").replace("_", " ")})]

@@ -27,13 +27,16 @@ import re
 
 import numpy as np
 
-from rigcad.manual.assembly_check import Assembly, Fastener, Step, Tool, manifold, penetration
+from rigcad.manual.assembly_check import Assembly, Fastener, Step, manifold, penetration
+from rigcad.manual.fasteners import DOWN, DRIVER_BLADE_MM, HEX_KEY, L_KEY, NUT_AF, SPANNER_MM, UP  # noqa: F401
+from rigcad.manual.fasteners import driver, spanner  # noqa: F401
+from rigcad.manual.fasteners import metric as _metric  # noqa: F401
+from rigcad.manual.fasteners import socket_head as _socket_head
 
 #: Units one step places together: an instrument with the lens built onto it.
 UNITS = (("projector_body", "projector_lens"), ("camera_body", "camera_lens"))
 #: Parts that slide in from the side into slots or grooves before anything is lowered onto them.
 SIDEWAYS_FIRST = ("beam", "beam_splitter")
-DOWN, UP = (0.0, 0.0, -1.0), (0.0, 0.0, 1.0)
 SIDEWAYS = ((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1.0, 0.0))
 #: How far (mm) a part is moved down to find what it rests on: above CLEARANCE_MM (a contact shows), below
 #: the printed fits' gaps (0.2 mm and up: a part in a slot is not taken to rest on the slot's ceiling).
@@ -41,39 +44,8 @@ SIDEWAYS = ((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1.0, 0.0)
 #: parts under it within REST_SEARCH_MM (mm) hold it.
 REST_SEARCH_MM = 5.0
 REST_PROBE_MM = 0.08
-#: Hex key (mm across flats, ISO 4762 socket) per thread; 1/4-20 and 3/8-16 socket heads take 3/16 in and 5/16 in.
-HEX_KEY = {"M2": 1.5, "M2.5": 2.0, "M3": 2.5, "M4": 3.0, "M5": 4.0, "M6": 5.0, "M8": 6.0, "M10": 8.0, "M12": 10.0,
-           "1/4-20 UNC": 4.7625, "3/8-16 UNC": 7.9375}
-#: Nut width across flats (mm, ISO 4032) per metric thread: the open-end spanner's size.
-NUT_AF = {"M2": 4.0, "M2.5": 5.0, "M3": 5.5, "M4": 7.0, "M5": 8.0, "M6": 10.0, "M8": 13.0, "M10": 16.0, "M12": 18.0}
-#: The hex screwdriver's blade (mm): a hand needs this much straight room above a head.
-DRIVER_BLADE_MM = 100.0
-#: The open-end spanner's reach (mm, DIN 3110 for M3-M6 nuts: 90-120 mm long).
-SPANNER_MM = 80.0
 #: Heat-set insert (M thread -> outer diameter, length) as sold for printed parts (e.g. M4: 5.6 x 8.1 mm, hole 5.6 mm).
 INSERT = {"M3": (4.5, 5.7), "M4": (5.6, 8.1), "M5": (6.4, 9.5), "M6": (8.0, 12.7)}
-
-
-#: ISO 2936 hex keys: key (mm across flats) -> long arm, short arm (mm).
-L_KEY = {1.5: (45.0, 14.0), 2.0: (50.0, 16.0), 2.5: (56.0, 18.0), 3.0: (63.0, 20.0), 4.0: (70.0, 25.0),
-         4.7625: (80.0, 28.0), 5.0: (80.0, 28.0), 6.0: (90.0, 32.0), 7.9375: (100.0, 36.0), 8.0: (100.0, 36.0),
-         10.0: (112.0, 40.0)}
-
-
-def driver(thread: str, out_dir=(1.0, 0.0, 0.0)) -> tuple[Tool, ...]:
-    """A hex screwdriver with a DRIVER_BLADE_MM blade; else an L hex key (ISO 2936) with its short
-    arm in the socket and its long arm out along ``out_dir`` (away from the rig's axis)."""
-    key = HEX_KEY[thread]
-    r = key / np.sqrt(3.0) + 0.5  # the key's corners, and a little play for the hand
-    long, short = L_KEY[key]
-    return (Tool(f"{key:g} mm hex screwdriver (ISO 2936 hex), {DRIVER_BLADE_MM:g} mm blade", DRIVER_BLADE_MM, r),
-            Tool(f"{key:g} mm L hex key (ISO 2936, {long:g} x {short:g} mm), short arm in", short, r, long,
-                 tuple(float(v) for v in out_dir)))
-
-
-def spanner(thread: str, nut_height: float) -> Tool:
-    # its jaws are about as thick as the nut is high: a cylinder of that diameter along its way out
-    return Tool(f"{NUT_AF[thread]:g} mm open-end spanner (DIN 3110)", SPANNER_MM, nut_height / 2 + 0.5)
 
 
 def _stem(name: str) -> str:
@@ -90,21 +62,6 @@ def groups(meshes) -> list[tuple[str, tuple[str, ...]]]:
         key = unit_of.get(m.name, _stem(m.name))
         out.setdefault(key, []).append(m.name)
     return [(k, tuple(v)) for k, v in out.items()]
-
-
-def _metric(thread: str):
-    from rigcad.manual.bom import METRIC
-
-    return next(r for r in METRIC if r[0] == thread)
-
-
-def _socket_head(item: str, head, axis, length: float, d: float, thread: str, **kw) -> Fastener:
-    h = np.array([head[0], head[1], 0.0])
-    out = tuple(h / np.linalg.norm(h)) if np.linalg.norm(h) > 1e-9 else (1.0, 0.0, 0.0)
-    if abs(np.dot(out, axis)) > 0.9:
-        out = (0.0, 0.0, -1.0)
-    return Fastener(item, tuple(float(v) for v in head), axis, float(length), d / 2, 0.75 * d, d,
-                    driver(thread, out), **kw)
 
 
 def bolt_fasteners(bolt: dict) -> tuple[Fastener, ...]:
@@ -283,7 +240,11 @@ def steps(rig, meshes) -> tuple[list[Step], dict]:
         options = bolt_fasteners(b)
         fits = [f for f in options if penetration(f.solids(), whole) <= _clearance()]
         bolts.setdefault(b["upper"], []).append((fits or options)[0])
+    from rigcad.manual.tower_joints import tower_fasteners
+
     screws = instrument_fasteners(rig, by_name)
+    for name, fs in tower_fasteners(rig, by_name).items():
+        screws[name] = screws.get(name, ()) + fs
     out = []
     for name, members in groups(meshes):
         fasteners = tuple(f for m in members for f in bolts.get(m, ())) + screws.get(name, ())
@@ -352,7 +313,9 @@ def hardware(steps: list[Step], rig=None) -> list[dict]:
             thread = f.item.split(" x ")[0]
             if f.thread_in == "nut":
                 extra[f"{thread} hex nut (ISO 4032)"] = extra.get(f"{thread} hex nut (ISO 4032)", 0) + 1
-                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 2
+                # a nut in a printed trap bears on the part: one washer, under the head
+                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + (
+                    1 if f.nut_tool is None else 2)
             else:
                 extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 1
             if f.thread_in == "insert":
