@@ -125,3 +125,29 @@ def test_scalar_rhs_agrees_with_the_vectorised_one(table31_geometry, far_geometr
     vec = dt_ds(g, s, t)
     sca = np.array([rhs(a, [b])[0] for a, b in zip(s, t)])
     assert np.max(np.abs(vec - sca)) < 1e-12 * np.max(np.abs(vec))  # same formulas, round-off only
+
+
+def test_a_dome_through_the_paraboloid_or_not_finite_is_refused(table31_geometry):
+    """_check_clear against the paraboloid's closed form r(z) = sqrt(4 f (z_v - z)) between its rim and
+    vertex: a dome point just inside it is refused naming layout.sample_to_rim, one just outside (or
+    above the vertex, or below the rim) is not; a non-finite point is refused naming
+    paraboloid.tangent_angle."""
+    from rigcad.errors import GeometryError
+    from rigcad.optics.dome import _check_clear
+
+    g = table31_geometry
+    z = np.array([g.rim_z, 0.5 * (g.rim_z + g.vertex_z), g.vertex_z - 1e-3])
+    r = np.sqrt(4 * g.focal_length * (g.vertex_z - z))
+    clear = np.column_stack([r * (1 + 1e-9) + 1e-12, z])
+    _check_clear(g, clear)  # outside the paraboloid at its rim, middle and near its vertex
+    _check_clear(g, np.array([[0.0, g.vertex_z + 1e-6], [0.0, g.rim_z - 1e-6]]))  # on the axis, out of its band
+    for k in range(3):
+        inside = clear.copy()
+        inside[k, 0] = r[k] * (1 - 1e-9)
+        with pytest.raises(GeometryError) as info:
+            _check_clear(g, inside)
+        assert info.value.param == "layout.sample_to_rim" and "passes through the paraboloid" in str(info.value)
+    bad = np.vstack([clear, [np.nan, 0.0]])
+    with pytest.raises(GeometryError) as info:
+        _check_clear(g, bad)
+    assert info.value.param == "paraboloid.tangent_angle" and "not finite" in str(info.value)
