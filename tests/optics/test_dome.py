@@ -146,11 +146,15 @@ def test_a_dome_through_the_paraboloid_or_not_finite_is_refused(table31_geometry
         inside[k, 0] = r[k] * (1 - 1e-9)
         with pytest.raises(GeometryError) as info:
             _check_clear(g, inside)
-        assert info.value.param == "layout.sample_to_rim" and "passes through the paraboloid" in str(info.value)
+        assert info.value.param == "layout.sample_to_rim" and str(info.value) == (
+            "the dome profile passes through the paraboloid: move the paraboloid away from the sample "
+            "(layout.sample_to_rim) or reduce its size (paraboloid.vertical_extent / rim_radius)")
     bad = np.vstack([clear, [np.nan, 0.0]])
     with pytest.raises(GeometryError) as info:
         _check_clear(g, bad)
-    assert info.value.param == "paraboloid.tangent_angle" and "not finite" in str(info.value)
+    assert info.value.param == "paraboloid.tangent_angle" and str(info.value) == (
+        "the dome profile is not finite: the paraboloid reflects rays back onto themselves; "
+        "check paraboloid.tangent_angle and layout")
 
 
 def _reflect(d, x, f):
@@ -346,3 +350,33 @@ def test_an_unreachable_automatic_tolerance_keeps_the_best_result(table31_geomet
     assert "float64 resolves on distances of" in str(info.value)
     asked = float(str(info.value).split("ask for ")[1].split(" mm")[0])
     assert asked == pytest.approx(dome.error_estimate, rel=0.05)  # the best estimate reached, named
+
+
+def test_a_paraboloid_that_occludes_nothing_lets_the_dome_run_to_the_vertex_ray(table31_geometry):
+    """With the rim seen at theta = 0 from O nothing is occluded: the dome runs to s = 0 (no root
+    to search); the reflected rays' record keeps the radii it was asked for."""
+    from dataclasses import replace
+
+    from rigcad.optics.dome import occlusion_s, reflected_rays, start
+
+    g = table31_geometry
+    assert occlusion_s(replace(g, occlusion_theta=0.0), start(g).path_length) == 0.0
+    s = np.array([1.0, 2.5, g.rim_radius])
+    assert np.array_equal(reflected_rays(g, s).s, s)
+
+
+def test_a_failed_integration_and_an_unknown_method_are_refused(table31_geometry, monkeypatch):
+    """scipy's failure is reported with the method, the tolerance and scipy's own message; an unknown
+    method names itself. The default sampling: 2001 rows, 2000 Euler steps."""
+    import scipy.integrate
+    from types import SimpleNamespace
+
+    g = table31_geometry
+    assert len(build_dome(g, "equal_path").s) == 2001
+    assert build_dome(g, "euler").stats["step_mm"] == g.rim_radius / 2000
+    with pytest.raises(ValueError, match=r"^unknown dome method 'rk4'$"):
+        build_dome(g, "rk4")
+    monkeypatch.setattr(scipy.integrate, "solve_ivp", lambda *a, **k: SimpleNamespace(success=False, message="step too small"))
+    with pytest.raises(IntegrationError) as info:
+        build_dome(g, "dop853", tolerance=1e-7)
+    assert str(info.value) == "dome integration (dop853, tolerance 1e-07 mm) failed: step too small"
