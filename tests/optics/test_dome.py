@@ -6,6 +6,7 @@ return to O (checked by the 2D tracer in test_trace2d.py).
 """
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -207,8 +208,9 @@ def test_start_refuses_a_rim_ray_that_never_comes_down_or_lands_inside_the_rim(f
     with pytest.raises(GeometryError) as info:
         start(flat)
     assert info.value.param == "paraboloid.tangent_angle"
-    assert "goes upward (direction" in str(info.value)
-    assert "reaches the sample plane: lower paraboloid.tangent_angle" in str(info.value)
+    assert re.fullmatch(r"the ray reflected at the paraboloid's rim goes upward \(direction [+-]0\.000 in z\) and never "
+                        r"reaches the sample plane: lower paraboloid\.tangent_angle \(or raise focal_length / rim_radius\)",
+                        str(info.value)), str(info.value)
     high = replace(g, vertex_z=10.0 + g.focal_length, focus_z=10.0,  # the focus 10 mm above the sample
                    rim_z=10.0 + g.focal_length - g.vertical_extent)
     s = g.rim_radius
@@ -217,8 +219,9 @@ def test_start_refuses_a_rim_ray_that_never_comes_down_or_lands_inside_the_rim(f
     with pytest.raises(GeometryError) as info:
         start(high)
     assert info.value.param == "layout.sample_to_rim"
-    assert f"reaches the sample plane at r = {r:.3f} mm, inside the paraboloid's rim ({s:.3f} mm)" in str(info.value)
-    assert "or paraboloid.tangent_angle" in str(info.value)
+    assert str(info.value) == (f"the rim ray reaches the sample plane at r = {r:.3f} mm, inside the paraboloid's rim "
+                               f"({s:.3f} mm): the dome would meet the paraboloid; raise layout.sample_to_rim "
+                               "or paraboloid.tangent_angle")
 
 
 def test_euler_polyline_is_built_ray_by_ray_by_its_bisecting_mirrors(table31_geometry):
@@ -380,3 +383,29 @@ def test_a_failed_integration_and_an_unknown_method_are_refused(table31_geometry
     with pytest.raises(IntegrationError) as info:
         build_dome(g, "dop853", tolerance=1e-7)
     assert str(info.value) == "dome integration (dop853, tolerance 1e-07 mm) failed: step too small"
+
+
+def test_a_tolerance_near_the_float64_floor_names_the_floor_and_what_to_ask_for(table31_geometry):
+    """The floor is 100 eps on the largest distance 2 t_rim (scipy's smallest rtol): a tolerance under
+    10x the floor cannot get a reference solve 10x tighter and is refused at once, asking for 100x the
+    floor; one just over 10x gets one pair of solves, misses, and is refused at the next local
+    tolerance asking for the estimate it reached."""
+    from rigcad.optics.dome import start
+
+    g = table31_geometry
+    t_rim = start(g).t
+    floor = 100 * np.finfo(float).eps * 2 * t_rim
+    below = 9.5 * floor
+    with pytest.raises(IntegrationError) as info:
+        build_dome(g, "dop853", tolerance=below, rows=101)
+    assert info.value.param == "dome.tolerance"
+    assert str(info.value) == (
+        f"dome.tolerance = {below:g} mm cannot be certified with dop853: estimating the global error needs a "
+        f"reference solve 10x tighter than local tolerance {below:.0e} mm, below the {floor:.1e} mm that float64 "
+        f"resolves on distances of {2 * t_rim:.0f} mm; ask for {100 * floor:.0e} mm or more")
+    above = 10.5 * floor
+    with pytest.raises(IntegrationError) as info:
+        build_dome(g, "dop853", tolerance=above, rows=101)
+    message = str(info.value)
+    assert f"than local tolerance {above / 10:.0e} mm" in message
+    assert float(message.split("ask for ")[1].split(" mm")[0]) > above  # the estimate its one pair reached
