@@ -252,3 +252,41 @@ def test_thin_lens_edge_rays_leave_the_aperture_edges_for_the_focal_point(design
         assert np.allclose(miss, edge.miss, rtol=0, atol=1e-12, equal_nan=True)
         assert np.count_nonzero(np.isfinite(miss)) >= len(dirs) - 2  # a lost ray or two at the ends
         assert np.nanmax(np.abs(miss)) > 1e-3
+
+
+def test_convergence_error_figures_of_a_known_trace():
+    """The figures from a trace built by hand: rays arriving at known angles along lines through a known
+    point X (their returning direction (-sin theta, -cos theta)), misses known; lost rays dropped from
+    the misses and from the angle errors (lost in either trace), counted; no ray at all gives NaN."""
+    from types import SimpleNamespace
+
+    X = np.array([0.4, -0.3])
+    theta = np.radians([20.0, 40.0, 60.0, 75.0, 85.0])
+    back = np.column_stack([-np.sin(theta), -np.cos(theta)])
+    D = X - np.array([[200.0], [220.0], [250.0], [270.0], [300.0]]) * back
+    ok = np.array([True, True, True, False, True])
+    tr = SimpleNamespace(ok=ok, theta=theta, miss=np.array([0.3, -0.4, 0.0, 9.0, 1.2]), dome_point=D)
+    ref = SimpleNamespace(ok=np.array([True, False, True, True, True]),
+                          theta=theta - np.array([1e-3, 5.0, -2e-3, 7.0, 5e-4]))
+    err = convergence_error(tr, ref)
+    assert err == {"rms_miss_mm": pytest.approx(math.sqrt((0.09 + 0.16 + 0 + 1.44) / 4), rel=1e-14),
+                   "max_miss_mm": 1.2,
+                   "convergence_point_x_mm": pytest.approx(X[0], abs=1e-9),
+                   "convergence_point_z_mm": pytest.approx(X[1], abs=1e-9),
+                   "max_theta_error_rad": pytest.approx(2e-3, rel=1e-9),
+                   "rays_lost": 1, "rays": 5}
+    none = convergence_error(SimpleNamespace(ok=np.zeros(5, bool), theta=theta, miss=tr.miss, dome_point=D), ref)
+    assert none["rays_lost"] == 5 and none["rays"] == 5
+    assert all(math.isnan(none[k]) for k in ("rms_miss_mm", "max_miss_mm", "convergence_point_x_mm",
+                                              "convergence_point_z_mm", "max_theta_error_rad"))
+
+
+def test_no_misalignment_offsets_and_tilts_nothing_about_the_meridional_normal():
+    """Misalignment.none(): every component unmoved, untilted, its tilt axis the y axis (normal to the
+    meridional plane x-z, the axis of the 2D study's tilts)."""
+    from rigcad.optics.frames import COMPONENTS, Misalignment
+
+    m = Misalignment.none()
+    assert set(m.offsets) == set(m.tilts) == set(m.axes) == set(COMPONENTS)
+    for c in COMPONENTS:
+        assert m.offsets[c] == (0.0, 0.0, 0.0) and m.tilts[c] == 0.0 and m.axes[c] == (0.0, 1.0, 0.0), c
