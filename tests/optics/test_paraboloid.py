@@ -79,3 +79,26 @@ def test_rays_through_the_rim_count_whichever_way_they_rounded():
         vs.append(np.array([np.nextafter(vs[-1][0], np.inf), vs[-1][1]]))
     vs = np.array(vs)
     assert PARA.blocks(np.tile(below, (len(vs), 1)), vs, np.full(len(vs), 100.0)).all()
+
+
+def test_blocks_segments_through_the_rim_chord_or_the_surface_and_no_others():
+    """Segments built from where they cross the body's rim chord (z = rim_z, |x - dx| <= rim) at a
+    known distance l: blocked when they reach it (l < length, from 0.5 mm or 10 mm below), not when
+    they stop 0.5 mm short, not when the crossing lies outside the rim; a segment through the surface
+    is blocked, one that stops 0.5 mm before the surface is not."""
+    v = unit(np.array([[0.3, 1.0]]))[0]
+    rim, dx, zc = PARA.rim_radius, PARA.dx, PARA.rim_z
+    cases = []  # (origin, direction, length, blocked)
+    for x_at_chord, l in ((dx - rim + 4.0, 10.0), (dx + rim - 0.5, 0.5), (dx + 2.0, 10.0)):
+        origin = np.array([x_at_chord, zc]) - l * v
+        cases += [(origin, v, l + 0.5, True), (origin, v, l - 0.4, False)]
+    outside = np.array([dx + rim + 0.5, zc]) - 10.0 * v
+    cases.append((outside, v, 10.5, False))
+    down = np.array([0.0, -1.0])
+    above = np.array([dx + 5.0, PARA.z(dx + 5.0) + 3.0])  # 3 mm above the surface, going down
+    cases += [(above, down, 3.5, True), (above, down, 2.5, False)]
+    origins = np.array([c[0] for c in cases])
+    dirs = np.array([c[1] for c in cases])
+    lengths = np.array([c[2] for c in cases])
+    expected = np.array([c[3] for c in cases])
+    assert np.array_equal(PARA.blocks(origins, dirs, lengths), expected)
