@@ -335,7 +335,9 @@ def _unreached(mine: list[dict], explained: dict) -> list[str]:
     lines = ["OPEN, no test of the group reaches these functions (mutants by number; `mutmut show` in "
              "build/mutate/<group>/ gives each diff):", ""]
     for function, numbers in by_function.items():
-        lines.append(f"- `{function}`: {len(numbers)} ({', '.join(sorted(numbers, key=int))})")
+        numbers = sorted(numbers, key=int)
+        every = numbers == [str(i) for i in range(1, len(numbers) + 1)]  # no test reaches the function
+        lines.append(f"- `{function}`: {len(numbers)} ({'all its mutants' if every else ', '.join(numbers)})")
     return lines + [""]
 
 
