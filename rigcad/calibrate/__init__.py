@@ -5,7 +5,8 @@ rig's misalignment with its own analytic tracer, the dome's residual slope map a
 pixel -> incidence map come from those rays (docs/calibrate.md).
 
 Modules: ``patterns`` (what the screen shows), ``decode`` (camera images -> screen points),
-``raxel`` (screen points -> rays), ``model`` (the rig's tracer as the forward model), ``simulate``
+``bias`` (the decoding's own bias, from the measured map), ``raxel`` (screen points ->
+rays), ``model`` (the rig's tracer as the forward model), ``simulate``
 (the images a capture would give), ``fit`` (the misalignment by least squares), ``maps`` (measured
 rays, residual slopes, the corrected map), ``images`` (reading and checking a capture), ``run`` (the
 stages, and a simulation's comparison with what was planted), ``kit`` (screen PNGs, spacers, the

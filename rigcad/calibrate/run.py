@@ -10,7 +10,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rigcad.calibrate import maps, model as M
+import dataclasses
+
+from rigcad.calibrate import bias as B, maps, model as M
 from rigcad.calibrate.decode import decode
 from rigcad.calibrate.fit import FitData, fit
 from rigcad.calibrate.patterns import Sequence
@@ -18,6 +20,9 @@ from rigcad.calibrate.patterns import Sequence
 
 #: Pixels within this many of an undecoded pixel are left out of the fit (the maps fill them).
 EDGE_PX = 2
+#: The decoding's own bias (:mod:`rigcad.calibrate.bias`) is removed from the decoded points before
+#: the fit: "map" (predicted from the measured map itself), or None (kept, for comparison).
+DECODING_BIAS = "map"
 
 
 @dataclass
@@ -44,9 +49,11 @@ class Calibration:
                 "pixels": int(g.size)}
 
 
-def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: None, check=None) -> Calibration:
+def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: None, check=None,
+              bias: str | None = DECODING_BIAS) -> Calibration:
     """Calibrate from ``images`` (per spacer, frame name -> full camera image as float, checked).
-    ``check(decoded)``: called with the decoded captures before the fit (it raises to refuse them)."""
+    ``check(decoded)``: called with the decoded captures before the fit (it raises to refuse them).
+    ``bias``: how the decoding's own bias is removed (:data:`DECODING_BIAS`)."""
     cal = rig.profile.calibration
     seq = Sequence.from_profile(cal)
     cam = M.Camera.of(rig)
@@ -57,6 +64,8 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     if check is not None:
         check(decoded)
     say(f"decoded {', '.join(str(d.stats()['decoded_pixels']) for d in decoded)} camera pixels per height")
+    if bias == "map":
+        decoded = _unbiased(decoded, B.map_bias(decoded, cam.shape, seq, cal.sim_blur))
     data = _fit_data(cam, decoded, cal.fit_stride)
     result = fit(optics, rig, cam, heights, data, say)
     t2 = time.perf_counter()
@@ -79,6 +88,15 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     design = cam.design.direction(pixel_rays(cam.design, cam.x_px, cam.y_px).dirs)
     return Calibration(cam, heights, decoded, result, model_tr, measured, slopes, corrected, design,
                        {"decode_s": t1 - t0, "fit_s": t2 - t1, "maps_s": t3 - t2})
+
+
+def _unbiased(decoded: list, bias: np.ndarray) -> list:
+    """The decoded points minus the decoding's bias (n, heights, 2) mm (unchanged where it is NaN)."""
+    out = []
+    for k, d in enumerate(decoded):
+        du, dv = (np.nan_to_num(bias[:, k, a]).reshape(d.u.shape) for a in range(2))
+        out.append(dataclasses.replace(d, u=d.u - du, v=d.v - dv))
+    return out
 
 
 def _fit_data(cam: M.Camera, decoded: list, stride: int) -> FitData:

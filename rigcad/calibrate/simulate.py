@@ -107,7 +107,7 @@ def random_misalignment(rig, heights: int, rng: np.random.Generator) -> np.ndarr
     return theta
 
 
-def _sub_offsets(s: int) -> np.ndarray:
+def sub_offsets(s: int) -> np.ndarray:
     return (np.arange(s) + 0.5) / s - 0.5
 
 
@@ -120,7 +120,7 @@ def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.
     cal = rig.profile.calibration
     s = cal.sim_supersample
     true_rig = M.moved(rig, theta)
-    off = _sub_offsets(s)
+    off = sub_offsets(s)
     ox, oy = [a.ravel() for a in np.meshgrid(off, off)]
     n = len(cam.x_px)
     x = (cam.x_px[:, None] + ox[None, :]).ravel()
@@ -131,7 +131,7 @@ def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.
     for pose in M.screens(heights, theta):
         su, sv = tr.screen(pose)
         cx, cy = seq.from_mm(su, sv)
-        edges = _sub_edges(cx.reshape(n, s, s), cy.reshape(n, s, s), cam.shape)
+        edges = sub_edges(cx.reshape(n, s, s), cy.reshape(n, s, s), cam.shape)
         frames = {}
         lit = np.repeat(tr.ok.reshape(n, s * s).any(axis=1), s * s)  # pixels with a sub-ray on a screen's side
         means = seq.footprint_means(seq.names(), np.nan_to_num(cx[lit], nan=-1e9), np.nan_to_num(cy[lit], nan=-1e9),
@@ -147,7 +147,7 @@ def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.
     return out
 
 
-def _sub_edges(cx: np.ndarray, cy: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+def sub_edges(cx: np.ndarray, cy: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     """Each sub-ray's footprint edges on the screen (n * s * s, 2, 2) px: the landing point's change
     over one sub-pixel step along the camera's columns and rows, from neighbouring pixels' centre
     sub-rays (central differences over the window; NaN neighbours give a point sample)."""

@@ -16,6 +16,7 @@ Frame: the part's working position, mm, rad.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -46,7 +47,7 @@ _BIG = 1e4
 TONGUE_DEPTHS = (None, 4.0, 3.0, 2.0)
 TONGUE_MAX_WIDTH = 3.0
 TONGUE_MIN_AREA = 5.0
-#: Grid splits of flat / off-axis parts: cuts per axis tried.
+#: Grid splits of flat, off-axis or tall parts: pieces per axis tried.
 GRID_COUNTS = (1, 2, 3, 4, 5, 6)
 
 
@@ -87,11 +88,14 @@ class Pin:
 
 @dataclass(frozen=True)
 class GridPlan:
-    """A flat or off-axis part cut by vertical planes in its own bounding box: ``x_cuts`` (planes
-    x = c) and ``y_cuts`` (planes y = c), mm; cell (i, j) is the i-th x slab and j-th y slab."""
+    """A flat, off-axis or tall part cut by planes in its own bounding box: ``x_cuts`` (planes
+    x = c), ``y_cuts`` (planes y = c) and ``z_cuts`` (planes z = c: a tall column is cut across its
+    height into stacked pieces, as a fabricator would), mm; cell (i, j, k) is the i-th x slab, j-th
+    y slab and k-th z slab."""
 
     x_cuts: tuple[float, ...]
     y_cuts: tuple[float, ...]
+    z_cuts: tuple[float, ...] = ()
 
     @property
     def nx(self) -> int:
@@ -102,8 +106,19 @@ class GridPlan:
         return len(self.y_cuts) + 1
 
     @property
+    def nz(self) -> int:
+        return len(self.z_cuts) + 1
+
+    @property
     def count(self) -> int:
-        return self.nx * self.ny
+        return self.nx * self.ny * self.nz
+
+    def cells(self) -> list[tuple[int, int, int]]:
+        """Every cell (i, j, k), z slabs outermost, then y, then x."""
+        return [(i, j, k) for k in range(self.nz) for j in range(self.ny) for i in range(self.nx)]
+
+    def cuts(self, axis: int) -> tuple[float, ...]:
+        return (self.x_cuts, self.y_cuts, self.z_cuts)[axis]
 
     # the sector interface (no sectors: pieces orient as generic parts)
     sectors = 1
@@ -113,9 +128,10 @@ class GridPlan:
         return None
 
     def describe(self) -> dict:
-        return {"kind": "grid of vertical planes in the part's bounding box", "sectors": 1, "bands": 1,
-                "grid": [self.nx, self.ny], "pieces": self.count, "x_cuts_mm": list(self.x_cuts),
-                "y_cuts_mm": list(self.y_cuts), "sector_planes_deg": [], "band_cuts_z_mm": []}
+        return {"kind": "grid of planes in the part's bounding box", "sectors": 1, "bands": 1,
+                "grid": [self.nx, self.ny, self.nz], "pieces": self.count, "x_cuts_mm": list(self.x_cuts),
+                "y_cuts_mm": list(self.y_cuts), "z_cuts_mm": list(self.z_cuts), "sector_planes_deg": [],
+                "band_cuts_z_mm": []}
 
 
 @dataclass
@@ -160,18 +176,17 @@ def cell(man: m3d.Manifold, plan: SplitPlan, i: int, j: int) -> m3d.Manifold:
     return out
 
 
-def grid_cell(man: m3d.Manifold, plan: GridPlan, i: int, j: int) -> m3d.Manifold:
-    """Cell (x slab i, y slab j) of ``man``."""
+def grid_cell(man: m3d.Manifold, plan: GridPlan, i: int, j: int, k: int = 0) -> m3d.Manifold:
+    """Cell (x slab i, y slab j, z slab k) of ``man``."""
     out = man
-    xs, ys = plan.x_cuts, plan.y_cuts
-    if i > 0:
-        out = out.trim_by_plane((1.0, 0.0, 0.0), xs[i - 1])
-    if i < len(xs):
-        out = out.trim_by_plane((-1.0, 0.0, 0.0), -xs[i])
-    if j > 0:
-        out = out.trim_by_plane((0.0, 1.0, 0.0), ys[j - 1])
-    if j < len(ys):
-        out = out.trim_by_plane((0.0, -1.0, 0.0), -ys[j])
+    for axis, idx in enumerate((i, j, k)):
+        cuts = plan.cuts(axis)
+        normal = [0.0, 0.0, 0.0]
+        normal[axis] = 1.0
+        if idx > 0:
+            out = out.trim_by_plane(tuple(normal), cuts[idx - 1])
+        if idx < len(cuts):
+            out = out.trim_by_plane(tuple(-v for v in normal), -cuts[idx])
     return out
 
 
@@ -184,46 +199,59 @@ def is_off_axis(man: m3d.Manifold, rtol: float = 0.05) -> bool:
     return bool(np.any(np.abs(c) > rtol * size))
 
 
+def _grid_options(size: np.ndarray) -> list[tuple[int, int, int]]:
+    """Cut counts (x, y, z) to try: fewest pieces first; among equal counts, the most cuts across
+    the longest side (sides equal to rounding, 1e-9 of the size, in x, y, z order on every CPU)."""
+    tol = 1e-9 * float(size.max())
+
+    def longer_first(a: int, b: int) -> int:
+        return -1 if size[a] > size[b] + tol else 1 if size[b] > size[a] + tol else a - b
+
+    order = sorted(range(3), key=functools.cmp_to_key(longer_first))
+    return sorted(((a, b, c) for a in GRID_COUNTS for b in GRID_COUNTS for c in GRID_COUNTS),
+                  key=lambda n: (n[0] * n[1] * n[2], tuple(-n[a] for a in order)))
+
+
 def plan_grid(man: m3d.Manifold, fits) -> GridPlan:
-    """The fewest-pieces grid of equal slabs (x cuts then y cuts, the long side cut first) whose
-    every cell ``fits(cell_manifold, plan, i, j)``; raises if none."""
+    """The fewest-pieces grid of equal slabs (the long side cut first; a tall part is cut across
+    its height) whose every cell ``fits(cell_manifold, plan, i, j)``; raises if none."""
     bb = np.asarray(man.bounding_box(), dtype=float)
-    x0, y0, x1, y1 = bb[0], bb[1], bb[3], bb[4]
-    # the long side, a square's (equal to rounding: 1e-9 of the size) counted as x on every CPU
-    long_x = (x1 - x0) >= (y1 - y0) - 1e-9 * max(x1 - x0, y1 - y0)
-    options = sorted(((a, b) for a in GRID_COUNTS for b in GRID_COUNTS),
-                     key=lambda ab: (ab[0] * ab[1], -ab[0] if long_x else -ab[1]))
-    for nx, ny in options:
-        plan = GridPlan(tuple(float(v) for v in np.linspace(x0, x1, nx + 1)[1:-1]),
-                        tuple(float(v) for v in np.linspace(y0, y1, ny + 1)[1:-1]))
-        if all(fits(grid_cell(man, plan, i, j), plan, i, j) for i in range(nx) for j in range(ny)):
+    for n in _grid_options(bb[3:] - bb[:3]):
+        plan = GridPlan(*(tuple(float(v) for v in np.linspace(bb[a], bb[a + 3], n[a] + 1)[1:-1]) for a in range(3)))
+        if all(fits(grid_cell(man, plan, i, j, k), plan, i, j) for i, j, k in plan.cells()):
             return plan
-    raise FabricationError(f"no grid of up to {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} pieces fits this printer; "
-                           "use a larger printer")
+    raise FabricationError(f"no grid of up to {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} pieces "
+                           "fits this printer; use a larger printer or buy the part (the profile's buy section)")
 
 
 def _grid_interfaces(plan: GridPlan):
+    """Every face between two neighbouring cells: (name, normal, origin, keep), ``keep`` the
+    points inside the face's slabs of the two other axes."""
     out = []
-    xs = (-_BIG, *plan.x_cuts, _BIG)
-    ys = (-_BIG, *plan.y_cuts, _BIG)
-    for k, x in enumerate(plan.x_cuts):
-        for j in range(plan.ny):
-            def keep(p, lo=ys[j], hi=ys[j + 1]):
-                return (p[:, 1] > lo) & (p[:, 1] < hi)
-            out.append((f"x cut {x:.1f} mm, y slab {j + 1}", np.array([1.0, 0.0, 0.0]), np.array([x, 0.0, 0.0]), keep))
-    for k, y in enumerate(plan.y_cuts):
-        for i in range(plan.nx):
-            def keep(p, lo=xs[i], hi=xs[i + 1]):
-                return (p[:, 0] > lo) & (p[:, 0] < hi)
-            out.append((f"y cut {y:.1f} mm, x slab {i + 1}", np.array([0.0, 1.0, 0.0]), np.array([0.0, y, 0.0]), keep))
+    slabs = [(-_BIG, *plan.cuts(a), _BIG) for a in range(3)]
+    for axis in range(3):
+        others = [a for a in range(3) if a != axis]
+        for c in plan.cuts(axis):
+            for s0 in range(len(slabs[others[0]]) - 1):
+                for s1 in range(len(slabs[others[1]]) - 1):
+                    lo = np.array([slabs[others[0]][s0], slabs[others[1]][s1]])
+                    hi = np.array([slabs[others[0]][s0 + 1], slabs[others[1]][s1 + 1]])
+
+                    def keep(p, lo=lo, hi=hi, others=others):
+                        q = p[:, others]
+                        return np.all((q > lo) & (q < hi), axis=1)
+                    n, o = np.zeros(3), np.zeros(3)
+                    n[axis], o[axis] = 1.0, c
+                    name = f"{'xyz'[axis]} cut {c:.1f} mm, {'xyz'[others[0]]} slab {s0 + 1}, {'xyz'[others[1]]} slab {s1 + 1}"
+                    out.append((name, n, o, keep))
     return out
 
 
 def _grid_planes_clear(pts: np.ndarray, plan: GridPlan, face_normal: np.ndarray, face_origin: np.ndarray,
                        margin: float) -> np.ndarray:
     ok = np.ones(len(pts), bool)
-    for axis, cuts in ((0, plan.x_cuts), (1, plan.y_cuts)):
-        for c in cuts:
+    for axis in range(3):
+        for c in plan.cuts(axis):
             if abs(face_normal[axis]) > 0.5 and abs(face_origin[axis] - c) < 1e-9:
                 continue
             ok &= np.abs(pts[:, axis] - c) >= margin
@@ -582,12 +610,12 @@ def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
         holes = [_cylinder(np.array(p.axis), np.array(p.centre), pin.hole_radius, pin.depth) for p in pins]
         drilled = m3d.Manifold.batch_boolean([man, *holes], m3d.OpType.Subtract)
         pieces = []
-        for j in range(plan.ny):
-            for i in range(plan.nx):
-                tag = ([f"x{i + 1}of{plan.nx}"] if plan.nx > 1 else []) + ([f"y{j + 1}of{plan.ny}"] if plan.ny > 1 else [])
-                piece = grid_cell(drilled, plan, i, j)
-                if not piece.is_empty():
-                    pieces.append(Piece(f"{name}_{'_'.join(tag)}", i, j, None, piece))
+        counts = (plan.nx, plan.ny, plan.nz)
+        for cell_index in plan.cells():
+            tag = [f"{'xyz'[a]}{cell_index[a] + 1}of{counts[a]}" for a in range(3) if counts[a] > 1]
+            piece = grid_cell(drilled, plan, *cell_index)
+            if not piece.is_empty():
+                pieces.append(Piece(f"{name}_{'_'.join(tag)}", cell_index[0], cell_index[1], None, piece))
         return pieces, pins, drilled
     tg = make_tongues(man, plan, pin, mirror)
     if tongues is not None:

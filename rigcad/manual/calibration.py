@@ -70,6 +70,35 @@ def film_shadows(rig) -> dict:
             "cop_z_mm": zc, "rim_z_mm": g.rim_z, "rim_radius_mm": g.rim_radius, "beam_top_z_mm": beam_top}
 
 
+#: Matte drafting film (polyester) for the film test: thin enough to lie flat on the plate's top, matte
+#: so the spot shows from below; the disc reaches FILM_MARGIN_MM past the bore to be taped down.
+FILM_THICKNESS_MM = 0.075
+FILM_MARGIN_MM = 20.0
+#: Room (mm) under the base plate's underside to look up through its bore: a 45 deg mirror as wide as
+#: the bore needs its width in height, and this much more for the hand and the phone.
+VIEW_MARGIN_MM = 10.0
+
+
+def film_setup(rig) -> dict:
+    """How the film of the circle test lies at the sample plane (mm): on the base plate's top, which is
+    the dome's base plane and the sample plane z = 0 by design, across the plate's bore (the sample
+    holder taken out), centred by the camera_cross_base (its cross's top is z = 0, its body fits the
+    bore as the holder does); seen from below through the bore, the rig lifted on three blocks. The
+    tongue reaches lower than the disc by ``tongue_below_disc_mm``: the disc's blocks are that much
+    taller than the tongue's. ``direct_light_seen``: whether light past the rim (outside the
+    paraboloid's shadow) falls inside the bore."""
+    p, t = rig.profile, rig.layout.tower
+    bore = p.sample_holder.radius + p.sample_holder.clearance
+    view = 10.0 * math.ceil((2 * bore + VIEW_MARGIN_MM) / 10.0)
+    below = (-p.base_plate.thickness) - t.bench_z if t is not None else 0.0
+    shadow = film_shadows(rig)["paraboloid_shadow_radius_mm"]
+    return {"bore_radius_mm": bore, "film_diameter_mm": 2 * (bore + FILM_MARGIN_MM),
+            "film_thickness_mm": FILM_THICKNESS_MM, "plate_thickness_mm": p.base_plate.thickness,
+            "block_under_disc_mm": view, "block_under_tongue_mm": view - below, "tongue_below_disc_mm": below,
+            "paraboloid_shadow_radius_mm": shadow, "direct_light_seen": shadow < bore,
+            "dome_bolts": len(rig.layout.bolt_angles)}
+
+
 def projector_shadows(rig, distances=PROJECTOR_DISTANCES_MM) -> dict:
     """The projector crosses' shadows on the backplate, aligned and per mm of projector offset."""
     c = rig.profile.crosses
@@ -94,7 +123,7 @@ def camera_crosses(rig) -> dict:
             "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
 
 
-__all__ = ["camera_crosses", "circle_image", "circle_page", "film_shadows", "projector_shadows"]
+__all__ = ["camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
 
 
 #: The adjustable circle page: a full-screen canvas, the disc drawn in device pixels (the projector's

@@ -23,6 +23,7 @@ from pathlib import Path
 from rigcad._version import __version__
 from rigcad.manual import bom as B
 from rigcad.manual import calibration as C
+from rigcad.manual import tower_joints
 from rigcad.units import hours_minutes
 
 MIL = 0.0254  # mm
@@ -302,9 +303,9 @@ def _section_bill(d: Doc, c) -> None:
 
     steps, _ = plan.steps(rig, c.meshes)
     hw = [[r["item"], r["quantity"], f"assembly steps: {r['steps']}", "as the assembly check fitted it"]
-          for r in plan.hardware(steps)]
+          for r in plan.hardware(steps, rig)]
     hw += [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"] if f.get("tower")
-           and "mounting holes" not in f["use"]]
+           and "mounting holes" not in f["use"] and not tower_joints.placed({"joins": f["use"]})]
     if bill["pins"]:
         pin = bill["pins"]
         hw.append([pin["item"], pin["quantity"], f"aligning split pieces ({pin['use']})", pin["note"]])
@@ -440,7 +441,9 @@ THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut wit
                                       "insert's outer diameter and melt the insert in flush with a soldering iron at "
                                       "its maker's temperature)",
              "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
-             "bench": "into the bench"}
+             "bench": "into the bench",
+             "trap": "a washer under the head; its nut waits in the square trap printed for it (put it in before "
+                     "the part with the trap stands on the bench), tighten crosswise by hand"}
 
 
 def assembly_order(rig, meshes):
@@ -472,7 +475,8 @@ def step_text(placed, meshes_by_name: dict) -> str:
     text += MOVES.get(_dir_name(placed.direction), f"move it in along {_dir_name(placed.direction)}").capitalize()
     text += (f" until it rests on the {', '.join(n.replace('_', ' ') for n in st.needs)}." if st.needs
              else " onto the bench.")
-    groups = Counter((f.item, f.tools[0].name, f.thread_in) for f in st.fasteners)
+    groups = Counter((f.item, f.tools[0].name, "trap" if f.thread_in == "nut" and f.nut_tool is None else f.thread_in)
+                     for f in st.fasteners)
     for (item, tool, thread_in), n in groups.items():
         text += f" Fix it with {n} x {item}, {THREAD_IN[thread_in]} (tool: {tool} or an L key)."
     return text
@@ -484,6 +488,7 @@ def _section_assemble(d: Doc, c) -> None:
 
     from rigcad import plots
     from rigcad.manual import assembly as A
+    from rigcad.manual import plan as plan_mod
 
     d.h(2, "5. Assemble")
     order, refusal = assembly_order(c.rig, c.meshes)
@@ -504,6 +509,11 @@ def _section_assemble(d: Doc, c) -> None:
         label = st.name.replace("_", " ") + (f" (x{len(members)})" if len(members) > 1 and st.name not in
                                              st.members else "")
         text = step_text(placed, by_name)
+        if st.name == "projector_body":
+            text += plan_mod.projector_screw_text(c.rig)
+        if st.name == "base_plate" and "camera_cross_base" in c.rig.recipes:
+            text += (" To calibrate (section 6), lay the film on the plate now, before the dome: see \"The film at "
+                     "the sample plane\".")
         for h in tower_at.get(st.name, []):
             size = f"{h['thread']} x {h['length_mm']:g} mm" if h.get("length_mm") else h["thread"]
             text += f" Fix it with {h['quantity']} x {h['item']} ({size}): {h['joins']}."
@@ -544,8 +554,8 @@ def _tower_rows_by_step(rig, steps) -> dict:
     names = [(s.name, m) for s in steps for m in s.members]
     out: dict = {}
     for h in B.tower_hardware(rig):
-        if "mounting holes" in h["joins"]:
-            continue  # the instruments' screws: the plan's
+        if "mounting holes" in h["joins"] or tower_joints.placed(h):
+            continue  # the instruments' screws and the tower joints' bolts: the plan's
         named = [s for s, m in names
                  if any(re.search(rf"\b{re.escape(k)}'?s?\b", h["joins"])
                         for k in {m.replace("_", " "), m.replace("tower_", "").replace("_body", "").replace("_", " ")})]
@@ -592,6 +602,39 @@ def _section_finish(d: Doc, c) -> None:
 #: The checkerboard's square (mm): 5 mm prints sharply on a laser printer and spans several camera
 #: pixels in the paraboloid's image of the base plate.
 CHECKER_SQUARE_MM = 5.0
+
+
+def _film_step(d: Doc, c) -> None:
+    """The film test as a lab does it: what holds the dome over the film at the sample plane, how the
+    film is registered at O and where it is seen from (rigcad.manual.calibration.film_setup)."""
+    f = C.film_setup(c.rig)
+    d.p("**The film at the sample plane.** The dome stands bolted on the base plate over the film: the plate's top "
+        "is the dome's base plane and the sample plane (z = 0) by design, and the plate's bore, which centres the "
+        "sample holder, centres the film's mark. The film goes on during the assembly, before the dome, and is seen "
+        "from below, through the bore:")
+    seen = ("light past the rim falls inside the bore too" if f["direct_light_seen"] else
+            f"light past the rim (outside the paraboloid's shadow, {f['paraboloid_shadow_radius_mm']:.1f} mm from O) "
+            f"falls on the plate outside the bore ({f['bore_radius_mm']:.2f} mm) and is not seen from below: judge the "
+            "circle by the spot, symmetric about the mark and smallest")
+    d.ol([
+        "In the assembly, once the base plate is down and before the dome goes on: lift the plate off the sample "
+        "holder, stand the `camera_cross_base` in its place (the same body and collar: the bore centres it the "
+        "same way) and set the plate back over it. The cross's top is z = 0, level with the plate's top.",
+        f"Lay a disc of matte drafting film ({1e3 * f['film_thickness_mm']:g} µm polyester, "
+        f"**{f['film_diameter_mm']:.0f} mm** across) on the plate's top, centred on the bore, and tape its edge to "
+        "the plate. Trace the cross under it with a fine pen: its centre is O. Then go on with the assembly (the "
+        f"dome's flange and its {f['dome_bolts']} bolts are far outside the film).",
+        f"For the test, lift the rig as one piece (plate, dome and tower are one rigid assembly; two people) onto "
+        f"three blocks: one **{f['block_under_tongue_mm']:g} mm** tall under the tongue below the column, two "
+        f"**{f['block_under_disc_mm']:g} mm** tall under the disc's rim either side of the dome (the tongue reaches "
+        f"{f['tongue_below_disc_mm']:g} mm lower than the disc). Take the plug out of the bore from below.",
+        f"Look up through the bore: a 45 deg mirror or a phone's camera on the bench under it (the "
+        f"{f['block_under_disc_mm']:g} mm blocks leave room for it). Project the circle and set it as described "
+        f"above; {seen}.",
+        "Afterwards cut the film out along the bore's edge from below with a scalpel (the ring under the dome stays: "
+        f"{1e3 * f['film_thickness_mm']:g} µm thick, outside the sample), push the `camera_cross_base` back in for the "
+        "camera's crosses (next), and set the rig down.",
+    ])
 
 
 def _calibration_more(d: Doc, c, cam: dict) -> None:
@@ -681,7 +724,7 @@ def _section_calibrate(d: Doc, c) -> None:
         f"projector's resolution): a bright disc of radius **{info['radius_px']:.1f} px** centred on pixel "
         f"({info['centre_px_from_top_left'][0]:g}, {info['centre_px_from_top_left'][1]:g}) from the top left, the "
         f"paraboloid's rim as the design maps it (the rim ray leaves the COP at {info['rim_angle_at_cop_deg']:.3f} "
-        f"deg from the axis). Cover the dome's base with a semitransparent film marked at the sample point O. "
+        f"deg from the axis). Lay a film over the dome's base, marked at the sample point O (as below). "
         "With the projector placed as designed the reflected light converges to the mark; move the circle in the "
         "image until the spot is symmetric about the mark, then adjust its radius until the light converges to a "
         f"point. A circle larger than the rim throws direct light onto the film around the paraboloid's shadow, "
@@ -690,6 +733,7 @@ def _section_calibrate(d: Doc, c) -> None:
         f"{info['occlusion_radius_px']:.1f} px from the centre are hidden by the paraboloid itself (occlusion limit).")
     d.img("calibration/circle.png", f"calibration/circle.png: the calibration image, {info['resolution_px'][0]} x "
                                     f"{info['resolution_px'][1]} px, shown at page width")
+    _film_step(d, c)
     d.h(3, "Camera: the two crosses")
     d.p(f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
         f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm) and put the `camera_cross_base` in the sample holder's place "

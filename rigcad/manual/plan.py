@@ -27,13 +27,16 @@ import re
 
 import numpy as np
 
-from rigcad.manual.assembly_check import Assembly, Fastener, Step, Tool, manifold, penetration
+from rigcad.manual.assembly_check import Assembly, Fastener, Step, manifold, penetration
+from rigcad.manual.fasteners import DOWN, DRIVER_BLADE_MM, HEX_KEY, L_KEY, NUT_AF, SPANNER_MM, UP  # noqa: F401
+from rigcad.manual.fasteners import driver, spanner  # noqa: F401
+from rigcad.manual.fasteners import metric as _metric  # noqa: F401
+from rigcad.manual.fasteners import socket_head as _socket_head
 
 #: Units one step places together: an instrument with the lens built onto it.
 UNITS = (("projector_body", "projector_lens"), ("camera_body", "camera_lens"))
 #: Parts that slide in from the side into slots or grooves before anything is lowered onto them.
 SIDEWAYS_FIRST = ("beam", "beam_splitter")
-DOWN, UP = (0.0, 0.0, -1.0), (0.0, 0.0, 1.0)
 SIDEWAYS = ((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1.0, 0.0))
 #: How far (mm) a part is moved down to find what it rests on: above CLEARANCE_MM (a contact shows), below
 #: the printed fits' gaps (0.2 mm and up: a part in a slot is not taken to rest on the slot's ceiling).
@@ -41,39 +44,8 @@ SIDEWAYS = ((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1.0, 0.0)
 #: parts under it within REST_SEARCH_MM (mm) hold it.
 REST_SEARCH_MM = 5.0
 REST_PROBE_MM = 0.08
-#: Hex key (mm across flats, ISO 4762 socket) per thread; 1/4-20 and 3/8-16 socket heads take 3/16 in and 5/16 in.
-HEX_KEY = {"M2": 1.5, "M2.5": 2.0, "M3": 2.5, "M4": 3.0, "M5": 4.0, "M6": 5.0, "M8": 6.0, "M10": 8.0, "M12": 10.0,
-           "1/4-20 UNC": 4.7625, "3/8-16 UNC": 7.9375}
-#: Nut width across flats (mm, ISO 4032) per metric thread: the open-end spanner's size.
-NUT_AF = {"M2": 4.0, "M2.5": 5.0, "M3": 5.5, "M4": 7.0, "M5": 8.0, "M6": 10.0, "M8": 13.0, "M10": 16.0, "M12": 18.0}
-#: The hex screwdriver's blade (mm): a hand needs this much straight room above a head.
-DRIVER_BLADE_MM = 100.0
-#: The open-end spanner's reach (mm, DIN 3110 for M3-M6 nuts: 90-120 mm long).
-SPANNER_MM = 80.0
 #: Heat-set insert (M thread -> outer diameter, length) as sold for printed parts (e.g. M4: 5.6 x 8.1 mm, hole 5.6 mm).
 INSERT = {"M3": (4.5, 5.7), "M4": (5.6, 8.1), "M5": (6.4, 9.5), "M6": (8.0, 12.7)}
-
-
-#: ISO 2936 hex keys: key (mm across flats) -> long arm, short arm (mm).
-L_KEY = {1.5: (45.0, 14.0), 2.0: (50.0, 16.0), 2.5: (56.0, 18.0), 3.0: (63.0, 20.0), 4.0: (70.0, 25.0),
-         4.7625: (80.0, 28.0), 5.0: (80.0, 28.0), 6.0: (90.0, 32.0), 7.9375: (100.0, 36.0), 8.0: (100.0, 36.0),
-         10.0: (112.0, 40.0)}
-
-
-def driver(thread: str, out_dir=(1.0, 0.0, 0.0)) -> tuple[Tool, ...]:
-    """A hex screwdriver with a DRIVER_BLADE_MM blade; else an L hex key (ISO 2936) with its short
-    arm in the socket and its long arm out along ``out_dir`` (away from the rig's axis)."""
-    key = HEX_KEY[thread]
-    r = key / np.sqrt(3.0) + 0.5  # the key's corners, and a little play for the hand
-    long, short = L_KEY[key]
-    return (Tool(f"{key:g} mm hex screwdriver (ISO 2936 hex), {DRIVER_BLADE_MM:g} mm blade", DRIVER_BLADE_MM, r),
-            Tool(f"{key:g} mm L hex key (ISO 2936, {long:g} x {short:g} mm), short arm in", short, r, long,
-                 tuple(float(v) for v in out_dir)))
-
-
-def spanner(thread: str, nut_height: float) -> Tool:
-    # its jaws are about as thick as the nut is high: a cylinder of that diameter along its way out
-    return Tool(f"{NUT_AF[thread]:g} mm open-end spanner (DIN 3110)", SPANNER_MM, nut_height / 2 + 0.5)
 
 
 def _stem(name: str) -> str:
@@ -90,21 +62,6 @@ def groups(meshes) -> list[tuple[str, tuple[str, ...]]]:
         key = unit_of.get(m.name, _stem(m.name))
         out.setdefault(key, []).append(m.name)
     return [(k, tuple(v)) for k, v in out.items()]
-
-
-def _metric(thread: str):
-    from rigcad.manual.bom import METRIC
-
-    return next(r for r in METRIC if r[0] == thread)
-
-
-def _socket_head(item: str, head, axis, length: float, d: float, thread: str, **kw) -> Fastener:
-    h = np.array([head[0], head[1], 0.0])
-    out = tuple(h / np.linalg.norm(h)) if np.linalg.norm(h) > 1e-9 else (1.0, 0.0, 0.0)
-    if abs(np.dot(out, axis)) > 0.9:
-        out = (0.0, 0.0, -1.0)
-    return Fastener(item, tuple(float(v) for v in head), axis, float(length), d / 2, 0.75 * d, d,
-                    driver(thread, out), **kw)
 
 
 def bolt_fasteners(bolt: dict) -> tuple[Fastener, ...]:
@@ -156,10 +113,11 @@ def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener,
     rows = [h for h in hardware(rig.profile, rig.layout) if h.get("length_mm") and "socket" in h["joins"]
             or h.get("length_mm") and "mounting holes" in h["joins"]]
     out: dict[str, tuple[Fastener, ...]] = {}
+    nominal = _projector_length(rig, t.shims_nominal)  # the stacks as drawn: shims_nominal shims each
     for h in rows:
         d = MOUNT_THREADS[h["thread"]]
-        item = f"{h['thread']} x {h['length_mm']:g} mm socket-head screw (ISO 4762 / ASME B18.3) with a washer"
-        if "projector" in h["joins"]:
+        item = _screw_item(h["thread"], h["length_mm"])
+        if "projector" in h["joins"] and h["length_mm"] == nominal:
             z = t.shelf_top_z - t.shelf_thickness - 1.0
             shims = sorted(n for n in meshes_by_name if n.startswith("projector_shims_"))
             out["projector_body"] = tuple(
@@ -172,6 +130,49 @@ def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener,
                              pierces=("camera_shims",))
                 for x, z in _camera_points(rig, meshes_by_name))
     return out
+
+
+def _screw_item(thread: str, length: float) -> str:
+    return f"{thread} x {length:g} mm socket-head screw (ISO 4762 / ASME B18.3) with a washer"
+
+
+def _projector_length(rig, shims: int) -> float:
+    """The projector screw's length (mm) for a stack of ``shims`` (rigcad.parts.tower.projector_screws)."""
+    from rigcad.parts.tower import projector_screws
+
+    return float(next(r["length_mm"] for r in projector_screws(rig.profile, rig.layout) if r["shims"] == shims))
+
+
+def projector_screw_rows(rig) -> list[dict]:
+    """The projector's screws, one row per length the shim stacks need (rigcad.parts.tower.hardware's
+    rows, sized by rigcad.parts.tower.projector_screws): item, quantity (one per foot: any stack may
+    end up at any count in the alignment), the stacks it serves and the extra washers per stack."""
+    from rigcad.parts.tower import hardware, projector_screws
+
+    extra = {r["shims"]: r["extra_washers"] for r in projector_screws(rig.profile, rig.layout)}
+    return [{"item": _screw_item(h["thread"], h["length_mm"]), "length_mm": h["length_mm"], "quantity": h["quantity"],
+             "stacks": list(h["for_stacks_of_shims"]),
+             "extra_washers": {n: extra[n] for n in h["for_stacks_of_shims"] if extra[n]}}
+            for h in hardware(rig.profile, rig.layout) if "for_stacks_of_shims" in h]
+
+
+def _stacks(ns: list[int]) -> str:
+    return f"{ns[0]} shims" if len(ns) == 1 else f"{ns[0]}..{ns[-1]} shims"
+
+
+def projector_screw_text(rig) -> str:
+    """What the projector's step says about its screws' lengths, stack by stack."""
+    rows = projector_screw_rows(rig)
+    if not rows:
+        return ""
+    parts = []
+    for r in rows:
+        washers = "".join(f"; with {w} extra washer{'s' * (w > 1)} under the head for {n} shims"
+                          for n, w in r["extra_washers"].items())
+        parts.append(f"{r['item'].split(' socket')[0]} for a stack of {_stacks(r['stacks'])}{washers}")
+    return (" Each screw's length follows its own stack: " + ", ".join(parts) + " (the shortest ISO 4762 length "
+            "that engages the projector's thread without bottoming in it). When the alignment adds or takes out "
+            "shims, change that foot's screw to the length of its new stack.")
 
 
 def _camera_points(rig, meshes_by_name) -> list[tuple[float, float]]:
@@ -239,7 +240,11 @@ def steps(rig, meshes) -> tuple[list[Step], dict]:
         options = bolt_fasteners(b)
         fits = [f for f in options if penetration(f.solids(), whole) <= _clearance()]
         bolts.setdefault(b["upper"], []).append((fits or options)[0])
+    from rigcad.manual.tower_joints import tower_fasteners
+
     screws = instrument_fasteners(rig, by_name)
+    for name, fs in tower_fasteners(rig, by_name).items():
+        screws[name] = screws.get(name, ()) + fs
     out = []
     for name, members in groups(meshes):
         fasteners = tuple(f for m in members for f in bolts.get(m, ())) + screws.get(name, ())
@@ -282,13 +287,25 @@ def assembly(rig, meshes) -> Assembly:
 __all__ = ["assembly", "bolt_fasteners", "driver", "groups", "instrument_fasteners", "spanner", "steps"]
 
 
-def hardware(steps: list[Step]) -> list[dict]:
+def hardware(steps: list[Step], rig=None) -> list[dict]:
     """The plan's fasteners as one list: each bolt or screw item with its count and the steps that use
-    it, then the nuts, washers and heat-set inserts they need (counted from the items)."""
+    it, then the nuts, washers and heat-set inserts they need (counted from the items). With ``rig``,
+    the projector's screws are one row per length, for the stacks it serves (:func:`projector_screw_rows`)."""
     rows: dict[str, dict] = {}
     extra: dict[str, int] = {}
+    per_length = projector_screw_rows(rig) if rig is not None else []
+    for r in per_length:
+        rows[r["item"]] = {"item": r["item"], "quantity": r["quantity"],
+                           "steps": [f"projector_body (stacks of {_stacks(r['stacks'])})"]}
+        thread = r["item"].split(" x ")[0]
+        extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + max(
+            r["extra_washers"].values(), default=0) * r["quantity"]
     for st in steps:
         for f in st.fasteners:
+            if per_length and st.name == "projector_body" and f.thread_in == "instrument":
+                washer = f"{f.item.split(' x ')[0]} washer (ISO 7089)"  # the screw: a row per length above
+                extra[washer] = extra.get(washer, 0) + 1
+                continue
             row = rows.setdefault(f.item, {"item": f.item, "quantity": 0, "steps": []})
             row["quantity"] += 1
             if st.name not in row["steps"]:
@@ -296,7 +313,9 @@ def hardware(steps: list[Step]) -> list[dict]:
             thread = f.item.split(" x ")[0]
             if f.thread_in == "nut":
                 extra[f"{thread} hex nut (ISO 4032)"] = extra.get(f"{thread} hex nut (ISO 4032)", 0) + 1
-                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 2
+                # a nut in a printed trap bears on the part: one washer, under the head
+                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + (
+                    1 if f.nut_tool is None else 2)
             else:
                 extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 1
             if f.thread_in == "insert":
@@ -307,4 +326,4 @@ def hardware(steps: list[Step]) -> list[dict]:
     return out + [{"item": k, "quantity": v, "steps": "with the bolts above"} for k, v in extra.items()]
 
 
-__all__ += ["hardware"]
+__all__ += ["hardware", "projector_screw_rows", "projector_screw_text"]

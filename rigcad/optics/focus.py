@@ -83,6 +83,23 @@ def _reachable(lens: FocusingLens) -> bool:
     return all(lo <= d <= hi for d in (lens.focus_near, lens.focus_far))
 
 
+def _ideal(near: float, far: float, focus_near: float, focus_far: float) -> float:
+    """The focal length (mm) that re-images the middle of the projector's focus range (distances from
+    the lens, mm) onto the middle of the paraboloid's (``near``..``far``), both middles in dioptres."""
+    mid_target = 0.5 * (_dioptres(near) + _dioptres(far))
+    mid_focus = 0.5 * (_dioptres(focus_near) + _dioptres(focus_far))
+    return 1.0 / (mid_target - mid_focus)
+
+
+def ideal_focal_length(profile, geometry) -> float:
+    """The focal length (mm) centred best on the paraboloid, catalogue or not (what
+    :func:`focusing_lens` rounds to the catalogue)."""
+    s = profile.lens.distance
+    near = geometry.cop_z - geometry.vertex_z - s
+    far = math.hypot(geometry.rim_radius, geometry.cop_z - geometry.rim_z) - s
+    return _ideal(near, far, profile.projector.focus_min - s, profile.projector.focus_max - s)
+
+
 def focusing_lens(profile, geometry) -> FocusingLens:
     """The focusing lens for ``profile`` (its ``lens.focal_length`` when given, else the catalogue
     value centred best on the paraboloid, in dioptres) and ``geometry`` (profile.derived.Derived);
@@ -103,10 +120,7 @@ def focusing_lens(profile, geometry) -> FocusingLens:
                 f"{lens.focus_far:.0f} mm, outside its range {d_min:g}..{d_max:g} mm (projector.focus_min, "
                 "focus_max); leave lens.focal_length out to have it computed", where=profile.where("lens", "focal_length"))
         return lens
-    # the range's middle in dioptres, re-imaged onto the paraboloid's middle in dioptres
-    mid_target = 0.5 * (_dioptres(near) + _dioptres(far))
-    mid_focus = 0.5 * (_dioptres(d_min - s) + _dioptres(d_max - s))
-    ideal = 1.0 / (mid_target - mid_focus)
+    ideal = _ideal(near, far, d_min - s, d_max - s)
     best = min(CATALOGUE_FOCAL_LENGTHS, key=lambda f: abs(1.0 / f - 1.0 / ideal))
     lens = _lens(best, s, near, far, d_min, d_max, True)
     if not _reachable(lens):

@@ -93,6 +93,9 @@ def design_yaml(problem: Problem, row: dict, base_name: str, note: str) -> str:
         sections.setdefault("dome", []).append(
             f"  tolerance: {row['dome_tolerance_mm']:g} mm   # the base's {problem.base.dome.tolerance:g} mm cannot be "
             "certified in float64 on this geometry")
+    if row.get("focal_length_mm") is not None:
+        sections.setdefault("lens", []).append(
+            f"  focal_length: {row['focal_length_mm']:g} mm   # no stock 2 in singlet focuses this design: a custom lens")
     f = row["figures"]
     head = [f"# Chosen by `rigcad optimize {base_name}` ({note}).",
             f"# theta {f['theta_min_deg']:.3f}..{f['theta_max_deg']:.1f} deg, {f['px_per_deg_mean']:.4f} px/deg mean "
@@ -132,6 +135,24 @@ def certified_rig(problem: Problem, row: dict):
     raise AssertionError("unreachable")
 
 
+def _custom_focal_length(profile, geometry) -> float | None:
+    """None when a stock focusing lens brings the design's paraboloid into the projector's focus range;
+    else the focal length (mm, to 0.1 mm) centred on it, checked to be reachable: the written design
+    names it (a custom lens). Raises GeometryError when no focal length can."""
+    import dataclasses
+
+    from rigcad.errors import GeometryError
+    from rigcad.optics.focus import focusing_lens, ideal_focal_length
+
+    try:
+        focusing_lens(profile, geometry)
+        return None
+    except GeometryError:
+        f = round(ideal_focal_length(profile, geometry), 1)
+        focusing_lens(dataclasses.replace(profile, lens=dataclasses.replace(profile.lens, focal_length=f)), geometry)
+        return f
+
+
 def certify(problem: Problem, row: dict) -> dict:
     """The chosen design on the certified path (converged DOP853 dome, the 2D design's report) beside
     the fast path's figures: the differences say how far the optimiser's evaluation can be trusted."""
@@ -139,10 +160,11 @@ def certify(problem: Problem, row: dict) -> dict:
 
     rig, tol = certified_rig(problem, row)
     # the refusals `rigcad build` makes, on the certified dome (GeometryError: the next design is tried):
-    # the layout (beam over the flange, holder inside the base, the tower's shelf over the dome's top)
-    # and every part's recipe; the search's constraints hold GEOMETRY_RESERVE mm short of them
+    # the layout (beam over the flange, holder inside the base, the tower's shelf over the dome's top),
+    # every part's recipe and the focusing lens; the search's constraints hold GEOMETRY_RESERVE mm short of them
     layout = rig.layout
     rig.recipes
+    row["focal_length_mm"] = _custom_focal_length(rig.profile, layout.geometry)
     row["dome_tolerance_mm"] = tol
     r = rig.design.report
     f = row["figures"]
@@ -156,6 +178,8 @@ def certify(problem: Problem, row: dict) -> dict:
                     "path's is exact at its nodes", "dome_rows": int(len(rig.dome.s)),
             "dome_error_estimate_mm": rig.dome.error_estimate, "dome_tolerance_mm": rig.dome.tolerance,
             "dome_tolerance_loosened": tol is not None,
+            # a focal length no stock lens has, written into the design (None: a stock lens focuses it)
+            "custom_focal_length_mm": row["focal_length_mm"],
             # room left between the projector's shelf and the dome's top beyond tower.clearance (mm)
             "tower_room_mm": None if rig.geometry.cop_at_infinity else
             shelf_bottom_z(rig.profile, rig.geometry.cop_z) - layout.dome_top_z - rig.profile.tower.clearance}

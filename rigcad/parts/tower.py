@@ -293,10 +293,15 @@ def column_joint_cuts(t: TowerLayout, profile: Profile, z0: float, height: float
     return (pocket, *_holes([(t.column_x, 0.0)], CORE_BOLT_HOLE, z0, height))
 
 
-#: Square nut traps under the tongue (mm): an M4 nut (7 mm across flats, 3.2 mm thick) drops in and
-#: cannot turn (its corners, 8.1 mm across, meet the sides); the tongue then stands on the bench.
-NUT_TRAP = 7.2
-NUT_TRAP_DEPTH = 3.6
+#: Square nut traps under the tongue (mm); the tongue then stands on the bench. An M4 nut (7 mm
+#: across flats, 8.08 across corners, 3.2 mm thick) goes into a square of side s when its widths in
+#: two perpendicular directions, 8.08 cos(d) and 8.08 cos(30 deg - d) (d: a corner's angle off a
+#: side), are both under s: s = 8.0 admits it for d in 8..22 deg and stops it turning further (a
+#: 7.2 mm square, 7.8 being the least any nut passes, would not take it). The depth puts the nut so
+#: high that a stocked 20 mm bolt reaches through it and ends 0.8 mm above the bench (the assembly
+#: check, rigcad.manual.tower_joints, verifies both).
+NUT_TRAP = 8.0
+NUT_TRAP_DEPTH = 5.6
 #: Counterbore under the tongue for the extrusion's M8 socket head (13 mm, 8 mm tall; ISO 4762).
 CORE_HEAD_BORE = (14.0, 8.5)
 
@@ -317,6 +322,31 @@ def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: floa
     base plate's tongue, its top flange under the shelf (the same pattern at both)."""
     return (_holes(_column_flange_points(t, profile), profile.tower.bolt_diameter, z0, height)
             + _holes(column_dowel_points(t, profile), profile.datum.dowel_diameter, z0, height))
+
+
+#: The shelf's joint to the printed column's top flange: bolts up from under the flange into M4
+#: heat-set inserts (5.6 x 8.1 mm; a bought aluminium shelf is tapped M4 instead) in blind holes in
+#: the shelf's underside, so nothing stands proud of the shelf's top under the projector, which stands
+#: on its shims only a few mm above it.
+SHELF_INSERT = (5.6, 8.1)  # the insert makers' hole (INSERT_HOLE["M4"]) and the insert's length
+
+
+def shelf_joint_cuts(t: TowerLayout, profile: Profile, z0: float) -> tuple:
+    """What the column joint cuts into the shelf from its underside (z0): for a printed column, a blind
+    insert hole (SHELF_INSERT, 0.5 mm deeper) at each bolt and a through hole at each dowel; for a
+    bought extrusion, its pocket and core bolt hole (:func:`column_joint_cuts`)."""
+    if profile.buy.column != "print":
+        return column_joint_cuts(t, profile, z0, t.shelf_thickness, "bottom")
+    d, long = SHELF_INSERT
+    blind = tuple(Cylinder((x, y, z0 - 1.0), d / 2, long + 1.5) for x, y in _column_flange_points(t, profile))
+    return blind + _holes(column_dowel_points(t, profile), profile.datum.dowel_diameter, z0, t.shelf_thickness)
+
+
+def shelf_bolt_length(profile: Profile) -> float:
+    """The shelf joint's bolt (mm): the longest stocked ISO 4762 length that stops 0.5 mm short of the
+    insert's end, through the column's flange and a washer."""
+    reach = profile.tower.wall + WASHER + SHELF_INSERT[1] - 0.5
+    return float(max(L for L in ISO_4762_LENGTHS if L <= reach + 1e-9))
 
 
 def _holder_flange_points(t: TowerLayout, profile: Profile):
@@ -432,7 +462,7 @@ def tower_shelf(profile: Profile, layout) -> Part:
     slots = tuple(_slot(x, y, d / 2 + tw.travel_along, d / 2 + tw.travel_across, z0, t.shelf_thickness)
                   for x, y in _projector_feet(t))
     _, _, _, lens_pts = _lens_foot(t, profile)
-    holes = column_joint_cuts(t, profile, z0, t.shelf_thickness, "bottom") + _holes(
+    holes = shelf_joint_cuts(t, profile, z0) + _holes(
         _holder_flange_points(t, profile) + lens_pts, tw.bolt_diameter, z0, t.shelf_thickness) + _seat_cuts(t, profile)
     bought = "" if profile.buy.shelf == "print" else (
         f"aluminium plate EN AW-5083, {t.shelf_thickness:g} mm, cut to {x1 - x0:.1f} x {y1 - y0:.1f} mm; drill and "
@@ -584,11 +614,16 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
                  "quantity": 2, "joins": "up through the base plate's tongue (its head in the counterbore underneath), "
                                          "and down through the shelf, into the extrusion's tapped core (16 mm engaged)"}]
     return [
-        {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + t.shelf_thickness, nut),
-         "quantity": 4, "joins": "the column's top flange to the shelf"},
+        {"item": "bolt and washer", "thread": "M4", "length_mm": shelf_bolt_length(profile), "quantity": 4,
+         "joins": "the column's top flange to the shelf: up from under the flange into "
+                  + ("heat-set inserts pressed into the shelf's underside" if profile.buy.shelf == "print" else
+                     "M4 threads tapped in the shelf's underside (8 mm deep)")},
         {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + tongue - NUT_TRAP_DEPTH, nut),
          "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (the nuts in the square traps "
                                  "under the tongue, put in before it stands on the bench)"},
+        *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT[0],
+            "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]
+          if profile.buy.shelf == "print" else []),
         {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
          "length_mm": _length(min(tw.wall, t.shelf_thickness) + tw.wall, 0.0), "quantity": 4,
          "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf "

@@ -552,7 +552,8 @@ class CalibrationParams:
     sim_ripple_period: float = spec("length", "simulation: the ripple's period along the print's z", "12 mm",
                                     lo=0, lo_open=True, hi=1000.0)
     sim_supersample: int = spec("int", "simulation: sub-pixel rays per camera pixel side", 3, lo=1, hi=16)
-    sim_blur: float = spec("float", "simulation: defocus blur, Gaussian sigma in camera pixels", 0.5, lo=0, hi=20)
+    sim_blur: float = spec("float", "defocus blur, Gaussian sigma in camera pixels: the simulation's, and the lens's "
+                           "that the decoding's bias correction assumes", 0.5, lo=0, hi=20)
     sim_full_well: float = spec("float", "simulation: electrons at a white screen pixel's full exposure", 10000.0,
                                 lo=1, hi=1e7)
     sim_read_noise: float = spec("float", "simulation: read noise, electrons RMS", 10.0, lo=0, hi=1e5)

@@ -4,7 +4,7 @@ nothing of the decoding), the fit and the corrected map, and the bad captures th
 with one line and nothing written."""
 
 import argparse
-import dataclasses
+import shutil
 
 import numpy as np
 import pytest
@@ -21,6 +21,9 @@ from rigcad.profile.schema import load_profile
 from rigcad.rig import Rig
 
 SMALL = "extends: achutha2006\ncamera:\n  resolution: [340, 256]\ncalibration:\n  sim_blur: 0.3\n"
+#: The command's tests (what is written, what is refused) need no accuracy: the fit on every 4th row
+#: and column (~1/4 of the small camera's fit pixels) is plenty to put a wrong spacer 2 mm off.
+COARSE_FIT = "  fit_stride: 4\n"
 
 
 @pytest.fixture(scope="module")
@@ -78,18 +81,29 @@ def test_calibration_corrects_the_map(small):
     assert np.nanmax(res.corrected["uncertainty_rad"]) > 0
 
 
-def _write_capture(folder, s, spoil=None):
-    folder.mkdir(parents=True, exist_ok=True)
-    for k, frames in enumerate(s["images"]):
+@pytest.fixture(scope="module")
+def capture(tmp_path_factory, small):
+    """The small capture written once as PNGs (each test copies it before spoiling it) and a profile
+    of the same rig with the coarser fit (:data:`COARSE_FIT`)."""
+    folder = tmp_path_factory.mktemp("capture") / "small"
+    folder.mkdir()
+    for k, frames in enumerate(small["images"]):
         for n, im in frames.items():
             Image.fromarray(im).save(folder / f"h{k}_{n}.png")
+    profile = folder.parent / "coarse.yaml"
+    profile.write_text(SMALL + COARSE_FIT)
+    return dict(folder=folder, profile=profile)
+
+
+def _write_capture(folder, capture, spoil=None):
+    shutil.copytree(capture["folder"], folder)
     if spoil:
         spoil(folder)
 
 
-def _run(tmp_path, s, folder):
-    args = argparse.Namespace(profile=str(s["path"]), images=str(folder), simulate=False, seed=0,
-                              exports=str(tmp_path / "exports"))
+def _run(tmp_path, capture, folder, profile=None):
+    args = argparse.Namespace(profile=str(profile or capture["profile"]), images=str(folder), simulate=False,
+                              seed=0, exports=str(tmp_path / "exports"))
     return cmd_calibrate(args)
 
 
@@ -103,35 +117,29 @@ def _run(tmp_path, s, folder):
     (lambda f: [(f / "h0_x_p16_s1.png").rename(f / "t.png"), (f / "h0_x_p16_s3.png").rename(f / "h0_x_p16_s1.png"),
                 (f / "t.png").rename(f / "h0_x_p16_s3.png")], ("h0_x_p16_s0", "wrong order")),
 ])
-def test_bad_captures_are_refused_with_one_line_naming_the_file(tmp_path, small, spoil, words):
+def test_bad_captures_are_refused_with_one_line_naming_the_file(tmp_path, capture, spoil, words):
     folder = tmp_path / "capture"
-    _write_capture(folder, small, spoil)
+    _write_capture(folder, capture, spoil)
     with pytest.raises(CaptureError) as info:
-        _run(tmp_path, small, folder)
+        _run(tmp_path, capture, folder)
     msg = str(info.value)
     assert "\n" not in msg and all(w in msg for w in words), msg
-    assert not (tmp_path / "exports" / "small" / "calibrate").exists()
+    assert not (tmp_path / "exports" / "coarse" / "calibrate").exists()
 
 
-def test_a_height_the_images_contradict(tmp_path, small):
+def test_a_height_the_images_contradict(tmp_path, capture):
     """The captures of a 10 mm spacer declared as 12 mm: the fit puts the screen 2 mm off."""
-    folder = tmp_path / "capture"
-    _write_capture(folder, small)
     wrong = tmp_path / "wrong.yaml"
-    wrong.write_text(SMALL + "  spacer_heights: [2 mm, 12 mm]\n")
-    args = argparse.Namespace(profile=str(wrong), images=str(folder), simulate=False, seed=0,
-                              exports=str(tmp_path / "exports"))
+    wrong.write_text(SMALL + COARSE_FIT + "  spacer_heights: [2 mm, 12 mm]\n")
     with pytest.raises(CaptureError) as info:
-        cmd_calibrate(args)
+        _run(tmp_path, capture, capture["folder"], wrong)
     assert "h1_white.png" in str(info.value) and "spacer" in str(info.value)
     assert not (tmp_path / "exports" / "wrong" / "calibrate").exists()
 
 
-def test_a_good_capture_is_written(tmp_path, small):
-    folder = tmp_path / "capture"
-    _write_capture(folder, small)
-    assert _run(tmp_path, small, folder) == 0
-    out = tmp_path / "exports" / "small" / "calibrate"
+def test_a_good_capture_is_written(tmp_path, small, capture):
+    assert _run(tmp_path, capture, capture["folder"]) == 0
+    out = tmp_path / "exports" / "coarse" / "calibrate"
     data = np.load(out / "corrected_map.npz")
     assert data["direction"].shape == small["cam"].shape + (3,)
     assert (out / "calibration.json").is_file()

@@ -179,7 +179,7 @@ def test_the_manual_is_written_with_its_pictures_and_one_self_contained_page(wri
     from rigcad.manual.assembly import picture_meshes
 
     # the hardware table is the plan's fasteners as the assembly check fits them (one source with the steps)
-    for row in plan.hardware(plan.steps(table31_rig, picture_meshes(table31_rig))[0]):
+    for row in plan.hardware(plan.steps(table31_rig, picture_meshes(table31_rig))[0], table31_rig):
         assert f"| {row['item']} | {row['quantity']} |" in md, row
     assert (out / "calibration" / "circle.png").is_file()
     import json

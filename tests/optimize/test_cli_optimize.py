@@ -56,7 +56,10 @@ def test_written_profile_extends_the_base_and_sets_only_what_changed(optimized):
     assert data["extends"] == "achutha2006_optimize"
     changed = {k for k, v in rep["chosen"]["parameters"].items() if v != rep["base"]["parameters"][k]}
     written = {f"{s}.{k}" for s, kv in data.items() if isinstance(kv, dict) for k in kv if s != "dome"}
-    assert written == {k.rsplit("_", 1)[0] for k in changed}
+    custom_lens = rep["certified_check"]["custom_focal_length_mm"]  # no stock lens focuses the design
+    assert written == {k.rsplit("_", 1)[0] for k in changed} | ({"lens.focal_length"} if custom_lens else set())
+    if custom_lens:
+        assert data["lens"]["focal_length"] == f"{custom_lens:g} mm"
 
 
 def test_written_profile_builds_and_passes_rigcad_check(optimized, tmp_path, capsys):

@@ -173,10 +173,16 @@ def test_hardware_is_computed_from_the_parts(rig, write_profile, table31_text):
     from rigcad.parts.tower import hardware
 
     items = hardware(rig.profile, rig.layout)
-    m4 = [i for i in items if i["item"] == "bolt, washer and nut"]
-    assert sum(i["quantity"] for i in m4) == 4 + 2 + 4  # column top, lens foot, column foot on the tongue
-    # 5 mm flange + 10 mm shelf (or 10 mm base plate tongue) + washer, nut, threads = 20.2 mm
-    assert all(i["length_mm"] == 25.0 for i in m4)
+    m4 = {i["joins"].split(" (")[0]: i for i in items if i["item"] == "bolt, washer and nut"}
+    assert sorted(i["quantity"] for i in m4.values()) == [2, 4]  # lens foot, column foot on the tongue
+    # lens foot: 5 mm foot + 10 mm shelf + washer, nut, threads = 20.2 mm; column foot: 5 mm foot + the tongue
+    # above its nut traps (15 - 5.6 mm) + washer, nut, threads = 19.6 mm (the bolt ends above the bench)
+    assert m4["the lens mount's slotted foot to the shelf"]["length_mm"] == 25.0
+    foot = m4["the column's foot to the base plate's datum tongue"]["length_mm"]
+    assert foot == 20.0 and foot <= rig.profile.tower.wall + 1.0 - rig.layout.tower.bench_z
+    # the shelf on the column's flange: up into inserts, 12 mm (5 mm flange + washer + 6 mm of the 8.1 mm insert)
+    shelf = next(i for i in items if i["joins"].startswith("the column's top flange to the shelf"))
+    assert shelf["quantity"] == 4 and shelf["length_mm"] == 12.0
     springs = next(i for i in items if "spring" in i["item"])
     assert springs["quantity"] == 2
     screws = [i for i in items if i["thread"] == rig.profile.projector.mount_thread and i["item"].startswith("screw")]

@@ -1,0 +1,77 @@
+"""The COP tower's own joints in the assembly check (rigcad.manual.tower_joints): declared where the
+tower's parts put their holes, checked for their tool paths and their nuts' room; a blocked tool
+path is refused."""
+
+from __future__ import annotations
+
+import manifold3d as m3
+import numpy as np
+import pytest
+
+from rigcad.errors import GeometryError
+from rigcad.manual import assembly_check as AC
+from rigcad.manual import plan, tower_joints
+from rigcad.manual.assembly import picture_meshes
+from rigcad.parts import tower
+
+
+def _box(lo, hi):
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    return m3.Manifold.cube(tuple(hi - lo)).translate(tuple(lo))
+
+
+@pytest.fixture(scope="module")
+def rig_assembly(table31_rig):
+    return plan.assembly(table31_rig, picture_meshes(table31_rig))
+
+
+def test_the_tower_joints_are_declared_from_the_parts_holes(table31_rig, rig_assembly):
+    t, p = table31_rig.layout.tower, table31_rig.profile
+    steps = {s.name: s for s in rig_assembly.steps}
+    flange = sorted(tower._column_flange_points(t, p))
+    for name, axis in (("tower_column", plan.DOWN), ("tower_shelf", plan.UP)):
+        fs = steps[name].fasteners
+        assert sorted((f.head[0], f.head[1]) for f in fs) == flange and all(f.axis == axis for f in fs)
+    holder = steps["splitter_holder"].fasteners
+    springs = [f for f in holder if f.thread_in == "nut"]
+    screws = [f for f in holder if f.thread_in == "insert"]
+    assert sorted((f.head[0], f.head[1]) for f in springs) == sorted(tower._holder_flange_points(t, p))
+    assert sorted((f.head[0], f.head[1]) for f in screws) == sorted(tower.seat_points(t, p).values())
+    # every hardware row placed here is one of the tower's rows, and the rest stay with the tower's list
+    rows = [h for h in tower.hardware(p, table31_rig.layout) if h.get("thread")]
+    assert sum(tower_joints.placed(h) for h in rows) == len(tower_joints.PLACED)
+
+
+def test_the_found_order_fits_the_tower_joints_and_a_blocked_tool_is_refused(rig_assembly):
+    order = [p.step.name for p in AC.find_order(rig_assembly)]
+    shelf_bolt = next(f for f in rig_assembly.by_name["tower_shelf"].fasteners)
+    x, y, z = shelf_bolt.head
+    # a block 50 mm under the bolt's head (it goes up from under the column's flange): in no part's
+    # way, only in the hex tools' (the driver's 100 mm blade, the L key's 20 mm short arm + its long arm)
+    blocker = _box((x - 5, y - 5, z - 30), (x + 5, y + 5, z - 24))
+    a = AC.Assembly({**rig_assembly.solids, "blocker": blocker},
+                    [AC.Step("blocker", ("blocker",), (plan.DOWN,), 10.0), *rig_assembly.steps])
+    names = list(order)
+    names.insert(names.index("tower_shelf"), "blocker")
+    with pytest.raises(GeometryError, match=r"tower_shelf.*M4 x \d+ mm socket-head bolt.*blocked by blocker"):
+        AC.check_order(a, names)
+    names.remove("blocker")
+    names.insert(names.index("tower_shelf") + 1, "blocker")  # after the shelf is bolted: no harm
+    assert [p.step.name for p in AC.check_order(a, names)] == names
+
+
+def test_the_nut_trap_holds_an_m4_nut_where_the_check_looks():
+    """The trap's side (tower.NUT_TRAP): the nut as the check sees it (a cylinder across its
+    corners) passes within CLEARANCE_MM in the 8.0 mm square; the old 7.2 mm square is refused."""
+    f = plan._socket_head("M4 bolt", (0.0, 0.0, 20.0), plan.DOWN, 20.0, 4.0, "M4", thread_in="nut",
+                          nut_size_mm=(plan.NUT_AF["M4"] / np.sqrt(3.0), 3.2), grip_mm=14.0)
+    nut = AC.cylinder(np.array([0.0, 0.0, 6.0]), np.array([0.0, 0.0, -1.0]), 3.2, plan.NUT_AF["M4"] / np.sqrt(3.0))
+
+    def trap(side):
+        h = side / 2
+        return _box((-20, -20, 0), (20, 20, 10)) - _box((-h, -h, -1), (h, h, 6.0)) - AC.cylinder(
+            np.array([0.0, 0.0, 20.0]), np.array([0.0, 0.0, -1.0]), 30.0, 2.25)
+
+    assert AC.penetration(nut, trap(tower.NUT_TRAP)) <= AC.CLEARANCE_MM
+    assert AC.penetration(nut, trap(7.2)) > AC.CLEARANCE_MM
+    assert f.nut_size_mm[0] * 2 > tower.NUT_TRAP  # the corners meet the sides: the nut cannot turn
