@@ -173,3 +173,120 @@ def test_far_cop_design_has_no_pixel_grid(write_profile, table31_text):
     assert d.report["thin_lens"] is None
     assert d.report["convergence"]["max_miss_mm"] < 1e-6
     assert math.isinf(d.geometry.cop_z)
+
+
+def test_each_component_offset_moves_that_component_alone():
+    """offsets_for: camera and projector both move the COP (x or z), the paraboloid and the dome move
+    sideways; every other offset stays 0."""
+    from rigcad.optics.misalignment import COMPONENT_OFFSETS, offsets_for
+
+    expected = {"camera_dx": Offsets(cop_dx=0.3), "camera_dz": Offsets(cop_dz=0.3),
+                "projector_dx": Offsets(cop_dx=0.3), "projector_dz": Offsets(cop_dz=0.3),
+                "paraboloid_dx": Offsets(paraboloid_dx=0.3), "dome_dx": Offsets(dome_dx=0.3)}
+    assert set(COMPONENT_OFFSETS) == set(expected)
+    for name, offsets in expected.items():
+        assert offsets_for(name, 0.3) == offsets, name
+
+
+def test_convergence_point_is_where_the_returning_lines_cross():
+    """Lines through a known point meet there (least squares exact); lines that miss it by +-e on
+    either side of a symmetric pair meet at it too; under two rays (the others not ok) it is NaN."""
+    from types import SimpleNamespace
+
+    from rigcad.optics.misalignment import convergence_point
+
+    X = np.array([0.7, -0.2])
+    angles = np.radians([10.0, 35.0, 80.0, 120.0])
+    dirs = np.column_stack([np.cos(angles), np.sin(angles)])
+    D = X + np.array([[5.0], [12.0], [-3.0], [40.0]]) * dirs
+    tr = SimpleNamespace(ok=np.array([True, True, True, True]), dome_point=D)
+    assert np.allclose(convergence_point(tr, dirs), X, rtol=0, atol=1e-12)
+    two = SimpleNamespace(ok=np.array([False, True, False, True]), dome_point=D)
+    assert np.allclose(convergence_point(two, dirs), X, rtol=0, atol=1e-12)
+    one = SimpleNamespace(ok=np.array([False, True, False, False]), dome_point=D)
+    out = convergence_point(one, dirs)
+    assert out.shape == (2,) and np.all(np.isnan(out))
+
+
+def test_thin_lens_summary_of_known_offsets():
+    """Means and maxima of |offset| over both edges, rays with a NaN angle or miss dropped and counted
+    lost; None when every ray is lost."""
+    from rigcad.optics.thin_lens import ThinLensResult
+
+    nan = float("nan")
+    r = ThinLensResult(123.0, np.array([1.0, 2.0, 3.0]), np.array([0.1, -0.3, nan]), np.array([-0.2, 0.4, 0.5]),
+                       np.array([1.0, -2.0, 0.0]), np.array([0.5, nan, -4.0]))
+    assert r.summary() == {"focal_distance_mm": 123.0,
+                           "mean_abs_angular_offset_rad": pytest.approx((0.1 + 0.3 + 0.2 + 0.5) / 4, rel=1e-15),
+                           "max_abs_angular_offset_rad": 0.5,
+                           "mean_abs_miss_mm": pytest.approx((1.0 + 2.0 + 0.5 + 4.0) / 4, rel=1e-15),
+                           "max_abs_miss_mm": 4.0, "edge_rays_lost": 2, "edge_rays": 6}
+    lost = ThinLensResult(1.0, np.array([1.0]), np.array([nan]), np.array([0.1]), np.array([0.0]), np.array([nan]))
+    assert lost.summary() == {"focal_distance_mm": 1.0, "mean_abs_angular_offset_rad": None,
+                              "max_abs_angular_offset_rad": None, "mean_abs_miss_mm": None,
+                              "max_abs_miss_mm": None, "edge_rays_lost": 2, "edge_rays": 2}
+
+
+def test_thin_lens_edge_rays_leave_the_aperture_edges_for_the_focal_point(design):
+    """The thesis's construction: edge rays from COP -+ a/2 (left, right) aimed at the chief ray's
+    point at the focal distance (the mean chief path); offsets are edge minus chief arrival angle,
+    misses the edge rays'; chief_x where the chief rays meet the paraboloid."""
+    from rigcad.optics.thin_lens import thin_lens_check
+    from rigcad.optics.trace2d import trace
+
+    d = design
+    cop = np.array([0.0, d.geometry.cop_z])
+    dirs = d.chief_dirs[::25]
+    a = 4.0
+    lens = thin_lens_check(d.paraboloid, d.curve, cop, dirs, a)
+    chief = trace(d.paraboloid, d.curve, np.tile(cop, (len(dirs), 1)), dirs)
+    focal = float(np.mean(chief.path_length))
+    assert lens.focal_distance == pytest.approx(focal, rel=1e-12)
+    assert np.allclose(lens.chief_x, chief.paraboloid_point[:, 0], rtol=0, atol=1e-9)
+    Q = cop + focal * dirs
+    for sign, alpha, miss in ((-1, lens.alpha_left, lens.miss_left), (1, lens.alpha_right, lens.miss_right)):
+        E = np.tile(cop + [sign * a / 2, 0.0], (len(dirs), 1))
+        v = (Q - E) / np.linalg.norm(Q - E, axis=1, keepdims=True)
+        edge = trace(d.paraboloid, d.curve, E, v)
+        assert np.allclose(alpha, edge.theta - chief.theta, rtol=0, atol=1e-12, equal_nan=True)
+        assert np.allclose(miss, edge.miss, rtol=0, atol=1e-12, equal_nan=True)
+        assert np.count_nonzero(np.isfinite(miss)) >= len(dirs) - 2  # a lost ray or two at the ends
+        assert np.nanmax(np.abs(miss)) > 1e-3
+
+
+def test_convergence_error_figures_of_a_known_trace():
+    """The figures from a trace built by hand: rays arriving at known angles along lines through a known
+    point X (their returning direction (-sin theta, -cos theta)), misses known; lost rays dropped from
+    the misses and from the angle errors (lost in either trace), counted; no ray at all gives NaN."""
+    from types import SimpleNamespace
+
+    X = np.array([0.4, -0.3])
+    theta = np.radians([20.0, 40.0, 60.0, 75.0, 85.0])
+    back = np.column_stack([-np.sin(theta), -np.cos(theta)])
+    D = X - np.array([[200.0], [220.0], [250.0], [270.0], [300.0]]) * back
+    ok = np.array([True, True, True, False, True])
+    tr = SimpleNamespace(ok=ok, theta=theta, miss=np.array([0.3, -0.4, 0.0, 9.0, 1.2]), dome_point=D)
+    ref = SimpleNamespace(ok=np.array([True, False, True, True, True]),
+                          theta=theta - np.array([1e-3, 5.0, -2e-3, 7.0, 5e-4]))
+    err = convergence_error(tr, ref)
+    assert err == {"rms_miss_mm": pytest.approx(math.sqrt((0.09 + 0.16 + 0 + 1.44) / 4), rel=1e-14),
+                   "max_miss_mm": 1.2,
+                   "convergence_point_x_mm": pytest.approx(X[0], abs=1e-9),
+                   "convergence_point_z_mm": pytest.approx(X[1], abs=1e-9),
+                   "max_theta_error_rad": pytest.approx(2e-3, rel=1e-9),
+                   "rays_lost": 1, "rays": 5}
+    none = convergence_error(SimpleNamespace(ok=np.zeros(5, bool), theta=theta, miss=tr.miss, dome_point=D), ref)
+    assert none["rays_lost"] == 5 and none["rays"] == 5
+    assert all(math.isnan(none[k]) for k in ("rms_miss_mm", "max_miss_mm", "convergence_point_x_mm",
+                                              "convergence_point_z_mm", "max_theta_error_rad"))
+
+
+def test_no_misalignment_offsets_and_tilts_nothing_about_the_meridional_normal():
+    """Misalignment.none(): every component unmoved, untilted, its tilt axis the y axis (normal to the
+    meridional plane x-z, the axis of the 2D study's tilts)."""
+    from rigcad.optics.frames import COMPONENTS, Misalignment
+
+    m = Misalignment.none()
+    assert set(m.offsets) == set(m.tilts) == set(m.axes) == set(COMPONENTS)
+    for c in COMPONENTS:
+        assert m.offsets[c] == (0.0, 0.0, 0.0) and m.tilts[c] == 0.0 and m.axes[c] == (0.0, 1.0, 0.0), c

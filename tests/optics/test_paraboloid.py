@@ -79,3 +79,62 @@ def test_rays_through_the_rim_count_whichever_way_they_rounded():
         vs.append(np.array([np.nextafter(vs[-1][0], np.inf), vs[-1][1]]))
     vs = np.array(vs)
     assert PARA.blocks(np.tile(below, (len(vs), 1)), vs, np.full(len(vs), 100.0)).all()
+
+
+def test_blocks_segments_through_the_rim_chord_or_the_surface_and_no_others():
+    """Segments built from where they cross the body's rim chord (z = rim_z, |x - dx| <= rim) at a
+    known distance l: blocked when they reach it (l < length, from 0.5 mm or 10 mm below), not when
+    they stop 0.5 mm short, not when the crossing lies outside the rim; a segment through the surface
+    is blocked, one that stops 0.5 mm before the surface is not."""
+    v = unit(np.array([[0.3, 1.0]]))[0]
+    rim, dx, zc = PARA.rim_radius, PARA.dx, PARA.rim_z
+    cases = []  # (origin, direction, length, blocked)
+    for x_at_chord, l in ((dx - rim + 4.0, 10.0), (dx + rim - 0.5, 0.5), (dx + 2.0, 10.0)):
+        origin = np.array([x_at_chord, zc]) - l * v
+        cases += [(origin, v, l + 0.5, True), (origin, v, l - 0.4, False)]
+    outside = np.array([dx + rim + 0.5, zc]) - 10.0 * v
+    cases.append((outside, v, 10.5, False))
+    down = np.array([0.0, -1.0])
+    above = np.array([dx + 5.0, PARA.z(dx + 5.0) + 3.0])  # 3 mm above the surface, going down
+    cases += [(above, down, 3.5, True), (above, down, 2.5, False)]
+    origins = np.array([c[0] for c in cases])
+    dirs = np.array([c[1] for c in cases])
+    lengths = np.array([c[2] for c in cases])
+    expected = np.array([c[3] for c in cases])
+    assert np.array_equal(PARA.blocks(origins, dirs, lengths), expected)
+
+
+def _first_hit_exact(p, origin, direction):
+    """The ray's first positive root of (X + l d_x)^2 + 4 f (z0 + l d_z - z_v) = 0 in 60-digit decimals
+    (the float inputs taken exactly), textbook formula: the reference for float64 accuracy."""
+    from decimal import Decimal, getcontext
+
+    getcontext().prec = 60
+    D = Decimal
+    X = D(float(origin[0])) - D(p.dx)
+    dx, dz = D(float(direction[0])), D(float(direction[1]))
+    a = dx * dx
+    b = 2 * X * dx + 4 * D(p.focal_length) * dz
+    c = X * X + 4 * D(p.focal_length) * (D(float(origin[1])) - D(p.vertex_z))
+    sq = (b * b - 4 * a * c).sqrt()
+    return min(r for r in ((-b - sq) / (2 * a), (-b + sq) / (2 * a)) if r > 0)
+
+
+def test_intersect_is_float_accurate_for_a_steep_ray_just_above_the_surface():
+    """A near-vertical ray (a = d_x^2 ~ 1e-8) from 0.5 mm above the surface: the far root is ~1e9 mm
+    away, the near one ~0.5 mm; the cancellation-free formula gets the near one to float precision
+    (the textbook formula would lose ~1e-7 mm to cancellation), and a hit 0.5 mm away is a hit."""
+    d = unit(np.array([[1e-4, -1.0], [-2e-4, -1.0], [3e-5, -1.0]]))
+    x = np.array([3.0, -9.0, 12.0]) + PARA.dx
+    origins = np.column_stack([x, PARA.z(x) + 0.5])
+    lam = PARA.intersect(origins, d)
+    exact = np.array([float(_first_hit_exact(PARA, o, v)) for o, v in zip(origins, d)])
+    assert np.all((exact > 0.49) & (exact < 0.51))
+    assert np.max(np.abs(lam - exact)) < 1e-12, lam - exact
+
+
+def test_a_horizontal_ray_through_the_vertex_touches_it():
+    """Tangent at the vertex: the discriminant is exactly 0 (a double root), still a hit, at the vertex."""
+    origin = np.array([[PARA.dx - 3.0, PARA.vertex_z]])
+    lam = PARA.intersect(origin, np.array([[1.0, 0.0]]))
+    assert lam[0] == 3.0
