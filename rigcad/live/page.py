@@ -195,7 +195,7 @@ _PAGE = r"""<!DOCTYPE html>
     if (msg.rays && msg.rays.key !== raysKey) setRays(msg.rays);
     frameView();
     if (msg.parts.length) partList(msg.parts, msg.changed);
-    highlight(msg.changed);
+    if (applied > 0) highlight(msg.changed);  // the first frame is the rig itself, not a change
     figures(msg.figures);
     checks(msg.rows, msg.check_pending);
     state.rows = msg.rows; state.figures = msg.figures; state.timings = msg.timings;
