@@ -32,6 +32,7 @@ from rigcad.manual.fasteners import DOWN, DRIVER_BLADE_MM, HEX_KEY, L_KEY, NUT_A
 from rigcad.manual.fasteners import driver, spanner  # noqa: F401
 from rigcad.manual.fasteners import metric as _metric  # noqa: F401
 from rigcad.manual.fasteners import socket_head as _socket_head
+from rigcad.parts.tower import HEAT_SET_INSERT
 
 #: Units one step places together: an instrument with the lens built onto it.
 UNITS = (("projector_body", "projector_lens"), ("camera_body", "camera_lens"))
@@ -44,8 +45,8 @@ SIDEWAYS = ((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1.0, 0.0)
 #: parts under it within REST_SEARCH_MM (mm) hold it.
 REST_SEARCH_MM = 5.0
 REST_PROBE_MM = 0.08
-#: Heat-set insert (M thread -> outer diameter, length) as sold for printed parts (e.g. M4: 5.6 x 8.1 mm, hole 5.6 mm).
-INSERT = {"M3": (4.5, 5.7), "M4": (5.6, 8.1), "M5": (6.4, 9.5), "M6": (8.0, 12.7)}
+#: Heat-set insert (M thread -> outer diameter, length): the parts' table.
+INSERT = HEAT_SET_INSERT
 
 
 def _stem(name: str) -> str:

@@ -328,7 +328,6 @@ def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: floa
 #: heat-set inserts (5.6 x 8.1 mm; a bought aluminium shelf is tapped M4 instead) in blind holes in
 #: the shelf's underside, so nothing stands proud of the shelf's top under the projector, which stands
 #: on its shims only a few mm above it.
-SHELF_INSERT = (5.6, 8.1)  # the insert makers' hole (INSERT_HOLE["M4"]) and the insert's length
 
 
 def shelf_joint_cuts(t: TowerLayout, profile: Profile, z0: float) -> tuple:
@@ -357,6 +356,11 @@ def _holder_flange_points(t: TowerLayout, profile: Profile):
 
 #: Heat-set insert holes (mm) for the seat's push screws: the insert makers' hole for each thread.
 INSERT_HOLE = {"M3": 4.0, "M4": 5.6, "M5": 6.4, "M6": 8.0}
+#: Heat-set inserts as sold for printed parts: M thread -> (outer diameter, length), mm (e.g. M4:
+#: 5.6 x 8.1 mm); the one home of these sizes (the parts' holes, the manual's plan and BOM).
+HEAT_SET_INSERT = {"M3": (4.5, 5.7), "M4": (5.6, 8.1), "M5": (6.4, 9.5), "M6": (8.0, 12.7)}
+#: The shelf's M4 inserts: the insert makers' hole and the insert's length (mm).
+SHELF_INSERT = (INSERT_HOLE["M4"], HEAT_SET_INSERT["M4"][1])
 #: Clearance (mm) of the spring bolts in the holder's flanges: room to tilt by the seat's travel.
 SPRING_HOLE = 6.0
 
