@@ -23,7 +23,7 @@ def live_html(title: str) -> bytes:
     """The page, UTF-8; ``title`` is escaped. Deterministic (same title, same bytes)."""
     from rigcad.manual.view import SCENE_JS, three_js
 
-    page = (_PAGE.replace("@@TITLE@@", html.escape(title)).replace("@@HIGHLIGHT_MS@@", str(HIGHLIGHT_MS))
+    page = (_PAGE.replace("@@CSP@@", CSP).replace("@@TITLE@@", html.escape(title)).replace("@@HIGHLIGHT_MS@@", str(HIGHLIGHT_MS))
             .replace("@@THREE@@", three_js()).replace("@@SCENE@@", SCENE_JS))
     return page.encode("utf-8")
 
@@ -37,7 +37,7 @@ _PAGE = r"""<!DOCTYPE html>
 <head>
 <meta charset="utf-8">
 <title>@@TITLE@@</title>
-<meta http-equiv="Content-Security-Policy" content="default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src data: blob:; connect-src 'self'">
+<meta http-equiv="Content-Security-Policy" content="@@CSP@@">
 <style>
   html, body { margin: 0; height: 100%; overflow: hidden; font: 13px/1.35 sans-serif; background: #f4f4f4; }
   #view { position: absolute; inset: 0; }
