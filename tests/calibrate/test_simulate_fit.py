@@ -16,6 +16,7 @@ from rigcad.cli.calibrate import cmd_calibrate
 from rigcad.calibrate.decode import decode
 from rigcad.calibrate.images import CaptureError
 from rigcad.calibrate.patterns import Sequence
+from rigcad.calibrate.raxel import rays, to_global
 from rigcad.calibrate.run import calibrate, compare
 from rigcad.profile.schema import load_profile
 from rigcad.rig import Rig
@@ -108,7 +109,9 @@ def test_pivot_rays_are_exact_on_exact_screen_points(small):
     assert np.max(maps.angle_between(got[ok], -tr.v[ok])) < 1e-9
     # the planted surface matters here: the undeflected rays are ~1 mrad off
     assert np.percentile(maps.angle_between(-base.v[ok], -tr.v[ok]), 90) > 3e-4
-    two = maps.measured_rays(decoded, M.screens(s["heights"], s["theta"]))
+    poses = M.screens(s["heights"], s["theta"])
+    _, two = rays([to_global(p, d.u, d.v).reshape(-1, 3) for d, p in zip(decoded, poses)])
+    assert np.max(maps.angle_between(two[ok & np.isfinite(two[:, 0])], -tr.v[ok & np.isfinite(two[:, 0])])) < 1e-9
     assert (ok & ~np.isfinite(two[:, 0])).sum() > 0
 
 
