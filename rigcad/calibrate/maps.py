@@ -1,8 +1,9 @@
 """From the fit to the maps: each camera pixel's measured ray (through its fitted dome point and its
 decoded points on the fitted screens: :func:`pivot_rays`), the dome's residual slopes
 (:mod:`rigcad.calibrate.fit`'s docstring) and the corrected pixel -> incidence map: the fitted
-model's direction plus the measured residual, smoothed (normalised Gaussian convolution over the decoded pixels, sigma SMOOTH_PX) and filled
-where no screen point was seen (the same at FILL_PX; beyond that reach, the model alone). Its
+model's direction plus the measured residual, smoothed (normalised Gaussian convolution over the
+decoded pixels, sigma SMOOTH_PX) and filled where no screen point was seen (the same at FILL_PX;
+beyond that reach, the model alone). Its
 uncertainty per pixel (rad): the fit's covariance carried through the model's direction, with the
 decoding noise (the measured residual's local scatter about its smoothed value, divided by the
 smoothing's effective count) where measured, or the residual's RMS over the decoded pixels where
