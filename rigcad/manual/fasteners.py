@@ -25,10 +25,11 @@ L_KEY = {1.5: (45.0, 14.0), 2.0: (50.0, 16.0), 2.5: (56.0, 18.0), 3.0: (63.0, 20
          10.0: (112.0, 40.0)}
 
 
-def driver(thread: str, out_dir=(1.0, 0.0, 0.0)) -> tuple[Tool, ...]:
+def driver(thread: str, out_dir=(1.0, 0.0, 0.0), key: float | None = None) -> tuple[Tool, ...]:
     """A hex screwdriver with a DRIVER_BLADE_MM blade; else an L hex key (ISO 2936) with its short
-    arm in the socket and its long arm out along ``out_dir`` (away from the rig's axis)."""
-    key = HEX_KEY[thread]
+    arm in the socket and its long arm out along ``out_dir`` (away from the rig's axis). ``key``:
+    the socket's size (mm) when it is not the cap screw's (HEX_KEY), as in a countersunk head."""
+    key = HEX_KEY[thread] if key is None else key
     r = key / np.sqrt(3.0) + 0.5  # the key's corners, and a little play for the hand
     long, short = L_KEY[key]
     return (Tool(f"{key:g} mm hex screwdriver (ISO 2936 hex), {DRIVER_BLADE_MM:g} mm blade", DRIVER_BLADE_MM, r),

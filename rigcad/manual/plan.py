@@ -317,7 +317,7 @@ def hardware(steps: list[Step], rig=None) -> list[dict]:
                 # a nut in a printed trap bears on the part: one washer, under the head
                 extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + (
                     1 if f.nut_tool is None else 2)
-            else:
+            elif f.thread_in != "tapped":  # a bought extrusion's core screws: heads sunk, no washer
                 extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 1
             if f.thread_in == "insert":
                 dia, long = INSERT[thread]
