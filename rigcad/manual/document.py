@@ -260,6 +260,25 @@ def measure_first(d: Doc, c) -> None:
         "place.")
     d.table(["key", "assumed", "what it is", "set in"],
             [[f"`{r['key']}`", r["value"], r["doc"], f"`{r['set_in']}`"] for r in rows])
+    d.p("Each size drawn on the instrument's outline (at the assumed sizes), between the two features to measure "
+        "from and to:")
+    for path, caption in measurement_figures(c.p, c.files):
+        d.img(path, caption)
+
+
+def measurement_figures(profile, files: dict) -> list[tuple[str, str]]:
+    """One figure per size to measure (rigcad.profile.instruments.sketch, drawn by
+    rigcad.plots.measurement_figure) into ``files`` (path -> PNG bytes): the (path, caption) of each."""
+    from rigcad import plots
+    from rigcad.profile.instruments import measurements, sketch
+
+    out = []
+    for m in measurements(profile):
+        path = f"images/measure/{m.key.replace('.', '_')}.png"
+        what = f"from: {m.between[0]}; to: {m.between[1]}"
+        files[path] = plots.measurement_figure(sketch(profile, m), what)
+        out.append((path, f"`{m.key}` ({m.view} view): {m.what}, {what}"))
+    return out
 
 
 def _introduction(d: Doc, c) -> None:
@@ -441,7 +460,7 @@ THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut wit
                                       "insert's outer diameter and melt the insert in flush with a soldering iron at "
                                       "its maker's temperature)",
              "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
-             "bench": "into the bench",
+             "bench": "into the bench (on a breadboard: into its tapped holes, on the grid)",
              "tapped": "into the thread tapped in the part",
              "trap": "a washer under the head; its nut waits in the square trap printed for it (put it in before "
                      "the part with the trap stands on the bench), tighten crosswise by hand"}
