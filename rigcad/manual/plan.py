@@ -318,7 +318,8 @@ def hardware(steps: list[Step], rig=None) -> list[dict]:
                 extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + (
                     1 if f.nut_tool is None else 2)
             elif f.thread_in != "tapped":  # a bought extrusion's core screws: heads sunk, no washer
-                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 1
+                washer = f"{thread} large washer (ISO 7093)" if "ISO 7093" in f.item else f"{thread} washer (ISO 7089)"
+                extra[washer] = extra.get(washer, 0) + 1
             if f.thread_in == "insert":
                 dia, long = INSERT[thread]
                 name = f"{thread} heat-set insert for printed parts, {dia:g} x {long:g} mm"

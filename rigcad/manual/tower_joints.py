@@ -138,14 +138,30 @@ def seat_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]
     return {"splitter_holder": tuple(out)}
 
 
+def breadboard_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
+    """On a breadboard (``datum.mount``): the base plate's screws down into the board's tapped holes,
+    on the grid (rigcad.parts.breadboard), a large washer under each head (step base_plate)."""
+    from rigcad.parts import breadboard
+
+    b = breadboard.board(rig.profile)
+    if b is None:
+        return {}
+    row = breadboard.hardware(rig.profile, rig.layout)[0]
+    pts = [q for qs in breadboard.anchor_points(rig.profile, rig.layout).values() for q in qs]
+    return {"base_plate": tuple(_socket_head(row["item"] + " into the breadboard", (x, y, b.washer[1]), DOWN,
+                                             row["length_mm"], b.diameter, b.thread, thread_in="bench",
+                                             passes=("base_plate",)) for x, y in pts)}
+
+
 def tower_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]:
-    """Step name -> the tower's own joints' fasteners (see the module docstring)."""
+    """Step name -> the tower's own joints' fasteners (see the module docstring) and the base plate's
+    screws into a breadboard."""
     if getattr(rig.layout, "tower", None) is None or "tower_column" not in meshes_by_name:
         return {}
-    out = dict(column_fasteners(rig))
+    out = dict(column_fasteners(rig)) | breadboard_fasteners(rig)
     if "splitter_holder" in meshes_by_name and "tower_shelf" in meshes_by_name:
         out.update(seat_fasteners(rig, meshes_by_name))
     return out
 
 
-__all__ = ["PLACED", "PLACED_BOUGHT", "column_fasteners", "extrusion_fasteners", "placed", "seat_fasteners", "tower_fasteners"]
+__all__ = ["PLACED", "PLACED_BOUGHT", "breadboard_fasteners", "column_fasteners", "extrusion_fasteners", "placed", "seat_fasteners", "tower_fasteners"]
