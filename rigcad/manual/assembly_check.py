@@ -106,13 +106,14 @@ class Fastener:
     countersunk: bool = False
 
     def solids(self):
-        """The fastener in place: its shank and head, and its nut when it has one."""
+        """The fastener in place: its shank and head, and its nut when it has one (a hexagon,
+        :func:`hex_prism`)."""
         a, h = np.asarray(self.axis, float), np.asarray(self.head, float)
         under = max(self.head_radius_mm - self.head_height_mm, 0.0) if self.countersunk else None  # 45 deg flanks
         body = [cylinder(h, a, self.length_mm, self.shank_radius_mm),
                 cylinder(h - a * self.head_height_mm, a, self.head_height_mm, self.head_radius_mm, under)]
         if self.thread_in == "nut":
-            body.append(cylinder(h + a * self.grip_mm, a, self.nut_size_mm[1], self.nut_size_mm[0]))
+            body.append(hex_prism(h + a * self.grip_mm, a, self.nut_size_mm[1], self.nut_size_mm[0]))
         return _union(body)
 
     def paths(self) -> list[tuple[str, object]]:
@@ -180,6 +181,29 @@ def cylinder(start, axis, length: float, radius: float, radius_end: float | None
     c = m3.Manifold.cylinder(length, r, r if radius_end is None else radius_end / np.cos(np.pi / 32), 32)
     m = np.column_stack([u, v, a, np.asarray(start, float)])
     return c.transform(m)
+
+
+#: A nut's hexagon has a corner this far (rad) round from the rig's x axis (from y, for a nut on an x
+#: axis): 15 deg, the middle of the turns a square nut trap admits (rigcad.parts.tower.NUT_TRAP).
+NUT_TURN_RAD = np.radians(15.0)
+
+
+def hex_prism(start, axis, length: float, corner_radius: float, turn: float = NUT_TURN_RAD):
+    """A hexagonal prism (a nut: ISO 4032 across flats = corner_radius x sqrt 3) from ``start`` (3,) mm
+    along the unit ``axis`` for ``length`` mm, exact (no circumscribing), one corner ``turn`` rad round
+    from the rig's x axis as seen along the axis."""
+    import manifold3d as m3
+
+    a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
+    ref = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u0 = ref - np.dot(ref, a) * a
+    u0 /= np.linalg.norm(u0)
+    v0 = np.cross(a, u0)
+    u = np.cos(turn) * u0 + np.sin(turn) * v0
+    v = np.cross(a, u)
+    c = m3.Manifold.cylinder(length, corner_radius, corner_radius, 6)  # a corner on its local +x
+    return c.transform(np.column_stack([u, v, a, np.asarray(start, float)]))
 
 
 def penetration(a, b) -> float:

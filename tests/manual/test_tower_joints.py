@@ -61,19 +61,23 @@ def test_the_found_order_fits_the_tower_joints_and_a_blocked_tool_is_refused(rig
 
 
 def test_the_nut_trap_holds_an_m4_nut_where_the_check_looks():
-    """The trap's side (tower.NUT_TRAP): the nut as the check sees it (a cylinder across its
-    corners) passes within CLEARANCE_MM in the 8.0 mm square; the old 7.2 mm square is refused."""
+    """The trap's side (tower.NUT_TRAP): the nut as the check sees it (an ISO 4032 hexagon, 7 mm across
+    flats, a corner 15 deg off a side) is clear of the 8.0 mm square: its width both ways is
+    8.08 cos 15 deg = 7.80 mm (closed form); the old 7.2 mm square is refused; the nut cannot turn in it."""
     f = plan._socket_head("M4 bolt", (0.0, 0.0, 20.0), plan.DOWN, 20.0, 4.0, "M4", thread_in="nut",
                           nut_size_mm=(plan.NUT_AF["M4"] / np.sqrt(3.0), 3.2), grip_mm=14.0)
-    nut = AC.cylinder(np.array([0.0, 0.0, 6.0]), np.array([0.0, 0.0, -1.0]), 3.2, plan.NUT_AF["M4"] / np.sqrt(3.0))
+    nut = f.solids() - AC.cylinder(np.array([0.0, 0.0, 30.0]), np.array([0.0, 0.0, -1.0]), 40.0, 2.5)
+    lo, hi = np.array(nut.bounding_box()[:3]), np.array(nut.bounding_box()[3:])
+    width = 2 * plan.NUT_AF["M4"] / np.sqrt(3.0) * np.cos(np.radians(15.0))
+    assert hi[0] - lo[0] == pytest.approx(width, abs=1e-6) and hi[1] - lo[1] == pytest.approx(width, abs=1e-6)
 
     def trap(side):
         h = side / 2
         return _box((-20, -20, 0), (20, 20, 10)) - _box((-h, -h, -1), (h, h, 6.0)) - AC.cylinder(
             np.array([0.0, 0.0, 20.0]), np.array([0.0, 0.0, -1.0]), 30.0, 2.25)
 
-    assert AC.penetration(nut, trap(tower.NUT_TRAP)) <= AC.CLEARANCE_MM
-    assert AC.penetration(nut, trap(7.2)) > AC.CLEARANCE_MM
+    assert abs(AC.penetration(f.solids(), trap(tower.NUT_TRAP))) < 1e-6  # it touches the ceiling only
+    assert AC.penetration(f.solids(), trap(7.2)) > AC.CLEARANCE_MM
     assert f.nut_size_mm[0] * 2 > tower.NUT_TRAP  # the corners meet the sides: the nut cannot turn
 
 
