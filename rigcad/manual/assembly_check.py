@@ -183,16 +183,15 @@ def cylinder(start, axis, length: float, radius: float, radius_end: float | None
     return c.transform(m)
 
 
-#: A nut's hexagon has a corner this far (rad) round from the rig's x axis (from y, for a nut on an x
-#: axis): 15 deg, the middle of the turns a square nut trap admits (rigcad.parts.tower.NUT_TRAP).
-NUT_TURN_RAD = np.radians(15.0)
-
-
-def hex_prism(start, axis, length: float, corner_radius: float, turn: float = NUT_TURN_RAD):
+def hex_prism(start, axis, length: float, corner_radius: float, turn: float | None = None):
     """A hexagonal prism (a nut: ISO 4032 across flats = corner_radius x sqrt 3) from ``start`` (3,) mm
     along the unit ``axis`` for ``length`` mm, exact (no circumscribing), one corner ``turn`` rad round
-    from the rig's x axis as seen along the axis."""
+    from the rig's x axis (from y, for an x axis) as seen along the axis; by default as the printed
+    nut traps hold a nut (rigcad.parts.tower.NUT_TRAP_TURN)."""
     import manifold3d as m3
+
+    if turn is None:
+        from rigcad.parts.tower import NUT_TRAP_TURN as turn
 
     a = np.asarray(axis, float)
     a = a / np.linalg.norm(a)

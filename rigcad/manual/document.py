@@ -462,7 +462,7 @@ THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut wit
              "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
              "bench": "into the bench (on a breadboard: into its tapped holes, on the grid)",
              "tapped": "into the thread tapped in the part",
-             "trap": "a washer under the head; its nut waits in the square trap printed for it (put it in before "
+             "trap": "a washer under the head; its nut waits in the hexagonal trap printed for it (put it in before "
                      "the part with the trap stands on the bench), tighten crosswise by hand"}
 
 

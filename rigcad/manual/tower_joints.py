@@ -5,7 +5,7 @@ placed where the tower's parts put their holes (rigcad.parts.tower: ``_column_fl
 path and the nut's room (and the spanner's way out where a hand holds the nut):
 
 - the printed column's foot: four bolts down through the foot and the base plate's datum tongue,
-  their nuts in the square traps under the tongue (put in before the plate stands on the bench:
+  their nuts in the hexagonal traps under the tongue (put in before the plate stands on the bench:
   the trap holds the nut, no spanner);
 - the shelf on the column's top flange: four bolts up from under the flange into inserts in the
   shelf's underside (nothing stands proud of the shelf's top, where the projector stands);

@@ -16,7 +16,7 @@ from rigcad.profile.schema import Profile
 def base_plate(profile: Profile, layout: RigLayout) -> Part:
     """The rig's datum: a disc bolted to the dome's flange, bored for the sample holder, with a tongue
     out to the COP tower's column, whose foot it locates by two dowels and holds by four bolts (nuts
-    in square traps underneath). The tongue reaches down to the bench (the sample holder's stop
+    in hexagonal traps underneath). The tongue reaches down to the bench (the sample holder's stop
     collar's level): the tower's weight goes into the bench, not through the disc."""
     t = profile.base_plate.thickness
     holder = profile.sample_holder

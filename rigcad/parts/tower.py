@@ -39,7 +39,8 @@ import numpy as np
 from rigcad.errors import GeometryError
 from rigcad.optics.focus import focusing_lens
 from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_point, splitter_plate
-from rigcad.parts.recipe import Box, Cylinder, Difference, Line, Part, Prism, Revolve, Section, Translate, Union_
+from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Translate,
+                                 Union_)
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import MOUNT_THREADS, Profile
 
@@ -304,14 +305,17 @@ def _countersink() -> Revolve:
                             Line((r, 0.0), (r, 1.0)), Line((r, 1.0), (0.0, 1.0)), Line((0.0, 1.0), (0.0, -k - 0.2)))))
 
 
-#: Square nut traps under the tongue (mm); the tongue then stands on the bench. An M4 nut (7 mm
-#: across flats, 8.08 across corners, 3.2 mm thick) goes into a square of side s when its widths in
-#: two perpendicular directions, 8.08 cos(d) and 8.08 cos(30 deg - d) (d: a corner's angle off a
-#: side), are both under s: s = 8.0 admits it for d in 8..22 deg and stops it turning further (a
-#: 7.2 mm square, 7.8 being the least any nut passes, would not take it). The depth puts the nut so
-#: high that a stocked 20 mm bolt reaches through it and ends 0.8 mm above the bench (the assembly
-#: check, rigcad.manual.tower_joints, verifies both).
-NUT_TRAP = 8.0
+#: ISO 4032 hex nuts: width across flats (mm) per metric thread (the spanner's size); the one home of
+#: these sizes (the nut traps here, the manual's nuts and spanners).
+NUT_AF = {"M2": 4.0, "M2.5": 5.0, "M3": 5.5, "M4": 7.0, "M5": 8.0, "M6": 10.0, "M8": 13.0, "M10": 16.0, "M12": 18.0}
+#: Hexagonal nut traps under the tongue (mm): the M4 nut's 7.0 mm across flats and a printed fit's gap
+#: (0.2 mm) on each flat; a corner on +x (NUT_TRAP_TURN, rad). The nut (4.04 mm to a corner) cannot turn
+#: in it (3.7 mm to a flat). The depth puts the nut so high that a stocked 20 mm bolt reaches through it
+#: and ends 0.8 mm above the bench; the tongue then stands on the bench (the assembly check,
+#: rigcad.manual.tower_joints, verifies both, the nut drawn as its hexagon).
+NUT_TRAP_GAP = 0.2
+NUT_TRAP = NUT_AF["M4"] + 2 * NUT_TRAP_GAP
+NUT_TRAP_TURN = 0.0
 NUT_TRAP_DEPTH = 5.6
 #: Counterbore under the tongue for the extrusion's M8 socket head (13 mm, 8 mm tall; ISO 4762):
 #: diameter, depth (mm). An ISO 7089 M8 washer (16 mm) does not fit it: the head bears on the floor.
@@ -335,13 +339,12 @@ def core_bolt_lengths(profile: Profile, t: TowerLayout) -> dict[str, float]:
 
 
 def tongue_underside_cuts(t: TowerLayout, profile: Profile, z_bottom: float) -> tuple:
-    """What the column joint cuts into the tongue's underside (z_bottom: the bench): a square nut
+    """What the column joint cuts into the tongue's underside (z_bottom: the bench): a hexagonal nut
     trap under each of the printed column's bolts, or a counterbore for the extrusion's M8 head."""
     if profile.buy.column != "print":
         d, depth = CORE_HEAD_BORE
         return (Cylinder((t.column_x, 0.0, z_bottom - 1.0), d / 2, depth + 1.0),)
-    h = NUT_TRAP / 2
-    return tuple(Box((x - h, y - h, z_bottom - 1.0), (x + h, y + h, z_bottom + NUT_TRAP_DEPTH))
+    return tuple(HexPrism((x, y, z_bottom - 1.0), NUT_TRAP, NUT_TRAP_DEPTH + 1.0, NUT_TRAP_TURN)
                  for x, y in _column_flange_points(t, profile))
 
 
@@ -656,7 +659,7 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
                   + ("heat-set inserts pressed into the shelf's underside" if profile.buy.shelf == "print" else
                      "M4 threads tapped in the shelf's underside (8 mm deep)")},
         {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + tongue - NUT_TRAP_DEPTH, nut),
-         "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (the nuts in the square traps "
+         "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
                                  "under the tongue, put in before it stands on the bench)"},
         *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT[0],
             "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]

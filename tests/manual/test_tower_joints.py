@@ -60,25 +60,43 @@ def test_the_found_order_fits_the_tower_joints_and_a_blocked_tool_is_refused(rig
     assert [p.step.name for p in AC.check_order(a, names)] == names
 
 
-def test_the_nut_trap_holds_an_m4_nut_where_the_check_looks():
-    """The trap's side (tower.NUT_TRAP): the nut as the check sees it (an ISO 4032 hexagon, 7 mm across
-    flats, a corner 15 deg off a side) is clear of the 8.0 mm square: its width both ways is
-    8.08 cos 15 deg = 7.80 mm (closed form); the old 7.2 mm square is refused; the nut cannot turn in it."""
+def test_the_nut_trap_holds_an_m4_nut_where_the_check_looks(table31_rig):
+    """The trap (tower.NUT_TRAP, a hexagon 7.0 + 2 x 0.2 mm across flats, in the base plate's recipe)
+    and the nut as the check sees it (an ISO 4032 hexagon, 7 mm across flats, a corner on +x as the
+    trap holds it: 8.08 mm along x, 7.0 mm along y, closed form): the nut is clear of the trap; a trap
+    0.2 mm narrower than the nut is refused; the nut cannot turn in its trap."""
+    from rigcad.parts.recipe import HexPrism
+
     f = plan._socket_head("M4 bolt", (0.0, 0.0, 20.0), plan.DOWN, 20.0, 4.0, "M4", thread_in="nut",
                           nut_size_mm=(plan.NUT_AF["M4"] / np.sqrt(3.0), 3.2), grip_mm=14.0)
     nut = f.solids() - AC.cylinder(np.array([0.0, 0.0, 30.0]), np.array([0.0, 0.0, -1.0]), 40.0, 2.5)
     lo, hi = np.array(nut.bounding_box()[:3]), np.array(nut.bounding_box()[3:])
-    width = 2 * plan.NUT_AF["M4"] / np.sqrt(3.0) * np.cos(np.radians(15.0))
-    assert hi[0] - lo[0] == pytest.approx(width, abs=1e-6) and hi[1] - lo[1] == pytest.approx(width, abs=1e-6)
+    assert hi[0] - lo[0] == pytest.approx(2 * 7.0 / np.sqrt(3.0), abs=1e-6)
+    assert hi[1] - lo[1] == pytest.approx(7.0, abs=1e-6)
+    traps = [c for c in _cuts(table31_rig.recipes["base_plate"].solid) if isinstance(c, HexPrism)]
+    assert len(traps) == 4 and all(c.across_flats == tower.NUT_TRAP == 7.4 for c in traps)
 
-    def trap(side):
-        h = side / 2
-        return _box((-20, -20, 0), (20, 20, 10)) - _box((-h, -h, -1), (h, h, 6.0)) - AC.cylinder(
+    def trap(across_flats):
+        pocket = AC.hex_prism(np.array([0.0, 0.0, -1.0]), np.array([0.0, 0.0, 1.0]), 7.0, across_flats / np.sqrt(3.0))
+        return _box((-20, -20, 0), (20, 20, 10)) - pocket - AC.cylinder(
             np.array([0.0, 0.0, 20.0]), np.array([0.0, 0.0, -1.0]), 30.0, 2.25)
 
     assert abs(AC.penetration(f.solids(), trap(tower.NUT_TRAP))) < 1e-6  # it touches the ceiling only
-    assert AC.penetration(f.solids(), trap(7.2)) > AC.CLEARANCE_MM
-    assert f.nut_size_mm[0] * 2 > tower.NUT_TRAP  # the corners meet the sides: the nut cannot turn
+    assert AC.penetration(f.solids(), trap(plan.NUT_AF["M4"] - 0.2)) > AC.CLEARANCE_MM
+    assert f.nut_size_mm[0] > tower.NUT_TRAP / 2  # its corners reach past the trap's flats: it cannot turn
+
+
+def _cuts(solid):
+    from rigcad.parts.recipe import Difference, Translate, Union_
+
+    if isinstance(solid, Difference):
+        yield from _cuts(solid.base)
+        yield from solid.cuts
+    elif isinstance(solid, Union_):
+        for s in solid.items:
+            yield from _cuts(s)
+    elif isinstance(solid, Translate):
+        yield from _cuts(solid.solid)
 
 
 @pytest.fixture(scope="module")
