@@ -306,6 +306,10 @@ def printed(rig, fab_report: dict) -> list[dict]:
         if "error" in e:
             rows.append({"part": name, "use": use, "quantity": None, "process": "not printable", "note": e["error"]})
             continue
+        if e.get("process") == "bought":  # the profile's buy: stock to order, nothing printed or cut
+            rows.append({"part": name, "use": use, "quantity": e["quantity"], "process": "bought",
+                         "pieces": 0, "time_s": None, "material_g": None, "source": None, "note": e["stock"]})
+            continue
         if "pieces" not in e:
             rows.append({"part": name, "use": use, "quantity": e["quantity"], "process": e["process"],
                          "pieces": 0, "time_s": None, "material_g": None, "source": None,

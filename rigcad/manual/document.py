@@ -302,8 +302,8 @@ def _section_bill(d: Doc, c) -> None:
     rows = []
     for r in bill["printed"]:
         if r.get("time_s") is None:
-            rows.append([f"`{r['part']}`", r["use"], r["quantity"] or "-", "cut" if r["quantity"] else "-",
-                         r["process"], "-", "-", r["note"]])
+            kind = "bought" if r["process"] == "bought" else "cut" if r["quantity"] else "-"
+            rows.append([f"`{r['part']}`", r["use"], r["quantity"] or "-", kind, r["process"], "-", "-", r["note"]])
         else:
             rows.append([f"`{r['part']}`", r["use"], r["quantity"], r["pieces"], r["process"], hours_minutes(r["time_s"]),
                          f"{r['material_g']:.0f} g", f"{r['note']} ({r['source']})"])
@@ -375,6 +375,8 @@ def _section_print(d: Doc, c) -> None:
                          f"{', '.join(sorted({pc['orientation'] for pc in e['pieces']}))}"
                          + ("; needs support" if support else "")
                          + (f"; {len(e['pins'])} pin holes" if e.get("pins") else ""))
+        elif e.get("process") == "bought":
+            items.append(f"`{name}`: bought, not printed: {e['stock']}")
         elif "error" not in e:
             items.append(f"`{name}`: cut from a {e['plate_thickness_mm']:g} mm plate (`outlines/{name}.dxf`, `.svg`)")
         else:
@@ -499,6 +501,10 @@ def step_text(placed, meshes_by_name: dict) -> str:
                      for f in st.fasteners)
     for (item, tool, thread_in), n in groups.items():
         text += f" Fix it with {n} x {item}, {THREAD_IN[thread_in]} (tool: {tool} or an L key)."
+    lift = max((f.lift_mm for f in st.fasteners), default=0.0)
+    if lift:
+        text += (f" Its screw goes in from below: lift the rig onto blocks {lift:g} mm high under the tongue (the "
+                 "film test's), turn it with the L key's short arm in the socket, then set the rig down.")
     return text
 
 

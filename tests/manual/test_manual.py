@@ -254,3 +254,12 @@ def test_the_manual_opens_with_a_figure_of_each_size_to_measure(table31):
     for key, (path, caption) in zip(keys, images):
         assert f"`{key}`" in caption and key.replace(".", "_") in path
         assert Image.open(io.BytesIO(c.files[path])).size[0] > 200
+
+
+def test_a_bought_part_is_billed_with_its_stock_not_as_a_cut_plate(table31_rig):
+    """The fab stage reports a bought part as {"process": "bought", "stock": ...} (no pieces, no plate):
+    the bill lists it with its stock (it used to read a cut plate's thickness and fail)."""
+    stock = "aluminium extrusion 40 x 40 mm, slot 8, cut to 292.0 mm"
+    rows = B.printed(table31_rig, {"parts": {"tower_column": {"process": "bought", "stock": stock, "quantity": 1}}})
+    assert rows == [{"part": "tower_column", "use": "rig", "quantity": 1, "process": "bought", "pieces": 0,
+                     "time_s": None, "material_g": None, "source": None, "note": stock}]

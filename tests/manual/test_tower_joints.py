@@ -117,6 +117,13 @@ def test_the_bought_extrusions_core_screws_are_checked_and_a_blocked_one_is_refu
     rig, a = bought_assembly
     t = rig.layout.tower
     (foot,), (top,) = a.by_name["tower_column"].fasteners, a.by_name["tower_shelf"].fasteners
+    from rigcad.manual.calibration import film_setup
+    from rigcad.manual.document import step_text
+
+    lift = film_setup(rig)["block_under_tongue_mm"]
+    assert foot.lift_mm == lift and top.lift_mm == 0.0
+    text = step_text(AC.Placed(a.by_name["tower_column"], plan.DOWN), {m.name: m for m in picture_meshes(rig)})
+    assert f"lift the rig onto blocks {lift:g} mm high" in text
     assert foot.head == pytest.approx((t.column_x, 0.0, t.bench_z + tower.CORE_HEAD_BORE[1]))
     assert top.head == pytest.approx((t.column_x, 0.0, t.shelf_top_z - tower.CORE_TOP_SCREW[1]))
     # engaged thread = length - what the screw passes (plate under the counterbore, minus the pocket)
