@@ -50,8 +50,9 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
     # the one Monte Carlo (rigcad.check.montecarlo) and the rank correlations the tolerance report adds
     # (not the tests that start a process pool or a dask cluster, as tolerance.limits; their claim,
     # the same bits on every engine, compares two runs of the same mutant and cannot kill one)
+    # (tests/check/test_montecarlo.py: its parts one at a time, seconds)
     "montecarlo": (["rigcad/check/montecarlo.py", "rigcad/tolerance/montecarlo.py"],
-                   [f"tests/tolerance/test_tolerance.py::{t}" for t in (
+                   ["tests/check/test_montecarlo.py"] + [f"tests/tolerance/test_tolerance.py::{t}" for t in (
                        "test_monte_carlo_is_not_vacuous", "test_monte_carlo_spots_match_an_independent_retrace",
                        "test_a_sample_does_not_depend_on_the_run_size", "test_limit_search_at_its_two_ends",
                        "test_scheduler_without_dask_says_what_to_install")]),
