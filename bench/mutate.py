@@ -44,7 +44,12 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
                              "test_inverse_limit_holds_at_the_limit_and_fails_at_twice_it",
                              "test_limit_search_at_its_two_ends",
                              "test_limit_rows_ranked_by_budget_and_a_zero_tolerance")]),
-    "check.tolerances": (["rigcad/check/tolerances.py"], ["tests/check/test_raycheck.py"]),
+    # the rows on a hand-made report (test_tolerances.py, milliseconds) and the printed table;
+    # test_raycheck.py's others keep their claims (every shipped profile passes on a real report, a
+    # coarse tessellation fails naming its key, the CLI) but trace rigs: minutes a mutant
+    "check.tolerances": (["rigcad/check/tolerances.py"],
+                         ["tests/check/test_tolerances.py",
+                          "tests/check/test_raycheck.py::test_the_table_is_fixed_width_with_a_verdict_per_row"]),
     "fab.estimate": (["rigcad/fab/estimate.py"], ["tests/fab/test_estimate.py"]),
     "basis.sh": (["rigcad/basis/sh.py"], ["tests/basis/test_sh.py"]),
     # the one Monte Carlo (rigcad.check.montecarlo) and the rank correlations the tolerance report adds
