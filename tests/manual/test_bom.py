@@ -163,6 +163,13 @@ def test_what_counts_as_a_bolt_hole():
                                   (Union_((Translate(Cylinder((1, 2, 3), 1.5, 4.0), (10, 20, 30)),)),)),
                        (100, 200, 300))
     assert list(B._holes(nested)) == [(111.0, 222.0, 333.0, 337.0, 3.0, True)]
+    # holes of a difference's base (a plate drilled, then cut again), moved with it; a cut whose own
+    # base is a hole (a hole with a key left in it) is a hole; a slot moved off the origin
+    drilled = Translate(Difference(Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((1, 2, 0), 1.0, 9.0),)),
+                                   (Difference(Cylinder((5, 6, 0), 2.0, 9.0), (Box((5, 6, 0), (5.5, 6.5, 9)),)),
+                                    Box((1, 2, 0), (4, 10, 9)))), (10, 20, 30))
+    assert list(B._holes(drilled)) == [(11.0, 22.0, 30.0, 39.0, 2.0, True), (15.0, 26.0, 30.0, 39.0, 4.0, True),
+                                       (12.5, 26.0, 30.0, 39.0, 3.0, False)]
 
 
 def test_bolt_axes_split_a_stack_where_its_holes_stop_touching_and_skip_lone_slots():
@@ -187,6 +194,51 @@ def test_bolt_axes_split_a_stack_where_its_holes_stop_touching_and_skip_lone_slo
                        "jig": _part("jig", flange, in_rig=False)})
     assert [b["parts"] for b in B.bolt_axes(rig)] == [("plate",)]
     assert [b["parts"] for b in B.bolt_axes(rig, tower=True)] == [("plate", "tower_column")]
+
+
+def test_holes_on_axes_0_5_mm_apart_are_separate_bolts_and_a_stack_is_ordered_by_its_bottoms():
+    def hole(x, y, z0, z1, r=1.0):
+        return Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((x, y, z0), r, z1 - z0),))
+
+    rig = _rig([], 1, {"a": _part("a", hole(0, 0, 0, 5)), "b": _part("b", hole(0, 0.5, 0, 5)),
+                       "c": _part("c", hole(0.5, 0, 0, 5))})
+    assert sorted((b["x"], b["y"], b["parts"]) for b in B.bolt_axes(rig)) == [
+        (0.0, 0.0, ("a",)), (0.0, 0.5, ("b",)), (0.5, 0.0, ("c",))]
+    # a long hole (0..10) holding two short ones (2..3, 5..6): one run, whatever order their tops come in
+    long_ = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((0, 0, 0), 1.0, 10.0), Cylinder((0, 0, 2), 1.0, 1.0)))
+    rig = _rig([], 1, {"p": _part("p", long_), "q": _part("q", hole(0, 0, 5, 6))})
+    (b,) = B.bolt_axes(rig)
+    assert b["parts"] == ("p", "q") and (b["bottom_z"], b["top_z"]) == (1.0, 9.0)
+    # the same bottom: the first by name gives the axis
+    rig = _rig([], 1, {"b": _part("b", hole(10.0, 0, 0, 5)), "a": _part("a", hole(10.01, 0, 0, 6))})
+    (b,) = B.bolt_axes(rig)
+    assert (b["x"], b["upper"]) == (10.01, "a")
+    # a hole starting exactly at the margin above the last top still joins it
+    edge = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((0, 0, 0), 1.0, 5.0),
+                                                  Cylinder((0, 0, 5.0 + 1e-6), 1.0, 5.0)))
+    assert len(B.bolt_axes(_rig([], 1, {"e": _part("e", edge)}))) == 1
+    # a lone slot under a separate round hole on its axis: the slot is skipped, the hole still a bolt
+    slot_then_hole = Difference(Box((0, 0, 0), (9, 9, 30)), (Box((0, 0, 0), (4, 2, 9)),
+                                                             Cylinder((2, 1, 20), 1.0, 5.0)))
+    (b,) = B.bolt_axes(_rig([], 1, {"s": _part("s", slot_then_hole)}))
+    assert (b["parts"], b["bottom_z"], b["top_z"]) == (("s",), 21.0, 24.0)
+
+
+def test_bolts_are_grouped_by_grip_to_the_micrometre_and_by_hole():
+    def pair(x, top, r=2.0):
+        lower = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((x, 0, -1), r, 8.0),))
+        upper = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((x, 0, 5), r, top - 4),))
+        return lower, upper
+
+    parts = {}
+    for k, (x, top, r) in enumerate([(0, 17.0, 2.0), (20, 17.0004, 2.0), (40, 17.4, 2.0), (60, 17.0, 2.25)]):
+        lo, up = pair(x, top, r)
+        parts[f"lo{k}"], parts[f"up{k}"] = lo, up
+    lower = Difference(Box((0, 0, 0), (99, 9, 9)), tuple(c for k in range(4) for c in parts[f"lo{k}"].cuts))
+    upper = Difference(Box((0, 0, 0), (99, 9, 9)), tuple(c for k in range(4) for c in parts[f"up{k}"].cuts))
+    rows = B.bolt_joints(_rig([], 1, {"lower": _part("lower", lower), "upper": _part("upper", upper)}))
+    assert [(r["count"], r["thread"], round(r["grip_mm"], 4)) for r in rows] == [
+        (2, "M3", 17.0), (1, "M4", 17.0), (1, "M3", 17.4)]
 
 
 def test_the_upper_part_is_the_one_whose_hole_reaches_highest_the_name_breaking_ties():
@@ -247,6 +299,7 @@ def test_fasteners_add_nuts_and_washers_per_thread_and_the_towers_own(monkeypatc
          "length_mm": None, "note": "1 mm thick"},
     ]
     assert B.tower_hardware(rig) == []  # no tower in this layout
+    assert B.tower_hardware(SimpleNamespace(layout=SimpleNamespace())) == []  # a layout that knows no tower
     import rigcad.parts.tower as T
 
     seen = []
@@ -289,6 +342,10 @@ def test_dowel_pins_count_per_part_times_its_quantity():
     assert B.dowel_pins(report, _printer(filament=1.75))["note"] == (
         "holes 1.9 mm x 6 mm deep into each piece (alignment_pin in printers/x.yaml); cut from the printer's own filament")
     assert B.dowel_pins(report, _printer(filament=2.85))["note"] == pins["note"]
+    assert B.dowel_pins(report, _printer(filament=0.0))["note"] == pins["note"]  # no filament diameter
+    none = _printer()
+    none.filament_diameter = None
+    assert B.dowel_pins(report, none)["note"] == pins["note"]
     assert B.dowel_pins({"parts": {"a": {"pins": []}, "b": {}}}, _printer()) is None
     assert B.dowel_drills(_printer()) == ("HSS twist drill 1.9 mm (DIN 338) for the pin holes; 4 mm H7 reamer for "
                                           "the column's dowel holes", "1 each")
@@ -312,7 +369,11 @@ def test_printed_rows_take_the_slicers_figures_only_when_every_piece_has_them():
             _piece(100.0, 5.0, "flat", {"print_time_s": 1000.0, "filament_g": 50.0}), _piece(200.0, 7.0, "flat")]},
         "extra": {"quantity": 3, "process": "laser", "plate_thickness_mm": 3.0, "outline_size_mm": (120.04, 80.26)},
         "broken": {"error": "too big"}}}
-    plate, jig, extra, broken = B.printed(rig, report)
+    report["parts"]["plain"] = {"quantity": 1, "process": "FDM", "pieces": [{**_piece(5.0, 1.0, "flat"), "gcode": {}}]}
+    first = {"parts": {"broken": report["parts"]["broken"], "plate": report["parts"]["plate"]}}
+    assert [r["part"] for r in B.printed(rig, first)] == ["broken", "plate"]  # an error row, then the others
+    plate, jig, extra, broken, plain = B.printed(rig, report)
+    assert plain["source"] == "rigcad estimate" and plain["time_s"] == 5.0  # G-code without estimates
     # sliced: the slicer's times and grams (the estimate's grams where the slicer gave none), times quantity
     assert plate == {"part": "plate", "use": "rig", "quantity": 2, "process": "FDM", "pieces": 2,
                      "time_s": 8000.0, "material_g": 114.0, "source": "slicer", "note": "flat, upright"}
@@ -336,6 +397,7 @@ class Camera:
     name: str | None = field(default=None, metadata={"spec": SimpleNamespace(kind="text", doc="")})
     bands: tuple = field(default=(1, 2), metadata={})
     model: str = "X-1"
+    mount_thread: str = "M6"
 
 
 def test_purchased_rows_describe_every_field_with_its_unit():
@@ -351,12 +413,13 @@ def test_purchased_rows_describe_every_field_with_its_unit():
     assert fov == "fov 28.65 deg (assumed)"
     assert rows == [
         {"item": "camera", "quantity": 1, "source": "p.yaml:3",
-         "spec": f"focal 12.5 mm; {fov}; resolution 1920 x 1080 px; bands [1, 2]; model X-1"},
+         "spec": f"focal 12.5 mm; {fov}; resolution 1920 x 1080 px; bands [1, 2]; model X-1; mount thread M6"},
         {"item": "lens", "quantity": 1, "source": "default",
-         "spec": f"focal 1235 mm; {fov}; resolution 1920 x 1080 px; name L; bands [1, 2]; model X-1"}]
+         "spec": f"focal 1235 mm; {fov}; resolution 1920 x 1080 px; name L; bands [1, 2]; model X-1; mount thread M6"}]
     assert asked == [("camera", "focal"), ("lens", "focal")]
-    profile.beam_splitter = Camera()
-    assert [r["item"] for r in B.purchased(SimpleNamespace(profile=profile))] == ["camera", "beam splitter", "lens"]
+    profile.beam_splitter = profile.splitter = profile.projector = Camera()
+    assert [r["item"] for r in B.purchased(SimpleNamespace(profile=profile))] == [
+        "projector", "camera", "beam splitter", "splitter", "lens"]
 
 
 def test_the_bill_sums_the_coating_by_layer_and_measures_each_mirror():
@@ -366,6 +429,8 @@ def test_the_bill_sums_the_coating_by_layer_and_measures_each_mirror():
     rig.profile.where = lambda *k: None
     report = {"parts": {"cup": {"quantity": 1, "process": "FDM", "pieces": [_piece(10.0, 1.0, "flat")]}},
               "totals": {"time_s": 10.0}}
+    pinned = {"parts": {"cup": {**report["parts"]["cup"], "pins": [1, 2]}}}
+    assert B.bill(rig, pinned, _printer())["pins"] == B.dowel_pins(pinned, _printer()) != None  # noqa: E711
     doc = B.bill(rig, report, _printer())
     coats = B.coating_rows(rig)
     assert doc["coating_by_mirror"] == [c.__dict__ for c in coats]
@@ -386,5 +451,7 @@ def test_the_bill_sums_the_coating_by_layer_and_measures_each_mirror():
 def test_feeler_gauge_names_the_leaves_the_gaps_need():
     assert B.feeler_gauge([0.0449, 0.02, 0.0151, 0.046, 0.3, 0.3001]) == (
         "Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: 0.02, 0.04, 0.05, 0.30 mm", "1")
+    assert B.feeler_gauge([0.031, 0.032]) == (  # one 0.03 leaf for both
+        "Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: 0.03 mm", "1")
     assert B.feeler_gauge([0.019999]) == (
         "Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: none (check against the light)", "1")
