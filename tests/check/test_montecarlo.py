@@ -157,6 +157,8 @@ def test_a_run_is_its_seeded_batches_in_order(monkeypatch):
     small = MC.run_monte_carlo(rig, 3, 100, Engine(1))
     assert seen["tasks"] == [range(0, 1), range(1, 2), range(2, 3)] and seen["job"].rays == 100
     assert small.summary["samples"] == 3
+    one = MC.run_monte_carlo(rig, 1, 100, Engine(1))  # a single sample: one row, its columns
+    assert one.columns["sample"].tolist() == [0] and one.summary["samples"] == 1
 
 
 def test_a_batch_records_each_samples_own_build(monkeypatch):
@@ -228,6 +230,9 @@ def test_a_camera_move_is_traced_through_the_splitter_on_the_camera_path_only(sc
     moved = MC.build_figures(optics, rig, design, Misalignment.none().with_("camera", offset=(0.4, 0.0, 0.0)), 150, 9)
     assert all(moved[f"projector_{k}"] == base[f"projector_{k}"] for k in MC.PATH_FIGURES)
     assert moved["camera_max_spot_radius_mm"] > 20 * base["camera_max_spot_radius_mm"] > 0
+    # aligned, the camera's rays still cross the splitter plate: its astigmatism, ~1e-4 mm; the
+    # projector's path has none of it (~1e-8 mm)
+    assert base["camera_max_spot_radius_mm"] > 1e-5 > 100 * base["projector_max_spot_radius_mm"]
 
 
 def test_sensitivity_is_each_probe_divided_by_its_size(scene):
@@ -250,6 +255,11 @@ def test_sensitivity_is_each_probe_divided_by_its_size(scene):
             assert row["max_spot_radius_mm"] > 1e-5, name
     # the projector turned about its COP: every ray still passes through it, the spot stays ~0
     assert small["projector_tilt"]["max_spot_radius_mm"] < 1e-6 < small["projector_dx"]["max_spot_radius_mm"] / 100
+    # the change of each ray's arrival from the aligned rig's, traced on the same rays, is its error
+    # against the design direction (the aligned rig arrives at its design to ~1e-8 rad), and small
+    for name, row in small.items():
+        assert row["max_angle_change_rad"] == pytest.approx(row["max_angle_error_rad"], abs=1e-7), name
+        assert row["max_angle_change_rad"] < 0.01, name
     # the camera's probe is seen on the camera's path: its spot, not the projector's
     cam = MC.trace_path(optics, rig, design, Misalignment.none().with_("camera", offset=(0.01, 0, 0)),
                         "camera", 120, 3)[0]
@@ -274,3 +284,44 @@ def test_the_check_report_is_the_monte_carlo_of_its_builds(table31_rig):
         "per_build": {"max_spot_radius_mm": c["max_spot_radius_mm"].tolist(),
                       "max_mirror_angle_error_rad": c["max_mirror_angle_error_rad"].tolist()}}
     assert len(set(rep["per_build"]["max_spot_radius_mm"])) == 3
+
+
+def test_the_worker_caches_hold_the_optics_and_the_aligned_rays(scene, monkeypatch):
+    """Each worker builds the analytic optics and the aligned rays once, under keys naming the rig
+    (and the rays and their seed): a build reads them from there."""
+    import rigcad.engine as E
+    from rigcad.check.sources import annulus_rays
+
+    optics, rig, design = scene
+    monkeypatch.setattr(E, "_CACHE", {})
+    o, d = MC.worker_optics(rig, "rig-key")
+    assert o.mode == "analytic" and d is rig.incidence
+    assert E._CACHE[("tolerance-optics", "rig-key")] == (o, d) and MC.worker_optics(rig, "rig-key")[0] is o
+    rays, dirs = MC.aligned_rays(design, 50, 5, "rig-key")
+    want = annulus_rays(design, 50, 5)
+    assert np.array_equal(rays.origins, want.origins) and np.array_equal(rays.dirs, want.dirs)
+    assert np.array_equal(dirs, design.direction(want.chief), equal_nan=True)
+    assert E._CACHE[("tolerance-rays", "rig-key", 50, 5)][0] is rays
+    # a build with the rig's key traces the cached rays (moved by each source's pose)
+    seen = []
+    real = MC.trace_path
+    monkeypatch.setattr(MC, "trace_path", lambda *a: seen.append(a[-1]) or real(*a))
+    MC.build_figures(optics, rig, design, Misalignment.none(), 60, 6, key="rig-key")
+    assert len(seen) == 2 and all(a is E._CACHE[("tolerance-rays", "rig-key", 60, 6)] for a in seen)
+    seen.clear()
+    MC.build_figures(optics, rig, design, Misalignment.none(), 60, 7)
+    assert seen == [None, None] and ("tolerance-rays", None, 60, 7) not in E._CACHE
+
+
+def test_the_check_runs_its_monte_carlo_in_this_process(monkeypatch):
+    got = []
+
+    def fake(rig, builds, rays, engine):
+        got.append((builds, rays, engine.n_workers))
+        return MC.MonteCarlo({k: np.zeros(2) for k in ("max_spot_radius_mm", "max_mirror_angle_error_rad")},
+                             {"samples": builds, "seed": 1, "rays_per_path": rays, "ray_seed": 2, "yield": 1.0,
+                              "figures": {k: {} for k in MC.PATH_FIGURES}})
+
+    monkeypatch.setattr(MC, "run_monte_carlo", fake)
+    rig = SimpleNamespace(profile=SimpleNamespace(tolerancing=_tol()))
+    assert MC.check_report(rig, 2, 50)["builds"] == 2 and got == [(2, 50, 1)]
