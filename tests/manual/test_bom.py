@@ -231,14 +231,15 @@ def test_bolts_are_grouped_by_grip_to_the_micrometre_and_by_hole():
         return lower, upper
 
     parts = {}
-    for k, (x, top, r) in enumerate([(0, 17.0, 2.0), (20, 17.0004, 2.0), (40, 17.4, 2.0), (60, 17.0, 2.25)]):
+    for k, (x, top, r) in enumerate([(0, 17.0, 2.0), (20, 17.0004, 2.0), (40, 17.4, 2.0), (60, 17.0, 2.25),
+                                     (80, 17.0, 2.0002)]):
         lo, up = pair(x, top, r)
         parts[f"lo{k}"], parts[f"up{k}"] = lo, up
-    lower = Difference(Box((0, 0, 0), (99, 9, 9)), tuple(c for k in range(4) for c in parts[f"lo{k}"].cuts))
-    upper = Difference(Box((0, 0, 0), (99, 9, 9)), tuple(c for k in range(4) for c in parts[f"up{k}"].cuts))
+    lower = Difference(Box((0, 0, 0), (99, 9, 9)), tuple(c for k in range(5) for c in parts[f"lo{k}"].cuts))
+    upper = Difference(Box((0, 0, 0), (99, 9, 9)), tuple(c for k in range(5) for c in parts[f"up{k}"].cuts))
     rows = B.bolt_joints(_rig([], 1, {"lower": _part("lower", lower), "upper": _part("upper", upper)}))
     assert [(r["count"], r["thread"], round(r["grip_mm"], 4)) for r in rows] == [
-        (2, "M3", 17.0), (1, "M4", 17.0), (1, "M3", 17.4)]
+        (3, "M3", 17.0), (1, "M4", 17.0), (1, "M3", 17.4)]  # holes the same to the micrometre: one joint
 
 
 def test_the_upper_part_is_the_one_whose_hole_reaches_highest_the_name_breaking_ties():
