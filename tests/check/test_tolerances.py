@@ -133,8 +133,9 @@ def test_the_tower_and_monte_carlo_rows():
                           "max_mirror_angle_error_rad": {"p90": 0.5 * DEG}}
     rows = evaluate(_profile(), rep)
     cam_spot, cam_angle, tower, mc = rows[6:]
-    assert (cam_spot.name, cam_spot.key, cam_spot.measured, cam_spot.limit, cam_spot.where, cam_spot.ok) == (
-        "camera via splitter: spot radius (max)", "raycheck.max_spot_radius", 0.04, 0.05, "p.yaml:10", True)
+    assert (cam_spot.name, cam_spot.key, cam_spot.measured, cam_spot.limit, cam_spot.relation, cam_spot.unit,
+            cam_spot.where, cam_spot.ok) == (
+        "camera via splitter: spot radius (max)", "raycheck.max_spot_radius", 0.04, 0.05, "<=", "mm", "p.yaml:10", True)
     assert cam_spot.hint == "the plate's astigmatism (beam_splitter.thickness, p.yaml:30): a thinner plate"
     assert (cam_angle.name, cam_angle.key, cam_angle.unit, cam_angle.where, cam_angle.ok) == (
         "camera via splitter: angle error, calibrated (max)", "raycheck.max_angle_error", "deg", "p.yaml:11", False)
