@@ -98,14 +98,18 @@ def test_a_stage_says_its_name_first_and_records_its_wall_time(monkeypatch):
     assert timings == {"x_s": 2.5}
 
 
-@pytest.fixture(scope="module")
-def analytic_run(table31_rig):
+# One test per run: mutmut maps the code a module-scoped fixture runs to the first test that uses
+# it only, so every claim on a run sits in the test that makes the run (helpers below).
+def test_an_analytic_run_of_500_rays(table31_rig, tmp_path):
     steps = []
-    return RC.run_raycheck(table31_rig, rays=500, mode="analytic", builds=2, progress=steps.append), steps
+    res = RC.run_raycheck(table31_rig, rays=500, mode="analytic", builds=2, progress=steps.append)
+    _analytic_report(res, steps, table31_rig)
+    _thin_lens(res)
+    _pixels(res, table31_rig)
+    _written(res, tmp_path)
 
 
-def test_an_analytic_run_reports_what_it_traced(analytic_run, table31_rig):
-    res, steps = analytic_run
+def _analytic_report(res, steps, table31_rig):
     rep, prof = res.report, res.profile
     assert steps == ["design", "pinhole", "tower", "pixels", "thin lens", "misalignment", "monte carlo"]
     assert set(res.timings_s) == {"design_s", "pinhole_s", "tower_s", "pixels_s", "thin_lens_s", "misalignment_s",
@@ -129,8 +133,7 @@ def test_an_analytic_run_reports_what_it_traced(analytic_run, table31_rig):
     assert rep["tower"]["camera_through_splitter"]["rays"] == 500
 
 
-def test_the_thin_lens_figures_are_its_edge_rays(analytic_run):
-    res, _ = analytic_run
+def _thin_lens(res):
     lens, prof = res.report["thin_lens"], res.profile
     # focused at the mean source-to-sample path of the exact pinhole trace (thesis 3.2.2)
     assert lens["focal_distance_mm"] == pytest.approx(float(np.nanmean(res.trace.path_length)), rel=1e-12)
@@ -140,8 +143,7 @@ def test_the_thin_lens_figures_are_its_edge_rays(analytic_run):
     assert 0 < lens["mean_miss_mm"] <= lens["max_miss_mm"] < 5.0 and 0 <= lens["edge_rays_lost_fraction"] < 0.5
 
 
-def test_pixels_per_degree_and_the_pixel_grid(analytic_run, table31_rig):
-    res, _ = analytic_run
+def _pixels(res, table31_rig):
     fan, grid = res.report["pixels_per_degree"], res.report["pixel_grid"]
     assert fan["azimuth_deg"] == pytest.approx(45.0, rel=1e-12) and fan["fan_step_px"] == RC.FAN_STEP_PX == 0.05
     # the fan's pixel radius against theta: the finite differences bound their own mean slope
@@ -184,15 +186,10 @@ def test_a_declared_misalignment_is_traced_on_both_paths(tmp_path):
         assert path_["rays"] == rig.profile.tolerancing.rays and "max_mirror_angle_error_rad" in path_
 
 
-@pytest.fixture(scope="module")
-def smooth_run(table31_rig):
+def test_a_mesh_run_reads_every_mesh_against_the_exact_surfaces(table31_rig, tmp_path):
     cache = {}
-    return RC.run_raycheck(table31_rig, rays=500, mode="smooth", chord_error=0.1, normal_error=0.1,
-                           monte_carlo=False, grid=False, optics_cache=cache), cache
-
-
-def test_a_mesh_run_reads_every_mesh_against_the_exact_surfaces(smooth_run, table31_rig):
-    res, cache = smooth_run
+    res = RC.run_raycheck(table31_rig, rays=500, mode="smooth", chord_error=0.1, normal_error=0.1,
+                          monte_carlo=False, grid=False, optics_cache=cache)
     rep = res.report
     assert rep["mode"] == "smooth" and list(rep["backends"]) == ["analytic", "mesh"]
     assert set(rep["readings"]) == {"analytic", "mesh", "smooth", "exact_normals", "mesh_float32", "smooth_float32",
@@ -225,16 +222,15 @@ def test_a_mesh_run_reads_every_mesh_against_the_exact_surfaces(smooth_run, tabl
     assert again.trace.miss[again.trace.ok].max() == pytest.approx(
         again.report["readings"]["mesh"]["max_spot_radius_mm"], rel=1e-12)
     assert again.report["readings"]["exact_normals"]["rays_traced"] == 100
+    # run without the pixel grid: no theta map written
+    assert sorted(p.name for p in RC.write_raycheck(res, tmp_path / "b")) == ["raycheck.json", "spot.png"]
 
 
-def test_the_written_files_are_the_report_and_its_pictures(analytic_run, smooth_run, tmp_path):
+def _written(res, tmp_path):
     import json
 
-    res, _ = analytic_run
     paths = RC.write_raycheck(res, tmp_path / "a", made_from="0" * 64)
     assert sorted(p.name for p in paths) == ["raycheck.json", "spot.png", "theta_map.png"]
     assert json.loads((tmp_path / "a" / "raycheck.json").read_text()) == json.loads(json.dumps(res.report))
     assert all(p.parent == tmp_path / "a" and p.stat().st_size > 0 for p in paths)
     assert (tmp_path / "a.made_from.json").is_file()  # the profile digest recorded beside the folder
-    no_grid, _ = smooth_run  # run without the pixel grid: no theta map
-    assert sorted(p.name for p in RC.write_raycheck(no_grid, tmp_path / "b")) == ["raycheck.json", "spot.png"]
