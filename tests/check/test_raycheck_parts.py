@@ -156,6 +156,12 @@ def _pixels(res, table31_rig):
     w, h = table31_rig.profile.projector.resolution
     assert grid["resolution"] == [w, h] and grid["pixels_total"] == w * h
     assert res.theta_map.shape == res.status_map.shape == tuple(grid["traced_window_px"][::-1])
+    # the window: the paraboloid's image (the rim's pixel radius, from the profile's derived figures)
+    # and a 4 px margin
+    side = 2 * math.ceil(table31_rig.geometry.pixels_vertex_to_rim) + 8
+    assert grid["traced_window_px"] == [side, side]
+    r0, c0 = grid["window_origin_row_col"]
+    assert (r0 + side / 2, c0 + side / 2) == pytest.approx((h / 2, w / 2), abs=1.0)
     assert grid["window_border_all_missed"] is True
     rim = table31_rig.geometry.pixels_vertex_to_rim
     assert abs(grid["pixels_on_paraboloid"] - math.pi * rim ** 2) < 2 * math.pi * rim
@@ -187,9 +193,15 @@ def test_a_declared_misalignment_is_traced_on_both_paths(tmp_path):
 
 
 def test_a_mesh_run_reads_every_mesh_against_the_exact_surfaces(table31_rig, tmp_path):
+    import time
+
     cache = {}
+    t0 = time.perf_counter()
     res = RC.run_raycheck(table31_rig, rays=500, mode="smooth", chord_error=0.1, normal_error=0.1,
                           monte_carlo=False, grid=False, optics_cache=cache)
+    wall = time.perf_counter() - t0
+    # the stages' times are durations within the run's own (no speed claim: a consistency check)
+    assert all(0.0 <= v <= wall for v in res.timings_s.values()), res.timings_s
     rep = res.report
     assert rep["mode"] == "smooth" and list(rep["backends"]) == ["analytic", "mesh"]
     assert set(rep["readings"]) == {"analytic", "mesh", "smooth", "exact_normals", "mesh_float32", "smooth_float32",
@@ -209,7 +221,10 @@ def test_a_mesh_run_reads_every_mesh_against_the_exact_surfaces(table31_rig, tmp
     # the checked trace is the smooth reading's (flat facets scatter more than interpolated normals)
     assert res.trace.miss[res.trace.ok].max() == pytest.approx(r["smooth"]["max_spot_radius_mm"], rel=1e-12)
     assert r["mesh"]["max_spot_radius_mm"] > r["smooth"]["max_spot_radius_mm"]
-    assert rep["meshes"]["tolerances"]["normal_error_rad"] == 0.1
+    assert rep["meshes"]["tolerances"] == {"chord_error_mm": 0.1, "normal_error_rad": 0.1}
+    assert set(rep["meshes"]) == {"sources", "tolerances", "triangles"}
+    assert set(rep["meshes"]["sources"]) == {"paraboloid", "dome", "paraboloid_mount", "beam"}
+    assert rep["meshes"]["sources"]["dome"] == "mirror_mesh() at 0.1 mm / 0.1 rad (no matching exported PLY)"
     assert set(rep["meshes"]["triangles"]) == {"paraboloid", "dome", "paraboloid_mount", "beam"}
     assert all(v > 0 for v in rep["meshes"]["triangles"].values())
     assert {"meshes_s", "embree_build_s"} <= set(res.timings_s)
@@ -234,3 +249,39 @@ def _written(res, tmp_path):
     assert json.loads((tmp_path / "a" / "raycheck.json").read_text()) == json.loads(json.dumps(res.report))
     assert all(p.parent == tmp_path / "a" and p.stat().st_size > 0 for p in paths)
     assert (tmp_path / "a.made_from.json").is_file()  # the profile digest recorded beside the folder
+
+
+def test_a_moved_projector_is_traced_where_it_stands_in_the_pixel_grid_too(table31_rig):
+    moved = table31_rig.moved("projector", offset=(0.5, 0.0, 0.0))
+    rep = RC.run_raycheck(moved, rays=300, mode="analytic", grid=True, monte_carlo=False).report
+    # the pinhole rays and every pixel of the grid leave the moved projector: spots of ~0.03 mm
+    # (the aligned rig's are ~1e-8 mm), the same largest spot on both within a few per cent
+    pin, grid = rep["readings"]["analytic"]["max_spot_radius_mm"], rep["pixel_grid"]["max_spot_radius_mm"]
+    assert pin > 1e-2 and grid == pytest.approx(pin, rel=0.05)
+
+
+def test_mirror_meshes_exported_at_the_profiles_tolerances_are_read_back(tmp_path):
+    from rigcad.export.mirror_mesh import mirror_mesh, write_ply
+    from rigcad.profile import load_profile
+    from rigcad.rig import Rig
+
+    path = tmp_path / "coarse.yaml"
+    path.write_text("extends: achutha2006\ntessellation:\n  mirror_chord_error: 0.1 mm\n"
+                    "  mirror_normal_error: 5 deg\n", encoding="utf-8")
+    rig = Rig.from_profile(load_profile(path))
+    tess = rig.profile.tessellation
+    exports = tmp_path / "exports"
+    plys = {}
+    for name, meridian in (("paraboloid", rig.layout.design_paraboloid), ("dome", rig.layout.design_dome)):
+        plys[name] = exports / rig.profile.name / "mirrors" / f"{name}.ply"
+        plys[name].parent.mkdir(parents=True, exist_ok=True)
+        write_ply(plys[name], mirror_mesh(meridian, name, tess.mirror_chord_error, tess.mirror_normal_error))
+    cache = {}
+    res = RC.run_raycheck(rig, exports, rays=100, mode="mesh", monte_carlo=False, grid=False, optics_cache=cache)
+    src = res.report["meshes"]["sources"]
+    assert (src["paraboloid"], src["dome"]) == (str(plys["paraboloid"]), str(plys["dome"]))
+    assert list(cache) == [(rig.profile.name, tess.mirror_chord_error, tess.mirror_normal_error, str(exports))]
+    # no cache given: the same meshes, made for this run alone
+    alone = RC.run_raycheck(rig, exports, rays=100, mode="mesh", monte_carlo=False, grid=False)
+    assert alone.report["meshes"] == res.report["meshes"]
+    assert alone.report["readings"]["mesh"] == res.report["readings"]["mesh"]
