@@ -382,3 +382,14 @@ def test_a_tube_in_quarters_and_two_bands_with_a_tongue_and_groove():
     assert SP.make_tongues(tube, SP.GridPlan((1.0,), ()), PIN, None) == []
     with pytest.raises(FabricationError, match=r"^band cut z 20\.0 mm: no tongue and groove fits \("):
         SP.make_tongues(_tube(r_out=36.3, h=40.0), plan, PIN, None)  # 1.3 mm: no groove leaves 0.6 mm walls
+
+
+def test_a_tongue_too_small_for_its_sectors_is_refused_naming_its_area():
+    # a 2.5 mm wall: a tongue 1.1 mm wide on a 36.25 mm radius, 2 pi 36.25 x 1.1 / 64 = 3.9 mm^2 a sector
+    tube = _tube(r_out=37.5, h=40.0)
+    plan = SP.SplitPlan(64, 2, 0.0, (0.0, 20.0, 40.0))
+    with pytest.raises(FabricationError, match=r"^band cut z 20\.0 mm: no tongue and groove fits \(a sector gets a "
+                                               r"tongue of only 3\.[89] mm\^2 at 2 mm depth\)$"):
+        SP.make_tongues(tube, plan, PIN, None)
+    (t,) = SP.make_tongues(tube, SP.SplitPlan(16, 2, 0.0, (0.0, 20.0, 40.0)), PIN, None)  # 15.6 mm^2: kept
+    assert t.depth == PIN.depth and t.min_clearance_to_mirror is None
