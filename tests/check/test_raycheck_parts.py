@@ -195,15 +195,18 @@ def test_a_declared_misalignment_is_traced_on_both_paths(tmp_path):
 def test_a_mesh_run_reads_every_mesh_against_the_exact_surfaces(table31_rig, tmp_path):
     import time
 
-    cache = {}
+    cache, steps = {}, []
     t0 = time.perf_counter()
     res = RC.run_raycheck(table31_rig, rays=500, mode="smooth", chord_error=0.1, normal_error=0.1,
-                          monte_carlo=False, grid=False, optics_cache=cache)
+                          monte_carlo=False, grid=False, optics_cache=cache, progress=steps.append)
     wall = time.perf_counter() - t0
     # the stages' times are durations within the run's own (no speed claim: a consistency check)
     assert all(0.0 <= v <= wall for v in res.timings_s.values()), res.timings_s
     rep = res.report
     assert rep["mode"] == "smooth" and list(rep["backends"]) == ["analytic", "mesh"]
+    assert steps == ["design", "meshes", "pinhole", "tower", "pixels", "thin lens", "misalignment"]
+    # the tower, the fan, the grid, the thin lens and the misalignment table trace the meshes too
+    assert rep["backend"] == rep["backends"]["mesh"] != rep["backends"]["analytic"]
     assert set(rep["readings"]) == {"analytic", "mesh", "smooth", "exact_normals", "mesh_float32", "smooth_float32",
                                     "mesh_paraboloid_mesh_only", "smooth_paraboloid_mesh_only",
                                     "mesh_dome_mesh_only", "smooth_dome_mesh_only"}
@@ -244,7 +247,8 @@ def test_a_mesh_run_reads_every_mesh_against_the_exact_surfaces(table31_rig, tmp
 def _written(res, tmp_path):
     import json
 
-    paths = RC.write_raycheck(res, tmp_path / "a", made_from="0" * 64)
+    paths = RC.write_raycheck(res, tmp_path / "a", lock=tmp_path / "given.lock", made_from="0" * 64)
+    assert (tmp_path / "given.lock").is_file() and not (tmp_path / ".a.lock").exists()  # the lock asked for
     assert sorted(p.name for p in paths) == ["raycheck.json", "spot.png", "theta_map.png"]
     assert json.loads((tmp_path / "a" / "raycheck.json").read_text()) == json.loads(json.dumps(res.report))
     assert all(p.parent == tmp_path / "a" and p.stat().st_size > 0 for p in paths)
@@ -258,6 +262,10 @@ def test_a_moved_projector_is_traced_where_it_stands_in_the_pixel_grid_too(table
     # (the aligned rig's are ~1e-8 mm), the same largest spot on both within a few per cent
     pin, grid = rep["readings"]["analytic"]["max_spot_radius_mm"], rep["pixel_grid"]["max_spot_radius_mm"]
     assert pin > 1e-2 and grid == pytest.approx(pin, rel=0.05)
+    # the fan that measures pixels per degree leaves it too: its thetas move with the projector
+    aligned = RC.run_raycheck(table31_rig, rays=300, mode="analytic", grid=False, monte_carlo=False).report
+    a, b = aligned["pixels_per_degree"]["px_per_deg_mean"], rep["pixels_per_degree"]["px_per_deg_mean"]
+    assert abs(a - b) > 1e-6 * a
 
 
 def test_mirror_meshes_exported_at_the_profiles_tolerances_are_read_back(tmp_path):
@@ -281,6 +289,13 @@ def test_mirror_meshes_exported_at_the_profiles_tolerances_are_read_back(tmp_pat
     src = res.report["meshes"]["sources"]
     assert (src["paraboloid"], src["dome"]) == (str(plys["paraboloid"]), str(plys["dome"]))
     assert list(cache) == [(rig.profile.name, tess.mirror_chord_error, tess.mirror_normal_error, str(exports))]
+    # one tolerance overridden: the exports (made at the profile's) are not read, the meshes are made
+    over = RC.run_raycheck(rig, exports, rays=100, mode="mesh", normal_error=0.1, monte_carlo=False, grid=False)
+    assert over.report["meshes"]["tolerances"] == {"chord_error_mm": tess.mirror_chord_error, "normal_error_rad": 0.1}
+    assert over.report["meshes"]["sources"]["dome"].startswith("mirror_mesh() at 0.1 mm / 0.1 rad")
+    over = RC.run_raycheck(rig, exports, rays=100, mode="mesh", chord_error=0.2, monte_carlo=False, grid=False)
+    assert over.report["meshes"]["tolerances"]["chord_error_mm"] == 0.2
+    assert over.report["meshes"]["sources"]["dome"].startswith("mirror_mesh() at 0.2 mm")
     # no cache given: the same meshes, made for this run alone
     alone = RC.run_raycheck(rig, exports, rays=100, mode="mesh", monte_carlo=False, grid=False)
     assert alone.report["meshes"] == res.report["meshes"]
