@@ -121,6 +121,11 @@ def _analytic_report(res, steps, table31_rig):
     assert rep["frame"] == "mm; sample point O at the origin; optical axis +z; projector pixel x to +x, rows to -y"
     assert list(rep["readings"]) == ["analytic"] and rep["readings"]["analytic"]["kernels"]
     assert res.trace.status.size == 500 and res.design_dirs.shape == (500, 3)
+    # the readings are those of the profile's seeded pinhole rays
+    from rigcad.check.sources import annulus_rays
+
+    src = annulus_rays(table31_rig.incidence, 500, prof.raycheck.seed, table31_rig.pose("projector"))
+    assert np.array_equal(res.design_dirs, table31_rig.incidence.direction(src.chief), equal_nan=True)
     assert rep["checks"] == [r.as_dict() for r in res.rows] and rep["passed"] is res.passed is True
     assert len(res.rows) >= 8 and rep["monte_carlo"]["builds"] == 2
     assert rep["monte_carlo"] == montecarlo.check_report(table31_rig, 2, prof.tolerancing.rays)
@@ -266,6 +271,8 @@ def test_a_moved_projector_is_traced_where_it_stands_in_the_pixel_grid_too(table
     aligned = RC.run_raycheck(table31_rig, rays=300, mode="analytic", grid=False, monte_carlo=False).report
     a, b = aligned["pixels_per_degree"]["px_per_deg_mean"], rep["pixels_per_degree"]["px_per_deg_mean"]
     assert abs(a - b) > 1e-6 * a
+    # and the thin lens's chief rays: their edge rays miss by what the move adds
+    assert rep["thin_lens"]["max_miss_mm"] != aligned["thin_lens"]["max_miss_mm"]
 
 
 def test_mirror_meshes_exported_at_the_profiles_tolerances_are_read_back(tmp_path):
