@@ -218,6 +218,9 @@ def test_a_mesh_run_reads_every_mesh_against_the_exact_surfaces(table31_rig, tmp
     r = rep["readings"]
     for name in ("exact_normals", "mesh_float32", "smooth_float32"):
         assert r[name]["rays_traced"] == 500 and r[name]["rays"] == 500
+    # Embree's own float32 hits (no refinement) on the same 500 rays: not the refined readings' numbers
+    assert r["mesh_float32"]["rms_spot_radius_mm"] != r["mesh"]["rms_spot_radius_mm"]
+    assert r["smooth_float32"]["rms_spot_radius_mm"] != r["smooth"]["rms_spot_radius_mm"]
     for name in ("mesh", "smooth"):
         assert r[name]["kernels"] and r[name]["mesh_minus_exact_angle_rad"]["max"] > 0
         for part in ("paraboloid", "dome"):
@@ -275,7 +278,7 @@ def test_a_moved_projector_is_traced_where_it_stands_in_the_pixel_grid_too(table
     assert rep["thin_lens"]["max_miss_mm"] != aligned["thin_lens"]["max_miss_mm"]
 
 
-def test_mirror_meshes_exported_at_the_profiles_tolerances_are_read_back(tmp_path):
+def test_mirror_meshes_exported_at_the_profiles_tolerances_are_read_back(tmp_path, monkeypatch):
     from rigcad.export.mirror_mesh import mirror_mesh, write_ply
     from rigcad.profile import load_profile
     from rigcad.rig import Rig
@@ -292,7 +295,11 @@ def test_mirror_meshes_exported_at_the_profiles_tolerances_are_read_back(tmp_pat
         plys[name].parent.mkdir(parents=True, exist_ok=True)
         write_ply(plys[name], mirror_mesh(meridian, name, tess.mirror_chord_error, tess.mirror_normal_error))
     cache = {}
+    monkeypatch.setattr(RC, "EXACT_NORMAL_RAYS", 60)  # the costly readings on the first 60 of the 100 rays
     res = RC.run_raycheck(rig, exports, rays=100, mode="mesh", monte_carlo=False, grid=False, optics_cache=cache)
+    for name in ("exact_normals", "mesh_float32", "smooth_float32"):
+        r = res.report["readings"][name]
+        assert r["rays_traced"] == 60 == r["rays"] and r["mesh_minus_exact_angle_rad"]["max"] > 0
     src = res.report["meshes"]["sources"]
     assert (src["paraboloid"], src["dome"]) == (str(plys["paraboloid"]), str(plys["dome"]))
     assert list(cache) == [(rig.profile.name, tess.mirror_chord_error, tess.mirror_normal_error, str(exports))]
