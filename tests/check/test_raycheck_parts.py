@@ -63,10 +63,11 @@ def test_a_reading_against_the_exact_trace():
     assert f["mesh_minus_exact_angle_rad"]["max"] == pytest.approx(1.0 * DEG, rel=1e-9)
     assert f["mesh_minus_exact_angle_rad"]["rms"] == pytest.approx(math.sqrt((0.25 + 1) / 2) * DEG, rel=1e-9)
     assert f["mesh_minus_exact_spot_mm"] == {"max": pytest.approx(0.2, abs=1e-15)}
+    assert f["max_angle_change_rad"] == pytest.approx(1.0 * DEG, rel=1e-9)  # the figures against the exact trace
     assert f["status_agreement_with_exact"] == 0.5
     assert f["max_spot_radius_mm"] == 0.3 and f["max_angle_error_rad"] == pytest.approx(0.0, abs=1e-7)
     alone = RC.reading(tr, ddirs, None, chief)
-    assert not any(k.startswith(("mesh_minus", "status_agreement")) for k in alone)
+    assert not any(k.startswith(("mesh_minus", "status_agreement", "max_angle_change")) for k in alone)
     # nothing arrives: NaN figures, every ray lost
     gone = _trace([1, 1], [0.0, 0.0], [1, 1], [0.0, 0.0])
     g = RC.reading(gone, -gone.v, gone, chief[:2])
