@@ -31,7 +31,7 @@ def _trace(status, theta_deg, segment, miss, phi_deg=None):
 def test_losses_by_cause_with_their_segment_azimuths_and_design_thetas():
     status = [0, 1, 1, 3, 3, 3, 0]
     tr = _trace(status, [10, 0, 0, 0, 0, 0, 20], [0, 1, 1, 2, 4, 4, 0], np.zeros(7))
-    az = np.radians([0.0, 15.0, 29.0, 31.0, -10.0, 359.0, 200.0])  # -10 deg is 350 deg
+    az = np.radians([0.0, 0.5, 29.0, 30.05, -0.5, 359.0, 200.0])  # -0.5 deg is 359.5 deg
     chief = np.stack([np.cos(az), np.sin(az), np.ones(7)], axis=1)
     design_theta = np.radians([5.0, 12.0, 40.0, 33.0, 35.0, 34.0, 6.0])
     ddirs = np.stack([np.sin(design_theta), np.zeros(7), np.cos(design_theta)], axis=1)
@@ -49,6 +49,8 @@ def test_losses_by_cause_with_their_segment_azimuths_and_design_thetas():
     assert RC._losses(tr, chief, ddirs)[STATUS_NAMES[1]]["design_theta_deg_range"] is None
     ddirs[1] = [0.0, 0.0, 1.5]  # a z beyond 1 is clipped, not NaN: theta 0
     assert RC._losses(tr, chief, ddirs)[STATUS_NAMES[1]]["design_theta_deg_range"] == [0.0, 0.0]
+    ddirs[1] = [0.0, 0.0, np.nextafter(-1.0, -2.0)]  # a unit vector's z rounded past -1: theta 180
+    assert RC._losses(tr, chief, ddirs)[STATUS_NAMES[1]]["design_theta_deg_range"] == [180.0, 180.0]
 
 
 def test_a_reading_against_the_exact_trace():
@@ -85,8 +87,9 @@ def test_overrides_replace_only_what_they_name(table31):
     tess = table31.tessellation
     p = RC._overridden(table31, None, None, 0.05, None, None)
     assert (p.tessellation.mirror_chord_error, p.tessellation.mirror_normal_error) == (0.05, tess.mirror_normal_error)
-    p = RC._overridden(table31, None, None, None, 0.01, None)
-    assert (p.tessellation.mirror_chord_error, p.tessellation.mirror_normal_error) == (tess.mirror_chord_error, 0.01)
+    assert tess.mirror_normal_error != 0.02
+    p = RC._overridden(table31, None, None, None, 0.02, None)
+    assert (p.tessellation.mirror_chord_error, p.tessellation.mirror_normal_error) == (tess.mirror_chord_error, 0.02)
     assert p.raycheck == table31.raycheck and p.tolerancing == table31.tolerancing
 
 
