@@ -267,9 +267,22 @@ def _written(res, tmp_path):
     assert (tmp_path / "a.made_from.json").is_file()  # the profile digest recorded beside the folder
 
 
-def test_a_moved_projector_is_traced_where_it_stands_in_the_pixel_grid_too(table31_rig):
+def test_a_moved_projector_is_traced_where_it_stands_in_the_pixel_grid_too(table31_rig, monkeypatch):
     moved = table31_rig.moved("projector", offset=(0.5, 0.0, 0.0))
+    poses = {}
+    real = RC.annulus_rays
+
+    def spy(design, count, seed, pose=None):
+        poses[seed] = pose
+        return real(design, count, seed, pose)
+
+    monkeypatch.setattr(RC, "annulus_rays", spy)
     rep = RC.run_raycheck(moved, rays=300, mode="analytic", grid=True, monte_carlo=False).report
+    # the pinhole rays (seed) and the thin lens's chief rays (seed + 7) leave the moved projector
+    seed = moved.profile.raycheck.seed
+    assert set(poses) == {seed, seed + 7}
+    assert all(p is not None and not p.is_identity for p in poses.values())
+    assert np.allclose(poses[seed + 7].globalize_points(np.zeros((1, 3))) - np.zeros(3), [[0.5, 0.0, 0.0]])
     # the pinhole rays and every pixel of the grid leave the moved projector: spots of ~0.03 mm
     # (the aligned rig's are ~1e-8 mm), the same largest spot on both within a few per cent
     pin, grid = rep["readings"]["analytic"]["max_spot_radius_mm"], rep["pixel_grid"]["max_spot_radius_mm"]
