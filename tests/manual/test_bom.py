@@ -97,7 +97,9 @@ def test_revolved_area_of_a_frustum_and_a_hemisphere():
 
 
 def _rig(layers, margin, recipes, tower=None):
-    profile = SimpleNamespace(coating=SimpleNamespace(layers=layers, margin=margin))
+    # no breadboard (datum.mount names none of parts.breadboard's): the rig stands on its own plate
+    profile = SimpleNamespace(coating=SimpleNamespace(layers=layers, margin=margin),
+                              datum=SimpleNamespace(mount="own base plate"), buy=SimpleNamespace(column="bought"))
     return SimpleNamespace(profile=profile, recipes=recipes, layout=SimpleNamespace(tower=tower))
 
 
@@ -312,7 +314,7 @@ def test_fasteners_add_nuts_and_washers_per_thread_and_the_towers_own(monkeypatc
                 {"thread": "", "item": "heat-set insert", "quantity": 4, "joins": "shelf"}]
 
     monkeypatch.setattr(T, "hardware", hardware)
-    rig.layout.tower = object()
+    rig.layout.tower = SimpleNamespace(column_x=500.0)  # a bought column: its core screw's axis, far off
     assert [h["item"] for h in B.tower_hardware(rig)] == ["button-head screw", "camera screw"]
     assert seen == [(rig.profile, rig.layout)]
     tower = B.fasteners(rig)[-2:]
