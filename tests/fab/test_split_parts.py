@@ -98,6 +98,9 @@ def test_a_part_off_the_axis_by_more_than_5_percent_of_its_size():
     assert not SP.is_off_axis(box.translate((4.9, -4.9, 50.0)))  # z does not count
     assert SP.is_off_axis(box.translate((5.1, 0, 0))) and SP.is_off_axis(box.translate((0, -5.1, 0)))
     assert SP.is_off_axis(box.translate((2.0, 0, 0)), rtol=0.01)
+    assert not SP.is_off_axis(box.translate((5.0, 0, 0)))  # exactly 5 % off: still on the axis
+    tall = m3d.Manifold.cube((40.0, 100.0, 10.0), True)  # its size is its y extent
+    assert not SP.is_off_axis(tall.translate((4.9, 0, 0))) and SP.is_off_axis(tall.translate((5.1, 0, 0)))
 
 
 def test_grid_options_fewest_pieces_first_and_the_longest_side_cut_first():
@@ -117,12 +120,20 @@ def test_plan_grid_cuts_the_long_side_into_equal_slabs_until_every_cell_fits():
     calls = []
 
     def fits(c, plan, i, j):
-        calls.append((i, j))
-        return float(np.ptp(_bbox(c).reshape(2, 3), axis=0).max()) <= 110.0
+        assert isinstance(plan, SP.GridPlan)
+        bb = _bbox(c)
+        calls.append((i, j, round(bb[0], 6), round(bb[3], 6)))
+        return float(np.ptp(bb.reshape(2, 3), axis=0).max()) <= 110.0
 
     plan = SP.plan_grid(box, fits)
     assert plan.x_cuts == pytest.approx((110.0, 210.0)) and plan.y_cuts == () and plan.z_cuts == ()
-    assert calls[-3:] == [(0, 0), (1, 0), (2, 0)]
+    # one failing cell each for 1 x 1 x 1 and the three 2-piece grids, then the three slabs of 3 x 1 x 1
+    assert len(calls) == 7 and calls[-3:] == [(0, 0, 10.0, 110.0), (1, 0, 110.0, 210.0), (2, 0, 210.0, 310.0)]
+    # two 2-piece grids fit: the longer side is cut, wherever the part lies
+    either = m3d.Manifold.cube((300.0, 280.0, 50.0)).translate((-400.0, -10.0, 0.0))
+    ext = lambda c: np.ptp(_bbox(c).reshape(2, 3), axis=0)  # noqa: E731
+    two = SP.plan_grid(either, lambda c, *a: ext(c)[0] <= 160.0 or ext(c)[1] <= 150.0)
+    assert (len(two.x_cuts), len(two.y_cuts)) == (1, 0) and two.x_cuts[0] == pytest.approx(-250.0)
     with pytest.raises(FabricationError) as e:
         SP.plan_grid(box, lambda *a: False)
     assert str(e.value) == ("no grid of up to 6 x 6 x 6 pieces fits this printer; use a larger printer or buy the "
@@ -172,6 +183,13 @@ def test_the_phase_keeps_the_cut_planes_off_a_hole():
     seen[0.0] = 7  # the angles counted already are not sliced again
     assert SP._loops_on_planes(holed, 2, 0.0, seen) == 8
     assert SP.choose_phase(holed, 1) == 0.0
+    seen = {}
+    SP.choose_phase(holed, 2, seen=seen)
+    assert len(seen) == 144  # 72 phases (0 .. 177.5 deg) x two half-planes, each sliced once, kept
+    # two clear runs as wide (holes at 0 and 90 deg): the first, 10 .. 80 deg
+    two = _tube() - m3d.Manifold.cylinder(40.0, 3.0, 3.0, 24).translate((42.5, 0.0, -5.0)) \
+        - m3d.Manifold.cylinder(40.0, 3.0, 3.0, 24).translate((0.0, 42.5, -5.0))
+    assert math.degrees(SP.choose_phase(two, 2)) == pytest.approx(45.0, abs=1e-9)
     # a hole at 0 deg: the two half-planes (phase, phase + 180) are clear from 10 to 170 deg: the middle
     assert math.degrees(SP.choose_phase(holed, 2)) == pytest.approx(90.0, abs=1e-9)
     assert math.degrees(SP.choose_phase(_tube_with_hole(30.0), 2)) == pytest.approx(120.0, abs=1e-9)
@@ -247,17 +265,28 @@ def test_other_planes_clear_keeps_points_off_every_other_cut():
         [True, False, True, True]
     assert SP._grid_planes_clear(gp, g, np.array([0, 1.0, 0]), np.array([0, 5.0, 0]), 1.0).tolist() == \
         [False, True, True, True]
+    # a face skips its own plane only: other cuts on its axis (20, and 10.5 half a millimetre away) and
+    # a cut on another axis through its origin's coordinate still count
+    g2 = SP.GridPlan((10.0, 10.5, 20.0), (0.0,))
+    p2 = np.array([[10.0, 3.0, 0.0], [10.4, 3.0, 0.0], [19.5, 3.0, 0.0], [5.0, 0.5, 0.0], [5.0, 3.0, 0.0]])
+    assert SP._grid_planes_clear(p2, g2, np.array([1.0, 0, 0]), np.array([10.0, 0, 0]), 1.0).tolist() == \
+        [False, False, False, False, True]
 
 
 def test_grid_interfaces_name_each_face_and_keep_its_slabs():
     faces = SP._grid_interfaces(SP.GridPlan((10.0,), (5.0,)))
     assert [f[0] for f in faces] == ["x cut 10.0 mm, y slab 1, z slab 1", "x cut 10.0 mm, y slab 2, z slab 1",
                                      "y cut 5.0 mm, x slab 1, z slab 1", "y cut 5.0 mm, x slab 2, z slab 1"]
+    assert faces[0][3](np.array([[10.0, 5.0, 0.0], [10.0, 4.9, 0.0]])).tolist() == [False, True]  # open slabs
     name, n, o, keep = faces[1]
     assert n.tolist() == [1.0, 0.0, 0.0] and o.tolist() == [10.0, 0.0, 0.0]
     p = np.array([[10.0, 6.0, 0.0], [10.0, 4.0, 0.0], [10.0, 5.0, 0.0]])
     assert keep(p).tolist() == [True, False, False]
     assert faces[2][3](np.array([[9.0, 5.0, 3.0], [11.0, 5.0, 3.0]])).tolist() == [True, False]
+    stacked = SP._grid_interfaces(SP.GridPlan((10.0,), (), (4.0,)))
+    assert [f[0] for f in stacked][:2] == ["x cut 10.0 mm, y slab 1, z slab 1", "x cut 10.0 mm, y slab 1, z slab 2"]
+    assert stacked[0][3](np.array([[10.0, 0.0, 3.0], [10.0, 0.0, 5.0]])).tolist() == [True, False]
+    assert stacked[1][3](np.array([[10.0, 0.0, 3.0], [10.0, 0.0, 5.0]])).tolist() == [False, True]
 
 
 def test_farthest_points_spread_and_skip_the_invalid():
@@ -369,6 +398,8 @@ def test_a_tube_in_quarters_and_two_bands_with_a_tongue_and_groove():
     assert SP.MIRROR_CLEARANCE <= t.min_clearance_to_mirror < SP.MIRROR_CLEARANCE + 0.1
     d = t.describe()
     assert d["groove_volume_mm3"] > d["tongue_volume_mm3"] > 0 and d["z_mm"] == 20.0 and d["depth_mm"] == 5.0
+    assert d["face"] == "band cut z 20.0 mm" and d["min_clearance_to_mirror_mm"] == t.min_clearance_to_mirror
+    assert set(d) == {"face", "z_mm", "depth_mm", "groove_volume_mm3", "tongue_volume_mm3", "min_clearance_to_mirror_mm"}
     # the band cut carries the tongue, not pins: every pin is on a sector plane
     assert pins and all(p.face.startswith("sector plane") for p in pins)
     assert {p.face for p in pins} == {f"sector plane {a:.1f} deg, band {j}" for a in (0, 90, 180, 270) for j in (1, 2)}
