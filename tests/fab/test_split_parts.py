@@ -424,3 +424,17 @@ def test_a_tongue_too_small_for_its_sectors_is_refused_naming_its_area():
         SP.make_tongues(tube, plan, PIN, None)
     (t,) = SP.make_tongues(tube, SP.SplitPlan(16, 2, 0.0, (0.0, 20.0, 40.0)), PIN, None)  # 15.6 mm^2: kept
     assert t.depth == PIN.depth and t.min_clearance_to_mirror is None
+
+
+def test_plan_grid_cuts_a_tall_part_across_its_height():
+    column = m3d.Manifold.cube((50.0, 50.0, 300.0))
+    zs = []
+
+    def fits(c, plan, i, j):
+        bb = _bbox(c)
+        zs.append((round(bb[2], 6), round(bb[5], 6)))
+        return bb[5] - bb[2] <= 110.0
+
+    plan = SP.plan_grid(column, fits)
+    assert (plan.x_cuts, plan.y_cuts) == ((), ()) and plan.z_cuts == pytest.approx((100.0, 200.0))
+    assert zs[-3:] == [(0.0, 100.0), (100.0, 200.0), (200.0, 300.0)]  # each stacked slab tried
