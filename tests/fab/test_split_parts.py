@@ -152,6 +152,7 @@ def test_plan_split_takes_the_fewest_pieces_then_the_fewest_bands():
     tube = _tube()
 
     def fits(c, plan, i, j):  # pieces at most 20 mm tall and 101 mm wide
+        assert isinstance(plan, SP.SplitPlan) and 0 <= i < plan.sectors and 0 <= j < plan.bands
         ext = np.ptp(_bbox(c).reshape(2, 3), axis=0)
         return ext[2] <= 20.0 and max(ext[0], ext[1]) <= 101.0
 
@@ -161,6 +162,15 @@ def test_plan_split_takes_the_fewest_pieces_then_the_fewest_bands():
     narrow = SP.plan_split(tube, lambda c, *a: float(np.ptp(_bbox(c).reshape(2, 3), axis=0)[:2].max()) <= 75.0)
     # a half ring is 100 mm long, a third 87 mm: quarters, at the phase that crosses fewest features
     assert (narrow.sectors, narrow.bands, narrow.phase) == (4, 1, SP.choose_phase(tube, 4))
+    # fewest pieces first: two halves (50 mm across) before three bands of the whole ring (10 mm tall)
+    def ext(c):
+        return np.ptp(_bbox(c).reshape(2, 3), axis=0)
+
+    halves = SP.plan_split(tube, lambda c, *a: max(ext(c)[:2]) <= 100.5 and (min(ext(c)[:2]) <= 60.0 or ext(c)[2] <= 12.0))
+    assert (halves.sectors, halves.bands) == (2, 1)
+    # two pieces in two bands before more pieces in one band (narrow sectors would fit too)
+    bands = SP.plan_split(tube, lambda c, *a: ext(c)[2] <= 20.0 or max(ext(c)[:2]) <= 30.0)
+    assert (bands.sectors, bands.bands) == (1, 2)
     with pytest.raises(FabricationError, match=r"^no split into up to 16 sectors x 4 bands fits this printer; "
                                                r"use a larger printer$"):
         SP.plan_split(tube, lambda *a: False)
@@ -196,6 +206,10 @@ def test_the_phase_keeps_the_cut_planes_off_a_hole():
     # the clear run wraps around the period: a hole at 100 deg, 2 sectors (period 180): clear from
     # 112.5 through 180 = 0 to 87.5 deg, its middle at 10 deg
     assert math.degrees(SP.choose_phase(_tube_with_hole(100.0), 2)) == pytest.approx(10.0, abs=1e-9)
+    # a clear run whose middle falls between the last two grid phases (175, 177.5) or on the last one
+    assert math.degrees(SP.choose_phase(_tube_with_hole(86.25), 2)) == pytest.approx(176.25, abs=1e-9)
+    assert math.degrees(SP.choose_phase(_tube_with_hole(87.5), 2)) == pytest.approx(177.5, abs=1e-9)
+    assert math.degrees(SP.choose_phase(_tube_with_hole(88.75), 2)) == pytest.approx(177.5, abs=1e-9)
     # every phase equally good: the middle of the whole period's grid (0 .. 87.5 deg)
     assert math.degrees(SP.choose_phase(plain, 4)) == pytest.approx(43.75, abs=1e-9)
     assert math.degrees(SP.choose_phase(plain, 4, step_deg=5.0)) == pytest.approx(42.5, abs=1e-9)
