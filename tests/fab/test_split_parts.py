@@ -452,3 +452,28 @@ def test_plan_grid_cuts_a_tall_part_across_its_height():
     plan = SP.plan_grid(column, fits)
     assert (plan.x_cuts, plan.y_cuts) == ((), ()) and plan.z_cuts == pytest.approx((100.0, 200.0))
     assert zs[-3:] == [(0.0, 100.0), (100.0, 200.0), (200.0, 300.0)]  # each stacked slab tried
+
+
+def _polygon_areas(r_in, r_out=None, n=720):
+    """The region's closed form: a 4e4 mm square (or an inscribed n-gon of circumradius r_out) less a
+    circumscribed n-gon about the circle r_in (area n tan(pi/n) r^2)."""
+    outer = (4 * SP._BIG) ** 2 if r_out is None else 0.5 * n * r_out ** 2 * math.sin(2 * math.pi / n)
+    return outer - (n * math.tan(math.pi / n) * r_in ** 2 if r_in > 0 else 0.0)
+
+
+def test_the_mirror_region_is_its_sampled_annuli_as_polygons():
+    r = np.arange(0.0, 60.0, 0.02)
+    # behind a cone mirror r = 35 + z / 2 at every height asked: from its widest (z = 10, r = 40) + 1 mm
+    cone = SimpleNamespace(signed_distance=lambda p: 35.0 + 0.5 * p[:, 2] - np.hypot(p[:, 0], p[:, 1]))
+    k = int(np.argmax(40.0 - r < -1.02))
+    region = SP._mirror_region(cone, np.array([10.0, 0.0]), 1.0, 60.0)
+    assert region.area() == pytest.approx(_polygon_areas(r[k]), abs=1e-3)
+    # a ring behind a mirror 16 .. 24 mm from the axis: the inscribed outer polygon, the circumscribed hole
+    ring = SimpleNamespace(signed_distance=lambda p: np.abs(np.hypot(p[:, 0], p[:, 1]) - 20.0) - 5.0)
+    ok = np.abs(r - 20.0) - 5.0 < -1.02
+    idx = np.flatnonzero(ok)
+    got = SP._mirror_region(ring, np.array([0.0]), 1.0, 60.0).area()
+    assert got == pytest.approx(_polygon_areas(r[idx[0]], r[idx[-1]]), rel=1e-9)
+    # nothing near: the whole plane, no hole at the axis
+    far = SimpleNamespace(signed_distance=lambda p: np.full(len(p), -100.0))
+    assert SP._mirror_region(far, np.array([0.0]), 1.0, 60.0).area() == pytest.approx((4 * SP._BIG) ** 2, abs=1e-3)
