@@ -19,7 +19,21 @@ from pathlib import Path
 import numpy as np
 
 
-def trial(optics, rig, seed: int) -> dict:
+def near_null(fit, count: int = 3) -> list:
+    """The fit's least-determined parameter combinations: the correlation matrix's smallest
+    eigenvalues, each with its eigenvector's largest components (parameter: weight)."""
+    names = list(fit.names)
+    free = [i for i in range(len(names)) if fit.standard_error[i] > 0]
+    vals, vecs = np.linalg.eigh(fit.correlation[np.ix_(free, free)])
+    out = []
+    for j in range(count):
+        order = np.argsort(-np.abs(vecs[:, j]))[:5]
+        out.append({"eigenvalue": float(vals[j]),
+                    "combination": {names[free[i]]: round(float(vecs[i, j]), 3) for i in order}})
+    return out
+
+
+def trial(optics, rig, seed: int, without_bias: bool = False) -> dict:
     from rigcad.calibrate import model as M, simulate as S
     from rigcad.calibrate.patterns import Sequence
     from rigcad.calibrate.run import calibrate, compare
@@ -38,11 +52,13 @@ def trial(optics, rig, seed: int) -> dict:
     t2 = time.perf_counter()
     cpu = time.process_time() - c1
     out = compare(optics, rig, result, theta, surface)
-    # the same capture without removing the decoding's own bias (rigcad.calibrate.bias), side by side
-    plain = compare(optics, rig, calibrate(optics, rig, frames, bias=None), theta, surface)
-    out["without_bias_correction"] = {k: plain[k] for k in (
-        "corrected_incidence_error_deg", "corrected_incidence_error_deg_by_source", "parameters_met",
-        "fitted_model_incidence_error_deg", "recovered_slope_rms_mrad", "slope_difference_rms_mrad")}
+    if without_bias:  # the same capture without removing the decoding's own bias (rigcad.calibrate.bias)
+        plain = compare(optics, rig, calibrate(optics, rig, frames, bias=None), theta, surface)
+        out["without_bias_correction"] = {k: plain[k] for k in (
+            "corrected_incidence_error_deg", "corrected_incidence_error_deg_by_source", "parameters_met",
+            "fitted_model_incidence_error_deg", "recovered_slope_rms_mrad", "slope_difference_rms_mrad")}
+    out["strong_correlations_over_0.9"] = result.fit.as_dict()["strong_correlations_over_0.9"]
+    out["near_null_combinations"] = near_null(result.fit)
     out.update(seed=seed, render_s=t1 - t0, calibration_s=t2 - t1, calibration_cpu_s=cpu, stages_s=result.timings_s,
                fit_rms_residual_mm=result.fit.rms_residual_mm)
     return out
@@ -50,7 +66,10 @@ def trial(optics, rig, seed: int) -> dict:
 
 #: The sweep's variants: name -> the calibration keys they change.
 VARIANTS = {"steps3": "  phase_steps: 3\n", "steps4": "  phase_steps: 4\n", "steps8": "  phase_steps: 8\n",
-            "heights_2_10_20mm": "  spacer_heights: [2 mm, 10 mm, 20 mm]\n"}
+            "heights_2_10mm": "  spacer_heights: [2 mm, 10 mm]\n",
+            "heights_1_20mm": "  spacer_heights: [1 mm, 20 mm]\n",
+            "heights_1_30mm": "  spacer_heights: [1 mm, 30 mm]\n",
+            "heights_1_10_20mm": "  spacer_heights: [1 mm, 10 mm, 20 mm]\n"}
 
 
 def sweep(base: str, trials: int) -> dict:
@@ -72,10 +91,49 @@ def sweep(base: str, trials: int) -> dict:
             out[name] = {"trials": trials,
                          "corrected_p99_deg": float(np.median([r["corrected_incidence_error_deg"]["p99"] for r in rows])),
                          "corrected_p50_deg": float(np.median([r["corrected_incidence_error_deg"]["p50"] for r in rows])),
+                         "measured_pixels_p99_deg": float(np.median(
+                             [r["corrected_incidence_error_deg_by_source"]["measured"]["p99"] for r in rows])),
+                         "parameters_met": float(np.median([r["parameters_met"] for r in rows])),
                          "calibration_cpu_s": float(np.median([r["calibration_cpu_s"] for r in rows])),
                          "render_s": float(np.median([r["render_s"] for r in rows]))}
             print(name, out[name], flush=True)
     return out
+
+
+def summarize(profile: str, resolution, trials: list) -> dict:
+    """The trials' figures against the targets, and the trials themselves."""
+    p99c = [t["corrected_incidence_error_deg"]["p99"] for t in trials]
+    measured = [t["corrected_incidence_error_deg_by_source"]["measured"]["p99"] for t in trials]
+    met = [t["parameters_met"] for t in trials]
+    ratio = [t["recovered_slope_rms_mrad"] / t["planted_slope_rms_mrad"] for t in trials]
+    summary = {
+        "profile": profile, "trials": len(trials), "camera_resolution_px": list(resolution),
+        "targets": {"parameter_error": "<= max(10 % of tolerance, 0.02 mm / 0.01 deg)",
+                    "corrected_incidence_error_p99_deg": 0.05, "slope_rms_recovery": "within 20 % or 0.1 mrad",
+                    "calibration_time_s": 60},
+        "parameters_within_target_fraction": float(np.mean([t["parameters_met"] / t["parameters_total"]
+                                                            for t in trials])),
+        "corrected_incidence_error_p99_deg_worst": float(max(p99c)),
+        "corrected_incidence_error_p99_deg_median": float(np.median(p99c)),
+        "corrected_incidence_error_p99_deg_median_measured_pixels": float(np.median(
+            [t["corrected_incidence_error_deg_by_source"]["measured"]["p99"] for t in trials])),
+        "corrected_incidence_error_p99_deg_range_measured_pixels": [float(f(measured)) for f in (np.min, np.max)],
+        "trials_with_measured_pixels_p99_within_target": int(np.sum(np.array(measured) <= 0.05)),
+        "measured_fraction_of_lit_median": float(np.median(
+            [t["corrected_incidence_error_deg_by_source"]["measured"]["pixels"] / t["lit_pixels"] for t in trials])),
+        "parameters_met_range": [int(min(met)), int(max(met))],
+        "parameter_met_fraction": {n: float(np.mean([t["parameters"][n]["met"] for t in trials]))
+                                   for n in trials[0]["parameters"]},
+        "slope_rms_ratio_range": [float(f(ratio)) for f in (np.min, np.max)],
+        "design_incidence_error_p99_deg_median": float(np.median([t["design_incidence_error_deg"]["p99"]
+                                                                  for t in trials])),
+        "calibration_s_median": float(np.median([t["calibration_s"] for t in trials])),
+        "calibration_cpu_s_median": float(np.median([t["calibration_cpu_s"] for t in trials])),
+        "machine_note": "shared 2-core machine under load from other jobs: wall times are upper bounds; the "
+                        "CPU time of this process is the comparable figure",
+        "per_trial": trials,
+    }
+    return summary
 
 
 def main() -> int:
@@ -83,6 +141,8 @@ def main() -> int:
     ap.add_argument("--trials", type=int, default=50, help="seeded trials (50 for the targets; fewer on a shared CPU)")
     ap.add_argument("--profile", default="achutha2006")
     ap.add_argument("--sweep-trials", type=int, default=1, help="trials per sweep variant (0: no sweep)")
+    ap.add_argument("--without-bias", action="store_true",
+                    help="also calibrate each capture without the decoding's bias correction (twice the time)")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "calibrate.json"))
     args = ap.parse_args()
     from rigcad.check.scene import analytic_optics
@@ -93,39 +153,16 @@ def main() -> int:
     optics = analytic_optics(rig)
     trials = []
     for seed in range(args.trials):
-        trials.append(trial(optics, rig, seed))
+        trials.append(trial(optics, rig, seed, args.without_bias))
         t = trials[-1]
         print(f"trial {seed}: {t['parameters_met']}/{t['parameters_total']} parameters within target; "
               f"corrected p99 {t['corrected_incidence_error_deg']['p99']:.3f} deg (measured pixels "
-              f"{t['corrected_incidence_error_deg_by_source']['measured']['p99']:.3f}; without the bias "
-              f"correction {t['without_bias_correction']['corrected_incidence_error_deg']['p99']:.3f}) vs design "
+              f"{t['corrected_incidence_error_deg_by_source']['measured']['p99']:.3f}) vs design "
               f"{t['design_incidence_error_deg']['p99']:.3f} deg; slopes {t['recovered_slope_rms_mrad']:.3f} vs "
               f"planted {t['planted_slope_rms_mrad']:.3f} mrad; {t['calibration_s']:.1f} s", flush=True)
-    p99c = [t["corrected_incidence_error_deg"]["p99"] for t in trials]
-    summary = {
-        "profile": args.profile, "trials": len(trials), "camera_resolution_px": list(rig.profile.camera.resolution),
-        "targets": {"parameter_error": "<= max(10 % of tolerance, 0.02 mm / 0.01 deg)",
-                    "corrected_incidence_error_p99_deg": 0.05, "slope_rms_recovery": "within 20 % or 0.1 mrad",
-                    "calibration_time_s": 60},
-        "parameters_within_target_fraction": float(np.mean([t["parameters_met"] / t["parameters_total"]
-                                                            for t in trials])),
-        "corrected_incidence_error_p99_deg_worst": float(max(p99c)),
-        "corrected_incidence_error_p99_deg_median": float(np.median(p99c)),
-        "corrected_incidence_error_p99_deg_median_measured_pixels": float(np.median(
-            [t["corrected_incidence_error_deg_by_source"]["measured"]["p99"] for t in trials])),
-        "without_bias_correction_p99_deg_median": float(np.median(
-            [t["without_bias_correction"]["corrected_incidence_error_deg"]["p99"] for t in trials])),
-        "without_bias_correction_p99_deg_median_measured_pixels": float(np.median(
-            [t["without_bias_correction"]["corrected_incidence_error_deg_by_source"]["measured"]["p99"]
-             for t in trials])),
-        "design_incidence_error_p99_deg_median": float(np.median([t["design_incidence_error_deg"]["p99"]
-                                                                  for t in trials])),
-        "calibration_s_median": float(np.median([t["calibration_s"] for t in trials])),
-        "calibration_cpu_s_median": float(np.median([t["calibration_cpu_s"] for t in trials])),
-        "machine_note": "shared 2-core machine under load from other jobs: wall times are upper bounds; the "
-                        "CPU time of this process is the comparable figure",
-        "per_trial": trials,
-    }
+        # written after every trial: a run stopped early keeps what it measured
+        summary = summarize(args.profile, rig.profile.camera.resolution, trials)
+        write_json(Path(args.out), summary)
     if args.sweep_trials:
         summary["sweep_phase_steps_and_heights"] = sweep(args.profile, args.sweep_trials)
     write_json(Path(args.out), summary)

@@ -1,12 +1,12 @@
 """Deflectometric calibration of the as-built rig: a flat screen at the sample shows phase-shifted
 sinusoids and Gray codes, the camera sees it through the paraboloid and the dome at two or more
-heights, and each camera pixel's ray in the sample frame follows (the raxel model). A fit of the
-rig's misalignment with its own analytic tracer, the dome's residual slope map and the corrected
-pixel -> incidence map come from those rays (docs/calibrate.md).
+heights, which gives each camera pixel's screen points. A fit of the rig's misalignment with its own
+analytic tracer, each pixel's ray through its fitted dome point and its screen points, the dome's
+residual slope map and the corrected pixel -> incidence map follow (docs/calibrate.md).
 
 Modules: ``patterns`` (what the screen shows), ``decode`` (camera images -> screen points),
-``bias`` (the decoding's own bias, from the measured map), ``raxel`` (screen points ->
-rays), ``model`` (the rig's tracer as the forward model), ``simulate``
+``bias`` (the decoding's own bias, from the measured map), ``raxel`` (screen poses, and
+the line through screen points), ``model`` (the rig's tracer as the forward model), ``simulate``
 (the images a capture would give), ``fit`` (the misalignment by least squares), ``maps`` (measured
 rays, residual slopes, the corrected map), ``images`` (reading and checking a capture), ``run`` (the
 stages, and a simulation's comparison with what was planted), ``kit`` (screen PNGs, spacers, the

@@ -1,8 +1,9 @@
-"""From the fit to the maps: each camera pixel's measured ray (the raxel through its decoded points
-on the fitted screens), the dome's residual slopes (:mod:`rigcad.calibrate.fit`'s docstring) and
-the corrected pixel -> incidence map: the fitted model's direction plus the measured residual,
-smoothed (normalised Gaussian convolution over the decoded pixels, sigma SMOOTH_PX) and filled
-where no screen point was seen (the same at FILL_PX; beyond that reach, the model alone). Its
+"""From the fit to the maps: each camera pixel's measured ray (through its fitted dome point and its
+decoded points on the fitted screens: :func:`pivot_rays`), the dome's residual slopes
+(:mod:`rigcad.calibrate.fit`'s docstring) and the corrected pixel -> incidence map: the fitted
+model's direction plus the measured residual, smoothed (normalised Gaussian convolution over the
+decoded pixels, sigma SMOOTH_PX) and filled where no screen point was seen (the same at FILL_PX;
+beyond that reach, the model alone). Its
 uncertainty per pixel (rad): the fit's covariance carried through the model's direction, with the
 decoding noise (the measured residual's local scatter about its smoothed value, divided by the
 smoothing's effective count) where measured, or the residual's RMS over the decoded pixels where
@@ -13,14 +14,19 @@ from __future__ import annotations
 import numpy as np
 
 from rigcad.calibrate import model as M
-from rigcad.calibrate.raxel import rays, to_global
+from rigcad.calibrate.raxel import to_global
 from rigcad.check.figures import _angles as angle_between  # noqa: F401  (the one home of the angle between rows)
 
 #: The smoothing of the measured residual (camera px): the sanding ripple's rings are ~7 px apart on
-#: Table 3.1's camera, which sigma 1.5 px would attenuate to 40 %, sigma 0.6 to 87 %.
-SMOOTH_PX = 0.6
-#: Decoded pixels within this many of an undecoded one are filled, not measured.
-EDGE_PX = 2
+#: Table 3.1's camera, which sigma 1.5 px would attenuate to 40 %, sigma 0.6 to 87 %, 0.3 to 97 %.
+#: The rays through the dome points carry little noise (a screen point's ~3 um over ~150 mm), so
+#: the least smoothing: 0.6 px took the recovered slope RMS to 0.83 of the planted (seed 1).
+SMOOTH_PX = 0.3
+#: A height's decoded pixels within this many of one it did not decode are not used at that height:
+#: their footprints see the screen's or a shadow's edge in part, which pulls the decoded point.
+HEIGHT_EDGE_PX = 3
+#: Measured pixels within this many of an unmeasured one are filled, not measured.
+EDGE_PX = 1
 FILL_PX = 6.0
 #: A pixel counts as measured when the smoothing's weight there is at least this (of a fully
 #: decoded neighbourhood); as filled when the fill's weight is.
@@ -28,11 +34,29 @@ MEASURED_WEIGHT = 0.5
 FILLED_WEIGHT = 0.02
 
 
-def measured_rays(decoded: list, poses: list) -> np.ndarray:
-    """Unit directions (n, 3), up, of each window pixel's raxel (NaN where < 2 heights decoded)."""
-    pts = [to_global(pose, d.u, d.v).reshape(-1, 3) for d, pose in zip(decoded, poses)]
-    _, direction = rays(pts)
-    return direction
+def pivot_rays(decoded: list, poses: list, model_tr: M.Traced, shape: tuple[int, int]) -> np.ndarray:
+    """Unit directions (n, 3), up, of each window pixel's ray through the fitted model's dome point
+    and its decoded screen points: per height, from the screen point to the dome point, averaged
+    over the heights that decoded the pixel away from their edges (NaN where none did).
+
+    The residual is a tilt of the dome's normal (module docstring): it turns the ray about its dome
+    point, which it does not move. So each screen point fixes the direction over the ~120-230 mm from
+    the dome, not over the spacers' gap (8 mm): the decoded points' bias (~10-40 um) costs ~0.1-0.3
+    mrad, not ~1-5. What the direction inherits instead is the fitted model's dome point, off the
+    true ray by the fit's error (~0.1 mm: ~0.6 mrad over the lever, smooth across the pixels), and a
+    paraboloid slope error, which moves the dome point, is read as a dome tilt there. A pixel seen
+    at one height (grazing rays past the upper screen's edge) is measured too."""
+    from scipy.ndimage import binary_erosion
+
+    total = np.zeros((int(np.prod(shape)), 3))
+    for d, pose in zip(decoded, poses):
+        inner = binary_erosion(d.valid, iterations=HEIGHT_EDGE_PX).ravel() & model_tr.ok
+        to_dome = model_tr.p2 - to_global(pose, d.u, d.v).reshape(-1, 3)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            to_dome /= np.linalg.norm(to_dome, axis=1)[:, None]
+        total += np.where(inner[:, None], np.nan_to_num(to_dome), 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return total / np.linalg.norm(total, axis=1)[:, None]
 
 
 def residual_slopes(tr: M.Traced, measured: np.ndarray) -> np.ndarray:

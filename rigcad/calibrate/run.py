@@ -14,7 +14,7 @@ import dataclasses
 
 from rigcad.calibrate import bias as B, maps, model as M
 from rigcad.calibrate.decode import decode
-from rigcad.calibrate.fit import FitData, fit
+from rigcad.calibrate.fit import SLOPE_PROJECTION, FitData, fit
 from rigcad.calibrate.patterns import Sequence
 
 
@@ -33,6 +33,7 @@ class Calibration:
     heights: np.ndarray
     decoded: list
     fit: object
+    map_fit: object
     model: M.Traced
     measured: np.ndarray
     slopes: np.ndarray
@@ -68,16 +69,19 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
         decoded = _unbiased(decoded, B.map_bias(decoded, cam.shape, seq, cal.sim_blur))
     data = _fit_data(cam, decoded, cal.fit_stride)
     result = fit(optics, rig, cam, heights, data, say)
-    t2 = time.perf_counter()
     say(f"fitted {len(result.theta)} parameters to {result.residuals_used} residuals "
         f"(RMS {result.rms_residual_mm * 1e3:.2f} um)")
-    poses = M.screens(heights, result.theta)
-    fitted = M.moved(rig, result.theta)
+    # the map's rays turn about the model's dome points: refit with the surface's signature
+    # down-weighted (fit.SLOPE_PROJECTION), from the plain fit
+    for_map = fit(optics, rig, cam, heights, data, say, slope_projection=SLOPE_PROJECTION, start=result.theta)
+    t2 = time.perf_counter()
+    poses = M.screens(heights, for_map.theta)
+    fitted = M.moved(rig, for_map.theta)
     model_tr = M.trace_camera(optics, fitted, cam.x_px, cam.y_px, cam.design)
-    measured = maps.measured_rays(decoded, poses)
+    measured = maps.pivot_rays(decoded, poses, model_tr, cam.shape)
     n_rig = len(M.RIG_NAMES)
-    jac = maps.direction_jacobian(optics, rig, cam, result.theta)
-    corrected = maps.corrected_map(model_tr, measured, cam.shape, jac, result.covariance[:n_rig, :n_rig])
+    jac = maps.direction_jacobian(optics, rig, cam, for_map.theta)
+    corrected = maps.corrected_map(model_tr, measured, cam.shape, jac, for_map.covariance[:n_rig, :n_rig])
     # the slopes from the smoothed measurement (the raw rays' noise, divided by 2 cos of the dome's
     # angle of incidence, would swamp them), where measured
     seen = (corrected["source"] == 1)[:, None]
@@ -86,7 +90,7 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     from rigcad.check.sources import pixel_rays
 
     design = cam.design.direction(pixel_rays(cam.design, cam.x_px, cam.y_px).dirs)
-    return Calibration(cam, heights, decoded, result, model_tr, measured, slopes, corrected, design,
+    return Calibration(cam, heights, decoded, result, for_map, model_tr, measured, slopes, corrected, design,
                        {"decode_s": t1 - t0, "fit_s": t2 - t1, "maps_s": t3 - t2})
 
 

@@ -93,7 +93,11 @@ def _check_heights(result, folder: Path) -> None:
 
 
 def _report(result) -> dict:
+    refit = result.map_fit.as_dict()
     return {"fit": result.fit.as_dict(), "residual_slopes": result.slope_figures(),
+            "map_model": {"about": "the corrected map's model: refit from the fit above with each pixel's dome-slope "
+                                   "residual component down-weighted (docs/calibrate.md)",
+                          "parameters": refit["parameters"], "rms_residual_mm": refit["rms_residual_mm"]},
             "residual_attribution": "the dome (sanded by hand); a paraboloid slope error at the paired point, "
                                     "and low-order figure errors that a fitted tilt or offset mimics, are not "
                                     "separable from it",

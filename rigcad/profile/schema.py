@@ -543,7 +543,7 @@ class CalibrationParams:
     screen_thickness: float = spec("length", "screen: from its back (on the spacer) to its emitting surface",
                                    "6 mm", lo=0, hi=100.0)
     spacer_heights: tuple[float, ...] = spec("lengths", "printed spacers under the screen, one capture per "
-                                             "spacer (two or more, distinct)", ["2 mm", "10 mm"], lo=0, hi=200.0)
+                                             "spacer (two or more, distinct)", ["1 mm", "20 mm"], lo=0, hi=200.0)
     phase_steps: int = spec("int", "phase shifts per sinusoid period (>= 3)", 4, lo=3, hi=64)
     periods: tuple[int, ...] = spec("ints", "sinusoid periods in screen pixels, coarse to fine unwrapping "
                                     "(the coarsest is unwrapped by the Gray code)", [128, 16], lo=4, hi=MAX_PIXELS)

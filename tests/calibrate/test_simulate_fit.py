@@ -16,11 +16,16 @@ from rigcad.cli.calibrate import cmd_calibrate
 from rigcad.calibrate.decode import decode
 from rigcad.calibrate.images import CaptureError
 from rigcad.calibrate.patterns import Sequence
+from rigcad.calibrate.raxel import rays, to_global
 from rigcad.calibrate.run import calibrate, compare
 from rigcad.profile.schema import load_profile
 from rigcad.rig import Rig
 
-SMALL = "extends: achutha2006\ncamera:\n  resolution: [340, 256]\ncalibration:\n  sim_blur: 0.3\n"
+#: The small camera's pixels are 4x the profile's: its footprints on a screen 25 mm up (the default
+#: upper spacer) blur the finest period away, which the command refuses (a finer period disagreeing
+#: with the coarser one); the screens stand lower, as for a coarse camera they must.
+SMALL = ("extends: achutha2006\ncamera:\n  resolution: [340, 256]\ncalibration:\n  sim_blur: 0.3\n"
+         "  spacer_heights: [2 mm, 10 mm]\n")
 #: The command's tests (what is written, what is refused) need no accuracy: the fit on every 4th row
 #: and column (~1/4 of the small camera's fit pixels) is plenty to put a wrong spacer 2 mm off.
 COARSE_FIT = "  fit_stride: 4\n"
@@ -81,6 +86,35 @@ def test_calibration_corrects_the_map(small):
     assert np.nanmax(res.corrected["uncertainty_rad"]) > 0
 
 
+def test_pivot_rays_are_exact_on_exact_screen_points(small):
+    """A dome slope error turns the ray about its dome point: from the true rig's dome points and the
+    screen points of the rays with the planted surface (the tracer's, no decoding), the measured
+    directions are the true ones; the two-point line through the same points too, but the pivot
+    keeps the grazing pixels one screen alone sees."""
+    from types import SimpleNamespace
+
+    s = small
+    truth_rig = M.moved(s["rig"], s["theta"])
+    base = M.trace_camera(s["optics"], truth_rig, s["cam"].x_px, s["cam"].y_px, s["cam"].design)
+    tr = S.with_surface(truth_rig, s["surface"], base)
+    decoded = []
+    for pose, half in zip(M.screens(s["heights"], s["theta"]), (60, 25)):  # the upper screen sees fewer
+        su, sv = tr.screen(pose)
+        inside = np.isfinite(su) & (np.abs(su) < 100) & (np.abs(sv) < half)
+        decoded.append(SimpleNamespace(u=np.where(inside, su, np.nan), v=np.where(inside, sv, np.nan),
+                                       valid=inside.reshape(s["cam"].shape)))
+    got = maps.pivot_rays(decoded, M.screens(s["heights"], s["theta"]), base, s["cam"].shape)
+    ok = np.isfinite(got[:, 0])
+    assert ok.sum() > 2000
+    assert np.max(maps.angle_between(got[ok], -tr.v[ok])) < 1e-9
+    # the planted surface matters here: the undeflected rays are ~1 mrad off
+    assert np.percentile(maps.angle_between(-base.v[ok], -tr.v[ok]), 90) > 3e-4
+    poses = M.screens(s["heights"], s["theta"])
+    _, two = rays([to_global(p, d.u, d.v).reshape(-1, 3) for d, p in zip(decoded, poses)])
+    assert np.max(maps.angle_between(two[ok & np.isfinite(two[:, 0])], -tr.v[ok & np.isfinite(two[:, 0])])) < 1e-9
+    assert (ok & ~np.isfinite(two[:, 0])).sum() > 0
+
+
 @pytest.fixture(scope="module")
 def capture(tmp_path_factory, small):
     """The small capture written once as PNGs (each test copies it before spoiling it) and a profile
@@ -130,7 +164,7 @@ def test_bad_captures_are_refused_with_one_line_naming_the_file(tmp_path, captur
 def test_a_height_the_images_contradict(tmp_path, capture):
     """The captures of a 10 mm spacer declared as 12 mm: the fit puts the screen 2 mm off."""
     wrong = tmp_path / "wrong.yaml"
-    wrong.write_text(SMALL + COARSE_FIT + "  spacer_heights: [2 mm, 12 mm]\n")
+    wrong.write_text(SMALL.replace("[2 mm, 10 mm]", "[2 mm, 12 mm]") + COARSE_FIT)
     with pytest.raises(CaptureError) as info:
         _run(tmp_path, capture, capture["folder"], wrong)
     assert "h1_white.png" in str(info.value) and "spacer" in str(info.value)
