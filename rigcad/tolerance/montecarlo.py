@@ -12,11 +12,14 @@ import numpy as np
 
 def rank_correlations(columns: dict) -> dict:
     """Spearman rank correlation of each parameter's magnitude in the samples (lateral offset
-    |(dx, dy)|, |dz|, tilt) with the sample's spot and mirror angle error."""
+    |(dx, dy)|, |dz|, tilt) with the sample's spot and mirror angle error. Tied values share their
+    mean rank: a parameter toleranced at 0 (every sample's magnitude 0) correlates with nothing."""
+    from scipy.stats import rankdata
+
     from rigcad.tolerance.params import PARAMETERS
 
     def ranks(v):
-        return np.argsort(np.argsort(v, kind="stable"), kind="stable").astype(float)
+        return rankdata(v, method="average")
 
     out = {}
     figs = {k: ranks(columns[k]) for k in ("max_spot_radius_mm", "max_mirror_angle_error_rad")}

@@ -1,0 +1,460 @@
+"""The bill of materials' arithmetic on hand-built inputs (no rig, no CAD; seconds): the ISO tables'
+look-ups at their edges, bolt lengths summed by hand, areas of revolution against closed forms, the
+coating stack's mid-surfaces, bolts found in recipes built here, the pins, the printed rows and the
+purchased rows, each field and each line of text written out. The whole rig's bill (the fab stage's
+report, the manual's files) is tested in test_manual.py."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from rigcad.errors import GeometryError
+from rigcad.manual import bom as B
+from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Translate, Union_
+
+
+# -- the ISO tables -------------------------------------------------------------------------------
+def test_thread_for_hole_takes_the_largest_clearance_that_fits_at_each_edge():
+    for k, (thread, hole, *_rest) in enumerate(B.METRIC):
+        assert B.thread_for_hole(hole)[0] == thread
+        assert B.thread_for_hole(hole - 5e-10)[0] == thread  # within the 1e-9 mm of round-off
+        assert B.thread_for_hole(hole + 1e-6)[0] == thread
+        if k:
+            assert B.thread_for_hole(hole - 1e-6) == B.METRIC[k - 1]
+    assert B.thread_for_hole(100.0) == ("M12", 13.5, 1.75, 10.8, 2.5)
+    with pytest.raises(GeometryError) as e:
+        B.thread_for_hole(2.4 - 1e-6)
+    assert e.value.param == "dome_shell.bolt_diameter"
+    assert str(e.value) == "a 2.4 mm hole takes no ISO metric bolt from M2 (2.4 mm clearance) up"
+
+
+def test_bolt_length_is_the_shortest_preferred_length_over_the_sum():
+    # grip + 2 washers + nut + 2 pitches, by hand
+    assert B.bolt_length(16.0, 0.7, 3.2, 0.8) == (25, pytest.approx(16 + 1.6 + 3.2 + 1.4, abs=1e-12))
+    length, need = B.bolt_length(10.0, 0.5, 2.5, 1.25)  # need = 10 + 2.5 + 2.5 + 1.0 = 16 exactly
+    assert need == 16.0 and length == 16
+    assert B.bolt_length(10.0 + 1e-10, 0.5, 2.5, 1.25)[0] == 16  # within the 1e-9 mm of round-off
+    assert B.bolt_length(10.0 + 1e-6, 0.5, 2.5, 1.25)[0] == 20
+    assert B.bolt_length(0.0, 0.0, 0.0, 0.0) == (5, 0.0)
+    assert B.bolt_length(200.0, 0.0, 0.0, 0.0) == (200, 200.0)
+    with pytest.raises(GeometryError) as e:
+        B.bolt_length(190.0, 1.0, 8.0, 2.0)  # 190 + 4 + 8 + 2 = 204 mm
+    assert e.value.param == "base_plate.thickness"
+    assert str(e.value) == ("bolts of 204.0 mm are longer than the longest preferred length (200 mm): "
+                            "the flange and plate are too thick")
+
+
+# -- areas and the coating stack ------------------------------------------------------------------
+class Segment:
+    """A meridian (r, z) that is a straight segment, moved ``offset`` mm outward in r by behind()."""
+
+    def __init__(self, a, b, offset=0.0):
+        self.a, self.b, self.offset = np.asarray(a, float), np.asarray(b, float), offset
+        self.calls = []
+
+    def sample(self, count):
+        self.calls.append(count)
+        return np.linspace(0.0, 1.0, count)
+
+    def points(self, u):
+        p = self.a + np.outer(u, self.b - self.a)
+        return p + np.array([self.offset, 0.0])
+
+    def behind(self, distance):
+        return Segment(self.a, self.b, self.offset + distance)
+
+
+class Arc:
+    """A quarter circle of radius R about the origin in (r, z): revolved, a hemisphere, 2 pi R^2."""
+
+    def __init__(self, R):
+        self.R = R
+
+    def sample(self, count):
+        return np.linspace(0.0, math.pi / 2, count)
+
+    def points(self, u):
+        return self.R * np.stack([np.cos(u), np.sin(u)], axis=1)
+
+
+def test_revolved_area_of_a_frustum_and_a_hemisphere():
+    # frustum r 3 -> 7 over a slant of 5 (dz = 3): pi (r1 + r2) L = 50 pi; the midpoint rule is exact on it
+    m = Segment((3.0, 0.0), (7.0, 3.0))
+    assert B.revolved_area(m) == pytest.approx(50 * math.pi, rel=1e-12)
+    assert m.calls == [20001]
+    # the mirror image (r < 0) sweeps the same surface
+    assert B.revolved_area(Segment((-3.0, 0.0), (-7.0, 3.0)), samples=11) == pytest.approx(50 * math.pi, rel=1e-12)
+    assert B.revolved_area(Segment((0.0, 0.0), (4.0, 3.0)), samples=2) == pytest.approx(20 * math.pi, rel=1e-12)
+    exact = 2 * math.pi * 10.0 ** 2
+    assert abs(B.revolved_area(Arc(10.0)) - exact) / exact < 1e-8  # second order: ~1e-9 at 20001 points
+    coarse = abs(B.revolved_area(Arc(10.0), samples=101) - exact) / exact
+    assert 1e-6 < coarse < 1e-4  # ~ (pi/2 / 100)^2 / 24: second order, not better
+
+
+def _rig(layers, margin, recipes, tower=None):
+    # no breadboard (datum.mount names none of parts.breadboard's): the rig stands on its own plate
+    profile = SimpleNamespace(coating=SimpleNamespace(layers=layers, margin=margin),
+                              datum=SimpleNamespace(mount="own base plate"), buy=SimpleNamespace(column="bought"))
+    return SimpleNamespace(profile=profile, recipes=recipes, layout=SimpleNamespace(tower=tower))
+
+
+def _part(name, solid=None, mirrors=(), in_rig=True):
+    return Part(name, solid if solid is not None else Box((0, 0, 0), (1, 1, 1)), (0.5, 0.5, 0.5), name,
+                in_rig=in_rig, mirrors=mirrors)
+
+
+def test_each_coating_layer_is_measured_on_its_own_mid_surface():
+    # a cylinder of radius 10 and height 20 whose parallel curves move outward: area 2 pi (10 + d) 20
+    H = 20.0
+    layers = [("base", 0.1), ("clear", 0.2), ("top", 0.05)]
+    rig = _rig(layers, 1.5, {"cup": _part("cup", mirrors=(("inner", Segment((10.0, 0.0), (10.0, H))),
+                                                          ("outer", Segment((30.0, 0.0), (30.0, H)))))})
+    rows = B.coating_rows(rig)
+    assert [(r.mirror, r.layer) for r in rows] == [(m, n) for m in ("inner", "outer") for n, _ in layers]
+    tops = {"base": 0.25, "clear": 0.05, "top": 0.0}  # the layers above each, bottom to top
+    for r in rows:
+        t = dict(layers)[r.layer]
+        R = (10.0 if r.mirror == "inner" else 30.0) + tops[r.layer] + t / 2
+        area = 2 * math.pi * R * H
+        assert r.part == "cup" and r.thickness_mm == t
+        assert r.top_behind_design_mm == pytest.approx(tops[r.layer], abs=1e-15)
+        assert r.area_mm2 == pytest.approx(area, rel=1e-12)
+        assert r.film_cm3 == pytest.approx(area * t / 1000, rel=1e-12)
+        assert r.to_buy_cm3 == pytest.approx(area * t / 1000 * 1.5, rel=1e-12)
+
+
+# -- bolts found in recipes -----------------------------------------------------------------------
+def _plate_and_flange():
+    """A plate (z 0..6) and a flange above it (z 6..16, placed by a Translate), a 4 mm hole through
+    both at (10, 20) (each hole 1 mm past the faces it crosses)."""
+    plate = Difference(Box((0, 0, 0), (50, 50, 6)), (Cylinder((10.0, 20.0, -1.0), 2.0, 8.0),))
+    flange = Translate(Difference(Box((0, 0, 0), (50, 50, 10)), (Cylinder((10.01 - 1, 20.0, -1.0), 2.0, 12.0),)),
+                       (1.0, 0.0, 6.0))
+    return plate, flange
+
+
+def test_a_hole_through_two_parts_is_one_bolt_through_both():
+    plate, flange = _plate_and_flange()
+    rig = _rig([], 1.0, {"plate": _part("plate", plate), "flange": _part("flange", flange)})
+    (b,) = B.bolt_axes(rig)
+    assert b == {"parts": ("flange", "plate"), "upper": "flange",
+                 "spans": {"flange": (6.0, 16.0), "plate": (0.0, 6.0)},
+                 "x": 10.0, "y": 20.0, "top_z": 16.0, "bottom_z": 0.0, "grip_mm": 16.0, "hole_mm": 4.0}
+    assert list(B._holes(plate)) == [(10.0, 20.0, -1.0, 7.0, 4.0, True)]
+    assert list(B._holes(plate.base)) == []  # the plate's own body is no hole
+
+
+def test_what_counts_as_a_bolt_hole():
+    def holes(cut):
+        return list(B._holes(Difference(Box((0, 0, 0), (90, 90, 9)), (cut,))))
+
+    assert holes(Cylinder((0, 0, 0), 8.0, 5.0)) == [(0.0, 0.0, 0.0, 5.0, 16.0, True)]  # 16 mm: still a hole
+    assert holes(Cylinder((0, 0, 0), 8.0 + 1e-9, 5.0)) == []
+    assert holes(Box((0, 0, 0), (16, 4, 9))) == [(8.0, 2.0, 0.0, 9.0, 4.0, False)]  # a slot, its narrow width
+    assert holes(Box((0, 0, 0), (4, 16, 9))) == [(2.0, 8.0, 0.0, 9.0, 4.0, False)]
+    assert holes(Box((0, 0, 0), (16.5, 4, 9))) == [] and holes(Box((0, 0, 0), (4, 16.5, 9))) == []
+    assert holes(Box((0, 0, 0), (4, 2, 16))) == []  # as deep as 4x its width: a channel, no bolt
+    assert holes(Box((0, 0, 0), (4, 2, 15.9))) == [(2.0, 1.0, 0.0, 15.9, 2.0, False)]
+    # a cut inside a union inside a translate, and a translate of the cut itself
+    nested = Translate(Difference(Union_((Box((0, 0, 0), (9, 9, 9)), Cylinder((0, 0, 0), 1.0, 9.0))),
+                                  (Union_((Translate(Cylinder((1, 2, 3), 1.5, 4.0), (10, 20, 30)),)),)),
+                       (100, 200, 300))
+    assert list(B._holes(nested)) == [(111.0, 222.0, 333.0, 337.0, 3.0, True)]
+    # holes of a difference's base (a plate drilled, then cut again), moved with it; a cut whose own
+    # base is a hole (a hole with a key left in it) is a hole; a slot moved off the origin
+    drilled = Translate(Difference(Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((1, 2, 0), 1.0, 9.0),)),
+                                   (Difference(Cylinder((5, 6, 0), 2.0, 9.0), (Box((5, 6, 0), (5.5, 6.5, 9)),)),
+                                    Box((1, 2, 0), (4, 10, 9)))), (10, 20, 30))
+    assert list(B._holes(drilled)) == [(11.0, 22.0, 30.0, 39.0, 2.0, True), (15.0, 26.0, 30.0, 39.0, 4.0, True),
+                                       (12.5, 26.0, 30.0, 39.0, 3.0, False)]
+
+
+def test_bolt_axes_split_a_stack_where_its_holes_stop_touching_and_skip_lone_slots():
+    touching = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((0, 0, 0), 1.0, 5.0),
+                                                      Cylinder((0, 0, 5.0 + 1e-7), 1.0, 5.0)))
+    apart = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((0, 0, 0), 1.0, 5.0),
+                                                   Cylinder((0, 0, 5.0 + 1e-5), 1.0, 5.0)))
+    slot = Difference(Box((0, 0, 0), (9, 9, 9)), (Box((30, 30, 0), (34, 31, 9)),))
+    assert [b["grip_mm"] for b in B.bolt_axes(_rig([], 1, {"a": _part("a", touching)}))] == \
+        [pytest.approx(10 + 1e-7 - 2)]
+    runs = B.bolt_axes(_rig([], 1, {"a": _part("a", apart)}))
+    assert [(b["bottom_z"], b["top_z"]) for b in runs] == [(1.0, 4.0), (pytest.approx(6 + 1e-5), pytest.approx(9 + 1e-5))]
+    assert B.bolt_axes(_rig([], 1, {"s": _part("s", slot)})) == []  # a slot of one part alone: no bolt
+    # a slot in one part under a round hole in another is a bolt through both
+    over = Difference(Box((0, 0, 9), (40, 40, 12)), (Cylinder((32, 30.5, 8), 0.5, 5.0),))
+    (b,) = B.bolt_axes(_rig([], 1, {"s": _part("s", slot), "o": _part("o", over)}))
+    assert b["parts"] == ("o", "s") and b["hole_mm"] == 1.0 and b["upper"] == "o"
+    assert (b["x"], b["y"]) == (32.0, 30.5)  # the lowest hole's axis
+    # parts left out of the rig, and the tower's unless asked for
+    plate, flange = _plate_and_flange()
+    rig = _rig([], 1, {"plate": _part("plate", plate), "tower_column": _part("tower_column", flange),
+                       "jig": _part("jig", flange, in_rig=False)})
+    assert [b["parts"] for b in B.bolt_axes(rig)] == [("plate",)]
+    assert [b["parts"] for b in B.bolt_axes(rig, tower=True)] == [("plate", "tower_column")]
+
+
+def test_holes_on_axes_0_5_mm_apart_are_separate_bolts_and_a_stack_is_ordered_by_its_bottoms():
+    def hole(x, y, z0, z1, r=1.0):
+        return Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((x, y, z0), r, z1 - z0),))
+
+    rig = _rig([], 1, {"a": _part("a", hole(0, 0, 0, 5)), "b": _part("b", hole(0, 0.5, 0, 5)),
+                       "c": _part("c", hole(0.5, 0, 0, 5))})
+    assert sorted((b["x"], b["y"], b["parts"]) for b in B.bolt_axes(rig)) == [
+        (0.0, 0.0, ("a",)), (0.0, 0.5, ("b",)), (0.5, 0.0, ("c",))]
+    # a long hole (0..10) holding two short ones (2..3, 5..6): one run, whatever order their tops come in
+    long_ = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((0, 0, 0), 1.0, 10.0), Cylinder((0, 0, 2), 1.0, 1.0)))
+    rig = _rig([], 1, {"p": _part("p", long_), "q": _part("q", hole(0, 0, 5, 6))})
+    (b,) = B.bolt_axes(rig)
+    assert b["parts"] == ("p", "q") and (b["bottom_z"], b["top_z"]) == (1.0, 9.0)
+    # the same bottom: the first by name gives the axis
+    rig = _rig([], 1, {"b": _part("b", hole(10.0, 0, 0, 5)), "a": _part("a", hole(10.01, 0, 0, 6))})
+    (b,) = B.bolt_axes(rig)
+    assert (b["x"], b["upper"]) == (10.01, "a")
+    # a hole starting exactly at the margin above the last top still joins it
+    edge = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((0, 0, 0), 1.0, 5.0),
+                                                  Cylinder((0, 0, 5.0 + 1e-6), 1.0, 5.0)))
+    assert len(B.bolt_axes(_rig([], 1, {"e": _part("e", edge)}))) == 1
+    # a lone slot under a separate round hole on its axis: the slot is skipped, the hole still a bolt
+    slot_then_hole = Difference(Box((0, 0, 0), (9, 9, 30)), (Box((0, 0, 0), (4, 2, 9)),
+                                                             Cylinder((2, 1, 20), 1.0, 5.0)))
+    (b,) = B.bolt_axes(_rig([], 1, {"s": _part("s", slot_then_hole)}))
+    assert (b["parts"], b["bottom_z"], b["top_z"]) == (("s",), 21.0, 24.0)
+
+
+def test_bolts_are_grouped_by_grip_to_the_micrometre_and_by_hole():
+    def pair(x, top, r=2.0):
+        lower = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((x, 0, -1), r, 8.0),))
+        upper = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((x, 0, 5), r, top - 4),))
+        return lower, upper
+
+    parts = {}
+    for k, (x, top, r) in enumerate([(0, 17.0, 2.0), (20, 17.0004, 2.0), (40, 17.4, 2.0), (60, 17.0, 2.25),
+                                     (80, 17.0, 2.0002)]):
+        lo, up = pair(x, top, r)
+        parts[f"lo{k}"], parts[f"up{k}"] = lo, up
+    lower = Difference(Box((0, 0, 0), (99, 9, 9)), tuple(c for k in range(5) for c in parts[f"lo{k}"].cuts))
+    upper = Difference(Box((0, 0, 0), (99, 9, 9)), tuple(c for k in range(5) for c in parts[f"up{k}"].cuts))
+    rows = B.bolt_joints(_rig([], 1, {"lower": _part("lower", lower), "upper": _part("upper", upper)}))
+    assert [(r["count"], r["thread"], round(r["grip_mm"], 4)) for r in rows] == [
+        (3, "M3", 17.0), (1, "M4", 17.0), (1, "M3", 17.4)]  # holes the same to the micrometre: one joint
+
+
+def test_the_upper_part_is_the_one_whose_hole_reaches_highest_the_name_breaking_ties():
+    a = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((0, 0, 0), 1.0, 5.0),))
+    b = Difference(Box((0, 0, 0), (9, 9, 9)), (Cylinder((0, 0, 4), 1.0, 1.0),))  # same top, higher bottom
+    (bolt,) = B.bolt_axes(_rig([], 1, {"b": _part("b", b), "a": _part("a", a)}))
+    assert bolt["upper"] == "b" and bolt["spans"] == {"a": (1.0, 4.0), "b": (5.0, 4.0)}
+    assert bolt["bottom_z"] == 1.0 and bolt["top_z"] == 4.0
+
+
+def _joints_rig():
+    """Two through bolts of 16 mm grip (4 mm holes: M3) and one of 10 mm between plate and flange,
+    and a lone 5.5 mm hole (M5) of the plate into the bench."""
+    plate = Difference(Box((0, 0, 0), (90, 90, 6)), (Cylinder((50, 50, -1), 2.75, 8.0),
+                                                     Cylinder((0, 0, -1), 2.0, 8.0), Cylinder((20, 0, -1), 2.0, 8.0),
+                                                     Cylinder((40, 0, -1), 2.0, 8.0)))
+    flange = Difference(Box((0, 0, 6), (90, 90, 16)), (Cylinder((0, 0, 5), 2.0, 12.0), Cylinder((20, 0, 5), 2.0, 12.0),
+                                                       Cylinder((40, 0, 5), 2.0, 6.0)))
+    return _rig([], 1, {"plate": _part("plate", plate), "flange": _part("flange", flange)})
+
+
+def test_bolt_joints_group_and_size_each_bolt():
+    rows = B.bolt_joints(_joints_rig())
+    assert [(r["parts"], r["grip_mm"], r["count"]) for r in rows] == \
+        [(("flange", "plate"), 10.0, 1), (("flange", "plate"), 16.0, 2), (("plate",), 6.0, 1)]
+    short, long_, alone = rows
+    # M3 (4 mm hole, 3.4 mm clearance): 16 + 2 x 0.5 + 2.4 + 2 x 0.5 = 20.4 -> 25; 10 + 4.4 = 14.4 -> 16
+    assert long_ == {"parts": ("flange", "plate"), "grip_mm": 16.0, "hole_mm": 4.0, "count": 2, "thread": "M3",
+                     "joins": "flange + plate", "item": "M3 x 25 mm socket-head bolt (ISO 4762)",
+                     "short": "M3 x 25 mm bolts", "length_mm": 25, "nuts": 2, "washers": 4,
+                     "note": "needs 20.4 mm: 16 mm grip + 2 washers + nut 2.4 mm + 2 pitches"}
+    assert short["length_mm"] == 16 and short["item"] == "M3 x 16 mm socket-head bolt (ISO 4762)"
+    assert alone == {"parts": ("plate",), "grip_mm": 6.0, "hole_mm": 5.5, "count": 1, "thread": "M5",
+                     "joins": "plate to what it stands on",
+                     "item": "M5 bolt, length to suit (passes 6 mm of plate)", "short": "M5 bolts",
+                     "length_mm": None, "nuts": 0, "washers": 1,
+                     "note": "into the bench (or what the part stands on): choose its length on site"}
+
+
+def test_fasteners_add_nuts_and_washers_per_thread_and_the_towers_own(monkeypatch):
+    rig = _joints_rig()
+    rows = B.fasteners(rig)
+    assert rows == [
+        {"item": "M3 x 16 mm socket-head bolt (ISO 4762)", "short": "M3 x 16 mm bolts", "quantity": 1,
+         "use": "flange + plate", "length_mm": 16, "thread": "M3",
+         "note": "needs 14.4 mm: 10 mm grip + 2 washers + nut 2.4 mm + 2 pitches"},
+        {"item": "M3 x 25 mm socket-head bolt (ISO 4762)", "short": "M3 x 25 mm bolts", "quantity": 2,
+         "use": "flange + plate", "length_mm": 25, "thread": "M3",
+         "note": "needs 20.4 mm: 16 mm grip + 2 washers + nut 2.4 mm + 2 pitches"},
+        {"item": "M5 bolt, length to suit (passes 6 mm of plate)", "short": "M5 bolts", "quantity": 1,
+         "use": "plate to what it stands on", "length_mm": None, "thread": "M5",
+         "note": "into the bench (or what the part stands on): choose its length on site"},
+        {"item": "M3 hex nut (ISO 4032)", "short": "M3 nuts", "quantity": 3, "use": "one per through bolt",
+         "length_mm": None, "note": "2.4 mm high"},
+        {"item": "M3 washer (ISO 7089)", "short": "M3 washers", "quantity": 6, "use": "under each bolt head and nut",
+         "length_mm": None, "note": "0.5 mm thick"},
+        {"item": "M5 washer (ISO 7089)", "short": "M5 washers", "quantity": 1, "use": "under each bolt head and nut",
+         "length_mm": None, "note": "1 mm thick"},
+    ]
+    assert B.tower_hardware(rig) == []  # no tower in this layout
+    assert B.tower_hardware(SimpleNamespace(layout=SimpleNamespace())) == []  # a layout that knows no tower
+    import rigcad.parts.tower as T
+
+    seen = []
+
+    def hardware(profile, layout):
+        seen.append((profile, layout))
+        return [{"thread": "M4", "length_mm": 12.0, "item": "button-head screw", "quantity": 3, "joins": "shelf + column"},
+                {"thread": "1/4-20", "item": "camera screw", "quantity": 1, "joins": "camera"},
+                {"thread": "", "item": "heat-set insert", "quantity": 4, "joins": "shelf"}]
+
+    monkeypatch.setattr(T, "hardware", hardware)
+    rig.layout.tower = SimpleNamespace(column_x=500.0)  # a bought column: its core screw's axis, far off
+    assert [h["item"] for h in B.tower_hardware(rig)] == ["button-head screw", "camera screw"]
+    assert seen == [(rig.profile, rig.layout)]
+    tower = B.fasteners(rig)[-2:]
+    assert tower == [
+        {"item": "M4 x 12 mm button-head screw", "short": "M4 x 12 mm button-head screw", "quantity": 3,
+         "use": "shelf + column", "length_mm": 12.0, "note": "COP tower (parts.tower.hardware)", "thread": "M4",
+         "tower": True},
+        {"item": "camera screw (1/4-20)", "short": "camera screw (1/4-20)", "quantity": 1, "use": "camera",
+         "length_mm": None, "note": "COP tower (parts.tower.hardware)", "thread": "1/4-20", "tower": True}]
+
+
+# -- pins, printed pieces, purchased items ----------------------------------------------------------
+def _printer(filament=None, **kw):
+    p = SimpleNamespace(alignment_pin=SimpleNamespace(diameter=1.75, depth=6.0, clearance=0.15),
+                        source="printers/x.yaml", **kw)
+    if filament is not None:
+        p.filament_diameter = filament
+    return p
+
+
+def test_dowel_pins_count_per_part_times_its_quantity():
+    report = {"parts": {"plate": {"pins": [1, 2, 3], "quantity": 2}, "dome": {"pins": [1]},
+                        "tool": {"pins": []}, "arm": {}}}
+    pins = B.dowel_pins(report, _printer())
+    assert pins == {"item": "dowel pin 1.75 mm x 11.5 mm", "quantity": 7, "diameter_mm": 1.75, "length_mm": 11.5,
+                    "per_part": {"plate": 6, "dome": 1}, "use": "plate: 6, dome: 1",
+                    "note": "holes 1.9 mm x 6 mm deep into each piece (alignment_pin in printers/x.yaml)"}
+    assert B.dowel_pins(report, _printer(filament=1.75))["note"] == (
+        "holes 1.9 mm x 6 mm deep into each piece (alignment_pin in printers/x.yaml); cut from the printer's own filament")
+    assert B.dowel_pins(report, _printer(filament=2.85))["note"] == pins["note"]
+    assert B.dowel_pins(report, _printer(filament=0.0))["note"] == pins["note"]  # no filament diameter
+    none = _printer()
+    none.filament_diameter = None
+    assert B.dowel_pins(report, none)["note"] == pins["note"]
+    assert B.dowel_pins({"parts": {"a": {"pins": []}, "b": {}}}, _printer()) is None
+    assert B.dowel_drills(_printer()) == ("HSS twist drill 1.9 mm (DIN 338) for the pin holes; 4 mm H7 reamer for "
+                                          "the column's dowel holes", "1 each")
+
+
+def _piece(t, g, orientation, gcode=None):
+    pc = {"estimate": {"print_time_s": t, "material_g": g}, "orientation": orientation}
+    if gcode is not None:
+        pc["gcode"] = {"estimates": gcode}
+    return pc
+
+
+def test_printed_rows_take_the_slicers_figures_only_when_every_piece_has_them():
+    recipes = {"plate": _part("plate"), "jig": _part("jig", in_rig=False)}
+    rig = _rig([], 1, recipes)
+    report = {"parts": {
+        "plate": {"quantity": 2, "process": "FDM", "pieces": [
+            _piece(100.0, 5.0, "flat", {"print_time_s": 1000.0, "filament_g": 50.0}),
+            _piece(200.0, 7.0, "upright", {"print_time_s": 3000.0, "filament_g": None})]},
+        "jig": {"quantity": 1, "process": "FDM", "pieces": [
+            _piece(100.0, 5.0, "flat", {"print_time_s": 1000.0, "filament_g": 50.0}), _piece(200.0, 7.0, "flat")]},
+        "extra": {"quantity": 3, "process": "laser", "plate_thickness_mm": 3.0, "outline_size_mm": (120.04, 80.26)},
+        "broken": {"error": "too big"}}}
+    report["parts"]["plain"] = {"quantity": 1, "process": "FDM", "pieces": [{**_piece(5.0, 1.0, "flat"), "gcode": {}}]}
+    first = {"parts": {"broken": report["parts"]["broken"], "plate": report["parts"]["plate"]}}
+    assert [r["part"] for r in B.printed(rig, first)] == ["broken", "plate"]  # an error row, then the others
+    plate, jig, extra, broken, plain = B.printed(rig, report)
+    assert plain["source"] == "rigcad estimate" and plain["time_s"] == 5.0  # G-code without estimates
+    # sliced: the slicer's times and grams (the estimate's grams where the slicer gave none), times quantity
+    assert plate == {"part": "plate", "use": "rig", "quantity": 2, "process": "FDM", "pieces": 2,
+                     "time_s": 8000.0, "material_g": 114.0, "source": "slicer", "note": "flat, upright"}
+    # one piece without G-code: every figure is rigcad's estimate
+    assert jig == {"part": "jig", "use": "tool", "quantity": 1, "process": "FDM", "pieces": 2,
+                   "time_s": 300.0, "material_g": 12.0, "source": "rigcad estimate", "note": "flat"}
+    assert extra == {"part": "extra", "use": "tool", "quantity": 3, "process": "laser", "pieces": 0, "time_s": None,
+                     "material_g": None, "source": None,
+                     "note": "3 mm plate, outline 120.0 x 80.3 mm (fab outlines/extra.dxf, .svg)"}
+    assert broken == {"part": "broken", "use": "tool", "quantity": None, "process": "not printable", "note": "too big"}
+    report["parts"]["plate"]["pieces"][1]["gcode"]["estimates"]["print_time_s"] = 0.0  # no time: not sliced
+    assert B.printed(rig, report)[0]["source"] == "rigcad estimate"
+    assert B.printed(rig, report)[0]["time_s"] == 600.0
+
+
+@dataclass(frozen=True)
+class Camera:
+    focal: float = field(default=12.5, metadata={"spec": SimpleNamespace(kind="length", doc="lens focal length")})
+    fov: float = field(default=0.5, metadata={"spec": SimpleNamespace(kind="angle", doc="Assumed field of view")})
+    resolution: tuple = field(default=(1920, 1080), metadata={"spec": SimpleNamespace(kind="pixels", doc=None)})
+    name: str | None = field(default=None, metadata={"spec": SimpleNamespace(kind="text", doc="")})
+    bands: tuple = field(default=(1, 2), metadata={})
+    model: str = "X-1"
+    mount_thread: str = "M6"
+
+
+def test_purchased_rows_describe_every_field_with_its_unit():
+    asked = []
+
+    def where(section, key):
+        asked.append((section, key))
+        return "p.yaml:3" if section == "camera" else None
+
+    profile = SimpleNamespace(camera=Camera(), lens=Camera(focal=1234.5678, name="L"), projector=None, where=where)
+    rows = B.purchased(SimpleNamespace(profile=profile))
+    fov = f"fov {0.5 * 180 / math.pi:.4g} deg (assumed)"
+    assert fov == "fov 28.65 deg (assumed)"
+    assert rows == [
+        {"item": "camera", "quantity": 1, "source": "p.yaml:3",
+         "spec": f"focal 12.5 mm; {fov}; resolution 1920 x 1080 px; bands [1, 2]; model X-1; mount thread M6"},
+        {"item": "lens", "quantity": 1, "source": "default",
+         "spec": f"focal 1235 mm; {fov}; resolution 1920 x 1080 px; name L; bands [1, 2]; model X-1; mount thread M6"}]
+    assert asked == [("camera", "focal"), ("lens", "focal")]
+    profile.beam_splitter = profile.splitter = profile.projector = Camera()
+    assert [r["item"] for r in B.purchased(SimpleNamespace(profile=profile))] == [
+        "projector", "camera", "beam splitter", "splitter", "lens"]
+
+
+def test_the_bill_sums_the_coating_by_layer_and_measures_each_mirror():
+    layers = [("base", 0.1), ("top", 0.05)]
+    a, b = Segment((10.0, 0.0), (10.0, 20.0)), Segment((5.0, 0.0), (5.0, 4.0))
+    rig = _rig(layers, 2.0, {"cup": _part("cup", mirrors=(("inner", a),)), "lid": _part("lid", mirrors=(("top", b),))})
+    rig.profile.where = lambda *k: None
+    report = {"parts": {"cup": {"quantity": 1, "process": "FDM", "pieces": [_piece(10.0, 1.0, "flat")]}},
+              "totals": {"time_s": 10.0}}
+    pinned = {"parts": {"cup": {**report["parts"]["cup"], "pins": [1, 2]}}}
+    assert B.bill(rig, pinned, _printer())["pins"] == B.dowel_pins(pinned, _printer()) != None  # noqa: E711
+    doc = B.bill(rig, report, _printer())
+    coats = B.coating_rows(rig)
+    assert doc["coating_by_mirror"] == [c.__dict__ for c in coats]
+    for name, t in layers:
+        mine = [c for c in coats if c.layer == name]
+        assert doc["coating"][[r["layer"] for r in doc["coating"]].index(name)] == {
+            "layer": name, "thickness_mm": t, "film_cm3": pytest.approx(sum(c.film_cm3 for c in mine), rel=1e-12),
+            "to_buy_cm3": pytest.approx(sum(c.to_buy_cm3 for c in mine), rel=1e-12),
+            "area_mm2": pytest.approx(sum(c.area_mm2 for c in mine), rel=1e-12)}
+    assert [r["layer"] for r in doc["coating"]] == ["base", "top"]
+    assert doc["mirrors"] == [{"mirror": "inner", "part": "cup", "design_area_mm2": pytest.approx(400 * math.pi)},
+                              {"mirror": "top", "part": "lid", "design_area_mm2": pytest.approx(40 * math.pi)}]
+    assert doc["coating_margin"] == 2.0 and doc["totals"] == {"time_s": 10.0} and doc["pins"] is None
+    assert doc["printed"] == B.printed(rig, report) and doc["fasteners"] == [] and doc["purchased"] == []
+    assert B.bill(rig, {"parts": {}}, _printer())["totals"] == {}
+
+
+def test_feeler_gauge_names_the_leaves_the_gaps_need():
+    assert B.feeler_gauge([0.0449, 0.02, 0.0151, 0.046, 0.3, 0.3001]) == (
+        "Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: 0.02, 0.04, 0.05, 0.30 mm", "1")
+    assert B.feeler_gauge([0.031, 0.032]) == (  # one 0.03 leaf for both
+        "Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: 0.03 mm", "1")
+    assert B.feeler_gauge([0.019999]) == (
+        "Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: none (check against the light)", "1")
