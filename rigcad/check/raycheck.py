@@ -296,7 +296,7 @@ def _pixel_grid(optics: Optics, design: DesignMap, profile: Profile, projector) 
         "pixels_on_paraboloid": int(np.sum(gt.status != 1)),
         "pixels_reaching_sample": int(gt.ok.sum()),
         "pixels_lost": {STATUS_NAMES[k]: int(np.sum(gt.status == k)) for k in STATUS_NAMES if k > 1},
-        "max_angle_error_rad": float(err.max()) if err.size else float("nan"),
+        "max_angle_error_rad": float(np.nanmax(err)) if np.isfinite(err).any() else float("nan"),
         "theta_min_deg": float(np.nanmin(theta_map)), "theta_max_deg": float(np.nanmax(theta_map)),
         "max_spot_radius_mm": float(np.nanmax(gt.miss)),
     }
