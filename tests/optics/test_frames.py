@@ -166,13 +166,14 @@ GEO = SimpleNamespace(cop_z=427.5, vertex_z=157.5)
                                                 ("dome", 0.0)])
 def test_each_component_tilts_about_its_own_pivot(component, pivot_z):
     tilt, offset = 0.01, (0.3, -0.1, 0.2)
-    pose = Misalignment.none().with_(component, offset, tilt, (1.0, 0.0, 0.0)).pose(component, GEO)
     pivot = np.array([0.0, 0.0, pivot_z])
-    assert np.max(np.abs(pose.rotation - _rot_x(tilt))) < TOL
-    hand = pivot + np.array(offset) - _rot_x(tilt) @ pivot
-    assert np.max(np.abs(pose.translation - hand)) < 1e-12 * 500
-    # and the pivot, seen from the global frame, moved by the offset alone
-    assert np.max(np.abs(pose.globalize_points(pivot[None])[0] - (pivot + offset))) < 1e-12 * 500
+    for axis, hand_rot in (((1.0, 0.0, 0.0), _rot_x), ((0.0, 1.0, 0.0), _rot_y)):
+        pose = Misalignment.none().with_(component, offset, tilt, axis).pose(component, GEO)
+        assert np.max(np.abs(pose.rotation - hand_rot(tilt))) < TOL
+        hand = pivot + np.array(offset) - hand_rot(tilt) @ pivot
+        assert np.max(np.abs(pose.translation - hand)) < 1e-12 * 500
+        # and the pivot, seen from the global frame, moved by the offset alone
+        assert np.max(np.abs(pose.globalize_points(pivot[None])[0] - (pivot + offset))) < 1e-12 * 500
 
 
 def test_a_component_left_alone_stands_at_the_identity():
@@ -181,6 +182,9 @@ def test_a_component_left_alone_stands_at_the_identity():
         assert m.pose(c, GEO).is_identity
     # an offset alone, or a tilt alone, moves it
     assert not Misalignment.none().with_("camera", (0.0, 0.0, 0.5)).pose("camera", GEO).is_identity
+    # a tilt of exactly 1 rad with no offset is a tilt too
+    one = Misalignment.none().with_("paraboloid", tilt=1.0).pose("paraboloid", GEO)
+    assert np.max(np.abs(one.rotation - _rot_y(1.0))) < TOL
     tilted = Misalignment.none().with_("camera", tilt=0.001).pose("camera", GEO)
     assert np.max(np.abs(tilted.rotation - _rot_y(0.001))) < TOL
     assert np.max(np.abs(tilted.translation - (GEO.cop_z * np.array([0, 0, 1.0]) - _rot_y(0.001) @ [0, 0, GEO.cop_z])))\

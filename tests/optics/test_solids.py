@@ -38,8 +38,10 @@ def test_slab_with_a_zero_direction_component_inside_or_outside_its_slab():
     lo, hi = slab(o, d, LO, HI)
     assert np.array_equal(lo, [4.0, math.inf, math.inf, 4.0])
     assert np.array_equal(hi, [8.0, -math.inf, -math.inf, 8.0])
-    # a ray that does not move at all: everywhere or nowhere
-    lo, hi = slab(np.array([[0.0, 3.0, 11.0], [0.0, 3.0, 13.0]]), np.zeros((2, 3)), LO, HI)
+    # a ray that does not move at all: everywhere or nowhere; no floating-point warning for the
+    # zero components (0 / 0 and x / 0 are decided without dividing)
+    with np.errstate(all="raise"):
+        lo, hi = slab(np.array([[0.0, 3.0, 11.0], [0.0, 3.0, 13.0]]), np.zeros((2, 3)), LO, HI)
     assert np.array_equal(lo, [-math.inf, math.inf]) and np.array_equal(hi, [math.inf, -math.inf])
 
 
@@ -132,6 +134,31 @@ def test_cylinder_default_centre_is_the_axis():
     o, d = _rays(((-7.0, 0.0, 2.0), (1.0, 0.0, 0.0)))
     lo, hi = z_cylinder(o, d, R, Z0, Z1)
     assert np.array_equal(lo, [5.0]) and np.array_equal(hi, [9.0])
+    lo, hi = z_cylinder(o, d, 3.0, Z0, Z1)  # radius 3: x from -3 to 3
+    assert np.array_equal(lo, [4.0]) and np.array_equal(hi, [10.0])
+
+
+def test_cylinder_vertical_rays_just_outside_the_radius_miss_without_a_warning():
+    # 2.1 mm and 2.2 mm from the axis of a 2 mm cylinder: x^2 + y^2 - r^2 is 0.41 and 0.84 mm^2
+    o, d = _rays(((3.0 + 2.1, -1.0, 9.0), (0.0, 0.0, -1.0)), ((3.0, -1.0 + 2.2, 9.0), (0.0, 0.0, 1.0)),
+                 ((3.0, -1.0, 9.0), (1.0, 0.0, 0.0)))  # level, above the cylinder
+    with np.errstate(all="raise"):  # the zero components are decided without dividing
+        lo, hi = z_cylinder(o, d, R, Z0, Z1, C)
+    assert np.array_equal(lo, [math.inf, math.inf, math.inf])
+    assert np.array_equal(hi, [-math.inf, -math.inf, -math.inf])
+
+
+def test_segments_grazing_an_edge_or_the_wall_count_as_hits():
+    # the closed solids: a segment touching the box's edge x = -1, y = 2 (t = 0.5 exactly), or the
+    # cylinder's wall tangentially (t = 0.625 exactly), enters and leaves at one t
+    a, b = np.array([[-3.0, 4.0, 11.0]]), np.array([[1.0, 0.0, 11.0]])
+    enter, leave = slab(a, b - a, LO, HI)
+    assert enter[0] == leave[0] == 0.5
+    assert segments_hit_box(a, b, LO, HI).tolist() == [True]
+    a, b = np.array([[-7.0, 1.0, 2.0]]), np.array([[9.0, 1.0, 2.0]])
+    enter, leave = z_cylinder(a, b - a, R, Z0, Z1, C)
+    assert enter[0] == leave[0] == 0.625
+    assert segments_hit_cylinder(a, b, R, Z0, Z1, C).tolist() == [True]
 
 
 def _inside_cyl(p, margin):
