@@ -35,7 +35,8 @@ def test_slab_with_a_zero_direction_component_inside_or_outside_its_slab():
                  ((-5.0, 6.0, 11.0), (1.0, 0.0, 0.0)),   # y above the box: never in
                  ((-5.0, 1.0, 11.0), (1.0, 0.0, 0.0)),   # y below the box: never in
                  ((-5.0, 2.0, 12.0), (1.0, 0.0, 0.0)))   # on the faces y = lo, z = hi: in (closed box)
-    lo, hi = slab(o, d, LO, HI)
+    with np.errstate(all="raise"):  # x / 0 and, on the faces, 0 / 0 are decided without a warning
+        lo, hi = slab(o, d, LO, HI)
     assert np.array_equal(lo, [4.0, math.inf, math.inf, 4.0])
     assert np.array_equal(hi, [8.0, -math.inf, -math.inf, 8.0])
     # a ray that does not move at all: everywhere or nowhere; no floating-point warning for the
