@@ -173,7 +173,8 @@ def _check_unchanged(group: str, work: Path) -> None:
 def retest_survivors(group: str, max_children: int) -> dict:
     """Test again, against the committed tests (HEAD), only the mutants of ``group`` that survived
     its last run (kept in build/mutate/<group>/): how the tests added for them are checked without
-    re-running every mutant. The modules must be unchanged since that run."""
+    re-running every mutant. The modules must be unchanged since that run. Each survivor meets
+    every test of the files that reach its function (see _widen_stats)."""
     work = ROOT / "build" / "mutate" / group
     modules, tests = GROUPS[group]
     names = []
@@ -183,6 +184,7 @@ def retest_survivors(group: str, max_children: int) -> dict:
         # coverage of the new tests before it runs the mutants)
         names += [k for k, v in meta["exit_code_by_key"].items() if v in SURVIVED or v in NO_TESTS]
     _check_unchanged(group, work)
+    _widen_stats(work)
     head = _head()  # the tests' commit, named before a commit made during the run can move HEAD
     archive = subprocess.run(["git", "-C", str(ROOT), "archive", head, "tests"], capture_output=True,
                              check=True).stdout
@@ -199,6 +201,24 @@ def retest_survivors(group: str, max_children: int) -> dict:
     done = work / "seconds.txt"
     total = (float(done.read_text()) if done.exists() else 0.0) + time.monotonic() - t0
     return collect(group, work, total)
+
+
+def _widen_stats(work: Path) -> None:
+    """Give each function every test of the test files its tests are in. mutmut gives a function
+    the tests during which it ran: one run by a module-scoped fixture (a rig, a design, a mesh
+    built once per file) belongs to the first test of the file alone, and its mutants would meet
+    no other test. The retest then runs them against the whole file (``-x`` stops at the first
+    failure, so a killed mutant costs little more)."""
+    path = work / "mutants" / "mutmut-stats.json"
+    stats = json.loads(path.read_text())
+    by_file: dict[str, list[str]] = {}
+    for test in stats["duration_by_test"]:
+        by_file.setdefault(test.split("::")[0], []).append(test)
+    tests_of = stats["tests_by_mangled_function_name"]
+    for function, tests in tests_of.items():
+        files = {t.split("::")[0] for t in tests}
+        tests_of[function] = sorted({*tests, *(t for f in files for t in by_file.get(f, []))})
+    path.write_text(json.dumps(stats))
 
 
 def _commit_of(work: Path) -> str:
