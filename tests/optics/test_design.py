@@ -290,3 +290,217 @@ def test_no_misalignment_offsets_and_tilts_nothing_about_the_meridional_normal()
     assert set(m.offsets) == set(m.tilts) == set(m.axes) == set(COMPONENTS)
     for c in COMPONENTS:
         assert m.offsets[c] == (0.0, 0.0, 0.0) and m.tilts[c] == 0.0 and m.axes[c] == (0.0, 1.0, 0.0), c
+
+
+# --- the design stage's helpers against figures written out by hand ---------------------------------
+
+def test_cop_bundle_radius_runs_from_the_rim_to_the_lens_aperture():
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import cop_bundle_radius
+
+    geo = SimpleNamespace(cop_at_infinity=False, rim_z=135.0, cop_z=435.0, rim_radius=16.0)
+    assert cop_bundle_radius(geo, 135.0, 6.0) == 16.0
+    assert cop_bundle_radius(geo, 435.0, 6.0) == 3.0  # half the aperture at the COP
+    assert cop_bundle_radius(geo, 235.0, 6.0) == pytest.approx(16.0 * 2 / 3 + 3.0 / 3, rel=1e-15)
+    far = SimpleNamespace(cop_at_infinity=True, rim_z=135.0, cop_z=math.inf, rim_radius=16.0)
+    assert cop_bundle_radius(far, 300.0, 6.0) == 16.0
+
+
+@pytest.mark.parametrize("count, half", [(8, 4), (9, 4), (1, 1)])
+def test_chief_rays_aim_at_the_cells_of_the_useful_annulus_on_both_sides(table31_geometry, count, half):
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import chief_rays
+    from rigcad.optics.paraboloid import Paraboloid
+
+    g = table31_geometry
+    para = Paraboloid(g.focal_length, g.vertex_z, g.rim_radius)
+    dome = SimpleNamespace(occlusion_s=2.0)
+    origins, dirs = chief_rays(g, para, dome, count)
+    cell = (g.rim_radius - 2.0) / half
+    x = 2.0 + cell * (np.arange(half) + 0.5)
+    x = np.concatenate([-x[::-1], x])
+    P = np.column_stack([x, g.vertex_z - x * x / (4 * g.focal_length)])
+    C = np.array([0.0, g.cop_z])
+    assert origins.shape == (2 * half, 2) and np.array_equal(origins, np.tile(C, (2 * half, 1)))
+    want = (P - C) / np.linalg.norm(P - C, axis=1, keepdims=True)
+    assert np.max(np.abs(dirs - want)) < 1e-15 * 10
+
+
+def test_chief_rays_from_a_cop_at_infinity_come_straight_down(table31_geometry):
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import chief_rays
+    from rigcad.optics.paraboloid import Paraboloid
+
+    g = replace(table31_geometry, cop_z=math.inf)
+    para = Paraboloid(g.focal_length, g.vertex_z, g.rim_radius)
+    origins, dirs = chief_rays(g, para, SimpleNamespace(occlusion_s=2.0), 4)
+    cell = (g.rim_radius - 2.0) / 2
+    x = np.array([-2.0 - 1.5 * cell, -2.0 - 0.5 * cell, 2.0 + 0.5 * cell, 2.0 + 1.5 * cell])
+    assert np.max(np.abs(origins[:, 0] - x)) < 1e-14 * 20 and np.all(origins[:, 1] == g.vertex_z + 1.0)
+    assert np.array_equal(dirs, np.tile([0.0, -1.0], (4, 1)))
+
+
+def test_profile_table_columns_are_the_traced_geometry(rig):
+    from rigcad.optics.design import profile_table
+
+    g, dome = rig.geometry, rig.dome
+    tab = profile_table(g, dome)
+    s = dome.s
+    z = g.vertex_z - s * s / (4 * g.focal_length)
+    assert np.array_equal(tab["paraboloid_r_mm"], s)
+    assert np.max(np.abs(tab["paraboloid_z_mm"] - z)) < 1e-12 * g.vertex_z
+    assert np.array_equal(tab["dome_r_mm"], dome.points[:, 0]) and np.array_equal(tab["dome_z_mm"], dome.points[:, 1])
+    assert np.array_equal(tab["reflected_distance_mm"], dome.t)
+    assert np.max(np.abs(tab["incidence_theta_deg"] - np.degrees(dome.theta))) < 1e-12
+    alpha = np.arctan2(s, g.cop_z - z)
+    assert np.max(np.abs(tab["cop_angle_deg"] - np.degrees(alpha))) < 1e-12
+    assert np.max(np.abs(tab["projector_pixel"] - 1792.0 * np.tan(alpha))) < 1e-9
+    # COP -> paraboloid -> dome -> O: the same optical path on every row (the equal-path dome)
+    path = np.hypot(s, g.cop_z - z) + dome.t + np.linalg.norm(dome.points, axis=1)
+    assert np.max(np.abs(tab["optical_path_mm"] - path)) < 1e-9
+    assert np.max(np.abs(tab["optical_path_mm"] - dome.path_length)) < 1e-6
+
+
+def test_a_far_cop_profile_table_has_no_pixels_and_a_vertical_source(far_design):
+    from rigcad.optics.design import profile_table
+
+    g, dome = far_design.geometry, far_design.dome
+    tab = profile_table(g, dome)
+    z = g.vertex_z - dome.s ** 2 / (4 * g.focal_length)
+    assert np.all(np.isnan(tab["projector_pixel"])) and np.array_equal(tab["cop_angle_deg"], np.zeros_like(dome.s))
+    # from the plane of the vertex straight down to the paraboloid, then as above
+    path = (g.vertex_z - z) + dome.t + np.linalg.norm(dome.points, axis=1)
+    assert np.max(np.abs(tab["optical_path_mm"] - path)) < 1e-9
+
+
+@pytest.fixture(scope="module")
+def far_design(tmp_path_factory, table31_text):
+    path = tmp_path_factory.mktemp("far") / "far.yaml"
+    path.write_text(table31_text.replace("27 cm", "inf"))
+    return Rig.from_profile(load_profile(path))
+
+
+def test_stat_ignores_nan_and_has_none_of_nothing():
+    from rigcad.optics.design import _stat
+
+    assert _stat(np.array([3.0, np.nan, -1.0, 2.0])) == {"min": -1.0, "max": 3.0}
+    empty = _stat(np.array([np.nan, np.nan]))
+    assert set(empty) == {"min", "max"} and math.isnan(empty["min"]) and math.isnan(empty["max"])
+    assert isinstance(_stat(np.array([1, 2]))["min"], float)
+
+
+def _hand_trace(status, miss, path):
+    from rigcad.optics.trace2d import Trace
+
+    n = len(status)
+    z = np.zeros((n, 2))
+    return Trace(np.array(status), z, z, np.array(miss, float), np.zeros(n), np.zeros(n), np.array(path, float))
+
+
+def test_convergence_figures_of_a_hand_trace():
+    from rigcad.optics.design import _convergence
+    from rigcad.optics.trace2d import STATUS_NAMES
+
+    codes = {name: code for code, name in STATUS_NAMES.items()}
+    tr = _hand_trace([0, 0, codes["missed_dome"], codes["escaped"], 0, codes["escaped"]],
+                     [0.1, -0.2, 5.0, 7.0, 0.2, 9.0], np.zeros(6))
+    c = _convergence(tr)
+    assert c["rays"] == 6 and c["rays_ok"] == 3
+    assert c["rays_lost"] == {"missed_paraboloid": 0, "missed_dome": 1, "occluded_by_paraboloid": 0, "escaped": 2}
+    assert c["rms_miss_mm"] == pytest.approx(math.sqrt((0.01 + 0.04 + 0.04) / 3), rel=1e-14)
+    assert c["max_miss_mm"] == pytest.approx(0.2, rel=1e-15)
+    assert c["note"].startswith("miss = distance from O to each returning ray")
+    lost = _convergence(_hand_trace([codes["escaped"]] * 2, [1.0, 2.0], [0.0, 0.0]))
+    assert lost["rays_ok"] == 0 and lost["rms_miss_mm"] is None and lost["max_miss_mm"] is None
+
+
+def test_paths_of_a_hand_design():
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import _paths
+
+    dome = SimpleNamespace(path_length=50.0, t=np.array([10.0, 12.0]), points=np.array([[3.0, 4.0], [6.0, 8.0]]))
+    table = {"optical_path_mm": np.array([50.0, 49.0])}
+    tr = _hand_trace([0, 0, 1], [0.0, 0.0, 0.0], [50.0, 50.5, 99.0])
+    p = _paths(dome, table, tr)
+    assert p["optical_path_mm"] == 50.0
+    assert p["chief_ray_path_spread_mm"] == pytest.approx(0.5, rel=1e-15)  # the lost ray not counted
+    assert p["cop_to_paraboloid_mm"] == {"min": 27.0, "max": 35.0}  # 50 - 10 - 5, 49 - 12 - 10
+    assert p["paraboloid_to_dome_mm"] == {"min": 10.0, "max": 12.0}
+    assert p["dome_to_sample_mm"] == {"min": 5.0, "max": 10.0}
+    assert _paths(dome, table, _hand_trace([1, 1], [0.0, 0.0], [1.0, 2.0]))["chief_ray_path_spread_mm"] is None
+
+
+def test_measurable_range_against_the_targets():
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import _measurable_range
+    from rigcad.units import DEG
+
+    def rng(theta_lo, theta_hi):
+        profile = SimpleNamespace(targets=SimpleNamespace(theta_min=9 * DEG, theta_max=90 * DEG))
+        dome = SimpleNamespace(theta=np.array([theta_hi, 0.5 * (theta_lo + theta_hi), theta_lo]))
+        return _measurable_range(profile, SimpleNamespace(occlusion_theta=7 * DEG), dome)
+
+    r = rng(8 * DEG, 90 * DEG)
+    assert r["theta_min_deg"] == pytest.approx(8.0, rel=1e-14) and r["theta_max_deg"] == pytest.approx(90.0, rel=1e-14)
+    assert r["occlusion_theta_deg"] == pytest.approx(7.0, rel=1e-14)
+    assert r["target_theta_min_deg"] == pytest.approx(9.0, rel=1e-14)
+    assert r["target_theta_max_deg"] == pytest.approx(90.0, rel=1e-14)
+    assert r["targets_met"] is True
+    # grazing to float precision reaches 90 deg: 5e-10 rad short does, 2e-9 rad short does not
+    assert rng(8 * DEG, 90 * DEG - 5e-10)["targets_met"] and not rng(8 * DEG, 90 * DEG - 2e-9)["targets_met"]
+    # the smallest angle must reach the target's: 1e-13 rad above it does, 1e-10 rad does not
+    assert rng(9 * DEG + 1e-13, 90 * DEG)["targets_met"] and not rng(9 * DEG + 1e-10, 90 * DEG)["targets_met"]
+    assert not rng(10 * DEG, 90 * DEG)["targets_met"] and not rng(8 * DEG, 80 * DEG)["targets_met"]
+
+
+def test_pixels_per_degree_of_a_hand_table():
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import _pixels
+    from rigcad.units import DEG
+
+    theta_deg = np.linspace(10.0, 40.0, 31)  # 1 deg apart
+    dome = SimpleNamespace(theta=theta_deg * DEG)
+    profile = SimpleNamespace(projector=SimpleNamespace(resolution=(1024, 768)))
+    geo = SimpleNamespace(cop_at_infinity=False, projector_focal_px=1792.0, pixels_vertex_to_rim=100.25)
+    # pixel = 0.1 theta^2 (theta in deg): d pixel / d theta = 0.2 theta, central differences exact
+    # inside, one-sided at the ends (0.2 theta_0 + 0.1, 0.2 theta_n - 0.1)
+    p = _pixels(profile, geo, dome, {"projector_pixel": 0.1 * theta_deg ** 2})
+    assert p["projector_resolution"] == [1024, 768] and p["projector_focal_px"] == 1792.0
+    assert p["vertex_to_rim_px"] == 100.25
+    assert p["useful_px"] == pytest.approx(0.1 * (1600 - 100), rel=1e-13)
+    assert p["px_per_deg_mean"] == pytest.approx(150.0 / 30.0, rel=1e-13)
+    assert p["px_per_deg_min"] == pytest.approx(2.1, rel=1e-12) and p["px_per_deg_max"] == pytest.approx(7.9, rel=1e-12)
+    # a falling pixel count counts by its size
+    p = _pixels(profile, geo, dome, {"projector_pixel": -3.0 * theta_deg})
+    assert p["px_per_deg_min"] == pytest.approx(3.0, rel=1e-12) and p["px_per_deg_max"] == pytest.approx(3.0, rel=1e-12)
+    far = _pixels(profile, SimpleNamespace(cop_at_infinity=True, projector_focal_px=1792.0, pixels_vertex_to_rim=math.nan),
+                  dome, {"projector_pixel": np.full(31, np.nan)})
+    assert all(far[k] is None for k in ("vertex_to_rim_px", "useful_px", "px_per_deg_mean", "px_per_deg_min",
+                                        "px_per_deg_max"))
+    assert far["projector_resolution"] == [1024, 768]
+
+
+def test_a_dome_tolerance_no_rows_can_meet_is_refused_with_what_to_ask(write_profile, table31_text):
+    from rigcad.errors import ProfileError
+    from rigcad.optics.design import CURVE_MISS_RTOL, TOLERANCE_SHARE
+    from rigcad.optics.dome import start
+    from rigcad.profile import derive
+
+    path = write_profile(table31_text + "dome:\n  method: dop853\n  tolerance: 1e-6 mm\n")
+    profile = load_profile(path)
+    with pytest.raises(ProfileError) as e:
+        Rig.from_profile(profile)
+    L = start(derive(profile)).path_length  # the rim ray's path, COP to O
+    need = TOLERANCE_SHARE * CURVE_MISS_RTOL * L
+    assert e.value.message == (
+        f"dome.tolerance = 1e-06 mm is looser than this rig's dome can be: its curve must return every chief ray "
+        f"to O within {CURVE_MISS_RTOL:g} of the {L:.0f} mm optical path ({2 * need:.2g} mm); ask for a tolerance "
+        f"well below that, e.g. {need / 10:.1g} mm, or leave it unset")
+    assert e.value.where.endswith("p.yaml:9")  # the tolerance's line
