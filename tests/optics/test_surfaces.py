@@ -274,3 +274,63 @@ def test_a_straight_enough_curve_takes_one_chord(geo):
     # a chord error above the whole curve's sagitta: the two ends alone
     u = paraboloid_meridian(geo).chord_parameters(1e3)
     assert np.array_equal(u, [-geo.rim_radius, 0.0])
+
+
+def test_no_negative_zeros_and_the_same_bits_from_points_normals(geo):
+    # at the vertex (u = 0, r = -0.0) the normal's r is a negative zero before the + 0.0
+    m = paraboloid_meridian(geo)
+    u = np.array([-geo.rim_radius, -1.0, 0.0])
+    assert not np.any(np.signbit(m.normals(u)[:, 0])) and m.normals(u)[2, 0] == 0.0
+    pts, nrm = m._points_normals(u)
+    assert np.array_equal(np.signbit(pts), np.signbit(m.points(u)))  # the same bits, zeros' signs included
+    assert np.array_equal(pts, m.points(u)) and np.array_equal(nrm, m.normals(u))
+
+
+def test_arc_length_parameters_count_the_whole_curve(geo):
+    # a spacing that fits the arc 10.00001 times: 11 steps, though 10 fit all but its last 1e-6
+    m = paraboloid_meridian(geo)
+    spacing = _arc(geo, geo.rim_radius) / 10.00001
+    assert len(m.arc_length_parameters(spacing)) == 12
+
+
+def test_foot_points_beyond_an_end_are_that_end(geo):
+    m = paraboloid_meridian(geo)
+    # near the parabola past the rim (r = rim + 2) and past the vertex on the other side (r = -3),
+    # 0.1 mm in front: the half-meridian's nearest points are its ends
+    r = np.array([geo.rim_radius + 2.0, -3.0])
+    p, n, _ = _para(geo, r)
+    u = m.foot_points(p + 0.1 * n)
+    assert u[0] == -geo.rim_radius and u[1] == 0.0
+
+
+@pytest.mark.parametrize("kind", ["paraboloid", "dome"])
+def test_unsettled_foot_points_are_no_farther_than_the_nearest_sample(geo, dome, kind):
+    # far behind (see test_a_points_foot_parameter_does_not_depend_on_its_batch) Newton does not
+    # settle; the result is the nearer of the seed (the nearest of the samples) and the last iterate
+    m = (paraboloid_meridian(geo) if kind == "paraboloid" else dome_meridian(dome)).behind(COATING)
+    rng = np.random.default_rng(9)
+    far = _points(m, rng, 300, *FAR_BEHIND_MM[kind])
+    got = np.linalg.norm(far - m.points(m.foot_points(far)), axis=1)
+    samples = m.points(m.sample(20001))
+    nearest = np.array([np.min(np.linalg.norm(samples - q, axis=1)) for q in far])
+    assert np.all(got <= nearest * (1 + 1e-12))
+
+
+def test_dome_chord_parameters_meet_the_chord_error_and_no_more(dome):
+    m = dome_meridian(dome)
+    chord_error = 0.01
+    u = m.chord_parameters(chord_error)
+    assert u[0] == m.u_range[0] and u[-1] == m.u_range[1]
+    # the points needed: the integral of sqrt(k / 8e) |dp/du| du (curvature and tangents measured
+    # against central differences above)
+    need = quad(lambda v: math.sqrt(m.curvature(v)[0] / (8 * chord_error)) * np.linalg.norm(m.tangents(v)[0]),
+                *m.u_range, epsabs=1e-10, limit=200)[0]
+    assert math.ceil(need) <= len(u) - 1 <= math.ceil(need * 1.001)
+    t = np.linspace(0.0, 1.0, 200)
+    worst = 0.0
+    for a, b in zip(u[:-1], u[1:]):
+        p0, p1 = m.points(np.array([a, b]))
+        c = m.points(a + t * (b - a))
+        e = (p1 - p0) / np.linalg.norm(p1 - p0)
+        worst = max(worst, np.max(np.abs((c[:, 0] - p0[0]) * e[1] - (c[:, 1] - p0[1]) * e[0])))
+    assert 0.9 * chord_error < worst <= chord_error * (1 + 1e-3)
