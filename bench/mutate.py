@@ -176,15 +176,16 @@ def retest_survivors(group: str, max_children: int) -> dict:
     """Test again, against the committed tests (HEAD), only the mutants of ``group`` that survived
     its last run (kept in build/mutate/<group>/): how the tests added for them are checked without
     re-running every mutant. The modules must be unchanged since that run. Each survivor meets
-    every test of the files that reach its function (see _widen_stats)."""
+    every test of the files that reach its function (see _widen_stats). Mutants a stopped run left
+    unchecked are tested too."""
     work = ROOT / "build" / "mutate" / group
     modules, tests = GROUPS[group]
     names = []
     for module in modules:
         meta = json.loads((work / "mutants" / (module + ".meta")).read_text())
         # "no tests" too: new tests may reach a function none reached before (mutmut collects the
-        # coverage of the new tests before it runs the mutants)
-        names += [k for k, v in meta["exit_code_by_key"].items() if v in SURVIVED or v in NO_TESTS]
+        # coverage of the new tests before it runs the mutants); and those a stopped run left unchecked
+        names += [k for k, v in meta["exit_code_by_key"].items() if v in SURVIVED or v in NO_TESTS or v is None]
     _check_unchanged(group, work)
     _widen_stats(work)
     head = _head()  # the tests' commit, named before a commit made during the run can move HEAD
