@@ -504,3 +504,73 @@ def test_a_dome_tolerance_no_rows_can_meet_is_refused_with_what_to_ask(write_pro
         f"to O within {CURVE_MISS_RTOL:g} of the {L:.0f} mm optical path ({2 * need:.2g} mm); ask for a tolerance "
         f"well below that, e.g. {need / 10:.1g} mm, or leave it unset")
     assert e.value.where.endswith("p.yaml:9")  # the tolerance's line
+
+
+def test_the_report_is_the_stages_figures_under_their_keys(rig, design):
+    """run_design's report, key by key, against the figures it gathers (each checked elsewhere)."""
+    from rigcad.optics.design import chief_rays, cop_bundle_radius, profile_entry, profile_table, run_design
+    from rigcad.optics.misalignment import COMPONENT_OFFSETS, offsets_for
+
+    steps = []
+    d = run_design(rig, progress=steps.append)
+    assert steps == ["chief rays", "thin lens", "misalignment"]
+    r, dome, g, prof = d.report, rig.dome, rig.geometry, rig.profile
+    assert list(r) == ["profile", "frame", "paraboloid", "dome", "measurable_range", "envelope", "top_aperture",
+                       "paths", "pixels", "convergence", "thin_lens", "misalignment"]
+    assert r["profile"] == profile_entry(prof) and r["profile"]["name"] == "achutha2006"
+    assert r["frame"] == "meridional plane; sample point O at the origin; optical axis +z; lengths mm"
+    assert r["paraboloid"] == g.as_dict()
+    assert r["dome"] == {"method": "dop853", "kind": "smooth", "tolerance_mm": dome.tolerance, "points": len(dome.s),
+                         "error_estimate_mm": dome.error_estimate, "error_vs_equal_path_mm": dome.error_vs_equal_path,
+                         "stats": dome.stats, "start_r_mm": float(dome.points[0, 0]),
+                         "end_paraboloid_r_mm": dome.occlusion_s}
+    width, height = 2 * dome.points[:, 0].max(), dome.points[:, 1].max()
+    assert r["envelope"] == {"width_mm": width, "height_mm": height, "base_radius_mm": float(dome.points[0, 0]),
+                             "width_in": width / 25.4, "height_in": height / 25.4,
+                             "note": "mirror (design) surface; the printed part adds coating and wall"}
+    end = dome.points[-1]
+    bundle = cop_bundle_radius(g, float(end[1]), prof.projector.aperture)
+    assert r["top_aperture"] == {"radius_mm": float(end[0]), "z_mm": float(end[1]),
+                                 "projector_bundle_radius_mm": bundle, "clearance_mm": float(end[0] - bundle)}
+    assert r["thin_lens"] == d.thin_lens.summary()
+    m = r["misalignment"]
+    assert m["probe_mm"] == prof.misalignment.probe == 1.0
+    assert m["note"] == "camera and projector share the COP: a pinhole offset of either moves the same rays"
+    assert list(m["sensitivity"]) == list(COMPONENT_OFFSETS)
+    for name in COMPONENT_OFFSETS:
+        traced = misaligned_trace(d.paraboloid, d.curve, d.chief_origins, d.chief_dirs, offsets_for(name, 1.0))
+        assert m["sensitivity"][name] == convergence_error(traced, d.aligned)
+    mis = prof.misalignment
+    assert m["declared"] == {}  # the shipped profile declares no offsets
+    # the Design's fields
+    assert d.profile is prof and d.geometry is g and d.paraboloid is rig.paraboloid and d.dome is dome
+    assert d.curve is rig.curve
+    o, u = chief_rays(g, rig.paraboloid, dome, mis.rays)
+    assert np.array_equal(d.chief_origins, o) and np.array_equal(d.chief_dirs, u) and len(o) == 400
+    tab = profile_table(g, dome)
+    assert list(d.table) == list(tab) and all(np.array_equal(d.table[k], tab[k], equal_nan=True) for k in tab)
+    assert np.array_equal(d.aligned.miss, design.aligned.miss)
+
+
+def test_without_an_aperture_there_is_no_thin_lens_check(write_profile, table31_text):
+    d = _design_of(write_profile, table31_text + "projector:\n  aperture: 0 mm\n")
+    assert d.thin_lens is None and d.report["thin_lens"] is None
+    assert d.report["convergence"]["rays_ok"] == d.report["convergence"]["rays"]
+
+
+@pytest.mark.parametrize("declared, paths", [("camera_dx: 0.5 mm", {"camera_path"}),
+                                             ("projector_dz: 0.4 mm", {"projector_path"}),
+                                             ("dome_dx: 0.2 mm", {"camera_path", "projector_path"}),
+                                             ("paraboloid_dx: 0.3 mm", {"camera_path", "projector_path"})])
+def test_declared_offsets_are_traced_for_each_light_path(write_profile, table31_text, declared, paths):
+    d = _design_of(write_profile, table31_text + "misalignment:\n  rays: 41\n  " + declared + "\n")
+    mis = d.profile.misalignment
+    got = d.report["misalignment"]["declared"]
+    assert set(got) == paths
+    for device in ("projector", "camera"):
+        off = Offsets(cop_dx=getattr(mis, f"{device}_dx"), cop_dz=getattr(mis, f"{device}_dz"),
+                      paraboloid_dx=mis.paraboloid_dx, dome_dx=mis.dome_dx)
+        if device + "_path" in paths:
+            traced = misaligned_trace(d.paraboloid, d.curve, d.chief_origins, d.chief_dirs, off)
+            assert got[device + "_path"] == convergence_error(traced, d.aligned)
+            assert got[device + "_path"]["max_miss_mm"] > 1e-4  # a real offset misses O (a COP dz by ~1e-3 mm)
