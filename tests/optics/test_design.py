@@ -574,3 +574,41 @@ def test_declared_offsets_are_traced_for_each_light_path(write_profile, table31_
             traced = misaligned_trace(d.paraboloid, d.curve, d.chief_origins, d.chief_dirs, off)
             assert got[device + "_path"] == convergence_error(traced, d.aligned)
             assert got[device + "_path"]["max_miss_mm"] > 1e-4  # a real offset misses O (a COP dz by ~1e-3 mm)
+
+
+def test_dome_rows_double_until_the_curve_returns_every_chief_ray(write_profile, table31_text):
+    """converged_dome: 31 rows, then 61, then 121 (2n - 1: the old rows kept), the first whose
+    spline returns every chief ray to O within CURVE_MISS_RTOL of the optical path."""
+    from rigcad.optics.design import CURVE_MISS_RTOL, chief_rays
+    from rigcad.optics.dome import build_dome
+    from rigcad.optics.trace2d import DomeCurve, trace
+
+    rig = Rig.from_profile(load_profile(write_profile(table31_text + "dome:\n  table_rows: 31\n")))
+    assert len(rig.dome.s) == 121
+    g, dp = rig.geometry, rig.profile.dome
+    for rows, meets in ((121, True), (61, False)):
+        dome = build_dome(g, dp.method, tolerance=dp.tolerance, rows=rows)
+        o, u = chief_rays(g, rig.paraboloid, dome, rig.profile.misalignment.rays)
+        tr = trace(rig.paraboloid, DomeCurve.from_profile(dome), o, u)
+        assert (np.abs(tr.miss[tr.ok]).max() <= CURVE_MISS_RTOL * dome.path_length) == meets
+    # the thesis's polyline is taken as it is: no curve to check
+    euler = Rig.from_profile(load_profile(write_profile(table31_text + "dome:\n  method: euler\n  euler_steps: 300\n",
+                                                        "e")))
+    assert euler.dome.kind == "polyline" and euler.dome.method == "euler"
+
+
+def test_a_design_measuring_under_a_degree_is_refused(write_profile, table31_text):
+    # the rim 0.1 mm above the sample plane: theta from atan2(rim radius, 0.1 mm) = 89.65 deg to 90
+    g_ok = Rig.from_profile(load_profile(write_profile(table31_text.replace("13.5 cm", "0.3 mm"), "ok")))
+    assert 1.0 < np.degrees(np.ptp(g_ok.dome.theta)) < 1.1  # 0.3 mm: a degree and a bit, accepted
+    path = write_profile(table31_text.replace("13.5 cm", "0.1 mm"))
+    with pytest.raises(GeometryError) as e:
+        Rig.from_profile(load_profile(path))
+    from rigcad.profile import derive
+
+    lo = math.degrees(math.atan2(derive(load_profile(path)).rim_radius, 0.1))
+    assert e.value.message == (
+        f"the design measures only {90 - lo:.3g} deg of incidence angle (theta {lo:.2f}..90.00 deg): the "
+        "paraboloid's rim is too close to the sample plane or its rim ray too flat; raise layout.sample_to_rim or "
+        "lower paraboloid.tangent_angle")
+    assert e.value.where.endswith("p.yaml:6")  # layout.sample_to_rim's line
