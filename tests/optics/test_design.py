@@ -612,3 +612,62 @@ def test_a_design_measuring_under_a_degree_is_refused(write_profile, table31_tex
         "paraboloid's rim is too close to the sample plane or its rim ray too flat; raise layout.sample_to_rim or "
         "lower paraboloid.tangent_angle")
     assert e.value.where.endswith("p.yaml:6")  # layout.sample_to_rim's line
+
+
+def _traced_miss(rig, rows, tolerance=None):
+    """The largest miss (mm) of the chief rays against the spline of a dome of ``rows`` rows (the
+    profile's method; its tolerance unless ``tolerance`` is given) and the dome's optical path."""
+    from rigcad.optics.design import chief_rays
+    from rigcad.optics.dome import build_dome
+    from rigcad.optics.trace2d import DomeCurve, trace
+
+    g, dp = rig.geometry, rig.profile.dome
+    dome = build_dome(g, dp.method, tolerance=tolerance or dp.tolerance, rows=rows)
+    o, u = chief_rays(g, rig.paraboloid, dome, rig.profile.misalignment.rays)
+    tr = trace(rig.paraboloid, DomeCurve.from_profile(dome), o, u)
+    return float(np.abs(tr.miss[tr.ok]).max()), dome.path_length
+
+
+def test_rows_stop_at_the_cap_naming_the_miss(write_profile, table31_text, monkeypatch):
+    from rigcad.optics import design as design_module
+
+    monkeypatch.setattr(design_module, "MAX_ROWS", 61)  # 31 rows, then 61: the cap, still missing
+    path = write_profile(table31_text + "dome:\n  table_rows: 31\n")
+    with pytest.raises(GeometryError) as e:
+        Rig.from_profile(load_profile(path))
+    worst, _ = _traced_miss(Rig.from_profile(load_profile(write_profile(table31_text, "plain"))), 61)
+    assert e.value.message == (
+        f"the dome's curve still misses the sample point by {worst:.2g} mm with 61 rows: the design is too close to "
+        "degenerate to build reliably; change layout.sample_to_rim or paraboloid.tangent_angle")
+    assert e.value.where.endswith("p.yaml:8")  # dome.table_rows's line
+
+
+def test_a_tolerance_whose_rows_stall_is_refused_with_what_to_ask(write_profile, table31_text):
+    """dome.tolerance 1e-7 mm: the integrator's error, not the rows, limits the curve; doubling the
+    rows no longer halves the miss (measured here by tracing both row counts)."""
+    import re
+
+    from rigcad.errors import ProfileError
+    from rigcad.optics.design import CURVE_MISS_RTOL, STALL_RATIO
+
+    text = table31_text + "dome:\n  tolerance: 1e-7 mm\n  table_rows: 31\n"
+    with pytest.raises(ProfileError) as e:
+        Rig.from_profile(load_profile(write_profile(text)))
+    m = re.fullmatch(r"dome\.tolerance = 1e-07 mm leaves the dome's curve (\S+) mm off the sample point however many "
+                     r"rows it has \((\S+) mm with half as many\); the curve needs (\S+) mm: ask for dome\.tolerance "
+                     r"<= (\S+) mm, or leave it unset", e.value.message)
+    assert m, e.value.message
+    assert e.value.where.endswith("p.yaml:8")  # dome.tolerance's line
+    # the two row counts: 31 x 2^k - (2^k - 1) and half of it; find the pair by tracing
+    rig = Rig.from_profile(load_profile(write_profile(table31_text, "plain")))
+    rows, prev = 31, None
+    while True:
+        worst, path = _traced_miss(rig, rows, tolerance=1e-7)
+        need = CURVE_MISS_RTOL * path
+        if worst <= need:
+            raise AssertionError(f"{rows} rows meet the requirement: no stall")
+        if prev is not None and worst > STALL_RATIO * prev:
+            break
+        prev, rows = worst, 2 * rows - 1
+    assert m.group(1) == f"{worst:.2g}" and m.group(2) == f"{prev:.2g}" and m.group(3) == f"{need:.2g}"
+    assert m.group(4) == f"{1e-7 * need / worst / 2:.1g}"
