@@ -477,6 +477,10 @@ def test_pixels_per_degree_of_a_hand_table():
     assert p["useful_px"] == pytest.approx(0.1 * (1600 - 100), rel=1e-13)
     assert p["px_per_deg_mean"] == pytest.approx(150.0 / 30.0, rel=1e-13)
     assert p["px_per_deg_min"] == pytest.approx(2.1, rel=1e-12) and p["px_per_deg_max"] == pytest.approx(7.9, rel=1e-12)
+    # theta 0.5 deg apart: the derivative is per degree, not per row (0.2 theta, ends one-sided)
+    half = np.linspace(10.0, 25.0, 31)
+    p = _pixels(profile, geo, SimpleNamespace(theta=half * DEG), {"projector_pixel": 0.1 * half ** 2})
+    assert p["px_per_deg_min"] == pytest.approx(2.05, rel=1e-12) and p["px_per_deg_max"] == pytest.approx(4.95, rel=1e-12)
     # a falling pixel count counts by its size
     p = _pixels(profile, geo, dome, {"projector_pixel": -3.0 * theta_deg})
     assert p["px_per_deg_min"] == pytest.approx(3.0, rel=1e-12) and p["px_per_deg_max"] == pytest.approx(3.0, rel=1e-12)
@@ -595,6 +599,8 @@ def test_dome_rows_double_until_the_curve_returns_every_chief_ray(write_profile,
     euler = Rig.from_profile(load_profile(write_profile(table31_text + "dome:\n  method: euler\n  euler_steps: 300\n",
                                                         "e")))
     assert euler.dome.kind == "polyline" and euler.dome.method == "euler"
+    # the profile's 300 Euler steps across the rim radius, not the default 2000
+    assert euler.dome.stats["step_mm"] == pytest.approx(euler.geometry.rim_radius / 300, rel=1e-12)
 
 
 def test_a_design_measuring_under_a_degree_is_refused(write_profile, table31_text):
@@ -671,3 +677,11 @@ def test_a_tolerance_whose_rows_stall_is_refused_with_what_to_ask(write_profile,
         prev, rows = worst, 2 * rows - 1
     assert m.group(1) == f"{worst:.2g}" and m.group(2) == f"{prev:.2g}" and m.group(3) == f"{need:.2g}"
     assert m.group(4) == f"{1e-7 * need / worst / 2:.1g}"
+
+
+def test_an_rk45_tolerance_no_rows_can_meet_is_refused_before_integrating(write_profile, table31_text):
+    from rigcad.errors import ProfileError
+
+    path = write_profile(table31_text + "dome:\n  method: rk45\n  tolerance: 1e-6 mm\n")
+    with pytest.raises(ProfileError, match=r"dome\.tolerance = 1e-06 mm is looser than this rig's dome can be"):
+        Rig.from_profile(load_profile(path))
