@@ -685,3 +685,44 @@ def calibration_maps(phase: np.ndarray, slope_mrad: np.ndarray, planted_mrad: np
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()
     return _png(fig)
+
+
+def measurement_figure(sketch, what: str) -> bytes:
+    """One size to measure before printing (rigcad.profile.instruments.sketch): the instrument's
+    outline in its view (or the sketch's detail window), the dimension drawn between its two
+    features (an arrow at each end; a call-out when the two are one feature), labelled with its
+    assumed value; ``what`` (the features in words) under the title."""
+    import textwrap
+
+    fig, ax = plt.subplots(figsize=(4.4, 3.6))
+    for name, pts in sketch.outlines:
+        xy = np.asarray(pts, float)
+        dashed = name in ("centre line", "wall") or "(cut)" in name
+        ax.plot(xy[:, 0], xy[:, 1], "--" if dashed else "-", color="0.35", lw=1.0 if dashed else 1.4)
+    for _name, (cx, cy), r in sketch.circles:
+        t = np.linspace(0.0, 2 * np.pi, 97)
+        ax.plot(cx + r * np.cos(t), cy + r * np.sin(t), color="0.35", lw=1.2)
+    (x0, y0), (x1, y1) = sketch.dimension
+    red = {"color": "tab:red", "fontsize": 8, "bbox": {"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1}}
+    if (x0, y0) != (x1, y1):
+        ax.annotate("", (x1, y1), (x0, y0), arrowprops={"arrowstyle": "<->", "color": "tab:red", "lw": 1.6,
+                                                         "shrinkA": 0, "shrinkB": 0})
+    # the label off the dimension's middle, up and right in the axes, with a leader to it
+    ax.annotate(sketch.label, (0.5 * (x0 + x1), 0.5 * (y0 + y1)), xytext=(0.62, 0.9), textcoords="axes fraction",
+                ha="center", arrowprops={"arrowstyle": "-" if (x0, y0) != (x1, y1) else "->", "color": "tab:red",
+                                         "lw": 0.8}, **red)
+    ax.set_aspect("equal", adjustable="datalim")
+    if sketch.window is not None:
+        (wx0, wy0), (wx1, wy1) = sketch.window
+        ax.set_xlim(wx0, wx1)
+        ax.set_ylim(wy0, wy1)
+        ax.set_aspect("equal", adjustable="box")
+    else:
+        ax.margins(0.12)
+    ax.set_xlabel(sketch.axes[0], fontsize=7)
+    ax.set_ylabel(sketch.axes[1], fontsize=7)
+    ax.tick_params(labelsize=7)
+    detail = ", detail" if sketch.window is not None else ""
+    ax.set_title(f"{sketch.key} ({sketch.view} view{detail})\n" + "\n".join(textwrap.wrap(what, 58)), fontsize=8)
+    fig.tight_layout()
+    return _png(fig, dpi=100)

@@ -15,7 +15,7 @@ import manifold3d as m3d
 import numpy as np
 
 from rigcad.errors import ExportError
-from rigcad.parts.recipe import Box, Cylinder, Difference, Prism, Revolve, Solid, Translate, Union_
+from rigcad.parts.recipe import Box, Cylinder, Difference, HexPrism, Prism, Revolve, Solid, Translate, Union_
 
 
 #: Chord error (mm) of the meshes drawn for pictures (the part renders, the manual's views and
@@ -62,6 +62,9 @@ def build(solid: Solid, chord_error: float) -> m3d.Manifold:
     if isinstance(solid, Cylinder):
         n = segments_for(solid.radius, chord_error)
         return m3d.Manifold.cylinder(solid.height, solid.radius, solid.radius, n).translate(solid.base)
+    if isinstance(solid, HexPrism):  # flat faces: exact
+        cs = m3d.CrossSection([np.asarray(solid.corners(), float)])
+        return m3d.Manifold.extrude(cs, solid.height).translate((0.0, 0.0, solid.base[2]))
     if isinstance(solid, Union_):
         return m3d.Manifold.batch_boolean([build(s, chord_error) for s in solid.items], m3d.OpType.Add)
     if isinstance(solid, Difference):

@@ -78,7 +78,10 @@ class Fastener:
     face ``head`` (3,) mm, its ``axis`` (unit, from the head into the joint), its length under the
     head and shank radius, its head (radius, height), the tool that drives it, and what takes its
     thread: "nut" (then ``nut_tool`` and ``nut_dir``, the spanner's way out), "insert" (a heat-set
-    insert or nut trap in the part), "instrument" (the instrument's threaded socket) or "bench"."""
+    insert or nut trap in the part), "tapped" (a thread tapped in the part: a bought extrusion's
+    core), "instrument" (the instrument's threaded socket) or "bench". A bolt that goes up from under
+    a part standing on the bench is put in with the rig lifted onto blocks ``lift_mm`` high: its
+    head's way in and its tools may reach that far below the bench's top."""
 
     item: str
     head: tuple[float, float, float]
@@ -97,14 +100,20 @@ class Fastener:
     #: Parts drawn without the hole it goes through (an instrument's or a shim stack's plain box):
     #: its body may run through them.
     pierces: tuple[str, ...] = ()
+    lift_mm: float = 0.0
+    #: A countersunk head (ISO 10642, 90 deg): a cone from ``head_radius_mm`` at its top down to the
+    #: shank, not a cylinder.
+    countersunk: bool = False
 
     def solids(self):
-        """The fastener in place: its shank and head, and its nut when it has one."""
+        """The fastener in place: its shank and head, and its nut when it has one (a hexagon,
+        :func:`hex_prism`)."""
         a, h = np.asarray(self.axis, float), np.asarray(self.head, float)
+        under = max(self.head_radius_mm - self.head_height_mm, 0.0) if self.countersunk else None  # 45 deg flanks
         body = [cylinder(h, a, self.length_mm, self.shank_radius_mm),
-                cylinder(h - a * self.head_height_mm, a, self.head_height_mm, self.head_radius_mm)]
+                cylinder(h - a * self.head_height_mm, a, self.head_height_mm, self.head_radius_mm, under)]
         if self.thread_in == "nut":
-            body.append(cylinder(h + a * self.grip_mm, a, self.nut_size_mm[1], self.nut_size_mm[0]))
+            body.append(hex_prism(h + a * self.grip_mm, a, self.nut_size_mm[1], self.nut_size_mm[0]))
         return _union(body)
 
     def paths(self) -> list[tuple[str, object]]:
@@ -157,9 +166,9 @@ def manifold(vertices: np.ndarray, faces: np.ndarray):
     return m3.Manifold(mesh)
 
 
-def cylinder(start, axis, length: float, radius: float):
+def cylinder(start, axis, length: float, radius: float, radius_end: float | None = None):
     """A solid cylinder (32 sides, circumscribed: it covers the true one) from ``start`` (3,) mm
-    along the unit ``axis`` for ``length`` mm."""
+    along the unit ``axis`` for ``length`` mm; with ``radius_end``, a cone to that radius at the end."""
     import manifold3d as m3
 
     a = np.asarray(axis, float)
@@ -169,9 +178,31 @@ def cylinder(start, axis, length: float, radius: float):
     u /= np.linalg.norm(u)
     v = np.cross(a, u)
     r = radius / np.cos(np.pi / 32)
-    c = m3.Manifold.cylinder(length, r, r, 32)
+    c = m3.Manifold.cylinder(length, r, r if radius_end is None else radius_end / np.cos(np.pi / 32), 32)
     m = np.column_stack([u, v, a, np.asarray(start, float)])
     return c.transform(m)
+
+
+def hex_prism(start, axis, length: float, corner_radius: float, turn: float | None = None):
+    """A hexagonal prism (a nut: ISO 4032 across flats = corner_radius x sqrt 3) from ``start`` (3,) mm
+    along the unit ``axis`` for ``length`` mm, exact (no circumscribing), one corner ``turn`` rad round
+    from the rig's x axis (from y, for an x axis) as seen along the axis; by default as the printed
+    nut traps hold a nut (rigcad.parts.tower.NUT_TRAP_TURN)."""
+    import manifold3d as m3
+
+    if turn is None:
+        from rigcad.parts.tower import NUT_TRAP_TURN as turn
+
+    a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
+    ref = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u0 = ref - np.dot(ref, a) * a
+    u0 /= np.linalg.norm(u0)
+    v0 = np.cross(a, u0)
+    u = np.cos(turn) * u0 + np.sin(turn) * v0
+    v = np.cross(a, u)
+    c = m3.Manifold.cylinder(length, corner_radius, corner_radius, 6)  # a corner on its local +x
+    return c.transform(np.column_stack([u, v, a, np.asarray(start, float)]))
 
 
 def penetration(a, b) -> float:
@@ -356,13 +387,13 @@ class Assembly:
                 out.append(f"{f.item} #{k + 1} at {_at(f.head)} runs {pen:.2f} mm into {what_in}")
             for what, path in f.paths():
                 pen, by = self._into(("path", name, what), lambda other, path=path: penetration(path, other), fitted,
-                                     path.bounding_box()[2])
+                                     path.bounding_box()[2] + f.lift_mm)
                 if pen > CLEARANCE_MM:
                     out.append(f"{f.item} #{k + 1} at {_at(f.head)}: {what} is blocked by {by} ({pen:.2f} mm)")
             tried = []
             for tool, path in f.tool_paths():
                 pen, by = self._into(("tool", name, tool.name), lambda other, path=path: penetration(path, other), fitted,
-                                     path.bounding_box()[2])
+                                     path.bounding_box()[2] + f.lift_mm)
                 if pen <= CLEARANCE_MM:
                     break
                 tried.append(f"the {tool.name}'s path is blocked by {by} ({pen:.2f} mm)")

@@ -141,6 +141,22 @@ def _holes(solid, offset=(0.0, 0.0, 0.0), cut=False):
             yield ((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2], hi[2], min(w[0], w[1]), False)
 
 
+def _own_rows(rig) -> list[tuple[float, float]]:
+    """Hole axes (x, y; mm) whose fasteners another module lists: the breadboard's screws, and the
+    column's joint in the base plate's tongue (bolts, dowels, or a bought extrusion's core screw)."""
+    from rigcad.parts import breadboard
+
+    out = ([q for qs in breadboard.anchor_points(rig.profile, rig.layout).values() for q in qs]
+           if breadboard.board(rig.profile) else [])
+    t = getattr(rig.layout, "tower", None)
+    if t is not None:
+        from rigcad.parts.tower import _column_flange_points, column_dowel_points
+
+        out += ([*_column_flange_points(t, rig.profile), *column_dowel_points(t, rig.profile)]
+                if rig.profile.buy.column == "print" else [(t.column_x, 0.0)])
+    return out
+
+
 def bolt_axes(rig, tower: bool = False) -> list[dict]:
     """Every bolt of the rig, found in the recipes: vertical holes of the in-rig printed parts that
     share an axis (x, y within 0.05 mm) and touch in z are one bolt through those parts; a round hole
@@ -152,10 +168,14 @@ def bolt_axes(rig, tower: bool = False) -> list[dict]:
         from rigcad.parts.tower import TOWER_PARTS
     except ImportError:  # pragma: no cover - a rig without the tower module
         TOWER_PARTS = ()
+    # a breadboard's screws and the tower's joints in the base plate's tongue have their own rows
+    # (breadboard.hardware, tower.hardware): not bolts found here
+    board = _own_rows(rig) if not tower else []
     holes = []
     for name, part in rig.recipes.items():
         if part.in_rig and (tower or name not in TOWER_PARTS):
-            holes += [(name, *h) for h in _holes(part.solid)]
+            holes += [(name, *h) for h in _holes(part.solid)
+                      if not any(abs(h[0] - x) < 0.05 and abs(h[1] - y) < 0.05 for x, y in board)]
     axes: dict[tuple, list] = {}
     for h in holes:
         axes.setdefault((round(h[1] / 0.05), round(h[2] / 0.05)), []).append(h)
@@ -243,6 +263,12 @@ def fasteners(rig) -> list[dict]:
             w = next(r for r in METRIC if r[0] == thread)
             rows.append({"item": f"{thread} washer (ISO 7089)", "short": f"{thread} washers", "quantity": n,
                          "use": "under each bolt head and nut", "length_mm": None, "note": f"{w[4]:g} mm thick"})
+    from rigcad.parts import breadboard
+
+    for h in breadboard.hardware(rig.profile, rig.layout):
+        rows.append({"item": h["item"], "short": h["item"], "quantity": h["quantity"], "use": h["joins"],
+                     "length_mm": h["length_mm"], "note": "on the breadboard's grid (parts.breadboard)",
+                     "thread": h["thread"]})
     for h in tower_hardware(rig):
         item = (f"{h['thread']} x {h['length_mm']:g} mm {h['item']}" if h.get("length_mm")
                 else f"{h['item']} ({h['thread']})")
@@ -279,6 +305,10 @@ def printed(rig, fab_report: dict) -> list[dict]:
         use = "rig" if part is not None and part.in_rig else "tool"
         if "error" in e:
             rows.append({"part": name, "use": use, "quantity": None, "process": "not printable", "note": e["error"]})
+            continue
+        if e.get("process") == "bought":  # the profile's buy: stock to order, nothing printed or cut
+            rows.append({"part": name, "use": use, "quantity": e["quantity"], "process": "bought",
+                         "pieces": 0, "time_s": None, "material_g": None, "source": None, "note": e["stock"]})
             continue
         if "pieces" not in e:
             rows.append({"part": name, "use": use, "quantity": e["quantity"], "process": e["process"],

@@ -260,6 +260,25 @@ def measure_first(d: Doc, c) -> None:
         "place.")
     d.table(["key", "assumed", "what it is", "set in"],
             [[f"`{r['key']}`", r["value"], r["doc"], f"`{r['set_in']}`"] for r in rows])
+    d.p("Each size drawn on the instrument's outline (at the assumed sizes), between the two features to measure "
+        "from and to:")
+    for path, caption in measurement_figures(c.p, c.files):
+        d.img(path, caption)
+
+
+def measurement_figures(profile, files: dict) -> list[tuple[str, str]]:
+    """One figure per size to measure (rigcad.profile.instruments.sketch, drawn by
+    rigcad.plots.measurement_figure) into ``files`` (path -> PNG bytes): the (path, caption) of each."""
+    from rigcad import plots
+    from rigcad.profile.instruments import measurements, sketch
+
+    out = []
+    for m in measurements(profile):
+        path = f"images/measure/{m.key.replace('.', '_')}.png"
+        what = f"from: {m.between[0]}; to: {m.between[1]}"
+        files[path] = plots.measurement_figure(sketch(profile, m), what)
+        out.append((path, f"`{m.key}` ({m.view} view): {m.what}, {what}"))
+    return out
 
 
 def _introduction(d: Doc, c) -> None:
@@ -283,8 +302,8 @@ def _section_bill(d: Doc, c) -> None:
     rows = []
     for r in bill["printed"]:
         if r.get("time_s") is None:
-            rows.append([f"`{r['part']}`", r["use"], r["quantity"] or "-", "cut" if r["quantity"] else "-",
-                         r["process"], "-", "-", r["note"]])
+            kind = "bought" if r["process"] == "bought" else "cut" if r["quantity"] else "-"
+            rows.append([f"`{r['part']}`", r["use"], r["quantity"] or "-", kind, r["process"], "-", "-", r["note"]])
         else:
             rows.append([f"`{r['part']}`", r["use"], r["quantity"], r["pieces"], r["process"], hours_minutes(r["time_s"]),
                          f"{r['material_g']:.0f} g", f"{r['note']} ({r['source']})"])
@@ -356,6 +375,8 @@ def _section_print(d: Doc, c) -> None:
                          f"{', '.join(sorted({pc['orientation'] for pc in e['pieces']}))}"
                          + ("; needs support" if support else "")
                          + (f"; {len(e['pins'])} pin holes" if e.get("pins") else ""))
+        elif e.get("process") == "bought":
+            items.append(f"`{name}`: bought, not printed: {e['stock']}")
         elif "error" not in e:
             items.append(f"`{name}`: cut from a {e['plate_thickness_mm']:g} mm plate (`outlines/{name}.dxf`, `.svg`)")
         else:
@@ -441,8 +462,9 @@ THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut wit
                                       "insert's outer diameter and melt the insert in flush with a soldering iron at "
                                       "its maker's temperature)",
              "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
-             "bench": "into the bench",
-             "trap": "a washer under the head; its nut waits in the square trap printed for it (put it in before "
+             "bench": "into the bench (on a breadboard: into its tapped holes, on the grid)",
+             "tapped": "into the thread tapped in the part",
+             "trap": "a washer under the head; its nut waits in the hexagonal trap printed for it (put it in before "
                      "the part with the trap stands on the bench), tighten crosswise by hand"}
 
 
@@ -479,6 +501,10 @@ def step_text(placed, meshes_by_name: dict) -> str:
                      for f in st.fasteners)
     for (item, tool, thread_in), n in groups.items():
         text += f" Fix it with {n} x {item}, {THREAD_IN[thread_in]} (tool: {tool} or an L key)."
+    lift = max((f.lift_mm for f in st.fasteners), default=0.0)
+    if lift:
+        text += (f" Its screw goes in from below: lift the rig onto blocks {lift:g} mm high under the tongue (the "
+                 "film test's), turn it with the L key's short arm in the socket, then set the rig down.")
     return text
 
 

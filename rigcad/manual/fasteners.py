@@ -8,13 +8,14 @@ from __future__ import annotations
 import numpy as np
 
 from rigcad.manual.assembly_check import Fastener, Tool
+from rigcad.parts.tower import NUT_AF as _NUT_AF
 
 DOWN, UP = (0.0, 0.0, -1.0), (0.0, 0.0, 1.0)
 #: Hex key (mm across flats, ISO 4762 socket) per thread; 1/4-20 and 3/8-16 socket heads take 3/16 in and 5/16 in.
 HEX_KEY = {"M2": 1.5, "M2.5": 2.0, "M3": 2.5, "M4": 3.0, "M5": 4.0, "M6": 5.0, "M8": 6.0, "M10": 8.0, "M12": 10.0,
            "1/4-20 UNC": 4.7625, "3/8-16 UNC": 7.9375}
-#: Nut width across flats (mm, ISO 4032) per metric thread: the open-end spanner's size.
-NUT_AF = {"M2": 4.0, "M2.5": 5.0, "M3": 5.5, "M4": 7.0, "M5": 8.0, "M6": 10.0, "M8": 13.0, "M10": 16.0, "M12": 18.0}
+#: Nut width across flats (mm, ISO 4032) per metric thread: the open-end spanner's size (the parts' table).
+NUT_AF = _NUT_AF
 #: The hex screwdriver's blade (mm): a hand needs this much straight room above a head.
 DRIVER_BLADE_MM = 100.0
 #: The open-end spanner's reach (mm, DIN 3110 for M3-M6 nuts: 90-120 mm long).
@@ -25,10 +26,11 @@ L_KEY = {1.5: (45.0, 14.0), 2.0: (50.0, 16.0), 2.5: (56.0, 18.0), 3.0: (63.0, 20
          10.0: (112.0, 40.0)}
 
 
-def driver(thread: str, out_dir=(1.0, 0.0, 0.0)) -> tuple[Tool, ...]:
+def driver(thread: str, out_dir=(1.0, 0.0, 0.0), key: float | None = None) -> tuple[Tool, ...]:
     """A hex screwdriver with a DRIVER_BLADE_MM blade; else an L hex key (ISO 2936) with its short
-    arm in the socket and its long arm out along ``out_dir`` (away from the rig's axis)."""
-    key = HEX_KEY[thread]
+    arm in the socket and its long arm out along ``out_dir`` (away from the rig's axis). ``key``:
+    the socket's size (mm) when it is not the cap screw's (HEX_KEY), as in a countersunk head."""
+    key = HEX_KEY[thread] if key is None else key
     r = key / np.sqrt(3.0) + 0.5  # the key's corners, and a little play for the hand
     long, short = L_KEY[key]
     return (Tool(f"{key:g} mm hex screwdriver (ISO 2936 hex), {DRIVER_BLADE_MM:g} mm blade", DRIVER_BLADE_MM, r),

@@ -317,8 +317,9 @@ def hardware(steps: list[Step], rig=None) -> list[dict]:
                 # a nut in a printed trap bears on the part: one washer, under the head
                 extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + (
                     1 if f.nut_tool is None else 2)
-            else:
-                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + 1
+            elif f.thread_in != "tapped":  # a bought extrusion's core screws: heads sunk, no washer
+                washer = f"{thread} large washer (ISO 7093)" if "ISO 7093" in f.item else f"{thread} washer (ISO 7089)"
+                extra[washer] = extra.get(washer, 0) + 1
             if f.thread_in == "insert":
                 dia, long = INSERT[thread]
                 name = f"{thread} heat-set insert for printed parts, {dia:g} x {long:g} mm"

@@ -5,7 +5,7 @@ placed where the tower's parts put their holes (rigcad.parts.tower: ``_column_fl
 path and the nut's room (and the spanner's way out where a hand holds the nut):
 
 - the printed column's foot: four bolts down through the foot and the base plate's datum tongue,
-  their nuts in the square traps under the tongue (put in before the plate stands on the bench:
+  their nuts in the hexagonal traps under the tongue (put in before the plate stands on the bench:
   the trap holds the nut, no spanner);
 - the shelf on the column's top flange: four bolts up from under the flange into inserts in the
   shelf's underside (nothing stands proud of the shelf's top, where the projector stands);
@@ -13,7 +13,10 @@ path and the nut's room (and the spanner's way out where a hand holds the nut):
   flanges, nut on the spring on top; three set screws in the holder's inserts, turned from above
   down onto their balls (drawn at the setting where they touch the balls).
 
-A bought extrusion column (one M8 bolt into its core at each end) keeps its hardware rows only.
+A bought extrusion column: one M8 bolt into its tapped core at each end, the foot's up from the
+counterbore under the tongue (``rigcad.parts.tower.CORE_HEAD_BORE``; put in with the rig lifted onto
+the film test's blocks, ``rigcad.manual.calibration.film_setup``: the tongue stands on the bench), the
+top's down through the shelf. The extrusion is drawn as a plain box: the bolts' threads run into it.
 Frame: mm, rig frame.
 """
 
@@ -29,11 +32,13 @@ from rigcad.manual.fasteners import socket_head as _socket_head
 #: The hardware rows' "joins" text (its start) that this module places as fasteners.
 PLACED = ("the column's top flange to the shelf", "the column's foot to the base plate's datum tongue",
           "the splitter holder's seat", "from under the shelf up through the holder's flange")
+#: The same for a bought extrusion column (its core bolts).
+PLACED_BOUGHT = ("up through the base plate's tongue", "down through the shelf (its head flush in the countersink")
 
 
 def placed(row: dict) -> bool:
     """Whether the tower's hardware ``row`` is placed here (the steps then carry it)."""
-    return any(row["joins"].startswith(p) for p in PLACED)
+    return any(row["joins"].startswith(p) for p in PLACED + PLACED_BOUGHT)
 
 
 def _row(rig, start: str) -> dict:
@@ -60,7 +65,7 @@ def column_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
 
     t, tw = rig.layout.tower, rig.profile.tower
     if rig.profile.buy.column != "print":
-        return {}
+        return extrusion_fasteners(rig)
     foot, top = _row(rig, PLACED[1]), _row(rig, PLACED[0])
     washer = _metric(foot["thread"])[4]
     pts = _column_flange_points(t, rig.profile)
@@ -77,6 +82,30 @@ def column_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
                                float(top["thread"].lstrip("M")), top["thread"], thread_in="insert",
                                passes=("tower_column", "tower_shelf")) for x, y in pts)
     return {"tower_column": feet, "tower_shelf": shelf}
+
+
+def extrusion_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
+    """The bought extrusion's two M8 core screws, no washers: the foot's ISO 4762 head sunk in the
+    counterbore under the tongue (step tower_column, put in from below with the rig on the film
+    test's blocks), the top's ISO 10642 countersunk head flush in the shelf's top (step tower_shelf)."""
+    from rigcad.manual.calibration import film_setup
+    from rigcad.parts.tower import CORE_HEAD_BORE, CORE_TOP_SCREW
+
+    t = rig.layout.tower
+    foot, top = _row(rig, PLACED_BOUGHT[0]), _row(rig, PLACED_BOUGHT[1])
+    core = "into the extrusion's tapped core"
+    head_d, head_h, key = CORE_TOP_SCREW
+    bolt = _socket_head(f"{foot['thread']} x {foot['length_mm']:g} mm socket-head bolt (ISO 4762) {core}, up from the "
+                        "counterbore under the tongue (the rig on blocks)", (t.column_x, 0.0, t.bench_z + CORE_HEAD_BORE[1]),
+                        UP, foot["length_mm"], 8.0, foot["thread"], thread_in="tapped",
+                        passes=("base_plate", "tower_column"), pierces=("tower_column",),
+                        lift_mm=film_setup(rig)["block_under_tongue_mm"])
+    screw = Fastener(f"{top['thread']} x {top['length_mm']:g} mm countersunk socket screw (ISO 10642) {core}, down "
+                     "from the shelf's countersink", (t.column_x, 0.0, t.shelf_top_z - head_h), DOWN,
+                     top["length_mm"] - head_h, 4.0, head_d / 2, head_h, driver(top["thread"], (1.0, 0.0, 0.0), key),
+                     thread_in="tapped", passes=("tower_shelf", "tower_column"), pierces=("tower_column",),
+                     countersunk=True)
+    return {"tower_column": (bolt,), "tower_shelf": (screw,)}
 
 
 def _outward(dx: float, dy: float) -> tuple[float, float, float]:
@@ -109,14 +138,30 @@ def seat_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]
     return {"splitter_holder": tuple(out)}
 
 
+def breadboard_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
+    """On a breadboard (``datum.mount``): the base plate's screws down into the board's tapped holes,
+    on the grid (rigcad.parts.breadboard), a large washer under each head (step base_plate)."""
+    from rigcad.parts import breadboard
+
+    b = breadboard.board(rig.profile)
+    if b is None:
+        return {}
+    row = breadboard.hardware(rig.profile, rig.layout)[0]
+    pts = [q for qs in breadboard.anchor_points(rig.profile, rig.layout).values() for q in qs]
+    return {"base_plate": tuple(_socket_head(row["item"] + " into the breadboard", (x, y, b.washer[1]), DOWN,
+                                             row["length_mm"], b.diameter, b.thread, thread_in="bench",
+                                             passes=("base_plate",)) for x, y in pts)}
+
+
 def tower_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]:
-    """Step name -> the tower's own joints' fasteners (see the module docstring)."""
+    """Step name -> the tower's own joints' fasteners (see the module docstring) and the base plate's
+    screws into a breadboard."""
     if getattr(rig.layout, "tower", None) is None or "tower_column" not in meshes_by_name:
         return {}
-    out = dict(column_fasteners(rig))
+    out = dict(column_fasteners(rig)) | breadboard_fasteners(rig)
     if "splitter_holder" in meshes_by_name and "tower_shelf" in meshes_by_name:
         out.update(seat_fasteners(rig, meshes_by_name))
     return out
 
 
-__all__ = ["PLACED", "column_fasteners", "placed", "seat_fasteners", "tower_fasteners"]
+__all__ = ["PLACED", "PLACED_BOUGHT", "breadboard_fasteners", "column_fasteners", "extrusion_fasteners", "placed", "seat_fasteners", "tower_fasteners"]

@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 
 from OCP.Approx import Approx_ChordLength
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
-from OCP.BRepBuilderAPI import (BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire,
-                                BRepBuilderAPI_Transform)
+from OCP.BRepBuilderAPI import (BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon,
+                                BRepBuilderAPI_MakeWire, BRepBuilderAPI_Transform)
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepPrimAPI import (BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakePrism,
@@ -31,7 +31,7 @@ from OCP.TopoDS import TopoDS_Shape
 from OCP.TopTools import TopTools_ListOfShape
 
 from rigcad.errors import GeometryError, KernelError
-from rigcad.parts.recipe import (Box, Curve, Cylinder, Difference, Line, Part, Prism, Revolve, Section, Solid,
+from rigcad.parts.recipe import (Box, Curve, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Solid,
                                  Translate, Union_)
 
 #: Points of the exact curve given to each B-spline fit, and (more) used to measure it.
@@ -127,6 +127,13 @@ def build(solid: Solid, tol: float, report: FitReport) -> TopoDS_Shape:
     if isinstance(solid, Cylinder):
         ax = gp_Ax2(gp_Pnt(*solid.base), gp_Dir(0, 0, 1))
         return BRepPrimAPI_MakeCylinder(ax, solid.radius, solid.height).Shape()
+    if isinstance(solid, HexPrism):
+        poly = BRepBuilderAPI_MakePolygon()
+        for x, y in solid.corners():
+            poly.Add(gp_Pnt(x, y, solid.base[2]))
+        poly.Close()
+        face = BRepBuilderAPI_MakeFace(poly.Wire(), True).Face()
+        return BRepPrimAPI_MakePrism(face, gp_Vec(0, 0, solid.height)).Shape()
     if isinstance(solid, Union_):
         shapes = [build(s, tol, report) for s in solid.items]
         return shapes[0] if len(shapes) == 1 else _boolean(BRepAlgoAPI_Fuse, shapes[0], shapes[1:])

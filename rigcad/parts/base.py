@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from rigcad.parts import breadboard
 from rigcad.parts.dome import bolt_holes
 from rigcad.parts.layout import RigLayout
 from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Union_
@@ -15,7 +16,7 @@ from rigcad.profile.schema import Profile
 def base_plate(profile: Profile, layout: RigLayout) -> Part:
     """The rig's datum: a disc bolted to the dome's flange, bored for the sample holder, with a tongue
     out to the COP tower's column, whose foot it locates by two dowels and holds by four bolts (nuts
-    in square traps underneath). The tongue reaches down to the bench (the sample holder's stop
+    in hexagonal traps underneath). The tongue reaches down to the bench (the sample holder's stop
     collar's level): the tower's weight goes into the bench, not through the disc."""
     t = profile.base_plate.thickness
     holder = profile.sample_holder
@@ -27,11 +28,18 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
     bore = Cylinder((0.0, 0.0, -t - 1.0), holder.radius + holder.clearance, t + 2.0)
     holes = bolt_holes(layout, profile.dome_shell.bolt_diameter, -t - 1.0, t + 2.0)
     joint = (*column_joint_cuts(tw, profile, tw.bench_z, -tw.bench_z, "top"), *tongue_underside_cuts(tw, profile, tw.bench_z))
-    return Part("base_plate", Difference(Union_((plate, tongue)), (bore, *holes, *joint)),
+    b = breadboard.board(profile)
+    pads = breadboard.pads(profile, layout) if b else ()
+    anchors = breadboard.holes(profile, layout) if b else ()
+    on_board = "" if b is None else (
+        f"; it stands on the {b.title}: the sample point over a tapped hole, the tongue along a row of holes, "
+        f"screwed down on the grid through its pad and the boss under the disc")
+    return Part("base_plate", Difference(Union_((plate, tongue, *pads)), (bore, *holes, *joint, *anchors)),
                 (0.55, 0.57, 0.6), "base plate, the rig's datum: bolts to the dome flange; the sample holder slides "
                 "into its bore; its tongue locates the tower's column " + (
                     f"by two {profile.datum.dowel_diameter:g} mm dowels (reamed H7) and four bolts"
-                    if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core"))
+                    if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core")
+                + on_board)
 
 
 def holder_body(profile: Profile, top_z: float) -> Cylinder | Union_:

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from rigcad.parts import breadboard
 from rigcad.parts.tower import EXTRUSION, POCKET_GAP
 
 #: Worst-case diametral clearance (mm) of an ISO 8734 dowel (m6: +0.004..+0.012 mm for 3..6 mm) in a
@@ -55,6 +56,9 @@ class DatumChain:
     """The chain's links and totals (mm)."""
 
     links: tuple[Link, ...]
+    #: The rig on a breadboard (rigcad.parts.breadboard.fit): no link of the chain (the rig is one
+    #: rigid piece), but what its screws' holes must take up; None on the base plate alone.
+    mount: dict | None = None
 
     @property
     def lateral_worst(self) -> float:
@@ -72,7 +76,7 @@ class DatumChain:
         return {"links": [{"name": k.name, "source": k.source, "lateral_mm": k.lateral, "vertical_mm": k.vertical}
                           for k in self.links],
                 "lateral_worst_mm": self.lateral_worst, "lateral_rss_mm": self.lateral_rss,
-                "vertical_worst_mm": self.vertical_worst}
+                "vertical_worst_mm": self.vertical_worst, "mount": self.mount}
 
 
 def _printed(profile, span: float) -> float:
@@ -116,7 +120,7 @@ def datum_chain(profile, layout) -> DatumChain:
         shelf,
         Link("splitter holder", f"printed: {holder_span:.0f} mm from its seat to the grooves",
              _printed(profile, holder_span), _printed(profile, holder_span)),
-    ))
+    ), breadboard.fit(profile, layout) if breadboard.board(profile) else None)
 
 
 def check_datum_chain(profile, layout) -> list[dict]:
@@ -126,10 +130,15 @@ def check_datum_chain(profile, layout) -> list[dict]:
       adjusters only refine) or not (then the calibration must use them);
     * ``lateral_within_travel``: the chain's worst lateral error is within the adjusters' travel
       across (``tower.travel_across``): the adjusters can always bring the COP back;
-    * ``vertical_within_travel``: the same along the axis (``tower.travel_along``)."""
+    * ``vertical_within_travel``: the same along the axis (``tower.travel_along``);
+    * on a breadboard, ``breadboard_holes_take_the_grid``: the screws' holes take the printed and the
+      board's position errors (rigcad.parts.breadboard.fit)."""
     chain = datum_chain(profile, layout)
     tol, tw = profile.tolerancing, profile.tower
-    return [
+    board = [] if chain.mount is None else [
+        {"claim": "breadboard_holes_take_the_grid", "value_mm": chain.mount["hole_needed_mm"],
+         "limit_mm": chain.mount["hole_mm"], "ok": chain.mount["hole_needed_mm"] <= chain.mount["hole_mm"]}]
+    return board + [
         {"claim": "needs_adjustment", "value_mm": chain.lateral_worst, "limit_mm": tol.projector_offset,
          "ok": True, "adjust": chain.lateral_worst > tol.projector_offset},
         {"claim": "lateral_within_travel", "value_mm": chain.lateral_worst, "limit_mm": tw.travel_across,

@@ -11,6 +11,7 @@ part's tree is its cache key. Frame: mm, sample point at the origin, optical axi
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass, field, fields, is_dataclass, replace
 from typing import Union
 
@@ -131,6 +132,23 @@ class Cylinder:
 
 
 @dataclass(frozen=True)
+class HexPrism:
+    """Regular hexagonal prism along +z from ``base`` (its bottom centre): ``across_flats`` and
+    ``height`` in mm, one corner ``turn`` rad round from +x (a nut trap)."""
+
+    base: Vec3
+    across_flats: float
+    height: float
+    turn: float = 0.0
+
+    def corners(self) -> list[tuple[float, float]]:
+        """The six corners (x, y; mm), counter-clockwise from the one at ``turn``."""
+        r = self.across_flats / math.sqrt(3.0)
+        return [(self.base[0] + r * math.cos(self.turn + k * math.pi / 3),
+                 self.base[1] + r * math.sin(self.turn + k * math.pi / 3)) for k in range(6)]
+
+
+@dataclass(frozen=True)
 class Union_:
     """Union of solids."""
 
@@ -153,7 +171,7 @@ class Translate:
     offset: Vec3
 
 
-Solid = Union[Revolve, Prism, Box, Cylinder, Union_, Difference, Translate]
+Solid = Union[Revolve, Prism, Box, Cylinder, HexPrism, Union_, Difference, Translate]
 
 
 @dataclass(frozen=True)

@@ -39,7 +39,8 @@ import numpy as np
 from rigcad.errors import GeometryError
 from rigcad.optics.focus import focusing_lens
 from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_point, splitter_plate
-from rigcad.parts.recipe import Box, Cylinder, Difference, Line, Part, Prism, Section, Translate, Union_
+from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Translate,
+                                 Union_)
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import MOUNT_THREADS, Profile
 
@@ -290,30 +291,60 @@ def column_joint_cuts(t: TowerLayout, profile: Profile, z0: float, height: float
     h = EXTRUSION / 2 + POCKET_GAP
     zp = z0 + height - POCKET_DEPTH if face == "top" else z0 - 1.0
     pocket = Box((t.column_x - h, -h, zp), (t.column_x + h, h, zp + POCKET_DEPTH + 1.0))
-    return (pocket, *_holes([(t.column_x, 0.0)], CORE_BOLT_HOLE, z0, height))
+    cuts = (pocket, *_holes([(t.column_x, 0.0)], CORE_BOLT_HOLE, z0, height))
+    if face == "bottom":  # the shelf: its top screw's head flush in a 90 deg countersink
+        cuts += (Translate(_countersink(), (t.column_x, 0.0, z0 + height)),)
+    return cuts
 
 
-#: Square nut traps under the tongue (mm); the tongue then stands on the bench. An M4 nut (7 mm
-#: across flats, 8.08 across corners, 3.2 mm thick) goes into a square of side s when its widths in
-#: two perpendicular directions, 8.08 cos(d) and 8.08 cos(30 deg - d) (d: a corner's angle off a
-#: side), are both under s: s = 8.0 admits it for d in 8..22 deg and stops it turning further (a
-#: 7.2 mm square, 7.8 being the least any nut passes, would not take it). The depth puts the nut so
-#: high that a stocked 20 mm bolt reaches through it and ends 0.8 mm above the bench (the assembly
-#: check, rigcad.manual.tower_joints, verifies both).
-NUT_TRAP = 8.0
+def _countersink() -> Revolve:
+    """The 90 deg countersink for the top core screw's head, its rim at z = 0 (mm), 1 mm of air above."""
+    r, k = CORE_TOP_SCREW[0] / 2 + 0.2, CORE_TOP_SCREW[1]
+    bottom = r - k - 0.2  # 45 deg flanks: the cone's radius at the head's underside depth, and a little play
+    return Revolve(Section((Line((0.0, -k - 0.2), (bottom, -k - 0.2)), Line((bottom, -k - 0.2), (r, 0.0)),
+                            Line((r, 0.0), (r, 1.0)), Line((r, 1.0), (0.0, 1.0)), Line((0.0, 1.0), (0.0, -k - 0.2)))))
+
+
+#: ISO 4032 hex nuts: width across flats (mm) per metric thread (the spanner's size); the one home of
+#: these sizes (the nut traps here, the manual's nuts and spanners).
+NUT_AF = {"M2": 4.0, "M2.5": 5.0, "M3": 5.5, "M4": 7.0, "M5": 8.0, "M6": 10.0, "M8": 13.0, "M10": 16.0, "M12": 18.0}
+#: Hexagonal nut traps under the tongue (mm): the M4 nut's 7.0 mm across flats and a printed fit's gap
+#: (0.2 mm) on each flat; a corner on +x (NUT_TRAP_TURN, rad). The nut (4.04 mm to a corner) cannot turn
+#: in it (3.7 mm to a flat). The depth puts the nut so high that a stocked 20 mm bolt reaches through it
+#: and ends 0.8 mm above the bench; the tongue then stands on the bench (the assembly check,
+#: rigcad.manual.tower_joints, verifies both, the nut drawn as its hexagon).
+NUT_TRAP_GAP = 0.2
+NUT_TRAP = NUT_AF["M4"] + 2 * NUT_TRAP_GAP
+NUT_TRAP_TURN = 0.0
 NUT_TRAP_DEPTH = 5.6
-#: Counterbore under the tongue for the extrusion's M8 socket head (13 mm, 8 mm tall; ISO 4762).
+#: Counterbore under the tongue for the extrusion's M8 socket head (13 mm, 8 mm tall; ISO 4762):
+#: diameter, depth (mm). An ISO 7089 M8 washer (16 mm) does not fit it: the head bears on the floor.
 CORE_HEAD_BORE = (14.0, 8.5)
+#: The top core screw: an M8 countersunk socket screw, ISO 10642 (head 16 mm across, 4.4 mm tall, 5 mm
+#: hex key; its length includes the head), flush in a 90 deg countersink in the shelf's top: the
+#: projector stands on its shims only ~2 mm above the shelf (a cap screw's 8 mm head would hit it;
+#: the assembly check, rigcad.manual.tower_joints, verifies the projector clears the screw).
+CORE_TOP_SCREW = (16.0, 4.4, 5.0)
+#: The extrusion's ends are tapped M8 this deep (mm); a core bolt's thread stops 1 mm short of it.
+CORE_TAP_DEPTH = 20.0
+
+
+def core_bolt_lengths(profile: Profile, t: TowerLayout) -> dict[str, float]:
+    """The bought extrusion's M8 core screws (mm): "foot" (ISO 4762, up from the tongue's counterbore)
+    and "top" (ISO 10642 countersunk, down from the shelf's top; its length includes the head), each
+    the longest stocked length whose thread stops 1 mm short of the tapped depth."""
+    grips = {"foot": -t.bench_z - CORE_HEAD_BORE[1] - POCKET_DEPTH, "top": t.shelf_thickness - POCKET_DEPTH}
+    return {k: float(max(L for L in ISO_4762_LENGTHS if L <= g + CORE_TAP_DEPTH - 1.0 + 1e-9))
+            for k, g in grips.items()}
 
 
 def tongue_underside_cuts(t: TowerLayout, profile: Profile, z_bottom: float) -> tuple:
-    """What the column joint cuts into the tongue's underside (z_bottom: the bench): a square nut
+    """What the column joint cuts into the tongue's underside (z_bottom: the bench): a hexagonal nut
     trap under each of the printed column's bolts, or a counterbore for the extrusion's M8 head."""
     if profile.buy.column != "print":
         d, depth = CORE_HEAD_BORE
         return (Cylinder((t.column_x, 0.0, z_bottom - 1.0), d / 2, depth + 1.0),)
-    h = NUT_TRAP / 2
-    return tuple(Box((x - h, y - h, z_bottom - 1.0), (x + h, y + h, z_bottom + NUT_TRAP_DEPTH))
+    return tuple(HexPrism((x, y, z_bottom - 1.0), NUT_TRAP, NUT_TRAP_DEPTH + 1.0, NUT_TRAP_TURN)
                  for x, y in _column_flange_points(t, profile))
 
 
@@ -613,17 +644,22 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
     each end of a printed column; one M8 bolt into the core at each end of a bought extrusion."""
     tw, tongue = profile.tower, -t.bench_z  # the tongue reaches down to the bench
     if profile.buy.column != "print":
-        grip = max(tongue - CORE_HEAD_BORE[1], t.shelf_thickness)
-        return [{"item": "bolt and washer, ISO 4762", "thread": "M8", "length_mm": float(_length(grip + 1.0, 16.0)),
-                 "quantity": 2, "joins": "up through the base plate's tongue (its head in the counterbore underneath), "
-                                         "and down through the shelf, into the extrusion's tapped core (16 mm engaged)"}]
+        length = core_bolt_lengths(profile, t)
+        return [{"item": "bolt, ISO 4762 (no washer: the head bears on its counterbore's floor)", "thread": "M8",
+                 "length_mm": length["foot"], "quantity": 1,
+                 "joins": "up through the base plate's tongue (its head in the counterbore underneath) into the "
+                          f"extrusion's core, tapped {CORE_TAP_DEPTH:g} mm deep"},
+                {"item": "countersunk socket screw, ISO 10642 (length with the head)", "thread": "M8",
+                 "length_mm": length["top"], "quantity": 1,
+                 "joins": "down through the shelf (its head flush in the countersink on top) into the extrusion's core, "
+                          f"tapped {CORE_TAP_DEPTH:g} mm deep"}]
     return [
         {"item": "bolt and washer", "thread": "M4", "length_mm": shelf_bolt_length(profile), "quantity": 4,
          "joins": "the column's top flange to the shelf: up from under the flange into "
                   + ("heat-set inserts pressed into the shelf's underside" if profile.buy.shelf == "print" else
                      "M4 threads tapped in the shelf's underside (8 mm deep)")},
         {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + tongue - NUT_TRAP_DEPTH, nut),
-         "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (the nuts in the square traps "
+         "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
                                  "under the tongue, put in before it stands on the bench)"},
         *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT[0],
             "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]

@@ -125,11 +125,114 @@ FIGURES: dict[str, tuple[str, str, str]] = {
     "pupil_height": ("side", "bottom (mounting) face", "optical axis (centre of the lens barrel)"),
     "pupil_lateral": ("top", "body's centre line", "optical axis (centre of the lens barrel)"),
     "mount_thread": ("bottom", "mounting hole", "its thread (screw a gauge or a known screw in)"),
-    "mount_depth": ("bottom", "mounting hole's mouth", "its bottom (a depth gauge or a screw with a nut)"),
+    "mount_depth": ("side (cut through a hole)", "mounting hole's mouth", "its bottom (a depth gauge or a screw "
+                    "with a nut)"),
     "mount_spacing": ("bottom", "first mounting hole's centre", "second mounting hole's centre"),
-    "focus_min": ("side", "lens front", "nearest wall the projector focuses sharply"),
-    "focus_max": ("side", "lens front", "farthest wall the projector focuses sharply"),
+    "focus_min": ("side", "entrance pupil (the COP)", "nearest wall the projector focuses sharply"),
+    "focus_max": ("side", "entrance pupil (the COP)", "farthest wall the projector focuses sharply"),
 }
+
+
+@dataclass(frozen=True)
+class Sketch:
+    """A measurement's figure as lines in the plane of its view (mm; ``axes``: what the horizontal
+    and vertical run along): the instrument's outline (``outlines``: named closed polylines,
+    ``circles``: named (centre, radius)), and the dimension drawn between its two features
+    (``dimension``: two points; equal points: a call-out pointing at one feature); ``window``: the
+    detail shown ((x0, y0), (x1, y1)) when the feature is small against the body, else None."""
+
+    key: str
+    view: str
+    axes: tuple[str, str]
+    outlines: tuple[tuple[str, tuple[tuple[float, float], ...]], ...]
+    circles: tuple[tuple[str, tuple[float, float], float], ...]
+    dimension: tuple[tuple[float, float], tuple[float, float]]
+    label: str
+    window: tuple[tuple[float, float], tuple[float, float]] | None = None
+
+
+def _around(x: float, y: float, half: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    return ((x - half, y - half), (x + half, y + half))
+
+
+def _rect(x0: float, y0: float, x1: float, y1: float) -> tuple[tuple[float, float], ...]:
+    return ((x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0))
+
+
+def _holes_along(params) -> list[float]:
+    """Where the mounting holes are drawn along the body's depth (mm from its back face): the
+    camera's two, mount_spacing apart about the middle; a projector's one, in the middle."""
+    d = params.body_depth
+    spacing = getattr(params, "mount_spacing", None)
+    return [d / 2 - spacing / 2, d / 2 + spacing / 2] if spacing else [d / 2]
+
+
+def _side(params, key: str, m: Measurement) -> Sketch:
+    """Side view: along the axis from the body's back face (0) to the lens front; up from the bottom face."""
+    d, h, ld, ll = params.body_depth, params.body_height, params.lens_diameter, params.lens_length
+    ph, front = params.pupil_height, params.body_depth + params.lens_length
+    pupil = front - params.pupil_depth
+    outlines = [("body", _rect(0.0, 0.0, d, h)), ("lens", _rect(d, ph - ld / 2, front, ph + ld / 2))]
+    dims = {"body_height": ((-0.1 * d, 0.0), (-0.1 * d, h)), "body_depth": ((0.0, -0.1 * h), (d, -0.1 * h)),
+             "lens_length": ((d, ph + ld / 2 + 0.1 * h), (front, ph + ld / 2 + 0.1 * h)),
+             "pupil_depth": ((pupil, ph), (front, ph)), "pupil_height": ((pupil, 0.0), (pupil, ph))}
+    if key in ("focus_min", "focus_max"):
+        wall = pupil + getattr(params, key)
+        outlines.append(("wall", ((wall, -0.5 * h), (wall, 1.5 * h))))
+        return Sketch(m.key, m.view, ("along the optical axis (mm)", "height (mm)"), tuple(outlines), (),
+                      ((pupil, ph), (wall, ph)), _label(m))
+    if key == "mount_depth":
+        x, r = _holes_along(params)[0], 2.5
+        outlines.append(("mounting hole (cut)", _rect(x - r, 0.0, x + r, params.mount_depth)))
+        return Sketch(m.key, m.view, ("along the optical axis (mm)", "height (mm)"), tuple(outlines), (),
+                      ((x + 2 * r, 0.0), (x + 2 * r, params.mount_depth)), _label(m),
+                      _around(x, params.mount_depth / 2, 2 * params.mount_depth))
+    return Sketch(m.key, m.view, ("along the optical axis (mm)", "height (mm)"), tuple(outlines), (), dims[key],
+                  _label(m))
+
+
+def _top(params, key: str, m: Measurement) -> Sketch:
+    """Top view: along the axis as in the side view; across from the body's centre line."""
+    d, w, ld, front = params.body_depth, params.body_width, params.lens_diameter, params.body_depth + params.lens_length
+    lat = getattr(params, "pupil_lateral", 0.0)
+    outlines = (("body", _rect(0.0, -w / 2, d, w / 2)), ("lens", _rect(d, lat - ld / 2, front, lat + ld / 2)),
+                ("centre line", ((-0.05 * d, 0.0), (front + 0.05 * d, 0.0))))
+    dims = {"body_width": ((0.5 * d, -w / 2), (0.5 * d, w / 2)), "pupil_lateral": ((front, 0.0), (front, lat))}
+    return Sketch(m.key, m.view, ("along the optical axis (mm)", "across (mm)"), outlines, (), dims[key], _label(m))
+
+
+def _front(params, key: str, m: Measurement) -> Sketch:
+    """Front view, into the lens: across from the centre line, up from the bottom face."""
+    w, h, ld, ph = params.body_width, params.body_height, params.lens_diameter, params.pupil_height
+    lat = getattr(params, "pupil_lateral", 0.0)
+    return Sketch(m.key, m.view, ("across (mm)", "height (mm)"), (("body", _rect(-w / 2, 0.0, w / 2, h)),),
+                  (("lens barrel", (lat, ph), ld / 2),), ((lat - ld / 2, ph), (lat + ld / 2, ph)), _label(m))
+
+
+def _bottom(params, key: str, m: Measurement) -> Sketch:
+    """Bottom view: along the axis from the back face; across from the centre line; the mounting holes."""
+    d, w = params.body_depth, params.body_width
+    xs = _holes_along(params)
+    circles = tuple((f"mounting hole {k + 1}", (x, 0.0), 2.5) for k, x in enumerate(xs))
+    dim = ((xs[0], 0.0), (xs[-1], 0.0)) if key == "mount_spacing" else ((xs[0], 0.0), (xs[0], 0.0))
+    window = _around(0.5 * (xs[0] + xs[-1]), 0.0, max(15.0, xs[-1] - xs[0]))
+    return Sketch(m.key, m.view, ("along the optical axis (mm)", "across (mm)"), (("body", _rect(0.0, -w / 2, d, w / 2)),),
+                  circles, dim, _label(m), window)
+
+
+def _label(m: Measurement) -> str:
+    value = f"{m.assumed:g} {m.unit}" if isinstance(m.assumed, (int, float)) else f"{m.assumed} {m.unit}".strip()
+    return f"{value} (assumed)"
+
+
+def sketch(profile, m: Measurement) -> Sketch:
+    """The figure of measurement ``m`` (one of :func:`measurements` for ``profile``): the instrument's
+    outline in ``m.view``, drawn at the profile's (assumed) sizes, with the dimension between the two
+    features FIGURES names for it."""
+    section, key = m.key.split(".", 1)
+    params = getattr(profile, section)
+    draw = {"side": _side, "top": _top, "front": _front, "bottom": _bottom}[m.view.split(" ")[0]]
+    return draw(params, key, m)
 
 
 def measurements(profile) -> list[Measurement]:
@@ -153,4 +256,4 @@ def measurements(profile) -> list[Measurement]:
 
 
 __all__ = ["CAMERA_SIZES", "C_MOUNT_FLANGE", "FIGURES", "Instrument", "LIBRARY", "Measurement", "PROJECTOR_SIZES",
-           "measurements", "names"]
+           "Sketch", "measurements", "names", "sketch"]

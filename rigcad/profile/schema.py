@@ -37,6 +37,10 @@ MAX_COATING_LAYER_MM = 1.0
 MOUNT_THREADS: dict[str, float] = {"M3": 3.0, "M4": 4.0, "M5": 5.0, "M6": 6.0, "1/4-20 UNC": 6.35,
                                    "3/8-16 UNC": 9.525}
 
+#: What the rig may stand on (``datum.mount``): its base plate on a bench, or an optical breadboard
+#: (rigcad.parts.breadboard holds each grid's pitch and thread).
+MOUNTS = ("base_plate", "breadboard_m6_25mm", "breadboard_imperial_1in")
+
 #: Thread pitches (mm) of the same threads: ISO 261 coarse; UNC 20 and 16 threads per inch.
 THREAD_PITCH: dict[str, float] = {"M3": 0.5, "M4": 0.7, "M5": 0.8, "M6": 1.0, "1/4-20 UNC": 25.4 / 20,
                                   "3/8-16 UNC": 25.4 / 16}
@@ -255,6 +259,12 @@ class DatumParams:
                               0.002, lo=0, hi=0.05)
     foot_flatness: float = spec("length", "out-of-flat of a printed foot or flange across its width (warp; "
                                 "assumed)", "0.1 mm", lo=0)
+    mount: str = spec("choice", "what the rig stands on: its own base plate on a bench, or screwed down to an "
+                      "optical breadboard's grid (M6 on 25 mm, or 1/4-20 UNC on 1 in; rigcad.parts.breadboard)",
+                      "base_plate", choices=MOUNTS)
+    breadboard_hole_position: float = spec(
+        "length", "a breadboard's tapped hole's position error, each way (assumed: 0.15 mm, the order of the "
+        "makers' figures for machined breadboards; no maker's specification was found to cite)", "0.15 mm", lo=0)
 
 
 @dataclass(frozen=True)

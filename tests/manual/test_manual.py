@@ -182,6 +182,13 @@ def test_the_manual_is_written_with_its_pictures_and_one_self_contained_page(wri
     for row in plan.hardware(plan.steps(table31_rig, picture_meshes(table31_rig))[0], table31_rig):
         assert f"| {row['item']} | {row['quantity']} |" in md, row
     assert (out / "calibration" / "circle.png").is_file()
+    # the opening section shows one figure per size to measure, before section 1
+    opening = md[:md.index("## 1.")]
+    from rigcad.profile.instruments import measurements
+
+    for m in measurements(table31_rig.profile):
+        ref = f"images/measure/{m.key.replace('.', '_')}.png"
+        assert f"]({ref})" in opening and (out / ref).is_file(), m.key
     import json
 
     from rigcad.manual import plan
@@ -227,3 +234,32 @@ def test_printed_times_are_the_slicers_when_it_sliced(fab_reports, table31_rig):
     estimate = next(r for r in B.printed(table31_rig, fab_reports["prusa_mk3s"]) if r["part"] == "base_plate")
     assert estimate["source"] == "rigcad estimate"
     assert estimate["time_s"] == pytest.approx(sum(pc["estimate"]["print_time_s"] for pc in pieces), rel=1e-12)
+
+
+def test_the_manual_opens_with_a_figure_of_each_size_to_measure(table31):
+    """Section 0 lists the assumed sizes and shows one figure per size, each a PNG written with it."""
+    import io
+    from types import SimpleNamespace
+
+    from PIL import Image
+
+    from rigcad.manual.document import Doc, measure_first
+    from rigcad.profile.instruments import measurements
+
+    d, c = Doc(), SimpleNamespace(p=table31, files={})
+    measure_first(d, c)
+    images = [(b[1], b[2]) for b in d.blocks if b[0] == "img"]
+    keys = [m.key for m in measurements(table31)]
+    assert len(images) == len(keys) == len(c.files)
+    for key, (path, caption) in zip(keys, images):
+        assert f"`{key}`" in caption and key.replace(".", "_") in path
+        assert Image.open(io.BytesIO(c.files[path])).size[0] > 200
+
+
+def test_a_bought_part_is_billed_with_its_stock_not_as_a_cut_plate(table31_rig):
+    """The fab stage reports a bought part as {"process": "bought", "stock": ...} (no pieces, no plate):
+    the bill lists it with its stock (it used to read a cut plate's thickness and fail)."""
+    stock = "aluminium extrusion 40 x 40 mm, slot 8, cut to 292.0 mm"
+    rows = B.printed(table31_rig, {"parts": {"tower_column": {"process": "bought", "stock": stock, "quantity": 1}}})
+    assert rows == [{"part": "tower_column", "use": "rig", "quantity": 1, "process": "bought", "pieces": 0,
+                     "time_s": None, "material_g": None, "source": None, "note": stock}]

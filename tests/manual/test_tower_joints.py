@@ -60,18 +60,104 @@ def test_the_found_order_fits_the_tower_joints_and_a_blocked_tool_is_refused(rig
     assert [p.step.name for p in AC.check_order(a, names)] == names
 
 
-def test_the_nut_trap_holds_an_m4_nut_where_the_check_looks():
-    """The trap's side (tower.NUT_TRAP): the nut as the check sees it (a cylinder across its
-    corners) passes within CLEARANCE_MM in the 8.0 mm square; the old 7.2 mm square is refused."""
+def test_the_nut_trap_holds_an_m4_nut_where_the_check_looks(table31_rig):
+    """The trap (tower.NUT_TRAP, a hexagon 7.0 + 2 x 0.2 mm across flats, in the base plate's recipe)
+    and the nut as the check sees it (an ISO 4032 hexagon, 7 mm across flats, a corner on +x as the
+    trap holds it: 8.08 mm along x, 7.0 mm along y, closed form): the nut is clear of the trap; a trap
+    0.2 mm narrower than the nut is refused; the nut cannot turn in its trap."""
+    from rigcad.parts.recipe import HexPrism
+
     f = plan._socket_head("M4 bolt", (0.0, 0.0, 20.0), plan.DOWN, 20.0, 4.0, "M4", thread_in="nut",
                           nut_size_mm=(plan.NUT_AF["M4"] / np.sqrt(3.0), 3.2), grip_mm=14.0)
-    nut = AC.cylinder(np.array([0.0, 0.0, 6.0]), np.array([0.0, 0.0, -1.0]), 3.2, plan.NUT_AF["M4"] / np.sqrt(3.0))
+    nut = f.solids() - AC.cylinder(np.array([0.0, 0.0, 30.0]), np.array([0.0, 0.0, -1.0]), 40.0, 2.5)
+    lo, hi = np.array(nut.bounding_box()[:3]), np.array(nut.bounding_box()[3:])
+    assert hi[0] - lo[0] == pytest.approx(2 * 7.0 / np.sqrt(3.0), abs=1e-6)
+    assert hi[1] - lo[1] == pytest.approx(7.0, abs=1e-6)
+    traps = [c for c in _cuts(table31_rig.recipes["base_plate"].solid) if isinstance(c, HexPrism)]
+    assert len(traps) == 4 and all(c.across_flats == tower.NUT_TRAP == 7.4 for c in traps)
 
-    def trap(side):
-        h = side / 2
-        return _box((-20, -20, 0), (20, 20, 10)) - _box((-h, -h, -1), (h, h, 6.0)) - AC.cylinder(
+    def trap(across_flats):
+        pocket = AC.hex_prism(np.array([0.0, 0.0, -1.0]), np.array([0.0, 0.0, 1.0]), 7.0, across_flats / np.sqrt(3.0))
+        return _box((-20, -20, 0), (20, 20, 10)) - pocket - AC.cylinder(
             np.array([0.0, 0.0, 20.0]), np.array([0.0, 0.0, -1.0]), 30.0, 2.25)
 
-    assert AC.penetration(nut, trap(tower.NUT_TRAP)) <= AC.CLEARANCE_MM
-    assert AC.penetration(nut, trap(7.2)) > AC.CLEARANCE_MM
-    assert f.nut_size_mm[0] * 2 > tower.NUT_TRAP  # the corners meet the sides: the nut cannot turn
+    assert abs(AC.penetration(f.solids(), trap(tower.NUT_TRAP))) < 1e-6  # it touches the ceiling only
+    assert AC.penetration(f.solids(), trap(plan.NUT_AF["M4"] - 0.2)) > AC.CLEARANCE_MM
+    assert f.nut_size_mm[0] > tower.NUT_TRAP / 2  # its corners reach past the trap's flats: it cannot turn
+
+
+def _cuts(solid):
+    from rigcad.parts.recipe import Difference, Translate, Union_
+
+    if isinstance(solid, Difference):
+        yield from _cuts(solid.base)
+        yield from solid.cuts
+    elif isinstance(solid, Union_):
+        for s in solid.items:
+            yield from _cuts(s)
+    elif isinstance(solid, Translate):
+        yield from _cuts(solid.solid)
+
+
+@pytest.fixture(scope="module")
+def bought_assembly(tmp_path_factory):
+    import rigcad
+
+    path = tmp_path_factory.mktemp("bought") / "p.yaml"
+    path.write_text("extends: achutha2006\nbuy:\n  column: extrusion_40x40\n  shelf: aluminium_plate\n", encoding="utf-8")
+    rig = rigcad.load(path)
+    return rig, plan.assembly(rig, picture_meshes(rig))
+
+
+def test_the_bought_extrusions_core_screws_are_checked_and_a_blocked_one_is_refused(bought_assembly):
+    """The extrusion's M8 core screws sit on the column's axis, heads in the tongue's counterbore
+    and the shelf's countersink; their thread stops short of the core's tapped depth; the found order
+    fits them; a block over the shelf's screw before the shelf is refused, after it passes; the foot's
+    screw, put in from below, needs the rig on blocks (without them the bench blocks its tools)."""
+    rig, a = bought_assembly
+    t = rig.layout.tower
+    (foot,), (top,) = a.by_name["tower_column"].fasteners, a.by_name["tower_shelf"].fasteners
+    from rigcad.manual.calibration import film_setup
+    from rigcad.manual.document import step_text
+
+    lift = film_setup(rig)["block_under_tongue_mm"]
+    assert foot.lift_mm == lift and top.lift_mm == 0.0
+    text = step_text(AC.Placed(a.by_name["tower_column"], plan.DOWN), {m.name: m for m in picture_meshes(rig)})
+    assert f"lift the rig onto blocks {lift:g} mm high" in text
+    assert foot.head == pytest.approx((t.column_x, 0.0, t.bench_z + tower.CORE_HEAD_BORE[1]))
+    assert top.head == pytest.approx((t.column_x, 0.0, t.shelf_top_z - tower.CORE_TOP_SCREW[1]))
+    # engaged thread = length - what the screw passes (plate under the counterbore, minus the pocket)
+    engaged_foot = foot.length_mm - (-t.bench_z - tower.CORE_HEAD_BORE[1] - tower.POCKET_DEPTH)
+    engaged_top = top.length_mm - (t.shelf_thickness - tower.CORE_TOP_SCREW[1] - tower.POCKET_DEPTH)
+    for e in (engaged_foot, engaged_top):
+        assert 1.5 * 8.0 <= e <= tower.CORE_TAP_DEPTH - 1.0
+    order = [p.step.name for p in AC.find_order(a)]
+    # a lid over the shelf's screw, going down with the shelf (one step): in the way of the driver's
+    # 100 mm blade and of the L key's 28 mm short arm, in no part's way
+    x, y, _ = top.head
+    z = t.shelf_top_z
+    lid = _box((x - 10, y - 10, z + 20), (x + 10, y + 10, z + 26))
+    shelf = a.by_name["tower_shelf"]
+    import dataclasses
+
+    lidded = dataclasses.replace(shelf, members=(*shelf.members, "lid"))
+    b = AC.Assembly({**a.solids, "lid": lid}, [lidded if s.name == "tower_shelf" else s for s in a.steps])
+    with pytest.raises(GeometryError, match=r"tower_shelf.*M8 x 25 mm countersunk.*blocked by lid"):
+        AC.check_order(b, order)
+    high = _box((x - 10, y - 10, z + 130), (x + 10, y + 10, z + 136))  # beyond the blade: no harm
+    b = AC.Assembly({**a.solids, "lid": high}, [lidded if s.name == "tower_shelf" else s for s in a.steps])
+    assert [p.step.name for p in AC.check_order(b, order)] == order
+    col = a.by_name["tower_column"]
+    flat = dataclasses.replace(col, fasteners=(dataclasses.replace(foot, lift_mm=0.0),))
+    c = AC.Assembly(a.solids, [flat if s.name == "tower_column" else s for s in a.steps])
+    with pytest.raises(GeometryError, match=r"tower_column.*M8 x 20 mm socket-head.*blocked by the bench"):
+        AC.check_order(c, order)
+
+
+def test_the_bought_columns_screws_go_in_the_hardware_once(bought_assembly):
+    rig, a = bought_assembly
+    rows = [h for h in tower.hardware(rig.profile, rig.layout) if h.get("thread") == "M8"]
+    assert len(rows) == 2 and all(tower_joints.placed(h) for h in rows)
+    table = plan.hardware(a.steps, rig)
+    m8 = [r for r in table if r["item"].startswith("M8")]
+    assert sorted(r["quantity"] for r in m8) == [1, 1] and not any("M8 washer" in r["item"] for r in table)

@@ -60,18 +60,18 @@ def test_a_bought_extrusion_and_plate_change_the_chain(write_profile, table31_te
 
 
 def test_the_tongue_stands_on_the_bench_with_nut_traps(table31_rig):
-    # the tower's weight goes into the bench: the tongue's underside is the bench level, and a 7 mm
-    # (across flats) M4 nut fits each trap under a column bolt, 0.1 mm clear each side
+    # the tower's weight goes into the bench: the tongue's underside is the bench level, and an M4 nut
+    # (ISO 4032: a hexagon 7 mm across flats) fits each trap under a column bolt, 0.2 mm clear each flat
     import manifold3d as m3d
 
     from rigcad.export import mesh as M
-    from rigcad.parts.recipe import Box
-    from rigcad.parts.tower import NUT_TRAP_DEPTH, _column_flange_points
+    from rigcad.parts.recipe import HexPrism
+    from rigcad.parts.tower import NUT_TRAP_DEPTH, NUT_TRAP_TURN, _column_flange_points
 
     t = table31_rig.layout.tower
     plate = M.build(table31_rig.recipe("base_plate").solid, 0.05)
     assert plate.bounding_box()[2] == pytest.approx(t.bench_z, abs=1e-9)
     for x, y in _column_flange_points(t, table31_rig.profile):
-        nut = M.build(Box((x - 3.5, y - 3.5, t.bench_z + 0.01), (x + 3.5, y + 3.5, t.bench_z + NUT_TRAP_DEPTH - 0.01)), 0.05)
+        nut = M.build(HexPrism((x, y, t.bench_z + 0.01), 7.0, NUT_TRAP_DEPTH - 0.02, NUT_TRAP_TURN), 0.05)
         assert (plate ^ nut).volume() < 1e-9
         assert (plate ^ nut).status() == m3d.Error.NoError

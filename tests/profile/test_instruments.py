@@ -42,3 +42,27 @@ def test_an_unknown_model_is_refused_with_the_valid_names(write_profile, table31
     with pytest.raises(ProfileError) as info:
         load_profile(write_profile(table31_text + "projector:\n  model: benq_mw632\n"))
     assert "projector.model" in str(info.value) and "benq_mw632st" in str(info.value)
+
+
+def test_each_measurement_sketch_draws_its_dimension_at_the_profiles_value(table31, write_profile, table31_text):
+    """The figure's dimension runs between two points whose distance is the size itself (the
+    profile's assumed value, not the sketch's arithmetic); a thread is a call-out at one hole; the
+    camera's two holes are mount_spacing apart; a profile's own value moves the drawing."""
+    import math
+
+    from rigcad.profile.instruments import sketch
+
+    for m in measurements(table31):
+        s = sketch(table31, m)
+        (x0, y0), (x1, y1) = s.dimension
+        if isinstance(m.assumed, str):
+            assert (x0, y0) == (x1, y1) and m.assumed in s.label  # a call-out naming the assumed thread
+            continue
+        assert math.hypot(x1 - x0, y1 - y0) == pytest.approx(m.assumed, abs=1e-9), m.key
+        assert f"{m.assumed:g} mm" in s.label
+    holes = [c for c in sketch(table31, next(m for m in measurements(table31) if m.key == "camera.mount_spacing")).circles]
+    assert abs(holes[1][1][0] - holes[0][1][0]) == pytest.approx(table31.camera.mount_spacing)
+    prof = load_profile(write_profile(table31_text + "projector:\n  pupil_lateral: 12 mm\n", "lateral"))
+    top = sketch(prof, next(m for m in measurements(table31) if m.key == "projector.pupil_lateral"))
+    (_, a), (_, b) = top.dimension
+    assert abs(b - a) == pytest.approx(12.0)
