@@ -685,3 +685,40 @@ def test_an_rk45_tolerance_no_rows_can_meet_is_refused_before_integrating(write_
     path = write_profile(table31_text + "dome:\n  method: rk45\n  tolerance: 1e-6 mm\n")
     with pytest.raises(ProfileError, match=r"dome\.tolerance = 1e-06 mm is looser than this rig's dome can be"):
         Rig.from_profile(load_profile(path))
+
+
+def test_profile_entry_names_the_profile_its_files_and_every_parameter(table31):
+    from rigcad.optics.design import profile_entry
+
+    e = profile_entry(table31)
+    assert list(e) == ["name", "sources", "parameters"]
+    assert e["name"] == "achutha2006" and e["sources"] == list(table31.sources) and e["parameters"] == table31.as_dict()
+
+
+def test_the_refused_openings_name_their_figures_and_the_cop_line(write_profile, table31_text):
+    from rigcad.optics.design import cop_bundle_radius
+
+    # the top opening cutting the bundle (as test_top_opening_cutting_the_projector_bundle_is_refused)
+    path = write_profile(table31_text.replace("2.25 cm", "2.5 mm").replace("13.5 cm", "1 m"))
+    rig = Rig.from_profile(load_profile(path))
+    end = rig.dome.points[-1]
+    bundle = cop_bundle_radius(rig.geometry, float(end[1]), rig.profile.projector.aperture)
+    with pytest.raises(GeometryError) as e:
+        rig.design
+    assert e.value.message == (
+        f"the dome's top opening (radius {end[0]:.2f} mm at z = {end[1]:.1f} mm) would cut the projector's ray bundle "
+        f"(radius {bundle:.2f} mm there): increase layout.cop_to_vertex")
+    assert e.value.where.endswith("p.yaml:5")  # layout.cop_to_vertex's line
+    # the COP inside the dome (as test_cop_inside_the_dome_is_refused)
+    rig = Rig.from_profile(load_profile(write_profile(table31_text.replace("27 cm", "1 cm"), "q")))
+    with pytest.raises(GeometryError) as e:
+        rig.design
+    top = rig.dome.points[np.argmax(rig.dome.points[:, 1])]
+    assert e.value.message == (f"the centre of projection (z = {rig.geometry.cop_z:.1f} mm) lies inside the dome (top at "
+                               f"{top[1]:.1f} mm): increase layout.cop_to_vertex")
+    assert e.value.where.endswith("q.yaml:5")
+
+
+def test_a_millimetre_aperture_is_checked_as_a_thin_lens(write_profile, table31_text):
+    d = _design_of(write_profile, table31_text + "projector:\n  aperture: 0.5 mm\n")
+    assert d.thin_lens is not None and d.report["thin_lens"] == d.thin_lens.summary()
