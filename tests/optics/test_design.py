@@ -290,3 +290,435 @@ def test_no_misalignment_offsets_and_tilts_nothing_about_the_meridional_normal()
     assert set(m.offsets) == set(m.tilts) == set(m.axes) == set(COMPONENTS)
     for c in COMPONENTS:
         assert m.offsets[c] == (0.0, 0.0, 0.0) and m.tilts[c] == 0.0 and m.axes[c] == (0.0, 1.0, 0.0), c
+
+
+# --- the design stage's helpers against figures written out by hand ---------------------------------
+
+def test_cop_bundle_radius_runs_from_the_rim_to_the_lens_aperture():
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import cop_bundle_radius
+
+    geo = SimpleNamespace(cop_at_infinity=False, rim_z=135.0, cop_z=435.0, rim_radius=16.0)
+    assert cop_bundle_radius(geo, 135.0, 6.0) == 16.0
+    assert cop_bundle_radius(geo, 435.0, 6.0) == 3.0  # half the aperture at the COP
+    assert cop_bundle_radius(geo, 235.0, 6.0) == pytest.approx(16.0 * 2 / 3 + 3.0 / 3, rel=1e-15)
+    far = SimpleNamespace(cop_at_infinity=True, rim_z=135.0, cop_z=math.inf, rim_radius=16.0)
+    assert cop_bundle_radius(far, 300.0, 6.0) == 16.0
+
+
+@pytest.mark.parametrize("count, half", [(8, 4), (9, 4), (1, 1)])
+def test_chief_rays_aim_at_the_cells_of_the_useful_annulus_on_both_sides(table31_geometry, count, half):
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import chief_rays
+    from rigcad.optics.paraboloid import Paraboloid
+
+    g = table31_geometry
+    para = Paraboloid(g.focal_length, g.vertex_z, g.rim_radius)
+    dome = SimpleNamespace(occlusion_s=2.0)
+    origins, dirs = chief_rays(g, para, dome, count)
+    cell = (g.rim_radius - 2.0) / half
+    x = 2.0 + cell * (np.arange(half) + 0.5)
+    x = np.concatenate([-x[::-1], x])
+    P = np.column_stack([x, g.vertex_z - x * x / (4 * g.focal_length)])
+    C = np.array([0.0, g.cop_z])
+    assert origins.shape == (2 * half, 2) and np.array_equal(origins, np.tile(C, (2 * half, 1)))
+    want = (P - C) / np.linalg.norm(P - C, axis=1, keepdims=True)
+    assert np.max(np.abs(dirs - want)) < 1e-15 * 10
+
+
+def test_chief_rays_from_a_cop_at_infinity_come_straight_down(table31_geometry):
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import chief_rays
+    from rigcad.optics.paraboloid import Paraboloid
+
+    g = replace(table31_geometry, cop_z=math.inf)
+    para = Paraboloid(g.focal_length, g.vertex_z, g.rim_radius)
+    origins, dirs = chief_rays(g, para, SimpleNamespace(occlusion_s=2.0), 4)
+    cell = (g.rim_radius - 2.0) / 2
+    x = np.array([-2.0 - 1.5 * cell, -2.0 - 0.5 * cell, 2.0 + 0.5 * cell, 2.0 + 1.5 * cell])
+    assert np.max(np.abs(origins[:, 0] - x)) < 1e-14 * 20 and np.all(origins[:, 1] == g.vertex_z + 1.0)
+    assert np.array_equal(dirs, np.tile([0.0, -1.0], (4, 1)))
+
+
+def test_profile_table_columns_are_the_traced_geometry(rig):
+    from rigcad.optics.design import profile_table
+
+    g, dome = rig.geometry, rig.dome
+    tab = profile_table(g, dome)
+    s = dome.s
+    z = g.vertex_z - s * s / (4 * g.focal_length)
+    assert np.array_equal(tab["paraboloid_r_mm"], s)
+    assert np.max(np.abs(tab["paraboloid_z_mm"] - z)) < 1e-12 * g.vertex_z
+    assert np.array_equal(tab["dome_r_mm"], dome.points[:, 0]) and np.array_equal(tab["dome_z_mm"], dome.points[:, 1])
+    assert np.array_equal(tab["reflected_distance_mm"], dome.t)
+    assert np.max(np.abs(tab["incidence_theta_deg"] - np.degrees(dome.theta))) < 1e-12
+    alpha = np.arctan2(s, g.cop_z - z)
+    assert np.max(np.abs(tab["cop_angle_deg"] - np.degrees(alpha))) < 1e-12
+    assert np.max(np.abs(tab["projector_pixel"] - 1792.0 * np.tan(alpha))) < 1e-9
+    # COP -> paraboloid -> dome -> O: the same optical path on every row (the equal-path dome)
+    path = np.hypot(s, g.cop_z - z) + dome.t + np.linalg.norm(dome.points, axis=1)
+    assert np.max(np.abs(tab["optical_path_mm"] - path)) < 1e-9
+    assert np.max(np.abs(tab["optical_path_mm"] - dome.path_length)) < 1e-6
+
+
+def test_a_far_cop_profile_table_has_no_pixels_and_a_vertical_source(far_design):
+    from rigcad.optics.design import profile_table
+
+    g, dome = far_design.geometry, far_design.dome
+    tab = profile_table(g, dome)
+    z = g.vertex_z - dome.s ** 2 / (4 * g.focal_length)
+    assert np.all(np.isnan(tab["projector_pixel"])) and np.array_equal(tab["cop_angle_deg"], np.zeros_like(dome.s))
+    # from the plane of the vertex straight down to the paraboloid, then as above
+    path = (g.vertex_z - z) + dome.t + np.linalg.norm(dome.points, axis=1)
+    assert np.max(np.abs(tab["optical_path_mm"] - path)) < 1e-9
+
+
+@pytest.fixture(scope="module")
+def far_design(tmp_path_factory, table31_text):
+    path = tmp_path_factory.mktemp("far") / "far.yaml"
+    path.write_text(table31_text.replace("27 cm", "inf"))
+    return Rig.from_profile(load_profile(path))
+
+
+def test_stat_ignores_nan_and_has_none_of_nothing():
+    from rigcad.optics.design import _stat
+
+    assert _stat(np.array([3.0, np.nan, -1.0, 2.0])) == {"min": -1.0, "max": 3.0}
+    empty = _stat(np.array([np.nan, np.nan]))
+    assert set(empty) == {"min", "max"} and math.isnan(empty["min"]) and math.isnan(empty["max"])
+    assert isinstance(_stat(np.array([1, 2]))["min"], float)
+
+
+def _hand_trace(status, miss, path):
+    from rigcad.optics.trace2d import Trace
+
+    n = len(status)
+    z = np.zeros((n, 2))
+    return Trace(np.array(status), z, z, np.array(miss, float), np.zeros(n), np.zeros(n), np.array(path, float))
+
+
+def test_convergence_figures_of_a_hand_trace():
+    from rigcad.optics.design import _convergence
+    from rigcad.optics.trace2d import STATUS_NAMES
+
+    codes = {name: code for code, name in STATUS_NAMES.items()}
+    tr = _hand_trace([0, 0, codes["missed_dome"], codes["escaped"], 0, codes["escaped"]],
+                     [0.1, -0.2, 5.0, 7.0, 0.2, 9.0], np.zeros(6))
+    c = _convergence(tr)
+    assert c["rays"] == 6 and c["rays_ok"] == 3
+    assert c["rays_lost"] == {"missed_paraboloid": 0, "missed_dome": 1, "occluded_by_paraboloid": 0, "escaped": 2}
+    assert c["rms_miss_mm"] == pytest.approx(math.sqrt((0.01 + 0.04 + 0.04) / 3), rel=1e-14)
+    assert c["max_miss_mm"] == pytest.approx(0.2, rel=1e-15)
+    assert c["note"].startswith("miss = distance from O to each returning ray")
+    lost = _convergence(_hand_trace([codes["escaped"]] * 2, [1.0, 2.0], [0.0, 0.0]))
+    assert lost["rays_ok"] == 0 and lost["rms_miss_mm"] is None and lost["max_miss_mm"] is None
+
+
+def test_paths_of_a_hand_design():
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import _paths
+
+    dome = SimpleNamespace(path_length=50.0, t=np.array([10.0, 12.0]), points=np.array([[3.0, 4.0], [6.0, 8.0]]))
+    table = {"optical_path_mm": np.array([50.0, 49.0])}
+    tr = _hand_trace([0, 0, 1], [0.0, 0.0, 0.0], [50.0, 50.5, 99.0])
+    p = _paths(dome, table, tr)
+    assert p["optical_path_mm"] == 50.0
+    assert p["chief_ray_path_spread_mm"] == pytest.approx(0.5, rel=1e-15)  # the lost ray not counted
+    assert p["cop_to_paraboloid_mm"] == {"min": 27.0, "max": 35.0}  # 50 - 10 - 5, 49 - 12 - 10
+    assert p["paraboloid_to_dome_mm"] == {"min": 10.0, "max": 12.0}
+    assert p["dome_to_sample_mm"] == {"min": 5.0, "max": 10.0}
+    assert _paths(dome, table, _hand_trace([1, 1], [0.0, 0.0], [1.0, 2.0]))["chief_ray_path_spread_mm"] is None
+
+
+def test_measurable_range_against_the_targets():
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import _measurable_range
+    from rigcad.units import DEG
+
+    def rng(theta_lo, theta_hi):
+        profile = SimpleNamespace(targets=SimpleNamespace(theta_min=9 * DEG, theta_max=90 * DEG))
+        dome = SimpleNamespace(theta=np.array([theta_hi, 0.5 * (theta_lo + theta_hi), theta_lo]))
+        return _measurable_range(profile, SimpleNamespace(occlusion_theta=7 * DEG), dome)
+
+    r = rng(8 * DEG, 90 * DEG)
+    assert r["theta_min_deg"] == pytest.approx(8.0, rel=1e-14) and r["theta_max_deg"] == pytest.approx(90.0, rel=1e-14)
+    assert r["occlusion_theta_deg"] == pytest.approx(7.0, rel=1e-14)
+    assert r["target_theta_min_deg"] == pytest.approx(9.0, rel=1e-14)
+    assert r["target_theta_max_deg"] == pytest.approx(90.0, rel=1e-14)
+    assert r["targets_met"] is True
+    # grazing to float precision reaches 90 deg: 5e-10 rad short does, 2e-9 rad short does not
+    assert rng(8 * DEG, 90 * DEG - 5e-10)["targets_met"] and not rng(8 * DEG, 90 * DEG - 2e-9)["targets_met"]
+    # the smallest angle must reach the target's: 1e-13 rad above it does, 1e-10 rad does not
+    assert rng(9 * DEG + 1e-13, 90 * DEG)["targets_met"] and not rng(9 * DEG + 1e-10, 90 * DEG)["targets_met"]
+    assert not rng(10 * DEG, 90 * DEG)["targets_met"] and not rng(8 * DEG, 80 * DEG)["targets_met"]
+
+
+def test_pixels_per_degree_of_a_hand_table():
+    from types import SimpleNamespace
+
+    from rigcad.optics.design import _pixels
+    from rigcad.units import DEG
+
+    theta_deg = np.linspace(10.0, 40.0, 31)  # 1 deg apart
+    dome = SimpleNamespace(theta=theta_deg * DEG)
+    profile = SimpleNamespace(projector=SimpleNamespace(resolution=(1024, 768)))
+    geo = SimpleNamespace(cop_at_infinity=False, projector_focal_px=1792.0, pixels_vertex_to_rim=100.25)
+    # pixel = 0.1 theta^2 (theta in deg): d pixel / d theta = 0.2 theta, central differences exact
+    # inside, one-sided at the ends (0.2 theta_0 + 0.1, 0.2 theta_n - 0.1)
+    p = _pixels(profile, geo, dome, {"projector_pixel": 0.1 * theta_deg ** 2})
+    assert p["projector_resolution"] == [1024, 768] and p["projector_focal_px"] == 1792.0
+    assert p["vertex_to_rim_px"] == 100.25
+    assert p["useful_px"] == pytest.approx(0.1 * (1600 - 100), rel=1e-13)
+    assert p["px_per_deg_mean"] == pytest.approx(150.0 / 30.0, rel=1e-13)
+    assert p["px_per_deg_min"] == pytest.approx(2.1, rel=1e-12) and p["px_per_deg_max"] == pytest.approx(7.9, rel=1e-12)
+    # theta 0.5 deg apart: the derivative is per degree, not per row (0.2 theta, ends one-sided)
+    half = np.linspace(10.0, 25.0, 31)
+    p = _pixels(profile, geo, SimpleNamespace(theta=half * DEG), {"projector_pixel": 0.1 * half ** 2})
+    assert p["px_per_deg_min"] == pytest.approx(2.05, rel=1e-12) and p["px_per_deg_max"] == pytest.approx(4.95, rel=1e-12)
+    # a falling pixel count counts by its size
+    p = _pixels(profile, geo, dome, {"projector_pixel": -3.0 * theta_deg})
+    assert p["px_per_deg_min"] == pytest.approx(3.0, rel=1e-12) and p["px_per_deg_max"] == pytest.approx(3.0, rel=1e-12)
+    far = _pixels(profile, SimpleNamespace(cop_at_infinity=True, projector_focal_px=1792.0, pixels_vertex_to_rim=math.nan),
+                  dome, {"projector_pixel": np.full(31, np.nan)})
+    assert all(far[k] is None for k in ("vertex_to_rim_px", "useful_px", "px_per_deg_mean", "px_per_deg_min",
+                                        "px_per_deg_max"))
+    assert far["projector_resolution"] == [1024, 768]
+
+
+def test_a_dome_tolerance_no_rows_can_meet_is_refused_with_what_to_ask(write_profile, table31_text):
+    from rigcad.errors import ProfileError
+    from rigcad.optics.design import CURVE_MISS_RTOL, TOLERANCE_SHARE
+    from rigcad.optics.dome import start
+    from rigcad.profile import derive
+
+    path = write_profile(table31_text + "dome:\n  method: dop853\n  tolerance: 1e-6 mm\n")
+    profile = load_profile(path)
+    with pytest.raises(ProfileError) as e:
+        Rig.from_profile(profile)
+    L = start(derive(profile)).path_length  # the rim ray's path, COP to O
+    need = TOLERANCE_SHARE * CURVE_MISS_RTOL * L
+    assert e.value.message == (
+        f"dome.tolerance = 1e-06 mm is looser than this rig's dome can be: its curve must return every chief ray "
+        f"to O within {CURVE_MISS_RTOL:g} of the {L:.0f} mm optical path ({2 * need:.2g} mm); ask for a tolerance "
+        f"well below that, e.g. {need / 10:.1g} mm, or leave it unset")
+    assert e.value.where.endswith("p.yaml:9")  # the tolerance's line
+
+
+def test_the_report_is_the_stages_figures_under_their_keys(rig, design):
+    """run_design's report, key by key, against the figures it gathers (each checked elsewhere)."""
+    from rigcad.optics.design import chief_rays, cop_bundle_radius, profile_entry, profile_table, run_design
+    from rigcad.optics.misalignment import COMPONENT_OFFSETS, offsets_for
+
+    steps = []
+    d = run_design(rig, progress=steps.append)
+    assert steps == ["chief rays", "thin lens", "misalignment"]
+    r, dome, g, prof = d.report, rig.dome, rig.geometry, rig.profile
+    assert list(r) == ["profile", "frame", "paraboloid", "dome", "measurable_range", "envelope", "top_aperture",
+                       "paths", "pixels", "convergence", "thin_lens", "misalignment"]
+    assert r["profile"] == profile_entry(prof) and r["profile"]["name"] == "achutha2006"
+    assert r["frame"] == "meridional plane; sample point O at the origin; optical axis +z; lengths mm"
+    assert r["paraboloid"] == g.as_dict()
+    assert r["dome"] == {"method": "dop853", "kind": "smooth", "tolerance_mm": dome.tolerance, "points": len(dome.s),
+                         "error_estimate_mm": dome.error_estimate, "error_vs_equal_path_mm": dome.error_vs_equal_path,
+                         "stats": dome.stats, "start_r_mm": float(dome.points[0, 0]),
+                         "end_paraboloid_r_mm": dome.occlusion_s}
+    width, height = 2 * dome.points[:, 0].max(), dome.points[:, 1].max()
+    assert r["envelope"] == {"width_mm": width, "height_mm": height, "base_radius_mm": float(dome.points[0, 0]),
+                             "width_in": width / 25.4, "height_in": height / 25.4,
+                             "note": "mirror (design) surface; the printed part adds coating and wall"}
+    end = dome.points[-1]
+    bundle = cop_bundle_radius(g, float(end[1]), prof.projector.aperture)
+    assert r["top_aperture"] == {"radius_mm": float(end[0]), "z_mm": float(end[1]),
+                                 "projector_bundle_radius_mm": bundle, "clearance_mm": float(end[0] - bundle)}
+    assert r["thin_lens"] == d.thin_lens.summary()
+    m = r["misalignment"]
+    assert m["probe_mm"] == prof.misalignment.probe == 1.0
+    assert m["note"] == "camera and projector share the COP: a pinhole offset of either moves the same rays"
+    assert list(m["sensitivity"]) == list(COMPONENT_OFFSETS)
+    for name in COMPONENT_OFFSETS:
+        traced = misaligned_trace(d.paraboloid, d.curve, d.chief_origins, d.chief_dirs, offsets_for(name, 1.0))
+        assert m["sensitivity"][name] == convergence_error(traced, d.aligned)
+    mis = prof.misalignment
+    assert m["declared"] == {}  # the shipped profile declares no offsets
+    # the Design's fields
+    assert d.profile is prof and d.geometry is g and d.paraboloid is rig.paraboloid and d.dome is dome
+    assert d.curve is rig.curve
+    o, u = chief_rays(g, rig.paraboloid, dome, mis.rays)
+    assert np.array_equal(d.chief_origins, o) and np.array_equal(d.chief_dirs, u) and len(o) == 400
+    tab = profile_table(g, dome)
+    assert list(d.table) == list(tab) and all(np.array_equal(d.table[k], tab[k], equal_nan=True) for k in tab)
+    assert np.array_equal(d.aligned.miss, design.aligned.miss)
+
+
+def test_without_an_aperture_there_is_no_thin_lens_check(write_profile, table31_text):
+    d = _design_of(write_profile, table31_text + "projector:\n  aperture: 0 mm\n")
+    assert d.thin_lens is None and d.report["thin_lens"] is None
+    assert d.report["convergence"]["rays_ok"] == d.report["convergence"]["rays"]
+
+
+@pytest.mark.parametrize("declared, paths", [("camera_dx: 0.5 mm", {"camera_path"}),
+                                             ("projector_dz: 0.4 mm", {"projector_path"}),
+                                             ("dome_dx: 0.2 mm", {"camera_path", "projector_path"}),
+                                             ("paraboloid_dx: 0.3 mm", {"camera_path", "projector_path"})])
+def test_declared_offsets_are_traced_for_each_light_path(write_profile, table31_text, declared, paths):
+    d = _design_of(write_profile, table31_text + "misalignment:\n  rays: 41\n  " + declared + "\n")
+    mis = d.profile.misalignment
+    got = d.report["misalignment"]["declared"]
+    assert set(got) == paths
+    for device in ("projector", "camera"):
+        off = Offsets(cop_dx=getattr(mis, f"{device}_dx"), cop_dz=getattr(mis, f"{device}_dz"),
+                      paraboloid_dx=mis.paraboloid_dx, dome_dx=mis.dome_dx)
+        if device + "_path" in paths:
+            traced = misaligned_trace(d.paraboloid, d.curve, d.chief_origins, d.chief_dirs, off)
+            assert got[device + "_path"] == convergence_error(traced, d.aligned)
+            assert got[device + "_path"]["max_miss_mm"] > 1e-4  # a real offset misses O (a COP dz by ~1e-3 mm)
+
+
+def test_dome_rows_double_until_the_curve_returns_every_chief_ray(write_profile, table31_text):
+    """converged_dome: 31 rows, then 61, then 121 (2n - 1: the old rows kept), the first whose
+    spline returns every chief ray to O within CURVE_MISS_RTOL of the optical path."""
+    from rigcad.optics.design import CURVE_MISS_RTOL, chief_rays
+    from rigcad.optics.dome import build_dome
+    from rigcad.optics.trace2d import DomeCurve, trace
+
+    rig = Rig.from_profile(load_profile(write_profile(table31_text + "dome:\n  table_rows: 31\n")))
+    assert len(rig.dome.s) == 121
+    g, dp = rig.geometry, rig.profile.dome
+    for rows, meets in ((121, True), (61, False)):
+        dome = build_dome(g, dp.method, tolerance=dp.tolerance, rows=rows)
+        o, u = chief_rays(g, rig.paraboloid, dome, rig.profile.misalignment.rays)
+        tr = trace(rig.paraboloid, DomeCurve.from_profile(dome), o, u)
+        assert (np.abs(tr.miss[tr.ok]).max() <= CURVE_MISS_RTOL * dome.path_length) == meets
+    # the thesis's polyline is taken as it is: no curve to check
+    euler = Rig.from_profile(load_profile(write_profile(table31_text + "dome:\n  method: euler\n  euler_steps: 300\n",
+                                                        "e")))
+    assert euler.dome.kind == "polyline" and euler.dome.method == "euler"
+    # the profile's 300 Euler steps across the rim radius, not the default 2000
+    assert euler.dome.stats["step_mm"] == pytest.approx(euler.geometry.rim_radius / 300, rel=1e-12)
+
+
+def test_a_design_measuring_under_a_degree_is_refused(write_profile, table31_text):
+    # the rim 0.1 mm above the sample plane: theta from atan2(rim radius, 0.1 mm) = 89.65 deg to 90
+    g_ok = Rig.from_profile(load_profile(write_profile(table31_text.replace("13.5 cm", "0.3 mm"), "ok")))
+    assert 1.0 < np.degrees(np.ptp(g_ok.dome.theta)) < 1.1  # 0.3 mm: a degree and a bit, accepted
+    path = write_profile(table31_text.replace("13.5 cm", "0.1 mm"))
+    with pytest.raises(GeometryError) as e:
+        Rig.from_profile(load_profile(path))
+    from rigcad.profile import derive
+
+    lo = math.degrees(math.atan2(derive(load_profile(path)).rim_radius, 0.1))
+    assert e.value.message == (
+        f"the design measures only {90 - lo:.3g} deg of incidence angle (theta {lo:.2f}..90.00 deg): the "
+        "paraboloid's rim is too close to the sample plane or its rim ray too flat; raise layout.sample_to_rim or "
+        "lower paraboloid.tangent_angle")
+    assert e.value.where.endswith("p.yaml:6")  # layout.sample_to_rim's line
+
+
+def _traced_miss(rig, rows, tolerance=None):
+    """The largest miss (mm) of the chief rays against the spline of a dome of ``rows`` rows (the
+    profile's method; its tolerance unless ``tolerance`` is given) and the dome's optical path."""
+    from rigcad.optics.design import chief_rays
+    from rigcad.optics.dome import build_dome
+    from rigcad.optics.trace2d import DomeCurve, trace
+
+    g, dp = rig.geometry, rig.profile.dome
+    dome = build_dome(g, dp.method, tolerance=tolerance or dp.tolerance, rows=rows)
+    o, u = chief_rays(g, rig.paraboloid, dome, rig.profile.misalignment.rays)
+    tr = trace(rig.paraboloid, DomeCurve.from_profile(dome), o, u)
+    return float(np.abs(tr.miss[tr.ok]).max()), dome.path_length
+
+
+def test_rows_stop_at_the_cap_naming_the_miss(write_profile, table31_text, monkeypatch):
+    from rigcad.optics import design as design_module
+
+    monkeypatch.setattr(design_module, "MAX_ROWS", 61)  # 31 rows, then 61: the cap, still missing
+    path = write_profile(table31_text + "dome:\n  table_rows: 31\n")
+    with pytest.raises(GeometryError) as e:
+        Rig.from_profile(load_profile(path))
+    worst, _ = _traced_miss(Rig.from_profile(load_profile(write_profile(table31_text, "plain"))), 61)
+    assert e.value.message == (
+        f"the dome's curve still misses the sample point by {worst:.2g} mm with 61 rows: the design is too close to "
+        "degenerate to build reliably; change layout.sample_to_rim or paraboloid.tangent_angle")
+    assert e.value.where.endswith("p.yaml:8")  # dome.table_rows's line
+
+
+def test_a_tolerance_whose_rows_stall_is_refused_with_what_to_ask(write_profile, table31_text):
+    """dome.tolerance 1e-7 mm: the integrator's error, not the rows, limits the curve; doubling the
+    rows no longer halves the miss (measured here by tracing both row counts)."""
+    import re
+
+    from rigcad.errors import ProfileError
+    from rigcad.optics.design import CURVE_MISS_RTOL, STALL_RATIO
+
+    text = table31_text + "dome:\n  tolerance: 1e-7 mm\n  table_rows: 31\n"
+    with pytest.raises(ProfileError) as e:
+        Rig.from_profile(load_profile(write_profile(text)))
+    m = re.fullmatch(r"dome\.tolerance = 1e-07 mm leaves the dome's curve (\S+) mm off the sample point however many "
+                     r"rows it has \((\S+) mm with half as many\); the curve needs (\S+) mm: ask for dome\.tolerance "
+                     r"<= (\S+) mm, or leave it unset", e.value.message)
+    assert m, e.value.message
+    assert e.value.where.endswith("p.yaml:8")  # dome.tolerance's line
+    # the two row counts: 31 x 2^k - (2^k - 1) and half of it; find the pair by tracing
+    rig = Rig.from_profile(load_profile(write_profile(table31_text, "plain")))
+    rows, prev = 31, None
+    while True:
+        worst, path = _traced_miss(rig, rows, tolerance=1e-7)
+        need = CURVE_MISS_RTOL * path
+        if worst <= need:
+            raise AssertionError(f"{rows} rows meet the requirement: no stall")
+        if prev is not None and worst > STALL_RATIO * prev:
+            break
+        prev, rows = worst, 2 * rows - 1
+    assert m.group(1) == f"{worst:.2g}" and m.group(2) == f"{prev:.2g}" and m.group(3) == f"{need:.2g}"
+    assert m.group(4) == f"{1e-7 * need / worst / 2:.1g}"
+
+
+def test_an_rk45_tolerance_no_rows_can_meet_is_refused_before_integrating(write_profile, table31_text):
+    from rigcad.errors import ProfileError
+
+    path = write_profile(table31_text + "dome:\n  method: rk45\n  tolerance: 1e-6 mm\n")
+    with pytest.raises(ProfileError, match=r"dome\.tolerance = 1e-06 mm is looser than this rig's dome can be"):
+        Rig.from_profile(load_profile(path))
+
+
+def test_profile_entry_names_the_profile_its_files_and_every_parameter(table31):
+    from rigcad.optics.design import profile_entry
+
+    e = profile_entry(table31)
+    assert list(e) == ["name", "sources", "parameters"]
+    assert e["name"] == "achutha2006" and e["sources"] == list(table31.sources) and e["parameters"] == table31.as_dict()
+
+
+def test_the_refused_openings_name_their_figures_and_the_cop_line(write_profile, table31_text):
+    from rigcad.optics.design import cop_bundle_radius
+
+    # the top opening cutting the bundle (as test_top_opening_cutting_the_projector_bundle_is_refused)
+    path = write_profile(table31_text.replace("2.25 cm", "2.5 mm").replace("13.5 cm", "1 m"))
+    rig = Rig.from_profile(load_profile(path))
+    end = rig.dome.points[-1]
+    bundle = cop_bundle_radius(rig.geometry, float(end[1]), rig.profile.projector.aperture)
+    with pytest.raises(GeometryError) as e:
+        rig.design
+    assert e.value.message == (
+        f"the dome's top opening (radius {end[0]:.2f} mm at z = {end[1]:.1f} mm) would cut the projector's ray bundle "
+        f"(radius {bundle:.2f} mm there): increase layout.cop_to_vertex")
+    assert e.value.where.endswith("p.yaml:5")  # layout.cop_to_vertex's line
+    # the COP inside the dome (as test_cop_inside_the_dome_is_refused)
+    rig = Rig.from_profile(load_profile(write_profile(table31_text.replace("27 cm", "1 cm"), "q")))
+    with pytest.raises(GeometryError) as e:
+        rig.design
+    top = rig.dome.points[np.argmax(rig.dome.points[:, 1])]
+    assert e.value.message == (f"the centre of projection (z = {rig.geometry.cop_z:.1f} mm) lies inside the dome (top at "
+                               f"{top[1]:.1f} mm): increase layout.cop_to_vertex")
+    assert e.value.where.endswith("q.yaml:5")
+
+
+def test_a_millimetre_aperture_is_checked_as_a_thin_lens(write_profile, table31_text):
+    d = _design_of(write_profile, table31_text + "projector:\n  aperture: 0.5 mm\n")
+    assert d.thin_lens is not None and d.report["thin_lens"] == d.thin_lens.summary()
