@@ -722,3 +722,47 @@ def test_the_refused_openings_name_their_figures_and_the_cop_line(write_profile,
 def test_a_millimetre_aperture_is_checked_as_a_thin_lens(write_profile, table31_text):
     d = _design_of(write_profile, table31_text + "projector:\n  aperture: 0.5 mm\n")
     assert d.thin_lens is not None and d.report["thin_lens"] == d.thin_lens.summary()
+
+
+def test_a_design_whose_chief_rays_all_miss_is_refused_with_their_losses(write_profile, table31_text, monkeypatch):
+    """No layout the loader accepts loses every chief ray (earlier checks refuse those first), so
+    the trace is made to lose them: 2 rays miss the dome, the rest are occluded by the paraboloid."""
+    import dataclasses
+
+    from rigcad.optics import design as design_module
+    from rigcad.optics.trace2d import MISSED_DOME, OCCLUDED
+
+    real = design_module.trace
+    traced = []
+
+    def lost(para, curve, origins, dirs):
+        tr = real(para, curve, origins, dirs)
+        traced.append(len(origins))
+        status = np.full_like(tr.status, OCCLUDED)
+        status[:2] = MISSED_DOME
+        return dataclasses.replace(tr, status=status)
+
+    rig = Rig.from_profile(load_profile(write_profile(table31_text)))
+    monkeypatch.setattr(design_module, "trace", lost)
+    with pytest.raises(GeometryError) as e:
+        rig.design
+    n = traced[0]  # the chief rays traced
+    assert e.value.message == (
+        "no chief ray of the design returns to the sample point ({'missed_paraboloid': 0, 'missed_dome': 2, "
+        f"'occluded_by_paraboloid': {n - 2}, 'escaped': 0}}): check the layout (layout.sample_to_rim, "
+        "layout.cop_to_vertex) and the paraboloid's size")
+    assert e.value.where.endswith("p.yaml:6")  # layout.sample_to_rim's line
+
+
+def test_a_top_opening_clearing_the_bundle_by_half_a_millimetre_is_accepted(rig, monkeypatch):
+    """Any positive clearance around the projector's bundle is accepted and reported as it is."""
+    from rigcad.optics import design as design_module
+
+    end = rig.dome.points[-1]
+    monkeypatch.setattr(design_module, "cop_bundle_radius", lambda geo, z, aperture: float(end[0]) - 0.5)
+    top = design_module._top_aperture(rig.profile, rig.geometry, rig.dome)
+    assert top == {"radius_mm": float(end[0]), "z_mm": float(end[1]), "projector_bundle_radius_mm": float(end[0]) - 0.5,
+                   "clearance_mm": pytest.approx(0.5, abs=1e-12)}
+    monkeypatch.setattr(design_module, "cop_bundle_radius", lambda geo, z, aperture: float(end[0]))
+    with pytest.raises(GeometryError, match="top opening"):  # no clearance at all
+        design_module._top_aperture(rig.profile, rig.geometry, rig.dome)
