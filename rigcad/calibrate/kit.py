@@ -38,6 +38,48 @@ def spacer(profile, k: int):
                 "the holder's seat", in_rig=False)
 
 
+def screen_room(rig) -> dict:
+    """Where the screen lies inside the dome (mm): the display's half diagonal (its corners' distance
+    from the axis when it lies centred) against the dome's inside radius, the least over the heights
+    the screen spans at each spacer (its back to its emitting surface, clipped at the sample plane
+    where the dome starts). ``fits``: the display clears the dome at every spacer; the body, a bezel
+    wider, must fit in ``body_diameter_mm`` (the manual says so)."""
+    p = rig.profile
+    cal = p.calibration
+    pts = rig.dome.points  # the mirror surface (r, z), rising from the sample plane
+    w, h = cal.screen_resolution
+    half_diagonal = cal.screen_pitch * math.hypot(w, h) / 2
+    rows = []
+    for k, top in enumerate(M.nominal_heights(p)):
+        z = np.linspace(max(top - cal.screen_thickness, 0.0), max(top, 0.0), 65)
+        r = np.interp(z, pts[:, 1], pts[:, 0])
+        i = int(np.argmin(r))
+        rows.append({"spacer": k, "z_mm": float(z[i]), "dome_radius_mm": float(r[i])})
+    tight = min(rows, key=lambda row: row["dome_radius_mm"])
+    return {"display_mm": [w * cal.screen_pitch, h * cal.screen_pitch], "half_diagonal_mm": half_diagonal,
+            "tightest": tight, "body_diameter_mm": 2 * tight["dome_radius_mm"],
+            "fits": half_diagonal < tight["dome_radius_mm"]}
+
+
+def check_screen_fits(rig) -> dict:
+    """:func:`screen_room`, refused with a ProfileError naming ``calibration.screen_resolution`` when
+    the display's corners would reach into the dome: no screen so placed can lie there."""
+    from rigcad.errors import ProfileError
+
+    room = screen_room(rig)
+    if not room["fits"]:
+        cal, t = rig.profile.calibration, room["tightest"]
+        (dw, dh), d = room["display_mm"], room["half_diagonal_mm"]
+        raise ProfileError(
+            f"calibration.screen_resolution {cal.screen_resolution[0]} x {cal.screen_resolution[1]} px at "
+            f"calibration.screen_pitch {cal.screen_pitch:g} mm is a {dw:.1f} x {dh:.1f} mm display whose corners lie "
+            f"{d:.1f} mm from the axis, but the dome's inside is {t['dome_radius_mm']:.1f} mm from the axis at "
+            f"z = {t['z_mm']:.1f} mm, where spacer {t['spacer']} ({cal.spacer_heights[t['spacer']]:g} mm) puts the "
+            f"screen: choose a screen whose display diagonal (and body) is under {room['body_diameter_mm']:.0f} mm",
+            where=rig.profile.where("calibration", "screen_resolution"))
+    return room
+
+
 def manual_page(rig) -> str:
     """The manual's page on the calibration (Markdown)."""
     p = rig.profile
@@ -49,6 +91,7 @@ def manual_page(rig) -> str:
     spacers = "\n".join(f"{k + 1}. spacer {k} ({cal.spacer_heights[k]:g} mm): screen surface {z:g} mm above the "
                         f"sample point; files `h{k}_<frame>.png`" for k, z in enumerate(heights))
     reach = math.degrees(math.atan((min(w, h) * cal.screen_pitch / 2) / max(heights)))
+    room = check_screen_fits(rig)
     return f"""# Calibrating the as-built rig (deflectometry)
 
 What it measures: each camera pixel's incidence direction at the sample, through the paraboloid and
@@ -56,7 +99,9 @@ the dome as they were built and placed; the fit of the misalignment; the dome's 
 
 ## The kit
 - A flat screen (a tablet): {w} x {h} px at {cal.screen_pitch:g} mm pitch, {cal.screen_thickness:g} mm from its
-  back to its emitting surface. Set it to its full brightness, no night shift, no auto-brightness, and a
+  back to its emitting surface. It lies inside the dome: its body, bezel included, must fit in a
+  {room['body_diameter_mm']:.0f} mm circle (the dome's inside at z = {room['tightest']['z_mm']:.1f} mm, where spacer
+  {room['tightest']['spacer']} puts it). Set it to its full brightness, no night shift, no auto-brightness, and a
   linear (gamma 1) response if it offers one; show each PNG of `patterns/` full screen, unscaled.
 - The spacers (`stl/calibration_spacer_<k>.stl`): each replaces the sample holder in the base plate's bore;
   lay the screen face up, centred on the axis, on its top.
@@ -91,6 +136,7 @@ def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
     from rigcad.parts import _kernel as K
 
     p = rig.profile
+    check_screen_fits(rig)
     seq = Sequence.from_profile(p.calibration)
     files, parts = {}, {}
     with Staging(out, lock=profile_lock(out.parent.parent, p.name) if out.parent.name == p.name else None,

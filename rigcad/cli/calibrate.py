@@ -24,9 +24,11 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from rigcad.progress import stages
     from rigcad.rig import load
 
+    from rigcad.calibrate.kit import check_screen_fits, write_kit
+
     rig = load(args.profile)
+    check_screen_fits(rig)  # a screen that cannot lie in the dome is refused before any work
     if getattr(args, "kit", False):
-        from rigcad.calibrate.kit import write_kit
 
         out = Path(args.exports) / rig.name / "calibrate_kit"
         manifest = write_kit(rig, out, say=print)

@@ -537,9 +537,13 @@ class CalibrationParams:
     sample_holder.sample_thickness (the spacer on the holder's seat). The ``sim_*`` keys shape the
     simulated capture (``--simulate``): the planted dome error and the camera's noise."""
 
-    screen_pitch: float = spec("length", "screen pixel pitch (a tablet: 0.05-0.1 mm)", "0.085 mm",
+    # the default: an 8.3-inch tablet (e.g. Apple's iPad mini, 6th generation: 2266 x 1488 px at 326 ppi): its
+    # 176.5 x 115.9 mm display lies inside the dome's 234.7 mm at the sample plane; a 10-inch 16:10
+    # tablet's corners (a 256.6 mm diagonal) would not (rigcad.calibrate.kit.check_screen_fits)
+    screen_pitch: float = spec("length", "screen pixel pitch (a tablet: 0.05-0.1 mm)", "0.0779 mm",
                                lo=0.005, hi=2.0)
-    screen_resolution: tuple[int, int] = spec("pixels", "screen [width, height] in pixels", [2560, 1600])
+    screen_resolution: tuple[int, int] = spec("pixels", "screen [width, height] in pixels; the display must lie "
+                                              "inside the dome at the spacers' heights", [2266, 1488])
     screen_thickness: float = spec("length", "screen: from its back (on the spacer) to its emitting surface",
                                    "6 mm", lo=0, hi=100.0)
     spacer_heights: tuple[float, ...] = spec("lengths", "printed spacers under the screen, one capture per "
