@@ -766,3 +766,20 @@ def test_a_top_opening_clearing_the_bundle_by_half_a_millimetre_is_accepted(rig,
     monkeypatch.setattr(design_module, "cop_bundle_radius", lambda geo, z, aperture: float(end[0]))
     with pytest.raises(GeometryError, match="top opening"):  # no clearance at all
         design_module._top_aperture(rig.profile, rig.geometry, rig.dome)
+
+
+def test_a_loose_tolerance_is_told_a_tenth_of_what_the_curve_needs(write_profile, table31_text, monkeypatch):
+    """The refusal's suggestion is a tenth of the tolerance the curve needs, at one digit: with the
+    requirement set so that need = 1.55e-7 mm, 1.55e-8 prints 2e-08 (a mistaken eleventh, 1e-08)."""
+    from rigcad.errors import ProfileError
+    from rigcad.optics import design as design_module
+    from rigcad.optics.dome import start
+
+    rig = Rig.from_profile(load_profile(write_profile(table31_text, "plain")))
+    path = start(rig.geometry).path_length
+    monkeypatch.setattr(design_module, "CURVE_MISS_RTOL", 1.55e-7 / (design_module.TOLERANCE_SHARE * path))
+    text = table31_text + "dome:\n  method: rk45\n  tolerance: 1e-6 mm\n"
+    with pytest.raises(ProfileError) as e:
+        Rig.from_profile(load_profile(write_profile(text)))
+    assert e.value.message.endswith(f"({2 * 1.55e-7:.2g} mm); ask for a tolerance well below that, e.g. 2e-08 mm, "
+                                    "or leave it unset")
