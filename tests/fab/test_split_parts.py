@@ -253,6 +253,33 @@ def test_interfaces_of_sectors_and_bands():
     assert mid(np.array([[40.0, 0.0, 15.0], [40.0, 0.0, 9.0], [40.0, 0.0, 21.0]])).tolist() == [True, False, False]
 
 
+def test_interface_masks_at_their_edges():
+    plan = SP.SplitPlan(4, 2, 0.0, (0.0, 12.0, 30.0))
+    faces = {f[0]: f[3] for f in SP._interfaces(plan, np.zeros(6))}
+    # the half-plane at 90 deg (x = 0, y > 0), band 1: strictly on the radial side, z not counted;
+    # the band's edges are open (z = 12 belongs to neither band's sector planes)
+    p = np.array([[0.0, -4.0, 5.0], [0.0, 0.0, 5.0], [0.0, 0.5, 5.0], [0.0, 40.0, 12.0]])
+    assert faces["sector plane 90.0 deg, band 1"](p).tolist() == [False, False, True, False]
+    # band 2, the last: open above (z = 31 past the top is on it), closed at z = 12
+    top = np.array([[0.0, 40.0, 31.0], [0.0, 40.0, 12.0]])
+    assert faces["sector plane 90.0 deg, band 2"](top).tolist() == [True, False]
+    # a band cut's sector: its angular range is [a0, a1): 0 deg in, 90 deg out, 315 deg in sector 4
+    q = np.array([[10.0, 0.0, 12.0], [0.0, 10.0, 12.0], [10.0, -10.0, 12.0]])
+    assert faces["band cut z 12.0 mm, sector 1"](q).tolist() == [True, False, False]
+    assert faces["band cut z 12.0 mm, sector 4"](q).tolist() == [False, False, True]
+    # one sector: the whole band cut, boolean, even a point whose angle rounds to -0 (2 pi modulo 2 pi)
+    one = SP._interfaces(SP.SplitPlan(1, 2, 0.0, (0.0, 12.0, 30.0)), np.zeros(6))[0][3]
+    m = one(np.array([[1.0, -1e-17, 12.0], [-1.0, 0.0, 12.0]]))
+    assert m.dtype == bool and m.tolist() == [True, True]
+    # two sectors: each band cut keeps its half
+    two = {f[0]: f[3] for f in SP._interfaces(SP.SplitPlan(2, 2, 0.0, (0.0, 12.0, 30.0)), np.zeros(6))}
+    assert two["band cut z 12.0 mm, sector 1"](np.array([[0.0, 10.0, 12.0], [0.0, -10.0, 12.0]])).tolist() == \
+        [True, False]
+    # plane angles past 360 deg are named modulo 360
+    names = [f[0] for f in SP._interfaces(SP.SplitPlan(2, 1, math.radians(300), (0.0, 30.0)), np.zeros(6))]
+    assert names == ["sector plane 300.0 deg, band 1", "sector plane 120.0 deg, band 1"]
+
+
 def test_other_planes_clear_keeps_points_off_every_other_cut():
     plan = SP.SplitPlan(4, 2, 0.0, (0.0, 12.0, 30.0))
     face_n, face_o = np.array([0.0, 1.0, 0.0]), np.zeros(3)  # the plane at 0 deg (its own: ignored)
@@ -273,6 +300,14 @@ def test_other_planes_clear_keeps_points_off_every_other_cut():
     # the opposite half-plane (180 deg) is the same plane as 0 deg: ignored too; a far point on the
     # other side of a half-plane's line is not near it
     assert SP._other_planes_clear(np.array([[-40.0, 0.2, 5.0], [-40.0, 0.0, 5.0]]), plan, face_n, face_o, 1.0).all()
+    # no groove by default: 1.5 mm under the band cut is clear
+    assert SP._other_planes_clear(np.array([[30.0, 30.0, 10.5]]), plan, face_n, face_o, 1.0).tolist() == [True]
+    # one sector: its phase half-plane is no cut; two sectors: both half-planes are
+    up = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 12.0])
+    near = np.array([[30.0, 0.5, 12.0], [-30.0, 0.5, 12.0]])
+    assert SP._other_planes_clear(near, SP.SplitPlan(1, 2, 0.0, (0.0, 12.0, 30.0)), *up, 1.0).tolist() == [True, True]
+    assert SP._other_planes_clear(near, SP.SplitPlan(2, 2, 0.0, (0.0, 12.0, 30.0)), *up, 1.0).tolist() == \
+        [False, False]
     g = SP.GridPlan((10.0,), (5.0,))
     gp = np.array([[10.0, 2.0, 0.0], [3.0, 5.5, 0.0], [3.0, 6.0, 0.0], [3.0, 2.0, 0.0]])
     assert SP._grid_planes_clear(gp, g, np.array([1.0, 0, 0]), np.array([10.0, 0, 0]), 1.0).tolist() == \
@@ -396,6 +431,23 @@ def test_a_grid_split_of_a_plate_with_pins_reassembles():
     assert sum(p.manifold.volume() for p in pieces) == pytest.approx(drilled.volume(), rel=1e-9)
     whole = SP.split_part(plate, "plate", SP.GridPlan((), ()), PIN, None)
     assert whole[0][0].name == "plate" and whole[1] == [] and whole[2] is plate
+    assert (whole[0][0].sector, whole[0][0].band, whole[0][0].sector_range) == (0, 0, None)
+    assert len(whole[0]) == 1 and whole[0][0].manifold is plate
+
+
+def test_a_grid_in_x_and_y_names_its_pieces_and_keeps_pins_behind_the_mirror():
+    plate = m3d.Manifold.cube((120.0, 40.0, 12.0)).translate((100.0, 0.0, 0.0))
+    plan = SP.GridPlan((160.0,), (20.0,))
+    wall = SimpleNamespace(signed_distance=lambda p: p[:, 0] - 200.0)  # a mirror at x = 200, behind it x < 200
+    pieces, pins, drilled = SP.split_part(plate, "plate", plan, PIN, wall)
+    assert [p.name for p in pieces] == ["plate_x1of2_y1of2", "plate_x2of2_y1of2", "plate_x1of2_y2of2",
+                                        "plate_x2of2_y2of2"]
+    assert [(p.sector, p.band) for p in pieces] == [(0, 0), (1, 0), (0, 1), (1, 1)]
+    assert pins
+    for p in pins:
+        assert SP._mirror_clear(np.array([p.centre]), np.array(p.axis), PIN, wall).tolist() == [True]
+        assert p.centre[0] + PIN.hole_radius < 200.0 - SP.MIRROR_CLEARANCE
+    assert sum(p.manifold.volume() for p in pieces) == pytest.approx(drilled.volume(), rel=1e-9)
 
 
 def test_a_tube_in_quarters_and_two_bands_with_a_tongue_and_groove():
@@ -416,6 +468,8 @@ def test_a_tube_in_quarters_and_two_bands_with_a_tongue_and_groove():
     assert set(d) == {"face", "z_mm", "depth_mm", "groove_volume_mm3", "tongue_volume_mm3", "min_clearance_to_mirror_mm"}
     # the band cut carries the tongue, not pins: every pin is on a sector plane
     assert pins and all(p.face.startswith("sector plane") for p in pins)
+    for p in pins:  # every hole behind the bore
+        assert SP._mirror_clear(np.array([p.centre]), np.array(p.axis), PIN, Bore()).tolist() == [True]
     assert {p.face for p in pins} == {f"sector plane {a:.1f} deg, band {j}" for a in (0, 90, 180, 270) for j in (1, 2)}
     # the pieces reassemble to the drilled part (the tongue moves from the lower to the upper piece)
     assert sum(p.manifold.volume() for p in pieces) == pytest.approx(drilled.volume(), rel=1e-6)
@@ -474,6 +528,48 @@ def test_the_mirror_region_is_its_sampled_annuli_as_polygons():
     idx = np.flatnonzero(ok)
     got = SP._mirror_region(ring, np.array([0.0]), 1.0, 60.0).area()
     assert got == pytest.approx(_polygon_areas(r[idx[0]], r[idx[-1]]), rel=1e-9)
+    # a run starting under 1 mm from the axis (0.54 mm) still has its hole
+    small = SimpleNamespace(signed_distance=lambda p: np.abs(np.hypot(p[:, 0], p[:, 1]) - 5.0) - 5.5)
+    idx = np.flatnonzero(np.abs(r - 5.0) - 5.5 < -1.02)
+    assert 0.0 < r[idx[0]] < 1.0
+    got = SP._mirror_region(small, np.array([0.0]), 1.0, 60.0).area()
+    assert got == pytest.approx(_polygon_areas(r[idx[0]], r[idx[-1]]), rel=1e-9)
     # nothing near: the whole plane, no hole at the axis
     far = SimpleNamespace(signed_distance=lambda p: np.full(len(p), -100.0))
     assert SP._mirror_region(far, np.array([0.0]), 1.0, 60.0).area() == pytest.approx((4 * SP._BIG) ** 2, abs=1e-3)
+
+
+def test_a_tube_in_two_halves_or_three_bands_names_its_pieces():
+    tube = _tube(h=40.0)
+    pieces, pins, drilled = SP.split_part(tube, "ring", SP.SplitPlan(2, 1, 0.0, (0.0, 40.0)), PIN, Bore())
+    assert [p.name for p in pieces] == ["ring_s1of2", "ring_s2of2"]
+    assert [p.sector_range for p in pieces] == [pytest.approx((0.0, math.pi)), pytest.approx((math.pi, 2 * math.pi))]
+    # three bands, one sector: two tongues, each carried by the piece above its cut; no pins
+    tall = _tube(h=60.0)
+    tongues = []
+    pieces, pins, drilled = SP.split_part(tall, "ring", SP.SplitPlan(1, 3, 0.0, (0.0, 20.0, 40.0, 60.0)), PIN,
+                                          Bore(), tongues)
+    assert [p.name for p in pieces] == ["ring_b1of3", "ring_b2of3", "ring_b3of3"] and pins == []
+    assert [(p.sector, p.band, p.sector_range) for p in pieces] == [(0, j, None) for j in range(3)]
+    assert len(tongues) == 2
+    vols = [p.manifold.volume() for p in pieces]
+    assert sum(vols) == pytest.approx(drilled.volume(), rel=1e-6)
+    ring = _polygon_area(50.0) - _polygon_area(35.0)
+    for j in (1, 2):  # the band above a cut holds its tongue: more than its slab less the groove above
+        assert vols[j] > ring * 20 - (tongues[j].groove.volume() if j < 2 else 0.0) - 1e-3 + \
+            0.9 * tongues[j - 1].tongue.volume()
+
+
+def test_band_0_holds_all_under_the_first_cut_even_past_its_start():
+    # band 0 is everything under the first cut (cell trims no floor): a plan whose band_z[0] (16 mm) lies
+    # above the part's bottom and inside the tongue's depth (15.2 .. 20 mm) still reassembles, the
+    # tongue whole in band 1's piece
+    tube = _tube(h=40.0)
+    tongues = []
+    pieces, pins, drilled = SP.split_part(tube, "ring", SP.SplitPlan(1, 2, 0.0, (16.0, 20.0, 40.0)), PIN, None,
+                                          tongues)
+    (t,) = tongues
+    ring = _polygon_area(50.0) - _polygon_area(35.0)
+    assert pieces[0].manifold.volume() == pytest.approx(ring * 20 - t.groove.volume(), rel=1e-6)
+    assert pieces[1].manifold.volume() == pytest.approx(ring * 20 + t.tongue.volume(), rel=1e-6)
+    assert sum(p.manifold.volume() for p in pieces) == pytest.approx(drilled.volume(), rel=1e-6)
