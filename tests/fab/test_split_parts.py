@@ -226,6 +226,10 @@ def test_the_plane_frame_puts_the_plane_at_z_0():
     vertical = SP._plane_frame(np.array([0.0, 1.0, 0.0]), np.zeros(3))
     assert vertical[0, :3] == pytest.approx([0.0, 0.0, 1.0])  # e1 = z for a vertical plane
     assert SP._plane_frame(np.array([0.0, 0.0, 1.0]), np.zeros(3))[0, :3] == pytest.approx([1.0, 0.0, 0.0])
+    # e1 is z projected onto the plane (x for a plane within 26 deg of horizontal)
+    assert SP._plane_frame(np.array([1.0, 0.0, 0.0]), np.zeros(3))[0, :3] == pytest.approx([0.0, 0.0, 1.0])
+    tilted = SP._plane_frame(np.array([0.0, 0.3, 0.95]), np.zeros(3))
+    assert tilted[0, :3] == pytest.approx([1.0, 0.0, 0.0], abs=1e-12)
 
 
 def test_interfaces_of_sectors_and_bands():
@@ -300,8 +304,31 @@ def test_other_planes_clear_keeps_points_off_every_other_cut():
     # the opposite half-plane (180 deg) is the same plane as 0 deg: ignored too; a far point on the
     # other side of a half-plane's line is not near it
     assert SP._other_planes_clear(np.array([[-40.0, 0.2, 5.0], [-40.0, 0.0, 5.0]]), plan, face_n, face_o, 1.0).all()
-    # no groove by default: 1.5 mm under the band cut is clear
-    assert SP._other_planes_clear(np.array([[30.0, 30.0, 10.5]]), plan, face_n, face_o, 1.0).tolist() == [True]
+    # no groove by default: 1.5 mm under the band cut is clear; exactly the margin above or below is clear
+    edge = np.array([[30.0, 30.0, 10.5], [30.0, 30.0, 13.0], [30.0, 30.0, 11.0]])
+    assert SP._other_planes_clear(edge, plan, face_n, face_o, 1.0).tolist() == [True, True, True]
+    # exactly the margin from the half-plane at 0 deg (its normal (0, 1, 0) exact): clear
+    assert SP._other_planes_clear(np.array([[40.0, 1.0, 5.0]]), plan, np.array([-1.0, 0.0, 0.0]), face_o,
+                                  1.0).tolist() == [True]
+    # three sectors (0, 120, 240 deg), the face at 120 deg: 0.5 mm from the 0 deg plane's line, on its
+    # half-plane's side (x = 0.9) or exactly the margin behind it (x = -1: clear)
+    three = SP.SplitPlan(3, 1, 0.0, (0.0, 30.0))
+    f120 = np.array([-math.sin(2 * math.pi / 3), math.cos(2 * math.pi / 3), 0.0])
+    assert SP._other_planes_clear(np.array([[0.9, 0.9, 5.0], [-1.0, 0.5, 5.0]]), three, f120, face_o,
+                                  1.0).tolist() == [False, True]
+    # the face at 0 deg: a point 0.5 mm from the 120 deg plane's line but 3 mm behind the axis (z ignored)
+    a = 2 * math.pi / 3
+    radial, normal = np.array([math.cos(a), math.sin(a), 0.0]), np.array([-math.sin(a), math.cos(a), 0.0])
+    behind = -3.0 * radial + 0.5 * normal + np.array([0.0, 0.0, 5.0])
+    assert SP._other_planes_clear(behind[None], three, face_n, face_o, 1.0).tolist() == [True]
+    # phase 45 deg: the 45 deg half-plane (normal (-1, 1) / sqrt 2) keeps a point 0.35 mm off it out
+    quad = SP.SplitPlan(4, 1, math.radians(45), (0.0, 30.0))
+    f135 = np.array([-math.sin(math.radians(135)), math.cos(math.radians(135)), 0.0])
+    assert SP._other_planes_clear(np.array([[30.0, 30.5, 5.0]]), quad, f135, face_o, 1.0).tolist() == [False]
+    # a band cut's face skips its own plane only: a cut 0.5 mm above it still counts
+    close = SP.SplitPlan(1, 3, 0.0, (0.0, 10.0, 10.5, 30.0))
+    assert SP._other_planes_clear(np.array([[30.0, 30.0, 11.2], [30.0, 30.0, 12.0]]), close,
+                                  np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 10.0]), 1.0).tolist() == [False, True]
     # one sector: its phase half-plane is no cut; two sectors: both half-planes are
     up = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 12.0])
     near = np.array([[30.0, 0.5, 12.0], [-30.0, 0.5, 12.0]])
@@ -380,6 +407,9 @@ def test_a_pin_keeps_its_hole_behind_the_mirror():
     # the hole's surface reaches r = x - 1.1 mm across; 1 mm clearance: x > 35 + 1 + 1.1 (and a little)
     x = np.array([[37.2, 0, 15.0], [37.0, 0, 15.0], [45.0, 0, 15.0]])
     assert SP._mirror_clear(x, n, PIN, Bore()).tolist() == [True, False, True]
+    # the hole runs +-5 mm along its axis, no further: a plane mirror at y = 7.5 is 2.5 mm from its end
+    plane = SimpleNamespace(signed_distance=lambda p: p[:, 1] - 7.5)
+    assert SP._mirror_clear(np.array([[0.0, 0.0, 0.0], [0.0, 1.6, 0.0]]), n, PIN, plane).tolist() == [True, False]
     assert r == pytest.approx(1.1)
     region = SP._mirror_region(Bore(), np.array([0.0, 10.0]), 1.0, 60.0)
     # all of the plane (a 4e4 mm square) but a disc of 35 + 1 mm (and the 0.02 mm sampling) about the axis
