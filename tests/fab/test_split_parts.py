@@ -76,6 +76,9 @@ def test_cells_of_a_tube_are_its_sectors_and_bands():
     three = SP.SplitPlan(1, 3, 0.0, (0.0, 5.0, 20.0, 30.0))
     assert [SP.cell(tube, three, 0, j).volume() for j in range(3)] == pytest.approx([ring * 5, ring * 15, ring * 10])
     assert SP.cell(tube, SP.SplitPlan(1, 1, 0.0, (0.0, 30.0)), 0, 0).volume() == pytest.approx(ring * 30)
+    # the first band holds all under the first cut and the last all above the last (no floor, no roof)
+    short = SP.SplitPlan(1, 2, 0.0, (10.0, 12.0, 20.0))
+    assert [SP.cell(tube, short, 0, j).volume() for j in range(2)] == pytest.approx([ring * 12, ring * 18])
 
 
 def test_grid_cells_are_the_slabs_of_the_box():
