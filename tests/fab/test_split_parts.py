@@ -606,3 +606,20 @@ def test_band_0_holds_all_under_the_first_cut_even_past_its_start():
     assert pieces[0].manifold.volume() == pytest.approx(ring * 20 - t.groove.volume(), rel=1e-6)
     assert pieces[1].manifold.volume() == pytest.approx(ring * 20 + t.tongue.volume(), rel=1e-6)
     assert sum(p.manifold.volume() for p in pieces) == pytest.approx(drilled.volume(), rel=1e-6)
+
+
+def test_pins_keep_off_the_band_cuts_by_their_guard_and_the_tongue_faces_by_the_normal():
+    tube = _tube(h=40.0)
+    plan = SP.SplitPlan(4, 2, 0.0, (0.0, 20.0, 40.0))
+    guard = PIN.hole_radius + SP.MIN_WALL
+    # no tongues: pins on the band cut too, and the sector planes' pins come to the guard under the cut
+    # (the eroded face sampled every 0.5 mm), no nearer
+    pins = SP.place_pins(tube, plan, PIN, None)
+    assert any(p.face.startswith("band cut") for p in pins)
+    low = [p.centre[2] for p in pins if p.face.endswith("band 1")]
+    assert max(low) <= 20.0 - guard + 1e-9 and max(low) > 20.0 - guard - 0.6
+    # tongues on a band cut at z = 0 (the part from -20 to 20 mm): no pins on it, told by its normal
+    shifted = _tube(h=40.0, z0=-20.0)
+    low_plan = SP.SplitPlan(4, 2, 0.0, (-20.0, 0.0, 20.0))
+    tg = SP.make_tongues(shifted, low_plan, PIN, None)
+    assert all(p.face.startswith("sector plane") for p in SP.place_pins(shifted, low_plan, PIN, None, tg))
