@@ -76,6 +76,9 @@ def test_cells_of_a_tube_are_its_sectors_and_bands():
     three = SP.SplitPlan(1, 3, 0.0, (0.0, 5.0, 20.0, 30.0))
     assert [SP.cell(tube, three, 0, j).volume() for j in range(3)] == pytest.approx([ring * 5, ring * 15, ring * 10])
     assert SP.cell(tube, SP.SplitPlan(1, 1, 0.0, (0.0, 30.0)), 0, 0).volume() == pytest.approx(ring * 30)
+    # the first band holds all under the first cut and the last all above the last (no floor, no roof)
+    short = SP.SplitPlan(1, 2, 0.0, (10.0, 12.0, 20.0))
+    assert [SP.cell(tube, short, 0, j).volume() for j in range(2)] == pytest.approx([ring * 12, ring * 18])
 
 
 def test_grid_cells_are_the_slabs_of_the_box():
@@ -226,6 +229,10 @@ def test_the_plane_frame_puts_the_plane_at_z_0():
     vertical = SP._plane_frame(np.array([0.0, 1.0, 0.0]), np.zeros(3))
     assert vertical[0, :3] == pytest.approx([0.0, 0.0, 1.0])  # e1 = z for a vertical plane
     assert SP._plane_frame(np.array([0.0, 0.0, 1.0]), np.zeros(3))[0, :3] == pytest.approx([1.0, 0.0, 0.0])
+    # e1 is z projected onto the plane (x for a plane within 26 deg of horizontal)
+    assert SP._plane_frame(np.array([1.0, 0.0, 0.0]), np.zeros(3))[0, :3] == pytest.approx([0.0, 0.0, 1.0])
+    tilted = SP._plane_frame(np.array([0.0, 0.3, 0.95]), np.zeros(3))
+    assert tilted[0, :3] == pytest.approx([1.0, 0.0, 0.0], abs=1e-12)
 
 
 def test_interfaces_of_sectors_and_bands():
@@ -253,6 +260,33 @@ def test_interfaces_of_sectors_and_bands():
     assert mid(np.array([[40.0, 0.0, 15.0], [40.0, 0.0, 9.0], [40.0, 0.0, 21.0]])).tolist() == [True, False, False]
 
 
+def test_interface_masks_at_their_edges():
+    plan = SP.SplitPlan(4, 2, 0.0, (0.0, 12.0, 30.0))
+    faces = {f[0]: f[3] for f in SP._interfaces(plan, np.zeros(6))}
+    # the half-plane at 90 deg (x = 0, y > 0), band 1: strictly on the radial side, z not counted;
+    # the band's edges are open (z = 12 belongs to neither band's sector planes)
+    p = np.array([[0.0, -4.0, 5.0], [0.0, 0.0, 5.0], [0.0, 0.5, 5.0], [0.0, 40.0, 12.0]])
+    assert faces["sector plane 90.0 deg, band 1"](p).tolist() == [False, False, True, False]
+    # band 2, the last: open above (z = 31 past the top is on it), closed at z = 12
+    top = np.array([[0.0, 40.0, 31.0], [0.0, 40.0, 12.0]])
+    assert faces["sector plane 90.0 deg, band 2"](top).tolist() == [True, False]
+    # a band cut's sector: its angular range is [a0, a1): 0 deg in, 90 deg out, 315 deg in sector 4
+    q = np.array([[10.0, 0.0, 12.0], [0.0, 10.0, 12.0], [10.0, -10.0, 12.0]])
+    assert faces["band cut z 12.0 mm, sector 1"](q).tolist() == [True, False, False]
+    assert faces["band cut z 12.0 mm, sector 4"](q).tolist() == [False, False, True]
+    # one sector: the whole band cut, boolean, even a point whose angle rounds to -0 (2 pi modulo 2 pi)
+    one = SP._interfaces(SP.SplitPlan(1, 2, 0.0, (0.0, 12.0, 30.0)), np.zeros(6))[0][3]
+    m = one(np.array([[1.0, -1e-17, 12.0], [-1.0, 0.0, 12.0]]))
+    assert m.dtype == bool and m.tolist() == [True, True]
+    # two sectors: each band cut keeps its half
+    two = {f[0]: f[3] for f in SP._interfaces(SP.SplitPlan(2, 2, 0.0, (0.0, 12.0, 30.0)), np.zeros(6))}
+    assert two["band cut z 12.0 mm, sector 1"](np.array([[0.0, 10.0, 12.0], [0.0, -10.0, 12.0]])).tolist() == \
+        [True, False]
+    # plane angles past 360 deg are named modulo 360
+    names = [f[0] for f in SP._interfaces(SP.SplitPlan(2, 1, math.radians(300), (0.0, 30.0)), np.zeros(6))]
+    assert names == ["sector plane 300.0 deg, band 1", "sector plane 120.0 deg, band 1"]
+
+
 def test_other_planes_clear_keeps_points_off_every_other_cut():
     plan = SP.SplitPlan(4, 2, 0.0, (0.0, 12.0, 30.0))
     face_n, face_o = np.array([0.0, 1.0, 0.0]), np.zeros(3)  # the plane at 0 deg (its own: ignored)
@@ -273,6 +307,37 @@ def test_other_planes_clear_keeps_points_off_every_other_cut():
     # the opposite half-plane (180 deg) is the same plane as 0 deg: ignored too; a far point on the
     # other side of a half-plane's line is not near it
     assert SP._other_planes_clear(np.array([[-40.0, 0.2, 5.0], [-40.0, 0.0, 5.0]]), plan, face_n, face_o, 1.0).all()
+    # no groove by default: 1.5 mm under the band cut is clear; exactly the margin above or below is clear
+    edge = np.array([[30.0, 30.0, 10.5], [30.0, 30.0, 13.0], [30.0, 30.0, 11.0]])
+    assert SP._other_planes_clear(edge, plan, face_n, face_o, 1.0).tolist() == [True, True, True]
+    # exactly the margin from the half-plane at 0 deg (its normal (0, 1, 0) exact): clear
+    assert SP._other_planes_clear(np.array([[40.0, 1.0, 5.0]]), plan, np.array([-1.0, 0.0, 0.0]), face_o,
+                                  1.0).tolist() == [True]
+    # three sectors (0, 120, 240 deg), the face at 120 deg: 0.5 mm from the 0 deg plane's line, on its
+    # half-plane's side (x = 0.9) or exactly the margin behind it (x = -1: clear)
+    three = SP.SplitPlan(3, 1, 0.0, (0.0, 30.0))
+    f120 = np.array([-math.sin(2 * math.pi / 3), math.cos(2 * math.pi / 3), 0.0])
+    assert SP._other_planes_clear(np.array([[0.9, 0.9, 5.0], [-1.0, 0.5, 5.0]]), three, f120, face_o,
+                                  1.0).tolist() == [False, True]
+    # the face at 0 deg: a point 0.5 mm from the 120 deg plane's line but 3 mm behind the axis (z ignored)
+    a = 2 * math.pi / 3
+    radial, normal = np.array([math.cos(a), math.sin(a), 0.0]), np.array([-math.sin(a), math.cos(a), 0.0])
+    behind = -3.0 * radial + 0.5 * normal + np.array([0.0, 0.0, 5.0])
+    assert SP._other_planes_clear(behind[None], three, face_n, face_o, 1.0).tolist() == [True]
+    # phase 45 deg: the 45 deg half-plane (normal (-1, 1) / sqrt 2) keeps a point 0.35 mm off it out
+    quad = SP.SplitPlan(4, 1, math.radians(45), (0.0, 30.0))
+    f135 = np.array([-math.sin(math.radians(135)), math.cos(math.radians(135)), 0.0])
+    assert SP._other_planes_clear(np.array([[30.0, 30.5, 5.0]]), quad, f135, face_o, 1.0).tolist() == [False]
+    # a band cut's face skips its own plane only: a cut 0.5 mm above it still counts
+    close = SP.SplitPlan(1, 3, 0.0, (0.0, 10.0, 10.5, 30.0))
+    assert SP._other_planes_clear(np.array([[30.0, 30.0, 11.2], [30.0, 30.0, 12.0]]), close,
+                                  np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 10.0]), 1.0).tolist() == [False, True]
+    # one sector: its phase half-plane is no cut; two sectors: both half-planes are
+    up = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 12.0])
+    near = np.array([[30.0, 0.5, 12.0], [-30.0, 0.5, 12.0]])
+    assert SP._other_planes_clear(near, SP.SplitPlan(1, 2, 0.0, (0.0, 12.0, 30.0)), *up, 1.0).tolist() == [True, True]
+    assert SP._other_planes_clear(near, SP.SplitPlan(2, 2, 0.0, (0.0, 12.0, 30.0)), *up, 1.0).tolist() == \
+        [False, False]
     g = SP.GridPlan((10.0,), (5.0,))
     gp = np.array([[10.0, 2.0, 0.0], [3.0, 5.5, 0.0], [3.0, 6.0, 0.0], [3.0, 2.0, 0.0]])
     assert SP._grid_planes_clear(gp, g, np.array([1.0, 0, 0]), np.array([10.0, 0, 0]), 1.0).tolist() == \
@@ -345,6 +410,9 @@ def test_a_pin_keeps_its_hole_behind_the_mirror():
     # the hole's surface reaches r = x - 1.1 mm across; 1 mm clearance: x > 35 + 1 + 1.1 (and a little)
     x = np.array([[37.2, 0, 15.0], [37.0, 0, 15.0], [45.0, 0, 15.0]])
     assert SP._mirror_clear(x, n, PIN, Bore()).tolist() == [True, False, True]
+    # the hole runs +-5 mm along its axis, no further: a plane mirror at y = 7.5 is 2.5 mm from its end
+    plane = SimpleNamespace(signed_distance=lambda p: p[:, 1] - 7.5)
+    assert SP._mirror_clear(np.array([[0.0, 0.0, 0.0], [0.0, 1.6, 0.0]]), n, PIN, plane).tolist() == [True, False]
     assert r == pytest.approx(1.1)
     region = SP._mirror_region(Bore(), np.array([0.0, 10.0]), 1.0, 60.0)
     # all of the plane (a 4e4 mm square) but a disc of 35 + 1 mm (and the 0.02 mm sampling) about the axis
@@ -396,6 +464,23 @@ def test_a_grid_split_of_a_plate_with_pins_reassembles():
     assert sum(p.manifold.volume() for p in pieces) == pytest.approx(drilled.volume(), rel=1e-9)
     whole = SP.split_part(plate, "plate", SP.GridPlan((), ()), PIN, None)
     assert whole[0][0].name == "plate" and whole[1] == [] and whole[2] is plate
+    assert (whole[0][0].sector, whole[0][0].band, whole[0][0].sector_range) == (0, 0, None)
+    assert len(whole[0]) == 1 and whole[0][0].manifold is plate
+
+
+def test_a_grid_in_x_and_y_names_its_pieces_and_keeps_pins_behind_the_mirror():
+    plate = m3d.Manifold.cube((120.0, 40.0, 12.0)).translate((100.0, 0.0, 0.0))
+    plan = SP.GridPlan((160.0,), (20.0,))
+    wall = SimpleNamespace(signed_distance=lambda p: p[:, 0] - 200.0)  # a mirror at x = 200, behind it x < 200
+    pieces, pins, drilled = SP.split_part(plate, "plate", plan, PIN, wall)
+    assert [p.name for p in pieces] == ["plate_x1of2_y1of2", "plate_x2of2_y1of2", "plate_x1of2_y2of2",
+                                        "plate_x2of2_y2of2"]
+    assert [(p.sector, p.band) for p in pieces] == [(0, 0), (1, 0), (0, 1), (1, 1)]
+    assert pins
+    for p in pins:
+        assert SP._mirror_clear(np.array([p.centre]), np.array(p.axis), PIN, wall).tolist() == [True]
+        assert p.centre[0] + PIN.hole_radius < 200.0 - SP.MIRROR_CLEARANCE
+    assert sum(p.manifold.volume() for p in pieces) == pytest.approx(drilled.volume(), rel=1e-9)
 
 
 def test_a_tube_in_quarters_and_two_bands_with_a_tongue_and_groove():
@@ -416,6 +501,8 @@ def test_a_tube_in_quarters_and_two_bands_with_a_tongue_and_groove():
     assert set(d) == {"face", "z_mm", "depth_mm", "groove_volume_mm3", "tongue_volume_mm3", "min_clearance_to_mirror_mm"}
     # the band cut carries the tongue, not pins: every pin is on a sector plane
     assert pins and all(p.face.startswith("sector plane") for p in pins)
+    for p in pins:  # every hole behind the bore
+        assert SP._mirror_clear(np.array([p.centre]), np.array(p.axis), PIN, Bore()).tolist() == [True]
     assert {p.face for p in pins} == {f"sector plane {a:.1f} deg, band {j}" for a in (0, 90, 180, 270) for j in (1, 2)}
     # the pieces reassemble to the drilled part (the tongue moves from the lower to the upper piece)
     assert sum(p.manifold.volume() for p in pieces) == pytest.approx(drilled.volume(), rel=1e-6)
@@ -474,6 +561,65 @@ def test_the_mirror_region_is_its_sampled_annuli_as_polygons():
     idx = np.flatnonzero(ok)
     got = SP._mirror_region(ring, np.array([0.0]), 1.0, 60.0).area()
     assert got == pytest.approx(_polygon_areas(r[idx[0]], r[idx[-1]]), rel=1e-9)
+    # a run starting under 1 mm from the axis (0.54 mm) still has its hole
+    small = SimpleNamespace(signed_distance=lambda p: np.abs(np.hypot(p[:, 0], p[:, 1]) - 5.0) - 5.5)
+    idx = np.flatnonzero(np.abs(r - 5.0) - 5.5 < -1.02)
+    assert 0.0 < r[idx[0]] < 1.0
+    got = SP._mirror_region(small, np.array([0.0]), 1.0, 60.0).area()
+    assert got == pytest.approx(_polygon_areas(r[idx[0]], r[idx[-1]]), rel=1e-9)
     # nothing near: the whole plane, no hole at the axis
     far = SimpleNamespace(signed_distance=lambda p: np.full(len(p), -100.0))
     assert SP._mirror_region(far, np.array([0.0]), 1.0, 60.0).area() == pytest.approx((4 * SP._BIG) ** 2, abs=1e-3)
+
+
+def test_a_tube_in_two_halves_or_three_bands_names_its_pieces():
+    tube = _tube(h=40.0)
+    pieces, pins, drilled = SP.split_part(tube, "ring", SP.SplitPlan(2, 1, 0.0, (0.0, 40.0)), PIN, Bore())
+    assert [p.name for p in pieces] == ["ring_s1of2", "ring_s2of2"]
+    assert [p.sector_range for p in pieces] == [pytest.approx((0.0, math.pi)), pytest.approx((math.pi, 2 * math.pi))]
+    # three bands, one sector: two tongues, each carried by the piece above its cut; no pins
+    tall = _tube(h=60.0)
+    tongues = []
+    pieces, pins, drilled = SP.split_part(tall, "ring", SP.SplitPlan(1, 3, 0.0, (0.0, 20.0, 40.0, 60.0)), PIN,
+                                          Bore(), tongues)
+    assert [p.name for p in pieces] == ["ring_b1of3", "ring_b2of3", "ring_b3of3"] and pins == []
+    assert [(p.sector, p.band, p.sector_range) for p in pieces] == [(0, j, None) for j in range(3)]
+    assert len(tongues) == 2
+    vols = [p.manifold.volume() for p in pieces]
+    assert sum(vols) == pytest.approx(drilled.volume(), rel=1e-6)
+    ring = _polygon_area(50.0) - _polygon_area(35.0)
+    for j in (1, 2):  # the band above a cut holds its tongue: more than its slab less the groove above
+        assert vols[j] > ring * 20 - (tongues[j].groove.volume() if j < 2 else 0.0) - 1e-3 + \
+            0.9 * tongues[j - 1].tongue.volume()
+
+
+def test_band_0_holds_all_under_the_first_cut_even_past_its_start():
+    # band 0 is everything under the first cut (cell trims no floor): a plan whose band_z[0] (16 mm) lies
+    # above the part's bottom and inside the tongue's depth (15.2 .. 20 mm) still reassembles, the
+    # tongue whole in band 1's piece
+    tube = _tube(h=40.0)
+    tongues = []
+    pieces, pins, drilled = SP.split_part(tube, "ring", SP.SplitPlan(1, 2, 0.0, (16.0, 20.0, 40.0)), PIN, None,
+                                          tongues)
+    (t,) = tongues
+    ring = _polygon_area(50.0) - _polygon_area(35.0)
+    assert pieces[0].manifold.volume() == pytest.approx(ring * 20 - t.groove.volume(), rel=1e-6)
+    assert pieces[1].manifold.volume() == pytest.approx(ring * 20 + t.tongue.volume(), rel=1e-6)
+    assert sum(p.manifold.volume() for p in pieces) == pytest.approx(drilled.volume(), rel=1e-6)
+
+
+def test_pins_keep_off_the_band_cuts_by_their_guard_and_the_tongue_faces_by_the_normal():
+    tube = _tube(h=40.0)
+    plan = SP.SplitPlan(4, 2, 0.0, (0.0, 20.0, 40.0))
+    guard = PIN.hole_radius + SP.MIN_WALL
+    # no tongues: pins on the band cut too, and the sector planes' pins come to the guard under the cut
+    # (the eroded face sampled every 0.5 mm), no nearer
+    pins = SP.place_pins(tube, plan, PIN, None)
+    assert any(p.face.startswith("band cut") for p in pins)
+    low = [p.centre[2] for p in pins if p.face.endswith("band 1")]
+    assert max(low) <= 20.0 - guard + 1e-9 and max(low) > 20.0 - guard - 0.6
+    # tongues on a band cut at z = 0 (the part from -20 to 20 mm): no pins on it, told by its normal
+    shifted = _tube(h=40.0, z0=-20.0)
+    low_plan = SP.SplitPlan(4, 2, 0.0, (-20.0, 0.0, 20.0))
+    tg = SP.make_tongues(shifted, low_plan, PIN, None)
+    assert all(p.face.startswith("sector plane") for p in SP.place_pins(shifted, low_plan, PIN, None, tg))
