@@ -623,3 +623,69 @@ def test_pins_keep_off_the_band_cuts_by_their_guard_and_the_tongue_faces_by_the_
     low_plan = SP.SplitPlan(4, 2, 0.0, (-20.0, 0.0, 20.0))
     tg = SP.make_tongues(shifted, low_plan, PIN, None)
     assert all(p.face.startswith("sector plane") for p in SP.place_pins(shifted, low_plan, PIN, None, tg))
+
+
+def _cone_shell(segments=360):
+    # a wall leaning in by 1 in 4: outer radius 50 - z/4, inner 44 - z/4 (6 mm across), 40 mm tall
+    outer = m3d.Manifold.cylinder(40.0, 50.0, 40.0, segments)
+    inner = m3d.Manifold.cylinder(42.0, 44.25, 33.75, segments).translate((0, 0, -1))
+    return outer - inner
+
+
+def _radii(man):
+    v = np.asarray(man.to_mesh().vert_properties)[:, :3]
+    r = np.hypot(v[:, 0], v[:, 1])
+    return r.min(), r.max(), v[:, 2].min(), v[:, 2].max()
+
+
+def test_a_groove_in_a_leaning_wall_is_the_wall_common_to_its_depth_and_keeps_off_a_leaning_mirror():
+    cone, plan = _cone_shell(), SP.SplitPlan(4, 2, 0.0, (0.0, 20.0, 40.0))
+    # no mirror: the groove (5 mm, the pin's depth, under z = 20) is what every height from 20 down
+    # to 20 - 5 - 0.6 has in common, eroded by the 0.6 mm wall: the inner surface's widest (z = 14.4:
+    # 40.4 mm) + 0.6, to the outer's narrowest (z = 20: 45 mm) - 0.6 (the 360-gon's vertices)
+    (t,) = SP.make_tongues(cone, plan, PIN, None)
+    r_in, r_out, z_lo, z_hi = _radii(t.groove)
+    assert t.depth == PIN.depth and (z_lo, z_hi) == pytest.approx((15.0, 20.0), abs=1e-9)
+    assert 40.4 * math.cos(math.pi / 360) + SP.MIN_WALL - 1e-6 <= r_in <= 40.4 + SP.MIN_WALL
+    assert r_out == pytest.approx((45.0 * math.cos(math.pi / 360) - SP.MIN_WALL) / math.cos(math.pi / 360), abs=1e-3)
+    # the tongue is the groove less half the pin's clearance on each side
+    assert _radii(t.tongue)[:2] == pytest.approx((r_in + PIN.clearance / 2, r_out - PIN.clearance / 2), abs=2e-3)
+    # the cone as the mirror (exact distance, its normal 1 in 4 off the horizontal): 1 mm behind it
+    # over the groove's depth is r > 44 - 15/4 + 1.02 / cos (0.02 mm the region's sampling), on the
+    # region's 0.02 mm grid; the groove's nearest point to the mirror then 1.04 mm from it
+    cos = 1 / math.hypot(1.0, 0.25)
+    lean = SimpleNamespace(signed_distance=lambda p: (44.0 - p[:, 2] / 4 - np.hypot(p[:, 0], p[:, 1])) * cos)
+    (m,) = SP.make_tongues(cone, plan, PIN, lean)
+    r_in, r_out, _, _ = _radii(m.groove)
+    assert m.depth == PIN.depth and r_out == pytest.approx(_radii(t.groove)[1], abs=1e-9)
+    assert 40.25 + 1.02 / cos <= r_in <= 40.25 + 1.02 / cos + 0.021
+    assert m.min_clearance_to_mirror == pytest.approx((r_in - 40.25) * cos, abs=1e-3)
+
+
+def test_a_wide_wall_gets_a_groove_along_each_face_at_most_3_mm_wide():
+    # the tube's 15 mm wall: the region 35.6-49.4 mm, the groove the 3 mm next to each of its edges
+    (t,) = SP.make_tongues(_tube(h=40.0), SP.SplitPlan(4, 2, 0.0, (0.0, 20.0, 40.0)), PIN, None)
+    rings = math.pi * (49.4 ** 2 - 46.4 ** 2 + 38.6 ** 2 - 35.6 ** 2)  # as circles: the 96-gon 0.02 % less
+    assert t.groove.volume() == pytest.approx(PIN.depth * rings, rel=1e-3)
+
+
+def test_pins_of_a_band_too_thin_for_them_are_refused_on_its_lower_cut():
+    # bands 4 mm apart: a 5 mm pin on the lower cut (z = 20) comes out through the upper one; the lower
+    # cut is refused, before the upper cut's pins (whose lower ends cross z = 20) are tried
+    with pytest.raises(FabricationError, match=r"^band cut z 20\.0 mm, sector 1: no room for two 2 mm pins"):
+        SP.place_pins(_tube(h=40.0), SP.SplitPlan(1, 3, 0.0, (0.0, 20.0, 24.0, 40.0)), PIN, None)
+
+
+def test_a_face_gets_a_pin_per_60_mm_from_two_to_six():
+    # faces 12 mm tall across a plate, less the 1.7 mm guard at each end: 296.6 mm -> 5, 416.6 -> 7 capped at 6
+    for length, count in ((300.0, 5), (420.0, 6), (100.0, 2)):
+        plate = m3d.Manifold.cube((40.0, length, 12.0))
+        assert len(SP.place_pins(plate, SP.GridPlan((20.0,), ()), PIN, None)) == count, length
+
+
+def test_a_cut_too_near_the_end_has_no_hole_with_its_wall():
+    # a cut 3 mm from the plate's end: a hole 5 mm deep each way leaves the part whatever its place
+    plate = m3d.Manifold.cube((120.0, 40.0, 12.0)).translate((100.0, 0.0, 0.0))
+    with pytest.raises(FabricationError, match=r"^x cut 103\.0 mm, y slab 1, z slab 1: fewer than two pin positions "
+                                               r"keep 0\.6 mm of wall around the hole; use thinner pins"):
+        SP.place_pins(plate, SP.GridPlan((103.0,), ()), PIN, None)
