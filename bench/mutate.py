@@ -107,8 +107,10 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
 # default 15). The clean run that mutmut times compiles the analytic tracer's numba kernels (~23 s,
 # cached on disk for the mutants after it): tolerance.limits's tests then take ~25 s clean and ~3 s
 # a mutant, so 15x would wait ~15 min of CPU on each of the 29 mutants that hang the limit search's
-# bisection; 1x still waits ~20 times a mutant's own run.
-TIMEOUT_MULTIPLIER = {"tolerance.limits": 1.0}
+# bisection; 1x still waits ~20 times a mutant's own run. fab.split's mutants of _mirror_region's
+# sampling loop hang it (~8 s of tests clean: 15x waits 6.5 min each); 3x waits 80 s, ~10 times a
+# surviving mutant's whole test file.
+TIMEOUT_MULTIPLIER = {"tolerance.limits": 1.0, "fab.split": 3.0}
 
 # folders the tests read, copied into each group's tree and into mutmut's mutants/ beside the code
 DATA = ["profiles", "bench/results"]
