@@ -377,6 +377,14 @@ def test_farthest_points_spread_and_skip_the_invalid():
     assert len(SP._farthest(pts, 9, lambda p: True)) == 5
     seen = []
     assert SP._farthest(pts, 2, lambda p: seen.append(1) or False) == [] and len(seen) == 5
+    # each pick is the farthest from all the picks so far, not from the last one alone: after 0 and
+    # 10, 5 (5 from both) and not 2.5 (7.5 from 10 but 2.5 from 0)
+    line = np.array([[x, 0.0, 0.0] for x in (0.0, 10.0, 5.0, 9.6, 2.5)])
+    assert [p[0] for p in SP._farthest(line, 4, lambda p: True)] == [0.0, 10.0, 5.0, 2.5]
+    # at most 200 candidates are tried: the 200th is, the 201st is not
+    calls = []
+    many = np.column_stack([np.arange(300.0), np.zeros(300), np.zeros(300)])
+    assert len(SP._farthest(many, 2, lambda p: calls.append(1) or len(calls) >= 200)) == 1 and len(calls) == 200
 
 
 def test_a_pin_hole_inside_the_wall_or_not():
@@ -420,6 +428,16 @@ def test_a_pin_keeps_its_hole_behind_the_mirror():
     assert 36.0 < hole < 36.06
     no = SP._mirror_region(SimpleNamespace(signed_distance=lambda p: np.ones(len(p))), np.array([0.0]), 1.0, 60.0)
     assert no.is_empty()
+    # the hole's circle sampled at 12 azimuths: a plane mirror in any direction across the axis is
+    # seen to within 15 degrees (r cos 15 deg of the hole's radius toward it), never less
+    e1, e2 = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])  # the plane frame of a y axis
+    for clearance in (SP.MIRROR_CLEARANCE + r * math.cos(math.pi / 12) - 2e-3, SP.MIRROR_CLEARANCE + r + 2e-3):
+        seen = []
+        for phi in np.radians(np.arange(360.0)):
+            u = math.cos(phi) * e1 + math.sin(phi) * e2
+            plane = SimpleNamespace(signed_distance=lambda p, u=u, d=clearance: p @ u - d)
+            seen.append(SP._mirror_clear(np.zeros((1, 3)), n, PIN, plane)[0])
+        assert seen == [clearance > SP.MIRROR_CLEARANCE + r] * 360, clearance
     ring = SP._mirror_region(SimpleNamespace(signed_distance=lambda p: np.abs(np.hypot(p[:, 0], p[:, 1]) - 20.0) - 5),
                              np.array([0.0]), 1.0, 60.0)
     assert ring.area() == pytest.approx(math.pi * (23.97 ** 2 - 16.03 ** 2), rel=5e-3)  # 16 < r < 24, 1 mm in
@@ -512,8 +530,15 @@ def test_a_tube_in_quarters_and_two_bands_with_a_tongue_and_groove():
     assert lower < ring * 20 - t.groove.volume() * 0.99 and upper > ring * 20 - 0.5 * t.groove.volume()
     assert SP.make_tongues(tube, SP.SplitPlan(4, 1, 0.0, (0.0, 40.0)), PIN, None) == []
     assert SP.make_tongues(tube, SP.GridPlan((1.0,), ()), PIN, None) == []
-    with pytest.raises(FabricationError, match=r"^band cut z 20\.0 mm: no tongue and groove fits \("):
-        SP.make_tongues(_tube(r_out=36.3, h=40.0), plan, PIN, None)  # 1.3 mm: no groove leaves 0.6 mm walls
+    with pytest.raises(FabricationError, match=r"^band cut z 20\.0 mm: no tongue and groove fits \(no room for a "
+                                               r"groove 2 mm deep\)$"):
+        SP.make_tongues(_tube(r_out=36.3, h=40.0), plan, PIN, None)  # 1.3 mm: 0.6 mm walls leave 0.1, the tongue none
+    # a mirror that is not round about the axis (a plane at y = 44, in front of the wall's outer 6 mm)
+    # is not in the clear region (annuli about the axis): the groove is measured against it and refused
+    wall = SimpleNamespace(signed_distance=lambda p: p[:, 1] - 44.0)
+    with pytest.raises(FabricationError, match=r"^band cut z 20\.0 mm: no tongue and groove fits \(the groove comes "
+                                               r"-5\.40 mm from the mirror\)$"):
+        SP.make_tongues(tube, plan, PIN, wall)
 
 
 def test_a_tongue_too_small_for_its_sectors_is_refused_naming_its_area():
@@ -689,3 +714,23 @@ def test_a_cut_too_near_the_end_has_no_hole_with_its_wall():
     with pytest.raises(FabricationError, match=r"^x cut 103\.0 mm, y slab 1, z slab 1: fewer than two pin positions "
                                                r"keep 0\.6 mm of wall around the hole; use thinner pins"):
         SP.place_pins(plate, SP.GridPlan((103.0,), ()), PIN, None)
+
+
+def _slotted_tube(z0, z1):
+    # the 15 mm tube with a slot 1 mm deep into its outer face between z0 and z1
+    ring = m3d.Manifold.cylinder(z1 - z0, 51.0, 51.0, SEG) - m3d.Manifold.cylinder(z1 - z0, 49.0, 49.0, SEG)
+    return _tube(h=40.0) - ring.translate((0.0, 0.0, z0))
+
+
+def test_a_slot_between_the_sampled_heights_is_caught_by_the_grooves_wall():
+    # the groove's region is the part's slices at 9 heights; a 0.2 mm slot between them is not seen
+    # there, but the groove widened by its wall would open into it. Between every depth's heights
+    # (17.45-17.65 mm): no depth is kept, and the reason is the last one's wall
+    plan = SP.SplitPlan(4, 2, 0.0, (0.0, 20.0, 40.0))
+    with pytest.raises(FabricationError, match=r"^band cut z 20\.0 mm: no tongue and groove fits \(the groove 2 mm "
+                                               r"deep leaves less than 0\.6 mm of wall\)$"):
+        SP.make_tongues(_slotted_tube(17.45, 17.65), plan, PIN, None)
+    # 19.35-19.55 mm, within the top 1.2 mm under the cut: between the 5 mm groove's heights (19.3, 20)
+    # so refused by its wall, and seen by the 4 mm groove's (19.425), whose region keeps off it
+    (t,) = SP.make_tongues(_slotted_tube(19.35, 19.55), plan, PIN, None)
+    assert t.depth == 4.0
