@@ -22,8 +22,12 @@ from rigcad.check.figures import _angles as angle_between  # noqa: F401  (the on
 #: The rays through the dome points carry little noise (a screen point's ~3 um over ~150 mm), so
 #: the least smoothing: 0.6 px took the recovered slope RMS to 0.83 of the planted (seed 1).
 SMOOTH_PX = 0.3
-#: A height's decoded pixels within this many of one it did not decode are not used at that height:
-#: their footprints see the screen's or a shadow's edge in part, which pulls the decoded point.
+#: A height's decoded pixels within this many of one it did not decode (steps along rows and
+#: columns: binary erosions) are not used at that height, here nor in the fit
+#: (:func:`rigcad.calibrate.run._fit_data`): their footprints see the screen's or a shadow's edge in
+#: part, which pulls the decoded point. Measured against the tracer (Table 3.1, seeds 101, 102, 105):
+#: 3 px from the edge the upper screen's points lie ~70 um outward on average, 4 px and more within
+#: 3 um; with 2 in the fit, those points pulled the fitted upper screen 15-23 um low (seeds 101-106).
 HEIGHT_EDGE_PX = 3
 #: Measured pixels within this many of an unmeasured one are filled, not measured.
 EDGE_PX = 1
