@@ -22,8 +22,12 @@ from rigcad.check.figures import _angles as angle_between  # noqa: F401  (the on
 #: The rays through the dome points carry little noise (a screen point's ~3 um over ~150 mm), so
 #: the least smoothing: 0.6 px took the recovered slope RMS to 0.83 of the planted (seed 1).
 SMOOTH_PX = 0.3
-#: A height's decoded pixels within this many of one it did not decode are not used at that height:
-#: their footprints see the screen's or a shadow's edge in part, which pulls the decoded point.
+#: A height's decoded pixels within this many of one it did not decode (steps along rows and
+#: columns: binary erosions) are not used at that height, here nor in the fit
+#: (:func:`rigcad.calibrate.run._fit_data`): their footprints see the screen's or a shadow's edge in
+#: part, which pulls the decoded point. Measured against the tracer (Table 3.1, seeds 101, 102, 105):
+#: 3 px from the edge the upper screen's points lie ~70 um outward on average, 4 px and more within
+#: 3 um; with 2 in the fit, those points pulled the fitted upper screen 15-23 um low (seeds 101-106).
 HEIGHT_EDGE_PX = 3
 #: Measured pixels within this many of an unmeasured one are filled, not measured.
 EDGE_PX = 1
@@ -43,9 +47,10 @@ def pivot_rays(decoded: list, poses: list, model_tr: M.Traced, shape: tuple[int,
     point, which it does not move. So each screen point fixes the direction over the ~120-230 mm from
     the dome, not over the spacers' gap (8 mm): the decoded points' bias (~10-40 um) costs ~0.1-0.3
     mrad, not ~1-5. What the direction inherits instead is the fitted model's dome point, off the
-    true ray by the fit's error (~0.1 mm: ~0.6 mrad over the lever, smooth across the pixels), and a
-    paraboloid slope error, which moves the dome point, is read as a dome tilt there. A pixel seen
-    at one height (grazing rays past the upper screen's edge) is measured too."""
+    true ray by the fit's error (0.01-0.05 mm median on seeds 101-106 with 1/20 mm spacers: ~0.1-0.35
+    mrad over the lever, smooth across the pixels), and a paraboloid slope error, which moves the
+    dome point, is read as a dome tilt there. A pixel seen at one height (grazing rays past the
+    upper screen's edge) is measured too."""
     from scipy.ndimage import binary_erosion
 
     total = np.zeros((int(np.prod(shape)), 3))

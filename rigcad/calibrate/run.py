@@ -18,8 +18,6 @@ from rigcad.calibrate.fit import SLOPE_PROJECTION, FitData, fit
 from rigcad.calibrate.patterns import Sequence
 
 
-#: Pixels within this many of an undecoded pixel are left out of the fit (the maps fill them).
-EDGE_PX = 2
 #: The decoding's own bias (:mod:`rigcad.calibrate.bias`) is removed from the decoded points before
 #: the fit: "map" (predicted from the measured map itself), or None (kept, for comparison).
 DECODING_BIAS = "map"
@@ -109,8 +107,9 @@ def _fit_data(cam: M.Camera, decoded: list, stride: int) -> FitData:
     pick = ((rows % stride == 0) & (cols % stride == 0)).ravel()
     from scipy.ndimage import binary_erosion
 
-    # pixels next to an undecoded one see a screen edge or a shadow's edge in part of their footprint
-    inner = [binary_erosion(d.valid, iterations=EDGE_PX).ravel() for d in decoded]
+    # pixels near an undecoded one see a screen edge or a shadow's edge in part of their footprint:
+    # the same rule as the map's rays (maps.HEIGHT_EDGE_PX)
+    inner = [binary_erosion(d.valid, iterations=maps.HEIGHT_EDGE_PX).ravel() for d in decoded]
     ok = pick & np.all(inner, axis=0)
     idx = np.nonzero(ok)[0]
     uv = np.stack([np.stack([d.u.ravel()[idx], d.v.ravel()[idx]], axis=-1) for d in decoded], axis=1)
