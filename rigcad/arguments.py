@@ -48,6 +48,18 @@ def port_number(text: str) -> int:
     return value
 
 
+def host_address(text: str) -> str:
+    """An argparse type: the address a server listens on, a host name or an IP address; not empty
+    (an empty one would listen on every interface) and of printable ASCII (a name the resolver can
+    take)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("expected an address such as 127.0.0.1 or localhost, got an empty one (an "
+                                         "empty address would serve every network interface; say 0.0.0.0 to mean it)")
+    if not (text.isascii() and text.isprintable()) or any(c.isspace() for c in text):
+        raise argparse.ArgumentTypeError(f"expected an address such as 127.0.0.1 or localhost, got {ascii(text)[:80]}")
+    return text
+
+
 def exports_root(text: str) -> str:
     """An argparse type: an output root, not empty (an empty one would write into the current folder)
     and without control or formatting characters (a newline or a right-to-left override in a folder

@@ -7,6 +7,7 @@ from pathlib import Path
 
 
 def cmd_watch(args: argparse.Namespace) -> int:
+    _refuse_at_start(args)
     from rigcad.live.page import live_html
     from rigcad.live.server import Hub, start
     from rigcad.live.session import LiveSession
@@ -21,11 +22,10 @@ def cmd_watch(args: argparse.Namespace) -> int:
             from rigcad.live.ocp import connect
 
             ocp = connect(args.ocp_port)
-        print(f"rigcad watch: {args.profile} -> {server.url} (open it in a browser; Ctrl-C stops)", flush=True)
-        watcher = Watcher(session, hub, say=lambda line: print(line, flush=True),
-                          write=Path(args.exports) if args.write else None, ocp=ocp)
         try:
-            watcher.run()
+            print(f"rigcad watch: {args.profile} -> {server.url} (open it in a browser; Ctrl-C stops)", flush=True)
+            Watcher(session, hub, say=lambda line: print(line, flush=True),
+                    write=Path(args.exports) if args.write else None, ocp=ocp).run()
         except KeyboardInterrupt:
             pass
     finally:
@@ -36,9 +36,25 @@ def cmd_watch(args: argparse.Namespace) -> int:
     return 0
 
 
+def _refuse_at_start(args: argparse.Namespace) -> None:
+    """One line now, before anything is served, for what no edit can mend: a profile or printer that
+    is nowhere (one with an error is served, with the error shown, and watched till it is fixed) and,
+    with --write, an exports root rigcad could never publish into."""
+    from rigcad.fab.printers import printer_path
+    from rigcad.profile.loader import resolve_profile_path
+
+    resolve_profile_path(args.profile)
+    for spec in args.printer or ():
+        printer_path(spec)
+    if args.write:
+        from rigcad.export.atomic import check_exports_root
+
+        check_exports_root(args.exports)
+
+
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``watch`` to rigcad's subcommands."""
-    from rigcad.arguments import port_number, profile_command
+    from rigcad.arguments import host_address, port_number, profile_command
 
     p = profile_command(
         subparsers, "watch", cmd_watch,
@@ -50,7 +66,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "A profile with an error shows it, with file:line, and keeps the last good rig. Ctrl-C stops.",
         epilog="By default nothing under the exports changes; --write publishes them after each good rebuild, "
                "as `rigcad stl` does. --ocp also shows the rig in a running OCP CAD Viewer. See docs/watch.md.")
-    p.add_argument("--host", default="127.0.0.1", help="address the live view is served on (default: 127.0.0.1, "
+    p.add_argument("--host", default="127.0.0.1", type=host_address, help="address the live view is served on (default: 127.0.0.1, "
                                                         "this machine only)")
     p.add_argument("--port", type=port_number, default=8765,
                    help="port of the live view (default 8765; taken: the next free one; 0: any free port)")

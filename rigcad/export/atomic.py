@@ -524,12 +524,42 @@ def check_exports(exports: Path, profile: str, folder: str | None = None) -> Non
     """Refuse at once, before any work, what publishing into ``exports/<profile>[/<folder>]`` would
     refuse at its end: a symbolic link on the way there, a lock file rigcad did not make. Creates
     nothing; the publication checks again under its lock."""
-    exports = Path(exports)
+    exports = check_exports_root(exports)
     target = exports / profile if folder is None else exports / profile / folder
     refuse_links(target, exports)
     lock = profile_lock(exports, profile)
     if os.path.lexists(lock):
         os.close(_open_lock(lock))
+    else:
+        _refuse_unwritable(lock.parent)
+
+
+def check_exports_root(exports: Path) -> Path:
+    """Refuse now an exports root rigcad could not publish into: a file, not a folder; a name the
+    system refuses; a folder this user cannot write (each would fail only after the work). The
+    root itself, as a Path."""
+    exports = Path(exports)
+    try:
+        os.lstat(exports)  # a name too long, a file on the way: refused here by the OSError, as main() says it
+    except FileNotFoundError:
+        pass
+    if os.path.exists(exports) and not exports.is_dir():
+        raise ExportError(f"--exports {exports} is not a folder: rigcad writes its outputs into a folder there; "
+                          "give --exports a folder (it is made if missing); nothing was written")
+    _refuse_unwritable(exports)
+    return exports
+
+
+def _refuse_unwritable(folder: Path) -> None:
+    """Refuse now when the nearest existing folder on the way to ``folder`` cannot take a new entry
+    (the permission bits, as ``access(2)`` judges them for this user): publishing would fail there
+    only after the work."""
+    near = Path(os.path.abspath(folder))
+    while not os.path.lexists(near) and near != near.parent:
+        near = near.parent
+    if near.is_dir() and not os.access(near, os.W_OK | os.X_OK):
+        raise WriteError(f"cannot write {near}: permission denied: choose a folder you can write (--exports); "
+                         "nothing was written")
 
 
 class _Lock:

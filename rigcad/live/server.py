@@ -274,9 +274,10 @@ def start(hub: Hub, page: bytes, host: str = DEFAULT_HOST, port: int = DEFAULT_P
     for candidate in range(port, port + PORT_TRIES) if port else [0]:
         try:
             server = LiveServer((host, candidate), hub, page)
-        except OSError as err:
-            if err.errno != errno.EADDRINUSE:
-                raise ServerError(f"cannot serve the live view on {host}:{candidate}: {err.strerror}; "
+        except (OSError, UnicodeError) as err:
+            if getattr(err, "errno", None) != errno.EADDRINUSE:
+                reason = getattr(err, "strerror", None) or str(err)
+                raise ServerError(f"cannot serve the live view on {host}:{candidate}: {reason}; "
                                   "give another --host or --port", param="--port") from err
             last_error = err
             continue

@@ -36,6 +36,8 @@ class Case:
     stress: bool = False
     #: A finding that is someone else's open work: the case is expected to fail (strictly) until it is fixed.
     xfail: str | None = None
+    #: A command that serves until stopped (`watch`): once it says it serves, Ctrl-C must stop it cleanly.
+    serves: bool = False
 
     @property
     def id(self) -> str:
@@ -414,6 +416,8 @@ def generic_cases(covered: set[tuple[str, str]]):
                 if words[0] in ("design", "build", "stl", "check", "fab", "basis", "optimize", "view", "manual",
                                 "tolerance", "sweep") and option != "--exports":
                     fixed += ["--exports", str(sb.exports)]
+                if words[0] == "watch" and option == "--exports":
+                    fixed += ["--write"]  # the exports are only used, so only checked, when it publishes
                 if option == "profile":
                     return [*words, value, *fixed]
                 return [*words, profile, *fixed, option, value]
@@ -422,7 +426,7 @@ def generic_cases(covered: set[tuple[str, str]]):
             # fail its tolerances (exit 1) after its work, which is a verdict, not a late refusal
             folder = option == "--exports" and value not in ("", "x" * 5000)
             yield Case("args", f"{command} {option} {value[:12]!r} (generic)", argv, expect_refusal=not folder,
-                       timed=not folder, stress=True, timeout=120)
+                       timed=not folder, stress=True, timeout=120, serves=words[0] == "watch")
 
 
 # -- links and files planted in the exports --------------------------------------------------------

@@ -41,11 +41,23 @@ def _check(case: corpus.Case, sandbox: Sandbox) -> None:
     if case.setup:
         case.setup(sandbox)
     argv = case.argv(sandbox)
-    o = run(argv, sandbox, timeout=case.timeout, name=case.kind)
+    o = _serve_and_stop(argv, sandbox, case) if case.serves else run(argv, sandbox, timeout=case.timeout,
+                                                                      name=case.kind)
     v = violations(o, sandbox, expect_refusal=case.expect_refusal, timed=case.timed)
+    if case.serves and o.killed is None and o.rc == 0 and "rigcad watch: stopped" not in o.stdout:
+        v.append("stopped by Ctrl-C without saying so")
     _figures.append({"case": case.id, "exit": o.rc, "killed": o.killed, "refused": o.refused, "cpu_s": o.cpu_s,
                      "wall_s": round(o.wall_s, 3), "peak_mb": round(o.maxrss_mb, 1), "violations": v})
     assert not v, f"{case.id}: {'; '.join(v)}\n  {o.describe()}"
+
+
+def _serve_and_stop(argv: list[str], sandbox: Sandbox, case: corpus.Case):
+    """Run a serving command until it says it serves (or ends), then stop it as a user does: Ctrl-C."""
+    child = Child(argv, sandbox, name=case.kind)
+    if child.wait_until(lambda: " -> http" in child.files["stdout"].read_text(errors="replace")
+                        if child.files["stdout"].exists() else False, case.timeout) and not child.poll():
+        child.signal_group(signal.SIGINT)
+    return child.finish(case.timeout)
 
 
 def test_the_corpus_has_every_kind_and_every_command():

@@ -1,5 +1,6 @@
-"""`rigcad watch` from the command line: a profile that does not exist is one line and a non-zero
-exit (there is nothing to watch); `--write` publishes the exports after each good rebuild through
+"""`rigcad watch` from the command line: what no edit can mend (a profile or printer that is
+nowhere, an empty --host that would serve every interface, with --write an exports root that is a
+file) is one line and a non-zero exit before anything is served; `--write` publishes the exports after each good rebuild through
 `rig.export` (the atomic publication and part cache of `rigcad stl`), so a second edit rebuilds
 only the parts it changed."""
 
@@ -20,13 +21,20 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def test_a_missing_profile_is_one_line(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "rigcad", "watch", "no_such_rig", "--port", "0"],
+@pytest.mark.parametrize("argv, named", [
+    (["no_such_rig"], "no_such_rig"),
+    (["achutha2006", "--printer", "no_such_printer"], "no_such_printer"),
+    (["achutha2006", "--host", ""], "--host"),
+    (["achutha2006", "--write", "--exports", "a_file"], "a_file"),
+], ids=["missing profile", "missing printer", "empty host (every interface)", "exports is a file"])
+def test_what_no_edit_can_mend_is_one_line_before_serving(tmp_path, argv, named):
+    (tmp_path / "a_file").write_text("not a folder")
+    run = subprocess.run([sys.executable, "-m", "rigcad", "watch", *argv, "--port", "0"],
                          capture_output=True, text=True, timeout=120, cwd=tmp_path,
                          env={**os.environ, "PYTHONPATH": str(ROOT)})
-    assert run.returncode != 0
-    errors = [line for line in run.stderr.splitlines() if line.strip()]
-    assert len(errors) == 1 and errors[0].startswith("rigcad: error: ") and "no_such_rig" in errors[0], run.stderr
+    assert run.returncode != 0 and "->" not in run.stdout, run.stdout
+    errors = [line for line in run.stderr.splitlines() if "error: " in line]  # argparse's usage lines aside
+    assert len(errors) == 1 and named in errors[0] and "Traceback" not in run.stderr, run.stderr
 
 
 @pytest.mark.slow
