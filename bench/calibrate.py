@@ -136,6 +136,67 @@ def summarize(profile: str, resolution, trials: list) -> dict:
     return summary
 
 
+#: The sweep's rows as docs/calibrate.md names them, in its order.
+VARIANT_LABELS = {"steps3": "3 phase steps", "steps4": "4 phase steps (the default)", "steps8": "8 phase steps",
+                  "heights_2_10mm": "spacers 2, 10 mm (the earlier default)",
+                  "heights_1_20mm": "spacers 1, 20 mm (the default)", "heights_1_30mm": "spacers 1, 30 mm",
+                  "heights_1_10_20mm": "spacers 1, 10, 20 mm"}
+
+
+def _spread(values, digits: int) -> str:
+    """'min-max; median' of ``values``, to ``digits`` decimals."""
+    lo, hi, mid = (f"{float(f(values)):.{digits}f}" for f in (np.min, np.max, np.median))
+    return f"{lo}-{hi}; {mid}"
+
+
+def tables(summary: dict) -> str:
+    """The bench's tables in Markdown, as docs/calibrate.md shows them (tests/test_docs.py holds the
+    page to this rendering of bench/results/calibrate.json)."""
+    trials = summary["per_trial"]
+    source = [t["corrected_incidence_error_deg_by_source"]["measured"] for t in trials]
+    measured = [s["p99"] for s in source]
+    lit = [t["corrected_incidence_error_deg"]["p99"] for t in trials]
+    met = [t["parameters_met"] for t in trials]
+    total = trials[0]["parameters_total"]
+    ratio = [t["recovered_slope_rms_mrad"] / t["planted_slope_rms_mrad"] for t in trials]
+    n, target = len(trials), summary["targets"]["corrected_incidence_error_p99_deg"]
+    def verdict(values):
+        k = int(np.sum(np.array(values) <= target))
+        return f"{target} deg: **{'met' if k == n else 'not met'}** ({k} of {n})"
+    cpu = [t["calibration_cpu_s"] for t in trials]
+    rows = [
+        "| figure (range over the trials; median) | value | target |", "|---|---|---|",
+        f"| corrected map p99, measured pixels ({100 * summary['measured_fraction_of_lit_median']:.0f} % of lit) "
+        f"| {_spread(measured, 3)} deg | {verdict(measured)} |",
+        f"| corrected map p99, all lit pixels | {_spread(lit, 3)} deg | {verdict(lit)} |",
+        f"| corrected map p50, measured pixels | {_spread([s['p50'] for s in source], 3)} deg | |",
+        f"| design (uncorrected) map p99, same rigs | {_spread([t['design_incidence_error_deg']['p99'] for t in trials], 1)}"
+        " deg | |",
+        f"| parameters within max(10 % tol, 0.02 mm / 0.01 deg) | {min(met)}-{max(met)} of {total}; "
+        f"{np.median(met):.0f} ({100 * summary['parameters_within_target_fraction']:.0f} %) | all: **"
+        f"{'met' if min(met) == total else 'not met'}** ({sum(m == total for m in met)} of {n}) |",
+        f"| slope RMS recovered / planted ({np.median([t['planted_slope_rms_mrad'] for t in trials]):.2f} mrad) "
+        f"| {min(ratio):.3f}-{max(ratio):.3f} | within 20 %: **{'met' if max(abs(r - 1) for r in ratio) <= 0.2 else 'not met'}** |",
+        f"| slope difference RMS, pointwise | {_spread([t['slope_difference_rms_mrad'] for t in trials], 2)} mrad | |",
+        f"| calibration CPU, one-off bench figure | {_spread(cpu, 1)} s | {summary['targets']['calibration_time_s']} s: "
+        f"**{'met' if max(cpu) <= summary['targets']['calibration_time_s'] else 'not met'}** (CPU) |",
+    ]
+    sweep_rows = summary.get("sweep_phase_steps_and_heights", {})
+    if sweep_rows:
+        k = next(iter(sweep_rows.values()))["trials"]
+        rows += ["", f"Sweep, {k} trial{'s' if k > 1 else ''} a variant (seed{'s' if k > 1 else ''} 1000"
+                     f"{f'-{999 + k}' if k > 1 else ''}; p99 and p50 in deg; CPU one-off):", "",
+                 "| variant | p99 all lit | p99 measured | p50 all lit | parameters within target | CPU s |",
+                 "|---|---|---|---|---|---|"]
+        for name, label in VARIANT_LABELS.items():
+            if name in sweep_rows:
+                r = sweep_rows[name]
+                rows.append(f"| {label} | {r['corrected_p99_deg']:.3f} | {r['measured_pixels_p99_deg']:.3f} | "
+                            f"{r['corrected_p50_deg']:.3f} | {r['parameters_met']:.0f} of {total} | "
+                            f"{r['calibration_cpu_s']:.1f} |")
+    return "\n".join(rows) + "\n"
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--trials", type=int, default=50, help="seeded trials (50 for the targets; fewer on a shared CPU)")
@@ -167,6 +228,7 @@ def main() -> int:
         summary["sweep_phase_steps_and_heights"] = sweep(args.profile, args.sweep_trials)
     write_json(Path(args.out), summary)
     print(json.dumps({k: v for k, v in summary.items() if k != "per_trial"}, indent=1))
+    print(tables(summary))
     return 0
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib
+import importlib.util
 import json
 import math
 import re
@@ -142,6 +143,24 @@ def test_an_unmarked_figure_is_caught():
     assert unmarked_figures("Edits are grouped (400 ms at most).") == []
     assert unmarked_figures("ended by 30<!--given--> ms of quiet") == []
     assert unmarked_figures("Targets: 1.5 s. It took 3.2 s.") == ["Targets: 1.5 s. It took 3.2 s"]
+
+
+def _bench_tables(page: str, marker: str) -> str:
+    """The block of ``page`` between ``<!-- {marker} -->`` and ``<!-- end of {marker} -->``."""
+    text = (DOCS / page).read_text(encoding="utf-8")
+    found = re.search(rf"<!-- {re.escape(marker)} -->\n(.*?)<!-- end of {re.escape(marker)} -->", text, re.S)
+    assert found, f"docs/{page} has no block marked <!-- {marker} -->"
+    return found.group(1)
+
+
+def test_calibration_tables_are_the_bench_results():
+    """docs/calibrate.md's tables are bench/calibrate.py's rendering of the committed
+    bench/results/calibrate.json: a rerun of the bench that is not copied into the page fails here."""
+    spec = importlib.util.spec_from_file_location("bench_calibrate", ROOT / "bench" / "calibrate.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    result = json.loads((ROOT / "bench" / "results" / "calibrate.json").read_text(encoding="utf-8"))
+    assert _bench_tables("calibrate.md", "bench/calibrate.py tables") == bench.tables(result)
 
 
 def test_every_figure_states_unit_source_and_tolerance(data):
