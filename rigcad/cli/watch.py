@@ -66,8 +66,8 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "A profile with an error shows it, with file:line, and keeps the last good rig. Ctrl-C stops.",
         epilog="By default nothing under the exports changes; --write publishes them after each good rebuild, "
                "as `rigcad stl` does. --ocp also shows the rig in a running OCP CAD Viewer. See docs/watch.md.")
-    p.add_argument("--host", default="127.0.0.1", type=host_address, help="address the live view is served on (default: 127.0.0.1, "
-                                                        "this machine only)")
+    p.add_argument("--host", default="127.0.0.1", type=host_address,
+                   help="address the live view is served on (default: 127.0.0.1, this machine only)")
     p.add_argument("--port", type=port_number, default=8765,
                    help="port of the live view (default 8765; taken: the next free one; 0: any free port)")
     p.add_argument("--printer", action="append", metavar="NAME",

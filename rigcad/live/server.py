@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import errno
 import json
+import socket
 import threading
 import time
 from collections import deque
@@ -277,8 +278,9 @@ def start(hub: Hub, page: bytes, host: str = DEFAULT_HOST, port: int = DEFAULT_P
         except (OSError, UnicodeError) as err:
             if getattr(err, "errno", None) != errno.EADDRINUSE:
                 reason = getattr(err, "strerror", None) or str(err)
+                resolver = isinstance(err, (UnicodeError, socket.gaierror))  # the name, not the port
                 raise ServerError(f"cannot serve the live view on {host}:{candidate}: {reason}; "
-                                  "give another --host or --port", param="--port") from err
+                                  "give another --host or --port", param="--host" if resolver else "--port") from err
             last_error = err
             continue
         if candidate != port and port:

@@ -1,7 +1,7 @@
 """`rigcad watch` from the command line: what no edit can mend (a profile or printer that is
 nowhere, an empty --host that would serve every interface, with --write an exports root that is a
-file) is one line and a non-zero exit before anything is served; `--write` publishes the exports after each good rebuild through
-`rig.export` (the atomic publication and part cache of `rigcad stl`), so a second edit rebuilds
+file) is one line and a non-zero exit before anything is served; `--write` publishes the exports
+after each good rebuild through `rig.export` (the atomic publication and part cache of `rigcad stl`), so a second edit rebuilds
 only the parts it changed."""
 
 from __future__ import annotations
