@@ -248,6 +248,33 @@ class Reference:
     error_estimate: float
 
 
+def _reference_nodes(zone: Zone, L: int, refine: float, per_panel: int, lobe_width_rad: float | None,
+                     lobe_centre: np.ndarray | None, illuminated: Callable[[np.ndarray], np.ndarray] | None):
+    """:func:`reference_set`'s quadrature at one refinement: polar nodes ``th``, azimuths ``ph`` (one
+    row for all, or one row per polar node where ``illuminated`` splits the rows), the directions
+    ``wi`` and the weights with cos(theta_i) folded in. ``lobe_centre``: the mirror direction the
+    lobe rule gathers its nodes around (only with ``lobe_width_rad``)."""
+    if illuminated is None:
+        if lobe_width_rad is None:
+            n = int(6 * (L + 8) * refine)
+            th, wt, ph, wp = zone_rule(zone, n, 2 * n)
+        else:
+            th, wt, ph, wp = lobe_rule(zone, lobe_centre, lobe_width_rad, per_panel, refine)
+        weight = wt[:, None] * wp[None, :]
+    else:
+        if lobe_width_rad is None:  # the uniform rule's nodes, azimuth in Gauss panels
+            n = int(6 * (L + 8) * refine)
+            th, wt, _, _ = zone_rule(zone, n, 1)
+            panels = max(1, math.ceil(2 * math.pi / min(MASKED_PANEL_RAD, 2 * math.pi * per_panel / (2 * n))))
+            breaks = np.linspace(0.0, 2 * math.pi, panels + 1)
+        else:
+            th, wt, breaks = _lobe_parts(zone, lobe_centre, lobe_width_rad, per_panel, refine, MASKED_PANEL_RAD)
+        ph, wp = _split_rows(illuminated, th, breaks, per_panel)  # (n_t, k) each
+        weight = wt[:, None] * wp
+    wi = angles_to_directions(th[:, None], ph if ph.ndim == 2 else ph[None, :])
+    return th, ph, wi, weight * wi[..., 2]
+
+
 def reference_set(brdfs: Mapping[str, Brdf], wo: np.ndarray, order: int, zone: Zone,
                   lobe_width_rad: float | None = None, per_panel: int = 8,
                   illuminated: Callable[[np.ndarray], np.ndarray] | None = None) -> dict[str, "Reference"]:
@@ -263,28 +290,14 @@ def reference_set(brdfs: Mapping[str, Brdf], wo: np.ndarray, order: int, zone: Z
     wo = _wo(wo)
     K = (L + 1) ** 2
     out = {name: np.empty((2, wo.shape[0], K)) for name in brdfs}
+    refinements = (1.0, 2.0)
+    # without a lobe the nodes do not depend on wo: built once a refinement, not once a direction
+    shared = {refine: _reference_nodes(zone, L, refine, per_panel, None, None, illuminated)
+              for refine in refinements} if lobe_width_rad is None else {}
     for o in range(wo.shape[0]):
-        for r, refine in enumerate((1.0, 2.0)):
-            if illuminated is None:
-                if lobe_width_rad is None:
-                    n = int(6 * (L + 8) * refine)
-                    th, wt, ph, wp = zone_rule(zone, n, 2 * n)
-                else:
-                    th, wt, ph, wp = lobe_rule(zone, mirror(wo[o]), lobe_width_rad, per_panel, refine)
-                weight = wt[:, None] * wp[None, :]
-            else:
-                if lobe_width_rad is None:  # the uniform rule's nodes, azimuth in Gauss panels
-                    n = int(6 * (L + 8) * refine)
-                    th, wt, _, _ = zone_rule(zone, n, 1)
-                    panels = max(1, math.ceil(2 * math.pi / min(MASKED_PANEL_RAD, 2 * math.pi * per_panel / (2 * n))))
-                    breaks = np.linspace(0.0, 2 * math.pi, panels + 1)
-                else:
-                    th, wt, breaks = _lobe_parts(zone, mirror(wo[o]), lobe_width_rad, per_panel, refine,
-                                                 MASKED_PANEL_RAD)
-                ph, wp = _split_rows(illuminated, th, breaks, per_panel)  # (n_t, k) each
-                weight = wt[:, None] * wp
-            wi = angles_to_directions(th[:, None], ph if ph.ndim == 2 else ph[None, :])
-            weight = weight * wi[..., 2]
+        for r, refine in enumerate(refinements):
+            th, ph, wi, weight = shared[refine] if shared else _reference_nodes(
+                zone, L, refine, per_panel, lobe_width_rad, mirror(wo[o]), illuminated)
             for name, brdf in brdfs.items():
                 g = np.asarray(brdf(wi, wo[o][None, None, :]), dtype=float) * weight
                 out[name][r, o] = zonal_moments(th, ph, g, L, zone)
