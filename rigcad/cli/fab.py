@@ -72,6 +72,9 @@ def cmd_fab(args: argparse.Namespace) -> int:
             print(f"  slicer {k}: {v:.2f} s")
     for p in res.problems:
         print(f"rigcad: fab: {p}", file=sys.stderr)
+    if res.problems:  # the verdict, on one line of its own: the problems above are its details
+        print(f"rigcad: error: fab found {len(res.problems)} problem(s), listed above; the outputs are written, "
+              f"with the problems in {out}/fab.json", file=sys.stderr)
     return 1 if res.problems else 0
 
 

@@ -36,3 +36,24 @@ def test_fab_gcode_reports_each_piece_sliced_and_the_slicers_figures(tmp_path):
     assert sorted(events[2:]) == ["sliced beam", "sliced sample_holder"]  # as each piece is done
     assert "total (prusa-slicer, with quantities):" in proc.stdout and " g filament" in proc.stdout
     assert "; slicer " in proc.stdout  # per part: the slicer's time and filament
+
+
+@pytest.mark.skipif(not have_slicer(), reason="prusa-slicer is not installed")
+def test_a_slicer_complaint_is_the_verdict_on_one_error_line_after_the_outputs(tmp_path):
+    """A custom G-code line the slicer cannot read ('touch x' reads as a tool change) is allowed into
+    the printer file (it is G-code, and nothing runs it); PrusaSlicer's complaint is fab's verdict:
+    its detail on a `rigcad: fab:` line, then one `rigcad: error:` line, exit 1, the outputs written
+    with the problem in fab.json."""
+    import json
+
+    shipped = (ROOT / "profiles" / "printers" / "prusa_mk3s.yaml").read_text()
+    printer = tmp_path / "touchy.yaml"
+    printer.write_text(shipped.replace("  overrides:\n", '  overrides:\n    start_gcode: "M117 hi\\ntouch x"\n', 1))
+    proc = _fab(tmp_path, "--printer", str(printer), "--gcode", "--parts", "beam")
+    assert proc.returncode == 1, proc.stderr[-2000:]
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip() and not ln.startswith("rigcad-event: ")]
+    errors = [ln for ln in lines if ln.startswith("rigcad: error: ")]
+    assert len(errors) == 1 and "1 problem(s)" in errors[0] and "fab.json" in errors[0], lines
+    assert any(ln.startswith("rigcad: fab: beam: slicer warnings:") and "toolchange" in ln for ln in lines), lines
+    report = json.loads((tmp_path / "achutha2006" / "fab" / "touchy" / "fab.json").read_text())
+    assert any("toolchange" in p for p in report["problems"]), report["problems"]
