@@ -12,7 +12,7 @@ SYSTEM_TOOLS := prusa-slicer chromium
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 EXPORTS ?= exports
 
-.PHONY: all stl design docs check gcode view manual tools test test-all test-slow test-portable bench stress mutate clean distclean help
+.PHONY: all stl design docs check gcode view manual tools test test-e2e test-all test-slow test-portable bench stress mutate clean distclean help
 
 all: stl
 
@@ -24,6 +24,7 @@ help:
 	@echo "make manual   - assembly and calibration manual for PRINTER=$(PRINTER) -> $(EXPORTS)/$(PROFILE)/manual/$(PRINTER)/"
 	@echo "make docs     - run the documented commands on $(PROFILE); every figure and picture of README.md and docs/"
 	@echo "make test     - the fast test suite (default run, < 5 min on 2 cores)"
+	@echo "make test-e2e - the whole-command and whole-rig runs make test leaves out (CI runs both)"
 	@echo "make test-slow - only the slow tests (the whole rig through PrusaSlicer)"
 	@echo "make test-all - every test, slow ones included"
 	@echo "make test-portable - the numerical tests as other CPUs compute them (BLAS kernels, numpy SIMD off, generic numba)"
@@ -71,7 +72,11 @@ docs: $(VENV)/.installed tools
 # --durations=15: the slowest tests on every run; --timeout (pytest-timeout): a hung test fails after
 # 10 min (the slow ones, the whole rig through PrusaSlicer, after an hour) instead of stalling the run
 test: $(VENV)/.installed tools
-	$(PY) -m pytest -q -n auto --dist loadfile -m "not slow and not stress" --durations=15 --timeout=600
+	$(PY) -m pytest -q -n auto --dist loadfile -m "not slow and not stress and not e2e" --durations=15 --timeout=600
+
+# The whole commands and whole-rig runs make test leaves out to stay under 5 min (marked e2e); CI runs them
+test-e2e: $(VENV)/.installed tools
+	$(PY) -m pytest -q -n auto --dist loadfile -m "e2e and not slow and not stress" --durations=15 --timeout=600
 
 # The numerical tests as other x86-64 CPUs compute them, on this one: OpenBLAS's kernel forced
 # (Prescott: SSE3 only; SkylakeX: AVX-512; Haswell: AVX2 + FMA), numpy's SIMD dispatch switched off

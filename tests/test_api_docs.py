@@ -8,6 +8,9 @@ from pathlib import Path
 
 import pytest
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 DOC = Path(__file__).resolve().parents[1] / "docs" / "api.md"
 
 

@@ -12,6 +12,9 @@ from pathlib import Path
 
 import pytest
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = ("ray_count", "float32", "tessellation", "make_stl", "basis", "optimize", "refusals")
 

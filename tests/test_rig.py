@@ -76,6 +76,7 @@ def test_one_dome_integration_serves_export_check_and_fab(tmp_path, monkeypatch)
     assert len(calls) == 1, f"the dome was integrated {len(calls)} times: {calls}"
 
 
+@pytest.mark.e2e  # the whole command or rig: make test-e2e
 def test_fab_pieces_are_cut_from_the_exported_dome(tmp_path):
     """A profile whose smooth curve needs more rows than it asks for (51 -> 201): the printed
     pieces come from the same converged dome as the exported part. Both meshes are manifold3d's
@@ -242,6 +243,7 @@ def test_load_works_outside_the_repository(tmp_path):
     assert res.stdout.split() == ["profiles/achutha2006.yaml", "10.66"]  # the thesis's ~11 in dome
 
 
+@pytest.mark.e2e  # the whole command or rig: make test-e2e
 def test_a_part_the_kernel_cannot_build_is_one_line_exit_1_nothing_written(tmp_path):
     """A clamp 1e-8 mm long passes the schema (> 0) but OpenCascade refuses a box that thin."""
     profile = tmp_path / "thin.yaml"

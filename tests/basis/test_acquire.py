@@ -12,6 +12,9 @@ from rigcad.basis.acquire import camera_view, models, simulate_on_rig
 from rigcad.basis.projector import zone_of
 from rigcad.errors import BasisError
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 #: Every 48th camera pixel: 26 exitant directions over the zone (the CLI's default, 32, gives 49).
 STRIDE = 48
 

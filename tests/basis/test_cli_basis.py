@@ -12,6 +12,9 @@ import pytest
 
 from rigcad.cli import main
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

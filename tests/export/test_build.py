@@ -16,6 +16,9 @@ from rigcad.parts import PARTS
 from rigcad.profile import load_profile
 from rigcad.rig import Rig
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

@@ -20,6 +20,9 @@ import pytest
 from rigcad.export.atomic import Staging, hold_lock
 from rigcad.export.manifest import listed_files
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 #: Coarse tessellations keep each cold build to a few seconds; the publication logic does not
 #: depend on them.
 FAST = """extends: achutha2006

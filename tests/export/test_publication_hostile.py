@@ -17,6 +17,9 @@ import pytest
 from rigcad.errors import ExportError, WriteError
 from rigcad.export.atomic import Staging, hold_lock, profile_lock
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 #: Coarse tessellations keep each build to seconds; publication does not depend on them.
 FAST = """extends: achutha2006
 tessellation:

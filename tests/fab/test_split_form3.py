@@ -19,6 +19,9 @@ from rigcad.parts import PARTS
 
 from .conftest import ROOT
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def form3():

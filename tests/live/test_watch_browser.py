@@ -25,6 +25,9 @@ import pytest
 
 from .conftest import CHROMIUM, CHROMIUM_ARGS
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 BACKGROUND = np.array([0xF4, 0xF4, 0xF4])
 #: A pixel is drawn (not background) when its RGB channels differ from it by more than this sum.
 PIXEL_DIFF = 30

@@ -20,6 +20,9 @@ from rigcad.manual import bom as B
 from rigcad.manual import calibration as C
 from rigcad.manual.document import build_manual, write_manual
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 MIL = 0.0254
 
 

@@ -14,6 +14,9 @@ from rigcad.manual import plan, tower_joints
 from rigcad.manual.assembly import picture_meshes
 from rigcad.parts import tower
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 
 def _box(lo, hi):
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)

@@ -14,6 +14,9 @@ import pytest
 
 from rigcad.parts import PARTS
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 
 def _rigcad(*args, timeout=600):
     return subprocess.run([sys.executable, "-m", "rigcad", *args], capture_output=True, text=True, timeout=timeout)

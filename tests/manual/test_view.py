@@ -18,6 +18,9 @@ from rigcad.manual import calibration as C
 from rigcad.manual.assembly import explode_offsets, picture_meshes
 from rigcad.manual.view import traced_rays, view_html
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 CHROMIUM = Path("/usr/bin/chromium")
 #: Headless Chromium without a GPU: WebGL through ANGLE's SwiftShader (software) backend, which
 #: Chromium only enables for WebGL when asked (--enable-unsafe-swiftshader); background services

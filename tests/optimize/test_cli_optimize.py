@@ -12,6 +12,9 @@ import yaml
 
 from rigcad.cli import main
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def optimized(tmp_path_factory):

@@ -16,6 +16,9 @@ from rigcad.manual import bom, plan
 from rigcad.manual.assembly import picture_meshes
 from rigcad.parts import breadboard
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 PITCH = {"breadboard_m6_25mm": 25.0, "breadboard_imperial_1in": 25.4}
 
 

@@ -18,6 +18,9 @@ import pytest
 import rigcad.engine as E
 from rigcad.engine import Engine, EngineError, run
 
+#: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
+pytestmark = pytest.mark.e2e
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
