@@ -28,7 +28,16 @@ it) gets the G-code's own configuration block as Metadata/Slic3r_PE.config, the 
 reads settings from, and is rewritten with fixed zip dates and without creation dates, so the
 same input gives the same bytes. PrusaSlicer's estimates are read from the G-code's comments. A
 piece whose STL and configuration did not change (content hash, with the slicer's version) is
-not sliced again. A missing slicer raises a FabricationError saying how to install it; the caller
+not sliced again.
+
+Each slice runs on one CPU. PrusaSlicer slices a mesh in TBB tasks, and the lines each task cuts
+from a layer are appended in the order the threads arrive (TriangleMeshSlicer's
+slice_facet_at_zs), so a closed loop's first point, and with it where a perimeter starts when
+several corners tie, can change from one run to the next: a 20 mm cube's first perimeter started
+at another corner in 2 of some 8 full test runs, and a finely meshed cube sliced 198 times gave a
+second G-code twice (on one CPU: 190 runs, one G-code). TBB sizes its thread pool from the CPU affinity mask, so a slicer started
+on one CPU runs its tasks on one thread, in a fixed order. The pieces are sliced side by side,
+each on its own CPU, so the cores stay busy. (Linux; elsewhere the slicer picks its threads.) A missing slicer raises a FabricationError saying how to install it; the caller
 decides whether the rest goes on.
 """
 
@@ -36,6 +45,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+import itertools
 import os
 import re
 import shutil
@@ -56,10 +66,11 @@ from rigcad.fab.vendor import TEXT
 
 SLICER = "prusa-slicer"
 INSTALL_HINT = "install it with `apt-get install prusa-slicer` (Debian/Ubuntu) or from https://www.prusa3d.com/"
-#: Seconds one slice may take before it is abandoned (the dome quarter takes ~20 s on one core).
+#: Seconds one slice may take before it is abandoned (a dome quarter takes ~45 s on one CPU).
 TIMEOUT_S = 900
-#: Part of every cache key: bump when the post-processing of G-code or 3MF changes.
-OUTPUT_FORMAT = "rigcad-slice-3"
+#: Part of every cache key: bump when the post-processing of G-code or 3MF, or the way the
+#: slicer is run, changes (4: one CPU per slice, whose G-code differs from a many-thread run's).
+OUTPUT_FORMAT = "rigcad-slice-4"
 
 #: Brim width (mm) when the rule asks for one: PrusaSlicer's usual 5 mm, several loops of a 0.4 mm nozzle.
 BRIM_WIDTH = 5.0
@@ -432,6 +443,25 @@ def _slicer(exe: str, args: list[str], d: Path, job: SliceJob) -> tuple[subproce
     return proc, time.perf_counter() - t0
 
 
+_next_cpu = itertools.count()
+
+
+def _on_one_cpu() -> None:
+    """Thread-pool initializer: the calling thread, and so every slicer it starts (a child keeps
+    its parent thread's affinity), runs on one CPU of those this process may use; successive
+    threads, and processes by their id, take different ones."""
+    if not hasattr(os, "sched_setaffinity"):
+        return
+    cpus = sorted(os.sched_getaffinity(0))
+    os.sched_setaffinity(0, {cpus[(os.getpid() + next(_next_cpu)) % len(cpus)]})
+
+
+def slicing_pool(workers: int) -> ThreadPoolExecutor:
+    """The threads that run the slicers: ``workers`` of them, each on one CPU (see the module's
+    note on determinism)."""
+    return ThreadPoolExecutor(max_workers=max(1, workers), initializer=_on_one_cpu)
+
+
 def _output(d: Path, name: str, job: SliceJob) -> bytes:
     """The output rigcad asked for at ``d/name``: a regular file (not a link), read without
     following links."""
@@ -498,7 +528,7 @@ def slice_all(jobs: list[SliceJob], cached: dict[str, tuple] | None = None,
         else:
             todo.append(job)
     n = workers or min(4, os.cpu_count() or 1)
-    with ThreadPoolExecutor(max_workers=max(1, n)) as pool:
+    with slicing_pool(n) as pool:
         futures = [pool.submit(_run, exe, j) for j in todo]
         for fut in as_completed(futures):
             res = fut.result()

@@ -6,8 +6,10 @@ zipfile and PrusaSlicer itself)."""
 from __future__ import annotations
 
 import io
+import os
 import re
 import subprocess
+import threading
 import zipfile
 from pathlib import Path
 
@@ -331,10 +333,33 @@ def test_a_cube_sliced_for_the_mk3s_carries_the_vendor_settings(tmp_path):
 
     # independent reader: PrusaSlicer opens the project alone (no --load) and slices the same G-code
     (tmp_path / "cube.3mf").write_bytes(res.project)
-    proc = subprocess.run(["prusa-slicer", "--export-gcode", "-o", "again.gcode", "cube.3mf"], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=300)
+    with S.slicing_pool(1) as pool:  # on one CPU, as rigcad runs it (the slicer's note on determinism)
+        proc = pool.submit(subprocess.run, ["prusa-slicer", "--export-gcode", "-o", "again.gcode", "cube.3mf"],
+                           cwd=tmp_path, capture_output=True, text=True, timeout=300).result()
     assert proc.returncode == 0, proc.stderr[-500:]
     assert S.normalise((tmp_path / "again.gcode").read_bytes()) == res.gcode
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2,
+                    reason="needs Linux's CPU affinity and two CPUs to tell one CPU from all")
+def test_each_slicer_starts_on_one_cpu_of_its_own_and_the_caller_keeps_every_cpu():
+    """What the slicing threads start runs on one CPU (PrusaSlicer's TBB then runs one thread, its
+    tasks in a fixed order: rigcad.fab.slicer's note on determinism); two threads side by side
+    take different CPUs; the calling thread keeps its mask."""
+    before = os.sched_getaffinity(0)
+    both = threading.Barrier(2, timeout=30)
+
+    def allowed(_):
+        both.wait()  # each of the two threads runs one task
+        out = subprocess.run(["grep", "Cpus_allowed_list", "/proc/self/status"], capture_output=True,
+                             text=True, timeout=30, check=True).stdout
+        return out.split(":")[1].strip()
+
+    with S.slicing_pool(2) as pool:
+        seen = list(pool.map(allowed, range(2)))
+    assert all(s.isdigit() for s in seen), seen  # one CPU each, e.g. "1", not "0-1"
+    assert len(set(seen)) == 2 and {int(s) for s in seen} <= before
+    assert os.sched_getaffinity(0) == before
 
 
 @needs_slicer
