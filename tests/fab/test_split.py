@@ -95,3 +95,35 @@ def test_pin_points_tied_to_rounding_are_chosen_in_their_order_on_every_cpu():
     p = pts.copy()
     p[2, 0] *= 1 + 1e-6
     assert np.array_equal(SP._farthest(p, 1, lambda q: True)[0], p[2])
+
+
+def test_pin_holes_judged_from_their_axis_as_from_their_whole_surface(layout):
+    """_mirror_clear skips the 84 surface samples of a hole whose axis lies deeper than clearance
+    + radius (a signed distance is 1-Lipschitz): on the dome's printed mirror, holes at every
+    depth around that threshold and along random axes get the answer of the full sampling."""
+    mirror = MirrorSurface("dome", layout.design_dome.behind(layout.coating), layout.design_dome)
+    pin = SP.AlignmentPin(3.0, 0.2, 6.0)
+    rng = np.random.default_rng(7)
+    n = 1200
+    u = rng.uniform(*mirror.printed.u_range, n)
+    rz, nrm = mirror.printed.points(u), mirror.printed.normals(u)
+    depth = -(SP.MIRROR_CLEARANCE + pin.hole_radius) + rng.uniform(-4.0, 1.0, n)  # behind the mirror
+    q2 = rz + depth[:, None] * nrm
+    phi = rng.uniform(0, 2 * math.pi, n)
+    pts = np.column_stack([q2[:, 0] * np.cos(phi), q2[:, 0] * np.sin(phi), q2[:, 1]])
+    axes = rng.normal(size=(n, 3))
+    axes /= np.linalg.norm(axes, axis=1)[:, None]
+
+    def full(p, axis):  # the definition: every one of the 7 x 12 samples of each hole's surface clear
+        e1, e2 = SP._plane_frame(axis, np.zeros(3))[:2, :3]
+        q = [p + s * axis + pin.hole_radius * (math.cos(a) * e1 + math.sin(a) * e2)
+             for s in np.linspace(-pin.depth, pin.depth, 7) for a in np.linspace(0, 2 * math.pi, 12, endpoint=False)]
+        return np.all(mirror.signed_distance(np.concatenate(q)).reshape(len(q), len(p)) < -SP.MIRROR_CLEARANCE, axis=0)
+
+    got, want = np.zeros(n, bool), np.zeros(n, bool)
+    for g in range(20):  # 20 axes, as place_pins asks one per cut face
+        idx = np.arange(g, n, 20)
+        got[idx] = SP._mirror_clear(pts[idx], axes[g], pin, mirror)
+        want[idx] = full(pts[idx], axes[g])
+    assert 0.2 < want.mean() < 0.8  # both answers, near the threshold too
+    assert np.array_equal(got, want), np.flatnonzero(got != want)[:10]
