@@ -195,6 +195,7 @@ def test_stl_figures_are_the_current_codes(tools, data, default_exports):
     assert not _changed(figs, fresh, data), "run `make docs`:\n" + "\n".join(_changed(figs, fresh, data))
 
 
+@pytest.mark.e2e  # the whole rig through fab on the MK3S: make test-e2e
 def test_fab_figures_are_the_current_codes(tools, data, shared_build, table31_rig):
     """Pieces and dowel pins per part on the MK3S, from this session's fab run of the dome and a few
     parts that print whole, equal the file's: one more pin in the split rule fails here until

@@ -17,6 +17,7 @@ from .conftest import have_slicer
 NO_SLICER = "prusa-slicer is not installed (apt-get install prusa-slicer); the project's CI installs it"
 
 
+@pytest.mark.e2e  # reads the shared fab run of the dome and small parts (prusa_run): make test-e2e
 def test_report_describes_every_part(prusa_run, prusa):
     out, res = prusa_run
     rep = json.loads((out / "fab.json").read_text())
@@ -66,6 +67,7 @@ def test_fab_outputs_are_deterministic(table31_rig, prusa, tmp_path):
         assert (a / rel).read_bytes() == (b / rel).read_bytes(), rel
 
 
+@pytest.mark.e2e  # reads the shared fab run of the dome and small parts (prusa_run): make test-e2e
 @pytest.mark.skipif(not have_slicer(), reason=NO_SLICER)
 def test_prusaslicer_reads_every_stl_as_a_clean_mesh(prusa_run):
     out, _ = prusa_run

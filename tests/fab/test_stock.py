@@ -53,6 +53,7 @@ def test_the_layout_moves_only_the_mirrors(table31_rig):
     assert lay.as_printed_dome is lay.printed_dome  # no stock: the design exports are unchanged
 
 
+@pytest.mark.e2e  # reads the shared fab run of the dome and small parts (prusa_run): make test-e2e
 def test_the_fab_mirrors_lie_the_stock_in_front_of_the_sanded_surface(prusa_run, table31_rig, prusa):
     """Measured on the printed STLs (print position undone) against the exact profiles: the
     vertices on the mirror lie the stock in front of the surface the coating goes on (which the
@@ -100,6 +101,7 @@ def test_the_fab_mirrors_lie_the_stock_in_front_of_the_sanded_surface(prusa_run,
         assert st["valley_behind_sanded_surface_mm"] == 0.0, st
 
 
+@pytest.mark.e2e  # reads the shared fab run of the dome and small parts (prusa_run): make test-e2e
 def test_the_templates_gauge_every_stage(prusa_run, table31_rig):
     out, _ = prusa_run
     rep = json.loads((out / "fab.json").read_text())
