@@ -28,17 +28,18 @@ it) gets the G-code's own configuration block as Metadata/Slic3r_PE.config, the 
 reads settings from, and is rewritten with fixed zip dates and without creation dates, so the
 same input gives the same bytes. PrusaSlicer's estimates are read from the G-code's comments. A
 piece whose STL and configuration did not change (content hash, with the slicer's version) is
-not sliced again.
+not sliced again. A missing slicer raises a FabricationError saying how to install it; the
+caller decides whether the rest goes on.
 
 Each slice runs on one CPU. PrusaSlicer slices a mesh in TBB tasks, and the lines each task cuts
 from a layer are appended in the order the threads arrive (TriangleMeshSlicer's
 slice_facet_at_zs), so a closed loop's first point, and with it where a perimeter starts when
 several corners tie, can change from one run to the next: a 20 mm cube's first perimeter started
 at another corner in 2 of some 8 full test runs, and a finely meshed cube sliced 198 times gave a
-second G-code twice (on one CPU: 190 runs, one G-code). TBB sizes its thread pool from the CPU affinity mask, so a slicer started
-on one CPU runs its tasks on one thread, in a fixed order. The pieces are sliced side by side,
-each on its own CPU, so the cores stay busy. (Linux; elsewhere the slicer picks its threads.) A missing slicer raises a FabricationError saying how to install it; the caller
-decides whether the rest goes on.
+second G-code twice (on one CPU: 190 runs, one G-code). TBB sizes its thread pool from the CPU
+affinity mask, so a slicer started on one CPU runs its tasks on one thread, in a fixed order. The
+pieces are sliced side by side, each on its own CPU, so the cores stay busy. (Linux; elsewhere
+the slicer picks its threads.)
 """
 
 from __future__ import annotations

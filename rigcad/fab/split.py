@@ -573,7 +573,8 @@ def _mirror_clear(pts: np.ndarray, axis: np.ndarray, pin: AlignmentPin, mirror: 
     frame = _plane_frame(axis, np.zeros(3))[:, :3]
     e1, e2 = frame[0], frame[1]
     depths = np.linspace(-pin.depth, pin.depth, 7)
-    on_axis = mirror.signed_distance(np.concatenate([pts + s * axis for s in depths])).reshape(len(depths), len(pts))
+    on_axis = mirror.signed_distance(np.concatenate([pts + s * axis for s in depths]))
+    on_axis = on_axis.reshape(len(depths), len(pts))
     ok = np.all(on_axis < -(MIRROR_CLEARANCE + r + LIPSCHITZ_MARGIN), axis=0)
     rest = np.flatnonzero(~ok)
     if len(rest):
