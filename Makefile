@@ -71,7 +71,7 @@ manual: $(VENV)/.installed stl
 # default profile (docs/figures.md): docs/figures.json, the pictures, the numbers in the pages.
 # About 10 minutes on 2 cores; niced, as it shares the machine.
 docs: $(VENV)/.installed tools
-	nice -n 10 $(PY) docs/figures.py run --exports $(EXPORTS)
+	nice -n 10 $(PY) docs/figures.py run
 
 # --durations=15: the slowest tests on every run; --timeout (pytest-timeout): a hung test fails after
 # 10 min (the slow ones, the whole rig through PrusaSlicer, after an hour) instead of stalling the run

@@ -2,6 +2,7 @@
 
     python docs/figures.py run [--exports DIR]   # the documented commands on the default profile, then
                                                  #   collect, copy the pictures, write the Markdown
+                                                 #   (DIR, build/docs by default, emptied first)
     python docs/figures.py collect [--exports DIR]   # the same without running the commands
     python docs/figures.py render                # only rewrite the Markdown from docs/figures.json
 
@@ -40,6 +41,8 @@ FILE = DOCS / "figures.json"
 PROFILE = "achutha2006"
 #: The wall times of the last `run`, beside its outputs (so that `collect` can be re-run alone).
 TIMES = "make_docs_times.json"
+#: Where `make docs` runs the commands: its own folder (emptied by ``run``), not the user's exports/.
+DOCS_EXPORTS = ROOT / "build" / "docs"
 
 #: A number as the docs write it (thousands commas, a decimal part, an exponent), or several joined by
 #: " x " (a size), followed by the marker naming its figure.
@@ -141,7 +144,11 @@ def today() -> str:
 
 
 def run_commands(runs, root: Path) -> dict[str, dict]:
-    """Each command in turn (`nice` is the caller's), timed; a failing one stops `make docs`."""
+    """Each command in turn (`nice` is the caller's), timed; a failing one stops `make docs`. The
+    profile's outputs under every exports root the commands use are removed first: each time is a
+    cold run (a command whose outputs are up to date returns at once) and no stale file is read."""
+    for folder in sorted({run.folder for run in runs}):
+        shutil.rmtree((root / folder if folder else root) / PROFILE, ignore_errors=True)
     times = {}
     for run in runs:
         exports = root / run.folder if run.folder else root
@@ -284,7 +291,7 @@ def main(argv: list[str] | None = None) -> int:
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("action", choices=["run", "collect", "render"])
-    ap.add_argument("--exports", type=Path, default=ROOT / "exports")
+    ap.add_argument("--exports", type=Path, default=DOCS_EXPORTS)
     args = ap.parse_args(argv)
     root = args.exports.resolve()
     if args.action != "render":

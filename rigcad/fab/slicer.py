@@ -39,7 +39,9 @@ at another corner in 2 of some 8 full test runs, and a finely meshed cube sliced
 second G-code twice (on one CPU: 190 runs, one G-code). TBB sizes its thread pool from the CPU
 affinity mask, so a slicer started on one CPU runs its tasks on one thread, in a fixed order. The
 pieces are sliced side by side, each on its own CPU, so the cores stay busy. (Linux; elsewhere
-the slicer picks its threads.)
+the slicer picks its threads.) This does not make every piece's G-code the same bytes: larger
+pieces (the paraboloid, the dome's quarters) still differ between one-thread runs (progress lines
+and some moves), so only the cache above makes a re-run byte-identical.
 """
 
 from __future__ import annotations
