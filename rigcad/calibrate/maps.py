@@ -38,6 +38,14 @@ MEASURED_WEIGHT = 0.5
 FILLED_WEIGHT = 0.02
 
 
+def away_from_edges(valid: np.ndarray) -> np.ndarray:
+    """(n,) the decoded pixels of one height (``valid`` (rows, cols)) at least :data:`HEIGHT_EDGE_PX`
+    steps along rows and columns from any it did not decode: the ones the rays and the fit read."""
+    from scipy.ndimage import binary_erosion
+
+    return binary_erosion(valid, iterations=HEIGHT_EDGE_PX).ravel()
+
+
 def pivot_rays(decoded: list, poses: list, model_tr: M.Traced, shape: tuple[int, int]) -> np.ndarray:
     """Unit directions (n, 3), up, of each window pixel's ray through the fitted model's dome point
     and its decoded screen points: per height, from the screen point to the dome point, averaged
@@ -51,17 +59,56 @@ def pivot_rays(decoded: list, poses: list, model_tr: M.Traced, shape: tuple[int,
     mrad over the lever, smooth across the pixels), and a paraboloid slope error, which moves the
     dome point, is read as a dome tilt there. A pixel seen at one height (grazing rays past the
     upper screen's edge) is measured too."""
-    from scipy.ndimage import binary_erosion
-
     total = np.zeros((int(np.prod(shape)), 3))
     for d, pose in zip(decoded, poses):
-        inner = binary_erosion(d.valid, iterations=HEIGHT_EDGE_PX).ravel() & model_tr.ok
+        inner = away_from_edges(d.valid) & model_tr.ok
         to_dome = model_tr.p2 - to_global(pose, d.u, d.v).reshape(-1, 3)
         with np.errstate(invalid="ignore", divide="ignore"):
             to_dome /= np.linalg.norm(to_dome, axis=1)[:, None]
         total += np.where(inner[:, None], np.nan_to_num(to_dome), 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         return total / np.linalg.norm(total, axis=1)[:, None]
+
+
+#: Why a pixel the fitted model lights (its ray reaches the sample) has no measured direction: the
+#: first of these that applies (:func:`unmeasured_causes`; code = index, -1 where the model's ray is lost).
+CAUSES = ("measured", "under_the_screens", "dark_in_every_capture", "lit_not_decoded",
+          "within_the_edge_rule", "next_to_unmeasured")
+CAUSE_NOTES = {
+    "measured": "a measured direction (the corrected map's source 1)",
+    "under_the_screens": "the fitted model's dome point lies below the lowest screen's surface: the ray passes "
+                         "under every screen (a screen surface nearer the sample plane reaches it)",
+    "dark_in_every_capture": "no capture lit the pixel: its ray meets the screens past their edges, or a shadow",
+    "lit_not_decoded": "lit, but no height decoded it: too little modulation (a footprint too long for the "
+                       "coarsest period) or a failed unwrapping check",
+    "within_the_edge_rule": f"decoded, but within {HEIGHT_EDGE_PX} pixels of an undecoded one at every height that "
+                            "decoded it (a screen's or a shadow's edge pulls its point)",
+    "next_to_unmeasured": "a ray was measured, but the map fills the pixel from its neighbours: it borders an "
+                          "unmeasured one, or too few measured neighbours surround it",
+}
+
+
+def unmeasured_causes(decoded: list, poses: list, model_tr: M.Traced, source: np.ndarray) -> np.ndarray:
+    """(n,) int8 index into :data:`CAUSES` per window pixel (-1 where the fitted model's ray is lost):
+    from the captures' lit and decoded masks, the rays' edge rule (:func:`away_from_edges`), the
+    corrected map's ``source`` and the fitted model's dome points against the lowest fitted screen."""
+    lowest = min(poses, key=lambda pose: float(pose.translation[2]))
+    q, _ = lowest.localize(np.nan_to_num(model_tr.p2), np.zeros_like(model_tr.p2))
+    lit = np.any([d.lit.ravel() for d in decoded], axis=0)
+    valid = np.any([d.valid.ravel() for d in decoded], axis=0)
+    inner = np.any([away_from_edges(d.valid) for d in decoded], axis=0)
+    checks = (source == 1, q[:, 2] < 0, ~lit, ~valid, ~inner)
+    out = np.full(len(source), len(CAUSES) - 1, dtype=np.int8)
+    for code in range(len(checks) - 1, -1, -1):  # the first cause that applies wins
+        out[checks[code]] = code
+    return np.where(model_tr.ok, out, -1).astype(np.int8)
+
+
+def cause_fractions(causes: np.ndarray) -> dict:
+    """Each cause's share of the pixels the fitted model lights (:func:`unmeasured_causes`)."""
+    lit = causes >= 0
+    n = max(int(lit.sum()), 1)
+    return {name: float(np.sum(causes == code)) / n for code, name in enumerate(CAUSES)}
 
 
 def residual_slopes(tr: M.Traced, measured: np.ndarray) -> np.ndarray:

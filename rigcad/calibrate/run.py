@@ -37,6 +37,8 @@ class Calibration:
     slopes: np.ndarray
     corrected: dict
     design: np.ndarray
+    #: per window pixel, why it has no measured direction (maps.unmeasured_causes)
+    causes: np.ndarray
     timings_s: dict = field(default_factory=dict)
 
     def slope_figures(self) -> dict:
@@ -84,11 +86,12 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     # angle of incidence, would swamp them), where measured
     seen = (corrected["source"] == 1)[:, None]
     slopes = np.where(seen, maps.residual_slopes(model_tr, np.where(seen, corrected["direction"], np.nan)), np.nan)
+    causes = maps.unmeasured_causes(decoded, poses, model_tr, corrected["source"])
     t3 = time.perf_counter()
     from rigcad.check.sources import pixel_rays
 
     design = cam.design.direction(pixel_rays(cam.design, cam.x_px, cam.y_px).dirs)
-    return Calibration(cam, heights, decoded, result, for_map, model_tr, measured, slopes, corrected, design,
+    return Calibration(cam, heights, decoded, result, for_map, model_tr, measured, slopes, corrected, design, causes,
                        {"decode_s": t1 - t0, "fit_s": t2 - t1, "maps_s": t3 - t2})
 
 
@@ -105,11 +108,9 @@ def _fit_data(cam: M.Camera, decoded: list, stride: int) -> FitData:
     """Every ``stride``-th row and column of the window that decoded at every height."""
     rows, cols = np.meshgrid(np.arange(cam.shape[0]), np.arange(cam.shape[1]), indexing="ij")
     pick = ((rows % stride == 0) & (cols % stride == 0)).ravel()
-    from scipy.ndimage import binary_erosion
-
     # pixels near an undecoded one see a screen edge or a shadow's edge in part of their footprint:
     # the same rule as the map's rays (maps.HEIGHT_EDGE_PX)
-    inner = [binary_erosion(d.valid, iterations=maps.HEIGHT_EDGE_PX).ravel() for d in decoded]
+    inner = [maps.away_from_edges(d.valid) for d in decoded]
     ok = pick & np.all(inner, axis=0)
     idx = np.nonzero(ok)[0]
     uv = np.stack([np.stack([d.u.ravel()[idx], d.v.ravel()[idx]], axis=-1) for d in decoded], axis=1)
@@ -151,6 +152,9 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
         "corrected_incidence_error_deg_by_source": {
             name: _stats(err_c[result.corrected["source"][lit] == code])
             for code, name in ((1, "measured"), (2, "filled"), (3, "model_only"))},
+        "unmeasured_causes": {name: {"fraction_of_lit": float(np.mean(result.causes[lit] == code)),
+                                     **_stats(err_c[result.causes[lit] == code])}
+                              for code, name in enumerate(maps.CAUSES)},
         "slope_pixels": int(seen.sum()), "planted_slope_rms_mrad": rms(g_p), "recovered_slope_rms_mrad": rms(g_r),
         "slope_difference_rms_mrad": rms(g_r - g_p),
     }

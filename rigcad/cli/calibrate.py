@@ -75,7 +75,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     f = report["fit"]
     print(f"calibrate {rig.name}: fit RMS {f['rms_residual_mm'] * 1e3:.2f} um over {f['residuals_used']} residuals; "
           f"dome residual slope RMS {report['residual_slopes']['residual_slope_rms_mrad']:.3f} mrad, worst "
-          f"{report['residual_slopes']['residual_slope_worst_mrad']:.3f} mrad; wrote {out}")
+          f"{report['residual_slopes']['residual_slope_worst_mrad']:.3f} mrad; "
+          f"{100 * report['unmeasured']['fraction_of_lit']['measured']:.0f} % of the lit pixels measured "
+          f"(the rest, and why: calibration.json 'unmeasured'); wrote {out}")
     return 0
 
 
@@ -95,6 +97,8 @@ def _check_heights(result, folder: Path) -> None:
 
 
 def _report(result) -> dict:
+    from rigcad.calibrate import maps
+
     refit = result.map_fit.as_dict()
     return {"fit": result.fit.as_dict(), "residual_slopes": result.slope_figures(),
             "map_model": {"about": "the corrected map's model: refit from the fit above with each pixel's dome-slope "
@@ -103,6 +107,10 @@ def _report(result) -> dict:
             "residual_attribution": "the dome (sanded by hand); a paraboloid slope error at the paired point, "
                                     "and low-order figure errors that a fitted tilt or offset mimics, are not "
                                     "separable from it",
+            "unmeasured": {"about": "why lit camera pixels (the fitted model's ray reaches the sample) have no "
+                                    "measured direction, each pixel counted under the first cause that applies; "
+                                    "corrected_map.npz's 'cause' shows where",
+                           "fraction_of_lit": maps.cause_fractions(result.causes), "causes": maps.CAUSE_NOTES},
             "decoding": [d.stats() for d in result.decoded], "screen_heights_mm": result.heights.tolist(),
             "timings_s": result.timings_s, "camera_window": {"row0": result.cam.row0, "col0": result.cam.col0,
                                                              "shape": list(result.cam.shape)}}
@@ -128,15 +136,18 @@ def _picture(name: str, result, extra) -> bytes:
 def _npz(result) -> bytes:
     import numpy as np
 
+    from rigcad.calibrate import maps
+
     buf = io.BytesIO()
     c = result.corrected
     shape = result.cam.shape + (3,)
     np.savez_compressed(buf, direction=c["direction"].reshape(shape), uncertainty_rad=c["uncertainty_rad"].reshape(
         result.cam.shape), source=c["source"].reshape(result.cam.shape), design=result.design.reshape(shape),
         row0=result.cam.row0, col0=result.cam.col0, resolution=np.array(result.cam.resolution),
-        residual_slope=result.slopes.reshape(shape), about=json.dumps(
+        residual_slope=result.slopes.reshape(shape), cause=result.causes.reshape(result.cam.shape), about=json.dumps(
             {"frame": "mm, O at the origin, +z up; unit directions from O towards the light",
-             "source": "0 none, 1 measured, 2 filled, 3 model only"}))
+             "source": "0 none, 1 measured, 2 filled, 3 model only",
+             "cause": "-1 the model's ray is lost; " + ", ".join(f"{k} {n}" for k, n in enumerate(maps.CAUSES))}))
     return buf.getvalue()
 
 
