@@ -660,11 +660,13 @@ def sweep_plot(key: str, unit: str, rows: list[dict], columns: list[tuple[str, s
 
 
 def calibration_maps(phase: np.ndarray, slope_mrad: np.ndarray, planted_mrad: np.ndarray | None,
-                     corrected_deg: np.ndarray | None, design_deg: np.ndarray | None, title: str) -> bytes:
+                     corrected_deg: np.ndarray | None, design_deg: np.ndarray | None, title: str,
+                     causes: np.ndarray | None = None, cause_names: tuple[str, ...] = ()) -> bytes:
     """Deflectometric calibration (rigcad calibrate), over the camera window: the decoded phase of the
     finest x period (rad), the dome's residual slope magnitude (mrad) and, for a simulation, the
-    planted one, and the corrected and design maps' incidence errors (deg). Arrays (rows, cols), NaN
-    where there is nothing to show."""
+    planted one and the corrected and design maps' incidence errors (deg); last, why each lit pixel
+    is or is not measured (``causes``: index into ``cause_names``, -1 not lit). Arrays (rows, cols),
+    NaN where there is nothing to show."""
     panels = [("decoded x phase, finest period (rad)", phase, "twilight"),
               ("residual slope |grad h| (mrad)", slope_mrad, "magma")]
     if planted_mrad is not None:
@@ -672,10 +674,15 @@ def calibration_maps(phase: np.ndarray, slope_mrad: np.ndarray, planted_mrad: np
     if corrected_deg is not None and design_deg is not None:
         panels += [("corrected map: incidence error (deg)", corrected_deg, "viridis"),
                    ("design map: incidence error (deg)", design_deg, "viridis")]
+    if causes is not None:
+        panels.append(("measured, or why not", causes, "causes"))
     fig, axes = plt.subplots(1, len(panels), figsize=(3.4 * len(panels), 3.4))
     slope_top = np.nanpercentile(np.concatenate([slope_mrad[np.isfinite(slope_mrad)]] + (
         [planted_mrad[np.isfinite(planted_mrad)]] if planted_mrad is not None else [])), 99)
     for ax, (name, data, cmap) in zip(np.atleast_1d(axes), panels):
+        if cmap == "causes":
+            _cause_panel(fig, ax, data, cause_names, name)
+            continue
         top = slope_top if "slope" in name else (np.nanpercentile(data, 99) if np.isfinite(data).any() else 1.0)
         im = ax.imshow(data, cmap=cmap, vmin=0, vmax=top, interpolation="nearest")
         ax.set_title(name, fontsize=8)
@@ -685,6 +692,20 @@ def calibration_maps(phase: np.ndarray, slope_mrad: np.ndarray, planted_mrad: np
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()
     return _png(fig)
+
+
+def _cause_panel(fig, ax, causes: np.ndarray, names: tuple[str, ...], title: str) -> None:
+    """One categorical panel: each pixel's cause in its own colour (not lit: blank), named on the bar."""
+    from matplotlib.colors import ListedColormap
+
+    colours = ["#2a9d8f", "#264653", "#8d99ae", "#e9c46a", "#f4a261", "#e76f51", "#9b5de5", "#00bbf9"][:len(names)]
+    shown = np.where(causes >= 0, causes, np.nan).astype(float)
+    im = ax.imshow(shown, cmap=ListedColormap(colours), vmin=-0.5, vmax=len(names) - 0.5, interpolation="nearest")
+    ax.set_title(title, fontsize=8)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    bar = fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04, ticks=range(len(names)))
+    bar.ax.set_yticklabels([n.replace("_", " ") for n in names], fontsize=6)
 
 
 def measurement_figure(sketch, what: str) -> bytes:

@@ -121,16 +121,18 @@ def _picture(name: str, result, extra) -> bytes:
     import numpy as np
 
     from rigcad import plots
+    from rigcad.calibrate import maps
 
     shape = result.cam.shape
     phase = result.decoded[0].axes["x"].fringes[-1].phase
     phase = np.where(result.decoded[0].valid, phase, np.nan)
     slope = (np.linalg.norm(result.slopes, axis=1) * 1e3).reshape(shape)
+    causes = {"causes": result.causes.reshape(shape), "cause_names": maps.CAUSES}
     if extra is None:
-        return plots.calibration_maps(phase, slope, None, None, None, f"{name}: calibration")
+        return plots.calibration_maps(phase, slope, None, None, None, f"{name}: calibration", **causes)
     return plots.calibration_maps(phase, slope, extra["planted_slope_mrad"].reshape(shape),
                                   extra["corrected_error_deg"].reshape(shape), extra["design_error_deg"].reshape(shape),
-                                  f"{name}: simulated calibration")
+                                  f"{name}: simulated calibration", **causes)
 
 
 def _npz(result) -> bytes:
