@@ -69,7 +69,13 @@ VARIANTS = {"steps3": "  phase_steps: 3\n", "steps4": "  phase_steps: 4\n", "ste
             "heights_2_10mm": "  spacer_heights: [2 mm, 10 mm]\n",
             "heights_1_20mm": "  spacer_heights: [1 mm, 20 mm]\n",
             "heights_1_30mm": "  spacer_heights: [1 mm, 30 mm]\n",
-            "heights_1_10_20mm": "  spacer_heights: [1 mm, 10 mm, 20 mm]\n"}
+            "heights_1_10_20mm": "  spacer_heights: [1 mm, 10 mm, 20 mm]\n",
+            # the grazing rays (docs/calibrate.md, "Why the all-lit p99 stays above"): a coarse period
+            # whose phase needs only 3 Gray bits survives long footprints; a thin panel's emitting
+            # surface 1 mm up (not the tablet's 6 mm) reaches the rays that pass under the tablet
+            "periods_1024_128_16": "  periods: [1024, 128, 16]\n  gray_bits: 3\n",
+            "thin_1mm": "  screen_thickness: 1 mm\n",
+            "thin_1mm_periods_1024_128_16": "  screen_thickness: 1 mm\n  periods: [1024, 128, 16]\n  gray_bits: 3\n"}
 
 
 def sweep(base: str, trials: int) -> dict:
@@ -93,11 +99,21 @@ def sweep(base: str, trials: int) -> dict:
                          "corrected_p50_deg": float(np.median([r["corrected_incidence_error_deg"]["p50"] for r in rows])),
                          "measured_pixels_p99_deg": float(np.median(
                              [r["corrected_incidence_error_deg_by_source"]["measured"]["p99"] for r in rows])),
+                         "measured_fraction_of_lit": float(np.median(
+                             [r["corrected_incidence_error_deg_by_source"]["measured"]["pixels"] / r["lit_pixels"]
+                              for r in rows])),
                          "parameters_met": float(np.median([r["parameters_met"] for r in rows])),
+                         "unmeasured_causes_fraction_of_lit": cause_medians(rows),
                          "calibration_cpu_s": float(np.median([r["calibration_cpu_s"] for r in rows])),
                          "render_s": float(np.median([r["render_s"] for r in rows]))}
             print(name, out[name], flush=True)
     return out
+
+
+def cause_medians(trials: list) -> dict:
+    """Per cause (rigcad.calibrate.maps.CAUSES), the median over ``trials`` of its share of the lit pixels."""
+    names = trials[0]["unmeasured_causes"]
+    return {n: float(np.median([t["unmeasured_causes"][n]["fraction_of_lit"] for t in trials])) for n in names}
 
 
 def summarize(profile: str, resolution, trials: list) -> dict:
@@ -122,6 +138,7 @@ def summarize(profile: str, resolution, trials: list) -> dict:
         "measured_fraction_of_lit_median": float(np.median(
             [t["corrected_incidence_error_deg_by_source"]["measured"]["pixels"] / t["lit_pixels"] for t in trials])),
         "parameters_met_range": [int(min(met)), int(max(met))],
+        "unmeasured_causes_fraction_of_lit_median": cause_medians(trials),
         "parameter_met_fraction": {n: float(np.mean([t["parameters"][n]["met"] for t in trials]))
                                    for n in trials[0]["parameters"]},
         "slope_rms_ratio_range": [float(f(ratio)) for f in (np.min, np.max)],
@@ -140,7 +157,10 @@ def summarize(profile: str, resolution, trials: list) -> dict:
 VARIANT_LABELS = {"steps3": "3 phase steps", "steps4": "4 phase steps (the default)", "steps8": "8 phase steps",
                   "heights_2_10mm": "spacers 2, 10 mm (the earlier default)",
                   "heights_1_20mm": "spacers 1, 20 mm (the default)", "heights_1_30mm": "spacers 1, 30 mm",
-                  "heights_1_10_20mm": "spacers 1, 10, 20 mm"}
+                  "heights_1_10_20mm": "spacers 1, 10, 20 mm",
+                  "periods_1024_128_16": "periods 1024, 128, 16 px (3 Gray bits)",
+                  "thin_1mm": "a 1 mm thin panel (surface 1 mm up, not 6)",
+                  "thin_1mm_periods_1024_128_16": "the 1 mm panel, periods 1024, 128, 16 px"}
 
 
 def _spread(values, digits: int) -> str:
@@ -186,15 +206,47 @@ def tables(summary: dict) -> str:
         k = next(iter(sweep_rows.values()))["trials"]
         rows += ["", f"Sweep, {k} trial{'s' if k > 1 else ''} a variant (seed{'s' if k > 1 else ''} 1000"
                      f"{f'-{999 + k}' if k > 1 else ''}; p99 and p50 in deg; CPU one-off):", "",
-                 "| variant | p99 all lit | p99 measured | p50 all lit | parameters within target | CPU s |",
-                 "|---|---|---|---|---|---|"]
+                 "| variant | p99 all lit | p99 measured | measured % of lit | p50 all lit | parameters within target "
+                 "| CPU s |", "|---|---|---|---|---|---|---|"]
         for name, label in VARIANT_LABELS.items():
             if name in sweep_rows:
                 r = sweep_rows[name]
                 rows.append(f"| {label} | {r['corrected_p99_deg']:.3f} | {r['measured_pixels_p99_deg']:.3f} | "
-                            f"{r['corrected_p50_deg']:.3f} | {r['parameters_met']:.0f} of {total} | "
+                            f"{100 * r['measured_fraction_of_lit']:.0f} | {r['corrected_p50_deg']:.3f} | {r['parameters_met']:.0f} of {total} | "
                             f"{r['calibration_cpu_s']:.1f} |")
+    rows += causes_table(summary)
     return "\n".join(rows) + "\n"
+
+
+#: The causes' column heads (rigcad.calibrate.maps.CAUSES but "measured").
+CAUSE_HEADS = {"under_the_screens": "under the screens", "dark_in_every_capture": "dark in every capture",
+               "lit_not_decoded": "lit, not decoded", "within_the_edge_rule": "within the edge rule",
+               "next_to_unmeasured": "next to unmeasured"}
+
+
+def causes_table(summary: dict) -> list[str]:
+    """Why lit pixels are not measured: each cause's median share of the lit pixels (%), for the
+    trials and each sweep variant, and the trials' incidence error p99 per cause."""
+    trials = summary["per_trial"]
+    if "unmeasured_causes" not in trials[0]:
+        return []
+    heads = list(CAUSE_HEADS)
+    pct = lambda shares: " | ".join(f"{100 * shares[c]:.1f}" for c in heads)  # noqa: E731
+    p99 = [np.median([t["unmeasured_causes"][c]["p99"] for t in trials if "p99" in t["unmeasured_causes"][c]])
+           if any("p99" in t["unmeasured_causes"][c] for t in trials) else np.nan for c in heads]
+    rows = ["", "Why lit pixels are not measured (rigcad.calibrate.maps.CAUSES; each pixel under the first cause "
+                "that applies; median % of the lit pixels):", "",
+            "| capture | measured | " + " | ".join(CAUSE_HEADS[c] for c in heads) + " |",
+            "|---" * (len(heads) + 2) + "|",
+            f"| the default, {len(trials)} trial{'s' if len(trials) > 1 else ''} | {100 * summary['unmeasured_causes_fraction_of_lit_median']['measured']:.1f}"
+            f" | {pct(summary['unmeasured_causes_fraction_of_lit_median'])} |",
+            "| its incidence error p99 (deg, median) | | " + " | ".join(f"{v:.3f}" for v in p99) + " |"]
+    sweep_rows = summary.get("sweep_phase_steps_and_heights", {})
+    for name, label in VARIANT_LABELS.items():
+        if "unmeasured_causes_fraction_of_lit" in sweep_rows.get(name, {}):
+            shares = sweep_rows[name]["unmeasured_causes_fraction_of_lit"]
+            rows.append(f"| {label} | {100 * shares['measured']:.1f} | {pct(shares)} |")
+    return rows
 
 
 def main() -> int:
@@ -204,12 +256,20 @@ def main() -> int:
     ap.add_argument("--sweep-trials", type=int, default=1, help="trials per sweep variant (0: no sweep)")
     ap.add_argument("--without-bias", action="store_true",
                     help="also calibrate each capture without the decoding's bias correction (twice the time)")
+    ap.add_argument("--sweep-only", action="store_true",
+                    help="re-run only the sweep into the existing --out file (its trials kept)")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "calibrate.json"))
     args = ap.parse_args()
     from rigcad.check.scene import analytic_optics
     from rigcad.export.atomic import write_json
     from rigcad.rig import load
 
+    if args.sweep_only:
+        summary = json.loads(Path(args.out).read_text(encoding="utf-8"))
+        summary["sweep_phase_steps_and_heights"] = sweep(args.profile, args.sweep_trials)
+        write_json(Path(args.out), summary)
+        print(tables(summary))
+        return 0
     rig = load(args.profile)
     optics = analytic_optics(rig)
     trials = []
