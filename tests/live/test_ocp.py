@@ -13,14 +13,13 @@ import os
 import re
 import signal
 import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
 
 import pytest
 
-from .conftest import closed_port
+from .conftest import closed_port, interruptible
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -29,8 +28,8 @@ def test_ocp_without_a_viewer_says_one_line_and_the_browser_view_runs(tmp_path):
     profile = tmp_path / "rig.yaml"
     profile.write_text("extends: achutha2006\n", encoding="utf-8")
     port = closed_port()
-    proc = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), "--port", "0", "--ocp",
-                             "--ocp-port", str(port), "--no-check"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    proc = subprocess.Popen(interruptible("rigcad", "watch", str(profile), "--port", "0", "--ocp",
+                                          "--ocp-port", str(port), "--no-check"), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, cwd=tmp_path)
     lines: list[str] = []
     threading.Thread(target=lambda: lines.extend(iter(proc.stdout.readline, "")), daemon=True).start()

@@ -16,7 +16,6 @@ import os
 import re
 import signal
 import subprocess
-import sys
 import tempfile
 import threading
 import time
@@ -24,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from .conftest import CHROMIUM, CHROMIUM_ARGS, closed_port
+from .conftest import CHROMIUM, CHROMIUM_ARGS, closed_port, interruptible
 
 ROOT = Path(__file__).resolve().parents[2]
 MARKERS = {"cop_marker", "projector_cop_marker", "camera_cop_marker"}
@@ -102,7 +101,7 @@ def viewer(tmp_path):
     port = closed_port()
     home = tmp_path / "home"
     home.mkdir()
-    proc = subprocess.Popen([sys.executable, "-m", "ocp_viewer", "--host", "127.0.0.1", "--port", str(port)],
+    proc = subprocess.Popen(interruptible("ocp_viewer", "--host", "127.0.0.1", "--port", str(port)),
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=tmp_path,
                             env={**os.environ, "HOME": str(home), "PYTHONUNBUFFERED": "1"})
     out = Lines(proc)
@@ -174,8 +173,8 @@ def test_watch_ocp_pushes_each_edit_to_the_standalone_viewer(viewer, tmp_path):
     port, out, page, drawn = viewer
     profile = tmp_path / "rig.yaml"
     profile.write_text("extends: achutha2006\nbeam:\n  width: 6 mm\n", encoding="utf-8")
-    watch = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), "--port", "0", "--ocp",
-                              "--ocp-port", str(port), "--no-check"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+    watch = subprocess.Popen(interruptible("rigcad", "watch", str(profile), "--port", "0", "--ocp",
+                                           "--ocp-port", str(port), "--no-check"), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                              text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)})
     said = Lines(watch)
     try:

@@ -14,7 +14,6 @@ import os
 import re
 import signal
 import subprocess
-import sys
 import tempfile
 import threading
 import time
@@ -23,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from .conftest import CHROMIUM, CHROMIUM_ARGS
+from .conftest import CHROMIUM, CHROMIUM_ARGS, interruptible
 
 #: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
 pytestmark = pytest.mark.e2e
@@ -39,7 +38,7 @@ class Watch:
 
     def __init__(self, profile: Path, *args: str) -> None:
         env = {**os.environ, "PYTHONPATH": str(ROOT)}
-        self.proc = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), *args],
+        self.proc = subprocess.Popen(interruptible("rigcad", "watch", str(profile), *args),
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
                                      cwd=profile.parent)
         self.lines: list[str] = []

@@ -18,6 +18,8 @@ from pathlib import Path
 
 import pytest
 
+from .conftest import interruptible
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -42,8 +44,8 @@ def test_write_publishes_the_exports_and_rebuilds_only_what_changed(tmp_path):
     profile = tmp_path / "rig.yaml"
     profile.write_text("extends: achutha2006\nbeam:\n  width: 6 mm\n", encoding="utf-8")
     exports = tmp_path / "out"
-    proc = subprocess.Popen([sys.executable, "-m", "rigcad", "watch", str(profile), "--port", "0", "--write",
-                             "--no-check", "--exports", str(exports)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    proc = subprocess.Popen(interruptible("rigcad", "watch", str(profile), "--port", "0", "--write",
+                                          "--no-check", "--exports", str(exports)), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)})
     lines: list[str] = []
     threading.Thread(target=lambda: lines.extend(iter(proc.stdout.readline, "")), daemon=True).start()
