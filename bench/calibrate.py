@@ -3,7 +3,7 @@ misalignments against their tolerances, the corrected map's incidence error (p99
 pixels) next to the design map's on the same rig, the dome's slope recovery, and one calibration's
 run time at the profile's camera resolution. Writes bench/results/calibrate.json.
 
-    python bench/calibrate.py [--trials N] [--profile achutha2006] [--sweep-trials M]
+    python bench/calibrate.py [--trials N] [--profile achutha2006] [--sweep-trials M] [--keep-sweep]
 
 The sweep (``--sweep-trials``, per variant): run time against error as the phase steps (3, 4, 8) and
 the spacer heights (two, three) vary, each a profile extending ``--profile``.
@@ -113,6 +113,20 @@ def cause_medians(trials: list) -> dict:
     return {n: float(np.median([t["unmeasured_causes"][n]["fraction_of_lit"] for t in trials])) for n in names}
 
 
+def coverage_medians(trials: list) -> dict:
+    """Per map source, the median over ``trials`` of how the stated uncertainty covers the error
+    (rigcad.calibrate.run.compare's ``uncertainty_coverage``; trials without such pixels left out)."""
+    if "uncertainty_coverage" not in trials[0]:
+        return {}
+    out = {}
+    for source in trials[0]["uncertainty_coverage"]:
+        rows = [t["uncertainty_coverage"][source] for t in trials if "within_1" in t["uncertainty_coverage"][source]]
+        if rows:
+            out[source] = {k: float(np.median([r[k] for r in rows])) for k in rows[0] if k != "pixels"}
+            out[source]["trials"] = len(rows)
+    return out
+
+
 def summarize(profile: str, resolution, trials: list) -> dict:
     """The trials' figures against the targets, and the trials themselves."""
     p99c = [t["corrected_incidence_error_deg"]["p99"] for t in trials]
@@ -136,6 +150,10 @@ def summarize(profile: str, resolution, trials: list) -> dict:
             [t["corrected_incidence_error_deg_by_source"]["measured"]["pixels"] / t["lit_pixels"] for t in trials])),
         "parameters_met_range": [int(min(met)), int(max(met))],
         "unmeasured_causes_fraction_of_lit_median": cause_medians(trials),
+        "uncertainty_coverage_median": coverage_medians(trials),
+        "frame_tilt_deg_range": [float(f([t["frame"]["tilt_deg"] for t in trials])) for f in (np.min, np.median, np.max)],
+        "measured_pixels_p99_deg_without_the_frame_tilt_range": [
+            float(f([t["frame"]["measured_error_without_it_deg"]["p99"] for t in trials])) for f in (np.min, np.median, np.max)],
         "parameter_met_fraction": {n: float(np.mean([t["parameters"][n]["met"] for t in trials]))
                                    for n in trials[0]["parameters"]},
         "slope_rms_ratio_range": [float(f(ratio)) for f in (np.min, np.max)],
@@ -187,6 +205,10 @@ def tables(summary: dict) -> str:
         f"| {_spread(measured, 3)} deg | {verdict(measured)} |",
         f"| corrected map p99, all lit pixels | {_spread(lit, 3)} deg | {verdict(lit)} |",
         f"| corrected map p50, measured pixels | {_spread([s['p50'] for s in source], 3)} deg | |",
+        f"| the frame's tilt (the fit's against the truth's; only the priors fix it) | "
+        f"{_spread([t['frame']['tilt_deg'] for t in trials], 3)} deg | |",
+        f"| corrected map p99, measured pixels, that tilt removed | "
+        f"{_spread([t['frame']['measured_error_without_it_deg']['p99'] for t in trials], 3)} deg | |",
         f"| design (uncorrected) map p99, same rigs | {_spread([t['design_incidence_error_deg']['p99'] for t in trials], 1)}"
         " deg | |",
         f"| parameters within max(10 % tol, 0.02 mm / 0.01 deg) | {min(met)}-{max(met)} of {total}; "
@@ -212,8 +234,31 @@ def tables(summary: dict) -> str:
                 rows.append(f"| {label} | {r['corrected_p99_deg']:.3f} | {r['measured_pixels_p99_deg']:.3f} | "
                             f"{100 * measured:.0f} | {r['corrected_p50_deg']:.3f} | {r['parameters_met']:.0f} of "
                             f"{total} | {r['calibration_cpu_s']:.1f} |")
-    rows += causes_table(summary)
+    rows += causes_table(summary) + coverage_table(summary)
     return "\n".join(rows) + "\n"
+
+
+#: The map's sources as the coverage table names them.
+SOURCE_LABELS = {"measured": "measured", "filled": "filled from neighbours", "model_only": "the fitted model alone"}
+
+
+def coverage_table(summary: dict) -> list[str]:
+    """How the corrected map's stated uncertainty covers its error against the truth, per source
+    (median over the trials), next to what a calibrated round Gaussian error gives."""
+    cov = summary.get("uncertainty_coverage_median", {})
+    if not cov:
+        return []
+    rows = ["", "How the stated uncertainty (`uncertainty_rad`, an RMS angle) covers the error against the truth "
+                "(median over the trials that have such pixels):", "",
+            "| map source | trials | error within 1 uncertainty | within 2 | error / uncertainty, p50 |",
+            "|---|---|---|---|---|"]
+    for source, label in SOURCE_LABELS.items():
+        if source in cov:
+            c = cov[source]
+            rows.append(f"| {label} | {c['trials']} | {100 * c['within_1']:.0f} % | {100 * c['within_2']:.0f} % | "
+                        f"{c['error_over_uncertainty_p50']:.2f} |")
+    rows.append("| calibrated (a round Gaussian error) | | 63 % | 98 % | 0.83 |")
+    return rows
 
 
 #: The causes' column heads (rigcad.calibrate.maps.CAUSES but "measured").
@@ -256,6 +301,8 @@ def main() -> int:
                     help="also calibrate each capture without the decoding's bias correction (twice the time)")
     ap.add_argument("--sweep-only", action="store_true",
                     help="re-run only the sweep into the existing --out file (its trials kept)")
+    ap.add_argument("--keep-sweep", action="store_true",
+                    help="re-run only the trials, keeping the existing --out file's sweep")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "calibrate.json"))
     args = ap.parse_args()
     from rigcad.check.scene import analytic_optics
@@ -270,6 +317,8 @@ def main() -> int:
         return 0
     rig = load(args.profile)
     optics = analytic_optics(rig)
+    kept = json.loads(Path(args.out).read_text(encoding="utf-8")).get("sweep_phase_steps_and_heights") \
+        if args.keep_sweep else None
     trials = []
     for seed in range(args.trials):
         trials.append(trial(optics, rig, seed, args.without_bias))
@@ -281,8 +330,10 @@ def main() -> int:
               f"planted {t['planted_slope_rms_mrad']:.3f} mrad; {t['calibration_s']:.1f} s", flush=True)
         # written after every trial: a run stopped early keeps what it measured
         summary = summarize(args.profile, rig.profile.camera.resolution, trials)
+        if kept:
+            summary["sweep_phase_steps_and_heights"] = kept
         write_json(Path(args.out), summary)
-    if args.sweep_trials:
+    if args.sweep_trials and not args.keep_sweep:
         summary["sweep_phase_steps_and_heights"] = sweep(args.profile, args.sweep_trials)
     write_json(Path(args.out), summary)
     print(json.dumps({k: v for k, v in summary.items() if k != "per_trial"}, indent=1))

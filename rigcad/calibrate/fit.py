@@ -8,7 +8,8 @@ parameter (the screens' columns reuse it: each touches its own height's rows onl
 solve, residuals beyond 5 robust sigmas (1.4826 MAD) are dropped and the fit repeated. Each
 pixel's residual component that a dome slope error makes (a turn about its dome point) is
 down-weighted in the map's refit (:data:`SLOPE_PROJECTION`). Standard
-errors: s^2 (J^T J)^-1 with s^2 the residual variance; the residual is dominated by the surface
+errors: the posterior under the tolerances' prior (:func:`posterior_covariance`), s^2 (J^T J)^-1
+where the data decide, s^2 the residual variance; the residual is dominated by the surface
 error, which is correlated between neighbouring pixels, so they understate the true spread
 (the bench compares them with the errors).
 
@@ -109,9 +110,8 @@ class Problem:
         self.n_rig = len(M.RIG_NAMES)
         self.keep = np.ones(len(data.pixels) * len(heights) * 2, bool)
         self.evaluations = 0
-        #: the fitted parameters: all but the first screen's height, the gauge (moving the rig and
-        #: every screen up together changes no image): the first spacer's screen defines z
-        self.free = np.array([i != self.n_rig for i in range(len(self.scale))])
+        #: the fitted parameters: all but the gauge (model.GAUGE)
+        self.free = np.array([n not in M.GAUGE for n in M.parameter_names(len(heights))])
 
     def trace(self, theta: np.ndarray) -> M.Traced:
         self.evaluations += 1
@@ -156,6 +156,18 @@ class Problem:
         return np.vstack([J[:, self.free], PRIOR_MM * np.eye(int(self.free.sum()))])
 
 
+def posterior_covariance(jac: np.ndarray, fun: np.ndarray) -> np.ndarray:
+    """The free parameters' covariance (tolerance units) under the prior the tolerances state (each
+    ~ N(0, 1) there) and the data rows' residual variance s^2: (J_d^T J_d / s^2 + I)^-1, J_d the
+    data rows of ``jac`` (its last rows are the prior's). Along what the data fix, s^2 (J_d^T J_d)^-1;
+    along what they do not (the frame's tilt: docs/calibrate.md), the tolerance itself, whatever the
+    fit's ridge weight (:data:`PRIOR_MM`) did to the solve."""
+    p = jac.shape[1]
+    jd, rd = jac[:-p], fun[:-p]
+    s2 = float(rd @ rd) / max(len(rd) - p, 1)
+    return np.linalg.inv(jd.T @ jd / max(s2, 1e-300) + np.eye(p))
+
+
 def fit(optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData, say=None, slope_projection: float = 0.0,
         start: np.ndarray | None = None) -> FitResult:
     """Fit the misalignment (module docstring); ``say``: a callable told each stage;
@@ -182,11 +194,8 @@ def fit(optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData, say=None
         prob.keep &= ~drop
         res = least_squares(prob.fun, res.x, jac=prob.jac, method="trf", xtol=1e-10, ftol=1e-10,
                             max_nfev=MAX_ITERATIONS)
-    J = res.jac
-    m, p = J.shape
-    s2 = float(res.fun @ res.fun) / max(m - p, 1)
     cov_z = np.zeros((len(prob.scale), len(prob.scale)))
-    cov_z[np.ix_(prob.free, prob.free)] = s2 * np.linalg.pinv(J.T @ J)
+    cov_z[np.ix_(prob.free, prob.free)] = posterior_covariance(res.jac, res.fun)
     cov = cov_z * np.outer(prob.scale, prob.scale)
     se = np.sqrt(np.diag(cov))
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -4,7 +4,10 @@ the camera), off the paraboloid and the dome (``Rig.moved`` poses), to the scree
 
 Parameters (mm, rad): the paraboloid's, the dome's and the camera's offsets (x, y, z) and tilts
 (the rotation vector's x and y; pivots as :meth:`rigcad.optics.frames.Misalignment.pose`), then per
-screen height its height offset and tilt (x, y). Frame: mm, O at the origin, +z up."""
+screen height its height offset, its tilt (x, y) and where the hand laid it within its plane: its
+centre's offset (u, v) and its turn about its normal (:func:`rigcad.calibrate.raxel.screen_pose`).
+Frame: mm, O at the origin, +z up; the gauge (:data:`GAUGE`) puts the first screen's centre on the
+axis at its nominal height."""
 
 from __future__ import annotations
 
@@ -22,8 +25,26 @@ RIG_NAMES = tuple(f"{c}_{k}" for c in COMPONENTS for k in ("dx_mm", "dy_mm", "dz
 WINDOW_MARGIN_PX = 40
 
 
+#: Each screen height's parameters, in order (:func:`screens`).
+SCREEN_KEYS = ("dz_mm", "tilt_x_rad", "tilt_y_rad", "du_mm", "dv_mm", "turn_rad")
+#: How far a screen laid on a printed spacer tilts from the holder's seat (the sample plane): the
+#: screens' tilt tolerance. No image shows the sample plane, and once the screens' placement within
+#: their planes is fitted, turning the rig and the screens together about the first screen's centre
+#: changes no image either: this prior, with the rig's tolerances, fixes the frame's tilt
+#: (docs/calibrate.md, "What fixes the frame").
+SCREEN_TILT_RAD = math.radians(0.2)
+#: How well a hand lays the screen on a spacer, centred on the axis and square (the kit's page asks
+#: for it): the placement parameters' tolerance (mm, rad).
+PLACEMENT_MM = 1.0
+PLACEMENT_TURN_RAD = math.radians(1.0)
+#: The parameters no image can tell from the rest, held at zero: moving the rig and every screen up
+#: together, or sideways together, changes no image; the first screen fixes both (its height and
+#: its centre: the frame's origin, which moves no direction).
+GAUGE = ("screen0_dz_mm", "screen0_du_mm", "screen0_dv_mm")
+
+
 def screen_names(k: int) -> tuple[str, ...]:
-    return (f"screen{k}_dz_mm", f"screen{k}_tilt_x_rad", f"screen{k}_tilt_y_rad")
+    return tuple(f"screen{k}_{key}" for key in SCREEN_KEYS)
 
 
 def parameter_names(heights: int) -> tuple[str, ...]:
@@ -31,14 +52,15 @@ def parameter_names(heights: int) -> tuple[str, ...]:
 
 
 def tolerance_scale(rig, heights: int) -> np.ndarray:
-    """Each parameter's tolerance (``tolerancing``; the screen's: 0.5 mm and 0.5 deg): the fit's
-    scale and the recovery targets' reference."""
+    """Each parameter's tolerance (``tolerancing``; the screen's: 0.5 mm for its height,
+    :data:`SCREEN_TILT_RAD`, :data:`PLACEMENT_MM` and :data:`PLACEMENT_TURN_RAD`): the fit's scale
+    and prior, and the recovery targets' reference."""
     t = rig.profile.tolerancing
     out = []
     for c in COMPONENTS:
         off, hgt, tilt = getattr(t, f"{c}_offset"), getattr(t, f"{c}_height"), getattr(t, f"{c}_tilt")
         out += [off, off, hgt, tilt, tilt]
-    out += [0.5, math.radians(0.5), math.radians(0.5)] * heights
+    out += [0.5, SCREEN_TILT_RAD, SCREEN_TILT_RAD, PLACEMENT_MM, PLACEMENT_MM, PLACEMENT_TURN_RAD] * heights
     return np.array(out)
 
 
@@ -55,8 +77,8 @@ def moved(rig, theta: np.ndarray):
 
 def screens(heights: np.ndarray, theta: np.ndarray) -> list:
     """The screens' poses: nominal heights (mm) plus the per-height parameters of ``theta``."""
-    s = np.asarray(theta[len(RIG_NAMES):]).reshape(-1, 3)
-    return [screen_pose(float(h + p[0]), float(p[1]), float(p[2])) for h, p in zip(heights, s)]
+    s = np.asarray(theta[len(RIG_NAMES):]).reshape(-1, len(SCREEN_KEYS))
+    return [screen_pose(float(h + p[0]), *(float(v) for v in p[1:])) for h, p in zip(heights, s)]
 
 
 @dataclass(frozen=True)

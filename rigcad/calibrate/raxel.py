@@ -2,8 +2,10 @@
 generic ("raxel") camera model of Grossberg and Nayar (2001) and Sturm and Ramalingam (2004), in
 which a pixel is the line of the points it sees, with no lens model.
 
-A screen placement: the emitting surface's centre at (0, 0, height) mm, tilted by the rotation
-vector (tilt_x, tilt_y, 0) rad (Rodrigues): screen-frame (u, v, 0) -> global R (u, v, 0) + c."""
+A screen placement: the emitting surface tilted by the rotation vector (tilt_x, tilt_y, 0) rad
+(Rodrigues: R) about its pivot (0, 0, height) mm, and placed within its own plane by hand: its
+centre at (du, dv) mm, turned by ``turn`` rad about its normal (T): screen-frame (u, v, 0) ->
+global R (T (u, v, 0) + (du, dv, 0)) + (0, 0, height)."""
 
 from __future__ import annotations
 
@@ -12,11 +14,17 @@ import numpy as np
 from rigcad.optics.frames import Pose
 
 
-def screen_pose(height: float, tilt_x: float = 0.0, tilt_y: float = 0.0) -> Pose:
-    """The screen's placement (module docstring) as a Pose (pivot: the screen's centre)."""
+def screen_pose(height: float, tilt_x: float = 0.0, tilt_y: float = 0.0, du: float = 0.0, dv: float = 0.0,
+                turn: float = 0.0) -> Pose:
+    """The screen's placement (module docstring) as a Pose."""
     angle = float(np.hypot(tilt_x, tilt_y))
     axis = (tilt_x / angle, tilt_y / angle, 0.0) if angle > 0 else (0.0, 1.0, 0.0)
-    return Pose.misaligned((0.0, 0.0, height), angle, axis)
+    tilted = Pose.misaligned((0.0, 0.0, height), angle, axis)
+    if not (du or dv or turn):
+        return tilted
+    c, s = np.cos(turn), np.sin(turn)
+    t = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    return Pose(tilted.rotation @ t, tilted.rotation @ np.array([du, dv, 0.0]) + tilted.translation)
 
 
 def to_global(pose: Pose, u: np.ndarray, v: np.ndarray) -> np.ndarray:

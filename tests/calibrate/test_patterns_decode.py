@@ -114,6 +114,21 @@ def test_screen_pose_round_trip_and_raxel_lines():
     uu, vv = on_screen(pose, g - 3.0 * np.array([0.3, 0.1, 0.9]), np.tile([0.3, 0.1, 0.9], (3, 1)))
     np.testing.assert_allclose(uu, u, atol=1e-12)
     np.testing.assert_allclose(vv, v, atol=1e-12)
+    # laid by hand: the screen's centre 0.7 mm along u and -0.4 along v, turned 0.5 deg about its
+    # normal, within its tilted plane; untilted, by hand: (u, v) -> T (u, v) + (du, dv) at height 7
+    t = np.radians(0.5)
+    flat = to_global(screen_pose(7.0, 0.0, 0.0, 0.7, -0.4, t), u, v)
+    np.testing.assert_allclose(flat[:, 0], np.cos(t) * u - np.sin(t) * v + 0.7, atol=1e-12)
+    np.testing.assert_allclose(flat[:, 1], np.sin(t) * u + np.cos(t) * v - 0.4, atol=1e-12)
+    np.testing.assert_allclose(flat[:, 2], 7.0, atol=1e-12)
+    placed = screen_pose(7.0, 0.01, -0.02, 0.7, -0.4, t)
+    # tilted: the placement moves the point within the tilted plane, by the same distance
+    np.testing.assert_allclose(np.linalg.norm(to_global(placed, u, v) - g, axis=1),
+                               np.linalg.norm(flat - to_global(screen_pose(7.0), u, v), axis=1), atol=1e-12)
+    uu, vv = on_screen(placed, to_global(placed, u, v) - 3.0 * np.array([0.3, 0.1, 0.9]),
+                       np.tile([0.3, 0.1, 0.9], (3, 1)))
+    np.testing.assert_allclose(uu, u, atol=1e-12)
+    np.testing.assert_allclose(vv, v, atol=1e-12)
     # lines through O with known directions, seen at 2 and at 3 heights
     d = np.array([[0.3, 0.1, 0.9], [-0.5, 0.2, 0.6], [0.0, 0.0, 1.0]])
     d /= np.linalg.norm(d, axis=1)[:, None]
