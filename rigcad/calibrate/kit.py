@@ -92,7 +92,7 @@ def manual_page(rig) -> str:
                         f"sample point; files `h{k}_<frame>.png`" for k, z in enumerate(heights))
     reach = math.degrees(math.atan((min(w, h) * cal.screen_pitch / 2) / max(heights)))
     room = check_screen_fits(rig)
-    tilt_mm = min(w, h) * cal.screen_pitch * math.tan(M.SCREEN_TILT_RAD)
+    tilt_mm = min(w, h) * cal.screen_pitch * math.tan(cal.screen_tilt)
     return f"""# Calibrating the as-built rig (deflectometry)
 
 What it measures: each camera pixel's incidence direction at the sample, through the paraboloid and
@@ -109,9 +109,10 @@ the dome as they were built and placed; the fit of the misalignment; the dome's 
   {M.PLACEMENT_MM:g} mm and {math.degrees(M.PLACEMENT_TURN_RAD):g} deg is enough, the fit finds where it lies at each spacer.
 - Lay it flat. No image shows the sample plane: the images cannot tell a screen tilted on its spacer
   from a rig tilted over the sample, so the map takes the screen to lie within
-  {math.degrees(M.SCREEN_TILT_RAD):g} deg of the holder's seat ({tilt_mm:.1f} mm across its {min(w, h) * cal.screen_pitch:.0f} mm side),
-  and its tilt there is the map's. Clean the spacer's top; a screen that rocks on a camera bump needs
-  a flat plate under it, counted in `screen_thickness`.
+  {math.degrees(cal.screen_tilt):g} deg of the holder's seat ({tilt_mm:.1f} mm across its {min(w, h) * cal.screen_pitch:.0f} mm side),
+  and its tilt there is the map's (`calibration.screen_tilt`: state what your spacers and screen
+  hold). Clean the spacer's top; a screen that rocks on a camera bump needs a flat plate under it,
+  counted in `screen_thickness`.
 
 ## Capture order
 For each spacer in turn:

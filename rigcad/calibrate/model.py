@@ -27,12 +27,6 @@ WINDOW_MARGIN_PX = 40
 
 #: Each screen height's parameters, in order (:func:`screens`).
 SCREEN_KEYS = ("dz_mm", "tilt_x_rad", "tilt_y_rad", "du_mm", "dv_mm", "turn_rad")
-#: How far a screen laid on a printed spacer tilts from the holder's seat (the sample plane): the
-#: screens' tilt tolerance. No image shows the sample plane, and once the screens' placement within
-#: their planes is fitted, turning the rig and the screens together about the first screen's centre
-#: changes no image either: this prior, with the rig's tolerances, fixes the frame's tilt
-#: (docs/calibrate.md, "What fixes the frame").
-SCREEN_TILT_RAD = math.radians(0.2)
 #: How well a hand lays the screen on a spacer, centred on the axis and square (the kit's page asks
 #: for it): the placement parameters' tolerance (mm, rad).
 PLACEMENT_MM = 1.0
@@ -53,14 +47,19 @@ def parameter_names(heights: int) -> tuple[str, ...]:
 
 def tolerance_scale(rig, heights: int) -> np.ndarray:
     """Each parameter's tolerance (``tolerancing``; the screen's: 0.5 mm for its height,
-    :data:`SCREEN_TILT_RAD`, :data:`PLACEMENT_MM` and :data:`PLACEMENT_TURN_RAD`): the fit's scale
-    and prior, and the recovery targets' reference."""
+    ``calibration.screen_tilt`` for its tilt, :data:`PLACEMENT_MM` and :data:`PLACEMENT_TURN_RAD`
+    within its plane): the fit's scale and prior, and the recovery targets' reference. No image
+    shows the sample plane, and once the screens' placement is fitted, turning the rig and the
+    screens together about the first screen's centre changes no image either: the screens' tilt
+    prior, with the rig's tolerances, fixes the frame's tilt (docs/calibrate.md, "What fixes the
+    frame")."""
     t = rig.profile.tolerancing
     out = []
     for c in COMPONENTS:
         off, hgt, tilt = getattr(t, f"{c}_offset"), getattr(t, f"{c}_height"), getattr(t, f"{c}_tilt")
         out += [off, off, hgt, tilt, tilt]
-    out += [0.5, SCREEN_TILT_RAD, SCREEN_TILT_RAD, PLACEMENT_MM, PLACEMENT_MM, PLACEMENT_TURN_RAD] * heights
+    tilt = rig.profile.calibration.screen_tilt
+    out += [0.5, tilt, tilt, PLACEMENT_MM, PLACEMENT_MM, PLACEMENT_TURN_RAD] * heights
     return np.array(out)
 
 

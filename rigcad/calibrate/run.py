@@ -167,7 +167,7 @@ def _frame(corrected: dict, up: np.ndarray, lit: np.ndarray) -> dict:
     up, least squares over the measured pixels) that best takes the true directions to the map's,
     as its tilt (the x and y parts) and turn (z), and the measured pixels' error once it is removed:
     what the images fix (the map's shape) apart from what only the priors fix (the tilt of the
-    sample plane, which no image shows: rigcad.calibrate.model.SCREEN_TILT_RAD)."""
+    sample plane, which no image shows: ``calibration.screen_tilt``)."""
     m = lit & (corrected["source"] == 1)
     u, e = up[m], corrected["direction"][m] - up[m]
     z = np.zeros(len(u))

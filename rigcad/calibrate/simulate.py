@@ -91,7 +91,7 @@ def with_surface(rig, surface: SurfaceError | None, tr: M.Traced) -> M.Traced:
 def random_misalignment(rig, heights: int, rng: np.random.Generator) -> np.ndarray:
     """A seeded build: each offset uniform within +- its tolerance, each tilt's rotation vector
     uniform in magnitude (0..tolerance) and direction; the screens' heights +-0.2 mm and tilts
-    within :data:`model.SCREEN_TILT_RAD` (a printed spacer, the screen laid on it); each screen laid
+    within ``calibration.screen_tilt`` (a printed spacer, the screen laid on it); each screen laid
     by hand, turned uniformly within +- the placement tolerance and, but the first, off centre
     within +- its tolerance along u and v. The first screen's height and centre are the fit's gauge
     (:data:`model.GAUGE`): they define the frame."""
@@ -106,7 +106,7 @@ def random_misalignment(rig, heights: int, rng: np.random.Generator) -> np.ndarr
     hand = rng.spawn(1)[0]
     for k in range(heights):
         j = len(M.RIG_NAMES) + len(M.SCREEN_KEYS) * k
-        mag, ang = rng.uniform(0, M.SCREEN_TILT_RAD), rng.uniform(0, 2 * math.pi)
+        mag, ang = rng.uniform(0, rig.profile.calibration.screen_tilt), rng.uniform(0, 2 * math.pi)
         theta[j: j + 3] = rng.uniform(-0.2, 0.2) if k else 0.0, mag * math.cos(ang), mag * math.sin(ang)
         centre = hand.uniform(-1, 1, 2) * tol[j + 3: j + 5]
         theta[j + 3: j + 6] = *(centre if k else (0.0, 0.0)), hand.uniform(-1, 1) * tol[j + 5]

@@ -548,6 +548,10 @@ class CalibrationParams:
                                    "6 mm", lo=0, hi=100.0)
     spacer_heights: tuple[float, ...] = spec("lengths", "printed spacers under the screen, one capture per "
                                              "spacer (two or more, distinct)", ["1 mm", "20 mm"], lo=0, hi=200.0)
+    screen_tilt: float = spec("angle", "how far the screen laid on a spacer may tilt from the holder's seat (the "
+                              "sample plane): no image shows that plane, so this sets the map's frame (the fit's "
+                              "prior; the simulation plants tilts within it)", "0.2 deg", lo=0, lo_open=True,
+                              hi=5 * DEG)
     phase_steps: int = spec("int", "phase shifts per sinusoid period (>= 3)", 4, lo=3, hi=64)
     periods: tuple[int, ...] = spec("ints", "sinusoid periods in screen pixels, coarse to fine unwrapping "
                                     "(the coarsest is unwrapped by the Gray code)", [128, 16], lo=4, hi=MAX_PIXELS)

@@ -143,13 +143,17 @@ def test_screen_pose_round_trip_and_raxel_lines():
 
 
 def test_calibration_section_units_and_errors(write_profile, table31_text):
-    p = load_profile(write_profile(table31_text + "calibration:\n  spacer_heights: [0.1 in, 1 cm, 15 mm]\n"))
+    p = load_profile(write_profile(table31_text + "calibration:\n  spacer_heights: [0.1 in, 1 cm, 15 mm]\n"
+                                                  "  screen_tilt: 3 mrad\n"))
     assert p.calibration.spacer_heights == pytest.approx((2.54, 10.0, 15.0))
+    assert p.calibration.screen_tilt == pytest.approx(0.003)
     for text, words in (("  spacer_heights: [3 mm, 3 mm]\n", ("spacer_heights", "distinct")),
                         ("  spacer_heights: [3 mm, 1 parsec]\n", ("spacer_heights[1]",)),
                         ("  periods: [16, 128]\n", ("periods", "coarse to fine")),
                         ("  gray_bits: 3\n", ("gray_bits", "need >= 6")),
-                        ("  phase_steps: 2\n", ("phase_steps", ">= 3"))):
+                        ("  phase_steps: 2\n", ("phase_steps", ">= 3")),
+                        ("  screen_tilt: 0 deg\n", ("screen_tilt", "> 0")),
+                        ("  screen_tilt: 2 mm\n", ("screen_tilt",))):
         with pytest.raises(ProfileError) as info:
             load_profile(write_profile(table31_text + "calibration:\n" + text))
         msg = str(info.value)

@@ -298,7 +298,7 @@ def test_full_size_calibration_against_the_truth(table31_rig):
     fit) and -0.9 um (the map's refit); with the pixels 3 steps from an edge read too, -30.8 and
     -20.4 um (before the screens' placement was fitted). The measured pixels' p99 once the frame's
     tilt is removed under 0.045 deg: 0.034 (0.098 with it; the frame's tilt 0.093 deg, within the
-    screens' 0.2 deg tilt tolerance that fixes it)."""
+    screens' 0.2 deg tilt tolerance, calibration.screen_tilt, that fixes it)."""
     from rigcad.check.scene import analytic_optics
 
     rig = table31_rig
@@ -319,7 +319,7 @@ def test_full_size_calibration_against_the_truth(table31_rig):
     # sample plane once the screens' placement is fitted; docs/calibrate.md, "What fixes the frame")
     frame = c["frame"]
     assert frame["measured_error_without_it_deg"]["p99"] < 0.045
-    assert frame["tilt_deg"] < math.degrees(M.SCREEN_TILT_RAD)
+    assert frame["tilt_deg"] < math.degrees(rig.profile.calibration.screen_tilt)
     # the stated uncertainty covers the error, the frame's tilt included (fit.posterior_covariance):
     # 99.7 % of the measured and 93.6 % of the filled pixels within two uncertainties here (98 % for a
     # calibrated round Gaussian); 21 % and 92 % (bench medians) with s^2 (J^T J)^-1 and its ridge
