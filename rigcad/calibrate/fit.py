@@ -9,9 +9,9 @@ solve, residuals beyond 5 robust sigmas (1.4826 MAD) are dropped and the fit rep
 pixel's residual component that a dome slope error makes (a turn about its dome point) is
 down-weighted in the map's refit (:data:`SLOPE_PROJECTION`). Standard
 errors: the posterior under the tolerances' prior (:func:`posterior_covariance`), s^2 (J^T J)^-1
-where the data decide, s^2 the residual variance; the residual is dominated by the surface
-error, which is correlated between neighbouring pixels, so they understate the true spread
-(the bench compares them with the errors).
+where the data decide, s^2 the residual variance. The residual is dominated by the surface
+error, which is correlated between neighbouring pixels; the bench compares the standard errors
+with the errors (docs/calibrate.md: they hold them, but the heights' by 1.2-1.5).
 
 Residual slopes: where the measured ray d (up, the raxel) differs from the fitted model's, the
 difference is read as a tilt of the dome's normal at the model ray's dome point: for the

@@ -169,12 +169,12 @@ def _frame(corrected: dict, up: np.ndarray, lit: np.ndarray) -> dict:
     what the images fix (the map's shape) apart from what only the priors fix (the tilt of the
     sample plane, which no image shows: ``calibration.screen_tilt``)."""
     m = lit & (corrected["source"] == 1)
+    if not m.any():
+        return {"pixels": 0}
     u, e = up[m], corrected["direction"][m] - up[m]
     z = np.zeros(len(u))
     a = np.stack([np.stack([z, u[:, 2], -u[:, 1]], 1), np.stack([-u[:, 2], z, u[:, 0]], 1),
                   np.stack([u[:, 1], -u[:, 0], z], 1)], axis=1)  # (n, 3 rows of w x u, 3)
-    if not len(u):
-        return {"pixels": 0}
     w = np.linalg.lstsq(a.reshape(-1, 3), e.ravel(), rcond=None)[0]
     rest = np.degrees(np.linalg.norm(e - a @ w, axis=1))
     return {"pixels": int(m.sum()), "tilt_deg": math.degrees(math.hypot(w[0], w[1])), "turn_deg": math.degrees(w[2]),
