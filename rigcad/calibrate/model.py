@@ -45,6 +45,11 @@ def parameter_names(heights: int) -> tuple[str, ...]:
     return RIG_NAMES + tuple(n for k in range(heights) for n in screen_names(k))
 
 
+def screen_index(k: int) -> int:
+    """Where screen ``k``'s parameters (:data:`SCREEN_KEYS`, in order) start in the parameter vector."""
+    return len(RIG_NAMES) + len(SCREEN_KEYS) * k
+
+
 def tolerance_scale(rig, heights: int) -> np.ndarray:
     """Each parameter's tolerance (``tolerancing``; the screen's: 0.5 mm for its height,
     ``calibration.screen_tilt`` for its tilt, :data:`PLACEMENT_MM` and :data:`PLACEMENT_TURN_RAD`

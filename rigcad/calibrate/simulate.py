@@ -105,11 +105,12 @@ def random_misalignment(rig, heights: int, rng: np.random.Generator) -> np.ndarr
     # the hand's placement from a stream of its own (spawning leaves ``rng``'s draws as they were)
     hand = rng.spawn(1)[0]
     for k in range(heights):
-        j = len(M.RIG_NAMES) + len(M.SCREEN_KEYS) * k
+        j = M.screen_index(k)
         mag, ang = rng.uniform(0, rig.profile.calibration.screen_tilt), rng.uniform(0, 2 * math.pi)
+        # (the first height draws no offset: the seeds' streams stay as they were)
         theta[j: j + 3] = rng.uniform(-0.2, 0.2) if k else 0.0, mag * math.cos(ang), mag * math.sin(ang)
-        centre = hand.uniform(-1, 1, 2) * tol[j + 3: j + 5]
-        theta[j + 3: j + 6] = *(centre if k else (0.0, 0.0)), hand.uniform(-1, 1) * tol[j + 5]
+        theta[j + 3: j + 6] = *(hand.uniform(-1, 1, 2) * tol[j + 3: j + 5]), hand.uniform(-1, 1) * tol[j + 5]
+    theta[[M.parameter_names(heights).index(n) for n in M.GAUGE]] = 0.0
     return theta
 
 

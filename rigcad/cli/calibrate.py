@@ -90,7 +90,7 @@ def _check_heights(result, folder: Path) -> None:
     from rigcad.calibrate.images import CaptureError, capture_path
 
     for k in range(len(result.heights)):
-        dz = float(result.fit.theta[len(M.RIG_NAMES) + len(M.SCREEN_KEYS) * k])
+        dz = float(result.fit.theta[M.screen_index(k)])
         if abs(dz) > HEIGHT_TOLERANCE_MM:
             raise CaptureError(f"{capture_path(folder, k, 'white')}: the images put the screen {dz:+.2f} mm from "
                                f"its spacer's height ({result.heights[k]:g} mm above O): wrong spacer or order")
