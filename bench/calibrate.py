@@ -39,12 +39,12 @@ def trial(optics, rig, seed: int, without_bias: bool = False) -> dict:
     from rigcad.calibrate.run import calibrate, compare
 
     seq = Sequence.from_profile(rig.profile.calibration)
-    heights = M.nominal_heights(rig.profile)
+    plan = M.Plan.of(rig.profile)
     rng = np.random.default_rng(seed)
-    theta = S.random_misalignment(rig, len(heights), rng)
+    theta = S.random_misalignment(rig, plan, rng)
     surface = S.planted_surface(rig, rng)
     t0 = time.perf_counter()
-    images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, heights, rng)
+    images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, plan, rng)
     t1 = time.perf_counter()
     c1 = time.process_time()
     frames = [{n: im.astype(float) / 255 for n, im in f.items()} for f in images]
@@ -76,8 +76,11 @@ VARIANTS = {"steps3": "  phase_steps: 3\n", "steps4": "  phase_steps: 4\n", "ste
             "periods_1024_128_16": "  periods: [1024, 128, 16]\n  gray_bits: 3\n",
             "thin_1mm": "  screen_thickness: 1 mm\n",
             "thin_1mm_periods_1024_128_16": "  screen_thickness: 1 mm\n  periods: [1024, 128, 16]\n  gray_bits: 3\n",
-            # the frame (docs/calibrate.md, "What fixes the frame"): a screen that lies flatter on its
-            # spacer, planted and assumed alike
+            # the frame (docs/calibrate.md, "What fixes the frame"): without the half turn, the
+            # screen's wedge sets it; a screen that settles less repeatably; one flatter on its spacer
+            # (planted and assumed alike)
+            "half_turn_none": "  half_turn: none\n",
+            "screen_seating_0.05deg": "  screen_seating: 0.05 deg\n",
             "screen_tilt_0.02deg": "  screen_tilt: 0.02 deg\n"}
 
 
@@ -106,6 +109,7 @@ def sweep(base: str, trials: int, names: list[str] | None = None) -> dict:
                          "measured_pixels_p99_deg": float(np.median(
                              [r["corrected_incidence_error_deg_by_source"]["measured"]["p99"] for r in rows])),
                          "parameters_met": float(np.median([r["parameters_met"] for r in rows])),
+                         "parameters_total": rows[0]["parameters_total"],
                          "unmeasured_causes_fraction_of_lit": cause_medians(rows),
                          "calibration_cpu_s": float(np.median([r["calibration_cpu_s"] for r in rows])),
                          "render_s": float(np.median([r["render_s"] for r in rows]))}
@@ -182,6 +186,8 @@ VARIANT_LABELS = {"steps3": "3 phase steps", "steps4": "4 phase steps (the defau
                   "periods_1024_128_16": "periods 1024, 128, 16 px (3 Gray bits)",
                   "thin_1mm": "a 1 mm thin panel (surface 1 mm up, not 6)",
                   "thin_1mm_periods_1024_128_16": "the 1 mm panel, periods 1024, 128, 16 px",
+                  "half_turn_none": "no half turn (the earlier capture)",
+                  "screen_seating_0.05deg": "the screen settling to 0.05 deg, not 0.02",
                   "screen_tilt_0.02deg": "the screen flat on its spacers to 0.02 deg, not 0.2"}
 
 
@@ -240,7 +246,7 @@ def tables(summary: dict) -> str:
                 measured = r["unmeasured_causes_fraction_of_lit"]["measured"]
                 rows.append(f"| {label} | {r['corrected_p99_deg']:.3f} | {r['measured_pixels_p99_deg']:.3f} | "
                             f"{100 * measured:.0f} | {r['corrected_p50_deg']:.3f} | {r['parameters_met']:.0f} of "
-                            f"{total} | {r['calibration_cpu_s']:.1f} |")
+                            f"{r['parameters_total']} | {r['calibration_cpu_s']:.1f} |")
     rows += causes_table(summary) + coverage_table(summary)
     return "\n".join(rows) + "\n"
 

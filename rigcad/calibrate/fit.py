@@ -2,9 +2,9 @@
 
 Fit: scipy.optimize.least_squares (trust-region reflective) over the parameters of
 :mod:`rigcad.calibrate.model`, scaled by their tolerances; residuals are the decoded screen points
-minus the forward model's (mm, both screen axes, every height) over every ``fit_stride``-th camera
-pixel that decoded at every height. The Jacobian is by forward differences with one trace per rig
-parameter (the screens' columns reuse it: each touches its own height's rows only). After a first
+minus the forward model's (mm, both screen axes, every capture) over every ``fit_stride``-th camera
+pixel that decoded in every capture. The Jacobian is by forward differences with one trace per rig
+parameter (the screens' columns reuse it: each touches its own capture's rows only). After a first
 solve, residuals beyond 5 robust sigmas (1.4826 MAD) are dropped and the fit repeated. Each
 pixel's residual component that a dome slope error makes (a turn about its dome point) is
 down-weighted in the map's refit (:data:`SLOPE_PROJECTION`). Standard
@@ -37,8 +37,8 @@ JAC_STEP = 1e-3
 #: The robust first solve's scale (mm on the screen): soft L1 above it. The dome's slope errors
 #: move the screen points by ~0.2 mm (1 mrad over the ~200 mm from the dome): they stay quadratic.
 ROBUST_SCALE_MM = 0.5
-#: The tolerances as a Gaussian prior (each parameter ~ N(0, tolerance)), one residual row per
-#: parameter of this weight (mm): a ridge that holds the near-null combinations (the camera's and
+#: The tolerances as a Gaussian prior (each parameter ~ N(0, tolerance), but the half turn's pair:
+#: :func:`rigcad.calibrate.model.prior_root`), one residual row per parameter of this weight (mm): a ridge that holds the near-null combinations (the camera's and
 #: the paraboloid's lateral offsets with the camera's tilt: they move the rays alike) at their prior
 #: instead of letting the surface error push them millimetres away; along every well-seen direction
 #: the tens of thousands of data rows outweigh it.
@@ -101,34 +101,35 @@ class FitResult:
 class Problem:
     """The residual function and its Jacobian (module docstring)."""
 
-    def __init__(self, optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData,
+    def __init__(self, optics, rig, cam: M.Camera, plan: M.Plan, data: FitData,
                  slope_projection: float = 0.0) -> None:
-        self.optics, self.rig, self.cam, self.heights, self.data = optics, rig, cam, heights, data
+        self.optics, self.rig, self.cam, self.plan, self.data = optics, rig, cam, plan, data
         self.slope_projection = slope_projection
         self.x, self.y = cam.x_px[data.pixels], cam.y_px[data.pixels]
-        self.scale = M.tolerance_scale(rig, len(heights))
+        self.scale = M.tolerance_scale(rig, len(plan))
         self.n_rig = len(M.RIG_NAMES)
-        self.keep = np.ones(len(data.pixels) * len(heights) * 2, bool)
+        self.keep = np.ones(len(data.pixels) * len(plan) * 2, bool)
         self.evaluations = 0
         #: the fitted parameters: all but the gauge (model.GAUGE)
-        self.free = np.array([n not in M.GAUGE for n in M.parameter_names(len(heights))])
+        self.free = np.array([n not in M.GAUGE for n in M.parameter_names(len(plan))])
+        #: the prior's residual rows over the free parameters (model.prior_root; mm)
+        self.prior = PRIOR_MM * M.prior_root(rig, plan)[np.ix_(self.free, self.free)]
 
     def trace(self, theta: np.ndarray) -> M.Traced:
         self.evaluations += 1
         return M.trace_camera(self.optics, M.moved(self.rig, theta), self.x, self.y, self.cam.design)
 
     def residual_of(self, tr: M.Traced, theta: np.ndarray) -> np.ndarray:
-        out = np.empty((len(self.x), len(self.heights), 2))
-        reach = np.empty((len(self.x), len(self.heights)))
-        for k, pose in enumerate(M.screens(self.heights, theta)):
+        out = np.empty((len(self.x), len(self.plan), 2))
+        reach = np.empty((len(self.x), len(self.plan)))
+        poses = M.screens(self.plan, theta)
+        for k, pose in enumerate(poses):
             su, sv = tr.screen(pose)
             out[:, k, 0], out[:, k, 1] = su, sv
             reach[:, k] = (pose.translation[2] - tr.p2[:, 2]) / tr.v[:, 2]
         r = out - self.data.screen_uv
         if self.slope_projection:
-            t = reach[:, :, None]
-            a = np.sum(t * r, axis=1, keepdims=True) / np.sum(t * t, axis=1, keepdims=True)
-            r = r - self.slope_projection * t * a
+            r = slope_projected(r, reach, np.stack([pose.rotation[:2, :2] for pose in poses]), self.slope_projection)
         return r.ravel()[self.keep]
 
     def full(self, z: np.ndarray) -> np.ndarray:
@@ -140,7 +141,7 @@ class Problem:
     def fun(self, z: np.ndarray) -> np.ndarray:
         theta = self.full(z) * self.scale
         r = self.residual_of(self.trace(theta), theta)
-        return np.concatenate([np.where(np.isfinite(r), r, 0.0), PRIOR_MM * z])
+        return np.concatenate([np.where(np.isfinite(r), r, 0.0), self.prior @ z])
 
     def jac(self, z: np.ndarray) -> np.ndarray:
         theta = self.full(z) * self.scale
@@ -153,29 +154,42 @@ class Problem:
             tr = self.trace(t) if i < self.n_rig else base_tr
             diff = (self.residual_of(tr, t) - base) / JAC_STEP
             J[:, i] = np.where(np.isfinite(diff), diff, 0.0)  # a ray lost on either side: no slope
-        return np.vstack([J[:, self.free], PRIOR_MM * np.eye(int(self.free.sum()))])
+        return np.vstack([J[:, self.free], self.prior])
 
 
-def posterior_covariance(jac: np.ndarray, fun: np.ndarray) -> np.ndarray:
+def slope_projected(r: np.ndarray, reach: np.ndarray, axes: np.ndarray, factor: float) -> np.ndarray:
+    """Residuals (n pixels, k screens, 2) mm with their dome-slope component scaled by 1 - ``factor``
+    (:data:`SLOPE_PROJECTION`): a turn of the pixel's ray about its dome point moves its point on
+    screen k by reach[:, k] (mm from the dome) times one (x, y) vector in the sample frame, so the
+    component is the projection on (reach_0, reach_1, ...) of the residuals turned into that frame by
+    ``axes`` (k, 2, 2: each screen's (u, v) -> (x, y); a turned capture's axes point the other way)."""
+    g = np.einsum("kij,nkj->nki", axes, r)
+    t = reach[:, :, None]
+    a = np.sum(t * g, axis=1, keepdims=True) / np.sum(t * t, axis=1, keepdims=True)
+    return r - factor * np.einsum("kji,nkj->nki", axes, t * a)
+
+
+def posterior_covariance(jac: np.ndarray, fun: np.ndarray, root: np.ndarray) -> np.ndarray:
     """The free parameters' covariance (tolerance units) under the prior the tolerances state (each
-    ~ N(0, 1) there) and the data rows' residual variance s^2: (J_d^T J_d / s^2 + I)^-1, J_d the
+    ~ N(0, 1) there, but for a turned capture's pair: ``root``, :func:`model.prior_root` over the
+    free parameters) and the data rows' residual variance s^2: (J_d^T J_d / s^2 + R^T R)^-1, J_d the
     data rows of ``jac`` (its last rows are the prior's). Along what the data fix, s^2 (J_d^T J_d)^-1;
-    along what they do not (the frame's tilt: docs/calibrate.md), the tolerance itself, whatever the
+    along what they do not (the frame's tilt: docs/calibrate.md), the prior itself, whatever the
     fit's ridge weight (:data:`PRIOR_MM`) did to the solve."""
     p = jac.shape[1]
     jd, rd = jac[:-p], fun[:-p]
     s2 = float(rd @ rd) / max(len(rd) - p, 1)
-    return np.linalg.inv(jd.T @ jd / max(s2, 1e-300) + np.eye(p))
+    return np.linalg.inv(jd.T @ jd / max(s2, 1e-300) + root.T @ root)
 
 
-def fit(optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData, say=None, slope_projection: float = 0.0,
+def fit(optics, rig, cam: M.Camera, plan: M.Plan, data: FitData, say=None, slope_projection: float = 0.0,
         start: np.ndarray | None = None) -> FitResult:
     """Fit the misalignment (module docstring); ``say``: a callable told each stage;
     ``slope_projection``: :data:`SLOPE_PROJECTION` for the map's refit, 0 for the plain fit;
     ``start``: the parameters to start from (the design by default)."""
     from scipy.optimize import least_squares
 
-    prob = Problem(optics, rig, cam, heights, data, slope_projection)
+    prob = Problem(optics, rig, cam, plan, data, slope_projection)
     z0 = np.zeros(int(prob.free.sum())) if start is None else (start / prob.scale)[prob.free]
     # robust first solve from the design: pixels near the screen's edges or the shadows decode wrong,
     # and rays near grazing meet the screen far away; soft L1 at ROBUST_SCALE_MM keeps them from
@@ -195,11 +209,11 @@ def fit(optics, rig, cam: M.Camera, heights: np.ndarray, data: FitData, say=None
         res = least_squares(prob.fun, res.x, jac=prob.jac, method="trf", xtol=1e-10, ftol=1e-10,
                             max_nfev=MAX_ITERATIONS)
     cov_z = np.zeros((len(prob.scale), len(prob.scale)))
-    cov_z[np.ix_(prob.free, prob.free)] = posterior_covariance(res.jac, res.fun)
+    cov_z[np.ix_(prob.free, prob.free)] = posterior_covariance(res.jac, res.fun, prob.prior / PRIOR_MM)
     cov = cov_z * np.outer(prob.scale, prob.scale)
     se = np.sqrt(np.diag(cov))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
     data = res.fun[:int(prob.keep.sum())]
-    return FitResult(prob.full(res.x) * prob.scale, M.parameter_names(len(heights)), se, np.nan_to_num(corr),
+    return FitResult(prob.full(res.x) * prob.scale, M.parameter_names(len(plan)), se, np.nan_to_num(corr),
                      float(np.sqrt(np.mean(data ** 2))), int(len(data)), outliers, prob.evaluations, cov)

@@ -1,10 +1,12 @@
 """Reading a capture, and refusing a bad one with one line that names the file.
 
-Naming scheme: a folder with one image per spacer and frame, ``h{k}_{frame}.{png|tif|tiff}``:
-k the spacer's index in ``calibration.spacer_heights`` (0 first), frame a name of
+Naming scheme: a folder with one image per capture and frame, ``{label}_{frame}.{png|tif|tiff}``:
+label ``h<k>`` for spacer k's capture, k its index in ``calibration.spacer_heights`` (0 first), and
+``h<k>r`` for the highest spacer's again, turned a half turn (``calibration.half_turn``;
+:class:`rigcad.calibrate.model.Plan`); frame a name of
 :meth:`rigcad.calibrate.patterns.Sequence.names` (white, black, x_gray0.., x_p128_s0.., y_...),
-e.g. ``h1_y_p16_s3.png``. Grey 8- or 16-bit PNG or TIFF (colour is averaged to grey), every image at
-the camera's resolution. Values are scaled to [0, 1] by the format's full scale."""
+e.g. ``h1_y_p16_s3.png``, ``h1r_white.png``. Grey 8- or 16-bit PNG or TIFF (colour is averaged to
+grey), every image at the camera's resolution. Values are scaled to [0, 1] by the format's full scale."""
 
 from __future__ import annotations
 
@@ -36,13 +38,14 @@ class CaptureError(RigcadError):
     """A capture that cannot be calibrated from: the message names the file and what is wrong."""
 
 
-def capture_path(folder: Path, k: int, name: str) -> Path:
-    """The capture's file for spacer ``k`` and frame ``name`` (any of SUFFIXES), or the .png expected."""
+def capture_path(folder: Path, label: str, name: str) -> Path:
+    """The file of capture ``label`` (``h0``, ``h1r``...) and frame ``name`` (any of SUFFIXES), or the
+    .png expected."""
     for suffix in SUFFIXES:
-        p = folder / f"h{k}_{name}{suffix}"
+        p = folder / f"{label}_{name}{suffix}"
         if p.is_file():
             return p
-    return folder / f"h{k}_{name}.png"
+    return folder / f"{label}_{name}.png"
 
 
 def read_image(path: Path, resolution: tuple[int, int]) -> np.ndarray:
@@ -50,7 +53,8 @@ def read_image(path: Path, resolution: tuple[int, int]) -> np.ndarray:
     from PIL import Image, UnidentifiedImageError
 
     if not path.is_file():
-        raise CaptureError(f"{path}: missing (naming scheme h<spacer>_<frame>.png|tif, see docs/calibrate.md)")
+        raise CaptureError(f"{path}: missing (naming scheme h<spacer>_<frame>.png|tif, h<spacer>r_ for the half "
+                           "turn: see docs/calibrate.md)")
     try:
         with Image.open(path) as im:
             im.load()
@@ -66,17 +70,17 @@ def read_image(path: Path, resolution: tuple[int, int]) -> np.ndarray:
     return arr.astype(float) / full
 
 
-def read_capture(folder: Path, seq: Sequence, heights: int, resolution: tuple[int, int]) -> list[dict]:
-    """Every frame of every spacer (module docstring), exposure-checked."""
+def read_capture(folder: Path, seq: Sequence, labels: tuple[str, ...], resolution: tuple[int, int]) -> list[dict]:
+    """Every frame of every capture (``labels``: the plan's, module docstring), exposure-checked."""
     out = []
-    for k in range(heights):
+    for k in labels:
         frames = {n: read_image(capture_path(folder, k, n), resolution) for n in seq.names()}
         check_exposure(folder, k, frames)
         out.append(frames)
     return out
 
 
-def check_exposure(folder: Path, k: int, frames: dict) -> None:
+def check_exposure(folder: Path, k: str, frames: dict) -> None:
     """All dark, saturated, or white and black swapped."""
     white, black = frames["white"], frames["black"]
     path = capture_path(folder, k, "white")
@@ -91,7 +95,7 @@ def check_exposure(folder: Path, k: int, frames: dict) -> None:
         raise CaptureError(f"{path}: saturated ({sat:.0%} of the lit pixels at full scale): shorten the exposure")
 
 
-def check_decoded(folder: Path, k: int, seq: Sequence, decoded) -> None:
+def check_decoded(folder: Path, k: str, seq: Sequence, decoded) -> None:
     """Too little modulation, or frames out of order (torn map, misfit to a sinusoid)."""
     lit = int(decoded.lit.sum())
     if lit == 0 or decoded.valid.sum() < MIN_DECODED_FRACTION * lit:

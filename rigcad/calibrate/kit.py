@@ -85,14 +85,25 @@ def manual_page(rig) -> str:
     p = rig.profile
     cal = p.calibration
     seq = Sequence.from_profile(cal)
-    heights = M.nominal_heights(p)
+    plan = M.Plan.of(p)
     w, h = cal.screen_resolution
     frames = seq.names()
-    spacers = "\n".join(f"{k + 1}. spacer {k} ({cal.spacer_heights[k]:g} mm): screen surface {z:g} mm above the "
-                        f"sample point; files `h{k}_<frame>.png`" for k, z in enumerate(heights))
-    reach = math.degrees(math.atan((min(w, h) * cal.screen_pitch / 2) / max(heights)))
+    turned = ", turned a half turn (the spacer in its bore and the screen on it, each by 180 deg)"
+    steps = "\n".join(
+        f"{c + 1}. spacer {k} ({cal.spacer_heights[k]:g} mm){turned if plan.repeats(c) is not None else ''}: "
+        f"screen surface {z:g} mm above the sample point; files `{label}_<frame>.png`"
+        for c, (k, z, label) in enumerate(zip(plan.spacers, plan.heights, plan.labels)))
+    reach = math.degrees(math.atan((min(w, h) * cal.screen_pitch / 2) / max(plan.heights)))
     room = check_screen_fits(rig)
-    tilt_mm = min(w, h) * cal.screen_pitch * math.tan(cal.screen_tilt)
+    side = min(w, h) * cal.screen_pitch
+    def across(angle: float) -> str:
+        return f"{math.degrees(angle):g} deg, {side * math.tan(angle):.2f} mm across its {side:.0f} mm side"
+
+    pair = [c for c in range(len(plan)) if plan.repeats(c) is not None]
+    half_turn = (f"the capture turned a half turn turns the wedge with it, so the two captures of spacer "
+                 f"{plan.spacers[pair[0]]} average it out, and the map's tilt is how the screen settles when laid "
+                 f"again (within {across(cal.screen_seating)}, `calibration.screen_seating`)." if pair
+                 else "the map's tilt is that wedge (`calibration.half_turn: highest` averages it out).")
     return f"""# Calibrating the as-built rig (deflectometry)
 
 What it measures: each camera pixel's incidence direction at the sample, through the paraboloid and
@@ -108,23 +119,23 @@ the dome as they were built and placed; the fit of the misalignment; the dome's 
   lay the screen face up on its top, centred on the axis and square to the base plate by eye: within
   {M.PLACEMENT_MM:g} mm and {math.degrees(M.PLACEMENT_TURN_RAD):g} deg is enough, the fit finds where it lies at each spacer.
 - Lay it flat. No image shows the sample plane: the images cannot tell a screen tilted on its spacer
-  from a rig tilted over the sample, so the map takes the screen to lie within
-  {math.degrees(cal.screen_tilt):g} deg of the holder's seat ({tilt_mm:.1f} mm across its {min(w, h) * cal.screen_pitch:.0f} mm side),
-  and its tilt there is the map's (`calibration.screen_tilt`: state what your spacers and screen
-  hold). Clean the spacer's top; a screen that rocks on a camera bump needs a flat plate under it,
-  counted in `screen_thickness`.
+  from a rig tilted over the sample, so the screen's tilt on the holder's seat is the map's. The
+  spacer's faces and the screen's back make a wedge (up to {across(cal.screen_tilt)},
+  `calibration.screen_tilt`); {half_turn}
+  Clean the spacer's top and the screen's back; a screen that rocks on a camera bump needs a flat
+  plate under it, counted in `screen_thickness`.
 
 ## Capture order
-For each spacer in turn:
-{spacers}
+In turn:
+{steps}
 
 and for each, the {len(frames)} frames in this order (the names of `patterns/`): {', '.join(frames[:4])}, ...,
-{frames[-1]}. Name each camera image `h<spacer>_<frame>.png` (or .tif, 8 or 16 bit, grey or colour) at the
+{frames[-1]}. Name each camera image `<capture>_<frame>.png` (or .tif, 8 or 16 bit, grey or colour) at the
 camera's full resolution, {p.camera.resolution[0]} x {p.camera.resolution[1]} px, all in one folder; then
 `rigcad calibrate {p.name} --images <folder>`.
 
 ## Exposure
-- One exposure for every frame of a spacer: set it on the white frame so the brightest lit pixels sit at
+- One exposure for every frame of a capture: set it on the white frame so the brightest lit pixels sit at
   80-90 % of full scale (a saturated white is refused; so is an all-dark one).
 - Keep the room dark: stray light lowers the fringes' modulation (pixels under
   {cal.min_modulation:g} modulation are not decoded).

@@ -4,8 +4,9 @@ the camera), off the paraboloid and the dome (``Rig.moved`` poses), to the scree
 
 Parameters (mm, rad): the paraboloid's, the dome's and the camera's offsets (x, y, z) and tilts
 (the rotation vector's x and y; pivots as :meth:`rigcad.optics.frames.Misalignment.pose`), then per
-screen height its height offset, its tilt (x, y) and where the hand laid it within its plane: its
-centre's offset (u, v) and its turn about its normal (:func:`rigcad.calibrate.raxel.screen_pose`).
+capture (:class:`Plan`) the screen's height offset, its tilt (x, y) and where the hand laid it
+within its plane: its centre's offset (u, v) and its turn about its normal from the capture's
+nominal one (:func:`rigcad.calibrate.raxel.screen_pose`).
 Frame: mm, O at the origin, +z up; the gauge (:data:`GAUGE`) puts the first screen's centre on the
 axis at its nominal height."""
 
@@ -37,6 +38,36 @@ PLACEMENT_TURN_RAD = math.radians(1.0)
 GAUGE = ("screen0_dz_mm", "screen0_du_mm", "screen0_dv_mm")
 
 
+@dataclass(frozen=True)
+class Plan:
+    """The captures, in the order the kit's page gives them: one per spacer (label ``h<k>``), then,
+    with ``calibration.half_turn`` 'highest', the highest spacer's again with the spacer and the
+    screen on it turned a half turn together (``h<k>r``): up there the screen meets the rays
+    furthest from the axis, where its tilt shows most. Per capture: the screen's nominal height (mm above
+    O, :func:`nominal_heights`), its nominal turn about the axis (rad: 0, or pi), the spacer's index."""
+
+    heights: np.ndarray
+    turns: np.ndarray
+    labels: tuple[str, ...]
+    spacers: tuple[int, ...]
+
+    @classmethod
+    def of(cls, profile) -> "Plan":
+        z = nominal_heights(profile)
+        spacers = tuple(range(len(z))) + ((int(np.argmax(z)),) if profile.calibration.half_turn == "highest" else ())
+        turned = [c >= len(z) for c in range(len(spacers))]
+        return cls(z[list(spacers)], np.where(turned, math.pi, 0.0),
+                   tuple(f"h{k}r" if t else f"h{k}" for k, t in zip(spacers, turned)), spacers)
+
+    def __len__(self) -> int:
+        return len(self.labels)
+
+    def repeats(self, c: int) -> int | None:
+        """The capture that capture ``c`` repeats turned (same spacer, taken before), or None."""
+        first = self.spacers.index(self.spacers[c])
+        return first if first != c else None
+
+
 def screen_names(k: int) -> tuple[str, ...]:
     return tuple(f"screen{k}_{key}" for key in SCREEN_KEYS)
 
@@ -51,21 +82,43 @@ def screen_index(k: int) -> int:
 
 
 def tolerance_scale(rig, heights: int) -> np.ndarray:
-    """Each parameter's tolerance (``tolerancing``; the screen's: 0.5 mm for its height,
-    ``calibration.screen_tilt`` for its tilt, :data:`PLACEMENT_MM` and :data:`PLACEMENT_TURN_RAD`
-    within its plane): the fit's scale and prior, and the recovery targets' reference. No image
-    shows the sample plane, and once the screens' placement is fitted, turning the rig and the
-    screens together about the first screen's centre changes no image either: the screens' tilt
-    prior, with the rig's tolerances, fixes the frame's tilt (docs/calibrate.md, "What fixes the
-    frame")."""
+    """Each parameter's tolerance (``tolerancing``; the screen's: 0.5 mm for its height, the
+    ``calibration.screen_tilt`` wedge and ``screen_seating`` together for its tilt,
+    :data:`PLACEMENT_MM` and :data:`PLACEMENT_TURN_RAD` within its plane), ``heights`` captures: the
+    fit's scale and prior (:func:`prior_root`), and the recovery targets' reference."""
     t = rig.profile.tolerancing
     out = []
     for c in COMPONENTS:
         off, hgt, tilt = getattr(t, f"{c}_offset"), getattr(t, f"{c}_height"), getattr(t, f"{c}_tilt")
         out += [off, off, hgt, tilt, tilt]
-    tilt = rig.profile.calibration.screen_tilt
+    cal = rig.profile.calibration
+    tilt = math.hypot(cal.screen_tilt, cal.screen_seating)
     out += [0.5, tilt, tilt, PLACEMENT_MM, PLACEMENT_MM, PLACEMENT_TURN_RAD] * heights
     return np.array(out)
+
+
+def prior_root(rig, plan: Plan) -> np.ndarray:
+    """A square root R (R^T R = C^-1) of the prior's inverse covariance C over the parameters in
+    :func:`tolerance_scale`'s units: each ~ N(0, 1), independent, but for a turned capture's tilt
+    and the one it repeats. Their wedge w (``screen_tilt``) is one, turned a half turn: tilts w + e
+    and -w + e', each e within ``screen_seating``, so per axis the pair's mean is known to the
+    seating / sqrt 2 and their half difference to the wedge: the rows are the mean's and the half
+    difference's, whitened (the turn's hand error, ~1 deg of the half turn, leaves ~1/60 of the
+    wedge in the mean: 0.003 deg at 0.2 deg). No image shows the sample plane; these priors, with the
+    rig's tolerances, set the map's frame (docs/calibrate.md, "What fixes the frame")."""
+    root = np.eye(len(RIG_NAMES) + len(SCREEN_KEYS) * len(plan))
+    cal = rig.profile.calibration
+    rho = cal.screen_tilt ** 2 / (cal.screen_tilt ** 2 + cal.screen_seating ** 2)  # -correlation, per axis
+    for c in range(len(plan)):
+        first = plan.repeats(c)
+        if first is None:
+            continue
+        for axis in (1, 2):
+            i, j = screen_index(first) + axis, screen_index(c) + axis
+            root[[i, j]] = 0.0
+            root[i, [i, j]] = 1 / math.sqrt(2 * (1 - rho))  # the mean, (z_i + z_j) / 2, over its sigma
+            root[j, [i, j]] = 1 / math.sqrt(2 * (1 + rho)), -1 / math.sqrt(2 * (1 + rho))
+    return root
 
 
 def moved(rig, theta: np.ndarray):
@@ -79,10 +132,11 @@ def moved(rig, theta: np.ndarray):
     return out
 
 
-def screens(heights: np.ndarray, theta: np.ndarray) -> list:
-    """The screens' poses: nominal heights (mm) plus the per-height parameters of ``theta``."""
+def screens(plan: Plan, theta: np.ndarray) -> list:
+    """The screens' poses: each capture's nominal height and turn plus its parameters in ``theta``."""
     s = np.asarray(theta[len(RIG_NAMES):]).reshape(-1, len(SCREEN_KEYS))
-    return [screen_pose(float(h + p[0]), *(float(v) for v in p[1:])) for h, p in zip(heights, s)]
+    return [screen_pose(float(h + p[0]), *(float(v) for v in p[1:5]), turn=float(t + p[5]))
+            for h, t, p in zip(plan.heights, plan.turns, s)]
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""The calibration's stages on captured (or simulated) images: decode each height, fit the
+"""The calibration's stages on captured (or simulated) images: decode each capture, fit the
 misalignment, the measured rays on the fitted screens, the dome's residual slopes, the corrected map;
 and, for a simulation, the comparison with what was planted."""
 
@@ -28,7 +28,7 @@ class Calibration:
     """Everything one calibration computed (window arrays (n,) or (n, 3) row-major over ``cam.shape``)."""
 
     cam: M.Camera
-    heights: np.ndarray
+    plan: M.Plan
     decoded: list
     fit: object
     map_fit: object
@@ -52,30 +52,34 @@ class Calibration:
 
 def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: None, check=None,
               bias: str | None = DECODING_BIAS) -> Calibration:
-    """Calibrate from ``images`` (per spacer, frame name -> full camera image as float, checked).
+    """Calibrate from ``images`` (per capture of :class:`model.Plan`, frame name -> full camera
+    image as float, checked).
     ``check(decoded)``: called with the decoded captures before the fit (it raises to refuse them).
     ``bias``: how the decoding's own bias is removed (:data:`DECODING_BIAS`)."""
     cal = rig.profile.calibration
     seq = Sequence.from_profile(cal)
     cam = M.Camera.of(rig)
-    heights = M.nominal_heights(rig.profile)
+    plan = M.Plan.of(rig.profile)
+    if len(images) != len(plan):
+        raise ValueError(f"{len(images)} captures given, the plan has {len(plan)}: {', '.join(plan.labels)}")
     t0 = time.perf_counter()
     decoded = [decode(seq, {n: cam.crop(im) for n, im in frames.items()}, cal.min_modulation) for frames in images]
     t1 = time.perf_counter()
     if check is not None:
         check(decoded)
-    say(f"decoded {', '.join(str(d.stats()['decoded_pixels']) for d in decoded)} camera pixels per height")
+    say(f"decoded {', '.join(str(d.stats()['decoded_pixels']) for d in decoded)} camera pixels per capture "
+        f"({', '.join(plan.labels)})")
     if bias == "map":
         decoded = _unbiased(decoded, B.map_bias(decoded, cam.shape, seq, cal.sim_blur))
     data = _fit_data(cam, decoded, cal.fit_stride)
-    result = fit(optics, rig, cam, heights, data, say)
+    result = fit(optics, rig, cam, plan, data, say)
     say(f"fitted {len(result.theta)} parameters to {result.residuals_used} residuals "
         f"(RMS {result.rms_residual_mm * 1e3:.2f} um)")
     # the map's rays turn about the model's dome points: refit with the surface's signature
     # down-weighted (fit.SLOPE_PROJECTION), from the plain fit
-    for_map = fit(optics, rig, cam, heights, data, say, slope_projection=SLOPE_PROJECTION, start=result.theta)
+    for_map = fit(optics, rig, cam, plan, data, say, slope_projection=SLOPE_PROJECTION, start=result.theta)
     t2 = time.perf_counter()
-    poses = M.screens(heights, for_map.theta)
+    poses = M.screens(plan, for_map.theta)
     fitted = M.moved(rig, for_map.theta)
     model_tr = M.trace_camera(optics, fitted, cam.x_px, cam.y_px, cam.design)
     measured = maps.pivot_rays(decoded, poses, model_tr, cam.shape)
@@ -91,12 +95,12 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     from rigcad.check.sources import pixel_rays
 
     design = cam.design.direction(pixel_rays(cam.design, cam.x_px, cam.y_px).dirs)
-    return Calibration(cam, heights, decoded, result, for_map, model_tr, measured, slopes, corrected, design, causes,
+    return Calibration(cam, plan, decoded, result, for_map, model_tr, measured, slopes, corrected, design, causes,
                        {"decode_s": t1 - t0, "fit_s": t2 - t1, "maps_s": t3 - t2})
 
 
 def _unbiased(decoded: list, bias: np.ndarray) -> list:
-    """The decoded points minus the decoding's bias (n, heights, 2) mm (unchanged where it is NaN)."""
+    """The decoded points minus the decoding's bias (n, captures, 2) mm (unchanged where it is NaN)."""
     out = []
     for k, d in enumerate(decoded):
         du, dv = (np.nan_to_num(bias[:, k, a]).reshape(d.u.shape) for a in range(2))
@@ -105,7 +109,7 @@ def _unbiased(decoded: list, bias: np.ndarray) -> list:
 
 
 def _fit_data(cam: M.Camera, decoded: list, stride: int) -> FitData:
-    """Every ``stride``-th row and column of the window that decoded at every height."""
+    """Every ``stride``-th row and column of the window that decoded in every capture."""
     rows, cols = np.meshgrid(np.arange(cam.shape[0]), np.arange(cam.shape[1]), indexing="ij")
     pick = ((rows % stride == 0) & (cols % stride == 0)).ravel()
     # pixels near an undecoded one see a screen edge or a shadow's edge in part of their footprint:
@@ -136,9 +140,9 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
     seen = np.isfinite(result.slopes[:, 0]) & np.isfinite(planted[:, 0])
     g_p, g_r = planted[seen], result.slopes[seen]
     rms = lambda a: float(np.sqrt(np.mean(np.sum(a * a, axis=1))) * 1e3) if len(a) else math.nan  # noqa: E731
-    tol = M.tolerance_scale(rig, len(result.heights))
+    tol = M.tolerance_scale(rig, len(result.plan))
     err = result.fit.theta - theta_true
-    names = M.parameter_names(len(result.heights))
+    names = M.parameter_names(len(result.plan))
     target = np.maximum(0.1 * tol, [math.radians(0.01) if n.endswith("_rad") else 0.02 for n in names])
     z = np.abs(err) / np.maximum(result.fit.standard_error, 1e-300)
     return {

@@ -88,29 +88,43 @@ def with_surface(rig, surface: SurfaceError | None, tr: M.Traced) -> M.Traced:
     return M.Traced(tr.p2, np.where(tr.ok[:, None], v, np.nan), tr.u, tr.ok)
 
 
-def random_misalignment(rig, heights: int, rng: np.random.Generator) -> np.ndarray:
+def random_misalignment(rig, plan: M.Plan, rng: np.random.Generator) -> np.ndarray:
     """A seeded build: each offset uniform within +- its tolerance, each tilt's rotation vector
-    uniform in magnitude (0..tolerance) and direction; the screens' heights +-0.2 mm and tilts
-    within ``calibration.screen_tilt`` (a printed spacer, the screen laid on it); each screen laid
-    by hand, turned uniformly within +- the placement tolerance and, but the first, off centre
-    within +- its tolerance along u and v. The first screen's height and centre are the fit's gauge
-    (:data:`model.GAUGE`): they define the frame."""
-    tol = M.tolerance_scale(rig, heights)
+    uniform in magnitude (0..tolerance) and direction. Each spacer's capture: the screen's height
+    +-0.2 mm, its wedge's tilt within ``calibration.screen_tilt`` (a printed spacer, the screen's
+    back); a turned capture (:class:`model.Plan`): its spacer's height and wedge, turned with the
+    screen. Each screen laid by hand: turned uniformly within +- the placement tolerance about its
+    nominal turn and, but the first, off centre within +- its tolerance along u and v; its tilt
+    is the wedge's plus a seating tilt within ``screen_seating``. The first screen's height and
+    centre are the fit's gauge (:data:`model.GAUGE`): they define the frame."""
+    cal = rig.profile.calibration
+    tol = M.tolerance_scale(rig, len(plan))
     theta = np.zeros(len(tol))
     for i in range(len(M.COMPONENTS)):
         j = 5 * i
         theta[j: j + 3] = rng.uniform(-1, 1, 3) * tol[j: j + 3]
         mag, ang = rng.uniform(0, tol[j + 3]), rng.uniform(0, 2 * math.pi)
         theta[j + 3: j + 5] = mag * math.cos(ang), mag * math.sin(ang)
-    # the hand's placement from a stream of its own (spawning leaves ``rng``'s draws as they were)
-    hand = rng.spawn(1)[0]
-    for k in range(heights):
-        j = M.screen_index(k)
-        mag, ang = rng.uniform(0, rig.profile.calibration.screen_tilt), rng.uniform(0, 2 * math.pi)
-        # (the first height draws no offset: the seeds' streams stay as they were)
-        theta[j: j + 3] = rng.uniform(-0.2, 0.2) if k else 0.0, mag * math.cos(ang), mag * math.sin(ang)
+    # the hand's placement and the seating from streams of their own (spawning leaves ``rng``'s
+    # draws as they were)
+    hand, seat = rng.spawn(1)[0], rng.spawn(1)[0]
+    for c in sorted(range(len(plan)), key=lambda c: plan.repeats(c) is not None):  # spacers first
+        j, first = M.screen_index(c), plan.repeats(c)
+        if first is None:
+            mag, ang = rng.uniform(0, cal.screen_tilt), rng.uniform(0, 2 * math.pi)
+            # (the first height draws no offset: the seeds' streams stay as they were)
+            theta[j: j + 3] = rng.uniform(-0.2, 0.2) if c else 0.0, mag * math.cos(ang), mag * math.sin(ang)
         theta[j + 3: j + 6] = *(hand.uniform(-1, 1, 2) * tol[j + 3: j + 5]), hand.uniform(-1, 1) * tol[j + 5]
-    theta[[M.parameter_names(heights).index(n) for n in M.GAUGE]] = 0.0
+        if first is not None:  # the same spacer and wedge, turned with the screen
+            f = M.screen_index(first)
+            turn = plan.turns[c] + theta[j + 5] - plan.turns[first] - theta[f + 5]
+            w = theta[f + 1: f + 3]
+            theta[j: j + 3] = theta[f], *(np.array([[math.cos(turn), -math.sin(turn)],
+                                                    [math.sin(turn), math.cos(turn)]]) @ w)
+    for c in range(len(plan)):
+        mag, ang = seat.uniform(0, cal.screen_seating), seat.uniform(0, 2 * math.pi)
+        theta[M.screen_index(c) + 1: M.screen_index(c) + 3] += mag * math.cos(ang), mag * math.sin(ang)
+    theta[[M.parameter_names(len(plan)).index(n) for n in M.GAUGE]] = 0.0
     return theta
 
 
@@ -119,8 +133,8 @@ def sub_offsets(s: int) -> np.ndarray:
 
 
 def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.Camera, seq: Sequence,
-           heights: np.ndarray, rng: np.random.Generator) -> list[dict[str, np.ndarray]]:
-    """Per screen height, every frame of ``seq`` as the camera records it: full-resolution uint8
+           plan: M.Plan, rng: np.random.Generator) -> list[dict[str, np.ndarray]]:
+    """Per capture (``plan``), every frame of ``seq`` as the camera records it: full-resolution uint8
     images (rows, cols) (module docstring). ``theta``: the true misalignment (model parameters)."""
     from scipy.ndimage import gaussian_filter
 
@@ -135,7 +149,7 @@ def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.
     tr = with_surface(true_rig, surface, M.trace_camera(optics, true_rig, x, y, cam.design))
     width, height = cam.resolution
     out = []
-    for pose in M.screens(heights, theta):
+    for pose in M.screens(plan, theta):
         su, sv = tr.screen(pose)
         cx, cy = seq.from_mm(su, sv)
         edges = sub_edges(cx.reshape(n, s, s), cy.reshape(n, s, s), cam.shape)

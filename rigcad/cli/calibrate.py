@@ -35,11 +35,11 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         print(f"calibration kit for {rig.name}: {len(manifest['files'])} files in {out}")
         return 0
     seq = Sequence.from_profile(rig.profile.calibration)
-    heights = M.nominal_heights(rig.profile)
+    plan = M.Plan.of(rig.profile)
     folder, images, truth = Path("<simulated>"), None, None
     if not args.simulate:  # a capture that is missing or the wrong size is refused before any work
         folder = Path(args.images)
-        images = read_capture(folder, seq, len(heights), rig.profile.camera.resolution)
+        images = read_capture(folder, seq, plan.labels, rig.profile.camera.resolution)
     with stages(3, "calibrate") as step:
         step("tracer")
         optics = analytic_optics(rig)
@@ -48,14 +48,14 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
             step("simulated capture")
             rng = np.random.default_rng(args.seed)
-            theta = S.random_misalignment(rig, len(heights), rng)
+            theta = S.random_misalignment(rig, plan, rng)
             surface = S.planted_surface(rig, rng)
-            images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, heights, rng)
+            images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, plan, rng)
             images = [{n: im.astype(float) / 255.0 for n, im in f.items()} for f in images]
             truth = (theta, surface)
         step("decode, fit, maps")
         check = None if args.simulate else (
-            lambda decoded: [check_decoded(folder, k, seq, d) for k, d in enumerate(decoded)])
+            lambda decoded: [check_decoded(folder, k, seq, d) for k, d in zip(plan.labels, decoded)])
         result = calibrate(optics, rig, images, say=print, check=check)
     _check_heights(result, folder)
     report = _report(result)
@@ -89,11 +89,12 @@ def _check_heights(result, folder: Path) -> None:
     from rigcad.calibrate import model as M
     from rigcad.calibrate.images import CaptureError, capture_path
 
-    for k in range(len(result.heights)):
+    plan = result.plan
+    for k, label in enumerate(plan.labels):
         dz = float(result.fit.theta[M.screen_index(k)])
         if abs(dz) > HEIGHT_TOLERANCE_MM:
-            raise CaptureError(f"{capture_path(folder, k, 'white')}: the images put the screen {dz:+.2f} mm from "
-                               f"its spacer's height ({result.heights[k]:g} mm above O): wrong spacer or order")
+            raise CaptureError(f"{capture_path(folder, label, 'white')}: the images put the screen {dz:+.2f} mm from "
+                               f"its spacer's height ({plan.heights[k]:g} mm above O): wrong spacer or order")
 
 
 def _report(result) -> dict:
@@ -111,7 +112,8 @@ def _report(result) -> dict:
                                     "measured direction, each pixel counted under the first cause that applies; "
                                     "corrected_map.npz's 'cause' shows where",
                            "fraction_of_lit": maps.cause_fractions(result.causes), "causes": maps.CAUSE_NOTES},
-            "decoding": [d.stats() for d in result.decoded], "screen_heights_mm": result.heights.tolist(),
+            "decoding": [d.stats() for d in result.decoded], "captures": list(result.plan.labels),
+            "screen_heights_mm": result.plan.heights.tolist(),
             "timings_s": result.timings_s, "camera_window": {"row0": result.cam.row0, "col0": result.cam.col0,
                                                              "shape": list(result.cam.shape)}}
 
@@ -161,13 +163,14 @@ def register(subparsers) -> argparse.ArgumentParser:
         subparsers, "calibrate", cmd_calibrate,
         help="deflectometric calibration of the as-built rig (a screen at the sample)",
         description="Decode a capture of the calibration screen at two or more spacer heights (images "
-                    "h<spacer>_<frame>.png|tif, docs/calibrate.md), fit the rig's misalignment with its own "
-                    "tracer, map the dome's residual slopes and write exports/<profile>/calibrate/: "
+                    "h<spacer>_<frame>.png|tif, h<spacer>r_<frame> for the half turn, docs/calibrate.md), fit "
+                    "the rig's misalignment with its own tracer, map the dome's residual slopes and write exports/<profile>/calibrate/: "
                     "calibration.json, corrected_map.npz (read by rigcad basis --simulate), maps.png. "
                     "--simulate renders a seeded capture of a moved rig with a planted dome error instead and "
                     "compares; --kit writes the screen patterns, the spacers and the manual's page.")
     src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif)")
+    src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif, "
+                     "h<spacer>r_<frame>)")
     src.add_argument("--simulate", action="store_true", help="render a seeded simulated capture and calibrate it")
     src.add_argument("--kit", action="store_true", help="write the calibration kit: screen patterns, spacers "
                      "(STL, STEP, manifest), the manual's page, into <exports>/<profile>/calibrate_kit")

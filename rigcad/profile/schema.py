@@ -549,9 +549,16 @@ class CalibrationParams:
     spacer_heights: tuple[float, ...] = spec("lengths", "printed spacers under the screen, one capture per "
                                              "spacer (two or more, distinct)", ["1 mm", "20 mm"], lo=0, hi=200.0)
     screen_tilt: float = spec("angle", "how far the screen laid on a spacer may tilt from the holder's seat (the "
-                              "sample plane): no image shows that plane, so this sets the map's frame (the fit's "
-                              "prior; the simulation plants tilts within it)", "0.2 deg", lo=0, lo_open=True,
-                              hi=5 * DEG)
+                              "sample plane), the wedge of the spacer's faces and the screen's back: no image "
+                              "shows that plane (the fit's prior; the simulation plants wedges within it)",
+                              "0.2 deg", lo=0, lo_open=True, hi=5 * DEG)
+    half_turn: str = spec("choice", "'highest': the highest spacer is captured again with the spacer and the screen "
+                          "on it turned a half turn together, so their wedge (screen_tilt) cancels between the two "
+                          "captures and the sample plane's tilt is known to screen_seating; 'none': the map's "
+                          "frame rests on screen_tilt", "highest", choices=("highest", "none"))
+    screen_seating: float = spec("angle", "how the same screen on the same spacer repeats its tilt when laid again "
+                                 "(dust, the print's texture): with half_turn, the map's frame's tolerance",
+                                 "0.02 deg", lo=0, lo_open=True, hi=5 * DEG)
     phase_steps: int = spec("int", "phase shifts per sinusoid period (>= 3)", 4, lo=3, hi=64)
     periods: tuple[int, ...] = spec("ints", "sinusoid periods in screen pixels, coarse to fine unwrapping "
                                     "(the coarsest is unwrapped by the Gray code)", [128, 16], lo=4, hi=MAX_PIXELS)

@@ -153,7 +153,9 @@ def test_calibration_section_units_and_errors(write_profile, table31_text):
                         ("  gray_bits: 3\n", ("gray_bits", "need >= 6")),
                         ("  phase_steps: 2\n", ("phase_steps", ">= 3")),
                         ("  screen_tilt: 0 deg\n", ("screen_tilt", "> 0")),
-                        ("  screen_tilt: 2 mm\n", ("screen_tilt",))):
+                        ("  screen_tilt: 2 mm\n", ("screen_tilt",)),
+                        ("  screen_seating: 0 deg\n", ("screen_seating", "> 0")),
+                        ("  half_turn: both\n", ("half_turn", "highest", "none"))):
         with pytest.raises(ProfileError) as info:
             load_profile(write_profile(table31_text + "calibration:\n" + text))
         msg = str(info.value)
