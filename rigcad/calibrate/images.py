@@ -32,6 +32,9 @@ MAX_JUMP_FRACTION = 0.05
 MAX_DISAGREEMENT = 0.2
 #: Out of order (N >= 4): the median misfit of a period's frames to a sinusoid above this.
 MAX_MISFIT = 0.35
+#: Not turned: a half turn's capture whose screen points turn from its partner's by more than this
+#: (deg) away from 180 (a forgotten or a quarter turn; the fit finds the hand's degree or so).
+HALF_TURN_SLACK_DEG = 20.0
 
 
 class CaptureError(RigcadError):
@@ -120,3 +123,25 @@ def check_decoded(folder: Path, k: str, seq: Sequence, decoded) -> None:
                     raise CaptureError(f"{capture_path(folder, k, f'{axis}_p{p}_s0')}: the {seq.steps} phase "
                                        f"steps of period {p} do not fit a sinusoid (misfit {mis:.2f}): "
                                        "frames in the wrong order")
+
+
+def check_half_turns(folder: Path, plan, decoded: list) -> None:
+    """A half turn's capture (``plan``: :class:`rigcad.calibrate.model.Plan`) whose screen did not
+    turn a half turn from its partner's: the rotation between the screen points the two decode at
+    the same camera pixels (2D Procrustes over the pixels both decoded) is its turn."""
+    for c, d in enumerate(decoded):
+        first = plan.repeats(c)
+        if first is None:
+            continue
+        a, b = decoded[first], d
+        both = (a.valid & b.valid).ravel()
+        if both.sum() < 3:
+            continue  # too little modulation is its own refusal (check_decoded)
+        p = np.stack([a.u.ravel()[both], a.v.ravel()[both]], axis=1)
+        q = np.stack([b.u.ravel()[both], b.v.ravel()[both]], axis=1)
+        p, q = p - p.mean(axis=0), q - q.mean(axis=0)
+        turn = float(np.degrees(np.arctan2(np.sum(p[:, 0] * q[:, 1] - p[:, 1] * q[:, 0]), np.sum(p * q))))
+        if 180.0 - abs(turn) > HALF_TURN_SLACK_DEG:  # turn in [-180, 180]
+            raise CaptureError(f"{capture_path(folder, plan.labels[c], 'white')}: its screen points are turned "
+                               f"{abs(turn):.0f} deg from {plan.labels[first]}'s, not a half turn: turn the spacer and the "
+                               "screen on it by 180 deg together (docs/calibrate.md, 'The half turn')")

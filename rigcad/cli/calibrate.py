@@ -15,7 +15,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     import numpy as np
 
     from rigcad.calibrate import model as M
-    from rigcad.calibrate.images import check_decoded, read_capture
+    from rigcad.calibrate.images import check_decoded, check_half_turns, read_capture
     from rigcad.calibrate.patterns import Sequence
     from rigcad.calibrate.run import calibrate, compare
     from rigcad.check.scene import analytic_optics
@@ -55,7 +55,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             truth = (theta, surface)
         step("decode, fit, maps")
         check = None if args.simulate else (
-            lambda decoded: [check_decoded(folder, k, seq, d) for k, d in zip(plan.labels, decoded)])
+            lambda decoded: [check_decoded(folder, k, seq, d) for k, d in zip(plan.labels, decoded)]
+            + [check_half_turns(folder, plan, decoded)])
         result = calibrate(optics, rig, images, say=print, check=check)
     _check_heights(result, folder)
     report = _report(result)

@@ -222,6 +222,8 @@ def _run(tmp_path, capture, folder, profile=None):
 @pytest.mark.parametrize("spoil, words", [
     (lambda f: (f / "h0_x_p16_s2.png").unlink(), ("h0_x_p16_s2.png", "missing")),
     (lambda f: (f / "h1r_y_p128_s0.png").unlink(), ("h1r_y_p128_s0.png", "missing", "half turn")),
+    (lambda f: [shutil.copy(p, f / p.name.replace("h1_", "h1r_")) for p in f.glob("h1_*.png")],
+     ("h1r_white.png", "turned 0 deg from h1's", "not a half turn")),
     (lambda f: Image.new("L", (10, 10)).save(f / "h1_black.png"), ("h1_black.png", "10 x 10 px")),
     (lambda f: Image.new("L", (340, 256)).save(f / "h0_white.png"), ("h0_white.png", "all dark")),
     (lambda f: Image.new("L", (340, 256), 255).save(f / "h1_white.png"), ("h1_white.png", "saturated")),
