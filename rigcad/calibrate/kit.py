@@ -100,8 +100,9 @@ def manual_page(rig) -> str:
         return f"{math.degrees(angle):g} deg, {side * math.tan(angle):.2f} mm across its {side:.0f} mm side"
 
     pair = [c for c in range(len(plan)) if plan.repeats(c) is not None]
-    half_turn = (f"the capture turned a half turn turns the wedge with it, so the two captures of spacer "
-                 f"{plan.spacers[pair[0]]} average it out, and the map's tilt is how the screen settles when laid "
+    twice = " and ".join(str(plan.spacers[c]) for c in pair)
+    half_turn = (f"a capture turned a half turn turns the wedge with it, so the two captures of "
+                 f"spacer{'s' * (len(pair) > 1)} {twice} average it out, and the map's tilt is how the screen settles when laid "
                  f"again (within {across(cal.screen_seating)}, `calibration.screen_seating`)." if pair
                  else "the map's tilt is that wedge (`calibration.half_turn: highest` averages it out).")
     return f"""# Calibrating the as-built rig (deflectometry)

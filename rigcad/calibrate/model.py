@@ -42,8 +42,8 @@ GAUGE = ("screen0_dz_mm", "screen0_du_mm", "screen0_dv_mm")
 class Plan:
     """The captures, in the order the kit's page gives them: one per spacer (label ``h<k>``), then,
     with ``calibration.half_turn`` 'highest', the highest spacer's again with the spacer and the
-    screen on it turned a half turn together (``h<k>r``): up there the screen meets the rays
-    furthest from the axis, where its tilt shows most. Per capture: the screen's nominal height (mm above
+    screen on it turned a half turn together (``h<k>r``): up there a tilt of the screen shows most
+    on the rays (docs/calibrate.md, "The half turn"); 'every': each spacer's. Per capture: the screen's nominal height (mm above
     O, :func:`nominal_heights`), its nominal turn about the axis (rad: 0, or pi), the spacer's index."""
 
     heights: np.ndarray
@@ -54,7 +54,8 @@ class Plan:
     @classmethod
     def of(cls, profile) -> "Plan":
         z = nominal_heights(profile)
-        spacers = tuple(range(len(z))) + ((int(np.argmax(z)),) if profile.calibration.half_turn == "highest" else ())
+        again = {"highest": (int(np.argmax(z)),), "every": tuple(range(len(z))), "none": ()}
+        spacers = tuple(range(len(z))) + again[profile.calibration.half_turn]
         turned = [c >= len(z) for c in range(len(spacers))]
         return cls(z[list(spacers)], np.where(turned, math.pi, 0.0),
                    tuple(f"h{k}r" if t else f"h{k}" for k, t in zip(spacers, turned)), spacers)

@@ -554,8 +554,9 @@ class CalibrationParams:
                               "0.2 deg", lo=0, lo_open=True, hi=5 * DEG)
     half_turn: str = spec("choice", "'highest': the highest spacer is captured again with the spacer and the screen "
                           "on it turned a half turn together, so their wedge (screen_tilt) cancels between the two "
-                          "captures and the sample plane's tilt is known to screen_seating; 'none': the map's "
-                          "frame rests on screen_tilt", "highest", choices=("highest", "none"))
+                          "captures and the sample plane's tilt is known to screen_seating; 'every': each spacer "
+                          "is; 'none': the map's frame rests on screen_tilt", "highest",
+                          choices=("highest", "every", "none"))
     screen_seating: float = spec("angle", "how the same screen on the same spacer repeats its tilt when laid again "
                                  "(dust, the print's texture): with half_turn, the map's frame's tolerance",
                                  "0.02 deg", lo=0, lo_open=True, hi=5 * DEG)

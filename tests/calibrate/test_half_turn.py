@@ -19,7 +19,7 @@ from rigcad.rig import Rig
 @pytest.fixture(scope="module")
 def rigs(tmp_path_factory):
     out = {}
-    for mode in ("highest", "none"):
+    for mode in ("highest", "every", "none"):
         path = tmp_path_factory.mktemp("half") / f"{mode}.yaml"
         path.write_text("extends: achutha2006\ncalibration:\n  spacer_heights: [1 mm, 10 mm, 20 mm]\n"
                         f"  half_turn: {mode}\n  screen_tilt: 0.3 deg\n  screen_seating: 0.03 deg\n")
@@ -35,6 +35,9 @@ def test_the_plan_repeats_the_highest_spacer_turned(rigs):
     assert [plan.repeats(c) for c in range(4)] == [None, None, None, 2]
     none = M.Plan.of(rigs["none"].profile)
     assert none.labels == ("h0", "h1", "h2") and not none.turns.any()
+    every = M.Plan.of(rigs["every"].profile)
+    assert every.labels == ("h0", "h1", "h2", "h0r", "h1r", "h2r")
+    assert [every.repeats(c) for c in range(6)] == [None, None, None, 0, 1, 2]
 
 
 def _covariance_by_hand(rig, plan) -> np.ndarray:
@@ -54,6 +57,16 @@ def test_the_prior_root_whitens_the_pair(rigs):
     plan = M.Plan.of(rig.profile)
     root = M.prior_root(rig, plan)
     assert np.allclose(root.T @ root, np.linalg.inv(_covariance_by_hand(rig, plan)), rtol=0, atol=1e-9)
+    # a half turn at every spacer: each pair whitened alike
+    every = M.Plan.of(rigs["every"].profile)
+    c = np.eye(len(M.RIG_NAMES) + len(M.SCREEN_KEYS) * len(every))
+    cal = rig.profile.calibration
+    for k in range(3):
+        for axis in (1, 2):
+            i, j = M.screen_index(k) + axis, M.screen_index(3 + k) + axis
+            c[i, j] = c[j, i] = -cal.screen_tilt ** 2 / (cal.screen_tilt ** 2 + cal.screen_seating ** 2)
+    root = M.prior_root(rigs["every"], every)
+    assert np.allclose(root.T @ root, np.linalg.inv(c), rtol=0, atol=1e-9)
     # without the half turn, the prior is the tolerances' alone
     assert np.array_equal(M.prior_root(rigs["none"], M.Plan.of(rigs["none"].profile)), np.eye(15 + 6 * 3))
 
