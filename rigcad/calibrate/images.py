@@ -2,7 +2,7 @@
 
 Naming scheme: a folder with one image per capture and frame, ``{label}_{frame}.{png|tif|tiff}``:
 label ``h<k>`` for spacer k's capture, k its index in ``calibration.spacer_heights`` (0 first), and
-``h<k>r`` for the highest spacer's again, turned a half turn (``calibration.half_turn``;
+``h<k>r`` for spacer k's again, turned a half turn (``calibration.half_turn``: the highest's or each's;
 :class:`rigcad.calibrate.model.Plan`); frame a name of
 :meth:`rigcad.calibrate.patterns.Sequence.names` (white, black, x_gray0.., x_p128_s0.., y_...),
 e.g. ``h1_y_p16_s3.png``, ``h1r_white.png``. Grey 8- or 16-bit PNG or TIFF (colour is averaged to
@@ -143,5 +143,5 @@ def check_half_turns(folder: Path, plan, decoded: list) -> None:
         turn = float(np.degrees(np.arctan2(np.sum(p[:, 0] * q[:, 1] - p[:, 1] * q[:, 0]), np.sum(p * q))))
         if 180.0 - abs(turn) > HALF_TURN_SLACK_DEG:  # turn in [-180, 180]
             raise CaptureError(f"{capture_path(folder, plan.labels[c], 'white')}: its screen points are turned "
-                               f"{abs(turn):.0f} deg from {plan.labels[first]}'s, not a half turn: turn the spacer and the "
-                               "screen on it by 180 deg together (docs/calibrate.md, 'The half turn')")
+                               f"{abs(turn):.0f} deg from {plan.labels[first]}'s, not a half turn: turn the spacer "
+                               "and the screen on it by 180 deg together (docs/calibrate.md, 'The half turn')")

@@ -43,8 +43,9 @@ class Plan:
     """The captures, in the order the kit's page gives them: one per spacer (label ``h<k>``), then,
     with ``calibration.half_turn`` 'highest', the highest spacer's again with the spacer and the
     screen on it turned a half turn together (``h<k>r``): up there a tilt of the screen shows most
-    on the rays (docs/calibrate.md, "The half turn"); 'every': each spacer's. Per capture: the screen's nominal height (mm above
-    O, :func:`nominal_heights`), its nominal turn about the axis (rad: 0, or pi), the spacer's index."""
+    on the rays (docs/calibrate.md, "The half turn"); with 'every', each spacer's. Per capture: the
+    screen's nominal height (mm above O, :func:`nominal_heights`), its nominal turn about the axis
+    (rad: 0, or pi), the spacer's index."""
 
     heights: np.ndarray
     turns: np.ndarray
@@ -73,8 +74,8 @@ def screen_names(k: int) -> tuple[str, ...]:
     return tuple(f"screen{k}_{key}" for key in SCREEN_KEYS)
 
 
-def parameter_names(heights: int) -> tuple[str, ...]:
-    return RIG_NAMES + tuple(n for k in range(heights) for n in screen_names(k))
+def parameter_names(captures: int) -> tuple[str, ...]:
+    return RIG_NAMES + tuple(n for k in range(captures) for n in screen_names(k))
 
 
 def screen_index(k: int) -> int:
@@ -82,10 +83,10 @@ def screen_index(k: int) -> int:
     return len(RIG_NAMES) + len(SCREEN_KEYS) * k
 
 
-def tolerance_scale(rig, heights: int) -> np.ndarray:
+def tolerance_scale(rig, captures: int) -> np.ndarray:
     """Each parameter's tolerance (``tolerancing``; the screen's: 0.5 mm for its height, the
     ``calibration.screen_tilt`` wedge and ``screen_seating`` together for its tilt,
-    :data:`PLACEMENT_MM` and :data:`PLACEMENT_TURN_RAD` within its plane), ``heights`` captures: the
+    :data:`PLACEMENT_MM` and :data:`PLACEMENT_TURN_RAD` within its plane), for ``captures`` screens: the
     fit's scale and prior (:func:`prior_root`), and the recovery targets' reference."""
     t = rig.profile.tolerancing
     out = []
@@ -94,7 +95,7 @@ def tolerance_scale(rig, heights: int) -> np.ndarray:
         out += [off, off, hgt, tilt, tilt]
     cal = rig.profile.calibration
     tilt = math.hypot(cal.screen_tilt, cal.screen_seating)
-    out += [0.5, tilt, tilt, PLACEMENT_MM, PLACEMENT_MM, PLACEMENT_TURN_RAD] * heights
+    out += [0.5, tilt, tilt, PLACEMENT_MM, PLACEMENT_MM, PLACEMENT_TURN_RAD] * captures
     return np.array(out)
 
 

@@ -112,7 +112,7 @@ def random_misalignment(rig, plan: M.Plan, rng: np.random.Generator) -> np.ndarr
         j, first = M.screen_index(c), plan.repeats(c)
         if first is None:
             mag, ang = rng.uniform(0, cal.screen_tilt), rng.uniform(0, 2 * math.pi)
-            # (the first height draws no offset: the seeds' streams stay as they were)
+            # (the first spacer draws no offset: the seeds' streams stay as they were)
             theta[j: j + 3] = rng.uniform(-0.2, 0.2) if c else 0.0, mag * math.cos(ang), mag * math.sin(ang)
         theta[j + 3: j + 6] = *(hand.uniform(-1, 1, 2) * tol[j + 3: j + 5]), hand.uniform(-1, 1) * tol[j + 5]
         if first is not None:  # the same spacer and wedge, turned with the screen
