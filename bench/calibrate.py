@@ -80,7 +80,7 @@ VARIANTS = {"steps3": "  phase_steps: 3\n", "steps4": "  phase_steps: 4\n", "ste
             # screen's wedge sets it; a screen that settles less repeatably; one flatter on its spacer
             # (planted and assumed alike)
             "half_turn_none": "  half_turn: none\n",
-            "half_turn_every": "  half_turn: every\n",
+            "half_turn_highest": "  half_turn: highest\n",
             "screen_seating_0.05deg": "  screen_seating: 0.05 deg\n",
             "screen_tilt_0.02deg": "  screen_tilt: 0.02 deg\n"}
 
@@ -188,7 +188,7 @@ VARIANT_LABELS = {"steps3": "3 phase steps", "steps4": "4 phase steps (the defau
                   "thin_1mm": "a 1 mm thin panel (surface 1 mm up, not 6)",
                   "thin_1mm_periods_1024_128_16": "the 1 mm panel, periods 1024, 128, 16 px",
                   "half_turn_none": "no half turn (the earlier capture)",
-                  "half_turn_every": "a half turn at every spacer (4 captures)",
+                  "half_turn_highest": "a half turn at the highest spacer only (3 captures)",
                   "screen_seating_0.05deg": "the screen settling to 0.05 deg, not 0.02",
                   "screen_tilt_0.02deg": "the screen flat on its spacers to 0.02 deg, not 0.2"}
 

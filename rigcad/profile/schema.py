@@ -552,11 +552,11 @@ class CalibrationParams:
                               "sample plane), the wedge of the spacer's faces and the screen's back: no image "
                               "shows that plane (the fit's prior; the simulation plants wedges within it)",
                               "0.2 deg", lo=0, lo_open=True, hi=5 * DEG)
-    half_turn: str = spec("choice", "'highest': the highest spacer is captured again with the spacer and the screen "
-                          "on it turned a half turn together, so their wedge (screen_tilt) cancels between the two "
-                          "captures and the sample plane's tilt is known to screen_seating; 'every': each spacer "
-                          "is; 'none': the map's frame rests on screen_tilt", "highest",
-                          choices=("highest", "every", "none"))
+    half_turn: str = spec("choice", "'every': each spacer is captured again with the spacer and the screen on it "
+                          "turned a half turn together, so their wedge (screen_tilt) cancels between the two "
+                          "captures and the sample plane's tilt is known to screen_seating; 'highest': the highest "
+                          "spacer only; 'none': the map's frame rests on screen_tilt", "every",
+                          choices=("every", "highest", "none"))
     screen_seating: float = spec("angle", "how the same screen on the same spacer repeats its tilt when laid again "
                                  "(dust, the print's texture): with half_turn, the map's frame's tolerance",
                                  "0.02 deg", lo=0, lo_open=True, hi=5 * DEG)

@@ -155,7 +155,7 @@ def test_calibration_section_units_and_errors(write_profile, table31_text):
                         ("  screen_tilt: 0 deg\n", ("screen_tilt", "> 0")),
                         ("  screen_tilt: 2 mm\n", ("screen_tilt",)),
                         ("  screen_seating: 0 deg\n", ("screen_seating", "> 0")),
-                        ("  half_turn: both\n", ("half_turn", "highest", "every", "none"))):
+                        ("  half_turn: both\n", ("half_turn", "every", "highest", "none"))):
         with pytest.raises(ProfileError) as info:
             load_profile(write_profile(table31_text + "calibration:\n" + text))
         msg = str(info.value)
