@@ -138,6 +138,21 @@ def coverage_medians(trials: list) -> dict:
     return out
 
 
+def merged(profile: str, runs: list[dict], sweep_rows: dict | None) -> dict:
+    """One summary from runs over disjoint seeds (``--first-seed``), their trials in seed order, with
+    ``sweep_rows`` (the sweep kept from the file merged into)."""
+    trials = sorted((t for run in runs for t in run["per_trial"]), key=lambda t: t["seed"])
+    seeds = [t["seed"] for t in trials]
+    if len(set(seeds)) != len(seeds):
+        raise SystemExit(f"--merge: seeds run twice: {sorted({s for s in seeds if seeds.count(s) > 1})}")
+    if {run["profile"] for run in runs} != {profile}:
+        raise SystemExit(f"--merge: runs of profiles {sorted({run['profile'] for run in runs})}, not {profile}")
+    summary = summarize(profile, runs[0]["camera_resolution_px"], trials)
+    if sweep_rows:
+        summary["sweep_phase_steps_and_heights"] = sweep_rows
+    return summary
+
+
 def summarize(profile: str, resolution, trials: list) -> dict:
     """The trials' figures against the targets, and the trials themselves."""
     p99c = [t["corrected_incidence_error_deg"]["p99"] for t in trials]
@@ -249,8 +264,40 @@ def tables(summary: dict) -> str:
                 rows.append(f"| {label} | {r['corrected_p99_deg']:.3f} | {r['measured_pixels_p99_deg']:.3f} | "
                             f"{100 * measured:.0f} | {r['corrected_p50_deg']:.3f} | {r['parameters_met']:.0f} of "
                             f"{r['parameters_total']} | {r['calibration_cpu_s']:.1f} |")
-    rows += causes_table(summary) + coverage_table(summary)
+    rows += causes_table(summary) + coverage_table(summary) + standard_error_table(summary)
     return "\n".join(rows) + "\n"
+
+
+#: The parameters' groups as the standard-error table names them: label -> (the name's start, its
+#: end); the gauge (rigcad.calibrate.model.GAUGE), which is not fitted, is left out.
+PARAMETER_GROUPS = {"the rig's tilts": ("", "_tilt_"), "the rig's lateral offsets": ("", ("_dx_mm", "_dy_mm")),
+                    "the rig's heights": ("", "_dz_mm"), "the screens' heights": ("screen", "_dz_mm"),
+                    "the screens' tilts": ("screen", "_tilt_"), "the screens' centres": ("screen", ("_du_mm", "_dv_mm")),
+                    "the screens' turns": ("screen", "_turn_rad")}
+
+
+def _in_group(name: str, group: tuple) -> bool:
+    start, part = group
+    parts = (part,) if isinstance(part, str) else part
+    return name.startswith(start) and (start or not name.startswith("screen")) and any(q in name for q in parts)
+
+
+def standard_error_table(summary: dict) -> list[str]:
+    """How the fit's standard errors hold its errors against the truth, per group of parameters:
+    the median over the trials and the group's parameters of |error| / standard error, and the share
+    within two (a Gaussian: 0.67 and 95 %)."""
+    from rigcad.calibrate.model import GAUGE
+
+    trials = summary["per_trial"]
+    rows = ["", "How the fit's standard errors hold its errors against the truth (over the trials and each group's "
+                "parameters; the first screen's height and centre are the gauge, not fitted):", "",
+            "| parameters | error / standard error, p50 | within 2 standard errors |", "|---|---|---|"]
+    for label, group in PARAMETER_GROUPS.items():
+        z = np.array([p["error_over_standard_error"] for t in trials for n, p in t["parameters"].items()
+                      if _in_group(n, group) and n not in GAUGE])
+        rows.append(f"| {label} | {np.median(z):.2f} | {100 * np.mean(z <= 2):.0f} % |")
+    rows.append("| calibrated (a Gaussian error) | 0.67 | 95 % |")
+    return rows
 
 
 #: The map's sources as the coverage table names them.
@@ -320,12 +367,22 @@ def main() -> int:
                     help="with --sweep-only: re-run only these variants, keeping the file's other rows")
     ap.add_argument("--keep-sweep", action="store_true",
                     help="re-run only the trials, keeping the existing --out file's sweep")
+    ap.add_argument("--first-seed", type=int, default=0,
+                    help="the trials' seeds start here (to split a run over processes; merge with --merge)")
+    ap.add_argument("--merge", nargs="+", metavar="JSON",
+                    help="write --out from these runs' trials (in seed order) and --out's sweep, then stop")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "calibrate.json"))
     args = ap.parse_args()
     from rigcad.check.scene import analytic_optics
     from rigcad.export.atomic import write_json
     from rigcad.rig import load
 
+    if args.merge:
+        summary = merged(args.profile, [json.loads(Path(f).read_text(encoding="utf-8")) for f in args.merge],
+                         json.loads(Path(args.out).read_text(encoding="utf-8")).get("sweep_phase_steps_and_heights"))
+        write_json(Path(args.out), summary)
+        print(tables(summary))
+        return 0
     if args.sweep_only:
         summary = json.loads(Path(args.out).read_text(encoding="utf-8"))
         rows = summary.get("sweep_phase_steps_and_heights", {}) if args.variants else {}
@@ -339,7 +396,7 @@ def main() -> int:
     kept = json.loads(Path(args.out).read_text(encoding="utf-8")).get("sweep_phase_steps_and_heights") \
         if args.keep_sweep else None
     trials = []
-    for seed in range(args.trials):
+    for seed in range(args.first_seed, args.first_seed + args.trials):
         trials.append(trial(optics, rig, seed, args.without_bias))
         t = trials[-1]
         print(f"trial {seed}: {t['parameters_met']}/{t['parameters_total']} parameters within target; "
