@@ -28,6 +28,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
     rig = load(args.profile)
     check_screen_fits(rig)  # a screen that cannot lie in the dome is refused before any work
+    capture_out = getattr(args, "write_capture", None)
+    if capture_out:
+        _check_capture_folder(Path(capture_out), args.simulate)
     if getattr(args, "kit", False):
 
         out = Path(args.exports) / rig.name / "calibrate_kit"
@@ -51,6 +54,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             theta = S.random_misalignment(rig, plan, rng)
             surface = S.planted_surface(rig, rng)
             images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, plan, rng)
+            if capture_out:
+                _write_capture(Path(capture_out), plan, images, args.profile)
             images = [{n: im.astype(float) / 255.0 for n, im in f.items()} for f in images]
             truth = (theta, surface)
         step("decode, fit, maps")
@@ -80,6 +85,33 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
           f"{100 * report['unmeasured']['fraction_of_lit']['measured']:.0f} % of the lit pixels measured "
           f"(the rest, and why: calibration.json 'unmeasured'); wrote {out}")
     return 0
+
+
+def _check_capture_folder(folder: Path, simulate: bool) -> None:
+    """``--write-capture``'s folder: with ``--simulate`` only, and new or empty (a capture is one
+    run's images: no frame of another may stay beside them)."""
+    from rigcad.errors import ExportError
+
+    if not simulate:
+        raise ExportError(f"--write-capture {folder}: only with --simulate (it writes the simulated capture)")
+    if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+        raise ExportError(f"--write-capture {folder}: it exists and is not an empty folder; name a new or empty one")
+
+
+def _write_capture(folder: Path, plan, images: list, profile: str) -> None:
+    """The simulated capture's images (per capture of ``plan``, frame name -> uint8 image) as the PNG
+    files ``--images`` reads (rigcad.calibrate.images.capture_path), published at once."""
+    from rigcad.calibrate.images import capture_path
+    from rigcad.export.atomic import Staging
+    from rigcad.export.png import gray_png
+
+    with Staging(folder) as st:
+        for label, frames in zip(plan.labels, images):
+            for name, im in frames.items():
+                st.write_bytes(capture_path(folder, label, name), gray_png(im))
+        st.commit()
+    print(f"wrote the simulated capture: {sum(len(f) for f in images)} images in {folder} "
+          f"(rigcad calibrate {profile} --images {folder} reads them)")
 
 
 #: A fitted screen height further than this (mm) from its spacer's is a height the images contradict.
@@ -176,4 +208,6 @@ def register(subparsers) -> argparse.ArgumentParser:
     src.add_argument("--kit", action="store_true", help="write the calibration kit: screen patterns, spacers "
                      "(STL, STEP, manifest), the manual's page, into <exports>/<profile>/calibrate_kit")
     p.add_argument("--seed", type=int, default=2006, help="seed of the simulated misalignment and noise")
+    p.add_argument("--write-capture", metavar="DIR", help="with --simulate: also write the simulated camera "
+                   "images into DIR (new or empty), named as --images reads them: a capture to rehearse on")
     return p

@@ -19,6 +19,7 @@ from rigcad.calibrate.images import CaptureError
 from rigcad.calibrate.patterns import Sequence
 from rigcad.calibrate.raxel import rays, to_global
 from rigcad.calibrate.run import calibrate, compare
+from rigcad.errors import ExportError
 from rigcad.profile.schema import load_profile
 from rigcad.rig import Rig
 
@@ -269,6 +270,32 @@ def test_a_good_capture_is_written(tmp_path, small, capture):
     assert np.array_equal(cause == 0, data["source"] == 1)
     lit = cause >= 0
     assert shares["measured"] == pytest.approx(np.mean(cause[lit] == 0))
+
+
+def test_a_simulated_capture_written_out_calibrates_the_same_from_its_files(tmp_path, small, capture):
+    """``--simulate --write-capture DIR`` writes the capture as ``--images`` reads it: the seed's
+    rendered images, each frame a file; calibrated from those files, the fit is the simulation's
+    own, to the last bit."""
+    profile, folder = str(capture["profile"]), tmp_path / "rehearsal"
+    args = argparse.Namespace(profile=profile, images=None, simulate=True, seed=1, exports=str(tmp_path / "sim"),
+                              write_capture=str(folder))
+    assert cmd_calibrate(args) == 0
+    assert len(list(folder.iterdir())) == len(small["seq"].names()) * len(small["plan"].labels)
+    for label, frames in zip(small["plan"].labels, small["images"]):  # the fixture's seed 1, rendered alike
+        for name, im in frames.items():
+            with Image.open(folder / f"{label}_{name}.png") as got:
+                assert np.array_equal(np.asarray(got), im), (label, name)
+    assert _run(tmp_path, capture, folder) == 0
+    simulated, read = (json.loads((tmp_path / root / "coarse" / "calibrate" / "calibration.json").read_text())["fit"]
+                       for root in ("sim", "exports"))
+    assert simulated["parameters"] == read["parameters"]
+    # a folder that holds files already, or the option without --simulate: refused, nothing written
+    with pytest.raises(ExportError, match="rehearsal.*not an empty folder"):
+        cmd_calibrate(argparse.Namespace(**{**vars(args), "exports": str(tmp_path / "again")}))
+    with pytest.raises(ExportError, match="only with --simulate"):
+        cmd_calibrate(argparse.Namespace(**{**vars(args), "simulate": False, "images": str(folder),
+                                            "write_capture": str(tmp_path / "other")}))
+    assert not (tmp_path / "again").exists() and not (tmp_path / "other").exists()
 
 
 def test_kit_patterns_spacers_and_page(tmp_path, small):
