@@ -268,7 +268,7 @@ PICTURES = (
 
 
 def _part_pictures() -> tuple[Picture, ...]:
-    return tuple(Picture(f"parts/{n}.png", "stl", f"renders/{n}.png", f"key:{n}") for n in _parts())
+    return tuple(Picture(f"parts/{n}.png", "stl", f"renders/{n}.png", f"part:{n}") for n in _parts())
 
 
 def _basis() -> list[Figure]:

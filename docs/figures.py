@@ -86,7 +86,7 @@ class Figure:
 class Picture:
     """A picture the docs show: ``docs/<doc>`` copied from ``<exports root>/<src>``; ``source`` names
     what it was drawn from: ``file`` (bytes), ``file#a.b`` (a JSON section), ``file#a,b,c`` (JSON
-    sections) or ``key:<part>`` (the part's recipe hash in the manifest)."""
+    sections) or ``part:<name>`` (the part's shape in the manifest: :data:`PART_SHAPE`)."""
 
     doc: str
     run: str
@@ -119,11 +119,48 @@ def sha256(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
+#: What a part's picture shows, as the manifest states it: the exact solid's volume, its bounding box
+#: and genus, and how many the rig takes. Not the part's recipe hash: that hashes every float of the
+#: recipe to the last bit, and another CPU's last bits change it (OPENBLAS_CORETYPE=Prescott with
+#: numpy's SIMD off changes 7 parts' hashes, their volumes by <= 4e-14 and boxes by <= 5e-13 mm).
+PART_SHAPE = ("volume_mm3", "bbox_min_mm", "bbox_max_mm", "genus", "quantity")
+
+
+def part_shape(root: Path, name: str) -> dict:
+    """Part ``name``'s :data:`PART_SHAPE` from the manifest under the exports root."""
+    entry = json.loads((root / PROFILE / "manifest.json").read_text())["parts"][name]
+    return {key: entry[key] for key in PART_SHAPE}
+
+
+def picture_source(root: Path, source: str) -> dict:
+    """What :func:`collect` records of a picture's source (see :class:`Picture`): a part's shape as
+    numbers (``source_values``), anything else as its SHA-256 (``source_sha256``)."""
+    if source.startswith("part:"):
+        return {"source_values": part_shape(root, source[len("part:"):])}
+    return {"source_sha256": source_digest(root, source)}
+
+
+def same_source(recorded: dict, now: dict) -> bool:
+    """Whether a picture's source is what it was drawn from: a digest the same, numbers within 1e-9
+    (relative, and absolute: mm), integers the same."""
+    if "source_sha256" in recorded or "source_sha256" in now:
+        return recorded.get("source_sha256") == now.get("source_sha256")
+    a, b = recorded.get("source_values"), now.get("source_values")
+    if a is None or b is None or set(a) != set(b):
+        return False
+    def close(x, y) -> bool:
+        if isinstance(x, list) and isinstance(y, list):
+            return len(x) == len(y) and all(close(u, v) for u, v in zip(x, y))
+        if isinstance(x, int) and isinstance(y, int):
+            return x == y
+        return isinstance(x, (int, float)) and isinstance(y, (int, float)) and math.isclose(
+            x, y, rel_tol=1e-9, abs_tol=1e-9)
+    return all(close(a[key], b[key]) for key in a)
+
+
 def source_digest(root: Path, source: str) -> str:
-    """SHA-256 of what a picture was drawn from (see :class:`Picture`), under the exports root."""
-    if source.startswith("key:"):
-        manifest = json.loads((root / PROFILE / "manifest.json").read_text())
-        return sha256(manifest["parts"][source[4:]]["key"].encode())
+    """SHA-256 of what a picture was drawn from (a file, or JSON sections: see :class:`Picture`),
+    under the exports root."""
     file, _, section = source.partition("#")
     path = root / PROFILE / file
     if path.suffix != ".json":
@@ -227,7 +264,7 @@ def collect(spec, root: Path, times: dict[str, dict] | None) -> dict:
         exports = root / run.folder if run.folder else root
         src = exports / PROFILE / pic.src
         pictures[pic.doc] = {"sha256": sha256(src.read_bytes()), "from": f"`{run.command}` -> {pic.src}",
-                             "source": pic.source, "source_sha256": source_digest(exports, pic.source)}
+                             "source": pic.source, **picture_source(exports, pic.source)}
     return {"about": "every figure README.md and docs/*.md quote; written by `make docs` (docs/figures.py)",
             "profile": PROFILE, "figures": dict(sorted(figures.items())), "pictures": dict(sorted(pictures.items()))}
 

@@ -266,17 +266,32 @@ def test_every_picture_shown_is_made_by_make_docs(data):
 
 
 def test_pictures_are_drawn_from_the_current_outputs(tools, data, default_exports, table31_rig):
-    """The part pictures' sources (each part's recipe hash) and the ray diagram's (design.json) are
-    what the current code gives."""
+    """The part pictures' sources (each part's shape in the manifest) and the ray diagram's
+    (design.json's sections) are what the current code gives."""
     figures, spec = tools
     checked = 0
     for pic in spec.PICTURES:
         if pic.run != "stl":
             continue
-        now = figures.source_digest(default_exports.root, pic.source)
-        assert now == data["pictures"][pic.doc]["source_sha256"], f"docs/{pic.doc}: drawn from older outputs; run `make docs`"
+        now = figures.picture_source(default_exports.root, pic.source)
+        assert figures.same_source(data["pictures"][pic.doc], now), f"docs/{pic.doc}: drawn from older outputs; run `make docs`"
         checked += 1
     assert checked > 10, checked
+
+
+def test_a_part_picture_is_stale_when_its_shape_moves_not_its_last_bits(tools):
+    """Another CPU's last bits (a volume by 4e-14, a box by 5e-13 mm) keep a part's picture current;
+    a part 1 um larger, a hole more, or a picture recorded by digest against one by numbers, do not."""
+    figures, _ = tools
+    shape = {"volume_mm3": 895152.0745144694, "bbox_min_mm": [-146.7, -146.7, 0.0], "bbox_max_mm": [146.7, 146.7, 233.9],
+             "genus": 11, "quantity": 1}
+    moved = lambda **kw: {"source_values": {**shape, **kw}}  # noqa: E731
+    recorded = {"source_values": shape}
+    assert figures.same_source(recorded, moved(volume_mm3=shape["volume_mm3"] * (1 + 4e-14),
+                                                bbox_min_mm=[-146.7, -146.7, 5e-13]))
+    assert not figures.same_source(recorded, moved(bbox_max_mm=[146.7, 146.7, 233.901]))
+    assert not figures.same_source(recorded, moved(genus=12))
+    assert not figures.same_source(recorded, {"source_sha256": "0" * 64})
 
 
 def test_every_page_is_linked_from_the_readme():
