@@ -370,7 +370,8 @@ def main() -> int:
     ap.add_argument("--first-seed", type=int, default=0,
                     help="the trials' seeds start here (to split a run over processes; merge with --merge)")
     ap.add_argument("--merge", nargs="+", metavar="JSON",
-                    help="write --out from these runs' trials (in seed order) and --out's sweep, then stop")
+                    help="write --out from these runs' trials (in seed order) and --out's sweep if it has one, "
+                         "then stop")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "calibrate.json"))
     args = ap.parse_args()
     from rigcad.check.scene import analytic_optics
@@ -378,8 +379,10 @@ def main() -> int:
     from rigcad.rig import load
 
     if args.merge:
-        summary = merged(args.profile, [json.loads(Path(f).read_text(encoding="utf-8")) for f in args.merge],
-                         json.loads(Path(args.out).read_text(encoding="utf-8")).get("sweep_phase_steps_and_heights"))
+        out = Path(args.out)
+        kept = json.loads(out.read_text(encoding="utf-8")).get("sweep_phase_steps_and_heights") \
+            if out.is_file() else None  # a new --out: no sweep to keep
+        summary = merged(args.profile, [json.loads(Path(f).read_text(encoding="utf-8")) for f in args.merge], kept)
         write_json(Path(args.out), summary)
         print(tables(summary))
         return 0
