@@ -251,7 +251,7 @@ PICTURES = (
     Picture("rig.png", "view", "view/rig.png", "view/rig.html"),
     # the diagram is drawn from the design of this profile: not from design.json's residuals at the
     # arithmetic's floor and finite-difference sensitivities, whose 9th digits move with the CPU
-    # (OPENBLAS_CORETYPE=Prescott with numpy's SIMD off moves 46 of them)
+    # (OPENBLAS_CORETYPE=Prescott with numpy's SIMD off moves 14 of them)
     Picture("rays.png", "stl", "rays.png", "design.json#profile,envelope,measurable_range,paraboloid"),
     Picture("spot.png", "check", "check/spot.png", "check/raycheck.json#readings"),
     Picture("theta_map.png", "check", "check/theta_map.png", "check/raycheck.json#pixel_grid"),

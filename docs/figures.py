@@ -64,6 +64,11 @@ class Run:
         return "rigcad " + " ".join(self.argv)
 
 
+#: How far a figure at the arithmetic's floor may move (:attr:`Figure.roundoff`): a changed design
+#: moves it by orders of magnitude (the dome integrated to 1e-6 mm instead of 1e-8), a CPU by percents.
+ROUNDOFF_FACTOR = 2.0
+
+
 @dataclass(frozen=True)
 class Figure:
     """A figure: ``get`` reads it from ``file`` (JSON, relative to the run's exports root)."""
@@ -78,8 +83,21 @@ class Figure:
     count: bool = False  # an integer count: held exactly
     # a residual at the arithmetic's floor (1e-8 mm on 100-mm parts): its size is the claim, not its
     # digits; another CPU's vector width and FMA move it by percents (1.48e-8 -> 1.47e-8 mm, the dome's
-    # largest miss on an AMD EPYC): tests/test_docs.py holds it within a factor (ROUNDOFF_FACTOR)
+    # largest miss on an AMD EPYC): held within a factor (ROUNDOFF_FACTOR)
     roundoff: bool = False
+
+    def holds(self, new: Any, old: Any) -> bool:
+        """Whether the current code's value ``new`` is still the recorded ``old``: a count exactly, a
+        residual at the floor within :data:`ROUNDOFF_FACTOR`, any other figure to 1e-6 relative (the
+        outputs are deterministic on one machine, another CPU's last bits move a figure by ~1e-12,
+        and a changed part moves it visibly)."""
+        news, olds = (new, old) if isinstance(new, list) else ([new], [old])
+        if self.count:
+            return news == olds
+        if self.roundoff:
+            return all(abs(a) <= ROUNDOFF_FACTOR * abs(b) and abs(b) <= ROUNDOFF_FACTOR * abs(a)
+                       for a, b in zip(news, olds))
+        return all(math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-12) for a, b in zip(news, olds))
 
 
 @dataclass(frozen=True)

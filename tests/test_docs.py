@@ -10,7 +10,6 @@ import hashlib
 import importlib
 import importlib.util
 import json
-import math
 import re
 import sys
 from pathlib import Path
@@ -170,31 +169,12 @@ def test_every_figure_states_unit_source_and_tolerance(data):
             assert e.get("machine") and e.get("date"), name
 
 
-#: How far a figure at the arithmetic's floor may move (figures.Figure.roundoff): a changed design
-#: moves it by orders of magnitude (the dome integrated to 1e-6 mm instead of 1e-8), a CPU by percents.
-ROUNDOFF_FACTOR = 2.0
-
-
 def _changed(spec_figs, fresh: dict, data: dict) -> list[str]:
-    out = []
-    for fig in spec_figs:
-        if fig.name not in fresh:
-            continue
-        new, old = fresh[fig.name], data["figures"][fig.name]["value"]
-        news, olds = (new, old) if isinstance(new, list) else ([new], [old])
-        # counts exactly; a residual at the arithmetic's floor within a factor (figures.Figure.roundoff);
-        # other figures to 1e-6 relative: the outputs are deterministic on one machine, and another
-        # CPU's last bits move a figure by ~1e-12, while a changed part moves it visibly
-        if fig.count:
-            same = news == olds
-        elif fig.roundoff:
-            same = all(abs(a) <= ROUNDOFF_FACTOR * abs(b) and abs(b) <= ROUNDOFF_FACTOR * abs(a)
-                       for a, b in zip(news, olds))
-        else:
-            same = all(math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-12) for a, b in zip(news, olds))
-        if not same:
-            out.append(f"{fig.name}: the current code gives {new}, docs/figures.json says {old}")
-    return out
+    """The figures of ``spec_figs`` whose current value (``fresh``) no longer holds the file's
+    (figures.Figure.holds)."""
+    return [f"{fig.name}: the current code gives {fresh[fig.name]}, docs/figures.json says "
+            f"{data['figures'][fig.name]['value']}" for fig in spec_figs
+            if fig.name in fresh and not fig.holds(fresh[fig.name], data["figures"][fig.name]["value"])]
 
 
 def test_a_figure_at_the_floor_may_move_by_a_cpu_not_by_a_change(tools):
