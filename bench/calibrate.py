@@ -60,7 +60,9 @@ def trial(optics, rig, seed: int, without_bias: bool = False) -> dict:
     out["strong_correlations_over_0.9"] = result.fit.as_dict()["strong_correlations_over_0.9"]
     out["near_null_combinations"] = near_null(result.fit)
     out.update(seed=seed, render_s=t1 - t0, calibration_s=t2 - t1, calibration_cpu_s=cpu, stages_s=result.timings_s,
-               fit_rms_residual_mm=result.fit.rms_residual_mm)
+               fit_rms_residual_mm=result.fit.rms_residual_mm,
+               fit_direct_view={"residuals": result.fit.direct_residuals, "weight": result.fit.direct_weight,
+                                "rms_residual_mm": result.fit.direct_rms_residual_mm})
     return out
 
 

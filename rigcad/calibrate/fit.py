@@ -57,6 +57,17 @@ PRIOR_MM = 0.2
 #: 0.032-0.056 (0.037); 0.9 0.032-0.044 (0.036); 0.95 0.032-0.054 on 101-106. 1, the component
 #: dropped, leaves the dome's tilts to the prior: 0.048-0.153 on 101-106.
 SLOPE_PROJECTION = 0.9
+#: The direct view's pixels (:func:`seen_direct`) the fit reads: every this-many-th of the fit's rows
+#: and columns (``calibration.fit_stride``). They fix the camera's pose against the screens with
+#: the decoding's micrometres, free of the mirrors' surface error; ~1,000 of them (4 captures, 2 axes
+#: each) outweigh the prior, and all ~16,000 doubled the fit's CPU time.
+DIRECT_STRIDE = 4
+#: The most the direct view's rows are weighted against the mirrored ones (the ratio of their robust
+#: sigmas after the first solve: ~40 in the plain fit on Table 3.1, ~4 in the map's refit, whose
+#: mirrored residual has the surface's part projected away). Measured on seeds 101-104 (kept out of
+#: the bench), parameters within target with the direct rows weighted 1, 10 and 40: 27-36, 28-39 and
+#: 33-39 of 39 (39 of 39 on three of the four at 40).
+MAX_DIRECT_WEIGHT = 1000.0
 #: Iterations of each solve (each costs a Jacobian: one trace per rig parameter).
 MAX_ITERATIONS = 40
 #: Outliers: residuals past this many robust sigmas are dropped before the second solve.
@@ -75,11 +86,43 @@ CLUSTER_PX = 64
 
 @dataclass
 class FitData:
-    """What the fit reads: pixel indices (into the camera window) and the decoded screen points
-    (n, heights, 2) mm."""
+    """What the fit reads: pixel indices (into the camera window), the decoded screen points
+    (n, heights, 2) mm, and which pixels see the screens directly (:func:`seen_direct`)."""
 
     pixels: np.ndarray
     screen_uv: np.ndarray
+    direct: np.ndarray
+
+    @classmethod
+    def of(cls, plan: M.Plan, design, pixels: np.ndarray, screen_uv: np.ndarray) -> "FitData":
+        """``design``: the camera's design map (:class:`rigcad.calibrate.model.Camera`'s)."""
+        return cls(pixels, screen_uv, seen_direct(plan, screen_uv, direct_ring_mm(design)))
+
+
+def direct_ring_mm(design) -> float:
+    """Where, on the sample plane, the camera's direct view past the paraboloid's rim begins (mm from
+    O): its pinhole ray past the rim, cop_z tan(alpha_max) (24 mm on Table 3.1)."""
+    return float(design.cop_z * math.tan(design.alpha_max))
+
+
+def seen_direct(plan: M.Plan, screen_uv: np.ndarray, ring_mm: float) -> np.ndarray:
+    """(n,) which pixels' decoded points (n, captures, 2) mm say the camera sees the screens
+    directly, past the paraboloid (:func:`rigcad.calibrate.model.direct_view`), not off the mirrors.
+    The line through a pixel's points on the lowest and the highest screen (each laid as planned),
+    carried down to the sample plane, meets it near O for a ray off the dome, whatever the
+    misalignment (a few mm), and at least ``ring_mm`` (:func:`direct_ring_mm`) out for a direct one:
+    the split is at half of that. The hand's placement (``model.PLACEMENT_MM``, 1 deg) moves that
+    point by well under a millimetre for a direct ray, about one for a grazing one. The fit reads
+    each pixel along the path its points show: near the paraboloid's rim, where the design and the
+    built rig see past the mirror at different pixels, the forward model's path at the current
+    parameters may not be the camera's."""
+    from rigcad.calibrate.raxel import to_global
+
+    poses = M.screens(plan, np.zeros(len(M.RIG_NAMES) + len(plan.heights) * len(M.SCREEN_KEYS)))
+    lo, hi = int(np.argmin(plan.heights)), int(np.argmax(plan.heights))
+    a, b = (to_global(poses[k], screen_uv[:, k, 0], screen_uv[:, k, 1]).reshape(-1, 3) for k in (lo, hi))
+    at_plane = a - (b - a) * (a[:, 2:3] / (b[:, 2:3] - a[:, 2:3]))
+    return np.hypot(at_plane[:, 0], at_plane[:, 1]) > ring_mm / 2
 
 
 @dataclass
@@ -93,6 +136,11 @@ class FitResult:
     outliers: int
     evaluations: int
     covariance: np.ndarray
+    #: of ``residuals_used``, the direct view's (:func:`seen_direct`), their RMS (mm, unweighted) and
+    #: the weight the fit gave them against the mirrored rows; ``rms_residual_mm`` is the mirrored rows'
+    direct_residuals: int
+    direct_rms_residual_mm: float
+    direct_weight: float
 
     def as_dict(self) -> dict:
         out = {}
@@ -104,6 +152,8 @@ class FitResult:
                   for i in range(len(self.names)) for j in range(i + 1, len(self.names))
                   if abs(self.correlation[i, j]) > 0.9]
         return {"parameters": out, "rms_residual_mm": self.rms_residual_mm, "residuals_used": self.residuals_used,
+                "direct_view_residuals": self.direct_residuals,
+                "direct_view_rms_residual_mm": self.direct_rms_residual_mm, "direct_view_weight": self.direct_weight,
                 "outliers_dropped": self.outliers, "evaluations": self.evaluations,
                 "strong_correlations_over_0.9": [{"a": a, "b": b, "correlation": c} for a, b, c in strong],
                 "correlation_order": list(self.names), "correlation": self.correlation.tolist()}
@@ -121,6 +171,8 @@ class Problem:
         self.n_rig = len(M.RIG_NAMES)
         self.keep = np.ones(len(data.pixels) * len(plan) * 2, bool)
         self.evaluations = 0
+        #: the direct view's rows' weight against the mirrored ones (:func:`fit` sets it)
+        self.direct_weight = 1.0
         #: the fitted parameters: all but the gauge (model.GAUGE)
         self.free = np.array([n not in M.GAUGE for n in M.parameter_names(len(plan))])
         #: the prior's residual rows over the free parameters (model.prior_root; mm)
@@ -131,16 +183,19 @@ class Problem:
         return M.trace_camera(self.optics, M.moved(self.rig, theta), self.x, self.y, self.cam.design)
 
     def residual_of(self, tr: M.Traced, theta: np.ndarray) -> np.ndarray:
-        out = np.empty((len(self.x), len(self.plan), 2))
+        out = np.full((len(self.x), len(self.plan), 2), np.nan)
+        path = np.where(self.data.direct, tr.direct, tr.ok)  # the path the decoded points show
         reach = np.empty((len(self.x), len(self.plan)))
         poses = M.screens(self.plan, theta)
         for k, pose in enumerate(poses):
             su, sv = tr.screen(pose)
-            out[:, k, 0], out[:, k, 1] = su, sv
+            out[path, k, 0], out[path, k, 1] = su[path], sv[path]
             reach[:, k] = (pose.translation[2] - tr.p2[:, 2]) / tr.v[:, 2]
         r = out - self.data.screen_uv
-        if self.slope_projection:
-            r = slope_projected(r, reach, np.stack([pose.rotation[:2, :2] for pose in poses]), self.slope_projection)
+        r[self.data.direct] *= self.direct_weight
+        if self.slope_projection:  # a direct view's point has no dome to turn about
+            r = np.where(tr.ok[:, None, None], slope_projected(
+                r, reach, np.stack([pose.rotation[:2, :2] for pose in poses]), self.slope_projection), r)
         return r.ravel()[self.keep]
 
     def clusters(self) -> np.ndarray:
@@ -232,16 +287,21 @@ def fit(optics, rig, cam: M.Camera, plan: M.Plan, data: FitData, say=None, slope
     # steering the fit
     res = least_squares(prob.fun, z0, jac=prob.jac, method="trf", loss="soft_l1", f_scale=ROBUST_SCALE_MM,
                         xtol=1e-10, ftol=1e-10, max_nfev=MAX_ITERATIONS)
-    r = res.fun[:int(prob.keep.sum())]
-    sigma = 1.4826 * np.median(np.abs(r - np.median(r)))
+    # each path at its own scale: a direct view's residual is the decoding's (~um), a mirrored one's
+    # the surface error's (~0.2 mm). Outliers by each one's robust sigma; then the direct rows
+    # weighted by the ratio of the sigmas, so every row counts at its own precision (and the
+    # posterior's s^2 is one scale)
+    direct_rows = np.repeat(data.direct, 2 * len(plan))
     full = np.zeros(len(prob.keep))
-    full[prob.keep] = r
-    drop = np.abs(full) > OUTLIER_SIGMAS * max(sigma, 1e-12)
+    full[prob.keep] = res.fun[:int(prob.keep.sum())]
+    drop, sigma = _outliers(full, prob.keep, direct_rows)
     outliers = int(drop.sum())
-    if outliers:
-        if say:
-            say(f"dropping {outliers} outlying residuals (> {OUTLIER_SIGMAS:g} robust sigmas); refitting")
-        prob.keep &= ~drop
+    if outliers and say:
+        say(f"dropping {outliers} outlying residuals (> {OUTLIER_SIGMAS:g} robust sigmas); refitting")
+    prob.keep &= ~drop
+    if sigma[True] > 0 and sigma[False] > 0:
+        prob.direct_weight = float(np.clip(sigma[False] / sigma[True], 1.0, MAX_DIRECT_WEIGHT))
+    if outliers or data.direct.any():
         res = least_squares(prob.fun, res.x, jac=prob.jac, method="trf", xtol=1e-10, ftol=1e-10,
                             max_nfev=MAX_ITERATIONS)
     cov_z = np.zeros((len(prob.scale), len(prob.scale)))
@@ -251,6 +311,23 @@ def fit(optics, rig, cam: M.Camera, plan: M.Plan, data: FitData, say=None, slope
     se = np.sqrt(np.diag(cov))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
-    data = res.fun[:int(prob.keep.sum())]
+    rows = res.fun[:int(prob.keep.sum())]
+    direct = direct_rows[prob.keep]
+    rms = lambda r: float(np.sqrt(np.mean(r ** 2))) if r.size else math.nan  # noqa: E731
     return FitResult(prob.full(res.x) * prob.scale, M.parameter_names(len(plan)), se, np.nan_to_num(corr),
-                     float(np.sqrt(np.mean(data ** 2))), int(len(data)), outliers, prob.evaluations, cov)
+                     rms(rows[~direct]), int(len(rows)), outliers, prob.evaluations, cov, int(direct.sum()),
+                     rms(rows[direct] / prob.direct_weight), prob.direct_weight)
+
+
+def _outliers(full: np.ndarray, keep: np.ndarray, direct_rows: np.ndarray) -> tuple[np.ndarray, dict]:
+    """Rows (of ``keep``) beyond :data:`OUTLIER_SIGMAS` robust sigmas (1.4826 MAD) of their own path's,
+    and each path's sigma in the units of ``full`` ({True: the direct view's, False: the mirrors'};
+    0 for a path with no rows)."""
+    drop = np.zeros(len(full), bool)
+    sigma = {}
+    for direct in (True, False):
+        rows = keep & (direct_rows == direct)
+        r = full[rows]
+        sigma[direct] = 1.4826 * float(np.median(np.abs(r - np.median(r)))) if r.size else 0.0
+        drop[rows] = np.abs(r) > OUTLIER_SIGMAS * max(sigma[direct], 1e-12)
+    return drop, sigma

@@ -137,7 +137,10 @@ camera's full resolution, {p.camera.resolution[0]} x {p.camera.resolution[1]} px
 
 ## Exposure
 - One exposure for every frame of a capture: set it on the white frame so the brightest lit pixels sit at
-  80-90 % of full scale (a saturated white is refused; so is an all-dark one).
+  80-90 % of full scale (a saturated white is refused; so is an all-dark one). The brightest are the
+  ring around the paraboloid's image, where the camera sees the screen directly through the dome's
+  top opening, with no mirror's loss: set the exposure there. Keep that ring in the images: the fit
+  reads it, and it fixes the camera's place.
 - Keep the room dark: stray light lowers the fringes' modulation (pixels under
   {cal.min_modulation:g} modulation are not decoded).
 - Focus between the two screen heights; a little defocus is harmless.

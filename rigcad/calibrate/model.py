@@ -180,17 +180,23 @@ class Camera:
 @dataclass
 class Traced:
     """Per pixel: the ray leaving the dome (point ``p2`` and unit direction ``v``, going down), the
-    direction ``u`` from the paraboloid to the dome, and ``ok`` (reached the sample plane)."""
+    direction ``u`` from the paraboloid to the dome, and ``ok`` (reached the sample plane off both
+    mirrors). ``direct``: the pixel's ray passes the paraboloid and its mount, through the dome's top
+    opening and past the beam, to the sample plane (:func:`direct_view`); ``p2`` and ``v`` are then
+    the ray below the splitter, and ``u`` is NaN."""
 
     p2: np.ndarray
     v: np.ndarray
     u: np.ndarray
     ok: np.ndarray
+    direct: np.ndarray
 
     def screen(self, pose) -> tuple[np.ndarray, np.ndarray]:
-        """Where each ray meets a screen: (u, v) mm in its frame, NaN where lost."""
+        """Where each ray, off the mirrors or direct, meets a screen: (u, v) mm in its frame, NaN
+        where lost."""
         su, sv = on_screen(pose, np.nan_to_num(self.p2), np.nan_to_num(self.v, nan=1.0))
-        return np.where(self.ok, su, np.nan), np.where(self.ok, sv, np.nan)
+        seen = self.ok | self.direct
+        return np.where(seen, su, np.nan), np.where(seen, sv, np.nan)
 
 
 def trace_camera(optics, rig, x_px: np.ndarray, y_px: np.ndarray, design) -> Traced:
@@ -199,15 +205,44 @@ def trace_camera(optics, rig, x_px: np.ndarray, y_px: np.ndarray, design) -> Tra
     from rigcad.check.scene import placed_as
     from rigcad.check.sources import pixel_rays
     from rigcad.check.tower import through_splitter
-    from rigcad.check.trace3d import trace
+    from rigcad.check.trace3d import MISSED_PARABOLOID, trace
 
     rays = pixel_rays(design, x_px, y_px, rig.pose("camera"))
     p, d, _ = through_splitter(rig, rays.origins, rays.dirs)
-    tr = trace(placed_as(optics, rig), p, d)
+    placed = placed_as(optics, rig)
+    tr = trace(placed, p, d)
     with np.errstate(invalid="ignore"):
         u = tr.p2 - tr.p1
         u /= np.linalg.norm(u, axis=1)[:, None]
-    return Traced(tr.p2, tr.v, u, tr.ok)
+    direct = direct_view(placed, rig, p, d, tr.status == MISSED_PARABOLOID)
+    return Traced(np.where(direct[:, None], p, tr.p2), np.where(direct[:, None], d, tr.v), u, tr.ok, direct)
+
+
+#: Points along the dome's meridian that a direct ray must pass inside (:func:`direct_view`).
+DIRECT_MERIDIAN_POINTS = 65
+
+
+def direct_view(optics, rig, p: np.ndarray, d: np.ndarray, passed: np.ndarray) -> np.ndarray:
+    """(n,) which rays (points ``p`` below the splitter, unit directions ``d``, going down) the camera
+    sees the sample plane along directly: ``passed`` the paraboloid and its mount (the tracer's
+    status), then in the dome's frame inside its mirror at each of :data:`DIRECT_MERIDIAN_POINTS`
+    heights of its meridian (the first is the top opening's edge), and clear of the beam down to the
+    sample plane. The dome's top opening is wider than the paraboloid's image: on Table 3.1 the
+    camera sees the screen directly between ~134 and ~336 px from the axis, past the tower's parts."""
+    out = np.zeros(len(p), bool)
+    i = np.nonzero(passed & (d[:, 2] < 0))[0]
+    if not i.size:
+        return out
+    lo, ld = optics.dome_pose.localize(p[i], d[i])
+    mer = rig.layout.design_dome
+    rz = mer.points(np.linspace(*mer.u_range, DIRECT_MERIDIAN_POINTS))
+    t = (rz[None, :, 1] - lo[:, 2:3]) / ld[:, 2:3]
+    r = np.hypot(lo[:, 0:1] + t * ld[:, 0:1], lo[:, 1:2] + t * ld[:, 1:2])
+    inside = np.all(r < rz[None, :, 0], axis=1)
+    to_plane = -p[i, 2] / d[i, 2]
+    clear = ~np.isfinite(optics.beam.intersect(lo, ld, to_plane).t)
+    out[i] = inside & clear
+    return out
 
 
 def nominal_heights(profile) -> np.ndarray:

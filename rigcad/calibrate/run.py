@@ -14,7 +14,7 @@ import dataclasses
 
 from rigcad.calibrate import bias as B, maps, model as M
 from rigcad.calibrate.decode import decode
-from rigcad.calibrate.fit import SLOPE_PROJECTION, FitData, fit
+from rigcad.calibrate.fit import DIRECT_STRIDE, SLOPE_PROJECTION, FitData, fit
 from rigcad.calibrate.patterns import Sequence
 
 
@@ -71,10 +71,11 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
         f"({', '.join(plan.labels)})")
     if bias == "map":
         decoded = _unbiased(decoded, B.map_bias(decoded, cam.shape, seq, cal.sim_blur))
-    data = _fit_data(cam, decoded, cal.fit_stride)
+    data = _fit_data(cam, plan, decoded, cal.fit_stride)
     result = fit(optics, rig, cam, plan, data, say)
-    say(f"fitted {len(result.theta)} parameters to {result.residuals_used} residuals "
-        f"(RMS {result.rms_residual_mm * 1e3:.2f} um)")
+    say(f"fitted {len(result.theta)} parameters to {result.residuals_used} residuals (RMS off the mirrors "
+        f"{result.rms_residual_mm * 1e3:.2f} um; {result.direct_residuals} of the screens seen directly, RMS "
+        f"{result.direct_rms_residual_mm * 1e3:.2f} um)")
     # the map's rays turn about the model's dome points: refit with the surface's signature
     # down-weighted (fit.SLOPE_PROJECTION), from the plain fit. Its covariance, which the map's
     # uncertainty carries, stays the plain posterior: the bench measured its coverage (measured
@@ -113,7 +114,7 @@ def _unbiased(decoded: list, bias: np.ndarray) -> list:
     return out
 
 
-def _fit_data(cam: M.Camera, decoded: list, stride: int) -> FitData:
+def _fit_data(cam: M.Camera, plan: M.Plan, decoded: list, stride: int) -> FitData:
     """Every ``stride``-th row and column of the window that decoded in every capture."""
     rows, cols = np.meshgrid(np.arange(cam.shape[0]), np.arange(cam.shape[1]), indexing="ij")
     pick = ((rows % stride == 0) & (cols % stride == 0)).ravel()
@@ -123,7 +124,10 @@ def _fit_data(cam: M.Camera, decoded: list, stride: int) -> FitData:
     ok = pick & np.all(inner, axis=0)
     idx = np.nonzero(ok)[0]
     uv = np.stack([np.stack([d.u.ravel()[idx], d.v.ravel()[idx]], axis=-1) for d in decoded], axis=1)
-    return FitData(idx, uv)
+    data = FitData.of(plan, cam.design, idx, uv)
+    coarse = stride * DIRECT_STRIDE  # the direct view's pixels: a coarser grid
+    keep = ~data.direct | ((rows.ravel()[idx] % coarse == 0) & (cols.ravel()[idx] % coarse == 0))
+    return FitData(idx[keep], uv[keep], data.direct[keep])
 
 
 def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -> dict:

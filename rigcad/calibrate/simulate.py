@@ -85,7 +85,7 @@ def with_surface(rig, surface: SurfaceError | None, tr: M.Traced) -> M.Traced:
     n2 = n - g
     n2 /= np.linalg.norm(n2, axis=1)[:, None]
     v = tr.u - 2 * np.sum(tr.u * n2, axis=1)[:, None] * n2
-    return M.Traced(tr.p2, np.where(tr.ok[:, None], v, np.nan), tr.u, tr.ok)
+    return M.Traced(tr.p2, np.where(tr.ok[:, None], v, tr.v), tr.u, tr.ok, tr.direct)
 
 
 def random_misalignment(rig, plan: M.Plan, rng: np.random.Generator) -> np.ndarray:
@@ -154,7 +154,8 @@ def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.
         cx, cy = seq.from_mm(su, sv)
         edges = sub_edges(cx.reshape(n, s, s), cy.reshape(n, s, s), cam.shape)
         frames = {}
-        lit = np.repeat(tr.ok.reshape(n, s * s).any(axis=1), s * s)  # pixels with a sub-ray on a screen's side
+        # pixels with a sub-ray on a screen's side, off the mirrors or direct
+        lit = np.repeat((tr.ok | tr.direct).reshape(n, s * s).any(axis=1), s * s)
         means = seq.footprint_means(seq.names(), np.nan_to_num(cx[lit], nan=-1e9), np.nan_to_num(cy[lit], nan=-1e9),
                                     edges[lit])
         for name in seq.names():

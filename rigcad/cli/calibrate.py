@@ -79,7 +79,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         st.write_bytes(out / "maps.png", picture)
         st.commit()
     f = report["fit"]
-    print(f"calibrate {rig.name}: fit RMS {f['rms_residual_mm'] * 1e3:.2f} um over {f['residuals_used']} residuals; "
+    print(f"calibrate {rig.name}: fit RMS {f['rms_residual_mm'] * 1e3:.2f} um off the mirrors, "
+          f"{f['direct_view_rms_residual_mm'] * 1e3:.2f} um on the screen seen directly, over {f['residuals_used']} "
+          f"residuals ({f['direct_view_residuals']} direct); "
           f"dome residual slope RMS {report['residual_slopes']['residual_slope_rms_mrad']:.3f} mrad, worst "
           f"{report['residual_slopes']['residual_slope_worst_mrad']:.3f} mrad; "
           f"{100 * report['unmeasured']['fraction_of_lit']['measured']:.0f} % of the lit pixels measured "

@@ -19,13 +19,37 @@ from rigcad.calibrate import maps
 from rigcad.calibrate.run import _fit_data
 
 
-def _capture(shape, holes):
-    """A decoded capture (what _fit_data reads): every pixel decoded but the ``holes`` (slices)."""
+def _capture(shape, holes, u=None, v=None):
+    """A decoded capture (what _fit_data reads): every pixel decoded but the ``holes`` (slices); its
+    points (u, v) mm, all at the screen's centre (rays off the mirrors, through O) by default."""
     valid = np.ones(shape, bool)
     for h in holes:
         valid[h] = False
-    u = np.arange(valid.size, dtype=float).reshape(shape)
-    return SimpleNamespace(valid=valid, u=u, v=-u)
+    zero = np.zeros(shape)
+    return SimpleNamespace(valid=valid, u=zero if u is None else u, v=zero if v is None else v)
+
+
+def test_the_direct_view_is_read_on_a_coarser_grid():
+    """Pixels whose points say the screen was seen directly (fit.seen_direct: here the right half,
+    on a line from a COP 427.5 mm up through 40 mm out on the sample plane) are read on every
+    fit.DIRECT_STRIDE-th of the fit's rows and columns; the mirrored ones on every one."""
+    from rigcad.calibrate.fit import DIRECT_STRIDE
+
+    shape = (40, 48)
+    cam = SimpleNamespace(shape=shape, design=SimpleNamespace(cop_z=427.5, alpha_max=0.056))
+    plan = SimpleNamespace(heights=np.array([6.0, 25.0]), turns=np.zeros(2))
+    right = np.zeros(shape, bool)
+    right[:, 24:] = True
+    captures = [_capture(shape, [], u=np.where(right, 40.0 * (1 - h / 427.5), 0.0)) for h in plan.heights]
+    data = _fit_data(cam, plan, captures, 2)
+    assert np.array_equal(data.direct, right.ravel()[data.pixels])
+    # beyond the window counts as undecoded: the edge rule keeps rows and columns 3 .. n - 4
+    rows, cols = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing="ij")
+    inner = (rows >= 3) & (rows <= shape[0] - 4) & (cols >= 3) & (cols <= shape[1] - 4)
+    on = lambda k: (rows % k == 0) & (cols % k == 0)  # noqa: E731
+    expect = inner & np.where(right, on(2 * DIRECT_STRIDE), on(2))
+    assert np.array_equal(np.sort(data.pixels), np.nonzero(expect.ravel())[0])
+    assert data.direct.sum() == 12 and (~data.direct).sum() == 170  # 4 x 3 on the right, 17 x 10 on the left
 
 
 def _steps(valid):
@@ -36,10 +60,10 @@ def _steps(valid):
 
 def test_the_fit_reads_no_pixel_the_map_s_rays_leave_out():
     shape = (60, 80)
-    cam = SimpleNamespace(shape=shape)
+    cam = SimpleNamespace(shape=shape, design=SimpleNamespace(cop_z=427.5, alpha_max=0.056))
     # the lower screen: a shadow in the middle; the upper: a shorter screen (the grazing rays pass its edge)
     captures = [_capture(shape, [np.s_[25:32, 30:41]]), _capture(shape, [np.s_[:, 62:], np.s_[:4, :]])]
-    data = _fit_data(cam, captures, 1)
+    data = _fit_data(cam, SimpleNamespace(heights=np.array([6.0, 25.0]), turns=np.zeros(2)), captures, 1)
     for c in captures:
         # no pixel of the biased ring, 3 px along a row or a column from an undecoded one (module
         # docstring), nor any nearer: at least 4 steps (city-block) from every undecoded pixel

@@ -122,8 +122,13 @@ def test_each_unmeasured_pixel_is_told_why_and_the_rays_under_the_screens_are_th
     assert np.all(truly_under <= binary_dilation(under)) and np.all(under <= binary_dilation(truly_under))
     # (215 of 269 overlap here; the one-pixel ring about a region this size is a fifth of it)
     assert np.sum(under & truly_under) > 0.75 * truly_under.sum()
+    # no capture lit them, but next to the ring where the camera sees the screen directly past the
+    # paraboloid's rim: part of such a pixel's footprint, and the blur, reach into the ring
     lit = np.any([d.lit.ravel() for d in res.decoded], axis=0)
-    assert np.mean(~lit[under.ravel()]) > 0.95
+    by_ring = binary_dilation(base.direct.reshape(s["cam"].shape)).ravel()
+    # (here 253 pixels, 68 lit: 67 of them next to the ring; 104 not next to it, one lit)
+    assert np.sum(under.ravel() & ~by_ring) > 0.3 * under.sum()
+    assert np.mean(~lit[under.ravel() & ~by_ring]) > 0.95
     shares = c["unmeasured_causes"]
     assert set(shares) == set(maps.CAUSES)
     assert sum(v["fraction_of_lit"] for v in shares.values()) == pytest.approx(1.0)
