@@ -38,11 +38,17 @@ MEASURED_WEIGHT = 0.5
 FILLED_WEIGHT = 0.02
 
 
-def away_from_edges(valid: np.ndarray) -> np.ndarray:
+def away_from_edges(valid: np.ndarray, other_path: np.ndarray | None = None) -> np.ndarray:
     """(n,) the decoded pixels of one height (``valid`` (rows, cols)) at least :data:`HEIGHT_EDGE_PX`
-    steps along rows and columns from any it did not decode: the ones the rays and the fit read."""
+    steps along rows and columns from any it did not decode: the ones the rays and the fit read.
+    ``other_path`` ((n,) bool): pixels that see the screen along the other path (directly past the
+    paraboloid, or off the mirrors: :func:`rigcad.calibrate.model.direct_view`) count as not
+    decoded. Where the two meet at the paraboloid's rim, a pixel's footprint and the blur mix both
+    views, as at a screen's edge: with a thin screen and a coarse period such pixels decode."""
     from scipy.ndimage import binary_erosion
 
+    if other_path is not None:
+        valid = valid & ~other_path.reshape(valid.shape)
     return binary_erosion(valid, iterations=HEIGHT_EDGE_PX).ravel()
 
 
@@ -61,7 +67,7 @@ def pivot_rays(decoded: list, poses: list, model_tr: M.Traced, shape: tuple[int,
     upper screen's edge) is measured too."""
     total = np.zeros((int(np.prod(shape)), 3))
     for d, pose in zip(decoded, poses):
-        inner = away_from_edges(d.valid) & model_tr.ok
+        inner = away_from_edges(d.valid, model_tr.direct) & model_tr.ok
         to_dome = model_tr.p2 - to_global(pose, d.u, d.v).reshape(-1, 3)
         with np.errstate(invalid="ignore", divide="ignore"):
             to_dome /= np.linalg.norm(to_dome, axis=1)[:, None]
@@ -96,7 +102,7 @@ def unmeasured_causes(decoded: list, poses: list, model_tr: M.Traced, source: np
     q, _ = lowest.localize(np.nan_to_num(model_tr.p2), np.zeros_like(model_tr.p2))
     lit = np.any([d.lit.ravel() for d in decoded], axis=0)
     valid = np.any([d.valid.ravel() for d in decoded], axis=0)
-    inner = np.any([away_from_edges(d.valid) for d in decoded], axis=0)
+    inner = np.any([away_from_edges(d.valid, model_tr.direct) for d in decoded], axis=0)
     checks = (source == 1, q[:, 2] < 0, ~lit, ~valid, ~inner)
     out = np.full(len(source), len(CAUSES) - 1, dtype=np.int8)
     for code in range(len(checks) - 1, -1, -1):  # the first cause that applies wins

@@ -118,16 +118,25 @@ def _fit_data(cam: M.Camera, plan: M.Plan, decoded: list, stride: int) -> FitDat
     """Every ``stride``-th row and column of the window that decoded in every capture."""
     rows, cols = np.meshgrid(np.arange(cam.shape[0]), np.arange(cam.shape[1]), indexing="ij")
     pick = ((rows % stride == 0) & (cols % stride == 0)).ravel()
-    # pixels near an undecoded one see a screen edge or a shadow's edge in part of their footprint:
-    # the same rule as the map's rays (maps.HEIGHT_EDGE_PX)
-    inner = [maps.away_from_edges(d.valid) for d in decoded]
+    # pixels near an undecoded one see a screen edge or a shadow's edge in part of their footprint,
+    # and pixels near the other path's (read from the points: fit.seen_direct) both views: the same
+    # rule as the map's rays (maps.away_from_edges, maps.HEIGHT_EDGE_PX)
+    every = np.nonzero(np.all([d.valid.ravel() for d in decoded], axis=0))[0]
+    direct = np.zeros(rows.size, bool)
+    direct[every] = FitData.of(plan, cam.design, every, _points(decoded, every)).direct
+    inner = [np.where(direct, maps.away_from_edges(d.valid, ~direct), maps.away_from_edges(d.valid, direct))
+             for d in decoded]
     ok = pick & np.all(inner, axis=0)
     idx = np.nonzero(ok)[0]
-    uv = np.stack([np.stack([d.u.ravel()[idx], d.v.ravel()[idx]], axis=-1) for d in decoded], axis=1)
-    data = FitData.of(plan, cam.design, idx, uv)
+    data = FitData.of(plan, cam.design, idx, _points(decoded, idx))
     coarse = stride * DIRECT_STRIDE  # the direct view's pixels: a coarser grid
     keep = ~data.direct | ((rows.ravel()[idx] % coarse == 0) & (cols.ravel()[idx] % coarse == 0))
-    return FitData(idx[keep], uv[keep], data.direct[keep])
+    return FitData(idx[keep], data.screen_uv[keep], data.direct[keep])
+
+
+def _points(decoded: list, idx: np.ndarray) -> np.ndarray:
+    """The decoded screen points (n, captures, 2) mm of window pixels ``idx``."""
+    return np.stack([np.stack([d.u.ravel()[idx], d.v.ravel()[idx]], axis=-1) for d in decoded], axis=1)
 
 
 def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -> dict:

@@ -32,7 +32,8 @@ def _capture(shape, holes, u=None, v=None):
 def test_the_direct_view_is_read_on_a_coarser_grid():
     """Pixels whose points say the screen was seen directly (fit.seen_direct: here the right half,
     on a line from a COP 427.5 mm up through 40 mm out on the sample plane) are read on every
-    fit.DIRECT_STRIDE-th of the fit's rows and columns; the mirrored ones on every one."""
+    fit.DIRECT_STRIDE-th of the fit's rows and columns; the mirrored ones on every one. Neither path
+    reads a pixel within the edge rule of the other's: there a footprint mixes both views."""
     from rigcad.calibrate.fit import DIRECT_STRIDE
 
     shape = (40, 48)
@@ -47,9 +48,11 @@ def test_the_direct_view_is_read_on_a_coarser_grid():
     rows, cols = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing="ij")
     inner = (rows >= 3) & (rows <= shape[0] - 4) & (cols >= 3) & (cols <= shape[1] - 4)
     on = lambda k: (rows % k == 0) & (cols % k == 0)  # noqa: E731
-    expect = inner & np.where(right, on(2 * DIRECT_STRIDE), on(2))
+    # and where the two paths meet, each keeps the edge rule's distance from the other's pixels
+    apart = (cols <= 23 - maps.HEIGHT_EDGE_PX) | (cols >= 24 + maps.HEIGHT_EDGE_PX)
+    expect = inner & apart & np.where(right, on(2 * DIRECT_STRIDE), on(2))
     assert np.array_equal(np.sort(data.pixels), np.nonzero(expect.ravel())[0])
-    assert data.direct.sum() == 12 and (~data.direct).sum() == 170  # 4 x 3 on the right, 17 x 10 on the left
+    assert data.direct.sum() == 8 and (~data.direct).sum() == 153  # 4 x 2 on the right, 17 x 9 on the left
 
 
 def _steps(valid):

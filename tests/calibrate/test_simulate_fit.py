@@ -153,7 +153,7 @@ def test_the_first_cause_that_applies_is_the_one_given():
         p2[:, 2] = z
         src = np.full(49, 2)
         src[centre] = source
-        tr = SimpleNamespace(p2=p2, ok=np.full(49, ok))
+        tr = SimpleNamespace(p2=p2, ok=np.full(49, ok), direct=np.zeros(49, bool))
         return maps.CAUSES[c] if (c := int(maps.unmeasured_causes([d], [screen_pose(5.0)], tr, src)[centre])) >= 0 \
             else "lost"
 
@@ -168,7 +168,12 @@ def test_the_first_cause_that_applies_is_the_one_given():
     # one undecoded pixel 3 steps from the centre puts it within the edge rule
     d = SimpleNamespace(lit=np.ones(shape, bool), valid=np.ones(shape, bool))
     d.valid[0, 3] = False
-    tr = SimpleNamespace(p2=np.tile([0.0, 0.0, 50.0], (49, 1)), ok=np.ones(49, bool))
+    tr = SimpleNamespace(p2=np.tile([0.0, 0.0, 50.0], (49, 1)), ok=np.ones(49, bool), direct=np.zeros(49, bool))
+    assert maps.CAUSES[maps.unmeasured_causes([d], [screen_pose(5.0)], tr, np.full(49, 2))[centre]] == \
+        "within_the_edge_rule"
+    # and so does a decoded pixel 3 steps away that sees the screen directly past the paraboloid
+    d.valid[0, 3] = True
+    tr.ok[3], tr.direct[3] = False, True
     assert maps.CAUSES[maps.unmeasured_causes([d], [screen_pose(5.0)], tr, np.full(49, 2))[centre]] == \
         "within_the_edge_rule"
 
