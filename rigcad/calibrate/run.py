@@ -14,7 +14,7 @@ import dataclasses
 
 from rigcad.calibrate import bias as B, maps, model as M
 from rigcad.calibrate.decode import decode
-from rigcad.calibrate.fit import DIRECT_STRIDE, SLOPE_PROJECTION, FitData, fit
+from rigcad.calibrate.fit import DIRECT_STRIDE, SLOPE_PROJECTION, FitData, direct_ring_mm, fit, seen_direct
 from rigcad.calibrate.patterns import Sequence
 
 
@@ -123,15 +123,14 @@ def _fit_data(cam: M.Camera, plan: M.Plan, decoded: list, stride: int) -> FitDat
     # rule as the map's rays (maps.away_from_edges, maps.HEIGHT_EDGE_PX)
     every = np.nonzero(np.all([d.valid.ravel() for d in decoded], axis=0))[0]
     direct = np.zeros(rows.size, bool)
-    direct[every] = FitData.of(plan, cam.design, every, _points(decoded, every)).direct
+    direct[every] = seen_direct(plan, _points(decoded, every), direct_ring_mm(cam.design))
     inner = [np.where(direct, maps.away_from_edges(d.valid, ~direct), maps.away_from_edges(d.valid, direct))
              for d in decoded]
     ok = pick & np.all(inner, axis=0)
     idx = np.nonzero(ok)[0]
-    data = FitData.of(plan, cam.design, idx, _points(decoded, idx))
     coarse = stride * DIRECT_STRIDE  # the direct view's pixels: a coarser grid
-    keep = ~data.direct | ((rows.ravel()[idx] % coarse == 0) & (cols.ravel()[idx] % coarse == 0))
-    return FitData(idx[keep], data.screen_uv[keep], data.direct[keep])
+    idx = idx[~direct[idx] | ((rows.ravel()[idx] % coarse == 0) & (cols.ravel()[idx] % coarse == 0))]
+    return FitData(idx, _points(decoded, idx), direct[idx])
 
 
 def _points(decoded: list, idx: np.ndarray) -> np.ndarray:
