@@ -228,7 +228,7 @@ def direct_view(optics, rig, p: np.ndarray, d: np.ndarray, passed: np.ndarray) -
     status), then in the dome's frame inside its mirror at each of :data:`DIRECT_MERIDIAN_POINTS`
     heights of its meridian (the first is the top opening's edge), and clear of the beam down to the
     sample plane. The dome's top opening is wider than the paraboloid's image: on Table 3.1 the
-    camera sees the screen directly between ~134 and ~336 px from the axis, past the tower's parts."""
+    camera sees the screen directly between ~134 and ~337 px from the axis, past the tower's parts."""
     out = np.zeros(len(p), bool)
     i = np.nonzero(passed & (d[:, 2] < 0))[0]
     if not i.size:
