@@ -184,6 +184,7 @@ def summarize(profile: str, resolution, trials: list) -> dict:
             float(f([t["frame"]["measured_error_without_it_deg"]["p99"] for t in trials])) for f in (np.min, np.median, np.max)],
         "parameter_met_fraction": {n: float(np.mean([t["parameters"][n]["met"] for t in trials]))
                                    for n in trials[0]["parameters"]},
+        **dome_frame_summary(trials),
         "slope_rms_ratio_range": [float(f(ratio)) for f in (np.min, np.max)],
         "design_incidence_error_p99_deg_median": float(np.median([t["design_incidence_error_deg"]["p99"]
                                                                   for t in trials])),
@@ -194,6 +195,19 @@ def summarize(profile: str, resolution, trials: list) -> dict:
         "per_trial": trials,
     }
     return summary
+
+
+def dome_frame_summary(trials: list) -> dict:
+    """The paraboloid's and the camera's placement against the dome (rigcad.calibrate.run.compare's
+    ``dome_frame``): per parameter, the share of the trials within target, and how many trials had
+    them all within target (empty for trials run before it was compared)."""
+    if "dome_frame" not in trials[0]:
+        return {}
+    rows = [t["dome_frame"] for t in trials]
+    return {"dome_frame_parameter_met_fraction": {n: float(np.mean([r["parameters"][n]["met"] for r in rows]))
+                                                  for n in rows[0]["parameters"]},
+            "dome_frame_trials_with_every_parameter_met": int(sum(r["parameters_met"] == r["parameters_total"]
+                                                                   for r in rows))}
 
 
 #: The sweep's rows as docs/calibrate.md names them, in its order.
@@ -246,6 +260,7 @@ def tables(summary: dict) -> str:
         f"| parameters within max(10 % tol, 0.02 mm / 0.01 deg) | {min(met)}-{max(met)} of {total}; "
         f"{np.median(met):.0f} ({100 * summary['parameters_within_target_fraction']:.0f} %) | all: **"
         f"{'met' if min(met) == total else 'not met'}** ({sum(m == total for m in met)} of {n}) |",
+        *dome_frame_rows(trials),
         f"| slope RMS recovered / planted ({np.median([t['planted_slope_rms_mrad'] for t in trials]):.2f} mrad) "
         f"| {min(ratio):.3f}-{max(ratio):.3f} | within 20 %: **{'met' if max(abs(r - 1) for r in ratio) <= 0.2 else 'not met'}** |",
         f"| slope difference RMS, pointwise | {_spread([t['slope_difference_rms_mrad'] for t in trials], 2)} mrad | |",
@@ -268,6 +283,21 @@ def tables(summary: dict) -> str:
                             f"{r['parameters_total']} | {r['calibration_cpu_s']:.1f} |")
     rows += causes_table(summary) + coverage_table(summary) + standard_error_table(summary)
     return "\n".join(rows) + "\n"
+
+
+def dome_frame_rows(trials: list) -> list[str]:
+    """The summary table's rows on the paraboloid and the camera against the dome, and on the dome's
+    tilts (the frame's share), for trials that compared them."""
+    if "dome_frame" not in trials[0]:
+        return []
+    met = [t["dome_frame"]["parameters_met"] for t in trials]
+    total, n = trials[0]["dome_frame"]["parameters_total"], len(trials)
+    tilts = [all(t["parameters"][f"dome_tilt_{a}_rad"]["met"] for a in "xy") for t in trials]
+    return [f"| the same, the paraboloid and the camera against the dome (what the images fix) | {min(met)}-{max(met)} "
+            f"of {total}; {np.median(met):.0f} | all: **{'met' if min(met) == total else 'not met'}** "
+            f"({sum(m == total for m in met)} of {n}) |",
+            f"| the same, the dome's tilts (the rig's tilt over the sample plane: the frame, the priors' part) | "
+            f"both within target in {sum(tilts)} of {n} | |"]
 
 
 #: The parameters' groups as the standard-error table names them: label -> (the name's start, its
@@ -298,6 +328,9 @@ def standard_error_table(summary: dict) -> list[str]:
         z = np.array([p["error_over_standard_error"] for t in trials for n, p in t["parameters"].items()
                       if _in_group(n, group) and n not in GAUGE])
         rows.append(f"| {label} | {np.median(z):.2f} | {100 * np.mean(z <= 2):.0f} % |")
+    if "dome_frame" in trials[0]:
+        z = np.array([p["error_over_standard_error"] for t in trials for p in t["dome_frame"]["parameters"].values()])
+        rows.append(f"| the paraboloid and the camera against the dome | {np.median(z):.2f} | {100 * np.mean(z <= 2):.0f} % |")
     rows.append("| calibrated (a Gaussian error) | 0.67 | 95 % |")
     return rows
 

@@ -95,6 +95,23 @@ class FitData:
     direct: np.ndarray
 
 
+def in_report_units(names, values: np.ndarray, standard_error: np.ndarray) -> dict:
+    """name -> value and standard error, angles in degrees (``_rad`` names become ``_deg``)."""
+    out = {}
+    for n, v, s in zip(names, values, standard_error):
+        scale = 180 / math.pi if n.endswith("_rad") else 1.0
+        out[n.replace("_rad", "_deg")] = {"value": float(v * scale), "standard_error": float(s * scale)}
+    return out
+
+
+def against_dome(rig, fit: FitResult) -> dict:
+    """The fit's paraboloid and camera against the dome (:func:`rigcad.calibrate.model.in_dome_frame`)
+    with their standard errors: what a technician adjusts, free of the frame's tilt that only the
+    priors fix (the fit's standard errors of the same parameters in the sample frame carry it)."""
+    cov = M.in_dome_frame_covariance(rig, fit.theta, fit.covariance)
+    return in_report_units(M.DOME_FRAME_NAMES, M.in_dome_frame(rig, fit.theta), np.sqrt(np.diag(cov)))
+
+
 def direct_ring_mm(design) -> float:
     """Where, on the sample plane, the camera's direct view past the paraboloid's rim begins (mm from
     O): its pinhole ray past the rim, cop_z tan(alpha_max) (24 mm on Table 3.1)."""
@@ -139,11 +156,7 @@ class FitResult:
     direct_weight: float
 
     def as_dict(self) -> dict:
-        out = {}
-        for n, v, s in zip(self.names, self.theta, self.standard_error):
-            scale = 180 / math.pi if n.endswith("_rad") else 1.0
-            key = n.replace("_rad", "_deg")
-            out[key] = {"value": float(v * scale), "standard_error": float(s * scale)}
+        out = in_report_units(self.names, self.theta, self.standard_error)
         strong = [(self.names[i], self.names[j], float(self.correlation[i, j]))
                   for i in range(len(self.names)) for j in range(i + 1, len(self.names))
                   if abs(self.correlation[i, j]) > 0.9]

@@ -134,6 +134,48 @@ def moved(rig, theta: np.ndarray):
     return out
 
 
+#: The paraboloid's and the camera's placement against the dome (:func:`in_dome_frame`), named as
+#: their parameters in the sample frame.
+DOME_FRAME_NAMES = tuple(n for n in RIG_NAMES if not n.startswith("dome"))
+
+
+def in_dome_frame(rig, theta: np.ndarray) -> np.ndarray:
+    """(10,) the paraboloid's and the camera's offsets (mm) and tilts (rad) against the dome, as
+    ``theta[:15]`` places the three (:data:`DOME_FRAME_NAMES`): each component's pose taken into
+    the dome's frame (the dome's pose undone) and read back as an offset of its pivot and a tilt
+    about it (:meth:`rigcad.optics.frames.Misalignment.pivot`); exact, not linearised. Turning or
+    shifting the whole rig together changes none of them: they are what the images fix apart from
+    the frame (the sample plane's tilt under the rig, which only the priors fix; docs/calibrate.md,
+    "The rig against its dome"). A turn about the dome's axis is not a parameter and is dropped."""
+    from scipy.spatial.transform import Rotation
+
+    from rigcad.optics.frames import Misalignment
+
+    placed = moved(rig, theta)
+    dome = placed.pose("dome")
+    out = []
+    for c in ("paraboloid", "camera"):
+        pose, pivot = placed.pose(c), np.array(Misalignment.pivot(c, rig.geometry), float)
+        at = (pose.globalize_points(pivot[None])[0] - dome.translation) @ dome.rotation
+        tilt = Rotation.from_matrix(dome.rotation.T @ pose.rotation).as_rotvec()
+        out += [*(at - pivot), tilt[0], tilt[1]]
+    return np.array(out)
+
+
+def in_dome_frame_covariance(rig, theta: np.ndarray, covariance: np.ndarray) -> np.ndarray:
+    """(10, 10) :func:`in_dome_frame`'s covariance from the parameters' (``covariance``, over
+    ``theta``; the rig's 15 first), through its Jacobian by central differences (steps of 1e-4 of
+    each tolerance-sized parameter: the map is linear to ~1e-6 there)."""
+    n = len(RIG_NAMES)
+    step = np.array([1e-5 if name.endswith("_rad") else 1e-4 for name in RIG_NAMES])
+    jac = np.empty((len(DOME_FRAME_NAMES), n))
+    for i in range(n):
+        e = np.zeros(len(theta))
+        e[i] = step[i]
+        jac[:, i] = (in_dome_frame(rig, theta + e) - in_dome_frame(rig, theta - e)) / (2 * step[i])
+    return jac @ covariance[:n, :n] @ jac.T
+
+
 def screens(plan: Plan, theta: np.ndarray) -> list:
     """The screens' poses: each capture's nominal height and turn plus its parameters in ``theta``."""
     s = np.asarray(theta[len(RIG_NAMES):]).reshape(-1, len(SCREEN_KEYS))

@@ -140,8 +140,9 @@ def _points(decoded: list, idx: np.ndarray) -> np.ndarray:
 
 def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -> dict:
     """A simulation's figures against what was planted: each parameter's error against its
-    tolerance, the corrected and the design (uncorrected) map's incidence error (deg, p99 and more
-    over the lit pixels), the residual slopes against the planted ones (mrad)."""
+    tolerance, and the paraboloid's and the camera's against the dome (``dome_frame``), the corrected
+    and the design (uncorrected) map's incidence error (deg, p99 and more over the lit pixels), the
+    residual slopes against the planted ones (mrad)."""
     from rigcad.calibrate.simulate import surface_slopes, with_surface
 
     cam = result.cam
@@ -158,15 +159,16 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
     g_p, g_r = planted[seen], result.slopes[seen]
     rms = lambda a: float(np.sqrt(np.mean(np.sum(a * a, axis=1))) * 1e3) if len(a) else math.nan  # noqa: E731
     tol = M.tolerance_scale(rig, len(result.plan))
-    err = result.fit.theta - theta_true
     names = M.parameter_names(len(result.plan))
     target = np.maximum(0.1 * tol, [math.radians(0.01) if n.endswith("_rad") else 0.02 for n in names])
-    z = np.abs(err) / np.maximum(result.fit.standard_error, 1e-300)
+    in_dome = [names.index(n) for n in M.DOME_FRAME_NAMES]
+    dome_se = np.sqrt(np.diag(M.in_dome_frame_covariance(rig, result.fit.theta, result.fit.covariance)))
+    dome_frame = _against(M.DOME_FRAME_NAMES, M.in_dome_frame(rig, theta_true), M.in_dome_frame(rig, result.fit.theta),
+                          target[in_dome], dome_se)
     return {
-        "parameters": {n: {"planted": float(t), "fitted": float(f), "error": float(e), "target": float(g),
-                           "met": bool(abs(e) <= g), "error_over_standard_error": float(zz)}
-                       for n, t, f, e, g, zz in zip(names, theta_true, result.fit.theta, err, target, z)},
-        "parameters_met": int(np.sum(np.abs(err) <= target)), "parameters_total": len(names),
+        **_against(names, theta_true, result.fit.theta, target, result.fit.standard_error),
+        "dome_frame": {"about": "the paraboloid's and the camera's placement against the dome (model.in_dome_frame): "
+                                "what the images fix apart from the frame's tilt", **dome_frame},
         "lit_pixels": int(lit.sum()),
         "corrected_incidence_error_deg": _stats(err_c), "design_incidence_error_deg": _stats(err_d),
         "fitted_model_incidence_error_deg": _stats(err_m),
@@ -181,6 +183,16 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
         "slope_pixels": int(seen.sum()), "planted_slope_rms_mrad": rms(g_p), "recovered_slope_rms_mrad": rms(g_r),
         "slope_difference_rms_mrad": rms(g_r - g_p),
     }
+
+
+def _against(names, planted: np.ndarray, fitted: np.ndarray, target: np.ndarray, se: np.ndarray) -> dict:
+    """Each named parameter's fitted value against the planted one, its target and its standard error."""
+    err = fitted - planted
+    z = np.abs(err) / np.maximum(se, 1e-300)
+    return {"parameters": {n: {"planted": float(t), "fitted": float(f), "error": float(e), "target": float(g),
+                               "met": bool(abs(e) <= g), "error_over_standard_error": float(zz)}
+                           for n, t, f, e, g, zz in zip(names, planted, fitted, err, target, z)},
+            "parameters_met": int(np.sum(np.abs(err) <= target)), "parameters_total": len(names)}
 
 
 def _frame(corrected: dict, up: np.ndarray, lit: np.ndarray) -> dict:

@@ -64,7 +64,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             + [check_half_turns(folder, plan, decoded)])
         result = calibrate(optics, rig, images, say=print, check=check)
     _check_heights(result, folder)
-    report = _report(result)
+    report = _report(result, rig)
     extra = None
     if truth is not None:
         from rigcad.calibrate.run import truth_maps
@@ -86,7 +86,17 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
           f"{report['residual_slopes']['residual_slope_worst_mrad']:.3f} mrad; "
           f"{100 * report['unmeasured']['fraction_of_lit']['measured']:.0f} % of the lit pixels measured "
           f"(the rest, and why: calibration.json 'unmeasured'); wrote {out}")
+    print(_against_dome_line(report["against_the_dome"]["parameters"]))
     return 0
+
+
+def _against_dome_line(params: dict) -> str:
+    """One line: the paraboloid's and the camera's placement against the dome, with standard errors."""
+    def part(c: str) -> str:
+        v = lambda k: f"{params[f'{c}_{k}']['value']:+.3f} ± {params[f'{c}_{k}']['standard_error']:.3f}"  # noqa: E731
+        return (f"{c} off by x {v('dx_mm')}, y {v('dy_mm')}, z {v('dz_mm')} mm, "
+                f"tilted x {v('tilt_x_deg')}, y {v('tilt_y_deg')} deg")
+    return f"against the dome's axis: {part('paraboloid')}; {part('camera')}"
 
 
 def _check_capture_folder(folder: Path, simulate: bool) -> None:
@@ -132,11 +142,18 @@ def _check_heights(result, folder: Path) -> None:
                                f"its spacer's height ({plan.heights[k]:g} mm above O): wrong spacer or order")
 
 
-def _report(result) -> dict:
+def _report(result, rig) -> dict:
     from rigcad.calibrate import maps
+    from rigcad.calibrate.fit import against_dome
 
     refit = result.map_fit.as_dict()
-    return {"fit": result.fit.as_dict(), "residual_slopes": result.slope_figures(),
+    return {"fit": result.fit.as_dict(),
+            "against_the_dome": {"about": "the paraboloid's and the camera's offsets (their pivots') and tilts against "
+                                          "the dome's axis (model.in_dome_frame): what the images fix apart from the "
+                                          "rig's tilt over the sample plane, which only the priors fix; the parameters "
+                                          "under 'fit' are in the sample frame (docs/calibrate.md)",
+                                 "parameters": against_dome(rig, result.fit)},
+            "residual_slopes": result.slope_figures(),
             "map_model": {"about": "the corrected map's model: refit from the fit above with each pixel's dome-slope "
                                    "residual component down-weighted (docs/calibrate.md)",
                           "parameters": refit["parameters"], "rms_residual_mm": refit["rms_residual_mm"]},

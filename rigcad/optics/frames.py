@@ -78,8 +78,14 @@ class Misalignment:
     def pose(self, component: str, geo) -> Pose:
         """The component's pose; tilts pivot about the COP (camera, projector), the paraboloid's
         vertex, or the sample point O (dome). ``geo``: the rig's derived geometry."""
-        pivot = {"projector": (0, 0, geo.cop_z), "camera": (0, 0, geo.cop_z),
-                 "paraboloid": (0, 0, geo.vertex_z), "dome": (0, 0, 0)}[component]
         if not any(self.offsets[component]) and self.tilts[component] == 0.0:
             return Pose()
-        return Pose.misaligned(self.offsets[component], self.tilts[component], self.axes[component], pivot)
+        return Pose.misaligned(self.offsets[component], self.tilts[component], self.axes[component],
+                               self.pivot(component, geo))
+
+    @staticmethod
+    def pivot(component: str, geo) -> tuple[float, float, float]:
+        """The point (mm) ``component``'s tilt turns it about, as designed: the COP (camera,
+        projector), the paraboloid's vertex, or the sample point O (dome)."""
+        return {"projector": (0, 0, geo.cop_z), "camera": (0, 0, geo.cop_z),
+                "paraboloid": (0, 0, geo.vertex_z), "dome": (0, 0, 0)}[component]

@@ -266,8 +266,9 @@ def test_a_height_the_images_contradict(tmp_path, capture):
     assert not (tmp_path / "exports" / "wrong" / "calibrate").exists()
 
 
-def test_a_good_capture_is_written(tmp_path, small, capture):
+def test_a_good_capture_is_written(tmp_path, small, capture, capsys):
     assert _run(tmp_path, capture, capture["folder"]) == 0
+    assert "against the dome's axis: paraboloid off by x " in capsys.readouterr().out
     out = tmp_path / "exports" / "coarse" / "calibrate"
     data = np.load(out / "corrected_map.npz")
     assert data["direction"].shape == small["cam"].shape + (3,)
@@ -280,6 +281,17 @@ def test_a_good_capture_is_written(tmp_path, small, capture):
     assert np.array_equal(cause == 0, data["source"] == 1)
     lit = cause >= 0
     assert shares["measured"] == pytest.approx(np.mean(cause[lit] == 0))
+    # the paraboloid and the camera against the dome: the fitted parameters (as written) taken into
+    # the dome's frame, each with a standard error
+    fit = report["fit"]["parameters"]
+    theta = np.array([np.radians(fit[n.replace("_rad", "_deg")]["value"]) if n.endswith("_rad") else fit[n]["value"]
+                      for n in M.parameter_names(len(small["plan"]))])
+    dome = report["against_the_dome"]["parameters"]
+    assert set(dome) == {n.replace("_rad", "_deg") for n in M.DOME_FRAME_NAMES}
+    want = M.in_dome_frame(small["rig"], theta)
+    np.testing.assert_allclose([dome[n.replace("_rad", "_deg")]["value"] * (np.pi / 180 if n.endswith("_rad") else 1)
+                                for n in M.DOME_FRAME_NAMES], want, rtol=1e-9, atol=1e-12)
+    assert all(0 < d["standard_error"] < 1 for d in dome.values())
 
 
 def test_a_simulated_capture_written_out_calibrates_the_same_from_its_files(tmp_path, small, capture):
