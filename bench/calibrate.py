@@ -79,11 +79,12 @@ VARIANTS = {"steps3": "  phase_steps: 3\n", "steps4": "  phase_steps: 4\n", "ste
             "thin_1mm": "  screen_thickness: 1 mm\n",
             "thin_1mm_periods_1024_128_16": "  screen_thickness: 1 mm\n  periods: [1024, 128, 16]\n  gray_bits: 3\n",
             # the frame (docs/calibrate.md, "What fixes the frame"): without the half turn, the
-            # screen's wedge sets it; a screen that settles less repeatably; one flatter on its spacer
-            # (planted and assumed alike)
+            # screen's wedge sets it; a screen that settles less repeatably, or more (on three pads);
+            # one flatter on its spacer (planted and assumed alike)
             "half_turn_none": "  half_turn: none\n",
             "half_turn_highest": "  half_turn: highest\n",
             "screen_seating_0.05deg": "  screen_seating: 0.05 deg\n",
+            "screen_seating_0.005deg": "  screen_seating: 0.005 deg\n",
             "screen_tilt_0.02deg": "  screen_tilt: 0.02 deg\n"}
 
 
@@ -221,6 +222,7 @@ VARIANT_LABELS = {"steps3": "3 phase steps", "steps4": "4 phase steps (the defau
                   "half_turn_none": "no half turn (the earlier capture)",
                   "half_turn_highest": "a half turn at the highest spacer only (3 captures)",
                   "screen_seating_0.05deg": "the screen settling to 0.05 deg, not 0.02",
+                  "screen_seating_0.005deg": "the screen settling to 0.005 deg (a three-point seat)",
                   "screen_tilt_0.02deg": "the screen flat on its spacers to 0.02 deg, not 0.2"}
 
 

@@ -146,6 +146,22 @@ camera's full resolution, {p.camera.resolution[0]} x {p.camera.resolution[1]} px
 - Focus between the two screen heights; a little defocus is harmless.
 - The screen reaches rays up to {reach:.0f} deg from the axis at the highest spacer: beyond that the
   corrected map is filled from the fit.
+
+{_after_the_fit(p.tolerancing)}"""
+
+
+def _after_the_fit(tol) -> str:
+    """The calibration page's last section: what the fit says to adjust, against the tolerances."""
+    parts = "; ".join(f"{c}: {getattr(tol, f'{c}_offset'):g} mm sideways, {getattr(tol, f'{c}_height'):g} mm "
+                      f"in height, {math.degrees(getattr(tol, f'{c}_tilt')):g} deg" for c in ("paraboloid", "camera"))
+    return f"""## After the fit: what to adjust
+The command prints, and `calibration.json`'s `against_the_dome` holds, where the paraboloid and the
+camera stand against the dome's axis: each one's offset (mm) and tilt (deg), with its standard
+error. That is the placement the images fix. A part off by more than its tolerance ({parts}) and by
+more than twice its standard error is worth re-seating: move it back by the offset, then capture
+and calibrate again. The same parts under `fit` are placed against the sample plane; they carry the
+rig's tilt over that plane too, which only the screen's seating fixes, so their standard errors are
+wider.
 """
 
 

@@ -22,9 +22,13 @@ def screen_pose(height: float, tilt_x: float = 0.0, tilt_y: float = 0.0, du: flo
     tilted = Pose.misaligned((0.0, 0.0, height), angle, axis)
     if not (du or dv or turn):
         return tilted
-    c, s = np.cos(turn), np.sin(turn)
-    t = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    return Pose(tilted.rotation @ t, tilted.rotation @ np.array([du, dv, 0.0]) + tilted.translation)
+    return Pose(tilted.rotation @ turn_matrix(turn), tilted.rotation @ np.array([du, dv, 0.0]) + tilted.translation)
+
+
+def turn_matrix(angle: float) -> np.ndarray:
+    """(3, 3) the turn by ``angle`` rad about +z (counter-clockwise seen from above)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def to_global(pose: Pose, u: np.ndarray, v: np.ndarray) -> np.ndarray:

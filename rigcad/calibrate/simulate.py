@@ -20,6 +20,7 @@ import numpy as np
 
 from rigcad.calibrate import model as M
 from rigcad.calibrate.patterns import Sequence
+from rigcad.calibrate.raxel import turn_matrix
 
 #: Fraction of full exposure the screen's black (and the room) gives: a display's contrast ~1000:1
 #: and some stray light.
@@ -119,8 +120,7 @@ def random_misalignment(rig, plan: M.Plan, rng: np.random.Generator) -> np.ndarr
             f = M.screen_index(first)
             turn = plan.turns[c] + theta[j + 5] - plan.turns[first] - theta[f + 5]
             w = theta[f + 1: f + 3]
-            theta[j: j + 3] = theta[f], *(np.array([[math.cos(turn), -math.sin(turn)],
-                                                    [math.sin(turn), math.cos(turn)]]) @ w)
+            theta[j: j + 3] = theta[f], *(turn_matrix(turn)[:2, :2] @ w)
     for c in range(len(plan)):
         mag, ang = seat.uniform(0, cal.screen_seating), seat.uniform(0, 2 * math.pi)
         theta[M.screen_index(c) + 1: M.screen_index(c) + 3] += mag * math.cos(ang), mag * math.sin(ang)
