@@ -156,8 +156,9 @@ def _after_the_fit(tol) -> str:
                       f"in height, {math.degrees(getattr(tol, f'{c}_tilt')):g} deg" for c in ("paraboloid", "camera"))
     return f"""## After the fit: what to adjust
 The command prints, and `calibration.json`'s `against_the_dome` holds, where the paraboloid and the
-camera stand against the dome's axis: each one's offset (mm) and tilt (deg), with its standard
-error. That is the placement the images fix. A part off by more than its tolerance ({parts}) and by
+camera stand against the dome's axis: each one's offset (mm) along x, y and z, and its tilt (deg)
+as turns about x and y, each with its standard error, in the rig's frame (+z up, the projector on
+the +x side, the beam along x). That is the placement the images fix. A part off by more than its tolerance ({parts}) and by
 more than twice its standard error is worth re-seating: move it back by the offset, then capture
 and calibrate again. The same parts under `fit` are placed against the sample plane; they carry the
 rig's tilt over that plane too, which only the screen's seating fixes, so their standard errors are
