@@ -103,13 +103,20 @@ def check_exposure(folder: Path, k: str, frames: dict) -> None:
         raise CaptureError(f"{path}: saturated ({sat:.0%} of the lit pixels at full scale): shorten the exposure")
 
 
-def check_decoded(folder: Path, k: str, seq: Sequence, decoded) -> None:
-    """Too little modulation, or frames out of order (torn map, misfit to a sinusoid)."""
+def check_decoded(folder: Path, k: str, seq: Sequence, decoded, mirrored: np.ndarray | None = None) -> None:
+    """Too little modulation (over the lit pixels, and over those of ``mirrored``, the window's
+    pixels that see the paraboloid in any build: :meth:`rigcad.calibrate.model.Camera.mirrored_core`),
+    or frames out of order (torn map, misfit to a sinusoid)."""
     lit = int(decoded.lit.sum())
+    first = capture_path(folder, k, f"x_p{seq.periods[0]}_s0")
     if lit == 0 or decoded.valid.sum() < MIN_DECODED_FRACTION * lit:
-        raise CaptureError(f"{capture_path(folder, k, f'x_p{seq.periods[0]}_s0')}: too little modulation: "
-                           f"{int(decoded.valid.sum())} of {lit} lit pixels decoded (focus on the screen, "
-                           "raise the exposure or the screen's brightness)")
+        raise CaptureError(f"{first}: too little modulation: {int(decoded.valid.sum())} of {lit} lit pixels decoded "
+                           "(focus on the screen, raise the exposure or the screen's brightness)")
+    core = decoded.lit & mirrored if mirrored is not None else np.zeros_like(decoded.lit)
+    if core.any() and decoded.valid[core].sum() < MIN_DECODED_FRACTION * core.sum():
+        raise CaptureError(f"{first}: too little modulation in the paraboloid's image: {int(decoded.valid[core].sum())} "
+                           f"of its {int(core.sum())} lit pixels decoded, though the screen seen directly around it "
+                           "decodes (focus on the paraboloid's image; clean the mirrors)")
     for axis, frac in decoded.jumps(seq.stripe).items():
         if frac > MAX_JUMP_FRACTION:
             raise CaptureError(f"{capture_path(folder, k, f'{axis}_gray0')}: the {axis} frames decode to a torn map "

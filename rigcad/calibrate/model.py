@@ -219,6 +219,21 @@ class Camera:
         """The window of a full camera image (rows, cols)."""
         return image[self.row0: self.row0 + self.shape[0], self.col0: self.col0 + self.shape[1]]
 
+    def mirrored_core(self, rig) -> np.ndarray:
+        """(rows, cols) the window's pixels that see the paraboloid's useful annulus in any build
+        within ``tolerancing``: the design's annulus (alpha_min to alpha_max) shrunk on both sides by
+        the most the camera's tilt and the camera's and the paraboloid's lateral offsets move the
+        image, f tan(tilt) + f (offsets) / (COP to vertex): 26 px of the 9-134 px annulus on Table
+        3.1. The capture check counts the decoded pixels there, where the screen seen directly past
+        the paraboloid (:func:`direct_view`, more pixels of the window than the mirrors') cannot
+        stand in for the mirrors."""
+        t, g = rig.profile.tolerancing, rig.geometry
+        f = self.design.focal_px
+        shift = f * math.tan(t.camera_tilt) + f * (t.camera_offset + t.paraboloid_offset) / (g.cop_z - g.vertex_z)
+        lo, hi = self.design.pixel_radius(np.array([self.design.alpha_min, self.design.alpha_max]))
+        r = np.hypot(self.x_px, self.y_px)
+        return ((r > lo + shift) & (r < hi - shift)).reshape(self.shape)
+
 
 @dataclass
 class Traced:

@@ -59,8 +59,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             images = [{n: im.astype(float) / 255.0 for n, im in f.items()} for f in images]
             truth = (theta, surface)
         step("decode, fit, maps")
+        core = M.Camera.of(rig).mirrored_core(rig)
         check = None if args.simulate else (
-            lambda decoded: [check_decoded(folder, k, seq, d) for k, d in zip(plan.labels, decoded)]
+            lambda decoded: [check_decoded(folder, k, seq, d, core) for k, d in zip(plan.labels, decoded)]
             + [check_half_turns(folder, plan, decoded)])
         result = calibrate(optics, rig, images, say=print, check=check)
     _check_heights(result, folder)
