@@ -201,9 +201,7 @@ def summarize(profile: str, resolution, trials: list) -> dict:
 def dome_frame_summary(trials: list) -> dict:
     """The paraboloid's and the camera's placement against the dome (rigcad.calibrate.run.compare's
     ``dome_frame``): per parameter, the share of the trials within target, and how many trials had
-    them all within target (empty for trials run before it was compared)."""
-    if "dome_frame" not in trials[0]:
-        return {}
+    them all within target."""
     rows = [t["dome_frame"] for t in trials]
     return {"dome_frame_parameter_met_fraction": {n: float(np.mean([r["parameters"][n]["met"] for r in rows]))
                                                   for n in rows[0]["parameters"]},
@@ -289,9 +287,7 @@ def tables(summary: dict) -> str:
 
 def dome_frame_rows(trials: list) -> list[str]:
     """The summary table's rows on the paraboloid and the camera against the dome, and on the dome's
-    tilts (the frame's share), for trials that compared them."""
-    if "dome_frame" not in trials[0]:
-        return []
+    tilts (the frame's share)."""
     met = [t["dome_frame"]["parameters_met"] for t in trials]
     total, n = trials[0]["dome_frame"]["parameters_total"], len(trials)
     tilts = [all(t["parameters"][f"dome_tilt_{a}_rad"]["met"] for a in "xy") for t in trials]
@@ -330,9 +326,8 @@ def standard_error_table(summary: dict) -> list[str]:
         z = np.array([p["error_over_standard_error"] for t in trials for n, p in t["parameters"].items()
                       if _in_group(n, group) and n not in GAUGE])
         rows.append(f"| {label} | {np.median(z):.2f} | {100 * np.mean(z <= 2):.0f} % |")
-    if "dome_frame" in trials[0]:
-        z = np.array([p["error_over_standard_error"] for t in trials for p in t["dome_frame"]["parameters"].values()])
-        rows.append(f"| the paraboloid and the camera against the dome | {np.median(z):.2f} | {100 * np.mean(z <= 2):.0f} % |")
+    z = np.array([p["error_over_standard_error"] for t in trials for p in t["dome_frame"]["parameters"].values()])
+    rows.append(f"| the paraboloid and the camera against the dome | {np.median(z):.2f} | {100 * np.mean(z <= 2):.0f} % |")
     rows.append("| calibrated (a Gaussian error) | 0.67 | 95 % |")
     return rows
 

@@ -104,12 +104,13 @@ def in_report_units(names, values: np.ndarray, standard_error: np.ndarray) -> di
     return out
 
 
-def against_dome(rig, fit: FitResult) -> dict:
-    """The fit's paraboloid and camera against the dome (:func:`rigcad.calibrate.model.in_dome_frame`)
-    with their standard errors: what a technician adjusts, free of the frame's tilt that only the
-    priors fix (the fit's standard errors of the same parameters in the sample frame carry it)."""
+def against_dome(rig, fit: FitResult) -> tuple[np.ndarray, np.ndarray]:
+    """The fit's paraboloid and camera against the dome (:func:`rigcad.calibrate.model.in_dome_frame`,
+    mm and rad, :data:`rigcad.calibrate.model.DOME_FRAME_NAMES`) and their standard errors: what a
+    technician adjusts, free of the frame's tilt that only the priors fix (the fit's standard errors
+    of the same parameters in the sample frame carry it)."""
     cov = M.in_dome_frame_covariance(rig, fit.theta, fit.covariance)
-    return in_report_units(M.DOME_FRAME_NAMES, M.in_dome_frame(rig, fit.theta), np.sqrt(np.diag(cov)))
+    return M.in_dome_frame(rig, fit.theta), np.sqrt(np.diag(cov))
 
 
 def direct_ring_mm(design) -> float:

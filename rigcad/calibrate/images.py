@@ -112,8 +112,8 @@ def check_decoded(folder: Path, k: str, seq: Sequence, decoded, mirrored: np.nda
     if lit == 0 or decoded.valid.sum() < MIN_DECODED_FRACTION * lit:
         raise CaptureError(f"{first}: too little modulation: {int(decoded.valid.sum())} of {lit} lit pixels decoded "
                            "(focus on the screen, raise the exposure or the screen's brightness)")
-    core = decoded.lit & mirrored if mirrored is not None else np.zeros_like(decoded.lit)
-    if core.any() and decoded.valid[core].sum() < MIN_DECODED_FRACTION * core.sum():
+    core = decoded.lit & mirrored if mirrored is not None else None
+    if core is not None and core.any() and decoded.valid[core].sum() < MIN_DECODED_FRACTION * core.sum():
         raise CaptureError(f"{first}: too little modulation in the paraboloid's image: {int(decoded.valid[core].sum())} "
                            f"of its {int(core.sum())} lit pixels decoded, though the screen seen directly around it "
                            "decodes (focus on the paraboloid's image; clean the mirrors)")

@@ -14,7 +14,8 @@ import dataclasses
 
 from rigcad.calibrate import bias as B, maps, model as M
 from rigcad.calibrate.decode import decode
-from rigcad.calibrate.fit import DIRECT_STRIDE, SLOPE_PROJECTION, FitData, direct_ring_mm, fit, seen_direct
+from rigcad.calibrate.fit import (DIRECT_STRIDE, SLOPE_PROJECTION, FitData, against_dome, direct_ring_mm, fit,
+                                  seen_direct)
 from rigcad.calibrate.patterns import Sequence
 
 
@@ -162,9 +163,8 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
     names = M.parameter_names(len(result.plan))
     target = np.maximum(0.1 * tol, [math.radians(0.01) if n.endswith("_rad") else 0.02 for n in names])
     in_dome = [names.index(n) for n in M.DOME_FRAME_NAMES]
-    dome_se = np.sqrt(np.diag(M.in_dome_frame_covariance(rig, result.fit.theta, result.fit.covariance)))
-    dome_frame = _against(M.DOME_FRAME_NAMES, M.in_dome_frame(rig, theta_true), M.in_dome_frame(rig, result.fit.theta),
-                          target[in_dome], dome_se)
+    dome_fitted, dome_se = against_dome(rig, result.fit)
+    dome_frame = _against(M.DOME_FRAME_NAMES, M.in_dome_frame(rig, theta_true), dome_fitted, target[in_dome], dome_se)
     return {
         **_against(names, theta_true, result.fit.theta, target, result.fit.standard_error),
         "dome_frame": {"about": "the paraboloid's and the camera's placement against the dome (model.in_dome_frame): "

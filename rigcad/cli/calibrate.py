@@ -145,7 +145,8 @@ def _check_heights(result, folder: Path) -> None:
 
 def _report(result, rig) -> dict:
     from rigcad.calibrate import maps
-    from rigcad.calibrate.fit import against_dome
+    from rigcad.calibrate import model as M
+    from rigcad.calibrate.fit import against_dome, in_report_units
 
     refit = result.map_fit.as_dict()
     return {"fit": result.fit.as_dict(),
@@ -153,7 +154,7 @@ def _report(result, rig) -> dict:
                                           "the dome's axis (model.in_dome_frame): what the images fix apart from the "
                                           "rig's tilt over the sample plane, which only the priors fix; the parameters "
                                           "under 'fit' are in the sample frame (docs/calibrate.md)",
-                                 "parameters": against_dome(rig, result.fit)},
+                                 "parameters": in_report_units(M.DOME_FRAME_NAMES, *against_dome(rig, result.fit))},
             "residual_slopes": result.slope_figures(),
             "map_model": {"about": "the corrected map's model: refit from the fit above with each pixel's dome-slope "
                                    "residual component down-weighted (docs/calibrate.md)",
