@@ -1,7 +1,8 @@
 """The camera images a calibration capture would give, without hardware (``rigcad calibrate
 --simulate``): the rig moved by a seeded random misalignment within ``tolerancing``, a planted
 surface error on the dome, each camera pixel's sub-rays traced to the screen with the pattern
-integrated over each sub-ray's footprint, defocus blur, photon and read noise, 8-bit quantisation.
+integrated over each sub-ray's footprint and dimmed by the two mirrors' reflectance, defocus blur,
+photon and read noise, 8-bit quantisation.
 
 The dome's surface error h (mm, along the reflecting side's normal, in the dome's own frame): a
 Gaussian bump of ``calibration.sim_bump_amplitude`` and width ``sim_bump_width`` centred on a
@@ -147,6 +148,7 @@ def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.
     x = (cam.x_px[:, None] + ox[None, :]).ravel()
     y = (cam.y_px[:, None] - oy[None, :]).ravel()
     tr = with_surface(true_rig, surface, M.trace_camera(optics, true_rig, x, y, cam.design))
+    gain = mirror_loss(rig, tr)
     width, height = cam.resolution
     out = []
     for pose in M.screens(plan, theta):
@@ -161,12 +163,19 @@ def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.
         for name in seq.names():
             val = np.zeros(n * s * s)
             val[lit] = means[name]
-            expected = (BLACK_LEVEL + (WHITE_LEVEL - BLACK_LEVEL) * val.reshape(n, s * s).mean(axis=1))
+            expected = (gain * (BLACK_LEVEL + (WHITE_LEVEL - BLACK_LEVEL) * val)).reshape(n, s * s).mean(axis=1)
             expected = gaussian_filter(expected.reshape(cam.shape), cal.sim_blur) if cal.sim_blur > 0 else \
                 expected.reshape(cam.shape)
             frames[name] = _expose(expected, cam, (height, width), cal, rng)
         out.append(frames)
     return out
+
+
+def mirror_loss(rig, tr: M.Traced) -> np.ndarray:
+    """Each sub-ray's share of the screen's light that reaches the camera (n,): the two mirrors'
+    ``coating.reflectance`` squared off the mirrors, 1 seen directly past the paraboloid, 1 where it
+    sees no screen (the black level there is the room's)."""
+    return np.where(tr.ok, rig.profile.coating.reflectance ** 2, 1.0)
 
 
 def sub_edges(cx: np.ndarray, cy: np.ndarray, shape: tuple[int, int]) -> np.ndarray:

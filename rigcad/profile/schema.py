@@ -371,6 +371,11 @@ class CoatingParams:
     margin: float = spec("float", "paint to have at hand per layer, as a multiple of the film's volume on the "
                          "mirrors (rigcad manual): spray guns land about half of what they spray (HVLP transfer "
                          "efficiency ~50-65 %), plus a test panel", 2.5, lo=1, hi=100)
+    reflectance: float = spec("float", "fraction of visible light the top layer (the mirror) reflects, the same on "
+                              "both mirrors; assumed 0.6: MirraChrome gives 95 % of chrome plating's reflectivity "
+                              "(thesis 3.4), and polished chrome reflects ~0.6-0.65 of visible light. A ray seen "
+                              "through the rig meets both mirrors, so it keeps its square", 0.6, lo=0, hi=1,
+                              lo_open=True)
 
 
 @dataclass(frozen=True)
