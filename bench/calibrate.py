@@ -66,26 +66,30 @@ def trial(optics, rig, seed: int, without_bias: bool = False) -> dict:
     return out
 
 
-#: The sweep's variants: name -> the calibration keys they change.
-VARIANTS = {"steps3": "  phase_steps: 3\n", "steps4": "  phase_steps: 4\n", "steps8": "  phase_steps: 8\n",
-            "heights_2_10mm": "  spacer_heights: [2 mm, 10 mm]\n",
-            "heights_1_20mm": "  spacer_heights: [1 mm, 20 mm]\n",
-            "heights_1_30mm": "  spacer_heights: [1 mm, 30 mm]\n",
-            "heights_1_10_20mm": "  spacer_heights: [1 mm, 10 mm, 20 mm]\n",
+#: The sweep's variants: name -> the profile keys they change (YAML under ``extends``).
+VARIANTS = {"steps3": "calibration:\n  phase_steps: 3\n", "steps4": "calibration:\n  phase_steps: 4\n",
+            "steps8": "calibration:\n  phase_steps: 8\n",
+            "heights_2_10mm": "calibration:\n  spacer_heights: [2 mm, 10 mm]\n",
+            "heights_1_20mm": "calibration:\n  spacer_heights: [1 mm, 20 mm]\n",
+            "heights_1_30mm": "calibration:\n  spacer_heights: [1 mm, 30 mm]\n",
+            "heights_1_10_20mm": "calibration:\n  spacer_heights: [1 mm, 10 mm, 20 mm]\n",
             # the grazing rays (docs/calibrate.md, "Why the all-lit p99 stays above"): a coarse period
             # whose phase needs only 3 Gray bits survives long footprints; a thin panel's emitting
             # surface 1 mm up (not the tablet's 6 mm) reaches the rays that pass under the tablet
-            "periods_1024_128_16": "  periods: [1024, 128, 16]\n  gray_bits: 3\n",
-            "thin_1mm": "  screen_thickness: 1 mm\n",
-            "thin_1mm_periods_1024_128_16": "  screen_thickness: 1 mm\n  periods: [1024, 128, 16]\n  gray_bits: 3\n",
+            "periods_1024_128_16": "calibration:\n  periods: [1024, 128, 16]\n  gray_bits: 3\n",
+            "thin_1mm": "calibration:\n  screen_thickness: 1 mm\n",
+            "thin_1mm_periods_1024_128_16": "calibration:\n  screen_thickness: 1 mm\n  periods: [1024, 128, 16]\n  gray_bits: 3\n",
             # the frame (docs/calibrate.md, "What fixes the frame"): without the half turn, the
             # screen's wedge sets it; a screen that settles less repeatably, or more (on three pads);
             # one flatter on its spacer (planted and assumed alike)
-            "half_turn_none": "  half_turn: none\n",
-            "half_turn_highest": "  half_turn: highest\n",
-            "screen_seating_0.05deg": "  screen_seating: 0.05 deg\n",
-            "screen_seating_0.005deg": "  screen_seating: 0.005 deg\n",
-            "screen_tilt_0.02deg": "  screen_tilt: 0.02 deg\n"}
+            "half_turn_none": "calibration:\n  half_turn: none\n",
+            "half_turn_highest": "calibration:\n  half_turn: highest\n",
+            "screen_seating_0.05deg": "calibration:\n  screen_seating: 0.05 deg\n",
+            "screen_seating_0.005deg": "calibration:\n  screen_seating: 0.005 deg\n",
+            "screen_tilt_0.02deg": "calibration:\n  screen_tilt: 0.02 deg\n",
+            # what the mirrors' loss costs: the capture as the simulation rendered it before
+            # coating.reflectance (both views at the screen's full light)
+            "mirrors_lossless": "coating:\n  reflectance: 1\n"}
 
 
 def sweep(base: str, trials: int, names: list[str] | None = None) -> dict:
@@ -103,7 +107,7 @@ def sweep(base: str, trials: int, names: list[str] | None = None) -> dict:
             if names and name not in names:
                 continue
             path = Path(tmp) / f"{name}.yaml"
-            path.write_text(f"extends: {base}\ncalibration:\n{keys}")
+            path.write_text(f"extends: {base}\n{keys}")
             rig = Rig.from_profile(load_profile(path))
             optics = analytic_optics(rig)
             rows = [trial(optics, rig, 1000 + seed) for seed in range(trials)]
@@ -221,7 +225,8 @@ VARIANT_LABELS = {"steps3": "3 phase steps", "steps4": "4 phase steps (the defau
                   "half_turn_highest": "a half turn at the highest spacer only (3 captures)",
                   "screen_seating_0.05deg": "the screen settling to 0.05 deg, not 0.02",
                   "screen_seating_0.005deg": "the screen settling to 0.005 deg (a three-point seat)",
-                  "screen_tilt_0.02deg": "the screen flat on its spacers to 0.02 deg, not 0.2"}
+                  "screen_tilt_0.02deg": "the screen flat on its spacers to 0.02 deg, not 0.2",
+                  "mirrors_lossless": "mirrors that lose no light (reflectance 1, not 0.6)"}
 
 
 def _spread(values, digits: int) -> str:

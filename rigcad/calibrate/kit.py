@@ -140,7 +140,9 @@ camera's full resolution, {p.camera.resolution[0]} x {p.camera.resolution[1]} px
   80-90 % of full scale (a saturated white is refused; so is an all-dark one). The brightest are the
   ring around the paraboloid's image, where the camera sees the screen directly through the dome's
   top opening, with no mirror's loss: set the exposure there. Keep that ring in the images: the fit
-  reads it, and it fixes the camera's place.
+  reads it, and it fixes the camera's place. The paraboloid's image inside it is dimmer: each
+  mirror reflects {100 * p.coating.reflectance:.0f} % (`coating.reflectance`), so it gets
+  {100 * p.coating.reflectance ** 2:.0f} % of the ring's light. That is expected; do not raise the exposure for it.
 - Keep the room dark: stray light lowers the fringes' modulation (pixels under
   {cal.min_modulation:g} modulation are not decoded).
 - Focus between the two screen heights; a little defocus is harmless.

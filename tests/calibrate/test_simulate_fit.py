@@ -394,6 +394,8 @@ def test_kit_patterns_spacers_and_page(tmp_path, small):
         assert manifest["parts"][f"calibration_spacer_{k}"]["volume_mm3"] == pytest.approx(vol, rel=1e-6)
     page = (out / "calibration.md").read_text()
     assert "h1_<frame>.png" in page and "h1r_<frame>.png" in page and "Exposure" in page
+    # the paraboloid's image at the mirrors' loss, the one the simulation renders (reflectance 0.6)
+    assert "each\n  mirror reflects 60 %" in page and "36 % of the ring's light" in page
     # what to adjust after the fit: the placement against the dome, held to the profile's tolerances
     assert "`against_the_dome`" in page and "paraboloid: 0.1 mm sideways, 0.2 mm in height, 0.2 deg" in page
 
