@@ -8,9 +8,10 @@ unwrapped from the one before (temporal unwrapping, Huntley and Saldner 1993). U
 pixel whose Gray stripe centre lies further than 3/4 of a stripe from its unwrapped coarse position,
 or whose next finer position rounds within 0.15 of a period from the ambiguity, is not refined
 past the last level that agreed (the coarse level failing: the pixel is not decoded). A pixel is
-decoded when it is lit (white - black above ``LIT_FRACTION`` of the image's 99th percentile) and
-its coarsest sinusoids show at least ``min_modulation`` in both axes. Coordinates as
-:mod:`rigcad.calibrate.patterns` (screen px, continuous; mm in the screen frame)."""
+decoded when it is lit (white - black above ``LIT_FRACTION`` of the image's 99th percentile, or of
+the paraboloid's image's where that is lower: :func:`decode`) and its coarsest sinusoids show at
+least ``min_modulation`` in both axes. Coordinates as :mod:`rigcad.calibrate.patterns` (screen px,
+continuous; mm in the screen frame)."""
 
 from __future__ import annotations
 
@@ -20,8 +21,9 @@ import numpy as np
 
 from rigcad.calibrate.patterns import AXES, Sequence
 
-#: Lit pixels: white - black above this fraction of its 99th percentile over the image. Below it a
-#: pixel sees no screen (the beam, the paraboloid's shadow, past the screen's edge).
+#: Lit pixels: white - black above this fraction of its 99th percentile over the image (or over the
+#: paraboloid's image, if dimmer: :func:`decode`). Below it a pixel sees no screen (the beam, the
+#: paraboloid's shadow, past the screen's edge).
 LIT_FRACTION = 0.05
 #: Unwrapping check margins (fractions of a Gray stripe, of a period): see the module docstring.
 GRAY_MARGIN = 0.75
@@ -156,11 +158,19 @@ class Decoded:
                 "finer_period_disagreements": {a: [list(t) for t in d.disagreements] for a, d in self.axes.items()}}
 
 
-def decode(seq: Sequence, images: dict[str, np.ndarray], min_modulation: float) -> Decoded:
-    """Decode one capture (``images``: every frame of ``seq.names()``, float camera images)."""
+def decode(seq: Sequence, images: dict[str, np.ndarray], min_modulation: float,
+           reference: np.ndarray | None = None) -> Decoded:
+    """Decode one capture (``images``: every frame of ``seq.names()``, float camera images).
+    ``reference`` ((h, w) bool, optional): the pixels of the paraboloid's image
+    (:meth:`rigcad.calibrate.model.Camera.mirrored_core`). The lit threshold is then taken from
+    the dimmer of the image's and their 99th percentiles: the mirrors keep ``coating.reflectance``
+    squared of the screen's light, and a threshold on the screen seen directly around them would
+    drop the mirrored pixels that see a screen's edge in part."""
     white, black = np.asarray(images["white"], float), np.asarray(images["black"], float)
     contrast = white - black
     top = float(np.percentile(contrast, 99)) if contrast.size else 0.0
+    if reference is not None and reference.any():
+        top = min(top, float(np.percentile(contrast[reference], 99)))
     lit = contrast > LIT_FRACTION * top if top > 0 else np.zeros(contrast.shape, bool)
     axes = {a: decode_axis(seq, a, images, white, black, lit, min_modulation) for a in AXES}
     cx, cy = axes["x"].coordinate, axes["y"].coordinate

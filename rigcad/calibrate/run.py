@@ -64,7 +64,9 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     if len(images) != len(plan):
         raise ValueError(f"{len(images)} captures given, the plan has {len(plan)}: {', '.join(plan.labels)}")
     t0 = time.perf_counter()
-    decoded = [decode(seq, {n: cam.crop(im) for n, im in frames.items()}, cal.min_modulation) for frames in images]
+    core = cam.mirrored_core(rig)
+    decoded = [decode(seq, {n: cam.crop(im) for n, im in frames.items()}, cal.min_modulation, core)
+               for frames in images]
     t1 = time.perf_counter()
     if check is not None:
         check(decoded)

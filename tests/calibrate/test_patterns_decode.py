@@ -97,6 +97,29 @@ def test_blurred_fine_period_falls_back_to_the_coarse_one():
     np.testing.assert_allclose(SEQ.from_mm(d.u, d.v)[0], cx, atol=0.6)
 
 
+def test_the_paraboloids_image_is_lit_against_its_own_white():
+    """The screen seen directly (left half, full light) beside the paraboloid's image (right half,
+    at the mirrors' 0.36): in the right half, a column of pixels sees the screen over a tenth of its
+    footprint (the rest past the screen's edge: black). Its contrast, 0.032 (a tenth of the right
+    half's 0.324), is under the lit threshold taken from the direct view's white (0.05 x 0.9) and
+    over the one taken from the mirrored image's own (0.05 x 0.324): with the paraboloid's image as
+    the reference it is lit, without it it is not; the pixels that see no screen stay unlit."""
+    rng = np.random.default_rng(5)
+    cx, cy = rng.uniform(2, 638, (20, 40)), rng.uniform(2, 398, (20, 40))
+    frames = _camera(SEQ, cx, cy)
+    gain = np.ones((20, 40))
+    gain[:, 20:] = 0.36
+    gain[:, 30] *= 0.1  # a tenth of the footprint on the screen
+    gain[:, 35] = 0.0  # no screen
+    images = {n: 0.02 + gain * (im - 0.05) for n, im in frames.items()}
+    core = np.zeros((20, 40), bool)
+    core[:, 20:] = True
+    plain, seen = decode(SEQ, images, 0.1), decode(SEQ, images, 0.1, core)
+    assert not plain.lit[:, 30].any() and seen.lit[:, 30].all()
+    assert plain.lit[:, :30].all() and seen.lit[:, :30].all()
+    assert not seen.lit[:, 35].any()
+
+
 def test_frames_out_of_order_tear_the_decoded_map():
     cx, cy = np.meshgrid(np.linspace(5, 630, 60), np.linspace(5, 390, 40))  # a smooth view of the screen
     images = _camera(SEQ, cx, cy)
