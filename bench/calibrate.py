@@ -37,23 +37,25 @@ def trial(optics, rig, seed: int, without_bias: bool = False) -> dict:
     from rigcad.calibrate import model as M, simulate as S
     from rigcad.calibrate.patterns import Sequence
     from rigcad.calibrate.run import calibrate, compare
+    from rigcad.calibrate.upright import random_placement
 
     seq = Sequence.from_profile(rig.profile.calibration)
     plan = M.Plan.of(rig.profile)
     rng = np.random.default_rng(seed)
     theta = S.random_misalignment(rig, plan, rng)
+    placement = random_placement(rig.profile, rng)
     surface = S.planted_surface(rig, rng)
     t0 = time.perf_counter()
-    images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, plan, rng)
+    images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, plan, rng, placement)
     t1 = time.perf_counter()
     c1 = time.process_time()
     frames = [{n: im.astype(float) / 255 for n, im in f.items()} for f in images]
     result = calibrate(optics, rig, frames)
     t2 = time.perf_counter()
     cpu = time.process_time() - c1
-    out = compare(optics, rig, result, theta, surface)
+    out = compare(optics, rig, result, theta, surface, placement)
     if without_bias:  # the same capture without removing the decoding's own bias (rigcad.calibrate.bias)
-        plain = compare(optics, rig, calibrate(optics, rig, frames, bias=None), theta, surface)
+        plain = compare(optics, rig, calibrate(optics, rig, frames, bias=None), theta, surface, placement)
         out["without_bias_correction"] = {k: plain[k] for k in (
             "corrected_incidence_error_deg", "corrected_incidence_error_deg_by_source", "parameters_met",
             "fitted_model_incidence_error_deg", "recovered_slope_rms_mrad", "slope_difference_rms_mrad")}
@@ -89,7 +91,12 @@ VARIANTS = {"steps3": "calibration:\n  phase_steps: 3\n", "steps4": "calibration
             "screen_tilt_0.02deg": "calibration:\n  screen_tilt: 0.02 deg\n",
             # what the mirrors' loss costs: the capture as the simulation rendered it before
             # coating.reflectance (both views at the screen's full light)
-            "mirrors_lossless": "coating:\n  reflectance: 1\n"}
+            "mirrors_lossless": "coating:\n  reflectance: 1\n",
+            # the upright display (rigcad.calibrate.upright): without it (the earlier capture); three
+            # turns rather than four; its active area starting at the sample plane, not 1 mm under it
+            "upright_none": "calibration:\n  upright_turns: 0\n",
+            "upright_turns_3": "calibration:\n  upright_turns: 3\n",
+            "upright_depth_0": "calibration:\n  upright_depth: 0 mm\n"}
 
 
 def sweep(base: str, trials: int, names: list[str] | None = None) -> dict:
@@ -226,7 +233,10 @@ VARIANT_LABELS = {"steps3": "3 phase steps", "steps4": "4 phase steps (the defau
                   "screen_seating_0.05deg": "the screen settling to 0.05 deg, not 0.02",
                   "screen_seating_0.005deg": "the screen settling to 0.005 deg (a three-point seat)",
                   "screen_tilt_0.02deg": "the screen flat on its spacers to 0.02 deg, not 0.2",
-                  "mirrors_lossless": "mirrors that lose no light (reflectance 1, not 0.6)"}
+                  "mirrors_lossless": "mirrors that lose no light (reflectance 1, not 0.6)",
+                  "upright_none": "no upright display (the earlier capture)",
+                  "upright_turns_3": "the upright display at 3 turns, not 4",
+                  "upright_depth_0": "its active area from the sample plane, not 1 mm under it"}
 
 
 def _spread(values, digits: int) -> str:
@@ -266,6 +276,7 @@ def tables(summary: dict) -> str:
         f"{np.median(met):.0f} ({100 * summary['parameters_within_target_fraction']:.0f} %) | all: **"
         f"{'met' if min(met) == total else 'not met'}** ({sum(m == total for m in met)} of {n}) |",
         *dome_frame_rows(trials),
+        *upright_rows(trials),
         f"| slope RMS recovered / planted ({np.median([t['planted_slope_rms_mrad'] for t in trials]):.2f} mrad) "
         f"| {min(ratio):.3f}-{max(ratio):.3f} | within 20 %: **{'met' if max(abs(r - 1) for r in ratio) <= 0.2 else 'not met'}** |",
         f"| slope difference RMS, pointwise | {_spread([t['slope_difference_rms_mrad'] for t in trials], 2)} mrad | |",
@@ -288,6 +299,19 @@ def tables(summary: dict) -> str:
                             f"{r['parameters_total']} | {r['calibration_cpu_s']:.1f} |")
     rows += causes_table(summary) + coverage_table(summary) + standard_error_table(summary)
     return "\n".join(rows) + "\n"
+
+
+def upright_rows(trials: list) -> list[str]:
+    """The summary table's row on the upright display's placements (none without it)."""
+    placed = [t["upright_placement"] for t in trials if "upright_placement" in t]
+    if not placed:
+        return []
+    mm = [1e3 * max(p[k] for k in ("dz_mm", "du_mm", "dv_mm")) for p in placed]
+    rad = [1e3 * max(p[k] for k in ("tilt_x_rad", "tilt_y_rad", "turn_rad")) for p in placed]
+    every = sum(p["captures_placed"] == p["captures"] for p in placed)
+    return [f"| the upright display's placements, the largest error over a trial's captures: offsets; tilts and "
+            f"turn | {_spread(mm, 1)} um; {_spread(rad, 3)} mrad | (every capture placed in {every} of "
+            f"{len(placed)}) |"]
 
 
 def dome_frame_rows(trials: list) -> list[str]:
@@ -382,7 +406,8 @@ def causes_table(summary: dict) -> list[str]:
             "|---" * (len(heads) + 2) + "|",
             f"| the default, {len(trials)} trial{'s' if len(trials) > 1 else ''} | {100 * summary['unmeasured_causes_fraction_of_lit_median']['measured']:.1f}"
             f" | {pct(summary['unmeasured_causes_fraction_of_lit_median'])} |",
-            "| its incidence error p99 (deg, median) | | " + " | ".join(f"{v:.3f}" for v in p99) + " |"]
+            "| its incidence error p99 (deg, median) | | "
+            + " | ".join("" if np.isnan(v) else f"{v:.3f}" for v in p99) + " |"]
     sweep_rows = summary.get("sweep_phase_steps_and_heights", {})
     for name, label in VARIANT_LABELS.items():
         if "unmeasured_causes_fraction_of_lit" in sweep_rows.get(name, {}):

@@ -3,7 +3,8 @@
 Naming scheme: a folder with one image per capture and frame, ``{label}_{frame}.{png|tif|tiff}``:
 label ``h<k>`` for spacer k's capture, k its index in ``calibration.spacer_heights`` (0 first), and
 ``h<k>r`` for spacer k's again, turned a half turn (``calibration.half_turn``: the highest's or each's;
-:class:`rigcad.calibrate.model.Plan`); frame a name of
+:class:`rigcad.calibrate.model.Plan`), ``u<j>`` for the upright display at its stand's turn j
+(``calibration.upright_turns``: :mod:`rigcad.calibrate.upright`); frame a name of
 :meth:`rigcad.calibrate.patterns.Sequence.names` (white, black, x_gray0.., x_p128_s0.., y_...),
 e.g. ``h1_y_p16_s3.png``, ``h1r_white.png``. Grey 8- or 16-bit PNG or TIFF (colour is averaged to
 grey), every image at the camera's resolution. Values are scaled to [0, 1] by the format's full scale."""
@@ -62,7 +63,7 @@ def read_image(path: Path, resolution: tuple[int, int]) -> np.ndarray:
 
     if not path.is_file():
         raise CaptureError(f"{path}: missing (naming scheme h<spacer>_<frame>.png|tif, h<spacer>r_ for the half "
-                           "turn: see docs/calibrate.md)")
+                           "turn, u<turn>_ for the upright display: see docs/calibrate.md)")
     try:
         with Image.open(path) as im:
             im.load()

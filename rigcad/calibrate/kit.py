@@ -38,6 +38,70 @@ def spacer(profile, k: int):
                 "the holder's seat", in_rig=False)
 
 
+#: The upright stand's slot: clearance around the display's module (mm, each side), and the least wall
+#: the stand's cylinder keeps around it.
+SLOT_CLEARANCE_MM = 0.2
+SLOT_WALL_MM = 1.0
+#: How far above the sample plane the stand's back holds the upright display (mm).
+STAND_BACK_MM = 12.0
+
+
+def upright_room(profile) -> dict:
+    """Where the upright display's module stands in its stand (mm): its slot's farthest corner from
+    the axis (the module's face ``upright_offset`` out, its body ``upright_thickness`` behind it,
+    ``upright_border`` beyond the active area at each side, plus the slot's clearance) against the
+    stand's radius (the sample holder's) less a wall. ``fits``: the slot stays inside the stand."""
+    cal, holder = profile.calibration, profile.sample_holder
+    half = cal.upright_resolution[0] * cal.upright_pitch / 2 + cal.upright_border + SLOT_CLEARANCE_MM
+    front = cal.upright_offset + SLOT_CLEARANCE_MM
+    back = cal.upright_offset - cal.upright_thickness - SLOT_CLEARANCE_MM
+    corner = max(math.hypot(front, half), math.hypot(back, half))
+    return {"corner_mm": corner, "room_mm": holder.radius - SLOT_WALL_MM, "half_width_mm": half,
+            "fits": corner <= holder.radius - SLOT_WALL_MM}
+
+
+def check_upright_fits(profile) -> dict:
+    """:func:`upright_room`, refused with a ProfileError naming ``calibration.upright_offset`` when the
+    upright display's module cannot stand in the holder's bore."""
+    from rigcad.errors import ProfileError
+
+    room = upright_room(profile)
+    if profile.calibration.upright_turns and not room["fits"]:
+        cal = profile.calibration
+        raise ProfileError(
+            f"calibration.upright_offset {cal.upright_offset:g} mm: the upright display's module "
+            f"({2 * (room['half_width_mm'] - SLOT_CLEARANCE_MM):.1f} mm wide with its border, "
+            f"{cal.upright_thickness:g} mm thick) would reach {room['corner_mm']:.1f} mm from the axis, but its stand in the "
+            f"holder's bore keeps {room['room_mm']:.1f} mm (sample_holder.radius less a {SLOT_WALL_MM:g} mm wall): "
+            "bring it nearer the axis, or choose a narrower display (calibration.upright_resolution)",
+            where=profile.where("calibration", "upright_offset"))
+    return room
+
+
+def upright_stand(profile):
+    """The upright display's stand as a recipe Part: the holder's plug (stop collar under the plate)
+    whose top stands ``upright_depth`` under the sample plane, with a slot whose floor holds the
+    module's lower edge so its active area starts there, and a back rising :data:`STAND_BACK_MM`
+    above the plane behind the module. Drawn for turn 0 (the display's face towards +x)."""
+    from rigcad.parts.base import holder_body
+    from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Union_
+
+    cal = profile.calibration
+    r = profile.sample_holder.radius
+    top, floor = -cal.upright_depth, -cal.upright_depth - cal.upright_border
+    room = upright_room(profile)
+    half = room["half_width_mm"]
+    front, back = cal.upright_offset + SLOT_CLEARANCE_MM, cal.upright_offset - cal.upright_thickness - SLOT_CLEARANCE_MM
+    body = holder_body(profile, top)
+    rise = Difference(Cylinder((0.0, 0.0, top - 1.0), r, STAND_BACK_MM - top + 1.0),
+                      (Box((back, -r - 1.0, top - 2.0), (r + 1.0, r + 1.0, STAND_BACK_MM + 1.0)),))
+    slot = Box((back, -half, floor), (front, half, STAND_BACK_MM + 1.0))
+    return Part("calibration_upright_stand", Difference(Union_((body, rise)), (slot,)), (0.6, 0.45, 0.2),
+                f"calibration stand for the upright display: replaces the sample holder; the display's module stands "
+                f"in its slot, face out {cal.upright_offset:g} mm from the axis, its active area from {cal.upright_depth:g} mm "
+                "under the sample plane", in_rig=False)
+
+
 def screen_room(rig) -> dict:
     """Where the screen lies inside the dome (mm): the display's half diagonal (its corners' distance
     from the axis when it lies centred) against the dome's inside radius, the least over the heights
@@ -125,16 +189,16 @@ the dome as they were built and placed; the fit of the misalignment; the dome's 
   `calibration.screen_tilt`); {half_turn}
   Clean the spacer's top and the screen's back; a screen that rocks on a camera bump needs a flat
   plate under it, counted in `screen_thickness`.
-
+{_upright_kit(p, len(plan))}
 ## Capture order
 In turn:
-{steps}
+{steps}{_upright_steps(p, len(plan))}
 
 and for each, the {len(frames)} frames in this order (the names of `patterns/`): {', '.join(frames[:4])}, ...,
 {frames[-1]}. Name each camera image `<capture>_<frame>.png` (or .tif, 8 or 16 bit, grey or colour) at the
 camera's full resolution, {p.camera.resolution[0]} x {p.camera.resolution[1]} px, all in one folder; then
 `rigcad calibrate {p.name} --images <folder>`.
-
+{_upright_by_eye(p)}
 ## Exposure
 - One exposure for every frame of a capture: set it on the white frame so the brightest lit pixels sit at
   80-90 % of full scale (a saturated white is refused; so is an all-dark one). The brightest are the
@@ -143,13 +207,64 @@ camera's full resolution, {p.camera.resolution[0]} x {p.camera.resolution[1]} px
   reads it, and it fixes the camera's place. The paraboloid's image inside it is dimmer: each
   mirror reflects {100 * p.coating.reflectance:.0f} % (`coating.reflectance`), so it gets
   {100 * p.coating.reflectance ** 2:.0f} % of the ring's light. That is expected; do not raise the exposure for it.
-- Keep the room dark: stray light lowers the fringes' modulation (pixels under
+{_upright_exposure(p)}- Keep the room dark: stray light lowers the fringes' modulation (pixels under
   {cal.min_modulation:g} modulation are not decoded).
 - Focus between the two screen heights; a little defocus is harmless.
-- The screen reaches rays up to {reach:.0f} deg from the axis at the highest spacer: beyond that the
-  corrected map is filled from the fit.
+- The screen reaches rays up to {reach:.0f} deg from the axis at the highest spacer: beyond that
+  {"the lower spacer's and then the upright display's captures take over" if cal.upright_turns else
+   "the corrected map is filled from the fit"}.
 
 {_after_the_fit(p.tolerancing)}"""
+
+
+def _upright_kit(p, flat: int) -> str:
+    """The kit's item for the upright display (empty without ``calibration.upright_turns``)."""
+    cal = p.calibration
+    if not cal.upright_turns:
+        return ""
+    w, h = cal.upright_resolution
+    return f"""- A small display stood on edge, the upright display: {w} x {h} px at {cal.upright_pitch:g} mm pitch
+  ({w * cal.upright_pitch:.1f} x {h * cal.upright_pitch:.1f} mm), its module {cal.upright_thickness:g} mm thick with
+  {cal.upright_border:g} mm of frame beyond the active area at the sides and below. Its stand
+  (`stl/calibration_upright_stand.stl`) replaces the sample holder in the bore: stand the module in the
+  slot, face out, on the slot's floor, against the stand's back; the active area then starts
+  {cal.upright_depth:g} mm under the sample plane, {cal.upright_offset:g} mm from the axis. It meets the rays
+  that reach the sample near grazing, which pass under the flat screen or meet it past its edge.
+  Show the PNGs of `patterns_upright/` on it full screen, unscaled (the same frames, at its size).
+"""
+
+
+def _upright_steps(p, flat: int) -> str:
+    """The capture order's steps for the upright display (empty without ``calibration.upright_turns``)."""
+    cal = p.calibration
+    if not cal.upright_turns:
+        return ""
+    step = 360 / cal.upright_turns
+    return "\n" + "\n".join(
+        f"{flat + j + 1}. the upright display in its stand, its face towards "
+        + ("the +x side (the projector's)" if j == 0 else f"{step * j:g} deg counter-clockwise from there, seen from above")
+        + f": files `u{j}_<frame>.png`" for j in range(cal.upright_turns))
+
+
+def _upright_by_eye(p) -> str:
+    """What the upright display's turns need (empty without ``calibration.upright_turns``)."""
+    cal = p.calibration
+    if not cal.upright_turns:
+        return ""
+    return f"""
+By eye is enough for the upright display's turns: the fit finds where it stands (within
+{math.degrees(cal.upright_tilt):g} deg of lean or turn and {M.PLACEMENT_MM:g} mm sideways), against the rays the flat
+captures measured. A turn far from its mark is refused, naming its file.
+"""
+
+
+def _upright_exposure(p) -> str:
+    """The exposure advice for the upright display (empty without ``calibration.upright_turns``)."""
+    if not p.calibration.upright_turns:
+        return ""
+    return """- The upright display's captures light nothing but the paraboloid's image (the display is edge on to
+  the direct view): set their exposure on that image, to the same 80-90 % of full scale.
+"""
 
 
 def _after_the_fit(tol) -> str:
@@ -170,16 +285,21 @@ wider.
 
 def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
     """Write the kit into ``out`` (published atomically): patterns/<frame>.png, stl/ and step/
-    calibration_spacer_<k>, calibration.md, manifest.json (each file's SHA-256, the spacers' volumes)."""
+    calibration_spacer_<k>, calibration.md, manifest.json (each file's SHA-256, the parts' volumes);
+    with ``upright_turns``, patterns_upright/<frame>.png and calibration_upright_stand too."""
     from rigcad.export import mesh as EM
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
     from rigcad.export.manifest import profile_digest, sha256_hex
     from rigcad.export.step import reimport_check, step_writer
     from rigcad.parts import _kernel as K
 
+    from rigcad.calibrate.upright import Uprights
+
     p = rig.profile
     check_screen_fits(rig)
+    check_upright_fits(p)
     seq = Sequence.from_profile(p.calibration)
+    ups = Uprights.of(p)
     files, parts = {}, {}
     with Staging(out, lock=profile_lock(out.parent.parent, p.name) if out.parent.name == p.name else None,
                  made_from=profile_digest(p)) as st:
@@ -187,8 +307,12 @@ def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
             data = pattern_png(seq, name)
             st.write_bytes(out / "patterns" / f"{name}.png", data)
             files[f"patterns/{name}.png"] = sha256_hex(data)
-        for k in range(len(p.calibration.spacer_heights)):
-            part = spacer(p, k)
+            if len(ups):
+                data = pattern_png(ups.seq, name)
+                st.write_bytes(out / "patterns_upright" / f"{name}.png", data)
+                files[f"patterns_upright/{name}.png"] = sha256_hex(data)
+        tools = [spacer(p, k) for k in range(len(p.calibration.spacer_heights))]
+        for part in tools + ([upright_stand(p)] if len(ups) else []):
             say(part.name)
             shape = K.part_solid(part, p.tessellation.fit_tolerance, K.FitReport(), p)
             step_path = out / "step" / f"{part.name}.step"
@@ -205,6 +329,7 @@ def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
         st.write_bytes(out / "calibration.md", page)
         files["calibration.md"] = sha256_hex(page)
         manifest = {"profile": p.name, "screen_resolution_px": list(p.calibration.screen_resolution),
+                    **({"upright_resolution_px": list(p.calibration.upright_resolution)} if len(ups) else {}),
                     "frames_in_capture_order": seq.names(), "parts": parts, "files": files}
         st.write_bytes(out / "manifest.json", json_bytes(manifest))
         st.commit()

@@ -38,7 +38,7 @@ MEASURED_WEIGHT = 0.5
 FILLED_WEIGHT = 0.02
 
 
-def away_from_edges(valid: np.ndarray, other_path: np.ndarray | None = None) -> np.ndarray:
+def away_from_edges(valid: np.ndarray, other_path: np.ndarray | None = None, steps: int = HEIGHT_EDGE_PX) -> np.ndarray:
     """(n,) the decoded pixels of one height (``valid`` (rows, cols)) at least :data:`HEIGHT_EDGE_PX`
     steps along rows and columns from any it did not decode: the ones the rays and the fit read.
     ``other_path`` ((n,) bool): pixels that see the screen along the other path (directly past the
@@ -49,10 +49,11 @@ def away_from_edges(valid: np.ndarray, other_path: np.ndarray | None = None) -> 
 
     if other_path is not None:
         valid = valid & ~other_path.reshape(valid.shape)
-    return binary_erosion(valid, iterations=HEIGHT_EDGE_PX).ravel()
+    return binary_erosion(valid, iterations=steps).ravel() if steps else valid.ravel()
 
 
-def pivot_rays(decoded: list, poses: list, model_tr: M.Traced, shape: tuple[int, int]) -> np.ndarray:
+def pivot_rays(decoded: list, poses: list, model_tr: M.Traced, shape: tuple[int, int],
+               steps: list[int] | None = None) -> np.ndarray:
     """Unit directions (n, 3), up, of each window pixel's ray through the fitted model's dome point
     and its decoded screen points: per height, from the screen point to the dome point, averaged
     over the heights that decoded the pixel away from their edges (NaN where none did).
@@ -64,10 +65,11 @@ def pivot_rays(decoded: list, poses: list, model_tr: M.Traced, shape: tuple[int,
     true ray by the fit's error (0.01-0.05 mm median on seeds 101-106 with 1/20 mm spacers: ~0.1-0.35
     mrad over the lever, smooth across the pixels), and a paraboloid slope error, which moves the
     dome point, is read as a dome tilt there. A pixel seen at one height (grazing rays past the
-    upper screen's edge) is measured too."""
+    upper screen's edge) is measured too. ``steps``: per capture, the edge rule's reach
+    (:func:`away_from_edges`; :data:`HEIGHT_EDGE_PX` each by default)."""
     total = np.zeros((int(np.prod(shape)), 3))
-    for d, pose in zip(decoded, poses):
-        inner = away_from_edges(d.valid, model_tr.direct) & model_tr.ok
+    for k, (d, pose) in enumerate(zip(decoded, poses)):
+        inner = away_from_edges(d.valid, model_tr.direct, HEIGHT_EDGE_PX if steps is None else steps[k]) & model_tr.ok
         to_dome = model_tr.p2 - to_global(pose, d.u, d.v).reshape(-1, 3)
         with np.errstate(invalid="ignore", divide="ignore"):
             to_dome /= np.linalg.norm(to_dome, axis=1)[:, None]
@@ -82,8 +84,9 @@ CAUSES = ("measured", "under_the_screens", "dark_in_every_capture", "lit_not_dec
           "within_the_edge_rule", "next_to_unmeasured")
 CAUSE_NOTES = {
     "measured": "a measured direction (the corrected map's source 1)",
-    "under_the_screens": "the fitted model's dome point lies below the lowest screen's surface: the ray passes "
-                         "under every screen (a screen surface nearer the sample plane reaches it)",
+    "under_the_screens": "the fitted model's dome point lies below the lowest flat screen's surface: the ray passes "
+                         "under every flat screen (a screen surface nearer the sample plane, or the upright display, "
+                         "reaches it)",
     "dark_in_every_capture": "no capture lit the pixel: its ray meets the screens past their edges, or a shadow",
     "lit_not_decoded": "lit, but no height decoded it: too little modulation (a footprint too long for the "
                        "coarsest period) or a failed unwrapping check",
@@ -94,15 +97,18 @@ CAUSE_NOTES = {
 }
 
 
-def unmeasured_causes(decoded: list, poses: list, model_tr: M.Traced, source: np.ndarray) -> np.ndarray:
+def unmeasured_causes(decoded: list, poses: list, model_tr: M.Traced, source: np.ndarray,
+                      steps: list[int] | None = None) -> np.ndarray:
     """(n,) int8 index into :data:`CAUSES` per window pixel (-1 where the fitted model's ray is lost):
     from the captures' lit and decoded masks, the rays' edge rule (:func:`away_from_edges`), the
-    corrected map's ``source`` and the fitted model's dome points against the lowest fitted screen."""
+    corrected map's ``source`` and the fitted model's dome points against the lowest of ``poses``
+    (the flat screens'). ``steps``: per capture of ``decoded``, the edge rule's reach."""
     lowest = min(poses, key=lambda pose: float(pose.translation[2]))
     q, _ = lowest.localize(np.nan_to_num(model_tr.p2), np.zeros_like(model_tr.p2))
     lit = np.any([d.lit.ravel() for d in decoded], axis=0)
     valid = np.any([d.valid.ravel() for d in decoded], axis=0)
-    inner = np.any([away_from_edges(d.valid, model_tr.direct) for d in decoded], axis=0)
+    reach = [HEIGHT_EDGE_PX] * len(decoded) if steps is None else steps
+    inner = np.any([away_from_edges(d.valid, model_tr.direct, r) for d, r in zip(decoded, reach)], axis=0)
     checks = (source == 1, q[:, 2] < 0, ~lit, ~valid, ~inner)
     out = np.full(len(source), len(CAUSES) - 1, dtype=np.int8)
     for code in range(len(checks) - 1, -1, -1):  # the first cause that applies wins
@@ -152,16 +158,21 @@ def direction_jacobian(optics, rig, cam: M.Camera, theta: np.ndarray) -> np.ndar
 
 
 def corrected_map(model_tr: M.Traced, measured: np.ndarray, shape: tuple[int, int], dir_jac: np.ndarray,
-                  cov_rig: np.ndarray) -> dict:
+                  cov_rig: np.ndarray, short: np.ndarray | None = None) -> dict:
     """The corrected map (module docstring): ``direction`` (n, 3), ``uncertainty_rad`` (n,),
-    ``source`` (n,: 0 none, 1 measured, 2 filled, 3 model only)."""
+    ``source`` (n,: 0 none, 1 measured, 2 filled, 3 model only). ``short`` (n,) bool: pixels
+    measured where their footprints are short (the upright display's,
+    :mod:`rigcad.calibrate.upright`), which :data:`EDGE_PX` does not fill."""
     from scipy.ndimage import binary_erosion
 
     model = -model_tr.v
     seen = np.all(np.isfinite(measured), axis=1) & model_tr.ok
     # a pixel next to an undecoded one sees the screen's or a shadow's edge in part of its footprint
-    # (its decoded point is pulled towards the lit part): filled from the inner ones instead
-    seen &= binary_erosion(seen.reshape(shape), iterations=EDGE_PX).ravel()
+    # (its decoded point is pulled towards the lit part): filled from the inner ones instead, but
+    # where its footprint is short
+    if EDGE_PX:
+        kept = seen & short if short is not None else np.zeros_like(seen)
+        seen = (seen & binary_erosion(seen.reshape(shape), iterations=EDGE_PX).ravel()) | kept
     resid = np.where(seen[:, None], measured - model, 0.0)
     sm, w1 = _smooth(resid, seen, shape, SMOOTH_PX)
     fill, w2 = _smooth(resid, seen, shape, FILL_PX)

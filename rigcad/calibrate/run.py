@@ -12,7 +12,7 @@ import numpy as np
 
 import dataclasses
 
-from rigcad.calibrate import bias as B, maps, model as M
+from rigcad.calibrate import bias as B, maps, model as M, upright as U
 from rigcad.calibrate.decode import decode
 from rigcad.calibrate.fit import (DIRECT_STRIDE, SLOPE_PROJECTION, FitData, against_dome, direct_ring_mm, fit,
                                   seen_direct)
@@ -41,6 +41,10 @@ class Calibration:
     #: per window pixel, why it has no measured direction (maps.unmeasured_causes)
     causes: np.ndarray
     timings_s: dict = field(default_factory=dict)
+    #: the upright display's captures (rigcad.calibrate.upright): their plan, decodings and placements
+    uprights: object = None
+    upright_decoded: list = field(default_factory=list)
+    placed: list = field(default_factory=list)
 
     def slope_figures(self) -> dict:
         """Residual slope RMS and worst (mrad) over the decoded pixels."""
@@ -61,15 +65,18 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     seq = Sequence.from_profile(cal)
     cam = M.Camera.of(rig)
     plan = M.Plan.of(rig.profile)
-    if len(images) != len(plan):
-        raise ValueError(f"{len(images)} captures given, the plan has {len(plan)}: {', '.join(plan.labels)}")
+    ups = U.Uprights.of(rig.profile)
+    if len(images) != len(plan) + len(ups):
+        raise ValueError(f"{len(images)} captures given, the plan has {len(plan) + len(ups)}: "
+                         f"{', '.join(plan.labels + ups.labels)}")
     t0 = time.perf_counter()
     core = cam.mirrored_core(rig)
-    decoded = [decode(seq, {n: cam.crop(im) for n, im in frames.items()}, cal.min_modulation, core)
-               for frames in images]
+    decoded = [decode(seq if c < len(plan) else ups.seq, {n: cam.crop(im) for n, im in frames.items()},
+                      cal.min_modulation, core) for c, frames in enumerate(images)]
     t1 = time.perf_counter()
     if check is not None:
         check(decoded)
+    decoded, upright_decoded = decoded[:len(plan)], decoded[len(plan):]
     say(f"decoded {', '.join(str(d.stats()['decoded_pixels']) for d in decoded)} camera pixels per capture "
         f"({', '.join(plan.labels)})")
     if bias == "map":
@@ -92,20 +99,31 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     fitted = M.moved(rig, for_map.theta)
     model_tr = M.trace_camera(optics, fitted, cam.x_px, cam.y_px, cam.design)
     measured = maps.pivot_rays(decoded, poses, model_tr, cam.shape)
+    placed = [U.place(p0, U.placement_scale(rig.profile), d, model_tr, measured, cam.shape)
+              for p0, d in zip(ups.nominal, upright_decoded)]
+    short = None
+    if placed:  # each placed upright capture's rays join the flat ones'
+        on = [k for k, pl in enumerate(placed) if pl.placed]
+        short = np.any([maps.away_from_edges(upright_decoded[k].valid, model_tr.direct, U.EDGE_PX) for k in on],
+                       axis=0) & model_tr.ok if on else None
+        measured = maps.pivot_rays(decoded + [upright_decoded[k] for k in on],
+                                   poses + ups.poses(np.array([placed[k].placement for k in on]).reshape(-1, 6)),
+                                   model_tr, cam.shape, [maps.HEIGHT_EDGE_PX] * len(plan) + [U.EDGE_PX] * len(on))
     n_rig = len(M.RIG_NAMES)
     jac = maps.direction_jacobian(optics, rig, cam, for_map.theta)
-    corrected = maps.corrected_map(model_tr, measured, cam.shape, jac, for_map.covariance[:n_rig, :n_rig])
+    corrected = maps.corrected_map(model_tr, measured, cam.shape, jac, for_map.covariance[:n_rig, :n_rig], short)
     # the slopes from the smoothed measurement (the raw rays' noise, divided by 2 cos of the dome's
     # angle of incidence, would swamp them), where measured
     seen = (corrected["source"] == 1)[:, None]
     slopes = np.where(seen, maps.residual_slopes(model_tr, np.where(seen, corrected["direction"], np.nan)), np.nan)
-    causes = maps.unmeasured_causes(decoded, poses, model_tr, corrected["source"])
+    causes = maps.unmeasured_causes(decoded + upright_decoded, poses, model_tr, corrected["source"],
+                                    [maps.HEIGHT_EDGE_PX] * len(plan) + [U.EDGE_PX] * len(upright_decoded))
     t3 = time.perf_counter()
     from rigcad.check.sources import pixel_rays
 
     design = cam.design.direction(pixel_rays(cam.design, cam.x_px, cam.y_px).dirs)
     return Calibration(cam, plan, decoded, result, for_map, model_tr, measured, slopes, corrected, design, causes,
-                       {"decode_s": t1 - t0, "fit_s": t2 - t1, "maps_s": t3 - t2})
+                       {"decode_s": t1 - t0, "fit_s": t2 - t1, "maps_s": t3 - t2}, ups, upright_decoded, placed)
 
 
 def _unbiased(decoded: list, bias: np.ndarray) -> list:
@@ -141,11 +159,13 @@ def _points(decoded: list, idx: np.ndarray) -> np.ndarray:
     return np.stack([np.stack([d.u.ravel()[idx], d.v.ravel()[idx]], axis=-1) for d in decoded], axis=1)
 
 
-def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -> dict:
+def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface,
+            placement: np.ndarray | None = None) -> dict:
     """A simulation's figures against what was planted: each parameter's error against its
     tolerance, and the paraboloid's and the camera's against the dome (``dome_frame``), the corrected
     and the design (uncorrected) map's incidence error (deg, p99 and more over the lit pixels), the
-    residual slopes against the planted ones (mrad)."""
+    residual slopes against the planted ones (mrad); with the upright captures' true ``placement``,
+    their fitted placements' errors."""
     from rigcad.calibrate.simulate import surface_slopes, with_surface
 
     cam = result.cam
@@ -184,7 +204,18 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -
         "frame": _frame(result.corrected, up, lit),
         "slope_pixels": int(seen.sum()), "planted_slope_rms_mrad": rms(g_p), "recovered_slope_rms_mrad": rms(g_r),
         "slope_difference_rms_mrad": rms(g_r - g_p),
+        **({} if placement is None or not len(placement) else
+           {"upright_placement": _placement_errors(result, placement)}),
     }
+
+
+def _placement_errors(result: Calibration, placement: np.ndarray) -> dict:
+    """The upright captures' fitted placements against the planted ones: the largest error over the
+    captures of each parameter (mm, or rad for the tilts and the turn), NaN for an unplaced capture."""
+    err = np.array([pl.placement for pl in result.placed]) - placement
+    return {"about": "largest |fitted - planted| over the upright captures, per placement parameter",
+            **{k: float(np.max(np.abs(err[:, i]))) for i, k in enumerate(M.SCREEN_KEYS)},
+            "captures": len(result.placed), "captures_placed": int(sum(pl.placed for pl in result.placed))}
 
 
 def _against(names, planted: np.ndarray, fitted: np.ndarray, target: np.ndarray, se: np.ndarray) -> dict:
@@ -230,9 +261,10 @@ def _coverage(err_deg: np.ndarray, corrected: dict, lit: np.ndarray) -> dict:
     return out
 
 
-def truth_maps(optics, rig, result: Calibration, theta_true: np.ndarray, surface) -> dict:
+def truth_maps(optics, rig, result: Calibration, theta_true: np.ndarray, surface, placement=None) -> dict:
     """Per window pixel, for a simulation's pictures: the planted slope magnitude (mrad, where the
-    calibration measured slopes) and both maps' incidence errors (deg)."""
+    calibration measured slopes) and both maps' incidence errors (deg). (``placement``, the upright
+    captures', changes none of them.)"""
     from rigcad.calibrate.simulate import surface_slopes, with_surface
 
     cam = result.cam

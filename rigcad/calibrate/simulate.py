@@ -134,41 +134,61 @@ def sub_offsets(s: int) -> np.ndarray:
 
 
 def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.Camera, seq: Sequence,
-           plan: M.Plan, rng: np.random.Generator) -> list[dict[str, np.ndarray]]:
-    """Per capture (``plan``), every frame of ``seq`` as the camera records it: full-resolution uint8
-    images (rows, cols) (module docstring). ``theta``: the true misalignment (model parameters)."""
-    from scipy.ndimage import gaussian_filter
+           plan: M.Plan, rng: np.random.Generator, placement: np.ndarray | None = None) -> list[dict[str, np.ndarray]]:
+    """Per capture (``plan``, then the upright display's, :mod:`rigcad.calibrate.upright`), every
+    frame as the camera records it: full-resolution uint8 images (rows, cols) (module docstring).
+    ``theta``: the true misalignment (model parameters); ``placement``: the upright captures' true
+    placements (:func:`rigcad.calibrate.upright.random_placement`), with ``calibration.upright_turns``.
+    The upright display is seen off the mirrors only, on its face (its back, and the screen seen
+    edge on past the paraboloid, are dark), and exposed for the paraboloid's image: nothing else
+    of the window is lit, so its mirrors' loss costs no exposure."""
+    from rigcad.calibrate.upright import Uprights
 
-    cal = rig.profile.calibration
-    s = cal.sim_supersample
+    ups = Uprights.of(rig.profile)
+    if len(ups) and (placement is None or len(placement) != len(ups)):
+        raise ValueError(f"render: {len(ups)} upright captures need their placements")
+    s = rig.profile.calibration.sim_supersample
     true_rig = M.moved(rig, theta)
     off = sub_offsets(s)
     ox, oy = [a.ravel() for a in np.meshgrid(off, off)]
-    n = len(cam.x_px)
     x = (cam.x_px[:, None] + ox[None, :]).ravel()
     y = (cam.y_px[:, None] - oy[None, :]).ravel()
     tr = with_surface(true_rig, surface, M.trace_camera(optics, true_rig, x, y, cam.design))
     gain = mirror_loss(rig, tr)
-    width, height = cam.resolution
-    out = []
-    for pose in M.screens(plan, theta):
+    # pixels with a sub-ray on a screen's side, off the mirrors or direct
+    out = [_capture(rig, cam, seq, *tr.screen(pose), tr.ok | tr.direct, gain, rng) for pose in M.screens(plan, theta)]
+    for pose in ups.poses(placement if len(ups) else np.zeros((0, 6))):
         su, sv = tr.screen(pose)
-        cx, cy = seq.from_mm(su, sv)
-        edges = sub_edges(cx.reshape(n, s, s), cy.reshape(n, s, s), cam.shape)
-        frames = {}
-        # pixels with a sub-ray on a screen's side, off the mirrors or direct
-        lit = np.repeat((tr.ok | tr.direct).reshape(n, s * s).any(axis=1), s * s)
-        means = seq.footprint_means(seq.names(), np.nan_to_num(cx[lit], nan=-1e9), np.nan_to_num(cy[lit], nan=-1e9),
-                                    edges[lit])
-        for name in seq.names():
-            val = np.zeros(n * s * s)
-            val[lit] = means[name]
-            expected = (gain * (BLACK_LEVEL + (WHITE_LEVEL - BLACK_LEVEL) * val)).reshape(n, s * s).mean(axis=1)
-            expected = gaussian_filter(expected.reshape(cam.shape), cal.sim_blur) if cal.sim_blur > 0 else \
-                expected.reshape(cam.shape)
-            frames[name] = _expose(expected, cam, (height, width), cal, rng)
-        out.append(frames)
+        face = tr.ok & (np.nan_to_num(tr.v) @ pose.rotation[:, 2] < 0)
+        out.append(_capture(rig, cam, ups.seq, np.where(face, su, np.nan), np.where(face, sv, np.nan), face,
+                            np.ones_like(gain), rng))
     return out
+
+
+def _capture(rig, cam: M.Camera, seq: Sequence, su: np.ndarray, sv: np.ndarray, seen: np.ndarray, gain: np.ndarray,
+             rng: np.random.Generator) -> dict[str, np.ndarray]:
+    """One capture's frames from each sub-ray's screen point (``su``, ``sv`` mm; ``seen``: the
+    sub-rays on the screen's side) and its share of the light (``gain``)."""
+    from scipy.ndimage import gaussian_filter
+
+    cal = rig.profile.calibration
+    s = cal.sim_supersample
+    n = len(cam.x_px)
+    width, height = cam.resolution
+    cx, cy = seq.from_mm(su, sv)
+    edges = sub_edges(cx.reshape(n, s, s), cy.reshape(n, s, s), cam.shape)
+    lit = np.repeat(seen.reshape(n, s * s).any(axis=1), s * s)
+    means = seq.footprint_means(seq.names(), np.nan_to_num(cx[lit], nan=-1e9), np.nan_to_num(cy[lit], nan=-1e9),
+                                edges[lit])
+    frames = {}
+    for name in seq.names():
+        val = np.zeros(n * s * s)
+        val[lit] = means[name]
+        expected = (gain * (BLACK_LEVEL + (WHITE_LEVEL - BLACK_LEVEL) * val)).reshape(n, s * s).mean(axis=1)
+        expected = gaussian_filter(expected.reshape(cam.shape), cal.sim_blur) if cal.sim_blur > 0 else \
+            expected.reshape(cam.shape)
+        frames[name] = _expose(expected, cam, (height, width), cal, rng)
+    return frames
 
 
 def mirror_loss(rig, tr: M.Traced) -> np.ndarray:

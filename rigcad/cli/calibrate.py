@@ -12,10 +12,9 @@ from pathlib import Path
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
-    import numpy as np
-
     from rigcad.calibrate import model as M
     from rigcad.calibrate.images import check_decoded, check_half_turns, read_capture
+    from rigcad.calibrate.upright import Uprights
     from rigcad.calibrate.patterns import Sequence
     from rigcad.calibrate.run import calibrate, compare
     from rigcad.check.scene import analytic_optics
@@ -24,10 +23,11 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from rigcad.progress import stages
     from rigcad.rig import load
 
-    from rigcad.calibrate.kit import check_screen_fits, write_kit
+    from rigcad.calibrate.kit import check_screen_fits, check_upright_fits, write_kit
 
     rig = load(args.profile)
     check_screen_fits(rig)  # a screen that cannot lie in the dome is refused before any work
+    check_upright_fits(rig.profile)  # nor an upright display that cannot stand in the bore
     capture_out = getattr(args, "write_capture", None)
     if capture_out:
         _check_capture_folder(Path(capture_out), args.simulate)
@@ -39,32 +39,27 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         return 0
     seq = Sequence.from_profile(rig.profile.calibration)
     plan = M.Plan.of(rig.profile)
+    ups = Uprights.of(rig.profile)
     folder, images, truth = Path("<simulated>"), None, None
     if not args.simulate:  # a capture that is missing or the wrong size is refused before any work
         folder = Path(args.images)
-        images = read_capture(folder, seq, plan.labels, rig.profile.camera.resolution)
+        images = (read_capture(folder, seq, plan.labels, rig.profile.camera.resolution)
+                  + read_capture(folder, ups.seq, ups.labels, rig.profile.camera.resolution))
     with stages(3, "calibrate") as step:
         step("tracer")
         optics = analytic_optics(rig)
         if args.simulate:
-            from rigcad.calibrate import simulate as S
-
             step("simulated capture")
-            rng = np.random.default_rng(args.seed)
-            theta = S.random_misalignment(rig, plan, rng)
-            surface = S.planted_surface(rig, rng)
-            images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, plan, rng)
-            if capture_out:
-                _write_capture(Path(capture_out), plan, images, args.profile)
-            images = [{n: im.astype(float) / 255.0 for n, im in f.items()} for f in images]
-            truth = (theta, surface)
+            images, truth = _simulated(optics, rig, args, capture_out)
         step("decode, fit, maps")
         core = M.Camera.of(rig).mirrored_core(rig)
         check = None if args.simulate else (
-            lambda decoded: [check_decoded(folder, k, seq, d, core) for k, d in zip(plan.labels, decoded)]
-            + [check_half_turns(folder, plan, decoded)])
+            lambda decoded: [check_decoded(folder, k, seq if c < len(plan) else ups.seq, d, core)
+                             for c, (k, d) in enumerate(zip(plan.labels + ups.labels, decoded))]
+            + [check_half_turns(folder, plan, decoded[:len(plan)])])
         result = calibrate(optics, rig, images, say=print, check=check)
     _check_heights(result, folder)
+    _check_uprights(result, rig.profile, folder)
     report = _report(result, rig)
     extra = None
     if truth is not None:
@@ -91,6 +86,27 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _simulated(optics, rig, args: argparse.Namespace, capture_out: str | None) -> tuple[list, tuple]:
+    """``--simulate``'s capture (seeded by ``--seed``), written out with ``--write-capture``, as the
+    images to calibrate (float) and the truth to compare with (misalignment, surface, upright placement)."""
+    import numpy as np
+
+    from rigcad.calibrate import model as M, simulate as S
+    from rigcad.calibrate.patterns import Sequence
+    from rigcad.calibrate.upright import Uprights, random_placement
+
+    plan = M.Plan.of(rig.profile)
+    rng = np.random.default_rng(args.seed)
+    theta = S.random_misalignment(rig, plan, rng)
+    placement = random_placement(rig.profile, rng)
+    surface = S.planted_surface(rig, rng)
+    images = S.render(optics, rig, theta, surface, M.Camera.of(rig), Sequence.from_profile(rig.profile.calibration),
+                      plan, rng, placement)
+    if capture_out:
+        _write_capture(Path(capture_out), plan.labels + Uprights.of(rig.profile).labels, images, args.profile)
+    return [{n: im.astype(float) / 255.0 for n, im in f.items()} for f in images], (theta, surface, placement)
+
+
 def _against_dome_line(params: dict) -> str:
     """One line: the paraboloid's and the camera's placement against the dome, with standard errors."""
     def part(c: str) -> str:
@@ -111,15 +127,16 @@ def _check_capture_folder(folder: Path, simulate: bool) -> None:
         raise ExportError(f"--write-capture {folder}: it exists and is not an empty folder; name a new or empty one")
 
 
-def _write_capture(folder: Path, plan, images: list, profile: str) -> None:
-    """The simulated capture's images (per capture of ``plan``, frame name -> uint8 image) as the PNG
-    files ``--images`` reads (rigcad.calibrate.images.capture_path), published at once."""
+def _write_capture(folder: Path, labels: tuple[str, ...], images: list, profile: str) -> None:
+    """The simulated capture's images (per capture ``labels``: the plan's, then the upright display's;
+    frame name -> uint8 image) as the PNG files ``--images`` reads
+    (rigcad.calibrate.images.capture_path), published at once."""
     from rigcad.calibrate.images import capture_path
     from rigcad.export.atomic import Staging
     from rigcad.export.png import gray_png
 
     with Staging(folder) as st:
-        for label, frames in zip(plan.labels, images):
+        for label, frames in zip(labels, images):
             for name, im in frames.items():
                 st.write_bytes(capture_path(folder, label, name), gray_png(im))
         st.commit()
@@ -141,6 +158,33 @@ def _check_heights(result, folder: Path) -> None:
         if abs(dz) > HEIGHT_TOLERANCE_MM:
             raise CaptureError(f"{capture_path(folder, label, 'white')}: the images put the screen {dz:+.2f} mm from "
                                f"its spacer's height ({plan.heights[k]:g} mm above O): wrong spacer or order")
+
+
+#: An upright capture placed further than this many of its tolerances from its nominal pose
+#: (upright.placement_scale) is one the images contradict: the stand at another turn's mark, or the
+#: display the wrong way round.
+UPRIGHT_TOLERANCES = 5.0
+
+
+def _check_uprights(result, profile, folder: Path) -> None:
+    """An upright capture that could not be placed, or that the images place far from its mark."""
+    import numpy as np
+
+    from rigcad.calibrate import model as M
+    from rigcad.calibrate.images import CaptureError, capture_path
+    from rigcad.calibrate.upright import MIN_REFERENCE_PIXELS, placement_scale
+
+    scale = placement_scale(profile)
+    for label, pl in zip(result.uprights.labels, result.placed):
+        where = capture_path(folder, label, "white")
+        if not pl.placed:
+            raise CaptureError(f"{where}: the upright display decodes at {pl.pixels} of the pixels the flat captures "
+                               f"measured, under the {MIN_REFERENCE_PIXELS} that place it: is it on, facing the dome, "
+                               "in the stand at its mark?")
+        worst = int(np.argmax(np.abs(pl.placement) / scale))
+        if abs(pl.placement[worst]) > UPRIGHT_TOLERANCES * scale[worst]:
+            raise CaptureError(f"{where}: the images place the upright display {abs(pl.placement[worst]) / scale[worst]:.0f} "
+                               f"tolerances from its mark ({M.SCREEN_KEYS[worst]}): wrong turn, or captures out of order")
 
 
 def _report(result, rig) -> dict:
@@ -166,10 +210,26 @@ def _report(result, rig) -> dict:
                                     "measured direction, each pixel counted under the first cause that applies; "
                                     "corrected_map.npz's 'cause' shows where",
                            "fraction_of_lit": maps.cause_fractions(result.causes), "causes": maps.CAUSE_NOTES},
-            "decoding": [d.stats() for d in result.decoded], "captures": list(result.plan.labels),
+            "decoding": [d.stats() for d in result.decoded + result.upright_decoded],
+            "captures": list(result.plan.labels + result.uprights.labels),
+            "upright_display": _uprights_report(result),
             "screen_heights_mm": result.plan.heights.tolist(),
             "timings_s": result.timings_s, "camera_window": {"row0": result.cam.row0, "col0": result.cam.col0,
                                                              "shape": list(result.cam.shape)}}
+
+
+def _uprights_report(result) -> dict:
+    """Each upright capture's fitted placement (in the display's own frame) and its resection."""
+    from rigcad.calibrate import model as M
+    from rigcad.calibrate.fit import in_report_units
+
+    names = [f"{k}" for k in M.SCREEN_KEYS]
+    return {"about": "the upright display's captures (rigcad.calibrate.upright): each placement from its nominal pose, "
+                     "in the display's frame (dz along its normal, tilts about its width and height, du sideways, dv "
+                     "up, its turn about its normal), fitted against the rays the flat captures measured",
+            "captures": {label: {"parameters": in_report_units(names, pl.placement, pl.standard_error),
+                                 "rms_residual_mm": pl.rms_mm, "reference_pixels": pl.pixels, "outliers_dropped": pl.outliers}
+                         for label, pl in zip(result.uprights.labels, result.placed)}}
 
 
 def _picture(name: str, result, extra) -> bytes:
@@ -217,14 +277,15 @@ def register(subparsers) -> argparse.ArgumentParser:
         subparsers, "calibrate", cmd_calibrate,
         help="deflectometric calibration of the as-built rig (a screen at the sample)",
         description="Decode a capture of the calibration screen at two or more spacer heights (images "
-                    "h<spacer>_<frame>.png|tif, h<spacer>r_<frame> for the half turn, docs/calibrate.md), fit "
+                    "h<spacer>_<frame>.png|tif, h<spacer>r_<frame> for the half turn, u<turn>_<frame> for the upright "
+                    "display, docs/calibrate.md), fit "
                     "the rig's misalignment with its own tracer, map the dome's residual slopes and write exports/<profile>/calibrate/: "
                     "calibration.json, corrected_map.npz (read by rigcad basis --simulate), maps.png. "
                     "--simulate renders a seeded capture of a moved rig with a planted dome error instead and "
                     "compares; --kit writes the screen patterns, the spacers and the manual's page.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif, "
-                     "h<spacer>r_<frame>)")
+                     "h<spacer>r_<frame>, u<turn>_<frame>)")
     src.add_argument("--simulate", action="store_true", help="render a seeded simulated capture and calibrate it")
     src.add_argument("--kit", action="store_true", help="write the calibration kit: screen patterns, spacers "
                      "(STL, STEP, manifest), the manual's page, into <exports>/<profile>/calibrate_kit")

@@ -565,6 +565,26 @@ class CalibrationParams:
     screen_seating: float = spec("angle", "how the same screen on the same spacer repeats its tilt when laid again "
                                  "(dust, the print's texture): with half_turn, the map's frame's tolerance",
                                  "0.02 deg", lo=0, lo_open=True, hi=5 * DEG)
+    upright_turns: int = spec("int", "captures of a second, small display stood on edge in the holder's bore, its face "
+                              "towards the dome (rigcad.calibrate.upright): one at each of this many equal turns about "
+                              "the axis (0: none; 3 or more cover every azimuth). It sees the rays near grazing, which "
+                              "pass under the flat screen", 4, lo=0, hi=24)
+    upright_offset: float = spec("length", "upright display: its face's distance from the axis (its module must stand in "
+                                 "the holder's bore: rigcad.calibrate.kit.check_upright_fits)", "7 mm", lo=0, hi=100.0)
+    upright_pitch: float = spec("length", "upright display: pixel pitch (a 2-inch 240 x 320 module: 0.1275 mm)",
+                                "0.1275 mm", lo=0.005, hi=2.0)
+    upright_resolution: tuple[int, int] = spec("pixels", "upright display: [width, height] in pixels, width along "
+                                               "the sample plane", [240, 320])
+    upright_depth: float = spec("length", "upright display: how far below the sample plane its active area starts "
+                                "(its stand sinks it into the holder's bore, so the last rays before grazing meet it)",
+                                "1 mm", lo=0, hi=20.0)
+    upright_border: float = spec("length", "upright display: its module's frame beyond the active area, at the sides "
+                                 "and below (the stand's ledge and the bore's room)", "2 mm", lo=0, hi=20.0)
+    upright_thickness: float = spec("length", "upright display: the module's thickness (its stand's slot)", "4 mm",
+                                    lo=0, lo_open=True, hi=30.0)
+    upright_tilt: float = spec("angle", "upright display: how far it may lean in its stand or the stand turn from its "
+                               "mark (the fit's prior; the simulation plants within it)", "2 deg", lo=0, lo_open=True,
+                               hi=10 * DEG)
     phase_steps: int = spec("int", "phase shifts per sinusoid period (>= 3)", 4, lo=3, hi=64)
     periods: tuple[int, ...] = spec("ints", "sinusoid periods in screen pixels, coarse to fine unwrapping "
                                     "(the coarsest is unwrapped by the Gray code)", [128, 16], lo=4, hi=MAX_PIXELS)
