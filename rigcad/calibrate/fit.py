@@ -304,7 +304,7 @@ def fit(optics, rig, cam: M.Camera, plan: M.Plan, data: FitData, say=None, slope
     direct_rows = np.repeat(data.direct, 2 * len(plan))
     full = np.zeros(len(prob.keep))
     full[prob.keep] = res.fun[:int(prob.keep.sum())]
-    drop, sigma = _outliers(full, prob.keep, direct_rows)
+    drop, sigma = outlying_rows(full, prob.keep, direct_rows)
     outliers = int(drop.sum())
     if outliers and say:
         say(f"dropping {outliers} outlying residuals (> {OUTLIER_SIGMAS:g} robust sigmas); refitting")
@@ -329,7 +329,7 @@ def fit(optics, rig, cam: M.Camera, plan: M.Plan, data: FitData, say=None, slope
                      rms(rows[direct] / prob.direct_weight), prob.direct_weight)
 
 
-def _outliers(full: np.ndarray, keep: np.ndarray, direct_rows: np.ndarray) -> tuple[np.ndarray, dict]:
+def outlying_rows(full: np.ndarray, keep: np.ndarray, direct_rows: np.ndarray) -> tuple[np.ndarray, dict]:
     """Rows (of ``keep``) beyond :data:`OUTLIER_SIGMAS` robust sigmas (1.4826 MAD) of their own path's,
     and each path's sigma in the units of ``full`` ({True: the direct view's, False: the mirrors'};
     0 for a path with no rows)."""

@@ -42,8 +42,6 @@ MIN_REFERENCE_PIXELS = 200
 #: The resection's robust first solve (mm on the display): the measured rays meet it within ~0.01 mm
 #: (0.1 mrad over ~100 mm) but near the flat screens' edges.
 ROBUST_SCALE_MM = 0.05
-#: Residuals beyond this many robust sigmas (1.4826 MAD) are dropped before the second solve.
-OUTLIER_SIGMAS = 5.0
 #: The simulated placement (:func:`random_placement`): how far the display sits from its slot's face
 #: along its normal, and from its ledge, within +- this (mm): a printed slot holds it to ~0.2 mm.
 SEAT_MM = 0.2
@@ -132,7 +130,7 @@ def place(nominal: Pose, scale: np.ndarray, decoded, model_tr: M.Traced, measure
     ``measured`` (n, 3) the flat captures' rays (up; NaN where none), ``model_tr`` the fitted model."""
     from scipy.optimize import least_squares
 
-    from rigcad.calibrate.fit import CLUSTER_PX, posterior_covariance
+    from rigcad.calibrate.fit import CLUSTER_PX, outlying_rows, posterior_covariance
     from rigcad.calibrate.maps import away_from_edges
 
     inner = (away_from_edges(decoded.valid, model_tr.direct, EDGE_PX) & model_tr.ok
@@ -148,11 +146,11 @@ def place(nominal: Pose, scale: np.ndarray, decoded, model_tr: M.Traced, measure
         su, sv = on_screen(compose(nominal, screen_pose(*(z * scale))), p, d)
         return np.nan_to_num((np.stack([su, sv], axis=1) - target).ravel()[keep], nan=1.0)
 
-    res = least_squares(fun, np.zeros(6), method="trf", loss="soft_l1", f_scale=ROBUST_SCALE_MM, xtol=1e-12, ftol=1e-12)
-    r = res.fun
-    sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
-    drop = np.abs(r) > OUTLIER_SIGMAS * max(sigma, 1e-12)
-    keep[np.nonzero(keep)[0][drop]] = False
+    res = least_squares(fun, np.zeros(6), method="trf", loss="soft_l1", f_scale=ROBUST_SCALE_MM, xtol=1e-12,
+                        ftol=1e-12)
+    # residuals past the fit's outlier limit (its robust sigmas) dropped, as the misalignment fit does
+    drop, _ = outlying_rows(res.fun, np.ones(len(res.fun), bool), np.zeros(len(res.fun), bool))
+    keep[drop] = False
     res = least_squares(fun, res.x, method="trf", xtol=1e-12, ftol=1e-12)
     tiles = (rows // shape[1] // CLUSTER_PX) * (shape[1] // CLUSTER_PX + 1) + rows % shape[1] // CLUSTER_PX
     # no prior: thousands of rays converging on O hold all six (standard errors ~1 um, ~0.1 mrad)
