@@ -79,10 +79,15 @@ def read_image(path: Path, resolution: tuple[int, int]) -> np.ndarray:
     return arr.astype(float) / full
 
 
-def read_capture(folder: Path, seq: Sequence, labels: tuple[str, ...], resolution: tuple[int, int]) -> list[dict]:
-    """Every frame of every capture (``labels``: the plan's, module docstring), exposure-checked."""
+def read_capture(folder: Path, seq: Sequence, labels: tuple[str, ...], resolution: tuple[int, int],
+                 absent: str = "") -> list[dict]:
+    """Every frame of every capture (``labels``: the plan's, module docstring), exposure-checked.
+    ``absent``: what to say when a capture has none of its files (how to calibrate without it)."""
     out = []
     for k in labels:
+        if absent and not any(capture_path(folder, k, n).is_file() for n in seq.names()):
+            raise CaptureError(f"{capture_path(folder, k, 'white')}: missing, and every other frame of capture {k}: "
+                               f"{absent}")
         frames = {n: read_image(capture_path(folder, k, n), resolution) for n in seq.names()}
         check_exposure(folder, k, frames)
         out.append(frames)

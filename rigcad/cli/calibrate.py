@@ -44,7 +44,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if not args.simulate:  # a capture that is missing or the wrong size is refused before any work
         folder = Path(args.images)
         images = (read_capture(folder, seq, plan.labels, rig.profile.camera.resolution)
-                  + read_capture(folder, ups.seq, ups.labels, rig.profile.camera.resolution))
+                  + read_capture(folder, ups.seq, ups.labels, rig.profile.camera.resolution,
+                                 absent=f"the upright display's (calibration.upright_turns: {len(ups)}); to "
+                                        "calibrate without one, set calibration.upright_turns: 0"))
     with stages(3, "calibrate") as step:
         step("tracer")
         optics = analytic_optics(rig)

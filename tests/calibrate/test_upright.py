@@ -196,14 +196,17 @@ def test_the_upright_captures_go_through_their_files(tmp_path, written):
 
 @pytest.mark.parametrize("spoil, words", [
     (lambda f: (f / "u2_y_p16_s1.png").unlink(), ("u2_y_p16_s1.png", "missing", "u<turn>_ for the upright display")),
+    (lambda f: [p.unlink() for p in f.glob("u*_*.png")],
+     ("u0_white.png", "missing, and every other frame of capture u0", "set calibration.upright_turns: 0")),
     (lambda f: [(f / p.name).rename(f / p.name.replace("u1_", "t_")) for p in f.glob("u1_*.png")]
      + [(f / p.name).rename(f / p.name.replace("u3_", "u1_")) for p in f.glob("u3_*.png")]
      + [(f / p.name).rename(f / p.name.replace("t_", "u3_")) for p in f.glob("t_*.png")],
      ("u1_white.png", "tolerances from its mark", "wrong turn")),
 ])
 def test_a_bad_upright_capture_is_refused_with_one_line_naming_the_file(tmp_path, written, spoil, words):
-    """A missing frame (before any work), and the stand's turns 1 and 3 swapped: the images put the
-    display far from u1's mark. Nothing is written."""
+    """A missing frame (before any work), no upright capture at all (a lab without the display is told
+    how to calibrate without it), and the stand's turns 1 and 3 swapped: the images put the display
+    far from u1's mark. Nothing is written."""
     from rigcad.calibrate.images import CaptureError
 
     with pytest.raises(CaptureError) as info:
