@@ -57,7 +57,7 @@ def upright_room(profile) -> dict:
     back = cal.upright_offset - cal.upright_thickness - SLOT_CLEARANCE_MM
     corner = max(math.hypot(front, half), math.hypot(back, half))
     return {"corner_mm": corner, "room_mm": holder.radius - SLOT_WALL_MM, "half_width_mm": half,
-            "fits": corner <= holder.radius - SLOT_WALL_MM}
+            "front_mm": front, "back_mm": back, "fits": corner <= holder.radius - SLOT_WALL_MM}
 
 
 def check_upright_fits(profile) -> dict:
@@ -90,8 +90,7 @@ def upright_stand(profile):
     r = profile.sample_holder.radius
     top, floor = -cal.upright_depth, -cal.upright_depth - cal.upright_border
     room = upright_room(profile)
-    half = room["half_width_mm"]
-    front, back = cal.upright_offset + SLOT_CLEARANCE_MM, cal.upright_offset - cal.upright_thickness - SLOT_CLEARANCE_MM
+    half, front, back = room["half_width_mm"], room["front_mm"], room["back_mm"]
     body = holder_body(profile, top)
     rise = Difference(Cylinder((0.0, 0.0, top - 1.0), r, STAND_BACK_MM - top + 1.0),
                       (Box((back, -r - 1.0, top - 2.0), (r + 1.0, r + 1.0, STAND_BACK_MM + 1.0)),))
