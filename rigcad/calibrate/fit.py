@@ -59,9 +59,12 @@ PRIOR_MM = 0.2
 SLOPE_PROJECTION = 0.9
 #: The direct view's pixels (:func:`seen_direct`) the fit reads: every this-many-th of the fit's rows
 #: and columns (``calibration.fit_stride``). They fix the camera's pose against the screens with
-#: the decoding's micrometres, free of the mirrors' surface error; ~1,000 of them (4 captures, 2 axes
-#: each) outweigh the prior, and all ~16,000 doubled the fit's CPU time.
-DIRECT_STRIDE = 4
+#: the decoding's micrometres, free of the mirrors' surface error. Measured one-off on the bench's
+#: two trials whose camera x offset against the dome missed its target (seeds 26 and 41), at 4, 2
+#: and 1: ~870, ~3,500 and ~13,700 pixels; that offset's error 1.04 and 1.05, 0.79 and 0.67, 0.74
+#: and 0.57 times its target; the calibration's CPU time (the flat captures, seed 41) 35.0, 39.0 and
+#: 60.6 s.
+DIRECT_STRIDE = 2
 #: The most the direct view's rows are weighted against the mirrored ones (the ratio of their robust
 #: sigmas after the first solve: ~40 in the plain fit on Table 3.1, ~4 in the map's refit, whose
 #: mirrored residual has the surface's part projected away). Measured on seeds 101-104 (kept out of

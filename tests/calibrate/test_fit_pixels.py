@@ -52,7 +52,7 @@ def test_the_direct_view_is_read_on_a_coarser_grid():
     apart = (cols <= 23 - maps.HEIGHT_EDGE_PX) | (cols >= 24 + maps.HEIGHT_EDGE_PX)
     expect = inner & apart & np.where(right, on(2 * DIRECT_STRIDE), on(2))
     assert np.array_equal(np.sort(data.pixels), np.nonzero(expect.ravel())[0])
-    assert data.direct.sum() == 8 and (~data.direct).sum() == 153  # 4 x 2 on the right, 17 x 9 on the left
+    assert data.direct.sum() == 45 and (~data.direct).sum() == 153  # 9 x 5 on the right, 17 x 9 on the left
 
 
 def _steps(valid):
