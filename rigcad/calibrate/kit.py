@@ -52,7 +52,7 @@ def upright_room(profile) -> dict:
     ``upright_border`` beyond the active area at each side, plus the slot's clearance) against the
     stand's radius (the sample holder's) less a wall. ``fits``: the slot stays inside the stand."""
     cal, holder = profile.calibration, profile.sample_holder
-    half = cal.upright_resolution[0] * cal.upright_pitch / 2 + cal.upright_border + SLOT_CLEARANCE_MM
+    half = Sequence.from_profile(cal, "upright").size_mm[0] / 2 + cal.upright_border + SLOT_CLEARANCE_MM
     front = cal.upright_offset + SLOT_CLEARANCE_MM
     back = cal.upright_offset - cal.upright_thickness - SLOT_CLEARANCE_MM
     corner = max(math.hypot(front, half), math.hypot(back, half))
@@ -110,8 +110,8 @@ def screen_room(rig) -> dict:
     p = rig.profile
     cal = p.calibration
     pts = rig.dome.points  # the mirror surface (r, z), rising from the sample plane
-    w, h = cal.screen_resolution
-    half_diagonal = cal.screen_pitch * math.hypot(w, h) / 2
+    size = Sequence.from_profile(cal).size_mm
+    half_diagonal = math.hypot(*size) / 2
     rows = []
     for k, top in enumerate(M.nominal_heights(p)):
         z = np.linspace(max(top - cal.screen_thickness, 0.0), max(top, 0.0), 65)
@@ -119,7 +119,7 @@ def screen_room(rig) -> dict:
         i = int(np.argmin(r))
         rows.append({"spacer": k, "z_mm": float(z[i]), "dome_radius_mm": float(r[i])})
     tight = min(rows, key=lambda row: row["dome_radius_mm"])
-    return {"display_mm": [w * cal.screen_pitch, h * cal.screen_pitch], "half_diagonal_mm": half_diagonal,
+    return {"display_mm": list(size), "half_diagonal_mm": half_diagonal,
             "tightest": tight, "body_diameter_mm": 2 * tight["dome_radius_mm"],
             "fits": half_diagonal < tight["dome_radius_mm"]}
 
@@ -156,9 +156,9 @@ def manual_page(rig) -> str:
         f"{c + 1}. spacer {k} ({cal.spacer_heights[k]:g} mm){turned if plan.repeats(c) is not None else ''}: "
         f"screen surface {z:g} mm above the sample point; files `{label}_<frame>.png`"
         for c, (k, z, label) in enumerate(zip(plan.spacers, plan.heights, plan.labels)))
-    reach = math.degrees(math.atan((min(w, h) * cal.screen_pitch / 2) / max(plan.heights)))
+    side = min(seq.size_mm)
+    reach = math.degrees(math.atan((side / 2) / max(plan.heights)))
     room = check_screen_fits(rig)
-    side = min(w, h) * cal.screen_pitch
     def across(angle: float) -> str:
         return f"{math.degrees(angle):g} deg, {side * math.tan(angle):.2f} mm across its {side:.0f} mm side"
 
@@ -221,9 +221,10 @@ def _upright_kit(p, flat: int) -> str:
     cal = p.calibration
     if not cal.upright_turns:
         return ""
-    w, h = cal.upright_resolution
+    seq = Sequence.from_profile(cal, "upright")
+    (w, h), (w_mm, h_mm) = seq.resolution, seq.size_mm
     return f"""- A small display stood on edge, the upright display: {w} x {h} px at {cal.upright_pitch:g} mm pitch
-  ({w * cal.upright_pitch:.1f} x {h * cal.upright_pitch:.1f} mm), its module {cal.upright_thickness:g} mm thick with
+  ({w_mm:.1f} x {h_mm:.1f} mm), its module {cal.upright_thickness:g} mm thick with
   {cal.upright_border:g} mm of frame beyond the active area at the sides and below. Its stand
   (`stl/calibration_upright_stand.stl`) replaces the sample holder in the bore: stand the module in the
   slot, face out, on the slot's floor, against the stand's back; the active area then starts

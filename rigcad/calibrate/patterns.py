@@ -57,10 +57,16 @@ class Sequence:
     pitch: float
 
     @classmethod
-    def from_profile(cls, cal) -> "Sequence":
-        """From a profile's ``calibration`` section."""
-        return cls(tuple(cal.periods), int(cal.phase_steps), int(cal.gray_bits), tuple(cal.screen_resolution),
-                   float(cal.screen_pitch))
+    def from_profile(cls, cal, display: str = "screen") -> "Sequence":
+        """From a profile's ``calibration`` section, for its flat ``screen`` or its ``upright`` display
+        (the same frames at that display's resolution and pitch)."""
+        return cls(tuple(cal.periods), int(cal.phase_steps), int(cal.gray_bits),
+                   tuple(getattr(cal, f"{display}_resolution")), float(getattr(cal, f"{display}_pitch")))
+
+    @property
+    def size_mm(self) -> tuple[float, float]:
+        """The display's active area (width, height), mm."""
+        return self.resolution[0] * self.pitch, self.resolution[1] * self.pitch
 
     @property
     def stripe(self) -> float:

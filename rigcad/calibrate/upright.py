@@ -59,9 +59,8 @@ class Uprights:
     @classmethod
     def of(cls, profile) -> "Uprights":
         cal = profile.calibration
-        seq = Sequence(tuple(cal.periods), int(cal.phase_steps), int(cal.gray_bits), tuple(cal.upright_resolution),
-                       float(cal.upright_pitch))
-        height = cal.upright_resolution[1] * cal.upright_pitch
+        seq = Sequence.from_profile(cal, "upright")
+        height = seq.size_mm[1]
         poses = []
         for j in range(cal.upright_turns):
             psi = 2 * math.pi * j / cal.upright_turns
