@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -37,12 +36,29 @@ if TYPE_CHECKING:  # pragma: no cover
     from rigcad.parts.layout import RigLayout
     from rigcad.parts.recipe import Part
 
-#: Geometry a move does not change: carried over by :meth:`Rig.moved` instead of recomputed.
-_SHARED = ("paraboloid", "curve", "design", "layout", "recipes", "instruments", "incidence", "occluders",
-           "_meshes")
 #: What depends on the geometry and the dome alone: carried over by :meth:`Rig.from_profile` from a
 #: previous rig with the same dome inputs.
 _DOME_ONLY = ("paraboloid", "curve", "incidence")
+
+
+class _shared:
+    """A rig's value that no move changes (its geometry, layout, recipes, maps, mesh cache): computed
+    on first use and kept in the cache that the rig shares with its moved copies (:meth:`Rig.moved`),
+    so that a value made on any of them, before the move or after it, serves them all. Read-only."""
+
+    def __init__(self, compute):
+        self.compute, self.__doc__ = compute, compute.__doc__
+
+    def __set_name__(self, owner, name):
+        self.name = name
+
+    def __get__(self, rig, owner=None):
+        if rig is None:
+            return self
+        cache = rig._cache
+        if self.name not in cache:
+            cache[self.name] = self.compute(rig)
+        return cache[self.name]
 
 
 @dataclass(frozen=True)
@@ -54,6 +70,8 @@ class Rig:
     geometry: Derived
     dome: DomeProfile
     misalignment: Misalignment = field(default_factory=Misalignment.none)
+    #: name -> value of the ``_shared`` properties, one dict for a rig and its moved copies.
+    _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     # -- construction ------------------------------------------------------------------------------
     @classmethod
@@ -70,8 +88,8 @@ class Rig:
         if previous is not None and previous.profile.dome == profile.dome and previous.geometry == geometry:
             rig = cls(profile, geometry, previous.dome)
             for key in _DOME_ONLY:
-                if key in previous.__dict__:
-                    rig.__dict__[key] = previous.__dict__[key]  # a cached value of the same inputs
+                if key in previous._cache:
+                    rig._cache[key] = previous._cache[key]  # a cached value of the same inputs
             return rig
         return cls(profile, geometry, converged_dome(profile, geometry))
 
@@ -80,7 +98,7 @@ class Rig:
         return self.profile.name
 
     # -- the shared geometry, computed on first use ------------------------------------------------
-    @cached_property
+    @_shared
     def paraboloid(self) -> "Paraboloid":
         """The paraboloid mirror in the meridional plane (closed form)."""
         from rigcad.optics.paraboloid import Paraboloid
@@ -88,21 +106,21 @@ class Rig:
         g = self.geometry
         return Paraboloid(g.focal_length, g.vertex_z, g.rim_radius)
 
-    @cached_property
+    @_shared
     def curve(self) -> "DomeCurve":
         """The dome as the 2D tracer reads it (the dome's one spline, or the thesis's polyline)."""
         from rigcad.optics.trace2d import DomeCurve
 
         return DomeCurve.from_profile(self.dome)
 
-    @cached_property
+    @_shared
     def design(self) -> "Design":
         """The 2D optical design: traced checks and the report (design.json), figures with units."""
         from rigcad.optics.design import run_design
 
         return run_design(self)
 
-    @cached_property
+    @_shared
     def layout(self) -> "RigLayout":
         """Placements and mirror surfaces (design, printed) shared by the parts. Raises
         GeometryError (with file:line) when the parts cannot be laid out (a polyline dome, a bolt
@@ -112,14 +130,14 @@ class Rig:
         with _located(self.profile):
             return rig_layout(self.profile, self.geometry, self.dome)
 
-    @cached_property
+    @_shared
     def recipes(self) -> dict[str, "Part"]:
         """Every part's kernel-free recipe, in build order (``rigcad.parts.PARTS``)."""
         from rigcad.parts import make_recipes
 
         return make_recipes(self.profile, self.layout)
 
-    @cached_property
+    @_shared
     def instruments(self) -> tuple["Part", ...]:
         """The bought items (projector, camera, beam splitter, focusing lens, nominal shim stacks) and
         the centre-of-projection markers as named solids in their working positions, for rig.step
@@ -128,7 +146,7 @@ class Rig:
 
         return instruments(self.profile, self.layout)
 
-    @cached_property
+    @_shared
     def incidence(self) -> "DesignMap":
         """Projector pixel / COP ray -> design incidence direction at O (finite COP only)."""
         from rigcad.optics.incidence import DesignMap
@@ -136,7 +154,7 @@ class Rig:
         with _located(self.profile):
             return DesignMap.from_design(self.geometry, self.dome)
 
-    @cached_property
+    @_shared
     def occluders(self) -> dict[str, tuple]:
         """Convex solids standing for the parts where light passes them, from the part recipes
         (``Part.occluders``): part name -> ((name, recipe Box or Cylinder), ...)."""
@@ -165,16 +183,13 @@ class Rig:
         if component not in COMPONENTS:
             raise ProfileError(f"cannot move {component!r}: components are {', '.join(COMPONENTS)}")
         moved = dataclasses.replace(self, misalignment=self.misalignment.with_(component, offset, tilt, axis))
-        self._meshes  # made now, so that this rig and the copy fill one mesh cache
-        for key in _SHARED:
-            if key in self.__dict__:
-                moved.__dict__[key] = self.__dict__[key]  # a cached_property's value, shared read-only
+        object.__setattr__(moved, "_cache", self._cache)  # one cache: what either makes, both read
         return moved
 
     def __getstate__(self) -> dict:
         """Pickled without the mesh cache (a worker meshes what it needs; the pickle stays small)."""
         state = dict(self.__dict__)
-        state.pop("_meshes", None)
+        state["_cache"] = {k: v for k, v in self._cache.items() if k != "_meshes"}
         return state
 
     # -- the stages, as a Python API ---------------------------------------------------------------
@@ -185,7 +200,7 @@ class Rig:
 
         return RigPart.build(self, name)
 
-    @cached_property
+    @_shared
     def _meshes(self) -> dict:
         """(recipe content hash, chord error) -> (vertices, faces), read-only: see :meth:`mesh`."""
         return {}

@@ -111,6 +111,21 @@ def test_rig_pickles_and_moves_without_changing(table31_rig):
         rig.moved("lens", offset=(1, 0, 0))
 
 
+def test_what_a_moved_copy_makes_after_the_move_serves_the_whole_family(table31_rig):
+    """Rig.moved shares one cache: the layout made on a copy of a copy, after both moves, is the
+    one the unmoved rig and the other copy then read (a lab script that moves a fresh rig and
+    traces it must not derive the layout once per trace), and a move changes no shared value."""
+    from rigcad.rig import Rig
+
+    rig = Rig(table31_rig.profile, table31_rig.geometry, table31_rig.dome)  # a fresh cache, the same dome
+    first = rig.moved("camera", offset=(0.1, 0.0, 0.0))
+    second = first.moved("dome", tilt=1e-3)
+    assert "layout" not in rig._cache
+    layout = second.layout
+    assert rig.layout is layout and first.layout is layout
+    assert layout.design_dome.u_range == table31_rig.layout.design_dome.u_range  # the unmoved rig's layout
+
+
 def test_a_moved_rig_is_traced_where_its_paraboloid_stands(table31_rig):
     """Moving the paraboloid 1 mm sideways moves the spot as the same move through the
     sensitivity path (Misalignment poses) does: the two routes share the optics, not the code path."""
@@ -149,7 +164,8 @@ def test_a_part_is_meshed_once_per_rig_and_chord(table31_rig, monkeypatch):
     assert np.array_equal(again.vertices, v) and np.array_equal(again.faces, f)
     rig.mesh("beam", 2 * chord)  # another chord is another mesh
     assert calls == [chord, 2 * chord]
-    assert "_meshes" not in pickle.loads(pickle.dumps(rig)).__dict__  # workers are not sent the meshes
+    assert "_meshes" not in pickle.loads(pickle.dumps(rig))._cache  # workers are not sent the meshes
+    assert "_meshes" in rig._cache  # ... and pickling left the rig's own cache whole
 
 
 def test_every_writer_under_exports_holds_the_profile_lock(table31_rig, tmp_path, monkeypatch):

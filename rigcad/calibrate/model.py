@@ -124,12 +124,9 @@ def prior_root(rig, plan: Plan) -> np.ndarray:
 
 
 def moved(rig, theta: np.ndarray):
-    """``rig`` moved by the rig parameters ``theta[:15]`` (module docstring). The rig's layout
-    (:func:`direct_view` reads its dome) is made on ``rig`` first, so that every moved copy shares
-    it (``Rig.moved`` shares only what was made before the move). ``analytic_optics(rig)`` makes it,
-    but a rig passed without it (another Rig than the optics' own) had each copy derive it again:
-    ~85 ms a trace, doubling the fit's time (measured one-off)."""
-    rig.layout
+    """``rig`` moved by the rig parameters ``theta[:15]`` (module docstring). The copies share the
+    rig's layout (:func:`direct_view` reads its dome) and maps, whichever of them makes them first
+    (``Rig.moved``)."""
     out = rig
     for i, c in enumerate(COMPONENTS):
         dx, dy, dz, tx, ty = (float(v) for v in theta[5 * i: 5 * i + 5])

@@ -209,13 +209,13 @@ class LiveSession:
         design_key = key_of(dome_key, *(getattr(profile, s) for s in DESIGN_SECTIONS))
         if old is not None and old.design_key == design_key:
             design = old.rig.design
-            rig.__dict__["design"] = dataclasses.replace(
+            rig._cache["design"] = dataclasses.replace(
                 design, profile=profile, report={**design.report, "profile": profile_entry(profile)})
         else:
             rig.design
             self.builds["design"] += 1
             ran.append("design")
-        rig.__dict__["_meshes"] = self._mesh_cache  # Rig.mesh's cache, keyed by recipe content
+        rig._cache["_meshes"] = self._mesh_cache  # Rig.mesh's cache, keyed by recipe content
         rig.layout
         return rig, dome_key, design_key
 
