@@ -33,9 +33,27 @@ def spacer(profile, k: int):
 
     h = profile.calibration.spacer_heights[k]
     top = -profile.sample_holder.sample_thickness + h
-    return Part(f"calibration_spacer_{k}", holder_body(profile, top), (0.3, 0.6, 0.3),
+    return Part(f"calibration_spacer_{k}", holder_body(profile, top, spacer_marks()), (0.3, 0.6, 0.3),
                 f"calibration spacer {k}: replaces the sample holder; the screen's back rests {h:g} mm above "
-                "the holder's seat", in_rig=False)
+                "the holder's seat; its collar's wide notch faces the base plate's groove, the narrow one after "
+                "the half turn", in_rig=False)
+
+
+def spacer_marks() -> tuple[tuple[float, float], ...]:
+    """A spacer's collar notches (rigcad.parts.base.holder_body): the wide one at +x, set at the base
+    plate's groove for its first capture; the narrow one opposite, there after the half turn."""
+    from rigcad.parts.base import NOTCH_MM, WIDE_NOTCH_MM
+
+    return (0.0, WIDE_NOTCH_MM), (math.pi, NOTCH_MM)
+
+
+def stand_marks(turns: int) -> tuple[tuple[float, float], ...]:
+    """The upright stand's collar notches (rigcad.parts.base.holder_body): turn j's at -360 j / turns
+    deg, so that the stand turned to put it at the base plate's groove (+x) faces its display towards
+    360 j / turns deg (:class:`rigcad.calibrate.upright.Uprights`); turn 0's is the wide one."""
+    from rigcad.parts.base import NOTCH_MM, WIDE_NOTCH_MM
+
+    return tuple((-2 * math.pi * j / turns, WIDE_NOTCH_MM if j == 0 else NOTCH_MM) for j in range(turns))
 
 
 #: The upright stand's slot: clearance around the display's module (mm, each side), and the least wall
@@ -91,7 +109,7 @@ def upright_stand(profile):
     top, floor = -cal.upright_depth, -cal.upright_depth - cal.upright_border
     room = upright_room(profile)
     half, front, back = room["half_width_mm"], room["front_mm"], room["back_mm"]
-    body = holder_body(profile, top)
+    body = holder_body(profile, top, stand_marks(cal.upright_turns))
     rise = Difference(Cylinder((0.0, 0.0, top - 1.0), r, STAND_BACK_MM - top + 1.0),
                       (Box((back, -r - 1.0, top - 2.0), (r + 1.0, r + 1.0, STAND_BACK_MM + 1.0)),))
     slot = Box((back, -half, floor), (front, half, STAND_BACK_MM + 1.0))
@@ -151,9 +169,11 @@ def manual_page(rig) -> str:
     plan = M.Plan.of(p)
     w, h = cal.screen_resolution
     frames = seq.names()
-    turned = ", turned a half turn (the spacer in its bore and the screen on it, each by 180 deg)"
+    turned = (", turned a half turn (the spacer in its bore, its narrow notch at the groove, and the screen on it, "
+              "each by 180 deg)")
     steps = "\n".join(
-        f"{c + 1}. spacer {k} ({cal.spacer_heights[k]:g} mm){turned if plan.repeats(c) is not None else ''}: "
+        f"{c + 1}. spacer {k} ({cal.spacer_heights[k]:g} mm)"
+        f"{turned if plan.repeats(c) is not None else ', its wide notch at the groove'}: "
         f"screen surface {z:g} mm above the sample point; files `{label}_<frame>.png`"
         for c, (k, z, label) in enumerate(zip(plan.spacers, plan.heights, plan.labels)))
     side = min(seq.size_mm)
@@ -179,8 +199,11 @@ the dome as they were built and placed; the fit of the misalignment; the dome's 
   {room['body_diameter_mm']:.0f} mm circle (the dome's inside at z = {room['tightest']['z_mm']:.1f} mm, where spacer
   {room['tightest']['spacer']} puts it). Set it to its full brightness, no night shift, no auto-brightness, and a
   linear (gamma 1) response if it offers one; show each PNG of `patterns/` full screen, unscaled.
-- The spacers (`stl/calibration_spacer_<k>.stl`): each replaces the sample holder in the base plate's bore;
-  lay the screen face up on its top, centred on the axis and square to the base plate by eye: within
+- The spacers (`stl/calibration_spacer_<k>.stl`): each replaces the sample holder in the base plate's bore.
+  Turn it, from below, by the notches in its collar's rim: the wide one faces the groove under the
+  base plate (on the tongue's side, +x) for its first capture, the narrow one after its half turn:
+  {_within(p)}.
+  Lay the screen face up on its top, centred on the axis and square to the base plate by eye: within
   {M.PLACEMENT_MM:g} mm and {math.degrees(M.PLACEMENT_TURN_RAD):g} deg is enough, the fit finds where it lies at each spacer.
 - Lay it flat. No image shows the sample plane: the images cannot tell a screen tilted on its spacer
   from a rig tilted over the sample, so the screen's tilt on the holder's seat is the map's. The
@@ -241,9 +264,25 @@ def _upright_steps(p, flat: int) -> str:
         return ""
     step = 360 / cal.upright_turns
     return "\n" + "\n".join(
-        f"{flat + j + 1}. the upright display in its stand, its face towards "
-        + ("the +x side (the projector's)" if j == 0 else f"{step * j:g} deg counter-clockwise from there, seen from above")
+        f"{flat + j + 1}. the upright display in its stand, "
+        + ("its wide notch at the groove (its face towards +x, the projector's side)" if j == 0 else
+           f"turned on by {step:g} deg, counter-clockwise seen from above: the {_ordinal(j)} notch counter-clockwise "
+           f"from the wide one, seen from below, at the groove (its face towards {step * j:g} deg)")
         + f": files `u{j}_<frame>.png`" for j in range(cal.upright_turns))
+
+
+def _ordinal(n: int) -> str:
+    return f"{n}{'th' if 10 <= n % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(n % 10, 'th')}"
+
+
+def _within(p) -> str:
+    """How closely a notch set on the base plate's groove by eye turns a plug: half the groove's width
+    at the collar's rim."""
+    from rigcad.parts.base import GROOVE_WIDTH_MM
+
+    off = GROOVE_WIDTH_MM / 2
+    return (f"a notch centred on the groove by eye, to {off:g} mm, sets the turn within "
+            f"{math.degrees(off / p.sample_holder.stop_radius):.1f} deg")
 
 
 def _upright_by_eye(p) -> str:
@@ -252,9 +291,10 @@ def _upright_by_eye(p) -> str:
     if not cal.upright_turns:
         return ""
     return f"""
-By eye is enough for the upright display's turns: the fit finds where it stands (within
+The stand's collar has a notch for each turn, the wide one for the first: set each turn from
+below with its notch centred on the base plate's groove. The fit finds where it stands (within
 {math.degrees(cal.upright_tilt):g} deg of lean or turn and {M.PLACEMENT_MM:g} mm sideways), against the rays the flat
-captures measured. A turn far from its mark is refused, naming its file.
+captures measured. A turn far from its notch is refused, naming its file.
 """
 
 

@@ -26,6 +26,7 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
     x0 = math.sqrt(layout.plate_r ** 2 - half ** 2) - 1.0  # 1 mm inside the disc's rim: one solid
     tongue = Box((x0, -half, tw.bench_z), (tw.column_x + half, half, 0.0))  # down to the bench: the tower's weight
     bore = Cylinder((0.0, 0.0, -t - 1.0), holder.radius + holder.clearance, t + 2.0)
+    groove = azimuth_groove(profile, tw.bench_z)
     holes = bolt_holes(layout, profile.dome_shell.bolt_diameter, -t - 1.0, t + 2.0)
     joint = (*column_joint_cuts(tw, profile, tw.bench_z, -tw.bench_z, "top"), *tongue_underside_cuts(tw, profile, tw.bench_z))
     b = breadboard.board(profile)
@@ -34,21 +35,49 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
     on_board = "" if b is None else (
         f"; it stands on the {b.title}: the sample point over a tapped hole, the tongue along a row of holes, "
         f"screwed down on the grid through its pad and the boss under the disc")
-    return Part("base_plate", Difference(Union_((plate, tongue, *pads)), (bore, *holes, *joint, *anchors)),
+    return Part("base_plate", Difference(Union_((plate, tongue, *pads)), (bore, groove, *holes, *joint, *anchors)),
                 (0.55, 0.57, 0.6), "base plate, the rig's datum: bolts to the dome flange; the sample holder slides "
-                "into its bore; its tongue locates the tower's column " + (
+                "into its bore (the groove under the disc on the tongue's side is the calibration parts' turn mark); "
+                "its tongue locates the tower's column " + (
                     f"by two {profile.datum.dowel_diameter:g} mm dowels (reamed H7) and four bolts"
                     if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core")
                 + on_board)
 
 
-def holder_body(profile: Profile, top_z: float) -> Cylinder | Union_:
-    """Holder cylinder up to ``top_z`` with its stop collar under the plate."""
+#: The turn mark under the base plate: a groove across the disc's underside along +x (the tongue's
+#: side), from just outside the sample holder's stop collar. A plug that stands in the bore at set
+#: turns (the calibration spacers, the upright display's stand: rigcad.calibrate.kit) carries notches
+#: in its collar's rim, and a turn is set, from below, by the notch that faces the groove.
+#: Width, depth into the disc, length, and its gap from the collar's rim (mm).
+GROOVE_WIDTH_MM, GROOVE_DEPTH_MM, GROOVE_LENGTH_MM, GROOVE_GAP_MM = 1.0, 0.6, 10.0, 0.5
+#: A collar's notches (vertical half-cylinders cut into its rim, through its thickness): a turn's own
+#: mark, and the wide one that marks the first turn (mm, radius).
+NOTCH_MM, WIDE_NOTCH_MM = 0.8, 1.6
+
+
+def azimuth_groove(profile: Profile, bench_z: float) -> Box:
+    """The base plate's turn mark (:data:`GROOVE_WIDTH_MM`): cut from below the bench level (``bench_z``,
+    through anything under the disc there) to its depth into the disc."""
+    t = profile.base_plate.thickness
+    r0 = profile.sample_holder.stop_radius + GROOVE_GAP_MM
+    w = GROOVE_WIDTH_MM / 2
+    return Box((r0, -w, min(bench_z, -t) - 1.0), (r0 + GROOVE_LENGTH_MM, w, -t + GROOVE_DEPTH_MM))
+
+
+def holder_body(profile: Profile, top_z: float, marks: tuple[tuple[float, float], ...] = ()) -> Cylinder | Union_ | Difference:
+    """Holder cylinder up to ``top_z`` with its stop collar under the plate. ``marks``: notches in the
+    collar's rim as (azimuth rad from +x, radius mm) (:data:`NOTCH_MM`): the plug turned so that
+    one faces the base plate's groove (:func:`azimuth_groove`) stands at that notch's turn."""
     t = profile.base_plate.thickness
     h = profile.sample_holder
     body = Cylinder((0.0, 0.0, -t), h.radius, top_z + t)
     collar = Cylinder((0.0, 0.0, -t - h.stop_thickness), h.stop_radius, h.stop_thickness)
-    return Union_((body, collar))
+    if not marks:
+        return Union_((body, collar))
+    ring = h.stop_radius - h.radius  # a notch keeps within the collar's ring, clear of the body
+    notches = tuple(Cylinder((h.stop_radius * math.cos(a), h.stop_radius * math.sin(a), -t - h.stop_thickness - 1.0),
+                             min(r, ring / 2), h.stop_thickness + 2.0) for a, r in marks)
+    return Union_((body, Difference(collar, notches)))
 
 
 def sample_holder(profile: Profile, layout: RigLayout) -> Part:

@@ -372,8 +372,16 @@ def test_a_simulated_capture_written_out_calibrates_the_same_from_its_files(tmp_
     assert not (tmp_path / "again").exists() and not (tmp_path / "other").exists()
 
 
+def _lens(R: float, r: float) -> float:
+    """The area (mm^2) a circle of radius r centred on a circle of radius R cuts from its disc (the
+    two circles' lens, closed form)."""
+    return (r * r * np.arccos(r / (2 * R)) + R * R * np.arccos(1 - r * r / (2 * R * R))
+            - 0.5 * np.sqrt(r * r * (2 * R - r) * (2 * R + r)))
+
+
 def test_kit_patterns_spacers_and_page(tmp_path, small):
     from rigcad.calibrate.kit import write_kit
+    from rigcad.parts.base import NOTCH_MM, WIDE_NOTCH_MM
 
     out = tmp_path / "exports" / "small" / "calibrate_kit"
     manifest = write_kit(small["rig"], out)
@@ -390,8 +398,9 @@ def test_kit_patterns_spacers_and_page(tmp_path, small):
         mesh = trimesh.load_mesh(out / "stl" / f"calibration_spacer_{k}.stl")
         assert mesh.bounds[1][2] == pytest.approx(-p.sample_holder.sample_thickness + h, abs=1e-6)
         hs = p.sample_holder
-        vol = np.pi * (hs.radius ** 2 * (p.base_plate.thickness - hs.sample_thickness + h)
-                       + hs.stop_radius ** 2 * hs.stop_thickness)
+        notches = sum(_lens(hs.stop_radius, r) for r in (WIDE_NOTCH_MM, NOTCH_MM))  # cut from the collar's rim
+        vol = np.pi * hs.radius ** 2 * (p.base_plate.thickness - hs.sample_thickness + h) + (
+            np.pi * hs.stop_radius ** 2 - notches) * hs.stop_thickness
         assert manifest["parts"][f"calibration_spacer_{k}"]["volume_mm3"] == pytest.approx(vol, rel=1e-6)
     page = (out / "calibration.md").read_text()
     assert "h1_<frame>.png" in page and "h1r_<frame>.png" in page and "Exposure" in page

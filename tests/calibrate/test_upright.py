@@ -247,11 +247,46 @@ def test_the_kit_has_the_upright_display_its_patterns_and_its_stand(tmp_path, sm
     behind[:, 0] = c - t - SLOT_CLEARANCE_MM - 1.0
     behind[:, 2] = np.clip(behind[:, 2], 0.5, 11.0)
     assert mesh.contains(under).all() and mesh.contains(behind).all()
+    _notches_turn_the_stand_to_its_captures(rig.profile, mesh)
     above_plate = mesh.vertices[mesh.vertices[:, 2] > -rig.profile.base_plate.thickness + 1e-6]
     assert np.hypot(above_plate[:, 0], above_plate[:, 1]).max() <= rig.profile.sample_holder.radius + 1e-6
     page = (tmp_path / "kit" / "calibration.md").read_text()
     assert "`stl/calibration_upright_stand.stl`" in page and "files `u3_<frame>.png`" in page
+    # the rule _notches_turn_the_stand_to_its_captures follows, as the page tells it
+    assert "the 3rd notch counter-clockwise from the wide one, seen from below, at the groove" in page
     assert "set their exposure on that image" in page
+
+
+def _notches_turn_the_stand_to_its_captures(profile, mesh):
+    """Found in the stand's STL: the gaps in its collar's rim, sampled every 0.05 deg just inside it.
+    Turned so that its j-th notch (counting counter-clockwise seen from below, from the wide one)
+    faces the base plate's groove (+x), the stand's slot faces where the fit expects capture u<j>
+    (Uprights.of): the page's steps, the stand and the fit agree."""
+    from rigcad.calibrate.upright import Uprights
+
+    h, t = profile.sample_holder, profile.base_plate.thickness
+    a = np.radians(np.arange(0.0, 360.0, 0.05))
+    r, z = h.stop_radius - 0.3, -t - h.stop_thickness / 2
+    solid = mesh.contains(np.stack([r * np.cos(a), r * np.sin(a), np.full_like(a, z)], axis=1))
+    start = np.flatnonzero(solid)[0]  # walk the rim from a solid sample: every gap is whole
+    gaps, width = [], 0
+    for i in range(start, start + len(a) + 1):
+        if not solid[i % len(a)]:
+            width += 1
+        elif width:
+            gaps.append(((i - width / 2 - 0.5) * 0.05 % 360.0, width))
+            width = 0
+    turns = profile.calibration.upright_turns
+    assert len(gaps) == turns, gaps
+    wide = max(gaps, key=lambda g: g[1])
+    assert all(wide[1] > 1.5 * g[1] for g in gaps if g is not wide)
+    # seen from below, counter-clockwise is seen from above clockwise: decreasing azimuth
+    order = sorted(gaps, key=lambda g: (wide[0] - g[0]) % 360.0)
+    nominal = Uprights.of(profile).nominal
+    for j, (azimuth, _) in enumerate(order):
+        turn = -azimuth  # the stand turned to bring this notch to +x: the slot's face, +x as drawn, turns with it
+        face = np.radians(turn)
+        assert np.allclose(nominal[j].rotation[:, 2], [np.cos(face), np.sin(face), 0.0], atol=2e-3), (j, azimuth)
 
 
 def test_a_display_too_wide_for_the_bore_is_refused_naming_its_key(tmp_path):

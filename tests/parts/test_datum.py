@@ -75,3 +75,27 @@ def test_the_tongue_stands_on_the_bench_with_nut_traps(table31_rig):
         nut = M.build(HexPrism((x, y, t.bench_z + 0.01), 7.0, NUT_TRAP_DEPTH - 0.02, NUT_TRAP_TURN), 0.05)
         assert (plate ^ nut).volume() < 1e-9
         assert (plate ^ nut).status() == m3d.Error.NoError
+
+
+def test_the_plate_has_the_calibration_parts_turn_mark_beside_the_collar(table31_rig):
+    """The groove under the disc (rigcad.parts.base.azimuth_groove) that the calibration parts'
+    notches turn to: open from below along +x (the tongue's side), just outside the holder's stop
+    collar where a technician under the lifted rig sees both, and no deeper into the disc than
+    stated (manifold3d's volume of the plate against a box where the groove runs)."""
+    from rigcad.export import mesh as M
+    from rigcad.parts.base import GROOVE_DEPTH_MM, GROOVE_GAP_MM, GROOVE_LENGTH_MM, GROOVE_WIDTH_MM
+    from rigcad.parts.recipe import Box
+
+    p = table31_rig.profile
+    t, r0 = p.base_plate.thickness, p.sample_holder.stop_radius + GROOVE_GAP_MM
+    plate = M.build(table31_rig.recipe("base_plate").solid, 0.05)
+
+    def solid(lo, hi) -> float:
+        return (plate ^ M.build(Box(lo, hi), 0.05)).volume()
+
+    w, d, L = GROOVE_WIDTH_MM / 2, GROOVE_DEPTH_MM, GROOVE_LENGTH_MM
+    assert solid((r0 + 0.01, -w + 0.01, -t - 0.5), (r0 + L - 0.01, w - 0.01, -t + d - 0.01)) < 1e-9  # the groove
+    assert solid((r0, -w, -t + d), (r0 + L, w, -t + d + 0.5)) == pytest.approx(2 * w * L * 0.5, rel=1e-9)  # its roof
+    beside = solid((r0, w, -t), (r0 + L, w + 1.0, -t + d))  # the disc on either side
+    assert beside == pytest.approx(L * d, rel=1e-9)
+    assert solid((-r0 - L, -w, -t), (-r0, w, -t + d)) == pytest.approx(2 * w * L * d, rel=1e-9)  # no mark at -x
