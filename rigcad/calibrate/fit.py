@@ -4,7 +4,8 @@ Fit: scipy.optimize.least_squares (trust-region reflective) over the parameters 
 :mod:`rigcad.calibrate.model`, scaled by their tolerances; residuals are the decoded screen points
 minus the forward model's (mm, both screen axes, every capture) over every ``fit_stride``-th camera
 pixel that decoded in every capture. The Jacobian is by forward differences with one trace per rig
-parameter (the screens' columns reuse it: each touches its own capture's rows only). After a first
+parameter (the screens' columns reuse the base trace and recompute their own capture's points only:
+the same columns to the last bit, a test holds it). After a first
 solve, residuals beyond 5 robust sigmas (1.4826 MAD) are dropped and the fit repeated. Each
 pixel's residual component that a dome slope error makes (a turn about its dome point) is
 down-weighted in the map's refit (:data:`SLOPE_PROJECTION`). Standard
@@ -195,15 +196,26 @@ class Problem:
         self.evaluations += 1
         return M.trace_camera(self.optics, M.moved(self.rig, theta), self.x, self.y, self.cam.design)
 
-    def residual_of(self, tr: M.Traced, theta: np.ndarray) -> np.ndarray:
+    @staticmethod
+    def on_capture(tr: M.Traced, pose) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Each ray's point (u, v) mm on one capture's screen, and its reach there (mm from the dome
+        along the ray; the slope projection's lever)."""
+        su, sv = tr.screen(pose)
+        return su, sv, (pose.translation[2] - tr.p2[:, 2]) / tr.v[:, 2]
+
+    def residual_of(self, tr: M.Traced, theta: np.ndarray, captures: list | None = None) -> np.ndarray:
+        """The residual rows at ``theta`` for the rays ``tr`` (traced at ``theta``'s rig part).
+        ``captures``: :meth:`on_capture` of each capture's screen at ``theta``, when the caller has
+        them (the Jacobian's screen columns change one capture's)."""
         out = np.full((len(self.x), len(self.plan), 2), np.nan)
         path = np.where(self.data.direct, tr.direct, tr.ok)  # the path the decoded points show
         reach = np.empty((len(self.x), len(self.plan)))
         poses = M.screens(self.plan, theta)
-        for k, pose in enumerate(poses):
-            su, sv = tr.screen(pose)
+        if captures is None:
+            captures = [self.on_capture(tr, pose) for pose in poses]
+        for k, (su, sv, lever) in enumerate(captures):
             out[path, k, 0], out[path, k, 1] = su[path], sv[path]
-            reach[:, k] = (pose.translation[2] - tr.p2[:, 2]) / tr.v[:, 2]
+            reach[:, k] = lever
         r = out - self.data.screen_uv
         r[self.data.direct] *= self.direct_weight
         if self.slope_projection:  # a direct view's point has no dome to turn about
@@ -229,17 +241,30 @@ class Problem:
         return np.concatenate([np.where(np.isfinite(r), r, 0.0), self.prior @ z])
 
     def jac(self, z: np.ndarray) -> np.ndarray:
+        """Forward differences over the free parameters, then the prior's rows. A rig parameter's
+        column traces again; a screen parameter's reuses the base trace and every other capture's
+        points (a screen's parameters move only its own pose: :func:`model.screens`)."""
         theta = self.full(z) * self.scale
         base_tr = self.trace(theta)
-        base = self.residual_of(base_tr, theta)
-        J = np.zeros((len(base), len(self.scale)))
-        for i in np.nonzero(self.free)[0]:
+        poses = M.screens(self.plan, theta)
+        captures = [self.on_capture(base_tr, pose) for pose in poses]
+        base = self.residual_of(base_tr, theta, captures)
+        free = np.nonzero(self.free)[0]
+        J = np.empty((len(base) + len(self.prior), len(free)))
+        for col, i in enumerate(free):
             t = theta.copy()
             t[i] += JAC_STEP * self.scale[i]
-            tr = self.trace(t) if i < self.n_rig else base_tr
-            diff = (self.residual_of(tr, t) - base) / JAC_STEP
-            J[:, i] = np.where(np.isfinite(diff), diff, 0.0)  # a ray lost on either side: no slope
-        return np.vstack([J[:, self.free], self.prior])
+            if i < self.n_rig:
+                r = self.residual_of(self.trace(t), t)
+            else:
+                k = (i - self.n_rig) // len(M.SCREEN_KEYS)
+                moved = list(captures)
+                moved[k] = self.on_capture(base_tr, M.screens(self.plan, t)[k])
+                r = self.residual_of(base_tr, t, moved)
+            diff = (r - base) / JAC_STEP
+            J[:len(base), col] = np.where(np.isfinite(diff), diff, 0.0)  # a ray lost on either side: no slope
+        J[len(base):] = self.prior
+        return J
 
 
 def slope_projected(r: np.ndarray, reach: np.ndarray, axes: np.ndarray, factor: float) -> np.ndarray:

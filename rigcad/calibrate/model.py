@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -254,9 +255,15 @@ class Traced:
     def screen(self, pose) -> tuple[np.ndarray, np.ndarray]:
         """Where each ray, off the mirrors or direct, meets a screen: (u, v) mm in its frame, NaN
         where lost."""
-        su, sv = on_screen(pose, np.nan_to_num(self.p2), np.nan_to_num(self.v, nan=1.0))
-        seen = self.ok | self.direct
+        p2, v, seen = self._finite
+        su, sv = on_screen(pose, p2, v)
         return np.where(seen, su, np.nan), np.where(seen, sv, np.nan)
+
+    @cached_property
+    def _finite(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``p2`` and ``v`` with the lost rays' NaNs replaced (a ray a screen is met along), and
+        the rays seen: made once for every screen a trace is met with."""
+        return np.nan_to_num(self.p2), np.nan_to_num(self.v, nan=1.0), self.ok | self.direct
 
 
 def trace_camera(optics, rig, x_px: np.ndarray, y_px: np.ndarray, design) -> Traced:

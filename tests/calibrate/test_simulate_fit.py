@@ -464,3 +464,30 @@ def test_full_size_calibration_against_the_truth(table31_rig):
     # calibrated round Gaussian); 21 % and 92 % (bench medians) with s^2 (J^T J)^-1 and its ridge
     for source in ("measured", "filled"):
         assert c["uncertainty_coverage"][source]["within_2"] > 0.9, (source, c["uncertainty_coverage"][source])
+
+
+def test_the_jacobian_is_the_plain_forward_difference_bit_for_bit(small):
+    """fit.Problem.jac re-traces for a rig parameter's column only, and for a screen parameter's
+    recomputes that capture's points alone. Its columns must be, to the last bit, the plain forward
+    difference that recomputes every residual from the parameters moved (here with the slope
+    projection on, which couples a pixel's captures), at a point off the design."""
+    from rigcad.calibrate.fit import JAC_STEP, SLOPE_PROJECTION, Problem
+    from rigcad.calibrate.run import _fit_data
+
+    s = small
+    cal = s["rig"].profile.calibration
+    decoded = [decode(s["seq"], {n: s["cam"].crop(im) / 255.0 for n, im in frames.items()}, cal.min_modulation)
+               for frames in s["images"]]
+    prob = Problem(s["optics"], s["rig"], s["cam"], s["plan"], _fit_data(s["cam"], s["plan"], decoded, 4),
+                   SLOPE_PROJECTION)
+    z = 0.3 * np.random.default_rng(5).standard_normal(int(prob.free.sum()))
+    J = prob.jac(z)
+    theta = prob.full(z) * prob.scale
+    base = prob.residual_of(prob.trace(theta), theta)
+    for col, i in enumerate(np.nonzero(prob.free)[0]):
+        t = theta.copy()
+        t[i] += JAC_STEP * prob.scale[i]
+        diff = (prob.residual_of(prob.trace(t), t) - base) / JAC_STEP
+        assert np.array_equal(J[:len(base), col], np.where(np.isfinite(diff), diff, 0.0)), M.parameter_names(len(s["plan"]))[i]
+    assert np.array_equal(J[len(base):], prob.prior) and J.shape[1] == int(prob.free.sum())
+    assert np.count_nonzero(J[:len(base), -1]) > 100  # the last screen's columns are not empty
