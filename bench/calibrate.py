@@ -55,10 +55,12 @@ def trial(optics, rig, seed: int, without_bias: bool = False) -> dict:
     placement = random_placement(rig.profile, rng)
     surface = S.planted_surface(rig, rng)
     t0 = time.perf_counter()
-    images = S.render(optics, rig, theta, surface, M.Camera.of(rig), seq, plan, rng, placement)
+    cam = M.Camera.of(rig)
+    images = S.render(optics, rig, theta, surface, cam, seq, plan, rng, placement)
     t1 = time.perf_counter()
     c1 = time.process_time()
-    frames = [{n: im.astype(float) / 255 for n, im in f.items()} for f in images]
+    # as rigcad calibrate --images reads them: the camera's window made floats (images.read_image)
+    frames = [{n: cam.crop(im).astype(float) / 255 for n, im in f.items()} for f in images]
     result = calibrate(optics, rig, frames)
     t2 = time.perf_counter()
     cpu = time.process_time() - c1

@@ -57,8 +57,12 @@ def capture_path(folder: Path, label: str, name: str) -> Path:
     return folder / f"{label}_{name}.png"
 
 
-def read_image(path: Path, resolution: tuple[int, int]) -> np.ndarray:
-    """One image as float in [0, 1] (rows, cols), checked for existence and size."""
+def read_image(path: Path, resolution: tuple[int, int], window=None) -> np.ndarray:
+    """One image as float in [0, 1] (rows, cols), checked for existence and size. ``window``: a
+    function that cuts the camera's window out of the image as read (``model.Camera.crop``), before
+    the colour is averaged and the values made floats: a full 1360 x 1024 frame made floats is
+    11 MB, and 240 of them cost more CPU than the decoding (docs/calibrate.md); the same values,
+    pixel for pixel. Full scale: 65535 for 16-bit files (as read), else 255."""
     from PIL import Image, UnidentifiedImageError
 
     if not path.is_file():
@@ -70,26 +74,33 @@ def read_image(path: Path, resolution: tuple[int, int]) -> np.ndarray:
             arr = np.asarray(im)
     except (OSError, UnidentifiedImageError, ValueError) as err:
         raise CaptureError(f"{path}: not a readable PNG or TIFF ({err})") from err
-    if arr.ndim == 3:
-        arr = arr[..., :3].mean(axis=2) if arr.shape[2] >= 3 else arr[..., 0]
     width, height = resolution
     if arr.shape[:2] != (height, width):
         raise CaptureError(f"{path}: {arr.shape[1]} x {arr.shape[0]} px, the camera's is {width} x {height}")
-    full = 65535.0 if np.asarray(arr).dtype == np.uint16 or arr.max() > 255 else 255.0
+    full = 65535.0 if arr.dtype == np.uint16 or arr.max() > 255 else 255.0
+    if window is not None:
+        arr = window(arr)
+    if arr.ndim == 3:
+        arr = arr[..., :3].mean(axis=2) if arr.shape[2] >= 3 else arr[..., 0]
     return arr.astype(float) / full
 
 
 def read_capture(folder: Path, seq: Sequence, labels: tuple[str, ...], resolution: tuple[int, int],
-                 absent: str = "") -> list[dict]:
-    """Every frame of every capture (``labels``: the plan's, module docstring), exposure-checked.
+                 absent: str = "", window=None) -> list[dict]:
+    """Every frame of every capture (``labels``: the plan's, module docstring), exposure-checked on
+    the whole white and black frames, then cut to ``window`` (:func:`read_image`; all whole without).
     ``absent``: what to say when a capture has none of its files (how to calibrate without it)."""
     out = []
     for k in labels:
         if absent and not any(capture_path(folder, k, n).is_file() for n in seq.names()):
             raise CaptureError(f"{capture_path(folder, k, 'white')}: missing, and every other frame of capture {k}: "
                                f"{absent}")
-        frames = {n: read_image(capture_path(folder, k, n), resolution) for n in seq.names()}
+        whole = ("white", "black")
+        frames = {n: read_image(capture_path(folder, k, n), resolution, None if n in whole else window)
+                  for n in seq.names()}
         check_exposure(folder, k, frames)
+        if window is not None:
+            frames.update({n: window(frames[n]).copy() for n in whole})  # the whole frames freed
         out.append(frames)
     return out
 

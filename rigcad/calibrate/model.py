@@ -219,7 +219,10 @@ class Camera:
                    height / 2 - jj.ravel() - 0.5, design)
 
     def crop(self, image: np.ndarray) -> np.ndarray:
-        """The window of a full camera image (rows, cols)."""
+        """The window of a full camera image (rows, cols, ...); an image of the window's size is taken
+        as the window already (the capture reader cuts it first: ``images.read_capture``)."""
+        if image.shape[:2] == self.shape:
+            return image
         return image[self.row0: self.row0 + self.shape[0], self.col0: self.col0 + self.shape[1]]
 
     def mirrored_core(self, rig) -> np.ndarray:

@@ -43,10 +43,11 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     folder, images, truth = Path("<simulated>"), None, None
     if not args.simulate:  # a capture that is missing or the wrong size is refused before any work
         folder = Path(args.images)
-        images = (read_capture(folder, seq, plan.labels, rig.profile.camera.resolution)
+        window = M.Camera.of(rig).crop
+        images = (read_capture(folder, seq, plan.labels, rig.profile.camera.resolution, window=window)
                   + read_capture(folder, ups.seq, ups.labels, rig.profile.camera.resolution,
                                  absent=f"the upright display's (calibration.upright_turns: {len(ups)}); to "
-                                        "calibrate without one, set calibration.upright_turns: 0"))
+                                        "calibrate without one, set calibration.upright_turns: 0", window=window))
     with stages(3, "calibrate") as step:
         step("tracer")
         optics = analytic_optics(rig)
@@ -106,7 +107,8 @@ def _simulated(optics, rig, args: argparse.Namespace, capture_out: str | None) -
                       plan, rng, placement)
     if capture_out:
         _write_capture(Path(capture_out), plan.labels + Uprights.of(rig.profile).labels, images, args.profile)
-    return [{n: im.astype(float) / 255.0 for n, im in f.items()} for f in images], (theta, surface, placement)
+    cam = M.Camera.of(rig)  # the window made floats, not the whole frame (images.read_image)
+    return [{n: cam.crop(im).astype(float) / 255.0 for n, im in f.items()} for f in images], (theta, surface, placement)
 
 
 def _against_dome_line(params: dict) -> str:
