@@ -59,8 +59,7 @@ def trial(optics, rig, seed: int, without_bias: bool = False) -> dict:
     images = S.render(optics, rig, theta, surface, cam, seq, plan, rng, placement)
     t1 = time.perf_counter()
     c1 = time.process_time()
-    # as rigcad calibrate --images reads them: the camera's window made floats (images.read_image)
-    frames = [{n: cam.crop(im).astype(float) / 255 for n, im in f.items()} for f in images]
+    frames = S.as_read(cam, images)
     result = calibrate(optics, rig, frames)
     t2 = time.perf_counter()
     cpu = time.process_time() - c1

@@ -133,6 +133,12 @@ def sub_offsets(s: int) -> np.ndarray:
     return (np.arange(s) + 0.5) / s - 0.5
 
 
+def as_read(cam: M.Camera, images: list[dict[str, np.ndarray]]) -> list[dict[str, np.ndarray]]:
+    """:func:`render`'s captures as ``rigcad calibrate --images`` reads files: the camera's window
+    of each frame, as float in [0, 1] (:func:`rigcad.calibrate.images.read_image`)."""
+    return [{n: cam.crop(im).astype(float) / 255.0 for n, im in f.items()} for f in images]
+
+
 def render(optics, rig, theta: np.ndarray, surface: SurfaceError | None, cam: M.Camera, seq: Sequence,
            plan: M.Plan, rng: np.random.Generator, placement: np.ndarray | None = None) -> list[dict[str, np.ndarray]]:
     """Per capture (``plan``, then the upright display's, :mod:`rigcad.calibrate.upright`), every

@@ -107,8 +107,7 @@ def _simulated(optics, rig, args: argparse.Namespace, capture_out: str | None) -
                       plan, rng, placement)
     if capture_out:
         _write_capture(Path(capture_out), plan.labels + Uprights.of(rig.profile).labels, images, args.profile)
-    cam = M.Camera.of(rig)  # the window made floats, not the whole frame (images.read_image)
-    return [{n: cam.crop(im).astype(float) / 255.0 for n, im in f.items()} for f in images], (theta, surface, placement)
+    return S.as_read(M.Camera.of(rig), images), (theta, surface, placement)
 
 
 def _against_dome_line(params: dict) -> str:
