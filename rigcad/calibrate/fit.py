@@ -273,10 +273,16 @@ def slope_projected(r: np.ndarray, reach: np.ndarray, axes: np.ndarray, factor: 
     screen k by reach[:, k] (mm from the dome) times one (x, y) vector in the sample frame, so the
     component is the projection on (reach_0, reach_1, ...) of the residuals turned into that frame by
     ``axes`` (k, 2, 2: each screen's (u, v) -> (x, y); a turned capture's axes point the other way)."""
-    g = np.einsum("kij,nkj->nki", axes, r)
-    t = reach[:, :, None]
-    a = np.sum(t * g, axis=1, keepdims=True) / np.sum(t * t, axis=1, keepdims=True)
-    return r - factor * np.einsum("kji,nkj->nki", axes, t * a)
+    (xu, xv), (yu, yv) = axes[:, 0].T, axes[:, 1].T  # each (k,): written out, no einsum (FMA varies)
+    ru, rv = r[..., 0], r[..., 1]
+    norm = np.sum(reach * reach, axis=1)
+    ax = np.sum(reach * (xu * ru + xv * rv), axis=1) / norm
+    ay = np.sum(reach * (yu * ru + yv * rv), axis=1) / norm
+    lever = factor * reach
+    out = np.empty_like(r)
+    out[..., 0] = ru - lever * (xu * ax[:, None] + yu * ay[:, None])
+    out[..., 1] = rv - lever * (xv * ax[:, None] + yv * ay[:, None])
+    return out
 
 
 def posterior_covariance(jac: np.ndarray, fun: np.ndarray, root: np.ndarray,
