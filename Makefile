@@ -16,6 +16,9 @@ EXPORTS ?= exports
 # them on every run: `pytest --collect-only` of make test's tests 18 s without the cache, 10 s with.
 unexport PYTHONDONTWRITEBYTECODE
 
+# numpy's huge-page advice off for every command here, as `rigcad` sets it (rigcad.cli.main.process_defaults)
+export NUMPY_MADVISE_HUGEPAGE ?= 0
+
 .PHONY: all stl design docs check gcode view manual tools test test-e2e test-all test-slow test-portable bench stress mutate clean distclean help
 
 all: stl
@@ -127,6 +130,7 @@ bench: $(VENV)/.installed stl
 	$(PY) bench/basis.py
 	$(PY) bench/optimize.py
 	$(PY) bench/startup.py
+	$(PY) bench/hugepages.py
 
 stress: $(VENV)/.installed
 	$(PY) -m pytest -q -m stress --hypothesis-show-statistics

@@ -94,3 +94,15 @@ def test_bench_script_quick_run_writes_json_and_png(name: str, tmp_path: Path) -
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
     assert b"Software" not in png, "PNG written without the Software metadata (same bytes every run)"
     CHECKS[name](data)
+
+
+def test_hugepages_quick_run_measures_both_settings(tmp_path: Path) -> None:
+    # bench/hugepages.py writes no picture: its JSON holds both settings of numpy's huge-page advice,
+    # each run's outputs the same bytes under both (where memory comes from changes no number)
+    cmd = [sys.executable, str(ROOT / "bench" / "hugepages.py"), "--quick", "--runs", "1", "--out", str(tmp_path)]
+    proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    data = json.loads((tmp_path / "hugepages.json").read_text())
+    assert "loadavg_1min" in data["run"]
+    assert {s["NUMPY_MADVISE_HUGEPAGE"] for s in data["settings"].values()} == {"0", "1"}
+    assert data["same_outputs"] and all(data["same_outputs"].values()), data["same_outputs"]

@@ -2,6 +2,7 @@
 
 import csv
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -111,3 +112,18 @@ def test_stl_returns_at_once_when_nothing_changed_and_repairs_a_damaged_file(exp
     repaired = run("stl", "achutha2006", "--exports", str(exports))
     assert "up to date" not in repaired.stdout and "1 part(s) built" in repaired.stdout
     assert stl.read_bytes() == good
+
+
+@pytest.mark.parametrize("given, advised", [(None, False), ("1", True), ("0", False)])
+def test_rigcad_starts_numpy_without_huge_page_advice_unless_told(given, advised, tmp_path):
+    # numpy reads NUMPY_MADVISE_HUGEPAGE once, when imported: a fresh process runs rigcad's main (a
+    # command that imports numpy), then asks numpy what it does. A value the user set wins.
+    env = {k: v for k, v in os.environ.items() if k != "NUMPY_MADVISE_HUGEPAGE"}
+    if given is not None:
+        env["NUMPY_MADVISE_HUGEPAGE"] = given
+    code = ("import sys; from rigcad.cli.main import main; assert 'numpy' not in sys.modules\n"
+            f"assert main(['design', 'achutha2006', '--exports', {str(tmp_path)!r}]) == 0; assert 'numpy' in sys.modules\n"
+            "from numpy._core.multiarray import _get_madvise_hugepage; print('advised', _get_madvise_hugepage())")
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == f"advised {advised}"

@@ -10,6 +10,7 @@ library; each ``cmd_*`` imports what it uses when it runs."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -17,6 +18,14 @@ from rigcad._version import __version__
 from rigcad.cli import (basis, build, calibrate, check, design, fab, manual, optimize, profile, stl, sweep, tolerance,
                         view, watch)
 from rigcad.errors import RigcadError, one_line
+
+#: numpy's switch for asking Linux to back its large arrays with transparent huge pages (numpy's
+#: default: on). Where the kernel's THP ``defrag`` setting is ``madvise`` (its default since Linux
+#: 4.6), a fault in memory so marked can stall on compaction instead of taking small pages (numpy
+#: gh-31590), and the marks stay on the heap after the array is freed. rigcad allocates and frees
+#: many large temporaries: a fifth to a third of a calibration's CPU time was the kernel's
+#: (bench/hugepages.py).
+NUMPY_HUGEPAGE_VARIABLE = "NUMPY_MADVISE_HUGEPAGE"
 
 #: The commands, in the order of ``rigcad --help``: each a module with ``register(subparsers)``.
 COMMANDS = (profile, design, build, stl, check, fab, basis, calibrate, optimize, view, watch, manual, tolerance, sweep)
@@ -42,7 +51,15 @@ def _error_line(message: object) -> str:
     return f"rigcad: error: {one_line(message)}"
 
 
+def process_defaults() -> None:
+    """rigcad's defaults for this process and the workers it starts, set before numpy is imported
+    (numpy reads :data:`NUMPY_HUGEPAGE_VARIABLE` once, at import): huge-page advice off. A value the
+    user set wins. (The Makefile sets the same for the tests, benchmarks and docs.)"""
+    os.environ.setdefault(NUMPY_HUGEPAGE_VARIABLE, "0")
+
+
 def main(argv: list[str] | None = None) -> int:
+    process_defaults()  # before anything imports numpy
     args = build_parser().parse_args(argv)  # --help and a bad argument end here: no engine, no numpy
     from rigcad.engine import run_temp_dir
 
