@@ -24,6 +24,10 @@ from pathlib import Path
 # wall time on the 2 free cores the target names.
 for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_name, "1")
+# and numpy's huge-page advice as `rigcad` sets it (bench/hugepages.py), run directly or by make
+from rigcad.cli.main import process_defaults  # noqa: E402
+
+process_defaults()
 
 import numpy as np  # noqa: E402
 
