@@ -23,8 +23,8 @@ from rigcad.errors import RigcadError, one_line
 #: default: on). Where the kernel's THP ``defrag`` setting is ``madvise`` (its default since Linux
 #: 4.6), a fault in memory so marked can stall on compaction instead of taking small pages (numpy
 #: gh-31590), and the marks stay on the heap after the array is freed. rigcad allocates and frees
-#: many large temporaries: a fifth to a third of a calibration's CPU time was the kernel's
-#: (bench/hugepages.py).
+#: many large temporaries: a fifth to a third of ``rigcad calibrate --simulate``'s CPU time was the
+#: kernel's (bench/hugepages.py).
 NUMPY_HUGEPAGE_VARIABLE = "NUMPY_MADVISE_HUGEPAGE"
 
 #: The commands, in the order of ``rigcad --help``: each a module with ``register(subparsers)``.
