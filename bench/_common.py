@@ -13,11 +13,29 @@ import io
 import math
 import os
 import platform
+import subprocess
+import tempfile
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results"
+
+
+def reaped(cmd: list[str], cwd: Path = ROOT, env: dict | None = None) -> dict:
+    """Run ``cmd`` as a child and reap it with os.wait4, which gives that child's own resource usage:
+    wall time (s), user and system CPU time (s), peak RSS (``ru_maxrss``, KiB on Linux), the exit code
+    and its output (stdout and stderr, through a temporary file)."""
+    with tempfile.TemporaryFile() as log:
+        t0 = time.perf_counter()
+        proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=log, stderr=subprocess.STDOUT)
+        _, status, ru = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t0
+        proc.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
+        log.seek(0)
+        text = log.read().decode(errors="replace")
+    return {"wall_s": wall, "user_s": ru.ru_utime, "system_s": ru.ru_stime, "peak_rss_kb": ru.ru_maxrss,
+            "exit_code": proc.returncode, "output": text}
 
 
 def run_info() -> dict:

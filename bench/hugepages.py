@@ -16,13 +16,11 @@ from __future__ import annotations
 
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-from _common import ROOT, arguments, run_info
+from _common import ROOT, arguments, reaped, run_info
 
 from rigcad.export.atomic import write_json
 
@@ -47,17 +45,10 @@ def thp_settings() -> dict:
 
 def measured(cmd: list[str], value: str) -> dict:
     env = {**os.environ, "PYTHONPATH": str(ROOT), "NUMPY_MADVISE_HUGEPAGE": value}
-    with tempfile.TemporaryFile() as log:
-        t0 = time.perf_counter()
-        proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
-        _, status, ru = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - t0
-        log.seek(0)
-        text = log.read().decode(errors="replace")
-    code = os.waitstatus_to_exitcode(status)
-    if code:
-        raise SystemExit(f"NUMPY_MADVISE_HUGEPAGE={value}: exit {code}:\n{text[-2000:]}")
-    return {"wall_s": wall, "user_s": ru.ru_utime, "system_s": ru.ru_stime, "peak_rss_kb": ru.ru_maxrss}
+    res = reaped(cmd, env=env)
+    if res["exit_code"]:
+        raise SystemExit(f"NUMPY_MADVISE_HUGEPAGE={value}: exit {res['exit_code']}:\n{res['output'][-2000:]}")
+    return {k: res[k] for k in ("wall_s", "user_s", "system_s", "peak_rss_kb")}
 
 
 def summary(runs: list[dict]) -> dict:

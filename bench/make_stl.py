@@ -25,13 +25,11 @@ import os
 import resource
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-from _common import ROOT, arguments, png, pyplot, run_info
+from _common import ROOT, arguments, png, pyplot, reaped, run_info
 
 from rigcad.export.atomic import write_bytes, write_json
 
@@ -43,17 +41,11 @@ TARGETS = {"stl_unchanged_wall_s": 1.0, "stl_cold_wall_s": 60.0}
 def measured(cmd: list[str]) -> dict:
     """Run ``cmd`` from the repository root; its wall time (s), CPU time (s), peak RSS (MiB) and
     exit code. Output goes to a temporary file (kept in the result only on failure)."""
-    with tempfile.TemporaryFile() as log:
-        t0 = time.perf_counter()
-        proc = subprocess.Popen(cmd, cwd=ROOT, stdout=log, stderr=subprocess.STDOUT)
-        _, status, ru = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - t0
-        proc.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
-        out = {"wall_s": wall, "cpu_s": ru.ru_utime + ru.ru_stime, "max_rss_mib": round(ru.ru_maxrss / 1024, 1),
-               "exit_code": proc.returncode}
-        if proc.returncode != 0:
-            log.seek(0)
-            out["output_tail"] = log.read().decode(errors="replace")[-2000:]
+    res = reaped(cmd)
+    out = {"wall_s": res["wall_s"], "cpu_s": res["user_s"] + res["system_s"],
+           "max_rss_mib": round(res["peak_rss_kb"] / 1024, 1), "exit_code": res["exit_code"]}
+    if res["exit_code"] != 0:
+        out["output_tail"] = res["output"][-2000:]
     return out
 
 

@@ -26,13 +26,12 @@ from __future__ import annotations
 
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from _common import ROOT, arguments, run_info
+from _common import ROOT, arguments, reaped, run_info
 
 from rigcad.export.atomic import write_json
 
@@ -54,15 +53,9 @@ def measured(cmd: list[str], tree: Path) -> dict:
     # warm means compiled: a shell that sets PYTHONDONTWRITEBYTECODE would have every run compile
     # rigcad's modules again (~0.1 s), which no user's installed rigcad does
     env.pop("PYTHONDONTWRITEBYTECODE", None)
-    with tempfile.TemporaryFile() as log:
-        t0 = time.perf_counter()
-        proc = subprocess.Popen(cmd, cwd=tree, env=env, stdout=log, stderr=subprocess.STDOUT)
-        _, status, ru = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - t0
-        proc.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
-        log.seek(0)
-        text = log.read().decode(errors="replace")
-    return {"wall_s": wall, "cpu_s": ru.ru_utime + ru.ru_stime, "exit_code": proc.returncode, "output": text}
+    res = reaped(cmd, cwd=tree, env=env)
+    return {"wall_s": res["wall_s"], "cpu_s": res["user_s"] + res["system_s"], "exit_code": res["exit_code"],
+            "output": res["output"]}
 
 
 def commands(scratch: Path, label: str, quick: bool) -> dict[str, tuple[list[str], int]]:
