@@ -117,6 +117,15 @@ def against_dome(rig, fit: FitResult) -> tuple[np.ndarray, np.ndarray]:
     return M.in_dome_frame(rig, fit.theta), np.sqrt(np.diag(cov))
 
 
+def screens_against_dome(rig, plan: M.Plan, fit: FitResult) -> tuple[np.ndarray, np.ndarray]:
+    """Each capture's screen tilt against the dome (:func:`rigcad.calibrate.model.screens_in_dome_frame`,
+    (captures, 2) rad) and its standard errors: what the same rig's calibrations compare to
+    measure how a screen settles (rigcad.calibrate.seating)."""
+    names = M.parameter_names(len(plan))
+    cov = M.covariance_through(lambda t: M.screens_in_dome_frame(rig, plan, t), fit.theta, fit.covariance, names)
+    return M.screens_in_dome_frame(rig, plan, fit.theta), np.sqrt(np.diag(cov)).reshape(-1, 2)
+
+
 def direct_ring_mm(design) -> float:
     """Where, on the sample plane, the camera's direct view past the paraboloid's rim begins (mm from
     O): its pinhole ray past the rim, cop_z tan(alpha_max) (24 mm on Table 3.1)."""

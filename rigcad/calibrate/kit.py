@@ -236,7 +236,8 @@ camera's full resolution, {p.camera.resolution[0]} x {p.camera.resolution[1]} px
   {"the lower spacer's and then the upright display's captures take over" if cal.upright_turns else
    "the corrected map is filled from the fit"}.
 
-{_after_the_fit(p.tolerancing)}"""
+{_after_the_fit(p.tolerancing)}
+{_measuring_the_seating(p)}"""
 
 
 def _upright_kit(p, flat: int) -> str:
@@ -304,6 +305,23 @@ def _upright_exposure(p) -> str:
         return ""
     return """- The upright display's captures light nothing but the paraboloid's image (the display is edge on to
   the direct view): set their exposure on that image, to the same 80-90 % of full scale.
+"""
+
+
+def _measuring_the_seating(p) -> str:
+    """The calibration page's section on measuring ``calibration.screen_seating`` (rigcad.calibrate.seating)."""
+    return f"""## Measuring how the screen settles
+The map's tilt over the sample plane is known as well as the screen settles when laid again on its
+spacer: `calibration.screen_seating`, {math.degrees(p.calibration.screen_seating):g} deg in this profile, a value stated, not
+measured. To measure it, leave the rig as it is and repeat the whole capture three to five times,
+lifting the screen and the spacers off and laying them again each time; calibrate each capture and
+keep each `calibration.json` (each calibration rewrites the folder). Then
+`rigcad calibrate {p.name} --seating <1>/calibration.json <2>/calibration.json ...`
+compares each screen's tilt against the dome between them, says how the screen settles (per axis,
+with a 95 % interval) and the value to state as `screen_seating`, and refuses captures between
+which the rig moved. A seat that settles tighter than the profile states makes the map's frame
+tighter when the profile says so; one that settles looser must be stated, or the frame's standard
+errors claim too much.
 """
 
 

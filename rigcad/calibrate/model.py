@@ -167,17 +167,39 @@ def in_dome_frame(rig, theta: np.ndarray) -> np.ndarray:
 
 def in_dome_frame_covariance(rig, theta: np.ndarray, covariance: np.ndarray) -> np.ndarray:
     """(10, 10) :func:`in_dome_frame`'s covariance from the parameters' (``covariance``, over
-    ``theta``; the rig's 15 first), through its Jacobian by central differences (steps of 0.1 um and
-    10 urad, a thousandth of the tightest tolerances: with ten times smaller steps the covariance
-    moves by ~3e-9 of its scale at a tolerance-sized misalignment, measured one-off)."""
-    n = len(RIG_NAMES)
-    step = np.array([1e-5 if name.endswith("_rad") else 1e-4 for name in RIG_NAMES])
-    jac = np.empty((len(DOME_FRAME_NAMES), n))
+    ``theta``; the rig's 15 first), through :func:`covariance_through`."""
+    return covariance_through(lambda t: in_dome_frame(rig, t), theta, covariance, RIG_NAMES)
+
+
+def covariance_through(f, theta: np.ndarray, covariance: np.ndarray, names) -> np.ndarray:
+    """The covariance of ``f(theta)`` from the parameters' (``covariance``, over ``theta``), through
+    f's Jacobian in the parameters ``names`` (the first ``len(names)`` of theta; f does not move
+    with the rest) by central differences: steps of 0.1 um and 10 urad, a thousandth of the
+    tightest tolerances (with ten times smaller steps :func:`in_dome_frame`'s covariance moves by
+    ~3e-9 of its scale at a tolerance-sized misalignment, measured one-off)."""
+    n = len(names)
+    step = np.array([1e-5 if name.endswith("_rad") else 1e-4 for name in names])
+    columns = []
     for i in range(n):
         e = np.zeros(len(theta))
         e[i] = step[i]
-        jac[:, i] = (in_dome_frame(rig, theta + e) - in_dome_frame(rig, theta - e)) / (2 * step[i])
+        columns.append((np.ravel(f(theta + e)) - np.ravel(f(theta - e))) / (2 * step[i]))
+    jac = np.stack(columns, axis=1)
     return jac @ covariance[:n, :n] @ jac.T
+
+
+def screens_in_dome_frame(rig, plan: Plan, theta: np.ndarray) -> np.ndarray:
+    """(captures, 2) each screen's tilt against the dome (rad): the x and y of the rotation vector
+    of the shortest turn from the dome's axis to the screen's normal, in the dome's frame; exact,
+    not linearised. Turning the rig and every screen together changes none of them, and neither
+    does a screen's turn about its normal: across calibrations of one rig, left as it is, the same
+    spacer's screen laid again differs only by how it settles (rigcad.calibrate.seating)."""
+    dome = moved(rig, theta).pose("dome")
+    normals = np.array([pose.rotation[:, 2] for pose in screens(plan, theta)]) @ dome.rotation
+    axes = np.cross([0.0, 0.0, 1.0], normals)  # sin(angle) times the turn's unit axis
+    sin = np.linalg.norm(axes, axis=1)
+    scale = np.where(sin > 0, np.arctan2(sin, normals[:, 2]) / np.where(sin > 0, sin, 1.0), 1.0)
+    return axes[:, :2] * scale[:, None]
 
 
 def screens(plan: Plan, theta: np.ndarray) -> list:

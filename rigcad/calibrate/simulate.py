@@ -90,7 +90,7 @@ def with_surface(rig, surface: SurfaceError | None, tr: M.Traced) -> M.Traced:
     return M.Traced(tr.p2, np.where(tr.ok[:, None], v, tr.v), tr.u, tr.ok, tr.direct)
 
 
-def random_misalignment(rig, plan: M.Plan, rng: np.random.Generator) -> np.ndarray:
+def random_misalignment(rig, plan: M.Plan, rng: np.random.Generator, laying: int = 0) -> np.ndarray:
     """A seeded build: each offset uniform within +- its tolerance, each tilt's rotation vector
     uniform in magnitude (0..tolerance) and direction. Each spacer's capture: the screen's height
     +-0.2 mm, its wedge's tilt within ``calibration.screen_tilt`` (a printed spacer, the screen's
@@ -98,7 +98,9 @@ def random_misalignment(rig, plan: M.Plan, rng: np.random.Generator) -> np.ndarr
     screen. Each screen laid by hand: turned uniformly within +- the placement tolerance about its
     nominal turn and, but the first, off centre within +- its tolerance along u and v; its tilt
     is the wedge's plus a seating tilt within ``screen_seating``. The first screen's height and
-    centre are the fit's gauge (:data:`model.GAUGE`): they define the frame."""
+    centre are the fit's gauge (:data:`model.GAUGE`): they define the frame. ``laying`` k > 0: the
+    same rig, spacers and wedges, each screen laid anew (the k-th time): its placement by hand and
+    its seating from streams of their own."""
     cal = rig.profile.calibration
     tol = M.tolerance_scale(rig, len(plan))
     theta = np.zeros(len(tol))
@@ -108,8 +110,8 @@ def random_misalignment(rig, plan: M.Plan, rng: np.random.Generator) -> np.ndarr
         mag, ang = rng.uniform(0, tol[j + 3]), rng.uniform(0, 2 * math.pi)
         theta[j + 3: j + 5] = mag * math.cos(ang), mag * math.sin(ang)
     # the hand's placement and the seating from streams of their own (spawning leaves ``rng``'s
-    # draws as they were)
-    hand, seat = rng.spawn(1)[0], rng.spawn(1)[0]
+    # draws as they were; the k-th laying's are the (2k, 2k + 1)-th children)
+    hand, seat = rng.spawn(2 + 2 * laying)[-2:]
     for c in sorted(range(len(plan)), key=lambda c: plan.repeats(c) is not None):  # spacers first
         j, first = M.screen_index(c), plan.repeats(c)
         if first is None:

@@ -1,7 +1,8 @@
 """``rigcad calibrate PROFILE (--images DIR | --simulate) [--seed N] [--exports DIR]``: decode the
 capture, fit the misalignment, write the residual slope map and the corrected pixel -> incidence
 map into ``<exports>/<profile>/calibrate/`` (published atomically: a refused capture writes
-nothing). ``--kit`` writes the calibration kit instead (rigcad.calibrate.kit)."""
+nothing). ``--kit`` writes the calibration kit instead (rigcad.calibrate.kit); ``--seating A B ...``
+measures how the screen settles from calibrations of one rig (rigcad.calibrate.seating)."""
 
 from __future__ import annotations
 
@@ -28,9 +29,12 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     rig = load(args.profile)
     check_screen_fits(rig)  # a screen that cannot lie in the dome is refused before any work
     check_upright_fits(rig.profile)  # nor an upright display that cannot stand in the bore
+    _check_laying(getattr(args, "laying", 0), args.simulate)
     capture_out = getattr(args, "write_capture", None)
     if capture_out:
         _check_capture_folder(Path(capture_out), args.simulate)
+    if getattr(args, "seating", None):
+        return _seating(rig, args)
     if getattr(args, "kit", False):
 
         out = Path(args.exports) / rig.name / "calibrate_kit"
@@ -91,7 +95,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
 def _simulated(optics, rig, args: argparse.Namespace, capture_out: str | None) -> tuple[list, tuple]:
     """``--simulate``'s capture (seeded by ``--seed``), written out with ``--write-capture``, as the
-    images to calibrate (float) and the truth to compare with (misalignment, surface, upright placement)."""
+    images to calibrate (float) and the truth to compare with (misalignment, surface, upright placement).
+    ``--laying`` k > 0: the same rig and surface, the screens and the upright display placed anew
+    and the camera's noise drawn anew (a capture for ``--seating``)."""
     import numpy as np
 
     from rigcad.calibrate import model as M, simulate as S
@@ -100,14 +106,41 @@ def _simulated(optics, rig, args: argparse.Namespace, capture_out: str | None) -
 
     plan = M.Plan.of(rig.profile)
     rng = np.random.default_rng(args.seed)
-    theta = S.random_misalignment(rig, plan, rng)
+    laying = getattr(args, "laying", 0)
+    theta = S.random_misalignment(rig, plan, rng, laying)
     placement = random_placement(rig.profile, rng)
     surface = S.planted_surface(rig, rng)
+    noise = np.random.default_rng([args.seed, laying]) if laying else rng
     images = S.render(optics, rig, theta, surface, M.Camera.of(rig), Sequence.from_profile(rig.profile.calibration),
-                      plan, rng, placement)
+                      plan, noise, placement)
     if capture_out:
         _write_capture(Path(capture_out), plan.labels + Uprights.of(rig.profile).labels, images, args.profile)
     return S.as_read(M.Camera.of(rig), images), (theta, surface, placement)
+
+
+def _seating(rig, args: argparse.Namespace) -> int:
+    """``--seating``: how the screen settles, from calibration.json files of one rig
+    (rigcad.calibrate.seating), into ``<exports>/<profile>/calibrate_seating/seating.json``."""
+    from rigcad.calibrate.images import CaptureError
+    from rigcad.calibrate.seating import line, measure
+    from rigcad.export.atomic import Staging, json_bytes, profile_lock
+    from rigcad.export.manifest import profile_digest
+
+    runs = []
+    for name in args.seating:
+        try:
+            runs.append((name, json.loads(Path(name).read_text(encoding="utf-8"))))
+        except FileNotFoundError:
+            raise CaptureError(f"{name}: missing (--seating reads the calibration.json of each calibration)") from None
+        except (OSError, ValueError) as err:
+            raise CaptureError(f"{name}: not a readable JSON file ({err})") from None
+    result = measure(runs, rig.profile)
+    out = Path(args.exports) / rig.name / "calibrate_seating"
+    with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
+        st.write_bytes(out / "seating.json", json_bytes(result))
+        st.commit()
+    print(f"{line(result)}; wrote {out}")
+    return 0
 
 
 def _against_dome_line(params: dict) -> str:
@@ -117,6 +150,16 @@ def _against_dome_line(params: dict) -> str:
         return (f"{c} off by x {v('dx_mm')}, y {v('dy_mm')}, z {v('dz_mm')} mm, "
                 f"tilted x {v('tilt_x_deg')}, y {v('tilt_y_deg')} deg")
     return f"against the dome's axis: {part('paraboloid')}; {part('camera')}"
+
+
+def _check_laying(laying: int, simulate: bool) -> None:
+    """``--laying``: with ``--simulate`` only, and 0 (the seed's own capture) or more."""
+    from rigcad.errors import ExportError
+
+    if laying and not simulate:
+        raise ExportError(f"--laying {laying}: only with --simulate (it lays the simulated screens anew)")
+    if laying < 0:
+        raise ExportError(f"--laying {laying}: a count of layings, 0 (the seed's own capture) or more")
 
 
 def _check_capture_folder(folder: Path, simulate: bool) -> None:
@@ -201,7 +244,8 @@ def _report(result, rig) -> dict:
                                           "the dome's axis (model.in_dome_frame): what the images fix apart from the "
                                           "rig's tilt over the sample plane, which only the priors fix; the parameters "
                                           "under 'fit' are in the sample frame (docs/calibrate.md)",
-                                 "parameters": in_report_units(M.DOME_FRAME_NAMES, *against_dome(rig, result.fit))},
+                                 "parameters": in_report_units(M.DOME_FRAME_NAMES, *against_dome(rig, result.fit)),
+                                 "screens": _screens_report(rig, result)},
             "residual_slopes": result.slope_figures(),
             "map_model": {"about": "the corrected map's model: refit from the fit above with each pixel's dome-slope "
                                    "residual component down-weighted (docs/calibrate.md)",
@@ -219,6 +263,16 @@ def _report(result, rig) -> dict:
             "screen_heights_mm": result.plan.heights.tolist(),
             "timings_s": result.timings_s, "camera_window": {"row0": result.cam.row0, "col0": result.cam.col0,
                                                              "shape": list(result.cam.shape)}}
+
+
+def _screens_report(rig, result) -> dict:
+    """Each flat capture's screen tilt against the dome, by label: what ``--seating`` compares
+    between calibrations of the same rig (rigcad.calibrate.seating)."""
+    from rigcad.calibrate.fit import in_report_units, screens_against_dome
+
+    tilts, se = screens_against_dome(rig, result.plan, result.fit)
+    return {label: in_report_units(("tilt_x_rad", "tilt_y_rad"), t, e)
+            for label, t, e in zip(result.plan.labels, tilts, se)}
 
 
 def _uprights_report(result) -> dict:
@@ -285,14 +339,21 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "the rig's misalignment with its own tracer, map the dome's residual slopes and write exports/<profile>/calibrate/: "
                     "calibration.json, corrected_map.npz (read by rigcad basis --simulate), maps.png. "
                     "--simulate renders a seeded capture of a moved rig with a planted dome error instead and "
-                    "compares; --kit writes the screen patterns, the spacers and the manual's page.")
+                    "compares; --kit writes the screen patterns, the spacers and the manual's page; --seating "
+                    "measures how the screen settles, from the calibration.json of repeated calibrations.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif, "
                      "h<spacer>r_<frame>, u<turn>_<frame>)")
     src.add_argument("--simulate", action="store_true", help="render a seeded simulated capture and calibrate it")
     src.add_argument("--kit", action="store_true", help="write the calibration kit: screen patterns, spacers "
                      "(STL, STEP, manifest), the manual's page, into <exports>/<profile>/calibrate_kit")
+    src.add_argument("--seating", nargs="+", metavar="JSON", help="how the screen settles on its spacer, from the "
+                     "calibration.json of two or more calibrations of one rig left as it is, the screen laid anew for "
+                     "each: the value for calibration.screen_seating, into <exports>/<profile>/calibrate_seating")
     p.add_argument("--seed", type=int, default=2006, help="seed of the simulated misalignment and noise")
+    p.add_argument("--laying", type=int, default=0, metavar="K", help="with --simulate: the screens laid anew the "
+                   "K-th time on --seed's rig (its misalignment, surface, spacers and wedges kept; the hand's "
+                   "placement, the seating and the noise drawn anew): captures for --seating")
     p.add_argument("--write-capture", metavar="DIR", help="with --simulate: also write the simulated camera "
                    "images into DIR (new or empty), named as --images reads them: a capture to rehearse on")
     return p

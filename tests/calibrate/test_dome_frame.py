@@ -82,3 +82,46 @@ def test_the_covariance_is_the_first_order_sum_of_the_variances(table31_rig):
         assert rel[k, k] == pytest.approx(sd[i[f"{c}_tilt_x_rad"]] ** 2 + sd[i["dome_tilt_x_rad"]] ** 2, rel=1e-6)
         k2 = M.DOME_FRAME_NAMES.index(f"{c}_dy_mm")  # the dome turned by t about x: dy + z t, tilt x - t
         assert rel[k2, k] == pytest.approx(-z * sd[i["dome_tilt_x_rad"]] ** 2, rel=1e-6)
+
+
+def _one_screen(dome_tilt, screen_tilt, turn=0.0) -> tuple[M.Plan, np.ndarray]:
+    """One capture at 30 mm, its screen tilted by the rotation vector ``screen_tilt`` and turned by
+    ``turn`` about its normal; the dome tilted by ``dome_tilt``."""
+    plan = M.Plan(np.array([30.0]), np.array([0.0]), ("h0",), (0,))
+    theta = np.zeros(len(M.RIG_NAMES) + len(M.SCREEN_KEYS))
+    theta[M.RIG_NAMES.index("dome_tilt_x_rad"): M.RIG_NAMES.index("dome_tilt_y_rad") + 1] = dome_tilt
+    s = M.screen_index(0)
+    theta[s + 1: s + 3] = screen_tilt
+    theta[s + 5] = turn
+    return plan, theta
+
+
+@pytest.mark.parametrize("turn", [0.0, math.pi, 0.4])
+def test_a_screen_against_the_dome_about_one_axis_is_the_difference_of_their_tilts(table31_rig, turn):
+    """Dome and screen tilted about x: the screen against the dome is the difference, whatever the
+    screen's turn about its normal (a half turn included)."""
+    plan, theta = _one_screen((2e-3, 0.0), (-3e-3, 0.0), turn)
+    np.testing.assert_allclose(M.screens_in_dome_frame(table31_rig, plan, theta), [[-5e-3, 0.0]], atol=1e-15)
+
+
+def test_a_screen_against_the_dome_about_crossed_axes_reads_the_exact_rotation(table31_rig):
+    """The dome turned a about x, the screen b about y: the screen's normal in the dome's frame is
+    (sin b, cos b sin a, cos b cos a), a turn of arccos(cos a cos b) about (-cos b sin a, sin b) / its
+    length (rotations written out here, not the model's)."""
+    a, b = 4e-3, -7e-3
+    plan, theta = _one_screen((a, 0.0), (0.0, b))
+    axis = np.array([-math.cos(b) * math.sin(a), math.sin(b)])
+    want = axis / np.linalg.norm(axis) * math.acos(math.cos(a) * math.cos(b))
+    np.testing.assert_allclose(M.screens_in_dome_frame(table31_rig, plan, theta)[0], want, rtol=1e-9)
+
+
+def test_a_screen_against_the_dome_has_the_variance_of_the_difference(table31_rig):
+    """Near zero the screen against the dome is the screen's tilt less the dome's: its variance per
+    axis is theirs summed, less twice their covariance (the central differences' Jacobian, first order)."""
+    plan, theta = _one_screen((1e-3, -2e-3), (2e-3, 1e-3))
+    names = M.parameter_names(1)
+    cov = np.eye(len(names)) * 1e-12
+    d, s = names.index("dome_tilt_x_rad"), names.index("screen0_tilt_x_rad")
+    cov[d, d], cov[s, s], cov[d, s], cov[s, d] = 1e-8, 4e-8, 1e-8, 1e-8
+    got = M.covariance_through(lambda t: M.screens_in_dome_frame(table31_rig, plan, t), theta, cov, names)
+    assert got[0, 0] == pytest.approx(1e-8 + 4e-8 - 2e-8, rel=1e-3)

@@ -1,0 +1,116 @@
+"""How the screen settles when it is laid again on its spacer, measured from two or more
+calibrations of one rig (``rigcad calibrate PROFILE --seating A.json B.json ...``; docs/calibrate.md,
+"Measuring the seating").
+
+With the half turns, the map's frame (the sample plane's tilt under the rig) is known to the
+seating, ``calibration.screen_seating``, and no image shows it. This measures it. Each
+calibration.json gives every flat capture's screen tilt against the dome (``against_the_dome``
+``screens``: :func:`rigcad.calibrate.model.screens_in_dome_frame`). With the rig left as it is
+between the calibrations and the screen laid anew for each, one label (``h<k>``, ``h<k>r``) is the
+same spacer in the same turn, hence the same wedge: its tilts differ by how the screen settled,
+and by the fit's noise between calibrations. Per axis, the spread about each label's mean, pooled
+over labels and axes (``2 L (N - 1)`` degrees of freedom for L labels in N calibrations), is the
+seating per axis, with a 95 % interval from the chi-squared distribution. The fit's noise is left
+in it, so it errs high, the safe side: the fit's standard errors are not taken out, because most of
+them is common to every calibration of one rig (the dome's figure steering its tilt) and cancels in
+the spread. docs/calibrate.md has the one-off figures.
+
+The profile's ``screen_seating`` is a bound: the simulation (rigcad.calibrate.simulate) lays each
+screen with a tilt uniform in size within it, in any direction, whose spread per axis is
+``screen_seating / sqrt 6``. The value to state is therefore ``sqrt 6`` times the interval's upper
+end."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rigcad.calibrate.images import CaptureError
+
+#: Two calibrations whose paraboloid or camera against the dome differ by more than this many
+#: combined standard errors were not of one rig left as it is.
+MOVED_SIGMAS = 5.0
+#: The simulation's seating (uniform in size within the bound, any direction): bound / per-axis spread.
+BOUND_OVER_SPREAD = math.sqrt(6.0)
+
+
+def measure(runs: list[tuple[str, dict]], profile) -> dict:
+    """``runs``: (name, calibration.json's content) of two or more calibrations of one rig, the
+    screen laid anew for each; the seating they measure (module docstring), against ``profile``'s."""
+    from scipy.stats import chi2
+
+    labels = _check(runs, profile)
+    tilts = np.array([[[r["against_the_dome"]["screens"][k][f"tilt_{a}_deg"]["value"] for a in "xy"]
+                       for k in labels] for _, r in runs])  # (N, L, 2) deg
+    se = np.array([[[r["against_the_dome"]["screens"][k][f"tilt_{a}_deg"]["standard_error"] for a in "xy"]
+                    for k in labels] for _, r in runs])
+    dev = tilts - tilts.mean(axis=0)
+    dof = 2 * len(labels) * (len(runs) - 1)
+    spread2 = float(np.sum(dev ** 2) / dof)
+    per_axis = [math.sqrt(spread2 * dof / v) for v in (dof, chi2.ppf(0.975, dof), chi2.ppf(0.025, dof))]
+    stated = math.degrees(profile.calibration.screen_seating)
+    suggested = BOUND_OVER_SPREAD * per_axis[2]
+    return {"calibrations": [name for name, _ in runs], "labels": list(labels), "degrees_of_freedom": dof,
+            "fit_standard_error_per_axis_deg": math.sqrt(float(np.mean(se ** 2))),
+            "seating_per_axis_deg": per_axis[0], "seating_per_axis_95_deg": per_axis[1:],
+            "largest_deviation_deg": float(np.max(np.linalg.norm(dev, axis=2))),
+            "screen_seating_stated_deg": stated, "screen_seating_measured_deg": suggested,
+            "verdict": _verdict(stated, BOUND_OVER_SPREAD * per_axis[1], suggested)}
+
+
+def _verdict(stated: float, low: float, high: float) -> str:
+    if stated < low:
+        return (f"the profile's screen_seating ({stated:.4g} deg) is tighter than this seat settles (at least "
+                f"{low:.4g} deg): the map's frame would be stated tighter than it is; set {high:.2g} deg")
+    if stated < high:
+        return (f"the profile's screen_seating ({stated:.4g} deg) is within this measurement's interval "
+                f"({low:.4g}-{high:.4g} deg); {high:.2g} deg is the safe value")
+    return (f"the profile's screen_seating ({stated:.4g} deg) covers this seat (at most {high:.4g} deg): "
+            f"stating {high:.2g} deg would tighten the map's frame to what the seat does")
+
+
+def line(result: dict) -> str:
+    """One line of ``measure``'s result."""
+    lo, hi = result["seating_per_axis_95_deg"]
+    return (f"seating from {len(result['calibrations'])} calibrations ({len(result['labels'])} captures each, "
+            f"{result['degrees_of_freedom']} degrees of freedom): {result['seating_per_axis_deg']:.4f} deg per axis "
+            f"(95 %: {lo:.4f}-{hi:.4f}; the fit's noise left in), "
+            f"screen_seating {result['screen_seating_measured_deg']:.4f} deg; {result['verdict']}")
+
+
+def _check(runs: list[tuple[str, dict]], profile) -> tuple[str, ...]:
+    """The flat captures' labels that every run has, as ``profile`` plans them; refuses runs that
+    cannot measure the seating, naming the file."""
+    from rigcad.calibrate.model import Plan
+
+    if len(runs) < 2:
+        raise CaptureError("--seating: give two or more calibration.json of one rig, left as it is, the screen "
+                           f"laid anew for each (got {len(runs)})")
+    labels = Plan.of(profile).labels
+    for name, r in runs:
+        screens = r.get("against_the_dome", {}).get("screens") if isinstance(r, dict) else None
+        if not isinstance(screens, dict):
+            raise CaptureError(f"{name}: no screen tilts against the dome (against_the_dome.screens): not a "
+                               "calibration.json, or one an earlier rigcad wrote; calibrate that capture again")
+        if set(screens) != set(labels):
+            raise CaptureError(f"{name}: captures {sorted(screens)}, the profile plans {sorted(labels)} "
+                               "(calibration.spacer_heights, calibration.half_turn): calibrated with another profile")
+    _check_unmoved(runs)
+    return labels
+
+
+def _check_unmoved(runs: list[tuple[str, dict]]) -> None:
+    """Refuses two runs whose paraboloid or camera against the dome differ by more than
+    :data:`MOVED_SIGMAS` combined standard errors: the rig moved between them."""
+    first_name, first = runs[0]
+    for name, r in runs[1:]:
+        for key, a in first["against_the_dome"]["parameters"].items():
+            b = r["against_the_dome"]["parameters"][key]
+            combined = math.hypot(a["standard_error"], b["standard_error"])
+            if abs(a["value"] - b["value"]) > MOVED_SIGMAS * combined:
+                unit = "deg" if key.endswith("_deg") else "mm"
+                raise CaptureError(
+                    f"{name}: {key} against the dome {b['value']:+.4f} {unit}, {first_name}: {a['value']:+.4f} "
+                    f"(standard errors {b['standard_error']:.4f}, {a['standard_error']:.4f}): the rig moved between "
+                    "them; measure the seating with the rig left as it is, only the screen laid again")
