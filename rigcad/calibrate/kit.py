@@ -314,9 +314,9 @@ def _measuring_the_seating(p) -> str:
 The map's tilt over the sample plane is known as well as the screen settles when laid again on its
 spacer: `calibration.screen_seating`, {math.degrees(p.calibration.screen_seating):g} deg in this profile, a value stated, not
 measured. To measure it, leave the rig as it is and repeat the whole capture three to five times,
-lifting the screen and the spacers off and laying them again each time; calibrate each capture and
-keep each `calibration.json` (each calibration rewrites the folder). Then
-`rigcad calibrate {p.name} --seating <1>/calibration.json <2>/calibration.json ...`
+lifting the screen and the spacers off and laying them again each time; calibrate each capture into
+a folder of its own (`rigcad calibrate {p.name} --images <capture k> --exports <k>`). Then
+`rigcad calibrate {p.name} --seating <1>/{p.name}/calibrate <2>/{p.name}/calibrate ...`
 compares each screen's tilt against the dome between them, says how the screen settles (per axis,
 with a 95 % interval) and the value to state as `screen_seating`, and refuses captures between
 which the rig moved. A seat that settles tighter than the profile states makes the map's frame

@@ -40,11 +40,15 @@ def measure(runs: list[tuple[str, dict]], profile) -> dict:
     screen laid anew for each; the seating they measure (module docstring), against ``profile``'s."""
     from scipy.stats import chi2
 
-    labels = _check(runs, profile)
-    tilts = np.array([[[r["against_the_dome"]["screens"][k][f"tilt_{a}_deg"]["value"] for a in "xy"]
-                       for k in labels] for _, r in runs])  # (N, L, 2) deg
-    se = np.array([[[r["against_the_dome"]["screens"][k][f"tilt_{a}_deg"]["standard_error"] for a in "xy"]
-                    for k in labels] for _, r in runs])
+    from rigcad.calibrate.model import Plan
+
+    if len(runs) < 2:
+        raise CaptureError("--seating: give two or more calibration.json of one rig, left as it is, the screen "
+                           f"laid anew for each (got {len(runs)})")
+    labels = Plan.of(profile).labels
+    read = [_figures(name, r, labels) for name, r in runs]
+    _check_unmoved([name for name, _ in runs], [parts for _, _, parts in read])
+    tilts, se = np.array([t for t, _, _ in read]), np.array([e for _, e, _ in read])  # (N, L, 2) deg
     dev = tilts - tilts.mean(axis=0)
     dof = 2 * len(labels) * (len(runs) - 1)
     spread2 = float(np.sum(dev ** 2) / dof)
@@ -79,38 +83,44 @@ def line(result: dict) -> str:
             f"screen_seating {result['screen_seating_measured_deg']:.4f} deg; {result['verdict']}")
 
 
-def _check(runs: list[tuple[str, dict]], profile) -> tuple[str, ...]:
-    """The flat captures' labels that every run has, as ``profile`` plans them; refuses runs that
-    cannot measure the seating, naming the file."""
-    from rigcad.calibrate.model import Plan
+def _figures(name: str, report, labels: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, dict]:
+    """One calibration.json's screen tilts against the dome and their standard errors ((labels, 2)
+    deg, in ``labels``' order) and its parts against the dome (name -> (value, standard error));
+    refuses, naming the file and the key, one that cannot measure the seating."""
+    def pair(key: str, entry) -> tuple[float, float]:
+        value, se = (entry.get(k) if isinstance(entry, dict) else None for k in ("value", "standard_error"))
+        for k, v in (("value", value), ("standard_error", se)):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or (k != "value" and v < 0):
+                raise CaptureError(f"{name}: {key}.{k} is {v!r}, not a finite number"
+                                   f"{' of 0 or more' if k != 'value' else ''}: not a calibration.json rigcad wrote")
+        return float(value), float(se)
 
-    if len(runs) < 2:
-        raise CaptureError("--seating: give two or more calibration.json of one rig, left as it is, the screen "
-                           f"laid anew for each (got {len(runs)})")
-    labels = Plan.of(profile).labels
-    for name, r in runs:
-        screens = r.get("against_the_dome", {}).get("screens") if isinstance(r, dict) else None
-        if not isinstance(screens, dict):
-            raise CaptureError(f"{name}: no screen tilts against the dome (against_the_dome.screens): not a "
-                               "calibration.json, or one an earlier rigcad wrote; calibrate that capture again")
-        if set(screens) != set(labels):
-            raise CaptureError(f"{name}: captures {sorted(screens)}, the profile plans {sorted(labels)} "
-                               "(calibration.spacer_heights, calibration.half_turn): calibrated with another profile")
-    _check_unmoved(runs)
-    return labels
+    dome = report.get("against_the_dome") if isinstance(report, dict) else None
+    screens, parts = (dome.get(k) if isinstance(dome, dict) else None for k in ("screens", "parameters"))
+    if not isinstance(screens, dict) or not isinstance(parts, dict):
+        raise CaptureError(f"{name}: no screen tilts against the dome (against_the_dome.screens): not a "
+                           "calibration.json, or one an earlier rigcad wrote; calibrate that capture again")
+    if set(screens) != set(labels):
+        raise CaptureError(f"{name}: captures {sorted(screens)}, the profile plans {sorted(labels)} "
+                           "(calibration.spacer_heights, calibration.half_turn): calibrated with another profile")
+    tilts = np.array([[pair(f"against_the_dome.screens.{k}.tilt_{a}_deg",
+                            screens[k].get(f"tilt_{a}_deg") if isinstance(screens[k], dict) else None)
+                       for a in "xy"] for k in labels])  # (labels, 2 axes, value and standard error)
+    return tilts[..., 0], tilts[..., 1], {k: pair(f"against_the_dome.parameters.{k}", v) for k, v in parts.items()}
 
 
-def _check_unmoved(runs: list[tuple[str, dict]]) -> None:
+def _check_unmoved(names: list[str], parts: list[dict]) -> None:
     """Refuses two runs whose paraboloid or camera against the dome differ by more than
     :data:`MOVED_SIGMAS` combined standard errors: the rig moved between them."""
-    first_name, first = runs[0]
-    for name, r in runs[1:]:
-        for key, a in first["against_the_dome"]["parameters"].items():
-            b = r["against_the_dome"]["parameters"][key]
-            combined = math.hypot(a["standard_error"], b["standard_error"])
-            if abs(a["value"] - b["value"]) > MOVED_SIGMAS * combined:
+    for name, other in zip(names[1:], parts[1:]):
+        if set(other) != set(parts[0]):
+            raise CaptureError(f"{name}: parts against the dome {sorted(other)}, {names[0]}: {sorted(parts[0])}: "
+                               "not calibrations of one profile")
+        for key, (a, a_se) in parts[0].items():
+            b, b_se = other[key]
+            if abs(a - b) > MOVED_SIGMAS * math.hypot(a_se, b_se):
                 unit = "deg" if key.endswith("_deg") else "mm"
                 raise CaptureError(
-                    f"{name}: {key} against the dome {b['value']:+.4f} {unit}, {first_name}: {a['value']:+.4f} "
-                    f"(standard errors {b['standard_error']:.4f}, {a['standard_error']:.4f}): the rig moved between "
-                    "them; measure the seating with the rig left as it is, only the screen laid again")
+                    f"{name}: {key} against the dome {b:+.4f} {unit}, {names[0]}: {a:+.4f} (standard errors "
+                    f"{b_se:.4f}, {a_se:.4f}): the rig moved between them; measure the seating with the rig left "
+                    "as it is, only the screen laid again")

@@ -128,8 +128,10 @@ def _seating(rig, args: argparse.Namespace) -> int:
 
     runs = []
     for name in args.seating:
+        path = Path(name) / "calibration.json" if Path(name).is_dir() else Path(name)
+        name = str(path)
         try:
-            runs.append((name, json.loads(Path(name).read_text(encoding="utf-8"))))
+            runs.append((name, json.loads(path.read_text(encoding="utf-8"))))
         except FileNotFoundError:
             raise CaptureError(f"{name}: missing (--seating reads the calibration.json of each calibration)") from None
         except (OSError, ValueError) as err:
@@ -348,8 +350,9 @@ def register(subparsers) -> argparse.ArgumentParser:
     src.add_argument("--kit", action="store_true", help="write the calibration kit: screen patterns, spacers "
                      "(STL, STEP, manifest), the manual's page, into <exports>/<profile>/calibrate_kit")
     src.add_argument("--seating", nargs="+", metavar="JSON", help="how the screen settles on its spacer, from the "
-                     "calibration.json of two or more calibrations of one rig left as it is, the screen laid anew for "
-                     "each: the value for calibration.screen_seating, into <exports>/<profile>/calibrate_seating")
+                     "calibration.json (or the calibrate/ folder holding it) of two or more calibrations of one rig left "
+                     "as it is, the screen laid anew for each: the value for calibration.screen_seating, into "
+                     "<exports>/<profile>/calibrate_seating")
     p.add_argument("--seed", type=int, default=2006, help="seed of the simulated misalignment and noise")
     p.add_argument("--laying", type=int, default=0, metavar="K", help="with --simulate: the screens laid anew the "
                    "K-th time on --seed's rig (its misalignment, surface, spacers and wedges kept; the hand's "

@@ -42,6 +42,16 @@ def _runs(tilts: np.ndarray, se: float = 0.0, moved: dict | None = None) -> list
     return runs
 
 
+def _set(report: dict, path: tuple, value) -> dict:
+    """A copy of ``report`` with against_the_dome's entry at ``path`` set to ``value``."""
+    out = json.loads(json.dumps(report))
+    entry = out["against_the_dome"]
+    for key in path[:-1]:
+        entry = entry[key]
+    entry[path[-1]] = value
+    return out
+
+
 def _draw(rng, n: int, spread: float) -> np.ndarray:
     """n calibrations: each label's wedge (0.2 deg) plus a seating per axis of ``spread`` deg."""
     wedge = rng.uniform(-0.2, 0.2, (1, len(LABELS), 2))
@@ -94,6 +104,14 @@ def test_the_verdict_compares_the_profiles_seating(tmp_path, stated, words):
     (lambda runs: [runs[0], (runs[1][0], {"fit": {}})], ("run1/calibration.json", "against_the_dome.screens")),
     (lambda runs: [runs[0], (runs[1][0], json.loads(json.dumps(runs[1][1]).replace('"h1r"', '"h2r"')))],
      ("run1/calibration.json", "'h2r'", "calibration.spacer_heights")),
+    (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("parameters", "camera_dx_mm", "value"), "x"))],
+     ("run1/calibration.json", "against_the_dome.parameters.camera_dx_mm.value is 'x'", "not a finite number")),
+    (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("screens", "h1", "tilt_y_deg", "value"), float("nan")))],
+     ("run1/calibration.json", "against_the_dome.screens.h1.tilt_y_deg.value is nan")),
+    (lambda runs: [runs[0], (runs[1][0], json.loads(json.dumps(runs[1][1]).replace('"standard_error": 0.0', '"standard_error": -1')))],
+     ("run1/calibration.json", "tilt_x_deg.standard_error is -1", "0 or more")),
+    (lambda runs: [runs[0], (runs[1][0], {"against_the_dome": []})], ("run1/calibration.json", "no screen tilts")),
+    (lambda runs: [runs[0], (runs[1][0], ["not", "a", "report"])], ("run1/calibration.json", "no screen tilts")),
 ])
 def test_runs_that_cannot_measure_it_are_refused_naming_the_file(profile, spoil, words):
     with pytest.raises(CaptureError) as info:
@@ -127,7 +145,7 @@ def test_three_layings_of_one_simulated_rig_measure_the_planted_seating(tmp_path
     for k in range(3):
         assert run(simulate=True, laying=k, exports=str(tmp_path / f"laying{k}")) == 0
         files.append(tmp_path / f"laying{k}" / "achutha2006" / "calibrate" / "calibration.json")
-    assert run(seating=[str(f) for f in files]) == 0
+    assert run(seating=[str(f.parent) for f in files]) == 0  # the calibrate/ folders
     assert "seating from 3 calibrations" in capsys.readouterr().out
     got = json.loads((tmp_path / "exports" / "achutha2006" / "calibrate_seating" / "seating.json").read_text())
     planted = np.array([[[json.loads(f.read_text())["simulation"]["parameters"][f"screen{c}_tilt_{a}_rad"]["planted"]
