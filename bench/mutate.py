@@ -98,6 +98,19 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
     # tubes and boxes built here (test_split_parts.py, seconds) and the rounding-tie test; the Table 3.1
     # dome and plate splits (test_split.py, test_split_form3.py) keep their claims (the real parts'
     # pieces, pins off the mirror, the beam slots avoided) but cost ~30 s a mutant
+    # the seating's maths and refusals on hand-made reports (seconds); the e2e test of three simulated
+    # layings keeps its claim (the planted spread measured) but costs ~2 min a mutant
+    "calibrate.seating": (["rigcad/calibrate/seating.py"],
+                          [f"tests/calibrate/test_seating.py::{t}" for t in (
+                              "test_the_spread_is_the_pooled_variance_about_each_labels_mean",
+                              "test_the_fits_standard_errors_are_reported_not_taken_out",
+                              "test_the_interval_covers_the_true_spread_95_times_in_100",
+                              "test_the_verdict_compares_the_profiles_seating",
+                              "test_runs_that_cannot_measure_it_are_refused_naming_the_file",
+                              "test_a_rig_that_moved_between_the_calibrations_is_refused",
+                              "test_a_tilt_that_moved_is_named_in_degrees",
+                              "test_the_command_refuses_in_one_line_and_writes_nothing",
+                              "test_the_command_writes_the_measurement")]),
     "fab.split": (["rigcad/fab/split.py"],
                   ["tests/fab/test_split_parts.py",
                    "tests/fab/test_split.py::test_pin_points_tied_to_rounding_are_chosen_in_their_order_on_every_cpu"]),

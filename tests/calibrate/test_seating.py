@@ -65,6 +65,9 @@ def test_the_spread_is_the_pooled_variance_about_each_labels_mean(profile):
     assert got["degrees_of_freedom"] == 2 * 4 * 4
     assert got["seating_per_axis_deg"] == pytest.approx(math.sqrt(want), rel=1e-12)
     assert got["screen_seating_measured_deg"] == pytest.approx(BOUND_OVER_SPREAD * got["seating_per_axis_95_deg"][1])
+    assert got["screen_seating_stated_deg"] == pytest.approx(0.02)  # the profile's
+    lengths = [math.hypot(*(tilts[i, k] - tilts[:, k].mean(axis=0))) for i in range(5) for k in range(4)]
+    assert got["largest_deviation_deg"] == pytest.approx(max(lengths), rel=1e-12)
 
 
 def test_the_fits_standard_errors_are_reported_not_taken_out(profile):
@@ -90,27 +93,53 @@ def test_the_interval_covers_the_true_spread_95_times_in_100(profile):
     assert abs(hits / 2000 - 0.95) < 3 * math.sqrt(0.95 * 0.05 / 2000)
 
 
-@pytest.mark.parametrize("stated, words", [("0.002 deg", "tighter than this seat settles"),
-                                           ("0.5 deg", "covers this seat")])
-def test_the_verdict_compares_the_profiles_seating(tmp_path, stated, words):
+@pytest.mark.parametrize("where, words", [(0.9, "is tighter than this seat settles (at least {low:.4g} deg)"),
+                                          (1.1, "is within this measurement's interval ({low:.4g}-{high:.4g} deg)"),
+                                          (None, "is within this measurement's interval ({low:.4g}-{high:.4g} deg)"),
+                                          (2.0, "covers this seat (at most {high:.4g} deg)")])
+def test_the_verdict_compares_the_profiles_seating(tmp_path, where, words):
+    """The profile's value just under the interval's low end (as screen_seating: sqrt 6 times the
+    spread's), just over it, in the middle, and past the high end."""
+    runs = _runs(_draw(np.random.default_rng(5), 4, 0.004))
+    lo, hi = (BOUND_OVER_SPREAD * v for v in measure(runs, load("achutha2006").profile)["seating_per_axis_95_deg"])
+    stated = math.sqrt(lo * hi) if where is None else (where * lo if where < 1.5 else where * hi)
     path = tmp_path / "p.yaml"
-    path.write_text(f"extends: achutha2006\ncalibration:\n  screen_seating: {stated}\n")
-    got = measure(_runs(_draw(np.random.default_rng(5), 4, 0.004)), load_profile(path))
-    assert words in got["verdict"], got["verdict"]
+    path.write_text(f"extends: achutha2006\ncalibration:\n  screen_seating: {stated!r} deg\n")
+    got = measure(runs, load_profile(path))
+    assert words.format(low=lo, high=hi) in got["verdict"], got["verdict"]
 
 
 @pytest.mark.parametrize("spoil, words", [
-    (lambda runs: runs[:1], ("two or more", "got 1")),
+    (lambda runs: runs[:1], ("--seating: give two or more calibration.json of one rig, left as it is, the screen "
+                             "laid anew for each (got 1)",)),
     (lambda runs: [runs[0], (runs[1][0], {"fit": {}})], ("run1/calibration.json", "against_the_dome.screens")),
     (lambda runs: [runs[0], (runs[1][0], json.loads(json.dumps(runs[1][1]).replace('"h1r"', '"h2r"')))],
      ("run1/calibration.json", "'h2r'", "calibration.spacer_heights")),
     (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("parameters", "camera_dx_mm", "value"), "x"))],
-     ("run1/calibration.json", "against_the_dome.parameters.camera_dx_mm.value is 'x'", "not a finite number")),
+     ("run1/calibration.json: against_the_dome.parameters.camera_dx_mm.value is 'x', not a finite number: not a "
+      "calibration.json rigcad wrote",)),
     (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("screens", "h1", "tilt_y_deg", "value"), float("nan")))],
      ("run1/calibration.json", "against_the_dome.screens.h1.tilt_y_deg.value is nan")),
     (lambda runs: [runs[0], (runs[1][0], json.loads(json.dumps(runs[1][1]).replace('"standard_error": 0.0', '"standard_error": -1')))],
      ("run1/calibration.json", "tilt_x_deg.standard_error is -1", "0 or more")),
     (lambda runs: [runs[0], (runs[1][0], {"against_the_dome": []})], ("run1/calibration.json", "no screen tilts")),
+    (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("parameters",), None))],
+     ("run1/calibration.json: no screen tilts against the dome (against_the_dome.screens): not a calibration.json, "
+      "or one an earlier rigcad wrote; calibrate that capture again",)),
+    (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("screens", "h0r", "tilt_x_deg"), 0.01))],
+     ("run1/calibration.json: against_the_dome.screens.h0r.tilt_x_deg.value is None, not a finite number: not a "
+      "calibration.json rigcad wrote",)),
+    (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("screens", "h0r"), 0.01))],
+     ("run1/calibration.json: against_the_dome.screens.h0r.tilt_x_deg.value is None",)),
+    (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("parameters", "camera_dx_mm"), [0.1]))],
+     ("run1/calibration.json: against_the_dome.parameters.camera_dx_mm.value is None",)),
+    (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("parameters", "paraboloid_dx_mm"),
+                                              {"value": 0.0, "standard_error": 0.01}))],
+     ("run1/calibration.json: parts against the dome ['camera_dx_mm', 'camera_tilt_x_deg', 'paraboloid_dx_mm'], "
+      "run0/calibration.json: ['camera_dx_mm', 'camera_tilt_x_deg']: not calibrations of one profile",)),
+    (lambda runs: [runs[0], (runs[1][0], json.loads(json.dumps(runs[1][1]).replace('"h1r"', '"h2r"')))],
+     ("run1/calibration.json: captures ['h0', 'h0r', 'h1', 'h2r'], the profile plans ['h0', 'h0r', 'h1', 'h1r'] "
+      "(calibration.spacer_heights, calibration.half_turn): calibrated with another profile",)),
     (lambda runs: [runs[0], (runs[1][0], ["not", "a", "report"])], ("run1/calibration.json", "no screen tilts")),
 ])
 def test_runs_that_cannot_measure_it_are_refused_naming_the_file(profile, spoil, words):
@@ -119,12 +148,33 @@ def test_runs_that_cannot_measure_it_are_refused_naming_the_file(profile, spoil,
     assert all(w in str(info.value) for w in words), str(info.value)
 
 
-def test_a_rig_that_moved_between_the_calibrations_is_refused(profile):
+@pytest.mark.parametrize("moved_run", [1, 2])
+def test_a_rig_that_moved_between_the_calibrations_is_refused(profile, moved_run):
+    """Against the first calibration, combined standard errors hypot(0.01, 0.02) mm: 4.9 of them kept,
+    5.1 refused, naming the file, the part, both values and their standard errors."""
     tilts = _draw(np.random.default_rng(7), 3, 0.004)
-    measure(_runs(tilts, moved={"camera_dx_mm": 0.04}), profile)  # 2.8 combined standard errors: kept
+    combined = math.hypot(0.01, 0.02)
+
+    def runs(sigmas):
+        out = _runs(tilts, moved={"camera_dx_mm": sigmas * combined})
+        if moved_run == 1:
+            out[1], out[2] = (out[1][0], out[2][1]), (out[2][0], out[1][1])
+        out[moved_run][1]["against_the_dome"]["parameters"]["camera_dx_mm"]["standard_error"] = 0.02
+        return out
+
+    measure(runs(4.9), profile)
     with pytest.raises(CaptureError) as info:
-        measure(_runs(tilts, moved={"camera_dx_mm": 0.08}), profile)  # 5.7
-    assert "run2/calibration.json: camera_dx_mm" in str(info.value) and "the rig moved" in str(info.value)
+        measure(runs(5.1), profile)
+    assert str(info.value) == (
+        f"run{moved_run}/calibration.json: camera_dx_mm against the dome {0.1 + 5.1 * combined:+.4f} mm, "
+        "run0/calibration.json: +0.1000 (standard errors 0.0200, 0.0100): the rig moved between them; measure the "
+        "seating with the rig left as it is, only the screen laid again")
+
+
+def test_a_tilt_that_moved_is_named_in_degrees(profile):
+    with pytest.raises(CaptureError) as info:
+        measure(_runs(_draw(np.random.default_rng(7), 2, 0.004), moved={"camera_tilt_x_deg": 0.05}), profile)
+    assert "camera_tilt_x_deg against the dome +0.0700 deg" in str(info.value)
 
 
 @pytest.mark.e2e  # three full-size simulated calibrations, ~2 min on one core: make test-e2e
