@@ -121,7 +121,8 @@ def test_the_verdict_compares_the_profiles_seating(tmp_path, where, words):
     (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("screens", "h1", "tilt_y_deg", "value"), float("nan")))],
      ("run1/calibration.json", "against_the_dome.screens.h1.tilt_y_deg.value is nan")),
     (lambda runs: [runs[0], (runs[1][0], json.loads(json.dumps(runs[1][1]).replace('"standard_error": 0.0', '"standard_error": -1')))],
-     ("run1/calibration.json", "tilt_x_deg.standard_error is -1", "0 or more")),
+     ("run1/calibration.json: against_the_dome.screens.h0.tilt_x_deg.standard_error is -1, not a finite number "
+      "of 0 or more: not a calibration.json rigcad wrote",)),
     (lambda runs: [runs[0], (runs[1][0], {"against_the_dome": []})], ("run1/calibration.json", "no screen tilts")),
     (lambda runs: [runs[0], (runs[1][0], _set(runs[1][1], ("parameters",), None))],
      ("run1/calibration.json: no screen tilts against the dome (against_the_dome.screens): not a calibration.json, "
