@@ -101,6 +101,7 @@ VARIANTS = {"steps3": "calibration:\n  phase_steps: 3\n", "steps4": "calibration
             "half_turn_none": "calibration:\n  half_turn: none\n",
             "half_turn_highest": "calibration:\n  half_turn: highest\n",
             "screen_seating_0.05deg": "calibration:\n  screen_seating: 0.05 deg\n",
+            "screen_seating_0.01deg": "calibration:\n  screen_seating: 0.01 deg\n",
             "screen_seating_0.005deg": "calibration:\n  screen_seating: 0.005 deg\n",
             "screen_tilt_0.02deg": "calibration:\n  screen_tilt: 0.02 deg\n",
             # what the mirrors' loss costs: the capture as the simulation rendered it before
@@ -116,34 +117,40 @@ VARIANTS = {"steps3": "calibration:\n  phase_steps: 3\n", "steps4": "calibration
 def sweep(base: str, trials: int, names: list[str] | None = None) -> dict:
     """One row per variant (``names``, all by default): median corrected p99, CPU seconds of the
     calibration."""
+    from rigcad.check.scene import analytic_optics
+
+    out = {}
+    for name in VARIANTS:
+        if names and name not in names:
+            continue
+        rig = variant_rig(base, name)
+        optics = analytic_optics(rig)
+        rows = [trial(optics, rig, 1000 + seed) for seed in range(trials)]
+        out[name] = {"trials": trials,
+                     "corrected_p99_deg": float(np.median([r["corrected_incidence_error_deg"]["p99"] for r in rows])),
+                     "corrected_p50_deg": float(np.median([r["corrected_incidence_error_deg"]["p50"] for r in rows])),
+                     "measured_pixels_p99_deg": float(np.median(
+                         [r["corrected_incidence_error_deg_by_source"]["measured"]["p99"] for r in rows])),
+                     "parameters_met": float(np.median([r["parameters_met"] for r in rows])),
+                     "parameters_total": rows[0]["parameters_total"],
+                     "unmeasured_causes_fraction_of_lit": cause_medians(rows),
+                     "calibration_cpu_s": float(np.median([r["calibration_cpu_s"] for r in rows])),
+                     "render_s": float(np.median([r["render_s"] for r in rows]))}
+        print(name, out[name], flush=True)
+    return out
+
+
+def variant_rig(base: str, name: str):
+    """The rig of profile ``base`` with the variant ``name``'s keys (:data:`VARIANTS`) over it."""
     import tempfile
 
-    from rigcad.check.scene import analytic_optics
     from rigcad.profile.schema import load_profile
     from rigcad.rig import Rig
 
-    out = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for name, keys in VARIANTS.items():
-            if names and name not in names:
-                continue
-            path = Path(tmp) / f"{name}.yaml"
-            path.write_text(f"extends: {base}\n{keys}")
-            rig = Rig.from_profile(load_profile(path))
-            optics = analytic_optics(rig)
-            rows = [trial(optics, rig, 1000 + seed) for seed in range(trials)]
-            out[name] = {"trials": trials,
-                         "corrected_p99_deg": float(np.median([r["corrected_incidence_error_deg"]["p99"] for r in rows])),
-                         "corrected_p50_deg": float(np.median([r["corrected_incidence_error_deg"]["p50"] for r in rows])),
-                         "measured_pixels_p99_deg": float(np.median(
-                             [r["corrected_incidence_error_deg_by_source"]["measured"]["p99"] for r in rows])),
-                         "parameters_met": float(np.median([r["parameters_met"] for r in rows])),
-                         "parameters_total": rows[0]["parameters_total"],
-                         "unmeasured_causes_fraction_of_lit": cause_medians(rows),
-                         "calibration_cpu_s": float(np.median([r["calibration_cpu_s"] for r in rows])),
-                         "render_s": float(np.median([r["render_s"] for r in rows]))}
-            print(name, out[name], flush=True)
-    return out
+        path = Path(tmp) / f"{name}.yaml"
+        path.write_text(f"extends: {base}\n{VARIANTS[name]}")
+        return Rig.from_profile(load_profile(path))
 
 
 def cause_medians(trials: list) -> dict:
@@ -245,6 +252,7 @@ VARIANT_LABELS = {"steps3": "3 phase steps", "steps4": "4 phase steps (the defau
                   "half_turn_none": "no half turn (the earlier capture)",
                   "half_turn_highest": "a half turn at the highest spacer only (3 captures)",
                   "screen_seating_0.05deg": "the screen settling to 0.05 deg, not 0.02",
+                  "screen_seating_0.01deg": "the screen settling to 0.01 deg",
                   "screen_seating_0.005deg": "the screen settling to 0.005 deg (a three-point seat)",
                   "screen_tilt_0.02deg": "the screen flat on its spacers to 0.02 deg, not 0.2",
                   "mirrors_lossless": "mirrors that lose no light (reflectance 1, not 0.6)",
@@ -448,17 +456,21 @@ def main() -> int:
     ap.add_argument("--merge", nargs="+", metavar="JSON",
                     help="write --out from these runs' trials (in seed order) and --out's sweep if it has one, "
                          "then stop")
+    ap.add_argument("--variant", choices=list(VARIANTS),
+                    help="run the trials on this sweep variant of --profile (e.g. a seat that settles better), "
+                         "into --out, without a sweep")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "calibrate.json"))
     args = ap.parse_args()
     from rigcad.check.scene import analytic_optics
     from rigcad.export.atomic import write_json
     from rigcad.rig import load
 
+    name = f"{args.profile} + {args.variant}" if args.variant else args.profile
     if args.merge:
         out = Path(args.out)
         kept = json.loads(out.read_text(encoding="utf-8")).get("sweep_phase_steps_and_heights") \
             if out.is_file() else None  # a new --out: no sweep to keep
-        summary = merged(args.profile, [json.loads(Path(f).read_text(encoding="utf-8")) for f in args.merge], kept)
+        summary = merged(name, [json.loads(Path(f).read_text(encoding="utf-8")) for f in args.merge], kept)
         write_json(Path(args.out), summary)
         print(tables(summary))
         return 0
@@ -470,7 +482,7 @@ def main() -> int:
         write_json(Path(args.out), summary)
         print(tables(summary))
         return 0
-    rig = load(args.profile)
+    rig = variant_rig(args.profile, args.variant) if args.variant else load(args.profile)
     optics = analytic_optics(rig)
     kept = json.loads(Path(args.out).read_text(encoding="utf-8")).get("sweep_phase_steps_and_heights") \
         if args.keep_sweep else None
@@ -484,11 +496,11 @@ def main() -> int:
               f"{t['design_incidence_error_deg']['p99']:.3f} deg; slopes {t['recovered_slope_rms_mrad']:.3f} vs "
               f"planted {t['planted_slope_rms_mrad']:.3f} mrad; {t['calibration_s']:.1f} s", flush=True)
         # written after every trial: a run stopped early keeps what it measured
-        summary = summarize(args.profile, rig.profile.camera.resolution, trials)
+        summary = summarize(name, rig.profile.camera.resolution, trials)
         if kept:
             summary["sweep_phase_steps_and_heights"] = kept
         write_json(Path(args.out), summary)
-    if args.sweep_trials and not args.keep_sweep:
+    if args.sweep_trials and not args.keep_sweep and not args.variant:
         summary["sweep_phase_steps_and_heights"] = sweep(args.profile, args.sweep_trials)
     write_json(Path(args.out), summary)
     print(json.dumps({k: v for k, v in summary.items() if k != "per_trial"}, indent=1))
