@@ -7,8 +7,13 @@ PY := $(VENV)/bin/python
 PROFILE ?= achutha2006
 PRINTER ?= prusa_mk3s
 # Debian packages the project runs (the G-code slicer; the browser the 3D view is tested in, driven by
-# playwright as /usr/bin/chromium); installed when missing, never assumed.
-SYSTEM_TOOLS := prusa-slicer chromium
+# playwright as /usr/bin/chromium; Node.js and npm for the Khronos glTF validator the tests run on
+# rig.glb); installed when missing, never assumed.
+SYSTEM_TOOLS := prusa-slicer chromium nodejs npm
+# The Khronos glTF validator (npm gltf-validator, pinned), installed into build/node by `make tools`;
+# tests/export/validate_gltf.js runs it with Node.js
+GLTF_VALIDATOR_VERSION := 2.0.0-dev.3.10
+GLTF_VALIDATOR := build/node/node_modules/gltf-validator/package.json
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 EXPORTS ?= exports
 # pytest keeps its assertion-rewritten test modules in __pycache__ only when Python may write
@@ -55,6 +60,8 @@ tools:
 	  echo "installing$$missing (apt-get)"; \
 	  $(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
+	@grep -qs '"version": "$(GLTF_VALIDATOR_VERSION)"' $(GLTF_VALIDATOR) || \
+	  npm install --prefix build/node --no-save --no-audit --no-fund --loglevel=error gltf-validator@$(GLTF_VALIDATOR_VERSION)
 
 stl: $(VENV)/.installed
 	$(VENV)/bin/rigcad stl $(PROFILE) --exports $(EXPORTS)
