@@ -661,12 +661,14 @@ def image_name(l: int, m: int, part: str) -> str:
 
 
 def write_basis(basis: ProjectorBasis, out_dir: str | Path, *, lowdin_images: bool = False,
-                progress: Progress = None, lock: Path | None = None, made_from: str | None = None) -> list[Path]:
+                progress: Progress = None, lock: Path | None = None, made_from: str | None = None,
+                also=None) -> list[Path]:
     """Write ``basis`` into ``out_dir`` (exports/<profile>/basis): projector/{8bit,16bit}/ (the frames
     to project), latlong/{8bit,16bit}/ and latlong_float32.npy (the 4.2.1 maps), with
     ``lowdin_images`` projector_lowdin/{8bit,16bit}/ (the re-orthonormalised set), contact_sheet.png,
     latlong_sheet.png and basis.json (the report and the list of files). All published together
-    (atomic); images of an earlier run that this one does not write are removed. ``progress(label)``
+    (atomic), with what ``also(staging, out_dir)`` stages (the simulation: files it returns are listed
+    in basis.json too); whatever an earlier run wrote that this one does not is removed. ``progress(label)``
     is called once per function and once at the end. ``lock``: the lock every run writing under
     exports/<profile> holds (export.atomic.profile_lock; default one beside ``out_dir``);
     ``made_from``: the SHA-256 of the profile the basis was made from (export.manifest.profile_digest),
@@ -681,10 +683,8 @@ def write_basis(basis: ProjectorBasis, out_dir: str | Path, *, lowdin_images: bo
     out = Path(out_dir)
     kinds = [("analytic", "projector")] + ([("lowdin", "projector_lowdin")] if lowdin_images else [])
     written = []
-    def carry(rel: Path) -> bool:  # images of an earlier run that this one does not write are dropped
-        return not (rel.parts[0] in ("projector", "projector_lowdin", "latlong") and rel.match("*bit/z_*.png"))
-
-    with Staging(out, lock, carry=carry, made_from=made_from) as st:
+    # one run's files only: no image, simulation or sheet of an earlier run is carried over
+    with Staging(out, lock, carry=lambda rel: False, made_from=made_from) as st:
         for k, (l, m) in enumerate(basis.indices):
             for part in ("positive", "negative"):
                 name = image_name(int(l), int(m), part)
@@ -700,6 +700,8 @@ def write_basis(basis: ProjectorBasis, out_dir: str | Path, *, lowdin_images: bo
         written.append(st.write_bytes(out / "latlong" / "latlong_float32.npy", buf.getvalue()))
         written.append(st.write_bytes(out / "contact_sheet.png", plots.basis_contact_sheet(basis)))
         written.append(st.write_bytes(out / "latlong_sheet.png", plots.basis_latlong_sheet(basis)))
+        if also is not None:
+            written += list(also(st, out))
         files = sorted(p.relative_to(out).as_posix() for p in written)
         report = {**basis.report, "files": files, "lowdin_images_written": lowdin_images}
         written.append(st.write_bytes(out / "basis.json", json_bytes(report)))
