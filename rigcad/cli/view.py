@@ -35,7 +35,7 @@ def cmd_view(args: argparse.Namespace) -> int:
     print(f"  wrote {r['html']} ({r['html_bytes'] / 1e6:.2f} MB, self-contained: open it in a browser, offline)")
     print(f"  wrote {r['png']}")
     if args.glb:
-        print(f"  wrote {r['glb']} (binary glTF: a named node per part, the rays as lines; mm, +z up)")
+        print(f"  wrote {r['glb']} (binary glTF 2.0: a named node per part, the rays as lines; metres, +Y up)")
     return 0
 
 

@@ -1,6 +1,6 @@
 """`rigcad view --glb`: one binary glTF, read back by trimesh and, independently, by parsing the
 GLB container by hand (glTF 2.0: a 12-byte header, a JSON chunk, a BIN chunk): a named node per
-in-rig part with its triangle count and colour, and the rays as line primitives (mode 1) with two
+in-rig part with its triangle count and colour (linear, as glTF has it), and the rays as line primitives (mode 1) with two
 vertices per segment. Same profile, same bytes."""
 
 from __future__ import annotations
@@ -66,7 +66,10 @@ def test_the_glb_holds_every_part_by_name_and_the_rays_as_lines(written):
         assert len(got.faces) == len(m.faces), m.name
         assert np.allclose(got.bounds, [m.lo, m.hi], atol=1e-3), m.name  # float32 in the file
         rgba = got.visual.material.baseColorFactor
-        assert np.allclose(rgba[:3], np.round(255 * np.asarray(m.color)), atol=1), m.name
+        # glTF's colour factors are linear, the parts' colours sRGB (IEC 61966-2-1's transfer function)
+        c = np.asarray(m.color)
+        linear = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+        assert np.allclose(rgba[:3], np.round(255 * linear), atol=1), m.name  # trimesh reads them as 8 bit
     assert isinstance(scene.geometry["rays"], trimesh.path.Path3D)
 
 
