@@ -2,7 +2,8 @@
 water-jet cutting: DXF (ezdxf, $INSUNITS = mm) and SVG (width/height in mm, viewBox in mm),
 true scale. The outline is the part's Prism section in the x-z plane, as a closed polyline
 within ``chord_error`` mm of the exact curves; the DXF also carries each mirror curve as a
-fit-point spline on its own layer, for CAM that prefers curves. Both writers give the same
+cubic B-spline (control points and knots, interpolating SPLINE_POINTS points of the curve) on its
+own layer, for CAM that prefers curves, and its extents ($EXTMIN, $EXTMAX) in the header. Both writers give the same
 bytes for the same outline.
 """
 
@@ -15,8 +16,11 @@ import numpy as np
 
 from rigcad.parts.recipe import Curve, Part, Prism
 
-#: Fit points per spline in the DXF (the polyline carries the accuracy; the spline is a courtesy).
+#: Points per mirror curve the DXF's spline passes through (the polyline carries the accuracy; the
+#: spline is a courtesy for CAM that prefers curves).
 SPLINE_POINTS = 200
+#: Degree of the DXF's splines: cubic, C2 like the mirror profiles' STEP splines.
+SPLINE_DEGREE = 3
 
 
 @dataclass(frozen=True)
@@ -45,8 +49,10 @@ def outline(part: Part, chord_error: float) -> Outline:
 
 def dxf_bytes(o: Outline) -> bytes:
     """DXF R2010, units mm: layer CUT the closed outline (LWPOLYLINE), layer CURVES the mirror
-    curves as splines through fit points, layer NOTE the name and plate thickness."""
+    curves as cubic B-splines (control points, knots), layer NOTE the name and plate thickness;
+    $EXTMIN and $EXTMAX the drawing's extents."""
     import ezdxf
+    import ezdxf.bbox
 
     saved = ezdxf.options.write_fixed_meta_data_for_testing
     ezdxf.options.write_fixed_meta_data_for_testing = True  # fixed dates and GUIDs: same bytes
@@ -60,10 +66,19 @@ def dxf_bytes(o: Outline) -> bytes:
         msp = doc.modelspace()
         msp.add_lwpolyline([tuple(map(float, p)) for p in o.polygon], close=True, dxfattribs={"layer": "CUT"})
         for c in o.curves:
-            msp.add_spline([(float(x), float(y), 0.0) for x, y in c], dxfattribs={"layer": "CURVES"})
+            # control points and knots, not fit points: a fit-point SPLINE leaves the curve to each
+            # reader's own interpolation, and GDAL's OGR refuses one without control points
+            msp.add_spline_control_frame([(float(x), float(y), 0.0) for x, y in c], degree=SPLINE_DEGREE,
+                                         method="chord", dxfattribs={"layer": "CURVES"})
         lo = o.polygon.min(axis=0)
         msp.add_text(f"{o.name} t={o.thickness:g} mm", height=3.0,
                      dxfattribs={"layer": "NOTE", "insert": (float(lo[0]), float(lo[1]) - 6.0)})
+        # the drawing's extents, which readers zoom to ("zoom extents"); ezdxf leaves them at +-1e20.
+        # fast: the text's box from its height and character count, no font files (same bytes anywhere)
+        box = ezdxf.bbox.extents(msp, fast=True)
+        doc.header["$EXTMIN"] = tuple(float(v) for v in box.extmin)
+        doc.header["$EXTMAX"] = tuple(float(v) for v in box.extmax)
+        msp.dxf.extmin, msp.dxf.extmax = doc.header["$EXTMIN"], doc.header["$EXTMAX"]
         # ezdxf adds a CLASS per entity type in use from a set, whose order follows string hashing
         # (random per process): declaring them first, sorted, fixes the CLASSES section's order
         for dxftype in sorted(doc.entitydb.dxf_types_in_use()):
