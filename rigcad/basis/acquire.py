@@ -125,6 +125,10 @@ def camera_view(rig, zone: Zone, stride: int = CAMERA_STRIDE_PX, focal_px: float
     wo = px.design_dirs[keep]
     if corrected is not None:
         measured = corrected.at(px.row[keep], px.col[keep])
+        if not np.isfinite(measured[:, 0]).any():
+            raise BasisError(f"the corrected map {corrected.path} has no direction at any of the {int(keep.sum())} "
+                             f"camera pixels sampled (every {stride} px): calibrate again, or remove it to use the "
+                             "design map")
         wo = np.where(np.isfinite(measured[:, :1]), measured, wo)
     return CameraView(px, keep, wo)
 
@@ -394,16 +398,29 @@ def simulation_steps(moved_count: int | None = None) -> int:
     return SIM_STEPS_FIXED - 1 + (2 if moved_count is None else moved_count)
 
 
-def write_simulation(sim: RigSimulation, out_dir, lock=None, made_from: str | None = None) -> list:
-    """Write simulation.json and simulation.png into ``out_dir`` (atomically, together; ``lock`` and
-    ``made_from`` as for :func:`rigcad.basis.projector.write_basis`)."""
+def stage_simulation(sim: RigSimulation, st, out_dir) -> list:
+    """Stage simulation.json and simulation.png into ``out_dir`` on ``st`` (an export.atomic.Staging
+    that publishes them, with the basis images of the same run: rigcad.basis.projector.write_basis's
+    ``also``); returns their paths."""
     from pathlib import Path
 
     from rigcad import plots
-    from rigcad.export.atomic import Staging, json_bytes
+    from rigcad.export.atomic import json_bytes
+
+    out = Path(out_dir)
+    return [st.write_bytes(out / "simulation.json", json_bytes(sim.report)),
+            st.write_bytes(out / "simulation.png", plots.basis_simulation(sim.report))]
+
+
+def write_simulation(sim: RigSimulation, out_dir, lock=None, made_from: str | None = None) -> list:
+    """Write simulation.json and simulation.png into ``out_dir`` (atomically, together; ``lock`` and
+    ``made_from`` as for :func:`rigcad.basis.projector.write_basis`), beside what is there.
+    ``rigcad basis --simulate`` publishes the simulation with its images instead (:func:`stage_simulation`)."""
+    from pathlib import Path
+
+    from rigcad.export.atomic import Staging
 
     out = Path(out_dir)
     with Staging(out, lock, made_from=made_from) as st:
-        st.write_bytes(out / "simulation.json", json_bytes(sim.report))
-        st.write_bytes(out / "simulation.png", plots.basis_simulation(sim.report))
+        stage_simulation(sim, st, out)
         return st.commit()

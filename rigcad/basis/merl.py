@@ -49,28 +49,50 @@ def _scales() -> np.ndarray:
 def read_merl(path: str | os.PathLike, *, physical: bool = True) -> np.ndarray:
     """Read a MERL .binary file: (3, 90, 90, 180) float64, in 1/sr (``physical``) or as stored.
 
-    Raises BasisError when the file is missing, its header product is not 90*90*180, or its size
-    does not match the header. The physical values are ``stored * scale`` computed in float64, as
-    the reference reader does. That product is not invertible bit for bit (two stored doubles can
-    scale to one), so a file is reproduced byte for byte only through ``physical=False`` on both
-    ends; see :func:`write_merl`.
+    Read as data, header first (the rules of rigcad.export.readback, which this pure module may not
+    import): opened without blocking, a regular file (a FIFO, a device or a folder is named as such);
+    its 12-byte header exactly 90, 90, 180 (the reference reader checks only the product, but every
+    index here is of that grid); its size, from ``fstat``, the header's (a bigger, sparse or endless
+    file is refused before its data is read); every value finite (negative marks a cell below the
+    horizon). Raises BasisError naming the file. The physical values are ``stored * scale`` computed
+    in float64, as the reference reader does. That product is not invertible bit for bit (two stored
+    doubles can scale to one), so a file is reproduced byte for byte only through ``physical=False``
+    on both ends; see :func:`write_merl`.
     """
+    import stat
+
     p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except OSError as err:
-        raise BasisError(f"MERL file {str(p)!r} cannot be read: {err.strerror}") from err
-    if len(raw) < 12:
-        raise BasisError(f"MERL file {str(p)!r} has {len(raw)} bytes: need a 12-byte header and data")
-    dims = np.frombuffer(raw, dtype=_HEADER, count=3)
-    n = int(dims[0]) * int(dims[1]) * int(dims[2])
-    if n != _N:
-        raise BasisError(f"MERL file {str(p)!r} header dims {dims.tolist()} (product {n}): need a product of "
-                         f"{_N} (90 x 90 x 180)")
+    shown = repr(str(p))
     expected = 12 + 3 * _N * 8
-    if len(raw) != expected:
-        raise BasisError(f"MERL file {str(p)!r} has {len(raw)} bytes: need {expected} (header + 3 x {_N} doubles)")
-    table = np.frombuffer(raw, dtype=_DATA, offset=12).astype(float).reshape(SHAPE)
+    try:
+        fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except FileNotFoundError:
+        raise BasisError(f"MERL file {shown}: missing") from None
+    except OSError as err:
+        raise BasisError(f"MERL file {shown} cannot be read: {err.strerror}") from None
+    with os.fdopen(fd, "rb") as fh:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = "a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode) else "a device"
+            raise BasisError(f"MERL file {shown} is {kind}, not a file")
+        head = fh.read(12)
+        if len(head) < 12:
+            raise BasisError(f"MERL file {shown} has {len(head)} bytes: need a 12-byte header and data")
+        dims = np.frombuffer(head, dtype=_HEADER, count=3)
+        if dims.tolist() != [N_THETA_HALF, N_THETA_DIFF, N_PHI_DIFF]:
+            n = int(dims[0]) * int(dims[1]) * int(dims[2])
+            raise BasisError(f"MERL file {shown} header dims {dims.tolist()} (product {n}): need 90, 90, 180 "
+                             f"(theta_half, theta_diff, phi_diff; a product of {_N})")
+        if st.st_size != expected:
+            raise BasisError(f"MERL file {shown} has {st.st_size} bytes: need {expected} (header + 3 x {_N} doubles)")
+        data = fh.read(expected - 11)  # one byte past the table: a file that grew is refused too
+    if len(data) != expected - 12:
+        raise BasisError(f"MERL file {shown} has {12 + len(data)} bytes: need {expected} (header + 3 x {_N} doubles)")
+    table = np.frombuffer(data, dtype=_DATA).astype(float).reshape(SHAPE)
+    bad = int(np.count_nonzero(~np.isfinite(table)))
+    if bad:
+        raise BasisError(f"MERL file {shown} holds {bad} NaN or infinite values: need finite BRDF values "
+                         "(negative marks a cell below the horizon)")
     return table * _scales() if physical else table
 
 

@@ -11,6 +11,7 @@ grey), every image at the camera's resolution. Values are scaled to [0, 1] by th
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -49,12 +50,22 @@ class CaptureError(RigcadError):
 
 def capture_path(folder: Path, label: str, name: str) -> Path:
     """The file of capture ``label`` (``h0``, ``h1r``...) and frame ``name`` (any of SUFFIXES), or the
-    .png expected."""
+    .png expected. Whatever is there under one of the names counts (a FIFO, a folder, a link to
+    nowhere): :func:`read_image` says what it is."""
     for suffix in SUFFIXES:
         p = folder / f"{label}_{name}{suffix}"
-        if p.is_file():
+        if os.path.lexists(p):
             return p
     return folder / f"{label}_{name}.png"
+
+
+#: The naming scheme, said when a frame is missing.
+NAMING = ("naming scheme h<spacer>_<frame>.png|tif, h<spacer>r_ for the half turn, u<turn>_ for the upright "
+          "display: see docs/calibrate.md")
+#: Most bytes a frame's file may hold per camera pixel (a 32-bit float RGBA TIFF, uncompressed: 16),
+#: and the headers' allowance.
+FRAME_BYTES_PER_PIXEL = 16
+FRAME_HEADER_BYTES = 1 << 20
 
 
 def read_image(path: Path, resolution: tuple[int, int], window=None) -> np.ndarray:
@@ -62,19 +73,29 @@ def read_image(path: Path, resolution: tuple[int, int], window=None) -> np.ndarr
     function that cuts the camera's window out of the image as read (``model.Camera.crop``), before
     the colour is averaged and the values made floats: a full 1360 x 1024 frame made floats is
     11 MB, and 240 of them cost more CPU than the decoding (docs/calibrate.md); the same values,
-    pixel for pixel. Full scale: 65535 for 16-bit files (as read), else 255."""
-    from PIL import Image, UnidentifiedImageError
+    pixel for pixel. Full scale: 65535 for 16-bit files (as read), else 255.
 
-    if not path.is_file():
-        raise CaptureError(f"{path}: missing (naming scheme h<spacer>_<frame>.png|tif, h<spacer>r_ for the half "
-                           "turn, u<turn>_ for the upright display: see docs/calibrate.md)")
-    try:
-        with Image.open(path) as im:
-            im.load()
-            arr = np.asarray(im)
-    except (OSError, UnidentifiedImageError, ValueError) as err:
-        raise CaptureError(f"{path}: not a readable PNG or TIFF ({err})") from err
+    Read as data (rigcad.export.readback): a regular file of at most FRAME_BYTES_PER_PIXEL bytes per
+    camera pixel, its size from the header checked against the camera's before a pixel is decoded,
+    no NaN or infinite value; each refusal one line naming the file."""
+    from rigcad.export.readback import open_image, read_bytes, shown
+
     width, height = resolution
+    data = read_bytes(path, "a capture frame", width * height * FRAME_BYTES_PER_PIXEL + FRAME_HEADER_BYTES,
+                      CaptureError, missing=NAMING)
+
+    def size_ok(size: tuple[int, int]) -> str | None:
+        return None if tuple(size) == (width, height) else f"the camera's is {width} x {height}"
+
+    with open_image(data, shown(path), size_ok, CaptureError) as im:
+        arr = np.asarray(im)
+    if arr.dtype.kind == "f":
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            raise CaptureError(f"{shown(path)}: {int(bad.sum())} pixel value(s) NaN or infinite: a capture holds "
+                               "finite values")
+    elif arr.dtype.kind not in "uib":
+        raise CaptureError(f"{shown(path)}: pixels of type {arr.dtype}, not integers or floats")
     if arr.shape[:2] != (height, width):
         raise CaptureError(f"{path}: {arr.shape[1]} x {arr.shape[0]} px, the camera's is {width} x {height}")
     full = 65535.0 if arr.dtype == np.uint16 or arr.max() > 255 else 255.0
@@ -92,7 +113,7 @@ def read_capture(folder: Path, seq: Sequence, labels: tuple[str, ...], resolutio
     ``absent``: what to say when a capture has none of its files (how to calibrate without it)."""
     out = []
     for k in labels:
-        if absent and not any(capture_path(folder, k, n).is_file() for n in seq.names()):
+        if absent and not any(os.path.lexists(capture_path(folder, k, n)) for n in seq.names()):
             raise CaptureError(f"{capture_path(folder, k, 'white')}: missing, and every other frame of capture {k}: "
                                f"{absent}")
         whole = ("white", "black")

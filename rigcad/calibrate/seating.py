@@ -27,6 +27,12 @@ import math
 import numpy as np
 
 from rigcad.calibrate.images import CaptureError
+from rigcad.export.readback import names as listed, quoted
+
+#: The largest figure a calibration.json states against the dome: a tilt (deg) or an offset (mm), and
+#: its standard error. A screen or part tilted 90 deg, or off by a metre, is no rig's.
+MAX_ANGLE_DEG = 90.0
+MAX_OFFSET_MM = 1000.0
 
 #: Two calibrations whose paraboloid or camera against the dome differ by more than this many
 #: combined standard errors were not of one rig left as it is.
@@ -89,10 +95,14 @@ def _figures(name: str, report, labels: tuple[str, ...]) -> tuple[np.ndarray, np
     refuses, naming the file and the key, one that cannot measure the seating."""
     def pair(key: str, entry) -> tuple[float, float]:
         value, se = (entry.get(k) if isinstance(entry, dict) else None for k in ("value", "standard_error"))
+        unit, bound = ("deg", MAX_ANGLE_DEG) if key.endswith("_deg") else ("mm", MAX_OFFSET_MM)
         for k, v in (("value", value), ("standard_error", se)):
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or (k != "value" and v < 0):
-                raise CaptureError(f"{name}: {key}.{k} is {v!r}, not a finite number"
+                raise CaptureError(f"{name}: {key}.{k} is {quoted(v)}, not a finite number"
                                    f"{' of 0 or more' if k != 'value' else ''}: not a calibration.json rigcad wrote")
+            if abs(v) > bound:
+                raise CaptureError(f"{name}: {key}.{k} is {v:.4g}, outside {'-' if k == 'value' else ''}{bound:g}.."
+                                   f"{bound:g} {unit}: not a calibration.json rigcad wrote")
         return float(value), float(se)
 
     dome = report.get("against_the_dome") if isinstance(report, dict) else None
@@ -101,7 +111,7 @@ def _figures(name: str, report, labels: tuple[str, ...]) -> tuple[np.ndarray, np
         raise CaptureError(f"{name}: no screen tilts against the dome (against_the_dome.screens): not a "
                            "calibration.json, or one an earlier rigcad wrote; calibrate that capture again")
     if set(screens) != set(labels):
-        raise CaptureError(f"{name}: captures {sorted(screens)}, the profile plans {sorted(labels)} "
+        raise CaptureError(f"{name}: captures {listed(screens)}, the profile plans {listed(labels)} "
                            "(calibration.spacer_heights, calibration.half_turn): calibrated with another profile")
     tilts = np.array([[pair(f"against_the_dome.screens.{k}.tilt_{a}_deg",
                             screens[k].get(f"tilt_{a}_deg") if isinstance(screens[k], dict) else None)
@@ -114,7 +124,7 @@ def _check_unmoved(names: list[str], parts: list[dict]) -> None:
     :data:`MOVED_SIGMAS` combined standard errors: the rig moved between them."""
     for name, other in zip(names[1:], parts[1:]):
         if set(other) != set(parts[0]):
-            raise CaptureError(f"{name}: parts against the dome {sorted(other)}, {names[0]}: {sorted(parts[0])}: "
+            raise CaptureError(f"{name}: parts against the dome {listed(other)}, {names[0]}: {listed(parts[0])}: "
                                "not calibrations of one profile")
         for key, (a, a_se) in parts[0].items():
             b, b_se = other[key]

@@ -19,8 +19,9 @@ def _order(text: str):
 
 def cmd_basis(args: argparse.Namespace) -> int:
     from rigcad import api
-    from rigcad.basis.acquire import simulate_on_rig, simulation_steps
-    from rigcad.basis.projector import BASIS_STEPS, check_basis_order
+    from rigcad.basis.acquire import simulate_on_rig, simulation_steps, stage_simulation
+    from rigcad.basis.projector import BASIS_STEPS, check_basis_order, write_basis
+    from rigcad.export.manifest import profile_digest
     from rigcad.progress import stages
     from rigcad.rig import load
 
@@ -39,6 +40,11 @@ def cmd_basis(args: argparse.Namespace) -> int:
             raise BasisError(f"--camera-stride-px {args.camera_stride_px}: the {profile.camera.resolution[0]} x "
                              f"{profile.camera.resolution[1]} px camera would be sampled at fewer than 2 x 2 pixels; "
                              f"valid: 1..{largest}")
+    corrected = None
+    if args.simulate:  # read before any work: a map that is not one is refused in one line, never replaced
+        from rigcad.calibrate import load_corrected_map
+
+        corrected = load_corrected_map(args.exports, profile.name, tuple(profile.camera.resolution))
     rig = load(profile)
     # written under the one lock of everything under exports/<profile>: a design or build publishing
     # the whole folder meanwhile waits, instead of deleting this run's staging folder
@@ -47,22 +53,20 @@ def cmd_basis(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with stages(total, f"basis {rig.name}") as step:
         basis = api.basis(rig, order, alpha, progress=step)
-        paths = api.write_basis(rig, basis, out, lowdin_images=args.lowdin, progress=step)
-        t_images = time.perf_counter() - t0
-        sim = None
-        if args.simulate:
-            from rigcad.calibrate import load_corrected_map
-
-            corrected = load_corrected_map(args.exports, rig.name)
+        sim, t_sim = None, time.perf_counter()
+        if args.simulate:  # simulated first: the images and the simulation are one run's, published together
             print("  camera exitant directions: " + (f"the corrected map {corrected.path}" if corrected else
                                                      "the design map (no corrected map: rigcad calibrate)"))
             sim = simulate_on_rig(rig, order, basis=basis, camera_stride_px=args.camera_stride_px, progress=step,
                                   corrected=corrected)
-            paths += api.write_simulation(rig, sim, out)
+        t_sim = time.perf_counter() - t_sim
+        paths = write_basis(basis, out, lowdin_images=args.lowdin, progress=step,
+                            lock=api.writer_lock(out, rig.name, ("basis",)), made_from=profile_digest(rig.profile),
+                            also=None if sim is None else lambda st, folder: stage_simulation(sim, st, folder))
     _print_basis(rig, basis, order)
-    print(f"  {len(paths)} files in {out}/ ({t_images:.1f} s)")
+    print(f"  {len(paths)} files in {out}/ ({time.perf_counter() - t0:.1f} s)")
     if sim is not None:
-        _print_simulation(sim, time.perf_counter() - t0 - t_images)
+        _print_simulation(sim, t_sim)
     return 0
 
 

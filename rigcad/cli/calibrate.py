@@ -126,16 +126,7 @@ def _seating(rig, args: argparse.Namespace) -> int:
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
     from rigcad.export.manifest import profile_digest
 
-    runs = []
-    for name in args.seating:
-        path = Path(name) / "calibration.json" if Path(name).is_dir() else Path(name)
-        name = str(path)
-        try:
-            runs.append((name, json.loads(path.read_text(encoding="utf-8"))))
-        except FileNotFoundError:
-            raise CaptureError(f"{name}: missing (--seating reads the calibration.json of each calibration)") from None
-        except (OSError, ValueError) as err:
-            raise CaptureError(f"{name}: not a readable JSON file ({err})") from None
+    runs = _seating_runs(args.seating)
     result = measure(runs, rig.profile)
     out = Path(args.exports) / rig.name / "calibrate_seating"
     with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
@@ -143,6 +134,34 @@ def _seating(rig, args: argparse.Namespace) -> int:
         st.commit()
     print(f"{line(result)}; wrote {out}")
     return 0
+
+
+#: The largest calibration.json --seating reads (rigcad's own are tens of KiB).
+SEATING_MAX_BYTES = 16 << 20
+
+
+def _seating_runs(given: list[str]) -> list[tuple[str, object]]:
+    """Each calibration.json ``--seating`` names (a file, or the calibrate/ folder holding one), read
+    as data (rigcad.export.readback: a regular file of at most SEATING_MAX_BYTES, strict JSON); one file
+    named twice, or two files with the same bytes, is refused: it would measure a seating of 0."""
+    import hashlib
+
+    from rigcad.calibrate.images import CaptureError
+    from rigcad.export.readback import read_file, parse_json, shown
+
+    runs, seen = [], {}
+    for name in given:
+        path = Path(name) / "calibration.json" if Path(name).is_dir() else Path(name)
+        data, st = read_file(path, "a calibration.json", SEATING_MAX_BYTES, CaptureError,
+                             missing="--seating reads the calibration.json of each calibration")
+        for key in ((st.st_dev, st.st_ino), hashlib.sha256(data).hexdigest()):
+            if key in seen:
+                raise CaptureError(f"{shown(path)}: the same calibration as {seen[key]} "
+                                   f"({'the same file' if isinstance(key, tuple) else 'the same bytes'}): give "
+                                   "calibrations of separate layings, each once")
+            seen[key] = shown(path)
+        runs.append((str(path), parse_json(data, shown(path), CaptureError)))
+    return runs
 
 
 def _against_dome_line(params: dict) -> str:

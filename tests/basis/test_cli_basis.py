@@ -93,3 +93,21 @@ def test_simulate_writes_its_report(tmp_path, capsys):
     assert (out / "simulation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     text = capsys.readouterr().out
     assert "gray card" in text and "paraboloid moved by (0.1, 0, 0) mm" in text
+
+
+def test_one_run_is_one_publication(tmp_path):
+    """The images and the simulation of one run are published together and listed together in
+    basis.json; a later run without --simulate leaves no simulation of the earlier one beside its
+    images (the folder never mixes two runs)."""
+    out = tmp_path / "achutha2006" / "basis"
+    assert main(["basis", "achutha2006", "--order", "1", "--simulate", "--camera-stride-px", "120",
+                 "--exports", str(tmp_path)]) == 0
+    listed = json.loads((out / "basis.json").read_text())["files"]
+    assert {"simulation.json", "simulation.png"} <= set(listed), listed
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()) == sorted(listed + ["basis.json"])
+    assert main(["basis", "achutha2006", "--order", "0", "--exports", str(tmp_path)]) == 0
+    report = json.loads((out / "basis.json").read_text())
+    assert report["order"] == 0
+    assert not (out / "simulation.json").exists() and not (out / "simulation.png").exists()
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()) == sorted(
+        report["files"] + ["basis.json"])

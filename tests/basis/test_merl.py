@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import struct
 
 import numpy as np
@@ -146,7 +147,7 @@ def test_bad_files_are_refused(tmp_path):
     p.write_bytes(struct.pack("<3i", 90, 90, 180) + bytes(80))
     with pytest.raises(BasisError, match="has 92 bytes"):
         read_merl(p)
-    with pytest.raises(BasisError, match="cannot be read"):
+    with pytest.raises(BasisError, match="missing.binary': missing"):
         read_merl(tmp_path / "missing.binary")
     with pytest.raises(BasisError, match="shape"):
         write_merl(tmp_path / "x.binary", np.zeros((3, 90, 90, 90)))
@@ -168,3 +169,35 @@ def test_in_plane_pairs_land_in_one_cell_on_every_cpu():
             j_seen.add(int(j))
     assert k_seen == {0}, k_seen
     assert j_seen == {20}, j_seen  # theta_diff exactly 20 deg: the boundary goes to the cell above
+
+
+@pytest.mark.parametrize("dims", [(-90, -90, 180), (1, 1, 1_458_000), (180, 90, 90)])
+def test_a_header_of_another_grid_is_refused_before_the_data(tmp_path, dims):
+    """The reference reader checks only the product; every index here is of the 90 x 90 x 180 grid."""
+    p = tmp_path / "other.binary"
+    p.write_bytes(struct.pack("<3i", *dims) + bytes(3 * 90 * 90 * 180 * 8))
+    with pytest.raises(BasisError, match=rf"header dims \[{dims[0]}, {dims[1]}, {dims[2]}\].*need 90, 90, 180"):
+        read_merl(p)
+
+
+def test_nan_data_and_oversized_files_are_refused(tmp_path):
+    import resource
+
+    table = np.full(SHAPE, 0.5)
+    table[1, 2, 3, 4] = np.nan
+    p = tmp_path / "nan.binary"
+    p.write_bytes(struct.pack("<3i", 90, 90, 180) + table.astype("<f8").tobytes())
+    with pytest.raises(BasisError, match="holds 1 NaN or infinite values"):
+        read_merl(p)
+    big = tmp_path / "big.binary"
+    with open(big, "wb") as fh:  # an 8 GiB sparse file: refused from its size, nothing read
+        fh.write(struct.pack("<3i", 90, 90, 180))
+        fh.truncate(8 << 30)
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(BasisError, match=r"has 8589934592 bytes: need 34992012 \(header"):
+        read_merl(big)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 100 * 1024  # KiB: far under 8 GiB
+    fifo = tmp_path / "fifo.binary"
+    os.mkfifo(fifo)
+    with pytest.raises(BasisError, match="is a FIFO, not a file"):
+        read_merl(fifo)
