@@ -14,11 +14,15 @@ pictures) report it all. Outputs are staged and published together (rigcad.expor
 Files: stl/<piece>.stl, gcode/<piece>.gcode, printer.ini, outlines/<part>[_printed|_sanded].{dxf,svg},
 staircase/<part>.png, support/<piece>.png, fab.json, fab.md. Timings are returned, not written
 (fab.json is deterministic). With G-code, also 3mf/<piece>.3mf: the PrusaSlicer project that made it.
+A run without problems also records its inputs' key and every file's SHA-256 (published.json,
+rigcad.export.reuse): a later run with the same key (:func:`inputs_key`), whichever command makes
+it, reads the folder back instead of doing the work again, while every file is intact.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import time
 from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
@@ -28,6 +32,7 @@ import numpy as np
 
 from rigcad import plots
 from rigcad.errors import FabricationError, RigcadError
+from rigcad.export import reuse
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import profile_digest, sha256_hex
 from rigcad.fab import choice, estimate, orientation, outlines, slicer, split, staircase
@@ -47,6 +52,27 @@ class FabResult:
     timings_s: dict[str, float] = field(default_factory=dict)
     slicer_s: dict[str, float] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
+    #: True when the result was read back from an earlier run's published folder (nothing recomputed).
+    reused: bool = False
+
+
+def inputs_key(rig, printer: Printer, gcode: bool, parts: list[str]) -> str | None:
+    """The key of a fab run's result (rigcad.export.reuse.stage_key): the resolved profile and
+    rigcad's code, the printer's resolved settings (its file, what it inherits, its slicer presets
+    and overrides), the parts, and with ``gcode`` the slicer program found (path, size, time:
+    a new PrusaSlicer slices anew). None for a moved rig: its result is never read back."""
+    from rigcad.optics.frames import Misalignment
+
+    if rig.misalignment != Misalignment.none():
+        return None
+    inputs = {"printer": printer.describe(), "slicer_unavailable": printer.slicer_unavailable,
+              "slicer_settings": printer.slicer_config.effective() if printer.slicer_config else None,
+              "gcode": bool(gcode), "parts": list(parts)}
+    if gcode and printer.slicer == "prusa-slicer":
+        exe = slicer.find_slicer()
+        st = os.stat(exe) if exe else None
+        inputs["slicer_program"] = [exe, st.st_size, st.st_mtime_ns] if st else None
+    return reuse.stage_key(rig.profile, "fab", inputs)
 
 
 @dataclass(frozen=True)
@@ -114,17 +140,27 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
     say = progress or (lambda msg: None)
     t0 = time.perf_counter()
     profile = rig.profile
+    names = select_parts(parts)
+    key = inputs_key(rig, printer, gcode, names)
+    lock = lock if lock is not None else out.parent / f".{out.name}.lock"  # Staging's own default
+    if key is not None:
+        back = reuse.read_back(out, key, profile_digest(profile), lock, read=("fab.json",))
+        if back is not None:  # published from the same inputs and intact: read back, nothing redone
+            report = json.loads(back["fab.json"])
+            for name in report["parts"]:
+                say(name)
+            return FabResult(report, [], {"read_back": time.perf_counter() - t0}, reused=True)
     timings: dict[str, float] = {"design_and_layout": time.perf_counter() - t0}
     chord = profile.tessellation.chord_error
     report_parts: dict[str, dict] = {}
     problems: list[str] = []
     done: dict[str, PartFab] = {}
     stocks: dict[str, float] = {}  # mirror name -> stock printed in front of it (mm)
-    with Staging(out, lock, made_from=profile_digest(rig.profile)) as stage:
+    with Staging(out, lock, made_from=profile_digest(rig.profile), carry=reuse.carried) as stage:
         # mesh vertices lie on the surface; facets within the chord error
         run = _Run(printer, chord, chord + 2e-3, (printer.build_volume.x / 2, printer.build_volume.y / 2), stage, out)
         old = _previous_report(out)  # read before anything is published over it
-        for name in select_parts(parts):
+        for name in names:
             part = rig.recipe(name)
             if part.bought:  # the profile's buy: standard stock, never printed
                 report_parts[name] = {"process": "bought", "stock": part.bought, "quantity": part.quantity}
@@ -167,6 +203,8 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
         report = fab_report(profile.name, printer, chord, run.tol_mirror, report_gcode, report_parts, problems)
         stage.write_bytes(out / "fab.json", json_bytes(report))
         stage.write_bytes(out / "fab.md", markdown(report).encode())
+        if key is not None and not problems:  # a run with problems is never read back: the next one retries
+            reuse.record(stage, out, key)
         timings["report"] = time.perf_counter() - t
         written = stage.commit()
     return FabResult(report, written, timings, slicer_s, problems)
