@@ -261,7 +261,7 @@ def _build_part(part: Part, key: str, rig, out: Path, stage: Staging, shapes: di
     if abs(mesh_vol - volume) > MESH_VOLUME_RTOL * volume:
         raise ExportError(f"{part.name}: STL volume {mesh_vol:.6g} differs from the STEP's {volume:.6g} mm^3 "
                           f"by more than {MESH_VOLUME_RTOL:.1%}")
-    stl = M.stl_bytes(vertices, faces, part.name)
+    stl = M.stl_bytes(vertices, faces, part.name, frame=M.RIG_FRAME)
     stl_path = out / "stl" / f"{part.name}.stl"
     stage.write_bytes(stl_path, stl)
     tmf_path = out / "3mf" / f"{part.name}.3mf"

@@ -14,6 +14,7 @@ from pathlib import Path
 import manifold3d as m3d
 import numpy as np
 
+from rigcad._version import __version__
 from rigcad.errors import ExportError
 from rigcad.parts.recipe import Box, Cylinder, Difference, HexPrism, Prism, Revolve, Solid, Translate, Union_
 
@@ -91,8 +92,15 @@ def genus(vertices: np.ndarray, faces: np.ndarray) -> int:
     return 1 - int(chi / 2)  # chi is even for closed orientable surfaces; truncation as in C++
 
 
-def stl_bytes(vertices: np.ndarray, faces: np.ndarray, name: str) -> bytes:
-    """Binary STL (float32, as the format has it) with facet normals; deterministic header."""
+#: The frame of the parts as built (export.build): what their STL headers say after the unit.
+RIG_FRAME = "sample point O at origin, optical axis +z"
+
+
+def stl_bytes(vertices: np.ndarray, faces: np.ndarray, name: str, frame: str | None = None) -> bytes:
+    """Binary STL (float32, as the format has it) with facet normals; deterministic header:
+    ``rigcad <version> <name>: mm`` and, when given, the ``frame`` the vertices are in (the
+    rig's, :data:`RIG_FRAME`, for the parts as built; none for a piece in print position, whose
+    frame is the printer's), cut to the format's 80 bytes."""
     tri = vertices[faces]
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     length = np.linalg.norm(n, axis=1, keepdims=True)
@@ -100,7 +108,8 @@ def stl_bytes(vertices: np.ndarray, faces: np.ndarray, name: str) -> bytes:
     rec = np.zeros(len(faces), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
     rec["n"] = n
     rec["v"] = tri
-    header = f"rigcad {name}: mm, sample point at origin, optical axis +z".encode()[:80].ljust(80, b" ")
+    text = f"rigcad {__version__} {name}: mm" + (f", {frame}" if frame else "")
+    header = text.encode("ascii", "replace")[:80].ljust(80, b" ")
     return header + np.uint32(len(faces)).tobytes() + rec.tobytes()
 
 
@@ -110,11 +119,34 @@ def mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
     return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)
 
 
+#: Date of every entry of the 3MF zips rigcad writes: the earliest a zip can hold (1980-01-01), so
+#: no clock leaks in. lib3mf leaves the date fields zero, which reads as 1980-00-00, not a date.
+ZIP_EPOCH = (1980, 1, 1, 0, 0, 0)
+
+
+def dated_zip(data: bytes) -> bytes:
+    """The zip ``data`` with every entry dated :data:`ZIP_EPOCH`, deflated, mode 0644, in the same
+    order with the same contents (rewritten by Python's zipfile)."""
+    import io
+    import zipfile
+
+    out = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(data)) as src, zipfile.ZipFile(out, "w") as dst:
+        for entry in src.infolist():
+            info = zipfile.ZipInfo(entry.filename, ZIP_EPOCH)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = 0o644 << 16
+            dst.writestr(info, src.read(entry.filename))
+    return out.getvalue()
+
+
 def threemf_writer(vertices: np.ndarray, faces: np.ndarray, name: str):
-    """A writer(path) for a 3MF file (lib3mf, the 3MF Consortium's library), units mm.
+    """A writer(path) for a 3MF file (lib3mf, the 3MF Consortium's library), units mm: one object
+    named ``name``, the model titled ``name`` and its Application ``rigcad <version>``.
 
     lib3mf stamps random UUIDs on objects and build items; they are fixed here (UUID5 of the
-    part's name and geometry) so the same part gives the same bytes.
+    part's name and geometry) so the same part gives the same bytes; its zip entries get a valid
+    fixed date (:func:`dated_zip`).
     """
     import hashlib
     import uuid
@@ -128,6 +160,9 @@ def threemf_writer(vertices: np.ndarray, faces: np.ndarray, name: str):
         wrapper = lib3mf.get_wrapper()
         model = wrapper.CreateModel()
         model.SetUnit(lib3mf.ModelUnit.MilliMeter)
+        meta = model.GetMetaDataGroup()
+        meta.AddMetaData("", "Title", name, "string", False)
+        meta.AddMetaData("", "Application", f"rigcad {__version__}", "string", False)
         mesh = model.AddMeshObject()
         mesh.SetName(name)
         # one copy each from numpy's buffers: lib3mf's Position is 3 float32, its Triangle 3 uint32
@@ -140,7 +175,7 @@ def threemf_writer(vertices: np.ndarray, faces: np.ndarray, name: str):
         model.SetBuildUUID(ids[2])
         # into memory, then written by Python: a full disk is then an OSError rigcad reports, never
         # lib3mf's native abort while writing the file ("Could not deflate data", exit 134)
-        data = bytes(model.QueryWriter("3mf").WriteToBuffer())
+        data = dated_zip(bytes(model.QueryWriter("3mf").WriteToBuffer()))
         Path(path).write_bytes(data)
 
     return writer

@@ -14,7 +14,8 @@ from pathlib import Path
 
 from rigcad.errors import ExportError
 
-#: The fixed header timestamp (STEP requires one; a clock time would change every file).
+#: The fixed header timestamp (STEP requires one; a clock time would change every file, so the
+#: header's description says the time stamp is fixed).
 TIMESTAMP = "2000-01-01T00:00:00"
 #: Re-imported volume must match the written shape's to this relative precision: both are the
 #: same B-rep integrated by the same adaptive rule (1e-9), so only STEP's float printing differs.
@@ -42,11 +43,39 @@ def step_writer(parts: list[tuple[str, object, tuple[float, float, float]]], lab
     def writer(tmp: Path) -> None:
         if not bd.export_step(target, str(tmp), timestamp=TIMESTAMP):
             raise ExportError(f"OCCT's STEP writer failed on {label}")
+        text = tmp.read_text(encoding="latin-1")
         if len(items) > 1:
-            text = tmp.read_text(encoding="latin-1")
-            tmp.write_text(canonical_step(text), encoding="latin-1", newline="\n")
+            text = canonical_step(text)
+        what = f"part {label}" if len(items) == 1 else f"assembly {label} of {len(items)} parts"
+        tmp.write_text(with_header(text, label, what), encoding="latin-1", newline="\n")
 
     return writer
+
+
+def _step_string(text: str) -> str:
+    """``text`` as an ISO 10303-21 string literal: quotes doubled, ASCII only (others as '?')."""
+    return "'" + text.encode("ascii", "replace").decode().replace("'", "''") + "'"
+
+
+def with_header(text: str, label: str, what: str) -> str:
+    """``text`` (a STEP file) with rigcad's HEADER section: FILE_DESCRIPTION says what it holds
+    (``what``, e.g. "part dome") and that the time stamp is fixed; FILE_NAME names ``label``, the
+    fixed :data:`TIMESTAMP`, no author or organisation (OCCT's placeholders 'Author' and
+    'Open CASCADE' removed), OCCT's STEP processor as the preprocessor (as it wrote it) and
+    ``rigcad <version>`` as the originating system. FILE_SCHEMA is kept as OCCT wrote it."""
+    from rigcad._version import __version__
+
+    start, end = text.find("HEADER;"), text.find("ENDSEC;")
+    schema = re.search(r"FILE_SCHEMA\s*\(.*?\)\s*;", text[start:end], re.S)
+    processor = re.search(r"FILE_NAME\s*\(.*?,\s*('Open CASCADE STEP processor [^']*')", text[start:end], re.S)
+    if start < 0 or end < start or schema is None or processor is None:
+        raise ExportError(f"OCCT's STEP file for {label} has no HEADER section with FILE_NAME and FILE_SCHEMA")
+    system = _step_string(f"rigcad {__version__}")
+    header = (f"HEADER;\nFILE_DESCRIPTION(({_step_string(f'rigcad {__version__}: {what}')},"
+              f"{_step_string('time stamp fixed: the same input gives the same bytes')}),'2;1');\n"
+              f"FILE_NAME({_step_string(label)},{_step_string(TIMESTAMP)},(''),(''),\n  {processor.group(1)},"
+              f"{system},'');\n{schema.group(0)}\n")
+    return text[:start] + header + text[end:]
 
 
 def reimport_check(path: Path, expected_volume: float, expected_solids: int) -> dict:

@@ -167,7 +167,7 @@ def _decode_png(data: bytes) -> np.ndarray:
     """A greyscale PNG decoder written here from the PNG specification (chunks, zlib, the five row
     filters), independent of the Pillow encoder under test."""
     assert data[:8] == b"\x89PNG\r\n\x1a\n"
-    pos, idat, header = 8, b"", None
+    pos, idat, header, gamma = 8, b"", None, None
     while pos < len(data):
         (n,), kind = struct.unpack(">I", data[pos:pos + 4]), data[pos + 4:pos + 8]
         body = data[pos + 8:pos + 8 + n]
@@ -176,9 +176,13 @@ def _decode_png(data: bytes) -> np.ndarray:
             header = struct.unpack(">IIBBBBB", body)
         elif kind == b"IDAT":
             idat += body
+        elif kind == b"gAMA":
+            assert idat == b"", "gAMA after IDAT"  # PNG: gAMA before the image data
+            (gamma,) = struct.unpack(">I", body)
         else:
             assert kind == b"IEND", kind  # no text or time chunks: the same bytes every run
         pos += 12 + n
+    assert gamma == 100_000, gamma  # gAMA 1.0 (PNG stores gamma x 100000): the levels are linear
     width, height, depth, colour, _, _, interlace = header
     assert colour == 0 and interlace == 0 and depth in (8, 16)
     bpp = depth // 8
