@@ -2,7 +2,8 @@
 and a stream of server-sent events (``/events``), from memory. No route reads a file, so no path
 can reach one: anything but those two exact paths is a 404, whatever it encodes. A request whose
 ``Host`` header is not this server's own address (a DNS-rebinding page that resolved its name to
-127.0.0.1) is refused with 403; methods other than GET and HEAD with 405.
+127.0.0.1) is refused with 403; methods other than GET and HEAD with 405 (every one, whatever its
+name). A client that disconnects early is silent: no traceback on the watcher's terminal.
 
 :class:`Hub` holds what a newly connected page needs (every part's mesh, the rays, the rows) and
 the recent deltas; :func:`frame_message` turns a :class:`rigcad.live.session.Frame` into the JSON
@@ -202,6 +203,13 @@ class _Handler(BaseHTTPRequestHandler):
 
     do_POST = do_PUT = do_DELETE = do_PATCH = do_OPTIONS = _other
 
+    def __getattr__(self, name: str):
+        """Every other method (TRACE, CONNECT, PROPFIND, a lowercase ``get``: methods are case-sensitive)
+        is refused as the ones above, 405, where http.server would answer 501 with an HTML page."""
+        if name.startswith("do_"):
+            return self._other
+        raise AttributeError(name)
+
     def _headers(self, kind: str, length: int | None) -> None:
         from rigcad.live.page import CSP
 
@@ -261,6 +269,17 @@ class LiveServer(ThreadingHTTPServer):
         self.allowed_hosts = {f"{n}:{port}".lower() for n in names}
         if host in ("::1",):
             self.allowed_hosts |= {f"[::1]:{port}", f"localhost:{port}"}
+
+    def handle_error(self, request, client_address) -> None:
+        """A client that goes away (closes early, resets, times out) is an ordinary disconnect: silent.
+        Anything else is one line on stderr, not socketserver's traceback."""
+        import sys
+
+        err = sys.exc_info()[1]
+        if isinstance(err, (ConnectionError, TimeoutError)):
+            return
+        print(f"rigcad watch: a request from {client_address[0]} failed: {type(err).__name__}: {err}"[:300],
+              file=sys.stderr, flush=True)
 
     @property
     def url(self) -> str:

@@ -184,15 +184,30 @@ class LiveSession:
         from rigcad.profile.loader import load_raw
         from rigcad.profile.schema import validate
 
+        named = self._named()
         files = [Path(self.spec).resolve()] if Path(str(self.spec)).is_file() else list(self.files[:1])
         try:
             raw = load_raw(self.spec)
             files = list(raw.files)
         finally:
-            self.files = tuple(dict.fromkeys([*files, *self._printer_files()]))
+            # the profile's own path as found (a link there is not followed: whatever a rename puts at
+            # that name is seen), then its extends: chain as read, then the printer files
+            self.files = tuple(dict.fromkeys([*named, *files, *self._printer_files()]))
         profile = validate(raw)
         self._load_printers()
         return profile
+
+    def _named(self) -> list[Path]:
+        """The profile's own file where the spec finds it, absolute, links not followed ([] when the
+        spec finds none now: the last one found is kept in :attr:`files`)."""
+        import os
+
+        from rigcad.profile.loader import resolve_profile_path
+
+        try:
+            return [Path(os.path.abspath(resolve_profile_path(self.spec)))]
+        except RigcadError:
+            return [f for f in self.files[:1]]
 
     def _rig(self, profile, ran: list):
         """The rig of ``profile``: the dome (Rig.from_profile with the last good rig) and the design

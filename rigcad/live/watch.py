@@ -5,7 +5,9 @@ exports, when asked) and summed up in one terminal line.
 
 The folders holding the files are watched, not the files: an editor that saves by writing a new
 file and renaming it over the old one (vim, most IDEs) replaces the inode a file watch would hold.
-Only events on the profile's own files count. When an edit changes the ``extends:`` chain the
+Only events on the profile's own files count. The profile's own path is watched as named, links not
+followed: a link renamed over it is read as data (its target too is then watched), and the real
+file renamed back is seen. When an edit changes the ``extends:`` chain the
 watch restarts on the new set of files.
 """
 
@@ -85,19 +87,25 @@ class Watcher:
                  f"{len(result.reused)} unchanged ({time.perf_counter() - t0:.1f} s)")
 
     def _signature(self) -> tuple:
-        """(file, modification time, size) of every watched file: what a rebuild has seen."""
+        """(file, the entry's inode and time, its content's time and size) of every watched file:
+        what a rebuild has seen (a link renamed over a file changes the entry, not only the content)."""
         out = []
         for path in sorted(self.watched()):
             try:
+                entry = path.lstat()
                 st = path.stat()
-                out.append((path, st.st_mtime_ns, st.st_size))
+                out.append((path, entry.st_ino, entry.st_mtime_ns, st.st_mtime_ns, st.st_size))
             except OSError:
-                out.append((path, None, None))
+                out.append((path, None, None, None, None))
         return tuple(out)
 
     def watched(self) -> frozenset[Path]:
+        """The session's files (the profile's own path as found, links not followed, its extends:
+        chain, the printers) and the spec itself when it names a path."""
+        import os
+
         spec = Path(str(self.session.spec))
-        extra = {spec.absolute()} if spec.is_file() else set()
+        extra = {Path(os.path.abspath(spec))} if os.path.lexists(spec) else set()
         return frozenset({Path(f) for f in self.session.files} | extra)
 
     def run(self, stop=None) -> None:

@@ -107,6 +107,35 @@ def test_other_methods_are_refused(server):
     assert code == 405
 
 
+@pytest.mark.parametrize("method", ["PUT", "DELETE", "TRACE", "CONNECT", "PROPFIND", "get", "Head", "M-SEARCH", "BREW"])
+def test_every_unsupported_method_gets_405_as_plain_text(server, method):
+    """Methods are case-sensitive: a lowercase ``get`` is not GET. http.server answers a method it has
+    no handler for with 501 and an HTML page; the docs say 405."""
+    port = server.server_address[1]
+    code, data = _raw(server, f"{method} / HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n".encode())
+    assert code == 405, (method, data[:200])
+    assert b"text/plain" in data and b"<html" not in data.lower()
+
+
+def test_clients_that_go_away_early_leave_no_traceback(server, capfd):
+    """A page closed mid-request (reset, or the request half sent) or mid-stream: ordinary
+    disconnects, nothing on the terminal (1,506 tracebacks in one run of watch before)."""
+    import struct
+    import time
+
+    port = server.server_address[1]
+    for request in (b"GET / HTTP/1.1\r\nHost: 127.0.0.1:%d\r\n" % port, b"GET /events HTTP/1.1\r\nHost: 127.0.0.1:%d\r\n\r\n" % port,
+                    b"GE"):
+        for _ in range(20):
+            s = socket.create_connection(server.server_address[:2], timeout=5)
+            s.sendall(request)
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))  # close with a reset
+            s.close()
+    time.sleep(0.5)  # the handler threads meet the resets
+    out, err = capfd.readouterr()
+    assert "Traceback" not in err and "Error" not in err, err[-2000:]
+
+
 def test_a_port_in_use_gets_one_line_and_the_next_free_port():
     taken = socket.socket()
     taken.bind(("127.0.0.1", 0))

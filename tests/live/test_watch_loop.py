@@ -106,3 +106,53 @@ def test_a_refused_write_is_one_line_and_the_watch_goes_on(tmp_path):
     refused = [line for line in lines if line.startswith("  not written: ")]
     assert len(refused) == 1 and "link" in refused[0], lines
     assert watcher.session.good is not None and list((tmp_path / "elsewhere").iterdir()) == []
+
+
+@pytest.fixture
+def named_loop(tmp_path, monkeypatch):
+    """The loop on a profile named (``w1``, found in ./profiles), as `rigcad watch w1` runs it."""
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / "profiles" / "w1.yaml"
+    path.parent.mkdir()
+    path.write_text("extends: achutha2006\nbeam:\n  width: 6 mm\n", encoding="utf-8")
+    watcher = Watcher(LiveSession("w1", check=False), Hub(), say=lambda line: None)
+    stop = threading.Event()
+    thread = threading.Thread(target=watcher.run, args=(stop,), daemon=True)
+    thread.start()
+    _wait(lambda: len(watcher.frames) >= 1, "the first build")
+    time.sleep(0.3)
+    yield watcher, path
+    stop.set()
+    thread.join(10)
+    assert not thread.is_alive()
+
+
+@pytest.mark.parametrize("which", ["named", "path"])
+def test_a_link_renamed_over_the_profile_is_read_and_the_real_file_back_is_seen(request, tmp_path, which):
+    """``ln -s elsewhere/other.yaml .l && mv -Tf .l w1.yaml``: the link is read as data (its rig
+    shown); a link to a file that is no profile is an error frame that quotes nothing of it; the real
+    file renamed back over the link brings a frame (the watch stays on the profile's own path)."""
+    watcher, path = request.getfixturevalue("named_loop" if which == "named" else "loop")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (elsewhere / "other.yaml").write_text("extends: achutha2006\nbeam:\n  width: 12 mm\n", encoding="utf-8")
+    (elsewhere / "secret.yaml").write_text("root:x:0:0:root:/root:/bin/bash\n", encoding="utf-8")
+    for target, width in ((elsewhere / "other.yaml", 12), (None, 13), (elsewhere / "secret.yaml", None), (None, 13)):
+        time.sleep(1.5)  # a user's pause: the watch has settled on the files the last frame read
+        before = len(watcher.frames)
+        if target is None:  # the real file, saved by rename over the link
+            real = path.with_name(".profile.new")
+            real.write_text("extends: achutha2006\nbeam:\n  width: 13 mm\n", encoding="utf-8")
+            os.replace(real, path)
+        else:
+            link = path.with_name(".l")
+            link.unlink(missing_ok=True)
+            link.symlink_to(target)
+            os.replace(link, path)
+        if width is None:
+            _wait(lambda: len(watcher.frames) > before and watcher.frames[-1]["error"], "the error frame", timeout=20)
+            assert "root:x" not in watcher.frames[-1]["error"]
+        else:
+            _wait(lambda: len(watcher.frames) > before and abs(_beam(watcher) - width) < 1e-9, f"width {width}",
+                  timeout=20)
+    assert not path.is_symlink()
