@@ -31,6 +31,8 @@ RUNS = (
     # The calibration picture, in a root of its own: `rigcad basis --simulate` reads a corrected map
     # when one lies beside it, and the basis figures must not depend on an earlier `make docs`.
     Run("calibrate", ("calibrate", P, "--simulate", "--seed", "7"), folder="calibrate"),
+    # The capture conventions' picture, drawn by the kit from the code's conventions
+    Run("calibrate_kit", ("calibrate", P, "--kit"), folder="calibrate"),
     # The support picture: the dome and the paraboloid sliced by PrusaSlicer (the whole rig through
     # the slicer is a one-off: see bench_figures). A root of its own: a partial fab run would replace
     # the full run's fab.json.
@@ -260,6 +262,7 @@ PICTURES = (
     Picture("tolerance_histograms.png", "tolerance", "tolerance/histograms.png", "tolerance/summary.json"),
     Picture("tolerance_sensitivity.png", "tolerance", "tolerance/sensitivity.png", "tolerance/summary.json"),
     Picture("calibrate_maps.png", "calibrate", "calibrate/maps.png", "calibrate/calibration.json#residual_slopes"),
+    Picture("calibrate_conventions.png", "calibrate_kit", "calibrate_kit/conventions.png", "calibrate_kit/conventions.png"),
     Picture("optimize_history.png", "optimize", "../achutha2006_optimize/optimize/history.png",
             "../achutha2006_optimize/optimize/optimize.json#evaluations"),
     Picture("optimize_pareto.png", "optimize", "../achutha2006_optimize/optimize/pareto.png",
