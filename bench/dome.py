@@ -17,6 +17,7 @@ scalar loop of rigcad.optics.dome.build_euler.
 
 from __future__ import annotations
 
+import argparse
 import math
 import time
 from pathlib import Path
@@ -140,14 +141,17 @@ def plot(cases: list[dict]) -> bytes:
 
 
 def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", type=Path, default=RESULTS, help="results folder (default: bench/results)")
+    out = ap.parse_args().out
     profile = load_profile(ROOT / "profiles" / "achutha2006.yaml")
     g = derive(profile)
     from dataclasses import replace
 
     far = replace(g, cop_z=math.inf)
     cases = [run_case("table31", g), run_case("far_cop_ellipse", far)]
-    write_json(RESULTS / "dome.json", {"note": __doc__.split("\n\n")[0], "cases": cases})
-    write_bytes(RESULTS / "dome.png", plot(cases))
+    write_json(out / "dome.json", {"note": __doc__.split("\n\n")[0], "cases": cases})
+    write_bytes(out / "dome.png", plot(cases))
     for c in cases:
         print(c["case"], c["speedup_at_1e-6_relative"])
 

@@ -135,10 +135,12 @@ def main() -> None:
     ap.add_argument("--estimates", action="store_true", help="rigcad's estimates against PrusaSlicer (MK3S)")
     ap.add_argument("--from-report", help="a fab.json written with --gcode (skips slicing)")
     ap.add_argument("--fit", action="store_true", help="refit the estimate model's coefficients")
+    ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results",
+                    help="results folder (default: bench/results)")
     args = ap.parse_args()
     profile = load_profile(args.profile)
     rig = Rig.from_profile(profile)
-    results = Path(__file__).parent / "results"
+    results = args.out
     if args.estimates:
         path = write_json(results / "fab_estimates.json", _estimates(args, rig))
     else:

@@ -18,6 +18,7 @@ REPEATS builds (the first build of a large mesh also pays the kernel's first tou
 
 from __future__ import annotations
 
+import argparse
 import tempfile
 import time
 from pathlib import Path
@@ -125,6 +126,9 @@ def plot(results: dict) -> bytes:
 
 
 def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", type=Path, default=RESULTS, help="results folder (default: bench/results)")
+    out = ap.parse_args().out
     geo = derive(load_profile(PROFILE))
     meridians = {
         "dome": dome_meridian(build_dome(geo, "dop853", tolerance=1e-9, rows=2001)),
@@ -143,8 +147,8 @@ def main() -> None:
                     for c in CHORD_ERRORS_MM]
             results["mirrors"][name] = rows
             print(table(name, rows), flush=True)
-    print(write_json(RESULTS / "mirror_mesh.json", results))
-    print(write_bytes(RESULTS / "mirror_mesh.png", plot(results)))
+    print(write_json(out / "mirror_mesh.json", results))
+    print(write_bytes(out / "mirror_mesh.png", plot(results)))
 
 
 if __name__ == "__main__":

@@ -126,6 +126,7 @@ def main() -> None:
     ap.add_argument("--rays", type=int, default=1_000_000)
     ap.add_argument("--profile", default="achutha2006")
     ap.add_argument("--exports", default="exports")
+    ap.add_argument("--out", type=Path, default=OUT, help="results folder (default: bench/results)")
     args = ap.parse_args()
     profile = load_profile(args.profile)
     rig = Rig.from_profile(profile)
@@ -198,8 +199,8 @@ def main() -> None:
         "rays": k, "trace_s": dt, "rays_per_s": k / dt, "raw_over_reading": raws["smooth"] * k / args.rays / dt}
     print("analytic_vectorised_numpy", result["readings"]["analytic_vectorised_numpy"])
     result["pinhole_table_sweep"] = table_sweep(analytic, geo, o, d)
-    OUT.mkdir(parents=True, exist_ok=True)
-    write_json(OUT / "raycheck.json", result)
+    args.out.mkdir(parents=True, exist_ok=True)
+    write_json(args.out / "raycheck.json", result)
 
     names = ["analytic_aligned", "analytic_misaligned", "smooth", "mesh", "analytic_vectorised_numpy"]
     labels = ["analytic\naligned", "analytic\nmisaligned", "smooth mesh\n(end to end)", "flat facets\n(end to end)",
@@ -220,7 +221,7 @@ def main() -> None:
     ax.set_title(f"{args.rays} rays, {t['paraboloid'] + t['dome']} mirror triangles, one process "
                  f"(load {os.getloadavg()[0]:.1f})", fontsize=10)
     ax.legend()
-    write_bytes(OUT / "raycheck.png", _png(fig))
+    write_bytes(args.out / "raycheck.png", _png(fig))
 
 
 if __name__ == "__main__":
