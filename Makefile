@@ -41,7 +41,7 @@ help:
 	@echo "make test-all - every test, slow ones included"
 	@echo "make test-portable - the numerical tests as other CPUs compute them (BLAS kernels, numpy SIMD off, generic numba)"
 	@echo "make stress   - numerical stress suite: 500 random profiles (hypothesis)"
-	@echo "make bench    - run time against error for each accuracy knob -> bench/results/*.json, *.png"
+	@echo "make bench    - run time against error for each accuracy knob -> build/bench/; each speed ratio against bench/results/ (REFRESH=1 updates it)"
 	@echo "make mutate   - mutation testing (mutmut) of the numerical core, each module against its own tests"
 	@echo "               -> bench/results/mutation.json, mutation.md (MUTATE='group ...' runs some; --list names them)"
 	@echo "make clean    - remove $(EXPORTS)/ ; make distclean also removes $(VENV)/"
@@ -124,20 +124,25 @@ test-slow: $(VENV)/.installed tools
 gcode: $(VENV)/.installed tools
 	$(VENV)/bin/rigcad fab $(PROFILE) --printer $(PRINTER) --exports $(EXPORTS) --gcode
 
+# The benchmarks write into $(BENCH_OUT); bench/compare.py then holds each speed ratio measured within
+# one run against the committed figure in bench/results/ (a drop of more than 10 %: a regression, exit 1).
+# The committed figures change only when the run says so: `make bench REFRESH=1` copies the results over.
+BENCH_OUT ?= build/bench
 bench: $(VENV)/.installed stl
-	$(PY) bench/dome.py
-	$(PY) bench/mirror_mesh.py
-	$(PY) bench/raycheck.py --exports $(EXPORTS)
-	$(PY) bench/tolerance.py
-	$(PY) bench/fab_stages.py
-	$(PY) bench/tessellation.py
-	$(PY) bench/ray_count.py --exports $(EXPORTS)
-	$(PY) bench/float32.py --exports $(EXPORTS)
-	$(PY) bench/make_stl.py
-	$(PY) bench/basis.py
-	$(PY) bench/optimize.py
-	$(PY) bench/startup.py
-	$(PY) bench/hugepages.py
+	$(PY) bench/dome.py --out $(BENCH_OUT)
+	$(PY) bench/mirror_mesh.py --out $(BENCH_OUT)
+	$(PY) bench/raycheck.py --exports $(EXPORTS) --out $(BENCH_OUT)
+	$(PY) bench/tolerance.py --out $(BENCH_OUT)
+	$(PY) bench/fab_stages.py --out $(BENCH_OUT)
+	$(PY) bench/tessellation.py --out $(BENCH_OUT)
+	$(PY) bench/ray_count.py --exports $(EXPORTS) --out $(BENCH_OUT)
+	$(PY) bench/float32.py --exports $(EXPORTS) --out $(BENCH_OUT)
+	$(PY) bench/make_stl.py --out $(BENCH_OUT)
+	$(PY) bench/basis.py --out $(BENCH_OUT)
+	$(PY) bench/optimize.py --out $(BENCH_OUT)
+	$(PY) bench/startup.py --out $(BENCH_OUT)
+	$(PY) bench/hugepages.py --out $(BENCH_OUT)
+	$(PY) bench/compare.py $(BENCH_OUT) $(if $(REFRESH),--refresh)
 
 stress: $(VENV)/.installed
 	$(PY) -m pytest -q -m stress --hypothesis-show-statistics
