@@ -6,16 +6,17 @@ its inputs (SHA-256 of their ``repr``: frozen dataclasses of float64, exact):
 
 * ``dome``: the dome's parameters and the derived geometry -> the integrated dome, and with it
   the paraboloid, the curve and the pixel-to-direction map (``Rig``'s cached values);
-* ``design``: the dome key, the projector, the targets and the misalignment probes -> the 2D
-  design (its report's ``profile`` entry refreshed: ``optics.design.profile_entry``);
+* ``design``: the dome key and the profile keys the design read when it last ran (recorded while it
+  runs: rigcad.live.reads, never a list kept by hand) -> the 2D design (its report's ``profile``
+  entry refreshed: ``optics.design.profile_entry``);
 * each part: its recipe's content hash (``Part.content_hash``, the export cache's part key) ->
   its picture mesh (``Rig.mesh``'s cache, shared from one rig to the next and pruned to the parts
   in use); the mirrors (dome, paraboloid) are parts like the others, so an edit that leaves the
   dome alone does not re-mesh it;
-* ``check``: the dome key, the layout, the occluders, the tower's parts and the instruments, and
-  the profile sections the check reads -> the design-level check rows (``check.tolerances``) on
-  the analytic tracer (``rigcad.check.raycheck``, mode ``analytic``, no Monte Carlo, no pixel
-  grid) and the rays the view draws.
+* ``check`` (and the view's ``rays``): the dome and design keys, the layout, the occluders, every
+  part's recipe hash, and the profile keys the check (the rays) read when it last ran -> the
+  design-level check rows (``check.tolerances``) on the analytic tracer (``rigcad.check.raycheck``,
+  mode ``analytic``, no Monte Carlo, no pixel grid) and the rays the view draws.
 
 A profile with an error gives a frame holding the error (with file:line) and the last good rig.
 :attr:`LiveSession.builds` counts each stage's runs (``mesh:<part>`` per part meshed), so that a
@@ -34,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from rigcad.errors import RigcadError
+from rigcad.live.reads import recording, unrecorded, values_at
 
 #: The stages of an update, in order, as the timings name them (seconds); ``push`` is the server's.
 STAGES = ("reload", "design", "parts", "meshes", "check", "push")
@@ -46,16 +48,17 @@ HEADLINE = {
     "px_per_deg_min": ("pixels per degree (min)", "px/deg", ("pixels", "px_per_deg_min")),
     "px_per_deg_mean": ("pixels per degree (mean)", "px/deg", ("pixels", "px_per_deg_mean")),
 }
-#: Profile sections the design reads besides the geometry and the dome (optics.design.run_design).
-DESIGN_SECTIONS = ("projector", "targets", "misalignment")
-#: Profile sections the design-level check reads (check.raycheck, check.tower, check.tolerances).
-CHECK_SECTIONS = ("projector", "camera", "lens", "beam_splitter", "tower", "targets", "misalignment", "raycheck",
-                  "tolerancing", "coating")
-
-
 def key_of(*items) -> str:
     """SHA-256 (hex) of the ``repr`` of ``items``: frozen parameters and recipes are exact there."""
     return hashlib.sha256("\x1f".join(repr(i) for i in items).encode()).hexdigest()
+
+
+def stage_key(profile, paths, *upstream) -> str | None:
+    """The key of a stage that read ``paths`` of ``profile`` when it last ran (rigcad.live.reads) and
+    takes ``upstream`` (earlier stages' keys) from before: None when it never ran."""
+    if paths is None:
+        return None
+    return key_of(*upstream, values_at(profile, paths))
 
 
 @dataclass
@@ -101,6 +104,8 @@ class _Good:
     figures: dict[str, float]
     rows: list[dict] | None
     printers: dict[str, dict]
+    #: stage -> the profile keys it read when it last ran (rigcad.live.reads)
+    reads: dict[str, frozenset] = field(default_factory=dict)
 
 
 class LiveSession:
@@ -119,6 +124,7 @@ class LiveSession:
         self._mesh_cache: dict = {}
         self._printers: dict[str, object] = {}
         self._pending: tuple | None = None
+        self._reads: dict[str, frozenset] = {}
 
     # -- the update ------------------------------------------------------------------------------
     def update(self) -> Frame:
@@ -146,20 +152,22 @@ class LiveSession:
         t0 = time.perf_counter()
         parts = [p for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig]
         keys = {p.name: p.content_hash() for p in parts}
-        check_key = self._check_key(rig, dome_key, keys)
+        check_key = self._check_key(rig, dome_key, design_key, keys)
         timings["parts"] = time.perf_counter() - t0
 
         t0 = time.perf_counter()
         meshes = self._meshes(rig, parts, keys, ran)
-        rays = self._rays(rig, check_key, ran)
+        rays = self._rays(rig, self._check_key(rig, dome_key, design_key, keys, "rays"),
+                          self._upstream(rig, dome_key, design_key, keys), ran)
         printers = self._printer_fits(rig, meshes, keys, ran)
         timings["meshes"] = time.perf_counter() - t0
 
         old = self.good
         rows, rows_key = (old.rows, old.check_key) if old is not None else (None, None)
-        self.good = _Good(rig, dome_key, design_key, rows_key, keys, meshes, rays, figures, rows, printers)
-        pending = self.check_enabled and rows_key != check_key
-        self._pending = (rig, check_key) if pending else None
+        self.good = _Good(rig, dome_key, design_key, rows_key, keys, meshes, rays, figures, rows, printers,
+                          dict(self._reads))
+        pending = self.check_enabled and (check_key is None or rows_key != check_key)
+        self._pending = (rig, self._upstream(rig, dome_key, design_key, keys)) if pending else None
         return self._frame(old, timings, ran, pending)
 
     def finish_check(self) -> Frame | None:
@@ -167,15 +175,17 @@ class LiveSession:
         check was pending; an error frame when the check could not run)."""
         if self._pending is None or self.good is None:
             return None
-        (rig, key), self._pending = self._pending, None
+        (rig, upstream), self._pending = self._pending, None
         t0 = time.perf_counter()
         self.seq += 1
         try:
-            rows = check_rows(rig)
+            with recording(rig.profile) as seen:
+                rows = check_rows(rig)
         except RigcadError as err:
             return self._error_frame(str(err), {"check": time.perf_counter() - t0}, ["check"])
         self.builds["check"] += 1
-        self.good.rows, self.good.check_key = rows, key
+        self._reads["check"] = self.good.reads["check"] = frozenset(seen.paths)
+        self.good.rows, self.good.check_key = rows, stage_key(rig.profile, self._reads["check"], upstream)
         return self._frame(None, {"check": time.perf_counter() - t0}, ["check"], False, swap=False)
 
     # -- stages ----------------------------------------------------------------------------------
@@ -221,15 +231,23 @@ class LiveSession:
             self.builds["dome"] += 1
             ran.append("dome")
         dome_key = key_of(profile.dome, rig.geometry)
-        design_key = key_of(dome_key, *(getattr(profile, s) for s in DESIGN_SECTIONS))
-        if old is not None and old.design_key == design_key:
+        reads = dict(old.reads) if old is not None else {}
+        design_key = stage_key(profile, reads.get("design"), dome_key)
+        if old is not None and design_key is not None and old.design_key == design_key:
             design = old.rig.design
             rig._cache["design"] = dataclasses.replace(
                 design, profile=profile, report={**design.report, "profile": profile_entry(profile)})
         else:
-            rig.design
+            from rigcad.optics import design as design_module
+
+            # the report's copy of the whole profile is refreshed on reuse (above): no input of the design
+            with recording(profile) as seen, unrecorded(design_module, "profile_entry"):
+                rig.design
+            reads["design"] = frozenset(seen.paths)
+            design_key = stage_key(profile, reads["design"], dome_key)
             self.builds["design"] += 1
             ran.append("design")
+        self._reads = reads
         rig._cache["_meshes"] = self._mesh_cache  # Rig.mesh's cache, keyed by recipe content
         rig.layout
         return rig, dome_key, design_key
@@ -250,25 +268,30 @@ class LiveSession:
             del self._mesh_cache[stale]
         return meshes
 
-    def _check_key(self, rig, dome_key: str, keys: dict) -> str:
-        """The inputs of the check rows and of the view's rays (see the module docstring)."""
-        from rigcad.parts.tower import TOWER_PARTS
+    def _upstream(self, rig, dome_key: str, design_key: str, keys: dict) -> str:
+        """What the check rows and the view's rays take from earlier stages, made before they run:
+        the dome and design keys, the layout, the occluders and every part's recipe hash."""
+        return key_of(dome_key, design_key, rig.layout.describe(), rig.occluders, sorted(keys.items()))
 
-        instruments = {p.name for p in rig.instruments}
-        tower = sorted((n, k) for n, k in keys.items() if n in TOWER_PARTS or n in instruments)
-        return key_of(dome_key, rig.layout.describe(), rig.occluders, tower,
-                      *(getattr(rig.profile, s) for s in CHECK_SECTIONS))
+    def _check_key(self, rig, dome_key: str, design_key: str, keys: dict, stage: str = "check") -> str | None:
+        """The inputs of the check rows (``stage`` "check") or of the view's rays ("rays"): the
+        earlier stages' keys and the profile keys the stage read when it last ran (None: it never ran)."""
+        return stage_key(rig.profile, self._reads.get(stage), self._upstream(rig, dome_key, design_key, keys))
 
-    def _rays(self, rig, check_key: str, ran: list) -> dict:
-        """The view's rays (manual.view.traced_rays), traced again only when their inputs changed."""
+    def _rays(self, rig, rays_key: str | None, upstream: str, ran: list) -> dict:
+        """The view's rays (manual.view.traced_rays), traced again only when their inputs changed
+        (``rays_key``: :meth:`_check_key` of "rays"; None when they were never traced)."""
         from rigcad.manual.view import VIEW_RAYS, traced_rays
 
         old = self.good
-        if old is not None and old.rays is not None and old.rays.get("key") == check_key:
+        if rays_key is not None and old is not None and old.rays is not None and old.rays.get("key") == rays_key:
             return old.rays
         self.builds["rays"] += 1
         ran.append("rays")
-        return {**traced_rays(rig, VIEW_RAYS), "key": check_key}
+        with recording(rig.profile) as seen:
+            rays = traced_rays(rig, VIEW_RAYS)
+        self._reads["rays"] = frozenset(seen.paths)
+        return {**rays, "key": stage_key(rig.profile, self._reads["rays"], upstream)}
 
     # -- printers --------------------------------------------------------------------------------
     def _printer_files(self) -> list[Path]:
