@@ -18,7 +18,7 @@ Which map: the exact map E is the one that decodes to the measured map D, so E <
 E = D, the sub-rays from E's second-order Taylor expansion over the camera window (finite
 differences), :data:`ITERATIONS` rounds. The fitted model's own map (a rig moved as a whole, no
 surface error) was tried first and made the corrected map worse: the bias is dominated by the
-surface error's curvature, which that model lacks (docs/calibrate.md has the figures).
+surface error's curvature, which that model lacks (docs/calibrate-notes.md has the figures).
 
 The blur is the lens's Gaussian sigma in camera pixels, as the profile states it
 (``calibration.sim_blur``: the simulation's; a real capture states its lens's from a focus test).

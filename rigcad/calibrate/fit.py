@@ -6,14 +6,16 @@ minus the forward model's (mm, both screen axes, every capture) over every ``fit
 pixel that decoded in every capture. The Jacobian is by forward differences with one trace per rig
 parameter (the screens' columns reuse the base trace and recompute their own capture's points only:
 the same columns to the last bit, a test holds it). After a first
-solve, residuals beyond 5 robust sigmas (1.4826 MAD) are dropped and the fit repeated. Each
+solve, residuals beyond 5 robust sigmas (1.4826 MAD) of their path, and beyond a fifth of the finest
+period (:data:`OUTLIER_PERIOD_FRACTION`), are dropped and the fit repeated. Each
 pixel's residual component that a dome slope error makes (a turn about its dome point) is
 down-weighted in the map's refit (:data:`SLOPE_PROJECTION`). Standard
 errors: the posterior under the tolerances' prior (:func:`posterior_covariance`), s^2 (J^T J)^-1
 where the data decide, s^2 the residual variance. The residual is dominated by the surface
 error, which is correlated between neighbouring pixels and alike in every capture of a pixel, so
 the reported fit's covariance is the cluster-robust sandwich over tiles of the camera window
-(:data:`CLUSTER_PX`); the bench compares the standard errors with the errors (docs/calibrate.md).
+(:data:`CLUSTER_PX`); the bench compares the standard errors with the errors (docs/calibrate.md;
+what was tried, with its figures: docs/calibrate-notes.md).
 
 Residual slopes: where the measured ray d (up, the raxel) differs from the fitted model's, the
 difference is read as a tilt of the dome's normal at the model ray's dome point: for the
@@ -50,42 +52,39 @@ PRIOR_MM = 0.2
 #: distances t_k from the dome, along one direction per screen axis. That component of each pixel's
 #: residual (its projection on (t_0, t_1, ...)) is scaled by 1 - this, so the unknown surface steers
 #: the dome points (what the map's rays turn about: :func:`rigcad.calibrate.maps.pivot_rays`) less.
-#: Measured on seeded trials kept out of the bench (spacers 1 and 20 mm), against the plain fit's
-#: model: measured pixels' map p99 0.155/0.065/0.071 -> 0.082/0.049/0.059 deg at 0.5 (101-103), but
-#: parameters within target 11/17/20 -> 11/13/14 of 21: the misalignment reported is the plain fit's.
-#: Once the fit no longer read the decoded points an edge pulls (maps.HEIGHT_EDGE_PX), the higher
-#: factors paid (seeds 101-110, measured pixels' p99, deg): 0.5 0.035-0.099 (median 0.046); 0.75
-#: 0.032-0.056 (0.037); 0.9 0.032-0.044 (0.036); 0.95 0.032-0.054 on 101-106. 1, the component
-#: dropped, leaves the dome's tilts to the prior: 0.048-0.153 on 101-106.
+#: 1 would leave the dome's tilts to the prior alone; 0.9 gave the best map of 0.5-1 on seeded trials
+#: kept out of the bench (docs/calibrate-notes.md, "The map's refit"). The misalignment reported is
+#: the plain fit's: the refit's parameters are worse.
 SLOPE_PROJECTION = 0.9
 #: The direct view's pixels (:func:`seen_direct`) the fit reads: every this-many-th of the fit's rows
 #: and columns (``calibration.fit_stride``). They fix the camera's pose against the screens with
-#: the decoding's micrometres, free of the mirrors' surface error. Measured one-off on the bench's
-#: two trials whose camera x offset against the dome missed its target (seeds 26 and 41), at 4, 2
-#: and 1: ~870, ~3,500 and ~13,700 pixels; that offset's error 1.04 and 1.05, 0.79 and 0.67, 0.74
-#: and 0.57 times its target; the calibration's CPU time (the flat captures, seed 41) 35.0, 39.0 and
-#: 60.6 s.
+#: the decoding's micrometres, free of the mirrors' surface error; every 2nd pixel put the camera's
+#: offset within target where every 4th did not, at less CPU than every one (docs/calibrate-notes.md,
+#: "The direct view").
 DIRECT_STRIDE = 2
 #: The most the direct view's rows are weighted against the mirrored ones (the ratio of their robust
-#: sigmas after the first solve: ~40 in the plain fit on Table 3.1, ~4 in the map's refit, whose
-#: mirrored residual has the surface's part projected away). Measured on seeds 101-104 (kept out of
-#: the bench), parameters within target with the direct rows weighted 1, 10 and 40: 27-36, 28-39 and
-#: 33-39 of 39 (39 of 39 on three of the four at 40). Over the bench's 50 trials the ratio came to
-#: 33-62 (bench/results/calibrate.json, ``fit_direct_view``).
+#: sigmas after the first solve, ~30-60 in practice): a cap against a degenerate sigma, not a setting.
 MAX_DIRECT_WEIGHT = 1000.0
 #: Iterations of each solve (each costs a Jacobian: one trace per rig parameter).
 MAX_ITERATIONS = 40
 #: Outliers: residuals past this many robust sigmas are dropped before the second solve.
 OUTLIER_SIGMAS = 5.0
+#: ... and only those past this share of the finest period on the screen (mm: 0.25 mm for 16 px of
+#: 0.0779 mm): what the test is for is a point decoded a period or a stripe away. On a rig with no
+#: surface error the mirrored rows' robust sigma is the decoding's few micrometres, and the long
+#: footprints near grazing decode ten times looser; 5 sigmas alone dropped thousands of them there
+#: (2,486 on a flat-only capture of an aligned rig, one-off) as if they were wrong.
+OUTLIER_PERIOD_FRACTION = 0.2
+#: A correlation the report lists (:meth:`FitResult.strong_correlations`): beyond this ...
+STRONG_CORRELATION = 0.9
+#: ... between parameters whose standard errors are over this share of their recovery targets (two
+#: standard errors span the target).
+LOOSE_SHARE = 0.5
 #: The reported fit's covariance treats the residuals of the camera pixels within one square tile
 #: this many pixels wide, every capture of them, as one draw (:func:`posterior_covariance`'s
 #: ``clusters``): the surface error's residual is smooth across the window and repeats in each
-#: capture of a pixel (a turned capture sees the same rays), so rows are not independent. Measured
-#: on seeded trials kept out of the bench (seeds 200-209), the median of |error| / standard error
-#: over the fitted parameters (a Gaussian gives 0.67): 0.48 without tiles; 0.55, 0.58, 0.58 with
-#: tiles of 32, 64, 128 px. Without tiles, the turned captures' heights and centres, which their
-#: partners' identical residuals cancel, were stated 30-100 times looser than their errors (0.01-0.04);
-#: with 64-px tiles, 0.26-1.05.
+#: capture of a pixel (a turned capture sees the same rays), so rows are not independent. 32-128 px
+#: gave alike (docs/calibrate-notes.md, "Rows that are not independent").
 CLUSTER_PX = 64
 
 
@@ -168,17 +167,48 @@ class FitResult:
     direct_residuals: int
     direct_rms_residual_mm: float
     direct_weight: float
+    #: each parameter's recovery target (mm, rad; :func:`rigcad.calibrate.model.recovery_targets`)
+    targets: np.ndarray | None = None
+
+    #: the paraboloid's and the camera's placement against the dome: its covariance
+    #: (:func:`rigcad.calibrate.model.in_dome_frame_covariance`, over
+    #: :data:`rigcad.calibrate.model.DOME_FRAME_NAMES`), when the caller computed it
+    dome_frame_covariance: np.ndarray | None = None
+
+    def strong_correlations(self) -> list[tuple[str, str, float]]:
+        """The pairs correlated beyond :data:`STRONG_CORRELATION` among the parameters a technician
+        adjusts, the paraboloid's and the camera's placement against the dome
+        (:attr:`dome_frame_covariance`; the fit's own parameters without it), whose parameters are
+        both loosely fixed: each one's standard error over :data:`LOOSE_SHARE` of its target. Those
+        trade off against each other within their targets. In the sample frame every part and
+        screen shares the frame's tilt, which correlates dozens of pairs on any rig, and a parameter
+        fixed well within its target is fixed whatever it correlates with."""
+        names, cov, targets = self.names, self.covariance, self.targets
+        if self.dome_frame_covariance is not None:
+            names = M.DOME_FRAME_NAMES
+            cov = self.dome_frame_covariance
+            targets = None if targets is None else targets[[self.names.index(n) for n in names]]
+        se = np.sqrt(np.diag(cov))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            corr = np.nan_to_num(cov / np.outer(se, se))
+        loose = se > LOOSE_SHARE * (targets if targets is not None else 0.0)
+        n = len(names)
+        return [(names[i], names[j], float(corr[i, j])) for i in range(n) for j in range(i + 1, n)
+                if abs(corr[i, j]) > STRONG_CORRELATION and loose[i] and loose[j]]
 
     def as_dict(self) -> dict:
         out = in_report_units(self.names, self.theta, self.standard_error)
-        strong = [(self.names[i], self.names[j], float(self.correlation[i, j]))
-                  for i in range(len(self.names)) for j in range(i + 1, len(self.names))
-                  if abs(self.correlation[i, j]) > 0.9]
+        strong = self.strong_correlations()
         return {"parameters": out, "rms_residual_mm": self.rms_residual_mm, "residuals_used": self.residuals_used,
                 "direct_view_residuals": self.direct_residuals,
                 "direct_view_rms_residual_mm": self.direct_rms_residual_mm, "direct_view_weight": self.direct_weight,
                 "outliers_dropped": self.outliers, "evaluations": self.evaluations,
-                "strong_correlations_over_0.9": [{"a": a, "b": b, "correlation": c} for a, b, c in strong],
+                "strong_correlations": {
+                    "about": "the paraboloid's and the camera's placement against the dome: pairs correlated beyond "
+                             f"{STRONG_CORRELATION:g} whose standard errors are both over {LOOSE_SHARE:g} of their "
+                             "recovery targets (a tenth of the tolerance, at least 0.02 mm or 0.01 deg), which the "
+                             "images fix only together; the sample frame's whole matrix is under 'correlation'",
+                    "pairs": [{"a": a, "b": b, "correlation": c} for a, b, c in strong]},
                 "correlation_order": list(self.names), "correlation": self.correlation.tolist()}
 
 
@@ -300,7 +330,7 @@ def posterior_covariance(jac: np.ndarray, fun: np.ndarray, root: np.ndarray,
     ~ N(0, 1) there, but for a turned capture's pair: ``root``, :func:`model.prior_root` over the
     free parameters) and the data rows' residual variance s^2: A^-1 = (J_d^T J_d / s^2 + R^T R)^-1,
     J_d the data rows of ``jac`` (its last rows are the prior's). Along what the data fix,
-    s^2 (J_d^T J_d)^-1; along what they do not (the frame's tilt: docs/calibrate.md), the prior
+    s^2 (J_d^T J_d)^-1; along what they do not (the frame's tilt: docs/calibrate.md, "What the figures mean"), the prior
     itself, whatever the fit's ridge weight (:data:`PRIOR_MM`) did to the solve.
 
     ``clusters`` (an int per data row): rows that share one are not taken as independent. The
@@ -347,10 +377,13 @@ def fit(optics, rig, cam: M.Camera, plan: M.Plan, data: FitData, say=None, slope
     direct_rows = np.repeat(data.direct, 2 * len(plan))
     full = np.zeros(len(prob.keep))
     full[prob.keep] = res.fun[:int(prob.keep.sum())]
-    drop, sigma = outlying_rows(full, prob.keep, direct_rows)
+    cal = rig.profile.calibration
+    floor = OUTLIER_PERIOD_FRACTION * min(cal.periods) * cal.screen_pitch
+    drop, sigma = outlying_rows(full, prob.keep, direct_rows, floor)
     outliers = int(drop.sum())
     if outliers and say:
-        say(f"dropping {outliers} outlying residuals (> {OUTLIER_SIGMAS:g} robust sigmas); refitting")
+        say(f"dropping {outliers} outlying residuals (> {OUTLIER_SIGMAS:g} robust sigmas and > {floor:.2f} mm: "
+            "points decoded a period or a stripe away); refitting")
     prob.keep &= ~drop
     if sigma[True] > 0 and sigma[False] > 0:
         prob.direct_weight = float(np.clip(sigma[False] / sigma[True], 1.0, MAX_DIRECT_WEIGHT))
@@ -369,11 +402,13 @@ def fit(optics, rig, cam: M.Camera, plan: M.Plan, data: FitData, say=None, slope
     rms = lambda r: float(np.sqrt(np.mean(r ** 2))) if r.size else math.nan  # noqa: E731
     return FitResult(prob.full(res.x) * prob.scale, M.parameter_names(len(plan)), se, np.nan_to_num(corr),
                      rms(rows[~direct]), int(len(rows)), outliers, prob.evaluations, cov, int(direct.sum()),
-                     rms(rows[direct] / prob.direct_weight), prob.direct_weight)
+                     rms(rows[direct] / prob.direct_weight), prob.direct_weight, M.recovery_targets(rig, len(plan)))
 
 
-def outlying_rows(full: np.ndarray, keep: np.ndarray, direct_rows: np.ndarray) -> tuple[np.ndarray, dict]:
-    """Rows (of ``keep``) beyond :data:`OUTLIER_SIGMAS` robust sigmas (1.4826 MAD) of their own path's,
+def outlying_rows(full: np.ndarray, keep: np.ndarray, direct_rows: np.ndarray,
+                  floor: float = 0.0) -> tuple[np.ndarray, dict]:
+    """Rows (of ``keep``) beyond :data:`OUTLIER_SIGMAS` robust sigmas (1.4826 MAD) of their own path's
+    and beyond ``floor`` (the units of ``full``: :data:`OUTLIER_PERIOD_FRACTION` of the finest period),
     and each path's sigma in the units of ``full`` ({True: the direct view's, False: the mirrors'};
     0 for a path with no rows)."""
     drop = np.zeros(len(full), bool)
@@ -382,5 +417,5 @@ def outlying_rows(full: np.ndarray, keep: np.ndarray, direct_rows: np.ndarray) -
         rows = keep & (direct_rows == direct)
         r = full[rows]
         sigma[direct] = 1.4826 * float(np.median(np.abs(r - np.median(r)))) if r.size else 0.0
-        drop[rows] = np.abs(r) > OUTLIER_SIGMAS * max(sigma[direct], 1e-12)
+        drop[rows] = np.abs(r) > max(OUTLIER_SIGMAS * sigma[direct], floor, 1e-12)
     return drop, sigma

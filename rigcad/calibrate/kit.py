@@ -220,6 +220,8 @@ and for each, the {len(frames)} frames in this order (the names of `patterns/`):
 {frames[-1]}. Name each camera image `<capture>_<frame>.png` (or .tif, 8 or 16 bit, grey or colour) at the
 camera's full resolution, {p.camera.resolution[0]} x {p.camera.resolution[1]} px, all in one folder; then
 `rigcad calibrate {p.name} --images <folder>`.
+Store each image as the camera gives it, not flipped or turned: the kit's `conventions.png` shows how
+the image's columns and rows, the screen's axes at each turn and the patterns are read.
 {_upright_by_eye(p)}
 ## Exposure
 - One exposure for every frame of a capture: set it on the white frame so the brightest lit pixels sit at
@@ -343,7 +345,8 @@ wider.
 
 def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
     """Write the kit into ``out`` (published atomically): patterns/<frame>.png, stl/ and step/
-    calibration_spacer_<k>, calibration.md, manifest.json (each file's SHA-256, the parts' volumes);
+    calibration_spacer_<k>, calibration.md, conventions.png (the capture conventions drawn:
+    :mod:`rigcad.calibrate.conventions`), manifest.json (each file's SHA-256, the parts' volumes);
     with ``upright_turns``, patterns_upright/<frame>.png and calibration_upright_stand too."""
     from rigcad.export import mesh as EM
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
@@ -386,6 +389,11 @@ def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
         page = manual_page(rig).encode()
         st.write_bytes(out / "calibration.md", page)
         files["calibration.md"] = sha256_hex(page)
+        from rigcad.calibrate import conventions
+
+        picture = conventions.figure(conventions.facts(rig))
+        st.write_bytes(out / "conventions.png", picture)
+        files["conventions.png"] = sha256_hex(picture)
         manifest = {"profile": p.name, "screen_resolution_px": list(p.calibration.screen_resolution),
                     **({"upright_resolution_px": list(p.calibration.upright_resolution)} if len(ups) else {}),
                     "frames_in_capture_order": seq.names(), "parts": parts, "files": files}

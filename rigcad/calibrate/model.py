@@ -100,6 +100,14 @@ def tolerance_scale(rig, captures: int) -> np.ndarray:
     return np.array(out)
 
 
+def recovery_targets(rig, captures: int) -> np.ndarray:
+    """Each parameter's recovery target (mm, rad): a tenth of its tolerance (:func:`tolerance_scale`),
+    but at least 0.02 mm or 0.01 deg: what the bench holds the fit to, and what a correlation has to
+    spoil to matter (:meth:`rigcad.calibrate.fit.FitResult.as_dict`)."""
+    floor = [math.radians(0.01) if n.endswith("_rad") else 0.02 for n in parameter_names(captures)]
+    return np.maximum(0.1 * tolerance_scale(rig, captures), floor)
+
+
 def prior_root(rig, plan: Plan) -> np.ndarray:
     """A square root R (R^T R = C^-1) of the prior's inverse covariance C over the parameters in
     :func:`tolerance_scale`'s units: each ~ N(0, 1), independent, but for a turned capture's tilt
@@ -108,7 +116,7 @@ def prior_root(rig, plan: Plan) -> np.ndarray:
     seating / sqrt 2 and their half difference to the wedge: the rows are the mean's and the half
     difference's, whitened (the turn's hand error, ~1 deg of the half turn, leaves ~1/60 of the
     wedge in the mean: 0.003 deg at 0.2 deg). No image shows the sample plane; these priors, with the
-    rig's tolerances, set the map's frame (docs/calibrate.md, "What fixes the frame")."""
+    rig's tolerances, set the map's frame (docs/calibrate-notes.md, "What fixes the frame")."""
     root = np.eye(len(RIG_NAMES) + len(SCREEN_KEYS) * len(plan))
     cal = rig.profile.calibration
     rho = cal.screen_tilt ** 2 / (cal.screen_tilt ** 2 + cal.screen_seating ** 2)  # -correlation, per axis
@@ -122,6 +130,25 @@ def prior_root(rig, plan: Plan) -> np.ndarray:
             root[i, [i, j]] = 1 / math.sqrt(2 * (1 - rho))  # the mean, (z_i + z_j) / 2, over its sigma
             root[j, [i, j]] = 1 / math.sqrt(2 * (1 + rho)), -1 / math.sqrt(2 * (1 + rho))
     return root
+
+
+def frame_tilt_variance(profile, plan: Plan) -> float:
+    """The variance (rad^2) per axis of the map's frame: the tilt of the sample plane under the rig,
+    which no image shows and the screens' placement on their spacers alone fixes. The profile's
+    ``screen_tilt`` (the wedge) and ``screen_seating`` are bounds, read as the simulation plants them
+    and as ``rigcad calibrate --seating`` states a seat: a tilt uniform in size within the bound and
+    in direction, whose spread per axis is the bound^2 / 6. A turned capture and the one it repeats
+    (the half turn) cancel their wedge: their mean is known to the seating^2 / 12; a capture with no
+    partner only to (wedge^2 + seating^2) / 6. The captures combine by their inverse variances. The
+    rig's tolerances, which the fit's prior also holds the frame by, are not counted: they state how
+    a part may be built, not where this one is."""
+    cal = profile.calibration
+    paired = {c for c in range(len(plan)) if plan.repeats(c) is not None}
+    paired |= {plan.repeats(c) for c in paired}
+    pairs = sum(plan.repeats(c) is not None for c in range(len(plan)))
+    alone = len(plan) - len(paired)
+    information = pairs * 12 / cal.screen_seating ** 2 + alone * 6 / (cal.screen_tilt ** 2 + cal.screen_seating ** 2)
+    return 1.0 / information
 
 
 def moved(rig, theta: np.ndarray):
@@ -148,7 +175,7 @@ def in_dome_frame(rig, theta: np.ndarray) -> np.ndarray:
     the dome's frame (the dome's pose undone) and read back as an offset of its pivot and a tilt
     about it (:meth:`rigcad.optics.frames.Misalignment.pivot`); exact, not linearised. Turning or
     shifting the whole rig together changes none of them: they are what the images fix apart from
-    the frame (the sample plane's tilt under the rig, which only the priors fix; docs/calibrate.md,
+    the frame (the sample plane's tilt under the rig, which only the priors fix; docs/calibrate-notes.md,
     "The rig against its dome"). A turn about the dome's axis is not a parameter and is dropped."""
     from scipy.spatial.transform import Rotation
 

@@ -47,10 +47,14 @@ class Calibration:
     placed: list = field(default_factory=list)
 
     def slope_figures(self) -> dict:
-        """Residual slope RMS and worst (mrad) over the decoded pixels."""
+        """Residual slope RMS, p99 and worst (mrad) over the measured pixels. The slopes are read from
+        the corrected map, which keeps a measured residual only in the share the noise allows
+        (:func:`rigcad.calibrate.maps.corrected_map`): on a dome with no slope error they stay near
+        0 rather than reading the decoding's noise, amplified near grazing, as slopes."""
         g = np.linalg.norm(self.slopes, axis=1)
         g = g[np.isfinite(g)]
         return {"residual_slope_rms_mrad": float(np.sqrt(np.mean(g ** 2)) * 1e3) if g.size else math.nan,
+                "residual_slope_p99_mrad": float(np.percentile(g, 99) * 1e3) if g.size else math.nan,
                 "residual_slope_worst_mrad": float(g.max() * 1e3) if g.size else math.nan,
                 "pixels": int(g.size)}
 
@@ -79,10 +83,13 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     decoded, upright_decoded = decoded[:len(plan)], decoded[len(plan):]
     say(f"decoded {', '.join(str(d.stats()['decoded_pixels']) for d in decoded)} camera pixels per capture "
         f"({', '.join(plan.labels)})")
+    applied = None
     if bias == "map":
-        decoded = _unbiased(decoded, B.map_bias(decoded, cam.shape, seq, cal.sim_blur))
+        applied = B.map_bias(decoded, cam.shape, seq, cal.sim_blur)
+        decoded = _unbiased(decoded, applied)
     data = _fit_data(cam, plan, decoded, cal.fit_stride)
     result = fit(optics, rig, cam, plan, data, say)
+    result.dome_frame_covariance = M.in_dome_frame_covariance(rig, result.theta, result.covariance)
     say(f"fitted {len(result.theta)} parameters to {result.residuals_used} residuals (RMS off the mirrors "
         f"{result.rms_residual_mm * 1e3:.2f} um; {result.direct_residuals} of the screens seen directly, RMS "
         f"{result.direct_rms_residual_mm * 1e3:.2f} um)")
@@ -101,17 +108,27 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     measured = maps.pivot_rays(decoded, poses, model_tr, cam.shape)
     placed = [U.place(p0, U.placement_scale(rig.profile), d, model_tr, measured, cam.shape)
               for p0, d in zip(ups.nominal, upright_decoded)]
+    on = [k for k, pl in enumerate(placed) if pl.placed]
+    captures = decoded + [upright_decoded[k] for k in on]
+    where = poses + (ups.poses(np.array([placed[k].placement for k in on]).reshape(-1, 6)) if on else [])
+    steps = [maps.HEIGHT_EDGE_PX] * len(plan) + [U.EDGE_PX] * len(on)
     short = None
-    if placed:  # each placed upright capture's rays join the flat ones'
-        on = [k for k, pl in enumerate(placed) if pl.placed]
+    if on:  # each placed upright capture's rays join the flat ones'
         short = np.any([maps.away_from_edges(upright_decoded[k].valid, model_tr.direct, U.EDGE_PX) for k in on],
-                       axis=0) & model_tr.ok if on else None
-        measured = maps.pivot_rays(decoded + [upright_decoded[k] for k in on],
-                                   poses + ups.poses(np.array([placed[k].placement for k in on]).reshape(-1, 6)),
-                                   model_tr, cam.shape, [maps.HEIGHT_EDGE_PX] * len(plan) + [U.EDGE_PX] * len(on))
+                       axis=0) & model_tr.ok
+        measured = maps.pivot_rays(captures, where, model_tr, cam.shape, steps)
     n_rig = len(M.RIG_NAMES)
     jac = maps.direction_jacobian(optics, rig, cam, for_map.theta)
-    corrected = maps.corrected_map(model_tr, measured, cam.shape, jac, for_map.covariance[:n_rig, :n_rig], short)
+    spread = maps.capture_spread(captures, where, model_tr, cam.shape, steps)
+    frame = M.frame_tilt_variance(rig.profile, plan)
+    say(f"the map's frame, the sample plane's tilt that no image shows, is known to "
+        f"{math.degrees(math.sqrt(2 * frame)):.4f} deg RMS from how the screen lies on its spacers"
+        + (" (calibration.screen_seating: each half turn cancels the spacer's wedge); every measured pixel's "
+           "uncertainty includes it" if plan.repeats(len(plan) - 1) is not None else
+           " (calibration.screen_tilt, the wedge: a half turn at each spacer, calibration.half_turn: every, would "
+           "tie it to screen_seating instead); every measured pixel's uncertainty includes it"))
+    corrected = maps.corrected_map(model_tr, measured, cam.shape, jac, for_map.covariance[:n_rig, :n_rig], short,
+                                   spread, frame, None if applied is None else maps.bias_turns(applied, poses, model_tr))
     # the slopes from the smoothed measurement (the raw rays' noise, divided by 2 cos of the dome's
     # angle of incidence, would swamp them), where measured
     seen = (corrected["source"] == 1)[:, None]
@@ -181,9 +198,8 @@ def compare(optics, rig, result: Calibration, theta_true: np.ndarray, surface,
     seen = np.isfinite(result.slopes[:, 0]) & np.isfinite(planted[:, 0])
     g_p, g_r = planted[seen], result.slopes[seen]
     rms = lambda a: float(np.sqrt(np.mean(np.sum(a * a, axis=1))) * 1e3) if len(a) else math.nan  # noqa: E731
-    tol = M.tolerance_scale(rig, len(result.plan))
     names = M.parameter_names(len(result.plan))
-    target = np.maximum(0.1 * tol, [math.radians(0.01) if n.endswith("_rad") else 0.02 for n in names])
+    target = M.recovery_targets(rig, len(result.plan))
     in_dome = [names.index(n) for n in M.DOME_FRAME_NAMES]
     dome_fitted, dome_se = against_dome(rig, result.fit)
     dome_frame = _against(M.DOME_FRAME_NAMES, M.in_dome_frame(rig, theta_true), dome_fitted, target[in_dome], dome_se)

@@ -387,6 +387,11 @@ def test_kit_patterns_spacers_and_page(tmp_path, small):
     manifest = write_kit(small["rig"], out)
     seq = small["seq"]
     assert manifest["frames_in_capture_order"] == seq.names()
+    # the capture conventions' figure, drawn from this rig's conventions (rigcad.calibrate.conventions)
+    from rigcad.calibrate import conventions
+
+    assert (out / "conventions.png").read_bytes() == conventions.figure(conventions.facts(small["rig"]))
+    assert "conventions.png" in manifest["files"]
     with Image.open(out / "patterns" / "x_p16_s1.png") as im:
         assert im.size == tuple(small["rig"].profile.calibration.screen_resolution) and im.mode == "L"
         assert np.array_equal(np.asarray(im), seq.image("x_p16_s1"))
@@ -419,7 +424,7 @@ def test_full_size_calibration_against_the_truth(table31_rig):
     fit) and +0.06 um (the map's refit); with the pixels 3 steps from an edge read too, -30.8 and
     -20.4 um (before the screens' placement was fitted). The measured pixels' p99 once the frame's
     tilt is removed under 0.045 deg: 0.029; with it, under 0.05 deg: 0.029, the frame's tilt 0.003 deg,
-    set by the half turns (docs/calibrate.md; 0.039 and 0.022 deg with the highest spacer's alone;
+    set by the half turns (docs/calibrate-notes.md; 0.039 and 0.022 deg with the highest spacer's alone;
     without any, 0.098 and 0.093 deg: the screens' wedge, calibration.screen_tilt, set the frame)."""
     from rigcad.check.scene import analytic_optics
 
@@ -439,7 +444,7 @@ def test_full_size_calibration_against_the_truth(table31_rig):
     for fitted in (res.fit, res.map_fit):
         assert abs(fitted.theta[upper] - theta[upper]) < 0.008
     # the map's shape (the images' part) against its tilt (the priors' part: no image shows the
-    # sample plane once the screens' placement is fitted; docs/calibrate.md, "What fixes the frame")
+    # sample plane once the screens' placement is fitted; docs/calibrate-notes.md, "What fixes the frame")
     frame = c["frame"]
     assert frame["measured_error_without_it_deg"]["p99"] < 0.045
     # the half turn: the pair's mean tilt is known to the seating / sqrt 2 (0.014 deg), far under the
