@@ -340,9 +340,11 @@ def _npz(result) -> bytes:
     np.savez_compressed(buf, direction=c["direction"].reshape(shape), uncertainty_rad=c["uncertainty_rad"].reshape(
         result.cam.shape), source=c["source"].reshape(result.cam.shape), design=result.design.reshape(shape),
         row0=result.cam.row0, col0=result.cam.col0, resolution=np.array(result.cam.resolution),
-        residual_slope=result.slopes.reshape(shape), cause=result.causes.reshape(result.cam.shape), about=json.dumps(
+        residual_slope=result.slopes.reshape(shape), cause=result.causes.reshape(result.cam.shape),
+        measurement_weight=c["measurement_weight"].reshape(result.cam.shape), about=json.dumps(
             {"frame": "mm, O at the origin, +z up; unit directions from O towards the light",
              "source": "0 none, 1 measured, 2 filled, 3 model only",
+             "measurement_weight": "the share of the measured residual the map kept (maps.corrected_map)",
              "cause": "-1 the model's ray is lost; " + ", ".join(f"{k} {n}" for k, n in enumerate(maps.CAUSES))}))
     return buf.getvalue()
 
