@@ -51,6 +51,6 @@ def register(subparsers) -> None:
                     "file with three.js and the geometry inside, nothing loaded from the network. Also "
                     "exports/<profile>/view/rig.png, a picture of the assembled rig.")
     p.add_argument("--rays", type=positive_int, default=300, help="rays traced from the COP (default: 300)")
-    p.add_argument("--glb", action="store_true", help="also write rig.glb: the assembled rig as one binary glTF "
-                                                      "(named nodes, colours, the rays as lines) for Blender, YACV "
-                                                      "or any glTF viewer")
+    p.add_argument("--glb", action="store_true", help="also write rig.glb: the assembled rig as one binary glTF 2.0 "
+                                                      "(metres, +Y up; named nodes and materials, normals, the rays "
+                                                      "as lines) for Blender, YACV or any glTF viewer")
