@@ -26,6 +26,10 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
     from rigcad.calibrate.kit import check_screen_fits, check_upright_fits, write_kit
 
+    if args.simulate:  # before the rig: a camera whose simulation cannot fit is one line, no work
+        from rigcad.profile import load_profile
+
+        check_simulation_memory(load_profile(args.profile))
     rig = load(args.profile)
     check_screen_fits(rig)  # a screen that cannot lie in the dome is refused before any work
     check_upright_fits(rig.profile)  # nor an upright display that cannot stand in the bore
@@ -91,6 +95,37 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
           f"(the rest, and why: calibration.json 'unmeasured'); wrote {out}")
     print(_against_dome_line(report["against_the_dome"]["parameters"]))
     return 0
+
+
+#: Peak memory of ``rigcad calibrate P --simulate``: fixed bytes plus bytes per camera pixel. Measured
+#: (/usr/bin/time -v, one run each, achutha2006 with camera.resolution changed): 680 x 512 px 657 MiB,
+#: 1360 x 1024 px 1,192 MiB, 2040 x 1536 px 2,047 MiB: 537 and 515 bytes per pixel between them,
+#: 502 MiB at none; the estimate is rounded up (560 bytes per pixel, 512 MiB): it is linear in the
+#: pixels since the rendered capture (240 frames) and the decoding are.
+SIMULATE_BYTES_PER_PIXEL = 560.0
+SIMULATE_FIXED_BYTES = 512.0 * 2 ** 20
+
+
+def check_simulation_memory(profile, memory: int | None = None) -> None:
+    """Refuse ``--simulate`` (ResourceError naming camera.resolution) when its estimated peak memory
+    (SIMULATE_FIXED_BYTES + SIMULATE_BYTES_PER_PIXEL per camera pixel) exceeds this machine's
+    (``memory`` bytes: engine.machine_memory by default); the line names the largest camera that fits."""
+    import math
+
+    from rigcad.engine import ResourceError, machine_memory
+
+    memory = machine_memory() if memory is None else memory
+    width, height = (int(v) for v in profile.camera.resolution)
+    need = SIMULATE_FIXED_BYTES + SIMULATE_BYTES_PER_PIXEL * width * height
+    if need <= memory:
+        return
+    pixels = max(0.0, (memory - SIMULATE_FIXED_BYTES) / SIMULATE_BYTES_PER_PIXEL)
+    scale = math.sqrt(pixels / (width * height))
+    fit_w, fit_h = int(width * scale), int(height * scale)
+    raise ResourceError(f"camera.resolution [{width}, {height}]: calibrate --simulate would need about "
+                        f"{need / 2 ** 30:.3g} GiB of memory, more than this machine's {memory / 2 ** 30:.3g} GiB; the "
+                        f"largest camera that fits has {int(pixels):,} px ([{fit_w}, {fit_h}] at this aspect)",
+                        param="camera.resolution")
 
 
 def _simulated(optics, rig, args: argparse.Namespace, capture_out: str | None) -> tuple[list, tuple]:
@@ -190,6 +225,9 @@ def _check_capture_folder(folder: Path, simulate: bool) -> None:
 
     if not simulate:
         raise ExportError(f"--write-capture {folder}: only with --simulate (it writes the simulated capture)")
+    from rigcad.export.atomic import refuse_links
+
+    refuse_links(folder, folder.parent)  # a link there is refused now, not after the simulation's work
     if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
         raise ExportError(f"--write-capture {folder}: it exists and is not an empty folder; name a new or empty one")
 
