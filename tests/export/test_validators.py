@@ -618,15 +618,18 @@ def test_gcode_reader_passes_the_mk3s_gcode_and_fails_broken_ones(mk3s_gcode):
 # -- the whole commands: every such file they write ---------------------------------------------------
 @pytest.fixture(scope="module")
 def written(tmp_path_factory):
-    """`rigcad build` (two parts), `rigcad view --glb` and `rigcad fab --gcode` (the two templates and
-    one printed part) on the default profile, into one exports folder."""
+    """`rigcad build` (two parts), `rigcad view --glb`, `rigcad fab --gcode` (the two templates and one
+    printed part), `rigcad basis --order 2` and `rigcad calibrate --kit` on the default profile, into
+    one exports folder."""
     if shutil.which("prusa-slicer") is None:
         pytest.skip("prusa-slicer is not installed")
     out = tmp_path_factory.mktemp("written")
     for args in (["build", "achutha2006", "--parts", "lens_mount", "beam"],
                  ["view", "achutha2006", "--rays", "40", "--glb"],
                  ["fab", "achutha2006", "--printer", "prusa_mk3s", "--gcode", "--parts", "dome_template",
-                  "paraboloid_template", "lens_mount"]):
+                  "paraboloid_template", "lens_mount"],
+                 ["basis", "achutha2006", "--order", "2"],
+                 ["calibrate", "achutha2006", "--kit"]):
         run = subprocess.run([sys.executable, "-m", "rigcad", *args, "--exports", str(out)], capture_output=True,
                              text=True, timeout=1200, cwd=ROOT)
         assert run.returncode == 0, (args, run.stderr)
@@ -665,4 +668,7 @@ def test_every_file_the_commands_write_passes_its_validator(written):
     for path in files[".gcode"]:
         assert gcode_check(path.read_text(), settings) == [], path
     for path in files[".png"]:
-        png_chunks(path.read_bytes())  # every chunk's CRC
+        chunks = dict(png_chunks(path.read_bytes()))  # every chunk's CRC
+        if path.name.startswith("z_"):  # the basis images: data, their levels linear
+            assert chunks.get(b"gAMA") == (100_000).to_bytes(4, "big"), path
+    assert sum(p.name.startswith("z_") for p in files[".png"]) > 0
