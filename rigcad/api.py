@@ -12,6 +12,10 @@ results computed in memory). The one home of what every caller must agree on:
   (:func:`export_up_to_date`); the profile's SHA-256 (``made_from``) recorded beside a result
   folder, so that a later export of another profile removes the results it no longer matches.
 
+- a fab run's key (rigcad.fab.published.inputs_key: the stl manifest's inputs with the printer's
+  resolved settings and the options): a run publishing it records it, and a later run with the
+  same key reads the folder back while it is intact, with no rig built (:func:`fab_published`).
+
 ``Rig.export``, ``Rig.check``, ``Rig.basis`` and ``Rig.fab`` call these, and so does every command.
 This module imports the stages when an operation runs: importing it costs nothing (an up-to-date
 ``rigcad stl`` reads it).
@@ -141,3 +145,20 @@ def fab(rig, printer, folder: str | Path | None = None, gcode: bool = False, par
     out = Path(folder) if folder is not None else default_folder(rig.name, "fab", p.name)
     return run_fab(rig, p, out, gcode=gcode, parts=parts, progress=progress, workers=workers,
                    lock=writer_lock(out, rig.name, ("fab", p.name)), slicing=slicing)
+
+
+def fab_published(profile, printer, folder: str | Path | None = None, gcode: bool = False,
+                  parts: list[str] | None = None, progress=None):
+    """The fab run for ``printer`` (as :func:`fab` takes it) of the rig of ``profile`` (a loaded
+    Profile) as designed, read back from ``folder`` (default ``exports/<profile>/fab/<printer>``)
+    under :func:`writer_lock` when an earlier run, of whichever command, published it from the
+    same inputs and it is intact (:func:`rigcad.fab.published.read_back`); None otherwise. Builds no
+    rig: a command asks this first and builds the rig only when there is work (:func:`fab` reads
+    back the same way on its own)."""
+    from rigcad.fab.printers import Printer, load_printer
+    from rigcad.fab.published import read_back
+
+    p = printer if isinstance(printer, Printer) else load_printer(printer)
+    out = Path(folder) if folder is not None else default_folder(profile.name, "fab", p.name)
+    return read_back(profile, p, out, gcode=gcode, parts=parts, progress=progress,
+                     lock=writer_lock(out, profile.name, ("fab", p.name)))

@@ -22,7 +22,6 @@ it, reads the folder back instead of doing the work again, while every file is i
 from __future__ import annotations
 
 import json
-import os
 import time
 from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
@@ -38,41 +37,13 @@ from rigcad.export.manifest import profile_digest, sha256_hex
 from rigcad.fab import choice, estimate, orientation, outlines, slicer, split, staircase
 from rigcad.fab.mirror import MirrorSurface, mirror_faces
 from rigcad.fab.printers import Printer
+from rigcad.fab.published import FabResult, inputs_key, read_back  # noqa: F401 (FabResult: this module's result)
 from rigcad.fab.report import fab_report, markdown
+from rigcad.optics.frames import Misalignment
 from rigcad.parts.recipe import Prism
 
 #: Parts cut from plate rather than printed.
 CUT_PARTS = ("dome_template", "paraboloid_template")
-
-
-@dataclass
-class FabResult:
-    report: dict
-    written: list[Path]
-    timings_s: dict[str, float] = field(default_factory=dict)
-    slicer_s: dict[str, float] = field(default_factory=dict)
-    problems: list[str] = field(default_factory=list)
-    #: True when the result was read back from an earlier run's published folder (nothing recomputed).
-    reused: bool = False
-
-
-def inputs_key(rig, printer: Printer, gcode: bool, parts: list[str]) -> str | None:
-    """The key of a fab run's result (rigcad.export.reuse.stage_key): the resolved profile and
-    rigcad's code, the printer's resolved settings (its file, what it inherits, its slicer presets
-    and overrides), the parts, and with ``gcode`` the slicer program found (path, size, time:
-    a new PrusaSlicer slices anew). None for a moved rig: its result is never read back."""
-    from rigcad.optics.frames import Misalignment
-
-    if rig.misalignment != Misalignment.none():
-        return None
-    inputs = {"printer": printer.describe(), "slicer_unavailable": printer.slicer_unavailable,
-              "slicer_settings": printer.slicer_config.effective() if printer.slicer_config else None,
-              "gcode": bool(gcode), "parts": list(parts)}
-    if gcode and printer.slicer == "prusa-slicer":
-        exe = slicer.find_slicer()
-        st = os.stat(exe) if exe else None
-        inputs["slicer_program"] = [exe, st.st_size, st.st_mtime_ns] if st else None
-    return reuse.stage_key(rig.profile, "fab", inputs)
 
 
 @dataclass(frozen=True)
@@ -141,15 +112,12 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
     t0 = time.perf_counter()
     profile = rig.profile
     names = select_parts(parts)
-    key = inputs_key(rig, printer, gcode, names)
-    lock = lock if lock is not None else out.parent / f".{out.name}.lock"  # Staging's own default
-    if key is not None:
-        back = reuse.read_back(out, key, profile_digest(profile), lock, read=("fab.json",))
-        if back is not None:  # published from the same inputs and intact: read back, nothing redone
-            report = json.loads(back["fab.json"])
-            for name in report["parts"]:
-                say(name)
-            return FabResult(report, [], {"read_back": time.perf_counter() - t0}, reused=True)
+    as_designed = rig.misalignment == Misalignment.none()  # a moved rig's result is never read back
+    if as_designed:
+        back = read_back(profile, printer, out, gcode=gcode, parts=parts, progress=progress, lock=lock)
+        if back is not None:  # published from the same inputs and intact: nothing redone
+            return back
+    key = inputs_key(profile, printer, gcode, parts) if as_designed else None
     timings: dict[str, float] = {"design_and_layout": time.perf_counter() - t0}
     chord = profile.tessellation.chord_error
     report_parts: dict[str, dict] = {}

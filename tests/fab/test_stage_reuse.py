@@ -123,3 +123,47 @@ def test_a_run_with_problems_is_never_read_back(table31_rig, prusa, tmp_path, fa
     monkeypatch.setattr(S, "_fab_part", real)
     calls = fab_calls["_cut_part"]
     assert not _run(table31_rig, prusa, out).reused and fab_calls["_cut_part"] == calls + 1
+
+
+@pytest.mark.e2e  # the whole rig's fab and manual through the command line (~40 s): make test-e2e
+def test_manual_right_after_fab_does_no_fab_work(tmp_path, fab_calls):
+    import contextlib
+    import io
+
+    from rigcad.cli import main
+
+    def run(*args):
+        err = io.StringIO()
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+            code = main([*args, "achutha2006", "--printer", "prusa_mk3s", "--exports", str(tmp_path)])
+        assert code == 0, err.getvalue()[-2000:]
+
+    run("fab")
+    done = dict(fab_calls)
+    report = json.loads((tmp_path / "achutha2006" / "fab" / "prusa_mk3s" / "fab.json").read_text())
+    printed = [e for e in report["parts"].values() if "pieces" in e]
+    # every printed part once, a mirror part twice (the second time with its stock), both templates
+    assert done == {"_fab_part": len(printed) + sum("sanding_stock" in e for e in printed), "_cut_part": 2}, done
+    run("manual")
+    assert fab_calls == done, fab_calls  # the manual read the fab run back: not one call more
+    assert (tmp_path / "achutha2006" / "manual" / "prusa_mk3s" / "manual.md").is_file()
+
+
+def test_the_api_reads_a_published_run_back_without_building_a_rig(table31_rig, prusa, tmp_path, fab_calls,
+                                                                   monkeypatch):
+    from rigcad import api
+    from rigcad.rig import Rig
+
+    out = tmp_path / "fab" / "prusa_mk3s"
+    profile = table31_rig.profile
+    assert api.fab_published(profile, prusa, out, parts=PARTS) is None  # nothing published yet
+    first = _run(table31_rig, prusa, out)
+
+    def no_rig(*args, **kwargs):
+        raise AssertionError("a rig was built")
+
+    monkeypatch.setattr(Rig, "from_profile", no_rig)
+    back = api.fab_published(profile, prusa, out, parts=PARTS)
+    assert back.reused and back.report == first.report and fab_calls["_fab_part"] == 1
+    assert api.fab_published(profile, prusa, out, parts=["beam"]) is None  # other parts: another key
+    assert api.fab_published(profile, prusa, out, parts=PARTS, gcode=True) is None  # G-code asked: another key
