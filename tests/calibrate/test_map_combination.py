@@ -201,3 +201,26 @@ def test_correlations_are_listed_where_they_cost_accuracy():
     result = F.FitResult(np.zeros(len(names)), names, se, np.eye(len(names)), 0.0, 0, 0, 0, np.diag(se ** 2), 0, 0.0,
                          1.0, targets, dome)
     assert [(a, b) for a, b, _ in result.strong_correlations()] == [("camera_dx_mm", "camera_tilt_y_rad")]
+
+
+def test_the_page_states_the_profiles_frame_and_floor(table31_rig):
+    """docs/calibrate.md's figures on the frame and the outlier floor, from the code on the default
+    profile: the frame's RMS tilt (both axes) with and without the half turns, the floor in mm, and
+    what a frame tilt of 0.01 deg moves the camera's COP by."""
+    import dataclasses
+
+    page = " ".join((ROOT / "docs" / "calibrate.md").read_text(encoding="utf-8").split())
+    p = table31_rig.profile
+
+    def rms_deg(mode):
+        q = dataclasses.replace(p, calibration=dataclasses.replace(p.calibration, half_turn=mode))
+        return math.degrees(math.sqrt(2 * M.frame_tilt_variance(q, M.Plan.of(q))))
+
+    wedge = math.degrees(p.calibration.screen_tilt)
+    assert (f"({rms_deg('none'):.2f} deg RMS at the default {wedge:g} deg wedge, against {rms_deg('every'):.3f} deg "
+            "with the half turns)") in page
+    assert f"{rms_deg('every'):.3f} deg RMS for the default capture" in page
+    floor = F.OUTLIER_PERIOD_FRACTION * min(p.calibration.periods) * p.calibration.screen_pitch
+    assert f"a fifth of the finest period ({floor:.2f} mm)" in page and F.OUTLIER_PERIOD_FRACTION == 0.2
+    cop = table31_rig.geometry.cop_z
+    assert f"the camera's COP, {cop:.1f} mm up, moves {cop * math.tan(math.radians(0.01)):.3f} mm sideways per 0.01 deg" in page
