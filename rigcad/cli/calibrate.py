@@ -26,6 +26,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
     from rigcad.calibrate.kit import check_screen_fits, check_upright_fits, write_kit
 
+    # --seating's files are read first: a file that is no calibration is one line before the rig is built
+    runs = _seating_runs(args.seating) if getattr(args, "seating", None) else None
     if args.simulate:  # before the rig: a camera whose simulation cannot fit is one line, no work
         from rigcad.profile import load_profile
 
@@ -37,8 +39,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     capture_out = getattr(args, "write_capture", None)
     if capture_out:
         _check_capture_folder(Path(capture_out), args.simulate)
-    if getattr(args, "seating", None):
-        return _seating(rig, args)
+    if runs is not None:
+        return _seating(rig, args, runs)
     if getattr(args, "kit", False):
 
         out = Path(args.exports) / rig.name / "calibrate_kit"
@@ -153,7 +155,7 @@ def _simulated(optics, rig, args: argparse.Namespace, capture_out: str | None) -
     return S.as_read(M.Camera.of(rig), images), (theta, surface, placement)
 
 
-def _seating(rig, args: argparse.Namespace) -> int:
+def _seating(rig, args: argparse.Namespace, runs: list) -> int:
     """``--seating``: how the screen settles, from calibration.json files of one rig
     (rigcad.calibrate.seating), into ``<exports>/<profile>/calibrate_seating/seating.json``."""
     from rigcad.calibrate.images import CaptureError
@@ -161,7 +163,6 @@ def _seating(rig, args: argparse.Namespace) -> int:
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
     from rigcad.export.manifest import profile_digest
 
-    runs = _seating_runs(args.seating)
     result = measure(runs, rig.profile)
     out = Path(args.exports) / rig.name / "calibrate_seating"
     with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
@@ -171,8 +172,9 @@ def _seating(rig, args: argparse.Namespace) -> int:
     return 0
 
 
-#: The largest calibration.json --seating reads (rigcad's own are tens of KiB).
-SEATING_MAX_BYTES = 16 << 20
+#: The largest calibration.json --seating reads: rigcad's own are ~83 KB (achutha2006, 4 captures and
+#: 3 upright ones); 4 MiB leaves room for fifty times as many captures.
+SEATING_MAX_BYTES = 4 << 20
 
 
 def _seating_runs(given: list[str]) -> list[tuple[str, object]]:

@@ -43,15 +43,17 @@ def _sparse(path, size: int) -> None:
 CASES = {
     "nested brackets": (lambda p: p.write_text("[" * 100_000 + "]" * 100_000), "nested 100000 levels deep"),
     "an integer of 400 digits": (lambda p: p.write_text('{"a": 1' + "0" * 399 + "}"), "an integer of 400 digits"),
-    "a sparse 1 GiB file": (lambda p: _sparse(p, 1 << 30), "1 GiB, more than the 16 MiB a calibration.json can be"),
+    "a sparse 1 GiB file": (lambda p: _sparse(p, 1 << 30), "1 GiB, more than the 4 MiB a calibration.json can be"),
     "/dev/zero": (lambda p: p.symlink_to("/dev/zero"), "a device, not a file"),
     "a FIFO": (lambda p: os.mkfifo(p), "a FIFO (named pipe), not a file"),
     "a tilt of 1.7e308": (lambda p: p.write_text(json.dumps(_set_tilt(_report(np.random.default_rng(1)), 1.7e308))),
                           "against_the_dome.screens.h1.tilt_x_deg.value is 1.7e+308, outside -90..90 deg"),
     "a tilt of -1.7e308": (lambda p: p.write_text(json.dumps(_set_tilt(_report(np.random.default_rng(1)), -1.7e308))),
                            "is -1.7e+308, outside -90..90 deg"),
+    "100,000 captures": (lambda p: p.write_text(json.dumps({"against_the_dome": {"parameters": {}, "screens": {
+        f"h{i}": {} for i in range(100_000)}}})), "(100000 in all)"),
     "300,000 captures": (lambda p: p.write_text(json.dumps({"against_the_dome": {"parameters": {}, "screens": {
-        f"h{i}": {} for i in range(300_000)}}})), "(300000 in all)"),
+        f"h{i}": {} for i in range(300_000)}}})), "more than the 4 MiB a calibration.json can be"),
     "a key twice": (lambda p: p.write_text('{"against_the_dome": {}, "against_the_dome": {}}'),
                     "the key 'against_the_dome' twice"),
 }

@@ -17,7 +17,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from .harness import Sandbox
+from .harness import FAST_PROFILE, Sandbox
 
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED_PRINTER = ROOT / "profiles" / "printers" / "prusa_mk3s.yaml"
@@ -38,6 +38,8 @@ class Case:
     xfail: str | None = None
     #: A command that serves until stopped (`watch`): once it says it serves, Ctrl-C must stop it cleanly.
     serves: bool = False
+    #: What a serving case does once it serves, before Ctrl-C: ``while_serving(sandbox, url)``.
+    while_serving: Callable[[Sandbox, str], None] | None = None
 
     @property
     def id(self) -> str:
@@ -511,6 +513,239 @@ def planted_cases():
                    _plant(_neighbour), timeout=120, stress=pattern == "*")
 
 
+# -- files rigcad reads back: a corrected map, calibration.json, capture frames; watch's link and clients --
+
+def _npz_bytes(**arrays) -> bytes:
+    import io
+
+    import numpy as np
+
+    buf = io.BytesIO()
+    np.savez(buf, **arrays, allow_pickle=True)
+    return buf.getvalue()
+
+
+def _map(kind: str) -> Callable[[Sandbox], None]:
+    """A corrected map planted at exports/fast/calibrate/corrected_map.npz, of ``kind``."""
+    def setup(sb: Sandbox) -> None:
+        import io
+        import zipfile
+
+        import numpy as np
+
+        path = sb.exports / "fast" / "calibrate" / "corrected_map.npz"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        good = dict(direction=np.tile([0.0, 0.0, 1.0], (4, 4, 1)), row0=np.int64(10), col0=np.int64(10))
+        if kind == "garbage":
+            path.write_bytes(b"PK\x03\x04" + os.urandom(4000))
+        elif kind == "pickle":
+            path.write_bytes(_npz_bytes(**{**good, "direction": np.array([[[{"x": 1}]]], dtype=object)}))
+        elif kind == "no direction":
+            path.write_bytes(_npz_bytes(row0=np.int64(0), col0=np.int64(0)))
+        elif kind == "string direction":
+            path.write_bytes(_npz_bytes(**{**good, "direction": np.full((2, 2, 3), "x")}))
+        elif kind == "row0 an array":
+            path.write_bytes(_npz_bytes(**{**good, "row0": np.arange(5)}))
+        elif kind in ("NaN", "1e300"):
+            path.write_bytes(_npz_bytes(**{**good, "direction": np.full((4, 4, 3), np.nan if kind == "NaN" else 1e300)}))
+        elif kind == "224 GiB header":
+            header = io.BytesIO()
+            np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False,
+                                                          "shape": (100_000, 100_000, 3)})
+            with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+                zf.writestr("direction.npy", header.getvalue() + bytes(1 << 22))
+                zf.writestr("row0.npy", _npy(np.int64(0)))
+                zf.writestr("col0.npy", _npy(np.int64(0)))
+        elif kind == "a link to /etc/passwd":
+            path.symlink_to("/etc/passwd")
+        elif kind == "a link to the decoy":
+            path.symlink_to(sb.decoy / "precious.txt")
+        elif kind == "a FIFO":
+            os.mkfifo(path)
+        elif kind == "a folder":
+            path.mkdir()
+        elif kind == "a sparse 4 GiB file":
+            with open(path, "wb") as fh:
+                fh.truncate(4 << 30)
+        sb.rebase()
+    return setup
+
+
+def _npy(arr) -> bytes:
+    import io
+
+    import numpy as np
+
+    buf = io.BytesIO()
+    np.save(buf, arr)
+    return buf.getvalue()
+
+
+def _seating_file(kind: str) -> Callable[[Sandbox], None]:
+    def setup(sb: Sandbox) -> None:
+        good = {"against_the_dome": {"parameters": {"camera_dx_mm": {"value": 0.1, "standard_error": 0.01}},
+                                     "screens": {k: {f"tilt_{a}_deg": {"value": 0.01, "standard_error": 0.001}
+                                                     for a in "xy"} for k in ("h0", "h1", "h0r", "h1r")}}}
+        (sb.work / "good.json").write_text(json.dumps(good))
+        bad = sb.work / "bad.json"
+        if kind == "nested":
+            bad.write_text("[" * 100_000 + "]" * 100_000)
+        elif kind == "400 digits":
+            bad.write_text('{"a": 1' + "0" * 399 + "}")
+        elif kind == "sparse 1 GiB":
+            with open(bad, "wb") as fh:
+                fh.truncate(1 << 30)
+        elif kind == "/dev/zero":
+            bad.symlink_to("/dev/zero")
+        elif kind == "a FIFO":
+            os.mkfifo(bad)
+        elif kind == "300000 keys":
+            bad.write_text(json.dumps({"against_the_dome": {"parameters": {}, "screens": {
+                f"h{i}": {} for i in range(300_000)}}}))
+        elif kind == "the same file twice":
+            bad.symlink_to(sb.work / "good.json")
+        elif kind == "tilts of 1.7e308":
+            bad.write_text(json.dumps({"against_the_dome": {"parameters": {}, "screens": {
+                k: {f"tilt_{a}_deg": {"value": 1.7e308, "standard_error": 0.0} for a in "xy"}
+                for k in ("h0", "h1", "h0r", "h1r")}}}))
+        elif kind == "a link to the decoy":
+            bad.symlink_to(sb.decoy / "precious.txt")
+    return setup
+
+
+def _frame(kind: str) -> Callable[[Sandbox], None]:
+    """A capture folder whose first frame (h0_white) is hostile."""
+    def setup(sb: Sandbox) -> None:
+        import struct
+        import zlib
+
+        folder = sb.work / "capture"
+        folder.mkdir(exist_ok=True)
+        path = folder / ("h0_white.tif" if "TIFF" in kind else "h0_white.png")
+
+        def chunk(k: bytes, body: bytes) -> bytes:
+            return struct.pack(">I", len(body)) + k + body + struct.pack(">I", zlib.crc32(k + body))
+
+        def png(w: int, h: int, colour: int) -> bytes:
+            return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, colour, 0, 0, 0))
+                    + chunk(b"IDAT", zlib.compress(b"\0" * 100_000)) + chunk(b"IEND", b""))
+        if kind == "100k x 100k PNG":
+            path.write_bytes(png(100_000, 100_000, 0))
+        elif kind == "13375 x 13375 RGBA PNG":
+            path.write_bytes(png(13_375, 13_375, 6))
+        elif kind == "a FIFO":
+            os.mkfifo(path)
+        elif kind == "a folder":
+            path.mkdir()
+        elif kind == "a link loop":
+            path.symlink_to(path)
+        elif kind == "/dev/zero":
+            path.symlink_to("/dev/zero")
+        elif kind == "corrupt deflate TIFF":
+            import io
+
+            import numpy as np
+            from PIL import Image
+
+            buf = io.BytesIO()
+            Image.fromarray(np.full((1024, 1360), 200, np.uint8)).save(buf, format="TIFF",
+                                                                      compression="tiff_adobe_deflate")
+            data = bytearray(buf.getvalue())
+            start = data.index(b"\x78")
+            data[start + 2: start + 40] = b"\xff" * 38
+            path.write_bytes(bytes(data))
+        elif kind == "NaN float TIFF":
+            import io
+
+            import numpy as np
+            from PIL import Image
+
+            arr = np.full((1024, 1360), 0.5, np.float32)
+            arr[100:200, 100:200] = np.nan
+            buf = io.BytesIO()
+            Image.fromarray(arr).save(buf, format="TIFF")
+            path.write_bytes(buf.getvalue())
+    return setup
+
+
+def _reset_clients(sb: Sandbox, url: str) -> None:
+    """Clients that go away early: 200 connections reset mid-request or mid-stream."""
+    import socket
+    import struct
+    from urllib.parse import urlsplit
+
+    where = urlsplit(url)
+    for i in range(200):
+        try:
+            s = socket.create_connection((where.hostname, where.port), timeout=5)
+            s.sendall([b"GET / HTTP/1.1\r\nHost: %s\r\n" % where.netloc.encode(),
+                       b"GET /events HTTP/1.1\r\nHost: %s\r\n\r\n" % where.netloc.encode(), b"GE"][i % 3])
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+            s.close()
+        except OSError:
+            pass
+    for method in ("TRACE", "CONNECT", "PROPFIND", "get"):
+        with socket.create_connection((where.hostname, where.port), timeout=5) as s:
+            s.sendall(f"{method} / HTTP/1.1\r\nHost: {where.netloc}\r\nConnection: close\r\n\r\n".encode())
+            answer = s.recv(100)
+        if not answer.startswith(b"HTTP/1.1 405"):
+            raise AssertionError(f"{method}: {answer[:40]!r}")
+
+
+def _swap_profile(target: str) -> Callable[[Sandbox, str], None]:
+    """``ln -s <target> .l && mv -Tf .l fast.yaml`` while watch serves, then the real file renamed back."""
+    def act(sb: Sandbox, url: str) -> None:
+        import time
+
+        real = (sb.work / "fast.yaml").read_text()
+        link = sb.work / ".l"
+        link.symlink_to(target if target.startswith("/") else sb.decoy / target)
+        os.replace(link, sb.work / "fast.yaml")
+        time.sleep(2.0)
+        (sb.work / ".new").write_text(real)
+        os.replace(sb.work / ".new", sb.work / "fast.yaml")
+        time.sleep(2.0)
+    return act
+
+
+def reader_cases():
+    for kind in ("garbage", "pickle", "no direction", "string direction", "row0 an array", "NaN", "1e300",
+                 "224 GiB header", "a link to /etc/passwd", "a link to the decoy", "a FIFO", "a folder",
+                 "a sparse 4 GiB file"):
+        yield Case("readers", f"basis --simulate corrected map {kind}",
+                   lambda sb: ["basis", "fast.yaml", "--order", "0", "--simulate", "--exports", str(sb.exports)],
+                   _map(kind), expect_refusal=True,
+                   stress=kind not in ("pickle", "224 GiB header", "NaN", "a link to /etc/passwd", "a FIFO"))
+    for kind in ("nested", "400 digits", "sparse 1 GiB", "/dev/zero", "a FIFO", "300000 keys", "the same file twice",
+                 "tilts of 1.7e308", "a link to the decoy"):
+        yield Case("readers", f"calibrate --seating {kind}",
+                   lambda sb: ["calibrate", "fast.yaml", "--seating", str(sb.work / "good.json"),
+                               str(sb.work / "bad.json"), "--exports", str(sb.exports)],
+                   _seating_file(kind), expect_refusal=True,
+                   stress=kind not in ("nested", "400 digits", "/dev/zero", "the same file twice"))
+    for kind in ("100k x 100k PNG", "13375 x 13375 RGBA PNG", "a FIFO", "a folder", "a link loop", "/dev/zero",
+                 "corrupt deflate TIFF", "NaN float TIFF"):
+        yield Case("readers", f"calibrate --images frame {kind}",
+                   lambda sb: ["calibrate", "fast.yaml", "--images", str(sb.work / "capture"),
+                               "--exports", str(sb.exports)],
+                   _frame(kind), expect_refusal=True,
+                   stress=kind not in ("13375 x 13375 RGBA PNG", "a FIFO", "corrupt deflate TIFF"))
+    yield Case("readers", "calibrate --simulate camera.resolution [16384, 16384]",
+               lambda sb: ["calibrate", "huge.yaml", "--simulate", "--exports", str(sb.exports)],
+               _write("huge.yaml", FAST_PROFILE + "camera:\n  resolution: [16384, 16384]\n"), expect_refusal=True)
+    yield Case("readers", "calibrate --write-capture through a link",
+               lambda sb: ["calibrate", "fast.yaml", "--simulate", "--write-capture", str(sb.work / "cap"),
+                           "--exports", str(sb.exports)],
+               lambda sb: (sb.work / "cap").symlink_to(sb.decoy / "folder"), expect_refusal=True)
+    yield Case("readers", "watch with clients that go away and other methods",
+               lambda sb: ["watch", "fast.yaml", "--port", "0", "--no-check"], serves=True, timeout=120,
+               while_serving=_reset_clients)
+    for target in ("/etc/passwd", "precious.yaml"):
+        yield Case("readers", f"watch with the profile swapped for a link to {target}",
+                   lambda sb: ["watch", "fast.yaml", "--port", "0", "--no-check"], serves=True, timeout=120,
+                   while_serving=_swap_profile(target), stress=target != "/etc/passwd")
+
+
 def all_cases(stress: bool = False) -> list[Case]:
-    cases = [*printer_cases(), *argument_cases(), *planted_cases()]
+    cases = [*printer_cases(), *argument_cases(), *planted_cases(), *reader_cases()]
     return cases if stress else [c for c in cases if not c.stress]
