@@ -6,7 +6,6 @@ capture order and the naming scheme, exposure advice)."""
 
 from __future__ import annotations
 
-import io
 import math
 from pathlib import Path
 
@@ -17,12 +16,11 @@ from rigcad.calibrate.patterns import Sequence
 
 
 def pattern_png(seq: Sequence, name: str) -> bytes:
-    """One frame as an 8-bit grey PNG at the screen's resolution."""
-    from PIL import Image
+    """One frame as an 8-bit grey PNG at the screen's resolution, its levels marked linear
+    (rigcad.export.png: gAMA 1.0; the screen is to show them through a linear response)."""
+    from rigcad.export.png import gray_png
 
-    buf = io.BytesIO()
-    Image.fromarray(seq.image(name), mode="L").save(buf, format="PNG")
-    return buf.getvalue()
+    return gray_png(seq.image(name))
 
 
 def spacer(profile, k: int):

@@ -669,6 +669,7 @@ def test_every_file_the_commands_write_passes_its_validator(written):
         assert gcode_check(path.read_text(), settings) == [], path
     for path in files[".png"]:
         chunks = dict(png_chunks(path.read_bytes()))  # every chunk's CRC
-        if path.name.startswith("z_"):  # the basis images: data, their levels linear
+        if path.name.startswith("z_") or path.parent.name.startswith("patterns"):  # data: levels linear
             assert chunks.get(b"gAMA") == (100_000).to_bytes(4, "big"), path
-    assert sum(p.name.startswith("z_") for p in files[".png"]) > 0
+    assert sum(p.name.startswith("z_") for p in files[".png"]) > 0 and any(p.parent.name == "patterns"
+                                                                          for p in files[".png"])
