@@ -22,27 +22,13 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
     from rigcad.export.manifest import profile_digest
     from rigcad.progress import stages
-    from rigcad.rig import load
+    from rigcad.calibrate.kit import write_kit
 
-    from rigcad.calibrate.kit import check_screen_fits, check_upright_fits, write_kit
-
-    # --seating's files are read first: a file that is no calibration is one line before the rig is built
-    runs = _seating_runs(args.seating) if getattr(args, "seating", None) else None
-    if args.simulate:  # before the rig: a camera whose simulation cannot fit is one line, no work
-        from rigcad.profile import load_profile
-
-        check_simulation_memory(load_profile(args.profile))
-    rig = load(args.profile)
-    check_screen_fits(rig)  # a screen that cannot lie in the dome is refused before any work
-    check_upright_fits(rig.profile)  # nor an upright display that cannot stand in the bore
-    _check_laying(getattr(args, "laying", 0), args.simulate)
+    rig, runs = _before_any_work(args)
     capture_out = getattr(args, "write_capture", None)
-    if capture_out:
-        _check_capture_folder(Path(capture_out), args.simulate)
     if runs is not None:
         return _seating(rig, args, runs)
     if getattr(args, "kit", False):
-
         out = Path(args.exports) / rig.name / "calibrate_kit"
         manifest = write_kit(rig, out, say=print)
         print(f"calibration kit for {rig.name}: {len(manifest['files'])} files in {out}")
@@ -128,6 +114,27 @@ def check_simulation_memory(profile, memory: int | None = None) -> None:
                         f"{need / 2 ** 30:.3g} GiB of memory, more than this machine's {memory / 2 ** 30:.3g} GiB; the "
                         f"largest camera that fits has {int(pixels):,} px ([{fit_w}, {fit_h}] at this aspect)",
                         param="camera.resolution")
+
+
+def _before_any_work(args: argparse.Namespace):
+    """The rig, and ``--seating``'s calibrations (None without it), after every refusal that needs no
+    work: --seating's files read first (before the rig is built), --simulate's memory from the
+    profile, a screen or upright display that cannot fit, --laying, --write-capture's folder."""
+    from rigcad.calibrate.kit import check_screen_fits, check_upright_fits
+    from rigcad.rig import load
+
+    runs = _seating_runs(args.seating) if getattr(args, "seating", None) else None
+    if args.simulate:  # a camera whose simulation cannot fit: one line, before the rig is built
+        from rigcad.profile import load_profile
+
+        check_simulation_memory(load_profile(args.profile))
+    rig = load(args.profile)
+    check_screen_fits(rig)  # a screen that cannot lie in the dome is refused before any work
+    check_upright_fits(rig.profile)  # nor an upright display that cannot stand in the bore
+    _check_laying(getattr(args, "laying", 0), args.simulate)
+    if getattr(args, "write_capture", None):
+        _check_capture_folder(Path(args.write_capture), args.simulate)
+    return rig, runs
 
 
 def _simulated(optics, rig, args: argparse.Namespace, capture_out: str | None) -> tuple[list, tuple]:
