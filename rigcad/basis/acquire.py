@@ -422,5 +422,28 @@ def write_simulation(sim: RigSimulation, out_dir, lock=None, made_from: str | No
 
     out = Path(out_dir)
     with Staging(out, lock, made_from=made_from) as st:
+        _check_beside(sim, out)
         stage_simulation(sim, st, out)
         return st.commit()
+
+
+#: The largest basis.json read back beside a simulation (order 12's Gram matrices: a few MB).
+BASIS_JSON_MAX_BYTES = 64 << 20
+
+
+def _check_beside(sim: RigSimulation, out) -> None:
+    """Refuse to publish ``sim`` beside a basis of another order (``out``/basis.json, read back as
+    data): the folder would mix two runs."""
+    import os
+
+    from rigcad.export.readback import read_json
+
+    path = out / "basis.json"
+    if not os.path.lexists(path):
+        return
+    report, _ = read_json(path, "a basis.json", BASIS_JSON_MAX_BYTES, BasisError)
+    order = report.get("order") if isinstance(report, dict) else None
+    if order != sim.report.get("order"):
+        raise BasisError(f"{path}: a basis of order {order!r}; a simulation of order {sim.report.get('order')!r} "
+                         "beside it would mix two runs: publish them together (rigcad basis --simulate; "
+                         "rigcad.basis.projector.write_basis's also=)")
