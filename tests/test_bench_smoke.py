@@ -106,3 +106,18 @@ def test_hugepages_quick_run_measures_both_settings(tmp_path: Path) -> None:
     assert "loadavg_1min" in data["run"]
     assert {s["NUMPY_MADVISE_HUGEPAGE"] for s in data["settings"].values()} == {"0", "1"}
     assert data["same_outputs"] and all(data["same_outputs"].values()), data["same_outputs"]
+
+
+def test_commands_quick_run_times_each_command_fresh_and_again(tmp_path: Path) -> None:
+    # bench/commands.py writes no picture: every command ran (exit 0) fresh and again, the steps the
+    # commands report were stamped (stl reports one per part), and stl's second run found nothing to do
+    cmd = [sys.executable, str(ROOT / "bench" / "commands.py"), "--quick", "--out", str(tmp_path)]
+    proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    data = json.loads((tmp_path / "commands.json").read_text())
+    assert "loadavg_1min" in data["run"]
+    runs = [r for c in data["commands"].values() for r in c.values()]
+    assert len(runs) == 4 and all(r["exit_code"] == 0 for r in runs), [r["output_tail"] for r in runs]
+    stl = data["commands"]["stl"]
+    assert len(stl["fresh"]["steps_s"]) > 10 and stl["fresh"]["dominating_step"] is not None
+    assert "up to date" in stl["rerun"]["output_tail"]
