@@ -142,6 +142,7 @@ bench: $(VENV)/.installed stl
 	$(PY) bench/optimize.py --out $(BENCH_OUT)
 	$(PY) bench/startup.py --out $(BENCH_OUT)
 	$(PY) bench/hugepages.py --out $(BENCH_OUT)
+	$(PY) bench/commands.py --out $(BENCH_OUT)
 	$(PY) bench/compare.py $(BENCH_OUT) $(if $(REFRESH),--refresh)
 
 stress: $(VENV)/.installed
