@@ -223,3 +223,27 @@ def test_stress_killed_at_each_stage(sandbox, argv, stage):
     small = [{"400": "2"}.get(a, a) for a in argv] if argv[0] == "tolerance" else None
     v = _kill_then_rerun(sb, argv, when, stage, rerun=small)
     assert not v, v
+
+
+@pytest.mark.stress
+@pytest.mark.parametrize("stage", ["Z_1^0 written", "contact sheets and basis.json written"])
+def test_stress_basis_simulate_killed_never_mixes_two_runs(sandbox, stage):
+    """kill -9 of `basis --order 1 --simulate` after an `--order 0 --simulate` run, while its images
+    are being staged or once it has published: the folder holds one run, basis.json and
+    simulation.json of the same order, every listed file there and nothing else (before, the images
+    were published first: a kill between left basis.json of order 1 beside order 0's simulation)."""
+    sb = sandbox
+    E = str(sb.exports)
+    simulate = ["--simulate", "--camera-stride-px", "120", "--exports", E]
+    first = run(["basis", "fast.yaml", "--order", "0", *simulate], sb, timeout=300)
+    assert first.rc == 0, first.describe()
+    c = Child(["basis", "fast.yaml", "--order", "1", *simulate], sb, _events(sb), name="killed")
+    assert c.wait_until(lambda: stage in c.events(), timeout=300), c.events()
+    c.kill(stage)
+    o = c.finish(60)
+    assert not violations(o, sb), violations(o, sb)
+    out = sb.exports / "fast" / "basis"
+    report = json.loads((out / "basis.json").read_text())
+    assert report["order"] == json.loads((out / "simulation.json").read_text())["order"], report["order"]
+    on_disk = sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file())
+    assert on_disk == sorted(report["files"] + ["basis.json"]), on_disk
