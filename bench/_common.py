@@ -38,10 +38,25 @@ def reaped(cmd: list[str], cwd: Path = ROOT, env: dict | None = None) -> dict:
             "exit_code": proc.returncode, "output": text}
 
 
+def cpu_model() -> str:
+    """The CPU's model name (/proc/cpuinfo's first ``model name``; platform.processor() elsewhere):
+    a ratio of two codes' times depends on it (Embree and the compiled kernels do not gain alike
+    from one CPU to another), and a virtual machine may be moved to another host's CPU."""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
 def run_info() -> dict:
     """The machine and its load when called (os.getloadavg: 1, 5, 15 minute run-queue averages)."""
     one, five, fifteen = os.getloadavg()
-    return {"cpus": os.cpu_count(), "machine": platform.machine(), "python": platform.python_version(),
+    return {"cpus": os.cpu_count(), "cpu_model": cpu_model(), "machine": platform.machine(),
+            "python": platform.python_version(),
             "loadavg_1min": round(one, 2), "loadavg_5min": round(five, 2), "loadavg_15min": round(fifteen, 2),
             "note": "timings (keys ending in _s) were taken with this much other load on the machine"}
 

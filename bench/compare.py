@@ -43,6 +43,14 @@ RATIOS = [
      "raw Embree / analytic tracer, aligned rig"),
     ("raycheck.analytic_misaligned", "raycheck.json", ("readings", "analytic_misaligned", "raw_over_reading"),
      "raw Embree / analytic tracer, misaligned rig"),
+    ("raycheck.smooth_cpu", "raycheck.json", ("readings", "smooth", "raw_over_reading_cpu"),
+     "the same in CPU time (time.process_time), which leaves out waiting for a core"),
+    ("raycheck.mesh_cpu", "raycheck.json", ("readings", "mesh", "raw_over_reading_cpu"),
+     "the same in CPU time"),
+    ("raycheck.analytic_aligned_cpu", "raycheck.json", ("readings", "analytic_aligned", "raw_over_reading_cpu"),
+     "the same in CPU time"),
+    ("raycheck.analytic_misaligned_cpu", "raycheck.json", ("readings", "analytic_misaligned", "raw_over_reading_cpu"),
+     "the same in CPU time"),
     ("dome.table31", "dome.json", ("cases", ("case", "table31"), "speedup_at_1e-6_relative", "speedup"),
      "Euler time / adaptive integrator time at 1e-6 relative, Table 3.1"),
     ("dome.far_cop_ellipse", "dome.json", ("cases", ("case", "far_cop_ellipse"), "speedup_at_1e-6_relative", "speedup"),
@@ -100,8 +108,26 @@ def compare(measured: Path, committed: Path) -> list[dict]:
             verdict = "regression" if new < (1 - DROP) * old else "ok"
         rows.append({"name": name, "file": file, "compares": what, "committed": old, "measured": new,
                      "measured_over_committed": new / old if new is not None and old is not None else None,
-                     "verdict": verdict})
+                     "verdict": verdict, "cpu_committed": _cpu(old_doc), "cpu_measured": _cpu(new_doc)})
     return rows
+
+
+def _cpu(doc) -> str | None:
+    """The CPU model a results file was measured on (bench/_common.run_info), None when unrecorded."""
+    run = doc.get("run") if isinstance(doc, dict) else None
+    return run.get("cpu_model") if isinstance(run, dict) else None
+
+
+def cpu_notes(rows: list[dict]) -> list[str]:
+    """One line per results file whose committed figures were measured on another CPU, or on one
+    not recorded: a ratio of two codes' times moves with the CPU, so such a drop may be the CPU's."""
+    notes = {}
+    for r in rows:
+        if r["verdict"] in ("ok", "regression") and r["cpu_committed"] != r["cpu_measured"]:
+            notes[r["file"]] = (f"note: {r['file']}: committed on {r['cpu_committed'] or 'a CPU not recorded'}, "
+                                f"measured on {r['cpu_measured'] or 'a CPU not recorded'}; a ratio moves with the "
+                                "CPU: compare on the CPU the figures were committed on, or refresh them there")
+    return list(notes.values())
 
 
 def refresh(measured: Path, committed: Path) -> list[Path]:
@@ -141,7 +167,7 @@ def main(argv: list[str] | None = None) -> int:
               "run the benchmarks with --out elsewhere (make bench: build/bench)", file=sys.stderr)
         return 2
     rows = compare(args.measured, args.results)
-    print(table(rows))
+    print("\n".join([table(rows), *cpu_notes(rows)]))
     out = args.json or args.measured / "compare.json"
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps({"drop_limit": DROP, "ratios": rows}, indent=2, sort_keys=True) + "\n")

@@ -16,9 +16,13 @@ reading against raw embreex on the same rays, side by side in one process:
   same rays (the kernel forced on for the coarse tables, which the tracer itself would not use).
 
 Ratios are raw Embree time over the reading's time (above 1: faster than raw Embree). Each of
-REPEATS rounds times every reading right after its raw Embree, so each ratio compares runs under
+REPEATS rounds times every reading next to its raw Embree, so each ratio compares runs under
 the same load (the machine is shared); the median ratio over the rounds is reported, with each
-round's, and the best times.
+round's, and the best times. Both in wall time (``raw_over_reading``) and in this process's CPU
+time (``raw_over_reading_cpu``, time.process_time; the reading and Embree's calls each run on
+the calling thread): on a shared machine a round's wall ratio also counts the time the process
+waited for a core, which the reading and its replay, a second apart, do not wait alike (rounds of
+one run at load ~11 read 0.10 to 1.20 in wall time); the CPU ratio leaves that out.
 
 Run from the repository root: ``.venv/bin/python bench/raycheck.py [--rays N] [--exports DIR]``.
 Writes bench/results/raycheck.json and raycheck.png. Timings (keys ending in ``_s`` and rates)
@@ -52,7 +56,7 @@ from rigcad.profile import load_profile  # noqa: E402
 from rigcad.rig import Rig  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
-REPEATS = 5
+REPEATS = 7
 #: Table sizes of the aligned kernel's sweep.
 TABLE_CELLS = (1024, 2048, 4096, 8192, 16384, 32768)
 #: Issue 12's targets: raw Embree time / reading time.
@@ -71,17 +75,32 @@ def best(fn, repeats=REPEATS):
     return min(times), out
 
 
+class Clock:
+    """Wall (time.perf_counter) and CPU (time.process_time: every thread of this process) seconds
+    since it was made; ``lap()`` returns both and starts again."""
+
+    def __init__(self):
+        self.wall, self.cpu = time.perf_counter(), time.process_time()
+
+    def lap(self) -> tuple[float, float]:
+        wall, cpu = time.perf_counter(), time.process_time()
+        out = (wall - self.wall, cpu - self.cpu)
+        self.wall, self.cpu = wall, cpu
+        return out
+
+
 def mesh_run(optics, timer, origins, dirs):
     """One end-to-end mesh trace as a user runs it (timed), then its Embree calls replayed alone:
-    (trace_s, raw_s, casts, trace). The calls are recorded by a second, untimed trace of the same
-    rays (the trace is deterministic: the same calls with the same inputs, checked by their ray
-    count): recording keeps every cast's float32 inputs, new memory that a user's trace does not
-    allocate, and that costs more than the arithmetic on it on a VM whose fresh pages are slow."""
+    (trace_s, raw_s, casts, trace, trace_cpu_s, raw_cpu_s). The calls are recorded by a second,
+    untimed trace of the same rays (the trace is deterministic: the same calls with the same
+    inputs, checked by their ray count): recording keeps every cast's float32 inputs, new memory
+    that a user's trace does not allocate, and that costs more than the arithmetic on it on a VM
+    whose fresh pages are slow."""
     timer.embree_s, timer.embree_rays, timer.calls = 0.0, 0, []
     timer.keep_inputs = False
-    t0 = time.perf_counter()
+    clock = Clock()
     tr = trace(optics, origins, dirs)
-    dt = time.perf_counter() - t0
+    dt, dt_cpu = clock.lap()
     casts = timer.embree_rays
     timer.embree_rays, timer.keep_inputs = 0, True
     trace(optics, origins, dirs)
@@ -89,12 +108,14 @@ def mesh_run(optics, timer, origins, dirs):
     calls, timer.calls = list(timer.calls), []
     if sum(len(c[1]) for c in calls) != casts:
         raise RuntimeError("the recording trace made other Embree calls than the timed one")
-    raw = 0.0
+    raw = raw_cpu = 0.0
     for member, o32, d32, t32 in calls:
-        t0 = time.perf_counter()
-        member.scene.run(o32, d32, dists=None if t32 is None else t32.copy(), output=1)
-        raw += time.perf_counter() - t0
-    return dt, raw, casts, tr
+        dists = None if t32 is None else t32.copy()
+        clock = Clock()
+        member.scene.run(o32, d32, dists=dists, output=1)
+        wall, cpu = clock.lap()
+        raw, raw_cpu = raw + wall, raw_cpu + cpu
+    return dt, raw, casts, tr, dt_cpu, raw_cpu
 
 
 def table_sweep(analytic, geo, o, d) -> list[dict]:
@@ -161,24 +182,37 @@ def main() -> None:
     # runs under the same load (the machine is shared); reported: the median ratio over repeats
     placed_mesh = share_scenes(base, "smooth").placed(pp, dp)
     placed = analytic.placed(pp, dp)
+    # one untimed round first: the first 1 M-ray trace of a process maps its ~120 MB of results
+    # onto fresh pages, which the raw replay, reusing Embree's small per-call outputs, never does
+    # (that first round read 0.10-0.48 in wall time and pulled the median of 5 down)
+    for mode in ("smooth", "mesh"):
+        mesh_run(share_scenes(base, mode), timer, o, d)
+    mesh_run(placed_mesh, timer, mis_rays.origins, mis_rays.dirs)
+    # each run: (trace wall, raw wall, casts, trace CPU, raw CPU), seconds
     runs = {n: [] for n in ("smooth", "mesh", "analytic_aligned", "analytic_misaligned")}
     last = {}
     for _ in range(REPEATS):
         for mode in ("smooth", "mesh"):
-            dt, raw, casts, tr = mesh_run(share_scenes(base, mode), timer, o, d)
-            runs[mode].append((dt, raw, casts))
+            dt, raw, casts, tr, dt_cpu, raw_cpu = mesh_run(share_scenes(base, mode), timer, o, d)
+            runs[mode].append((dt, raw, casts, dt_cpu, raw_cpu))
             last[mode] = tr
-        t0 = time.perf_counter()
+        clock = Clock()
         last["analytic_aligned"] = trace(analytic, o, d)
-        runs["analytic_aligned"].append((time.perf_counter() - t0, runs["smooth"][-1][1], None))
-        _, raw_mis, casts, _ = mesh_run(placed_mesh, timer, mis_rays.origins, mis_rays.dirs)
-        t0 = time.perf_counter()
+        dt, dt_cpu = clock.lap()
+        smooth = runs["smooth"][-1]
+        runs["analytic_aligned"].append((dt, smooth[1], None, dt_cpu, smooth[4]))
+        _, raw_mis, casts, _, _, raw_mis_cpu = mesh_run(placed_mesh, timer, mis_rays.origins, mis_rays.dirs)
+        clock = Clock()
         last["analytic_misaligned"] = trace(placed, mis_rays.origins, mis_rays.dirs)
-        runs["analytic_misaligned"].append((time.perf_counter() - t0, raw_mis, casts))
+        dt, dt_cpu = clock.lap()
+        runs["analytic_misaligned"].append((dt, raw_mis, casts, dt_cpu, raw_mis_cpu))
     for name, rr in runs.items():
-        ratios = sorted(raw / dt for dt, raw, _ in rr)
+        ratios = sorted(r[1] / r[0] for r in rr)
+        cpu_ratios = sorted(r[4] / r[3] for r in rr)
         tr = last[name]
         rec = {"trace_s": min(r[0] for r in rr), "raw_embree_s": min(r[1] for r in rr),
+               "trace_cpu_s": min(r[3] for r in rr), "raw_embree_cpu_s": min(r[4] for r in rr),
+               "raw_over_reading_cpu": float(np.median(cpu_ratios)), "raw_over_reading_cpu_per_repeat": cpu_ratios,
                "raw_over_reading": float(np.median(ratios)), "raw_over_reading_per_repeat": ratios,
                "rays_per_s": args.rays / min(r[0] for r in rr), "raw_embree_rays_per_s": args.rays / min(r[1] for r in rr),
                "target": TARGETS[name], "kernels": tr.kernels}
@@ -206,17 +240,19 @@ def main() -> None:
     labels = ["analytic\naligned", "analytic\nmisaligned", "smooth mesh\n(end to end)", "flat facets\n(end to end)",
               "analytic\nnumpy (before)"]
     vals = [result["readings"][n]["raw_over_reading"] for n in names]
+    cpu = [result["readings"][n].get("raw_over_reading_cpu") for n in names]
     fig, ax = plt.subplots(figsize=(8.5, 4.5))
     x = np.arange(len(names))
     ax.bar(x, vals, 0.6, color=["tab:green", "tab:green", "tab:blue", "tab:blue", "0.6"])
     for i, n in enumerate(names):
         if n in TARGETS:
             ax.plot([i - 0.35, i + 0.35], [TARGETS[n]] * 2, color="tab:red", lw=2, label="target" if i == 0 else None)
-        ax.text(i, vals[i], f"{vals[i]:.2f}x", ha="center", va="bottom", fontsize=9)
+        ax.text(i, vals[i], f"{vals[i]:.2f}x" + (f"\nCPU {cpu[i]:.2f}x" if cpu[i] else ""), ha="center", va="bottom",
+                fontsize=8)
     ax.axhline(1.0, color="0.3", lw=0.8)
     ax.set_yscale("log")
     ax.set_xticks(x, labels, fontsize=8)
-    ax.set_ylabel("raw Embree time / reading time (same rays)")
+    ax.set_ylabel("raw Embree time / reading time (same rays, wall)")
     t = result["triangles"]
     ax.set_title(f"{args.rays} rays, {t['paraboloid'] + t['dome']} mirror triangles, one process "
                  f"(load {os.getloadavg()[0]:.1f})", fontsize=10)

@@ -86,3 +86,15 @@ def test_a_missing_or_unreadable_figure_is_not_a_pass(compare, tmp_path):
     broken.mkdir()
     (broken / "raycheck.json").write_text(json.dumps({"readings": {"smooth": {"raw_over_reading": "fast"}}}))
     assert _row(compare.compare(broken, committed), "raycheck.smooth")["verdict"] == "not measured"
+
+
+def test_a_figure_committed_on_another_cpu_is_said_so(compare, tmp_path):
+    committed = _results(tmp_path, "committed", 0.84)
+    measured = _results(tmp_path, "measured", 0.84)
+    for folder, cpu in ((committed, "Intel Xeon"), (measured, "AMD EPYC")):
+        doc = json.loads((folder / "raycheck.json").read_text())
+        doc["run"]["cpu_model"] = cpu
+        (folder / "raycheck.json").write_text(json.dumps(doc))
+    notes = compare.cpu_notes(compare.compare(measured, committed))
+    assert len(notes) == 1 and "Intel Xeon" in notes[0] and "AMD EPYC" in notes[0]  # one line per file
+    assert compare.cpu_notes(compare.compare(measured, measured)) == []  # the same CPU: nothing to say
