@@ -9,7 +9,6 @@ geometry it changes. All files of a run are staged and published together at the
 from __future__ import annotations
 
 import hashlib
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -191,10 +190,10 @@ def _alignment(rig) -> dict:
 
 def _read_manifest(path: Path) -> dict:
     """The previous manifest, or {} when there is none or it is unreadable (then nothing is reused)."""
-    try:
-        return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
-    except (OSError, ValueError):
-        return {}
+    from rigcad.export.readback import own_json
+
+    manifest = own_json(path)  # read as data: a FIFO, a giant or a nesting bomb is no manifest
+    return manifest if isinstance(manifest, dict) else {}
 
 
 def _mirror_key(meridian, profile: Profile) -> str:

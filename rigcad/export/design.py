@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import io
-import json
 from pathlib import Path
 
 import numpy as np
 
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import profile_digest, sha256_hex
+from rigcad.export.readback import own_json
 from rigcad.optics.design import Design
 
 
@@ -46,10 +46,7 @@ def write_design(design: Design, out_dir: Path, lock: Path | None = None) -> lis
             stage.write_bytes(out_dir / name, data)
         manifest = out_dir / "manifest.json"
         if manifest.is_file():  # the build's manifest vouches for these files: keep it truthful
-            try:
-                m = json.loads(manifest.read_text(encoding="utf-8"))
-            except (OSError, ValueError):
-                m = None
+            m = own_json(manifest)  # read as data: None when it is not one rigcad wrote
             shas = {name: sha256_hex(data) for name, data in files.items()}
             if isinstance(m, dict) and (m.get("design_files") != shas or stage.stale):
                 if m.get("design_files") != shas:

@@ -63,14 +63,10 @@ def listed_files(manifest: dict) -> dict[str, str]:
 def up_to_date(out: Path, key: str) -> bool:
     """True when ``out/manifest.json`` was written from inputs ``key`` and every file it lists is
     still there, unchanged."""
-    path = out / "manifest.json"
-    if not path.is_file():
-        return False
-    try:
-        manifest = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return False
-    if manifest.get("inputs_key") != key:
+    from rigcad.export.readback import own_json
+
+    manifest = own_json(out / "manifest.json")  # read as data: an unreadable one means "rebuild"
+    if not isinstance(manifest, dict) or manifest.get("inputs_key") != key:
         return False
     files = listed_files(manifest)
     return bool(files) and all(file_sha(out / rel) == digest for rel, digest in files.items())

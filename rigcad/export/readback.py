@@ -217,6 +217,21 @@ def read_json(path, what: str, limit: int, error: type[RigcadError] = ExportErro
     return parse_json(data, shown(path), error), st
 
 
+#: The largest manifest rigcad reads back (its own list files and hashes: tens of KB).
+MANIFEST_MAX_BYTES = 64 << 20
+
+
+def own_json(path) -> Any:
+    """A JSON file rigcad wrote and reads back for itself (a manifest): its content, or None when it
+    is missing or not one rigcad could have written (then the caller rebuilds). Read with
+    :func:`read_json`'s discipline, at most MANIFEST_MAX_BYTES: a FIFO, a sparse giant or a nesting
+    bomb is None, never a hang or a traceback."""
+    try:
+        return read_json(path, "a manifest", MANIFEST_MAX_BYTES)[0]
+    except ExportError:
+        return None
+
+
 def number_in(value: Any, where: str, low: float, high: float, unit: str, error: type[RigcadError] = ExportError,
               what: str = "") -> float:
     """``value`` as a float when it is a finite number (not a bool) in [low, high], else ``error``
@@ -374,5 +389,5 @@ def open_image(data: bytes, where: str, size_ok: Callable[[tuple[int, int]], str
 
 
 __all__ = ["ArraySpec", "JSON_MAX_DEPTH", "JSON_MAX_DIGITS", "captured_stderr", "json_depth", "names", "number_in",
-           "open_image", "parse_json", "quoted", "read_bytes", "read_file", "read_json", "read_npz", "shown",
+           "open_image", "own_json", "parse_json", "quoted", "read_bytes", "read_file", "read_json", "read_npz", "shown",
            "size_text"]

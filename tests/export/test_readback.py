@@ -205,3 +205,19 @@ def test_a_bomb_past_pillows_limit_is_one_line():
 def test_an_image_of_the_asked_size_decodes():
     im = R.open_image(_png(64, 48), "ok.png", lambda size: None if size == (64, 48) else "no")
     assert np.asarray(im).shape == (48, 64)
+
+
+@pytest.mark.parametrize("make", [
+    lambda p: p.write_text("[" * 100_000 + "]" * 100_000),
+    lambda p: os.mkfifo(p),
+    lambda p: p.write_text('{"inputs_key": "k", "inputs_key": "k"}'),
+    lambda p: p.symlink_to("/dev/zero"),
+])
+def test_a_manifest_that_is_no_manifest_means_rebuild(tmp_path, make):
+    """rigcad's own manifests read back (export.manifest.up_to_date, the build's reuse): a nesting
+    bomb (a RecursionError traceback from `rigcad stl` before), a FIFO or a device is no manifest."""
+    from rigcad.export.manifest import up_to_date
+
+    make(tmp_path / "manifest.json")
+    assert R.own_json(tmp_path / "manifest.json") is None
+    assert up_to_date(tmp_path, "k") is False
