@@ -397,9 +397,11 @@ def read_made_from(folder: Path) -> str | None:
         return None
     finally:
         os.close(fd)
-    try:
-        value = json.loads(data).get("profile_sha256")
-    except (ValueError, AttributeError):
+    from rigcad.export.readback import parse_json
+
+    try:  # read as data: a nesting bomb or a duplicated key is no record
+        value = parse_json(data, str(path)).get("profile_sha256")
+    except (ExportError, AttributeError):
         return None
     return value if isinstance(value, str) and re.fullmatch(r"[0-9a-f]{64}", value) else None
 

@@ -142,7 +142,10 @@ def read_bytes(path, what: str, limit: int, error: type[RigcadError] = ExportErr
 
 def json_depth(data: bytes) -> int:
     """The deepest nesting of brackets and braces in a JSON text, those inside strings left out:
-    vectorised, linear in the length (a quote is escaped after an odd run of backslashes)."""
+    linear in the length (a quote is escaped after an odd run of backslashes); vectorised past 64 KiB,
+    a plain loop below (no numpy import for a small manifest)."""
+    if len(data) <= 1 << 16:
+        return _json_depth_small(data)
     import numpy as np
 
     b = np.frombuffer(data, dtype=np.uint8)
@@ -159,6 +162,27 @@ def json_depth(data: bytes) -> int:
     steps = (np.isin(b, (ord("["), ord("{"))) & outside).astype(np.int64) - (
         np.isin(b, (ord("]"), ord("}"))) & outside).astype(np.int64)
     return int(np.cumsum(steps).max())
+
+
+def _json_depth_small(data: bytes) -> int:
+    depth = deepest = 0
+    inside = escaped = False
+    for c in data:
+        if inside:
+            if escaped:
+                escaped = False
+            elif c == 0x5C:  # backslash
+                escaped = True
+            elif c == 0x22:  # quote
+                inside = False
+        elif c == 0x22:
+            inside = True
+        elif c in (0x5B, 0x7B):  # [ {
+            depth += 1
+            deepest = max(deepest, depth)
+        elif c in (0x5D, 0x7D):  # ] }
+            depth -= 1
+    return deepest
 
 
 class _Refused(ValueError):

@@ -221,3 +221,15 @@ def test_a_manifest_that_is_no_manifest_means_rebuild(tmp_path, make):
     make(tmp_path / "manifest.json")
     assert R.own_json(tmp_path / "manifest.json") is None
     assert up_to_date(tmp_path, "k") is False
+
+
+def test_a_made_from_record_that_is_a_nesting_bomb_is_no_record(tmp_path):
+    """export.atomic.read_made_from reads 4096 bytes: 4096 brackets made json raise RecursionError."""
+    from rigcad.export.atomic import made_from_path, read_made_from
+
+    folder = tmp_path / "check"
+    folder.mkdir()
+    made_from_path(folder).write_bytes(b"[" * 4096)
+    assert read_made_from(folder) is None
+    made_from_path(folder).write_text(json.dumps({"profile_sha256": "a" * 64}))
+    assert read_made_from(folder) == "a" * 64
