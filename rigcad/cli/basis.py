@@ -17,6 +17,43 @@ def _order(text: str):
         return text
 
 
+#: Peak memory of ``rigcad basis`` (images, lat-long maps, Gram matrices; --simulate's own not counted):
+#: fixed bytes, bytes per projector pixel and per pixel and function ((order + 1)^2 functions).
+#: Measured (/usr/bin/time -v, one run each): 1024 x 768 px: order 0 256 MiB, order 4 346 MiB, order 8
+#: 558 MiB; 2048 x 1536 px: order 0 290 MiB, order 4 557 MiB; 16384 x 16384 px, order 0: 3,418 MiB.
+#: That is 12-15 bytes per pixel and 3-5 per pixel and function; the estimate rounds up to 16 and 8.
+BASIS_FIXED_BYTES = 256.0 * 2 ** 20
+BASIS_BYTES_PER_PIXEL = 16.0
+BASIS_BYTES_PER_PIXEL_FUNCTION = 8.0
+
+
+def check_basis_memory(resolution, order: int, memory: int | None = None) -> None:
+    """Refuse a basis of ``order`` for a projector of ``resolution`` (width, height) px when its
+    estimated peak memory exceeds this machine's (``memory`` bytes; engine.machine_memory by default):
+    one line naming the largest order that fits, or the largest projector when no order does."""
+    import math
+
+    from rigcad.engine import ResourceError, machine_memory
+
+    memory = machine_memory() if memory is None else memory
+    width, height = (int(v) for v in resolution)
+    pixels = width * height
+
+    def need(functions: int) -> float:
+        return BASIS_FIXED_BYTES + pixels * (BASIS_BYTES_PER_PIXEL + BASIS_BYTES_PER_PIXEL_FUNCTION * functions)
+
+    if need((order + 1) ** 2) <= memory:
+        return
+    functions = ((memory - BASIS_FIXED_BYTES) / pixels - BASIS_BYTES_PER_PIXEL) / BASIS_BYTES_PER_PIXEL_FUNCTION
+    head = (f"projector.resolution [{width}, {height}] with --order {order}: the basis would need about "
+            f"{need((order + 1) ** 2) / 2 ** 30:.3g} GiB of memory, more than this machine's {memory / 2 ** 30:.3g} GiB")
+    if functions >= 1:
+        raise ResourceError(f"{head}; the largest order that fits is {math.isqrt(int(functions)) - 1}", param="--order")
+    largest = max(0.0, (memory - BASIS_FIXED_BYTES) / (BASIS_BYTES_PER_PIXEL + BASIS_BYTES_PER_PIXEL_FUNCTION))
+    raise ResourceError(f"{head}; even order 0 does not fit: the largest projector that fits has {int(largest):,} px",
+                        param="projector.resolution")
+
+
 def cmd_basis(args: argparse.Namespace) -> int:
     from rigcad import api
     from rigcad.basis.acquire import simulate_on_rig, simulation_steps, stage_simulation
@@ -32,6 +69,7 @@ def cmd_basis(args: argparse.Namespace) -> int:
 
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "basis")  # a planted link or lock: one line now, not after the work
+    check_basis_memory(profile.projector.resolution, order)  # a basis no memory here holds: one line, no work
     if args.simulate:  # before the images: a stride that samples no 2 x 2 camera pixels is refused now
         largest = min(profile.camera.resolution) // 2
         if args.camera_stride_px > largest:

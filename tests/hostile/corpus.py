@@ -733,6 +733,9 @@ def reader_cases():
     yield Case("readers", "calibrate --simulate camera.resolution [16384, 16384]",
                lambda sb: ["calibrate", "huge.yaml", "--simulate", "--exports", str(sb.exports)],
                _write("huge.yaml", FAST_PROFILE + "camera:\n  resolution: [16384, 16384]\n"), expect_refusal=True)
+    yield Case("readers", "basis --order 12 with projector.resolution [16384, 16384]",
+               lambda sb: ["basis", "huge.yaml", "--order", "12", "--exports", str(sb.exports)],
+               _write("huge.yaml", FAST_PROFILE + "projector:\n  resolution: [16384, 16384]\n"), expect_refusal=True)
     yield Case("readers", "calibrate --write-capture through a link",
                lambda sb: ["calibrate", "fast.yaml", "--simulate", "--write-capture", str(sb.work / "cap"),
                            "--exports", str(sb.exports)],
