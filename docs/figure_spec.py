@@ -169,8 +169,8 @@ def _manual() -> list[Figure]:
         m("pieces", "bill.totals.pieces", "pieces", "d", True),
         m("print_hours", lambda j: j["bill"]["totals"]["estimate_print_time_s"] / 3600, "h", ".0f"),
         m("material_g", "bill.totals.estimate_material_g", "g", ",.0f"),
-        m("flange_bolts", lambda j: next(r["quantity"] for r in j["bill"]["fasteners"] if "grip" in r.get("note", "")),
-          "bolts", "d", True),
+        m("flange_bolts", lambda j: next(r["quantity"] for r in j["bill"]["hardware"]
+                                         if r["steps"] == ["dome"] and "bolt" in r["item"]), "bolts", "d", True),
         m("dome_area_cm2", lambda j: j["bill"]["mirrors"][0]["design_area_mm2"] / 100, "cm^2", ".1f"),
         m("paraboloid_area_cm2", lambda j: j["bill"]["mirrors"][1]["design_area_mm2"] / 100, "cm^2", ".1f"),
         m("base_paint_ml", "bill.coating.0.to_buy_cm3", "ml", ".0f"),

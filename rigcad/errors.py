@@ -44,6 +44,19 @@ class KernelError(GeometryError):
     exit_code = 1
 
 
+class AssemblyError(GeometryError):
+    """No order puts the rig together: ``step`` (the assembly step that cannot be done, placing the
+    parts ``members``) runs into ``obstacles`` (parts, or the steps whose fasteners are in the way).
+    Exit code 1: the profile was valid, the rig it describes cannot be assembled."""
+
+    exit_code = 1
+
+    def __init__(self, message: str, *, step: str | None = None, members: tuple[str, ...] = (),
+                 obstacles: tuple[str, ...] = (), where: str | None = None, param: str | None = None) -> None:
+        super().__init__(message, where=where, param=param)
+        self.step, self.members, self.obstacles = step, tuple(members), tuple(obstacles)
+
+
 class IntegrationError(RigcadError):
     """The dome integrator failed or could not meet its requested tolerance."""
 

@@ -125,10 +125,10 @@ class Rig:
         """Placements and mirror surfaces (design, printed) shared by the parts. Raises
         GeometryError (with file:line) when the parts cannot be laid out (a polyline dome, a bolt
         that does not fit its flange, ...)."""
-        from rigcad.parts.layout import rig_layout
+        from rigcad.parts import make_layout
 
         with _located(self.profile):
-            return rig_layout(self.profile, self.geometry, self.dome)
+            return make_layout(self.profile, self.geometry, self.dome)
 
     @_shared
     def recipes(self) -> dict[str, "Part"]:

@@ -22,9 +22,12 @@ def cmd_fab(args: argparse.Namespace) -> int:
 
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "fab")  # a planted link or lock: one line now, not after the work
+    names = select_parts(args.parts)  # a bad part name costs no rig
     rig = load(profile)
+    from rigcad.manual.gate import gate
+
+    gate(rig, args.exports)  # a rig that cannot be put together is refused before a piece is sliced
     out = api.default_folder(profile.name, "fab", printer.name, root=args.exports)
-    names = select_parts(args.parts)
     with stages(len(names), f"fab {profile.name}") as step:
         def progress(msg: str) -> None:
             step(msg)

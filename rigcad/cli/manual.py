@@ -21,6 +21,9 @@ def cmd_manual(args: argparse.Namespace) -> int:
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "manual")  # a planted link or lock: one line now, not after the work
     rig = load(profile)
+    from rigcad.manual.gate import gate
+
+    gate(rig, args.exports)  # a rig that cannot be put together gets no manual
     root = Path(args.exports) / rig.name
     total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
     with stages(total, f"manual {rig.name} ({printer.name})") as step:

@@ -16,23 +16,43 @@ def cmd_stl(args: argparse.Namespace) -> int:
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name)
     out = api.default_folder(profile.name, root=args.exports)
+    from rigcad.manual import gate
+
     if api.export_up_to_date(profile, out):
-        print(f"{profile.name}: up to date ({out}/manifest.json)")
-        return 0
+        kept = gate.read_verdict(args.exports, profile)
+        if kept is not None:
+            print(f"{profile.name}: up to date ({out}/manifest.json)")
+            return _verdict_exit(kept)
     from rigcad.parts import PARTS
     from rigcad.rig import Rig
 
-    with stages(len(PARTS) + 6, f"stl {profile.name}") as step:
+    with stages(len(PARTS) + 7, f"stl {profile.name}") as step:
         rig = Rig.from_profile(profile)
         step("dome integrated")
         rig.design  # traced here, for the progress bar; the export reuses it
         step("design traced")
         result = api.export(rig, out, progress=step)
+        verdict = gate.checked(rig, args.exports, progress=step)
+        step("assembly checked")
     env = rig.design.report["envelope"]
     print(f"{profile.name}: dome mirror {env['width_in']:.2f} x {env['height_in']:.2f} in; "
           f"{len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
     print("\n".join(part_lines(result, list(PARTS))))
-    return 0
+    return _verdict_exit(verdict)
+
+
+def _verdict_exit(verdict) -> int:
+    """0 when the assembly check finds an order; else its one line (the parts stay written, for
+    inspection) and exit code 1."""
+    import sys
+
+    from rigcad.errors import one_line
+
+    if verdict.ok:
+        return 0
+    print(f"rigcad: error: {one_line(verdict.line())}; the parts are written for inspection only: do not print "
+          "them", file=sys.stderr)
+    return 1
 
 
 def register(subparsers) -> None:

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rigcad.errors import GeometryError
+from rigcad.errors import AssemblyError, GeometryError
 
 #: Overlap thickness (mm) above which two solids collide: a printed fit's gap is ~0.2 mm, so 0.05 mm
 #: is an interference no hand would push through, and well above the mesher's chord error in a contact.
@@ -104,6 +104,18 @@ class Fastener:
     #: A countersunk head (ISO 10642, 90 deg): a cone from ``head_radius_mm`` at its top down to the
     #: shank, not a cylinder.
     countersunk: bool = False
+    #: Plain washers (ISO 7089) it is fitted with: under its head, and under its nut when it has one
+    #: held by a spanner (a nut in a trap bears on the part). None: that rule; 0 for a set screw.
+    washers: int | None = None
+
+    @property
+    def washer_count(self) -> int:
+        """The plain washers this fastener takes (see ``washers``)."""
+        if self.washers is not None:
+            return self.washers
+        if self.thread_in == "tapped":  # a bought extrusion's core screws: heads sunk, no washer
+            return 0
+        return 2 if self.thread_in == "nut" and self.nut_tool is not None else 1
 
     def solids(self):
         """The fastener in place: its shank and head, and its nut when it has one (a hexagon,
@@ -286,6 +298,11 @@ class Refusal:
 
     reason: str
     blocked: bool
+    #: The parts (or, for a fitted fastener, the step that fits it) it runs into, shallowest first.
+    obstacles: tuple[str, ...] = ()
+    #: How far (mm) the way in that comes nearest still runs into something: the least penetration
+    #: over the step's directions, or the deepest of its fasteners' collisions (0: waiting, not blocked).
+    depth: float = 0.0
 
     def __str__(self) -> str:
         return self.reason
@@ -313,6 +330,12 @@ class Assembly:
         self.bench_top = float(min(s.bounding_box()[2] for s in solids.values())) if with_bench else None
         self._memo: dict = {}
         self._pairs: dict = {}
+        #: A fitted fastener's name -> the step that fits it (an obstacle is named by its part or step).
+        self._owner = {_fastener_name(s, k): s.name for s in self.steps for k in range(len(s.fasteners))}
+
+    def owner(self, obstacle: str) -> str:
+        """The part or step an obstacle's name stands for (a fastener: the step that fits it)."""
+        return self._owner.get(obstacle, obstacle)
 
     def _obstacles(self, done: frozenset[str], extra: tuple[str, ...] = ()) -> list[tuple[str, object]]:
         """Named solids in place once the steps ``done`` are: parts, fitted fasteners, the bench."""
@@ -354,7 +377,7 @@ class Assembly:
         if missing:
             return Refusal(f"needs {', '.join(missing)} in place first", False)
         obstacles = self._obstacles(done)
-        direction, reasons = None, []
+        direction, reasons, hits = None, [], []
         for d in step.directions:
             worst = max((self._into(("sweep", m, d, step.travel_mm),
                                     lambda other, m=m, d=d: sweep_penetration(self.solids[m], d, step.travel_mm,
@@ -365,14 +388,26 @@ class Assembly:
                 direction = d
                 break
             reasons.append(f"moved in along {_dir_name(d)} it runs {worst[0]:.2f} mm into {worst[1]}")
+            hits.append(worst)
         if direction is None:
-            return Refusal("; ".join(reasons) or "no direction declared", True)
-        blocked = self._fastener_problems(step, self._obstacles(done, step.members))
+            return Refusal("; ".join(reasons) or "no direction declared", True, self._named(hits),
+                           min((h[0] for h in hits), default=float("inf")))
+        blocked = self._fastener_problems(step, self._obstacles(done, step.members), hits)
         if blocked:
-            return Refusal("; ".join(blocked), True)
+            return Refusal("; ".join(blocked), True, self._named(hits), max((h[0] for h in hits), default=0.0))
         return Placed(step, tuple(float(v) for v in direction))
 
-    def _fastener_problems(self, step: Step, obstacles: list) -> list[str]:
+    def _named(self, hits: list[tuple[float, str]]) -> tuple[str, ...]:
+        """The obstacles of ``hits`` ((depth, name) pairs) by part or step, each once, the shallowest
+        first (the way in that comes nearest); the bench only when nothing else is in the way."""
+        out: list[str] = []
+        for _, name in sorted(hits, key=lambda h: h[0]):
+            if self.owner(name) not in out and name != "nothing":
+                out.append(self.owner(name))
+        return tuple(n for n in out if n != "the bench") or tuple(out)
+
+    def _fastener_problems(self, step: Step, obstacles: list, hits: list) -> list[str]:
+        """Why a step's fasteners cannot be fitted (sentences); each obstacle met is added to ``hits``."""
         out = []
         fitted = list(obstacles)
         for k, f in enumerate(step.fasteners):
@@ -385,19 +420,23 @@ class Assembly:
                                       None if f.thread_in == "bench" else body.bounding_box()[2])
             if pen > CLEARANCE_MM:
                 out.append(f"{f.item} #{k + 1} at {_at(f.head)} runs {pen:.2f} mm into {what_in}")
+                hits.append((pen, what_in))
             for what, path in f.paths():
                 pen, by = self._into(("path", name, what), lambda other, path=path: penetration(path, other), fitted,
                                      path.bounding_box()[2] + f.lift_mm)
                 if pen > CLEARANCE_MM:
                     out.append(f"{f.item} #{k + 1} at {_at(f.head)}: {what} is blocked by {by} ({pen:.2f} mm)")
-            tried = []
+                    hits.append((pen, by))
+            tried, tool_hits = [], []
             for tool, path in f.tool_paths():
                 pen, by = self._into(("tool", name, tool.name), lambda other, path=path: penetration(path, other), fitted,
                                      path.bounding_box()[2] + f.lift_mm)
                 if pen <= CLEARANCE_MM:
                     break
                 tried.append(f"the {tool.name}'s path is blocked by {by} ({pen:.2f} mm)")
-            else:
+                tool_hits.append((pen, by))
+            else:  # every tool blocked
+                hits += tool_hits
                 out.append(f"{f.item} #{k + 1} at {_at(f.head)}: " + "; ".join(tried or ["no tool declared"]))
             fitted.append((name, body))
         return out
@@ -463,7 +502,7 @@ def find_order(assembly: Assembly) -> list[Placed]:
 
     order = search(frozenset(), [])
     if order is None:
-        raise GeometryError("no feasible assembly order: " + _stuck(assembly))
+        raise _stuck(assembly)
     return order
 
 
@@ -480,8 +519,9 @@ def _refuse_cycles(assembly: Assembly) -> None:
         for nxt in sorted(after[name]):
             if state.get(nxt) == 1:
                 loop = trail[trail.index(nxt):] + [nxt] if nxt in trail else [name, nxt]
-                raise GeometryError("no feasible assembly order: the steps need each other in a loop: "
-                                    + " needs ".join(loop))
+                raise AssemblyError("no feasible assembly order: the steps need each other in a loop: "
+                                    + " needs ".join(loop), step=loop[0],
+                                    members=assembly.by_name[loop[0]].members, obstacles=tuple(loop[1:-1]))
             if nxt not in state:
                 visit(nxt, [*trail, nxt])
         state[name] = 2
@@ -514,12 +554,13 @@ def _refuse_blocked_at_first(assembly: Assembly) -> None:
     for step in assembly.steps:
         r = assembly.attempt(step, _before(assembly)[step.name])
         if isinstance(r, Refusal) and r.blocked:
-            raise GeometryError(f"no feasible assembly order: {step.name} cannot go in even with only what it "
-                                f"needs in place: {r}")
+            raise AssemblyError(f"no feasible assembly order: {step.name} cannot go in even with only what it "
+                                f"needs in place: {r}", step=step.name, members=step.members, obstacles=r.obstacles)
 
 
-def _stuck(assembly: Assembly) -> str:
-    """The longest feasible prefix the declared order first allows, and why each step left fails."""
+def _stuck(assembly: Assembly) -> AssemblyError:
+    """The longest feasible prefix the declared order first allows, and why each step left fails: the
+    error naming the first step left that is blocked (else the first left) and what it runs into."""
     done: frozenset[str] = frozenset()
     progress = True
     while progress:
@@ -528,8 +569,10 @@ def _stuck(assembly: Assembly) -> str:
             if step.name not in done and isinstance(assembly.attempt(step, done), Placed):
                 done, progress = done | {step.name}, True
                 break
-    left = [s for s in assembly.steps if s.name not in done]
-    return "; ".join(f"{s.name}: {assembly.attempt(s, done)}" for s in left)
+    left = [(s, assembly.attempt(s, done)) for s in assembly.steps if s.name not in done]
+    first = next(((s, r) for s, r in left if r.blocked), left[0])
+    return AssemblyError("no feasible assembly order: " + "; ".join(f"{s.name}: {r}" for s, r in left),
+                         step=first[0].name, members=first[0].members, obstacles=first[1].obstacles)
 
 
 __all__ = ["Assembly", "CLEARANCE_MM", "Fastener", "Placed", "Refusal", "SWEEP_STEP_MM", "Step", "Tool", "check_order",

@@ -17,25 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rigcad import standards
 from rigcad.errors import GeometryError
 
-# -- metric fasteners (ISO tables: the one place rigcad states them) --------------------------------
-#: ISO 273 medium-series clearance hole (mm) -> thread; with its coarse pitch (ISO 261), ISO 4032
-#: hex nut height (m max), ISO 7089 washer thickness, all mm.
-METRIC = (  # thread, clearance hole, pitch, nut height, washer thickness
-    ("M2", 2.4, 0.4, 1.6, 0.3),
-    ("M2.5", 2.9, 0.45, 2.0, 0.5),
-    ("M3", 3.4, 0.5, 2.4, 0.5),
-    ("M4", 4.5, 0.7, 3.2, 0.8),
-    ("M5", 5.5, 0.8, 4.7, 1.0),
-    ("M6", 6.6, 1.0, 5.2, 1.6),
-    ("M8", 9.0, 1.25, 6.8, 1.6),
-    ("M10", 11.0, 1.5, 8.4, 2.0),
-    ("M12", 13.5, 1.75, 10.8, 2.5),
-)
-#: ISO 4762 / ISO 4017 preferred lengths (mm) of socket-head and hex bolts.
-BOLT_LENGTHS = (5, 6, 8, 10, 12, 16, 20, 25, 30, 35, 40, 45, 50, 55, 60, 65, 70, 80, 90, 100, 110, 120, 130, 140,
-                150, 160, 180, 200)
+# -- fasteners (their figures: rigcad.standards, the one home of them) ------------------------------
 #: A bolt shows at least this many thread pitches beyond its nut (common practice: 1-2 pitches).
 PROTRUSION_PITCHES = 2
 #: A dowel pin is cut this much (mm) shorter than its two holes' depths together (2 x alignment_pin.depth),
@@ -43,25 +28,25 @@ PROTRUSION_PITCHES = 2
 PIN_END_GAP_MM = 0.5
 
 
-def thread_for_hole(hole: float) -> tuple:
-    """The largest ISO metric thread whose medium clearance hole fits in ``hole`` mm."""
-    fits = [row for row in METRIC if row[1] <= hole + 1e-9]
-    if not fits:
-        raise GeometryError(f"a {hole:g} mm hole takes no ISO metric bolt from M2 (2.4 mm clearance) up",
-                            param="dome_shell.bolt_diameter")
-    return fits[-1]
+def thread_for_hole(hole: float) -> standards.Thread:
+    """The largest ISO metric thread whose medium clearance hole (ISO 273) fits in ``hole`` mm."""
+    try:
+        return standards.thread_for_hole(hole)
+    except ValueError as err:
+        raise GeometryError(str(err), param="dome_shell.bolt_diameter") from err
 
 
-def bolt_length(grip: float, pitch: float, nut: float, washer: float) -> tuple[int, float]:
-    """The shortest preferred length (mm) for a bolt through ``grip`` mm of parts with a washer under
-    its head and under its nut, and PROTRUSION_PITCHES pitches beyond the nut; and the length needed."""
-    need = grip + 2 * washer + nut + PROTRUSION_PITCHES * pitch
-    for length in BOLT_LENGTHS:
-        if length >= need - 1e-9:
-            return length, need
-    raise GeometryError(f"bolts of {need:.1f} mm are longer than the longest preferred length "
-                        f"({BOLT_LENGTHS[-1]} mm): the flange and plate are too thick",
-                        param="base_plate.thickness")
+def bolt_length(grip: float, thread: standards.Thread) -> tuple[int, float]:
+    """The shortest preferred length (mm) for a bolt of ``thread`` through ``grip`` mm of parts with a
+    washer under its head and under its nut, and PROTRUSION_PITCHES pitches beyond the nut; and the
+    length needed."""
+    need = grip + 2 * thread.washer_thickness + thread.nut_height + PROTRUSION_PITCHES * thread.pitch
+    length = standards.shortest_screw(thread.name, need)
+    if length is None:
+        raise GeometryError(f"{thread.name} bolts of {need:.1f} mm are longer than the longest ISO 4762 length "
+                            f"({standards.screw_lengths(thread.name)[-1]} mm): the flange and plate are too thick",
+                            param="base_plate.thickness")
+    return length, need
 
 
 # -- mirror areas and coating ---------------------------------------------------------------------
@@ -142,12 +127,14 @@ def _holes(solid, offset=(0.0, 0.0, 0.0), cut=False):
 
 
 def _own_rows(rig) -> list[tuple[float, float]]:
-    """Hole axes (x, y; mm) whose fasteners another module lists: the breadboard's screws, and the
-    column's joint in the base plate's tongue (bolts, dowels, or a bought extrusion's core screw)."""
+    """Hole axes (x, y; mm) whose fasteners another module lists: the breadboard's screws, the joints
+    the parts declare (``Part.joints``), and the column's joint in the base plate's tongue (bolts,
+    dowels, or a bought extrusion's core screw)."""
     from rigcad.parts import breadboard
 
     out = ([q for qs in breadboard.anchor_points(rig.profile, rig.layout).values() for q in qs]
            if breadboard.board(rig.profile) else [])
+    out += [q for part in rig.recipes.values() for j in part.joints for q in j.points]  # declared: plan fits them
     t = getattr(rig.layout, "tower", None)
     if t is not None:
         from rigcad.parts.tower import _column_flange_points, column_dowel_points
@@ -214,7 +201,8 @@ def bolt_joints(rig) -> list[dict]:
                                 "count": 0})["count"] += 1
     rows = []
     for g in sorted(groups.values(), key=lambda g: (-len(g["parts"]), g["parts"], g["grip_mm"])):
-        thread, _, pitch, nut, washer = thread_for_hole(g["hole_mm"])
+        th = thread_for_hole(g["hole_mm"])
+        thread = th.name
         alone = len(g["parts"]) == 1
         row = {**g, "thread": thread, "joins": " + ".join(g["parts"]) + (" to what it stands on" if alone else "")}
         if alone:  # into the bench or a part's slot: the user's fixing; the grip is what a bolt passes
@@ -222,10 +210,10 @@ def bolt_joints(rig) -> list[dict]:
                        short=f"{thread} bolts", length_mm=None, nuts=0, washers=g["count"],
                        note="into the bench (or what the part stands on): choose its length on site")
         else:
-            length, need = bolt_length(g["grip_mm"], pitch, nut, washer)
+            length, need = bolt_length(g["grip_mm"], th)
             row.update(item=f"{thread} x {length} mm socket-head bolt (ISO 4762)", short=f"{thread} x {length} mm bolts",
                        length_mm=length, nuts=g["count"], washers=2 * g["count"],
-                       note=f"needs {need:.1f} mm: {g['grip_mm']:g} mm grip + 2 washers + nut {nut:g} mm + "
+                       note=f"needs {need:.1f} mm: {g['grip_mm']:g} mm grip + 2 washers + nut {th.nut_height:g} mm + "
                             f"{PROTRUSION_PITCHES} pitches")
         rows.append(row)
     return rows
@@ -255,14 +243,14 @@ def fasteners(rig) -> list[dict]:
         washers[j["thread"]] = washers.get(j["thread"], 0) + j["washers"]
     for thread, n in nuts.items():
         if n:
-            nut = next(r for r in METRIC if r[0] == thread)
             rows.append({"item": f"{thread} hex nut (ISO 4032)", "short": f"{thread} nuts", "quantity": n,
-                         "use": "one per through bolt", "length_mm": None, "note": f"{nut[3]:g} mm high"})
+                         "use": "one per through bolt", "length_mm": None,
+                         "note": f"{standards.THREADS[thread].nut_height:g} mm high"})
     for thread, n in washers.items():
         if n:
-            w = next(r for r in METRIC if r[0] == thread)
             rows.append({"item": f"{thread} washer (ISO 7089)", "short": f"{thread} washers", "quantity": n,
-                         "use": "under each bolt head and nut", "length_mm": None, "note": f"{w[4]:g} mm thick"})
+                         "use": "under each bolt head and nut", "length_mm": None,
+                         "note": f"{standards.THREADS[thread].washer_thickness:g} mm thick"})
     from rigcad.parts import breadboard
 
     for h in breadboard.hardware(rig.profile, rig.layout):

@@ -214,8 +214,12 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
 
     step = progress or (lambda label: None)
     meshes = A.picture_meshes(rig)
+    from rigcad.manual import plan
+
+    bill = B.bill(rig, fab_report, printer)
+    bill["hardware"] = plan.bill_hardware(rig, plan.steps(rig, meshes)[0], bill)  # what the steps fit: one list
     c = SimpleNamespace(rig=rig, printer=printer, fab_report=fab_report, p=rig.profile, files={}, meshes=meshes,
-                        bill=B.bill(rig, fab_report, printer), cut_away=A.encloses(meshes), step=step)
+                        bill=bill, cut_away=A.encloses(meshes), step=step)
     c.files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
                                                   cut_away=c.cut_away)
     step("rig picture")
@@ -225,7 +229,8 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
                     _section_assemble, _section_calibrate):
         section(d, c)
     figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
-               "bill": c.bill, "calibration": c.calibration, "finishing": c.finishing,
+               # the hardware as the steps fit it; bom.fasteners' candidate joints stay internal
+               "bill": {k: v for k, v in c.bill.items() if k != "fasteners"}, "calibration": c.calibration, "finishing": c.finishing,
                "coating_gauged_layer": c.gauged, "coating_total_mm": c.total,
                "assembly_order": getattr(c, "assembly_order", None)}
     return d, c.files, figures
@@ -318,17 +323,7 @@ def _section_bill(d: Doc, c) -> None:
                                    + (": `rigcad manual ... --gcode` uses PrusaSlicer's own figures)"
                                       if printer.slicer == "prusa-slicer" else ")")) + ".")
     d.h(3, "Hardware")
-    from rigcad.manual import plan
-
-    steps, _ = plan.steps(rig, c.meshes)
-    hw = [[r["item"], r["quantity"], f"assembly steps: {r['steps']}", "as the assembly check fitted it"]
-          for r in plan.hardware(steps, rig)]
-    hw += [[f["item"], f["quantity"], f["use"], f["note"]] for f in bill["fasteners"] if f.get("tower")
-           and "mounting holes" not in f["use"] and not tower_joints.placed({"joins": f["use"]})]
-    if bill["pins"]:
-        pin = bill["pins"]
-        hw.append([pin["item"], pin["quantity"], f"aligning split pieces ({pin['use']})", pin["note"]])
-    d.table(["item", "qty", "where", "note"], hw)
+    d.table(["item", "qty", "where", "note"], [[r["item"], r["quantity"], r["where"], r["note"]] for r in bill["hardware"]])
     if not bill["pins"]:
         d.p(f"No part is split on {printer.name}: no dowel pins.")
     d.h(3, "Optics and instruments")
@@ -458,9 +453,10 @@ MOVES = {"-z (down)": "lower it from above", "+z (up)": "push it up from below",
          "-y": "slide it in level along -y, from the +y side", "+y": "slide it in level along +y, from the -y side"}
 #: Fastenings by what takes the thread: what the step says after the bolt.
 THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut with the spanner, tighten crosswise by "
-                    "hand", "insert": "screwed into the insert (first drill the part's hole out to the "
-                                      "insert's outer diameter and melt the insert in flush with a soldering iron at "
-                                      "its maker's temperature)",
+                    "hand", "insert": "screwed into the insert (its pocket is printed at the hole its maker gives, "
+                                      "named with the insert: if it printed small, drill it to that size, never to "
+                                      "the insert's outside; melt the insert in flush with a soldering iron at its "
+                                      "maker's temperature before the part is closed in)",
              "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
              "bench": "into the bench (on a breadboard: into its tapped holes, on the grid)",
              "tapped": "into the thread tapped in the part",
@@ -470,14 +466,16 @@ THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut wit
 
 def assembly_order(rig, meshes):
     """The order rigcad's assembly check finds (rigcad.manual.assembly_check.find_order over
-    rigcad.manual.plan's steps), or the check's refusal (a GeometryError's message)."""
-    from rigcad.errors import GeometryError
-    from rigcad.manual import assembly_check, plan
+    rigcad.manual.plan's steps). A rig with no order gets no manual: the gate's refusal
+    (rigcad.manual.gate: AssemblyError, its one line naming the parts and the profile keys)."""
+    from rigcad.errors import AssemblyError
+    from rigcad.manual import assembly_check, gate, plan
 
     try:
-        return assembly_check.find_order(plan.assembly(rig, meshes)), None
-    except GeometryError as err:
-        return None, str(err)
+        return assembly_check.find_order(plan.assembly(rig, meshes))
+    except AssemblyError as err:
+        v = gate.refused(rig, err, search=False)
+        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles) from err
 
 
 def step_text(placed, meshes_by_name: dict) -> str:
@@ -517,10 +515,7 @@ def _section_assemble(d: Doc, c) -> None:
     from rigcad.manual import plan as plan_mod
 
     d.h(2, "5. Assemble")
-    order, refusal = assembly_order(c.rig, c.meshes)
-    if order is None:
-        d.p(f"**rigcad's assembly check finds no order in which this rig can be put together:** {refusal}")
-        return
+    order = assembly_order(c.rig, c.meshes)
     d.p("The order below is the one rigcad's assembly check found: each part, swept along the direction the "
         "step names, clears everything already in place; each bolt's head, nut and tool have a straight way "
         "in. Each picture shows what is in place (grey) and what goes in (orange), drawn before its place "

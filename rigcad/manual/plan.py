@@ -28,11 +28,9 @@ import re
 import numpy as np
 
 from rigcad.manual.assembly_check import Assembly, Fastener, Step, manifold, penetration
-from rigcad.manual.fasteners import DOWN, DRIVER_BLADE_MM, HEX_KEY, L_KEY, NUT_AF, SPANNER_MM, UP  # noqa: F401
-from rigcad.manual.fasteners import driver, spanner  # noqa: F401
-from rigcad.manual.fasteners import metric as _metric  # noqa: F401
+from rigcad.manual.fasteners import DOWN, UP, spanner
 from rigcad.manual.fasteners import socket_head as _socket_head
-from rigcad.parts.tower import HEAT_SET_INSERT
+from rigcad.standards import INSERTS, THREADS, longest_screw, shortest_screw
 
 #: Units one step places together: an instrument with the lens built onto it.
 UNITS = (("projector_body", "projector_lens"), ("camera_body", "camera_lens"))
@@ -45,8 +43,6 @@ SIDEWAYS = ((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1.0, 0.0)
 #: parts under it within REST_SEARCH_MM (mm) hold it.
 REST_SEARCH_MM = 5.0
 REST_PROBE_MM = 0.08
-#: Heat-set insert (M thread -> outer diameter, length): the parts' table.
-INSERT = HEAT_SET_INSERT
 
 
 def _stem(name: str) -> str:
@@ -69,36 +65,57 @@ def bolt_fasteners(bolt: dict) -> tuple[Fastener, ...]:
     """The ways to fit one bolt of :func:`rigcad.manual.bom.bolt_axes`, best first: through with a
     washer and a nut under the lower part; into a heat-set insert in the lower part; into the bench
     (a bolt of one part alone)."""
-    from rigcad.manual.bom import BOLT_LENGTHS, bolt_length, thread_for_hole
+    from rigcad.manual.bom import bolt_length, thread_for_hole
 
-    thread, _, pitch, nut_h, washer = thread_for_hole(bolt["hole_mm"])
-    d = float(re.sub(r"[^0-9.]", "", thread))
+    th = thread_for_hole(bolt["hole_mm"])
+    thread, nut_h, washer = th.name, th.nut_height, th.washer_thickness
     head = (bolt["x"], bolt["y"], bolt["top_z"] + washer)
     if len(bolt["parts"]) == 1:
-        need = bolt["grip_mm"] + washer + 1.5 * d  # 1.5 d of thread into the bench (wood or a tapped plate)
-        length = next(n for n in BOLT_LENGTHS if n >= need - 1e-9)
+        need = bolt["grip_mm"] + washer + 1.5 * th.major  # 1.5 d of thread into the bench (wood or a tapped plate)
+        length = shortest_screw(thread, need) or shortest_screw(None, need)
         return (_socket_head(f"{thread} x {length} mm socket-head screw (ISO 4762) into the bench", head, DOWN,
-                             length, d, thread, thread_in="bench", passes=bolt["parts"]),)
-    length, _ = bolt_length(bolt["grip_mm"], pitch, nut_h, washer)
+                             length, thread, thread_in="bench", passes=bolt["parts"]),)
+    length, _ = bolt_length(bolt["grip_mm"], th)
     out_dir = np.array([bolt["x"], bolt["y"], 0.0])
     out_dir = tuple(out_dir / np.linalg.norm(out_dir)) if np.linalg.norm(out_dir) > 1e-9 else (1.0, 0.0, 0.0)
-    nut_r = NUT_AF[thread] / np.sqrt(3.0)
+    nut_r = th.nut_corner_radius
     options = [_socket_head(f"{thread} x {length} mm socket-head bolt (ISO 4762) with 2 washers (ISO 7089) and a "
-                            f"nut (ISO 4032)", head, DOWN, length, d, thread, thread_in="nut",
+                            f"nut (ISO 4032)", head, DOWN, length, thread, thread_in="nut",
                             nut_size_mm=(nut_r, nut_h), nut_tool=spanner(thread, nut_h), nut_dir=out_dir,
                             passes=bolt["parts"], grip_mm=bolt["grip_mm"] + 2 * washer)]
     lower = min((n for n in bolt["parts"] if n != bolt["upper"]), key=lambda n: bolt["spans"][n][1])
     lo, hi = bolt["spans"][lower]
-    if thread in INSERT and hi - lo >= INSERT[thread][1]:
-        need = (bolt["top_z"] - hi) + washer + INSERT[thread][1]
-        fits = [n for n in BOLT_LENGTHS if n <= need + 1e-9]
-        if fits:
-            dia, long = INSERT[thread]
+    insert = INSERTS.get(thread)
+    if insert is not None and hi - lo >= insert.pocket_depth:
+        fit = longest_screw(thread, (bolt["top_z"] - hi) + washer + insert.length)
+        if fit:
             options.append(_socket_head(
-                f"{thread} x {fits[-1]} mm socket-head bolt (ISO 4762) with a washer (ISO 7089) into a {thread} "
-                f"heat-set insert ({dia:g} x {long:g} mm) melted into {lower}", head, DOWN, fits[-1], d, thread,
+                f"{thread} x {fit} mm socket-head bolt (ISO 4762) with a washer (ISO 7089) into a {thread} "
+                f"heat-set insert ({insert.length:g} mm long, in a {insert.hole:g} mm hole) melted into {lower}",
+                head, DOWN, fit, thread,
                 thread_in="insert", passes=bolt["parts"]))
     return tuple(options)
+
+
+def joint_fasteners(joint) -> tuple[Fastener, ...]:
+    """The screws of a declared joint (rigcad.parts.joints.ScrewJoint), one per point: heads on
+    their washers on the upper part, driven from above; into inserts, or nuts under the lower part
+    held by a spanner from the side."""
+    th = THREADS[joint.thread]
+    out = []
+    for x, y in joint.points:
+        head = (x, y, joint.head_z)
+        if joint.into == "insert":
+            out.append(_socket_head(joint.item, head, DOWN, joint.length, joint.thread, thread_in="insert",
+                                    passes=(joint.upper, joint.lower)))
+            continue
+        r = np.hypot(x, y)
+        out_dir = (x / r, y / r, 0.0) if r > 1e-9 else (1.0, 0.0, 0.0)
+        grip = (joint.upper_z[1] - joint.upper_z[0]) + (joint.lower_z[1] - joint.lower_z[0]) + 2 * th.washer_thickness
+        out.append(_socket_head(joint.item, head, DOWN, joint.length, joint.thread, thread_in="nut",
+                                nut_size_mm=(th.nut_corner_radius, th.nut_height), nut_tool=spanner(joint.thread, th.nut_height),
+                                nut_dir=out_dir, passes=(joint.upper, joint.lower), grip_mm=grip))
+    return tuple(out)
 
 
 def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]:
@@ -109,24 +126,21 @@ def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener,
     if t is None:
         return {}
     from rigcad.parts.tower import hardware
-    from rigcad.profile.schema import MOUNT_THREADS
-
     rows = [h for h in hardware(rig.profile, rig.layout) if h.get("length_mm") and "socket" in h["joins"]
             or h.get("length_mm") and "mounting holes" in h["joins"]]
     out: dict[str, tuple[Fastener, ...]] = {}
     nominal = _projector_length(rig, t.shims_nominal)  # the stacks as drawn: shims_nominal shims each
     for h in rows:
-        d = MOUNT_THREADS[h["thread"]]
         item = _screw_item(h["thread"], h["length_mm"])
         if "projector" in h["joins"] and h["length_mm"] == nominal:
             z = t.shelf_top_z - t.shelf_thickness - 1.0
             shims = sorted(n for n in meshes_by_name if n.startswith("projector_shims_"))
             out["projector_body"] = tuple(
-                _socket_head(item, (*_centre(meshes_by_name[n])[:2], z), UP, h["length_mm"], d, h["thread"],
+                _socket_head(item, (*_centre(meshes_by_name[n])[:2], z), UP, h["length_mm"], h["thread"],
                              thread_in="instrument", passes=("tower_shelf", n), pierces=(n,)) for n in shims)
         elif "camera" in h["joins"] and "camera_shims" in meshes_by_name:
             out["camera_body"] = tuple(
-                _socket_head(item, (x, -t.wall_y[1] - 1.0, z), (0.0, 1.0, 0.0), h["length_mm"], d, h["thread"],
+                _socket_head(item, (x, -t.wall_y[1] - 1.0, z), (0.0, 1.0, 0.0), h["length_mm"], h["thread"],
                              thread_in="instrument", passes=("splitter_holder", "camera_shims"),
                              pierces=("camera_shims",))
                 for x, z in _camera_points(rig, meshes_by_name))
@@ -241,6 +255,10 @@ def steps(rig, meshes) -> tuple[list[Step], dict]:
         options = bolt_fasteners(b)
         fits = [f for f in options if penetration(f.solids(), whole) <= _clearance()]
         bolts.setdefault(b["upper"], []).append((fits or options)[0])
+    for part in rig.recipes.values():  # the joints the parts declare: fitted as declared
+        for j in part.joints:
+            if {j.upper, j.lower} <= set(solids):
+                bolts.setdefault(j.upper, []).extend(joint_fasteners(j))
     from rigcad.manual.tower_joints import tower_fasteners
 
     screws = instrument_fasteners(rig, by_name)
@@ -285,7 +303,7 @@ def assembly(rig, meshes) -> Assembly:
     return Assembly(solids, declared)
 
 
-__all__ = ["assembly", "bolt_fasteners", "driver", "groups", "instrument_fasteners", "spanner", "steps"]
+__all__ = ["assembly", "bolt_fasteners", "groups", "instrument_fasteners", "joint_fasteners", "spanner", "steps"]
 
 
 def hardware(steps: list[Step], rig=None) -> list[dict]:
@@ -314,18 +332,36 @@ def hardware(steps: list[Step], rig=None) -> list[dict]:
             thread = f.item.split(" x ")[0]
             if f.thread_in == "nut":
                 extra[f"{thread} hex nut (ISO 4032)"] = extra.get(f"{thread} hex nut (ISO 4032)", 0) + 1
-                # a nut in a printed trap bears on the part: one washer, under the head
-                extra[f"{thread} washer (ISO 7089)"] = extra.get(f"{thread} washer (ISO 7089)", 0) + (
-                    1 if f.nut_tool is None else 2)
-            elif f.thread_in != "tapped":  # a bought extrusion's core screws: heads sunk, no washer
+            if f.washer_count:
                 washer = f"{thread} large washer (ISO 7093)" if "ISO 7093" in f.item else f"{thread} washer (ISO 7089)"
-                extra[washer] = extra.get(washer, 0) + 1
+                extra[washer] = extra.get(washer, 0) + f.washer_count
             if f.thread_in == "insert":
-                dia, long = INSERT[thread]
-                name = f"{thread} heat-set insert for printed parts, {dia:g} x {long:g} mm"
+                ins = INSERTS[thread]
+                name = f"{thread} heat-set insert for printed parts, {ins.length:g} mm long, {ins.hole:g} mm hole"
                 extra[name] = extra.get(name, 0) + 1
     out = [{**r, "steps": ", ".join(r["steps"])} for r in rows.values()]
     return out + [{"item": k, "quantity": v, "steps": "with the bolts above"} for k, v in extra.items()]
 
 
-__all__ += ["hardware", "projector_screw_rows", "projector_screw_text"]
+def bill_hardware(rig, steps: list[Step], bill: dict) -> list[dict]:
+    """The manual's one hardware list, for its table and manual.json alike: the plan's fasteners and
+    what they need (:func:`hardware`: what the assembly steps fit, so the bill and the steps cannot
+    disagree), then the COP tower's items no step fits (dowels, balls, springs; the tower's heat-set
+    inserts are counted from the steps' fasteners, not again), then the split pieces' dowel pins.
+    Each row: item, quantity, where (the steps, or what it joins) and a note."""
+    from rigcad.manual import tower_joints
+
+    rows = [{"item": r["item"], "quantity": r["quantity"], "where": f"assembly steps: {r['steps']}",
+             "note": "as the assembly check fitted it", "steps": [s.split(" (")[0] for s in r["steps"].split(", ")]}
+            for r in hardware(steps, rig)]
+    rows += [{"item": f["item"], "quantity": f["quantity"], "where": f["use"], "note": f["note"], "steps": []}
+             for f in bill["fasteners"] if f.get("tower") and "mounting holes" not in f["use"]
+             and not tower_joints.placed({"joins": f["use"]}) and "heat-set insert" not in f["item"]]
+    pin = bill["pins"]
+    if pin:
+        rows.append({"item": pin["item"], "quantity": pin["quantity"], "where": f"aligning split pieces ({pin['use']})",
+                     "note": pin["note"], "steps": []})
+    return rows
+
+
+__all__ += ["bill_hardware", "hardware", "projector_screw_rows", "projector_screw_text"]

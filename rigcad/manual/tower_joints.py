@@ -25,9 +25,9 @@ from __future__ import annotations
 import numpy as np
 
 from rigcad.manual.assembly_check import Fastener
-from rigcad.manual.fasteners import DOWN, NUT_AF, UP, driver, spanner
-from rigcad.manual.fasteners import metric as _metric
+from rigcad.manual.fasteners import DOWN, UP, driver, spanner
 from rigcad.manual.fasteners import socket_head as _socket_head
+from rigcad.standards import THREADS
 
 #: The hardware rows' "joins" text (its start) that this module places as fasteners.
 PLACED = ("the column's top flange to the shelf", "the column's foot to the base plate's datum tongue",
@@ -50,10 +50,9 @@ def _row(rig, start: str) -> dict:
 def _nut_bolt(item: str, head, axis, length: float, thread: str, grip: float, passes, out_dir=None) -> Fastener:
     """A through bolt with a washer under its head and a nut at ``grip`` (mm) from the head's face;
     ``out_dir``: the spanner's way out, or None for a nut held in a trap."""
-    _, _, _, nut_h, _ = _metric(thread)
-    d = float(thread.lstrip("M"))
-    return _socket_head(item, head, axis, length, d, thread, thread_in="nut",
-                        nut_size_mm=(NUT_AF[thread] / np.sqrt(3.0), nut_h),
+    nut_h = THREADS[thread].nut_height
+    return _socket_head(item, head, axis, length, thread, thread_in="nut",
+                        nut_size_mm=(THREADS[thread].nut_corner_radius, nut_h),
                         nut_tool=None if out_dir is None else spanner(thread, nut_h), nut_dir=out_dir,
                         passes=passes, grip_mm=grip)
 
@@ -67,7 +66,7 @@ def column_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
     if rig.profile.buy.column != "print":
         return extrusion_fasteners(rig)
     foot, top = _row(rig, PLACED[1]), _row(rig, PLACED[0])
-    washer = _metric(foot["thread"])[4]
+    washer = THREADS[foot["thread"]].washer_thickness
     pts = _column_flange_points(t, rig.profile)
     z_foot = t.column_base_z + tw.wall + washer
     grip_foot = washer + tw.wall + (t.column_base_z - t.bench_z) - NUT_TRAP_DEPTH
@@ -79,7 +78,7 @@ def column_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
     into = "heat-set insert in" if rig.profile.buy.shelf == "print" else "thread tapped in"
     shelf = tuple(_socket_head(f"{top['thread']} x {top['length_mm']:g} mm socket-head bolt (ISO 4762) with a washer, "
                                f"up into the {into} the shelf", (x, y, z_top), UP, top["length_mm"],
-                               float(top["thread"].lstrip("M")), top["thread"], thread_in="insert",
+                               top["thread"], thread_in="insert",
                                passes=("tower_column", "tower_shelf")) for x, y in pts)
     return {"tower_column": feet, "tower_shelf": shelf}
 
@@ -97,7 +96,7 @@ def extrusion_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
     head_d, head_h, key = CORE_TOP_SCREW
     bolt = _socket_head(f"{foot['thread']} x {foot['length_mm']:g} mm socket-head bolt (ISO 4762) {core}, up from the "
                         "counterbore under the tongue (the rig on blocks)", (t.column_x, 0.0, t.bench_z + CORE_HEAD_BORE[1]),
-                        UP, foot["length_mm"], 8.0, foot["thread"], thread_in="tapped",
+                        UP, foot["length_mm"], foot["thread"], thread_in="tapped",
                         passes=("base_plate", "tower_column"), pierces=("tower_column",),
                         lift_mm=film_setup(rig)["block_under_tongue_mm"])
     screw = Fastener(f"{top['thread']} x {top['length_mm']:g} mm countersunk socket screw (ISO 10642) {core}, down "
@@ -119,14 +118,14 @@ def seat_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]
 
     t, tw, a = rig.layout.tower, rig.profile.tower, rig.profile.adjusters
     spring, screw = _row(rig, PLACED[3]), _row(rig, PLACED[2])
-    washer = _metric(spring["thread"])[4]
+    washer = THREADS[spring["thread"]].washer_thickness
     z_head = t.shelf_top_z - t.shelf_thickness - washer
     grip = 2 * washer + t.shelf_thickness + seat_gap(rig.profile) + tw.wall + spring["spring_mm"]["free_length"]
     item = f"{spring['thread']} x {spring['length_mm']:g} mm socket-head bolt (ISO 4762), 2 washers, spring and nut"
     out = [_nut_bolt(item, (x, y, z_head), UP, spring["length_mm"], spring["thread"], grip,
                      ("tower_shelf", "splitter_holder"), (0.0, float(np.sign(y)), 0.0))
            for x, y in _holder_flange_points(t, rig.profile)]
-    d = float(screw["thread"].lstrip("M"))
+    d = THREADS[screw["thread"]].major
     balls = sorted(n for n in meshes_by_name if n.startswith("seat_ball_"))
     for (x, y), ball in zip(seat_points(t, rig.profile).values(), balls):
         tip = float(meshes_by_name[ball].hi[2])  # the screw turned down onto its ball
@@ -134,7 +133,7 @@ def seat_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]
         out.append(Fastener(f"{screw['thread']} x {screw['length_mm']:g} mm set screw (ISO 4026, flat point) in a "
                             "heat-set insert", head, DOWN, float(screw["length_mm"]), d / 2, d / 2, 0.5,
                             driver(screw["thread"], _outward(x, y) if abs(x) + abs(y) > 1e-9 else (1.0, 0.0, 0.0)),
-                            thread_in="insert", passes=("splitter_holder", ball)))
+                            thread_in="insert", passes=("splitter_holder", ball), washers=0))
     return {"splitter_holder": tuple(out)}
 
 
@@ -149,7 +148,7 @@ def breadboard_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
     row = breadboard.hardware(rig.profile, rig.layout)[0]
     pts = [q for qs in breadboard.anchor_points(rig.profile, rig.layout).values() for q in qs]
     return {"base_plate": tuple(_socket_head(row["item"] + " into the breadboard", (x, y, b.washer[1]), DOWN,
-                                             row["length_mm"], b.diameter, b.thread, thread_in="bench",
+                                             row["length_mm"], b.thread, thread_in="bench",
                                              passes=("base_plate",)) for x, y in pts)}
 
 

@@ -38,7 +38,7 @@ PARTS: dict[str, Callable[[Profile, RigLayout], Part]] = {
     "tower_shim": tower_shim,
 }
 
-__all__ = ["PARTS", "Part", "RigLayout", "make_recipe", "make_recipes", "rig_layout"]
+__all__ = ["PARTS", "Part", "RigLayout", "make_layout", "make_recipe", "make_recipes", "rig_layout"]
 
 
 class _Reads:
@@ -68,6 +68,14 @@ def make_recipe(profile: Profile, layout: RigLayout, name: str) -> Part:
     reads = _Reads(profile)
     part = PARTS[name](reads, layout)  # type: ignore[arg-type]  # reads every attribute through to the profile
     return replace(part, shaped_by=tuple(dict.fromkeys(reads.keys)))
+
+
+def make_layout(profile: Profile, geometry, dome) -> RigLayout:
+    """The rig's placements (:func:`rig_layout`), with the profile keys the layout read
+    (``RigLayout.shaped_by``)."""
+    reads = _Reads(profile)
+    layout = rig_layout(reads, geometry, dome)  # type: ignore[arg-type]  # reads every attribute through
+    return replace(layout, shaped_by=tuple(dict.fromkeys(reads.keys)))
 
 
 def make_recipes(profile: Profile, layout: RigLayout) -> dict[str, Part]:

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 from rigcad.parts.datum import datum_chain
 from rigcad.parts.tower import projector_screws, seat_points
-from rigcad.profile.schema import THREAD_PITCH
+from rigcad.standards import THREADS
 
 
 
@@ -69,7 +69,7 @@ def splitter_adjusters(profile, layout) -> list[Adjuster]:
     the vee's screw about the other axis; the cone's screw, with both, sets its height."""
     t, a, tol = layout.tower, profile.adjusters, profile.tolerancing
     pts = seat_points(t, profile)
-    step = THREAD_PITCH[a.seat_thread] * a.turn_fraction
+    step = THREADS[a.seat_thread].pitch * a.turn_fraction
     # the printed grooves' angle error: each face print_position off across the plate's length
     groove = 2 * profile.datum.print_position / profile.beam_splitter.length
     out = []
@@ -78,7 +78,7 @@ def splitter_adjusters(profile, layout) -> list[Adjuster]:
         arm = _lever(pts[screw], pts[o1], pts[o2])
         out.append(Adjuster(
             f"splitter tilt {what}",
-            f"{a.seat_thread} x {THREAD_PITCH[a.seat_thread]:g} mm push screw over the {screw} ball, "
+            f"{a.seat_thread} x {THREADS[a.seat_thread].pitch:g} mm push screw over the {screw} ball, "
             f"{a.turn_fraction:g} turn, on a {arm:.1f} mm lever; the reflected axis turns twice the plate",
             "tolerancing.projector_tilt", tol.projector_tilt, "rad",
             2 * a.seat_travel / arm, 2 * step / arm, 2 * groove))

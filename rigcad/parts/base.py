@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 from rigcad.parts import breadboard
-from rigcad.parts.dome import bolt_holes
+from rigcad.parts.dome import flange_joint
 from rigcad.parts.layout import RigLayout
 from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Union_
 from rigcad.parts.tower import column_joint_cuts, tongue_underside_cuts
@@ -27,7 +27,7 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
     tongue = Box((x0, -half, tw.bench_z), (tw.column_x + half, half, 0.0))  # down to the bench: the tower's weight
     bore = Cylinder((0.0, 0.0, -t - 1.0), holder.radius + holder.clearance, t + 2.0)
     groove = azimuth_groove(profile, tw.bench_z)
-    holes = bolt_holes(layout, profile.dome_shell.bolt_diameter, -t - 1.0, t + 2.0)
+    holes = flange_joint(profile, layout).thread_holes()  # the dome's screws' insert pockets, as the joint declares
     joint = (*column_joint_cuts(tw, profile, tw.bench_z, -tw.bench_z, "top"), *tongue_underside_cuts(tw, profile, tw.bench_z))
     b = breadboard.board(profile)
     pads = breadboard.pads(profile, layout) if b else ()
@@ -36,7 +36,7 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
         f"; it stands on the {b.title}: the sample point over a tapped hole, the tongue along a row of holes, "
         f"screwed down on the grid through its pad and the boss under the disc")
     return Part("base_plate", Difference(Union_((plate, tongue, *pads)), (bore, groove, *holes, *joint, *anchors)),
-                (0.55, 0.57, 0.6), "base plate, the rig's datum: bolts to the dome flange; the sample holder slides "
+                (0.55, 0.57, 0.6), "base plate, the rig's datum: the dome's flange screws into its heat-set inserts; the sample holder slides "
                 "into its bore (the groove under the disc on the tongue's side is the calibration parts' turn mark); "
                 "its tongue locates the tower's column " + (
                     f"by two {profile.datum.dowel_diameter:g} mm dowels (reamed H7) and four bolts"

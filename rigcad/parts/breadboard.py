@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 from rigcad.errors import GeometryError
 from rigcad.parts.recipe import Box, Cylinder
+from rigcad.standards import INCH, INCH_SCREW_LENGTHS, LARGE_WASHERS, THREADS, screw_lengths
 
 
 @dataclass(frozen=True)
@@ -45,20 +46,19 @@ class Breadboard:
     lengths: tuple[tuple[float, str], ...]
 
 
-_INCH = 25.4
+def _grid(title: str, pitch: float, thread: str, lengths: tuple[tuple[float, str], ...]) -> Breadboard:
+    """A grid's screws from rigcad.standards: the thread's medium (normal-fit) clearance and an ISO 7093-1
+    large washer (it covers the opened hole)."""
+    th = THREADS[thread]
+    return Breadboard(title, pitch, thread, th.major, th.clearance, LARGE_WASHERS[thread], lengths)
+
+
 BREADBOARDS = {
-    # ISO 273 medium clearance 6.6 mm; ISO 7093-1 large washer, size 6: 18 x 1.6 mm (it covers the
-    # opened hole); ISO 4762 lengths
-    "breadboard_m6_25mm": Breadboard("metric optical breadboard, M6 tapped holes on a 25 mm grid", 25.0, "M6", 6.0,
-                                     6.6, (18.0, 1.6), tuple((float(n), f"{n} mm") for n in (12, 16, 20, 25, 30, 35,
-                                                                                            40, 45, 50))),
-    # ASME B18.2.8 normal-fit clearance for 1/4 in: 0.281 in; the ISO 7093-1 size-6 washer (6.4 mm
-    # bore) takes a 1/4 in screw; ASME B18.3 inch socket-head cap screws in 1/8 in steps
-    "breadboard_imperial_1in": Breadboard("imperial optical breadboard, 1/4-20 UNC tapped holes on a 1 in grid",
-                                          _INCH, "1/4-20 UNC", 0.25 * _INCH, 0.281 * _INCH, (18.0, 1.6),
-                                          tuple((n * _INCH, f"{label} in") for n, label in (
-                                              (0.5, "1/2"), (0.625, "5/8"), (0.75, "3/4"), (0.875, "7/8"), (1.0, "1"),
-                                              (1.25, "1 1/4"), (1.5, "1 1/2"), (1.75, "1 3/4"), (2.0, "2")))),
+    "breadboard_m6_25mm": _grid("metric optical breadboard, M6 tapped holes on a 25 mm grid", 25.0, "M6",
+                                tuple((float(n), f"{n} mm") for n in screw_lengths("M6") if 12 <= n <= 50)),
+    "breadboard_imperial_1in": _grid("imperial optical breadboard, 1/4-20 UNC tapped holes on a 1 in grid", INCH,
+                                     "1/4-20 UNC", tuple((n * INCH, label) for n, label in INCH_SCREW_LENGTHS
+                                                         if 0.5 <= n <= 2.0)),
 }
 #: Room (mm) a hand and a hex key need between the disc screw's washer and the dome's flange.
 HAND_ROOM_MM = 15.0

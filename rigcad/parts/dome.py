@@ -7,19 +7,31 @@ import math
 
 import numpy as np
 
+from rigcad.errors import GeometryError
+from rigcad.parts.joints import ScrewJoint
 from rigcad.parts.layout import RigLayout, u_at_height
-from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section
+from rigcad.parts.recipe import Box, Curve, Difference, Line, Part, Revolve, Section
 from rigcad.profile.schema import Profile
+from rigcad.standards import thread_for_hole
 
 
 def _pt(m, u) -> tuple[float, float]:
     return tuple(float(v) for v in m.points(np.array([u]))[0])
 
 
-def bolt_holes(layout: RigLayout, diameter: float, z0: float, height: float) -> tuple[Cylinder, ...]:
-    """Vertical holes on the flange's bolt circle, from z0 up ``height`` mm."""
+def flange_joint(profile: Profile, layout: RigLayout) -> ScrewJoint:
+    """The dome's flange on the base plate: ``dome_shell.bolts`` screws on the flange's bolt circle,
+    down through the flange into heat-set inserts in the plate (the plate stands on the bench: no
+    nut fits under it); the thread is the largest whose clearance hole is ``dome_shell.bolt_diameter``."""
+    shell = profile.dome_shell
+    try:
+        thread = thread_for_hole(shell.bolt_diameter).name
+    except ValueError as err:
+        raise GeometryError(str(err), where=profile.where("dome_shell", "bolt_diameter")) from err
     r = layout.bolt_circle_r
-    return tuple(Cylinder((r * math.cos(a), r * math.sin(a), z0), diameter / 2, height) for a in layout.bolt_angles)
+    points = tuple((r * math.cos(a), r * math.sin(a)) for a in layout.bolt_angles)
+    return ScrewJoint("dome_flange", "dome", "base_plate", thread, points, (0.0, shell.flange_thickness),
+                      (-profile.base_plate.thickness, 0.0), "insert", "dome_shell.bolt_diameter")
 
 
 def dome(profile: Profile, layout: RigLayout) -> Part:
@@ -50,7 +62,8 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
     half_w = profile.beam.width / 2 + c
     reach = layout.slot_r + 5.0
     slot = Box((-reach, -half_w, z0), (reach, half_w, z1 + c))  # the beam rests on the slot's floor
-    holes = bolt_holes(layout, shell.bolt_diameter, -1.0, t_f + 2.0)
+    joint = flange_joint(profile, layout)
+    holes = joint.clearance_holes(shell.bolt_diameter)
     return Part("dome", Difference(Revolve(section), (slot, *holes)), (0.82, 0.82, 0.86),
                 "dome: mirror surface inside (paint it), wall, base flange bolted to the base plate, beam slots",
-                mirrors=(("dome", layout.design_dome),))
+                mirrors=(("dome", layout.design_dome),), joints=(joint,))

@@ -10,7 +10,7 @@ bolted to the base plate whose top face is the sample plane z = 0.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -63,6 +63,9 @@ class RigLayout:
     slot_r: float  #: the wall's largest outer radius across the beam's slot band
     dome_top_z: float  #: the dome's highest point
     tower: "TowerLayout"  #: the COP tower and its instruments (rigcad.parts.tower)
+    #: The profile keys ("section.key") the layout read (rigcad.parts.make_layout): what moves every
+    #: placement, so what the assembly gate may name when placed parts collide.
+    shaped_by: tuple[str, ...] = field(default=(), compare=False)
     #: Sanding stock (mm) printed in front of ``printed_dome`` / ``printed_paraboloid`` (0 for the
     #: design exports; the fab stage sets it, :meth:`with_sanding_stock`).
     dome_stock: float = 0.0

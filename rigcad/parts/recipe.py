@@ -198,6 +198,9 @@ class Part:
     occluders: tuple[tuple[str, Box | Cylinder], ...] = field(default=(), compare=False)
     #: The profile keys ("section.key") this part's function read: named when the kernel fails.
     shaped_by: tuple[str, ...] = field(default=(), compare=False)
+    #: The joints this part's screws make with another part (rigcad.parts.joints.ScrewJoint), declared
+    #: by the part the heads bear on; its holes and the other part's are cut from them.
+    joints: tuple = field(default=(), compare=False)
 
     def content_hash(self) -> str:
         """SHA-256 of the solid's full definition (every number, every curve's coefficients)."""

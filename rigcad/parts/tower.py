@@ -42,10 +42,9 @@ from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_po
 from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Translate,
                                  Union_)
 from rigcad.profile.derived import Derived
-from rigcad.profile.schema import MOUNT_THREADS, Profile
+from rigcad.profile.schema import Profile
+from rigcad.standards import INSERTS, THREADS, longest_dowel, longest_screw, screw_lengths, shortest_screw
 
-#: Clearance hole over a thread's major diameter (mm): ISO 273 medium for M4 is 4.5 mm.
-THREAD_CLEARANCE = 0.5
 #: Gap around the splitter plate in its grooves (mm): a printed groove comes out ~0.1 mm narrow.
 GROOVE_GAP = 0.2
 #: Depth of the grooves into the holder's side walls (mm): the plate's edge rests on this much.
@@ -57,8 +56,9 @@ FOOT_INSET = 30.0
 
 
 def clearance_hole(thread: str) -> float:
-    """Clearance hole diameter (mm) for a named mounting thread."""
-    return MOUNT_THREADS[thread] + THREAD_CLEARANCE
+    """Clearance hole diameter (mm) for a named mounting thread: ISO 273 medium (ASME B18.2.8 normal
+    for an inch thread), from rigcad.standards."""
+    return THREADS[thread].clearance
 
 
 @dataclass(frozen=True)
@@ -305,16 +305,13 @@ def _countersink() -> Revolve:
                             Line((r, 0.0), (r, 1.0)), Line((r, 1.0), (0.0, 1.0)), Line((0.0, 1.0), (0.0, -k - 0.2)))))
 
 
-#: ISO 4032 hex nuts: width across flats (mm) per metric thread (the spanner's size); the one home of
-#: these sizes (the nut traps here, the manual's nuts and spanners).
-NUT_AF = {"M2": 4.0, "M2.5": 5.0, "M3": 5.5, "M4": 7.0, "M5": 8.0, "M6": 10.0, "M8": 13.0, "M10": 16.0, "M12": 18.0}
 #: Hexagonal nut traps under the tongue (mm): the M4 nut's 7.0 mm across flats and a printed fit's gap
 #: (0.2 mm) on each flat; a corner on +x (NUT_TRAP_TURN, rad). The nut (4.04 mm to a corner) cannot turn
 #: in it (3.7 mm to a flat). The depth puts the nut so high that a stocked 20 mm bolt reaches through it
 #: and ends 0.8 mm above the bench; the tongue then stands on the bench (the assembly check,
 #: rigcad.manual.tower_joints, verifies both, the nut drawn as its hexagon).
 NUT_TRAP_GAP = 0.2
-NUT_TRAP = NUT_AF["M4"] + 2 * NUT_TRAP_GAP
+NUT_TRAP = THREADS["M4"].nut_af + 2 * NUT_TRAP_GAP
 NUT_TRAP_TURN = 0.0
 NUT_TRAP_DEPTH = 5.6
 #: Counterbore under the tongue for the extrusion's M8 socket head (13 mm, 8 mm tall; ISO 4762):
@@ -334,8 +331,7 @@ def core_bolt_lengths(profile: Profile, t: TowerLayout) -> dict[str, float]:
     and "top" (ISO 10642 countersunk, down from the shelf's top; its length includes the head), each
     the longest stocked length whose thread stops 1 mm short of the tapped depth."""
     grips = {"foot": -t.bench_z - CORE_HEAD_BORE[1] - POCKET_DEPTH, "top": t.shelf_thickness - POCKET_DEPTH}
-    return {k: float(max(L for L in ISO_4762_LENGTHS if L <= g + CORE_TAP_DEPTH - 1.0 + 1e-9))
-            for k, g in grips.items()}
+    return {k: float(longest_screw("M8", g + CORE_TAP_DEPTH - 1.0)) for k, g in grips.items()}
 
 
 def tongue_underside_cuts(t: TowerLayout, profile: Profile, z_bottom: float) -> tuple:
@@ -356,7 +352,7 @@ def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: floa
 
 
 #: The shelf's joint to the printed column's top flange: bolts up from under the flange into M4
-#: heat-set inserts (5.6 x 8.1 mm; a bought aluminium shelf is tapped M4 instead) in blind holes in
+#: heat-set inserts (SHELF_INSERT; a bought aluminium shelf is tapped M4 instead) in blind holes in
 #: the shelf's underside, so nothing stands proud of the shelf's top under the projector, which stands
 #: on its shims only a few mm above it.
 
@@ -367,7 +363,7 @@ def shelf_joint_cuts(t: TowerLayout, profile: Profile, z0: float) -> tuple:
     bought extrusion, its pocket and core bolt hole (:func:`column_joint_cuts`)."""
     if profile.buy.column != "print":
         return column_joint_cuts(t, profile, z0, t.shelf_thickness, "bottom")
-    d, long = SHELF_INSERT
+    d, long = SHELF_INSERT.hole, SHELF_INSERT.length
     blind = tuple(Cylinder((x, y, z0 - 1.0), d / 2, long + 1.5) for x, y in _column_flange_points(t, profile))
     return blind + _holes(column_dowel_points(t, profile), profile.datum.dowel_diameter, z0, t.shelf_thickness)
 
@@ -375,8 +371,8 @@ def shelf_joint_cuts(t: TowerLayout, profile: Profile, z0: float) -> tuple:
 def shelf_bolt_length(profile: Profile) -> float:
     """The shelf joint's bolt (mm): the longest stocked ISO 4762 length that stops 0.5 mm short of the
     insert's end, through the column's flange and a washer."""
-    reach = profile.tower.wall + WASHER + SHELF_INSERT[1] - 0.5
-    return float(max(L for L in ISO_4762_LENGTHS if L <= reach + 1e-9))
+    reach = profile.tower.wall + THREADS["M4"].washer_thickness + SHELF_INSERT.length - 0.5
+    return float(longest_screw("M4", reach))
 
 
 def _holder_flange_points(t: TowerLayout, profile: Profile):
@@ -385,13 +381,8 @@ def _holder_flange_points(t: TowerLayout, profile: Profile):
     return [(t.holder_x[0] + 8.0, s * y) for s in (-1, 1)]
 
 
-#: Heat-set insert holes (mm) for the seat's push screws: the insert makers' hole for each thread.
-INSERT_HOLE = {"M3": 4.0, "M4": 5.6, "M5": 6.4, "M6": 8.0}
-#: Heat-set inserts as sold for printed parts: M thread -> (outer diameter, length), mm (e.g. M4:
-#: 5.6 x 8.1 mm); the one home of these sizes (the parts' holes, the manual's plan and BOM).
-HEAT_SET_INSERT = {"M3": (4.5, 5.7), "M4": (5.6, 8.1), "M5": (6.4, 9.5), "M6": (8.0, 12.7)}
-#: The shelf's M4 inserts: the insert makers' hole and the insert's length (mm).
-SHELF_INSERT = (INSERT_HOLE["M4"], HEAT_SET_INSERT["M4"][1])
+#: The shelf's M4 heat-set inserts (rigcad.standards.INSERTS: the maker's hole and the insert's length).
+SHELF_INSERT = INSERTS["M4"]
 #: Clearance (mm) of the spring bolts in the holder's flanges: room to tilt by the seat's travel.
 SPRING_HOLE = 6.0
 
@@ -576,7 +567,7 @@ def splitter_holder(profile: Profile, layout) -> Part:
     flanges = [Box((x0, -yo - fl, z0), (x1, -yo, z0 + tw.wall)), Box((x0, yo, z0), (x1, yo + fl, z0 + tw.wall)),
                Box((x0 - fl, -yo, z0), (x0, yo, z0 + tw.wall))]
     bracket, slot = _camera_bracket(t, profile)
-    holes = (_holes(seat_points(t, profile).values(), INSERT_HOLE[a.seat_thread], z0, tw.wall)
+    holes = (_holes(seat_points(t, profile).values(), INSERTS[a.seat_thread].hole, z0, tw.wall)
              + _holes(_holder_flange_points(t, profile), SPRING_HOLE, z0, tw.wall))
     solid = Difference(Union_((*walls, back, *flanges, *bracket)), (_groove(t), slot, *holes))
     return Part("splitter_holder", solid, (0.3, 0.5, 0.75),
@@ -626,17 +617,26 @@ def tower_shim(profile: Profile, layout) -> Part:
 
 TOWER_PARTS = ("tower_column", "tower_shelf", "splitter_holder", "lens_mount", "tower_shim")
 
-#: What a bolt needs past its grip (mm): a washer and a nut (0.8 d) for a through bolt, and two
-#: threads proud; or, screwed into an instrument, the thread engaged in its socket (assumed 5 mm).
-NUT_FACTOR = 0.8
-WASHER = 1.0
+#: Screwed into an instrument, a screw engages its socket this far (mm; assumed: 5 mm).
 SOCKET_ENGAGEMENT = 5.0
-#: Bolt lengths are rounded up to this step (mm): ISO 4762 lengths run in 5 mm steps from 10 to 50.
-LENGTH_STEP = 5.0
 
 
-def _length(grip: float, extra: float) -> float:
-    return LENGTH_STEP * math.ceil((grip + extra) / LENGTH_STEP - 1e-9)
+def _length(thread: str | None, grip: float, extra: float) -> float:
+    """The shortest preferred length (mm, rigcad.standards) of a screw of ``thread`` through ``grip``
+    mm that needs ``extra`` mm past it (a nut and washers, or a socket's engagement)."""
+    need = grip + extra
+    length = shortest_screw(thread, need)
+    if length is None:
+        raise GeometryError(f"no {thread or ''} screw of the preferred lengths is {need:.1f} mm long: "
+                            "the joint's parts are too thick", param="tower.wall")
+    return float(length)
+
+
+def nut_allowance(thread: str, washers: int = 2) -> float:
+    """What a through bolt needs past its grip (mm): ``washers`` washers (under its head and under
+    its nut; one when the nut sits in a printed trap), the nut, and two pitches proud (rigcad.standards)."""
+    th = THREADS[thread]
+    return washers * th.washer_thickness + th.nut_height + 2 * th.pitch
 
 
 def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
@@ -658,14 +658,14 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
          "joins": "the column's top flange to the shelf: up from under the flange into "
                   + ("heat-set inserts pressed into the shelf's underside" if profile.buy.shelf == "print" else
                      "M4 threads tapped in the shelf's underside (8 mm deep)")},
-        {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length(tw.wall + tongue - NUT_TRAP_DEPTH, nut),
+        {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length("M4", tw.wall + tongue - NUT_TRAP_DEPTH, nut_allowance("M4", washers=1)),
          "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
                                  "under the tongue, put in before it stands on the bench)"},
-        *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT[0],
+        *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT.hole,
             "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]
           if profile.buy.shelf == "print" else []),
         {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
-         "length_mm": _length(min(tw.wall, t.shelf_thickness) + tw.wall, 0.0), "quantity": 4,
+         "length_mm": float(longest_dowel(min(tw.wall, t.shelf_thickness) + tw.wall)), "quantity": 4,
          "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf "
                   f"(ream the printed holes {profile.datum.dowel_diameter:g} H7)"},
     ]
@@ -678,23 +678,21 @@ def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
     spring = 10.0  # free length (mm) of the compression spring under the nut (assumed stock: 10 mm)
     return [
         {"item": "set screw, ISO 4026 (flat point)", "thread": a.seat_thread,
-         "length_mm": _length(tw.wall + a.seat_travel + 1.0, 0.0), "quantity": 3,
+         "length_mm": _length(None, tw.wall + a.seat_travel + 1.0, 0.0), "quantity": 3,
          "joins": "the splitter holder's seat: pushes on a ball, turned from above (tip/tilt)"},
         {"item": "heat-set insert", "thread": a.seat_thread, "length_mm": None, "quantity": 3,
-         "hole_mm": INSERT_HOLE[a.seat_thread], "joins": "pressed into the holder's three seat holes from above"},
+         "hole_mm": INSERTS[a.seat_thread].hole, "joins": "pressed into the holder's three seat holes from above"},
         {"item": "steel ball, DIN 5401", "thread": None, "length_mm": None, "quantity": 3, "diameter_mm": a.seat_ball,
          "joins": "in the shelf's cone, vee and flat, under the push screws"},
         {"item": "bolt, two washers, nut and compression spring", "thread": "M4",
-         "length_mm": _length(t.shelf_thickness + gap + tw.wall + spring, nut), "quantity": 2,
+         "length_mm": _length("M4", t.shelf_thickness + gap + tw.wall + spring, nut), "quantity": 2,
          "spring_mm": {"inner_diameter": 4.5, "free_length": spring},
          "joins": "from under the shelf up through the holder's flange; the spring under the nut holds the holder "
                   "on its three balls"},
     ]
 
 
-#: ISO 4762 socket head cap screw lengths (mm) stocked for M3..M6 (the standard's preferred series).
-ISO_4762_LENGTHS = (6, 8, 10, 12, 16, 20, 25, 30, 35, 40, 45, 50, 55, 60, 65, 70, 80)
-#: Washers (1 mm, ISO 7089 for M4 is 0.8 mm: rounded up) a screw may carry under its head to reach
+#: Washers (ISO 7089 for the projector's thread: rigcad.standards) a screw may carry under its head to reach
 #: the right depth: more and the joint loses stiffness.
 MAX_EXTRA_WASHERS = 3
 
@@ -707,9 +705,11 @@ def projector_screws(profile, layout) -> list[dict]:
     t, tw, pj = layout.tower, profile.tower, profile.projector
     rows = []
     for n in range(t.shims_per_stack + 1):
-        grip = WASHER + t.shelf_thickness + n * tw.shim_thickness
-        fits = [(L, w, L - grip - w * WASHER) for L in ISO_4762_LENGTHS for w in range(MAX_EXTRA_WASHERS + 1)
-                if SOCKET_ENGAGEMENT - 1e-9 <= L - grip - w * WASHER <= pj.mount_depth + 1e-9]
+        washer = THREADS[pj.mount_thread].washer_thickness
+        grip = washer + t.shelf_thickness + n * tw.shim_thickness
+        fits = [(L, w, L - grip - w * washer) for L in screw_lengths(pj.mount_thread)
+                for w in range(MAX_EXTRA_WASHERS + 1)
+                if SOCKET_ENGAGEMENT - 1e-9 <= L - grip - w * washer <= pj.mount_depth + 1e-9]
         length, washers, reach = fits[0] if fits else (None, None, None)
         rows.append({"shims": n, "grip_mm": grip, "length_mm": length, "extra_washers": washers,
                      "engagement_mm": reach, "ok": bool(fits)})
@@ -736,14 +736,14 @@ def _projector_screw_rows(profile: Profile, layout) -> list[dict]:
 
 def hardware(profile: Profile, layout) -> list[dict]:
     """The tower's bought hardware, computed from the parts (mm; units in keys): each item's name,
-    quantity, thread and length (grip plus nut or socket engagement, rounded up to LENGTH_STEP), and
+    quantity, thread and length (grip plus nut or socket engagement, the shortest preferred length), and
     what it joins: the datum chain's dowels and bolts, the splitter seat's parts, the projector's
     screws per shim stack, the camera's two screws, the splitter and the focusing lens (bought to
     the catalogue specification: ``splitter_spec``, ``rigcad.optics.focus``)."""
     t, tw, cm, bs, ln = layout.tower, profile.tower, profile.camera, profile.beam_splitter, profile.lens
     m4 = "M4"
-    nut = NUT_FACTOR * MOUNT_THREADS[m4] + WASHER + 1.0  # + two threads of 0.7 mm pitch, rounded
-    through = _length(tw.wall + t.shelf_thickness, nut)  # the lens mount's foot on the shelf
+    nut = nut_allowance(m4)
+    through = _length(m4, tw.wall + t.shelf_thickness, nut)  # the lens mount's foot on the shelf
     shim_max = t.shims_per_stack * tw.shim_thickness
     bracket = t.bracket_y + t.wall_y[1]  # the camera bracket's thickness (y)
     _, _, _, lens_pts = _lens_foot(t, profile)
@@ -755,7 +755,7 @@ def hardware(profile: Profile, layout) -> list[dict]:
          "joins": "the lens mount's slotted foot to the shelf"},
         *_projector_screw_rows(profile, layout),
         {"item": "screw and washer", "thread": cm.mount_thread,
-         "length_mm": _length(bracket + shim_max, SOCKET_ENGAGEMENT), "quantity": 2,
+         "length_mm": _length(cm.mount_thread, bracket + shim_max, SOCKET_ENGAGEMENT), "quantity": 2,
          "joins": f"the camera's two mounting holes ({cm.mount_spacing:g} mm apart along its axis), through the "
                   "bracket's slot and its shim stack"},
         {"item": "plate beam splitter", "thread": None, "length_mm": None, "quantity": 1,

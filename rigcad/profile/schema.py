@@ -15,6 +15,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 from rigcad.errors import ProfileError
+from rigcad.standards import MOUNT_THREADS
 from rigcad.profile import instruments as instrument_library
 from rigcad.profile.loader import Key, RawProfile
 from rigcad.units import DEG, UnitError, parse_quantity
@@ -32,18 +33,9 @@ MAX_SEED = 2**63 - 1
 MAX_PIXELS = 16_384
 #: Thickest coating layer (mm): paint films are 0.01..0.1 mm; a millimetre is a unit slip.
 MAX_COATING_LAYER_MM = 1.0
-#: Mounting threads an instrument may name, with their major diameters (mm): ISO metric coarse, and
-#: the unified 1/4-20 and 3/8-16 UNC of camera tripod sockets (ISO 1222).
-MOUNT_THREADS: dict[str, float] = {"M3": 3.0, "M4": 4.0, "M5": 5.0, "M6": 6.0, "1/4-20 UNC": 6.35,
-                                   "3/8-16 UNC": 9.525}
-
 #: What the rig may stand on (``datum.mount``): its base plate on a bench, or an optical breadboard
 #: (rigcad.parts.breadboard holds each grid's pitch and thread).
 MOUNTS = ("base_plate", "breadboard_m6_25mm", "breadboard_imperial_1in")
-
-#: Thread pitches (mm) of the same threads: ISO 261 coarse; UNC 20 and 16 threads per inch.
-THREAD_PITCH: dict[str, float] = {"M3": 0.5, "M4": 0.7, "M5": 0.8, "M6": 1.0, "1/4-20 UNC": 25.4 / 20,
-                                  "3/8-16 UNC": 25.4 / 16}
 
 _POS = {"lo": 0, "lo_open": True}
 

@@ -11,7 +11,8 @@ import pytest
 
 from rigcad.errors import GeometryError
 from rigcad.manual import assembly_check as AC
-from rigcad.manual import plan
+from rigcad.manual import fasteners, plan
+from rigcad.standards import DRIVER_BLADE_MM
 
 DOWN = (0.0, 0.0, -1.0)
 
@@ -23,7 +24,7 @@ def box(lo, hi):
 
 def bolt(head_z: float, x: float = 0.0, tools=None) -> AC.Fastener:
     """An M4 x 12 screw straight down at (x, 0) into a heat-set insert in the plate."""
-    tools = tools or plan.driver("M4")
+    tools = tools or fasteners.driver("M4")
     return AC.Fastener("M4 x 12 mm screw", (x, 0.0, head_z), DOWN, 12.0, 2.0, 3.0, 4.0, tools,
                        thread_in="insert", passes=("plate", "block"))
 
@@ -85,8 +86,8 @@ def test_the_tool_path_is_the_tools_length():
     """The driver's blade is 100 mm and the screw's head top is 4 mm above the block (z = 14): a roof
     1 mm beyond the blade's reach is clear of it, one 1 mm short of it is not; the tool's stated
     length decides (the driver alone here: no L key)."""
-    only_driver = plan.driver("M4")[:1]
-    for gap, ok in ((plan.DRIVER_BLADE_MM + 4.0 + 1.0, True), (plan.DRIVER_BLADE_MM + 4.0 - 1.0, False)):
+    only_driver = fasteners.driver("M4")[:1]
+    for gap, ok in ((DRIVER_BLADE_MM + 4.0 + 1.0, True), (DRIVER_BLADE_MM + 4.0 - 1.0, False)):
         a = world(cover_gap=gap, tools=only_driver)
         try:
             AC.check_order(a, ["plate", "cover", "block"])

@@ -15,37 +15,29 @@ import pytest
 
 from rigcad.errors import GeometryError
 from rigcad.manual import bom as B
+from rigcad.standards import THREADS
 from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Translate, Union_
 
 
-# -- the ISO tables -------------------------------------------------------------------------------
-def test_thread_for_hole_takes_the_largest_clearance_that_fits_at_each_edge():
-    for k, (thread, hole, *_rest) in enumerate(B.METRIC):
-        assert B.thread_for_hole(hole)[0] == thread
-        assert B.thread_for_hole(hole - 5e-10)[0] == thread  # within the 1e-9 mm of round-off
-        assert B.thread_for_hole(hole + 1e-6)[0] == thread
-        if k:
-            assert B.thread_for_hole(hole - 1e-6) == B.METRIC[k - 1]
-    assert B.thread_for_hole(100.0) == ("M12", 13.5, 1.75, 10.8, 2.5)
+# -- the ISO tables (their figures: rigcad.standards; tests/test_standards.py) ----------------------
+def test_thread_for_hole_refuses_a_hole_under_m2_naming_the_profile_key():
     with pytest.raises(GeometryError) as e:
         B.thread_for_hole(2.4 - 1e-6)
     assert e.value.param == "dome_shell.bolt_diameter"
-    assert str(e.value) == "a 2.4 mm hole takes no ISO metric bolt from M2 (2.4 mm clearance) up"
+    assert str(e.value) == "a 2.4 mm hole takes no ISO metric bolt from M2 (2.4 mm clearance, ISO 273 medium) up"
 
 
 def test_bolt_length_is_the_shortest_preferred_length_over_the_sum():
-    # grip + 2 washers + nut + 2 pitches, by hand
-    assert B.bolt_length(16.0, 0.7, 3.2, 0.8) == (25, pytest.approx(16 + 1.6 + 3.2 + 1.4, abs=1e-12))
-    length, need = B.bolt_length(10.0, 0.5, 2.5, 1.25)  # need = 10 + 2.5 + 2.5 + 1.0 = 16 exactly
-    assert need == 16.0 and length == 16
-    assert B.bolt_length(10.0 + 1e-10, 0.5, 2.5, 1.25)[0] == 16  # within the 1e-9 mm of round-off
-    assert B.bolt_length(10.0 + 1e-6, 0.5, 2.5, 1.25)[0] == 20
-    assert B.bolt_length(0.0, 0.0, 0.0, 0.0) == (5, 0.0)
-    assert B.bolt_length(200.0, 0.0, 0.0, 0.0) == (200, 200.0)
+    m4 = THREADS["M4"]
+    # grip + 2 washers (ISO 7089 M4: 0.8 mm) + nut (ISO 4032 M4: 3.2 mm) + 2 pitches (0.7 mm), by hand
+    assert B.bolt_length(16.0, m4) == (25, pytest.approx(16 + 1.6 + 3.2 + 1.4, abs=1e-12))
+    assert B.bolt_length(20.0 - 6.2, m4)[0] == 20  # need exactly 20
+    assert B.bolt_length(20.0 - 6.2 + 1e-6, m4)[0] == 25
+    assert B.bolt_length(0.0, m4)[0] == 8  # need 6.2: the shortest M4 that ISO 4762 sells of 6.2 mm or more
     with pytest.raises(GeometryError) as e:
-        B.bolt_length(190.0, 1.0, 8.0, 2.0)  # 190 + 4 + 8 + 2 = 204 mm
+        B.bolt_length(40.0, m4)  # 46.2 mm: past ISO 4762's longest M4 (40 mm)
     assert e.value.param == "base_plate.thickness"
-    assert str(e.value) == ("bolts of 204.0 mm are longer than the longest preferred length (200 mm): "
+    assert str(e.value) == ("M4 bolts of 46.2 mm are longer than the longest ISO 4762 length (40 mm): "
                             "the flange and plate are too thick")
 
 

@@ -266,3 +266,63 @@ def test_a_bought_part_is_billed_with_its_stock_not_as_a_cut_plate(table31_rig):
     rows = B.printed(table31_rig, {"parts": {"tower_column": {"process": "bought", "stock": stock, "quantity": 1}}})
     assert rows == [{"part": "tower_column", "use": "rig", "quantity": 1, "process": "bought", "pieces": 0,
                      "time_s": None, "material_g": None, "source": None, "note": stock}]
+
+
+# -- manual.md states what manual.json holds -------------------------------------------------------
+def _md_table(md: str, heading: str) -> list[list[str]]:
+    """The rows (cells stripped, header and rule dropped) of the first table after ``### heading``."""
+    section = md.split(f"### {heading}\n", 1)[1].split("\n### ", 1)[0].splitlines()
+    start = next(k for k, ln in enumerate(section) if ln.startswith("|"))
+    lines = []
+    for ln in section[start:]:
+        if not ln.startswith("|"):
+            break
+        lines.append(ln)
+    return [[c.strip() for c in ln.strip("|").split("|")] for ln in lines[2:]]
+
+
+def disagreements(md: str, doc: dict) -> list[str]:
+    """Where manual.md's bill (its hardware, printed parts, optics and coating tables and the total
+    line) differs from manual.json's: each difference as a sentence; [] when they agree."""
+    from rigcad.units import hours_minutes
+
+    bill, out = doc["bill"], []
+    pairs = [("Hardware", [[r[0], r[1]] for r in _md_table(md, "Hardware")],
+              [[r["item"], str(r["quantity"])] for r in bill["hardware"]]),
+             ("Printed and cut parts", [[r[0].strip("`"), r[2], r[3]] for r in _md_table(md, "Printed and cut parts")],
+              [[r["part"], str(r["quantity"] or "-"), str(r["pieces"]) if r.get("time_s") is not None else
+                ("bought" if r["process"] == "bought" else "cut" if r["quantity"] else "-")] for r in bill["printed"]]),
+             ("Optics and instruments", [[r[0], r[1]] for r in _md_table(md, "Optics and instruments")],
+              [[r["item"], str(r["quantity"])] for r in bill["purchased"]]),
+             ("Paint and clearcoat", [[r[0], r[4].strip("*")] for r in _md_table(md, "Paint and clearcoat")],
+              [[c["layer"], f"{c['to_buy_cm3']:.1f} ml"] for c in bill["coating"]])]
+    for name, shown, held in pairs:
+        if shown != held:
+            out.append(f"{name}: manual.md {shown} against manual.json {held}")
+    timed = [r for r in bill["printed"] if r.get("time_s") is not None]
+    total = (f"In all: **{sum(r['pieces'] * r['quantity'] for r in timed)} printed pieces, "
+             f"{hours_minutes(sum(r['time_s'] for r in timed))} of printing and "
+             f"{sum(r['material_g'] for r in timed):.0f} g")
+    if total not in md:
+        out.append(f"the total line: manual.md does not say {total!r}")
+    return out
+
+
+def test_manual_md_states_the_figures_manual_json_holds(written):
+    import json
+
+    out, _ = written
+    md = (out / "manual.md").read_text(encoding="utf-8")
+    doc = json.loads((out / "manual.json").read_text(encoding="utf-8"))
+    assert disagreements(md, doc) == []
+    assert doc["bill"]["hardware"] and "fasteners" not in doc["bill"]  # one hardware list, the steps'
+    # planted contradictions, one at a time, each found
+    row = doc["bill"]["hardware"][0]
+    planted = md.replace(f"| {row['item']} | {row['quantity']} |", f"| {row['item']} | {row['quantity'] + 1} |", 1)
+    assert planted != md and disagreements(planted, doc)
+    other = json.loads(json.dumps(doc))
+    other["bill"]["coating"][0]["to_buy_cm3"] += 0.5
+    assert disagreements(md, other)
+    other = json.loads(json.dumps(doc))
+    other["bill"]["printed"][0]["quantity"] = (other["bill"]["printed"][0]["quantity"] or 0) + 1
+    assert disagreements(md, other)

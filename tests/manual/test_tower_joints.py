@@ -11,6 +11,7 @@ import pytest
 from rigcad.errors import GeometryError
 from rigcad.manual import assembly_check as AC
 from rigcad.manual import plan, tower_joints
+from rigcad.standards import THREADS
 from rigcad.manual.assembly import picture_meshes
 from rigcad.parts import tower
 
@@ -70,9 +71,11 @@ def test_the_nut_trap_holds_an_m4_nut_where_the_check_looks(table31_rig):
     0.2 mm narrower than the nut is refused; the nut cannot turn in its trap."""
     from rigcad.parts.recipe import HexPrism
 
-    f = plan._socket_head("M4 bolt", (0.0, 0.0, 20.0), plan.DOWN, 20.0, 4.0, "M4", thread_in="nut",
-                          nut_size_mm=(plan.NUT_AF["M4"] / np.sqrt(3.0), 3.2), grip_mm=14.0)
-    nut = f.solids() - AC.cylinder(np.array([0.0, 0.0, 30.0]), np.array([0.0, 0.0, -1.0]), 40.0, 2.5)
+    f = plan._socket_head("M4 bolt", (0.0, 0.0, 20.0), plan.DOWN, 20.0, "M4", thread_in="nut",
+                          nut_size_mm=(THREADS["M4"].nut_af / np.sqrt(3.0), 3.2), grip_mm=14.0)
+    # the nut alone: the shank and everything above z = 10 (the head, 7 mm across: ISO 4762) taken away
+    nut = (f.solids() - AC.cylinder(np.array([0.0, 0.0, 30.0]), np.array([0.0, 0.0, -1.0]), 40.0, 2.5)
+           - AC.cylinder(np.array([0.0, 0.0, 30.0]), np.array([0.0, 0.0, -1.0]), 20.0, 10.0))
     lo, hi = np.array(nut.bounding_box()[:3]), np.array(nut.bounding_box()[3:])
     assert hi[0] - lo[0] == pytest.approx(2 * 7.0 / np.sqrt(3.0), abs=1e-6)
     assert hi[1] - lo[1] == pytest.approx(7.0, abs=1e-6)
@@ -85,7 +88,7 @@ def test_the_nut_trap_holds_an_m4_nut_where_the_check_looks(table31_rig):
             np.array([0.0, 0.0, 20.0]), np.array([0.0, 0.0, -1.0]), 30.0, 2.25)
 
     assert abs(AC.penetration(f.solids(), trap(tower.NUT_TRAP))) < 1e-6  # it touches the ceiling only
-    assert AC.penetration(f.solids(), trap(plan.NUT_AF["M4"] - 0.2)) > AC.CLEARANCE_MM
+    assert AC.penetration(f.solids(), trap(THREADS["M4"].nut_af - 0.2)) > AC.CLEARANCE_MM
     assert f.nut_size_mm[0] > tower.NUT_TRAP / 2  # its corners reach past the trap's flats: it cannot turn
 
 

@@ -50,9 +50,11 @@ def test_projector_screws_suit_every_stack(table31_rig):
     p, t = table31_rig.profile, table31_rig.layout.tower
     for row in projector_screws(p, table31_rig.layout):
         assert row["ok"]
-        # its thread engages the projector by 5 mm to mount_depth, through washer + shelf + stack + extra washers
-        reach = row["length_mm"] - (1.0 + t.shelf_thickness + row["shims"] * p.tower.shim_thickness) \
-            - row["extra_washers"] * 1.0
+        # its thread engages the projector by 5 mm to mount_depth, through washer + shelf + stack + extra
+        # washers, each an ISO 7089 M4 washer 0.8 mm thick (the standard's figure, not rigcad's table)
+        assert p.projector.mount_thread == "M4"
+        reach = row["length_mm"] - (0.8 + t.shelf_thickness + row["shims"] * p.tower.shim_thickness) \
+            - row["extra_washers"] * 0.8
         assert reach == pytest.approx(row["engagement_mm"]) and 5.0 - 1e-9 <= reach <= p.projector.mount_depth + 1e-9
 
 

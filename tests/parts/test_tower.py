@@ -175,8 +175,9 @@ def test_hardware_is_computed_from_the_parts(rig, write_profile, table31_text):
     items = hardware(rig.profile, rig.layout)
     m4 = {i["joins"].split(" (")[0]: i for i in items if i["item"] == "bolt, washer and nut"}
     assert sorted(i["quantity"] for i in m4.values()) == [2, 4]  # lens foot, column foot on the tongue
-    # lens foot: 5 mm foot + 10 mm shelf + washer, nut, threads = 20.2 mm; column foot: 5 mm foot + the tongue
-    # above its nut traps (15 - 5.6 mm) + washer, nut, threads = 19.6 mm (the bolt ends above the bench)
+    # lens foot: 5 mm foot + 10 mm shelf + 2 washers (0.8, ISO 7089), nut (3.2, ISO 4032), 2 pitches (1.4) =
+    # 21.2 mm; column foot: 5 mm foot + the tongue above its nut traps (15 - 5.6 mm) + one washer (the nut
+    # sits in its trap), nut, pitches = 19.8 mm (the bolt ends above the bench)
     assert m4["the lens mount's slotted foot to the shelf"]["length_mm"] == 25.0
     foot = m4["the column's foot to the base plate's datum tongue"]["length_mm"]
     assert foot == 20.0 and foot <= rig.profile.tower.wall + 1.0 - rig.layout.tower.bench_z

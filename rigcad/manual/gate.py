@@ -1,0 +1,312 @@
+"""The assembly gate: a rig that cannot be put together is refused, not printed.
+
+:func:`verdict` runs the assembly check (rigcad.manual.assembly_check.find_order over
+rigcad.manual.plan's steps) on a rig and returns a typed :class:`Verdict`: the order found, or the
+step that cannot be done, what it runs into, the profile keys that would fix it and, for the keys
+the profile itself sets, the nearest value at which that step goes in. ``rigcad stl``, ``fab`` and
+``manual`` turn a failed verdict into one line and a non-zero exit.
+
+Which keys: the keys that shape the parts involved (``Part.shaped_by``, recorded as each recipe
+read the profile), the keys of the instruments' own sections (the projector, the camera, the
+splitter, the focusing lens) and, of the keys the rig's layout read (``RigLayout.shaped_by``), those
+the profile's files set. Keys the profile's own file sets come first: they are what the user chose.
+
+The nearest value: the length keys the profile sets are ranked by how much a move of each (one
+probe each way) cuts the blocked step's overlap; for the :data:`SEARCH_KEYS` that cut it most, the
+value is moved away from the profile's own in growing steps each way (``STEP_MM`` doubling, at most
+``MAX_PROBES`` probes) until the blocked step goes in with what it needs in place (the exact test
+the check uses to refuse it), then bisected to ``RESOLUTION_MM``. Each probe rebuilds the rig's
+layout and meshes (the dome is kept), about 2 s on 2 cores. Frame and units: mm.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from rigcad.errors import AssemblyError, GeometryError
+
+#: Length keys searched for the nearest working value (the rest are named only), chosen among the
+#: first RANK_KEYS the profile sets by how much a move of RANK_STEP_MM (mm) each way cuts the overlap.
+SEARCH_KEYS = 2
+RANK_KEYS = 8
+RANK_STEP_MM = 5.0
+#: The first step (mm) away from the profile's value, doubled each probe, and the probes per side.
+STEP_MM = 1.0
+MAX_PROBES = 6
+#: The bisection stops when the passing and failing values are this close (mm): a tenth of a
+#: printed fit's gap, finer than anyone sets an instrument's size.
+RESOLUTION_MM = 0.1
+#: Instruments' parts -> the profile section that sizes them (the recipes name their own keys).
+INSTRUMENT_SECTIONS = {"projector": "projector", "camera": "camera", "beam_splitter": "beam_splitter",
+                       "focusing_lens": "lens", "projector_shims": "tower", "camera_shims": "tower"}
+
+
+@dataclass(frozen=True)
+class Fix:
+    """A key the profile sets (``where``: its file:line), its value now and the nearest value (mm) at
+    which the blocked step goes in; ``value`` None: none found within the probes."""
+
+    key: str
+    where: str
+    now: float
+    value: float | None
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The assembly check's answer for one rig: ``order`` (the steps' names, in a feasible order)
+    when it can be put together; else the ``step`` that cannot be done, the parts it places
+    (``members``), what it runs into (``obstacles``), the check's ``reason``, the profile ``keys``
+    that would fix it and the ``fixes`` found for the keys the profile sets."""
+
+    profile: str
+    order: tuple[str, ...] = ()
+    step: str | None = None
+    members: tuple[str, ...] = ()
+    obstacles: tuple[str, ...] = ()
+    reason: str = ""
+    keys: tuple[str, ...] = ()
+    fixes: tuple[Fix, ...] = ()
+
+    @property
+    def ok(self) -> bool:
+        return self.step is None and not self.reason
+
+    def line(self) -> str:
+        """One line: which parts collide, the keys that would fix it, the nearest values found."""
+        if self.ok:
+            return f"{self.profile}: the assembly check finds an order of {len(self.order)} steps"
+        what = " + ".join(self.members) or (self.step or "a step")
+        into = ", ".join(self.obstacles) or "what is in place"
+        found = [f"{f.key} {f.now:g} -> {f.value:g} mm ({f.where})" for f in self.fixes if f.value is not None]
+        keys = ", ".join(self.keys[:6]) + (", ..." if len(self.keys) > 6 else "")
+        return (f"{self.profile} cannot be assembled: {what} cannot go in, it runs into {into}"
+                + (f"; nearest values that let it in: {'; '.join(found)}" if found else "")
+                + (f"; keys that move it: {keys}" if keys else "")
+                + f" (the check's whole reason: {VERDICT_FILE} beside the export)")
+
+    def as_json(self) -> dict:
+        """The verdict as the writers store it (assembly.json; units in the keys)."""
+        return {"ok": self.ok, "order": list(self.order), "step": self.step, "members": list(self.members),
+                "obstacles": list(self.obstacles), "reason": self.reason, "keys": list(self.keys),
+                "fixes": [{"key": f.key, "where": f.where, "now_mm": f.now, "value_mm": f.value} for f in self.fixes],
+                "line": self.line()}
+
+
+def _order(rig, meshes):
+    from rigcad.manual import assembly_check, plan
+
+    return assembly_check.find_order(plan.assembly(rig, meshes))
+
+
+def verdict(rig, meshes=None, search: bool = True, progress=None) -> Verdict:
+    """The assembly check's verdict on ``rig`` (meshes: rigcad.manual.assembly.picture_meshes, made
+    when None). ``search``: look for the nearest working values of the keys the profile sets (a few
+    seconds a probe; only when the check refuses)."""
+    from rigcad.manual.assembly import picture_meshes
+
+    meshes = picture_meshes(rig) if meshes is None else meshes
+    try:
+        order = _order(rig, meshes)
+    except AssemblyError as err:
+        return refused(rig, err, search, progress)
+    return Verdict(rig.name, order=tuple(p.step.name for p in order))
+
+
+def refused(rig, err: AssemblyError, search: bool = True, progress=None) -> Verdict:
+    """The verdict for the check's refusal ``err``: the keys and, with ``search``, the fixes."""
+    keys = candidate_keys(rig, (*err.members, *err.obstacles))
+    fixes = tuple(nearest_values(rig, err, keys, progress)) if search and err.step else ()
+    return Verdict(rig.name, step=err.step, members=err.members, obstacles=err.obstacles, reason=str(err),
+                   keys=keys, fixes=fixes)
+
+
+def candidate_keys(rig, names) -> tuple[str, ...]:
+    """The profile keys that move or size the parts ``names`` (see the module docstring): the keys
+    the profile's own file sets that the layout or the parts read, then the parts' own keys."""
+    p = rig.profile
+    own: list[str] = []
+    for name in names:
+        recipe = rig.recipes.get(name)
+        if recipe is not None:
+            own += list(recipe.shaped_by)
+        section = next((s for prefix, s in INSTRUMENT_SECTIONS.items() if name.startswith(prefix)), None)
+        if section is not None:
+            own += [k for k in rig.layout.shaped_by if k.startswith(section + ".")]
+    read = list(dict.fromkeys([*own, *rig.layout.shaped_by]))
+    leaf = p.sources[0] if p.sources else None
+
+    def setter(key: str) -> str | None:
+        return p.marks.get(tuple(key.split(".")))
+
+    first = [k for k in read if setter(k) and leaf and setter(k).startswith(leaf + ":")]
+    return tuple(dict.fromkeys([*first, *own]))
+
+
+def _with(profile, key: str, value: float):
+    section, name = key.split(".")
+    return dataclasses.replace(profile, **{section: dataclasses.replace(getattr(profile, section), **{name: value})})
+
+
+def _depth(rig, profile, step: str) -> float:
+    """How far (mm) ``step``, with only what it needs in place, still runs into something on the rig
+    of ``profile`` (its dome kept from ``rig``): 0 when it goes in (the check's own test for a
+    blocked step), inf when the layout refuses the profile."""
+    from rigcad.manual import assembly_check, plan
+    from rigcad.manual.assembly import picture_meshes
+    from rigcad.rig import Rig
+
+    try:
+        other = Rig.from_profile(profile, previous=rig)
+        a = plan.assembly(other, picture_meshes(other))
+    except GeometryError:  # the layout refuses the value: not a way in
+        return float("inf")
+    if step not in a.by_name:
+        return float("inf")
+    r = a.attempt(a.by_name[step], assembly_check._before(a)[step])
+    return 0.0 if isinstance(r, assembly_check.Placed) else (r.depth if r.blocked else float("inf"))
+
+
+def _goes_in(rig, profile, step: str) -> bool:
+    return _depth(rig, profile, step) == 0.0
+
+
+def _set_lengths(rig, keys) -> list[tuple[str, str, float]]:
+    """(key, file:line, value) of the length keys among ``keys`` the profile sets."""
+    p, out = rig.profile, []
+    for key in keys:
+        where = p.marks.get(tuple(key.split(".")))
+        section, name = key.split(".")
+        now = getattr(getattr(p, section), name, None)
+        if where is not None and isinstance(now, float) and not isinstance(now, bool):
+            out.append((key, where, now))
+    return out
+
+
+def nearest_values(rig, err: AssemblyError, keys, progress=None):
+    """Fixes for the SEARCH_KEYS length keys the profile sets whose move brings the blocked step
+    nearest to going in: each of the first RANK_KEYS of them is moved RANK_STEP_MM each way once,
+    and the keys are ranked by how much that cuts the step's overlap (a key that does not cut it is
+    not searched: it is not what blocks the part)."""
+    p = rig.profile
+    base = _depth(rig, p, err.step)
+    gains = []
+    for key, where, now in _set_lengths(rig, keys)[:RANK_KEYS]:
+        if progress:
+            progress(f"assembly gate: how {key} moves {err.step}")
+        best = min(_depth(rig, _with(p, key, now + s * RANK_STEP_MM), err.step) for s in (1.0, -1.0)
+                   if now + s * RANK_STEP_MM > 0.0)
+        if best < base - 1e-6:
+            gains.append((base - best, key, where, now))
+    for _, key, where, now in sorted(gains, key=lambda g: -g[0])[:SEARCH_KEYS]:
+        yield Fix(key, where, now, _search(rig, p, key, now, err.step, progress))
+
+
+def _search(rig, p, key: str, now: float, step: str, progress) -> float | None:
+    """The value nearest ``now`` at which ``step`` goes in (within RESOLUTION_MM), or None."""
+    for k in range(MAX_PROBES):
+        delta = STEP_MM * 2 ** k
+        for sign in (1.0, -1.0):
+            v = now + sign * delta
+            if v <= 0.0:
+                continue
+            if progress:
+                progress(f"assembly gate: {key} = {v:g} mm")
+            if _goes_in(rig, _with(p, key, v), step):
+                bad = now + sign * (delta / 2 if k else 0.0)
+                good = v
+                while abs(good - bad) > RESOLUTION_MM:
+                    mid = 0.5 * (good + bad)
+                    if progress:
+                        progress(f"assembly gate: {key} = {mid:g} mm")
+                    if _goes_in(rig, _with(p, key, mid), step):
+                        good = mid
+                    else:
+                        bad = mid
+                return round(good + (0.05 if good > bad else -0.05), 1)  # rounded away from the failing side
+    return None
+
+
+# -- the verdict kept beside the export: stl, fab and manual check a profile once -----------------
+#: The verdict's file in exports/<profile>/, keyed by everything `rigcad stl` depends on.
+VERDICT_FILE = "assembly.json"
+#: A verdict file larger than this (bytes) is not ours: it is checked anew.
+MAX_VERDICT_BYTES = 1 << 20
+
+
+def verdict_path(root, name: str):
+    from pathlib import Path
+
+    return Path(root) / name / VERDICT_FILE
+
+
+def _from_json(data: dict, name: str) -> Verdict:
+    fixes = tuple(Fix(str(f["key"]), str(f["where"]), float(f["now_mm"]),
+                      None if f["value_mm"] is None else float(f["value_mm"])) for f in data["fixes"])
+    return Verdict(name, order=tuple(map(str, data["order"])), step=data["step"], members=tuple(map(str, data["members"])),
+                   obstacles=tuple(map(str, data["obstacles"])), reason=str(data["reason"]),
+                   keys=tuple(map(str, data["keys"])), fixes=fixes)
+
+
+def read_verdict(root, profile) -> Verdict | None:
+    """The verdict kept for ``profile`` under the exports ``root``, when it was made from this profile
+    by this code (the stl cache key, rigcad.export.manifest.inputs_key); None otherwise (missing, not
+    a plain file, too large, unreadable, another key: it is made anew)."""
+    import json
+    import os
+    import stat
+
+    from rigcad.export.manifest import inputs_key
+
+    path = verdict_path(root, profile.name)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError:
+        return None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        data = os.read(fd, MAX_VERDICT_BYTES + 1)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+    if len(data) > MAX_VERDICT_BYTES:
+        return None
+    try:
+        doc = json.loads(data)
+        if doc.get("inputs_key") != inputs_key(profile):
+            return None
+        return _from_json(doc, profile.name)
+    except (ValueError, TypeError, KeyError, AttributeError):
+        return None
+
+
+def checked(rig, root, progress=None) -> Verdict:
+    """The rig's verdict, read back from exports ``root`` when this profile and code made it, else
+    checked (:func:`verdict`) and kept there (atomically) for the next command."""
+    from rigcad.export.atomic import write_json
+    from rigcad.export.manifest import inputs_key
+
+    kept = read_verdict(root, rig.profile)
+    if kept is not None:
+        return kept
+    found = verdict(rig, progress=progress)
+    path = verdict_path(root, rig.name)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_json(path, {"inputs_key": inputs_key(rig.profile), **found.as_json()})
+    return found
+
+
+def gate(rig, root, progress=None) -> Verdict:
+    """:func:`checked`, raising AssemblyError (exit code 1, its message the verdict's one line) when
+    the rig cannot be put together: what ``fab``, ``manual`` and ``optimize`` call before any work."""
+    v = checked(rig, root, progress)
+    if not v.ok:
+        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles)
+    return v
+
+
+__all__ = ["Fix", "VERDICT_FILE", "Verdict", "candidate_keys", "checked", "gate", "nearest_values", "read_verdict",
+           "refused", "verdict", "verdict_path"]

@@ -1,0 +1,201 @@
+"""Standard hardware: the one home of every figure rigcad takes from a standard or a maker's table.
+
+Threads, clearance holes, socket-head screws, hex nuts, washers, preferred lengths, hex keys,
+heat-set inserts, dowel pins and balls. Each table names the standard (or the maker's datasheet)
+its figures come from; nothing else in rigcad states these numbers (tests/test_standards.py greps
+the tree for them). The parts cut their holes from these figures, the bill orders by them and the
+assembly steps fit them, so the solid, the bill and the steps cannot disagree.
+
+Units: millimetres throughout. No imports from the rest of rigcad: a leaf every floor may use.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+INCH = 25.4  #: mm per inch (exact, by definition since 1959)
+
+
+@dataclass(frozen=True)
+class Thread:
+    """One screw thread and the hardware rigcad uses with it (mm).
+
+    ``major``: nominal (major) diameter; ``pitch``: coarse pitch (ISO 261; UNC: 1 in / threads per
+    inch, ASME B1.1); ``clearance_fine``, ``clearance_medium``: through-hole series (ISO 273 fine and
+    medium; UNC: ASME B18.2.8 close and normal fit); ``head_diameter``, ``head_height``: the socket
+    head cap screw's head (ISO 4762 dk max, k max; UNC: ASME B18.3); ``hex_key``: its socket across
+    flats (ISO 4762 s; ASME B18.3); ``nut_af``, ``nut_height``: the hex nut's width across flats and
+    height (ISO 4032 s, m max; UNC: ASME B18.2.2 hex nut); ``washer_od``, ``washer_thickness``: the
+    plain washer (ISO 7089 d2, h; UNC: ASME B18.22.1 type A narrow)."""
+
+    name: str
+    major: float
+    pitch: float
+    clearance_fine: float
+    clearance_medium: float
+    head_diameter: float
+    head_height: float
+    hex_key: float
+    nut_af: float
+    nut_height: float
+    washer_od: float
+    washer_thickness: float
+
+    @property
+    def clearance(self) -> float:
+        """The clearance hole rigcad cuts for a bolt through a part: the medium (normal) series."""
+        return self.clearance_medium
+
+    @property
+    def nut_corner_radius(self) -> float:
+        """A hex nut's centre-to-corner distance (mm): the across-flats width over sqrt 3."""
+        return self.nut_af / 3.0 ** 0.5
+
+
+# name, major, pitch, clearance fine, medium, head dk, k, hex key s, nut s, m, washer d2, h
+_METRIC = (
+    ("M2", 2.0, 0.4, 2.2, 2.4, 3.8, 2.0, 1.5, 4.0, 1.6, 5.0, 0.3),
+    ("M2.5", 2.5, 0.45, 2.7, 2.9, 4.5, 2.5, 2.0, 5.0, 2.0, 6.0, 0.5),
+    ("M3", 3.0, 0.5, 3.2, 3.4, 5.5, 3.0, 2.5, 5.5, 2.4, 7.0, 0.5),
+    ("M4", 4.0, 0.7, 4.3, 4.5, 7.0, 4.0, 3.0, 7.0, 3.2, 9.0, 0.8),
+    ("M5", 5.0, 0.8, 5.3, 5.5, 8.5, 5.0, 4.0, 8.0, 4.7, 10.0, 1.0),
+    ("M6", 6.0, 1.0, 6.4, 6.6, 10.0, 6.0, 5.0, 10.0, 5.2, 12.0, 1.6),
+    ("M8", 8.0, 1.25, 8.4, 9.0, 13.0, 8.0, 6.0, 13.0, 6.8, 16.0, 1.6),
+    ("M10", 10.0, 1.5, 10.5, 11.0, 16.0, 10.0, 8.0, 16.0, 8.4, 20.0, 2.0),
+    ("M12", 12.0, 1.75, 13.0, 13.5, 18.0, 12.0, 10.0, 18.0, 10.8, 24.0, 2.5),
+)
+# Unified coarse threads of camera and projector sockets (ISO 1222 names 1/4-20 and 3/8-16 UNC), in
+# inches as their standards give them: major, threads per inch, close and normal clearance
+# (ASME B18.2.8), head A and H (ASME B18.3), key, nut F and H (ASME B18.2.2), washer OD and thickness
+# (ASME B18.22.1, type A narrow).
+_UNC = (
+    ("1/4-20 UNC", 0.25, 20, 0.266, 0.281, 0.375, 0.25, 3 / 16, 7 / 16, 7 / 32, 0.625, 0.065),
+    ("3/8-16 UNC", 0.375, 16, 0.397, 0.406, 0.5625, 0.375, 5 / 16, 9 / 16, 21 / 64, 0.812, 0.065),
+)
+
+#: Every thread rigcad knows, by name.
+THREADS: dict[str, Thread] = {
+    **{r[0]: Thread(*r) for r in _METRIC},
+    **{r[0]: Thread(r[0], r[1] * INCH, INCH / r[2], *(v * INCH for v in r[3:])) for r in _UNC},
+}
+#: The threads an instrument's mounting holes or an adjuster's screws may have (the profile's choices).
+MOUNT_THREADS = ("M3", "M4", "M5", "M6", "1/4-20 UNC", "3/8-16 UNC")
+#: Metric threads from the smallest up, for choosing a bolt by the hole it passes through.
+METRIC_THREADS = tuple(r[0] for r in _METRIC)
+
+
+def thread(name: str) -> Thread:
+    """The thread named ``name`` (e.g. "M4", "1/4-20 UNC"); KeyError names the valid ones."""
+    try:
+        return THREADS[name]
+    except KeyError:
+        raise KeyError(f"unknown thread {name!r}; valid: {', '.join(THREADS)}") from None
+
+
+def thread_for_hole(hole: float) -> Thread:
+    """The largest ISO metric thread whose medium clearance hole (ISO 273) fits in ``hole`` mm;
+    ValueError when even M2's does not."""
+    fits = [THREADS[n] for n in METRIC_THREADS if THREADS[n].clearance_medium <= hole + 1e-9]
+    if not fits:
+        raise ValueError(f"a {hole:g} mm hole takes no ISO metric bolt from M2 "
+                         f"({THREADS['M2'].clearance_medium:g} mm clearance, ISO 273 medium) up")
+    return fits[-1]
+
+
+#: ISO 4762 (and ISO 4017) preferred nominal lengths (mm) of socket-head and hex bolts.
+SCREW_LENGTHS = (5, 6, 8, 10, 12, 16, 20, 25, 30, 35, 40, 45, 50, 55, 60, 65, 70, 80, 90, 100, 110, 120, 130,
+                 140, 150, 160, 180, 200)
+#: ISO 4762's range of nominal lengths (mm) per thread, as sold: (shortest, longest).
+SCREW_LENGTH_RANGE = {"M2": (3, 20), "M2.5": (4, 25), "M3": (5, 30), "M4": (6, 40), "M5": (8, 50), "M6": (10, 60),
+                      "M8": (12, 80), "M10": (16, 100), "M12": (20, 120)}
+
+
+def screw_lengths(name: str | None = None) -> tuple[int, ...]:
+    """The preferred lengths (mm) ISO 4762 sells for thread ``name`` (every preferred length when
+    None or an inch thread, whose lengths run in the same steps)."""
+    lo, hi = SCREW_LENGTH_RANGE.get(name, (SCREW_LENGTHS[0], SCREW_LENGTHS[-1])) if name else (0, 10 ** 9)
+    return tuple(n for n in SCREW_LENGTHS if lo <= n <= hi)
+
+
+def shortest_screw(name: str | None, need: float) -> int | None:
+    """The shortest preferred length (mm) of at least ``need`` mm, or None past the longest."""
+    return next((n for n in screw_lengths(name) if n >= need - 1e-9), None)
+
+
+def longest_screw(name: str | None, reach: float) -> int | None:
+    """The longest preferred length (mm) of at most ``reach`` mm, or None under the shortest."""
+    fits = [n for n in screw_lengths(name) if n <= reach + 1e-9]
+    return fits[-1] if fits else None
+
+
+#: ASME B18.3 inch socket-head cap screws' nominal lengths (in) as ordered, in 1/8 in steps and then 1/4 in.
+INCH_SCREW_LENGTHS = ((0.5, "1/2 in"), (0.625, "5/8 in"), (0.75, "3/4 in"), (0.875, "7/8 in"), (1.0, "1 in"),
+                      (1.25, "1 1/4 in"), (1.5, "1 1/2 in"), (1.75, "1 3/4 in"), (2.0, "2 in"))
+#: ISO 7093-1 large washers (outer diameter, thickness; mm) per thread; the size-6 washer (6.4 mm bore)
+#: also takes a 1/4 in screw.
+LARGE_WASHERS = {"M3": (9.0, 0.8), "M4": (12.0, 1.0), "M5": (15.0, 1.2), "M6": (18.0, 1.6), "1/4-20 UNC": (18.0, 1.6)}
+
+#: ISO 8734 dowel pins' preferred lengths (mm).
+DOWEL_LENGTHS = (3, 4, 5, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30, 32, 35, 40, 45, 50, 55, 60)
+
+
+def longest_dowel(depth: float) -> int:
+    """The longest ISO 8734 dowel (mm) no longer than the two holes' joint ``depth`` mm: a longer pin
+    would hold the faces apart. ValueError under the shortest."""
+    fits = [n for n in DOWEL_LENGTHS if n <= depth + 1e-9]
+    if not fits:
+        raise ValueError(f"no ISO 8734 dowel pin is as short as {depth:g} mm (shortest {DOWEL_LENGTHS[0]} mm)")
+    return fits[-1]
+
+
+@dataclass(frozen=True)
+class Insert:
+    """A heat-set threaded insert for printed parts (mm): the hole its maker says to print or drill
+    (``hole``), its knurled outside (``outer``) and its length; ``source``: the maker's table."""
+
+    thread: str
+    hole: float
+    outer: float
+    length: float
+    source: str
+
+    @property
+    def pocket_depth(self) -> float:
+        """The blind pocket's depth: the insert's length and 0.5 mm for the melt to flow into."""
+        return self.length + 0.5
+
+
+_INSERT_SOURCE = "ruthex RX-series datasheet (hole for printed parts; outer diameter of the knurl)"
+#: Heat-set inserts by thread: the makers' hole sizes, never the insert's outside (drilling to that
+#: leaves nothing for the knurl to grip).
+INSERTS = {
+    "M3": Insert("M3", 4.0, 4.6, 5.7, _INSERT_SOURCE),
+    "M4": Insert("M4", 5.6, 6.3, 8.1, _INSERT_SOURCE),
+    "M5": Insert("M5", 6.4, 7.0, 9.5, _INSERT_SOURCE),
+    "M6": Insert("M6", 8.0, 8.7, 12.7, _INSERT_SOURCE),
+}
+
+
+@dataclass(frozen=True)
+class HexKey:
+    """An L hex key (ISO 2936) across flats ``size`` (mm): its long and short arms (mm)."""
+
+    size: float
+    long_arm: float
+    short_arm: float
+
+
+#: ISO 2936 hex keys, short series: across flats (mm) -> long arm, short arm (mm); inch keys by the
+#: same table's nearest rows.
+HEX_KEYS = {s: HexKey(s, lo, sh) for s, lo, sh in (
+    (1.5, 45.0, 14.0), (2.0, 50.0, 16.0), (2.5, 56.0, 18.0), (3.0, 63.0, 20.0), (4.0, 70.0, 25.0),
+    (3 / 16 * INCH, 80.0, 28.0), (5.0, 80.0, 28.0), (6.0, 90.0, 32.0), (5 / 16 * INCH, 100.0, 36.0),
+    (8.0, 100.0, 36.0), (10.0, 112.0, 40.0))}
+#: A hex screwdriver's blade (mm): a hand needs this much straight room above a socket head.
+DRIVER_BLADE_MM = 100.0
+#: An open-end spanner's reach (mm; DIN 3110 spanners for M3-M6 nuts are 90-120 mm long).
+SPANNER_MM = 80.0
+
+__all__ = ["INCH_SCREW_LENGTHS", "LARGE_WASHERS", "DOWEL_LENGTHS", "longest_dowel", "DRIVER_BLADE_MM", "HEX_KEYS", "HexKey", "INCH", "INSERTS",
+           "Insert", "METRIC_THREADS", "MOUNT_THREADS", "SCREW_LENGTHS", "SCREW_LENGTH_RANGE", "SPANNER_MM", "THREADS",
+           "Thread", "longest_screw", "screw_lengths", "shortest_screw", "thread", "thread_for_hole"]
