@@ -76,17 +76,31 @@ def figure(data: dict) -> bytes:
 
     from rigcad.plots import _png
 
-    cam, scr = data["camera"], data["screen"]
     fig, axes = plt.subplots(1, 4, figsize=(15, 4.2))
-    arrow = dict(arrowstyle="->", lw=1.6)
+    _camera_panel(axes[0], data["camera"])
+    for ax, label in ((axes[1], "turn 0"), (axes[2], "half turn")):
+        _screen_panel(ax, data["screen"], label)
+    _tilt_panel(axes[3], data)
+    for ax in axes:
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.tight_layout()
+    return _png(fig, dpi=90)
 
-    def frame_arrows(ax, origin, length, labels, color):
-        for (dx, dy), text in zip(((length, 0), (0, length)), labels):
-            ax.annotate("", (origin[0] + dx, origin[1] + dy), origin, arrowprops={**arrow, "color": color})
-            ax.text(origin[0] + 1.25 * dx, origin[1] + 1.25 * dy, text, color=color, ha="center", va="center")
 
-    # 1. the camera image, drawn as a file shows it (row 0 at the top)
-    ax = axes[0]
+_ARROW = dict(arrowstyle="->", lw=1.6)
+
+
+def _frame_arrows(ax, origin, length, labels, color) -> None:
+    for (dx, dy), text in zip(((length, 0), (0, length)), labels):
+        ax.annotate("", (origin[0] + dx, origin[1] + dy), origin, arrowprops={**_ARROW, "color": color})
+        ax.text(origin[0] + 1.25 * dx, origin[1] + 1.25 * dy, text, color=color, ha="center", va="center")
+
+
+def _camera_panel(ax, cam: dict) -> None:
+    """The camera image, drawn as a file shows it (row 0 at the top)."""
+    import matplotlib.pyplot as plt
+
     w, h = cam["resolution_px"]
     win = cam["window"]
     ax.add_patch(plt.Rectangle((0, 0), w, h, fill=False, lw=1.2))
@@ -96,10 +110,10 @@ def figure(data: dict) -> bytes:
     ax.plot([w / 2], [h / 2], "+", color="C3", ms=12)
     ax.text(w / 2 + 40, h / 2 + 90, f"principal point\n({w / 2:g}, {h / 2:g}) px\nf = {cam['focal_px']:.0f} px",
             color="C3", fontsize=8)
-    frame_arrows(ax, (40, 60), 200, ("column", "row"), "k")
+    _frame_arrows(ax, (40, 60), 200, ("column", "row"), "k")
     up = "+y" if cam["row_axis"] == "-y" else "-y"
-    ax.annotate("", (300, h - 60), (60, h - 60), arrowprops={**arrow, "color": "C0"})
-    ax.annotate("", (60, h - 300), (60, h - 60), arrowprops={**arrow, "color": "C0"})
+    ax.annotate("", (300, h - 60), (60, h - 60), arrowprops={**_ARROW, "color": "C0"})
+    ax.annotate("", (60, h - 300), (60, h - 60), arrowprops={**_ARROW, "color": "C0"})
     ax.text(320, h - 60, f"rig {cam['column_axis']}", color="C0", va="center")
     ax.text(60, h - 340, f"rig {up}", color="C0", ha="center")
     ax.text(0, -20, "pixel (row 0, col 0) at top left, its centre at (0.5, 0.5)", fontsize=8)
@@ -108,33 +122,37 @@ def figure(data: dict) -> bytes:
     ax.set_aspect("equal")
     ax.set_title("camera image as stored (the camera looks down)", fontsize=10)
 
-    # 2, 3. the screen, seen from above, at turn 0 and at the half turn
-    sw, sh = scr["size_mm"]
-    for ax, label in ((axes[1], "turn 0"), (axes[2], "half turn")):
-        s = scr[label]
-        flip = -1.0 if s["u"] == "-x" else 1.0
-        ax.add_patch(plt.Rectangle((-sw / 2, -sh / 2), sw, sh, fill=False, lw=1.2))
-        corner = (flip * -sw / 2, flip * sh / 2)  # pixel (0, 0): u = -W/2, v = +H/2
-        ax.plot(*corner, "s", color="C3", ms=7)
-        ax.text(corner[0] + flip * 6, corner[1] - flip * 10, "pixel (0, 0)", color="C3", fontsize=8,
-                ha="left" if flip > 0 else "right")
-        ax.annotate("", (flip * 45, 0), (0, 0), arrowprops={**arrow, "color": "k"})
-        ax.annotate("", (0, flip * 45), (0, 0), arrowprops={**arrow, "color": "k"})
-        ax.text(flip * 55, 0, "u (columns)", ha="center", va="center")
-        ax.text(flip * 4, flip * 45, "v (rows run -v)", ha="left" if flip > 0 else "right", va="center")
-        frame_arrows(ax, (-sw / 2 + 8, -sh / 2 - 22), 30, ("rig +x", "rig +y"), "C0")
-        ax.text(sw / 2 - 2, -sh / 2 - 22, f"du along rig {s['du']}, dv along rig {s['dv']}", color="C0",
-                ha="right", fontsize=8)
-        ax.plot([0], [0], "o", color="C1")
-        ax.text(-flip * 4, -flip * 10, "(u, v) = (0, 0)\non the axis", color="C1", fontsize=8,
-                ha="right" if flip > 0 else "left", va="center")
-        ax.set_xlim(-sw / 2 - 15, sw / 2 + 15)
-        ax.set_ylim(-sh / 2 - 40, sh / 2 + 15)
-        ax.set_aspect("equal")
-        ax.set_title(f"screen from above, {label}: u = rig {s['u']}, v = rig {s['v']}", fontsize=10)
 
-    # 4. the tilts' sign (side view along -x: +y to the right), and the Gray code's form
-    ax = axes[3]
+def _screen_panel(ax, scr: dict, label: str) -> None:
+    """The screen seen from above at one turn (``label``: 'turn 0' or 'half turn')."""
+    import matplotlib.pyplot as plt
+
+    sw, sh = scr["size_mm"]
+    s = scr[label]
+    flip = -1.0 if s["u"] == "-x" else 1.0
+    ax.add_patch(plt.Rectangle((-sw / 2, -sh / 2), sw, sh, fill=False, lw=1.2))
+    corner = (flip * -sw / 2, flip * sh / 2)  # pixel (0, 0): u = -W/2, v = +H/2
+    ax.plot(*corner, "s", color="C3", ms=7)
+    ax.text(corner[0] + flip * 6, corner[1] - flip * 10, "pixel (0, 0)", color="C3", fontsize=8,
+            ha="left" if flip > 0 else "right")
+    ax.annotate("", (flip * 45, 0), (0, 0), arrowprops={**_ARROW, "color": "k"})
+    ax.annotate("", (0, flip * 45), (0, 0), arrowprops={**_ARROW, "color": "k"})
+    ax.text(flip * 55, 0, "u (columns)", ha="center", va="center")
+    ax.text(flip * 4, flip * 45, "v (rows run -v)", ha="left" if flip > 0 else "right", va="center")
+    _frame_arrows(ax, (-sw / 2 + 8, -sh / 2 - 22), 30, ("rig +x", "rig +y"), "C0")
+    ax.text(sw / 2 - 2, -sh / 2 - 22, f"du along rig {s['du']}, dv along rig {s['dv']}", color="C0",
+            ha="right", fontsize=8)
+    ax.plot([0], [0], "o", color="C1")
+    ax.text(-flip * 4, -flip * 10, "(u, v) = (0, 0)\non the axis", color="C1", fontsize=8,
+            ha="right" if flip > 0 else "left", va="center")
+    ax.set_xlim(-sw / 2 - 15, sw / 2 + 15)
+    ax.set_ylim(-sh / 2 - 40, sh / 2 + 15)
+    ax.set_aspect("equal")
+    ax.set_title(f"screen from above, {label}: u = rig {s['u']}, v = rig {s['v']}", fontsize=10)
+
+
+def _tilt_panel(ax, data: dict) -> None:
+    """The tilts' sign (side view along -x: +y to the right), and the Gray code's form."""
     ax.plot([-1, 1], [0, 0], color="0.6", lw=1)
     t = 0.25 if data["tilt"]["tilt_x_lifts"] == "+y" else -0.25
     ax.plot([-math.cos(t), math.cos(t)], [-math.sin(t), math.sin(t)], color="k", lw=2)
@@ -150,8 +168,3 @@ def figure(data: dict) -> bytes:
     ax.set_xlim(-1.3, 1.3)
     ax.set_ylim(-1.1, 1.1)
     ax.set_title("tilts (side view) and the Gray code", fontsize=10)
-    for ax in axes:
-        ax.set_xticks([])
-        ax.set_yticks([])
-    fig.tight_layout()
-    return _png(fig, dpi=90)

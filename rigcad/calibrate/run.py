@@ -120,13 +120,7 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     n_rig = len(M.RIG_NAMES)
     jac = maps.direction_jacobian(optics, rig, cam, for_map.theta)
     spread = maps.capture_spread(captures, where, model_tr, cam.shape, steps)
-    frame = M.frame_tilt_variance(rig.profile, plan)
-    say(f"the map's frame, the sample plane's tilt that no image shows, is known to "
-        f"{math.degrees(math.sqrt(2 * frame)):.4f} deg RMS from how the screen lies on its spacers"
-        + (" (calibration.screen_seating: each half turn cancels the spacer's wedge); every measured pixel's "
-           "uncertainty includes it" if plan.repeats(len(plan) - 1) is not None else
-           " (calibration.screen_tilt, the wedge: a half turn at each spacer, calibration.half_turn: every, would "
-           "tie it to screen_seating instead); every measured pixel's uncertainty includes it"))
+    frame = _frame_variance(rig, plan, say)
     corrected = maps.corrected_map(model_tr, measured, cam.shape, jac, for_map.covariance[:n_rig, :n_rig], short,
                                    spread, frame, None if applied is None else maps.bias_turns(applied, poses, model_tr))
     # the slopes from the smoothed measurement (the raw rays' noise, divided by 2 cos of the dome's
@@ -141,6 +135,19 @@ def calibrate(optics, rig, images: list[dict[str, np.ndarray]], say=lambda msg: 
     design = cam.design.direction(pixel_rays(cam.design, cam.x_px, cam.y_px).dirs)
     return Calibration(cam, plan, decoded, result, for_map, model_tr, measured, slopes, corrected, design, causes,
                        {"decode_s": t1 - t0, "fit_s": t2 - t1, "maps_s": t3 - t2}, ups, upright_decoded, placed)
+
+
+def _frame_variance(rig, plan: M.Plan, say) -> float:
+    """The map's frame's tilt variance per axis (rad^2, :func:`rigcad.calibrate.model.frame_tilt_variance`),
+    said: what it rests on, and with no half turn, that one would tie it to the seating."""
+    frame = M.frame_tilt_variance(rig.profile, plan)
+    say(f"the map's frame, the sample plane's tilt that no image shows, is known to "
+        f"{math.degrees(math.sqrt(2 * frame)):.4f} deg RMS from how the screen lies on its spacers"
+        + (" (calibration.screen_seating: each half turn cancels the spacer's wedge); every measured pixel's "
+           "uncertainty includes it" if plan.repeats(len(plan) - 1) is not None else
+           " (calibration.screen_tilt, the wedge: a half turn at each spacer, calibration.half_turn: every, would "
+           "tie it to screen_seating instead); every measured pixel's uncertainty includes it"))
+    return frame
 
 
 def _unbiased(decoded: list, bias: np.ndarray) -> list:
