@@ -85,49 +85,55 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
-#: Peak memory of ``rigcad calibrate P --simulate``: fixed bytes plus bytes per camera pixel. Measured
-#: (/usr/bin/time -v, one run each, achutha2006 with camera.resolution changed): 680 x 512 px 657 MiB,
-#: 1360 x 1024 px 1,192 MiB, 2040 x 1536 px 2,047 MiB: 537 and 515 bytes per pixel between them,
-#: 502 MiB at none; the estimate is rounded up (560 bytes per pixel, 512 MiB): it is linear in the
-#: pixels since the rendered capture (240 frames) and the decoding are.
+#: Peak memory of ``rigcad calibrate P --simulate`` and ``--images``: fixed bytes plus bytes per camera
+#: pixel. Measured (/usr/bin/time -v, one run each, achutha2006 with camera.resolution changed):
+#: --simulate 680 x 512 px 657 MiB, 1360 x 1024 px 1,192 MiB, 2040 x 1536 px 2,047 MiB (537 and 515 bytes
+#: per pixel between them, 502 MiB at none); --images (the capture --simulate --write-capture wrote)
+#: 680 x 512 px 447 MiB, 1360 x 1024 px 843 MiB (398 bytes per pixel, 315 MiB at none). Rounded up:
+#: linear in the pixels, as the frames, the camera's window and the decoding are.
 SIMULATE_BYTES_PER_PIXEL = 560.0
 SIMULATE_FIXED_BYTES = 512.0 * 2 ** 20
+IMAGES_BYTES_PER_PIXEL = 448.0
+IMAGES_FIXED_BYTES = 384.0 * 2 ** 20
 
 
-def check_simulation_memory(profile, memory: int | None = None) -> None:
-    """Refuse ``--simulate`` (ResourceError naming camera.resolution) when its estimated peak memory
-    (SIMULATE_FIXED_BYTES + SIMULATE_BYTES_PER_PIXEL per camera pixel) exceeds this machine's
-    (``memory`` bytes: engine.machine_memory by default); the line names the largest camera that fits."""
+def check_simulation_memory(profile, memory: int | None = None, simulate: bool = True) -> None:
+    """Refuse ``--simulate`` (``simulate``; else ``--images``) with a ResourceError naming
+    camera.resolution when its estimated peak memory (the constants above, per camera pixel) exceeds
+    this machine's (``memory`` bytes: engine.machine_memory by default); the line names the largest
+    camera that fits."""
     import math
 
     from rigcad.engine import ResourceError, machine_memory
 
     memory = machine_memory() if memory is None else memory
+    fixed, per_pixel = ((SIMULATE_FIXED_BYTES, SIMULATE_BYTES_PER_PIXEL) if simulate else
+                        (IMAGES_FIXED_BYTES, IMAGES_BYTES_PER_PIXEL))
     width, height = (int(v) for v in profile.camera.resolution)
-    need = SIMULATE_FIXED_BYTES + SIMULATE_BYTES_PER_PIXEL * width * height
+    need = fixed + per_pixel * width * height
     if need <= memory:
         return
-    pixels = max(0.0, (memory - SIMULATE_FIXED_BYTES) / SIMULATE_BYTES_PER_PIXEL)
+    pixels = max(0.0, (memory - fixed) / per_pixel)
     scale = math.sqrt(pixels / (width * height))
     fit_w, fit_h = int(width * scale), int(height * scale)
-    raise ResourceError(f"camera.resolution [{width}, {height}]: calibrate --simulate would need about "
-                        f"{need / 2 ** 30:.3g} GiB of memory, more than this machine's {memory / 2 ** 30:.3g} GiB; the "
-                        f"largest camera that fits has {int(pixels):,} px ([{fit_w}, {fit_h}] at this aspect)",
-                        param="camera.resolution")
+    raise ResourceError(f"camera.resolution [{width}, {height}]: calibrate {'--simulate' if simulate else '--images'} "
+                        f"would need about {need / 2 ** 30:.3g} GiB of memory, more than this machine's "
+                        f"{memory / 2 ** 30:.3g} GiB; the largest camera that fits has {int(pixels):,} px "
+                        f"([{fit_w}, {fit_h}] at this aspect)", param="camera.resolution")
 
 
 def _before_any_work(args: argparse.Namespace):
     """The rig, and ``--seating``'s calibrations (None without it), after every refusal that needs no
-    work: --seating's files read first (before the rig is built), --simulate's memory from the
+    work: --seating's files read first (before the rig is built), --simulate's or --images' memory from the
     profile, a screen or upright display that cannot fit, --laying, --write-capture's folder."""
     from rigcad.calibrate.kit import check_screen_fits, check_upright_fits
     from rigcad.rig import load
 
     runs = _seating_runs(args.seating) if getattr(args, "seating", None) else None
-    if args.simulate:  # a camera whose simulation cannot fit: one line, before the rig is built
+    if args.simulate or getattr(args, "images", None):  # a camera that cannot fit: one line, before the rig
         from rigcad.profile import load_profile
 
-        check_simulation_memory(load_profile(args.profile))
+        check_simulation_memory(load_profile(args.profile), simulate=bool(args.simulate))
     rig = load(args.profile)
     check_screen_fits(rig)  # a screen that cannot lie in the dome is refused before any work
     check_upright_fits(rig.profile)  # nor an upright display that cannot stand in the bore

@@ -8,7 +8,8 @@ import dataclasses
 
 import pytest
 
-from rigcad.cli.calibrate import SIMULATE_BYTES_PER_PIXEL, SIMULATE_FIXED_BYTES, check_simulation_memory
+from rigcad.cli.calibrate import (IMAGES_BYTES_PER_PIXEL, IMAGES_FIXED_BYTES, SIMULATE_BYTES_PER_PIXEL,
+                                  SIMULATE_FIXED_BYTES, check_simulation_memory)
 from rigcad.engine import ResourceError
 from rigcad.profile.schema import load_profile
 
@@ -16,6 +17,23 @@ from rigcad.profile.schema import load_profile
 def _with(resolution):
     p = load_profile("achutha2006")
     return dataclasses.replace(p, camera=dataclasses.replace(p.camera, resolution=resolution))
+
+
+def test_the_measured_runs_fit_their_estimates():
+    """Each measured peak (MiB, the constants' comment) is under its estimate, and within 1.5x of it."""
+    runs = [(True, 680 * 512, 657), (True, 1360 * 1024, 1192), (True, 2040 * 1536, 2047),
+            (False, 680 * 512, 447), (False, 1360 * 1024, 843)]
+    for simulate, pixels, measured_mib in runs:
+        fixed, per = ((SIMULATE_FIXED_BYTES, SIMULATE_BYTES_PER_PIXEL) if simulate else
+                      (IMAGES_FIXED_BYTES, IMAGES_BYTES_PER_PIXEL))
+        est = fixed + per * pixels
+        assert measured_mib * 2 ** 20 <= est < 1.5 * measured_mib * 2 ** 20, (simulate, pixels, est / 2 ** 20)
+
+
+def test_images_are_refused_past_the_machine_too():
+    with pytest.raises(ResourceError, match=r"calibrate --images would need about 112 GiB"):
+        check_simulation_memory(_with((16384, 16384)), memory=24 << 30, simulate=False)
+    check_simulation_memory(_with((1360, 1024)), memory=8 << 30, simulate=False)
 
 
 def test_the_default_camera_fits_an_8_gib_machine():
