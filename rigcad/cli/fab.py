@@ -23,19 +23,23 @@ def cmd_fab(args: argparse.Namespace) -> int:
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "fab")  # a planted link or lock: one line now, not after the work
     names = select_parts(args.parts)  # a bad part name costs no rig
-    rig = load(profile)
-    from rigcad.manual.gate import gate
+    from rigcad.manual.gate import gate, kept_gate
 
-    gate(rig, args.exports)  # a rig that cannot be put together is refused before a piece is sliced
     out = api.default_folder(profile.name, "fab", printer.name, root=args.exports)
-    with stages(len(names), f"fab {profile.name}") as step:
-        def progress(msg: str) -> None:
-            step(msg)
-            if args.verbose:
-                print(f"  {msg}", file=sys.stderr)
+    # a verdict and a fab run both kept from these inputs: read back, no rig built
+    res = (api.fab_published(profile, printer, out, gcode=args.gcode, parts=args.parts)
+           if kept_gate(args.exports, profile) else None)
+    if res is None:
+        rig = load(profile)
+        gate(rig, args.exports)  # a rig that cannot be put together is refused before a piece is sliced
+        with stages(len(names), f"fab {profile.name}") as step:
+            def progress(msg: str) -> None:
+                step(msg)
+                if args.verbose:
+                    print(f"  {msg}", file=sys.stderr)
 
-        res = api.fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs, progress=progress,
-                      slicing=lambda total: stages(total, f"slicing ({printer.slicer})"))
+            res = api.fab(rig, printer, out, gcode=args.gcode, parts=args.parts, workers=args.jobs,
+                          progress=progress, slicing=lambda total: stages(total, f"slicing ({printer.slicer})"))
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")
     for name, e in res.report["parts"].items():

@@ -299,6 +299,16 @@ def checked(rig, root, progress=None) -> Verdict:
     return found
 
 
+def kept_gate(root, profile) -> bool:
+    """Whether a verdict kept for ``profile`` under ``root`` (:func:`read_verdict`) lets the rig
+    through: True when it does, False when none is kept (the rig must be checked); AssemblyError when
+    the kept verdict refuses it. No rig is built."""
+    v = read_verdict(root, profile)
+    if v is not None and not v.ok:
+        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles)
+    return v is not None
+
+
 def gate(rig, root, progress=None) -> Verdict:
     """:func:`checked`, raising AssemblyError (exit code 1, its message the verdict's one line) when
     the rig cannot be put together: what ``fab``, ``manual`` and ``optimize`` call before any work."""
@@ -308,5 +318,5 @@ def gate(rig, root, progress=None) -> Verdict:
     return v
 
 
-__all__ = ["Fix", "VERDICT_FILE", "Verdict", "candidate_keys", "checked", "gate", "nearest_values", "read_verdict",
+__all__ = ["Fix", "VERDICT_FILE", "Verdict", "candidate_keys", "checked", "gate", "kept_gate", "nearest_values", "read_verdict",
            "refused", "verdict", "verdict_path"]

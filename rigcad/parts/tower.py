@@ -455,12 +455,13 @@ def tower_column(profile: Profile, layout) -> Part:
     xc, z0 = t.column_x, t.column_base_z
     foot_h = t.column_foot_half
     foot = Box((xc - foot_h, -foot_h, z0), (xc + foot_h, foot_h, z0 + tw.wall))
-    tube = Difference(Box((xc - w, -w, z0), (xc + w, w, top)),
-                      (Box((xc - w + tw.wall, -w + tw.wall, z0 + tw.wall), (xc + w - tw.wall, w - tw.wall,
-                                                                             top - tw.wall)),))
+    # the bore runs through the foot and the flange: a closed bore would be a sealed void (a second shell
+    # in the STEP, an inward-facing box in the STL, a second part to the slicer)
+    bore = Box((xc - w + tw.wall, -w + tw.wall, z0 - 1.0), (xc + w - tw.wall, w - tw.wall, top + 1.0))
+    tube = Box((xc - w, -w, z0), (xc + w, w, top))
     flange = Box((xc - foot_h, -foot_h, top - tw.wall), (xc + foot_h, foot_h, top))
     holes = tuple(h for z in (z0, top - tw.wall) for h in column_joint_holes(t, profile, z, tw.wall))
-    return Part("tower_column", Difference(Union_((foot, tube, flange)), holes), (0.55, 0.57, 0.6),
+    return Part("tower_column", Difference(Union_((foot, tube, flange)), (bore, *holes)), (0.55, 0.57, 0.6),
                 f"COP tower: hollow {tw.column_width:g} mm column on the base plate's datum tongue, under the "
                 f"projector's shelf; two {profile.datum.dowel_diameter:g} mm dowels and four bolts at each end")
 

@@ -9,18 +9,6 @@ import pytest
 
 from rigcad.parts import PARTS
 
-#: tower_column's tube is cut by a box closed at both ends by the foot and the flange (parts/tower.py),
-#: which seals a 40 x 40 x 280.5 mm void inside it. The fix belongs to rigcad/parts; until it lands the
-#: test is expected to fail there, and strict: it fails once the part is one body, to drop this line.
-SEALED = {"tower_column": "sealed cavity in the column's tube (parts/tower.py: the inner box stops a wall "
-                          "short of both ends)"}
-
-
-def _cases():
-    return [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=SEALED[n])) if n in SEALED else n
-            for n in PARTS]
-
-
 @pytest.fixture(scope="module")
 def rig():
     from rigcad.rig import load
@@ -28,7 +16,7 @@ def rig():
     return load("achutha2006")
 
 
-@pytest.mark.parametrize("name", _cases())
+@pytest.mark.parametrize("name", list(PARTS))
 def test_every_part_meshes_to_one_body(rig, name):
     from rigcad.export import mesh
 
@@ -59,7 +47,7 @@ def _shells(shape) -> int:
 
 
 @pytest.mark.e2e
-@pytest.mark.parametrize("name", _cases())
+@pytest.mark.parametrize("name", list(PARTS))
 def test_every_part_is_one_shell_in_its_step(rig, name, tmp_path):
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPControl import STEPControl_Reader
