@@ -231,8 +231,6 @@ def _search(rig, p, key: str, now: float, step: str, progress) -> float | None:
 # -- the verdict kept beside the export: stl, fab and manual check a profile once -----------------
 #: The verdict's file in exports/<profile>/, keyed by everything `rigcad stl` depends on.
 VERDICT_FILE = "assembly.json"
-#: A verdict file larger than this (bytes) is not ours: it is checked anew.
-MAX_VERDICT_BYTES = 1 << 20
 
 
 def verdict_path(root, name: str):
@@ -252,31 +250,14 @@ def _from_json(data: dict, name: str) -> Verdict:
 def read_verdict(root, profile) -> Verdict | None:
     """The verdict kept for ``profile`` under the exports ``root``, when it was made from this profile
     by this code (the stl cache key, rigcad.export.manifest.inputs_key); None otherwise (missing, not
-    a plain file, too large, unreadable, another key: it is made anew)."""
-    import json
-    import os
-    import stat
-
+    a plain file, too large, a nesting bomb, unreadable, another key: it is made anew). Read as
+    rigcad reads back its own files (rigcad.export.readback.own_json)."""
     from rigcad.export.manifest import inputs_key
+    from rigcad.export.readback import own_json
 
-    path = verdict_path(root, profile.name)
+    doc = own_json(verdict_path(root, profile.name))
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
-    except OSError:
-        return None
-    try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            return None
-        data = os.read(fd, MAX_VERDICT_BYTES + 1)
-    except OSError:
-        return None
-    finally:
-        os.close(fd)
-    if len(data) > MAX_VERDICT_BYTES:
-        return None
-    try:
-        doc = json.loads(data)
-        if doc.get("inputs_key") != inputs_key(profile):
+        if not isinstance(doc, dict) or doc.get("inputs_key") != inputs_key(profile):
             return None
         return _from_json(doc, profile.name)
     except (ValueError, TypeError, KeyError, AttributeError):

@@ -72,6 +72,9 @@ def test_the_verdict_is_read_back_only_for_the_same_profile_and_code(tmp_path, l
     path.write_text("{not json")  # damaged: checked anew, not a traceback
     gate.checked(low_rig, tmp_path)
     assert calls == ["low", "low", "low"]
+    path.write_text("[" * 100_000)  # a nesting bomb: checked anew, no RecursionError
+    gate.checked(low_rig, tmp_path)
+    assert calls == ["low", "low", "low", "low"]
     with pytest.raises(AssemblyError) as e:
         gate.gate(low_rig, tmp_path)
     assert e.value.exit_code == 1 and e.value.step == "beam_splitter"
