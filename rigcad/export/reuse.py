@@ -21,7 +21,9 @@ import stat
 from pathlib import Path
 
 from rigcad.export.atomic import Staging, hold_lock, json_bytes, read_made_from
+from rigcad.errors import ExportError
 from rigcad.export.manifest import code_version, profile_digest, sha256_hex
+from rigcad.export.readback import parse_json
 
 #: The record inside a result folder: ``{"inputs_key": ..., "files": {relative path: sha256}}``.
 RECORD = "published.json"
@@ -73,8 +75,8 @@ def read_back(folder: Path, key: str, made_from: str, lock: Path, read: tuple[st
         if read_made_from(folder) != made_from:
             return None
         try:
-            rec = json.loads(_read_plain(folder / RECORD))
-        except (OSError, ValueError):
+            rec = parse_json(_read_plain(folder / RECORD), str(folder / RECORD))
+        except (OSError, ExportError):  # unreadable, or not JSON rigcad could have written (a nesting bomb)
             return None
         files = rec.get("files") if isinstance(rec, dict) else None
         if rec.get("inputs_key") != key or not isinstance(files, dict) or not files \

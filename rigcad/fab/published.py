@@ -7,14 +7,15 @@ settings and the run's options; the record and its checks: rigcad.export.reuse.
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from rigcad.export import reuse
+from rigcad.errors import ExportError
 from rigcad.export.manifest import profile_digest
+from rigcad.export.readback import parse_json
 from rigcad.fab.printers import Printer
 
 
@@ -60,7 +61,12 @@ def read_back(profile, printer: Printer, out: Path, *, gcode: bool = False, part
     back = reuse.read_back(out, key, profile_digest(profile), lock, read=("fab.json",))
     if back is None:
         return None
-    report = json.loads(back["fab.json"])
+    try:
+        report = parse_json(back["fab.json"], str(out / "fab.json"))
+    except ExportError:  # not a report rigcad could have written: run the stage
+        return None
+    if not isinstance(report, dict) or not isinstance(report.get("parts"), dict):
+        return None
     for name in report["parts"]:
         (progress or (lambda msg: None))(name)
     return FabResult(report, [], {"read_back": time.perf_counter() - t0}, reused=True)

@@ -21,7 +21,6 @@ it, reads the folder back instead of doing the work again, while every file is i
 
 from __future__ import annotations
 
-import json
 import time
 from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
@@ -180,11 +179,10 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
 
 def _previous_report(out: Path) -> dict:
     """The fab.json of an earlier run in ``out`` ({} when there is none or it cannot be read)."""
-    path = out / "fab.json"
-    try:
-        return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
-    except (OSError, ValueError):
-        return {}  # unreadable: nothing is reused
+    from rigcad.export.readback import own_json
+
+    old = own_json(out / "fab.json")  # read as data: a bomb, a FIFO or a giant is None, never a traceback
+    return old if isinstance(old, dict) else {}  # unreadable: nothing is reused
 
 
 def _cached_gcode(old: dict, out: Path) -> dict[str, tuple]:

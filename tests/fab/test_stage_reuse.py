@@ -167,3 +167,20 @@ def test_the_api_reads_a_published_run_back_without_building_a_rig(table31_rig, 
     assert back.reused and back.report == first.report and fab_calls["_fab_part"] == 1
     assert api.fab_published(profile, prusa, out, parts=["beam"]) is None  # other parts: another key
     assert api.fab_published(profile, prusa, out, parts=PARTS, gcode=True) is None  # G-code asked: another key
+
+
+def test_a_nesting_bomb_in_a_published_record_or_report_reads_as_nothing_published(tmp_path):
+    """rigcad reads its own records back as data (rigcad.export.readback): a record, or an earlier
+    fab.json, of 10^5 nested brackets is no run to reuse, never a RecursionError."""
+    from rigcad.export import reuse
+    from rigcad.fab import stage
+
+    folder = tmp_path / "fab"
+    folder.mkdir()
+    (folder / "fab.json").write_text("[" * 100_000)
+    assert stage._previous_report(folder) == {}
+    (folder / reuse.RECORD).write_text("[" * 100_000)
+    from rigcad.export.atomic import made_from_path
+
+    made_from_path(folder).write_text('{"profile_sha256": "' + "0" * 64 + '"}')  # the record is read, not skipped
+    assert reuse.read_back(folder, "k" * 64, "0" * 64, tmp_path / ".fab.lock") is None
