@@ -91,26 +91,26 @@ def test_revolved_area_matches_the_paraboloids_closed_form(table31_rig):
 
 
 def _dome_joint(rig):
-    joints = [j for j in B.bolt_joints(rig) if j["parts"] == ("base_plate", "dome")]
-    assert len(joints) == 1, B.bolt_joints(rig)
-    return joints[0]
+    (joint,) = rig.recipes["dome"].joints  # declared by the dome (rigcad.parts.dome.flange_joint)
+    assert not [j for j in B.bolt_joints(rig) if j["parts"] == ("base_plate", "dome")], \
+        "a declared joint is not found again from the holes"
+    return joint
 
 
-def test_bolts_are_found_in_the_recipes_and_sized_from_the_grip(tmp_path, table31_rig):
+def test_the_flange_joint_is_declared_and_sized_from_the_standards(tmp_path, table31_rig):
     p = table31_rig.profile
     j = _dome_joint(table31_rig)
-    # the holes of the flange and the plate line up: one bolt each, through both
-    assert j["count"] == p.dome_shell.bolts == 8
-    assert j["grip_mm"] == pytest.approx(p.dome_shell.flange_thickness + p.base_plate.thickness, abs=1e-9)
-    assert j["item"].startswith("M4 x 25 mm")  # 6 + 10 mm grip + 2 x 0.8 + 3.2 + 2 x 0.7 = 22.2 -> 25
+    assert j.count == p.dome_shell.bolts == 8 and (j.thread, j.into) == ("M4", "insert")
+    # into an insert: 0.8 washer + 6 flange + 8.1 insert = 14.9 mm of reach -> the longest M4 sold within it, 12
+    assert j.length == 12 and j.item.startswith("M4 x 12 mm")
     other = _profile(tmp_path, "bolts", "base_plate:\n  thickness: 20 mm\ndome_shell:\n  bolt_diameter: 5.5 mm\n"
                                         "  bolts: 12\n  flange_width: 24 mm\n")
     j = _dome_joint(other)
-    # M5 (5.5 mm medium clearance): 6 + 20 + 2 x 1.0 + 4.7 + 2 x 0.8 = 34.3 mm -> 35 mm
-    assert j["item"].startswith("M5 x 35 mm") and j["count"] == 12 and j["washers"] == 24
-    # every through bolt of the rig joins parts that exist, with some grip
-    for j in B.bolt_joints(table31_rig):
-        assert all(n in table31_rig.recipes for n in j["parts"]) and j["grip_mm"] > 0 and j["count"] > 0
+    # M5 (5.5 mm medium clearance): 1.0 washer + 6 flange + 9.5 insert = 16.5 mm -> 16 mm
+    assert j.thread == "M5" and j.count == 12 and j.length == 16 and j.item.startswith("M5 x 16 mm")
+    # every through bolt the plan still finds from holes joins parts that exist, with some grip
+    for b in B.bolt_joints(table31_rig):
+        assert all(n in table31_rig.recipes for n in b["parts"]) and b["grip_mm"] > 0 and b["count"] > 0
 
 
 def test_the_tower_hardware_is_the_towers_and_follows_the_mounting_threads(tmp_path, table31_rig):
