@@ -292,7 +292,7 @@ def kept_gate(root, profile) -> bool:
 
 def gate(rig, root, progress=None) -> Verdict:
     """:func:`checked`, raising AssemblyError (exit code 1, its message the verdict's one line) when
-    the rig cannot be put together: what ``fab``, ``manual`` and ``optimize`` call before any work."""
+    the rig cannot be put together: what ``fab`` and ``manual`` call before any work."""
     v = checked(rig, root, progress)
     if not v.ok:
         raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles)
