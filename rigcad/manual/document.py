@@ -217,9 +217,10 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     from rigcad.manual import plan
 
     bill = B.bill(rig, fab_report, printer)
-    bill["hardware"] = plan.bill_hardware(rig, plan.steps(rig, meshes)[0], bill)  # what the steps fit: one list
+    steps, solids = plan.steps(rig, meshes)  # once: the bill's hardware and section 5's order both read them
+    bill["hardware"] = plan.bill_hardware(rig, steps, bill)  # what the steps fit: one list
     c = SimpleNamespace(rig=rig, printer=printer, fab_report=fab_report, p=rig.profile, files={}, meshes=meshes,
-                        bill=bill, cut_away=A.encloses(meshes), step=step)
+                        bill=bill, cut_away=A.encloses(meshes), step=step, steps=steps, solids=solids)
     c.files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
                                                   cut_away=c.cut_away)
     step("rig picture")
@@ -464,15 +465,15 @@ THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut wit
                      "the part with the trap stands on the bench), tighten crosswise by hand"}
 
 
-def assembly_order(rig, meshes):
+def assembly_order(rig, steps, solids):
     """The order rigcad's assembly check finds (rigcad.manual.assembly_check.find_order over
     rigcad.manual.plan's steps). A rig with no order gets no manual: the gate's refusal
     (rigcad.manual.gate: AssemblyError, its one line naming the parts and the profile keys)."""
     from rigcad.errors import AssemblyError
-    from rigcad.manual import assembly_check, gate, plan
+    from rigcad.manual import assembly_check, gate
 
     try:
-        return assembly_check.find_order(plan.assembly(rig, meshes))
+        return assembly_check.find_order(assembly_check.Assembly(solids, steps))
     except AssemblyError as err:
         v = gate.refused(rig, err, search=False)
         raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles) from err
@@ -515,7 +516,7 @@ def _section_assemble(d: Doc, c) -> None:
     from rigcad.manual import plan as plan_mod
 
     d.h(2, "5. Assemble")
-    order = assembly_order(c.rig, c.meshes)
+    order = assembly_order(c.rig, c.steps, c.solids)
     d.p("The order below is the one rigcad's assembly check found: each part, swept along the direction the "
         "step names, clears everything already in place; each bolt's head, nut and tool have a straight way "
         "in. Each picture shows what is in place (grey) and what goes in (orange), drawn before its place "
