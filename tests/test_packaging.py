@@ -22,18 +22,19 @@ def test_every_package_folder_is_in_the_wheel():
              if d.is_dir() and "__pycache__" not in d.parts and any(d.glob("*.py"))}
     found.add("rigcad")
     listed = set(SETUPTOOLS["packages"])
-    assert found == listed - {"rigcad.profiles", "rigcad.profiles.printers"}
+    assert found == listed - {"rigcad.profiles", "rigcad.profiles.printers", "rigcad.profiles.instruments"}
 
 
 def test_the_wheel_maps_the_top_profiles_folder_into_the_package():
     assert SETUPTOOLS["package-dir"] == {"rigcad.profiles": "profiles"}
-    assert {"rigcad.profiles", "rigcad.profiles.printers"} <= set(SETUPTOOLS["packages"])
+    assert {"rigcad.profiles", "rigcad.profiles.printers", "rigcad.profiles.instruments"} <= set(SETUPTOOLS["packages"])
     for package, patterns in SETUPTOOLS["package-data"].items():
         if package.startswith("rigcad.profiles"):
             folder = ROOT / "profiles" / Path(*package.split(".")[2:])
             assert all(list(folder.glob(p)) for p in patterns), (package, patterns)
     shipped = sorted(p.relative_to(ROOT / "profiles") for p in (ROOT / "profiles").rglob("*.yaml"))
     assert Path("achutha2006.yaml") in shipped and Path("printers/prusa_mk3s.yaml") in shipped
+    assert Path("instruments/prosilica_ec1350c.yaml") in shipped
     assert not (ROOT / "rigcad" / "profiles").exists()  # one home: the top folder
 
 
