@@ -320,13 +320,19 @@ def purchased(rig) -> list[dict]:
     """Optics and instruments the profile names (its projector and camera; with the COP tower, the
     beam splitter and the lens): one row each, every figure from the profile."""
     p = rig.profile
+    chosen = getattr(p, "instrument", lambda *k: None)  # the instrument file the profile names, if any
     rows = []
     for section in ("projector", "camera", "beam_splitter", "splitter", "lens"):
         obj = getattr(p, section, None)
         if obj is None:
             continue
-        rows.append({"item": section.replace("_", " "), "quantity": 1,
-                     "spec": _describe(obj), "source": p.where(section, _first_field(obj)) or "default"})
+        inst = chosen(section, "model")
+        rows.append({"item": section.replace("_", " ") + (f": {inst.title}" if inst else ""), "quantity": 1,
+                     "spec": _describe(obj, p, section), "source": p.where(section, _first_field(obj)) or "default"})
+        lens = chosen(section, "lens") if section == "camera" else None
+        if lens:
+            rows.append({"item": f"camera lens: {lens.title}", "quantity": 1, "source": lens.file,
+                         "spec": "; ".join(f"{k.replace('_', ' ')} {v}" for k, v in lens.figures.items())})
     return rows
 
 
@@ -336,8 +342,10 @@ def _first_field(obj) -> str:
     return fields(obj)[0].name
 
 
-def _describe(obj) -> str:
-    """A one-line description of a profile section: every field with its unit."""
+def _describe(obj, profile=None, section: str = "") -> str:
+    """A one-line description of a profile section: every field with its unit, "(assumed)" on a
+    field whose doc says so and that neither the profile nor an instrument file set
+    (``profile.set_by``)."""
     from dataclasses import fields
 
     from rigcad.units import DEG
@@ -357,7 +365,9 @@ def _describe(obj) -> str:
             text = f"{v[0]} x {v[1]} px"
         else:
             text = str(list(v) if isinstance(v, tuple) else v)
-        assumed = "assumed" in (getattr(spec, "doc", "") or "").lower()
+        set_by = getattr(profile, "set_by", None)
+        assumed = ("assumed" in (getattr(spec, "doc", "") or "").lower()
+                   and (set_by is None or set_by(section, f.name) == "default"))
         out.append(f"{f.name.replace('_', ' ')} {text}" + (" (assumed)" if assumed else ""))
     return "; ".join(out)
 
