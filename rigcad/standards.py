@@ -1,7 +1,7 @@
 """Standard hardware: the one home of every figure rigcad takes from a standard or a maker's table.
 
 Threads, clearance holes, socket-head screws, hex nuts, washers, preferred lengths, hex keys,
-heat-set inserts, dowel pins and balls. Each table names the standard (or the maker's datasheet)
+heat-set inserts, dowel pins and balls, cup-point set screws, gauge blocks, spring steel. Each table names the standard (or the maker's datasheet)
 its figures come from; nothing else in rigcad states these numbers (tests/test_standards.py greps
 the tree for them). The parts cut their holes from these figures, the bill orders by them and the
 assembly steps fit them, so the solid, the bill and the steps cannot disagree.
@@ -176,6 +176,47 @@ INSERTS = {
 }
 
 
+#: ISO 8734 dowel pins' diameters (mm), m6.
+DOWEL_DIAMETERS = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0)
+
+
+def dowel_diameter_for(at_most: float) -> float:
+    """The largest ISO 8734 dowel diameter (mm) no larger than ``at_most`` mm; ValueError under 1 mm."""
+    fits = [d for d in DOWEL_DIAMETERS if d <= at_most + 1e-9]
+    if not fits:
+        raise ValueError(f"no ISO 8734 dowel pin is as thin as {at_most:g} mm (thinnest {DOWEL_DIAMETERS[0]:g} mm)")
+    return fits[-1]
+
+
+#: Cup-point socket set screws: the cup's diameter (mm, dp max): ISO 4029 for metric threads, ASME
+#: B18.3 (C max, in inches as printed) for the unified ones. A ball larger than the cup sits on its rim.
+CUP_POINT = {"M3": 1.4, "M4": 2.0, "M5": 2.5, "M6": 3.0, "M8": 5.0,
+             "1/4-20 UNC": 0.132 * INCH, "3/8-16 UNC": 0.212 * INCH}
+#: ISO 4029's range of nominal lengths (mm) per thread, from SET_SCREW_LENGTHS.
+SET_SCREW_LENGTHS = (3, 4, 5, 6, 8, 10, 12, 16, 20, 25, 30)
+SET_SCREW_LENGTH_RANGE = {"M3": (3, 16), "M4": (4, 20), "M5": (5, 25), "M6": (6, 30), "M8": (8, 30)}
+
+
+def shortest_set_screw(name: str, need: float) -> int | None:
+    """The shortest ISO 4029 set screw length (mm) of at least ``need`` mm for thread ``name``, or None
+    past the longest (an inch thread: the same steps, which ASME B18.3 also stocks near enough)."""
+    lo, hi = SET_SCREW_LENGTH_RANGE.get(name, (SET_SCREW_LENGTHS[0], SET_SCREW_LENGTHS[-1]))
+    return next((n for n in SET_SCREW_LENGTHS if lo <= n <= hi and n >= need - 1e-9), None)
+
+
+#: ISO 3650 gauge blocks of nominal length 0.5 to 10 mm: their measuring faces' size (mm): 30 x 9.
+GAUGE_BLOCK_FACE = (30.0, 9.0)
+#: Shear modulus (N/mm^2) of patented cold-drawn spring steel wire (EN 10270-1), as EN 13906-1 gives it
+#: for the spring rate R = G d^4 / (8 D^3 n).
+SPRING_STEEL_G = 81500.0
+
+
+def spring_rate(wire: float, mean_diameter: float, active_coils: float) -> float:
+    """A helical compression spring's rate (N/mm) by EN 13906-1: G d^4 / (8 D^3 n), d the wire and
+    D the mean coil diameter (mm), n the active coils; G: SPRING_STEEL_G."""
+    return SPRING_STEEL_G * wire ** 4 / (8.0 * mean_diameter ** 3 * active_coils)
+
+
 @dataclass(frozen=True)
 class HexKey:
     """An L hex key (ISO 2936) across flats ``size`` (mm): its long and short arms (mm)."""
@@ -196,6 +237,7 @@ DRIVER_BLADE_MM = 100.0
 #: An open-end spanner's reach (mm; DIN 3110 spanners for M3-M6 nuts are 90-120 mm long).
 SPANNER_MM = 80.0
 
-__all__ = ["INCH_SCREW_LENGTHS", "LARGE_WASHERS", "DOWEL_LENGTHS", "longest_dowel", "DRIVER_BLADE_MM", "HEX_KEYS", "HexKey", "INCH", "INSERTS",
+__all__ = ["CUP_POINT", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
+           "SPRING_STEEL_G", "dowel_diameter_for", "shortest_set_screw", "spring_rate", "INCH_SCREW_LENGTHS", "LARGE_WASHERS", "DOWEL_LENGTHS", "longest_dowel", "DRIVER_BLADE_MM", "HEX_KEYS", "HexKey", "INCH", "INSERTS",
            "Insert", "METRIC_THREADS", "MOUNT_THREADS", "SCREW_LENGTHS", "SCREW_LENGTH_RANGE", "SPANNER_MM", "THREADS",
            "Thread", "longest_screw", "screw_lengths", "shortest_screw", "thread", "thread_for_hole"]
