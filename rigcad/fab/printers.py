@@ -31,6 +31,7 @@ from typing import Any
 
 from rigcad.errors import FabricationError, ProfileError
 from rigcad.fab import vendor as V
+from rigcad.parts.process import ProcessErrors, from_measurements
 from rigcad.profile.loader import RawProfile, find_file, load_raw
 from rigcad.profile.paths import PRINTERS_SUBDIR, display, names_on_search_path, search_path
 # The schema's own readers, so printer files follow the same unit, range and error rules.
@@ -98,6 +99,9 @@ class Printer:
     slicer_unavailable: str | None = None
     #: Figures read from the preset because the printer file left them out.
     from_preset: tuple[str, ...] = ()
+    #: The process's dimensional errors (``process_errors:``; rigcad.parts.process), or the
+    #: process's published defaults (DEFAULT_PROCESS) when the file states none.
+    process_errors: ProcessErrors | None = None
 
     @property
     def usable(self) -> tuple[float, float, float]:
@@ -118,6 +122,7 @@ class Printer:
                "sanding_stock_mm": "auto" if self.sanding_stock is None else self.sanding_stock,
                "slicer_presets": self.slicer_config.describe() if self.slicer_config else None,
                "figures_from_preset": list(self.from_preset),
+               "process_errors": self.process_errors.describe() if self.process_errors else None,
                "alignment_pin": {"diameter_mm": self.alignment_pin.diameter,
                                  "clearance_mm": self.alignment_pin.clearance,
                                  "depth_mm": self.alignment_pin.depth}}
@@ -166,6 +171,29 @@ _PRESET_FIGURES = {"layer_height": "layer_height", "first_layer_height": "first_
 #: below any printer's resolution, above the rounding of decimal text such as "0.15".
 AGREE_TOL = 1e-6
 _SECTIONS = {"build_volume": BuildVolume, "alignment_pin": AlignmentPin}
+#: Keys of ``process_errors`` (rigcad.parts.process), of its ``hole_shrink`` and of its ``measured``.
+_PROCESS_KEYS = ("scale", "position", "hole_shrink", "layer_step", "source", "measured")
+_SHRINK_KEYS = ("vertical", "horizontal", "per_mm")
+_MEASURED_KEYS = ("lengths", "holes_vertical", "holes_horizontal")
+#: Largest relative error a printer file may state (a fraction): 5 % is a printer out of calibration
+#: by far; more is a slip (0.2 for 0.2 %).
+MAX_SCALE = 0.05
+#: Largest hole shrink or position error a printer file may state (mm): several nozzle widths.
+MAX_PROCESS_MM = 2.0
+#: The process errors of a printer file that states none, by process, from published figures:
+#: FDM: Xometry's guideline for FDM parts, "+/- 0.004 in or +/- 0.002 in per inch, whichever is
+#: greater" (https://xometry.zendesk.com/hc/en-us/articles/217170527-Accuracy-for-3D-Printed-Plastics),
+#: holes "0.1-0.3 mm undersize" (Layer X, https://layerx3d.in/blog/3d-printing-tolerances-dimensional-accuracy-guide:
+#: the middle for vertical axes, the top of the range for horizontal ones, whose top droops);
+#: SLA: Layer X's "+/- 0.1 mm standard" and "a further 0.1-0.2 % over 48 hours" (the top), holes as the
+#: position. layer_step: the file's layer height.
+DEFAULT_PROCESS = {
+    "fdm": {"scale": 0.002, "position": 0.1016, "vertical": 0.2, "horizontal": 0.3,
+            "source": "default for fdm printers: Xometry's FDM guideline (0.004 in + 0.002 in/in), holes 0.1-0.3 mm "
+                      "undersize (Layer X)"},
+    "sla": {"scale": 0.002, "position": 0.1, "vertical": 0.1, "horizontal": 0.1,
+            "source": "default for sla printers: Layer X's +-0.1 mm and 0.1-0.2 % post-cure shrinkage"},
+}
 
 
 def printer_path(name: str | Path) -> Path:
@@ -201,7 +229,7 @@ def load_printer(name: str | Path) -> Printer:
     """Read and validate a printer profile; errors name the file:line, key, value and what is valid."""
     path = printer_path(name)
     raw = load_raw(path)
-    valid = sorted([*_TOP, *_SECTIONS])
+    valid = sorted([*_TOP, *_SECTIONS, "process_errors"])
     for key in raw.data:
         if key not in valid:
             raise ProfileError(f"unknown printer key {unknown_key(key)}{suggest(str(key), valid)}; valid: "
@@ -263,6 +291,7 @@ def load_printer(name: str | Path) -> Printer:
     if 2 * margin >= min(vol.x, vol.y):
         raise ProfileError(f"bed_margin: {margin:g} mm leaves no bed ({vol.x:g} x {vol.y:g} mm)",
                            where=raw.where(("bed_margin",)))
+    process = read_process_errors(raw, top["process"], top["layer_height"], path)
     return Printer(name=raw.name, description=top["description"], process=top["process"], build_volume=vol,
                    bed_margin=margin, layer_height=top["layer_height"],
                    first_layer_height=top["first_layer_height"], nozzle=top["nozzle"], pixel=top["pixel"],
@@ -271,7 +300,97 @@ def load_printer(name: str | Path) -> Printer:
                    deposition_rate_mm3_s=top["deposition_rate_mm3_s"], layer_time_s=top["layer_time_s"],
                    slicer=top["slicer"], alignment_pin=sections["alignment_pin"], sanding_stock=top["sanding_stock"],
                    source=" <- ".join(str(s) for s in raw.sources), marks=dict(raw.marks),
-                   slicer_config=slicer_cfg, slicer_unavailable=unavailable, from_preset=tuple(from_preset))
+                   slicer_config=slicer_cfg, slicer_unavailable=unavailable, from_preset=tuple(from_preset),
+                   process_errors=process)
+
+
+def _percent(raw: RawProfile, key: tuple[str, ...], lo: float = 0.0) -> float:
+    """A relative error written as a percentage ("0.2 %"), as a fraction."""
+    value, name, where = raw.data, ".".join(key), raw.where(key)
+    for k in key:
+        value = value[k]
+    text = str(value).strip() if isinstance(value, (str, int, float)) and not isinstance(value, bool) else None
+    m = re.fullmatch(r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*%", text or "")
+    if not m:
+        raise ProfileError(f"{name}: expected a percentage such as '0.2 %', got {value!r} (a bare number is refused: "
+                           "0.2 could be 0.2 % or 20 %)", where=where)
+    out = float(m.group(1)) / 100
+    if not lo <= out <= MAX_SCALE:
+        raise ProfileError(f"{name}: {m.group(1)} % is outside {100 * lo:g}..{100 * MAX_SCALE:g} %", where=where)
+    return out
+
+
+def _process_length(raw: RawProfile, key: tuple[str, ...], doc: str) -> float:
+    value = raw.data
+    for k in key:
+        value = value[k]
+    return convert_value(Spec("length", doc, lo=0, hi=MAX_PROCESS_MM), value, ".".join(key), raw.where(key))
+
+
+def _mapping(raw: RawProfile, key: tuple[str, ...], valid: tuple[str, ...], example: str) -> dict:
+    value = raw.data
+    for k in key:
+        value = value[k]
+    name = ".".join(key)
+    if not isinstance(value, dict):
+        raise ProfileError(f"{name}: expected a mapping, e.g. {example}, got {value!r}", where=raw.where(key))
+    for k in value:
+        if k not in valid:
+            raise ProfileError(f"unknown key {name}.{unknown_key(k)}{suggest(str(k), list(valid))}; valid keys in "
+                               f"{name}: {', '.join(valid)}", where=raw.where((*key, k)))
+    return value
+
+
+def _measured_rows(raw: RawProfile, key: tuple[str, ...]) -> list[tuple[float, float]]:
+    """A list of [nominal, measured] pairs of lengths (mm)."""
+    value = raw.data
+    for k in key:
+        value = value[k]
+    name, where = ".".join(key), raw.where(key)
+    if not isinstance(value, list) or not all(isinstance(r, list) and len(r) == 2 for r in value):
+        raise ProfileError(f"{name}: expected a list of [nominal, measured] pairs, e.g. [[20 mm, 19.96 mm], "
+                           f"[100 mm, 99.81 mm]], got {value!r}", where=where)
+    s = Spec("length", "a nominal or measured size", lo=0, hi=1000, lo_open=True)
+    return [(convert_value(s, a, name, where), convert_value(s, b, name, where)) for a, b in value]
+
+
+def read_process_errors(raw: RawProfile, process: str, layer_height: float, path: Path) -> ProcessErrors:
+    """The printer file's ``process_errors`` (rigcad.parts.process): the stated figures, or the
+    process's published defaults (DEFAULT_PROCESS) for those left out; ``measured`` (the calibration
+    print's [nominal, measured] lengths and hole diameters) replaces them all. Every length carries
+    its unit, the relative errors their '%'; errors name the file:line."""
+    base = DEFAULT_PROCESS[process]
+    if "process_errors" not in raw.data:
+        return ProcessErrors(base["scale"], base["position"], base["vertical"], base["horizontal"], 0.0,
+                             layer_height, base["source"])
+    sec = _mapping(raw, ("process_errors",), _PROCESS_KEYS, "{scale: 0.2 %, position: 0.1 mm}")
+    layer = (_process_length(raw, ("process_errors", "layer_step"), "the step printed heights come in")
+             if "layer_step" in sec else layer_height)
+    if "measured" in sec:
+        m = _mapping(raw, ("process_errors", "measured"), _MEASURED_KEYS, "{lengths: [[20 mm, 19.96 mm], ...]}")
+        rows = {k: _measured_rows(raw, ("process_errors", "measured", k)) for k in _MEASURED_KEYS if k in m}
+        return from_measurements(rows.get("lengths", []), rows.get("holes_vertical", []),
+                                 rows.get("holes_horizontal", []), layer_step=layer,
+                                 source=f"the calibration print, measured ({display(path)})",
+                                 where=raw.where(("process_errors", "measured")))
+    shrink = (_mapping(raw, ("process_errors", "hole_shrink"), _SHRINK_KEYS, "{vertical: 0.2 mm, horizontal: 0.3 mm}")
+              if "hole_shrink" in sec else {})
+    source = sec.get("source", base["source"] if not sec.keys() - {"source"} else "stated in the printer file")
+    if not isinstance(source, str) or not source.strip() or _CONTROL.search(source):
+        raise ProfileError("process_errors.source: one line of text saying where the figures come from",
+                           where=raw.where(("process_errors", "source")))
+    return ProcessErrors(
+        scale=_percent(raw, ("process_errors", "scale")) if "scale" in sec else base["scale"],
+        position=(_process_length(raw, ("process_errors", "position"), "a printed feature's position error")
+                  if "position" in sec else base["position"]),
+        hole_shrink_vertical=(_process_length(raw, ("process_errors", "hole_shrink", "vertical"), "diametral "
+                              "undersize of a hole with a vertical axis") if "vertical" in shrink else base["vertical"]),
+        hole_shrink_horizontal=(_process_length(raw, ("process_errors", "hole_shrink", "horizontal"), "diametral "
+                                "undersize of a hole with a horizontal axis") if "horizontal" in shrink
+                                else base["horizontal"]),
+        hole_shrink_per_mm=(_percent(raw, ("process_errors", "hole_shrink", "per_mm"))
+                            if "per_mm" in shrink else 0.0),
+        layer_step=layer, source=source.strip())
 
 
 def _read_slicer(raw: RawProfile, path: Path) -> tuple[V.VendorConfig | None, str | None]:

@@ -14,6 +14,10 @@ projector's virtual COP and whose plate the camera looks through):
 5. the shelf: its dowel holes to the splitter seat's cone (a printed, or a cut and drilled, length);
 6. the splitter holder: the seat's balls to the grooves the plate rests on (printed).
 
+The print accuracy is the profile's ``datum`` figures (assumed), or, given a printer's
+``process`` (rigcad.parts.process.ProcessErrors: what the tolerance stack, rigcad.fab.stack, uses),
+its figures: a length as ``position + scale * span``, a height as half a layer step plus the scale.
+
 Each link's error is its worst case; the chain's worst case is their sum and its likely value
 their root sum of squares (independent links). Links 1-5 move the whole tower (projector, camera
 and splitter together): the COPs move as much. Link 6 moves the splitter alone: its virtual image
@@ -27,6 +31,7 @@ import math
 from dataclasses import dataclass, replace
 
 from rigcad.parts import breadboard
+from rigcad.parts.process import ProcessErrors
 from rigcad.parts.tower import EXTRUSION, POCKET_GAP
 
 #: Worst-case diametral clearance (mm) of an ISO 8734 dowel (m6: +0.004..+0.012 mm for 3..6 mm) in a
@@ -79,47 +84,57 @@ class DatumChain:
                 "vertical_worst_mm": self.vertical_worst, "mount": self.mount}
 
 
-def _printed(profile, span: float) -> float:
+def _printed(profile, span: float, process: ProcessErrors | None = None) -> float:
     """Position error (mm) of a printed feature ``span`` mm from the part's datum feature."""
+    if process is not None:
+        return process.length_error(span)
     d = profile.datum
     return d.print_position + d.print_scale * abs(span)
 
 
-def _column_links(profile, t) -> tuple[Link, Link, Link]:
+def _height(profile, span: float, process: ProcessErrors | None = None) -> float:
+    """Error (mm) of a printed height ``span`` mm: as a position (the profile's figures), or half a
+    layer step and the scale (a printer's process)."""
+    return _printed(profile, span) if process is None else process.height_error(span)
+
+
+def _column_links(profile, t, process: ProcessErrors | None = None) -> tuple[Link, Link, Link]:
     """The column and its two joints: a printed column on dowels, or a bought extrusion in pockets."""
     d = profile.datum
     height = t.shelf_top_z - t.shelf_thickness - t.column_base_z
     if profile.buy.column == "print":
         foot = 2 * t.column_foot_half
         dowels = Link("dowels", f"ISO 8734 m6 in H7: {DOWEL_FIT:g} mm", DOWEL_FIT, 0.0)
-        return (dowels, Link("column", f"printed: dowel pattern {_printed(profile, 0):.2f} mm; lean: the foot's "
+        pattern = _printed(profile, 0, process)
+        return (dowels, Link("column", f"printed: dowel pattern {pattern:.2f} mm; lean: the foot's "
                              f"{d.foot_flatness:g} mm out-of-flat over {foot:.0f} mm, times {height:.0f} mm",
-                             _printed(profile, 0) + d.foot_flatness / foot * height, _printed(profile, height)), dowels)
+                             pattern + d.foot_flatness / foot * height, _height(profile, height, process)), dowels)
     pocket = Link("pocket", f"square pocket, a slide fit: {POCKET_GAP:g} mm each side", POCKET_GAP, 0.0)
     return (pocket, Link("column", f"extrusion: saw-cut ends square to {EXTRUSION_END_SQUARENESS:g} mm over "
                          f"{EXTRUSION:g} mm, times {height:.0f} mm; cut length to {EXTRUSION_END_SQUARENESS:g} mm",
                          EXTRUSION_END_SQUARENESS / EXTRUSION * height, EXTRUSION_END_SQUARENESS), pocket)
 
 
-def datum_chain(profile, layout) -> DatumChain:
-    """The chain from the base plate's bore to the splitter for ``profile`` and ``layout`` (RigLayout)."""
+def datum_chain(profile, layout, process: ProcessErrors | None = None) -> DatumChain:
+    """The chain from the base plate's bore to the splitter for ``profile`` and ``layout`` (RigLayout),
+    at the profile's assumed print accuracy or, given, a printer's ``process`` figures."""
     t = layout.tower
-    low, column, high = _column_links(profile, t)
+    low, column, high = _column_links(profile, t, process)
     span = t.column_x - t.holder_x[1]
-    shelf = (Link("shelf", f"printed: {span:.0f} mm from its column joint to the seat", _printed(profile, span),
-                  _printed(profile, t.shelf_thickness)) if profile.buy.shelf == "print" else
+    shelf = (Link("shelf", f"printed: {span:.0f} mm from its column joint to the seat", _printed(profile, span, process),
+                  _height(profile, t.shelf_thickness, process)) if profile.buy.shelf == "print" else
              Link("shelf", f"aluminium plate drilled through a printed template ({PLATE_HOLE_POSITION:g} mm)",
                   PLATE_HOLE_POSITION, 0.0))
     holder_span = t.holder_top_z - t.shelf_top_z
     return DatumChain((
         Link("base plate", f"printed: {t.column_x:.0f} mm from its bore to the tongue's column joint",
-             _printed(profile, t.column_x), _printed(profile, profile.base_plate.thickness)),
+             _printed(profile, t.column_x, process), _height(profile, profile.base_plate.thickness, process)),
         replace(low, name=f"{low.name}, tongue to column"),
         column,
         replace(high, name=f"{high.name}, column to shelf"),
         shelf,
         Link("splitter holder", f"printed: {holder_span:.0f} mm from its seat to the grooves",
-             _printed(profile, holder_span), _printed(profile, holder_span)),
+             _printed(profile, holder_span, process), _height(profile, holder_span, process)),
     ), breadboard.fit(profile, layout) if breadboard.board(profile) else None)
 
 
