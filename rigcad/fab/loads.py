@@ -1,0 +1,349 @@
+"""Loads on the printed rig: bolt torques into plastic, and the sag and first mode of the beam, the
+shelf and the column under the instruments' weights, each against the tolerance it eats
+(kernel-free; SI inside each formula as stated: N, mm, MPa = N/mm2, kg, Hz).
+
+Closed forms, each from a textbook:
+
+* a bolt's preload from its torque, T = K F d (the short-form torque equation, with the nut factor
+  K = 0.2 for plain steel fasteners: Shigley's Mechanical Engineering Design, 9th ed., section 8-8,
+  eq. 8-27 and Table 8-15); the pressure under a washer, a nut or a head is the preload over its
+  bearing ring (outer circle or hexagon less the hole). The torque rigcad gives is the one that
+  puts :data:`BEARING_SHARE` of the material's yield strength under the smaller bearing face;
+* a simply supported beam with a central point load P and its own weight q per length: mid-span
+  sag P L^3 / (48 E I) + 5 q L^4 / (384 E I) (Roark's Formulas for Stress and Strain, 7th ed.,
+  Table 8.1, cases 1a and 2a); its first mode by Rayleigh's method with the beam's effective mass
+  17/35 of its own (f = sqrt(k / m) / 2 pi, k = 48 E I / L^3; Blevins, Formulas for Natural
+  Frequency and Mode Shape, Table 8-2 footnote);
+* a cantilever with point loads P_i at a_i: deflection at x >= a_i, P a^2 (3 x - a) / (6 E I), and
+  slope P a^2 / (2 E I) (Roark Table 8.1 case 1a, fixed-free); a uniform load q over length l:
+  q l^4 / (8 E I) and q l^3 / (6 E I) at its end;
+* the column: a cantilever under the shelf's moment M at its top, deflection M H^2 / (2 E I),
+  rotation M H / (E I); its sway mode with a tip mass and 33/140 of its own mass (Blevins Table 8-2).
+
+A printed section is stiffer than its infill and weaker than solid: its second moment of area is
+the solid one less (1 - infill) of its core, the core being the section less :data:`SKIN_MM`
+of perimeters each side (:func:`printed_inertia`). The modulus is taken at the low end of the
+material's published range (the largest sag) and the strength as published.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigcad.errors import FabricationError
+from rigcad.fab.printers import Printer
+from rigcad.parts.dome import flange_joint
+from rigcad.parts.tower import _projector_feet, _shelf_extent, seat_points
+from rigcad.standards import LARGE_WASHERS, THREADS
+
+G = 9.80665  #: standard gravity (m/s2)
+#: Short-form torque equation's nut factor for plain steel fasteners (Shigley, Table 8-15).
+NUT_FACTOR = 0.2
+#: A sustained bearing pressure on printed plastic kept to half its yield strength: a creep allowance
+#: (assumed; thermoplastics creep under sustained stress well below their short-term yield).
+BEARING_SHARE = 0.5
+#: Perimeters each side of a printed section (mm): 3 perimeters of a 0.45 mm extrusion (the MK3S
+#: file's 3 perimeters; PrusaSlicer's extrusion width for a 0.4 mm nozzle).
+SKIN_MM = 1.35
+#: Infill of a printed core (the MK3S file's 20 %).
+INFILL = 0.20
+#: A hand-tight screw with a hex key (N m): the torque a lab applies when no figure is given.
+HAND_TIGHT_NM = 1.0
+#: Instruments' and printed parts' masses the profile does not state (kg; assumed: a desktop
+#: projector of the PB6210 class, a machine-vision camera with its lens, the printed splitter holder
+#: with its plate and lens mount). A profile's ``projector.mass`` / ``camera.mass`` replace them.
+ASSUMED_MASS_KG = {"projector": 3.0, "camera": 0.3, "holder": 0.2}
+
+
+@dataclass(frozen=True)
+class Material:
+    """A printed material's published figures: modulus range (MPa), yield strength (MPa; the weaker
+    direction), and where they come from."""
+
+    name: str
+    modulus_low: float
+    modulus_high: float
+    yield_strength: float
+    source: str
+
+
+#: Materials by the printer file's ``material`` (case-insensitive).
+MATERIALS = {
+    "pla": Material("PLA", 2539.0, 3039.0, 26.0, "Stratasys PLA data sheet (ASTM D638): tensile modulus 2,539 MPa XY, "
+                    "3,039 MPa XZ; yield 26 MPa XY"),
+    "abs": Material("ABS", 1443.0, 2482.0, 22.1, "Stratasys P400 ABS (FDM 2000 manual, App. M1): 360,000 psi, 5,000 "
+                    "psi; printed ABS 1,443 MPa (Kimya, ISO 527); yield the low end of MatWeb's ABS (22.1 MPa)"),
+}
+
+
+def material(printer: Printer) -> Material:
+    """The printer's material's figures; FabricationError naming the known ones otherwise."""
+    m = MATERIALS.get(printer.material.strip().lower())
+    if m is None:
+        raise FabricationError(f"printer {printer.name}: no published strength and stiffness for material "
+                               f"{printer.material!r} in rigcad.fab.loads.MATERIALS (known: "
+                               f"{', '.join(v.name for v in MATERIALS.values())}), so no loads")
+    return m
+
+
+def printed_inertia(width: float, height: float, skin: float = SKIN_MM, infill: float = INFILL) -> float:
+    """Second moment of area (mm^4) of a printed ``width`` x ``height`` mm rectangle bending about
+    its horizontal axis: the solid one less (1 - infill) of its core's."""
+    core_w, core_h = max(width - 2 * skin, 0.0), max(height - 2 * skin, 0.0)
+    return (width * height ** 3 - (1 - infill) * core_w * core_h ** 3) / 12
+
+
+def printed_tube_inertia(side: float, wall: float, skin: float = SKIN_MM, infill: float = INFILL) -> float:
+    """The same for a square tube of ``side`` and ``wall`` (mm): solid wall less the wall's core."""
+    outer, inner = side ** 4, (side - 2 * wall) ** 4
+    solid = (outer - inner) / 12
+    if wall <= 2 * skin:
+        return solid
+    core_out, core_in = (side - 2 * skin) ** 4, (side - 2 * wall + 2 * skin) ** 4
+    return solid - (1 - infill) * (core_out - core_in) / 12
+
+
+# --------------------------------------------------------------------------------------- bolts
+
+@dataclass(frozen=True)
+class BoltLoad:
+    """A bolted joint into printed plastic: ``count`` screws of ``thread``; ``bearing``: what bears
+    on the plastic (washer, nut); ``area_mm2``: the smaller bearing ring; ``torque_nm`` and
+    ``preload_n``: the torque rigcad gives and its preload; ``pressure_mpa`` under it against
+    ``allowable_mpa``; ``hand_tight_mpa``: the pressure of a hand-tight HAND_TIGHT_NM; ``spring_washer``:
+    whether creep would relax the joint (it locates a datum) so a conical spring washer goes under the head."""
+
+    joint: str
+    thread: str
+    count: int
+    bearing: str
+    area_mm2: float
+    torque_nm: float
+    preload_n: float
+    pressure_mpa: float
+    allowable_mpa: float
+    hand_tight_mpa: float
+    spring_washer: bool
+
+    def describe(self) -> dict:
+        return {"joint": self.joint, "thread": self.thread, "count": self.count, "bearing": self.bearing,
+                "bearing_area_mm2": self.area_mm2, "torque_nm": self.torque_nm, "preload_n": self.preload_n,
+                "pressure_mpa": self.pressure_mpa, "allowable_mpa": self.allowable_mpa,
+                "hand_tight_pressure_mpa": self.hand_tight_mpa, "spring_washer": self.spring_washer}
+
+
+def washer_area(thread: str, hole: float, large: bool = False) -> float:
+    """Bearing ring (mm2) of an ISO 7089 (or ISO 7093 large) washer on a printed ``hole`` mm."""
+    od = LARGE_WASHERS[thread][0] if large else THREADS[thread].washer_od
+    return math.pi / 4 * (od ** 2 - hole ** 2)
+
+
+def nut_area(thread: str, hole: float) -> float:
+    """Bearing face (mm2) of an ISO 4032 hex nut on a printed ``hole`` mm: the hexagon less the hole."""
+    s = THREADS[thread].nut_af
+    return math.sqrt(3) / 2 * s ** 2 - math.pi / 4 * hole ** 2
+
+
+def bolt_load(joint: str, thread: str, count: int, faces: dict[str, float], mat: Material, datum: bool) -> BoltLoad:
+    """The torque for ``count`` ``thread`` screws whose bearing faces on plastic are ``faces``
+    (name -> area mm2): the smallest face at BEARING_SHARE of the yield."""
+    bearing, area = min(faces.items(), key=lambda kv: kv[1])
+    allow = BEARING_SHARE * mat.yield_strength
+    preload = allow * area
+    d = THREADS[thread].major
+    torque = NUT_FACTOR * preload * d / 1000.0
+    hand = HAND_TIGHT_NM * 1000.0 / (NUT_FACTOR * d) / area
+    return BoltLoad(joint, thread, count, bearing, area, torque, preload, allow, allow, hand, datum)
+
+
+def bolt_loads(profile, layout, printer: Printer) -> tuple[BoltLoad, ...]:
+    """Every bolted joint into printed plastic with its torque: the dome's flange (into inserts),
+    the column's foot (nuts in the tongue's traps) and top (into the shelf's inserts), the
+    projector's and the camera's screws through printed slots."""
+    mat, tw = material(printer), profile.tower
+    fj = flange_joint(profile, layout)
+    hole = tw.bolt_diameter
+    out = [bolt_load("dome flange on the base plate", fj.thread, fj.count,
+                     {"washer": washer_area(fj.thread, profile.dome_shell.bolt_diameter)}, mat, True)]
+    if profile.buy.column == "print":
+        out.append(bolt_load("column foot on the tongue", "M4", 4,
+                             {"washer": washer_area("M4", hole), "nut (in its trap)": nut_area("M4", hole)}, mat, True))
+        out.append(bolt_load("column top under the shelf", "M4", 4, {"washer": washer_area("M4", hole)}, mat, True))
+    pj, cm = profile.projector, profile.camera
+    pjh = THREADS[pj.mount_thread].clearance
+    out.append(bolt_load("projector on the shelf's slots", pj.mount_thread, 4,
+                         {"washer": washer_area(pj.mount_thread, pjh)}, mat, False))
+    cmh = THREADS[cm.mount_thread].clearance
+    out.append(bolt_load("camera on its bracket's slot", cm.mount_thread, 2,
+                         {"washer": washer_area(cm.mount_thread, cmh)}, mat, False))
+    return tuple(out)
+
+
+# --------------------------------------------------------------------------------- deflections
+
+@dataclass(frozen=True)
+class Deflection:
+    """A printed part under the instruments' weights: ``sag_mm`` and ``tilt_rad`` where the optics
+    sit, at the low modulus; ``first_mode_hz``; ``eats``: the tolerancing key it eats, with
+    ``tolerance`` (mm or rad, as the key) and ``share`` (the sag, or tilt, over it); ``model``: the
+    closed form; ``holds``: the static figure within the tolerance (the alignment then takes it
+    out); ``buy``: what replaces the part when it does not."""
+
+    part: str
+    model: str
+    sag_mm: float
+    tilt_rad: float
+    first_mode_hz: float
+    eats: str
+    tolerance: float
+    share: float
+    buy: str = ""
+
+    @property
+    def holds(self) -> bool:
+        return self.share <= 1.0
+
+    def describe(self) -> dict:
+        return {"part": self.part, "model": self.model, "sag_mm": float(self.sag_mm),
+                "tilt_deg": math.degrees(self.tilt_rad), "first_mode_hz": float(self.first_mode_hz), "eats": [f"tolerancing.{k}" for k in self.eats.split(", ")],
+                "share_of_tolerance": float(self.share), "holds": bool(self.holds), "buy": self.buy}
+
+
+def simply_supported(P: float, q: float, L: float, EI: float, m_point: float, m_beam: float) -> tuple[float, float]:
+    """Mid-span sag (mm) of a simply supported beam (span L mm, EI N mm2) under a central load P (N)
+    and its weight q (N/mm), and its first mode (Hz) with a central mass m_point and its own mass
+    m_beam (kg): Roark Table 8.1 cases 1a, 2a; Rayleigh with 17/35 of the beam's mass."""
+    sag = P * L ** 3 / (48 * EI) + 5 * q * L ** 4 / (384 * EI)
+    k = 48 * EI / L ** 3 * 1000.0  # N/mm -> N/m
+    f = math.sqrt(k / (m_point + 17 / 35 * m_beam)) / (2 * math.pi)
+    return sag, f
+
+
+def cantilever(loads: list[tuple[float, float]], q: float, length: float, x: float, EI: float) -> tuple[float, float]:
+    """Deflection (mm) and slope (rad) at ``x`` mm from the root of a cantilever of ``length`` mm
+    (EI N mm2) under point loads (P N, a mm) and a uniform q N/mm over its length (superposed
+    closed forms, Roark Table 8.1 cases 1a and 2a: the uniform load's q x^2 (6 l^2 - 4 l x + x^2) /
+    (24 E I) and slope q x (3 l^2 - 3 l x + x^2) / (6 E I))."""
+    y = th = 0.0
+    for P, a in loads:
+        if x >= a:
+            y += P * a ** 2 * (3 * x - a) / (6 * EI)
+            th += P * a ** 2 / (2 * EI)
+        else:
+            y += P * x ** 2 * (3 * a - x) / (6 * EI)
+            th += P * x * (2 * a - x) / (2 * EI)
+    if q:
+        y += q * x ** 2 * (6 * length ** 2 - 4 * length * x + x ** 2) / (24 * EI)
+        th += q * x * (3 * length ** 2 - 3 * length * x + x ** 2) / (6 * EI)
+    return y, th
+
+
+def _mass(profile, key: str, masses) -> float:
+    if masses and key in masses:
+        return masses[key]
+    section = getattr(profile, key, None)
+    return getattr(section, "mass", None) or ASSUMED_MASS_KG[key]
+
+
+def deflections(profile, layout, printer: Printer, masses: dict[str, float] | None = None) -> tuple[Deflection, ...]:
+    """The beam (under the paraboloid), the shelf (under the projector, the holder and the camera)
+    and the column (under the shelf's moment), at the material's low modulus."""
+    mat, tol = material(printer), profile.tolerancing
+    E = mat.modulus_low
+    rho = printer.material_density_g_cm3 * 1e-6  # kg/mm3
+    # the beam: simply supported on the slots' floors, the paraboloid (its back as a solid disc) at mid-span
+    b, h = profile.beam.width, profile.beam.height
+    L = 2 * layout.slot_r - profile.dome_shell.wall
+    rim = layout.printed_paraboloid.points(np.array([layout.printed_paraboloid.u_range[0]]))[0]
+    m_para = rho * math.pi * float(rim[0]) ** 2 * (float(rim[1]) - layout.beam_z[1])
+    sag, f = simply_supported(m_para * G, rho * b * h * G, L, E * printed_inertia(b, h), m_para, rho * b * h * L)
+    beam = Deflection("beam", f"simply supported over {L:.0f} mm, {b:g} x {h:g} mm, the paraboloid "
+                      f"({m_para * 1000:.0f} g, its back as a solid disc) at mid-span", sag, 0.0, f,
+                      "paraboloid_height", tol.paraboloid_height, sag / tol.paraboloid_height,
+                      "a bought beam: ground steel or aluminium flat bar")
+    return (beam, *_tower_deflections(profile, layout, printer, mat, masses))
+
+
+def _tower_deflections(profile, layout, printer: Printer, mat: Material, masses) -> tuple[Deflection, Deflection]:
+    """The shelf: a cantilever from its column flange's edge towards the axis, as wide as it is,
+    under the projector's near feet (a quarter of its weight each), the holder and camera at the
+    seat and its own weight. The column: a cantilever from the tongue under the shelf's moment about
+    its axis; its sway with the top's mass."""
+    t, tw, tol = layout.tower, profile.tower, profile.tolerancing
+    E, rho = mat.modulus_low, printer.material_density_g_cm3 * 1e-6
+    m_pj, m_cam, m_hold = (_mass(profile, k, masses) for k in ("projector", "camera", "holder"))
+    root = t.column_x - t.column_foot_half
+    seat = seat_points(t, profile)["cone"][0]
+    x0, x1, y0, y1 = _shelf_extent(t, profile)
+    width, overhang, a_seat = y1 - y0, root - x0, root - seat
+    feet = [x for x, _ in _projector_feet(t)]
+    loads = [(m_pj * G / 4, root - x) for x in feet if x < root] + [((m_cam + m_hold) * G, a_seat)]
+    EI = E * printed_inertia(width, t.shelf_thickness)
+    sag, tilt = cantilever(loads, rho * width * t.shelf_thickness * G, overhang, a_seat, EI)
+    shelf = Deflection("shelf", f"cantilever {overhang:.0f} mm from the column's flange, {width:.0f} x "
+                       f"{t.shelf_thickness:g} mm printed; the holder and camera ({m_cam + m_hold:.1f} kg) at the seat "
+                       f"{a_seat:.0f} mm out, the projector's near feet, its own weight", sag, tilt, math.nan,
+                       "projector_height, projector_tilt", tol.projector_height,
+                       max(sag / tol.projector_height, tilt / tol.projector_tilt), "buy.shelf: aluminium_plate")
+    H = t.shelf_top_z - t.shelf_thickness - t.column_base_z
+    EI_col = E * printed_tube_inertia(tw.column_width, tw.wall)
+    m_shelf = rho * (x1 - x0) * width * t.shelf_thickness
+    points = [(m_pj * G / 4, x) for x in feet] + [((m_cam + m_hold) * G, seat), (m_shelf * G, (x0 + x1) / 2)]
+    moment = abs(sum(P * (t.column_x - x) for P, x in points))
+    rot = moment * H / EI_col
+    drop = rot * (t.column_x - seat)
+    m_col = rho * 4 * tw.column_width * tw.wall * H
+    k = 3 * EI_col / H ** 3 * 1000.0
+    top = m_pj + m_cam + m_hold + m_shelf
+    f_col = math.sqrt(k / (top + 33 / 140 * m_col)) / (2 * math.pi)
+    column = Deflection("column", f"cantilever {H:.0f} mm, {tw.column_width:g} mm square tube, {tw.wall:g} mm printed "
+                        f"wall, under the shelf's moment {moment / 1000:.2f} N m (the seat drops by its turn over "
+                        f"{t.column_x - seat:.0f} mm); sway with the top's {top:.1f} kg", drop, rot, f_col,
+                        "projector_height, projector_tilt", tol.projector_height,
+                        max(drop / tol.projector_height, rot / tol.projector_tilt), "buy.column: extrusion_40x40")
+    return shelf, column
+
+
+@dataclass(frozen=True)
+class Loads:
+    """The loads report: the material, every bolted joint and every deflection."""
+
+    material: Material
+    bolts: tuple[BoltLoad, ...]
+    deflections: tuple[Deflection, ...]
+
+    def record(self) -> dict:
+        """JSON-able, units in the keys (a first mode not computed is null)."""
+        return {"material": {"name": self.material.name, "modulus_low_mpa": self.material.modulus_low,
+                             "modulus_high_mpa": self.material.modulus_high,
+                             "yield_strength_mpa": self.material.yield_strength, "source": self.material.source},
+                "bolts": [b.describe() for b in self.bolts],
+                "deflections": [{k: (None if isinstance(v, float) and math.isnan(v) else v)
+                                 for k, v in d.describe().items()} for d in self.deflections]}
+
+    def table_lines(self) -> list[str]:
+        """Markdown: the torques, then the deflections."""
+        out = ["| joint | screws | bears on | torque | preload | pressure (allowed) | hand-tight 1 N m | spring washer |",
+               "|---|---|---|---|---|---|---|---|"]
+        for b in self.bolts:
+            out.append(f"| {b.joint} | {b.count} x {b.thread} | {b.bearing}, {b.area_mm2:.0f} mm2 | {b.torque_nm:.2f} N m "
+                       f"| {b.preload_n:.0f} N | {b.pressure_mpa:.0f} MPa | {b.hand_tight_mpa:.0f} MPa | "
+                       f"{'yes' if b.spring_washer else 'no'} |")
+        out += ["", "| part | model | sag | tilt | first mode | eats | share | holds |", "|---|---|---|---|---|---|---|---|"]
+        for d in self.deflections:
+            mode = "-" if math.isnan(d.first_mode_hz) else f"{d.first_mode_hz:.0f} Hz"
+            out.append(f"| {d.part} | {d.model} | {d.sag_mm:.3f} mm | {math.degrees(d.tilt_rad):.3f} deg | {mode} | "
+                       f"{d.eats} | {100 * d.share:.0f} % | {'yes' if d.holds else 'no: ' + d.buy} |")
+        return out
+
+
+def loads(profile, layout, printer: Printer, masses: dict[str, float] | None = None) -> Loads:
+    """Torques and deflections of the printed rig on ``printer``'s material."""
+    return Loads(material(printer), bolt_loads(profile, layout, printer), deflections(profile, layout, printer, masses))
+
+
+__all__ = ["ASSUMED_MASS_KG", "BoltLoad", "Deflection", "Loads", "MATERIALS", "Material", "bolt_loads", "cantilever",
+           "deflections", "loads", "material", "printed_inertia", "printed_tube_inertia", "simply_supported"]
