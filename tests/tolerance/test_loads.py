@@ -1,0 +1,125 @@
+"""Loads on the printed rig (rigcad.fab.loads): the closed forms against an independent finite-element
+computation (Euler-Bernoulli beam elements, numpy/scipy), the bolt figures against their definitions,
+and the default rig's figures within the tolerances they eat."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+from rigcad.errors import FabricationError
+from rigcad.fab import loads as L
+from rigcad.fab.printers import load_printer
+
+
+def _fe_beam(length: float, n: int, EI: float, rho_a: float, support: str):
+    """Stiffness and consistent mass matrices (N/mm, kg) of a beam of ``n`` Hermite elements (dofs:
+    deflection, slope per node), with its supports' dofs removed; returns (K, M, free dof indices)."""
+    le = length / n
+    k = EI / le ** 3 * np.array([[12, 6 * le, -12, 6 * le], [6 * le, 4 * le ** 2, -6 * le, 2 * le ** 2],
+                                 [-12, -6 * le, 12, -6 * le], [6 * le, 2 * le ** 2, -6 * le, 4 * le ** 2]])
+    m = rho_a * le / 420 * np.array([[156, 22 * le, 54, -13 * le], [22 * le, 4 * le ** 2, 13 * le, -3 * le ** 2],
+                                     [54, 13 * le, 156, -22 * le], [-13 * le, -3 * le ** 2, -22 * le, 4 * le ** 2]])
+    K = np.zeros((2 * n + 2, 2 * n + 2))
+    M = np.zeros_like(K)
+    for e in range(n):
+        s = slice(2 * e, 2 * e + 4)
+        K[s, s] += k
+        M[s, s] += m
+    fixed = {0, 2 * n} if support == "simple" else {0, 1}
+    free = [i for i in range(2 * n + 2) if i not in fixed]
+    return K, M, free
+
+
+def test_simply_supported_sag_and_first_mode_match_a_finite_element_model():
+    L_, EI, P, q, m_point, rho_a = 268.0, 2539.0 * 500.0, 0.11, 7.3e-4, 0.011, 7.44e-5  # mm, N mm2, N, N/mm, kg, kg/mm
+    n = 40
+    K, M, free = _fe_beam(L_, n, EI, rho_a, "simple")
+    F = np.zeros(2 * n + 2)
+    le = L_ / n
+    for e in range(n):  # consistent load of the uniform weight
+        F[2 * e: 2 * e + 4] += q * le * np.array([0.5, le / 12, 0.5, -le / 12])
+    F[n] += P  # the mid node's deflection dof
+    u = np.zeros_like(F)
+    u[free] = np.linalg.solve(K[np.ix_(free, free)], F[free])
+    M[n, n] += m_point
+    w2 = scipy.linalg.eigh(K[np.ix_(free, free)] * 1000.0, M[np.ix_(free, free)], eigvals_only=True)[0]
+    sag, f = L.simply_supported(P, q, L_, EI, m_point, rho_a * L_)
+    assert sag == pytest.approx(u[n], rel=1e-9)  # Hermite elements are exact at the nodes
+    assert f == pytest.approx(math.sqrt(w2) / (2 * math.pi), rel=0.01)  # Rayleigh: within 1 %
+
+
+def test_cantilever_deflection_and_slope_match_a_finite_element_model():
+    length, EI, q = 200.0, 2539.0 * 2.4e4, 3.6e-2
+    loads = [(3.9, 142.0), (7.4, 47.0)]
+    n = 200  # nodes every 1 mm: the loads and the seat at nodes
+    K, _, free = _fe_beam(length, n, EI, 1.0, "cantilever")
+    F = np.zeros(2 * n + 2)
+    le = length / n
+    for e in range(n):
+        F[2 * e: 2 * e + 4] += q * le * np.array([0.5, le / 12, 0.5, -le / 12])
+    for P, a in loads:
+        F[2 * round(a / le)] += P
+    u = np.zeros_like(F)
+    u[free] = np.linalg.solve(K[np.ix_(free, free)], F[free])
+    for x in (142.0, 100.0, 200.0):
+        y, th = L.cantilever(loads, q, length, x, EI)
+        i = round(x / le)
+        assert y == pytest.approx(u[2 * i], rel=1e-6) and th == pytest.approx(u[2 * i + 1], rel=1e-6)  # round-off of 400 dofs
+
+
+def test_printed_sections_lie_between_their_core_and_solid():
+    assert L.printed_inertia(6, 10, infill=1.0) == pytest.approx(6 * 10 ** 3 / 12)
+    assert L.printed_inertia(6, 10, skin=5.0, infill=0.0) == pytest.approx(6 * 10 ** 3 / 12)  # all skin
+    assert L.printed_inertia(294, 10) == pytest.approx((294 * 1000 - 0.8 * 291.3 * 7.3 ** 3) / 12)
+    solid = (50 ** 4 - 40 ** 4) / 12
+    assert L.printed_tube_inertia(50, 5, infill=1.0) == pytest.approx(solid)
+    assert 0.5 * solid < L.printed_tube_inertia(50, 5) < solid
+
+
+def test_bolt_torque_is_the_short_form_equation_on_the_bearing_ring(table31_rig):
+    mk3s = load_printer("prusa_mk3s")
+    rows = {b.joint: b for b in L.bolt_loads(table31_rig.profile, table31_rig.layout, mk3s)}
+    b = rows["dome flange on the base plate"]
+    area = math.pi / 4 * (9.0 ** 2 - 4.5 ** 2)  # ISO 7089 M4 washer (9 mm) on the 4.5 mm hole
+    assert b.area_mm2 == pytest.approx(area)
+    assert b.pressure_mpa == pytest.approx(L.BEARING_SHARE * 26.0)
+    assert b.torque_nm == pytest.approx(0.2 * b.preload_n * 4.0 / 1000)
+    # a hand-tight 1 N m: 1.25 kN on an M4, 26 MPa under its washer
+    assert b.hand_tight_mpa == pytest.approx(1250.0 / area) and 25 < b.hand_tight_mpa < 27
+    foot = rows["column foot on the tongue"]
+    assert foot.bearing.startswith("nut") and foot.spring_washer and foot.torque_nm < b.torque_nm
+    assert not rows["projector on the shelf's slots"].spring_washer
+
+
+def test_the_default_rig_holds_its_loads_and_the_record_is_json(table31_rig):
+    r = L.loads(table31_rig.profile, table31_rig.layout, load_printer("prusa_mk3s"))
+    d = {x.part: x for x in r.deflections}
+    assert all(x.holds for x in r.deflections)
+    assert 0 < d["beam"].sag_mm < table31_rig.profile.tolerancing.paraboloid_height
+    assert d["beam"].first_mode_hz > 20 and d["column"].first_mode_hz > 10
+    rec = json.loads(json.dumps(r.record()))
+    assert rec["deflections"][1]["first_mode_hz"] is None  # the shelf's mode is not computed
+    assert len(r.table_lines()) == 2 + len(r.bolts) + 3 + len(r.deflections)
+
+
+def test_a_softer_material_eats_more_and_an_unknown_one_is_refused(table31_rig):
+    from dataclasses import replace
+
+    mk3s = load_printer("prusa_mk3s")
+    pla = L.deflections(table31_rig.profile, table31_rig.layout, mk3s)
+    abs_ = L.deflections(table31_rig.profile, table31_rig.layout, replace(mk3s, material="ABS"))
+    assert abs_[1].sag_mm > pla[1].sag_mm  # ABS's low modulus is below PLA's
+    with pytest.raises(FabricationError, match="no published strength.*'standard resin'.*known: PLA, ABS"):
+        L.loads(table31_rig.profile, table31_rig.layout, load_printer("form3"))
+
+
+def test_heavier_instruments_sag_the_shelf_in_proportion(table31_rig):
+    mk3s = load_printer("prusa_mk3s")
+    light = L.deflections(table31_rig.profile, table31_rig.layout, mk3s, {"camera": 0.3, "holder": 0.2})[1]
+    heavy = L.deflections(table31_rig.profile, table31_rig.layout, mk3s, {"camera": 0.8, "holder": 0.2})[1]
+    assert heavy.sag_mm > light.sag_mm
