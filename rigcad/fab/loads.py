@@ -261,7 +261,7 @@ def deflections(profile, layout, printer: Printer, masses: dict[str, float] | No
     m_para = rho * math.pi * float(rim[0]) ** 2 * (float(rim[1]) - layout.beam_z[1])
     sag, f = simply_supported(m_para * G, rho * b * h * G, L, E * printed_inertia(b, h), m_para, rho * b * h * L)
     beam = Deflection("beam", f"simply supported over {L:.0f} mm, {b:g} x {h:g} mm, the paraboloid "
-                      f"({m_para * 1000:.0f} g, its back as a solid disc) at mid-span", sag, 0.0, f,
+                      f"({m_para * G:.2f} N, its back as a solid disc) at mid-span", sag, 0.0, f,
                       "paraboloid_height", tol.paraboloid_height, sag / tol.paraboloid_height,
                       "a bought beam: ground steel or aluminium flat bar")
     return (beam, *_tower_deflections(profile, layout, printer, mat, masses))
@@ -284,7 +284,7 @@ def _tower_deflections(profile, layout, printer: Printer, mat: Material, masses)
     EI = E * printed_inertia(width, t.shelf_thickness)
     sag, tilt = cantilever(loads, rho * width * t.shelf_thickness * G, overhang, a_seat, EI)
     shelf = Deflection("shelf", f"cantilever {overhang:.0f} mm from the column's flange, {width:.0f} x "
-                       f"{t.shelf_thickness:g} mm printed; the holder and camera ({m_cam + m_hold:.1f} kg) at the seat "
+                       f"{t.shelf_thickness:g} mm printed; the holder and camera ({(m_cam + m_hold) * G:.1f} N) at the seat "
                        f"{a_seat:.0f} mm out, the projector's near feet, its own weight", sag, tilt, math.nan,
                        "projector_height, projector_tilt", tol.projector_height,
                        max(sag / tol.projector_height, tilt / tol.projector_tilt), "buy.shelf: aluminium_plate")
@@ -301,7 +301,7 @@ def _tower_deflections(profile, layout, printer: Printer, mat: Material, masses)
     f_col = math.sqrt(k / (top + 33 / 140 * m_col)) / (2 * math.pi)
     column = Deflection("column", f"cantilever {H:.0f} mm, {tw.column_width:g} mm square tube, {tw.wall:g} mm printed "
                         f"wall, under the shelf's moment {moment / 1000:.2f} N m (the seat drops by its turn over "
-                        f"{t.column_x - seat:.0f} mm); sway with the top's {top:.1f} kg", drop, rot, f_col,
+                        f"{t.column_x - seat:.0f} mm); sway with the top's {top * G:.0f} N", drop, rot, f_col,
                         "projector_height, projector_tilt", tol.projector_height,
                         max(drop / tol.projector_height, rot / tol.projector_tilt), "buy.column: extrusion_40x40")
     return shelf, column
@@ -345,5 +345,14 @@ def loads(profile, layout, printer: Printer, masses: dict[str, float] | None = N
     return Loads(material(printer), bolt_loads(profile, layout, printer), deflections(profile, layout, printer, masses))
 
 
-__all__ = ["ASSUMED_MASS_KG", "BoltLoad", "Deflection", "Loads", "MATERIALS", "Material", "bolt_loads", "cantilever",
+def refuse(report: Loads) -> None:
+    """Raise FabricationError when a printed part cannot hold the tolerance its static sag or tilt
+    eats, naming the part and its ``buy:`` option."""
+    bad = [d for d in report.deflections if not d.holds]
+    if bad:
+        raise FabricationError("printed parts that bend past the tolerance they eat: " + "; ".join(
+            f"{d.part} ({100 * d.share:.0f} % of tolerancing.{d.eats}); buy: {d.buy}" for d in bad))
+
+
+__all__ = ["refuse", "ASSUMED_MASS_KG", "BoltLoad", "Deflection", "Loads", "MATERIALS", "Material", "bolt_loads", "cantilever",
            "deflections", "loads", "material", "printed_inertia", "printed_tube_inertia", "simply_supported"]

@@ -558,6 +558,14 @@ def refuse(report: StackReport) -> None:
                            + " | ".join(parts))
 
 
+def check(profile, layout, printer: Printer, **options) -> StackReport:
+    """:func:`stack` then :func:`refuse`: the report when every element is held or adjusted, else
+    FabricationError (what ``rigcad fab`` would call with the run's seams: ``seams_from_pieces``)."""
+    report = stack(profile, layout, printer, **options)
+    refuse(report)
+    return report
+
+
 # -------------------------------------------------------------------------------------- rendering
 
 def _fmt(v: float, axis: str) -> str:
@@ -597,5 +605,5 @@ def with_process(printer: Printer, **figures) -> Printer:
 
 
 __all__ = ["AXES", "AdjusterSpec", "AxisVerdict", "ELEMENTS", "ElementStack", "Link", "Locator", "RESOLUTION_SHARE",
-           "StackReport", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_pieces", "stack",
+           "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_pieces", "stack",
            "table_lines", "with_process"]

@@ -123,3 +123,13 @@ def test_heavier_instruments_sag_the_shelf_in_proportion(table31_rig):
     light = L.deflections(table31_rig.profile, table31_rig.layout, mk3s, {"camera": 0.3, "holder": 0.2})[1]
     heavy = L.deflections(table31_rig.profile, table31_rig.layout, mk3s, {"camera": 0.8, "holder": 0.2})[1]
     assert heavy.sag_mm > light.sag_mm
+
+
+def test_a_part_that_bends_past_its_tolerance_is_refused_with_its_buy_option(table31_rig):
+    mk3s = load_printer("prusa_mk3s")
+    ok = L.loads(table31_rig.profile, table31_rig.layout, mk3s)
+    L.refuse(ok)  # the default rig holds
+    heavy = L.loads(table31_rig.profile, table31_rig.layout, mk3s, {"camera": 6.0})
+    with pytest.raises(FabricationError, match=r"shelf \(\d+ % of tolerancing.projector_height, projector_tilt\); "
+                                               r"buy: buy.shelf: aluminium_plate"):
+        L.refuse(heavy)
