@@ -43,8 +43,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
-import numpy as np
-
 from rigcad.errors import FabricationError
 from rigcad.fab.printers import Printer
 from rigcad.fab.split import PIN_SPACING
@@ -74,8 +72,9 @@ TOLERANCE_KEYS = {
 #: An adjuster serves a tolerance when its resolution is at most this share of it: a setting must
 #: land well inside the tolerance, not merely within one step of its edge.
 RESOLUTION_SHARE = 0.25
-#: The parts whose seams lie on some element's chain.
-CHAIN_PARTS = ("base_plate", "dome", "tower_column", "tower_shelf", "splitter_holder", "beam", "paraboloid")
+#: The split parts whose seams may lie on an element's chain (the beam, the paraboloid and its clamp
+#: print whole on every shipped printer).
+CHAIN_PARTS = ("base_plate", "dome", "tower_column", "tower_shelf", "splitter_holder")
 #: Dominating links named in a refusal: the fewest largest links making this share of the stack, at most MAX_NAMED.
 DOMINANT_SHARE = 0.5
 MAX_NAMED = 3
@@ -214,12 +213,11 @@ def _finite(v: float) -> float | None:
 # ----------------------------------------------------------------------------------------- seams
 
 def _extents(profile, layout) -> dict[str, tuple[float, float, float]]:
-    """Each chain part's bounding box (mm), from the layout (no kernel)."""
+    """Each chain part's (CHAIN_PARTS) bounding box (mm), from the layout (no kernel)."""
     t, tw = layout.tower, profile.tower
     x0, x1, y0, y1 = _shelf_extent(t, profile)
     foot = 2 * t.column_foot_half
     r = layout.plate_r
-    rim = float(layout.printed_paraboloid.points(np.array([layout.printed_paraboloid.u_range[0]]))[0, 0])
     return {
         "base_plate": (t.column_x + t.column_foot_half + r, 2 * r, profile.base_plate.thickness),
         "dome": (2 * layout.flange_outer_r, 2 * layout.flange_outer_r, layout.dome_top_z),
@@ -227,8 +225,6 @@ def _extents(profile, layout) -> dict[str, tuple[float, float, float]]:
         "tower_shelf": (x1 - x0, y1 - y0, t.shelf_thickness),
         "splitter_holder": (t.holder_x[1] - t.holder_x[0] + 2 * tw.wall, 2 * t.wall_y[1],
                             t.holder_top_z - t.shelf_top_z),
-        "beam": (2 * layout.beam_half_length, profile.beam.width, profile.beam.height),
-        "paraboloid": (2 * rim, 2 * rim, t.cop[2] - profile.layout.cop_to_vertex - layout.beam_z[0]),
     }
 
 
