@@ -60,7 +60,8 @@ from rigcad.basis.gram import (IlluminationSampling, QuantisedImages, Reorthonor
                                off_identity, quantise_images, reorthonormalise)
 from rigcad.basis.zonal import Zone, basis_indices, check_order, direction_angles, zonal_basis
 from rigcad.errors import BasisError
-from rigcad.optics.incidence import camera_focal_px  # noqa: F401  (named here too: the basis's callers import it from here)
+from rigcad.optics.incidence import camera_focal_px, camera_principal_point  # noqa: F401  (camera_focal_px named
+# here too: the basis's callers import it from here)
 
 #: Sub-points per side of a pixel on an edge (its lit part in steps of 1/16): the error of the lit
 #: part's solid angle is then ~1/8 of a pixel row along the edges.
@@ -217,13 +218,17 @@ def trace_pixels(rig, device: str = "projector", *, as_built: bool = False, stri
     r_out = float(design.pixel_radius(np.array([design.alpha_max]))[0])
     side = 2 * math.ceil(r_out) + 2 * WINDOW_MARGIN_PX
     w, h = min(width, side), min(height, side)
-    c0, r0 = (width - w) // 2, (height - h) // 2
+    # about the device's principal point (the camera's lens may move it; the projector's is the centre),
+    # kept on the device ((W - w) // 2 for the centre)
+    cx, cy = camera_principal_point(rig) if device == "camera" else (width / 2, height / 2)
+    c0 = min(max(math.floor(cx - w / 2), 0), width - w)
+    r0 = min(max(math.floor(cy - h / 2), 0), height - h)
     rows = np.arange(r0 + stride // 2, r0 + h, stride)
     cols = np.arange(c0 + stride // 2, c0 + w, stride)
     jj, ii = np.meshgrid(rows, cols, indexing="ij")
     row, col = jj.ravel(), ii.ravel()
-    x = col + 0.5 - width / 2
-    y = height / 2 - row - 0.5
+    x = col + 0.5 - cx
+    y = cy - row - 0.5
     rays = pixel_rays(design, x, y, rig.pose(device) if as_built else None)
     tr = trace(optics if optics is not None else _optics(rig, as_built), rays.origins, rays.dirs)
     J, _ = pixel_jacobian(design, x, y)

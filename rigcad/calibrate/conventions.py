@@ -55,8 +55,10 @@ def facts(rig) -> dict:
     lift_y = to_global(screen_pose(0.0, tilt_y=1e-3), np.array(1.0), np.array(0.0))[2]
     g = np.arange(8)
     return {
-        "camera": {"resolution_px": [width, height], "focal_px": f, "principal_point_px": [width / 2, height / 2],
-                   "pixel_centre": "x = col + 0.5 - W / 2, y = H / 2 - row - 0.5",
+        "camera": {"resolution_px": [width, height], "focal_px": f, "principal_point_px": list(cam.principal_point),
+                   "pixel_centre": ("x = col + 0.5 - W / 2, y = H / 2 - row - 0.5"
+                                    if tuple(cam.principal_point) == (width / 2, height / 2)
+                                    else "x = col + 0.5 - c_x, y = c_y - row - 0.5 (c: the principal point)"),
                    "first_pixel_centre_px": [float(cam.x_px[0] - cam.col0), float(cam.y_px[0] + cam.row0)],
                    "column_axis": column_axis, "row_axis": row_axis,
                    "window": {"row0": cam.row0, "col0": cam.col0, "rows": cam.shape[0], "cols": cam.shape[1]}},
@@ -107,8 +109,9 @@ def _camera_panel(ax, cam: dict) -> None:
     ax.add_patch(plt.Rectangle((win["col0"], win["row0"]), win["cols"], win["rows"], fill=False, ls="--", color="C2"))
     ax.text(win["col0"], win["row0"] - 18, f"window: rows {win['row0']}-{win['row0'] + win['rows'] - 1}, "
             f"cols {win['col0']}-{win['col0'] + win['cols'] - 1}", color="C2", fontsize=8)
-    ax.plot([w / 2], [h / 2], "+", color="C3", ms=12)
-    ax.text(w / 2 + 40, h / 2 + 90, f"principal point\n({w / 2:g}, {h / 2:g}) px\nf = {cam['focal_px']:.0f} px",
+    cx, cy = cam["principal_point_px"]
+    ax.plot([cx], [cy], "+", color="C3", ms=12)
+    ax.text(cx + 40, cy + 90, f"principal point\n({cx:g}, {cy:g}) px\nf = {cam['focal_px']:.0f} px",
             color="C3", fontsize=8)
     _frame_arrows(ax, (40, 60), 200, ("column", "row"), "k")
     up = "+y" if cam["row_axis"] == "-y" else "-y"

@@ -240,7 +240,9 @@ def screens(plan: Plan, theta: np.ndarray) -> list:
 class Camera:
     """The camera's pixels in a window around the paraboloid's image: ``shape`` (rows, cols), the
     window's first ``row0``/``col0``, image coordinates x_px, y_px (n,) row-major (pixel centre
-    x = col + 0.5 - W / 2, y = H / 2 - row - 0.5) and the design map in the camera's pixels."""
+    x = col + 0.5 - c_x, y = c_y - row - 0.5 about the principal point (c_x, c_y), the image's centre
+    (W / 2, H / 2) unless ``camera.principal_point`` moves it) and the design map in the camera's
+    pixels (its focal length the lens's: rigcad.optics.camera)."""
 
     resolution: tuple[int, int]
     shape: tuple[int, int]
@@ -249,23 +251,28 @@ class Camera:
     x_px: np.ndarray
     y_px: np.ndarray
     design: object
+    principal_point: tuple[float, float] = (math.nan, math.nan)
 
     @classmethod
     def of(cls, rig, stride: int = 1) -> "Camera":
         import dataclasses
 
-        from rigcad.optics.incidence import camera_focal_px
+        from rigcad.optics.camera import camera_model
 
-        design = dataclasses.replace(rig.incidence, focal_px=camera_focal_px(rig))
+        model = camera_model(rig.profile, rig.geometry)
+        design = dataclasses.replace(rig.incidence, focal_px=model.focal_px)
         width, height = rig.profile.camera.resolution
+        cx, cy = model.principal_point
         r = float(design.pixel_radius(np.array([design.alpha_max]))[0])
         side = 2 * math.ceil(r) + 2 * WINDOW_MARGIN_PX
         w, h = min(width, side), min(height, side)
-        c0, r0 = (width - w) // 2, (height - h) // 2
+        # the window about the principal point, kept on the sensor ((W - w) // 2 for the centre)
+        c0 = min(max(math.floor(cx - w / 2), 0), width - w)
+        r0 = min(max(math.floor(cy - h / 2), 0), height - h)
         rows, cols = np.arange(r0, r0 + h, stride), np.arange(c0, c0 + w, stride)
         jj, ii = np.meshgrid(rows, cols, indexing="ij")
-        return cls((width, height), (len(rows), len(cols)), int(r0), int(c0), ii.ravel() + 0.5 - width / 2,
-                   height / 2 - jj.ravel() - 0.5, design)
+        return cls((width, height), (len(rows), len(cols)), int(r0), int(c0), ii.ravel() + 0.5 - cx,
+                   cy - jj.ravel() - 0.5, design, (cx, cy))
 
     def crop(self, image: np.ndarray) -> np.ndarray:
         """The window of a full camera image (rows, cols, ...); an image of the window's size is taken

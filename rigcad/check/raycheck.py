@@ -22,6 +22,7 @@ import numpy as np
 from rigcad.check import montecarlo, tolerances
 from rigcad.check.scene import Optics, analytic_optics, mesh_optics, mirror_meshes, mixed, placed_as, share_scenes
 from rigcad.check.sources import annulus_rays, pixel_grid, pixel_rays, thin_lens_rays
+from rigcad.optics.camera import camera_model
 from rigcad.optics.incidence import DesignMap
 from rigcad.check.result import STATUS_NAMES, Trace3D
 from rigcad.check.trace3d import trace
@@ -184,6 +185,7 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
         "tower": tower,
         "misalignment": misalignment,
         "monte_carlo": mc,
+        "camera": camera_model(profile, rig.geometry).as_dict(),  # its lens and the paraboloid's image
     }
     rows = tolerances.evaluate(profile, report)
     report["checks"] = [r.as_dict() for r in rows]

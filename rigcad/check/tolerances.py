@@ -86,6 +86,8 @@ def evaluate(profile, report: dict) -> list[Row]:
     rows.append(Row("rays lost (occluded, escaped)", "raycheck.max_lost_fraction", main["lost_fraction"],
                     rc.max_lost_fraction, "<=", "", w("raycheck", "max_lost_fraction"),
                     "see readings.<mode>.losses for where; the beam's width sets most of it"))
+    if report.get("camera"):
+        rows += camera_rows(profile, report["camera"])
     tower = report.get("tower")
     if tower is not None:
         cam = tower["camera_through_splitter"]
@@ -110,6 +112,34 @@ def evaluate(profile, report: dict) -> list[Row]:
                         tol.min_yield, ">=", "", w("tolerancing", "min_yield"),
                         f"p90 spot {mc['max_spot_radius_mm']['p90']:.3g} mm, p90 angle "
                         f"{mc['max_mirror_angle_error_rad']['p90'] / DEG:.3g} deg: tighten the tolerancing.* placements"))
+    return rows
+
+
+def camera_rows(profile, cam: dict) -> list[Row]:
+    """The camera's rows from its model in the report (``report["camera"]``:
+    rigcad.optics.camera.CameraModel.as_dict, closed forms on the profile's lens): how much of the
+    sensor the paraboloid's image fills, and whether it is all on the sensor (the rim's image radius
+    over the room from the principal point to the nearest edge, at most 1); with a known closest
+    focus (camera.min_working_distance), whether the lens focuses on the paraboloid."""
+    from rigcad.optics.camera import DEFAULT_FILL
+
+    w = profile.where
+    radius, short = cam["paraboloid_image_radius_px"], min(cam["resolution_px"])
+    f_mm, f_px = cam["focal_length_mm"], cam["focal_length_px"]
+    lens = (f"the {f_mm:.4g} mm lens" if f_mm is not None else f"the {f_px:.0f} px lens") + f" ({cam['focal_from']})"
+    fill_px = f_px * DEFAULT_FILL / cam["paraboloid_image_fill_of_short_side"]  # r is linear in f
+    fill = f"{fill_px * cam['pixel_pitch_mm']:.3g} mm" if cam["pixel_pitch_mm"] else f"{fill_px:.0f} px"
+    rows = [Row(f"camera: paraboloid image {2 * radius:.0f} px, {cam['paraboloid_image_fill_of_short_side']:.0%} of "
+                f"{short} px", "camera.focal_length", cam["reach_over_room"], 1.0, "<=", "",
+                w("camera", "focal_length") or w("camera", "lens"),
+                f"{lens} puts the rim {radius:.0f} px from the principal point, {radius / cam['reach_over_room']:g} px "
+                f"from the sensor's nearest edge: a shorter camera.focal_length; {fill} fills {DEFAULT_FILL:.0%}")]
+    if cam["min_working_distance_mm"] is not None:
+        rows.append(Row("camera: lens front to paraboloid vertex (closest focus)", "camera.min_working_distance",
+                        cam["working_distance_mm"], cam["min_working_distance_mm"], ">=", "mm",
+                        w("camera", "min_working_distance"),
+                        "the lens cannot focus this close: a lens with a shorter closest focus, or a close-up "
+                        "ring / extension tube (then camera.min_working_distance is the combination's)"))
     return rows
 
 

@@ -36,9 +36,38 @@ def cmd_design(args: argparse.Namespace) -> int:
     if not rng["targets_met"]:
         print(f"warning: the design covers theta {rng['theta_min_deg']:.2f}..{rng['theta_max_deg']:.2f} deg, "
               f"not the target {rng['target_theta_min_deg']:g}..{rng['target_theta_max_deg']:g} deg", file=sys.stderr)
+    _suggest_lens(rig, args.fill)
     for p in paths:
         print(f"  wrote {p}")
     return 0
+
+
+def _suggest_lens(rig, fill: float) -> None:
+    """The camera's lens against the paraboloid's image (rigcad.optics.camera): how much of the
+    sensor's short side the image fills, and the focal length that fills ``fill`` of it."""
+    from rigcad.optics.camera import camera_model
+
+    if rig.geometry.cop_at_infinity:
+        return
+    cam = camera_model(rig.profile, rig.geometry)
+    f_px, f_mm = cam.focal_for_fill(fill)
+    lens = f"{cam.focal_length:.4g} mm" if cam.focal_length is not None else f"{cam.focal_px:.0f} px"
+    print(f"camera: the {lens} lens ({cam.focal_from}) images the paraboloid {2 * cam.image_radius_px:.0f} px across, "
+          f"{cam.fill:.0%} of the {cam.short_side_px} px short side"
+          + ("" if cam.on_sensor else " (NOT all on the sensor)") + f"; {fill:.0%} needs "
+          + (f"a {f_mm:.3g} mm lens ({f_px:.0f} px)" if f_mm is not None
+             else f"{f_px:.0f} px (set camera.pixel_pitch for millimetres)"))
+
+
+def fill_fraction(text: str) -> float:
+    """An argparse type: a fraction 0 < f <= 1 of the sensor's short side, written 0.9 or 90%."""
+    try:
+        value = float(text[:-1]) / 100 if text.endswith("%") else float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a fraction such as 0.9 or 90%, got {text!r}") from None
+    if not 0 < value <= 1:
+        raise argparse.ArgumentTypeError(f"expected a fraction 0 < f <= 1 (or 1%..100%), got {text!r}")
+    return value
 
 
 def register(subparsers) -> None:
@@ -49,4 +78,9 @@ def register(subparsers) -> None:
         subparsers, "design", cmd_design,
         help="2D optical design: dome profile, ray diagram, derived figures",
         description="Integrate the dome profile, trace the design in 2D (pinhole, thin lens, misalignment) "
-                    "and write exports/<profile>/design.json, dome_profile.csv, rays.png and incidence.png.")
+                    "and write exports/<profile>/design.json, dome_profile.csv, rays.png and incidence.png; "
+                    "say how much of the camera's sensor the paraboloid's image fills, and the focal length "
+                    "that fills --fill of it.")
+    p.add_argument("--fill", type=fill_fraction, default=0.9, metavar="FRACTION",
+                   help="the fraction of the camera sensor's short side the suggested lens fills with the "
+                        "paraboloid's image (default: 0.9)")

@@ -1,10 +1,13 @@
-"""``rigcad profile show PROFILE [--json]``: every resolved parameter with the file:line that set it,
-and the derived geometry (closed forms: no dome is integrated to show them)."""
+"""``rigcad profile show PROFILE [--json]``: every resolved parameter with where it came from (the
+profile's file:line, the instrument file's file:line, or "default"), where each instrument figure
+was read (its datasheet), and the derived geometry and camera (closed forms: no dome is integrated
+to show them)."""
 
 from __future__ import annotations
 
 import argparse
 import math
+import re
 import sys
 from dataclasses import fields
 
@@ -23,6 +26,16 @@ def _fmt(spec, value) -> str:
     return str(list(value) if isinstance(value, tuple) else value)
 
 
+#: "(assumed)" or "(assumed: why)" in a key's doc: true of the default only.
+_ASSUMED = re.compile(r"\s*\(assumed(?::[^)]*)?\)")
+
+
+def _doc(profile, section: str, f) -> str:
+    """The key's doc; a key the profile or an instrument file set is no longer "(assumed)"."""
+    doc = f.metadata["spec"].doc
+    return doc if profile.set_by(section, f.name) == "default" else _ASSUMED.sub("", doc)
+
+
 def _columns(row, widths) -> str:
     """One line of a table: each cell padded to its column's width (the widest cell), the last free."""
     return " ".join(f"{cell:<{w}}" for cell, w in zip(row, widths)) + " " + " ".join(row[len(widths):])
@@ -30,20 +43,35 @@ def _columns(row, widths) -> str:
 
 def cmd_show(args: argparse.Namespace) -> int:
     from rigcad.export.atomic import json_bytes
+    from rigcad.optics.camera import camera_model
     from rigcad.profile import derive, load_profile
     from rigcad.profile.schema import SECTIONS
 
     profile = load_profile(args.profile)
     geo = derive(profile)  # the profile's own figures; no dome is integrated to show them
+    camera = None if geo.cop_at_infinity else camera_model(profile, geo)
     if args.json:
-        sys.stdout.write(json_bytes({"parameters": profile.as_dict(), "derived": geo.as_dict()}).decode())
+        origins = {section: {f.name: {"set_by": profile.set_by(section, f.name), "where": profile.origin(section, f.name),
+                                      **({"source": profile.source(section, f.name)}
+                                         if profile.source(section, f.name) else {})}
+                             for f in fields(getattr(profile, section))} for section in SECTIONS}
+        instruments = {key: {"kind": i.kind, "name": i.name, "title": i.title, "file": i.file}
+                       for key, i in profile.instruments.items()}
+        sys.stdout.write(json_bytes({"parameters": profile.as_dict(), "origins": origins, "instruments": instruments,
+                                     "derived": geo.as_dict(),
+                                     "camera": camera.as_dict() if camera else None}).decode())
         return 0
     print(f"profile {profile.name}  ({' <- '.join(profile.sources)})")
     if profile.description:
         print(f"  {profile.description}")
+    for key, inst in profile.instruments.items():
+        print(f"  {key}: {inst.name} = {inst.title} ({inst.file})")
     table = {section: [(f.name, _fmt(f.metadata["spec"], getattr(getattr(profile, section), f.name)),
-                        profile.marks.get((section, f.name)) or "default", f.metadata["spec"].doc)
+                        profile.origin(section, f.name), _doc(profile, section, f))
                        for f in fields(getattr(profile, section))] for section in SECTIONS}
+    if camera is not None and camera.focal_from == "derived":  # no lens stated: the one rigcad derives
+        table["camera"] = [(n, f"({camera.focal_px:.5g} px)", "derived", d) if n == "focal_length" else (n, v, o, d)
+                           for n, v, o, d in table["camera"]]
     # a value wider than this (the coating's layer list) goes on its own line under its row, so that
     # one long cell does not push every other row's columns to the right
     cap = 32
@@ -74,7 +102,38 @@ def cmd_show(args: argparse.Namespace) -> int:
     width = max(len(name) for name, _ in rows)
     for name, value in rows:
         print(f"  {name:<{width}} {value}")
+    if camera is not None:
+        _print_camera(camera)
+    sourced = [(f"{section}.{f.name}", profile.source(section, f.name)) for section in SECTIONS
+               for f in fields(getattr(profile, section)) if profile.source(section, f.name)]
+    if sourced:
+        print("\n[sources] where each instrument figure was read")
+        width = max(len(key) for key, _ in sourced)
+        for key, source in sourced:
+            print(f"  {key:<{width}} {source}")
     return 0
+
+
+def _print_camera(camera) -> None:
+    """The camera's derived figures (rigcad.optics.camera): its lens and the paraboloid's image."""
+    from rigcad.optics.camera import DEFAULT_FILL
+
+    f_fill, f_fill_mm = camera.focal_for_fill(DEFAULT_FILL)
+    mm = (lambda v: "-" if v is None else f"{v:.4g} mm")
+    rows = [
+        ("focal_length", f"{mm(camera.focal_length)} = {camera.focal_px:.5g} px ({camera.focal_from})"),
+        ("principal_point", f"[{camera.principal_point[0]:g}, {camera.principal_point[1]:g}] px"),
+        ("paraboloid_image", f"{2 * camera.image_radius_px:.4g} px across, {camera.fill:.1%} of the "
+                             f"{camera.short_side_px} px short side, "
+                             + ("all on the sensor" if camera.on_sensor else "NOT all on the sensor")),
+        (f"focal_length_for_{DEFAULT_FILL:.0%}".replace("%", "pc"), f"{mm(f_fill_mm)} = {f_fill:.5g} px"),
+        ("working_distance", f"{camera.working_distance:.4g} mm (lens front to the paraboloid's vertex; closest "
+                             f"focus {mm(camera.min_working_distance)})"),
+    ]
+    print("\n[derived camera]")
+    width = max(len(name) for name, _ in rows)
+    for name, value in rows:
+        print(f"  {name:<{width}} {value}")
 
 
 def register(subparsers) -> None:

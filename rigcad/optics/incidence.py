@@ -108,10 +108,19 @@ class DesignMap:
 
 
 def camera_focal_px(rig) -> float:
-    """The camera's focal length in its own pixels. The profile gives only the camera's resolution;
-    rigcad assumes the camera, behind the beam splitter at the projector's COP (thesis 3.1,
-    Figure 3.4), frames the paraboloid as the projector does: the same field of view across the
-    sensor's height, f_camera = f_projector x camera height / projector height (2389 px for
-    Table 3.1: the rim at 134 px from the image centre, 1.5 camera pixels per degree on average).
-    ``rig``: a :class:`rigcad.rig.Rig` (its design map and profile)."""
-    return rig.incidence.focal_px * rig.profile.camera.resolution[1] / rig.profile.projector.resolution[1]
+    """The camera's focal length in its own pixels (rigcad.optics.camera): the profile's
+    ``camera.focal_length`` or its lens file's over ``camera.pixel_pitch``; without either, the lens
+    that frames the paraboloid as the projector does, f_camera = f_projector x camera height /
+    projector height (2389 px for Table 3.1: the rim 134 px from the image centre). ``rig``: a
+    :class:`rigcad.rig.Rig` (its profile and derived geometry)."""
+    from rigcad.optics.camera import camera_model
+
+    return camera_model(rig.profile, rig.geometry).focal_px
+
+
+def camera_principal_point(rig) -> tuple[float, float]:
+    """Where the camera's optical axis meets its sensor: (x, y) px from the image's top-left corner
+    (``camera.principal_point``; default the centre)."""
+    from rigcad.optics.camera import camera_model
+
+    return camera_model(rig.profile, rig.geometry).principal_point

@@ -1,25 +1,40 @@
-"""The instrument library: projectors and cameras a profile picks by name (``projector.model``,
-``camera.model``), with the sizes the COP tower is built around (mm), each with its source.
+"""Instruments as data: one YAML file per projector, camera, lens and beam splitter, which a profile
+names by file name (``projector.model``, ``camera.model``, ``camera.lens``, ``beam_splitter.model``).
 
-A dimension is *sourced* when a maker's published page gives it (the address is in ``sources``);
-every other dimension the tower needs is *assumed*: the profile schema's default stands in, and
-:func:`measurements` lists it for the lab to measure before printing (the manual opens with that
-list). A profile that gives a key itself (``projector.pupil_height: 52 mm``) has measured it: it
-leaves the list.
+Instrument files are found like profiles (rigcad.profile.paths): in ``instruments/`` beside the
+profile, then under each folder of the profile search path (``./profiles/instruments``,
+``$RIGCAD_PROFILES/<folder>/instruments``, the shipped ``profiles/instruments``), first match wins:
+a lab adds its own camera in its own folder without touching rigcad. Each file crosses the same
+hostile-input boundary as a profile (rigcad.profile.loader.parse) and its errors name its file:line.
 
-Sourcing (this module was written without web access; the makers' pages were read through a
-stored-page search): Basler publishes the ace U body size per model (docs.baslerweb.com); FLIR
-publishes the Blackfly S mounting holes (softwareservices.flir.com, "Physical Interface"); the
-C-mount flange distance is the standard's. No projector drawing (body, mounting holes, lens
-position) was found: every projector size is assumed and marked so. Kernel-free, numpy-free data.
+A file says its ``kind`` (projector, camera, lens or splitter), a ``title`` (what to buy), an
+optional ``note``, its figures as the profile's own keys (``resolution: [2048, 1536]``,
+``pixel_pitch: 3.45 um``, ``body_width: 29 mm``; a lens file fills the camera's lens keys) and
+``sources:`` (per figure, where it was read: a datasheet's address, or the thesis). The shipped files
+give a figure only with its source. A figure no file gives and the profile does not set is the
+schema's default: *assumed*, and :func:`measurements` lists the instrument sizes among those for the
+lab to measure before printing (the manual opens with that list). A key the profile sets itself is
+the lab's measurement: it wins over every file.
+
+Sourcing (the shipped files were written without web access; the makers' pages were read through a
+stored-page search): Basler publishes the ace U body size, sensor and pixel size per model
+(docs.baslerweb.com); FLIR publishes the Blackfly S mounting holes; the C-mount flange distance is
+the standard's. No projector drawing (body, mounting holes, lens position) was found: every projector
+size is assumed. Kernel-free, numpy-free.
 """
 
 from __future__ import annotations
 
+import difflib
+import re
 from dataclasses import dataclass, field
+from pathlib import Path
+
+from rigcad.errors import ProfileError
+from rigcad.profile.paths import INSTRUMENTS_SUBDIR, display, names_on_search_path, search_path
 
 #: The keys of ``projector`` / ``camera`` whose values describe the body and its optics (mm, or a
-#: thread name): what a library entry may source and what :func:`measurements` may ask for.
+#: thread name): what an instrument file may source and what :func:`measurements` may ask for.
 PROJECTOR_SIZES = ("body_width", "body_height", "body_depth", "lens_diameter", "lens_length", "pupil_depth",
                    "pupil_height", "pupil_lateral", "mount_thread", "mount_depth", "focus_min", "focus_max")
 CAMERA_SIZES = ("body_width", "body_height", "body_depth", "lens_diameter", "lens_length", "pupil_depth",
@@ -30,73 +45,154 @@ CAMERA_SIZES = ("body_width", "body_height", "body_depth", "lens_diameter", "len
 #: https://support.thinklucid.com/knowledgebase/back-focal-distance).
 C_MOUNT_FLANGE = 17.526
 
+#: Each kind of instrument file: the profile key that names one, and the profile section its
+#: figures fill (a lens file fills the camera's lens keys).
+NAMED_BY: dict[str, tuple[str, str]] = {"projector": ("projector", "model"), "camera": ("camera", "model"),
+                                        "lens": ("camera", "lens"), "splitter": ("beam_splitter", "model")}
+#: The figures each kind of file may give, as the keys of the section it fills.
+FIGURE_KEYS: dict[str, tuple[str, ...]] = {
+    "projector": ("resolution", "throw_ratio") + PROJECTOR_SIZES,
+    "camera": ("resolution", "pixel_pitch") + CAMERA_SIZES,
+    "lens": ("focal_length", "lens_diameter", "lens_length", "pupil_depth", "min_working_distance"),
+    "splitter": ("width", "length", "thickness", "reflectance", "coating", "index"),
+}
+#: The keys of a file besides its figures.
+HEADER_KEYS = ("kind", "title", "note", "sources")
+#: An instrument's name: its file's name without ``.yaml`` (no path: a profile names a file, it
+#: cannot reach outside the instrument folders).
+INSTRUMENT_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.+-]{0,99}")
+#: A key an error may quote as written (the schema quotes anything else only by its kind).
+_KEY = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,39}")
+
 
 @dataclass(frozen=True)
 class Instrument:
-    """One library entry: ``sizes`` maps profile keys (``PROJECTOR_SIZES`` / ``CAMERA_SIZES``) to
-    sourced values (mm, or a thread name), ``sources`` maps each such key to where it was read,
-    ``resolution`` is the sensor's or modulator's [width, height] in pixels, ``note`` what a reader
-    should know (discontinued, which variant)."""
+    """One instrument file as read: ``figures`` maps the section's keys to the values as written
+    (the schema converts them with the key's own Spec), ``marks`` each figure to the ``file:line``
+    that gives it, ``sources`` each figure that says so to where it was read (a datasheet)."""
 
-    kind: str  #: "projector" or "camera"
+    kind: str  #: "projector", "camera", "lens" or "splitter"
     name: str
     title: str
-    resolution: tuple[int, int]
-    resolution_source: str
-    sizes: dict[str, object] = field(default_factory=dict)
+    file: str  #: the file as messages name it (``profiles/instruments/<name>.yaml``)
+    figures: dict[str, object] = field(default_factory=dict)
+    marks: dict[str, str] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)
     note: str = ""
 
+    @property
+    def section(self) -> str:
+        return NAMED_BY[self.kind][0]
+
     def sourced(self, key: str) -> bool:
-        return key in self.sizes
+        """True when the file gives ``key`` with the source it was read from."""
+        return key in self.figures and key in self.sources
 
 
-_BASLER_ACA2040_55UC = "https://docs.baslerweb.com/aca2040-55uc/ (Specifications: Size, Lens Mount, Resolution)"
-_FLIR_BFS_PHYSICAL = "https://softwareservices.flir.com/BFS-U3-200S6/latest/Family/PhysicalDescription.htm"
-_FLIR_BFS_32S4_SPEC = "https://softwareservices.flir.com/BFS-U3-32S4/latest/Model/spec.html"
-
-LIBRARY: dict[str, Instrument] = {e.name: e for e in (
-    # -- projectors --------------------------------------------------------------------------------
-    Instrument("projector", "benq_pb6210", "BenQ PB6210 (the thesis's, 3.1; discontinued)", (1024, 768),
-               "thesis 3.1", note="no datasheet at hand: every size is the schema's assumed default"),
-    Instrument("projector", "ti_dlp_lightcrafter_4500", "Texas Instruments DLP LightCrafter 4500 EVM (DLPLCR4500EVM)",
-               (912, 1140), "TI DLPC350/DLP4500 0.45 in WXGA DMD, 912 x 1140 diamond array (TI product page; "
-               "not re-read here: assumed)",
-               note="the mechanical drawing (DLPU011 user's guide) was not found by the stored-page search: the "
-                    "optical engine's sizes, its M2.5/M3 mounting holes and its focus range are assumed; measure them"),
-    Instrument("projector", "benq_mw632st", "BenQ MW632ST short-throw business projector (WXGA)", (1280, 800),
-               "BenQ product page (not found by the stored-page search: assumed)",
-               note="no drawing found: sizes assumed; its ceiling-mount holes are M4 on BenQ's business models "
-                    "(assumed)"),
-    Instrument("projector", "epson_eb_w52", "Epson EB-W52 business projector (WXGA, 3LCD)", (1280, 800),
-               "Epson product page (not found by the stored-page search: assumed)",
-               note="no drawing found: sizes assumed"),
-    # -- cameras -----------------------------------------------------------------------------------
-    Instrument("camera", "prosilica_ec1350c", "Prosilica EC 1350C (the thesis's, 3.1; discontinued)", (1360, 1024),
-               "thesis 3.1", note="no datasheet at hand: every size is the schema's assumed default"),
-    Instrument("camera", "basler_ace_u_aca2040_55uc", "Basler ace U acA2040-55uc (USB 3.0, C-mount)", (2048, 1536),
-               _BASLER_ACA2040_55UC,
-               sizes={"body_width": 29.0, "body_height": 29.0, "body_depth": 29.3},
-               sources={"body_width": _BASLER_ACA2040_55UC, "body_height": _BASLER_ACA2040_55UC,
-                        "body_depth": _BASLER_ACA2040_55UC + ": 29.3 x 29 x 29 mm without lens mount or connectors"},
-               note="the ace has no 1/4-20 socket on the body (a tripod adapter or its M3 holes, spacing not "
-                    "published on the page read): mount_thread and mount_spacing assumed; the lens (and so its "
-                    "pupil) is the lab's choice"),
-    Instrument("camera", "flir_blackfly_s_bfs_u3_32s4c", "FLIR Blackfly S BFS-U3-32S4C (USB 3, C-mount)", (2048, 1536),
-               _FLIR_BFS_32S4_SPEC,
-               sizes={"mount_thread": "M3"},
-               sources={"mount_thread": _FLIR_BFS_PHYSICAL + ": M3x2.5 and M2x2.5 mounting holes"},
-               note="body size (29 x 29 x 30 mm in FLIR's drawing, not re-read here) and the M3 holes' spacing "
-                    "assumed; the lens is the lab's choice"),
-    Instrument("camera", "allied_vision_alvium_1800_u_319c", "Allied Vision Alvium 1800 U-319c (USB 3, C-mount)",
-               (2064, 1544), "Allied Vision Alvium 1800 U data sheet (not found by the stored-page search: assumed)",
-               note="no drawing found: sizes and mounting holes assumed"),
-)}
+def unknown_key(key: object) -> str:
+    """A key as an error shows it: quoted when it looks like a setting's name, else not shown (a
+    line of a file that is no instrument file is never echoed)."""
+    return repr(key) if isinstance(key, str) and _KEY.fullmatch(key) else "(not a setting's name; not shown)"
 
 
-def names(kind: str) -> tuple[str, ...]:
-    """The library's entries of ``kind`` ("projector" or "camera"), in library order."""
-    return tuple(n for n, e in LIBRARY.items() if e.kind == kind)
+def suggest(name: str, valid: list[str]) -> str:
+    close = difflib.get_close_matches(name, valid, n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def folders(near: Path | None = None) -> list[Path]:
+    """Where instrument files are looked for, first match wins: ``near`` (the profile's own
+    ``instruments/``), then ``instruments/`` under each folder of the profile search path."""
+    return ([near] if near is not None else []) + search_path(INSTRUMENTS_SUBDIR)
+
+
+def find(name: object, kind: str, where: str | None, near: Path | None = None) -> Path:
+    """The file of instrument ``name`` (a ``kind``, named by the profile key NAMED_BY[kind] at
+    ``where``), or a ProfileError naming the key, where it looked and the closest names found."""
+    from rigcad.profile.loader import find_file
+
+    key = ".".join(NAMED_BY[kind])
+    if not isinstance(name, str) or not INSTRUMENT_NAME.fullmatch(name):
+        raise ProfileError(f"{key}: {str(name)[:60]!r} is not an instrument's name; name a {kind} file under "
+                           f"{INSTRUMENTS_SUBDIR}/ by its name without .yaml (letters, digits, '_', '.', '+', '-')",
+                           where=where)
+    try:
+        return find_file(name, kind, sub=INSTRUMENTS_SUBDIR, near=near, as_path=False)
+    except ProfileError as err:
+        known = names_on_search_path(INSTRUMENTS_SUBDIR)
+        if near is not None and near.is_dir():
+            known = sorted(set(known) | {p.stem for p in near.glob("*.yaml")})
+        close = difflib.get_close_matches(name, known, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise ProfileError(f"{key}: {err.message}{hint}; add your own as {INSTRUMENTS_SUBDIR}/{name}.yaml beside the "
+                           "profile", where=where) from None
+
+
+def read(path: Path, kind: str, named_where: str | None = None) -> Instrument:
+    """Read and check instrument file ``path``, which the profile names as a ``kind``: its structure,
+    its kind, its keys (those of FIGURE_KEYS[kind]) and its sources (each names a figure of the
+    file). The values are converted by the schema. Raises ProfileError with the file:line."""
+    from rigcad.profile.loader import parse
+
+    shown = display(path)
+    data, marks = parse(path, "instrument")
+    key = ".".join(NAMED_BY[kind])
+    if not isinstance(data, dict):
+        raise ProfileError(f"an instrument file is a mapping of keys (kind, title, its figures, sources), named by "
+                           f"{key}" + (f" at {named_where}" if named_where else ""), where=f"{shown}:1")
+
+    def at(*k: str) -> str:
+        return marks.get(k) or f"{shown}:1"
+
+    given = data.get("kind")
+    if given not in NAMED_BY:
+        raise ProfileError(f"kind: {str(given)[:40]!r}: an instrument file says its kind, one of "
+                           f"{', '.join(NAMED_BY)}", where=at("kind"))
+    if given != kind:
+        raise ProfileError(f"kind: {given}, but {key}" + (f" ({named_where})" if named_where else "")
+                           + f" names a {kind}: name a {kind} file there, or this file under "
+                           f"{'.'.join(NAMED_BY[given])}", where=at("kind"))
+    valid = list(HEADER_KEYS) + list(FIGURE_KEYS[kind])
+    for k in data:
+        if k not in valid:
+            raise ProfileError(f"unknown key {unknown_key(k)} in a {kind} file{suggest(str(k), valid)}; valid: "
+                               f"{', '.join(valid)}", where=at(str(k)))
+    title = data.get("title")
+    if not isinstance(title, str) or not title.strip():
+        raise ProfileError(f"title: a {kind} file names what it is (the maker's name and model, what the bill "
+                           "lists), as text", where=at("title"))
+    note = data.get("note", "")
+    if not isinstance(note, str):
+        raise ProfileError("note: expected text", where=at("note"))
+    figures = {k: v for k, v in data.items() if k not in HEADER_KEYS}
+    sources = data.get("sources") or {}
+    if not isinstance(sources, dict):
+        raise ProfileError("sources: expected a mapping of each figure to where it was read (a datasheet's "
+                           "address)", where=at("sources"))
+    for k, v in sources.items():
+        if k not in figures:
+            shown_key = k if isinstance(k, str) and _KEY.fullmatch(k) else unknown_key(k)
+            raise ProfileError(f"sources.{shown_key}: not a figure of this file; the sources name its figures: "
+                               f"{', '.join(figures) or 'none given'}", where=at("sources", str(k)))
+        if not isinstance(v, str) or not v.strip():
+            raise ProfileError(f"sources.{k}: expected where the figure was read, as text", where=at("sources", k))
+    return Instrument(kind=kind, name=path.stem, title=title.strip(), file=shown, figures=figures,
+                      marks={k: at(k) for k in figures}, sources=dict(sources), note=note.strip())
+
+
+def shipped(kind: str | None = None) -> list[Instrument]:
+    """The instrument files shipped with rigcad (of ``kind``, or all), by name."""
+    from rigcad.profile.paths import SHIPPED_PROFILES
+
+    out = []
+    for path in sorted((SHIPPED_PROFILES / INSTRUMENTS_SUBDIR).glob("*.yaml")):
+        from rigcad.profile.loader import parse
+
+        data, _ = parse(path, "instrument")
+        k = data.get("kind") if isinstance(data, dict) else None
+        if k in NAMED_BY and (kind is None or k == kind):
+            out.append(read(path, k))
+    return out
 
 
 @dataclass(frozen=True)
@@ -237,16 +333,16 @@ def sketch(profile, m: Measurement) -> Sketch:
 
 def measurements(profile) -> list[Measurement]:
     """What must be measured before printing, for ``profile`` (a validated Profile): each projector
-    and camera size that neither the chosen library entry sources nor the profile gives."""
+    and camera size that neither an instrument file the profile names gives nor the profile sets
+    (``profile.set_by(section, key) == "default"``)."""
     from dataclasses import fields
 
     out: list[Measurement] = []
     for section, keys in (("projector", PROJECTOR_SIZES), ("camera", CAMERA_SIZES)):
         params = getattr(profile, section)
-        entry = LIBRARY[params.model]
         docs = {f.name: f.metadata["spec"] for f in fields(params)}
         for key in keys:
-            if entry.sourced(key) or (section, key) in profile.marks:
+            if profile.set_by(section, key) != "default":
                 continue
             view, a, b = FIGURES[key]
             value = getattr(params, key)
@@ -255,5 +351,5 @@ def measurements(profile) -> list[Measurement]:
     return out
 
 
-__all__ = ["CAMERA_SIZES", "C_MOUNT_FLANGE", "FIGURES", "Instrument", "LIBRARY", "Measurement", "PROJECTOR_SIZES",
-           "Sketch", "measurements", "names", "sketch"]
+__all__ = ["CAMERA_SIZES", "C_MOUNT_FLANGE", "FIGURES", "FIGURE_KEYS", "Instrument", "Measurement", "NAMED_BY",
+           "PROJECTOR_SIZES", "Sketch", "find", "folders", "measurements", "read", "shipped", "sketch"]

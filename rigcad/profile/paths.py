@@ -2,7 +2,8 @@
 
 A profile given by name is looked up, first match wins, in the working directory's ``profiles/``,
 in each folder of ``$RIGCAD_PROFILES`` (``os.pathsep``-separated) and in the profiles shipped with
-rigcad (:data:`SHIPPED_PROFILES`). Printers are the same with ``printers/`` below each folder.
+rigcad (:data:`SHIPPED_PROFILES`). Printers are the same with ``printers/`` below each folder, and
+instruments (projectors, cameras, lenses, splitters) with ``instruments/``.
 
 The shipped profiles live at the top of the repository, ``profiles/``, where people edit them; a
 wheel carries the same files inside the package as ``rigcad/profiles/`` (pyproject.toml maps the
@@ -23,6 +24,9 @@ PROFILES_ENV = "RIGCAD_PROFILES"
 SHIPPED_NAME = "profiles"
 #: Printer files live in this folder under each folder of the profile search path.
 PRINTERS_SUBDIR = "printers"
+#: Instrument files (one YAML per projector, camera, lens, splitter) live in this folder under each
+#: folder of the profile search path.
+INSTRUMENTS_SUBDIR = "instruments"
 
 
 def _shipped_folder() -> Path:

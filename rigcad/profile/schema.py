@@ -16,7 +16,7 @@ from typing import Any
 
 from rigcad.errors import ProfileError
 from rigcad.standards import MOUNT_THREADS
-from rigcad.profile import instruments as instrument_library
+from rigcad.profile import instruments as instrument_files
 from rigcad.profile.loader import Key, RawProfile
 from rigcad.units import DEG, UnitError, parse_quantity
 
@@ -46,8 +46,9 @@ class Spec:
 
     ``kind`` is ``length`` (mm), ``angle`` (rad), ``int``, ``float``, ``choice``, ``pixels``
     (a ``[width, height]`` pair of positive integers), ``layers`` (a list of named thicknesses),
-    ``lengths`` (a list of lengths, mm, each within the bounds) or ``ints`` (a list of whole numbers,
-    each within the bounds).
+    ``lengths`` (a list of lengths, mm, each within the bounds), ``ints`` (a list of whole numbers,
+    each within the bounds), ``name`` (an instrument file's name, rigcad.profile.instruments) or
+    ``point`` (an ``[x, y]`` pair of pixel coordinates, each 0..MAX_PIXELS).
     Bounds are in internal units.
     """
 
@@ -65,6 +66,10 @@ class Spec:
         unit, scale = {"length": ("mm", 1.0), "angle": ("deg", DEG)}.get(self.kind, ("", 1.0))
         if self.kind == "choice":
             return "one of " + ", ".join(self.choices)
+        if self.kind == "name":
+            return "the name of a file under instruments/, without .yaml"
+        if self.kind == "point":
+            return f"[x, y] in pixels, each 0..{MAX_PIXELS}"
         parts = []
         if self.lo is not None:
             parts.append(f"{'>' if self.lo_open else '>='} {self.lo / scale:g} {unit}".rstrip())
@@ -116,12 +121,12 @@ class LayoutParams:
 
 @dataclass(frozen=True)
 class ProjectorParams:
-    """The projector at the COP, looking down the optical axis. ``model`` picks an entry of the
-    instrument library (rigcad.profile.instruments): its sourced sizes replace the defaults below,
-    which stay ASSUMED otherwise (``rigcad.profile.instruments.measurements`` lists them)."""
+    """The projector at the COP, looking down the optical axis. ``model`` names a projector file
+    (``instruments/<model>.yaml``, rigcad.profile.instruments): its figures replace the defaults
+    below but for the keys the profile sets; the sizes neither gives stay ASSUMED
+    (``rigcad.profile.instruments.measurements`` lists them)."""
 
-    model: str = spec("choice", "instrument library entry (rigcad.profile.instruments)", "benq_pb6210",
-                      choices=instrument_library.names("projector"))
+    model: str = spec("name", "projector file under instruments/ (rigcad.profile.instruments)", "benq_pb6210")
     resolution: tuple[int, int] = spec("pixels", "[width, height] in pixels", [1024, 768])
     throw_ratio: float = spec("float", "throw distance / image width (sets the field of view)", 1.75,
                               lo=0, lo_open=True, hi=100)
@@ -152,11 +157,26 @@ class ProjectorParams:
 @dataclass(frozen=True)
 class CameraParams:
     """The camera, sharing the COP through the beam splitter: behind it on the optical axis, looking
-    down through the plate (thesis Figure 3.4, right). ``model``: as for the projector."""
+    down through the plate (thesis Figure 3.4, right). ``model``: a camera file, as for the
+    projector; ``lens``: a lens file (its focal length, sizes and closest focus fill the lens keys).
+    Without a lens file or ``focal_length`` the lens is the one that frames the paraboloid as the
+    projector does (rigcad.optics.camera, reported as derived)."""
 
-    model: str = spec("choice", "instrument library entry (rigcad.profile.instruments)", "prosilica_ec1350c",
-                      choices=instrument_library.names("camera"))
+    model: str = spec("name", "camera file under instruments/ (rigcad.profile.instruments)", "prosilica_ec1350c")
     resolution: tuple[int, int] = spec("pixels", "[width, height] in pixels", [1360, 1024])
+    pixel_pitch: float | None = spec("length", "the sensor's pixel pitch (e.g. 3.45 um); default: unknown, the "
+                                     "lens then known in pixels only", None, lo=0, lo_open=True, hi=0.1)
+    lens: str | None = spec("name", "lens file under instruments/ (its focal length, sizes, closest focus); "
+                            "default: none, the lens that frames the paraboloid as the projector does (derived)",
+                            None)
+    focal_length: float | None = spec("length", "the lens's focal length (needs pixel_pitch); default: the lens "
+                                      "file's, else derived (rigcad.optics.camera)", None, lo=0, lo_open=True,
+                                      hi=2000.0)
+    principal_point: tuple[float, float] | None = spec(
+        "point", "[x, y] px from the image's top-left corner where the optical axis meets the sensor; "
+        "default: the centre, [width / 2, height / 2]", None)
+    min_working_distance: float | None = spec("length", "the lens's closest focus, from its front (the "
+                                              "datasheet's MOD); default: unknown, not checked", None, lo=0)
     # The Prosilica EC 1350C of thesis 3.1: resolution from the thesis; the sizes are ASSUMED
     # (a C-mount FireWire machine-vision camera of its class), no datasheet at hand.
     body_width: float = spec("length", "body width across its optical axis (assumed)", "46 mm", **_POS)
@@ -195,8 +215,11 @@ class LensParams:
 class BeamSplitterParams:
     """The plate beam splitter at 45 deg on the optical axis (thesis 3.1, item 4; Figure 3.4): its
     coated front face reflects the projector down onto the paraboloid; the camera looks through the
-    plate, whose thickness shifts the transmitted axis sideways (rigcad.optics.splitter)."""
+    plate, whose thickness shifts the transmitted axis sideways (rigcad.optics.splitter). ``model``
+    names a splitter file (its figures replace the defaults below but for the keys the profile sets)."""
 
+    model: str | None = spec("name", "splitter file under instruments/ (rigcad.profile.instruments); default: "
+                             "none, the sizes below", None)
     width: float = spec("length", "plate width across the plane of incidence (assumed)", "50 mm", **_POS)
     length: float = spec("length", "plate length along the 45 deg slope (assumed)", "50 mm", **_POS)
     thickness: float = spec("length", "plate thickness (catalogue plate beam splitters are 1.1 mm soda-lime or "
@@ -429,12 +452,6 @@ class CrossesParams:
     arm_length: float = spec("length", "half-length of each cross arm from the centre", "15 mm", **_POS)
     bar_width: float = spec("length", "width of the cross bars", "2 mm", **_POS)
     thickness: float = spec("length", "thickness of the cross plate", "2 mm", **_POS)
-    projector_axis_height: float = spec("length", "height of the projector's optical axis above its mounting "
-                                        "plate (the projector crosses' centres)", "100 mm", **_POS)
-    projector_spacing: float = spec("length", "distance between the two projector crosses along the axis",
-                                    "150 mm", **_POS)
-    backplate_distance: float = spec("length", "distance from the far cross to the backplate", "100 mm", **_POS)
-    backplate_size: float = spec("length", "side of the square backplate", "120 mm", **_POS)
 
 
 @dataclass(frozen=True)
@@ -666,10 +683,38 @@ class Profile:
     calibration: CalibrationParams
     sources: tuple[str, ...]
     marks: dict[Key, str] = field(compare=False, repr=False)
+    #: The instrument files the profile names, by the key that names each ("camera.model", "camera.lens").
+    instruments: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    #: file:line of each key an instrument file set (the profile did not).
+    instrument_marks: dict[Key, str] = field(default_factory=dict, compare=False, repr=False)
 
     def where(self, section: str, key: str) -> str | None:
-        """file:line of a parameter, when it came from a file."""
-        return self.marks.get((section, key)) or self.marks.get((section,))
+        """file:line of a parameter, when it came from a file (the profile's, else an instrument file's)."""
+        return (self.marks.get((section, key)) or self.instrument_marks.get((section, key))
+                or self.marks.get((section,)))
+
+    def set_by(self, section: str, key: str) -> str:
+        """Who set ``section.key``: "profile", "instrument" (a file the profile names) or "default"."""
+        if (section, key) in self.marks:
+            return "profile"
+        return "instrument" if (section, key) in self.instrument_marks else "default"
+
+    def origin(self, section: str, key: str) -> str:
+        """Where ``section.key`` came from, as ``rigcad profile show`` says it: the profile's file:line,
+        the instrument file's file:line, or "default"."""
+        return self.marks.get((section, key)) or self.instrument_marks.get((section, key)) or "default"
+
+    def source(self, section: str, key: str) -> str | None:
+        """Where the instrument file that set ``section.key`` read it (a datasheet), if it says."""
+        mark = self.instrument_marks.get((section, key))
+        for inst in self.instruments.values():
+            if mark is not None and inst.section == section and inst.marks.get(key) == mark:
+                return inst.sources.get(key)
+        return None
+
+    def instrument(self, section: str, key: str = "model"):
+        """The instrument file named by ``section.key`` (rigcad.profile.instruments.Instrument), or None."""
+        return self.instruments.get(f"{section}.{key}")
 
     def as_dict(self) -> dict[str, dict[str, Any]]:
         """Resolved parameters in internal units, keys suffixed with their unit."""
@@ -717,6 +762,8 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
 
     if value is None:
         raise fail(f"has no value; expected {s.doc} ({s.describe_range()})")
+    if s.kind in ("str", "name", "point"):  # text, an instrument file's name, a pixel point: no range after
+        return _text_or_point(s, value, fail)
     if s.kind in ("length", "angle"):
         try:
             out = parse_quantity(value, s.kind)
@@ -742,10 +789,6 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
             out = math.inf
         if not math.isfinite(out):
             raise fail(f"must be finite, got {_r(value)} ({s.describe_range()})")
-    elif s.kind == "str":
-        if not isinstance(value, str) or not value:
-            raise fail(f"expected text, got {_r(value)}")
-        return value
     elif s.kind == "choice":
         if value not in s.choices:
             raise fail(f"{_r(value)} is not valid; {s.describe_range()}{suggest(str(value), list(s.choices))}")
@@ -790,6 +833,26 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
     if too_low or too_high:
         raise fail(f"{_r(value)} is out of range; valid: {s.describe_range()}")
     return out
+
+
+def _text_or_point(s: Spec, value: Any, fail) -> Any:
+    """``value`` read as text (kind ``str``), an instrument file's name (``name``) or an ``[x, y]``
+    pixel point (``point``); ``fail(message)`` makes the error naming the key."""
+    if s.kind == "str":
+        if not isinstance(value, str) or not value:
+            raise fail(f"expected text, got {_r(value)}")
+        return value
+    if s.kind == "name":
+        if not isinstance(value, str) or not instrument_files.INSTRUMENT_NAME.fullmatch(value):
+            raise fail(f"{_r(value)} is not an instrument's name; {s.describe_range()} (letters, digits, '_', '.', "
+                       "'+', '-')")
+        return value
+    ok = (isinstance(value, list) and len(value) == 2
+          and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                  and 0 <= v <= MAX_PIXELS for v in value))
+    if not ok:
+        raise fail(f"expected [x, y] in pixels, each 0..{MAX_PIXELS}, got {_r(value)}")
+    return (float(value[0]), float(value[1]))
 
 
 def bound(section: str, key: str) -> float | None:
@@ -838,17 +901,51 @@ def read_section(raw: RawProfile, name: str, cls: type) -> Any:
     return cls(**values)
 
 
-def _with_model(raw: RawProfile, section: str, params: Any) -> Any:
-    """``params`` with its library entry's sourced sizes and resolution (``params.model``), but for the
-    keys the profile gives itself (a lab's measurement wins over the library)."""
+def _with_instruments(raw: RawProfile, sections: dict[str, Any]) -> tuple[dict[str, Any], dict[Key, str]]:
+    """The instrument files the profile names (``projector.model``, ``camera.model``, ``camera.lens``,
+    ``beam_splitter.model``), read and checked (rigcad.profile.instruments), their figures converted
+    with each key's own Spec into ``sections`` but for the keys the profile gives itself (a lab's
+    measurement wins over any file; a lens file over the camera's for the lens keys). Returns the
+    files by naming key and the file:line of each key a file set."""
     from dataclasses import replace
 
-    entry = instrument_library.LIBRARY[params.model]
-    given = raw.data.get(section) or {}
-    updates = {k: v for k, v in entry.sizes.items() if k not in given}
-    if "resolution" not in given:
-        updates["resolution"] = entry.resolution
-    return replace(params, **updates)
+    from rigcad.profile.paths import INSTRUMENTS_SUBDIR
+
+    near = raw.files[0].parent / INSTRUMENTS_SUBDIR if raw.files else None
+    chosen: dict[str, Any] = {}
+    marks: dict[Key, str] = {}
+    for kind, (section, key) in instrument_files.NAMED_BY.items():
+        name = getattr(sections[section], key)
+        if name is None:
+            continue
+        where = raw.marks.get((section, key))
+        chosen[f"{section}.{key}"] = instrument_files.read(instrument_files.find(name, kind, where, near), kind, where)
+    for inst in chosen.values():
+        given = raw.data.get(inst.section) or {}
+        specs = {f.name: f.metadata["spec"] for f in fields(SECTIONS[inst.section])}
+        updates = {}
+        for key, value in inst.figures.items():
+            if key in given:
+                continue
+            updates[key] = convert_value(specs[key], value, f"{inst.section}.{key}", inst.marks[key])
+            marks[(inst.section, key)] = inst.marks[key]
+        sections[inst.section] = replace(sections[inst.section], **updates)
+    return chosen, marks
+
+
+def _check_camera(cam: CameraParams, where) -> None:
+    """The camera keys that depend on each other: a focal length in mm needs the pixel pitch; the
+    principal point lies on the sensor."""
+    if cam.focal_length is not None and cam.pixel_pitch is None:
+        raise ProfileError(f"camera.focal_length {cam.focal_length:g} mm needs camera.pixel_pitch (the sensor's pixel "
+                           "size, e.g. 3.45 um) to place the lens in pixels: set it, or name a camera file that gives "
+                           "it", where=where("focal_length"))
+    if cam.principal_point is not None:
+        (x, y), (w, h) = cam.principal_point, cam.resolution
+        if not (0 < x < w and 0 < y < h):
+            raise ProfileError(f"camera.principal_point [{x:g}, {y:g}] px is not on the {w} x {h} px sensor "
+                               f"(camera.resolution): need 0 < x < {w} and 0 < y < {h}; the centre is "
+                               f"[{w / 2:g}, {h / 2:g}]", where=where("principal_point"))
 
 
 def validate(raw: RawProfile) -> Profile:
@@ -860,8 +957,9 @@ def validate(raw: RawProfile) -> Profile:
                                f"{', '.join(valid_top)}",
                                where=raw.where((key,)))
     sections = {name: read_section(raw, name, cls) for name, cls in SECTIONS.items()}
-    for name in ("projector", "camera"):
-        sections[name] = _with_model(raw, name, sections[name])
+    chosen, instrument_marks = _with_instruments(raw, sections)
+    _check_camera(sections["camera"], lambda key: raw.marks.get(("camera", key)) or instrument_marks.get(("camera", key))
+                  or raw.where(("camera",)))
     par: ParaboloidParams = sections["paraboloid"]
     pair_a = (par.vertical_extent, par.tangent_angle)
     pair_b = (par.focal_length, par.rim_radius)
@@ -897,7 +995,7 @@ def validate(raw: RawProfile) -> Profile:
     if not isinstance(description, str):
         raise ProfileError("description must be text", where=raw.where(("description",)))
     return Profile(name=raw.name, description=description, sources=tuple(str(p) for p in raw.sources),
-                   marks=dict(raw.marks), **sections)
+                   marks=dict(raw.marks), instruments=chosen, instrument_marks=instrument_marks, **sections)
 
 
 def _check_calibration(cal: CalibrationParams, raw: RawProfile) -> None:

@@ -186,10 +186,11 @@ def test_pixel_radius_is_the_focal_length_times_tan_alpha(dm):
 def test_camera_focal_length_frames_the_paraboloid_as_the_projector(rig, dm):
     # f_camera = f_projector x camera height / projector height: 1792 x 1024 / 768 (thesis Table 3.1: 2389 px)
     assert camera_focal_px(rig) == pytest.approx(1792 * 1024 / 768, rel=1e-15)
-    fake = SimpleNamespace(incidence=SimpleNamespace(focal_px=1000.0),
-                           profile=SimpleNamespace(camera=SimpleNamespace(resolution=(640, 300)),
-                                                   projector=SimpleNamespace(resolution=(800, 600))))
-    assert camera_focal_px(fake) == pytest.approx(500.0, rel=1e-15)
+    from rigcad.optics.camera import derived_focal_px
+
+    # without a lens (no camera.focal_length, no camera.lens) the camera's is derived this way
+    fake = SimpleNamespace(camera=SimpleNamespace(resolution=(640, 300)), projector=SimpleNamespace(resolution=(800, 600)))
+    assert derived_focal_px(fake, SimpleNamespace(projector_focal_px=1000.0)) == pytest.approx(500.0, rel=1e-15)
 
 
 def test_a_cop_at_infinity_has_no_projector_pixels(tmp_path, table31_text):
