@@ -38,11 +38,12 @@ def test_a_file_without_the_section_gets_its_process_defaults(tmp_path):
 
 def test_stated_figures_are_read_with_their_units(tmp_path):
     p = _printer(tmp_path, "process_errors:\n  scale: 0.3 %\n  position: 4 mil\n  hole_shrink:\n"
-                           "    vertical: 0.25 mm\n    per_mm: 1 %\n  source: our measurements\n").process_errors
+                           "    vertical: 0.25 mm\n    per_mm: 1 %\n  source: our measurements\n  layer_step: 4 mil\n").process_errors
     assert p.scale == pytest.approx(0.003) and p.position == pytest.approx(0.1016)
     assert p.hole_shrink_vertical == 0.25 and p.hole_shrink_per_mm == pytest.approx(0.01)
     assert p.hole_shrink_horizontal == DEFAULT_PROCESS["fdm"]["horizontal"]
     assert p.shrink(10.0, "vertical") == pytest.approx(0.35) and p.source == "our measurements"
+    assert p.layer_step == pytest.approx(0.1016) and p.height_error(100.0) == pytest.approx(0.0508 + 0.3)
 
 
 @pytest.mark.parametrize("text, line, words", [
