@@ -72,6 +72,7 @@ def test_without_a_lens_the_camera_keeps_the_derived_one(table31):
     assert cam.focal_px == 1024 * 1.75 * 1024 / 768 and cam.focal_from == "derived"
     assert cam.focal_length is None and cam.principal_point == (680.0, 512.0)
     assert 2 * cam.image_radius_px == pytest.approx(2 * cam.focal_px * _rim_tan(), rel=1e-12)
+    assert round(2 * cam.image_radius_px) == 268 and round(100 * cam.fill) == 26  # docs/design.md states these
 
 
 def test_two_lenses_give_two_incidence_maps_and_the_calibration_takes_the_lens(write_profile, table31_text):
