@@ -64,9 +64,9 @@ def fill_fraction(text: str) -> float:
     try:
         value = float(text[:-1]) / 100 if text.endswith("%") else float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a fraction such as 0.9 or 90%, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected a fraction such as 0.9 or 90%, got {text[:40]!r}") from None
     if not 0 < value <= 1:
-        raise argparse.ArgumentTypeError(f"expected a fraction 0 < f <= 1 (or 1%..100%), got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a fraction 0 < f <= 1 (or 1%..100%), got {text[:40]!r}")
     return value
 
 

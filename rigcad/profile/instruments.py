@@ -331,6 +331,23 @@ def sketch(profile, m: Measurement) -> Sketch:
     return draw(params, key, m)
 
 
+def size_origin(profile, section: str, keys: tuple[str, ...]) -> str:
+    """Where an instrument's size (``keys`` of ``section``) came from, for a label: "assumed size"
+    when no key was set, "size set in the profile" or "size from <instrument file name>" when every
+    key was, else "size partly assumed (<the keys nothing set>)" (``profile.set_by``)."""
+    by = {k: profile.set_by(section, k) for k in keys}
+    if all(v == "default" for v in by.values()):
+        return "assumed size"
+    assumed = [k for k, v in by.items() if v == "default"]
+    if assumed:
+        return f"size partly assumed ({', '.join(assumed)})"
+    if all(v == "profile" for v in by.values()):
+        return "size set in the profile"
+    files = sorted({profile.origin(section, k).rsplit(":", 1)[0].rsplit("/", 1)[-1].removesuffix(".yaml")
+                    for k, v in by.items() if v == "instrument"})
+    return f"size from {', '.join(files)}" + (" and the profile" if "profile" in by.values() else "")
+
+
 def measurements(profile) -> list[Measurement]:
     """What must be measured before printing, for ``profile`` (a validated Profile): each projector
     and camera size that neither an instrument file the profile names gives nor the profile sets
@@ -352,4 +369,4 @@ def measurements(profile) -> list[Measurement]:
 
 
 __all__ = ["CAMERA_SIZES", "C_MOUNT_FLANGE", "FIGURES", "FIGURE_KEYS", "Instrument", "Measurement", "NAMED_BY",
-           "PROJECTOR_SIZES", "Sketch", "find", "folders", "measurements", "read", "shipped", "sketch"]
+           "PROJECTOR_SIZES", "Sketch", "find", "folders", "measurements", "read", "shipped", "size_origin", "sketch"]

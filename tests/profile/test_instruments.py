@@ -215,3 +215,17 @@ def test_the_default_profile_names_the_shipped_files():
     p = load_profile(ROOT / "profiles" / "achutha2006.yaml")
     assert p.instrument("camera").file == "profiles/instruments/prosilica_ec1350c.yaml"
     assert p.instrument("projector").name == "benq_pb6210" and p.instrument("camera", "lens") is None
+
+
+def test_a_size_label_says_who_set_it(tmp_path, table31):
+    """The label a part or a bill line gives an instrument's size comes from who set it, never from
+    the key's doc: assumed, set in the profile, from a file, or partly assumed naming the keys."""
+    from rigcad.profile.instruments import size_origin
+
+    body = ("body_width", "body_height", "body_depth")
+    assert size_origin(table31, "camera", body) == "assumed size"
+    lab = load_profile(_lab(tmp_path, LAB_PROFILE))
+    assert size_origin(lab, "camera", body) == "size partly assumed (body_depth)"
+    assert size_origin(lab, "camera", ("body_width",)) == "size from lab_cam"
+    assert size_origin(lab, "camera", ("body_width", "body_height")) == "size from lab_cam and the profile"
+    assert size_origin(lab, "camera", ("body_height",)) == "size set in the profile"
