@@ -75,6 +75,13 @@ RESOLUTION_SHARE = 0.25
 #: The split parts whose seams may lie on an element's chain (the beam, the paraboloid and its clamp
 #: print whole on every shipped printer).
 CHAIN_PARTS = ("base_plate", "dome", "tower_column", "tower_shelf", "splitter_holder")
+#: The links a locating feature replaces, by what it locates: the paraboloid's (a locating block with
+#: an adjuster in x, y and height replaces the beam's and the clamp's floats), the dome's (a register
+#: replaces the bolts' float) and the splitter seat's (a kinematic seat, on the COP's, the splitter's
+#: and the camera's chains). A Locator's ``replaces`` names these.
+PARABOLOID_FLOATS = ("beam across its slots", "beam along its slots", "clamp on the beam", "clamp along the beam")
+DOME_FLOATS = ("dome's bolts in their holes",)
+SEAT_FLOATS = ("splitter seat",)
 #: Dominating links named in a refusal: the fewest largest links making this share of the stack, at most MAX_NAMED.
 DOMINANT_SHARE = 0.5
 MAX_NAMED = 3
@@ -601,5 +608,5 @@ def with_process(printer: Printer, **figures) -> Printer:
 
 
 __all__ = ["AXES", "AdjusterSpec", "AxisVerdict", "ELEMENTS", "ElementStack", "Link", "Locator", "RESOLUTION_SHARE",
-           "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_pieces", "stack",
+           "DOME_FLOATS", "PARABOLOID_FLOATS", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_pieces", "stack",
            "table_lines", "with_process"]

@@ -92,10 +92,9 @@ def _fixed_rig(profile, layout, printer):
     """The default rig with what a designer would add: locating features for the paraboloid, the dome
     and the splitter, and adjusters sized at 1.05x the stack on the printer's stated process."""
     tiny = S.Link("located", "joint", "a stated locating feature", 0.02, 0.0, 1e-4)
-    loc = (S.Locator("paraboloid locator", "paraboloid",
-                     ("beam along its slots", "clamp along the beam", "clamp on the beam"), tiny),
-           S.Locator("dome register", "dome", ("dome's bolts in their holes",), tiny),
-           *(S.Locator("kinematic seat", e, ("splitter seat",), tiny) for e in ("cop", "splitter", "camera")))
+    loc = (S.Locator("paraboloid locator", "paraboloid", S.PARABOLOID_FLOATS, tiny),
+           S.Locator("dome register", "dome", S.DOME_FLOATS, tiny),
+           *(S.Locator("kinematic seat", e, S.SEAT_FLOATS, tiny) for e in ("cop", "splitter", "camera")))
     first = S.stack(profile, layout, printer, locators=loc, adjusters=())
     adj = tuple(S.AdjusterSpec(f"{v.element} {v.axis} adjuster", v.element, v.axis, 1.05 * v.worst,
                                0.2 * v.tolerance) for e in first.elements for v in e.axes)
