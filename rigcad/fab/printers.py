@@ -310,7 +310,7 @@ def _percent(raw: RawProfile, key: tuple[str, ...], lo: float = 0.0) -> float:
     for k in key:
         value = value[k]
     text = str(value).strip() if isinstance(value, (str, int, float)) and not isinstance(value, bool) else None
-    m = re.fullmatch(r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*%", text or "")
+    m = re.fullmatch(r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*%", text or "", re.ASCII)
     if not m:
         raise ProfileError(f"{name}: expected a percentage such as '0.2 %', got {value!r} (a bare number is refused: "
                            "0.2 could be 0.2 % or 20 %)", where=where)

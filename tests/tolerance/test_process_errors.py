@@ -92,3 +92,24 @@ def test_a_measured_section_replaces_the_stated_figures(tmp_path):
     assert pe.scale == pytest.approx(0.0025) and pe.position == pytest.approx(0.0, abs=1e-12)
     assert (pe.hole_shrink_vertical, pe.hole_shrink_horizontal) == (pytest.approx(0.2), pytest.approx(0.4))
     assert "calibration print" in pe.source
+
+
+@pytest.mark.parametrize("text", [
+    "process_errors: 5\n", "process_errors: [1, 2]\n", "process_errors:\n  scale: '\uff11 %'\n",
+    "process_errors:\n  scale: 1e400 %\n", "process_errors:\n  scale: nan %\n", "process_errors:\n  scale: [1]\n",
+    "process_errors:\n  scale: -0.2 %\n", "process_errors:\n  scale: true\n", "process_errors:\n  position: inf mm\n",
+    "process_errors:\n  position: .nan\n", "process_errors:\n  position: 3 mm\n", "process_errors:\n  hole_shrink: 0.2 mm\n",
+    "process_errors:\n  hole_shrink:\n    per_mm: 0.01\n", "process_errors:\n  source: ''\n",
+    "process_errors:\n  source: [a]\n", "process_errors:\n  layer_step: -1 mm\n",
+    "process_errors:\n  measured: yes\n", "process_errors:\n  measured:\n    lengths: x\n",
+    "process_errors:\n  measured:\n    lengths: [[1 mm]]\n", "process_errors:\n  measured:\n    lengths: [[1 mm, 2 mm, 3 mm]]\n",
+    "process_errors:\n  measured:\n    lengths: [[a, b]]\n", "process_errors:\n  measured:\n    lengths: [[0 mm, 1 mm]]\n",
+    "process_errors:\n  measured:\n    lengths: [[20 mm, 20 mm], [20 mm, 20.1 mm]]\n    holes_vertical: [[3 mm, 2.8 mm]]\n"
+    "    holes_horizontal: [[3 mm, 2.7 mm]]\n",
+    "process_errors:\n  measured:\n    lenghts: []\n",
+])
+def test_hostile_process_errors_are_refused_in_one_line(tmp_path, text):
+    with pytest.raises(ProfileError) as err:
+        _printer(tmp_path, text, "hostile")
+    msg = str(err.value)
+    assert "hostile.yaml" in msg and "\n" not in msg and "Traceback" not in msg
