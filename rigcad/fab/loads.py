@@ -35,8 +35,9 @@ import numpy as np
 
 from rigcad.errors import FabricationError
 from rigcad.fab.printers import Printer
+from rigcad.parts import breadboard
 from rigcad.parts.dome import flange_joint
-from rigcad.parts.tower import _projector_feet, _shelf_extent, seat_points
+from rigcad.parts.tower import _lens_foot, _projector_feet, _shelf_extent, seat_points
 from rigcad.standards import LARGE_WASHERS, THREADS
 
 G = 9.80665  #: standard gravity (m/s2)
@@ -161,8 +162,10 @@ def bolt_load(joint: str, thread: str, count: int, faces: dict[str, float], mat:
 
 def bolt_loads(profile, layout, printer: Printer) -> tuple[BoltLoad, ...]:
     """Every bolted joint into printed plastic with its torque: the dome's flange (into inserts),
-    the column's foot (nuts in the tongue's traps) and top (into the shelf's inserts), the
-    projector's and the camera's screws through printed slots."""
+    the column's foot (nuts in the tongue's traps) and top (into the shelf's inserts), the lens
+    mount's foot, the breadboard's screws (on a breadboard), the projector's and the camera's screws
+    through printed slots. The splitter holder's two spring bolts are set by their springs' length,
+    not a torque, and its seat screws are adjusters (rigcad.parts.adjusters)."""
     mat, tw = material(printer), profile.tower
     fj = flange_joint(profile, layout)
     hole = tw.bolt_diameter
@@ -172,6 +175,15 @@ def bolt_loads(profile, layout, printer: Printer) -> tuple[BoltLoad, ...]:
         out.append(bolt_load("column foot on the tongue", "M4", 4,
                              {"washer": washer_area("M4", hole), "nut (in its trap)": nut_area("M4", hole)}, mat, True))
         out.append(bolt_load("column top under the shelf", "M4", 4, {"washer": washer_area("M4", hole)}, mat, True))
+    lens = len(_lens_foot(layout.tower, profile)[3])
+    out.append(bolt_load("lens mount's foot on the shelf", "M4", lens,
+                         {"washer": washer_area("M4", hole), "nut (under the shelf)": nut_area("M4", hole)}, mat, False))
+    b = breadboard.board(profile)
+    if b is not None:
+        held = len([q for qs in breadboard.anchor_points(profile, layout).values() for q in qs])
+        hb = breadboard.fit(profile, layout)["hole_mm"]
+        out.append(bolt_load("the rig on the breadboard", b.thread, held,
+                             {"large washer": washer_area(b.thread, hb, large=True)}, mat, True))
     pj, cm = profile.projector, profile.camera
     pjh = THREADS[pj.mount_thread].clearance
     out.append(bolt_load("projector on the shelf's slots", pj.mount_thread, 4,

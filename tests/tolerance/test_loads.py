@@ -133,3 +133,17 @@ def test_a_part_that_bends_past_its_tolerance_is_refused_with_its_buy_option(tab
     with pytest.raises(FabricationError, match=r"shelf \(\d+ % of tolerancing.projector_height, projector_tilt\); "
                                                r"buy: buy.shelf: aluminium_plate"):
         L.refuse(heavy)
+
+
+def test_a_breadboard_adds_its_screws_on_large_washers(write_profile, table31_text):
+    from rigcad.profile import load_profile
+    from rigcad.rig import Rig
+
+    rig = Rig.from_profile(load_profile(write_profile(table31_text + "datum:\n  mount: breadboard_m6_25mm\n")))
+    rows = {b.joint: b for b in L.bolt_loads(rig.profile, rig.layout, load_printer("prusa_mk3s"))}
+    b = rows["the rig on the breadboard"]
+    assert (b.thread, b.count, b.bearing, b.spring_washer) == ("M6", 3, "large washer", True)
+    assert b.area_mm2 == pytest.approx(math.pi / 4 * (18.0 ** 2 - 8.6 ** 2))  # ISO 7093 M6 on the 8.6 mm hole
+    plain = Rig.from_profile(load_profile(write_profile(table31_text)))
+    assert "the rig on the breadboard" not in {x.joint for x in L.bolt_loads(plain.profile, plain.layout,
+                                                                              load_printer("prusa_mk3s"))}
