@@ -136,4 +136,36 @@ def from_measurements(lengths, holes_vertical=(), holes_horizontal=(), *, layer_
                          layer_step=layer_step, source=source)
 
 
-__all__ = ["HOLE_AXES", "ProcessErrors", "from_measurements"]
+@dataclass(frozen=True)
+class CalibrationPrint:
+    """What the lab prints and measures to state its printer's process (the manual's step): bars
+    of ``bars`` nominal lengths (mm), measured end to end; holes of ``holes`` nominal diameters (mm),
+    once through a flat plate (their axes vertical as printed) and once through an upright wall
+    (their axes horizontal); each measured with a caliper (bars) and gauge pins or drill shanks
+    (holes: the largest that enters), after the part has cooled a day."""
+
+    bars: tuple[float, ...] = (20.0, 50.0, 100.0)
+    holes: tuple[float, ...] = (2.0, 3.0, 4.0, 6.0, 8.0)
+
+    def steps(self) -> list[str]:
+        """The manual's instructions, one line each."""
+        bars = ", ".join(f"{b:g}" for b in self.bars)
+        holes = ", ".join(f"{h:g}" for h in self.holes)
+        return [f"Print three bars {bars} mm long, and a plate and an upright wall each with holes of {holes} mm, "
+                "with the settings the rig's parts print with; let them cool for a day.",
+                "Measure each bar end to end with a caliper, and each hole with gauge pins (or drill shanks): the "
+                "largest that enters.",
+                "Write the pairs under process_errors.measured in the printer file: lengths: [[nominal, measured], "
+                "...], holes_vertical: (the plate's), holes_horizontal: (the wall's).",
+                "Run the command again: rigcad fits the printer's scale, position and hole shrink from them "
+                "(rigcad.parts.process.from_measurements)."]
+
+    def yaml_template(self) -> str:
+        """The ``measured`` section to fill in, the nominal sizes written, the measured ones blank."""
+        bars = ", ".join(f"[{b:g} mm, ]" for b in self.bars)
+        holes = ", ".join(f"[{h:g} mm, ]" for h in self.holes)
+        return (f"process_errors:\n  measured:\n    lengths: [{bars}]\n    holes_vertical: [{holes}]\n"
+                f"    holes_horizontal: [{holes}]\n")
+
+
+__all__ = ["CalibrationPrint", "HOLE_AXES", "ProcessErrors", "from_measurements"]

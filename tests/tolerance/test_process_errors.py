@@ -113,3 +113,23 @@ def test_hostile_process_errors_are_refused_in_one_line(tmp_path, text):
         _printer(tmp_path, text, "hostile")
     msg = str(err.value)
     assert "hostile.yaml" in msg and "\n" not in msg and "Traceback" not in msg
+
+
+def test_the_calibration_prints_nominal_sizes_fit_back(tmp_path):
+    from rigcad.parts.process import CalibrationPrint
+
+    cal = CalibrationPrint()
+    assert len(set(cal.bars)) >= 2 and cal.holes  # enough to tell scale from position
+    # fill the manual's template as a lab would, from a process with 0.3 % scale and 0.25 / 0.35 mm shrink
+    text = cal.yaml_template()
+    for b in cal.bars:
+        text = text.replace(f"[{b:g} mm, ]", f"[{b:g} mm, {b * 0.997:.4f} mm]", 1)
+    wall = text.index("holes_horizontal")
+    head, tail = text[:wall], text[wall:]
+    for h in cal.holes:
+        head = head.replace(f"[{h:g} mm, ]", f"[{h:g} mm, {h - 0.25:.4f} mm]", 1)
+        tail = tail.replace(f"[{h:g} mm, ]", f"[{h:g} mm, {h - 0.35:.4f} mm]", 1)
+    p = _printer(tmp_path, head + tail).process_errors
+    assert p.scale == pytest.approx(0.003, abs=1e-6) and p.position == pytest.approx(0.0, abs=1e-4)
+    assert (p.hole_shrink_vertical, p.hole_shrink_horizontal) == (pytest.approx(0.25), pytest.approx(0.35))
+    assert len(cal.steps()) == 4 and all("\n" not in s for s in cal.steps())
