@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rigcad.errors import ProfileError
-from rigcad.profile.paths import INSTRUMENTS_SUBDIR, display, names_on_search_path, search_path
+from rigcad.profile.paths import INSTRUMENTS_SUBDIR, display, search_path
 
 #: The keys of ``projector`` / ``camera`` whose values describe the body and its optics (mm, or a
 #: thread name): what an instrument file may source and what :func:`measurements` may ask for.
@@ -118,13 +118,8 @@ def find(name: object, kind: str, where: str | None, near: Path | None = None) -
                            where=where)
     try:
         return find_file(name, kind, sub=INSTRUMENTS_SUBDIR, near=near, as_path=False)
-    except ProfileError as err:
-        known = names_on_search_path(INSTRUMENTS_SUBDIR)
-        if near is not None and near.is_dir():
-            known = sorted(set(known) | {p.stem for p in near.glob("*.yaml")})
-        close = difflib.get_close_matches(name, known, n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise ProfileError(f"{key}: {err.message}{hint}; add your own as {INSTRUMENTS_SUBDIR}/{name}.yaml beside the "
+    except ProfileError as err:  # it says where it looked and the closest name found
+        raise ProfileError(f"{key}: {err.message}; add your own as {INSTRUMENTS_SUBDIR}/{name}.yaml beside the "
                            "profile", where=where) from None
 
 

@@ -18,6 +18,7 @@ file is never opened, so its content is never echoed.
 
 from __future__ import annotations
 
+import difflib
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -231,15 +232,20 @@ def find_file(spec: str | Path, kind: str, sub: str = "", near: Path | None = No
             candidate = folder / (path.name if not named else f"{path.name}.yaml")
             if candidate.is_file():
                 return candidate
-    looked = []
+    looked, known = [], []
     unique: dict[Path, Path] = {}
     for folder in folders:
         unique.setdefault(folder.resolve(), folder)  # each folder once (./profiles may be the shipped one)
     for folder in unique.values():
+        if not folder.is_dir() and not is_shipped(folder):
+            continue  # a folder that is not there (./profiles elsewhere) would read as the shipped one's name
         names = sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
+        known += names
         shipped = "shipped with rigcad: " if is_shipped(folder) else ""
         looked.append(f"{_display(folder)}/ ({shipped}{', '.join(names) if names else 'none'})")
-    raise ProfileError(f"no {kind} {str(spec)!r}: looked for {candidates[-1].name} in " + "; ".join(looked)
+    close = difflib.get_close_matches(path.stem if named else path.name, known, n=1)
+    raise ProfileError(f"no {kind} {str(spec)!r}" + (f" (did you mean {close[0]!r}?)" if close else "")
+                       + f": looked for {candidates[-1].name} in " + "; ".join(looked)
                        + f" (set ${PROFILES_ENV} to add folders)")
 
 

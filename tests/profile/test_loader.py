@@ -100,5 +100,15 @@ def test_missing_name_says_where_it_looked(tmp_path, monkeypatch):
     with pytest.raises(ProfileError) as err:
         load_raw("nope")
     msg = str(err.value)
-    assert "profiles/ (none)" in msg and "lab/ (none)" in msg and "RIGCAD_PROFILES" in msg
+    assert "lab/ (none)" in msg and "RIGCAD_PROFILES" in msg
     assert "profiles/ (shipped with rigcad: achutha2006" in msg
+    # the working folder has no profiles/: it is not listed, or it would read as a second "profiles/"
+    assert msg.count("profiles/") == 1, msg
+    assert "did you mean" not in msg  # nothing close to "nope"
+
+
+def test_a_mistyped_name_gets_the_closest_one(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ProfileError) as err:
+        load_raw("achuta2006")
+    assert str(err.value).startswith("no profile 'achuta2006' (did you mean 'achutha2006'?): looked for ")
