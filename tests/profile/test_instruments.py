@@ -229,3 +229,25 @@ def test_a_size_label_says_who_set_it(tmp_path, table31):
     assert size_origin(lab, "camera", ("body_width",)) == "size from lab_cam"
     assert size_origin(lab, "camera", ("body_width", "body_height")) == "size from lab_cam and the profile"
     assert size_origin(lab, "camera", ("body_height",)) == "size set in the profile"
+
+
+def test_a_labs_own_projector_is_used_and_billed(tmp_path, monkeypatch):
+    """The issue's pico projector, 1280 x 720 with its throw ratio from its datasheet, as a file in the
+    lab's folder: the profile names it, the design reads its figures, the bill names it."""
+    from types import SimpleNamespace
+
+    from rigcad.manual.bom import purchased
+    from rigcad.profile import derive
+
+    monkeypatch.chdir(tmp_path)
+    path = _lab(tmp_path, LAB_PROFILE + "projector:\n  model: pico_dlp_720p\n")
+    (tmp_path / "instruments" / "pico_dlp_720p.yaml").write_text(
+        "kind: projector\ntitle: Pico DLP 720p\nresolution: [1280, 720]\nthrow_ratio: 1.4\n"
+        "sources:\n  throw_ratio: the maker's datasheet (1.4:1)\n")
+    p = load_profile(path)
+    assert p.projector.resolution == (1280, 720) and p.projector.throw_ratio == 1.4
+    assert p.origin("projector", "throw_ratio") == "instruments/pico_dlp_720p.yaml:4"
+    assert p.source("projector", "throw_ratio") == "the maker's datasheet (1.4:1)"
+    assert derive(p).projector_focal_px == 1280 * 1.4  # the design's projector is the file's
+    items = [r["item"] for r in purchased(SimpleNamespace(profile=p))]
+    assert "projector: Pico DLP 720p" in items and "camera: Lab camera, 2448 x 2048, 3.45 um" in items
