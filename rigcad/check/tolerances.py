@@ -135,7 +135,7 @@ def camera_rows(profile, cam: dict) -> list[Row]:
                 f"{lens} puts the rim {radius:.0f} px from the principal point, {radius / cam['reach_over_room']:g} px "
                 f"from the sensor's nearest edge: a shorter camera.focal_length; {fill} fills {DEFAULT_FILL:.0%}")]
     if cam["min_working_distance_mm"] is not None:
-        rows.append(Row("camera: lens front to paraboloid vertex (closest focus)", "camera.min_working_distance",
+        rows.append(Row("camera: lens front to vertex vs closest focus", "camera.min_working_distance",
                         cam["working_distance_mm"], cam["min_working_distance_mm"], ">=", "mm",
                         w("camera", "min_working_distance"),
                         "the lens cannot focus this close: a lens with a shorter closest focus, or a close-up "
