@@ -79,6 +79,7 @@ class Instrument:
     marks: dict[str, str] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)
     note: str = ""
+    path: str = ""  #: the file, absolute (what a watcher of the profile watches)
 
     @property
     def section(self) -> str:
@@ -172,7 +173,8 @@ def read(path: Path, kind: str, named_where: str | None = None) -> Instrument:
         if not isinstance(v, str) or not v.strip():
             raise ProfileError(f"sources.{k}: expected where the figure was read, as text", where=at("sources", k))
     return Instrument(kind=kind, name=path.stem, title=title.strip(), file=shown, figures=figures,
-                      marks={k: at(k) for k in figures}, sources=dict(sources), note=note.strip())
+                      marks={k: at(k) for k in figures}, sources=dict(sources), note=note.strip(),
+                      path=str(path.absolute()))
 
 
 def shipped(kind: str | None = None) -> list[Instrument]:

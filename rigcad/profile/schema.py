@@ -12,6 +12,7 @@ import difflib
 import math
 import re
 from dataclasses import dataclass, field, fields
+from pathlib import Path
 from typing import Any
 
 from rigcad.errors import ProfileError
@@ -711,6 +712,11 @@ class Profile:
             if mark is not None and inst.section == section and inst.marks.get(key) == mark:
                 return inst.sources.get(key)
         return None
+
+    @property
+    def instrument_files(self) -> tuple[Path, ...]:
+        """The instrument files the profile names, absolute: what a watcher of the profile watches too."""
+        return tuple(Path(i.path) for i in self.instruments.values())
 
     def instrument(self, section: str, key: str = "model"):
         """The instrument file named by ``section.key`` (rigcad.profile.instruments.Instrument), or None."""
