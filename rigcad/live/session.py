@@ -121,6 +121,7 @@ class LiveSession:
         self.good: _Good | None = None
         self.seq = 0
         self.files: tuple[Path, ...] = ()
+        self._instruments: tuple[Path, ...] = ()  # the instrument files the last valid profile named
         self._mesh_cache: dict = {}
         self._printers: dict[str, object] = {}
         self._pending: tuple | None = None
@@ -202,8 +203,10 @@ class LiveSession:
         finally:
             # the profile's own path as found (a link there is not followed: whatever a rename puts at
             # that name is seen), then its extends: chain as read, then the printer files
-            self.files = tuple(dict.fromkeys([*named, *files, *self._printer_files()]))
+            self.files = tuple(dict.fromkeys([*named, *files, *self._printer_files(), *self._instruments]))
         profile = validate(raw)
+        self._instruments = profile.instrument_files  # its projector, camera, lens, splitter files
+        self.files = tuple(dict.fromkeys([*self.files, *self._instruments]))
         self._load_printers()
         return profile
 

@@ -42,6 +42,8 @@ def test_first_frame_builds_everything_and_watches_the_extends_chain(live):
     session, path = live
     names = [f.name for f in session.files]
     assert names[:2] == ["rig.yaml", "achutha2006.yaml"], names  # the profile, then what it extends
+    # and the instrument files it names: an edit of its camera's file rebuilds as an edit of the profile
+    assert {"benq_pb6210.yaml", "prosilica_ec1350c.yaml"} <= set(names), names
     assert session.builds["dome"] == 1 and session.builds["design"] == 1 and session.builds["check"] == 1
     assert len(session.good.parts) == len(session.good.keys) > 10
 
