@@ -102,6 +102,11 @@ def _construct(loader: yaml.SafeLoader, node: yaml.Node, shown: str, key: Key) -
                            "number", where=_mark(shown, node)) from None
 
 
+def _a(kind: str) -> str:
+    """``kind`` with its article: "a profile", "an instrument"."""
+    return f"{'an' if kind[:1] in 'aeiou' else 'a'} {kind}"
+
+
 def read_text(path: Path, kind: str = "profile") -> str:
     """The text of a profile or printer file, refused (ProfileError naming the file, the line and
     the byte offset, never the content) unless it is at most MAX_BYTES of UTF-8 without control
@@ -117,7 +122,7 @@ def read_text(path: Path, kind: str = "profile") -> str:
     except OSError as err:
         raise ProfileError(f"cannot read {kind} {shown}: {err.strerror}") from err
     if len(data) > MAX_BYTES:
-        raise ProfileError(f"{kind} {shown} is larger than {MAX_BYTES // 1024} KiB, the limit for a {kind} file "
+        raise ProfileError(f"{kind} {shown} is larger than {MAX_BYTES // 1024} KiB, the limit for {_a(kind)} file "
                            "(rigcad's own are ~4 KiB): is it the right file?")
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise ProfileError(f"{kind} {shown} is UTF-16 (byte-order mark at offset 0): save it as UTF-8")
@@ -132,7 +137,7 @@ def read_text(path: Path, kind: str = "profile") -> str:
     if bad:
         line = text.count("\n", 0, bad.start()) + 1
         column = bad.start() - (text.rfind("\n", 0, bad.start()) + 1) + 1
-        raise ProfileError(f"control character U+{ord(bad.group()):04X} at column {column}: a {kind} is plain "
+        raise ProfileError(f"control character U+{ord(bad.group()):04X} at column {column}: {_a(kind)} is plain "
                            "text (is this a binary file?)", where=f"{shown}:{line}")
     return text
 
@@ -219,7 +224,7 @@ def find_file(spec: str | Path, kind: str, sub: str = "", near: Path | None = No
     ``near`` and then on :func:`search_path` (``sub`` below each folder); a missing name lists where
     it looked and the names found there. Raises ProfileError."""
     if not str(spec).strip() or "\x00" in str(spec):
-        raise ProfileError(f"a {kind} is named by its name or the path of its .yaml file; got {str(spec)!r}")
+        raise ProfileError(f"{_a(kind)} is named by its name or the path of its .yaml file; got {str(spec)!r}")
     path = Path(spec)
     named = path.suffix == ""
     candidates = [path, path.with_suffix(".yaml")] if named else [path]

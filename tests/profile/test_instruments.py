@@ -251,3 +251,20 @@ def test_a_labs_own_projector_is_used_and_billed(tmp_path, monkeypatch):
     assert derive(p).projector_focal_px == 1280 * 1.4  # the design's projector is the file's
     items = [r["item"] for r in purchased(SimpleNamespace(profile=p))]
     assert "projector: Pico DLP 720p" in items and "camera: Lab camera, 2448 x 2048, 3.45 um" in items
+
+
+@pytest.mark.parametrize("content, message", [
+    (b"kind: camera\n" + b"#" * (300 * 1024), "larger than 256 KiB, the limit for an instrument file"),
+    (b"kind: camera\ntitle: \x07\n", "control character U+0007"),
+    ("kind: camera".encode("utf-16"), "UTF-16"),
+    (b"a: &a [x]\n" + b"".join(b"a%d: &a%d [*a%d, *a%d, *a%d, *a%d]\n" % (i + 1, i + 1, i, i, i, i) for i in range(12)),
+     "alias bomb"),
+])
+def test_a_hostile_instrument_file_crosses_the_loaders_boundary(tmp_path, content, message):
+    """The same boundary as a profile's (rigcad.profile.loader): refused in one line naming the file,
+    never read whole, never echoed."""
+    path = _lab(tmp_path, LAB_PROFILE)
+    (tmp_path / "instruments" / "lab_cam.yaml").write_bytes(content)
+    with pytest.raises(ProfileError) as info:
+        load_profile(path)
+    assert message in str(info.value) and "lab_cam.yaml" in str(info.value) and "\n" not in str(info.value)
