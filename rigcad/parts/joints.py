@@ -14,7 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from rigcad.errors import GeometryError
-from rigcad.parts.recipe import Cylinder
+import math
+
+from rigcad.parts.recipe import Cylinder, Solid, bounds
 from rigcad.standards import INSERTS, THREADS, longest_screw, shortest_screw
 
 #: What may take a joint's thread.
@@ -119,4 +121,156 @@ class ScrewJoint:
         return tuple(Cylinder((x, y, z0 - 1.0), d / 2, z1 - z0 + 2.0) for x, y in self.points)
 
 
-__all__ = ["INTO", "ScrewJoint"]
+#: What a datum feature may be: a dowel's hole, a bore that locates a part (the sample holder's), a
+#: seat (a kinematic contact's pocket), a heat-set insert's pocket, a register (a spigot, its recess).
+DATUM_KINDS = ("dowel", "bore", "seat", "insert", "register")
+
+
+@dataclass(frozen=True)
+class Datum:
+    """A locating feature of a part, declared as data where the part cuts it: ``name``, ``kind``
+    (:data:`DATUM_KINDS`) and ``shape``, the solid it takes out of the part (a hole, a pocket;
+    rig frame, mm). A split keeps its cut planes off the shape's bounds (rigcad.fab.split), so no
+    glue seam runs through a dowel hole, a bore or a seat; the seams that remain between two datum
+    features are listed by rigcad.fab.split.datum_seams."""
+
+    name: str
+    kind: str
+    shape: Solid
+
+    def __post_init__(self) -> None:
+        if self.kind not in DATUM_KINDS:
+            raise GeometryError(f"datum {self.name}: a datum feature is one of {DATUM_KINDS}, not {self.kind!r}")
+
+    @property
+    def bounds(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """The feature's axis-aligned box (lo, hi; mm)."""
+        return bounds(self.shape)
+
+    @property
+    def centre(self) -> tuple[float, float, float]:
+        lo, hi = self.bounds
+        return tuple(0.5 * (a + b) for a, b in zip(lo, hi))
+
+    def describe(self) -> dict:
+        lo, hi = self.bounds
+        return {"name": self.name, "kind": self.kind, "lo_mm": list(lo), "hi_mm": list(hi)}
+
+
+def datums_of(kind: str, name: str, shapes) -> tuple[Datum, ...]:
+    """One :class:`Datum` per shape, named ``name 1``, ``name 2``... (just ``name`` for one)."""
+    shapes = tuple(shapes)
+    return tuple(Datum(name if len(shapes) == 1 else f"{name} {k + 1}", kind, sh) for k, sh in enumerate(shapes))
+
+
+@dataclass(frozen=True)
+class Bought:
+    """One bought item of a declared mechanism, as it is ordered: what it is (``item``: the standard
+    and its size), how many, its size figures (mm, units in the keys) and what it does."""
+
+    item: str
+    standard: str
+    quantity: int
+    size_mm: dict
+    role: str
+
+    def describe(self) -> dict:
+        return {"item": self.item, "standard": self.standard, "quantity": self.quantity,
+                "size_mm": dict(self.size_mm), "role": self.role}
+
+
+@dataclass(frozen=True)
+class SeatContact:
+    """One contact of a kinematic seat: ``kind`` "cone" (a ball on three balls: three constraints),
+    "vee" (a ball between two parallel pins: two) or "flat" (a ball on a flat pad: one); where the
+    moving part's ball stands (x, y; mm) and the height of its centre at the nominal setting (z, mm);
+    ``axis``: the vee's direction (unit x, y) along its pins."""
+
+    kind: str
+    x: float
+    y: float
+    ball_z: float
+    axis: tuple[float, float] = (0.0, 0.0)
+
+    #: Constraints each contact takes away (Maxwell's count for Kelvin's clamp: 3 + 2 + 1 = 6).
+    CONSTRAINTS = {"cone": 3, "vee": 2, "flat": 1}
+
+
+@dataclass(frozen=True)
+class KinematicSeat:
+    """A kinematic mount (Kelvin's clamp) declared as data: ``moving`` part's three hard balls, each
+    on the end of an adjusting screw (``thread``, ``pitch_mm``), on a cone (three balls), a vee (two
+    dowel pins) and a flat (a steel pad) in ``fixed``; held down by ``springs`` compression springs of
+    ``spring_rate`` N/mm compressed by ``spring_deflection`` mm. ``travel``: each screw's range each
+    way from its nominal setting (mm); ``step``: the finest turn a hand sets (a fraction of a turn).
+    ``bought``: every hard part, as ordered (the bill lists these)."""
+
+    name: str
+    moving: str
+    fixed: str
+    contacts: tuple[SeatContact, ...]
+    thread: str
+    travel: float
+    step: float
+    springs: int
+    spring_rate: float
+    spring_deflection: float
+    bought: tuple[Bought, ...]
+
+    def __post_init__(self) -> None:
+        kinds = sorted(c.kind for c in self.contacts)
+        if kinds != ["cone", "flat", "vee"]:
+            raise GeometryError(f"seat {self.name}: a kinematic seat is a cone, a vee and a flat, not {kinds}")
+        if self.constraints != 6:  # pragma: no cover - guarded by the kinds above
+            raise GeometryError(f"seat {self.name}: {self.constraints} constraints, not 6")
+        cone, vee = self.contact("cone"), self.contact("vee")
+        to_cone = (cone.x - vee.x, cone.y - vee.y)
+        n = math.hypot(*to_cone)
+        # the vee's pins must point at the cone: then the seat's thermal growth leaves the cone fixed
+        if abs(vee.axis[0] * to_cone[1] - vee.axis[1] * to_cone[0]) > 1e-9 * n:
+            raise GeometryError(f"seat {self.name}: the vee's pins must point at the cone")
+
+    @property
+    def constraints(self) -> int:
+        return sum(SeatContact.CONSTRAINTS[c.kind] for c in self.contacts)
+
+    def contact(self, kind: str) -> SeatContact:
+        return next(c for c in self.contacts if c.kind == kind)
+
+    @property
+    def pitch(self) -> float:
+        return THREADS[self.thread].pitch
+
+    @property
+    def resolution(self) -> float:
+        """The finest height step of one contact (mm): the screw's pitch times the finest turn."""
+        return self.pitch * self.step
+
+    @property
+    def preload(self) -> float:
+        """The springs' total force holding the seat down (N)."""
+        return self.springs * self.spring_rate * self.spring_deflection
+
+    def lever(self, kind: str) -> float:
+        """Distance (mm) from contact ``kind`` to the line through the other two: its screw tilts the
+        moving part about that line by (height change) / lever."""
+        p = self.contact(kind)
+        a, b = (c for c in self.contacts if c.kind != kind)
+        return abs((b.x - a.x) * (a.y - p.y) - (a.x - p.x) * (b.y - a.y)) / math.hypot(b.x - a.x, b.y - a.y)
+
+    def tilt(self, kind: str) -> dict:
+        """The tilt contact ``kind``'s screw sets: range each way and resolution (rad)."""
+        arm = self.lever(kind)
+        return {"contact": kind, "lever_mm": arm, "range_rad": self.travel / arm, "resolution_rad": self.resolution / arm}
+
+    def describe(self) -> dict:
+        return {"name": self.name, "moving": self.moving, "fixed": self.fixed,
+                "contacts": [{"kind": c.kind, "x_mm": c.x, "y_mm": c.y, "ball_z_mm": c.ball_z,
+                              "constraints": SeatContact.CONSTRAINTS[c.kind]} for c in self.contacts],
+                "screw": {"thread": self.thread, "pitch_mm": self.pitch, "travel_each_way_mm": self.travel,
+                          "resolution_mm": self.resolution},
+                "tilts": [self.tilt(k) for k in ("flat", "vee")],
+                "preload_N": self.preload, "bought": [b.describe() for b in self.bought]}
+
+
+__all__ = ["DATUM_KINDS", "INTO", "Bought", "Datum", "KinematicSeat", "ScrewJoint", "SeatContact", "datums_of"]

@@ -201,12 +201,51 @@ class Part:
     #: The joints this part's screws make with another part (rigcad.parts.joints.ScrewJoint), declared
     #: by the part the heads bear on; its holes and the other part's are cut from them.
     joints: tuple = field(default=(), compare=False)
+    #: The part's datum features (rigcad.parts.joints.Datum: dowel holes, bores, seats, insert pockets,
+    #: registers), declared where the part cuts them: a split keeps its cut planes off them.
+    datums: tuple = field(default=(), compare=False)
 
     def content_hash(self) -> str:
         """SHA-256 of the solid's full definition (every number, every curve's coefficients)."""
         h = hashlib.sha256()
         _feed(h, self.solid)
         return h.hexdigest()
+
+
+def bounds(solid: Solid) -> tuple[Vec3, Vec3]:
+    """The axis-aligned box (lo, hi; mm) that holds ``solid``: exact for boxes, z cylinders, hexagonal
+    prisms and their unions and translations; a difference is bounded by its base; a revolved
+    section by its largest radius and its z range; a prism by its section's x-z range and its
+    thickness (the sections' curves sampled densely: mirror meridians are monotone pieces)."""
+    if isinstance(solid, Box):
+        return solid.lo, solid.hi
+    if isinstance(solid, Cylinder):
+        (x, y, z), r = solid.base, solid.radius
+        return (x - r, y - r, z), (x + r, y + r, z + solid.height)
+    if isinstance(solid, HexPrism):
+        c = np.array(solid.corners())
+        z = solid.base[2]
+        return (float(c[:, 0].min()), float(c[:, 1].min()), z), (float(c[:, 0].max()), float(c[:, 1].max()),
+                                                                z + solid.height)
+    if isinstance(solid, Union_):
+        boxes = [bounds(s) for s in solid.items]
+        return (tuple(min(b[0][k] for b in boxes) for k in range(3)),
+                tuple(max(b[1][k] for b in boxes) for k in range(3)))
+    if isinstance(solid, Difference):
+        return bounds(solid.base)
+    if isinstance(solid, Translate):
+        lo, hi = bounds(solid.solid)
+        o = solid.offset
+        return tuple(lo[k] + o[k] for k in range(3)), tuple(hi[k] + o[k] for k in range(3))
+    if isinstance(solid, (Revolve, Prism)):
+        pts = np.concatenate([np.array([seg.p0, seg.p1]) if isinstance(seg, Line) else seg.dense(201)
+                              for seg in solid.section.segments])
+        if isinstance(solid, Revolve):
+            r = float(np.abs(pts[:, 0]).max())
+            return (-r, -r, float(pts[:, 1].min())), (r, r, float(pts[:, 1].max()))
+        h = solid.thickness / 2
+        return (float(pts[:, 0].min()), -h, float(pts[:, 1].min())), (float(pts[:, 0].max()), h, float(pts[:, 1].max()))
+    raise TypeError(f"no bounds for {type(solid).__name__}")  # pragma: no cover - a new solid type
 
 
 def _feed(h, value) -> None:

@@ -39,11 +39,13 @@ import numpy as np
 from rigcad.errors import GeometryError
 from rigcad.optics.focus import focusing_lens
 from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_point, splitter_plate
+from rigcad.parts.joints import Bought, Datum, KinematicSeat, SeatContact, datums_of
 from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Translate,
                                  Union_)
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
-from rigcad.standards import INSERTS, THREADS, longest_dowel, longest_screw, screw_lengths, shortest_screw
+from rigcad.standards import (CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for, longest_dowel,
+                              longest_screw, screw_lengths, shortest_screw, shortest_set_screw, spring_rate)
 
 #: Gap around the splitter plate in its grooves (mm): a printed groove comes out ~0.1 mm narrow.
 GROOVE_GAP = 0.2
@@ -344,6 +346,15 @@ def tongue_underside_cuts(t: TowerLayout, profile: Profile, z_bottom: float) -> 
                  for x, y in _column_flange_points(t, profile))
 
 
+def column_datums(t: TowerLayout, profile: Profile, z0: float, height: float, face: str, where: str) -> tuple[Datum, ...]:
+    """The column joint's datum features in the plate it stands on or hangs under (``where`` names
+    it): the printed column's two dowel holes, or the bought extrusion's square pocket (a register)."""
+    if profile.buy.column == "print":
+        return datums_of("dowel", f"{where} dowel hole",
+                         _holes(column_dowel_points(t, profile), profile.datum.dowel_diameter, z0, height))
+    return (Datum(f"{where} extrusion pocket", "register", column_joint_cuts(t, profile, z0, height, face)[0]),)
+
+
 def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: float) -> tuple[Cylinder, ...]:
     """The bolt and dowel holes of a column joint through z0..z0+height: the column's foot on the
     base plate's tongue, its top flange under the shelf (the same pattern at both)."""
@@ -388,33 +399,195 @@ SPRING_HOLE = 6.0
 
 
 def seat_points(t: TowerLayout, profile: Profile) -> dict[str, tuple[float, float]]:
-    """The splitter holder's kinematic seat (x, y; mm): a cone and a vee on the side flanges at its
-    +x end, a flat on its back flange (y = 0): each a push screw in the holder over a steel ball in
-    the shelf. The vee's slot points at the cone."""
+    """The splitter holder's kinematic seat (x, y; mm): a cone and a vee under the side flanges at its
+    +x end, a flat under its back flange (y = 0): each a ball-ended push screw in the holder over its
+    seat in the shelf (:func:`splitter_seat`). The vee's pins point at the cone."""
     tw = profile.tower
     y = t.wall_y[1] + 1.5 * tw.bolt_diameter
     x0, x1 = t.holder_x
     return {"cone": (x1 - 8.0, -y), "vee": (x1 - 8.0, y), "flat": (x0 - 1.5 * tw.bolt_diameter, 0.0)}
 
 
+#: The seat's push screws: cup-point socket set screws (ISO 4029; ASME B18.3 for a UNC thread) in
+#: heat-set inserts in bosses on the holder's flanges, each with a steel ball (``adjusters.seat_ball``,
+#: ISO 3290 grade G10) held in its cup by a drop of retaining compound: a hard ball on the screw's end,
+#: centred by the cup's rim. The ball must stand clear of the rim by this much of its radius (a ball
+#: no larger than the cup would fall into it).
+SEAT_BALL_OVER_CUP = 1.2
+#: The screws' end stays this far (mm) below the holder's underside at their shortest setting.
+SEAT_SCREW_CLEAR = 0.5
+#: Floor (mm) under each insert's pocket in its boss: the screw passes it in a clearance hole.
+SEAT_BOSS_FLOOR = 1.0
+#: Wall (mm) round an insert's knurl in its boss: five 0.4 mm perimeters.
+SEAT_BOSS_WALL = 2.0
+#: The flat: an ISO 3650 gauge block (hardened steel, lapped flat) of this nominal length (mm), in a
+#: pocket its own size, its top flush with the shelf's top.
+SEAT_PAD_LENGTH = 2.0
+#: The vee's two ISO 8734 dowel pins (mm long) side by side in a channel along the line to the cone.
+SEAT_PIN_LENGTH = 10
+#: The two preload springs: helical compression springs of patented spring steel wire (EN 10270-1),
+#: ends closed and ground, over the M4 spring bolts (inner diameter 5.4 mm), as ordered: wire, outer
+#: diameter, free length (mm), active coils; and the length (mm) the nut sets them to.
+SEAT_SPRING = {"wire": 0.8, "outer_diameter": 7.0, "free_length": 12.0, "active_coils": 5, "installed_length": 8.0}
+
+
+@dataclass(frozen=True)
+class SeatGeometry:
+    """The splitter seat's heights (mm, above the shelf's top ``S``) and sizes, from the profile:
+    ``ball`` (the hard balls, on the screws and in the cone), ``pin`` (the vee's dowels), ``cup_rise``
+    (a ball's centre under its screw's cup rim), ``centre`` (the screws' balls' centres at the nominal
+    setting: on the flat pad, flush with the shelf), ``cone_drop`` and ``vee_drop`` (the cone's balls'
+    and the vee's pins' centres under ``centre``), ``gap`` (the holder's underside over the shelf)."""
+
+    ball: float
+    pin: float
+    cup_rise: float
+    centre: float
+    cone_drop: float
+    vee_drop: float
+    gap: float
+    travel: float
+
+    @property
+    def cone_radius(self) -> float:
+        """Radius (mm) of the pocket that holds the cone's three balls touching each other."""
+        return self.ball / math.sqrt(3.0) + self.ball / 2
+
+    @property
+    def cone_floor(self) -> float:
+        return self.centre - self.cone_drop - self.ball / 2
+
+    @property
+    def vee_floor(self) -> float:
+        return self.centre - self.vee_drop - self.pin / 2
+
+
+def seat_geometry(profile: Profile) -> SeatGeometry:
+    """The seat's geometry (:class:`SeatGeometry`); GeometryError when the ball cannot sit on its
+    screw's cup."""
+    a = profile.adjusters
+    ball, cup = a.seat_ball, CUP_POINT[a.seat_thread]
+    if ball < SEAT_BALL_OVER_CUP * cup:
+        raise GeometryError(f"adjusters.seat_ball ({ball:g} mm) cannot sit on the {a.seat_thread} cup-point screw's "
+                            f"{cup:.2f} mm cup: use a ball of at least {SEAT_BALL_OVER_CUP * cup:.2f} mm",
+                            where=profile.where("adjusters", "seat_ball"))
+    pin = dowel_diameter_for(ball)
+    rise = math.sqrt((ball / 2) ** 2 - (cup / 2) ** 2)
+    centre = ball / 2
+    cone = math.sqrt(ball ** 2 - ball ** 2 / 3.0)  # a ball on three of its size, touching: sqrt(2/3) d
+    vee = math.sqrt(((ball + pin) / 2) ** 2 - (pin / 2) ** 2)
+    gap = centre + rise + a.seat_travel + SEAT_SCREW_CLEAR
+    return SeatGeometry(ball, pin, rise, centre, cone, vee, gap, a.seat_travel)
+
+
 def seat_gap(profile: Profile) -> float:
     """Gap (mm) between the shelf's top and the holder's underside with the screws at their nominal
-    setting: the ball's top (it sinks 0.2 of its diameter into a cone hole 0.8 of it wide) plus the
-    screws' travel plus 0.5 mm, so the holder never lands on a ball."""
-    a = profile.adjusters
-    return 0.8 * a.seat_ball + a.seat_travel + 0.5
+    setting: the balls' centres over the flat pad, their screws' cup rims above, the screws' travel
+    and SEAT_SCREW_CLEAR, so the holder never comes down onto the seat."""
+    return seat_geometry(profile).gap
 
 
 def _seat_cuts(t: TowerLayout, profile: Profile) -> tuple:
-    """The shelf's seats for the three balls: a cone (a hole 0.8 ball wide), a vee (a slot 0.8 ball
-    wide along y, towards the cone) and a flat (a 0.3 mm pocket 2.5 balls wide, the ball free in it)."""
-    b = profile.adjusters.seat_ball
+    """The shelf's seats (cone, vee, flat): a round pocket that holds three balls touching (the cone:
+    a ball on three balls), a channel that holds two dowel pins side by side along the line to the
+    cone (the vee), a pocket the gauge block fills flush with the shelf's top (the flat). Drawn at the
+    nominal sizes: a printed hole's shrink is the balls' and pins' press fit."""
+    g = seat_geometry(profile)
     top = t.shelf_top_z
     pts = seat_points(t, profile)
     (cx, cy), (vx, vy), (fx, fy) = pts["cone"], pts["vee"], pts["flat"]
-    return (Cylinder((cx, cy, top - 0.6 * b), 0.4 * b, 0.6 * b + 1.0),
-            Box((vx - 0.4 * b, vy - b, top - 0.6 * b), (vx + 0.4 * b, vy + b, top + 1.0)),
-            Cylinder((fx, fy, top - 0.3), 1.25 * b, 1.3))
+    half = SEAT_PIN_LENGTH / 2
+    pad_y, pad_x = GAUGE_BLOCK_FACE  # the block's long side along y, under the back flange
+    return (Cylinder((cx, cy, top + g.cone_floor), g.cone_radius, -g.cone_floor + 1.0),
+            Box((vx - g.pin, vy - half, top + g.vee_floor), (vx + g.pin, vy + half, top + 1.0)),
+            Box((fx - pad_x / 2, fy - pad_y / 2, top - SEAT_PAD_LENGTH), (fx + pad_x / 2, fy + pad_y / 2, top + 1.0)))
+
+
+def _seat_boss(profile: Profile) -> tuple[float, float]:
+    """The seat screws' bosses: radius, and height above the holder's flange (mm): the insert's pocket
+    (the maker's depth) over SEAT_BOSS_FLOOR."""
+    ins = INSERTS[profile.adjusters.seat_thread]
+    return ins.outer / 2 + SEAT_BOSS_WALL, max(0.0, ins.pocket_depth + SEAT_BOSS_FLOOR - profile.tower.wall)
+
+
+def seat_screw_length(profile: Profile) -> int:
+    """The seat screws' length (mm, ISO 4029): through the boss and out by the longest setting, so the
+    screw's whole length stays in the insert's thread at every setting."""
+    a = profile.adjusters
+    _, boss = _seat_boss(profile)
+    need = profile.tower.wall + boss + 2 * a.seat_travel + SEAT_SCREW_CLEAR
+    found = shortest_set_screw(a.seat_thread, need)
+    if found is None:
+        raise GeometryError(f"no {a.seat_thread} set screw is {need:.1f} mm long: lower adjusters.seat_travel",
+                            where=profile.where("adjusters", "seat_travel"))
+    return found
+
+
+def spring_force(k: int = 1) -> dict:
+    """The seat's preload springs (SEAT_SPRING): rate (N/mm, EN 13906-1) and the force of ``k`` of them
+    at their installed length (N)."""
+    sp = SEAT_SPRING
+    mean = sp["outer_diameter"] - sp["wire"]
+    rate = spring_rate(sp["wire"], mean, sp["active_coils"])
+    return {"rate_N_per_mm": rate, "force_N": k * rate * (sp["free_length"] - sp["installed_length"])}
+
+
+def splitter_seat(profile: Profile, layout) -> KinematicSeat:
+    """The splitter holder's kinematic seat as data (rigcad.parts.joints.KinematicSeat): its three
+    contacts, its screws' range and resolution, its springs' preload, and every bought hard part
+    (the bill lists them: :attr:`KinematicSeat.bought`)."""
+    t, a = layout.tower, profile.adjusters
+    g = seat_geometry(profile)
+    pts = seat_points(t, profile)
+    z = t.shelf_top_z + g.centre
+    (cx, cy), (vx, vy) = pts["cone"], pts["vee"]
+    n = math.hypot(cx - vx, cy - vy)
+    contacts = (SeatContact("cone", *pts["cone"], z), SeatContact("vee", *pts["vee"], z, ((cx - vx) / n, (cy - vy) / n)),
+                SeatContact("flat", *pts["flat"], z))
+    sp = SEAT_SPRING
+    force = spring_force(1)
+    springs = _holder_flange_points(t, profile)
+    _check_preload_inside(contacts, springs, profile)
+    thread = a.seat_thread
+    std = "ISO 4029" if thread.startswith("M") else "ASME B18.3"
+    bought = (
+        Bought(f"{thread} x {seat_screw_length(profile)} mm cup-point socket set screw", std, 3,
+               {"length": seat_screw_length(profile), "cup_diameter": CUP_POINT[thread]},
+               "the seat's push screws, in the holder's bosses' heat-set inserts, turned from above"),
+        Bought(f"{g.ball:g} mm steel ball, grade G10", "ISO 3290-1", 6, {"diameter": g.ball},
+               "three in the screws' cups (a drop of retaining compound holds each), three pressed into the "
+               "shelf's cone pocket, touching"),
+        Bought(f"dowel pin {g.pin:g} m6 x {SEAT_PIN_LENGTH} mm", "ISO 8734", 2,
+               {"diameter": g.pin, "length": SEAT_PIN_LENGTH}, "the vee: pressed side by side into the shelf's channel"),
+        Bought(f"gauge block {SEAT_PAD_LENGTH:g} mm, grade 2, steel", "ISO 3650", 1,
+               {"length": SEAT_PAD_LENGTH, "face": list(GAUGE_BLOCK_FACE)},
+               "the flat: pressed into its pocket, flush with the shelf's top"),
+        Bought(f"compression spring, wire {sp['wire']:g} mm, {sp['outer_diameter']:g} mm outside, "
+               f"{sp['free_length']:g} mm free, {sp['active_coils']} active coils, ends closed and ground",
+               "EN 13906-1 (wire EN 10270-1)", len(springs),
+               {"wire": sp["wire"], "outer_diameter": sp["outer_diameter"], "free_length": sp["free_length"],
+                "installed_length": sp["installed_length"]},
+               f"preload: on each spring bolt under its nut, set to {sp['installed_length']:g} mm "
+               f"({force['force_N']:.1f} N each, {force['rate_N_per_mm']:.2f} N/mm)"),
+    )
+    return KinematicSeat("splitter seat", "splitter_holder", "tower_shelf", contacts, thread, a.seat_travel,
+                         a.turn_fraction, len(springs), force["rate_N_per_mm"],
+                         sp["free_length"] - sp["installed_length"], bought)
+
+
+def _check_preload_inside(contacts, springs, profile: Profile) -> None:
+    """The springs' resultant (their mean point: equal springs) must lie inside the three contacts'
+    triangle, or the preload would lift one contact off its seat."""
+    (ax, ay), (bx, by), (cx, cy) = ((c.x, c.y) for c in contacts)
+    px, py = (sum(p[0] for p in springs) / len(springs), sum(p[1] for p in springs) / len(springs))
+
+    def side(x0, y0, x1, y1):
+        return (x1 - x0) * (py - y0) - (y1 - y0) * (px - x0)
+
+    s = (side(ax, ay, bx, by), side(bx, by, cx, cy), side(cx, cy, ax, ay))
+    if not (all(v > 0 for v in s) or all(v < 0 for v in s)):
+        raise GeometryError(f"the splitter seat's springs pull at ({px:.1f}, {py:.1f}) mm, outside its three contacts: "
+                            "the preload would lift one off its seat", where=profile.where("tower", "bolt_diameter"))
 
 
 def _lens_foot(t: TowerLayout, profile: Profile):
@@ -461,9 +634,12 @@ def tower_column(profile: Profile, layout) -> Part:
     tube = Box((xc - w, -w, z0), (xc + w, w, top))
     flange = Box((xc - foot_h, -foot_h, top - tw.wall), (xc + foot_h, foot_h, top))
     holes = tuple(h for z in (z0, top - tw.wall) for h in column_joint_holes(t, profile, z, tw.wall))
+    datums = (*column_datums(t, profile, z0, tw.wall, "top", "foot"),
+              *column_datums(t, profile, top - tw.wall, tw.wall, "bottom", "top flange"))
     return Part("tower_column", Difference(Union_((foot, tube, flange)), (bore, *holes)), (0.55, 0.57, 0.6),
                 f"COP tower: hollow {tw.column_width:g} mm column on the base plate's datum tongue, under the "
-                f"projector's shelf; two {profile.datum.dowel_diameter:g} mm dowels and four bolts at each end")
+                f"projector's shelf; two {profile.datum.dowel_diameter:g} mm dowels and four bolts at each end",
+                datums=datums)
 
 
 def _extrusion_column(profile: Profile, t: TowerLayout) -> Part:
@@ -489,8 +665,13 @@ def tower_shelf(profile: Profile, layout) -> Part:
     slots = tuple(_slot(x, y, d / 2 + tw.travel_along, d / 2 + tw.travel_across, z0, t.shelf_thickness)
                   for x, y in _projector_feet(t))
     _, _, _, lens_pts = _lens_foot(t, profile)
-    holes = shelf_joint_cuts(t, profile, z0) + _holes(
-        _holder_flange_points(t, profile) + lens_pts, tw.bolt_diameter, z0, t.shelf_thickness) + _seat_cuts(t, profile)
+    seat = _seat_cuts(t, profile)
+    joint = shelf_joint_cuts(t, profile, z0)
+    holes = joint + _holes(_holder_flange_points(t, profile) + lens_pts, tw.bolt_diameter, z0, t.shelf_thickness) + seat
+    inserts = joint[:4] if profile.buy.column == "print" else ()
+    datums = (*column_datums(t, profile, z0, t.shelf_thickness, "bottom", "shelf"),
+              *datums_of("insert", "shelf insert pocket", inserts),
+              *(Datum(f"splitter seat {kind}", "seat", cut) for kind, cut in zip(("cone", "vee", "flat"), seat)))
     bought = "" if profile.buy.shelf == "print" else (
         f"aluminium plate EN AW-5083, {t.shelf_thickness:g} mm, cut to {x1 - x0:.1f} x {y1 - y0:.1f} mm; drill and "
         "mill its holes, slots and the seat's cone, vee and flat as drawn (print the shelf at 0.2 mm layers as a "
@@ -498,7 +679,7 @@ def tower_shelf(profile: Profile, layout) -> Part:
     return Part("tower_shelf", Difference(plate, (hole, *slots, *holes)), (0.55, 0.57, 0.6),
                 f"COP tower: shelf under the projector; {pj.mount_thread} screws through its four slots "
                 f"(+-{tw.travel_along:g} mm along the projector's axis, +-{tw.travel_across:g} mm across) hold it "
-                "on its shim stacks; a hole passes the ray bundle", bought=bought)
+                "on its shim stacks; a hole passes the ray bundle", bought=bought, datums=datums)
 
 
 def _groove(t: TowerLayout) -> Translate:
@@ -568,14 +749,25 @@ def splitter_holder(profile: Profile, layout) -> Part:
     flanges = [Box((x0, -yo - fl, z0), (x1, -yo, z0 + tw.wall)), Box((x0, yo, z0), (x1, yo + fl, z0 + tw.wall)),
                Box((x0 - fl, -yo, z0), (x0, yo, z0 + tw.wall))]
     bracket, slot = _camera_bracket(t, profile)
-    holes = (_holes(seat_points(t, profile).values(), INSERTS[a.seat_thread].hole, z0, tw.wall)
+    ins = INSERTS[a.seat_thread]
+    boss_r, boss_h = _seat_boss(profile)
+    top = z0 + tw.wall + boss_h
+    pts = tuple(seat_points(t, profile).values())
+    bosses = tuple(Cylinder((x, y, z0), boss_r, tw.wall + boss_h) for x, y in pts)
+    # each insert's pocket at its maker's hole and depth from the boss's top; the screw on through the floor
+    pockets = tuple(Cylinder((x, y, top - ins.pocket_depth), ins.hole / 2, ins.pocket_depth + 1.0) for x, y in pts)
+    holes = (_holes(pts, THREADS[a.seat_thread].clearance, z0, tw.wall + boss_h) + pockets
              + _holes(_holder_flange_points(t, profile), SPRING_HOLE, z0, tw.wall))
-    solid = Difference(Union_((*walls, back, *flanges, *bracket)), (_groove(t), slot, *holes))
+    groove = _groove(t)
+    datums = (*datums_of("insert", "seat screw insert pocket", pockets), Datum("splitter grooves", "seat", groove))
+    solid = Difference(Union_((*walls, back, *flanges, *bosses, *bracket)), (groove, slot, *holes))
     return Part("splitter_holder", solid, (0.3, 0.5, 0.75),
                 f"COP tower: holds the {profile.beam_splitter.thickness:g} mm plate beam splitter at 45 deg in its "
-                f"grooves (slide it in through the +y wall) on a kinematic seat (three {a.seat_thread} push screws "
-                f"in heat-set inserts on {a.seat_ball:g} mm balls, two spring bolts), and the camera on its bracket "
-                f"above (two {cm.mount_thread} screws in the slot; shims between camera and bracket)")
+                f"grooves (slide it in through the +y wall) on a kinematic seat (three {a.seat_thread} cup-point push "
+                f"screws in heat-set inserts in bosses, a {a.seat_ball:g} mm ball in each cup, on a cone of three balls, "
+                "a vee of two dowel pins and a gauge block in the shelf; two spring bolts), and the camera on its "
+                f"bracket above (two {cm.mount_thread} screws in the slot; shims between camera and bracket)",
+                datums=datums)
 
 
 def lens_mount(profile: Profile, layout) -> Part:
@@ -673,23 +865,39 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
 
 
 def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
-    """The splitter seat's push screws, inserts, balls, spring bolts and springs."""
+    """The splitter seat's push screws, inserts and spring bolts (threaded: the bill's fasteners), then
+    its balls, dowel pins, gauge block and springs (the seat's bought hard parts, :func:`splitter_seat`)."""
     a, tw = profile.adjusters, profile.tower
     gap = seat_gap(profile)
-    spring = 10.0  # free length (mm) of the compression spring under the nut (assumed stock: 10 mm)
+    spring = SEAT_SPRING
+    g = seat_geometry(profile)
+    std = "ISO 4029" if a.seat_thread.startswith("M") else "ASME B18.3"
+    force = spring_force(1)
     return [
-        {"item": "set screw, ISO 4026 (flat point)", "thread": a.seat_thread,
-         "length_mm": _length(None, tw.wall + a.seat_travel + 1.0, 0.0), "quantity": 3,
-         "joins": "the splitter holder's seat: pushes on a ball, turned from above (tip/tilt)"},
+        {"item": f"set screw, {std} (cup point), a {g.ball:g} mm ball held in its cup", "thread": a.seat_thread,
+         "length_mm": seat_screw_length(profile), "quantity": 3,
+         "joins": "the splitter holder's seat: a ball-ended push screw on the shelf's cone, vee or flat, turned from "
+                  "above (tip/tilt and height)"},
         {"item": "heat-set insert", "thread": a.seat_thread, "length_mm": None, "quantity": 3,
-         "hole_mm": INSERTS[a.seat_thread].hole, "joins": "pressed into the holder's three seat holes from above"},
-        {"item": "steel ball, DIN 5401", "thread": None, "length_mm": None, "quantity": 3, "diameter_mm": a.seat_ball,
-         "joins": "in the shelf's cone, vee and flat, under the push screws"},
+         "hole_mm": INSERTS[a.seat_thread].hole, "joins": "pressed into the holder's three seat bosses from above"},
+        {"item": "steel ball, ISO 3290-1 grade G10", "thread": None, "length_mm": None, "quantity": 6,
+         "diameter_mm": g.ball,
+         "joins": "three in the seat screws' cups (a drop of retaining compound), three pressed into the shelf's cone "
+                  "pocket, touching"},
+        {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": g.pin, "length_mm": float(SEAT_PIN_LENGTH),
+         "quantity": 2, "joins": "the seat's vee: pressed side by side into the shelf's channel"},
+        {"item": f"gauge block, ISO 3650 grade 2, {SEAT_PAD_LENGTH:g} mm", "thread": None, "length_mm": None,
+         "quantity": 1, "size_mm": [*GAUGE_BLOCK_FACE, SEAT_PAD_LENGTH],
+         "joins": "the seat's flat: pressed into its pocket in the shelf, flush with its top"},
         {"item": "bolt, two washers, nut and compression spring", "thread": "M4",
-         "length_mm": _length("M4", t.shelf_thickness + gap + tw.wall + spring, nut), "quantity": 2,
-         "spring_mm": {"inner_diameter": 4.5, "free_length": spring},
+         "length_mm": _length("M4", t.shelf_thickness + gap + tw.wall + spring["free_length"], nut), "quantity": 2,
+         "spring_mm": {"inner_diameter": spring["outer_diameter"] - 2 * spring["wire"], "wire": spring["wire"],
+                       "outer_diameter": spring["outer_diameter"], "free_length": spring["free_length"],
+                       "installed_length": spring["installed_length"], "active_coils": spring["active_coils"]},
+         "spring_rate_N_per_mm": force["rate_N_per_mm"], "preload_N": force["force_N"],
          "joins": "from under the shelf up through the holder's flange; the spring under the nut holds the holder "
-                  "on its three balls"},
+                  f"on its three contacts (nut set to {spring['installed_length']:g} mm of spring: "
+                  f"{force['force_N']:.1f} N each, EN 13906-1)"},
     ]
 
 
@@ -790,13 +998,54 @@ def _marker(name: str, p, color) -> Part:
                 f"marker: {name.replace('_', ' ')} at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) mm")
 
 
+def _sphere(centre, r: float, n: int = 16) -> Translate:
+    """A ball drawn as the polygon of ``n`` sides inscribed in its meridian, revolved (inside the ball:
+    a drawing never reaches past the true surface)."""
+    pts = [(r * math.sin(math.pi * k / n), -r * math.cos(math.pi * k / n)) for k in range(n + 1)]
+    pts[0], pts[-1] = (0.0, -r), (0.0, r)
+    segs = tuple(Line(pts[k], pts[k + 1]) for k in range(n)) + (Line((0.0, r), (0.0, -r)),)
+    return Translate(Revolve(Section(segs)), tuple(float(v) for v in centre))
+
+
+def _pin_along_y(centre, r: float, length: float, n: int = 16) -> Translate:
+    """A dowel pin along y drawn as the inscribed polygon of ``n`` sides, extruded."""
+    pts = [(r * math.cos(2 * math.pi * k / n), r * math.sin(2 * math.pi * k / n)) for k in range(n)]
+    return Translate(Prism(Section(tuple(Line(pts[k], pts[(k + 1) % n]) for k in range(n))), length),
+                     tuple(float(v) for v in centre))
+
+
+#: The seat's balls and pins are drawn this much (mm) under their radius: their pockets are cut at the
+#: nominal size (a press fit in print), and a mesh's facets would otherwise show them pressing in.
+DRAWN_UNDER = 0.1
+
+
 def _seat_balls(profile: Profile, t: TowerLayout) -> tuple[Part, ...]:
-    """The splitter seat's three steel balls, each drawn as the cylinder it fills from the shelf's top
-    to its own top (0.8 of its diameter: it sinks 0.2 into its seat), under the holder's push screws."""
-    b = profile.adjusters.seat_ball
-    return tuple(Part(f"seat_ball_{i + 1}", Cylinder((x, y, t.shelf_top_z), b / 2, 0.8 * b), (0.8, 0.8, 0.85),
-                      f"{b:g} mm steel ball (DIN 5401) in the shelf's {kind}, under the holder's push screw")
-                 for i, (kind, (x, y)) in enumerate(seat_points(t, profile).items()))
+    """The splitter seat's bought hard parts in place: the three balls in the push screws' cups (on the
+    cone, the vee and the flat), the cone's three balls, the vee's two dowel pins and the flat's gauge
+    block (:func:`splitter_seat`); balls and pins DRAWN_UNDER their size."""
+    g = seat_geometry(profile)
+    S = t.shelf_top_z
+    pts = seat_points(t, profile)
+    steel = (0.8, 0.8, 0.85)
+    out = [Part(f"seat_ball_{i + 1}", _sphere((x, y, S + g.centre), g.ball / 2 - DRAWN_UNDER), steel,
+                f"{g.ball:g} mm steel ball (ISO 3290) in the {kind}'s push screw's cup, on the shelf's {kind}")
+           for i, (kind, (x, y)) in enumerate(pts.items())]
+    (cx, cy), (vx, vy), (fx, fy) = pts["cone"], pts["vee"], pts["flat"]
+    rc = g.ball / math.sqrt(3.0)
+    for k in range(3):
+        ang = math.pi / 2 + 2 * math.pi * k / 3
+        out.append(Part(f"seat_cone_ball_{k + 1}", _sphere((cx + rc * math.cos(ang), cy + rc * math.sin(ang),
+                                                            S + g.centre - g.cone_drop), g.ball / 2 - DRAWN_UNDER),
+                        steel, f"{g.ball:g} mm steel ball (ISO 3290) pressed into the shelf's cone pocket: one of the "
+                        "three the seat's cone is made of"))
+    for k, side in enumerate((-1, 1)):
+        out.append(Part(f"seat_vee_pin_{k + 1}", _pin_along_y((vx + side * g.pin / 2, vy, S + g.centre - g.vee_drop),
+                                                              g.pin / 2 - DRAWN_UNDER, SEAT_PIN_LENGTH),
+                        steel, f"{g.pin:g} mm dowel pin (ISO 8734) in the shelf's channel: one side of the seat's vee"))
+    py, px = GAUGE_BLOCK_FACE
+    out.append(Part("seat_flat_pad", Box((fx - px / 2, fy - py / 2, S - SEAT_PAD_LENGTH), (fx + px / 2, fy + py / 2, S)),
+                    steel, f"{SEAT_PAD_LENGTH:g} mm gauge block (ISO 3650) in the shelf's pocket: the seat's flat"))
+    return tuple(out)
 
 
 def instruments(profile: Profile, layout) -> tuple[Part, ...]:
