@@ -8,9 +8,16 @@ part on the planes have the fewest loops, and the phase is the middle of the wid
 
 Each face between two neighbouring cells gets dowel-pin holes (a hole of the pin's diameter plus
 clearance, ``depth`` into each piece), placed on the cut face where the material around the hole
-is at least ``MIN_WALL`` thick (a boolean test on the mesh: the hole widened by the wall must lie
+is at least two perimeters thick (:func:`pin_wall`, from the printer) (a boolean test on the mesh: the hole widened by the wall must lie
 inside the part) and, on a mirror part, at least ``MIRROR_CLEARANCE`` from the mirror surface
 (measured on the exact surface). The booleans are manifold3d's on the part's mesh.
+
+No cut crosses a datum feature (rigcad.parts.joints.Datum: a dowel hole, a bore, a seat, an insert
+pocket, a register, declared on the part): the planner treats each feature's box, grown by
+``DATUM_MARGIN``, as a keep-out zone, moving a grid's cut to the nearer clear position (or the
+farther) and leaving out the sector phases and band heights that would cross one. The seams that
+remain between two datum features of one part (a glue line on its datum chain) are listed by
+:func:`datum_seams`.
 Frame: the part's working position, mm, rad.
 """
 
@@ -27,8 +34,16 @@ from rigcad.errors import FabricationError
 from rigcad.fab.mirror import MirrorSurface
 from rigcad.fab.printers import AlignmentPin
 
-#: Material kept around a pin hole (mm): two FDM perimeters of a 0.4 mm nozzle, less a little.
+#: Material kept around a pin hole (mm) when no printer says more: an SLA part's thinnest unsupported
+#: wall (Formlabs' design guide: 0.6 mm). An FDM printer's is two perimeters (:func:`pin_wall`).
 MIN_WALL = 0.6
+#: PrusaSlicer's automatic perimeter width: 1.125 x the nozzle (its "extrusion width = 0" rule).
+AUTO_WIDTH_OVER_NOZZLE = 1.125
+#: A seam keeps this far (mm) from a datum feature's box: the feature's own wall stays whole (two
+#: perimeters, ~0.9 mm) and glue squeezed out of the seam (about 1 mm) does not reach it.
+DATUM_MARGIN = 2.0
+#: Grid cut positions tried per plan (each cut at its equal-slab place or moved off a keep-out).
+KEEPOUT_TRIES = 6
 #: Distance kept between a pin hole and the printed mirror surface (mm): sanding removes up to
 #: ~0.2 mm there and the pin must not print-through as a bump (about five layers of material).
 MIRROR_CLEARANCE = 1.0
@@ -83,11 +98,14 @@ class SplitPlan:
 
 @dataclass(frozen=True)
 class Pin:
-    """A pin hole: centre on a cut face (mm), unit axis (the face's normal)."""
+    """A pin hole: centre on a cut face (mm), unit axis (the face's normal); the pin's and the hole's
+    diameters (mm; 0: the printer's alignment pin)."""
 
     centre: tuple[float, float, float]
     axis: tuple[float, float, float]
     face: str
+    diameter: float = 0.0
+    hole_diameter: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -216,15 +234,108 @@ def _grid_options(size: np.ndarray) -> list[tuple[int, int, int]]:
                   key=lambda n: (n[0] * n[1] * n[2], tuple(-n[a] for a in order)))
 
 
-def plan_grid(man: m3d.Manifold, fits) -> GridPlan:
-    """The fewest-pieces grid of equal slabs (the long side cut first; a tall part is cut across
-    its height) whose every cell ``fits(cell_manifold, plan, i, j)``; raises if none."""
+def pin_wall(printer) -> float:
+    """Wall (mm) kept around every pin hole: two perimeters of an FDM printer (2 x its perimeter
+    line width: the PrusaSlicer preset's ``perimeter_extrusion_width`` when it states one in mm, else
+    AUTO_WIDTH_OVER_NOZZLE x the nozzle), or MIN_WALL for a resin printer; never under MIN_WALL."""
+    if getattr(printer, "process", "fdm") != "fdm" or not getattr(printer, "nozzle", None):
+        return MIN_WALL
+    width = AUTO_WIDTH_OVER_NOZZLE * printer.nozzle
+    cfg = getattr(printer, "slicer_config", None)
+    if cfg is not None:
+        text = str(cfg.effective().get("perimeter_extrusion_width", "")).strip()
+        try:
+            stated = float(text)  # "0.45"; "0" is automatic; "112.5%" is not in mm (then the rule)
+        except ValueError:
+            stated = 0.0
+        if stated > 0:
+            width = stated
+    return max(MIN_WALL, 2.0 * width)
+
+
+#: Hole shrink (mm, diametral) assumed when the printer file states no process errors: FDM holes print
+#: 0.1-0.3 mm undersize (the top of that range for a horizontal axis, whose top droops); resin 0.1.
+DEFAULT_HOLE_SHRINK = {"fdm": 0.3, "sla": 0.1}
+
+
+def pin_fit(printer, pins) -> dict:
+    """How a part's pins fit their holes (mm): the pin and its hole as drawn, the printer's hole shrink
+    for a hole of that size whose axis may lie either way as printed (its ``process_errors``, else
+    DEFAULT_HOLE_SHRINK), the hole as it prints, the class (slip: the drawn hole's clearance, ``press``
+    when the print's shrink takes it below the pin) and the shop step that makes it right: every pin
+    hole drilled to its drawn size after printing (a hole printed with a horizontal axis droops at its
+    top; the drill, run in by hand, trues it and two perimeters of wall keep it from breaking out)."""
+    pin = printer.alignment_pin
+    d = max((p.diameter for p in pins), default=pin.diameter) or pin.diameter
+    hole = d + pin.clearance
+    errors = getattr(printer, "process_errors", None)
+    if errors is not None and hasattr(errors, "shrink"):
+        shrink, source = float(errors.shrink(hole, "unknown")), getattr(errors, "source", "the printer file")
+    else:
+        shrink, source = DEFAULT_HOLE_SHRINK.get(printer.process, 0.3), "rigcad's default (no process errors stated)"
+    printed = hole - shrink
+    return {"pin_diameter_mm": d, "hole_drawn_mm": hole, "hole_shrink_mm": shrink, "shrink_source": source,
+            "hole_as_printed_mm": printed, "class_as_printed": "slip" if printed > d else "press",
+            "class_after_drilling": "slip" if pin.clearance > 0 else "press",
+            "step": f"drill every pin hole {hole:g} mm, {pin.depth:g} mm deep, by hand after printing "
+                    f"(it prints about {printed:.2f} mm), then push a {d:g} mm pin in: a "
+                    f"{'slip' if pin.clearance > 0 else 'press'} fit"}
+
+
+def keepouts(datums) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The keep-out boxes (lo, hi; mm) of a part's datum features: each feature's bounds grown by
+    DATUM_MARGIN."""
+    return [(np.asarray(d.bounds[0], float) - DATUM_MARGIN, np.asarray(d.bounds[1], float) + DATUM_MARGIN)
+            for d in datums]
+
+
+def _blocked(boxes, axis: int) -> list[tuple[float, float]]:
+    """The keep-outs' intervals on ``axis``, merged (sorted, disjoint)."""
+    spans = sorted((float(lo[axis]), float(hi[axis])) for lo, hi in boxes)
+    out: list[list[float]] = []
+    for a, b in spans:
+        if out and a <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    return [(a, b) for a, b in out]
+
+
+def clear_cuts(base, lo: float, hi: float, blocked) -> list[tuple[float, ...]]:
+    """Cut positions on one axis (between ``lo`` and ``hi``, increasing) near ``base`` that cross no
+    ``blocked`` interval: a cut inside one moves to its nearer edge or its farther; the choices in
+    order of the total move (ties: the first in order), at most KEEPOUT_TRIES."""
+    import itertools
+
+    options = []
+    for c in base:
+        hit = next(((a, b) for a, b in blocked if a < c < b), None)
+        options.append([c] if hit is None else sorted(hit, key=lambda e: (abs(e - c), e)))
+    out = []
+    for combo in itertools.product(*options):
+        if all(lo < c < hi for c in combo) and all(b - a > 1e-6 for a, b in zip(combo, combo[1:])):
+            out.append((sum(abs(c - b) for c, b in zip(combo, base)), combo))
+    out.sort(key=lambda t: t[0])
+    return [tuple(float(c) for c in combo) for _, combo in out[:KEEPOUT_TRIES]]
+
+
+def plan_grid(man: m3d.Manifold, fits, keep_out=()) -> GridPlan:
+    """The fewest-pieces grid (the long side cut first; a tall part is cut across its height) whose
+    every cell ``fits(cell_manifold, plan, i, j)``: equal slabs, each cut moved off the ``keep_out``
+    boxes (:func:`keepouts`) it would cross (:func:`clear_cuts`); raises if none."""
+    import itertools
+
     bb = np.asarray(man.bounding_box(), dtype=float)
+    blocked = [_blocked(keep_out, a) for a in range(3)]
     for n in _grid_options(bb[3:] - bb[:3]):
-        plan = GridPlan(*(tuple(float(v) for v in np.linspace(bb[a], bb[a + 3], n[a] + 1)[1:-1]) for a in range(3)))
-        if all(fits(grid_cell(man, plan, i, j, k), plan, i, j) for i, j, k in plan.cells()):
-            return plan
-    raise FabricationError(f"no grid of up to {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} pieces "
+        per_axis = [clear_cuts(tuple(float(v) for v in np.linspace(bb[a], bb[a + 3], n[a] + 1)[1:-1]),
+                               float(bb[a]), float(bb[a + 3]), blocked[a]) for a in range(3)]
+        for cuts in itertools.islice(itertools.product(*per_axis), KEEPOUT_TRIES):
+            plan = GridPlan(*cuts)
+            if all(fits(grid_cell(man, plan, i, j, k), plan, i, j) for i, j, k in plan.cells()):
+                return plan
+    kept = f" whose cuts keep off its {len(keep_out)} datum features" if len(keep_out) else ""
+    raise FabricationError(f"no grid of up to {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} pieces{kept} "
                            "fits this printer; use a larger printer or buy the part (the profile's buy section)")
 
 
@@ -297,16 +408,35 @@ def _loops_on_planes(man: m3d.Manifold, sectors: int, phase: float, seen: dict |
     return total
 
 
-def choose_phase(man: m3d.Manifold, sectors: int, step_deg: float = 2.5, seen: dict | None = None) -> float:
+def _half_plane_crosses(a: float, boxes) -> bool:
+    """Whether the half-plane through the z axis at angle ``a`` (rad) meets any of ``boxes``."""
+    n = np.array([-math.sin(a), math.cos(a)])
+    radial = np.array([math.cos(a), math.sin(a)])
+    for lo, hi in boxes:
+        corners = np.array([(x, y) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])])
+        s = corners @ n
+        if s.min() < 0.0 < s.max() and (corners @ radial).max() > 0.0:
+            return True
+    return False
+
+
+def choose_phase(man: m3d.Manifold, sectors: int, step_deg: float = 2.5, seen: dict | None = None,
+                 keep_out=()) -> float | None:
     """Sector phase (rad) crossing the fewest features; the middle of the widest range of such.
     ``seen``: the slices counted so far on ``man`` (see _loops_on_planes), shared between sector
-    counts (2 and 4 sectors share half their half-planes, bit for bit)."""
+    counts (2 and 4 sectors share half their half-planes, bit for bit). Phases whose half-planes
+    meet a ``keep_out`` box are left out; None when that leaves none."""
     if sectors == 1:
         return 0.0
     period = 360.0 / sectors
     grid = np.arange(0.0, period, step_deg)
+    allowed = np.array([not any(_half_plane_crosses(math.radians(g) + i * 2 * math.pi / sectors, keep_out)
+                                for i in range(sectors)) for g in grid])
+    if not allowed.any():
+        return None
     seen = {} if seen is None else seen
-    loops = np.array([_loops_on_planes(man, sectors, math.radians(g), seen) for g in grid])
+    loops = np.array([_loops_on_planes(man, sectors, math.radians(g), seen) if ok else np.iinfo(np.int64).max
+                      for g, ok in zip(grid, allowed)])
     best = loops == loops.min()
     # widest circular run of best phases
     n = len(grid)
@@ -329,17 +459,23 @@ def band_cuts(z0: float, z1: float, bands: int):
         yield tuple(np.linspace(z0, z1, bands + 1))
 
 
-def plan_split(man: m3d.Manifold, fits) -> SplitPlan:
-    """The fewest-pieces plan whose every cell ``fits(cell_manifold, plan, i, j)``; raises if none."""
+def plan_split(man: m3d.Manifold, fits, keep_out=()) -> SplitPlan:
+    """The fewest-pieces plan whose every cell ``fits(cell_manifold, plan, i, j)`` and whose cuts
+    meet no ``keep_out`` box (:func:`keepouts`); raises if none."""
     bb = np.asarray(man.bounding_box(), dtype=float)
     z0, z1 = bb[2], bb[5]
     options = sorted(((s, b) for s in SECTOR_COUNTS for b in BAND_COUNTS), key=lambda sb: (sb[0] * sb[1], sb[1]))
-    phases: dict[int, float] = {}
+    phases: dict[int, float | None] = {}
     seen: dict[float, int] = {}  # half-plane angle -> loops, shared by the sector counts
+    z_blocked = _blocked(keep_out, 2)
     for s, b in options:
         if s not in phases:
-            phases[s] = choose_phase(man, s, seen=seen)
+            phases[s] = choose_phase(man, s, seen=seen, keep_out=keep_out)
+        if phases[s] is None:
+            continue
         for cuts in band_cuts(z0, z1, b):
+            if any(a < z < c for z in cuts[1:-1] for a, c in z_blocked):
+                continue
             plan = SplitPlan(s, b, phases[s], cuts)
             if all(fits(cell(man, plan, i, j), plan, i, j) for i in range(s) for j in range(b)):
                 return plan
@@ -409,11 +545,12 @@ def _other_planes_clear(pts: np.ndarray, plan: SplitPlan, face_normal: np.ndarra
 
 
 def place_pins(man: m3d.Manifold, plan, pin: AlignmentPin, mirror: MirrorSurface | None,
-               tongues: list[Tongue] | None = None) -> list[Pin]:
+               tongues: list[Tongue] | None = None, wall: float | None = None) -> list[Pin]:
     """Pin holes on every cut face (see the module docstring); raises if a face gets fewer than two.
     With ``tongues``, the band cuts carry those instead of pins, and pins keep clear of them."""
     r = pin.hole_radius
-    guard = r + MIN_WALL
+    wall = MIN_WALL if wall is None else wall
+    guard = r + wall
     bb = np.asarray(man.bounding_box(), dtype=float)
     pins: list[Pin] = []
     if isinstance(plan, GridPlan):
@@ -462,15 +599,27 @@ def place_pins(man: m3d.Manifold, plan, pin: AlignmentPin, mirror: MirrorSurface
         pts = pts[mask]
         if len(pts) < 2:
             raise FabricationError(f"{name}: no room for two {pin.diameter:g} mm pins at {MIRROR_CLEARANCE:g} mm from "
-                                   f"the mirror and {MIN_WALL:g} mm walls; use thinner pins (alignment_pin.diameter)")
+                                   f"the mirror and {wall:g} mm walls; use thinner pins (alignment_pin.diameter)")
         extent = float(np.max(np.ptp(pts, axis=0)))
         want = int(min(6, max(2, round(extent / PIN_SPACING))))
-        chosen = _farthest(pts, want, lambda p: _inside(man, p, n, guard, pin.depth))
+        chosen = _farthest(pts, want, lambda p: _inside(man, p, n, guard, pin.depth, wall))
         if len(chosen) < 2:
-            raise FabricationError(f"{name}: fewer than two pin positions keep {MIN_WALL:g} mm of wall around the "
+            raise FabricationError(f"{name}: fewer than two pin positions keep {wall:g} mm of wall around the "
                                    f"hole; use thinner pins (alignment_pin.diameter)")
-        pins += [Pin(tuple(float(v) for v in p), tuple(float(v) for v in n), name) for p in chosen]
+        pins += [Pin(tuple(float(v) for v in p), tuple(float(v) for v in n), name, pin.diameter, 2 * r)
+                 for p in chosen]
     return pins
+
+
+def pin_choices(pin: AlignmentPin) -> list[AlignmentPin]:
+    """The pins a part's seams may take, in order: the printer's alignment pin, then thinner ISO 8734
+    dowel pins (down to 1 mm) with its clearance and depth, for a wall too thin for two perimeters
+    round the printer's pin (a dome's shell)."""
+    from dataclasses import replace
+
+    from rigcad.standards import DOWEL_DIAMETERS
+
+    return [pin, *(replace(pin, diameter=d) for d in sorted(DOWEL_DIAMETERS, reverse=True) if d < pin.diameter)]
 
 
 def _mirror_region(mirror: MirrorSurface, zs: np.ndarray, clearance: float, rmax: float) -> m3d.CrossSection:
@@ -585,9 +734,10 @@ def _mirror_clear(pts: np.ndarray, axis: np.ndarray, pin: AlignmentPin, mirror: 
     return ok
 
 
-def _inside(man: m3d.Manifold, centre: np.ndarray, axis: np.ndarray, radius: float, depth: float) -> bool:
+def _inside(man: m3d.Manifold, centre: np.ndarray, axis: np.ndarray, radius: float, depth: float,
+            wall: float = MIN_WALL) -> bool:
     """The hole widened by the wall lies inside the part (its part outside has no volume)."""
-    cyl = _cylinder(axis, centre, radius, depth + MIN_WALL)
+    cyl = _cylinder(axis, centre, radius, depth + wall)
     outside = cyl - man
     return outside.volume() < 1e-6 * cyl.volume()
 
@@ -615,7 +765,7 @@ def _farthest(pts: np.ndarray, want: int, valid) -> list[np.ndarray]:
 
 
 def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
-               mirror: MirrorSurface | None, tongues: list | None = None) -> tuple[list[Piece], list[Pin], m3d.Manifold]:
+               mirror: MirrorSurface | None, tongues: list | None = None, wall: float | None = None) -> tuple[list[Piece], list[Pin], m3d.Manifold]:
     """Drill the pin holes, sink the band cuts' grooves and cut ``man`` into the plan's pieces.
     Returns the pieces, the pins and the drilled part (what the pieces reassemble to: the part less
     the pin holes and the clearance between tongue and groove); ``tongues``, a list, receives the
@@ -623,7 +773,7 @@ def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
     if plan.count == 1:
         return [Piece(name, 0, 0, None, man)], [], man
     if isinstance(plan, GridPlan):
-        pins = place_pins(man, plan, pin, mirror)
+        pins, pin = _pins_that_fit(lambda q: place_pins(man, plan, q, mirror, wall=wall), pin)
         holes = [_cylinder(np.array(p.axis), np.array(p.centre), pin.hole_radius, pin.depth) for p in pins]
         drilled = m3d.Manifold.batch_boolean([man, *holes], m3d.OpType.Subtract)
         pieces = []
@@ -637,7 +787,7 @@ def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
     tg = make_tongues(man, plan, pin, mirror)
     if tongues is not None:
         tongues.extend(tg)
-    pins = place_pins(man, plan, pin, mirror, tg)
+    pins, pin = _pins_that_fit(lambda q: place_pins(man, plan, q, mirror, tg, wall=wall), pin)
     holes = [_cylinder(np.array(p.axis), np.array(p.centre), pin.hole_radius, pin.depth) for p in pins]
     gaps = [t.groove - t.tongue for t in tg]
     drilled = m3d.Manifold.batch_boolean([man, *holes, *gaps], m3d.OpType.Subtract)
@@ -659,3 +809,80 @@ def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
             pieces.append(Piece(f"{name}_{'_'.join(tag)}", i, j,
                                 plan.sector_range(i) if plan.sectors > 1 else None, piece))
     return pieces, pins, drilled
+
+
+def crossed(datums, plan) -> list[str]:
+    """The datum features (rigcad.parts.joints.Datum) a plan's cut planes run through (their boxes,
+    not grown: what a fabricator would see cut), by name; empty for a plan that keeps off them."""
+    out = []
+    for d in datums:
+        lo, hi = (np.asarray(v, float) for v in d.bounds)
+        box = [(lo, hi)]
+        if isinstance(plan, GridPlan):
+            hit = any(lo[a] < c < hi[a] for a in range(3) for c in plan.cuts(a))
+        else:
+            hit = any(lo[2] < z < hi[2] for z in plan.band_z[1:-1]) or (
+                plan.sectors > 1 and any(_half_plane_crosses(plan.sector_range(i)[0], box) for i in range(plan.sectors)))
+        if hit:
+            out.append(d.name)
+    return out
+
+
+def _cell_of(plan, p: np.ndarray) -> tuple:
+    """The cell holding point ``p`` (mm): grid (i, j, k), or (sector, band)."""
+    if isinstance(plan, GridPlan):
+        return tuple(int(np.searchsorted(plan.cuts(a), p[a])) for a in range(3))
+    band = int(np.searchsorted(plan.band_z[1:-1], p[2]))
+    if plan.sectors == 1:
+        return (0, band)
+    ang = (math.atan2(p[1], p[0]) - plan.phase) % (2 * math.pi)
+    return (int(ang // (2 * math.pi / plan.sectors)) % plan.sectors, band)
+
+
+def _seams_between(plan, p: np.ndarray, q: np.ndarray) -> list[str]:
+    """The cut faces a straight chain from ``p`` to ``q`` (mm) crosses, named as place_pins names
+    the planes (a grid's cut by axis and place; a sector plane; a band cut); for sectors, the shorter
+    way round."""
+    if isinstance(plan, GridPlan):
+        return [f"{'xyz'[a]} cut {c:.1f} mm" for a in range(3) for c in plan.cuts(a)
+                if min(p[a], q[a]) < c < max(p[a], q[a])]
+    out = [f"band cut z {z:.1f} mm" for z in plan.band_z[1:-1] if min(p[2], q[2]) < z < max(p[2], q[2])]
+    if plan.sectors > 1:
+        i, j = _cell_of(plan, p)[0], _cell_of(plan, q)[0]
+        up = (j - i) % plan.sectors
+        steps = range(1, up + 1) if up <= plan.sectors - up else range(0, up - plan.sectors, -1)
+        for k in steps:
+            a = plan.sector_range((i + k) % plan.sectors)[0]
+            out.append(f"sector plane {math.degrees(a) % 360:.1f} deg")
+    return out
+
+
+def datum_seams(datums, plan) -> list[dict]:
+    """The seams on a part's datum chains: for every two datum features of one part that the plan
+    puts in different pieces, the cut faces between them (``between``: the two features' names,
+    ``kinds``: theirs, ``seams``: the faces crossed on the straight line between their centres,
+    ``count``). A seam there is a glued joint inside what was one printed length: its pins' fit and
+    the pieces' hole positions add to the link between the two features (rigcad's tolerance stack
+    counts them from this list). Empty for a whole part or when every feature shares one piece."""
+    items = [(d, np.asarray(d.centre, float)) for d in datums]
+    out = []
+    for k, (a, pa) in enumerate(items):
+        for b, pb in items[k + 1:]:
+            if _cell_of(plan, pa) == _cell_of(plan, pb):
+                continue
+            seams = _seams_between(plan, pa, pb)
+            out.append({"between": [a.name, b.name], "kinds": [a.kind, b.kind], "seams": seams,
+                        "count": len(seams)})
+    return out
+
+
+def _pins_that_fit(place, pin: AlignmentPin) -> tuple[list[Pin], AlignmentPin]:
+    """The first of :func:`pin_choices` whose holes ``place(pin)`` can place with their walls; the
+    printer's pin's refusal when none can."""
+    first = None
+    for q in pin_choices(pin):
+        try:
+            return place(q), q
+        except FabricationError as err:
+            first = first or err
+    raise first
