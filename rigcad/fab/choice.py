@@ -38,10 +38,11 @@ def fits(vertices, cands: list[orientation.Orientation], printer: Printer) -> bo
     return any(orientation.fit_spin(vertices, o.direction, printer.usable)[0] is not None for o in cands)
 
 
-def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer):
+def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer, keep_out=()):
     """The fewest pieces the part ``man`` (its mesh ``vertices``) prints in: whole when it fits in one
     of its orientations; else sectors and bands about the axis (rigcad.fab.split.plan_split), or a
-    grid in its own bounding box for a flat or off-axis part (or when no sector split fits)."""
+    grid in its own bounding box for a flat or off-axis part (or when no sector split fits); no cut
+    crosses a ``keep_out`` box (its datum features: rigcad.fab.split.keepouts)."""
     from rigcad.export import mesh
 
     if fits(vertices, candidates(has_mirror, plate), printer):
@@ -56,11 +57,11 @@ def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer):
                     printer)
 
     if split.is_off_axis(man):
-        return split.plan_grid(man, cell_fits)
+        return split.plan_grid(man, cell_fits, keep_out)
     try:
-        return split.plan_split(man, cell_fits)
+        return split.plan_split(man, cell_fits, keep_out)
     except FabricationError:
-        return split.plan_grid(man, cell_fits)
+        return split.plan_grid(man, cell_fits, keep_out)
 
 
 def evaluate(vertices, faces, orient: orientation.Orientation, printer: Printer, mirror_f) -> dict:

@@ -24,7 +24,7 @@ def fab_report(profile: str, printer, chord: float, tol_mirror: float, gcode: di
         "frame": "part frame: mm, sample point at the origin, optical axis +z, working position; print "
                  "frame: build direction +z, bed at z = 0",
         "tolerances": {"stl_chord_error_mm": chord, "mirror_face_tolerance_mm": tol_mirror,
-                       "pin_min_wall_mm": split.MIN_WALL, "pin_mirror_clearance_mm": split.MIRROR_CLEARANCE,
+                       "pin_min_wall_mm": split.pin_wall(printer), "pin_mirror_clearance_mm": split.MIRROR_CLEARANCE,
                        "orientation_cusp_tie_rtol": CUSP_TIE_RTOL,
                        "overhang_angle_deg": math.degrees(orientation.OVERHANG_ANGLE)},
         "gcode": gcode,

@@ -382,15 +382,21 @@ def _fab_part(part, layout, run: _Run, plan=None, orient_only: bool = False) -> 
     t = time.perf_counter()
     v, _ = mesh.mesh_arrays(man)
     plate = None if mirror else orientation.plate_axis(v)
+    datums = getattr(part, "datums", ())
     if plan is None:
-        plan = choice.split_plan(man, v, mirror is not None, plate, run.printer)
+        plan = choice.split_plan(man, v, mirror is not None, plate, run.printer, split.keepouts(datums))
     tongues: list = []
-    pieces, pins, drilled = split.split_part(man, name, plan, run.printer.alignment_pin, mirror, tongues)
+    pieces, pins, drilled = split.split_part(man, name, plan, run.printer.alignment_pin, mirror, tongues,
+                                             wall=split.pin_wall(run.printer))
     timings[f"{name}:fit_split"] = time.perf_counter() - t
     entry = {"process": run.printer.process, "quantity": part.quantity, "description": part.description,
              "volume_mm3": man.volume(), "split": plan.describe(), "mirror": mirror.name if mirror else None}
     if plan.count > 1 and not orient_only:
-        entry["pins"] = [{"centre_mm": list(p.centre), "axis": list(p.axis), "face": p.face} for p in pins]
+        entry["pins"] = [{"centre_mm": list(p.centre), "axis": list(p.axis), "face": p.face, "diameter_mm": p.diameter}
+                         for p in pins]
+        entry["pin_fit"] = split.pin_fit(run.printer, pins)
+        if datums:
+            entry["datum_seams"] = split.datum_seams(datums, plan)
         if tongues:
             entry["tongues"] = [t.describe() for t in tongues]
         entry["reassembly"] = reassembly(man, drilled, pieces, mirror, run.tol_mirror, pins, run.printer)
@@ -519,6 +525,6 @@ def reassembly(man, drilled, pieces, mirror, tol, pins, printer) -> dict:
         if pins:
             c = np.array([p.centre for p in pins])
             out["pin_centre_min_depth_behind_mirror_mm"] = float(-mirror.signed_distance(c).max())
-            out["pin_hole_min_clearance_to_mirror_mm"] = float(-mirror.signed_distance(c).max()
-                                                               - printer.alignment_pin.hole_radius)
+            r = np.array([p.hole_diameter / 2 or printer.alignment_pin.hole_radius for p in pins])
+            out["pin_hole_min_clearance_to_mirror_mm"] = float((-mirror.signed_distance(c) - r).min())
     return out
