@@ -159,6 +159,20 @@ def check_screen_fits(rig) -> dict:
     return room
 
 
+def _dome_off(rig) -> str:
+    """How the screens get inside the dome: it lifts off its register (rigcad.parts.dome.register)."""
+    from rigcad.parts.dome import flange_joint, register
+
+    reg, joint = register(rig.profile, rig.layout), flange_joint(rig.profile, rig.layout)
+    lateral, turn = reg.repeatability
+    return (f"- The screen goes in with the dome off: take out the dome's {joint.count} flange screws and lift it "
+            f"straight up off its {len(reg.points)} register pins (the beam and the paraboloid ride with it, in its "
+            "slots; two hands, level), put the spacer in the bore and the screen on it, then lower the dome back over "
+            f"the pins and screw it down. The register puts it back within {1e3 * lateral:.0f} µm and "
+            f"{1e3 * math.degrees(turn):.1f} mdeg (`tolerancing.dome_offset` is {rig.profile.tolerancing.dome_offset:g} "
+            "mm), so every capture sees the same dome.")
+
+
 def manual_page(rig) -> str:
     """The manual's page on the calibration (Markdown)."""
     p = rig.profile
@@ -209,6 +223,7 @@ the dome as they were built and placed; the fit of the misalignment; the dome's 
   `calibration.screen_tilt`); {half_turn}
   Clean the spacer's top and the screen's back; a screen that rocks on a camera bump needs a flat
   plate under it, counted in `screen_thickness`.
+{_dome_off(rig)}
 {_upright_kit(p, len(plan))}
 ## Capture order
 In turn:

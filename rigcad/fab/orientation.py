@@ -124,8 +124,8 @@ def overhang_area(vertices: np.ndarray, faces: np.ndarray, direction, mask: np.n
 
 
 #: A part is a thin plate when its smallest bounding-box side is under this fraction of the next:
-#: on edge it is a fin (the projector mounting plate, 7.5 mm thick, would stand 144 mm tall) that
-#: sways under the nozzle and levers itself off the bed, so it prints flat.
+#: on edge it is a fin (a 7.5 mm plate would stand 144 mm tall) that sways under the nozzle and levers
+#: itself off the bed, so it prints flat.
 THIN_PLATE_RATIO = 0.1
 
 

@@ -327,13 +327,36 @@ def purchased(rig) -> list[dict]:
         if obj is None:
             continue
         inst = chosen(section, "model")
-        rows.append({"item": section.replace("_", " ") + (f": {inst.title}" if inst else ""), "quantity": 1,
-                     "spec": _describe(obj, p, section), "source": p.where(section, _first_field(obj)) or "default"})
+        rows.append({"item": _ITEMS.get(section, section.replace("_", " ")) + (f": {inst.title}" if inst else ""),
+                     "quantity": 1, "spec": _lead(rig, section) + _describe(obj, p, section),
+                     "source": p.where(section, _first_field(obj)) or "default"})
         lens = chosen(section, "lens") if section == "camera" else None
         if lens:
             rows.append({"item": f"camera lens: {lens.title}", "quantity": 1, "source": lens.file,
                          "spec": "; ".join(f"{k.replace('_', ' ')} {v}" for k, v in lens.figures.items())})
     return rows
+
+
+#: What a profile section is, as one orders it.
+_ITEMS = {"lens": "focusing lens", "beam_splitter": "plate beam splitter"}
+
+
+def _lead(rig, section: str) -> str:
+    """What an optic's row says before the profile's figures: the focusing lens's focal length (computed
+    by rigcad.optics.focus unless the profile gives it) and which way its curved face goes; the
+    splitter's coated face."""
+    if section == "lens" and getattr(getattr(rig, "layout", None), "tower", None) is not None:
+        from rigcad.optics.focus import focusing_lens
+
+        f = focusing_lens(rig.profile, rig.geometry)
+        how = ("the catalogue focal length whose focus range is centred on the paraboloid, rigcad.optics.focus"
+               if f.from_catalogue else "lens.focal_length")
+        return (f"**plano-convex singlet, f = {f.focal_length:g} mm** ({how}; a stock 50.8 mm (2 in) lens, e.g. "
+                "Thorlabs LA1xxx or Edmund Optics), its curved face towards the projector; ")
+    if section == "beam_splitter":
+        return ("**its coated (reflecting) face towards the projector and down, onto the paraboloid**: the "
+                "projector's light reflects off its front face, the camera looks through the plate; ")
+    return ""
 
 
 def _first_field(obj) -> str:
@@ -404,7 +427,6 @@ CONSUMABLES = (
     ("Wet-or-dry silicon carbide paper, P120 P240 P400 P600 P800 P1000 P1500 P2000 P3000 (ISO 6344), 230 x 280 mm "
      "sheets", "2 sheets of each"),
     ("Dry guide coat powder (black, e.g. 3M 05861) with its applicator", "1"),
-    ("Filler primer: 1K acrylic high-build aerosol, 400 ml (or 2K epoxy primer with hardener)", "2"),
     ("Cutting compound and finishing polish (automotive, e.g. 3M 06085 + 06068 class), 250 ml each", "1 each"),
     ("Foam polishing pads, 75 mm, cutting and finishing", "2 each"),
     ("Cyanoacrylate glue, medium viscosity, 20 g, for the split pieces' cut faces", "1"),

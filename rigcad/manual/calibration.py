@@ -8,10 +8,10 @@
 - What the film over the dome's base shows: the reflected light converges to the sample point O;
   light projected past the rim (a circle too large) falls straight onto the film outside the
   paraboloid's shadow, whose radius is computed here, and the beam's shadow strip with it.
-- The projector crosses (on their mounting plate) and the backplate: aligned, both shadows are
+- The projector crosses (on their mounting plate, on the shelf) and the backplate: aligned, both shadows are
   centred on the backplate at the axis height; a projector off the crosses' line by d mm separates
   the two shadows by d x (X / a - b / (s + a)) (a: projector to near cross, s: cross spacing,
-  b: far cross to backplate, X = s + b), tabulated for a few distances a.
+  b: far cross to backplate, X = s + b), at the distance the shelf puts them from the projector.
 - The camera crosses (hung at the paraboloid's vertex, on the base at z = 0): a camera off the axis
   by d mm sees them apart by d x (1 / (cop_z - z_vertex) - 1 / cop_z) rad.
 
@@ -26,11 +26,6 @@ import math
 import numpy as np
 
 from rigcad.errors import GeometryError
-
-#: Distances (mm) from the projector's COP to the near cross for the shadow table: the bench set-up
-#: is the user's; these span a projector a hand's width to an arm's length from the first cross.
-PROJECTOR_DISTANCES_MM = (150.0, 300.0, 600.0)
-
 
 def circle_image(rig) -> tuple[bytes, dict]:
     """The calibration circle at the projector's resolution (8-bit grey PNG: 255 inside the rim's
@@ -99,18 +94,66 @@ def film_setup(rig) -> dict:
             "dome_bolts": len(rig.layout.bolt_angles)}
 
 
-def projector_shadows(rig, distances=PROJECTOR_DISTANCES_MM) -> dict:
-    """The projector crosses' shadows on the backplate, aligned and per mm of projector offset."""
-    c = rig.profile.crosses
-    s, b, L = c.projector_spacing, c.backplate_distance, c.arm_length
+def projector_shadows(rig) -> dict:
+    """The projector crosses' shadows on the backplate, as they stand on the shelf
+    (rigcad.parts.crosses.cross_fixture): aligned, and per mm of the projector's offset across its axis."""
+    from rigcad.parts.crosses import cross_fixture
+
+    f = cross_fixture(rig.profile, rig.layout)
+    s, b, L, a = f.spacing, f.backplate_distance, rig.profile.crosses.arm_length, f.projector_distance
     X = s + b
+    return {"axis_height_mm": f.axis_height, "spacing_mm": s, "backplate_distance_mm": b, "arm_length_mm": L,
+            "backplate_size_mm": f.backplate_size, "plate_length_mm": f.plate_x[1] - f.plate_x[0],
+            "rows": [{"projector_to_near_cross_mm": a,
+                      "near_shadow_arm_mm": L * (X + a) / a, "far_shadow_arm_mm": L * (X + a) / (s + a),
+                      "separation_per_mm_offset": X / a - b / (s + a)}]}
+
+
+def access(rig) -> list[dict]:
+    """How each calibration item reaches its place, and what rigcad checked of it: one row per item
+    (item, the way in, what moves out of its way, how that part goes back, the check). The checks are
+    the ones the parts and the kit run (they raise GeometryError or ProfileError naming the key when
+    an item cannot go in); this lists them for the manual."""
+    from rigcad.parts.crosses import cross_fixture
+    from rigcad.parts.dome import register
+
+    p = rig.profile
+    reg = register(p, rig.layout)
+    lateral, _ = reg.repeatability
+    back = (f"on its {len(reg.points)} register pins, within {1e3 * lateral:.0f} µm "
+            f"(`tolerancing.dome_offset` {p.tolerancing.dome_offset:g} mm)")
+    bore = f"the base plate's bore ({2 * (p.sample_holder.radius + p.sample_holder.clearance):g} mm), from below"
     rows = []
-    for a in distances:
-        rows.append({"projector_to_near_cross_mm": a,
-                     "near_shadow_arm_mm": L * (X + a) / a, "far_shadow_arm_mm": L * (X + a) / (s + a),
-                     "separation_per_mm_offset": X / a - b / (s + a)})
-    return {"axis_height_mm": c.projector_axis_height, "spacing_mm": s, "backplate_distance_mm": b,
-            "arm_length_mm": L, "rows": rows}
+    if getattr(rig.layout, "tower", None) is not None:
+        f = cross_fixture(p, rig.layout)
+        rows.append({"item": "projector crosses, backplate and their plate", "way": "onto the shelf, from above",
+                     "out_of_the_way": "the splitter holder (with the camera) and the focusing lens",
+                     "back": "the holder on its kinematic seat; the lens in its pocket",
+                     "checked": f"the plate ({f.plate_x[1] - f.plate_x[0]:.0f} mm) fits between the shelf's end and the "
+                                "lens mount, clear of the seat; the crosses' centres on the projector's axis"})
+    rows += [
+        {"item": "camera cross on the beam", "way": "onto the beam in the paraboloid's place",
+         "out_of_the_way": "the dome (the beam and the paraboloid come off with it)", "back": back,
+         "checked": "the same clamp as the paraboloid's, at its vertex height"},
+        {"item": "camera cross in the base plate, gray card", "way": bore, "out_of_the_way": "the sample holder",
+         "back": "the holder in the bore", "checked": "the holder's own body and collar"},
+        {"item": "film at the sample plane, checkerboard disc", "way": "onto the base plate, from above",
+         "out_of_the_way": "the dome", "back": back,
+         "checked": "the disc cut to the dome's inside at the plate, less 1 mm"},
+    ]
+    if getattr(p, "calibration", None) is not None:
+        from rigcad.calibrate.kit import check_screen_fits
+
+        room = check_screen_fits(rig)
+        rows.append({"item": "calibration screen on its spacers", "way": "spacer into " + bore + "; the screen on it, "
+                     "from above", "out_of_the_way": "the dome", "back": back,
+                     "checked": f"the screen fits the dome's inside at every spacer (a {room['body_diameter_mm']:.0f} mm "
+                                "circle at the tightest)"})
+        if p.calibration.upright_turns:
+            rows.append({"item": "upright display on its stand", "way": bore, "out_of_the_way": "the sample holder",
+                         "back": "the holder in the bore", "checked": "the display's module fits the stand's slot in "
+                                                                        "the bore (rigcad calibrate --kit)"})
+    return rows
 
 
 def camera_crosses(rig) -> dict:
@@ -123,7 +166,7 @@ def camera_crosses(rig) -> dict:
             "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
 
 
-__all__ = ["camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
+__all__ = ["access", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
 
 
 #: The adjustable circle page: a full-screen canvas, the disc drawn in device pixels (the projector's

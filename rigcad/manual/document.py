@@ -24,6 +24,7 @@ from rigcad._version import __version__
 from rigcad.manual import bom as B
 from rigcad.manual import calibration as C
 from rigcad.manual import tower_joints
+from rigcad.parts.locating import DowelRegister
 from rigcad.units import hours_minutes
 
 MIL = 0.0254  # mm
@@ -403,9 +404,10 @@ def _section_sand(d: Doc, c) -> None:
     sand = []
     for name, e in fab_report["parts"].items():
         if "polishing" in e:
+            stock = printed_stock(e)
             sand.append(f"`{name}`: sand away the print's staircase, {e['polishing']['sanding_depth_mm']:.3f} mm "
                         "deep at most (the steps' height; the mirror was printed forward by "
-                        f"{e['polishing']['stock_to_add_mm']:.3f} mm of stock, so sanding stops before the design)")
+                        f"{stock:.3f} mm of sanding stock, so sanding stops before the design)")
     d.ul(sand)
     d.p(f"The templates (`dome_template`, `paraboloid_template`, cut from plate) carry the surface of the "
         f"**{gauged}** layer. Sanded to size, the bare print lies {total - gd:.3f} mm ({_mil(total - gd)}: the layers "
@@ -479,6 +481,20 @@ def assembly_order(rig, steps, solids):
         raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles) from err
 
 
+def register_text(reg) -> str:
+    """What a step says of the register a part sits on (rigcad.parts.locating.DowelRegister)."""
+    lateral, turn = reg.repeatability
+    lower, upper = reg.lower.replace("_", " "), reg.upper.replace("_", " ")
+    return (f"Before the {upper}: press its {len(reg.points)} register pins ({reg.item}) into the {lower}'s two "
+            f"holes, printed at the pin's size, with a vise or a soft hammer until {reg.upper_engagement:g} mm stands "
+            f"proud ({reg.length - reg.upper_engagement:g} mm in); a pin that goes in loose is glued in with epoxy: it "
+            f"must not move. Ream the {upper}'s round hole {reg.diameter:g} mm H7 and file its slot until a pin slides "
+            f"along it but not across. The {upper} drops onto the pins: lifted off and set back (section 6 does, for "
+            f"the calibration screens and the checkerboard) it returns to within {1e3 * lateral:.0f} µm and "
+            f"{1e3 * math.degrees(turn):.1f} mdeg, whatever its screws do; tighten its screws only once it sits on the "
+            "pins. ")
+
+
 def step_text(placed, meshes_by_name: dict) -> str:
     """What a found step says: what goes in, how (its direction), on what, and each group of like
     fasteners with its tool and what takes its thread."""
@@ -530,9 +546,20 @@ def _section_assemble(d: Doc, c) -> None:
         members = [index[n] for n in st.members]
         label = st.name.replace("_", " ") + (f" (x{len(members)})" if len(members) > 1 and st.name not in
                                              st.members else "")
-        text = step_text(placed, by_name)
+        text = "".join(register_text(j) for m in st.members if m in c.rig.recipes
+                       for j in c.rig.recipes[m].joints if isinstance(j, DowelRegister))
+        text += step_text(placed, by_name)
         if st.name == "projector_body":
             text += plan_mod.projector_screw_text(c.rig)
+        if st.name == "beam_splitter":
+            text += (" Its coated face (the reflecting one: the maker marks its edge, or a pen tip touching it shows "
+                     "one reflection, where the uncoated face shows two) goes towards the projector (+x) and down, "
+                     "towards the paraboloid.")
+        if st.name == "focusing_lens":
+            from rigcad.optics.focus import focusing_lens
+
+            text += (f" It is the f = {focusing_lens(c.p, c.rig.geometry).focal_length:g} mm plano-convex lens of "
+                     "the bill, its curved face towards the projector.")
         if st.name == "base_plate" and "camera_cross_base" in c.rig.recipes:
             text += (" To calibrate (section 6), lay the film on the plate now, before the dome: see \"The film at "
                      "the sample plane\".")
@@ -586,13 +613,25 @@ def _tower_rows_by_step(rig, steps) -> dict:
     return out
 
 
+def printed_stock(entry: dict) -> float:
+    """The sanding stock a mirror part was printed forward by (mm): the fab report's record of it
+    (rigcad.fab.stage), the one figure the manual and docs/fab.md state."""
+    if entry.get("sanding_stock"):
+        return entry["sanding_stock"]["stock_mm"]
+    return entry["polishing"]["stock_to_add_mm"]  # a report written without a stocked print: what it needs
+
+
 def _section_finish(d: Doc, c) -> None:
     """The finishing recipe, the blocks from the mirrors' curvature, the templates' cutting, and the
     optical acceptance test (rigcad.manual.finishing)."""
     from rigcad.manual import finishing as F
 
     d.h(3, "Finishing recipe, stage by stage")
-    d.table(["stage", "what", "how", "cure / wait", "check"], [list(r) for r in F.RECIPE])
+    stock = {n: printed_stock(e) for n, e in c.fab_report["parts"].items() if "polishing" in e}
+    d.p("One recipe from the print to the mirror: the coats are the profile's `coating.layers`, in their order, and "
+        "nothing else is sprayed (a coat not in them would move the surface off the design by its thickness). The "
+        "slope test comes before the mirror coat, while a bad area can still be sanded.")
+    d.table(["stage", "what", "how", "cure / wait", "check"], [list(r) for r in F.recipe(c.p, stock)])
     blocks = F.sanding_blocks(c.rig)
     d.p(f"Sanding blocks, from the mirrors' curvature: a flat block of length L stands off a curve of radius R by "
         f"L²/(8R); keep that under {F.BLOCK_SAG_MM:g} mm (1 mil, the thinnest coat). Longer blocks must be curved "
@@ -613,7 +652,8 @@ def _section_finish(d: Doc, c) -> None:
         f"the sample point O. Print a white disc of **{acc['disc_radius_mm']:g} mm radius** "
         "(`tolerancing.max_spot_radius`) on matte black card, put it in the sample holder centred on O, light it "
         "from the side through a beam slot, and take the camera's picture through the splitter with the rig "
-        "assembled. **Pass:** the paraboloid's image is white (outside the occlusion disc of the calibration "
+        "assembled: first on the polished coat, before the mirror coat (the recipe's slope test: a bad area can "
+        "still be sanded), then again on the finished mirrors. **Pass:** the paraboloid's image is white (outside the occlusion disc of the calibration "
         f"circle) over at least {100 * acc['pass_fraction']:g} % of its pixels (`tolerancing.min_yield`); black "
         "patches mark the mirror areas to block and polish again. This holds the dome's slope to "
         f"{acc['dome_slope_tolerance_mrad']:.1f} mrad at its farthest point from O "
@@ -660,37 +700,29 @@ def _film_step(d: Doc, c) -> None:
 
 
 def _calibration_more(d: Doc, c, cam: dict) -> None:
-    """The steps after the crosses: where the projector crosses' plate goes, the turned camera crosses,
-    the checkerboard and the gray card (thesis 4.1.1, 4.1.2)."""
+    """The steps after the crosses: the turned camera crosses, the checkerboard and the gray card
+    (thesis 4.1.1, 4.1.2)."""
     import numpy as np
 
     rig = c.rig
-    t = getattr(rig.layout, "tower", None)
-    if t is not None and "projector_mounting_plate" in rig.recipes:
-        plate = rig.mesh(rig.recipes["projector_mounting_plate"])
-        base = -float(np.asarray(plate.vertices)[:, 2].min())  # the plate's thickness under its top face (z = 0)
-        above = t.projector_cop[2] - t.shelf_top_z
-        want = base + c.p.crosses.projector_axis_height
-        d.p(f"Where the crosses' plate goes: lift the splitter holder off its three balls (its kinematic seat puts it "
-            f"back in the same place) and take the focusing lens out of its mount. Stand the "
-            f"`projector_mounting_plate` on the shelf in front of the projector, its fences' line on the shelf's "
-            f"centre line y = 0 (square it from the shelf's two long edges, measure the centre with the caliper). "
-            f"The projector's axis is {above:.1f} mm above the shelf; the crosses' centres stand {want:.1f} mm above "
-            f"it ({base:.1f} mm of plate + `crosses.projector_axis_height`)"
-            + (f": put {above - want:.1f} mm of shims under the plate." if above - want > 0.05 else
-               f": the crosses stand {want - above:.1f} mm too high; lower `crosses.projector_axis_height` by that "
-               "and print them again." if want - above > 0.05 else "."))
     hidden = cam["base_cross_arm_mrad"] < cam["hung_cross_arm_mrad"]
     d.p("Turn the base cross 45 degrees to the hung one (it turns freely in the holder's bore)"
         + (f": seen from the COP its arms span {cam['base_cross_arm_mrad']:.1f} mrad, less than the hung cross's "
            f"{cam['hung_cross_arm_mrad']:.1f} mrad, so aligned it would hide behind it; turned, its arms show in the "
            "gaps between the hung cross's arms." if hidden else ": its arms then show between the hung cross's."))
-    r = rig.layout.plate_r
-    d.p(f"Camera pixels to paraboloid points: paste a checkerboard of {CHECKER_SQUARE_MM:g} mm black and white "
-        f"squares ({math.ceil(2 * r / CHECKER_SQUARE_MM)} x {math.ceil(2 * r / CHECKER_SQUARE_MM)} squares, a "
-        f"{2 * r:.0f} mm disc: matte paper, laser-printed at 600 dpi, checked with the caliper over ten squares) on the "
-        "base plate, project the calibrated circle and locate the paraboloid's image in the camera's picture: its "
-        "centre and radius in pixels are the camera's correspondence.")
+    lay = rig.layout
+    inside = float(lay.printed_dome.points(np.array([lay.u_inner_base]))[0, 0])  # the dome's inside at the plate
+    r = math.floor(inside - 1.0)
+    bore = c.p.sample_holder.radius + c.p.sample_holder.clearance
+    n = math.ceil(2 * r / CHECKER_SQUARE_MM)
+    d.p(f"Camera pixels to paraboloid points: print a checkerboard of {CHECKER_SQUARE_MM:g} mm black and white "
+        f"squares ({n} x {n} squares on matte paper, laser-printed at 600 dpi, checked with the caliper over ten "
+        f"squares) and cut it to a **{2 * r:.0f} mm** disc, a square's corner at its centre, with a {2 * bore:.0f} mm "
+        f"hole there for the bore: it lies on the base plate inside the dome ({2 * inside:.1f} mm across at the plate). "
+        "Lift the dome off its register pins (as for the calibration screens), lay the disc on the plate centred on "
+        "the bore, set the dome back and screw it down. Project the calibrated circle and locate the paraboloid's "
+        "image in the camera's picture: its centre and radius in pixels are the camera's correspondence. Then lift "
+        "the dome again to take the disc out.")
     d.h(3, "Reflectance (thesis 4.1.2)")
     d.p("Put an 18 % diffuse gray card (photographic, e.g. a Kodak R-27 class card cut to the sample holder's "
         "diameter) in the sample holder, its face at z = 0. Project the zonal harmonic basis images up to order 2 "
@@ -725,18 +757,29 @@ def _section_calibrate(d: Doc, c) -> None:
     pshadow = C.projector_shadows(rig)
     cam = C.camera_crosses(rig)
     d.h(2, "6. Calibrate (thesis 4.1.1)")
+    d.p("How each calibration item gets to its place, and what rigcad checked (a rig where one cannot is refused "
+        "before this manual is written):")
+    d.table(["item", "goes in", "what comes out of its way", "which goes back", "checked"],
+            [[r["item"], r["way"], r["out_of_the_way"], r["back"], r["checked"]] for r in C.access(rig)])
     d.h(3, "Projector: the crosses and the backplate")
-    d.p(f"Stand the two `projector_cross`es and the `projector_backplate` in the fences of the "
-        f"`projector_mounting_plate`: the crosses' centres are {pshadow['axis_height_mm']:g} mm above the plate "
-        f"(the projector's axis height, `crosses.projector_axis_height`), {pshadow['spacing_mm']:g} mm apart, the "
-        f"backplate {pshadow['backplate_distance_mm']:g} mm behind the far cross. Project a white image and move the "
-        "projector until the two shadows coincide, centred on the backplate at the axis height. A projector off "
-        "the crosses' line by 1 mm separates the two shadows by:")
-    d.table(["projector to near cross", "near cross's shadow arm", "far cross's shadow arm", "shadows apart per mm of offset"],
-            [[f"{r['projector_to_near_cross_mm']:g} mm", f"{r['near_shadow_arm_mm']:.1f} mm",
-              f"{r['far_shadow_arm_mm']:.1f} mm", f"{r['separation_per_mm_offset']:.2f} mm"] for r in pshadow["rows"]])
-    d.p(f"(Arms of {pshadow['arm_length_mm']:g} mm, `crosses.arm_length`; the closer the projector, the finer the "
-        f"check. The profile allows `tolerancing.projector_offset` = {p.tolerancing.projector_offset:g} mm.)")
+    row = pshadow["rows"][0]
+    d.p("Lift the splitter holder, with the camera on it, off its seat (its kinematic seat puts it back in the same "
+        "place; the seat's balls stay on the shelf) and take the focusing lens out of its mount; leave the mount "
+        f"where it is. Lay the `projector_mounting_plate` ({pshadow['plate_length_mm']:.0f} mm long) on the shelf in "
+        "the holder's place, its end pushed against the lens mount's foot and its two tabs either side of the foot: "
+        "the tabs centre it on the projector's axis, and the pocket in its underside clears the seat's balls. Stand "
+        "the `projector_backplate` in the fence at the shelf's end, its cut cross towards the projector, and the "
+        "two `projector_cross`es in the other two fences: their centres are then on the projector's axis, "
+        f"{pshadow['axis_height_mm']:.1f} mm above the plate, {pshadow['spacing_mm']:.1f} mm apart, the far one "
+        f"{pshadow['backplate_distance_mm']:.1f} mm in front of the backplate.")
+    d.p(f"Project a white image. The near cross stands {row['projector_to_near_cross_mm']:.1f} mm from the projector's "
+        f"COP: its shadow's arms reach {row['near_shadow_arm_mm']:.1f} mm on the backplate, the far cross's "
+        f"{row['far_shadow_arm_mm']:.1f} mm. Aligned, the two shadows' centres coincide on the backplate's cut cross. "
+        f"A projector off the crosses' line by 1 mm across the axis separates them by "
+        f"**{row['separation_per_mm_offset']:.2f} mm**: move the projector on its slots (across) and its shims "
+        f"(height) until they coincide. The profile allows `tolerancing.projector_offset` = "
+        f"{p.tolerancing.projector_offset:g} mm. Then take the plate, crosses and backplate off, put the lens back "
+        "and set the holder back on its seat.")
     d.h(3, "Projector: the circle on the paraboloid")
     d.p("Take the focusing lens out of its mount first: the circle is set with the projector's own optics. Open "
         "`calibration/circle.html` in a browser on the projector's screen and press f (full screen): arrow keys "

@@ -75,26 +75,68 @@ def slope_acceptance(rig) -> dict:
             "dome_slope_tolerance_mrad": 1e3 * limit / (2.0 * far), "pass_fraction": p.tolerancing.min_yield}
 
 
-#: The finishing recipe, stage by stage: (stage, what, how, cure / wait, check). A 2K (isocyanate)
-#: primer or clear needs a supplied-air or A2/P3 respirator; 1K products are given as the safer choice.
-RECIPE = (
-    ("1. Knock down the layer lines", "wet-or-dry SiC paper P120 then P240 (ISO 6344) on the sanding block "
-     "below", "wet sanding, water with a drop of soap; strokes along the meridian, then across", "-",
-     "guide coat (black dry powder, e.g. 3M 05861) wiped on: sand until it is gone everywhere"),
-    ("2. Filler primer", "1K high-build filler primer (aerosol, e.g. acrylic), or 2K epoxy/polyurethane primer "
-     "with its hardener", "3 thin coats, 10 min flash-off between; 20-25 cm from the surface", "1K: 24 h; 2K: "
-     "per data sheet (typically 12 h at 20 C)", "-"),
-    ("3. Block the primer", "P400 then P600 wet", "guide coat again; block until it is gone", "-",
-     "template: the primer's gap (table in section 4); feeler gauge"),
-    ("4. Base coat", "the profile's base paint (coating.layers)", "spray: HVLP gun 1.3-1.4 mm nozzle at "
-     "~2 bar, or aerosol; 2-3 wet coats", "per data sheet (1K: 24 h before sanding)", "template gap"),
-    ("5. Level the base", "P800 then P1000 wet", "light pressure, guide coat", "-", "template gap; no orange peel"),
-    ("6. Clear coat", "the profile's clear (coating.layers)", "HVLP 1.3 mm, 2 coats, 10-15 min flash", "2K clear: "
-     "24 h at 20 C before sanding; a week before polishing hard", "template gap"),
-    ("7. Cut and polish", "P1500, P2000, P3000 wet; then cutting compound (e.g. 3M 06085 equivalent) and a finishing "
-     "polish on a foam pad", "by hand or a 75 mm DA polisher at low speed; keep the block for P1500-P2000", "-",
-     "the optical acceptance test below"),
-)
+#: Specular reflectance of a polished clear coat over a black base at normal incidence: Fresnel's
+#: ((n - 1) / (n + 1))^2 for a clear of index n = 1.5 (polyurethane 1.49-1.52): 0.04.
+CLEAR_REFLECTANCE = 0.04
+
+#: How each coat of the shipped profiles' ``coating.layers`` goes on, by the layer's name as the profile
+#: gives it: (what, how, cure / wait). A layer not named here is applied as its maker's data sheet says.
+#: A 2K (isocyanate) coat needs a supplied-air or A2/P3 respirator; 1K products are the safer choice.
+LAYER_METHODS = {
+    "black base paint": ("gloss black base (1K acrylic or 2K polyurethane), the ground the mirror coat needs",
+                         "HVLP gun, 1.3-1.4 mm nozzle at ~2 bar (or aerosol), 2-3 thin wet coats, 10 min flash-off "
+                         "between, 20-25 cm from the surface", "1K: 24 h; 2K: per data sheet (about 12 h at 20 C)"),
+    "polyurethane primer": ("2K polyurethane primer-surfacer with its hardener: it fills what sanding left",
+                            "HVLP 1.4 mm, 2 coats, 10 min flash; then block it wet P600-P800 on the sanding blocks "
+                            "with a guide coat until the guide coat is gone", "per data sheet (about 12 h at 20 C) "
+                            "before sanding"),
+    "polyurethane clearcoat": ("2K polyurethane clear with its hardener", "HVLP 1.3 mm, 2 coats, 10-15 min flash; "
+                               "after the cure wet-sand P1500, P2000, P3000 on the blocks, then cutting compound "
+                               "(e.g. 3M 06085 class) and a finishing polish on a 75 mm foam pad, by hand or a DA "
+                               "polisher at low speed", "24 h at 20 C before sanding; a week before polishing hard"),
+    "MirraChrome": ("MirraChrome (Alsa Corp.) spray chrome, over the polished gloss coat",
+                    "its own low-pressure spray system (an airbrush or a 0.8-1.0 mm HVLP at ~1 bar), mist coats "
+                    "until the surface turns mirror, no more; dust-free room, 20-25 C, gloves: never touch it",
+                    "per its data sheet (dust-dry in minutes; handle after 24 h); no clear on top unless the data "
+                    "sheet allows it"),
+}
 
 
-__all__ = ["BLOCK_SAG_MM", "KERF_MM", "RECIPE", "principal_radii", "sanding_blocks", "slope_acceptance"]
+def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str, str, str, str, str]]:
+    """The finishing recipe, stage by stage, from print to mirror: (stage, what, how, cure / wait, check).
+
+    One recipe for the profile's ``coating.layers`` in their order, nothing else sprayed: knock the
+    staircase down to the template (the print stands forward by its sanding stock, ``stock_mm`` by
+    mirror), then each coat, with the template's check after each up to the gauged layer, and the slope
+    test on the polished coat before the last (the mirror) coat goes on."""
+    from rigcad.parts.templates import gauged_depth
+
+    layers = list(profile.coating.layers)
+    total = float(sum(t for _, t in layers))
+    gap = total - gauged_depth(profile)
+    stock = "" if not stock_mm else " (" + ", ".join(f"{k} {v:.3f} mm" for k, v in stock_mm.items()) + " of stock)"
+    rows = [("1. Knock down the layer lines", "wet-or-dry SiC paper P120, P240, P400 (ISO 6344) on the sanding blocks "
+             "below", "wet, a drop of soap in the water; strokes along the meridian, then across", "-",
+             f"guide coat (dry black powder, e.g. 3M 05861) gone everywhere; the template's gap {gap:.3f} mm "
+             f"({gap / 0.0254:.1f} mil) all along it: the print's staircase is gone{stock}")]
+    for k, (name, t) in enumerate(layers):
+        gap -= t
+        what, how, cure = LAYER_METHODS.get(name, (name, "as its maker's data sheet says", "per data sheet"))
+        if k == len(layers) - 1 and len(layers) > 1:
+            rows.append((f"{k + 2}. Slope test before the mirror coat", "the optical acceptance test below, on the "
+                         "polished coat", "the rig assembled as for the test; the polished coat reflects about "
+                         f"{100 * CLEAR_REFLECTANCE:g} % where the mirror coat will reflect "
+                         f"{100 * profile.coating.reflectance:.0f} % (`coating.reflectance`): light the disc brighter "
+                         f"or expose {(profile.coating.reflectance / CLEAR_REFLECTANCE) ** 2:.0f} times longer (two "
+                         "reflections)", "-", "pass as below; a black patch: block and polish that area again, never "
+                         "under the mirror coat"))
+            k += 1
+        check = ("template flush along its whole edge" if abs(gap) < 1e-9 else
+                 f"template gap {gap:.3f} mm ({gap / 0.0254:.1f} mil)" if gap > 0 else
+                 "past the gauged layer: do not force the template")
+        rows.append((f"{k + 2}. {name} ({t / 0.0254:g} mil)", what, how, cure, check))
+    return rows
+
+
+__all__ = ["BLOCK_SAG_MM", "CLEAR_REFLECTANCE", "KERF_MM", "LAYER_METHODS", "principal_radii", "recipe",
+           "sanding_blocks", "slope_acceptance"]

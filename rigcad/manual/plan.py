@@ -30,6 +30,8 @@ import numpy as np
 from rigcad.manual.assembly_check import Assembly, Fastener, Step, manifold, penetration
 from rigcad.manual.fasteners import DOWN, UP, spanner
 from rigcad.manual.fasteners import socket_head as _socket_head
+from rigcad.parts.joints import ScrewJoint
+from rigcad.parts.locating import DowelRegister
 from rigcad.standards import INSERTS, THREADS, longest_screw, shortest_screw
 
 #: Units one step places together: an instrument with the lens built onto it.
@@ -255,9 +257,9 @@ def steps(rig, meshes) -> tuple[list[Step], dict]:
         options = bolt_fasteners(b)
         fits = [f for f in options if penetration(f.solids(), whole) <= _clearance()]
         bolts.setdefault(b["upper"], []).append((fits or options)[0])
-    for part in rig.recipes.values():  # the joints the parts declare: fitted as declared
+    for part in rig.recipes.values():  # the screw joints the parts declare: fitted as declared
         for j in part.joints:
-            if {j.upper, j.lower} <= set(solids):
+            if isinstance(j, ScrewJoint) and {j.upper, j.lower} <= set(solids):
                 bolts.setdefault(j.upper, []).extend(joint_fasteners(j))
     from rigcad.manual.tower_joints import tower_fasteners
 
@@ -357,6 +359,13 @@ def bill_hardware(rig, steps: list[Step], bill: dict) -> list[dict]:
     rows += [{"item": f["item"], "quantity": f["quantity"], "where": f["use"], "note": f["note"], "steps": []}
              for f in bill["fasteners"] if f.get("tower") and "mounting holes" not in f["use"]
              and not tower_joints.placed({"joins": f["use"]}) and "heat-set insert" not in f["item"]]
+    for part in rig.recipes.values():  # the locating pins the parts declare, in the step of the part they locate
+        for j in part.joints:
+            if isinstance(j, DowelRegister) and any(j.upper in st.members for st in steps):
+                step = next(st.name for st in steps if j.upper in st.members)
+                rows.append({"item": j.item, "quantity": len(j.points), "where": f"assembly steps: {step}",
+                             "note": f"pressed into the {j.lower.replace('_', ' ')}: the {j.upper.replace('_', ' ')}'s "
+                                     "register", "steps": [step]})
     pin = bill["pins"]
     if pin:
         rows.append({"item": pin["item"], "quantity": pin["quantity"], "where": f"aligning split pieces ({pin['use']})",

@@ -9,6 +9,7 @@ import numpy as np
 
 from rigcad.errors import GeometryError
 from rigcad.parts.joints import ScrewJoint
+from rigcad.parts.locating import DowelRegister, bolt_hole
 from rigcad.parts.layout import RigLayout, u_at_height
 from rigcad.parts.recipe import Box, Curve, Difference, Line, Part, Revolve, Section
 from rigcad.profile.schema import Profile
@@ -32,6 +33,45 @@ def flange_joint(profile: Profile, layout: RigLayout) -> ScrewJoint:
     points = tuple((r * math.cos(a), r * math.sin(a)) for a in layout.bolt_angles)
     return ScrewJoint("dome_flange", "dome", "base_plate", thread, points, (0.0, shell.flange_thickness),
                       (-profile.base_plate.thickness, 0.0), "insert", "dome_shell.bolt_diameter")
+
+
+def _pins(layout: RigLayout) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The register's pins (x, y; mm): the round hole's at +x, the slot's at -x, on the bolt circle."""
+    r = layout.bolt_circle_r
+    return (r, 0.0), (-r, 0.0)
+
+
+def register(profile: Profile, layout: RigLayout) -> DowelRegister:
+    """The dome's register on the base plate: two ``datum.dowel_diameter`` pins pressed into the plate
+    on the x axis at the bolt circle (the bolts stand half a pitch off it), the round hole at +x, the
+    slot at -x (along x: it takes the print's scale error over the flange's width). The dome lifts off
+    and goes back on them: the calibration screens go in on the plate while it is off."""
+    shell, d = profile.dome_shell, profile.datum
+    pins = _pins(layout)
+    slot = 2 * (2 * d.print_position + d.print_scale * 2 * layout.bolt_circle_r)
+    reg = DowelRegister("dome_register", "dome", "base_plate", d.dowel_diameter, pins,
+                        (0.0, shell.flange_thickness), (-profile.base_plate.thickness, 0.0), slot,
+                        "datum.dowel_diameter")
+    bolt_r = flange_bolt_hole(profile, layout) / 2
+    for x, y in flange_joint(profile, layout).points:
+        for (px, py) in reg.points:
+            gap = math.hypot(x - px, y - py) - bolt_r - d.dowel_diameter / 2 - slot / 2
+            if gap < profile.tower.wall:
+                raise GeometryError(f"the dome's register pin at ({px:.1f}, {py:.1f}) mm comes within {gap:.1f} mm of a "
+                                    f"flange bolt: fewer bolts (dome_shell.bolts) or thinner pins (datum.dowel_diameter)",
+                                    where=profile.where("dome_shell", "bolts"))
+    return reg
+
+
+def flange_bolt_hole(profile: Profile, layout: RigLayout) -> float:
+    """The flange's bolt holes (mm): ``dome_shell.bolt_diameter``, opened where the print's errors
+    need it (rigcad.parts.locating.bolt_hole, at the farthest bolt from the register's round pin): the
+    register locates the dome, the bolts only clamp it."""
+    d = profile.datum
+    joint = flange_joint(profile, layout)
+    (px, py) = _pins(layout)[0]
+    far = max(math.hypot(x - px, y - py) for x, y in joint.points)
+    return max(profile.dome_shell.bolt_diameter, bolt_hole(joint.thread, far, d.print_position, d.print_scale))
 
 
 def dome(profile: Profile, layout: RigLayout) -> Part:
@@ -62,8 +102,10 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
     half_w = profile.beam.width / 2 + c
     reach = layout.slot_r + 5.0
     slot = Box((-reach, -half_w, z0), (reach, half_w, z1 + c))  # the beam rests on the slot's floor
-    joint = flange_joint(profile, layout)
-    holes = joint.clearance_holes(shell.bolt_diameter)
-    return Part("dome", Difference(Revolve(section), (slot, *holes)), (0.82, 0.82, 0.86),
-                "dome: mirror surface inside (paint it), wall, base flange bolted to the base plate, beam slots",
-                mirrors=(("dome", layout.design_dome),), joints=(joint,))
+    joint, reg = flange_joint(profile, layout), register(profile, layout)
+    holes = joint.clearance_holes(flange_bolt_hole(profile, layout))
+    lateral, _ = reg.repeatability
+    return Part("dome", Difference(Revolve(section), (slot, *holes, *reg.upper_holes())), (0.82, 0.82, 0.86),
+                "dome: mirror surface inside (paint it), wall, base flange on two dowels in the base plate (a round "
+                f"hole and a slot: it lifts off and goes back to within {lateral:g} mm) and bolted to it, beam slots",
+                mirrors=(("dome", layout.design_dome),), joints=(joint, reg))

@@ -73,9 +73,11 @@ def test_form3_dome_sectors_and_bands_with_tongue_and_groove(table31, layout, fo
     assert r["pin_hole_min_clearance_to_mirror_mm"] >= SP.MIRROR_CLEARANCE - 1e-9
 
 
-def test_form3_mounting_plate_grid_split(table31, layout, form3):
-    part = PARTS["projector_mounting_plate"](table31, layout)
-    man = M.build(part.solid, table31.tessellation.chord_error)
+def test_form3_long_plate_grid_split(table31, layout, form3):
+    from rigcad.parts.recipe import Box
+
+    # a plate off the axis, 297.4 x 144.4 x 7.5 mm (as the projector crosses' plate once was)
+    man = M.build(Box((-22.2, -72.2, -6.0), (275.2, 72.2, 1.5)), table31.tessellation.chord_error)
     assert SP.is_off_axis(man)
 
     def fits(c, plan, i, j):

@@ -57,12 +57,13 @@ def test_the_model_puts_support_under_an_overhang_and_on_what_it_stands_on():
 def test_thin_plates_print_flat(table31_rig, prusa, tmp_path):
     from rigcad.fab.stage import run_fab
 
-    res = run_fab(table31_rig, prusa, tmp_path, parts=["projector_mounting_plate"])
-    e = res.report["parts"]["projector_mounting_plate"]
+    res = run_fab(table31_rig, prusa, tmp_path, parts=["tower_shim"])
+    e = res.report["parts"]["tower_shim"]
     assert res.problems == []
-    assert len(e["pieces"]) == 2  # 297 mm long: two flat pieces on a 250 x 210 bed
+    assert len(e["pieces"]) == 1  # 0.5 mm thick, 30 mm across: flat, never a fin on edge
     for pc in e["pieces"]:
-        assert pc["orientation"].startswith("flat") and abs(pc["extents_mm"]["z_mm"] - 7.5) < 1e-9
+        thickness = table31_rig.profile.tower.shim_thickness
+        assert pc["orientation"].startswith("flat") and abs(pc["extents_mm"]["z_mm"] - thickness) < 1e-9
     assert O.plate_axis(np.array([[0, 0, 0], [300, 144, 7.5]])) == 2
     assert O.plate_axis(np.array([[0, 0, 0], [301.6, 6.0, 10.0]])) is None  # the beam is a bar, not a plate
 

@@ -409,12 +409,13 @@ def test_purchased_rows_describe_every_field_with_its_unit():
     assert rows == [
         {"item": "camera", "quantity": 1, "source": "p.yaml:3",
          "spec": f"focal 12.5 mm; {fov}; resolution 1920 x 1080 px; bands [1, 2]; model X-1; mount thread M6"},
-        {"item": "lens", "quantity": 1, "source": "default",
+        {"item": "focusing lens", "quantity": 1, "source": "default",
          "spec": f"focal 1235 mm; {fov}; resolution 1920 x 1080 px; name L; bands [1, 2]; model X-1; mount thread M6"}]
     assert asked == [("camera", "focal"), ("lens", "focal")]
     profile.beam_splitter = profile.splitter = profile.projector = Camera()
-    assert [r["item"] for r in B.purchased(SimpleNamespace(profile=profile))] == [
-        "projector", "camera", "beam splitter", "splitter", "lens"]
+    rows = B.purchased(SimpleNamespace(profile=profile))
+    assert [r["item"] for r in rows] == ["projector", "camera", "plate beam splitter", "splitter", "focusing lens"]
+    assert rows[2]["spec"].startswith("**its coated (reflecting) face towards the projector")
 
 
 def test_the_bill_sums_the_coating_by_layer_and_measures_each_mirror():
@@ -450,3 +451,15 @@ def test_feeler_gauge_names_the_leaves_the_gaps_need():
         "Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: 0.03 mm", "1")
     assert B.feeler_gauge([0.019999]) == (
         "Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: none (check against the light)", "1")
+
+
+def test_the_bill_names_the_focusing_lens_by_its_focal_length(table31_rig):
+    from rigcad.optics.focus import focusing_lens
+
+    (row,) = [r for r in B.purchased(table31_rig) if r["item"] == "focusing lens"]
+    f = focusing_lens(table31_rig.profile, table31_rig.geometry)
+    # the lens re-images the projector focused at its nearest into the paraboloid's span (thin lens, eq. 1)
+    s = table31_rig.profile.lens.distance
+    u = 1.0 / (1.0 / f.focal_length + 1.0 / (f.focus_near - s))
+    assert u == pytest.approx(f.image_near, rel=1e-9)
+    assert f"f = {f.focal_length:g} mm" in row["spec"] and "plano-convex" in row["spec"]

@@ -41,3 +41,27 @@ def test_the_dome_slope_held_by_the_disc_test(table31_rig):
     assert acc["dome_farthest_from_o_mm"] >= float(np.max(np.hypot(rim[:, 0], rim[:, 1]))) - 1e-9
     e = acc["dome_slope_tolerance_mrad"] / 1e3
     assert 2 * e * acc["dome_farthest_from_o_mm"] == pytest.approx(p.tolerancing.max_spot_radius, rel=1e-12)
+
+
+def test_the_recipe_sprays_the_profiles_coats_only_and_tests_slope_before_the_mirror(table31, tmp_path):
+    """Every coat of ``coating.layers`` is a stage, in order, and nothing else is sprayed; the slope test
+    stands right before the last (mirror) coat; the template checks follow the coats' thicknesses."""
+    import dataclasses
+
+    other = (("gloss black", 0.05), ("clear", 0.04), ("silver", 0.001))
+    for layers, gauged in ((table31.coating.layers, table31.templates.gauged_layer), (other, "clear")):
+        p = dataclasses.replace(table31, coating=dataclasses.replace(table31.coating, layers=tuple(layers)),
+                                templates=dataclasses.replace(table31.templates, gauged_layer=gauged))
+        rows = F.recipe(p, {"dome": 0.093})
+        names = [name for name, _ in layers]
+        coats = [r for r in rows if any(r[0].split(". ", 1)[1].startswith(n + " (") for n in names)]
+        assert [r[0].split(". ", 1)[1].split(" (")[0] for r in coats] == names
+        assert not any("filler" in " ".join(r).lower() for r in rows)
+        slope = [i for i, r in enumerate(rows) if "Slope test" in r[0]]
+        assert slope == [len(rows) - 2]  # right before the mirror coat
+        assert [int(r[0].split(".")[0]) for r in rows] == list(range(1, len(rows) + 1))
+        assert "0.093 mm of stock" in rows[0][4]
+    # the shipped profile: the template fits flush after the gauged layer (the clear coat)
+    rows = F.recipe(table31)
+    (flush,) = [r for r in rows if r[4].startswith("template flush")]
+    assert table31.templates.gauged_layer in flush[0]
