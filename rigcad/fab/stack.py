@@ -50,7 +50,7 @@ from rigcad.parts import adjusters as A
 from rigcad.parts.datum import DOWEL_FIT, datum_chain
 from rigcad.parts.dome import flange_joint
 from rigcad.parts.process import ProcessErrors
-from rigcad.parts.tower import SPRING_HOLE, _projector_feet, _shelf_extent, column_dowel_points
+from rigcad.parts.tower import _projector_feet, _shelf_extent, column_dowel_points, splitter_seat
 from rigcad.standards import THREADS
 
 #: The optical elements, in the order the tables list them.
@@ -75,6 +75,11 @@ RESOLUTION_SHARE = 0.25
 #: The split parts whose seams may lie on an element's chain (the beam, the paraboloid and its clamp
 #: print whole on every shipped printer).
 CHAIN_PARTS = ("base_plate", "dome", "tower_column", "tower_shelf", "splitter_holder")
+#: How far a kinematic seat of hard balls on a cone, a vee and a flat returns to its place after a
+#: lift-off (mm): "ordinary quality kinematic hardware" repeats "in the micrometer range" (Bal-tec,
+#: The Kinematic Encyclopedia, precisionballs.com); 5 um taken for balls pressed into printed pockets
+#: (assumed).
+KINEMATIC_REPEAT = 0.005
 #: The links a locating feature replaces, by what it locates: the paraboloid's (a locating block with
 #: an adjuster in x, y and height replaces the beam's and the clamp's floats), the dome's (a register
 #: replaces the bolts' float) and the splitter seat's (a kinematic seat, on the COP's, the splitter's
@@ -367,12 +372,13 @@ def _tower_links(profile, layout, process: ProcessErrors, seams, holder: bool = 
                      "buy.shelf: aluminium_plate" if printed_shelf else ""))
     out.extend(seams("tower_shelf"))
     if holder:
-        bolt = THREADS["M4"].major
-        out.append(Link("splitter seat", "clearance",
-                        f"not kinematic: flat-point screws on loose balls; its two M4 spring bolts in {SPRING_HOLE:g} mm "
-                        "holes bound a lift-off", (SPRING_HOLE - bolt) / 2,
-                        buy="a kinematic seat: ball-ended screws on a cone, a vee and a flat (or a bought kinematic "
-                            "mount)"))
+        seat = splitter_seat(profile, layout)
+        kinds = [c.kind for c in seat.contacts]
+        kinds = f"{', a '.join(kinds[:-1])} and a {kinds[-1]}"
+        out.append(Link("splitter seat", "joint",
+                        f"kinematic: ball-ended screws on a {kinds} (sprung, {seat.preload:.0f} N): it repeats on "
+                        f"lift-off to {KINEMATIC_REPEAT * 1000:g} um (assumed)", KINEMATIC_REPEAT,
+                        buy="a bought kinematic mount"))
     return tuple(out)
 
 
