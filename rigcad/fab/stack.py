@@ -267,6 +267,21 @@ def seams_from_pieces(pieces: dict[str, int]) -> dict[str, int]:
     return {k: (0 if k == "dome" else max(0, n - 1)) for k, n in pieces.items()}
 
 
+def seams_from_fab(parts: dict[str, dict]) -> dict[str, int]:
+    """Seams on a chain from a fab run's record of its parts (fab.json's ``parts``): a part's
+    ``datum_seams`` (rigcad.fab.split.datum_seams: the seams between two of its datum features), the
+    most any two of them cross; a split part that declares no datum features, its pieces less one
+    (:func:`seams_from_pieces`); a whole part, none."""
+    out = {}
+    for name, entry in parts.items():
+        if entry.get("datum_seams"):
+            out[name] = max(int(s.get("count", 0)) for s in entry["datum_seams"])
+        else:
+            pieces = int((entry.get("split") or {}).get("pieces", 1))
+            out[name] = seams_from_pieces({name: pieces})[name]
+    return out
+
+
 # ----------------------------------------------------------------------------------------- links
 
 def _drilled(hole: float, inner: float, process: ProcessErrors, axis: str) -> tuple[float, str]:
@@ -614,5 +629,5 @@ def with_process(printer: Printer, **figures) -> Printer:
 
 
 __all__ = ["AXES", "AdjusterSpec", "AxisVerdict", "ELEMENTS", "ElementStack", "Link", "Locator", "RESOLUTION_SHARE",
-           "DOME_FLOATS", "PARABOLOID_FLOATS", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_pieces", "stack",
+           "DOME_FLOATS", "PARABOLOID_FLOATS", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
            "table_lines", "with_process"]

@@ -151,3 +151,14 @@ def test_a_locator_naming_no_link_is_refused(table31_rig, mk3s):
     bad = S.Locator("register", "dome", ("no such link",), S.Link("x", "joint", ""))
     with pytest.raises(FabricationError, match="no link no such link on the dome's chain"):
         S.stack(table31_rig.profile, table31_rig.layout, mk3s, locators=(bad,))
+
+
+def test_seams_from_a_fab_record():
+    record = {
+        "base_plate": {"split": {"pieces": 4}, "datum_seams": [{"between": ["bore", "dowel 1"], "count": 1},
+                                                               {"between": ["bore", "dowel 2"], "count": 2}]},
+        "tower_shelf": {"split": {"pieces": 4}},  # no datum features declared: conservative n - 1
+        "tower_column": {"split": {"pieces": 1}},
+        "dome": {"split": {"pieces": 4}},  # its sectors are each bolted down
+    }
+    assert S.seams_from_fab(record) == {"base_plate": 2, "tower_shelf": 3, "tower_column": 0, "dome": 0}
