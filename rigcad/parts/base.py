@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 from rigcad.parts import breadboard
-from rigcad.parts.dome import flange_joint
+from rigcad.parts.dome import flange_joint, register
 from rigcad.parts.layout import RigLayout
 from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Union_
 from rigcad.parts.tower import column_joint_cuts, tongue_underside_cuts
@@ -28,6 +28,7 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
     bore = Cylinder((0.0, 0.0, -t - 1.0), holder.radius + holder.clearance, t + 2.0)
     groove = azimuth_groove(profile, tw.bench_z)
     holes = flange_joint(profile, layout).thread_holes()  # the dome's screws' insert pockets, as the joint declares
+    holes += register(profile, layout).lower_holes()  # the dome's register pins, pressed in
     joint = (*column_joint_cuts(tw, profile, tw.bench_z, -tw.bench_z, "top"), *tongue_underside_cuts(tw, profile, tw.bench_z))
     b = breadboard.board(profile)
     pads = breadboard.pads(profile, layout) if b else ()
