@@ -227,7 +227,15 @@ def tower_hardware(rig) -> list[dict]:
         return []
     from rigcad.parts.tower import hardware
 
-    return [h for h in hardware(rig.profile, rig.layout) if h.get("thread")]
+    return [h for h in hardware(rig.profile, rig.layout) if "spec" not in h]  # the optics: the purchased rows
+
+
+def tower_item(h: dict) -> str:
+    """A tower hardware row's item as it is ordered: thread and length, or its size."""
+    if h.get("thread"):
+        return f"{h['thread']} x {h['length_mm']:g} mm {h['item']}" if h.get("length_mm") else f"{h['item']} ({h['thread']})"
+    size = ([h["diameter_mm"]] if h.get("diameter_mm") else []) + ([h["length_mm"]] if h.get("length_mm") else [])
+    return f"{h['item']}, " + " x ".join(f"{v:g}" for v in size) + " mm" if size else h["item"]
 
 
 def fasteners(rig) -> list[dict]:
@@ -258,11 +266,10 @@ def fasteners(rig) -> list[dict]:
                      "length_mm": h["length_mm"], "note": "on the breadboard's grid (parts.breadboard)",
                      "thread": h["thread"]})
     for h in tower_hardware(rig):
-        item = (f"{h['thread']} x {h['length_mm']:g} mm {h['item']}" if h.get("length_mm")
-                else f"{h['item']} ({h['thread']})")
+        item = tower_item(h)
         rows.append({"item": item, "short": item, "quantity": h["quantity"],
                      "use": h["joins"], "length_mm": h.get("length_mm"), "note": "COP tower (parts.tower.hardware)",
-                     "thread": h["thread"], "tower": True})
+                     "thread": h["thread"], "tower": True, "steps": list(h.get("steps", ()))})
     return rows
 
 
@@ -342,21 +349,16 @@ _ITEMS = {"lens": "focusing lens", "beam_splitter": "plate beam splitter"}
 
 
 def _lead(rig, section: str) -> str:
-    """What an optic's row says before the profile's figures: the focusing lens's focal length (computed
-    by rigcad.optics.focus unless the profile gives it) and which way its curved face goes; the
-    splitter's coated face."""
-    if section == "lens" and getattr(getattr(rig, "layout", None), "tower", None) is not None:
-        from rigcad.optics.focus import focusing_lens
+    """What an optic's row says before the profile's figures: the catalogue line the tower states for it
+    (rigcad.parts.tower.hardware: the focusing lens's focal length from rigcad.optics.focus and which
+    way it faces; the splitter's ratio and its coated face), the one home of those facts."""
+    if getattr(getattr(rig, "layout", None), "tower", None) is None:
+        return ""
+    from rigcad.parts.tower import hardware
 
-        f = focusing_lens(rig.profile, rig.geometry)
-        how = ("the catalogue focal length whose focus range is centred on the paraboloid, rigcad.optics.focus"
-               if f.from_catalogue else "lens.focal_length")
-        return (f"**plano-convex singlet, f = {f.focal_length:g} mm** ({how}; a stock 50.8 mm (2 in) lens, e.g. "
-                "Thorlabs LA1xxx or Edmund Optics), its curved face towards the projector; ")
-    if section == "beam_splitter":
-        return ("**its coated (reflecting) face towards the projector and down, onto the paraboloid**: the "
-                "projector's light reflects off its front face, the camera looks through the plate; ")
-    return ""
+    item = {"lens": "focusing lens", "beam_splitter": "plate beam splitter"}.get(section)
+    row = next((h for h in hardware(rig.profile, rig.layout) if h["item"] == item), None)
+    return f"**{row['spec']}** ({row['joins']}); " if row else ""
 
 
 def _first_field(obj) -> str:
@@ -418,7 +420,7 @@ def bill(rig, fab_report: dict, printer) -> dict:
 
 
 __all__ = ["bill", "bolt_axes", "bolt_joints", "bolt_length", "coating_rows", "dowel_pins", "fasteners", "printed", "purchased",
-           "revolved_area", "thread_for_hole", "tower_hardware"]
+           "revolved_area", "thread_for_hole", "tower_hardware", "tower_item"]
 
 
 # -- consumables and tools ------------------------------------------------------------------------

@@ -564,8 +564,7 @@ def _section_assemble(d: Doc, c) -> None:
             text += (" To calibrate (section 6), lay the film on the plate now, before the dome: see \"The film at "
                      "the sample plane\".")
         for h in tower_at.get(st.name, []):
-            size = f"{h['thread']} x {h['length_mm']:g} mm" if h.get("length_mm") else h["thread"]
-            text += f" Fix it with {h['quantity']} x {h['item']} ({size}): {h['joins']}."
+            text += f" {'Fix it with' if h.get('thread') else 'Fit'} {h['quantity']} x {B.tower_item(h)}: {h['joins']}."
         d.h(3, f"Step {k + 1}: {label}")
         d.p(text)
         path = f"images/step_{k + 1:02d}_{st.name}.png"
@@ -599,17 +598,16 @@ def _approach(meshes, done: list[int], new: list[int], direction) -> dict:
 
 def _tower_rows_by_step(rig, steps) -> dict:
     """The tower's hardware rows (rigcad.parts.tower.hardware) that the plan does not place itself
-    (the tower's own joints), each with the last step whose part its "joins" text names."""
-    names = [(s.name, m) for s in steps for m in s.members]
+    (the tower's own joints), each in the last of the steps it declares (``steps``: data) that this
+    assembly has."""
+    order = [s.name for s in steps]
     out: dict = {}
     for h in B.tower_hardware(rig):
         if "mounting holes" in h["joins"] or tower_joints.placed(h):
             continue  # the instruments' screws and the tower joints' bolts: the plan's
-        named = [s for s, m in names
-                 if any(re.search(rf"\b{re.escape(k)}'?s?\b", h["joins"])
-                        for k in {m.replace("_", " "), m.replace("tower_", "").replace("_body", "").replace("_", " ")})]
+        named = [s for s in h.get("steps", ()) if s in order]
         if named:
-            out.setdefault(named[-1], []).append(h)
+            out.setdefault(max(named, key=order.index), []).append(h)
     return out
 
 

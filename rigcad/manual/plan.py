@@ -356,7 +356,10 @@ def bill_hardware(rig, steps: list[Step], bill: dict) -> list[dict]:
     rows = [{"item": r["item"], "quantity": r["quantity"], "where": f"assembly steps: {r['steps']}",
              "note": "as the assembly check fitted it", "steps": [s.split(" (")[0] for s in r["steps"].split(", ")]}
             for r in hardware(steps, rig)]
-    rows += [{"item": f["item"], "quantity": f["quantity"], "where": f["use"], "note": f["note"], "steps": []}
+    have = {st.name for st in steps}
+    rows += [{"item": f["item"], "quantity": f["quantity"],
+              "where": (f"assembly steps: {', '.join(s for s in f['steps'] if s in have)}: " if f.get("steps") else "")
+              + f["use"], "note": f["note"], "steps": [s for s in f.get("steps", ()) if s in have]}
              for f in bill["fasteners"] if f.get("tower") and "mounting holes" not in f["use"]
              and not tower_joints.placed({"joins": f["use"]}) and "heat-set insert" not in f["item"]]
     for part in rig.recipes.values():  # the locating pins the parts declare, in the step of the part they locate

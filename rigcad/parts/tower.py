@@ -840,26 +840,26 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
         length = core_bolt_lengths(profile, t)
         return [{"item": "bolt, ISO 4762 (no washer: the head bears on its counterbore's floor)", "thread": "M8",
                  "length_mm": length["foot"], "quantity": 1,
-                 "joins": "up through the base plate's tongue (its head in the counterbore underneath) into the "
+                 "steps": ('tower_column',), "joins": "up through the base plate's tongue (its head in the counterbore underneath) into the "
                           f"extrusion's core, tapped {CORE_TAP_DEPTH:g} mm deep"},
                 {"item": "countersunk socket screw, ISO 10642 (length with the head)", "thread": "M8",
                  "length_mm": length["top"], "quantity": 1,
-                 "joins": "down through the shelf (its head flush in the countersink on top) into the extrusion's core, "
+                 "steps": ('tower_shelf',), "joins": "down through the shelf (its head flush in the countersink on top) into the extrusion's core, "
                           f"tapped {CORE_TAP_DEPTH:g} mm deep"}]
     return [
         {"item": "bolt and washer", "thread": "M4", "length_mm": shelf_bolt_length(profile), "quantity": 4,
-         "joins": "the column's top flange to the shelf: up from under the flange into "
+         "steps": ('tower_shelf',), "joins": "the column's top flange to the shelf: up from under the flange into "
                   + ("heat-set inserts pressed into the shelf's underside" if profile.buy.shelf == "print" else
                      "M4 threads tapped in the shelf's underside (8 mm deep)")},
         {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length("M4", tw.wall + tongue - NUT_TRAP_DEPTH, nut_allowance("M4", washers=1)),
-         "quantity": 4, "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
+         "quantity": 4, "steps": ('tower_column',), "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
                                  "under the tongue, put in before it stands on the bench)"},
         *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT.hole,
-            "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]
+            "steps": ('tower_shelf',), "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]
           if profile.buy.shelf == "print" else []),
         {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
          "length_mm": float(longest_dowel(min(tw.wall, t.shelf_thickness) + tw.wall)), "quantity": 4,
-         "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf "
+         "steps": ('tower_column', 'tower_shelf'), "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf "
                   f"(ream the printed holes {profile.datum.dowel_diameter:g} H7)"},
     ]
 
@@ -876,26 +876,26 @@ def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
     return [
         {"item": f"set screw, {std} (cup point), a {g.ball:g} mm ball held in its cup", "thread": a.seat_thread,
          "length_mm": seat_screw_length(profile), "quantity": 3,
-         "joins": "the splitter holder's seat: a ball-ended push screw on the shelf's cone, vee or flat, turned from "
+         "steps": ('splitter_holder',), "joins": "the splitter holder's seat: a ball-ended push screw on the shelf's cone, vee or flat, turned from "
                   "above (tip/tilt and height)"},
         {"item": "heat-set insert", "thread": a.seat_thread, "length_mm": None, "quantity": 3,
-         "hole_mm": INSERTS[a.seat_thread].hole, "joins": "pressed into the holder's three seat bosses from above"},
+         "hole_mm": INSERTS[a.seat_thread].hole, "steps": ('splitter_holder',), "joins": "pressed into the holder's three seat bosses from above"},
         {"item": "steel ball, ISO 3290-1 grade G10", "thread": None, "length_mm": None, "quantity": 6,
          "diameter_mm": g.ball,
-         "joins": "three in the seat screws' cups (a drop of retaining compound), three pressed into the shelf's cone "
+         "steps": ('seat_cone_ball', 'seat_ball'), "joins": "three in the seat screws' cups (a drop of retaining compound), three pressed into the shelf's cone "
                   "pocket, touching"},
         {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": g.pin, "length_mm": float(SEAT_PIN_LENGTH),
-         "quantity": 2, "joins": "the seat's vee: pressed side by side into the shelf's channel"},
+         "quantity": 2, "steps": ('seat_vee_pin',), "joins": "the seat's vee: pressed side by side into the shelf's channel"},
         {"item": f"gauge block, ISO 3650 grade 2, {SEAT_PAD_LENGTH:g} mm", "thread": None, "length_mm": None,
          "quantity": 1, "size_mm": [*GAUGE_BLOCK_FACE, SEAT_PAD_LENGTH],
-         "joins": "the seat's flat: pressed into its pocket in the shelf, flush with its top"},
+         "steps": ('seat_flat_pad',), "joins": "the seat's flat: pressed into its pocket in the shelf, flush with its top"},
         {"item": "bolt, two washers, nut and compression spring", "thread": "M4",
          "length_mm": _length("M4", t.shelf_thickness + gap + tw.wall + spring["free_length"], nut), "quantity": 2,
          "spring_mm": {"inner_diameter": spring["outer_diameter"] - 2 * spring["wire"], "wire": spring["wire"],
                        "outer_diameter": spring["outer_diameter"], "free_length": spring["free_length"],
                        "installed_length": spring["installed_length"], "active_coils": spring["active_coils"]},
          "spring_rate_N_per_mm": force["rate_N_per_mm"], "preload_N": force["force_N"],
-         "joins": "from under the shelf up through the holder's flange; the spring under the nut holds the holder "
+         "steps": ('splitter_holder',), "joins": "from under the shelf up through the holder's flange; the spring under the nut holds the holder "
                   f"on its three contacts (nut set to {spring['installed_length']:g} mm of spring: "
                   f"{force['force_N']:.1f} N each, EN 13906-1)"},
     ]
@@ -938,7 +938,7 @@ def _projector_screw_rows(profile: Profile, layout) -> list[dict]:
         stacks.setdefault(r["length_mm"], []).append(r["shims"])
     return [{"item": "screw and washer", "thread": profile.projector.mount_thread, "length_mm": float(L),
              "quantity": len(_projector_feet(layout.tower)), "for_stacks_of_shims": ns,
-             "joins": "the projector's mounting holes, through the shelf's slots and a stack of "
+             "steps": ("projector_body",), "joins": "the projector's mounting holes, through the shelf's slots and a stack of "
                       f"{ns[0]}..{ns[-1]} shims (extra washers per stack: rigcad.parts.tower.projector_screws)"}
             for L, ns in stacks.items()]
 
@@ -948,7 +948,8 @@ def hardware(profile: Profile, layout) -> list[dict]:
     quantity, thread and length (grip plus nut or socket engagement, the shortest preferred length), and
     what it joins: the datum chain's dowels and bolts, the splitter seat's parts, the projector's
     screws per shim stack, the camera's two screws, the splitter and the focusing lens (bought to
-    the catalogue specification: ``splitter_spec``, ``rigcad.optics.focus``)."""
+    the catalogue specification: ``splitter_spec``, ``rigcad.optics.focus``). ``steps``: the assembly
+    steps (named by their part) that fit the item, as data: the manual places each row there."""
     t, tw, cm, bs, ln = layout.tower, profile.tower, profile.camera, profile.beam_splitter, profile.lens
     m4 = "M4"
     nut = nut_allowance(m4)
@@ -961,20 +962,21 @@ def hardware(profile: Profile, layout) -> list[dict]:
         *_column_hardware(profile, t, nut),
         *_seat_hardware(profile, t, nut),
         {"item": "bolt, washer and nut", "thread": m4, "length_mm": through, "quantity": len(lens_pts),
-         "joins": "the lens mount's slotted foot to the shelf"},
+         "steps": ('lens_mount',), "joins": "the lens mount's slotted foot to the shelf"},
         *_projector_screw_rows(profile, layout),
         {"item": "screw and washer", "thread": cm.mount_thread,
          "length_mm": _length(cm.mount_thread, bracket + shim_max, SOCKET_ENGAGEMENT), "quantity": 2,
-         "joins": f"the camera's two mounting holes ({cm.mount_spacing:g} mm apart along its axis), through the "
+         "steps": ('camera_body',), "joins": f"the camera's two mounting holes ({cm.mount_spacing:g} mm apart along its axis), through the "
                   "bracket's slot and its shim stack"},
         {"item": "plate beam splitter", "thread": None, "length_mm": None, "quantity": 1,
          "size_mm": [bs.width, bs.length, bs.thickness], "index": bs.index, "spec": splitter_spec(profile),
-         "joins": "slides into the splitter holder's grooves through its +y wall, coated face towards the projector"},
+         "steps": ('beam_splitter',), "joins": "slides into the splitter holder's grooves through its +y wall, coated face towards the projector"},
         {"item": "focusing lens", "thread": None, "length_mm": None, "quantity": 1,
          "size_mm": [ln.diameter, ln.thickness], "focal_length_mm": focus.focal_length,
          "spec": f"plano-convex singlet, {ln.diameter:g} mm diameter, f = {focus.focal_length:g} mm, N-BK7, "
-                 "AR coated 400-700 nm; its flat side towards the projector",
-         "joins": "drops into the lens mount's pocket"},
+                 "AR coated 400-700 nm; its curved side towards the projector (the nearly collimated beam: the "
+                 "least spherical aberration)",
+         "steps": ('focusing_lens',), "joins": "drops into the lens mount's pocket"},
     ]
 
 

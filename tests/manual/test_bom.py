@@ -303,19 +303,25 @@ def test_fasteners_add_nuts_and_washers_per_thread_and_the_towers_own(monkeypatc
         seen.append((profile, layout))
         return [{"thread": "M4", "length_mm": 12.0, "item": "button-head screw", "quantity": 3, "joins": "shelf + column"},
                 {"thread": "1/4-20", "item": "camera screw", "quantity": 1, "joins": "camera"},
-                {"thread": "", "item": "heat-set insert", "quantity": 4, "joins": "shelf"}]
+                {"thread": None, "item": "dowel pin", "diameter_mm": 4.0, "length_mm": 12.0, "quantity": 4,
+                 "joins": "shelf", "steps": ("tower_shelf",)},
+                {"thread": None, "item": "focusing lens", "spec": "f = 200 mm", "quantity": 1, "joins": "lens"}]
 
     monkeypatch.setattr(T, "hardware", hardware)
     rig.layout.tower = SimpleNamespace(column_x=500.0)  # a bought column: its core screw's axis, far off
-    assert [h["item"] for h in B.tower_hardware(rig)] == ["button-head screw", "camera screw"]
+    # every row but the optics (the purchased table's), the thread-less ones too
+    assert [h["item"] for h in B.tower_hardware(rig)] == ["button-head screw", "camera screw", "dowel pin"]
     assert seen == [(rig.profile, rig.layout)]
-    tower = B.fasteners(rig)[-2:]
+    tower = B.fasteners(rig)[-3:]
     assert tower == [
         {"item": "M4 x 12 mm button-head screw", "short": "M4 x 12 mm button-head screw", "quantity": 3,
          "use": "shelf + column", "length_mm": 12.0, "note": "COP tower (parts.tower.hardware)", "thread": "M4",
-         "tower": True},
+         "tower": True, "steps": []},
         {"item": "camera screw (1/4-20)", "short": "camera screw (1/4-20)", "quantity": 1, "use": "camera",
-         "length_mm": None, "note": "COP tower (parts.tower.hardware)", "thread": "1/4-20", "tower": True}]
+         "length_mm": None, "note": "COP tower (parts.tower.hardware)", "thread": "1/4-20", "tower": True, "steps": []},
+        {"item": "dowel pin, 4 x 12 mm", "short": "dowel pin, 4 x 12 mm", "quantity": 4, "use": "shelf",
+         "length_mm": 12.0, "note": "COP tower (parts.tower.hardware)", "thread": None, "tower": True,
+         "steps": ["tower_shelf"]}]
 
 
 # -- pins, printed pieces, purchased items ----------------------------------------------------------
@@ -415,7 +421,7 @@ def test_purchased_rows_describe_every_field_with_its_unit():
     profile.beam_splitter = profile.splitter = profile.projector = Camera()
     rows = B.purchased(SimpleNamespace(profile=profile))
     assert [r["item"] for r in rows] == ["projector", "camera", "plate beam splitter", "splitter", "focusing lens"]
-    assert rows[2]["spec"].startswith("**its coated (reflecting) face towards the projector")
+
 
 
 def test_the_bill_sums_the_coating_by_layer_and_measures_each_mirror():
@@ -463,3 +469,6 @@ def test_the_bill_names_the_focusing_lens_by_its_focal_length(table31_rig):
     u = 1.0 / (1.0 / f.focal_length + 1.0 / (f.focus_near - s))
     assert u == pytest.approx(f.image_near, rel=1e-9)
     assert f"f = {f.focal_length:g} mm" in row["spec"] and "plano-convex" in row["spec"]
+    assert "curved side towards the projector" in row["spec"]
+    (row,) = [r for r in B.purchased(table31_rig) if r["item"].startswith("plate beam splitter")]
+    assert "coated face towards the projector" in row["spec"]

@@ -121,7 +121,8 @@ def test_the_tower_hardware_is_the_towers_and_follows_the_mounting_threads(tmp_p
 
     rows = B.fasteners(table31_rig)
     tower = [r for r in rows if r.get("tower")]
-    assert len(tower) == len([h for h in hardware(table31_rig.profile, table31_rig.layout) if h.get("thread")]) > 0
+    # every row of the tower's but its optics (those are the purchased table's)
+    assert len(tower) == len([h for h in hardware(table31_rig.profile, table31_rig.layout) if "spec" not in h]) > 0
     assert not any(set(j["parts"]) & {"tower_column", "tower_shelf"} for j in B.bolt_joints(table31_rig)), \
         "the tower's joints have one home (parts.tower.hardware), not two"
     other = _profile(tmp_path, "thread", "projector:\n  mount_thread: M6\n")
@@ -328,3 +329,24 @@ def test_manual_md_states_the_figures_manual_json_holds(written):
     other = json.loads(json.dumps(doc))
     other["bill"]["printed"][0]["quantity"] = (other["bill"]["printed"][0]["quantity"] or 0) + 1
     assert disagreements(md, other)
+
+
+def test_every_hardware_line_has_its_step_and_every_bought_step_its_line(table31_rig):
+    """The bill's hardware lines name the steps that fit them (as data: the plan's fasteners, the parts'
+    declared registers, the tower's rows' ``steps``), and every bought part a step puts in is in the
+    bill: the optics table or a hardware line of that step."""
+    from rigcad.manual import bom as B
+    from rigcad.manual import plan
+    from rigcad.manual.assembly import picture_meshes
+
+    steps = plan.steps(table31_rig, picture_meshes(table31_rig))[0]
+    names = {s.name for s in steps}
+    rows = plan.bill_hardware(table31_rig, steps, {"fasteners": B.fasteners(table31_rig), "pins": None})
+    for r in rows:
+        if r["steps"] == ["with the bolts above"]:
+            continue  # the nuts, washers and inserts counted from the bolts of the steps above
+        assert r["steps"] and set(r["steps"]) <= names, r
+    optics = {"projector_body", "camera_body", "beam_splitter", "focusing_lens"}
+    for st in steps:
+        if st.bought and st.name not in optics:
+            assert any(st.name in r["steps"] for r in rows), st.name
