@@ -24,6 +24,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from rigcad.progress import stages
     from rigcad.calibrate.kit import write_kit
 
+    if any(getattr(args, k, None) for k in ("gray_card", "gray_card_kit", "gray_card_simulate")):
+        return _gray_card(args)
     rig, runs = _before_any_work(args)
     capture_out = getattr(args, "write_capture", None)
     if runs is not None:
@@ -427,6 +429,18 @@ def register(subparsers) -> argparse.ArgumentParser:
                      "calibration.json (or the calibrate/ folder holding it) of two or more calibrations of one rig left "
                      "as it is, the screen laid anew for each: the value for calibration.screen_seating, into "
                      "<exports>/<profile>/calibrate_seating")
+    src.add_argument("--gray-card", metavar="DIR", help="the reflectance calibration (thesis 4.1.2): captures of the "
+                     "18 %% gray card (white_<ms>ms, z_<l>_<m>_<pos|neg>_<ms>ms .png|tif): the camera's response curve, "
+                     "the scale factors and PASS or FAIL, into <exports>/<profile>/calibrate_graycard")
+    src.add_argument("--gray-card-kit", action="store_true", help="write the gray card's projector images and "
+                     "capture plan into <exports>/<profile>/calibrate_graycard_kit")
+    src.add_argument("--gray-card-simulate", action="store_true", help="render a seeded simulated gray card capture "
+                     "(a planted response curve, card and throughputs) and calibrate from it")
+    p.add_argument("--exposures-ms", nargs="+", type=float, metavar="MS", default=None,
+                   help="with --gray-card*: the basis frames' exposures (default 62.5 125 250, thesis Figure 4.4)")
+    p.add_argument("--response-exposures-ms", nargs="+", type=float, metavar="MS", default=None,
+                   help="with --gray-card*: the white field's bracket for the response curve "
+                        "(default 7.8125 15.625 31.25 62.5 125 250 500)")
     p.add_argument("--seed", type=int, default=2006, help="seed of the simulated misalignment and noise")
     p.add_argument("--laying", type=int, default=0, metavar="K", help="with --simulate: the screens laid anew the "
                    "K-th time on --seed's rig (its misalignment, surface, spacers and wedges kept; the hand's "
@@ -434,3 +448,125 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--write-capture", metavar="DIR", help="with --simulate: also write the simulated camera "
                    "images into DIR (new or empty), named as --images reads them: a capture to rehearse on")
     return p
+
+
+def _gray_card(args: argparse.Namespace) -> int:
+    """``--gray-card DIR``, ``--gray-card-simulate``, ``--gray-card-kit``: the reflectance calibration
+    (rigcad.calibrate.graycard) into ``<exports>/<profile>/calibrate_graycard/`` (graycard.json,
+    scale_factors.npz; published together, on PASS and on FAIL, which exits 1), or its kit into
+    ``calibrate_graycard_kit/``. Every refusal comes before anything is written."""
+    import numpy as np
+
+    from rigcad.basis.card_light import card_light
+    from rigcad.calibrate import graycard as G
+    from rigcad.errors import ExportError
+    from rigcad.export.atomic import Staging, json_bytes, profile_lock
+    from rigcad.export.manifest import profile_digest
+    from rigcad.rig import load
+
+    plan = G.Plan(exposures_ms=tuple(args.exposures_ms or G.EXPOSURES_MS),
+                  response_exposures_ms=tuple(args.response_exposures_ms or G.RESPONSE_EXPOSURES_MS))
+    for flag, bad in (("--laying", getattr(args, "laying", 0)), ("--seating", getattr(args, "seating", None))):
+        if bad:
+            raise ExportError(f"{flag}: not with the gray card (it belongs to the deflectometric calibration)")
+    capture_out = getattr(args, "write_capture", None)
+    if capture_out:
+        if not args.gray_card_simulate:
+            raise ExportError(f"--write-capture {capture_out}: only with --simulate or --gray-card-simulate (it "
+                              "writes the simulated capture)")
+        _check_capture_folder(Path(capture_out), True)
+    rig = load(args.profile)
+    light = card_light(rig, plan.order)
+    if args.gray_card_kit:
+        return _gray_card_kit(rig, plan, light, Path(args.exports))
+    view = G.view_of(rig)
+    truth = None
+    if args.gray_card_simulate:
+        truth = G.planted(view, light)
+        images = G.render(plan, view, light, truth, np.random.default_rng(args.seed))
+        if capture_out:
+            _write_gray_capture(Path(capture_out), plan, view, images, args.profile)
+        capture = G.as_read(plan, images)
+    else:
+        capture = G.read(Path(args.gray_card), plan, view)
+    result = G.analyse(plan, capture, view, light)
+    report = {"profile": rig.name, "source": "simulated" if truth else str(args.gray_card), **result.report}
+    if truth is not None:
+        report["simulation"] = {"seed": args.seed, "planted": "gamma 2.2 camera, 18 % card, the camera side falling "
+                                "20 % to grazing, the light 15 % (graycard.planted)",
+                                **G.compare(result, truth, view, light)}
+    out = Path(args.exports) / rig.name / "calibrate_graycard"
+    with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
+        st.write_bytes(out / "graycard.json", json_bytes(report))
+        st.write_bytes(out / "scale_factors.npz", _gray_npz(result, view, light))
+        st.commit()
+    print(G.summary(result))
+    print(f"wrote {out}")
+    return 0 if result.passed else 1
+
+
+def _gray_npz(result, view, light) -> bytes:
+    """scale_factors.npz: the camera side's scale factor per window pixel, the light side's per lit
+    projector pixel and as zonal coefficients, and the response curve."""
+    import numpy as np
+
+    cam = view.cam
+    buf = io.BytesIO()
+    np.savez_compressed(
+        buf, camera_scale=result.camera_scale, row0=cam.row0, col0=cam.col0, resolution=np.array(cam.resolution),
+        light_throughput=result.fit.light_g, projector_row=light.row, projector_col=light.col,
+        light_zonal_coefficients=result.fit.b, alpha_rad=light.alpha_rad,
+        response_knots=result.response.knots, response_log_exposure=result.response.log_radiance,
+        response_toe=result.response.toe, about=json.dumps({
+            "camera_scale": "1 / t per camera window pixel (NaN off the card's pixels): divide a capture's radiance by "
+                            "t, i.e. multiply by this",
+            "light_throughput": "kappa g per lit projector pixel (radiance per second per projector level per unit "
+                                "f cos theta per sr): eq. 4.2's lambda = 1 / light_throughput "
+                                "(rigcad.calibrate.graycard.calibrated applies both)",
+            "light_zonal_coefficients": "kappa g in the zonal basis (order 2, zone alpha_rad..pi/2)",
+            "response": "log linear exposure at the knots (fractions of full scale), linear to 0 below response_toe"}))
+    return buf.getvalue()
+
+
+def _write_gray_capture(folder: Path, plan, view, images: dict, profile: str) -> None:
+    """The simulated gray card capture as the full-frame PNG files ``--gray-card`` reads, at once."""
+    from rigcad.calibrate import graycard as G
+    from rigcad.export.atomic import Staging
+    from rigcad.export.png import gray_png
+
+    with Staging(folder) as st:
+        for (frame, ms), im in images.items():
+            e = (plan.response_exposures_ms if frame == G.WHITE else plan.exposures_ms).index(ms)
+            st.write_bytes(plan.path(folder, frame, e), gray_png(G.full_frame(view, im)))
+        st.commit()
+    print(f"wrote the simulated gray card capture: {len(images)} images in {folder} (rigcad calibrate {profile} "
+          f"--gray-card {folder} reads them)")
+
+
+def _gray_card_kit(rig, plan, light, exports: Path) -> int:
+    """The gray card's kit: the projector images (white.png, z_<l>_<m>_<pos|neg>.png), capture_plan.json
+    (every file to capture) and procedure.md, into ``<exports>/<profile>/calibrate_graycard_kit/``."""
+    from rigcad.calibrate import graycard as G
+    from rigcad.export.atomic import Staging, json_bytes, profile_lock
+    from rigcad.export.manifest import profile_digest
+    from rigcad.export.png import gray_png
+
+    out = exports / rig.name / "calibrate_graycard_kit"
+    files = [(G.WHITE, ms) for ms in plan.response_exposures_ms] + [(f, ms) for f in plan.frames() for ms in plan.exposures_ms]
+    capture = {"about": "show each projector image, capture it at each of its exposures (gain fixed, automatic "
+                        "exposure off) into one folder; then rigcad calibrate PROFILE --gray-card FOLDER",
+               "projector_images": [f"projector/{f}.png" for f in (G.WHITE,) + plan.frames()],
+               "captures": [{"show": f"projector/{f}.png", "exposure_ms": ms,
+                             "file": plan.path(Path("."), f, (plan.response_exposures_ms if f == G.WHITE
+                                                              else plan.exposures_ms).index(ms)).name}
+                            for f, ms in files]}
+    with Staging(out, lock=profile_lock(exports, rig.name), carry=lambda rel: False,
+                 made_from=profile_digest(rig.profile)) as st:
+        for f in (G.WHITE,) + plan.frames():
+            st.write_bytes(out / "projector" / f"{f}.png", gray_png(light.image(f)))
+        st.write_bytes(out / "capture_plan.json", json_bytes(capture))
+        st.write_bytes(out / "procedure.md", (f"# The gray card (thesis 4.1.2)\n\n{G.manual_text(rig)}\n").encode())
+        st.commit()
+    print(f"gray card kit for {rig.name}: {len(plan.frames()) + 1} projector images, {len(files)} captures to take; "
+          f"wrote {out}")
+    return 0
