@@ -185,7 +185,8 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
         "tower": tower,
         "misalignment": misalignment,
         "monte_carlo": mc,
-        "camera": camera_model(profile, rig.geometry).as_dict(),  # its lens and the paraboloid's image
+        # the camera's lens and the paraboloid's image on its sensor (none with the COP at infinity)
+        "camera": None if rig.geometry.cop_at_infinity else camera_model(profile, rig.geometry).as_dict(),
     }
     rows = tolerances.evaluate(profile, report)
     report["checks"] = [r.as_dict() for r in rows]
