@@ -41,6 +41,17 @@ def refuse_foreign_design(profile_spec, name: str, out: Path) -> None:
                            "so the design goes under the exports")
 
 
+def assembly_gate(rig) -> None:
+    """The assembly gate on a certified design (rigcad.manual.gate.verdict, no search for fixes): a rig
+    that cannot be put together raises AssemblyError, and the optimiser tries its next design."""
+    from rigcad.errors import AssemblyError
+    from rigcad.manual import gate
+
+    v = gate.verdict(rig, search=False)
+    if not v.ok:
+        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles)
+
+
 def cmd_optimize(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
@@ -60,7 +71,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
         bar.set_postfix_str(f"best merit {best:.6g}")
 
     try:
-        run = run_optimize(args.profile, Path(args.exports), engine, overrides, progress)
+        run = run_optimize(args.profile, Path(args.exports), engine, overrides, progress, certify_also=assembly_gate)
     finally:
         bar.close()
     rep = run.report

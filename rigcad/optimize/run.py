@@ -153,9 +153,11 @@ def _custom_focal_length(profile, geometry) -> float | None:
         return f
 
 
-def certify(problem: Problem, row: dict) -> dict:
+def certify(problem: Problem, row: dict, also=None) -> dict:
     """The chosen design on the certified path (converged DOP853 dome, the 2D design's report) beside
-    the fast path's figures: the differences say how far the optimiser's evaluation can be trusted."""
+    the fast path's figures: the differences say how far the optimiser's evaluation can be trusted.
+    ``also(rig)``: a further check of the design's rig that raises a RigcadError to refuse it (the
+    command passes the assembly gate, rigcad.manual.gate, which lives on a floor this one cannot import)."""
     from rigcad.parts.tower import shelf_bottom_z
 
     rig, tol = certified_rig(problem, row)
@@ -165,6 +167,8 @@ def certify(problem: Problem, row: dict) -> dict:
     layout = rig.layout
     rig.recipes
     row["focal_length_mm"] = _custom_focal_length(rig.profile, layout.geometry)
+    if also is not None:
+        also(rig)
     row["dome_tolerance_mm"] = tol
     r = rig.design.report
     f = row["figures"]
@@ -186,9 +190,10 @@ def certify(problem: Problem, row: dict) -> dict:
 
 
 def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine | None = None, overrides=None,
-                 progress=None) -> OptimizeRun:
+                 progress=None, certify_also=None) -> OptimizeRun:
     """Search and publish (module docstring). Raises OptimizeError (after publishing the record of
-    every evaluation) when no design meets the constraints."""
+    every evaluation) when no design meets the constraints. ``certify_also``: :func:`certify`'s
+    ``also``, a check every certified design must pass (a design it refuses gives way to the next)."""
     from rigcad import plots
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
 
@@ -201,7 +206,7 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
     report = _report(problem, result, engine)
     files: dict[str, bytes] = {}
     profile_path = None
-    rejected = _certify_choice(problem, result, report) if result.chosen is not None else []
+    rejected = _certify_choice(problem, result, report, certify_also) if result.chosen is not None else []
     if result.chosen is not None:
         note = f"seed {spec.seed}, {len(result.history)} evaluations, {result.method}; {result.reason}"
         stem = f"{name}_design"
@@ -260,7 +265,7 @@ def _report(problem, result, engine: Engine) -> dict:
     }
 
 
-def _certify_choice(problem, result, report: dict) -> list[dict]:
+def _certify_choice(problem, result, report: dict, also=None) -> list[dict]:
     """Certify the search's choice: the certified path (converged DOP853 dome at the profile's
     dome.tolerance) has the last word, and a design it refuses (e.g. a tolerance float64 cannot
     certify there) gives way to the next in preference, up to MAX_CERTIFY. Sets ``result.chosen``
@@ -268,7 +273,7 @@ def _certify_choice(problem, result, report: dict) -> list[dict]:
     rejected = []
     for row, why in preference(problem, result)[:MAX_CERTIFY]:
         try:
-            report["certified_check"] = certify(problem, row)
+            report["certified_check"] = certify(problem, row, also)
         except RigcadError as err:
             rejected.append({"index": row["index"], "error": str(err)})
             continue
