@@ -600,8 +600,7 @@ def analyse(plan: Plan, capture: Capture, view: View, light: Light, albedo: floa
          f"the card's response separates to {np.percentile(blocks, 95):.2%} over {BLOCK_PX} x {BLOCK_PX} px blocks "
          f"(95th percentile; bound {MAX_SEPARABLE_RESIDUAL:.0%})"),
         ("card_flat", 0 < ratio <= MAX_ILLUMINATION_RATIO,
-         f"the light's throughput over the lit directions varies {ratio:.2f}x (bound {MAX_ILLUMINATION_RATIO:g}x: "
-         "a tilted card reads as more)"),
+         f"the light's throughput over the lit directions varies {ratio:.2f}x (bound {MAX_ILLUMINATION_RATIO:g}x)"),
         ("no_outliers", outliers <= MAX_OUTLIER_SHARE,
          f"{outliers:.2%} of the card's pixels off the median throughput by over {OUTLIER_FACTOR:g}x (bound "
          f"{MAX_OUTLIER_SHARE:.1%})"),
