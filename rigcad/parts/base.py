@@ -7,9 +7,10 @@ import math
 
 from rigcad.parts import breadboard
 from rigcad.parts.dome import flange_joint, register
+from rigcad.parts.joints import Datum, datums_of
 from rigcad.parts.layout import RigLayout
 from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Union_
-from rigcad.parts.tower import column_joint_cuts, tongue_underside_cuts
+from rigcad.parts.tower import column_datums, column_joint_cuts, tongue_underside_cuts
 from rigcad.profile.schema import Profile
 
 
@@ -27,22 +28,29 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
     tongue = Box((x0, -half, tw.bench_z), (tw.column_x + half, half, 0.0))  # down to the bench: the tower's weight
     bore = Cylinder((0.0, 0.0, -t - 1.0), holder.radius + holder.clearance, t + 2.0)
     groove = azimuth_groove(profile, tw.bench_z)
-    holes = flange_joint(profile, layout).thread_holes()  # the dome's screws' insert pockets, as the joint declares
-    holes += register(profile, layout).lower_holes()  # the dome's register pins, pressed in
+    inserts = flange_joint(profile, layout).thread_holes()  # the dome's screws' insert pockets, as the joint declares
+    pins = register(profile, layout).lower_holes()  # the dome's register pins, pressed in
+    holes = inserts + pins
     joint = (*column_joint_cuts(tw, profile, tw.bench_z, -tw.bench_z, "top"), *tongue_underside_cuts(tw, profile, tw.bench_z))
+    # the datum features a split keeps off: the sample bore (O), the dome's insert pockets and register pins,
+    # the column's dowel holes (or the extrusion's pocket) in the tongue; each is also one of the cuts above
+    datums = (Datum("sample bore", "bore", bore), *datums_of("insert", "flange insert pocket", inserts),
+              *datums_of("register", "dome register pin hole", pins),
+              *column_datums(tw, profile, tw.bench_z, -tw.bench_z, "top", "tongue"))
     b = breadboard.board(profile)
     pads = breadboard.pads(profile, layout) if b else ()
     anchors = breadboard.holes(profile, layout) if b else ()
     on_board = "" if b is None else (
         f"; it stands on the {b.title}: the sample point over a tapped hole, the tongue along a row of holes, "
         f"screwed down on the grid through its pad and the boss under the disc")
+    desc = ("base plate, the rig's datum: the dome's flange screws into its heat-set inserts; the sample holder slides "
+            "into its bore (the groove under the disc on the tongue's side is the calibration parts' turn mark); "
+            "its tongue locates the tower's column " + (
+                f"by two {profile.datum.dowel_diameter:g} mm dowels (reamed H7) and four bolts"
+                if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core")
+            + on_board)
     return Part("base_plate", Difference(Union_((plate, tongue, *pads)), (bore, groove, *holes, *joint, *anchors)),
-                (0.55, 0.57, 0.6), "base plate, the rig's datum: the dome's flange screws into its heat-set inserts; the sample holder slides "
-                "into its bore (the groove under the disc on the tongue's side is the calibration parts' turn mark); "
-                "its tongue locates the tower's column " + (
-                    f"by two {profile.datum.dowel_diameter:g} mm dowels (reamed H7) and four bolts"
-                    if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core")
-                + on_board)
+                (0.55, 0.57, 0.6), desc, datums=datums)
 
 
 #: The turn mark under the base plate: a groove across the disc's underside along +x (the tongue's
