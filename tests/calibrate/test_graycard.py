@@ -243,3 +243,19 @@ def test_command_simulates_writes_and_reads_back(tmp_path, capsys):
     kit = ex / "achutha2006" / "calibrate_graycard_kit"
     plan = json.loads((kit / "capture_plan.json").read_text())
     assert len(plan["captures"]) == 7 + 18 * 3 and (kit / "projector" / "z_2_+2_neg.png").exists()
+
+
+def test_the_page_states_the_codes_criterion_and_plan():
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[2] / "docs" / "calibrate.md").read_text(encoding="utf-8")
+    section = " ".join(page[page.index("## The gray card"):page.index("## How it works")].replace("<!--given-->", "").split())
+    want = [f"within {G.MAX_EXPOSURE_SPREAD:.1%} RMS".replace("%", " %"),
+            f"separable within {G.MAX_SEPARABLE_RESIDUAL:.0%}".replace("%", " %"),
+            f"within {G.MAX_ILLUMINATION_RATIO:g}x", f"at most {G.MAX_OUTLIER_SHARE:.1%}".replace("%", " %"),
+            f"by {G.OUTLIER_FACTOR:g}x", f"at least {G.MIN_FILL:.0%}".replace("%", " %"),
+            f"{G.RESPONSE_EXPOSURES_MS[0]:g}-{G.RESPONSE_EXPOSURES_MS[-1]:g} ms",
+            ", ".join(f"{v:g}" for v in G.EXPOSURES_MS[:-1]) + f" and {G.EXPOSURES_MS[-1]:g} ms",
+            f"order {G.ORDER}", f"{G.BLOCK_PX} x {G.BLOCK_PX} px"]
+    missing = [w for w in want if w not in section]
+    assert not missing, missing
