@@ -596,7 +596,7 @@ def analyse(plan: Plan, capture: Capture, view: View, light: Light, albedo: floa
     theta_o = view.theta_o.reshape(view.cam.shape)[used]
     checks = [
         ("exposures_agree", spread["rms"] <= MAX_EXPOSURE_SPREAD,
-         f"exposures agree to {spread['rms']:.2%} RMS once linearised (bound {MAX_EXPOSURE_SPREAD:.0%})"),
+         f"exposures agree to {spread['rms']:.2%} RMS once linearised (bound {MAX_EXPOSURE_SPREAD:.1%})"),
         ("curve_rises", response.monotone(), "the response curve rises over the values captured"),
         ("card_lambertian", float(np.percentile(blocks, 95)) <= MAX_SEPARABLE_RESIDUAL,
          f"the card's response separates to {np.percentile(blocks, 95):.2%} over {BLOCK_PX} x {BLOCK_PX} px blocks "

@@ -98,7 +98,7 @@ def test_a_mislabelled_exposure_fails(rig_sides, gamma_run):
     wrong = G.Plan(exposures_ms=(62.5, 125.0, 500.0))
     result = G.analyse(wrong, capture, view, light)
     spread = result.report["response_curve"]["exposure_spread"]["frames"]["rms"]
-    assert not result.passed and spread > G.MAX_EXPOSURE_SPREAD, spread
+    assert not result.passed and spread > G.MAX_EXPOSURE_SPREAD, spread  # measured 16 % (seed 0)
     assert "exposures agree" in G.summary(result) and "failed" in G.summary(result)
 
 
@@ -110,7 +110,7 @@ def test_a_camera_taken_as_linear_fails(rig_sides, gamma_run):
                         result.response.covered)
     white_b = G.series_blocks(capture.white[None], view.used)
     spread = G.exposure_spread(linear, white_b, plan.response_exposures_s)["rms"]
-    assert spread > 10 * G.MAX_EXPOSURE_SPREAD, spread  # measured ~0.3: a factor 2 of exposure reads as 1.37
+    assert spread > 10 * G.MAX_EXPOSURE_SPREAD, spread  # measured 0.52 (seed 0): a factor 2 of exposure reads as 1.37
 
 
 @pytest.mark.e2e
