@@ -225,6 +225,12 @@ class HexKey:
     long_arm: float
     short_arm: float
 
+    @property
+    def room(self) -> float:
+        """The radius (mm) a key and the hand turning it need around its axis: its corners (across
+        flats / sqrt 3) and half a millimetre of play."""
+        return self.size / 3 ** 0.5 + 0.5
+
 
 #: ISO 2936 hex keys, short series: across flats (mm) -> long arm, short arm (mm); inch keys by the
 #: same table's nearest rows.

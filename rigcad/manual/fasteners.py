@@ -18,7 +18,7 @@ def driver(thread: str, out_dir=(1.0, 0.0, 0.0), key: float | None = None) -> tu
     arm in the socket and its long arm out along ``out_dir`` (away from the rig's axis). ``key``:
     the socket's size (mm) when it is not the cap screw's (HEX_KEY), as in a countersunk head."""
     key = THREADS[thread].hex_key if key is None else key
-    r = key / np.sqrt(3.0) + 0.5  # the key's corners, and a little play for the hand
+    r = HEX_KEYS[key].room  # the key's corners, and a little play for the hand
     long, short = HEX_KEYS[key].long_arm, HEX_KEYS[key].short_arm
     return (Tool(f"{key:g} mm hex screwdriver (ISO 2936 hex), {DRIVER_BLADE_MM:g} mm blade", DRIVER_BLADE_MM, r),
             Tool(f"{key:g} mm L hex key (ISO 2936, {long:g} x {short:g} mm), short arm in", short, r, long,

@@ -28,6 +28,7 @@ import numpy as np
 from rigcad.errors import GeometryError
 from rigcad.optics.design import MIN_THETA_SPAN_DEG, cop_bundle_radius
 from rigcad.optics.dome import dt_ds, equal_path_t, occlusion_s, reflected_rays, start
+from rigcad.parts.layout import flange_extent
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
 
@@ -188,7 +189,7 @@ def _printed_outline(profile: Profile, Do, u):
     outer = inner + shell.wall * normal
     fl_in = float(np.interp(shell.flange_thickness, outer[:, 1], outer[:, 0])) if outer[0, 1] < shell.flange_thickness \
         else float(outer[0, 0])
-    fl_out = fl_in + shell.flange_width
+    fl_out, _ = flange_extent(fl_in, outer, shell, lambda z: np.interp(z, outer[:, 1], outer[:, 0]))
     outline = Outline(outer=outer[outer[:, 1] >= shell.flange_thickness], inner=inner[inner[:, 1] >= 0.0],
                       flange=np.array([[fl_out, 0.0], [fl_out, shell.flange_thickness], [fl_in, shell.flange_thickness],
                                        [float(np.interp(0.0, inner[:, 1], inner[:, 0])), 0.0]]))

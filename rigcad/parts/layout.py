@@ -108,6 +108,31 @@ class RigLayout:
         }
 
 
+def flange_extent(flange_in: float, wall: np.ndarray, shell, wall_r_at=None) -> tuple[float, float]:
+    """The flange's outer radius and bolt circle radius (mm) for a dome whose outer wall meets the
+    flange's top at ``flange_in`` mm, its wall sampled as (r, z) rows ``wall`` (``wall_r_at(z)``: the
+    wall's radius at a height, exactly, when the caller has it). The bolts stand mid-flange, or farther
+    out where the wall leans over the flange: each bolt is turned by its hex key's short arm up from
+    the head and its long arm out from the arm's end, and the key must clear the wall (ISO 2936,
+    ``HexKey.room``; the thread is the one the flange's holes are for). One home for the optimiser's
+    fast outline (rigcad.optimize.fast) and the parts' layout."""
+    from rigcad.standards import HEX_KEYS, THREADS, thread_for_hole
+
+    bolt = flange_in + shell.flange_width / 2
+    try:
+        th = THREADS[thread_for_hole(shell.bolt_diameter).name]
+    except ValueError:
+        return bolt + shell.flange_width / 2, bolt  # no thread fits the hole: the flange joint refuses it
+    key = HEX_KEYS[th.hex_key]
+    top = shell.flange_thickness + th.washer_thickness + th.head_height + key.short_arm + key.room
+    band = list(wall[(wall[:, 1] >= shell.flange_thickness) & (wall[:, 1] <= top), 0])
+    if wall_r_at is not None and wall[:, 1].max() >= top:  # the band's top edge: the wall rises towards it
+        band.append(float(wall_r_at(top)))
+    if band:
+        bolt = max(bolt, max(band) + key.room)
+    return bolt + shell.flange_width / 2, bolt
+
+
 def rig_layout(profile: Profile, geometry: Derived, dome: DomeProfile) -> RigLayout:
     """Compute the placements; raise GeometryError naming the parameter when parts cannot fit."""
     if dome.kind != "smooth":
@@ -131,7 +156,10 @@ def rig_layout(profile: Profile, geometry: Derived, dome: DomeProfile) -> RigLay
             f"bolt holes of {shell.bolt_diameter:g} mm do not fit a {shell.flange_width:g} mm flange with 1 mm of "
             "material each side: widen dome_shell.flange_width or shrink dome_shell.bolt_diameter",
             where=profile.where("dome_shell", "bolt_diameter"))
-    bolt_r = 0.5 * (flange_in + flange_out)
+    # mid-flange, or out from under a wall that leans over it (the bolts' hex keys: flange_extent)
+    flange_out, bolt_r = flange_extent(
+        flange_in, dome_outer.points(dome_outer.sample(4001)), shell,
+        lambda z: dome_outer.points(np.array([u_at_height(dome_outer, z)]))[0, 0])
     angles = tuple((k + 0.5) * 2 * math.pi / shell.bolts for k in range(shell.bolts))
 
     mount, beam = profile.paraboloid_mount, profile.beam
