@@ -294,19 +294,26 @@ class Capture:
     frames: np.ndarray
 
 
-def read(folder: Path, plan: Plan, view: View) -> Capture:
-    """Every file of the capture (:meth:`Plan.files`), cut to the camera's window; each missing,
-    mis-sized, saturated, dark or mislabelled one refused with one line naming its file."""
-    from rigcad.calibrate.images import read_image
-
+def check_present(folder: Path, plan: Plan) -> list[Path]:
+    """Every file of the capture (:meth:`Plan.files`'s order), or a refusal naming the first missing
+    one and the naming scheme (no image read: before any work)."""
     folder = Path(folder)
-    cam = view.cam
     index = {WHITE: plan.response_exposures_ms} | {f: plan.exposures_ms for f in plan.frames()}
     paths = [plan.path(folder, f, index[f].index(e)) for f, e in plan.files()]
     missing = [p for p in paths if not os.path.lexists(p)]
     if missing:
         more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
-        raise GrayCardError(f"{missing[0]}: missing{more}; the gray card's capture is {plan.naming()}")
+        raise GrayCardError(f"{_shown(missing[0])}: missing{more}; the gray card's capture is {plan.naming()}")
+    return paths
+
+
+def read(folder: Path, plan: Plan, view: View) -> Capture:
+    """Every file of the capture (:meth:`Plan.files`), cut to the camera's window; each missing,
+    mis-sized, saturated, dark or mislabelled one refused with one line naming its file."""
+    from rigcad.calibrate.images import read_image
+
+    cam = view.cam
+    paths = check_present(folder, plan)
     images = np.stack([read_image(p, cam.resolution, window=cam.crop) for p in paths])
     nw = len(plan.response_exposures_ms)
     capture = Capture(images[:nw], images[nw:].reshape((len(plan.frames()), len(plan.exposures_ms)) + cam.shape))
@@ -323,12 +330,12 @@ def check_exposures(folder: Path, plan: Plan, view: View, capture: Capture) -> N
         sat = float(np.mean(image[used] >= SATURATED))
         if sat > SATURATED_SHARE:
             ms = (plan.response_exposures_ms if f == WHITE else plan.exposures_ms)[0]
-            raise GrayCardError(f"{plan.path(folder, f, 0)}: saturated ({sat:.1%} of the card's pixels at full "
+            raise GrayCardError(f"{_shown(plan.path(folder, f, 0))}: saturated ({sat:.1%} of the card's pixels at full "
                                 f"scale at the shortest exposure, {ms:g} ms): shorten the exposures or dim the "
                                 "projector")
     top = capture.white[-1][used]
     if np.percentile(top, 99) < DARK_LEVEL:
-        raise GrayCardError(f"{plan.path(folder, WHITE, len(plan.response_exposures_ms) - 1)}: all dark (99th "
+        raise GrayCardError(f"{_shown(plan.path(folder, WHITE, len(plan.response_exposures_ms) - 1))}: all dark (99th "
                             f"percentile {np.percentile(top, 99):.3f} of full scale over the card): is the projector "
                             "on, the lens cap off, the card in the holder?")
     bright = int(np.argmax([np.median(capture.frames[i, -1][used]) for i in range(len(plan.frames()))]))
@@ -337,9 +344,15 @@ def check_exposures(folder: Path, plan: Plan, view: View, capture: Capture) -> N
         med = [float(np.median(im[used])) for im in series]
         for e in range(1, len(med)):
             if med[e - 1] < SATURATED and med[e] <= med[e - 1]:
-                raise GrayCardError(f"{plan.path(folder, f, e)}: not brighter than {plan.path(folder, f, e - 1).name} "
+                raise GrayCardError(f"{_shown(plan.path(folder, f, e))}: not brighter than {_shown(plan.path(folder, f, e - 1).name)} "
                                     f"(median {med[e]:.3f} against {med[e - 1]:.3f} of full scale) though exposed "
                                     f"{ms[e]:g} ms against {ms[e - 1]:g} ms: exposures mislabelled")
+
+
+def _shown(path) -> str:
+    from rigcad.export.readback import shown
+
+    return shown(path)
 
 
 # -- the response curve --------------------------------------------------------------------------------

@@ -26,6 +26,12 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
     if any(getattr(args, k, None) for k in ("gray_card", "gray_card_kit", "gray_card_simulate")):
         return _gray_card(args)
+    for flag in ("exposures_ms", "response_exposures_ms"):
+        if getattr(args, flag, None):
+            from rigcad.errors import ExportError
+
+            raise ExportError(f"--{flag.replace('_', '-')}: only with --gray-card, --gray-card-simulate or "
+                              "--gray-card-kit (the gray card's exposures)")
     rig, runs = _before_any_work(args)
     capture_out = getattr(args, "write_capture", None)
     if runs is not None:
@@ -472,9 +478,13 @@ def _gray_card(args: argparse.Namespace) -> int:
     capture_out = getattr(args, "write_capture", None)
     if capture_out:
         if not args.gray_card_simulate:
-            raise ExportError(f"--write-capture {capture_out}: only with --simulate or --gray-card-simulate (it "
+            from rigcad.export.readback import shown
+
+            raise ExportError(f"--write-capture {shown(capture_out)}: only with --simulate or --gray-card-simulate (it "
                               "writes the simulated capture)")
         _check_capture_folder(Path(capture_out), True)
+    if args.gray_card:
+        G.check_present(Path(args.gray_card), plan)  # a missing capture: one line before the rig is built
     rig = load(args.profile)
     light = card_light(rig, plan.order)
     if args.gray_card_kit:

@@ -206,14 +206,24 @@ def test_bad_exposure_lists_are_refused():
             G.Plan(exposures_ms=bad)
 
 
-@pytest.mark.e2e
-def test_command_refuses_a_missing_capture_and_writes_nothing(tmp_path, capsys):
+def test_command_refuses_a_missing_capture_before_any_work(tmp_path, capsys, monkeypatch):
+    import rigcad.rig
     from rigcad.cli.main import main
 
+    def no_work(*a, **k):  # the rig (the dome's integration, the first real work) must not be built
+        raise AssertionError("the rig was loaded before the capture was refused")
+
+    monkeypatch.setattr(rigcad.rig, "load", no_work)
     rc = main(["calibrate", "achutha2006", "--gray-card", str(tmp_path / "none"), "--exports", str(tmp_path / "x")])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and "white_7.8125ms.png: missing" in err and len(err.splitlines()) == 1, err
-    assert not (tmp_path / "x" / "achutha2006" / "calibrate_graycard").exists()
+    assert not (tmp_path / "x").exists()  # nothing written, not even the exports folder
+    for argv in (["--simulate", "--exposures-ms", "1", "2"], ["--gray-card-simulate", "--exposures-ms", "1"],
+                 ["--gray-card", str(tmp_path), "--write-capture", str(tmp_path / "w")]):
+        assert main(["calibrate", "achutha2006", *argv, "--exports", str(tmp_path / "x")]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and ("--exposures-ms" in err or "--write-capture" in err), err
+    assert not (tmp_path / "x").exists()
 
 
 @pytest.mark.e2e
