@@ -531,20 +531,36 @@ def _verdict(element: str, axis: str, links: tuple[Link, ...], key: str, tol: fl
                        reason)
 
 
+def declared_locators(profile, layout, process: ProcessErrors) -> tuple[Locator, ...]:
+    """The locating features the parts declare (rigcad.parts.locating), as the stack reads them: the
+    dome's register (rigcad.parts.dome.register) replaces the bolts' float by its pins' fit and the
+    printed position of the flange's round hole about the dome's axis."""
+    from rigcad.parts.dome import register
+
+    reg = register(profile, layout)
+    lateral, turn = reg.repeatability
+    return (Locator("dome register", "dome", DOME_FLOATS,
+                    Link("dome register: pins in the plate, a reamed hole and a slot in the flange", "joint",
+                         f"two {reg.diameter:g} mm ISO 8734 m6 pins: {lateral * 1e3:.0f} um of fit; the flange's round hole "
+                         f"printed about the dome's axis ({process.position:g} mm)", lateral + process.position, 0.0,
+                         turn)),)
+
+
 def stack(profile, layout, printer: Printer, *, seams: dict[str, int] | None = None,
-          adjusters: tuple[AdjusterSpec, ...] | None = None, locators: tuple[Locator, ...] = (),
+          adjusters: tuple[AdjusterSpec, ...] | None = None, locators: tuple[Locator, ...] | None = None,
           process: ProcessErrors | None = None) -> StackReport:
     """Every optical element's stack on ``printer`` (its ``process_errors``, or ``process``): the
     seams on each chain part from ``seams`` (part -> seams a chain crosses: :func:`seams_from_pieces`
     of a fab run; default :func:`estimate_seams`), against ``tolerancing``, with ``adjusters``
     (default :func:`default_adjusters`) and the ``locators`` (each replaces links on its element's
-    chain)."""
+    chain; default: the ones the parts declare, :func:`declared_locators`)."""
     proc = process or printer.process_errors
     if proc is None:
         raise FabricationError(f"printer {printer.name}: no process_errors, so no tolerance stack")
     estimated = seams is None
     counts = dict(estimate_seams(profile, layout, printer) if estimated else seams)
     adj = default_adjusters(profile, layout) if adjusters is None else tuple(adjusters)
+    locators = declared_locators(profile, layout, proc) if locators is None else tuple(locators)
 
     def on_chain(part: str) -> tuple[Link, ...]:
         k = seam_link(part, counts.get(part, 0), printer, proc)
@@ -629,5 +645,5 @@ def with_process(printer: Printer, **figures) -> Printer:
 
 
 __all__ = ["AXES", "AdjusterSpec", "AxisVerdict", "ELEMENTS", "ElementStack", "Link", "Locator", "RESOLUTION_SHARE",
-           "DOME_FLOATS", "PARABOLOID_FLOATS", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
+           "DOME_FLOATS", "PARABOLOID_FLOATS", "declared_locators", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
            "table_lines", "with_process"]

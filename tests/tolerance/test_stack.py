@@ -162,3 +162,17 @@ def test_seams_from_a_fab_record():
         "dome": {"split": {"pieces": 4}},  # its sectors are each bolted down
     }
     assert S.seams_from_fab(record) == {"base_plate": 2, "tower_shelf": 3, "tower_column": 0, "dome": 0}
+
+
+def test_the_dome_register_the_parts_declare_is_on_the_domes_chain(table31_rig, mk3s):
+    from rigcad.parts.locating import DowelRegister
+
+    (reg,) = [j for j in table31_rig.recipes["dome"].joints if isinstance(j, DowelRegister)]
+    r = S.stack(table31_rig.profile, table31_rig.layout, mk3s)
+    names = [k.name for k in r.element("dome").links]
+    assert not set(S.DOME_FLOATS) & set(names)  # the bolts' float is gone: the pins locate
+    (link,) = [k for k in r.element("dome").links if k.name.startswith("dome register")]
+    assert link.lateral == pytest.approx(reg.repeatability[0] + mk3s.process_errors.position)
+    # with no locators given, the bolts' float is back
+    bare = S.stack(table31_rig.profile, table31_rig.layout, mk3s, locators=())
+    assert set(S.DOME_FLOATS) <= {k.name for k in bare.element("dome").links}
