@@ -461,6 +461,8 @@ def _gray_card(args: argparse.Namespace) -> int:
     (rigcad.calibrate.graycard) into ``<exports>/<profile>/calibrate_graycard/`` (graycard.json,
     scale_factors.npz; published together, on PASS and on FAIL, which exits 1), or its kit into
     ``calibrate_graycard_kit/``. Every refusal comes before anything is written."""
+    import dataclasses
+
     import numpy as np
 
     from rigcad.basis.card_light import card_light
@@ -484,7 +486,10 @@ def _gray_card(args: argparse.Namespace) -> int:
                               "writes the simulated capture)")
         _check_capture_folder(Path(capture_out), True)
     if args.gray_card:
+        plan = plan.with_turned(Path(args.gray_card))  # the half turn's frames when the folder holds any
         G.check_present(Path(args.gray_card), plan)  # a missing capture: one line before the rig is built
+    else:
+        plan = dataclasses.replace(plan, turned=True)  # the kit asks for it; the simulation rehearses it
     rig = load(args.profile)
     light = card_light(rig, plan.order)
     if args.gray_card_kit:
@@ -502,8 +507,9 @@ def _gray_card(args: argparse.Namespace) -> int:
     result = G.analyse(plan, capture, view, light)
     report = {"profile": rig.name, "source": "simulated" if truth else str(args.gray_card), **result.report}
     if truth is not None:
-        report["simulation"] = {"seed": args.seed, "planted": "gamma 2.2 camera, 18 % card, the camera side falling "
-                                "20 % to grazing, the light 15 % (graycard.planted)",
+        report["simulation"] = {"seed": args.seed, "planted": "gamma 2.2 camera, 18 % card lying flat, captured again "
+                                "turned a half turn, the camera side falling 20 % to grazing, the light 15 % "
+                                "(graycard.planted)",
                                 **G.compare(result, truth, view, light)}
     out = Path(args.exports) / rig.name / "calibrate_graycard"
     with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
@@ -562,13 +568,14 @@ def _gray_card_kit(rig, plan, light, exports: Path) -> int:
     from rigcad.export.png import gray_png
 
     out = exports / rig.name / "calibrate_graycard_kit"
-    files = [(G.WHITE, ms) for ms in plan.response_exposures_ms] + [(f, ms) for f in plan.frames() for ms in plan.exposures_ms]
+    files = plan.files()
     capture = {"about": "show each projector image, capture it at each of its exposures (gain fixed, automatic "
                         "exposure off) into one folder; then rigcad calibrate PROFILE --gray-card FOLDER",
                "projector_images": [f"projector/{f}.png" for f in (G.WHITE,) + plan.frames()],
-               "captures": [{"show": f"projector/{f}.png", "exposure_ms": ms,
+               "captures": [{"show": f"projector/{f.removeprefix(G.TURNED)}.png", "exposure_ms": ms,
                              "file": plan.path(Path("."), f, (plan.response_exposures_ms if f == G.WHITE
-                                                              else plan.exposures_ms).index(ms)).name}
+                                                              else plan.exposures_ms).index(ms)).name,
+                             **({"card": "turned a half turn in the holder"} if f.startswith(G.TURNED) else {})}
                             for f, ms in files]}
     with Staging(out, lock=profile_lock(exports, rig.name), carry=lambda rel: False,
                  made_from=profile_digest(rig.profile)) as st:
