@@ -664,8 +664,22 @@ def analyse(plan: Plan, capture: Capture, view: View, light: Light, albedo: floa
     g = fit.light_g
     ratio = float(g.max() / g.min()) if g.min() > 0 else math.inf
     outliers = float(np.mean((fit.t > OUTLIER_FACTOR) | (fit.t < 1 / OUTLIER_FACTOR)))
-    theta_o = view.theta_o.reshape(view.cam.shape)[used]
-    tilt_deg = None if tilt is None else math.degrees(math.hypot(*tilt))
+    f = dict(plan=plan, view=view, response=response, fit=fit, blocks=blocks, tilt=tilt, albedo=albedo,
+             frames_spread=frames_spread, white_spread=white_spread, spread=spread, own=own, bright=bright, fill=fill,
+             ratio=ratio, outliers=outliers)
+    checks = _checks(f)
+    failures = [text for _, ok, text in checks if not ok]
+    report = _report(f, checks, failures)
+    scale = np.full(view.cam.shape, np.nan)
+    scale[used] = 1.0 / fit.t
+    return Result(plan, response, fit, report, not failures, failures, scale)
+
+
+def _checks(f: dict) -> list[tuple[str, bool, str]]:
+    """The pass criterion's checks (name, passed, the figure in words) from :func:`analyse`'s figures."""
+    spread, response, blocks, ratio = f["spread"], f["response"], f["blocks"], f["ratio"]
+    outliers, fill = f["outliers"], f["fill"]
+    tilt_deg = None if f["tilt"] is None else math.degrees(math.hypot(*f["tilt"]))
     checks = [
         ("card_level", tilt_deg is None or tilt_deg <= MAX_TILT_DEG,
          "the card's tilt not measured (no half turn)" if tilt_deg is None else
@@ -684,7 +698,17 @@ def analyse(plan: Plan, capture: Capture, view: View, light: Light, albedo: floa
         ("exposed", fill >= MIN_FILL, f"the brightest frame fills {fill:.0%} of full scale at the longest exposure "
                                       f"(at least {MIN_FILL:.0%})"),
     ]
-    failures = [text for _, ok, text in checks if not ok]
+    return checks
+
+
+def _report(f: dict, checks: list, failures: list) -> dict:
+    """graycard.json's figures (units in keys) from :func:`analyse`'s figures and checks."""
+    plan, view, response, fit, blocks, tilt, albedo = (f[k] for k in ("plan", "view", "response", "fit", "blocks",
+                                                                         "tilt", "albedo"))
+    used, g, own, bright, fill = view.used, fit.light_g, f["own"], f["bright"], f["fill"]
+    frames_spread, white_spread, ratio, outliers = f["frames_spread"], f["white_spread"], f["ratio"], f["outliers"]
+    theta_o = view.theta_o.reshape(view.cam.shape)[used]
+    tilt_deg = None if tilt is None else math.degrees(math.hypot(*tilt))
     pct = lambda a, q: float(np.percentile(a, q))  # noqa: E731
     report = {
         "thesis": "4.1.2 (reflectance calibration, eqs. 4.1-4.2); HDR from multiple exposures (4.2.2-4.2.3)",
@@ -730,9 +754,7 @@ def analyse(plan: Plan, capture: Capture, view: View, light: Light, albedo: floa
                                          "p5": pct(own, 5), "p50": pct(own, 50), "p95": pct(own, 95)},
         },
     }
-    scale = np.full(view.cam.shape, np.nan)
-    scale[used] = 1.0 / fit.t
-    return Result(plan, response, fit, report, not failures, failures, scale)
+    return report
 
 
 def summary(result: Result) -> str:
