@@ -228,12 +228,12 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     d = Doc()
     _introduction(d, c)
     for section in (_section_bill, _bill_consumables, _section_print, _section_sand, _section_finish, _section_coat,
-                    _section_assemble, _section_calibrate):
+                    _section_assemble, _section_mechanics, _section_calibrate):
         section(d, c)
     figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
                # the hardware as the steps fit it; bom.fasteners' candidate joints stay internal
                "bill": {k: v for k, v in c.bill.items() if k != "fasteners"}, "calibration": c.calibration, "finishing": c.finishing,
-               "coating_gauged_layer": c.gauged, "coating_total_mm": c.total,
+               "coating_gauged_layer": c.gauged, "coating_total_mm": c.total, "mechanics": c.mechanics,
                "assembly_order": getattr(c, "assembly_order", None)}
     return d, c.files, figures
 
@@ -579,6 +579,47 @@ def _section_assemble(d: Doc, c) -> None:
         c.step(f"step {k + 1}")
     c.assembly_order = [{"step": p.step.name, "parts": list(p.step.members), "direction": list(p.direction),
                          "fasteners": [f.item for f in p.step.fasteners]} for p in order]
+
+
+def _md_tables(d: Doc, lines: list[str]) -> None:
+    """Tables another module wrote as Markdown lines (a header, its rule, rows; blank lines between
+    tables), as the document's own tables."""
+    blocks, block = [], []
+    for line in [*lines, ""]:
+        if line.startswith("|"):
+            block.append([cell.strip() for cell in line.strip().strip("|").split("|")])
+        elif block:
+            blocks.append(block)
+            block = []
+    for b in blocks:
+        d.table(b[0], b[2:])
+
+
+def _section_mechanics(d: Doc, c) -> None:
+    """Torques for the bolts into printed plastic and what bends (rigcad.fab.loads), and the tolerance
+    stack of every optical element on this printer (rigcad.fab.stack), as findings the lab reads
+    before it aligns."""
+    from rigcad.fab import loads as L
+    from rigcad.fab import stack as S
+
+    c.mechanics = None
+    if c.printer.process_errors is None or getattr(c.rig.layout, "tower", None) is None:
+        return
+    loads = L.loads(c.p, c.rig.layout, c.printer)
+    report = S.stack(c.p, c.rig.layout, c.printer)
+    d.h(3, "Torques, and what bends")
+    d.p("Tighten every bolt into printed plastic with a torque screwdriver to the torque below, never hand-tight: "
+        "a hand-tight M4 presses the plastic past half its yield, and it creeps. Put a spring washer (DIN 127) "
+        "under the joints marked yes: they locate a datum, and creep would relax them.")
+    _md_tables(d, loads.table_lines())
+    d.h(3, "The tolerance stack on this printer")
+    d.p(f"Each optical element's position and tilt error from the datum (the base plate's bore) through every printed "
+        f"link, seam, pin and clearance, on the {c.printer.name}'s process errors (`process_errors` in its printer file; "
+        "measure yours with the calibration print, docs/rig-mechanics.md), against `tolerancing:`. 'adjusted': an "
+        "adjuster's range covers it at a quarter of the tolerance or finer; 'refused': neither a locating feature "
+        "nor an adjuster holds it yet, and the last column names the links that dominate.")
+    _md_tables(d, S.table_lines(report))
+    c.mechanics = {"loads": loads.record(), "stack": S.record(report)}
 
 
 def _approach(meshes, done: list[int], new: list[int], direction) -> dict:
