@@ -764,10 +764,15 @@ def _calibration_more(d: Doc, c, cam: dict) -> None:
         "the dome again to take the disc out.")
     d.h(3, "Reflectance (thesis 4.1.2)")
     d.p("Put an 18 % diffuse gray card (photographic, e.g. a Kodak R-27 class card cut to the sample holder's "
-        "diameter) in the sample holder, its face at z = 0. Project the zonal harmonic basis images up to order 2 "
-        "(`rigcad basis`), capture each at three exposures (thesis: 62.5, 125 and 250 ms), and recover the card's "
-        "hemispherical reflectance; the scale factor for each direction is (0.18 / pi) cos(theta) divided by the "
-        "measured value (thesis eq. 4.2). Keep the card dry and out of the light between uses.")
+        f"diameter) in the sample holder, its face at z = 0. `rigcad calibrate {c.p.name} --gray-card-kit` writes the "
+        "images the projector shows (the zonal basis up to order 2, positive and negative, and a white field) and the "
+        "capture plan: every image at each of the thesis's exposures (62.5, 125 and 250 ms), named as the plan says. "
+        f"Then `rigcad calibrate {c.p.name} --gray-card <folder>` fits the camera's response curve (Debevec and Malik) "
+        "from the exposures, the card's light per direction and the scale factors (thesis eq. 4.2: (0.18 / pi) "
+        "cos(theta) over the measured value), and prints PASS or FAIL with its figures (the criteria: "
+        "docs/calibrate.md, 'The gray card'); it exits non-zero on FAIL. `--gray-card-simulate` runs the same on "
+        "simulated captures first, to see what a good capture gives. Keep the card dry and out of the light between "
+        "uses.")
 
 
 def _as_built(d: Doc, c) -> None:
