@@ -285,6 +285,6 @@ def test_the_page_states_the_codes_criterion_and_plan():
             f"by {G.OUTLIER_FACTOR:g}x", f"at least {G.MIN_FILL:.0%}".replace("%", " %"),
             f"{G.RESPONSE_EXPOSURES_MS[0]:g}-{G.RESPONSE_EXPOSURES_MS[-1]:g} ms",
             ", ".join(f"{v:g}" for v in G.EXPOSURES_MS[:-1]) + f" and {G.EXPOSURES_MS[-1]:g} ms",
-            f"order {G.ORDER}", f"{G.BLOCK_PX} x {G.BLOCK_PX} px"]
+            f"order {G.ORDER}", f"{G.BLOCK_PX} x {G.BLOCK_PX} px", f"tilted within {G.MAX_TILT_DEG:g} deg"]
     missing = [w for w in want if w not in section]
     assert not missing, missing
