@@ -288,3 +288,13 @@ def test_the_page_states_the_codes_criterion_and_plan():
             f"order {G.ORDER}", f"{G.BLOCK_PX} x {G.BLOCK_PX} px", f"tilted within {G.MAX_TILT_DEG:g} deg"]
     missing = [w for w in want if w not in section]
     assert not missing, missing
+
+
+def test_the_manuals_paragraph_names_the_commands_and_the_folder(rig_sides):
+    rig, _, _ = rig_sides
+    text = G.manual_text(rig)
+    for want in (f"rigcad calibrate {rig.name} --gray-card-kit", f"rigcad calibrate {rig.name} --gray-card FOLDER",
+                 f"exports/{rig.name}/calibrate_graycard/", "62.5, 125, 250 ms", "turned_<frame>_<ms>ms.png",
+                 f"{2 * rig.profile.sample_holder.radius:g} mm disc"):
+        assert want in text, want
+    assert "{" not in text and "\n" not in text  # every field filled, one paragraph
