@@ -42,6 +42,7 @@ from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_po
 from rigcad.parts.joints import Bought, Datum, KinematicSeat, SeatContact, datums_of
 from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Translate,
                                  Union_)
+from rigcad.profile.instruments import size_origin
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
 from rigcad.standards import (CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for, longest_dowel,
@@ -1080,10 +1081,14 @@ def instruments(profile: Profile, layout) -> tuple[Part, ...]:
     dark = (0.15, 0.15, 0.17)
     return (
         Part("projector_body", Box(*t.projector_box), dark, f"projector body ({profile.projector.body_width:g} x "
-             f"{profile.projector.body_depth:g} x {profile.projector.body_height:g} mm, assumed)"),
-        Part("projector_lens", Box(*t.projector_lens_box), dark, "projector lens barrel (assumed size)"),
-        Part("camera_body", Box(*t.camera_box), dark, "camera body (assumed size)"),
-        Part("camera_lens", Box(*t.camera_lens_box), dark, "camera lens (assumed size)"),
+             f"{profile.projector.body_depth:g} x {profile.projector.body_height:g} mm, "
+             f"{size_origin(profile, 'projector', ('body_width', 'body_depth', 'body_height'))})"),
+        Part("projector_lens", Box(*t.projector_lens_box), dark,
+             f"projector lens barrel ({size_origin(profile, 'projector', ('lens_diameter', 'lens_length'))})"),
+        Part("camera_body", Box(*t.camera_box), dark,
+             f"camera body ({size_origin(profile, 'camera', ('body_width', 'body_height', 'body_depth'))})"),
+        Part("camera_lens", Box(*t.camera_lens_box), dark,
+             f"camera lens ({size_origin(profile, 'camera', ('lens_diameter', 'lens_length'))})"),
         Part("beam_splitter", plate, glass, f"plate beam splitter {profile.beam_splitter.width:g} x "
              f"{profile.beam_splitter.length:g} x {profile.beam_splitter.thickness:g} mm at 45 deg"),
         Part("focusing_lens", Box((t.lens_x - ln.thickness / 2, -r, zc - r), (t.lens_x + ln.thickness / 2, r, zc + r)),

@@ -135,3 +135,18 @@ def test_projector_crosses_stand_on_the_shelf_on_the_projectors_axis(rig):
         assert zmax - r.profile.crosses.arm_length == pytest.approx(cop[2], abs=1e-6)
         assert (cy0 + cy1) / 2 == pytest.approx(cop[1], abs=1e-6)
         assert x0 < cx0 and cx1 < x1
+
+
+def test_instrument_boxes_say_who_set_their_size(tmp_path):
+    """The rig's instrument boxes name where their size came from (rigcad.profile.instruments.size_origin):
+    assumed by default, the instrument file a profile names, or the profile itself."""
+    import rigcad
+    from rigcad.manual.assembly import picture_meshes
+
+    path = tmp_path / "lab.yaml"
+    path.write_text("extends: achutha2006\ncamera:\n  model: basler_ace_u_aca2040_55uc\nprojector:\n"
+                    "  lens_diameter: 40 mm\n  lens_length: 25 mm\n", encoding="utf-8")
+    by = {m.name: m.description for m in picture_meshes(rigcad.load(path))}
+    assert by["camera_body"].endswith("(size from basler_ace_u_aca2040_55uc)")
+    assert by["projector_lens"].endswith("(size set in the profile)")
+    assert by["camera_lens"].endswith("(assumed size)")
