@@ -763,16 +763,9 @@ def _calibration_more(d: Doc, c, cam: dict) -> None:
         "image in the camera's picture: its centre and radius in pixels are the camera's correspondence. Then lift "
         "the dome again to take the disc out.")
     d.h(3, "Reflectance (thesis 4.1.2)")
-    d.p("Put an 18 % diffuse gray card (photographic, e.g. a Kodak R-27 class card cut to the sample holder's "
-        f"diameter) in the sample holder, its face at z = 0. `rigcad calibrate {c.p.name} --gray-card-kit` writes the "
-        "images the projector shows (the zonal basis up to order 2, positive and negative, and a white field) and the "
-        "capture plan: every image at each of the thesis's exposures (62.5, 125 and 250 ms), named as the plan says. "
-        f"Then `rigcad calibrate {c.p.name} --gray-card <folder>` fits the camera's response curve (Debevec and Malik) "
-        "from the exposures, the card's light per direction and the scale factors (thesis eq. 4.2: (0.18 / pi) "
-        "cos(theta) over the measured value), and prints PASS or FAIL with its figures (the criteria: "
-        "docs/calibrate.md, 'The gray card'); it exits non-zero on FAIL. `--gray-card-simulate` runs the same on "
-        "simulated captures first, to see what a good capture gives. Keep the card dry and out of the light between "
-        "uses.")
+    from rigcad.calibrate.graycard import manual_text
+
+    d.p(manual_text(rig))  # the gray card command's own procedure (one home)
 
 
 def _as_built(d: Doc, c) -> None:
