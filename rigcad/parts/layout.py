@@ -124,12 +124,19 @@ def flange_extent(flange_in: float, wall: np.ndarray, shell, wall_r_at=None) -> 
     except ValueError:
         return bolt + shell.flange_width / 2, bolt  # no thread fits the hole: the flange joint refuses it
     key = HEX_KEYS[th.hex_key]
-    top = shell.flange_thickness + th.washer_thickness + th.head_height + key.short_arm + key.room
-    band = list(wall[(wall[:, 1] >= shell.flange_thickness) & (wall[:, 1] <= top), 0])
-    if wall_r_at is not None and wall[:, 1].max() >= top:  # the band's top edge: the wall rises towards it
-        band.append(float(wall_r_at(top)))
-    if band:
-        bolt = max(bolt, max(band) + key.room)
+    shaft = shell.flange_thickness + th.washer_thickness + th.head_height + key.short_arm  # the short arm's end
+
+    def widest(z0: float, z1: float) -> float | None:
+        band = list(wall[(wall[:, 1] >= z0) & (wall[:, 1] <= z1), 0])
+        if wall_r_at is not None and wall[:, 1].max() >= z1:  # the band's top edge: the wall rises towards it
+            band.append(float(wall_r_at(z1)))
+        return max(band) if band else None
+
+    arm, over = widest(shell.flange_thickness, shaft), widest(shaft, shaft + key.room)
+    if arm is not None:  # the short arm, and the room about it, up to its end
+        bolt = max(bolt, arm + key.room)
+    if over is not None:  # the long arm leaves the short one's end outwards: its end face stands on the bolt's axis
+        bolt = max(bolt, over)
     return bolt + shell.flange_width / 2, bolt
 
 

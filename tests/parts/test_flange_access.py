@@ -30,12 +30,20 @@ def test_the_hex_key_clears_the_wall_over_the_flange(tmp_path, angle):
     lay, shell = rig.layout, rig.profile.dome_shell
     th = THREADS["M4"]
     key = HEX_KEYS[th.hex_key]
-    top = shell.flange_thickness + th.washer_thickness + th.head_height + key.short_arm + key.room
-    z = np.linspace(shell.flange_thickness, top, 2001)
+    shaft = shell.flange_thickness + th.washer_thickness + th.head_height + key.short_arm  # the short arm's end
     o = lay.dome_outer
     pts = o.points(o.sample(20001))
-    wall = np.interp(z, pts[:, 1], pts[:, 0]) if pts[0, 1] < pts[-1, 1] else np.interp(z, pts[::-1, 1], pts[::-1, 0])
-    assert lay.bolt_circle_r - key.room >= wall.max() - 1e-3  # 1 um: the layout samples the wall on 4001 points
+    order = np.argsort(pts[:, 1])
+
+    def wall(z0, z1):
+        z = np.linspace(z0, z1, 2001)
+        return np.interp(z, pts[order, 1], pts[order, 0]).max()
+
+    # the short arm and its room clear the wall up to its end; the long arm's end face (on the bolt's
+    # axis, the arm going outwards) clears it over the arm's thickness above (1 um: the layout samples
+    # the wall on 4001 points)
+    assert lay.bolt_circle_r - key.room >= wall(shell.flange_thickness, shaft) - 1e-3
+    assert lay.bolt_circle_r >= wall(shaft, shaft + key.room) - 1e-3
 
 
 def test_a_dome_leaning_over_its_flange_still_passes_the_gate(tmp_path):
