@@ -424,7 +424,10 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "calibration.json, corrected_map.npz (read by rigcad basis --simulate), maps.png. "
                     "--simulate renders a seeded capture of a moved rig with a planted dome error instead and "
                     "compares; --kit writes the screen patterns, the spacers and the manual's page; --seating "
-                    "measures how the screen settles, from the calibration.json of repeated calibrations.")
+                    "measures how the screen settles, from the calibration.json of repeated calibrations. "
+                    "--gray-card DIR is the reflectance calibration of thesis 4.1.2 (an 18 %% gray card: the camera's "
+                    "response curve, the scale factors, PASS or FAIL) into exports/<profile>/calibrate_graycard/; "
+                    "--gray-card-kit writes its projector images and capture plan, --gray-card-simulate rehearses it.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif, "
                      "h<spacer>r_<frame>, u<turn>_<frame>)")
