@@ -425,7 +425,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "--simulate renders a seeded capture of a moved rig with a planted dome error instead and "
                     "compares; --kit writes the screen patterns, the spacers and the manual's page; --seating "
                     "measures how the screen settles, from the calibration.json of repeated calibrations. "
-                    "--gray-card DIR is the reflectance calibration of thesis 4.1.2 (an 18 %% gray card: the camera's "
+                    "--gray-card DIR is the reflectance calibration of thesis 4.1.2 (an 18 % gray card: the camera's "
                     "response curve, the scale factors, PASS or FAIL) into exports/<profile>/calibrate_graycard/; "
                     "--gray-card-kit writes its projector images and capture plan, --gray-card-simulate rehearses it.")
     src = p.add_mutually_exclusive_group(required=True)
