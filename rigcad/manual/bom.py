@@ -443,6 +443,7 @@ TOOLS = (
     ("Spirit level 200 mm, 0.3 mm/m", "1"),
     ("Hex screwdrivers 2.5, 3, 4 mm and 3/16 in, 100 mm blades; L hex key set (ISO 2936)", "1 set"),
     ("Open-end spanners 5.5, 7, 8 mm (DIN 3110)", "1 set"),
+    ("Torque screwdriver 0.2-3 N m with hex bits 2.5, 3, 4 mm and 3/16 in (ISO 6789)", "1"),
     ("Soldering iron with a heat-set insert tip (M3, M4)", "1"),
     ("HVLP spray gun 1.3-1.4 mm nozzle and a compressor (or aerosol cans only)", "1"),
     ("Respirator, half mask with A2P3 filters (EN 14387); supplied-air hood for 2K isocyanate coats", "1"),

@@ -455,16 +455,17 @@ MOVES = {"-z (down)": "lower it from above", "+z (up)": "push it up from below",
          "-x": "slide it in level along -x, from the +x side", "+x": "slide it in level along +x, from the -x side",
          "-y": "slide it in level along -y, from the +y side", "+y": "slide it in level along +y, from the -y side"}
 #: Fastenings by what takes the thread: what the step says after the bolt.
-THREAD_IN = {"nut": "a washer under the head and under the nut; hold the nut with the spanner, tighten crosswise by "
-                    "hand", "insert": "screwed into the insert (its pocket is printed at the hole its maker gives, "
-                                      "named with the insert: if it printed small, drill it to that size, never to "
-                                      "the insert's outside; melt the insert in flush with a soldering iron at its "
-                                      "maker's temperature before the part is closed in)",
+TORQUE = "tighten crosswise with a torque screwdriver to the joint's torque (section 5's 'Torques, and what bends')"
+THREAD_IN = {"nut": f"a washer under the head and under the nut; hold the nut with the spanner, {TORQUE}",
+             "insert": "screwed into the insert (its pocket is printed at the hole its maker gives, named with the "
+                       "insert: if it printed small, drill it to that size, never to the insert's outside; melt the "
+                       "insert in flush with a soldering iron at its maker's temperature before the part is closed "
+                       f"in); {TORQUE}",
              "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
              "bench": "into the bench (on a breadboard: into its tapped holes, on the grid)",
              "tapped": "into the thread tapped in the part",
              "trap": "a washer under the head; its nut waits in the hexagonal trap printed for it (put it in before "
-                     "the part with the trap stands on the bench), tighten crosswise by hand"}
+                     f"the part with the trap stands on the bench), {TORQUE}"}
 
 
 def assembly_order(rig, steps, solids):

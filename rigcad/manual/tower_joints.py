@@ -121,7 +121,10 @@ def seat_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]
     washer = THREADS[spring["thread"]].washer_thickness
     z_head = t.shelf_top_z - t.shelf_thickness - washer
     grip = 2 * washer + t.shelf_thickness + seat_gap(rig.profile) + tw.wall + spring["spring_mm"]["free_length"]
-    item = f"{spring['thread']} x {spring['length_mm']:g} mm socket-head bolt (ISO 4762), 2 washers, spring and nut"
+    sp = spring["spring_mm"]
+    item = (f"{spring['thread']} x {spring['length_mm']:g} mm socket-head bolt (ISO 4762), 2 washers, nut and a "
+            f"compression spring ({sp['wire']:g} mm wire, {sp['outer_diameter']:g} mm outside, {sp['free_length']:g} mm "
+            "free, steel, EN 13906-1)")
     out = [_nut_bolt(item, (x, y, z_head), UP, spring["length_mm"], spring["thread"], grip,
                      ("tower_shelf", "splitter_holder"), (0.0, float(np.sign(y)), 0.0))
            for x, y in _holder_flange_points(t, rig.profile)]
@@ -130,8 +133,8 @@ def seat_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener, ...]]
     for (x, y), ball in zip(seat_points(t, rig.profile).values(), balls):
         tip = float(meshes_by_name[ball].hi[2])  # the screw turned down onto its ball
         head = (x, y, tip + screw["length_mm"])
-        out.append(Fastener(f"{screw['thread']} x {screw['length_mm']:g} mm set screw (ISO 4026, flat point) in a "
-                            "heat-set insert", head, DOWN, float(screw["length_mm"]), d / 2, d / 2, 0.5,
+        out.append(Fastener(f"{screw['thread']} x {screw['length_mm']:g} mm {screw['item']}, in a heat-set insert",
+                            head, DOWN, float(screw["length_mm"]), d / 2, d / 2, 0.5,
                             driver(screw["thread"], _outward(x, y) if abs(x) + abs(y) > 1e-9 else (1.0, 0.0, 0.0)),
                             thread_in="insert", passes=("splitter_holder", ball), washers=0))
     return {"splitter_holder": tuple(out)}

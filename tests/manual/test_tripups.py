@@ -63,8 +63,8 @@ def test_profile_show_columns_line_up_for_long_names():
     assert run.returncode == 0, run.stderr
     rows = [ln for ln in run.stdout.splitlines() if re.match(r"  \w", ln) and ("default" in ln or ".yaml:" in ln)]
     assert len(rows) > 60
-    # the origin column ('default' or file:line) starts at one offset in every section
-    starts = {re.search(r" (default|\S+\.yaml:\d+) ", ln).start() for ln in rows}
+    # the origin column ('default', 'derived' or file:line) starts at one offset in every section
+    starts = {re.search(r" (default|derived|\S+\.yaml:\d+) ", ln).start() for ln in rows}
     assert len(starts) == 1, sorted(starts)
 
 
