@@ -168,6 +168,14 @@ def certify(problem: Problem, row: dict, also=None) -> dict:
     rig.recipes
     row["focal_length_mm"] = _custom_focal_length(rig.profile, layout.geometry)
     if also is not None:
+        if row["focal_length_mm"] is not None:  # the design names its custom lens: check the rig with it
+            import dataclasses
+
+            from rigcad.rig import Rig
+
+            p = rig.profile
+            rig = Rig.from_profile(dataclasses.replace(p, lens=dataclasses.replace(p.lens, focal_length=row["focal_length_mm"])),
+                                   previous=rig)  # the same dome: only the lens changes
         also(rig)
     row["dome_tolerance_mm"] = tol
     r = rig.design.report
