@@ -120,7 +120,8 @@ def _as_profile_value(v, kind: str):
 
 def profile_with(raw, spec: SweepSpec, value):
     """The profile ``raw`` (a RawProfile) with the swept key at ``value``, validated."""
-    from rigcad.profile.loader import RawProfile
+    from dataclasses import replace
+
     from rigcad.profile.schema import validate
 
     data = copy.deepcopy(raw.data)
@@ -130,7 +131,8 @@ def profile_with(raw, spec: SweepSpec, value):
     data[spec.section][spec.key] = _as_profile_value(value, spec.kind)
     marks = dict(raw.marks)
     marks[(spec.section, spec.key)] = f"--set {spec.name}"
-    return validate(RawProfile(raw.name, data, marks, raw.sources))
+    depths = {k: d for k, d in raw.depths.items() if k != (spec.section, spec.key)}  # --set: the profile's own
+    return validate(replace(raw, data=data, marks=marks, depths=depths))  # the same precedence as the profile
 
 
 @dataclass(frozen=True)
