@@ -13,8 +13,10 @@ optional ``note``, its figures as the profile's own keys (``resolution: [2048, 1
 ``sources:`` (per figure, where it was read: a datasheet's address, or the thesis). The shipped files
 give a figure only with its source. A figure no file gives and the profile does not set is the
 schema's default: *assumed*, and :func:`measurements` lists the instrument sizes among those for the
-lab to measure before printing (the manual opens with that list). A key the profile sets itself is
-the lab's measurement: it wins over every file.
+lab to measure before printing (the manual opens with that list). Precedence, most specific first
+(rigcad.profile.schema): what the profile's own file states (the lab's measurement) > the instrument
+files it names > what it inherits by ``extends:`` > the schema's defaults; in a chain, each profile's
+own keys win over the files it names, and those over what it extends.
 
 Sourcing (the shipped files were written without web access; the makers' pages were read through a
 stored-page search): Basler publishes the ace U body size, sensor and pixel size per model

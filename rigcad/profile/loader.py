@@ -5,7 +5,8 @@ directory's ``profiles/``, the folders in ``$RIGCAD_PROFILES`` (``os.pathsep``-s
 profiles shipped with rigcad (the repository's ``profiles/``), in that order; or given as a path. A profile may
 say ``extends: other`` (a name looked up first beside it, then on the search path, or a file) and
 override a few keys; mappings merge key by key, anything else is replaced. Each value keeps the mark of
-the file and line that set it, so validation errors point at the line to edit.
+the file and line that set it, so validation errors point at the line to edit, and its depth in the
+chain (RawProfile.depth), so that an instrument file a profile names wins over what it inherits.
 
 Every file rigcad reads this way (profiles, printers, what they extend) crosses one hostile-input
 boundary, :func:`read_text` and :func:`parse`: at most :data:`MAX_BYTES`, strict UTF-8 (the first
@@ -20,7 +21,7 @@ from __future__ import annotations
 
 import difflib
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -60,6 +61,8 @@ class RawProfile:
     sources: tuple[Path, ...]
     #: The same files, resolved (child first): what a watcher of the profile watches.
     files: tuple[Path, ...] = ()
+    #: For each key of ``marks``, the index in ``sources`` of the file that set it (0: the profile itself).
+    depths: dict[Key, int] = field(default_factory=dict)
 
     def where(self, key: Key) -> str | None:
         """The file:line that set ``key`` or, failing that, its nearest parent; None if unknown."""
@@ -68,6 +71,16 @@ class RawProfile:
             if mark:
                 return mark
         return None
+
+    def depth(self, key: Key) -> int | None:
+        """How far up the ``extends:`` chain the file that set ``key`` is: 0 for the profile itself (or
+        a value a caller set on top of it, such as a sweep's ``--set``), 1 for the profile it extends,
+        and so on; None when no file set ``key``. The nearer file is the more specific:
+        rigcad.profile.schema puts an instrument file between the file that names it and the files
+        that file extends."""
+        if key not in self.marks:
+            return None
+        return self.depths.get(key, 0)
 
 
 def _mark(shown: str, node: yaml.Node) -> str:
@@ -331,8 +344,11 @@ def load_raw(spec: str | Path) -> RawProfile:
             current = _resolve_extends(parent, current, marks.get(("extends",)))
     data: dict[str, Any] = {}
     marks: dict[Key, str] = {}
-    for layer_data, layer_marks in reversed(layers):
+    depths: dict[Key, int] = {}
+    for depth in range(len(layers) - 1, -1, -1):  # the farthest base first, the profile itself last
+        layer_data, layer_marks = layers[depth]
         data = _merge(data, layer_data)
         marks.update({k: v for k, v in layer_marks.items() if k != ("extends",)})
+        depths.update({k: depth for k in layer_marks if k != ("extends",)})
     return RawProfile(name=path.stem, data=data, marks=marks, sources=tuple(Path(_display(p)) for p in chain),
-                      files=tuple(chain))
+                      files=tuple(chain), depths=depths)

@@ -910,8 +910,7 @@ def read_section(raw: RawProfile, name: str, cls: type) -> Any:
 def _with_instruments(raw: RawProfile, sections: dict[str, Any]) -> tuple[dict[str, Any], dict[Key, str]]:
     """The instrument files the profile names (``projector.model``, ``camera.model``, ``camera.lens``,
     ``beam_splitter.model``), read and checked (rigcad.profile.instruments), their figures converted
-    with each key's own Spec into ``sections`` but for the keys the profile gives itself (a lab's
-    measurement wins over any file; a lens file over the camera's for the lens keys). Returns the
+    with each key's own Spec into ``sections`` where they win (:func:`_instrument_wins`). Returns the
     files by naming key and the file:line of each key a file set."""
     from dataclasses import replace
 
@@ -919,24 +918,53 @@ def _with_instruments(raw: RawProfile, sections: dict[str, Any]) -> tuple[dict[s
 
     near = raw.files[0].parent / INSTRUMENTS_SUBDIR if raw.files else None
     chosen: dict[str, Any] = {}
-    marks: dict[Key, str] = {}
     for kind, (section, key) in instrument_files.NAMED_BY.items():
         name = getattr(sections[section], key)
         if name is None:
             continue
         where = raw.marks.get((section, key))
         chosen[f"{section}.{key}"] = instrument_files.read(instrument_files.find(name, kind, where, near), kind, where)
-    for inst in chosen.values():
-        given = raw.data.get(inst.section) or {}
-        specs = {f.name: f.metadata["spec"] for f in fields(SECTIONS[inst.section])}
+    winners: dict[Key, tuple[tuple, Any]] = {}  # each key a file sets -> (its rank, the file)
+    for naming, inst in chosen.items():
+        rank = _instrument_rank(raw, naming, inst.kind)
+        for key in inst.figures:
+            k = (inst.section, key)
+            if _instrument_wins(raw, k, rank) and (k not in winners or rank < winners[k][0]):
+                winners[k] = (rank, inst)
+    marks: dict[Key, str] = {}
+    for section in dict.fromkeys(k[0] for k in winners):
+        specs = {f.name: f.metadata["spec"] for f in fields(SECTIONS[section])}
         updates = {}
-        for key, value in inst.figures.items():
-            if key in given:
-                continue
-            updates[key] = convert_value(specs[key], value, f"{inst.section}.{key}", inst.marks[key])
-            marks[(inst.section, key)] = inst.marks[key]
-        sections[inst.section] = replace(sections[inst.section], **updates)
+        for (sec, key), (_, inst) in winners.items():
+            if sec == section:
+                updates[key] = convert_value(specs[key], inst.figures[key], f"{section}.{key}", inst.marks[key])
+                marks[(section, key)] = inst.marks[key]
+        sections[section] = replace(sections[section], **updates)
     return chosen, marks
+
+
+def _instrument_rank(raw: RawProfile, naming: str, kind: str) -> tuple[float, int]:
+    """How specific an instrument file is, smaller first: the depth in the ``extends:`` chain of the
+    file that names it (RawProfile.depth; a model no file names, the schema's default, after every
+    file), then a lens file before the camera's (the lens keys describe the lens mounted)."""
+    depth = raw.depth(tuple(naming.split(".")))
+    return (math.inf if depth is None else depth, 0 if kind == "lens" else 1)
+
+
+def _instrument_wins(raw: RawProfile, key: Key, rank: tuple[float, int]) -> bool:
+    """True when an instrument file of ``rank`` sets ``key`` over the profile. Most specific first:
+    what a profile file states > the instrument files it names > what it extends > the schema's
+    defaults. So a key the profile itself sets is the lab's measurement and wins over any file, and
+    an instrument the profile names wins over the figures it inherits from the profile it extends
+    (a base profile's resolution is its own projector's, not the one named here)."""
+    depth = raw.depth(key)
+    return depth is None or depth > rank[0]
+
+
+def _profile_marks(marks: dict[Key, str], instrument_marks: dict[Key, str]) -> dict[Key, str]:
+    """The profile files' marks but for the keys an instrument file set over them (and their items):
+    a value's mark is where the value in force came from."""
+    return {k: v for k, v in marks.items() if not any(k[:len(i)] == i for i in instrument_marks)}
 
 
 def _check_camera(cam: CameraParams, where) -> None:
@@ -964,7 +992,8 @@ def validate(raw: RawProfile) -> Profile:
                                where=raw.where((key,)))
     sections = {name: read_section(raw, name, cls) for name, cls in SECTIONS.items()}
     chosen, instrument_marks = _with_instruments(raw, sections)
-    _check_camera(sections["camera"], lambda key: raw.marks.get(("camera", key)) or instrument_marks.get(("camera", key))
+    marks = _profile_marks(raw.marks, instrument_marks)
+    _check_camera(sections["camera"], lambda key: marks.get(("camera", key)) or instrument_marks.get(("camera", key))
                   or raw.where(("camera",)))
     par: ParaboloidParams = sections["paraboloid"]
     pair_a = (par.vertical_extent, par.tangent_angle)
@@ -1001,7 +1030,7 @@ def validate(raw: RawProfile) -> Profile:
     if not isinstance(description, str):
         raise ProfileError("description must be text", where=raw.where(("description",)))
     return Profile(name=raw.name, description=description, sources=tuple(str(p) for p in raw.sources),
-                   marks=dict(raw.marks), instruments=chosen, instrument_marks=instrument_marks, **sections)
+                   marks=marks, instruments=chosen, instrument_marks=instrument_marks, **sections)
 
 
 def _check_calibration(cal: CalibrationParams, raw: RawProfile) -> None:
