@@ -204,6 +204,12 @@ def shortest_set_screw(name: str, need: float) -> int | None:
     return next((n for n in SET_SCREW_LENGTHS if lo <= n <= hi and n >= need - 1e-9), None)
 
 
+#: Precision shim foil (mm): stainless steel strip (EN 10088-2 1.4310, thickness tolerances EN 10140),
+#: the thicknesses shim assortments are sold in. A pack of these under a stop sets a part in steps of
+#: the thinnest; the packs are cut to size with scissors.
+SHIM_FOIL = (0.02, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5)
+
+
 #: ISO 3650 gauge blocks of nominal length 0.5 to 10 mm: their measuring faces' size (mm): 30 x 9.
 GAUGE_BLOCK_FACE = (30.0, 9.0)
 #: Shear modulus (N/mm^2) of patented cold-drawn spring steel wire (EN 10270-1), as EN 13906-1 gives it
@@ -243,7 +249,7 @@ DRIVER_BLADE_MM = 100.0
 #: An open-end spanner's reach (mm; DIN 3110 spanners for M3-M6 nuts are 90-120 mm long).
 SPANNER_MM = 80.0
 
-__all__ = ["CUP_POINT", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
+__all__ = ["CUP_POINT", "SHIM_FOIL", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
            "SPRING_STEEL_G", "dowel_diameter_for", "shortest_set_screw", "spring_rate", "INCH_SCREW_LENGTHS", "LARGE_WASHERS", "DOWEL_LENGTHS", "longest_dowel", "DRIVER_BLADE_MM", "HEX_KEYS", "HexKey", "INCH", "INSERTS",
            "Insert", "METRIC_THREADS", "MOUNT_THREADS", "SCREW_LENGTHS", "SCREW_LENGTH_RANGE", "SPANNER_MM", "THREADS",
            "Thread", "longest_screw", "screw_lengths", "shortest_screw", "thread", "thread_for_hole"]
