@@ -246,11 +246,14 @@ class TowerParams:
                                     "(the projector's COP is as far from the axis)", "70 mm", **_POS)
     travel_along: float = spec("length", "adjustment each way along the optical axis (camera: its bracket's slot; "
                                "projector: its shelf's slots along its own axis); at least tolerancing's "
-                               "camera_height and projector_height", "2 mm", lo=0)
+                               "camera_height and projector_height, and the vertical stack (rigcad.fab.stack)",
+                               "2 mm", lo=0)
     travel_across: float = spec("length", "adjustment each way across the optical axis (camera: its bracket's "
                                 "slot and shims; projector: its shelf's slots and shims); at least tolerancing's "
-                                "camera_offset and projector_offset", "2 mm", lo=0)
-    shim_thickness: float = spec("length", "thickness of one printed adjustment shim", "0.5 mm", **_POS)
+                                "camera_offset and projector_offset, and the lateral stack, seams and all "
+                                "(rigcad.fab.stack)", "6 mm", lo=0)
+    shim_thickness: float = spec("length", "thickness of one printed adjustment shim (the range; bought stainless "
+                                 "shims, rigcad.parts.tower.fine_shims, set the fine steps)", "1 mm", **_POS)
     column_width: float = spec("length", "side of the square column", "50 mm", **_POS)
     wall: float = spec("length", "wall of the column, the splitter holder and the lens mount (the shelf is "
                        "twice as thick)", "5 mm", **_POS)
