@@ -97,46 +97,6 @@ def test_coated_mirrors_lie_on_the_design_surfaces(rig):
                 assert abs(dist.Value() - expected) <= 1e-3, (name, r, z, depth, dist.Value())  # 1 um
 
 
-def test_projector_crosses_stand_on_the_shelf_on_the_projectors_axis(rig):
-    """The crosses' plate lies on the shelf in the splitter holder's place, touching nothing that stays
-    there (the shelf, the lens mount, the seat's balls); the crosses (one moved to the far fence) and
-    the backplate stand in its fences, and both crosses' centres are on the projector's axis."""
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-
-    from rigcad.parts.crosses import cross_fixture
-    from rigcad.parts.recipe import Translate
-
-    r = rig[0]
-    f = cross_fixture(r.profile, r.layout)
-
-    def solid(name, dx=0.0):
-        part = r.recipe(name)
-        recipe = Translate(part.solid, (dx, 0.0, 0.0)) if dx else part.solid
-        return K.single_solid(K.build(recipe, 1e-4, K.FitReport()))
-
-    plate = solid("projector_mounting_plate")
-    stays = [solid(n) for n in ("tower_shelf", "lens_mount")] + [
-        solid(n) for n in r.recipes if n.startswith("seat_ball")]
-    others = [solid("projector_cross"), solid("projector_cross", -f.spacing), solid("projector_backplate")]
-    for other in stays + others:
-        assert K.volume(BRepAlgoAPI_Common(plate, other).Shape()) < 1e-6
-    box = Bnd_Box()
-    BRepBndLib.Add_s(plate, box)
-    x0, _, z0, x1, _, _ = box.Get()
-    assert z0 == pytest.approx(r.layout.tower.shelf_top_z, abs=1e-6)  # it lies on the shelf
-    cop = r.layout.tower.projector_cop
-    for cross in others[:2]:
-        box = Bnd_Box()
-        BRepBndLib.Add_s(cross, box)
-        cx0, cy0, _, cx1, cy1, zmax = box.Get()
-        # the cross's centre (top of the vertical bar minus the arm) on the axis: its height and y = 0
-        assert zmax - r.profile.crosses.arm_length == pytest.approx(cop[2], abs=1e-6)
-        assert (cy0 + cy1) / 2 == pytest.approx(cop[1], abs=1e-6)
-        assert x0 < cx0 and cx1 < x1
-
-
 def test_instrument_boxes_say_who_set_their_size(tmp_path):
     """The rig's instrument boxes name where their size came from (rigcad.profile.instruments.size_origin):
     assumed by default, the instrument file a profile names, or the profile itself."""
