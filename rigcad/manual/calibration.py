@@ -129,8 +129,9 @@ def access(rig) -> list[dict]:
         rows.append({"item": "projector crosses, backplate and their plate", "way": "onto the shelf, from above",
                      "out_of_the_way": "the splitter holder (with the camera) and the focusing lens",
                      "back": "the holder on its kinematic seat; the lens in its pocket",
-                     "checked": f"the plate ({f.plate_x[1] - f.plate_x[0]:.0f} mm) fits between the shelf's end and the "
-                                "lens mount, clear of the seat; the crosses' centres on the projector's axis"})
+                     "checked": f"the plate ({f.plate_x[1] - f.plate_x[0]:.0f} mm) sits on the splitter seat's cone, vee and "
+                                "flat on its three balls, short of the lens mount at either end of its slots; the "
+                                "crosses' centres on the projector's axis"})
     rows += [
         {"item": "camera cross on the beam", "way": "onto the beam in the paraboloid's place",
          "out_of_the_way": "the dome (the beam and the paraboloid come off with it)", "back": back,

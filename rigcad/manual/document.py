@@ -803,9 +803,10 @@ def _section_calibrate(d: Doc, c) -> None:
     row = pshadow["rows"][0]
     d.p("Lift the splitter holder, with the camera on it, off its seat (its kinematic seat puts it back in the same "
         "place; the seat's balls stay on the shelf) and take the focusing lens out of its mount; leave the mount "
-        f"where it is. Lay the `projector_mounting_plate` ({pshadow['plate_length_mm']:.0f} mm long) on the shelf in "
-        "the holder's place, its end pushed against the lens mount's foot and its two tabs either side of the foot: "
-        "the tabs centre it on the projector's axis, and the pocket in its underside clears the seat's balls. Stand "
+        f"where it is. Set the `projector_mounting_plate` ({pshadow['plate_length_mm']:.0f} mm long) on the splitter "
+        "seat in the holder's place: its three steel balls (pressed into the pockets in its underside, a drop of "
+        "retaining compound in each) sit on the seat's cone, vee and flat, where the holder's own balls sat, so it "
+        "registers on the shelf's fixed seat alone; it stops short of the lens mount's foot and never touches it. Stand "
         "the `projector_backplate` in the fence at the shelf's end, its cut cross towards the projector, and the "
         "two `projector_cross`es in the other two fences: their centres are then on the projector's axis, "
         f"{pshadow['axis_height_mm']:.1f} mm above the plate, {pshadow['spacing_mm']:.1f} mm apart, the far one "
