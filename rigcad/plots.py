@@ -708,6 +708,39 @@ def _cause_panel(fig, ax, causes: np.ndarray, names: tuple[str, ...], title: str
     bar.ax.set_yticklabels([n.replace("_", " ") for n in names], fontsize=6)
 
 
+def template_drawing(row: dict) -> bytes:
+    """A profile template drawn flat in its gauging plane (``rigcad.manual.finishing.template_datums``'
+    row, mm): its outline, the gauging edge (thick), the datum (red: an edge or a corner) and the rig's
+    axis (dashed), with the template's width and height."""
+    fig, ax = plt.subplots(figsize=(4.4, 4.8))
+    xy = np.asarray(row["outline_mm"], float)
+    xy = np.vstack([xy, xy[:1]])
+    ax.fill(xy[:, 0], xy[:, 1], color=(0.95, 0.85, 0.3), alpha=0.5, lw=0)
+    ax.plot(xy[:, 0], xy[:, 1], color="0.3", lw=1.0)
+    for g in row["gauging_edge_mm"]:
+        g = np.asarray(g, float)
+        ax.plot(g[:, 0], g[:, 1], color="tab:blue", lw=2.4)
+    d = np.asarray(row["datum_mm"], float)
+    if row["datum"] == "edge":
+        ax.plot(d[:, 0], d[:, 1], color="tab:red", lw=3.0)
+        label = f"datum edge, z = {row['datum_z_mm']:.1f} mm"
+    else:
+        ax.plot(d[:, 0], d[:, 1], "o", color="tab:red", ms=9)
+        label = f"datum corner: on the plate, {row['datum_r_mm']:.1f} mm from the axis"
+    ax.annotate(label, tuple(d.mean(axis=0)), xytext=(0.5, 0.04), textcoords="axes fraction", ha="center", color="0.1",
+                fontsize=8, arrowprops={"arrowstyle": "->", "color": "0.1", "lw": 0.8})  # only the datum is red
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    pad = 0.08 * float(np.max(hi - lo))
+    ax.plot([row["axis_x_mm"]] * 2, [lo[1] - pad, hi[1] + pad], "--", color="0.2", lw=1.0)
+    ax.text(row["axis_x_mm"], hi[1] + pad, " axis", fontsize=8, va="bottom")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("mm from the rig's axis")
+    ax.set_ylabel("mm above the sample plane")
+    ax.grid(alpha=0.3)
+    return _trimmed_png(fig, f"{row['template']} ({row['width_mm']:.1f} x {row['height_mm']:.1f} mm)\n"
+                             "gauging edge blue, datum red")
+
+
 def measurement_figure(sketch, what: str) -> bytes:
     """One size to measure before printing (rigcad.profile.instruments.sketch): the instrument's
     outline in its view (or the sketch's detail window), the dimension drawn between its two
