@@ -57,6 +57,10 @@ HAND_TIGHT_NM = 1.0
 #: projector of the PB6210 class, a machine-vision camera with its lens, the printed splitter holder
 #: with its plate and lens mount). A profile's ``projector.mass`` / ``camera.mass`` replace them.
 ASSUMED_MASS_KG = {"projector": 3.0, "camera": 0.3, "holder": 0.2}
+#: A tilt of the shelf under the splitter's seat turns the projector's reflected axis this many times
+#: (the law of reflection; the projector's feet stand elsewhere on the shelf): it eats
+#: ``tolerancing.projector_tilt`` twice. The column's turn tilts the whole tower: once.
+SPLITTER_TURN = 2.0
 
 
 @dataclass(frozen=True)
@@ -160,24 +164,44 @@ def bolt_load(joint: str, thread: str, count: int, faces: dict[str, float], mat:
     return BoltLoad(joint, thread, count, bearing, area, torque, preload, allow, allow, hand, datum)
 
 
+def _faces(stack) -> dict[str, float]:
+    """A washer stack (rigcad.parts.washers.WasherStack) as a bearing face: its name and real area."""
+    w = stack.bearing
+    kind = "large washer" if w.standard == "ISO 7093-1" else "washer"
+    what = "slot" if stack.opening[0] == "slot" else "hole"
+    return {f"{kind} ({w.standard} {w.size}, {w.outer:g} mm) over the {what}": stack.area_mm2}
+
+
 def bolt_loads(profile, layout, printer: Printer) -> tuple[BoltLoad, ...]:
     """Every bolted joint into printed plastic with its torque: the dome's flange (into inserts),
     the column's foot (nuts in the tongue's traps) and top (into the shelf's inserts), the lens
     mount's foot, the breadboard's screws (on a breadboard), the projector's and the camera's screws
-    through printed slots. The splitter holder's two spring bolts are set by their springs' length,
-    not a torque, and its seat screws are adjusters (rigcad.parts.adjusters)."""
+    through printed slots. Each bears on the area its washer really has: its annulus less the slot or
+    the opened hole under it (rigcad.parts.washers; the tower's washers: rigcad.parts.tower.joint_washers).
+    The splitter holder's two spring bolts are set by their springs' length, not a torque, and its seat
+    screws are adjusters (rigcad.parts.adjusters)."""
+    from rigcad.parts.tower import joint_washers
+    from rigcad.parts.washers import washers_over
+
     mat, tw = material(printer), profile.tower
     fj = flange_joint(profile, layout)
+    try:
+        from rigcad.parts.dome import flange_bolt_hole
+        flange_hole = flange_bolt_hole(profile, layout)
+    except ImportError:
+        flange_hole = profile.dome_shell.bolt_diameter
     hole = tw.bolt_diameter
     out = [bolt_load("dome flange on the base plate", fj.thread, fj.count,
-                     {"washer": washer_area(fj.thread, profile.dome_shell.bolt_diameter)}, mat, True)]
+                     _faces(washers_over(fj.thread, ("round", flange_hole))), mat, True)]
+    washers = joint_washers(profile, layout)
     if profile.buy.column == "print":
+        column = _faces(washers["column"])
         out.append(bolt_load("column foot on the tongue", "M4", 4,
-                             {"washer": washer_area("M4", hole), "nut (in its trap)": nut_area("M4", hole)}, mat, True))
-        out.append(bolt_load("column top under the shelf", "M4", 4, {"washer": washer_area("M4", hole)}, mat, True))
+                             {**column, "nut (in its trap)": nut_area("M4", hole)}, mat, True))
+        out.append(bolt_load("column top under the shelf", "M4", 4, column, mat, True))
     lens = len(_lens_foot(layout.tower, profile)[3])
     out.append(bolt_load("lens mount's foot on the shelf", "M4", lens,
-                         {"washer": washer_area("M4", hole), "nut (under the shelf)": nut_area("M4", hole)}, mat, False))
+                         {**_faces(washers["lens"]), "nut (under the shelf)": nut_area("M4", hole)}, mat, False))
     b = breadboard.board(profile)
     if b is not None:
         held = len([q for qs in breadboard.anchor_points(profile, layout).values() for q in qs])
@@ -185,12 +209,9 @@ def bolt_loads(profile, layout, printer: Printer) -> tuple[BoltLoad, ...]:
         out.append(bolt_load("the rig on the breadboard", b.thread, held,
                              {"large washer": washer_area(b.thread, hb, large=True)}, mat, True))
     pj, cm = profile.projector, profile.camera
-    pjh = THREADS[pj.mount_thread].clearance
-    out.append(bolt_load("projector on the shelf's slots", pj.mount_thread, 4,
-                         {"washer": washer_area(pj.mount_thread, pjh)}, mat, False))
-    cmh = THREADS[cm.mount_thread].clearance
-    out.append(bolt_load("camera on its bracket's slot", cm.mount_thread, 2,
-                         {"washer": washer_area(cm.mount_thread, cmh)}, mat, False))
+    out.append(bolt_load("projector on the shelf's slots", pj.mount_thread, 4, _faces(washers["projector"]), mat,
+                         False))
+    out.append(bolt_load("camera on its bracket's slot", cm.mount_thread, 2, _faces(washers["camera"]), mat, False))
     return tuple(out)
 
 
@@ -297,9 +318,10 @@ def _tower_deflections(profile, layout, printer: Printer, mat: Material, masses)
     sag, tilt = cantilever(loads, rho * width * t.shelf_thickness * G, overhang, a_seat, EI)
     shelf = Deflection("shelf", f"cantilever {overhang:.0f} mm from the column's flange, {width:.0f} x "
                        f"{t.shelf_thickness:g} mm printed; the holder and camera ({(m_cam + m_hold) * G:.1f} N) at the seat "
-                       f"{a_seat:.0f} mm out, the projector's near feet, its own weight", sag, tilt, math.nan,
+                       f"{a_seat:.0f} mm out, the projector's near feet, its own weight; its tilt under the seat turns "
+                       f"the splitter, whose reflected axis turns {SPLITTER_TURN:g} x as much", sag, tilt, math.nan,
                        "projector_height, projector_tilt", tol.projector_height,
-                       max(sag / tol.projector_height, tilt / tol.projector_tilt), "buy.shelf: aluminium_plate")
+                       max(sag / tol.projector_height, SPLITTER_TURN * tilt / tol.projector_tilt), "buy.shelf: aluminium_plate")
     H = t.shelf_top_z - t.shelf_thickness - t.column_base_z
     EI_col = E * printed_tube_inertia(tw.column_width, tw.wall)
     m_shelf = rho * (x1 - x0) * width * t.shelf_thickness

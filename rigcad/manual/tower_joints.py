@@ -66,17 +66,17 @@ def column_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
     if rig.profile.buy.column != "print":
         return extrusion_fasteners(rig)
     foot, top = _row(rig, PLACED[1]), _row(rig, PLACED[0])
-    washer = THREADS[foot["thread"]].washer_thickness
+    washer = foot.get("washer_mm", THREADS[foot["thread"]].washer_thickness)
     pts = _column_flange_points(t, rig.profile)
     z_foot = t.column_base_z + tw.wall + washer
     grip_foot = washer + tw.wall + (t.column_base_z - t.bench_z) - NUT_TRAP_DEPTH
-    item = "{} x {:g} mm socket-head bolt (ISO 4762) with a washer (ISO 7089) and a nut (ISO 4032){}"
+    item = "{} x {:g} mm socket-head bolt (ISO 4762) with a large washer (ISO 7093-1) and a nut (ISO 4032){}"
     feet = tuple(_nut_bolt(item.format(foot["thread"], foot["length_mm"], " in the trap under the tongue"),
                            (x, y, z_foot), DOWN, foot["length_mm"], foot["thread"], grip_foot,
                            ("base_plate", "tower_column")) for x, y in pts)
-    z_top = t.shelf_top_z - t.shelf_thickness - tw.wall - washer  # under the column's top flange
+    z_top = t.shelf_top_z - t.shelf_thickness - tw.wall - top.get("washer_mm", washer)  # under the column's top flange
     into = "heat-set insert in" if rig.profile.buy.shelf == "print" else "thread tapped in"
-    shelf = tuple(_socket_head(f"{top['thread']} x {top['length_mm']:g} mm socket-head bolt (ISO 4762) with a washer, "
+    shelf = tuple(_socket_head(f"{top['thread']} x {top['length_mm']:g} mm socket-head bolt (ISO 4762) with a large washer, "
                                f"up into the {into} the shelf", (x, y, z_top), UP, top["length_mm"],
                                top["thread"], thread_in="insert",
                                passes=("tower_column", "tower_shelf")) for x, y in pts)

@@ -7,7 +7,8 @@ the nominal placement and its *resolution* the smallest step a hand sets reliabl
   (``adjusters.turn_fraction``, assumed 1/8 turn), over the lever arm it acts on;
 * a slot: how finely a hand slides a part against a caliper or a feeler gauge
   (``adjusters.hand_slide``, assumed 0.1 mm);
-* a shim stack: one shim.
+* a shim stack: the thinnest shim of its bought set (rigcad.parts.tower.fine_shims: stainless shim
+  stock between the printed shims, which give the range).
 
 Each serves a tolerance of ``tolerancing`` (the Monte Carlo's placement limits): a setting can be
 brought within one step of its target, so the resolution must not exceed the tolerance; and the
@@ -25,8 +26,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from rigcad.parts.datum import datum_chain
-from rigcad.parts.tower import projector_screws, seat_points
+from rigcad.parts.tower import fine_shims, projector_screws, seat_points
 from rigcad.standards import THREADS
 
 
@@ -64,9 +67,23 @@ def _lever(p, a, b) -> float:
     return abs((bx - ax) * (ay - py) - (ax - px) * (by - ay)) / math.hypot(bx - ax, by - ay)
 
 
+def reflected_turn(normal, axis, incoming=(-1.0, 0.0, 0.0)) -> float:
+    """How fast (rad per rad) the reflection of the ``incoming`` direction (the projector's axis, -x)
+    in a mirror of unit ``normal`` turns when the mirror turns about the unit ``axis``: |dr/d delta|
+    with r = d - 2 (d.n) n and dn = axis x n (first order). 2 for an axis in the mirror's plane
+    perpendicular to the plane of incidence; 1 for the plate at 45 deg turned about x (the axis
+    half along its normal)."""
+    n, u, d = (np.asarray(v, float) for v in (normal, axis, incoming))
+    dn = np.cross(u / np.linalg.norm(u), n)
+    dr = -2 * ((d @ dn) * n + (d @ n) * dn)
+    return float(np.linalg.norm(dr))
+
+
 def splitter_adjusters(profile, layout) -> list[Adjuster]:
     """The seat's three screws: the flat's screw tilts the plate in the plane of incidence (its 45 deg),
-    the vee's screw about the other axis; the cone's screw, with both, sets its height."""
+    the vee's screw about the other axis; the cone's screw, with both, sets its height. Each turns
+    the holder about the line through the other two balls; the projector's axis turns by that times
+    :func:`reflected_turn` (2 about the cone-vee line, less about the cone-flat line)."""
     t, a, tol = layout.tower, profile.adjusters, profile.tolerancing
     pts = seat_points(t, profile)
     step = THREADS[a.seat_thread].pitch * a.turn_fraction
@@ -76,12 +93,14 @@ def splitter_adjusters(profile, layout) -> list[Adjuster]:
     for screw, (o1, o2), what in (("flat", ("cone", "vee"), "in the plane of incidence (its 45 deg)"),
                                   ("vee", ("cone", "flat"), "across the plane of incidence")):
         arm = _lever(pts[screw], pts[o1], pts[o2])
+        (x1, y1), (x2, y2) = pts[o1], pts[o2]
+        k = reflected_turn(t.plate.normal, (x2 - x1, y2 - y1, 0.0))
         out.append(Adjuster(
             f"splitter tilt {what}",
             f"{a.seat_thread} x {THREADS[a.seat_thread].pitch:g} mm push screw over the {screw} ball, "
-            f"{a.turn_fraction:g} turn, on a {arm:.1f} mm lever; the reflected axis turns twice the plate",
+            f"{a.turn_fraction:g} turn, on a {arm:.1f} mm lever; the reflected axis turns {k:.2f} x the plate",
             "tolerancing.projector_tilt", tol.projector_tilt, "rad",
-            2 * a.seat_travel / arm, 2 * step / arm, 2 * groove))
+            k * a.seat_travel / arm, k * step / arm, 2 * groove))
     return out
 
 
@@ -97,20 +116,22 @@ def slot_adjusters(profile, layout) -> list[Adjuster]:
     lat, vert = chain.lateral_worst, chain.vertical_worst
     shims = t.shims_nominal * tw.shim_thickness
     slot = f"in a slot, set against a caliper or feeler gauge ({a.hand_slide:g} mm)"
-    stack = f"{tw.shim_thickness:g} mm shims"
+    fine = fine_shims(profile)
+    stack = (f"{tw.shim_thickness:g} mm printed shims and a bought set of {', '.join(f'{v:g}' for v in fine)} mm "
+             "stainless shims")
     return [
         _slot("camera along the axis", "two screws " + slot, "tolerancing.camera_height", tol.camera_height,
               tw.travel_along, vert, a.hand_slide),
         _slot("camera across (x)", "two screws " + slot, "tolerancing.camera_offset", tol.camera_offset,
               tw.travel_across, lat, a.hand_slide),
         _slot("camera across (y)", stack + " between camera and bracket", "tolerancing.camera_offset",
-              tol.camera_offset, shims, lat, tw.shim_thickness),
+              tol.camera_offset, shims, lat, fine[0]),
         _slot("projector along its axis (its COP along the optical axis)", "four screws " + slot,
               "tolerancing.projector_height", tol.projector_height, tw.travel_along, vert, a.hand_slide),
         _slot("projector across (y)", "four screws " + slot, "tolerancing.projector_offset", tol.projector_offset,
               tw.travel_across, lat, a.hand_slide),
         _slot("projector height (its COP across, x)", stack + " under its four feet", "tolerancing.projector_offset",
-              tol.projector_offset, shims, lat, tw.shim_thickness),
+              tol.projector_offset, shims, lat, fine[0]),
     ]
 
 

@@ -103,8 +103,15 @@ def _column_links(profile, t, process: ProcessErrors | None = None) -> tuple[Lin
     d = profile.datum
     height = t.shelf_top_z - t.shelf_thickness - t.column_base_z
     if profile.buy.column == "print":
+        from rigcad.parts.locating import SLOT_FIT_MM
+        from rigcad.parts.tower import column_dowel_points
+
         foot = 2 * t.column_foot_half
-        dowels = Link("dowels", f"ISO 8734 m6 in H7: {DOWEL_FIT:g} mm", DOWEL_FIT, 0.0)
+        a, b = column_dowel_points(t, profile)
+        yaw = SLOT_FIT_MM / math.dist(a, b)
+        dowels = Link("dowels", f"ISO 8734 m6 in H7: {DOWEL_FIT:g} mm; the second pin in a slot filed to "
+                      f"{SLOT_FIT_MM:g} mm turns the column {yaw * 1e3:.2f} mrad, which swings the axis "
+                      f"{t.column_x:.0f} mm away by {yaw * t.column_x:.2f} mm", DOWEL_FIT + yaw * t.column_x, 0.0)
         pattern = _printed(profile, 0, process)
         return (dowels, Link("column", f"printed: dowel pattern {pattern:.2f} mm; lean: the foot's "
                              f"{d.foot_flatness:g} mm out-of-flat over {foot:.0f} mm, times {height:.0f} mm",

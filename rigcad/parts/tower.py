@@ -110,6 +110,28 @@ def _box(lo, hi) -> tuple[tuple[float, float, float], tuple[float, float, float]
     return tuple(float(v) for v in lo), tuple(float(v) for v in hi)
 
 
+#: Bought shim stock (mm): precision shims of stainless steel (AISI 301 shim stock, +-0.005 mm on 0.05-0.2,
+#: +-0.01 mm on 0.5 mm, as sold), slotted to SHIM_SIDE like the printed ones, the thicknesses the fine set
+#: is made of. The printed shims (``tower.shim_thickness``) give the travel; the bought ones the fine
+#: steps between two printed ones, so an adjuster's step is the thinnest bought shim.
+SHIM_STOCK = (0.05, 0.1, 0.2, 0.5)
+#: The fine set reaches this many printed shims' thickness: 20 % past one, so a printed shim a little
+#: thicker than drawn (its layer error) leaves no gap between two settings.
+FINE_SET_REACH = 1.2
+
+
+def fine_shims(profile: Profile) -> tuple[float, ...]:
+    """One stack's set of bought shims (mm, thinnest first): each next the thickest of SHIM_STOCK no
+    thicker than what the set reaches so far plus the thinnest, so every multiple of the thinnest up
+    to the set's sum can be stacked, until it reaches FINE_SET_REACH printed shims."""
+    step, out, reach = SHIM_STOCK[0], [], 0.0
+    while reach < FINE_SET_REACH * profile.tower.shim_thickness - 1e-9:
+        s = max(v for v in SHIM_STOCK if v <= reach + step + 1e-9)
+        out.append(s)
+        reach += s
+    return tuple(out)
+
+
 def shims_nominal(profile: Profile) -> int:
     """Shims under the projector and behind the camera at the nominal placement: the travel across."""
     tw = profile.tower
@@ -275,6 +297,11 @@ def column_dowel_points(t: TowerLayout, profile: Profile):
     return [(t.column_x - h, 0.0), (t.column_x + h, 0.0)]
 
 
+#: A printed face lapped flat (mm): rubbed on abrasive paper (P240, wet) laid on float glass until a steel
+#: straightedge across it admits no 0.03 mm feeler leaf (a shop step: the tower's hardware rows state it).
+#: The printed column's glue faces are lapped so: two faces glued leave the upper piece leaning by at
+#: most 2 x this over the tube's side.
+LAPPED_FLATNESS = 0.03
 #: A bought column: 40 x 40 mm aluminium extrusion (slot 8) whose ends stand in square pockets in the
 #: base plate's tongue and under the shelf (POCKET_DEPTH deep, POCKET_GAP wider each side than the
 #: extrusion's nominal 40 mm, whose tolerance is about +-0.2 mm: ream or file the pocket to a slide
@@ -356,6 +383,42 @@ def column_datums(t: TowerLayout, profile: Profile, z0: float, height: float, fa
     return (Datum(f"{where} extrusion pocket", "register", column_joint_cuts(t, profile, z0, height, face)[0]),)
 
 
+def column_register(t: TowerLayout, profile: Profile, z0: float, height: float, end: str):
+    """The printed column's dowel register at one ``end`` ("foot" or "top") through its flange at
+    z0..z0+height (rigcad.parts.locating.DowelRegister): the pins stand in round reamed holes in the
+    tongue (foot) or the shelf (top); the column's flange takes the first in a round hole and the
+    second in a slot along the line between them, so the print's scale error over their spacing
+    cannot bind the joint (two round holes at each end would)."""
+    from rigcad.parts.locating import DowelRegister
+
+    d = profile.datum
+    a, b = column_dowel_points(t, profile)
+    spacing = math.dist(a, b)
+    other = (t.bench_z, t.column_base_z) if end == "foot" else (t.shelf_top_z - t.shelf_thickness, t.shelf_top_z)
+    return DowelRegister(f"column {end}", "tower_column", "base_plate" if end == "foot" else "tower_shelf",
+                         d.dowel_diameter, (a, b), (z0, z0 + height), other,
+                         2 * (2 * d.print_position + d.print_scale * spacing), param="datum.dowel_diameter")
+
+
+def column_bolt_hole(t: TowerLayout, profile: Profile) -> float:
+    """The printed column's bolt holes (mm): opened past the M4 clearance by both parts' print position
+    errors and the scale error out to the farthest bolt from the round pin, each side
+    (rigcad.parts.locating.bolt_hole), so the dowels locate and the bolts only clamp."""
+    from rigcad.parts.locating import bolt_hole
+
+    d = profile.datum
+    pin = column_dowel_points(t, profile)[0]
+    far = max(math.dist(pin, q) for q in _column_flange_points(t, profile))
+    return bolt_hole("M4", far, d.print_position, d.print_scale)
+
+
+def _column_own_holes(t: TowerLayout, profile: Profile, z0: float, height: float, end: str) -> tuple:
+    """The printed column's flange at one end: its opened bolt holes and its register's round hole
+    and slot (:func:`column_register`)."""
+    return (_holes(_column_flange_points(t, profile), column_bolt_hole(t, profile), z0, height)
+            + column_register(t, profile, z0, height, end).upper_holes())
+
+
 def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: float) -> tuple[Cylinder, ...]:
     """The bolt and dowel holes of a column joint through z0..z0+height: the column's foot on the
     base plate's tongue, its top flange under the shelf (the same pattern at both)."""
@@ -383,7 +446,14 @@ def shelf_joint_cuts(t: TowerLayout, profile: Profile, z0: float) -> tuple:
 def shelf_bolt_length(profile: Profile) -> float:
     """The shelf joint's bolt (mm): the longest stocked ISO 4762 length that stops 0.5 mm short of the
     insert's end, through the column's flange and a washer."""
-    reach = profile.tower.wall + THREADS["M4"].washer_thickness + SHELF_INSERT.length - 0.5
+    from rigcad.parts.locating import bolt_hole
+    from rigcad.parts.washers import washers_over
+
+    # the large washer the column's opened hole takes (column_bolt_hole, before the layout: its largest)
+    d = profile.datum
+    hole = bolt_hole("M4", 2 * (profile.tower.column_width / 2 + 1.5 * profile.tower.bolt_diameter), d.print_position,
+                     d.print_scale)
+    reach = profile.tower.wall + washers_over("M4", ("round", hole)).thickness + SHELF_INSERT.length - 0.5
     return float(longest_screw("M4", reach))
 
 
@@ -399,14 +469,50 @@ SHELF_INSERT = INSERTS["M4"]
 SPRING_HOLE = 6.0
 
 
+#: An adjuster serves a tolerance when its resolution is at most this share of it: a setting must land
+#: well inside the tolerance, not merely within one step of its edge (rigcad.fab.stack reads it too).
+RESOLUTION_SHARE = 0.25
+#: The flat's screw stands this much farther out than the least lever its resolution needs, so that a
+#: printed flange a little short still serves (a margin on the lever, not a tolerance).
+FLAT_LEVER_MARGIN = 1.1
+
+
+def flat_lever(profile: Profile) -> float:
+    """The least lever (mm) of the seat's flat screw about the cone-vee line: its step (the seat
+    thread's pitch x ``adjusters.turn_fraction``) tilts the plate in its plane of incidence, which
+    turns the reflected (projector's) axis by twice as much; that turn must be at most
+    RESOLUTION_SHARE of ``tolerancing.projector_tilt``."""
+    a = profile.adjusters
+    step = THREADS[a.seat_thread].pitch * a.turn_fraction
+    return 2 * step / (RESOLUTION_SHARE * profile.tolerancing.projector_tilt)
+
+
+def _flat_reach(t: TowerLayout, profile: Profile) -> float:
+    """How far (mm) the flat's screw stands behind the holder's back wall (-x): under the middle of a
+    back flange three bolts wide, or farther when its lever would be short of FLAT_LEVER_MARGIN x
+    :func:`flat_lever` (the flange then reaches back to it)."""
+    tw = profile.tower
+    cone_x = t.holder_x[1] - 8.0
+    reach = max(1.5 * tw.bolt_diameter, FLAT_LEVER_MARGIN * flat_lever(profile) - (cone_x - t.holder_x[0]))
+    if reach > t.holder_x[1] - t.holder_x[0]:
+        a = profile.adjusters
+        raise GeometryError(f"the splitter seat's flat screw would need a {flat_lever(profile):.0f} mm lever (its "
+                            f"{a.seat_thread} pitch x {a.turn_fraction:g} turn, twice on the reflected axis, within "
+                            f"{RESOLUTION_SHARE:g} of tolerancing.projector_tilt): a back flange longer than the holder; "
+                            "use a finer adjusters.seat_thread or a smaller adjusters.turn_fraction",
+                            where=profile.where("adjusters", "seat_thread"))
+    return reach
+
+
 def seat_points(t: TowerLayout, profile: Profile) -> dict[str, tuple[float, float]]:
     """The splitter holder's kinematic seat (x, y; mm): a cone and a vee under the side flanges at its
-    +x end, a flat under its back flange (y = 0): each a ball-ended push screw in the holder over its
-    seat in the shelf (:func:`splitter_seat`). The vee's pins point at the cone."""
+    +x end, a flat under its back flange (y = 0), as far back as its screw's resolution needs
+    (:func:`flat_lever`): each a ball-ended push screw in the holder over its seat in the shelf
+    (:func:`splitter_seat`). The vee's pins point at the cone."""
     tw = profile.tower
     y = t.wall_y[1] + 1.5 * tw.bolt_diameter
     x0, x1 = t.holder_x
-    return {"cone": (x1 - 8.0, -y), "vee": (x1 - 8.0, y), "flat": (x0 - 1.5 * tw.bolt_diameter, 0.0)}
+    return {"cone": (x1 - 8.0, -y), "vee": (x1 - 8.0, y), "flat": (x0 - _flat_reach(t, profile), 0.0)}
 
 
 #: The seat's push screws: cup-point socket set screws (ISO 4029; ASME B18.3 for a UNC thread) in
@@ -611,7 +717,7 @@ def _shelf_extent(t: TowerLayout, profile: Profile):
     hy = t.wall_y[1] + 3 * tw.bolt_diameter
     _, _, lens_hy, _ = _lens_foot(t, profile)
     flange = tw.column_width / 2 + 3 * tw.bolt_diameter
-    x0 = t.holder_x[0] - 3 * tw.bolt_diameter - tw.wall  # under the holder's back flange
+    x0 = t.holder_x[0] - _flat_reach(t, profile) - 1.5 * tw.bolt_diameter - tw.wall  # under the holder's back flange
     x1 = max(bx1 + tw.wall, t.column_x + flange)
     y0 = min(by0 - tw.wall, -hy - tw.wall, -lens_hy - tw.wall, -flange)
     y1 = max(by1 + tw.wall, hy + tw.wall, lens_hy + tw.wall, flange)
@@ -634,12 +740,15 @@ def tower_column(profile: Profile, layout) -> Part:
     bore = Box((xc - w + tw.wall, -w + tw.wall, z0 - 1.0), (xc + w - tw.wall, w - tw.wall, top + 1.0))
     tube = Box((xc - w, -w, z0), (xc + w, w, top))
     flange = Box((xc - foot_h, -foot_h, top - tw.wall), (xc + foot_h, foot_h, top))
-    holes = tuple(h for z in (z0, top - tw.wall) for h in column_joint_holes(t, profile, z, tw.wall))
-    datums = (*column_datums(t, profile, z0, tw.wall, "top", "foot"),
-              *column_datums(t, profile, top - tw.wall, tw.wall, "bottom", "top flange"))
+    holes = (*_column_own_holes(t, profile, z0, tw.wall, "foot"), *_column_own_holes(t, profile, top - tw.wall, tw.wall, "top"))
+    datums = tuple(Datum(f"{where} dowel {kind}", "dowel", shape) for z, end, where in
+                   ((z0, "foot", "foot"), (top - tw.wall, "top", "top flange"))
+                   for kind, shape in (("hole", column_register(t, profile, z, tw.wall, end).upper_holes()[0]),
+                                       ("slot", Union_(column_register(t, profile, z, tw.wall, end).upper_holes()[1:]))))
     return Part("tower_column", Difference(Union_((foot, tube, flange)), (bore, *holes)), (0.55, 0.57, 0.6),
                 f"COP tower: hollow {tw.column_width:g} mm column on the base plate's datum tongue, under the "
-                f"projector's shelf; two {profile.datum.dowel_diameter:g} mm dowels and four bolts at each end",
+                f"projector's shelf; two {profile.datum.dowel_diameter:g} mm dowels (a round hole and a slot in its flange) and "
+                f"four bolts in {column_bolt_hole(t, profile):.1f} mm holes at each end",
                 datums=datums)
 
 
@@ -700,14 +809,6 @@ def _groove(t: TowerLayout) -> Translate:
     return Translate(slab, (0.0, 0.5 * (y0 + y1), 0.0))
 
 
-def camera_screws(t: TowerLayout, profile: Profile) -> list[tuple[float, float]]:
-    """The camera's two screws (x, z; mm) at the nominal placement: in line along the optical axis,
-    ``camera.mount_spacing`` apart, about the body's middle (two points: the camera cannot pivot)."""
-    (cx0, _, cz0), (cx1, _, cz1) = t.camera_box
-    cx, cz, s = 0.5 * (cx0 + cx1), 0.5 * (cz0 + cz1), profile.camera.mount_spacing
-    return [(cx, cz - s / 2), (cx, cz + s / 2)]
-
-
 def _camera_bracket(t: TowerLayout, profile: Profile) -> tuple[tuple[Box, Box], Box]:
     """The camera bracket on the holder's -y wall (a ledge into the wall's top and an upright) and its
     slot: both camera screws slide in it by travel_along along the axis and travel_across across."""
@@ -722,7 +823,12 @@ def _camera_bracket(t: TowerLayout, profile: Profile) -> tuple[tuple[Box, Box], 
         raise GeometryError(f"the camera's screws ({cm.mount_spacing:g} mm apart) do not fit its body "
                             f"({cm.body_depth:g} mm deep along its axis): check camera.mount_spacing",
                             where=profile.where("camera", "mount_spacing"))
-    half_w = max((cx1 - cx0) / 2, d / 2 + tw.travel_across + tw.wall)
+    from rigcad.parts.washers import washers_over
+
+    # the bracket carries the washer that bears over the slot wherever the screws are set in it
+    (_, q0), (_, q1) = camera_screws(t, profile)
+    bearing = washers_over(cm.mount_thread, ("slot", d + 2 * tw.travel_across, q1 - q0 + d + 2 * tw.travel_along))
+    half_w = max((cx1 - cx0) / 2, d / 2 + tw.travel_across + tw.wall, tw.travel_across + bearing.bearing.outer / 2 + 1.0)
     bx0, bx1 = max(cx - half_w, x0), min(cx + half_w, x1)
     ledge = Box((bx0, -yo, z1 - tw.wall), (bx1, -yi, z1))  # sits into the -y wall's top
     upright = Box((bx0, -yo, z1 - tw.wall), (bx1, t.bracket_y, cz1))
@@ -748,7 +854,7 @@ def splitter_holder(profile: Profile, layout) -> Part:
     back = Box((x0, -yo, z0), (x0 + tw.wall, yo, z1))
     fl = 3 * tw.bolt_diameter
     flanges = [Box((x0, -yo - fl, z0), (x1, -yo, z0 + tw.wall)), Box((x0, yo, z0), (x1, yo + fl, z0 + tw.wall)),
-               Box((x0 - fl, -yo, z0), (x0, yo, z0 + tw.wall))]
+               Box((x0 - _flat_reach(t, profile) - 1.5 * tw.bolt_diameter, -yo, z0), (x0, yo, z0 + tw.wall))]
     bracket, slot = _camera_bracket(t, profile)
     ins = INSERTS[a.seat_thread]
     boss_r, boss_h = _seat_boss(profile)
@@ -847,21 +953,39 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
                  "length_mm": length["top"], "quantity": 1,
                  "steps": ('tower_shelf',), "joins": "down through the shelf (its head flush in the countersink on top) into the extrusion's core, "
                           f"tapped {CORE_TAP_DEPTH:g} mm deep"}]
+    from rigcad.parts.locating import SLOT_FIT_MM
+    from rigcad.parts.washers import washers_over
+
+    hole = column_bolt_hole(t, profile)
+    big = washers_over("M4", ("round", hole))
+    extra = big.thickness - THREADS["M4"].washer_thickness
+    lap = (f"lap the column's foot-side and flange-side glue faces flat before they are glued: wet P240 paper on "
+           f"float glass, figure-of-eight strokes, until a steel straightedge laid across each face in four directions "
+           f"admits no {LAPPED_FLATNESS:g} mm feeler leaf")
     return [
-        {"item": "bolt and washer", "thread": "M4", "length_mm": shelf_bolt_length(profile), "quantity": 4,
+        {"item": "bolt and large washer (ISO 7093-1)", "thread": "M4", "length_mm": shelf_bolt_length(profile),
+         "quantity": 4, "washer_mm": big.thickness, "washers": [w.name() for w in big.washers],
          "steps": ('tower_shelf',), "joins": "the column's top flange to the shelf: up from under the flange into "
                   + ("heat-set inserts pressed into the shelf's underside" if profile.buy.shelf == "print" else
-                     "M4 threads tapped in the shelf's underside (8 mm deep)")},
-        {"item": "bolt, washer and nut", "thread": "M4", "length_mm": _length("M4", tw.wall + tongue - NUT_TRAP_DEPTH, nut_allowance("M4", washers=1)),
-         "quantity": 4, "steps": ('tower_column',), "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
-                                 "under the tongue, put in before it stands on the bench)"},
+                     "M4 threads tapped in the shelf's underside (8 mm deep)")
+                  + f" ({big.describe()}: the dowels locate, the bolts only clamp)"},
+        {"item": "bolt, large washer (ISO 7093-1) and nut", "thread": "M4",
+         "length_mm": _length("M4", tw.wall + tongue - NUT_TRAP_DEPTH + extra, nut_allowance("M4", washers=1)),
+         "quantity": 4, "washer_mm": big.thickness, "washers": [w.name() for w in big.washers],
+         "steps": ('tower_column',), "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
+                  f"under the tongue, put in before it stands on the bench; {big.describe()})"},
         *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT.hole,
             "steps": ('tower_shelf',), "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]
           if profile.buy.shelf == "print" else []),
         {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
          "length_mm": float(longest_dowel(min(tw.wall, t.shelf_thickness) + tw.wall)), "quantity": 4,
-         "steps": ('tower_column', 'tower_shelf'), "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf "
-                  f"(ream the printed holes {profile.datum.dowel_diameter:g} H7)"},
+         "steps": ('tower_column', 'tower_shelf'), "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf: "
+                  f"pressed into the tongue's and the shelf's holes (ream them {profile.datum.dowel_diameter:g} H7 a size under, "
+                  f"or glue the pins); at each end the column's flange takes the first pin in its round hole (reamed "
+                  f"{profile.datum.dowel_diameter:g} H7) and the second in its slot (file it until the pin slides, "
+                  f"{SLOT_FIT_MM:g} mm across); {lap}",
+         "shop_steps": [f"ream the column's round dowel holes and the tongue's and shelf's {profile.datum.dowel_diameter:g} H7",
+                        f"file the column's dowel slots until the pin slides ({SLOT_FIT_MM:g} mm)", lap]},
     ]
 
 
@@ -905,43 +1029,141 @@ def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
 #: Washers (ISO 7089 for the projector's thread: rigcad.standards) a screw may carry under its head to reach
 #: the right depth: more and the joint loses stiffness.
 MAX_EXTRA_WASHERS = 3
+#: ... or as many thin washers as make this much (mm): a shallow socket (an M3 camera's 2.5 mm) takes a
+#: screw only within half a millimetre, and the stocked lengths step by up to 5 mm.
+MAX_EXTRA_WASHER_MM = 5.0
+
+
+#: A camera's mounting socket's thread depth (mm) by its thread, when no figure is at hand: M3 from the
+#: FLIR Blackfly S's "M3x2.5" holes (profiles/instruments, its cited source); the others assumed (a
+#: tripod socket 1/4-20 or 3/8-16: 5 mm; a metric hole: one diameter). Measure yours.
+CAMERA_SOCKET_DEPTH = {"1/4-20 UNC": 5.0, "3/8-16 UNC": 5.0, "M3": 2.5, "M4": 4.0, "M5": 5.0, "M6": 6.0}
+
+
+def slot_openings(profile: Profile, layout) -> dict[str, tuple]:
+    """The openings under the tower's bolts (rigcad.parts.washers): ("slot", width x, width y) for the
+    projector's slots in the shelf (along its axis, across), the camera's slot in its bracket (across,
+    along the axis) and the lens mount's foot; ("round", d) for the printed column's opened holes."""
+    t, tw = layout.tower, profile.tower
+    d_pj = clearance_hole(profile.projector.mount_thread)
+    d_cm = clearance_hole(profile.camera.mount_thread)
+    (_, s0), (_, s1) = camera_screws(t, profile)
+    return {"projector": ("slot", d_pj + 2 * tw.travel_along, d_pj + 2 * tw.travel_across),
+            "camera": ("slot", d_cm + 2 * tw.travel_across, s1 - s0 + d_cm + 2 * tw.travel_along),
+            "lens": ("slot", tw.bolt_diameter + 2 * tw.travel_along, tw.bolt_diameter),
+            "column": ("round", column_bolt_hole(t, profile))}
+
+
+def joint_washers(profile: Profile, layout) -> dict:
+    """The washers under each of the tower's bolts over a slot or an opened hole
+    (rigcad.parts.washers.washers_over): keys as :func:`slot_openings`."""
+    from rigcad.parts.washers import washers_over
+
+    threads = {"projector": profile.projector.mount_thread, "camera": profile.camera.mount_thread, "lens": "M4",
+               "column": "M4"}
+    return {k: washers_over(threads[k], op) for k, op in slot_openings(profile, layout).items()}
+
+
+def _stack_screws(thread: str, fixed: float, shim: float, stacks: int, fine: float, washer: float,
+                  depth: float, shallow: bool = False) -> list[dict]:
+    """Screws into an instrument's socket through ``fixed`` mm (washers under the head, the printed part),
+    a stack of n printed ``shim`` mm shims (n = 0..stacks) and the whole bought set (``fine`` mm: the
+    bought shims not in the stack go under the head's washers, so the reach does not change with the
+    fine setting): the shortest stocked length, with the fewest extra ``washer`` mm washers (at most
+    MAX_EXTRA_WASHERS, or MAX_EXTRA_WASHER_MM of thin ones), that engages the socket by
+    SOCKET_ENGAGEMENT, or, with ``shallow`` (a light instrument whose maker's socket is shorter), by the
+    socket's depth less one washer (the step the extra washers set), and never passes ``depth`` (a
+    screw that bottoms out does not clamp)."""
+    least = min(SOCKET_ENGAGEMENT, depth - washer) if shallow else SOCKET_ENGAGEMENT
+    rows = []
+    for n in range(stacks + 1):
+        grip = fixed + n * shim + fine
+        most = max(MAX_EXTRA_WASHERS, math.floor(MAX_EXTRA_WASHER_MM / washer + 1e-9))
+        fits = [(L, w, L - grip - w * washer) for L in screw_lengths(thread) for w in range(most + 1)
+                if least - 1e-9 <= L - grip - w * washer <= depth + 1e-9]
+        length, washers, reach = fits[0] if fits else (None, None, None)
+        rows.append({"shims": n, "grip_mm": grip, "length_mm": length, "extra_washers": washers,
+                     "engagement_mm": reach, "least_engagement_mm": least, "ok": bool(fits)})
+    return rows
 
 
 def projector_screws(profile, layout) -> list[dict]:
-    """The projector's screws for each shim stack (0..shims_per_stack shims; mm): the shortest ISO 4762
-    length, with the fewest extra washers under its head (at most MAX_EXTRA_WASHERS), that engages the
-    projector's thread by SOCKET_ENGAGEMENT to ``projector.mount_depth``, through a washer, the shelf
-    and the stack. ``ok`` False: no stocked length fits that stack."""
+    """The projector's screws for each shim stack (0..shims_per_stack printed shims and the bought set,
+    :func:`fine_shims`; mm): through the washers over the shelf's slot (:func:`joint_washers`), the
+    shelf and the stack, engaging the projector's thread by SOCKET_ENGAGEMENT to
+    ``projector.mount_depth`` (:func:`_stack_screws`). ``ok`` False: no stocked length fits that stack."""
     t, tw, pj = layout.tower, profile.tower, profile.projector
-    rows = []
-    for n in range(t.shims_per_stack + 1):
-        washer = THREADS[pj.mount_thread].washer_thickness
-        grip = washer + t.shelf_thickness + n * tw.shim_thickness
-        fits = [(L, w, L - grip - w * washer) for L in screw_lengths(pj.mount_thread)
-                for w in range(MAX_EXTRA_WASHERS + 1)
-                if SOCKET_ENGAGEMENT - 1e-9 <= L - grip - w * washer <= pj.mount_depth + 1e-9]
-        length, washers, reach = fits[0] if fits else (None, None, None)
-        rows.append({"shims": n, "grip_mm": grip, "length_mm": length, "extra_washers": washers,
-                     "engagement_mm": reach, "ok": bool(fits)})
-    return rows
+    fixed = joint_washers(profile, layout)["projector"].thickness + t.shelf_thickness
+    return _stack_screws(pj.mount_thread, fixed, tw.shim_thickness, t.shims_per_stack, sum(fine_shims(profile)),
+                         THREADS[pj.mount_thread].washer_thickness, pj.mount_depth)
+
+
+def camera_socket_depth(profile: Profile) -> float:
+    """The camera's mounting socket's thread depth (mm): CAMERA_SOCKET_DEPTH for its thread."""
+    return CAMERA_SOCKET_DEPTH[profile.camera.mount_thread]
+
+
+def camera_screws(t: TowerLayout, profile: Profile) -> list[tuple[float, float]]:
+    """The camera's two screws (x, z; mm) at the nominal placement: in line along the optical axis,
+    ``camera.mount_spacing`` apart, about the body's middle (two points: the camera cannot pivot)."""
+    (cx0, _, cz0), (cx1, _, cz1) = t.camera_box
+    cx, cz, s = 0.5 * (cx0 + cx1), 0.5 * (cz0 + cz1), profile.camera.mount_spacing
+    return [(cx, cz - s / 2), (cx, cz + s / 2)]
+
+
+def camera_stack_screws(profile: Profile, layout) -> list[dict]:
+    """The camera's two screws for each shim stack behind it, as :func:`projector_screws`: through the
+    washers over the bracket's slot, the bracket and the stack, into the camera's socket no deeper than
+    :func:`camera_socket_depth` (a screw that bottoms out would not clamp)."""
+    t, tw, cm = layout.tower, profile.tower, profile.camera
+    fixed = joint_washers(profile, layout)["camera"].thickness + (t.bracket_y + t.wall_y[1])
+    return _stack_screws(cm.mount_thread, fixed, tw.shim_thickness, t.shims_per_stack, sum(fine_shims(profile)),
+                         THREADS[cm.mount_thread].washer_thickness, camera_socket_depth(profile), shallow=True)
+
+
+def _screw_rows(rows: list[dict], thread: str, count: int, step: str, what: str, param: tuple[str, str],
+                profile: Profile, washers, key: str = "for_stacks_of_shims") -> list[dict]:
+    """One hardware row per screw length ``rows`` (:func:`_stack_screws`) needs; ``key`` names the stacks
+    each length serves (the projector's ``for_stacks_of_shims``; the camera's its own key)."""
+    bad = [r["shims"] for r in rows if not r["ok"]]
+    if bad:
+        raise GeometryError(f"no stocked {thread} screw suits {what} on a stack of {bad[0]} shims (with the bought "
+                            f"set) without bottoming in its socket: check {param[0]}.{param[1]}",
+                            where=profile.where(*param))
+    stacks: dict[float, list[int]] = {}
+    for r in rows:
+        stacks.setdefault(r["length_mm"], []).append(r["shims"])
+    return [{"item": "screw and washers", "thread": thread, "length_mm": float(L), "quantity": count,
+             key: ns, "washers": [w.name() for w in washers.washers],
+             "steps": (step,), "joins": f"{what}, through {washers.describe()}, the slot and a stack of {ns[0]}..{ns[-1]} "
+                      "printed shims and the bought ones (extra washers per stack: rigcad.parts.tower, "
+                      f"{'projector_screws' if step == 'projector_body' else 'camera_stack_screws'})"}
+            for L, ns in stacks.items()]
 
 
 def _projector_screw_rows(profile: Profile, layout) -> list[dict]:
     """The projector's screws: one row per length the shim stacks need (:func:`projector_screws`)."""
-    rows = projector_screws(profile, layout)
-    bad = [r["shims"] for r in rows if not r["ok"]]
-    if bad:
-        raise GeometryError(f"no stocked {profile.projector.mount_thread} screw suits a stack of {bad[0]} shims with "
-                            f"projector.mount_depth {profile.projector.mount_depth:g} mm: check it",
-                            where=profile.where("projector", "mount_depth"))
-    stacks: dict[float, list[int]] = {}
-    for r in rows:
-        stacks.setdefault(r["length_mm"], []).append(r["shims"])
-    return [{"item": "screw and washer", "thread": profile.projector.mount_thread, "length_mm": float(L),
-             "quantity": len(_projector_feet(layout.tower)), "for_stacks_of_shims": ns,
-             "steps": ("projector_body",), "joins": "the projector's mounting holes, through the shelf's slots and a stack of "
-                      f"{ns[0]}..{ns[-1]} shims (extra washers per stack: rigcad.parts.tower.projector_screws)"}
-            for L, ns in stacks.items()]
+    return _screw_rows(projector_screws(profile, layout), profile.projector.mount_thread,
+                       len(_projector_feet(layout.tower)), "projector_body", "the projector's mounting holes",
+                       ("projector", "mount_depth"), profile, joint_washers(profile, layout)["projector"])
+
+
+def _fine_shim_rows(profile: Profile) -> list[dict]:
+    """The bought shims: one set per stack (four under the projector, one behind the camera), a row per
+    thickness, with the shop step that makes them."""
+    counts: dict[float, int] = {}
+    for v in fine_shims(profile):
+        counts[v] = counts.get(v, 0) + 1
+    stacks = 5
+    return [{"item": f"precision shim, stainless steel (AISI 301 shim stock), {v:g} mm", "thread": None,
+             "length_mm": None, "quantity": stacks * n, "thickness_mm": v, "size_mm": [SHIM_SIDE, SHIM_SIDE, v],
+             "steps": ("projector_body", "camera_body"),
+             "joins": f"{n} with each of the five shim stacks (four under the projector's feet, one behind the camera): "
+                      f"in the stack, between the printed {profile.tower.shim_thickness:g} mm shims, the fine steps of the "
+                      "alignment; the rest under the screw's washers, so its reach stays the same "
+                      f"(cut {SHIM_SIDE:g} x {SHIM_SIDE:g} mm from the sheet with tin snips, the printed shim as the "
+                      "template for its U slot; deburr with a file)"}
+            for v, n in sorted(counts.items())]
 
 
 def hardware(profile: Profile, layout) -> list[dict]:
@@ -954,21 +1176,23 @@ def hardware(profile: Profile, layout) -> list[dict]:
     t, tw, cm, bs, ln = layout.tower, profile.tower, profile.camera, profile.beam_splitter, profile.lens
     m4 = "M4"
     nut = nut_allowance(m4)
-    through = _length(m4, tw.wall + t.shelf_thickness, nut)  # the lens mount's foot on the shelf
-    shim_max = t.shims_per_stack * tw.shim_thickness
-    bracket = t.bracket_y + t.wall_y[1]  # the camera bracket's thickness (y)
+    washers = joint_washers(profile, layout)
+    # the lens mount's foot on the shelf: its washers over the foot's slot, the nut's under the shelf
+    through = _length(m4, tw.wall + t.shelf_thickness + washers["lens"].thickness - THREADS[m4].washer_thickness, nut)
     _, _, _, lens_pts = _lens_foot(t, profile)
     focus = focusing_lens(profile, layout.geometry)
     return [
         *_column_hardware(profile, t, nut),
         *_seat_hardware(profile, t, nut),
-        {"item": "bolt, washer and nut", "thread": m4, "length_mm": through, "quantity": len(lens_pts),
-         "steps": ('lens_mount',), "joins": "the lens mount's slotted foot to the shelf"},
+        {"item": "bolt, large washer (ISO 7093-1) over its slot, washer and nut", "thread": m4, "length_mm": through,
+         "quantity": len(lens_pts), "washers": [w.name() for w in washers["lens"].washers],
+         "steps": ('lens_mount',), "joins": f"the lens mount's slotted foot to the shelf ({washers['lens'].describe()})"},
         *_projector_screw_rows(profile, layout),
-        {"item": "screw and washer", "thread": cm.mount_thread,
-         "length_mm": _length(cm.mount_thread, bracket + shim_max, SOCKET_ENGAGEMENT), "quantity": 2,
-         "steps": ('camera_body',), "joins": f"the camera's two mounting holes ({cm.mount_spacing:g} mm apart along its axis), through the "
-                  "bracket's slot and its shim stack"},
+        *_screw_rows(camera_stack_screws(profile, layout), cm.mount_thread, 2, "camera_body",
+                     f"the camera's two mounting holes ({cm.mount_spacing:g} mm apart along its axis; "
+                     f"{camera_socket_depth(profile):g} mm deep, rigcad.parts.tower.CAMERA_SOCKET_DEPTH)",
+                     ("camera", "mount_thread"), profile, washers["camera"], "for_camera_stacks_of_shims"),
+        *_fine_shim_rows(profile),
         {"item": "plate beam splitter", "thread": None, "length_mm": None, "quantity": 1,
          "size_mm": [bs.width, bs.length, bs.thickness], "index": bs.index, "spec": splitter_spec(profile),
          "steps": ('beam_splitter',), "joins": "slides into the splitter holder's grooves through its +y wall, coated face towards the projector"},

@@ -28,4 +28,4 @@ def test_projector_screws_per_stack(table31_rig):
     text = plan.projector_screw_text(rig)
     for r in rows:
         assert r["item"].split(" socket")[0] in text
-    assert per_stack[0] != per_stack[rig.layout.tower.shims_per_stack]  # the default needs two lengths
+    assert per_stack[0] != per_stack[rig.layout.tower.shims_per_stack]  # the default needs several lengths

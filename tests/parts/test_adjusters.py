@@ -5,8 +5,11 @@ import math
 
 import pytest
 
-from rigcad.parts.adjusters import adjusters, camera_mount_tilt, projector_screws, splitter_adjusters
-from rigcad.parts.tower import seat_points
+import numpy as np
+
+from rigcad.errors import GeometryError
+from rigcad.parts.adjusters import adjusters, camera_mount_tilt, projector_screws, reflected_turn, splitter_adjusters
+from rigcad.parts.tower import camera_socket_depth, camera_stack_screws, fine_shims, joint_washers, seat_points
 from rigcad.profile import load_profile
 from rigcad.rig import Rig
 
@@ -27,16 +30,35 @@ def test_splitter_tilt_is_pitch_times_turn_over_the_lever_doubled(table31_rig):
     step = 0.5 * p.adjusters.turn_fraction  # M3: 0.5 mm pitch
     assert flat.resolution == pytest.approx(2 * step / lever, rel=1e-12)
     assert flat.range == pytest.approx(2 * p.adjusters.seat_travel / lever, rel=1e-12)
-    # 1/8 turn of M3 on a ~46 mm lever: ~0.16 deg of the projector's axis, inside its 0.5 deg
-    assert math.degrees(flat.resolution) < math.degrees(p.tolerancing.projector_tilt)
+    # the flat stands far enough back that 1/8 turn of M3 is within a quarter of the 0.5 deg tolerance
+    assert flat.resolution <= 0.25 * p.tolerancing.projector_tilt
 
 
-def test_a_coarse_seat_screw_fails_its_tolerance(write_profile, table31_text):
-    # a 3/8-16 screw (1.59 mm pitch) set to a quarter turn: ~1 deg of the axis, twice the 0.5 deg allowed
+def test_the_reflected_axis_turns_by_the_law_of_reflection():
+    # the plate at 45 deg (normal (1, 0, -1)/sqrt 2), the projector's axis along -x: turned about y (in the
+    # plate, across the plane of incidence) the reflection turns twice; about x, once (checked by
+    # reflecting the axis in the turned plate)
+    n = np.array([1.0, 0.0, -1.0]) / math.sqrt(2.0)
+    d = np.array([-1.0, 0.0, 0.0])
+
+    def turned(axis, delta):
+        u = np.asarray(axis, float) / np.linalg.norm(axis)
+        m = n * math.cos(delta) + np.cross(u, n) * math.sin(delta) + u * (u @ n) * (1 - math.cos(delta))
+        r0, r1 = d - 2 * (d @ n) * n, d - 2 * (d @ m) * m
+        return math.acos(np.clip(r0 @ r1, -1, 1)) / delta
+
+    for axis in ((0, 1, 0), (1, 0, 0), (1, 1, 0), (0.3, -1, 0)):
+        assert reflected_turn(n, axis) == pytest.approx(turned(axis, 1e-5), rel=1e-4)
+    assert reflected_turn(n, (0, 1, 0)) == pytest.approx(2.0) and reflected_turn(n, (1, 0, 0)) == pytest.approx(1.0)
+
+
+def test_a_coarse_seat_screw_is_refused_naming_the_thread(write_profile, table31_text):
+    # a 3/8-16 screw (1.59 mm pitch) set to a quarter turn would need a ~360 mm lever for 1/4 of 0.5 deg
     rig = Rig.from_profile(load_profile(write_profile(
         table31_text + "adjusters:\n  seat_thread: 3/8-16 UNC\n  turn_fraction: 0.25\n")))
-    flat = splitter_adjusters(rig.profile, rig.layout)[0]
-    assert not flat.ok and flat.resolution > rig.profile.tolerancing.projector_tilt
+    with pytest.raises(GeometryError) as err:
+        splitter_adjusters(rig.profile, rig.layout)
+    assert "adjusters.seat_thread" in str(err.value) and "p.yaml" in str(err.value)
 
 
 def test_camera_screws_too_close_let_it_tilt(write_profile, table31_text):
@@ -48,14 +70,28 @@ def test_camera_screws_too_close_let_it_tilt(write_profile, table31_text):
 
 def test_projector_screws_suit_every_stack(table31_rig):
     p, t = table31_rig.profile, table31_rig.layout.tower
+    washers = joint_washers(p, table31_rig.layout)["projector"]
+    fine = sum(fine_shims(p))
     for row in projector_screws(p, table31_rig.layout):
         assert row["ok"]
-        # its thread engages the projector by 5 mm to mount_depth, through washer + shelf + stack + extra
-        # washers, each an ISO 7089 M4 washer 0.8 mm thick (the standard's figure, not rigcad's table)
-        assert p.projector.mount_thread == "M4"
-        reach = row["length_mm"] - (0.8 + t.shelf_thickness + row["shims"] * p.tower.shim_thickness) \
+        # its thread engages the projector by 5 mm to mount_depth, through the washers over the slot (an ISO
+        # 7093-1 M4, 1 mm, on an M5, 1.2 mm), the shelf, the printed stack and the whole bought set (those not
+        # in the stack go under the washers), and extra ISO 7089 M4 washers, 0.8 mm each
+        assert p.projector.mount_thread == "M4" and washers.thickness == pytest.approx(2.2)
+        reach = row["length_mm"] - (2.2 + t.shelf_thickness + row["shims"] * p.tower.shim_thickness + fine) \
             - row["extra_washers"] * 0.8
         assert reach == pytest.approx(row["engagement_mm"]) and 5.0 - 1e-9 <= reach <= p.projector.mount_depth + 1e-9
+
+
+def test_camera_screws_never_bottom_out(table31_rig, write_profile, table31_text):
+    p = table31_rig.profile
+    for row in camera_stack_screws(p, table31_rig.layout):
+        assert row["ok"] and row["engagement_mm"] <= camera_socket_depth(p) + 1e-9
+        assert row["engagement_mm"] >= row["least_engagement_mm"] - 1e-9
+    # an M3 camera's 2.5 mm holes (FLIR's M3x2.5): every stack still has a screw, none past 2.5 mm
+    rig = Rig.from_profile(load_profile(write_profile(table31_text + "camera:\n  mount_thread: M3\n")))
+    rows = camera_stack_screws(rig.profile, rig.layout)
+    assert all(r["ok"] and 2.0 - 1e-9 <= r["engagement_mm"] <= 2.5 + 1e-9 for r in rows)
 
 
 def test_a_shallow_projector_thread_has_no_screw(write_profile, table31_text):

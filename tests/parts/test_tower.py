@@ -170,28 +170,36 @@ def test_a_too_small_splitter_names_the_key(write_profile, table31_text):
 
 
 def test_hardware_is_computed_from_the_parts(rig, write_profile, table31_text):
-    from rigcad.parts.tower import hardware
+    from rigcad.parts.tower import fine_shims, hardware
 
     items = hardware(rig.profile, rig.layout)
-    m4 = {i["joins"].split(" (")[0]: i for i in items if i["item"] == "bolt, washer and nut"}
+    m4 = {i["joins"].split(" (")[0]: i for i in items if i["thread"] == "M4" and " nut" in i["item"]
+          and "spring" not in i["item"]}
     assert sorted(i["quantity"] for i in m4.values()) == [2, 4]  # lens foot, column foot on the tongue
-    # lens foot: 5 mm foot + 10 mm shelf + 2 washers (0.8, ISO 7089), nut (3.2, ISO 4032), 2 pitches (1.4) =
-    # 21.2 mm; column foot: 5 mm foot + the tongue above its nut traps (15 - 5.6 mm) + one washer (the nut
-    # sits in its trap), nut, pitches = 19.8 mm (the bolt ends above the bench)
+    # lens foot: 5 mm foot + 10 mm shelf + a large washer over the foot's slot (1.0, ISO 7093-1) and one under
+    # the nut (0.8, ISO 7089), nut (3.2, ISO 4032), 2 pitches (1.4) = 21.4 mm; column foot: 5 mm foot + the
+    # tongue above its nut traps (15 - 5.6 mm) + a large washer over its opened hole (the nut sits in its
+    # trap), nut, pitches = 20.0 mm (the bolt ends above the bench)
     assert m4["the lens mount's slotted foot to the shelf"]["length_mm"] == 25.0
     foot = m4["the column's foot to the base plate's datum tongue"]["length_mm"]
     assert foot == 20.0 and foot <= rig.profile.tower.wall + 1.0 - rig.layout.tower.bench_z
-    # the shelf on the column's flange: up into inserts, 12 mm (5 mm flange + washer + 6 mm of the 8.1 mm insert)
+    # the shelf on the column's flange: up into inserts, 12 mm (5 mm flange + large washer + 6 mm of the 8.1 mm insert)
     shelf = next(i for i in items if i["joins"].startswith("the column's top flange to the shelf"))
-    assert shelf["quantity"] == 4 and shelf["length_mm"] == 12.0
+    assert shelf["quantity"] == 4 and shelf["length_mm"] == 12.0 and "ISO 7093-1" in shelf["item"]
     springs = next(i for i in items if "spring" in i["item"])
     assert springs["quantity"] == 2
-    screws = [i for i in items if i["thread"] == rig.profile.projector.mount_thread and i["item"].startswith("screw")]
+    screws = [i for i in items if "for_stacks_of_shims" in i]
     # every stack from 0 to shims_per_stack has its screw, four of each length (one per foot)
     assert sorted(n for i in screws for n in i["for_stacks_of_shims"]) == list(range(rig.layout.tower.shims_per_stack + 1))
-    # more travel: more shims in each stack, longer screws through the thickest
-    more = Rig.from_profile(load_profile(write_profile(table31_text + "tower:\n  travel_across: 6 mm\n")))
-    screws2 = [i for i in hardware(more.profile, more.layout) if i["item"].startswith("screw")
-               and i["thread"] == more.profile.projector.mount_thread]
-    assert max(i["length_mm"] for i in screws2) > max(i["length_mm"] for i in screws)
-    assert more.recipe("tower_shim").quantity == 5 * 24  # 12 mm of 0.5 mm shims per stack
+    assert all(i["quantity"] == 4 and i["thread"] == rig.profile.projector.mount_thread for i in screws)
+    # the camera's likewise, two of each length
+    cam = [i for i in items if "for_camera_stacks_of_shims" in i]
+    assert sorted(n for i in cam for n in i["for_camera_stacks_of_shims"]) == list(range(rig.layout.tower.shims_per_stack + 1))
+    # the bought shims: one fine set per stack (four under the projector, one behind the camera)
+    fine = [i for i in items if i["item"].startswith("precision shim")]
+    assert sum(i["quantity"] for i in fine) == 5 * len(fine_shims(rig.profile))
+    # less travel: fewer shims in each stack, shorter screws through the thickest
+    less = Rig.from_profile(load_profile(write_profile(table31_text + "tower:\n  travel_across: 3 mm\n")))
+    screws2 = [i for i in hardware(less.profile, less.layout) if "for_stacks_of_shims" in i]
+    assert max(i["length_mm"] for i in screws2) < max(i["length_mm"] for i in screws)
+    assert less.recipe("tower_shim").quantity == 5 * 6  # 6 mm of 1 mm shims per stack

@@ -79,10 +79,11 @@ def test_seams_enter_the_tower_chain_at_the_pins_float(table31_rig, mk3s):
 def test_the_default_rig_is_refused_and_says_why(table31_rig, mk3s):
     r = S.stack(table31_rig.profile, table31_rig.layout, mk3s)
     status = {(v.element, v.axis): v for e in r.elements for v in e.axes}
-    # nothing holds the paraboloid along the beam; the printed shims step 0.5 mm, 4x a quarter of 0.5 mm
+    # nothing holds the paraboloid along the beam
     assert status["paraboloid", "lateral"].status == "refused"
     assert set(status["paraboloid", "lateral"].dominating) == {"beam along its slots", "clamp along the beam"}
-    assert "resolution 0.5 mm exceeds a quarter" in status["camera", "lateral"].reason
+    # the tower's elements are held or adjusted on every axis (tests/tolerance/test_tower_stack.py)
+    assert all(status[e, a].ok for e in ("cop", "splitter", "camera") for a in S.AXES)
     assert status["camera", "tilt"].status == "held" and status["cop", "vertical"].status == "adjusted"
     with pytest.raises(FabricationError, match=r"paraboloid lateral \(tolerancing.paraboloid_offset\).*beam along"):
         S.refuse(r)

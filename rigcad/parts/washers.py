@@ -1,0 +1,140 @@
+"""Washers over slots and opened holes: which washer a bolt needs so that it bears on printed plastic
+at least as well as a plain washer on its clearance hole, and the bearing area it really has
+(kernel-free; mm, mm2).
+
+A washer bears on the annulus between its bore and its outside diameter, less whatever opening the
+bolt passes through: a clearance hole, a hole opened past it, or an adjuster's slot (a rectangle the
+bolt moves in). The bolt is taken at the slot's middle, where the opening covers most of the
+washer. When the plain washer (ISO 7089; ASME B18.22.1 for an inch thread) bears less than it would
+on its own clearance hole, a large washer (ISO 7093-1) of the bolt's size is tried, then larger
+ISO 7093-1 sizes, each under a large washer of the bolt's own size (the head bears on that one, the
+big one on the plastic; a washer between when the big one's bore is too wide for the small one to
+cover by a millimetre a side): the first that bears as much is chosen.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rigcad.errors import GeometryError
+from rigcad.standards import THREADS
+
+#: ISO 7093-1 large washers, by size: bore d1, outside diameter d2, thickness h (mm; the standard's
+#: nominal figures). Size 6 also serves 1/4-20 UNC (6.4 mm bore over 6.35 mm).
+ISO_7093 = {"M3": (3.2, 9.0, 0.8), "M4": (4.3, 12.0, 1.0), "M5": (5.3, 15.0, 1.2), "M6": (6.4, 18.0, 1.6),
+            "M8": (8.4, 24.0, 2.0), "M10": (10.5, 30.0, 2.5), "M12": (13.0, 37.0, 3.0)}
+#: The large washer a thread takes (its own size, or the one whose bore passes it).
+OWN_SIZE = {"1/4-20 UNC": "M6", "3/8-16 UNC": "M10"}
+
+
+@dataclass(frozen=True)
+class Washer:
+    """One washer: its standard and size, bore, outside diameter and thickness (mm)."""
+
+    standard: str
+    size: str
+    bore: float
+    outer: float
+    thickness: float
+
+    def name(self) -> str:
+        return f"{self.size} washer ({self.standard}, {self.outer:g} mm outside, {self.thickness:g} mm)"
+
+
+@dataclass(frozen=True)
+class WasherStack:
+    """The washers under one bolt's head, head side first: the last bears on the plastic over
+    ``opening`` (("round", diameter) or ("slot", width_x, width_y), mm); ``area_mm2``: its bearing
+    area there; ``target_mm2``: a plain washer's on the bolt's clearance hole."""
+
+    washers: tuple[Washer, ...]
+    opening: tuple
+    area_mm2: float
+    target_mm2: float
+
+    @property
+    def thickness(self) -> float:
+        return sum(w.thickness for w in self.washers)
+
+    @property
+    def bearing(self) -> Washer:
+        return self.washers[-1]
+
+    def describe(self) -> str:
+        kind = "hole" if self.opening[0] == "round" else "slot"
+        size = (f"{self.opening[1]:.2f} mm" if kind == "hole" else f"{self.opening[1]:.1f} x {self.opening[2]:.1f} mm")
+        return (" on ".join(w.name() for w in self.washers) + f": bears {self.area_mm2:.0f} mm2 over the {size} {kind}")
+
+
+def plain(thread: str) -> Washer:
+    """The plain washer of ``thread`` (rigcad.standards: ISO 7089, or ASME B18.22.1 for UNC)."""
+    th = THREADS[thread]
+    std = "ISO 7089" if thread.startswith("M") else "ASME B18.22.1"
+    return Washer(std, thread, th.clearance if not thread.startswith("M") else _iso7089_bore(thread), th.washer_od,
+                  th.washer_thickness)
+
+
+def _iso7089_bore(thread: str) -> float:
+    """ISO 7089's bore: the fine clearance hole (ISO 273 fine: d + 0.2..0.4 mm)."""
+    return {"M2": 2.2, "M2.5": 2.7, "M3": 3.2, "M4": 4.3, "M5": 5.3, "M6": 6.4, "M8": 8.4, "M10": 10.5,
+            "M12": 13.0}.get(thread, THREADS[thread].clearance)
+
+
+def large(size: str) -> Washer:
+    d1, d2, h = ISO_7093[size]
+    return Washer("ISO 7093-1", size, d1, d2, h)
+
+
+def _disc_in_rect(r: float, a: float, b: float) -> float:
+    """Area (mm2) of a disc of radius ``r`` inside the centred rectangle |x| <= a, |y| <= b."""
+    if r <= 0 or a <= 0 or b <= 0:
+        return 0.0
+    x1 = min(a, r)
+    x0 = math.sqrt(r * r - b * b) if r > b else 0.0
+    x0 = min(x0, x1)
+
+    def prim(x: float) -> float:  # the integral of sqrt(r^2 - x^2)
+        return 0.5 * (x * math.sqrt(max(r * r - x * x, 0.0)) + r * r * math.asin(min(x / r, 1.0)))
+
+    return 4.0 * (b * x0 + prim(x1) - prim(x0))
+
+
+def bearing_area(washer: Washer, opening: tuple) -> float:
+    """The bearing area (mm2) of ``washer`` centred on ``opening``: its annulus less the opening."""
+    ring = math.pi / 4 * (washer.outer ** 2 - washer.bore ** 2)
+    if opening[0] == "round":
+        d = max(opening[1], washer.bore)
+        return max(0.0, math.pi / 4 * (washer.outer ** 2 - d ** 2))
+    a, b = opening[1] / 2, opening[2] / 2
+    covered = _disc_in_rect(washer.outer / 2, a, b) - _disc_in_rect(washer.bore / 2, a, b)
+    return max(0.0, ring - covered)
+
+
+def washers_over(thread: str, opening: tuple) -> WasherStack:
+    """The washers a ``thread`` bolt needs over ``opening`` (see the module docstring); GeometryError
+    when no ISO 7093-1 size bears as much as a plain washer on its clearance hole."""
+    target = bearing_area(plain(thread), ("round", THREADS[thread].clearance))
+    own = large(OWN_SIZE.get(thread, thread)) if OWN_SIZE.get(thread, thread) in ISO_7093 else None
+    candidates = [(plain(thread),)] + ([(own,)] if own else [])
+    if own is not None:
+        sizes = [large(k) for k in ISO_7093]
+        for big in (w for w in sizes if w.outer > own.outer):
+            chain = [own]
+            while chain[-1] is not big:
+                # the largest size up to the big one whose bore the washer above still covers by 1 mm a side
+                nxt = [w for w in sizes if chain[-1].outer < w.outer <= big.outer and w.bore + 2.0 < chain[-1].outer]
+                if not nxt:
+                    break
+                chain.append(max(nxt, key=lambda w: w.outer))
+            if chain[-1] is big:
+                candidates.append(tuple(chain))
+    for stack in candidates:
+        area = bearing_area(stack[-1], opening)
+        if area >= target - 1e-9:
+            return WasherStack(stack, opening, area, target)
+    raise GeometryError(f"no ISO 7093-1 washer under a {thread} bolt bears {target:.0f} mm2 over a {opening} mm "
+                        "opening: make the slot narrower (tower.travel_across)", param="tower.travel_across")
+
+
+__all__ = ["ISO_7093", "Washer", "WasherStack", "bearing_area", "large", "plain", "washers_over"]
