@@ -47,10 +47,10 @@ from rigcad.errors import FabricationError
 from rigcad.fab.printers import Printer
 from rigcad.fab.split import PIN_SPACING
 from rigcad.parts import adjusters as A
-from rigcad.parts.datum import DOWEL_FIT, datum_chain
+from rigcad.parts.datum import datum_chain
 from rigcad.parts.dome import flange_joint
 from rigcad.parts.process import ProcessErrors
-from rigcad.parts.tower import _projector_feet, _shelf_extent, column_dowel_points, splitter_seat
+from rigcad.parts.tower import LAPPED_FLATNESS, _projector_feet, _shelf_extent, splitter_seat
 from rigcad.standards import THREADS
 
 #: The optical elements, in the order the tables list them.
@@ -363,28 +363,49 @@ def _dome_links(profile, layout, process: ProcessErrors, seams) -> tuple[Link, .
                  "on the flange: half a layer", 0.0, process.height_error(0.0)))
 
 
-def _tower_links(profile, layout, process: ProcessErrors, seams, holder: bool = True) -> tuple[Link, ...]:
+def _column_glue(profile, layout, link: Link, point) -> Link:
+    """The printed column's seams (cut across its height) with their glue faces: each face lapped
+    flat to LAPPED_FLATNESS (a shop step the column's hardware row states) leaves the upper piece
+    leaning by up to 2 x LAPPED_FLATNESS over the tube's side; that lean, taken about the column's
+    foot (the lowest a seam can be), moves ``point`` (x, z; mm) across by the lean x its height and
+    along the axis by the lean x its reach from the column, on top of the pins' float."""
+    t, tw = layout.tower, profile.tower
+    lean = 2 * LAPPED_FLATNESS / tw.column_width
+    x, z = point
+    return replace(link, source=link.source + f"; its glue faces lapped flat to {LAPPED_FLATNESS:g} mm lean the upper "
+                   f"piece {math.degrees(lean):.3f} deg over the {tw.column_width:g} mm tube, up to "
+                   f"{z - t.column_base_z:.0f} mm below the element", lateral=link.lateral + lean * (z - t.column_base_z),
+                   vertical=lean * abs(t.column_x - x), tilt=lean)
+
+
+def _tower_links(profile, layout, process: ProcessErrors, seams, holder: bool = True, mirror: float = 1.0,
+                 point=None) -> tuple[Link, ...]:
     """O to the splitter holder's seat (and, with ``holder``, through it), with the datum chain's
-    links (rigcad.parts.datum at the process's figures), their tilts and the seams of their parts."""
+    links (rigcad.parts.datum at the process's figures), their tilts and the seams of their parts.
+    ``mirror``: how many times a tilt of the shelf under the seat turns the element's axis (2 for the
+    projector's reflected axis: the splitter turns on the shelf, the projector's feet elsewhere; 1
+    for the camera on the holder); ``point``: the element's (x, z) mm, for the column's glue faces."""
     t, flat = layout.tower, profile.datum.foot_flatness
     chain = {k.name: k for k in datum_chain(profile, layout, process).links}
-    dowels = column_dowel_points(t, profile)
-    spacing = math.dist(dowels[0], dowels[1]) if len(dowels) >= 2 else 2 * t.column_foot_half
     span = t.column_x - t.holder_x[1]
+    point = point or (0.0, t.plate.center[2])
     printed_column, printed_shelf = profile.buy.column == "print", profile.buy.shelf == "print"
     out = [_link(chain["base plate"], "printed", 0.0), *seams("base_plate")]
     for name in chain:
         if name.endswith("tongue to column") or name.endswith("column to shelf"):
-            tilt = DOWEL_FIT / spacing if printed_column else 0.0
-            out.append(_link(chain[name], "joint", tilt))
+            out.append(_link(chain[name], "joint", 0.0))  # a turn about the column's axis tilts no axis
             if name.endswith("tongue to column"):
                 c = chain["column"]
                 out.append(_link(c, "printed" if printed_column else "bought", flat / (2 * t.column_foot_half)
                                  if printed_column else c.lateral / (t.shelf_top_z - t.column_base_z),
                                  "" if not printed_column else "buy.column: extrusion_40x40"))
-                out.extend(seams("tower_column"))
-    out.append(_link(chain["shelf"], "printed" if printed_shelf else "bought", flat / span if printed_shelf else 0.0,
-                     "buy.shelf: aluminium_plate" if printed_shelf else ""))
+                out.extend(_column_glue(profile, layout, k, point) for k in seams("tower_column"))
+    shelf = _link(chain["shelf"], "printed" if printed_shelf else "bought",
+                  mirror * flat / span if printed_shelf else 0.0, "buy.shelf: aluminium_plate" if printed_shelf else "")
+    if mirror != 1.0 and printed_shelf:
+        shelf = replace(shelf, source=shelf.source + f"; its tilt under the seat ({flat:g} mm over {span:.0f} mm) "
+                        f"turns the reflected axis {mirror:g} x")
+    out.append(shelf)
     out.extend(seams("tower_shelf"))
     if holder:
         seat = splitter_seat(profile, layout)
@@ -405,7 +426,7 @@ def _link(k, kind: str, tilt: float, buy: str = "") -> Link:
 def _splitter_links(profile, layout, process: ProcessErrors, seams) -> tuple[Link, ...]:
     holder = {k.name: k for k in datum_chain(profile, layout, process).links}["splitter holder"]
     groove = 2 * process.position / profile.beam_splitter.length
-    return (*_tower_links(profile, layout, process, seams), *seams("splitter_holder"),
+    return (*_tower_links(profile, layout, process, seams, mirror=2.0), *seams("splitter_holder"),
             Link(holder.name, "printed", holder.source + f"; the grooves' faces +-{process.position:.2f} mm over "
                  f"the {profile.beam_splitter.length:g} mm plate (the reflected axis turns twice)",
                  holder.lateral, holder.vertical, 2 * groove))
@@ -431,7 +452,8 @@ def _camera_links(profile, layout, process: ProcessErrors, seams) -> tuple[Link,
     """The tower to the holder's seat, the holder to the camera bracket, the camera's two screws."""
     cm, a = profile.camera, profile.adjusters
     holder = {k.name: k for k in datum_chain(profile, layout, process).links}["splitter holder"]
-    return (*_tower_links(profile, layout, process, seams), *seams("splitter_holder"),
+    cam = layout.tower.camera.cop
+    return (*_tower_links(profile, layout, process, seams, point=(cam[0], cam[2])), *seams("splitter_holder"),
             Link(holder.name + " to the camera bracket", "printed", holder.source, holder.lateral, holder.vertical),
             Link("camera on its two screws", "joint", f"two screws {cm.mount_spacing:g} mm apart in one slot, each set "
                  f"to {a.hand_slide:g} mm", 0.0, 0.0, a.hand_slide / cm.mount_spacing,
