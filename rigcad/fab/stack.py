@@ -47,7 +47,7 @@ from rigcad.errors import FabricationError
 from rigcad.fab.printers import Printer
 from rigcad.fab.split import PIN_SPACING
 from rigcad.parts import adjusters as A
-from rigcad.parts.datum import datum_chain
+from rigcad.parts.datum import DOWEL_FIT, datum_chain
 from rigcad.parts.dome import flange_joint
 from rigcad.parts.process import ProcessErrors
 from rigcad.parts.tower import LAPPED_FLATNESS, _projector_feet, _shelf_extent, splitter_seat
@@ -293,21 +293,28 @@ def _drilled(hole: float, inner: float, process: ProcessErrors, axis: str) -> tu
     return hole - inner, f"prints {printed:.2f} mm, drilled to {hole:g} mm"
 
 
-def seam_link(part: str, seams: int, printer: Printer, process: ProcessErrors) -> Link | None:
+def seam_link(part: str, seams: int, printer: Printer, process: ProcessErrors, dowels: bool = False) -> Link | None:
     """The ``seams`` seams of ``part`` on a chain (None for none): each lets the pieces shift along
     the cut by the pin's float in its two holes and each hole's position error. The pieces are
     glued face to face (flat parts on a flat table), so a seam adds no step across the cut and no
-    tilt."""
+    tilt (a part cut across its height adds its glue faces' lean: :func:`_column_glue`). With
+    ``dowels``, the ``buy`` option: ISO 8734 m6 steel dowels in holes reamed H7 (the shop step), whose
+    fit (DOWEL_FIT) replaces the pin's float; the holes' printed positions stay."""
     if seams <= 0:
         return None
+    buy = "a printer whose bed takes the part whole, or reamed holes and ISO 8734 steel dowels across the seam"
+    if dowels:
+        e = DOWEL_FIT + 2 * process.position
+        return Link(f"{part.replace('_', ' ')} seams", "seam",
+                    f"{seams} seam(s): ISO 8734 m6 dowels in holes reamed H7 ({DOWEL_FIT:g} mm), each hole "
+                    f"+-{process.position:.2f} mm", e, 0.0, 0.0, seams, buy)
     pin = printer.alignment_pin
     hole = pin.diameter + pin.clearance
     play, how = _drilled(hole, pin.diameter, process, "unknown")
     e = play + 2 * process.position
     return Link(f"{part.replace('_', ' ')} seams", "seam",
                 f"{seams} seam(s): {pin.diameter:g} mm pins in {hole:g} mm holes ({how}), each hole "
-                f"+-{process.position:.2f} mm", e, 0.0, 0.0, seams,
-                "a printer whose bed takes the part whole, or reamed holes and ISO 8734 steel dowels across the seam")
+                f"+-{process.position:.2f} mm", e, 0.0, 0.0, seams, buy)
 
 
 def _paraboloid_links(profile, layout, process: ProcessErrors, seams) -> tuple[Link, ...]:
