@@ -3,6 +3,7 @@ the code's for the default rig on the shipped printers."""
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
@@ -55,8 +56,8 @@ def test_the_prose_figures_are_the_codes(page, table31_rig, mk3s_stack):
     seam = next(k for k in mk3s_stack.element("dome").links if k.kind == "seam")
     assert f"({seam.lateral:.2f} mm on the MK3S)" in text and f"seams across the base plate ({seam.lateral:.2f} mm" in text
     bolts = {b.joint: b for b in L.bolt_loads(table31_rig.profile, table31_rig.layout, load_printer("prusa_mk3s"))}
-    assert (f"would put {bolts['dome flange on the base plate'].hand_tight_mpa:.0f} MPa under a washer and "
-            f"{bolts['column foot on the tongue'].hand_tight_mpa:.0f} MPa under the tongue's nut") in text
+    assert (f"would put {bolts['dome flange on the base plate'].hand_tight_mpa:.0f} MPa under the dome flange's large "
+            f"washer and {bolts['column foot on the tongue'].hand_tight_mpa:.0f} MPa under the tongue's nut") in text
     assert f"past PLA's {L.MATERIALS['pla'].yield_strength:.0f} MPa yield" in text
     for name, pe in (("prusa_mk3s", "0.2 % | 0.004 in | 0.2 / 0.3 mm | 0.15 mm"),
                      ("vantage_i", "0.2 % | 0.004 in | 0.2 / 0.3 mm | 0.007 in"),
@@ -69,3 +70,64 @@ def test_the_prose_figures_are_the_codes(page, table31_rig, mk3s_stack):
         pos = nums[1] * (inch if "0.004 in" in pe else 1)
         assert (nums[0] / 100, pos, nums[2], nums[3]) == pytest.approx(
             (p.scale, p.position, p.hole_shrink_vertical, p.hole_shrink_horizontal))
+
+
+def test_the_tower_figures_are_the_codes(page, table31_rig, mk3s_stack):
+    """The datum chain's and the adjusters' tables and the tower's prose figures."""
+    from rigcad.parts import tower as T
+    from rigcad.parts.adjusters import adjusters
+    from rigcad.parts.datum import datum_chain
+    from rigcad.parts.washers import bearing_area, plain
+
+    p, lay = table31_rig.profile, table31_rig.layout
+    t = lay.tower
+    text = " ".join(page.split())
+    chain = datum_chain(p, lay)
+    rows = [f"{k.lateral:.2f}" if k.lateral >= 0.01 else f"{k.lateral:.3f}" for k in chain.links]
+    table = page[page.index("| link | lateral (mm) | vertical (mm) |"):page.index("`check_datum_chain` states")]
+    got = [ln.split("|")[2].strip() for ln in table.splitlines()[2:-1] if ln.startswith("| ") and "sum" not in ln]
+    assert got == rows
+    assert [ln.split("|")[3].strip() for ln in table.splitlines()[2:-1] if "sum" not in ln and ln.startswith("| ")] == [
+        f"{k.vertical:.2f}" if k.vertical else "0" for k in chain.links]
+    assert f"**{chain.lateral_worst:.2f}** / {chain.lateral_rss:.2f} | **{chain.vertical_worst:.2f}**" in table
+    assert f"0.1 mm over {2 * t.column_foot_half:.0f} mm x {t.shelf_top_z - t.shelf_thickness - t.column_base_z:.0f} mm" in table
+    # the adjusters' table: range and resolution of each, in the code's order
+    adj = page[page.index("| adjuster | serves |"):page.index("* **Splitter tip/tilt**")]
+    lines = [ln for ln in adj.splitlines()[2:] if ln.startswith("| ")]
+    assert len(lines) == len(adjusters(p, lay))
+    for ln, a in zip(lines, adjusters(p, lay)):
+        cells = [c.strip() for c in ln.strip("|").split("|")]
+        f = math.degrees if a.unit == "rad" else float
+        unit = "deg" if a.unit == "rad" else "mm"
+        assert cells[1] == a.tolerance_key.split(".")[1] and cells[2] == f"{f(a.tolerance):g} {unit}"
+        assert cells[3] == ("-" if a.range == 0 else f"{f(a.range):.2g} {unit}" if a.unit == "rad" else f"{a.range:g} mm")
+        assert cells[4] == (f"{f(a.resolution):.2f} {unit}" if a.unit == "rad" else f"{a.resolution:g} mm")
+    flat, vee = adjusters(p, lay)[:2]
+    pts = T.seat_points(t, p)
+    assert f"{pts['cone'][0] - pts['flat'][0]:.0f} mm lever (the axis turns 2x)" in lines[0]
+    assert f"(the axis turns {float(vee.how.split('turns ')[1].split(' x')[0]):.2f}x)" in lines[1]
+    assert f"0.5 mm pitch, doubled, within a quarter of 0.5 deg: {T.flat_lever(p):.0f} mm, taken {T.FLAT_LEVER_MARGIN:g} times" in text
+    fine = T.fine_shims(p)
+    assert (", ".join(f"{v:g}" for v in fine[:-1]) + f" and {fine[-1]:g} mm") in text
+    assert f"every multiple of {min(fine):g} mm up to {sum(fine):g} mm" in text
+    w = T.joint_washers(p, lay)
+    slot = T.slot_openings(p, lay)["projector"]
+    assert (f"the projector's {slot[1]:g} x {slot[2]:g} mm slots take an M4 large washer on an M5 one "
+            f"({w['projector'].area_mm2:.0f} mm2, where a plain washer would bear "
+            f"{bearing_area(plain('M4'), slot):.0f} mm2)") in text
+    assert f"{T.slot_openings(p, lay)['camera'][1]:.1f} mm wide slot an M6 on an M10 ({w['camera'].area_mm2:.0f} mm2)" in text
+    assert f"opened to {T.column_bolt_hole(t, p):.1f} mm" in text
+    assert f"`tower.travel_across` {p.tower.travel_across:g} mm, `travel_along` {p.tower.travel_along:g} mm" in text
+    # the stack's prose
+    v = {(x.element, x.axis): x for e in mk3s_stack.elements for x in e.axes}
+    assert f"already covers the stack with the printed pins ({v['cop', 'lateral'].worst:.2f} mm worst case)" in text
+    assert f"camera's tilt ({math.degrees(v['camera', 'tilt'].worst):.2f} deg) is held" in text
+    assert f"0.11 deg per eighth of a turn at most" in text and math.degrees(flat.resolution) < 0.115
+    dowel = S.seam_link("base_plate", 1, load_printer("prusa_mk3s"), load_printer("prusa_mk3s").process_errors,
+                        dowels=True)
+    assert f"dowel's fit ({dowel.lateral:.2f} mm on the MK3S)" in text
+    lean = math.degrees(2 * T.LAPPED_FLATNESS / p.tower.column_width)
+    assert f"twice that over the {p.tower.column_width:g} mm tube ({lean:.2f} deg)" in text
+    assert f"lapped flat to {T.LAPPED_FLATNESS:g} mm" in text
+    assert f"unlapped ({p.datum.foot_flatness:g} mm) they would lean the column " \
+           f"{math.degrees(2 * p.datum.foot_flatness / p.tower.column_width):.2f} deg" in text

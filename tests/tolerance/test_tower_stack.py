@@ -141,3 +141,20 @@ def test_the_column_register_is_one_hole_and_one_slot_and_its_bolts_only_clamp(t
     assert hole == pytest.approx(bolt_hole("M4", far, p.datum.print_position, p.datum.print_scale)) and hole > 5.0
     for x, y in T._column_flange_points(t, p):
         assert free(x + hole / 2 - 0.1, y, z) and not free(x + hole / 2 + 0.2, y, z)
+
+
+def test_unlapped_glue_faces_would_tilt_the_camera_past_its_tolerance(table31_rig, mk3s, monkeypatch):
+    p, lay = table31_rig.profile, table31_rig.layout
+    assert _axes(S.stack(p, lay, mk3s))["camera", "tilt"].status == "held"
+    monkeypatch.setattr(S, "LAPPED_FLATNESS", p.datum.foot_flatness)  # the faces as printed, 0.1 mm
+    v = _axes(S.stack(p, lay, mk3s))["camera", "tilt"]
+    assert v.status == "refused" and v.worst > p.tolerancing.camera_tilt
+
+
+def test_steel_dowels_across_a_seam_cut_it_to_the_holes_positions(mk3s):
+    pe = mk3s.process_errors
+    printed = S.seam_link("tower_shelf", 2, mk3s, pe)
+    dowelled = S.seam_link("tower_shelf", 2, mk3s, pe, dowels=True)
+    assert dowelled.lateral == pytest.approx(0.008 + 2 * pe.position) and dowelled.lateral < printed.lateral
+    assert printed.lateral == pytest.approx(mk3s.alignment_pin.clearance + 2 * pe.position)
+    assert dowelled.count == printed.count == 2 and "ISO 8734" in printed.buy
