@@ -13,6 +13,23 @@ so D = inf gives u = f, and the projector's focus range [D_min, D_max] maps onto
 paraboloid spans u_near (its vertex) to u_far (its rim). :func:`focusing_lens` picks the catalogue
 focal length whose range, in dioptres, is centred nearest to the paraboloid's, and checks that both
 ends of the paraboloid are reachable by turning the projector's focus ring.
+
+The lens also moves the projector's centre of projection as the paraboloid sees it, and scales the
+angles of its pixels (:func:`through_lens`). A chief ray leaving the real COP at angle a, s_H from the
+lens's front principal plane H, leaves the back one H' with slope tan a (1 - s_H / f), so every
+chief ray seems to come from one point, the COP's virtual image s_H f / (f - s_H) before H':
+
+    shift = s_H^2 / (f - s_H) - (H' - H)      away from the lens, from the real COP          (2)
+
+and the projector's focal length in pixels grows by f / (f - s_H). The lens is the plano-convex
+singlet the bill orders, its curved side towards the projector: H on the curved vertex, H' at t / n
+before the flat face (t its centre thickness: the edge ``lens.thickness`` plus the curved face's
+sag over ``lens.diameter``; n its glass's index), so H' - H = t (n - 1) / n. A thin lens (t = 0,
+s_H = s) gives s^2 / (f - s): 2.27 mm for Table 3.1 (f = 300 mm, s = 25 mm). The thick one moves
+the other way: its principal planes stand 2.7 mm apart, and the COP appears 1.31 mm nearer the
+lens, its pixels' angles x 1/1.071 (tests/optics/test_focus_cop.py: an exact Snell trace agrees to
+2e-6 mm paraxially, 0.007 mm at the rim's angle). The circle of thesis 4.1.1, which the basis is
+shown through, is set with the lens in place (rigcad.manual.calibration).
 """
 
 from __future__ import annotations
@@ -55,13 +72,83 @@ class FocusingLens:
     focus_min: float
     focus_max: float
     from_catalogue: bool
+    edge_thickness: float = 0.0  #: mm, at ``diameter`` (0, 0: a thin lens)
+    diameter: float = 0.0
 
     def describe(self) -> dict:
+        shift, scale = self.through()
         return {"focal_length_mm": self.focal_length, "lens_distance_mm": self.lens_distance,
                 "paraboloid_from_lens_mm": [self.image_near, self.image_far],
                 "projector_focus_mm": [self.focus_near, _finite(self.focus_far)],
                 "projector_focus_range_mm": [self.focus_min, _finite(self.focus_max)],
-                "from_catalogue": self.from_catalogue}
+                "from_catalogue": self.from_catalogue,
+                "cop_shift_mm": _finite(shift), "pixel_scale": _finite(scale)}
+
+    def through(self) -> tuple[float, float]:
+        """(COP shift away from the lens, mm; growth of the projector's focal length in pixels) of
+        this lens (:func:`through_lens`)."""
+        return through_lens(self.focal_length, self.lens_distance, self.edge_thickness, self.diameter)
+
+    def projector(self, focal_px: float, cop_z: float) -> "LensedProjector":
+        """The projector seen through this lens, its real COP at height ``cop_z`` (mm, rig frame: the
+        projector's axis folded onto the optical axis, the lens below the COP) with ``focal_px`` (px)
+        of its own: where its chief rays seem to come from, and its focal length in pixels."""
+        shift, scale = self.through()
+        return LensedProjector(cop_z + shift, focal_px * scale, shift, scale)
+
+
+@dataclass(frozen=True)
+class LensedProjector:
+    """The projector and its focusing lens as one pinhole (paraxial): ``cop_z`` (mm) where its chief
+    rays seem to come from, ``focal_px`` its focal length in pixels, ``cop_shift`` (mm) how far that
+    point stands beyond the real COP (away from the lens; negative: nearer), ``pixel_scale`` the
+    focal length's growth through the lens."""
+
+    cop_z: float
+    focal_px: float
+    cop_shift: float
+    pixel_scale: float
+
+    def pixel_radius(self, r: float, z: float) -> float:
+        """How far (px) from the image centre the projector, through its lens, shows the point at
+        radius ``r`` and height ``z`` (mm, below the COP) of the rig."""
+        return self.focal_px * r / (self.cop_z - z)
+
+    def ring_radius(self, geometry, alpha: float) -> float:
+        """How far (px) from the image centre the projector, through its lens, shows the paraboloid's
+        point that the design's chief ray at ``alpha`` (rad from the axis at the real COP, the lens
+        out) meets: the rim for the rim's angle (``geometry``: profile.derived.Derived; the
+        paraboloid z = z_vertex - r^2 / (4 f_p), thesis 3.2)."""
+        t, fp = math.tan(alpha), geometry.focal_length
+        h = (self.cop_z - self.cop_shift) - geometry.vertex_z  # the real COP above the vertex
+        r = 2 * h * t / (1 + math.sqrt(1 - h * t * t / fp))  # the nearer root of r^2 t / (4 fp) - r + h t = 0
+        return self.pixel_radius(r, geometry.vertex_z - r * r / (4 * fp))
+
+
+#: The focusing lens's glass: N-BK7 at 587.6 nm, what the bill orders (rigcad.parts.tower.hardware).
+LENS_INDEX = 1.5168
+
+
+def through_lens(focal_length: float, lens_distance: float, edge_thickness: float = 0.0, diameter: float = 0.0,
+                 index: float = LENS_INDEX) -> tuple[float, float]:
+    """The focusing lens's effect on the projector whose COP stands ``lens_distance`` (s, mm) before
+    the lens's centre (module docstring, equation 2): (the shift of the COP away from the lens, mm;
+    the growth of the focal length in pixels). The lens: a plano-convex singlet of ``focal_length``
+    (its effective focal length, f = R / (n - 1)) and ``index``, its curved side towards the
+    projector, ``edge_thickness`` thick at its ``diameter``; both 0: a thin lens. Paraxial. Both inf
+    when the front principal plane stands f from the COP (the lens collimates the chief rays)."""
+    f, n = focal_length, index
+    radius = f * (n - 1)
+    half = diameter / 2
+    if half >= radius:
+        raise GeometryError(f"a plano-convex lens of f = {f:g} mm (surface radius {radius:.1f} mm in glass of "
+                            f"index {n:g}) cannot be {diameter:g} mm across", param="lens.diameter")
+    sag = radius - math.sqrt(radius * radius - half * half)
+    centre = edge_thickness + sag
+    s = lens_distance - edge_thickness / 2 - sag  # the COP to the front principal plane (the curved vertex)
+    if f == s:
+        return math.inf, math.inf
+    return s * s / (f - s) - centre * (n - 1) / n, f / (f - s)
 
 
 def _finite(v: float):
@@ -72,8 +159,10 @@ def _dioptres(d: float) -> float:
     return 0.0 if math.isinf(d) else 1.0 / d
 
 
-def _lens(f: float, s: float, near: float, far: float, d_min: float, d_max: float, catalogue: bool) -> FocusingLens:
-    return FocusingLens(f, s, near, far, focus_for(f, s, near), focus_for(f, s, far), d_min, d_max, catalogue)
+def _lens(f: float, s: float, near: float, far: float, d_min: float, d_max: float, catalogue: bool,
+          edge_thickness: float = 0.0, diameter: float = 0.0) -> FocusingLens:
+    return FocusingLens(f, s, near, far, focus_for(f, s, near), focus_for(f, s, far), d_min, d_max, catalogue,
+                        edge_thickness, diameter)
 
 
 def _reachable(lens: FocusingLens) -> bool:
@@ -113,7 +202,7 @@ def focusing_lens(profile, geometry) -> FocusingLens:
         raise GeometryError(f"projector.focus_min ({d_min:g} mm) must lie beyond the focusing lens (lens.distance "
                             f"{s:g} mm) and below projector.focus_max", where=profile.where("projector", "focus_min"))
     if ln.focal_length is not None:
-        lens = _lens(ln.focal_length, s, near, far, d_min, d_max, False)
+        lens = _lens(ln.focal_length, s, near, far, d_min, d_max, False, ln.thickness, ln.diameter)
         if not _reachable(lens):
             raise GeometryError(
                 f"lens.focal_length {ln.focal_length:g} mm needs the projector focused at {lens.focus_near:.0f}.."
@@ -122,7 +211,7 @@ def focusing_lens(profile, geometry) -> FocusingLens:
         return lens
     ideal = _ideal(near, far, d_min - s, d_max - s)
     best = min(CATALOGUE_FOCAL_LENGTHS, key=lambda f: abs(1.0 / f - 1.0 / ideal))
-    lens = _lens(best, s, near, far, d_min, d_max, True)
+    lens = _lens(best, s, near, far, d_min, d_max, True, ln.thickness, ln.diameter)
     if not _reachable(lens):
         raise GeometryError(
             f"no catalogue focusing lens brings the paraboloid ({near:.0f}..{far:.0f} mm from the lens) into the "

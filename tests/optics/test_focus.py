@@ -127,4 +127,5 @@ def test_no_real_image_is_inf_and_describe_names_every_figure():
     lens = FocusingLens(200.0, 25.0, 250.0, 270.0, 1500.0, 2500.0, 1000.0, 3000.0, True)
     assert lens.describe() == {"focal_length_mm": 200.0, "lens_distance_mm": 25.0,
                                "paraboloid_from_lens_mm": [250.0, 270.0], "projector_focus_mm": [1500.0, 2500.0],
-                               "projector_focus_range_mm": [1000.0, 3000.0], "from_catalogue": True}
+                               "projector_focus_range_mm": [1000.0, 3000.0], "from_catalogue": True,
+                               "cop_shift_mm": pytest.approx(25.0 ** 2 / 175.0), "pixel_scale": pytest.approx(200 / 175)}

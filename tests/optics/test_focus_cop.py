@@ -1,0 +1,115 @@
+"""The focusing lens moves the projector's COP as the paraboloid sees it and scales its pixels'
+angles (rigcad.optics.focus.through_lens). Held against truths from outside the code: the Gaussian
+lens equation for a thin lens, and an exact ray trace (Snell's law at both faces, written here) of
+the plano-convex singlet the bill orders, curved side towards the projector."""
+
+import math
+
+import numpy as np
+import pytest
+
+from rigcad.optics.focus import LENS_INDEX, focusing_lens, through_lens
+from rigcad.profile import derive
+
+
+def _trace(angle: float, f: float, s: float, edge: float, diameter: float, n: float = LENS_INDEX):
+    """One chief ray leaving the COP (the origin) at ``angle`` (rad) from the axis (+x), through the
+    plano-convex lens centred ``s`` mm away (its edge ``edge`` thick at ``diameter``; surface radius
+    f (n - 1), the curved face first): where it leaves the flat face and its direction (2D)."""
+    radius = f * (n - 1)
+    sag = radius - math.sqrt(radius ** 2 - (diameter / 2) ** 2)
+    v1, v2 = s - edge / 2 - sag, s + edge / 2  # the curved vertex, the flat face
+    centre = np.array([v1 + radius, 0.0])
+    d = np.array([math.cos(angle), math.sin(angle)])
+    oc = -centre
+    b = oc @ d
+    p = (-b - math.sqrt(b * b - (oc @ oc - radius ** 2))) * d  # the first hit on the sphere
+
+    def refract(d, normal, eta):  # normal against the ray
+        ci = -normal @ d
+        return eta * d + (eta * ci - math.sqrt(1 - eta ** 2 * (1 - ci ** 2))) * normal
+
+    d = refract(d, (p - centre) / radius, 1 / n)
+    p = p + (v2 - p[0]) / d[0] * d
+    return p, refract(d, np.array([-1.0, 0.0]), n)
+
+
+def _seen_from(angle, *lens):
+    """Where (x, mm; + towards the lens) the ray leaving the lens crosses the axis when extended back
+    (the COP the paraboloid sees), and its tan over the ray's tan at the COP."""
+    p, d = _trace(angle, *lens)
+    return p[0] - p[1] / d[1] * d[0], (d[1] / d[0]) / math.tan(angle)
+
+
+@pytest.mark.parametrize("f, s", [(300.0, 25.0), (100.0, 25.0), (75.0, 60.0), (500.0, 10.0)])
+def test_a_thin_lens_moves_the_cop_to_its_virtual_image(f, s):
+    """The thin lens (no thickness): the COP's image by the Gaussian lens equation (1/v - 1/u = 1/f,
+    u = -s): virtual, v = s f / (s - f) on the projector's side; angles scale by u / v."""
+    v = s * f / (s - f)
+    shift, scale = through_lens(f, s)
+    assert shift == pytest.approx(-v - s, rel=1e-12)  # the reviewer's thin-lens sum: 2.27 mm for (300, 25)
+    assert 1 / scale == pytest.approx((-s) / v, rel=1e-12)
+    assert through_lens(300.0, 25.0)[0] == pytest.approx(2.2727, abs=1e-4)
+
+
+def test_the_ordered_lens_moves_the_cop_as_an_exact_trace_finds(table31):
+    """The default rig's lens as the bill orders it (f = 300 mm N-BK7, 6 mm edge over 50 mm, curved
+    side towards the projector, 25 mm from the COP): every chief ray, extended back from where it
+    leaves the lens, crosses the axis 1.31 mm NEARER the lens than the real COP (the thin-lens sum's
+    2.27 mm away from it is the lens's thickness left out: its principal planes stand 2.7 mm apart),
+    and its angle's tan is 1/1.071 of the COP's."""
+    lens = focusing_lens(table31, derive(table31))
+    args = (lens.focal_length, lens.lens_distance, table31.lens.thickness, table31.lens.diameter)
+    assert args == (300.0, 25.0, 6.0, 50.0)
+    shift, scale = lens.through()
+    x, ratio = _seen_from(math.radians(0.05), *args)  # paraxial
+    assert -x == pytest.approx(shift, abs=1e-5)  # mm: a 0.05 deg ray is paraxial to ~2e-6 mm
+    assert 1 / ratio == pytest.approx(scale, abs=1e-6)
+    assert shift == pytest.approx(-1.311, abs=1e-3) and scale == pytest.approx(1.0713, abs=1e-4)
+    rim = derive(table31).rim_angle_at_cop
+    x, ratio = _seen_from(rim, *args)
+    # the rim's ray (3.2 deg) meets the lens's spherical aberration: 0.007 mm, 5e-4 of the scale measured
+    assert abs(-x - shift) < 0.02 and abs(1 / ratio - scale) < 1e-3
+
+
+def test_the_projector_through_its_lens_shows_the_rim_where_a_trace_puts_it(table31):
+    """The pixel radius of the paraboloid's rim through the lens (LensedProjector.pixel_radius) from
+    the exact trace: the COP ray whose traced exit ray meets the rim, found by bisection, read in the
+    projector's own pixels (focal_px tan of its angle at the real COP)."""
+    geo = derive(table31)
+    lens = focusing_lens(table31, geo)
+    lensed = lens.projector(geo.projector_focal_px, geo.cop_z)
+    args = (lens.focal_length, lens.lens_distance, table31.lens.thickness, table31.lens.diameter)
+    depth = geo.cop_z - geo.rim_z  # the rim's plane from the real COP, along the unfolded axis
+
+    def height_at_rim(a):  # the exit ray's distance from the axis at the rim's plane
+        p, d = _trace(a, *args)
+        return p[1] + (depth - p[0]) * d[1] / d[0]
+
+    lo, hi = 1e-4, 0.2
+    for _ in range(80):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if height_at_rim(mid) < geo.rim_radius else (lo, mid)
+    traced = geo.projector_focal_px * math.tan(lo)
+    bare = geo.projector_focal_px * geo.rim_radius / depth
+    # 0.1 px: the paraxial model leaves out the spherical aberration at the rim (0.05 px measured, 5e-4 of it)
+    assert lensed.pixel_radius(geo.rim_radius, geo.rim_z) == pytest.approx(traced, abs=0.1)
+    assert traced / bare == pytest.approx(1.076, abs=1e-3)  # the lens out, the circle would be 7.6 % small
+
+
+def test_a_design_ray_is_shown_through_the_lens_where_its_paraboloid_point_is(table31):
+    """LensedProjector.ring_radius: the paraboloid point a design ray meets (found here by bisection
+    along the ray against z = z_vertex - r^2 / (4 f_p)), seen from the lensed COP; the rim's angle
+    gives the rim."""
+    geo = derive(table31)
+    lensed = focusing_lens(table31, geo).projector(geo.projector_focal_px, geo.cop_z)
+    assert lensed.ring_radius(geo, geo.rim_angle_at_cop) == pytest.approx(
+        lensed.pixel_radius(geo.rim_radius, geo.rim_z), rel=1e-12)
+    for alpha in np.linspace(0.002, geo.rim_angle_at_cop, 7):
+        lo, hi = 0.0, (geo.cop_z - geo.rim_z) / math.cos(alpha) + 1.0  # along the ray: above, then below the surface
+        for _ in range(100):
+            mid = (lo + hi) / 2
+            r, z = mid * math.sin(alpha), geo.cop_z - mid * math.cos(alpha)
+            lo, hi = (mid, hi) if z > geo.vertex_z - r * r / (4 * geo.focal_length) else (lo, mid)
+        r, z = lo * math.sin(alpha), geo.cop_z - lo * math.cos(alpha)
+        assert lensed.ring_radius(geo, alpha) == pytest.approx(lensed.pixel_radius(r, z), rel=1e-9)
