@@ -1,9 +1,10 @@
 """Calibration as thesis 4.1.1 does it, with the figures rigcad can compute for it.
 
 - The projector's circle image: a bright disc at the projector's resolution whose edge is the
-  paraboloid's rim as the design map sees it (pixel radius = focal length in px x tan of the rim
-  ray's angle at the COP; image centre on the optical axis), so that "the projected circle matches
-  the circumference of the parabola base". Frame of the image: as rigcad.check.sources.pixel_grid
+  paraboloid's rim as the projector shows it through its focusing lens, which stays in place as for
+  the basis (rigcad.optics.focus.LensedProjector: the lens moves the COP the paraboloid sees and
+  scales the pixels' angles; image centre on the optical axis), so that "the projected circle
+  matches the circumference of the parabola base". Frame of the image: as rigcad.check.sources.pixel_grid
   (pixel centre x = column + 0.5 - width / 2, y = height / 2 - row - 0.5).
 - What the film over the dome's base shows: the reflected light converges to the sample point O;
   light projected past the rim (a circle too large) falls straight onto the film outside the
@@ -35,9 +36,12 @@ def circle_image(rig) -> tuple[bytes, dict]:
     if rig.geometry.cop_at_infinity:
         raise GeometryError("the calibration circle needs a finite COP (layout.cop_to_vertex)",
                             param="layout.cop_to_vertex")
-    design = rig.incidence
+    from rigcad.optics.focus import focusing_lens
+
+    design, g = rig.incidence, rig.geometry
     width, height = rig.profile.projector.resolution
-    radius = float(design.pixel_radius(np.array([design.alpha_max]))[0])
+    lensed = focusing_lens(rig.profile, g).projector(g.projector_focal_px, g.cop_z)  # set with the lens in place
+    radius = lensed.ring_radius(g, design.alpha_max)
     x = np.arange(width) + 0.5 - width / 2
     y = height / 2 - np.arange(height) - 0.5
     inside = x[None, :] ** 2 + y[:, None] ** 2 <= radius ** 2
@@ -49,7 +53,9 @@ def circle_image(rig) -> tuple[bytes, dict]:
     info = {"resolution_px": [width, height], "centre_px_from_top_left": [width / 2, height / 2],
             "radius_px": radius, "lit_pixels": int(inside.sum()),
             "rim_angle_at_cop_deg": math.degrees(design.alpha_max),
-            "occlusion_radius_px": float(design.pixel_radius(np.array([design.alpha_min]))[0])}
+            "occlusion_radius_px": lensed.ring_radius(g, design.alpha_min),
+            "radius_without_lens_px": float(design.pixel_radius(np.array([design.alpha_max]))[0]),
+            "lens_cop_shift_mm": lensed.cop_shift, "lens_pixel_scale": lensed.pixel_scale}
     return buf.getvalue(), info
 
 

@@ -803,10 +803,9 @@ def _section_calibrate(d: Doc, c) -> None:
     row = pshadow["rows"][0]
     d.p("Lift the splitter holder, with the camera on it, off its seat (its kinematic seat puts it back in the same "
         "place; the seat's balls stay on the shelf) and take the focusing lens out of its mount; leave the mount "
-        f"where it is. Set the `projector_mounting_plate` ({pshadow['plate_length_mm']:.0f} mm long) on the splitter "
-        "seat in the holder's place: its three steel balls (pressed into the pockets in its underside, a drop of "
-        "retaining compound in each) sit on the seat's cone, vee and flat, where the holder's own balls sat, so it "
-        "registers on the shelf's fixed seat alone; it stops short of the lens mount's foot and never touches it. Stand "
+        f"where it is. Set the `projector_mounting_plate` ({pshadow['plate_length_mm']:.0f} mm long) on the splitter seat "
+        "in the holder's place: the three steel balls pressed into its underside (retaining compound) sit on the seat's "
+        "cone, vee and flat where the holder's sat; it stops short of the lens mount's foot and never touches it. Stand "
         "the `projector_backplate` in the fence at the shelf's end, its cut cross towards the projector, and the "
         "two `projector_cross`es in the other two fences: their centres are then on the projector's axis, "
         f"{pshadow['axis_height_mm']:.1f} mm above the plate, {pshadow['spacing_mm']:.1f} mm apart, the far one "
@@ -820,15 +819,15 @@ def _section_calibrate(d: Doc, c) -> None:
         f"{p.tolerancing.projector_offset:g} mm. Then take the plate, crosses and backplate off, put the lens back "
         "and set the holder back on its seat.")
     d.h(3, "Projector: the circle on the paraboloid")
-    d.p("Take the focusing lens out of its mount first: the circle is set with the projector's own optics. Open "
+    d.p("Leave the focusing lens in its mount: the circle is set through it, as the basis images are shown. Open "
         "`calibration/circle.html` in a browser on the projector's screen and press f (full screen): arrow keys "
         "move the circle (Shift: 10 px), + and - change its radius, 0 restores the design's circle, and its centre "
         "and radius in pixels are shown at the top left (h hides them). The same circle as a fixed image:")
     d.p(f"`calibration/circle.png` ({info['resolution_px'][0]} x {info['resolution_px'][1]} px, the "
         f"projector's resolution): a bright disc of radius **{info['radius_px']:.1f} px** centred on pixel "
         f"({info['centre_px_from_top_left'][0]:g}, {info['centre_px_from_top_left'][1]:g}) from the top left, the "
-        f"paraboloid's rim as the design maps it (the rim ray leaves the COP at {info['rim_angle_at_cop_deg']:.3f} "
-        f"deg from the axis). Lay a film over the dome's base, marked at the sample point O (as below). "
+        f"paraboloid's rim through the lens ({info['radius_without_lens_px']:.1f} px without it: the lens scales the "
+        f"pixels' angles x {info['lens_pixel_scale']:.3f}). Lay a film over the dome's base, marked at the sample point O (as below). "
         "With the projector placed as designed the reflected light converges to the mark; move the circle in the "
         "image until the spot is symmetric about the mark, then adjust its radius until the light converges to a "
         f"point. A circle larger than the rim throws direct light onto the film around the paraboloid's shadow, "
