@@ -129,6 +129,22 @@ class LensedProjector:
 LENS_INDEX = 1.5168
 
 
+def cop_distance_for(seen: float, focal_length: float, edge_thickness: float = 0.0, diameter: float = 0.0,
+                     index: float = LENS_INDEX) -> float:
+    """Where (mm before the lens's centre) the projector's real COP must stand for the paraboloid to
+    see it ``seen`` mm before the lens's centre, through the lens of :func:`through_lens` (its
+    inverse): with u the real COP's distance to the front principal plane, the COP seen stands
+    u f / (f - u) before the back one, so u = c f / (f + c), c = ``seen`` less the back principal
+    plane's distance before the lens's centre."""
+    f, n = focal_length, index
+    radius = f * (n - 1)
+    sag = radius - math.sqrt(radius * radius - (diameter / 2) ** 2)
+    front = edge_thickness / 2 + sag  # the front principal plane (the curved vertex) before the lens's centre
+    back = front - (edge_thickness + sag) * (n - 1) / n  # the back one, t (n - 1) / n after it
+    c = seen - back
+    return front + c * f / (f + c)
+
+
 def through_lens(focal_length: float, lens_distance: float, edge_thickness: float = 0.0, diameter: float = 0.0,
                  index: float = LENS_INDEX) -> tuple[float, float]:
     """The focusing lens's effect on the projector whose COP stands ``lens_distance`` (s, mm) before

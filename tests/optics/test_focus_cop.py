@@ -113,3 +113,22 @@ def test_a_design_ray_is_shown_through_the_lens_where_its_paraboloid_point_is(ta
             lo, hi = (mid, hi) if z > geo.vertex_z - r * r / (4 * geo.focal_length) else (lo, mid)
         r, z = lo * math.sin(alpha), geo.cop_z - lo * math.cos(alpha)
         assert lensed.ring_radius(geo, alpha) == pytest.approx(lensed.pixel_radius(r, z), rel=1e-9)
+
+
+@pytest.mark.parametrize("thick", [False, True])
+def test_where_the_real_cop_must_stand_for_the_paraboloid_to_see_it_at_the_design(table31, thick):
+    """cop_distance_for inverts through_lens: the COP placed where it says is seen at the design's
+    distance, by the closed form and by the exact trace (thick lens); for Table 3.1 the projector
+    stands 26.14 mm before the lens's centre, 1.14 mm farther than the 25 mm the paraboloid must see."""
+    from rigcad.optics.focus import cop_distance_for
+
+    size = (table31.lens.thickness, table31.lens.diameter) if thick else (0.0, 0.0)
+    s = cop_distance_for(25.0, 300.0, *size)
+    shift, _ = through_lens(300.0, s, *size)
+    assert s + shift == pytest.approx(25.0, abs=1e-9)
+    if thick:
+        x, _ = _seen_from(math.radians(0.05), 300.0, s, *size)
+        assert s - x == pytest.approx(25.0, abs=1e-5)  # the traced COP seen: 25 mm before the lens's centre
+        assert s == pytest.approx(26.14, abs=0.01)
+    else:
+        assert s == pytest.approx(25.0 * 300.0 / 325.0, rel=1e-12)  # thin: s f / (f + s), the Gaussian inverse
