@@ -132,3 +132,20 @@ def test_where_the_real_cop_must_stand_for_the_paraboloid_to_see_it_at_the_desig
         assert s == pytest.approx(26.14, abs=0.01)
     else:
         assert s == pytest.approx(25.0 * 300.0 / 325.0, rel=1e-12)  # thin: s f / (f + s), the Gaussian inverse
+
+
+def test_the_figures_docs_states(table31):
+    """docs/calibration-focusing-lens.md's figures: the rim 100.3 px bare and 108.0 px through the
+    lens (x 1.076), the centre thickness 8.03 mm, the principal planes 2.7 mm apart, a 0.5 mm
+    decentred lens moving the COP's image 0.04 mm."""
+    geo = derive(table31)
+    lens = focusing_lens(table31, geo)
+    seen = lens.projector(geo.projector_focal_px, geo.cop_z)
+    bare = geo.projector_focal_px * geo.rim_radius / (geo.cop_z - geo.rim_z)
+    through = seen.ring_radius(geo, geo.rim_angle_at_cop)
+    assert (round(bare, 1), round(through, 1), round(through / bare, 3)) == (100.3, 108.0, 1.076)
+    radius = 300.0 * (LENS_INDEX - 1)
+    centre = 6.0 + radius - math.sqrt(radius ** 2 - 25.0 ** 2)
+    assert round(centre, 2) == 8.03 and round(centre * (LENS_INDEX - 1) / LENS_INDEX, 1) == 2.7
+    s_h = 25.0 - 3.0 - (centre - 6.0)
+    assert round(0.5 * s_h / (300.0 - s_h), 2) == 0.04
