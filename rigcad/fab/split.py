@@ -258,14 +258,16 @@ def pin_wall(printer) -> float:
 DEFAULT_HOLE_SHRINK = {"fdm": 0.3, "sla": 0.1}
 
 
-def pin_fit(printer, pins) -> dict:
+def pin_fit(printer, pins, pin: AlignmentPin | None = None) -> dict:
     """How a part's pins fit their holes (mm): the pin and its hole as drawn, the printer's hole shrink
     for a hole of that size whose axis may lie either way as printed (its ``process_errors``, else
     DEFAULT_HOLE_SHRINK), the hole as it prints, the class (slip: the drawn hole's clearance, ``press``
     when the print's shrink takes it below the pin) and the shop step that makes it right: every pin
     hole drilled to its drawn size after printing (a hole printed with a horizontal axis droops at its
-    top; the drill, run in by hand, trues it and two perimeters of wall keep it from breaking out)."""
-    pin = printer.alignment_pin
+    top; the drill, run in by hand, trues it and two perimeters of wall keep it from breaking out).
+    ``pin``: the pin the part was split with (default the printer's; a split mirror's floats,
+    rigcad.fab.seams.float_pin: the glue, not the pin, fills its clearance)."""
+    pin = pin or printer.alignment_pin
     d = max((p.diameter for p in pins), default=pin.diameter) or pin.diameter
     hole = d + pin.clearance
     errors = getattr(printer, "process_errors", None)

@@ -33,7 +33,7 @@ from rigcad.errors import FabricationError, RigcadError
 from rigcad.export import reuse
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import profile_digest, sha256_hex
-from rigcad.fab import choice, estimate, orientation, outlines, slicer, split, staircase
+from rigcad.fab import choice, estimate, orientation, outlines, seams, slicer, split, staircase
 from rigcad.fab.mirror import MirrorSurface, mirror_faces
 from rigcad.fab.printers import Printer
 from rigcad.fab.published import FabResult, inputs_key, read_back  # noqa: F401 (FabResult: this module's result)
@@ -145,6 +145,7 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                     problems.append(f"{name}: {err}")
                     done[name] = PartFab({"error": str(err)})
             report_parts[name] = done[name].entry
+            problems += seams.problems(name, done[name].entry.get("seams"))
             timings.update(done[name].timings)
             say(name)
         jobs = [job for d in done.values() for job in d.jobs]
@@ -341,6 +342,9 @@ def _with_stock(rig, part, run: _Run) -> tuple[PartFab, float]:
     if "polishing" in new:
         record["valley_behind_sanded_surface_mm"] = max(0.0, new["polishing"]["stock_to_add_mm"] - stock)
     new["sanding_stock"] = record
+    if "seams" in new:
+        new["seams"].update(seams.mirror_record(run.printer, stock, rig.profile.templates.thickness,
+                                                (new.get("pin_fit") or {}).get("pin_diameter_mm")))
     done.timings = {**first.timings, f"{name}:orient_for_stock": stock_s, **done.timings}
     return done, stock
 
@@ -386,15 +390,17 @@ def _fab_part(part, layout, run: _Run, plan=None, orient_only: bool = False) -> 
     if plan is None:
         plan = choice.split_plan(man, v, mirror is not None, plate, run.printer, split.keepouts(datums))
     tongues: list = []
-    pieces, pins, drilled = split.split_part(man, name, plan, run.printer.alignment_pin, mirror, tongues,
-                                             wall=split.pin_wall(run.printer))
+    pin = run.printer.alignment_pin
+    if mirror is not None and run.printer.process_errors is not None:
+        pin = seams.float_pin(pin, run.printer.process_errors.position)  # glued on a gauge, not on the pins
+    pieces, pins, drilled = split.split_part(man, name, plan, pin, mirror, tongues, wall=split.pin_wall(run.printer))
     timings[f"{name}:fit_split"] = time.perf_counter() - t
     entry = {"process": run.printer.process, "quantity": part.quantity, "description": part.description,
              "volume_mm3": man.volume(), "split": plan.describe(), "mirror": mirror.name if mirror else None}
     if plan.count > 1 and not orient_only:
         entry["pins"] = [{"centre_mm": list(p.centre), "axis": list(p.axis), "face": p.face, "diameter_mm": p.diameter}
                          for p in pins]
-        entry["pin_fit"] = split.pin_fit(run.printer, pins)
+        entry["pin_fit"] = split.pin_fit(run.printer, pins, pin)
         if datums:
             entry["datum_seams"] = split.datum_seams(datums, plan)
         if tongues:
@@ -409,6 +415,8 @@ def _fab_part(part, layout, run: _Run, plan=None, orient_only: bool = False) -> 
                             "mirror_max_abs_normal_along_build": o.steepest} for pc, o in zip(pieces, oriented)]
         timings[f"{name}:orient_slice"] = time.perf_counter() - t
         return PartFab(entry, plan=plan, timings=timings)
+    if plan.count > 1:
+        entry["seams"] = seams.glue_record(run.printer, plan, pieces, oriented)
     done = PartFab(entry, plan=plan, timings=timings)
     entry["pieces"], maps = [], []
     for pc, o in zip(pieces, oriented):

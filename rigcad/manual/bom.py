@@ -286,9 +286,28 @@ def dowel_pins(fab_report: dict, printer) -> dict | None:
     return {"item": f"dowel pin {pin.diameter:g} mm x {length:g} mm", "quantity": count,
             "diameter_mm": pin.diameter, "length_mm": length, "per_part": per_part,
             "use": ", ".join(f"{n}: {k}" for n, k in per_part.items()),
-            "note": (f"holes {pin.diameter + pin.clearance:g} mm x {pin.depth:g} mm deep into each piece "
-                     f"(alignment_pin in {printer.source})"
+            "note": (f"holes {_pin_holes(fab_report)} x {pin.depth:g} mm deep into each piece "
+                     f"(alignment_pin in {printer.source}; a split mirror's wider: its seams are glued on a gauge)"
                      + ("; cut from the printer's own filament" if filament else ""))}
+
+
+def _pin_holes(fab_report: dict) -> str:
+    """The split parts' pin holes as drawn (fab.json's ``pin_fit``), each with its parts."""
+    by: dict[float, list[str]] = {}
+    for n, e in fab_report["parts"].items():
+        if e.get("pin_fit"):
+            by.setdefault(round(e["pin_fit"]["hole_drawn_mm"], 3), []).append(n)
+    return ", ".join(f"{h:g} mm ({', '.join(ns)})" for h, ns in sorted(by.items()))
+
+
+def glue_rows(fab_report: dict) -> list[tuple[str, str]]:
+    """The glues the split parts' cut faces need (fab.json's ``seams``: rigcad.fab.seams.glue_for),
+    each with the parts it joins; the pins are set in the same glue."""
+    by: dict[str, list[str]] = {}
+    for n, e in fab_report["parts"].items():
+        if e.get("seams"):
+            by.setdefault(e["seams"]["glue"], []).append(n)
+    return [(f"{g[:1].upper() + g[1:]}, for the cut faces and pins of {', '.join(ns)}", "1") for g, ns in by.items()]
 
 
 def printed(rig, fab_report: dict) -> list[dict]:
@@ -431,8 +450,6 @@ CONSUMABLES = (
     ("Dry guide coat powder (black, e.g. 3M 05861) with its applicator", "1"),
     ("Cutting compound and finishing polish (automotive, e.g. 3M 06085 + 06068 class), 250 ml each", "1 each"),
     ("Foam polishing pads, 75 mm, cutting and finishing", "2 each"),
-    ("Cyanoacrylate glue, medium viscosity, 20 g, for the split pieces' cut faces", "1"),
-    ("Two-part epoxy, 5 min, 25 ml (pins into holes)", "1"),
     ("Isopropyl alcohol 99 %, 500 ml, and lint-free wipes (degreasing before each coat)", "1"),
     ("Tack cloths", "5"),
 )
@@ -456,17 +473,19 @@ def feeler_gauge(gaps_mm: list[float]) -> tuple[str, str]:
     """A feeler gauge set (DIN 2275 / ISO 2768 leaves) with the leaves the template checks need: the
     gaps rounded to the set's 0.01 mm steps; a gap under 0.02 mm (the thinnest leaf) is checked
     against the light instead."""
-    leaves = sorted({round(g, 2) for g in gaps_mm if g >= 0.02})
+    from rigcad.fab.seams import FEELER_LEAF
+
+    leaves = sorted({round(g, 2) for g in gaps_mm if g >= FEELER_LEAF})
     return (f"Feeler gauge set 0.02-1.00 mm in 0.01 mm steps (DIN 2275); leaves used: "
             + (", ".join(f"{v:.2f}" for v in leaves) + " mm" if leaves else "none (check against the light)"),
             "1")
 
 
-def dowel_drills(printer) -> tuple[str, str]:
-    """The drill for the split pieces' pin holes (the printer's alignment pin plus its clearance)."""
-    pin = printer.alignment_pin
-    return (f"HSS twist drill {pin.diameter + pin.clearance:g} mm (DIN 338) for the pin holes; 4 mm H7 reamer "
+def dowel_drills(fab_report: dict) -> tuple[str, str]:
+    """The drills for the split pieces' pin holes (each part's hole as drawn, fab.json's ``pin_fit``)."""
+    holes = _pin_holes(fab_report)
+    return (f"HSS twist drills (DIN 338) for the pin holes: {holes or 'none'}; 4 mm H7 reamer "
             "for the column's dowel holes", "1 each")
 
 
-__all__ += ["CONSUMABLES", "TOOLS", "dowel_drills", "feeler_gauge"]
+__all__ += ["CONSUMABLES", "TOOLS", "dowel_drills", "feeler_gauge", "glue_rows"]

@@ -353,10 +353,10 @@ def _bill_consumables(d: Doc, c) -> None:
         if gap > 1e-9:
             gaps.append(gap)
     d.h(3, "Consumables")
-    d.table(["item", "qty"], [list(r) for r in B.CONSUMABLES])
+    d.table(["item", "qty"], [list(r) for r in (*B.CONSUMABLES, *B.glue_rows(c.fab_report))])
     d.h(3, "Tools")
     d.table(["item", "qty"], [list(r) for r in (*B.TOOLS, B.feeler_gauge([total - gauged_depth(c.p), *gaps]),
-                                                B.dowel_drills(c.printer))])
+                                                B.dowel_drills(c.fab_report))])
 
 
 def _section_print(d: Doc, c) -> None:
@@ -384,8 +384,34 @@ def _section_print(d: Doc, c) -> None:
     d.ul(items)
     if bill["pins"]:
         d.p(f"Split pieces: cut {bill['pins']['quantity']} pins of {bill['pins']['length_mm']:g} mm from "
-            f"{bill['pins']['diameter_mm']:g} mm rod (or filament), push them into one piece's holes, join the "
-            "next piece on them and glue the cut faces.")
+            f"{bill['pins']['diameter_mm']:g} mm rod (or filament), drill each part's pin holes to the size "
+            "the tools list gives, push the pins into one piece's holes, join the next piece on them and glue "
+            "the cut faces with the glue the consumables list names for that part.")
+        _glue_mirror_seams(d, c)
+
+
+def _glue_mirror_seams(d: Doc, c) -> None:
+    """How a split mirror's seams are glued: on the printed-stage template, not on the pins
+    (rigcad.fab.seams: the pins alone would step the mirror by more than its sanding stock)."""
+    from rigcad.fab.seams import FEELER_LEAF
+
+    for name, e in c.fab_report["parts"].items():
+        s = e.get("seams") or {}
+        if "step_on_gauge_mm" not in s:
+            continue
+        template = f"{name}_template_printed"
+        d.p(f"**The {name}'s seams are glued on a gauge, not on their pins.** Its pins alone would let a seam step "
+            f"{s['step_on_pins_mm']:.2f} mm ({s['step_on_pins_how']}) against {s['stock_mm']:.3f} mm of sanding "
+            f"stock: sanding to the template would leave the lower side as a groove. So its pin holes are drawn "
+            f"wide and the glue fills them. Cut `outlines/{template}.dxf` from the same plate as the templates (its "
+            f"edge is the surface as printed) and glue one seam at a time, the pieces standing on the base plate "
+            f"(packing tape over the plate under the seam, so no glue reaches it) with their flange screws in, "
+            f"finger-tight: mix the {s['glue']} ({s['glue_open_min']:g} min to set the seam), butter both cut faces "
+            f"and the pins, push the pieces together, stand the template in the seam's plane with its datum edge on "
+            f"the plate and its axis line on the centre mark, and push both pieces against its edge until a "
+            f"{FEELER_LEAF:g} mm feeler leaf passes under it on neither "
+            f"side, along the whole seam. Tape the seam on the outside and leave it to cure before the next. That "
+            f"holds the step to {s['step_on_gauge_mm']:.3f} mm ({s['step_on_gauge_how']}), within the stock.")
 
 
 def _section_sand(d: Doc, c) -> None:

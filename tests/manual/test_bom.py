@@ -334,22 +334,30 @@ def _printer(filament=None, **kw):
 
 
 def test_dowel_pins_count_per_part_times_its_quantity():
-    report = {"parts": {"plate": {"pins": [1, 2, 3], "quantity": 2}, "dome": {"pins": [1]},
+    report = {"parts": {"plate": {"pins": [1, 2, 3], "quantity": 2, "pin_fit": {"hole_drawn_mm": 1.9}},
+                        "dome": {"pins": [1], "pin_fit": {"hole_drawn_mm": 2.1}},
                         "tool": {"pins": []}, "arm": {}}}
     pins = B.dowel_pins(report, _printer())
+    note = ("holes 1.9 mm (plate), 2.1 mm (dome) x 6 mm deep into each piece (alignment_pin in printers/x.yaml; a "
+            "split mirror's wider: its seams are glued on a gauge)")
     assert pins == {"item": "dowel pin 1.75 mm x 11.5 mm", "quantity": 7, "diameter_mm": 1.75, "length_mm": 11.5,
-                    "per_part": {"plate": 6, "dome": 1}, "use": "plate: 6, dome: 1",
-                    "note": "holes 1.9 mm x 6 mm deep into each piece (alignment_pin in printers/x.yaml)"}
-    assert B.dowel_pins(report, _printer(filament=1.75))["note"] == (
-        "holes 1.9 mm x 6 mm deep into each piece (alignment_pin in printers/x.yaml); cut from the printer's own filament")
+                    "per_part": {"plate": 6, "dome": 1}, "use": "plate: 6, dome: 1", "note": note}
+    assert B.dowel_pins(report, _printer(filament=1.75))["note"] == note + "; cut from the printer's own filament"
     assert B.dowel_pins(report, _printer(filament=2.85))["note"] == pins["note"]
     assert B.dowel_pins(report, _printer(filament=0.0))["note"] == pins["note"]  # no filament diameter
     none = _printer()
     none.filament_diameter = None
     assert B.dowel_pins(report, none)["note"] == pins["note"]
     assert B.dowel_pins({"parts": {"a": {"pins": []}, "b": {}}}, _printer()) is None
-    assert B.dowel_drills(_printer()) == ("HSS twist drill 1.9 mm (DIN 338) for the pin holes; 4 mm H7 reamer for "
-                                          "the column's dowel holes", "1 each")
+    assert B.dowel_drills(report) == ("HSS twist drills (DIN 338) for the pin holes: 1.9 mm (plate), 2.1 mm (dome); "
+                                      "4 mm H7 reamer for the column's dowel holes", "1 each")
+
+
+def test_each_glue_the_seams_need_is_listed_once_with_its_parts():
+    report = {"parts": {"plate": {"seams": {"glue": "cyanoacrylate glue, thin"}}, "shelf": {"seams": {"glue": "cyanoacrylate glue, thin"}},
+                        "dome": {"seams": {"glue": "two-part epoxy (e.g. Loctite EA 3430)"}}, "arm": {}}}
+    assert B.glue_rows(report) == [("Cyanoacrylate glue, thin, for the cut faces and pins of plate, shelf", "1"),
+                                   ("Two-part epoxy (e.g. Loctite EA 3430), for the cut faces and pins of dome", "1")]
 
 
 def _piece(t, g, orientation, gcode=None):
