@@ -1133,7 +1133,10 @@ def _screw_rows(rows: list[dict], thread: str, count: int, step: str, what: str,
     stacks: dict[float, list[int]] = {}
     for r in rows:
         stacks.setdefault(r["length_mm"], []).append(r["shims"])
-    return [{"item": "screw and washers", "thread": thread, "length_mm": float(L), "quantity": count,
+    names = " on ".join(f"{w.size} {w.standard}" for w in washers.washers)
+    std = "ISO 4762" if thread.startswith("M") else "ASME B18.3"
+    return [{"item": f"socket-head screw ({std}) with {names} washers", "thread": thread, "length_mm": float(L),
+             "quantity": count,
              key: ns, "washers": [w.name() for w in washers.washers],
              "steps": (step,), "joins": f"{what}, through {washers.describe()}, the slot and a stack of {ns[0]}..{ns[-1]} "
                       "printed shims and the bought ones (extra washers per stack: rigcad.parts.tower, "
