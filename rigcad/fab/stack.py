@@ -80,8 +80,9 @@ CHAIN_PARTS = ("base_plate", "dome", "tower_column", "tower_shelf", "splitter_ho
 #: The Kinematic Encyclopedia, precisionballs.com); 5 um taken for balls pressed into printed pockets
 #: (assumed).
 KINEMATIC_REPEAT = 0.005
-#: The links a locating feature replaces, by what it locates: the paraboloid's (a locating block with
-#: an adjuster in x, y and height replaces the beam's and the clamp's floats), the dome's (a register
+#: The links a locating feature replaces, by what it locates: the paraboloid's (its shim stops: the
+#: beam pressed onto its seats, the clamp onto the beam's pin, replace the beam's and the clamp's
+#: floats), the dome's (a register
 #: replaces the bolts' float) and the splitter seat's (a kinematic seat, on the COP's, the splitter's
 #: and the camera's chains). A Locator's ``replaces`` names these.
 PARABOLOID_FLOATS = ("beam across its slots", "beam along its slots", "clamp on the beam", "clamp along the beam")
@@ -327,8 +328,8 @@ def _paraboloid_links(profile, layout, process: ProcessErrors, seams) -> tuple[L
     slot_play, slot_how = _drilled(profile.beam.width + clear, profile.beam.width, process, "unknown")
     return (*_dome_seat(profile, layout, process, seams),
             Link("dome: flange to the beam's slots", "printed",
-                 f"printed: the slots' floors {z0:.0f} mm above the flange; the two slots, {2 * layout.slot_r:.0f} mm "
-                 "apart, centred on the axis (the scale moves both alike), their floors each within half a layer",
+                 f"printed: the beam's seats (or slots) {z0:.0f} mm above the flange, {2 * layout.slot_r:.0f} mm apart, "
+                 "centred on the axis (the scale moves both alike), their floors each within half a layer",
                  process.position, process.height_error(z0), process.layer_step / (2 * layout.slot_r)),
             *seams("dome"),
             Link("beam across its slots", "clearance",
@@ -562,17 +563,62 @@ def _verdict(element: str, axis: str, links: tuple[Link, ...], key: str, tol: fl
 
 def declared_locators(profile, layout, process: ProcessErrors) -> tuple[Locator, ...]:
     """The locating features the parts declare (rigcad.parts.locating), as the stack reads them: the
-    dome's register (rigcad.parts.dome.register) replaces the bolts' float by its pins' fit and the
-    printed position of the flange's round hole about the dome's axis."""
+    dome's register (rigcad.parts.dome.register) replaces the bolts' float by its pins' fit (or, when it
+    is printed in place rather than drilled in place, that and the printed position of the flange's
+    round hole about the dome's axis); the paraboloid's shim stops (rigcad.parts.paraboloid.stops, the
+    beam's seats: rigcad.parts.dome.beam_seats) replace the beam's and the clamp's floats by what holds
+    them: :func:`_paraboloid_held`."""
     from rigcad.parts.dome import register
 
     reg = register(profile, layout)
     lateral, turn = reg.repeatability
-    return (Locator("dome register", "dome", DOME_FLOATS,
-                    Link("dome register: pins in the plate, a reamed hole and a slot in the flange", "joint",
-                         f"two {reg.diameter:g} mm ISO 8734 m6 pins: {lateral * 1e3:.0f} um of fit; the flange's round hole "
-                         f"printed about the dome's axis ({process.position:g} mm)", lateral + process.position, 0.0,
-                         turn)),)
+    printed = 0.0 if reg.drilled else process.position
+    how = ("drilled and reamed in the plate through the flange's round hole and slot once the dome is indicated in"
+           if reg.drilled else f"the flange's round hole printed about the dome's axis ({process.position:g} mm)")
+    pins = Link("dome register: pins in the plate, a reamed hole and a slot in the flange", "joint",
+                f"two {reg.diameter:g} mm ISO 8734 m6 pins: {lateral * 1e3:.0f} um of fit; {how}", lateral + printed, 0.0,
+                turn)
+    # the paraboloid rides on the dome: its chain passes the same register
+    return (Locator("dome register", "dome", DOME_FLOATS, pins),
+            Locator("dome register", "paraboloid", DOME_FLOATS, pins),
+            Locator("paraboloid on its stops", "paraboloid", PARABOLOID_FLOATS,
+                    _paraboloid_held(profile, layout, process)))
+
+
+def _paraboloid_held(profile, layout, process: ProcessErrors) -> Link:
+    """What holds the paraboloid once its stops replace the floats (one link): the beam pressed onto its
+    seats' floors and -y walls by their set screws, set along x by hand (its overhangs equal to
+    ``adjusters.hand_slide``); the stop pin's hole printed in the beam and the clamp's end face and -y
+    wall printed about its stem; the clamp's roof flat on the beam's top to the print's position error
+    over its length (a tilt the seats' packs take out)."""
+    from rigcad.parts.paraboloid import mount
+
+    m, a = mount(profile, layout), profile.adjusters
+    pin_x = abs(m.pin.base[0])
+    length = m.clamp.hi[0] - m.clamp.lo[0]
+    lateral = a.hand_slide + process.length_error(pin_x) + process.length_error(length / 2)
+    return Link("paraboloid on its stops: the beam on its seats, the clamp on the beam's pin", "joint",
+                f"the beam pressed onto its seats by set screws, centred by hand to {a.hand_slide:g} mm "
+                f"(adjusters.hand_slide); the pin's hole {pin_x:.1f} mm from the beam's middle and the clamp's end "
+                f"{length / 2:g} mm from its stem, printed; the clamp's roof flat to {process.position:.2f} mm over "
+                f"its {length:g} mm", lateral, 0.0, process.position / length,
+                buy="a bought miniature XY stage under the stem")
+
+
+def located_adjusters(profile, layout, process: ProcessErrors | None = None) -> tuple[AdjusterSpec, ...]:
+    """The paraboloid's and the dome's adjusters the parts declare (rigcad.parts.locating.ShimStop): the
+    clamp's x and y shim stops (rigcad.parts.paraboloid.stops), the beam's seats' height and tilt
+    (rigcad.parts.dome.beam_seats) and the dome's indicating in from the bore (rigcad.parts.dome.indicating,
+    its travel less the flange's bolt holes' shrink on ``process``)."""
+    from rigcad.parts.dome import beam_seats, flange_bolt_hole, indicate_travel, indicating
+    from rigcad.parts.paraboloid import stops as clamp_stops
+
+    stops = (*clamp_stops(profile, layout), *beam_seats(profile, layout).stops())
+    ind = indicating(profile, layout)
+    if process is not None:
+        hole = flange_bolt_hole(profile, layout)
+        ind = replace(ind, range=indicate_travel(profile, layout, process.shrink(hole, "vertical")))
+    return tuple(AdjusterSpec(s.name, s.element, s.axis, s.range, s.resolution, s.how) for s in (*stops, ind))
 
 
 def stack(profile, layout, printer: Printer, *, seams: dict[str, int] | None = None,
@@ -582,13 +628,15 @@ def stack(profile, layout, printer: Printer, *, seams: dict[str, int] | None = N
     seams on each chain part from ``seams`` (part -> seams a chain crosses: :func:`seams_from_pieces`
     of a fab run; default :func:`estimate_seams`), against ``tolerancing``, with ``adjusters``
     (default :func:`default_adjusters`) and the ``locators`` (each replaces links on its element's
-    chain; default: the ones the parts declare, :func:`declared_locators`)."""
+    chain; default: the ones the parts declare, :func:`declared_locators`). The default adjusters
+    add the paraboloid's and the dome's (:func:`located_adjusters`)."""
     proc = process or printer.process_errors
     if proc is None:
         raise FabricationError(f"printer {printer.name}: no process_errors, so no tolerance stack")
     estimated = seams is None
     counts = dict(estimate_seams(profile, layout, printer) if estimated else seams)
-    adj = default_adjusters(profile, layout) if adjusters is None else tuple(adjusters)
+    adj = (*default_adjusters(profile, layout), *located_adjusters(profile, layout, proc)) if adjusters is None \
+        else tuple(adjusters)
     locators = declared_locators(profile, layout, proc) if locators is None else tuple(locators)
 
     def on_chain(part: str) -> tuple[Link, ...]:
@@ -674,5 +722,5 @@ def with_process(printer: Printer, **figures) -> Printer:
 
 
 __all__ = ["AXES", "AdjusterSpec", "AxisVerdict", "ELEMENTS", "ElementStack", "Link", "Locator", "RESOLUTION_SHARE",
-           "DOME_FLOATS", "PARABOLOID_FLOATS", "declared_locators", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
+           "DOME_FLOATS", "PARABOLOID_FLOATS", "declared_locators", "located_adjusters", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
            "table_lines", "with_process"]

@@ -1,19 +1,42 @@
 """The dome (thesis 3.1, 3.4): the integrated profile revolved, printed behind the coating, with a
-wall, a bolted base flange, and the slots the mounting beam passes through and rests in."""
+wall, a bolted base flange, the slots the mounting beam passes through, and the beam's two seats.
+
+Each seat is a block standing on the flange outside the wall at a slot, within the flange's radius
+(the dome's footprint on a bed does not grow): the beam passes through its tunnel and rests on a
+pack of shim foil on the tunnel's floor, pressed down by a set screw in the roof and against the
+tunnel's -y wall by a set screw in its +y wall (heat-set inserts take both). Both packs together set
+the paraboloid's height, one against the other its tilt along the beam (rigcad.parts.locating.ShimStop).
+
+The dome is centred on the sample bore by indicating it in, and its register is then drilled in place
+(rigcad.parts.locating): a dial test indicator on an arm turning in the bore sweeps the mirror's
+lower edge; the flange's bolt holes leave it :data:`INDICATE_TRAVEL_MM` of travel each way for that."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from rigcad.errors import GeometryError
-from rigcad.parts.joints import ScrewJoint
-from rigcad.parts.locating import DowelRegister, bolt_hole
+from rigcad.parts.joints import Bought, ScrewJoint, datums_of
+from rigcad.parts.locating import (INDICATOR_MM, PIN_FIT_MM, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole,
+                                   foil_step, teardrop_along_y)
 from rigcad.parts.layout import RigLayout, u_at_height
-from rigcad.parts.recipe import Box, Curve, Difference, Line, Part, Revolve, Section
+from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Union_
 from rigcad.profile.schema import Profile
-from rigcad.standards import thread_for_hole
+from rigcad.standards import INSERTS, THREADS, thread_for_hole
+
+#: How far the dome may be moved on the base plate each way when it is indicated in from the sample
+#: bore (mm): its flange's bolt holes leave this much beyond the print's errors. It covers the base
+#: plate's print errors and glue seams between its bore and its inserts (0.81 mm worst case on the
+#: MK3S by rigcad.fab.stack's estimate; the stack refuses a printer whose seams need more).
+INDICATE_TRAVEL_MM = 1.0
+#: The seats' set screws' thread (heat-set inserts in the seats' roofs and +y walls).
+SEAT_SCREW = "M3"
+#: The least radial depth of a seat (mm): room for its set screws' inserts (a 4 mm hole, 4.6 mm over
+#: the knurl) and 2 mm walls.
+SEAT_DEPTH_MM = 9.0
 
 
 def _pt(m, u) -> tuple[float, float]:
@@ -36,22 +59,25 @@ def flange_joint(profile: Profile, layout: RigLayout) -> ScrewJoint:
 
 
 def _pins(layout: RigLayout) -> tuple[tuple[float, float], tuple[float, float]]:
-    """The register's pins (x, y; mm): the round hole's at +x, the slot's at -x, on the bolt circle."""
+    """The register's pins (x, y; mm): the round hole's at +y, the slot's at -y, on the bolt circle
+    (clear of the beam's seats at +-x, which stand over the flange there)."""
     r = layout.bolt_circle_r
-    return (r, 0.0), (-r, 0.0)
+    return (0.0, r), (0.0, -r)
 
 
 def register(profile: Profile, layout: RigLayout) -> DowelRegister:
     """The dome's register on the base plate: two ``datum.dowel_diameter`` pins pressed into the plate
-    on the x axis at the bolt circle (the bolts stand half a pitch off it), the round hole at +x, the
-    slot at -x (along x: it takes the print's scale error over the flange's width). The dome lifts off
-    and goes back on them: the calibration screens go in on the plate while it is off."""
+    on the y axis at the bolt circle (the bolts stand half a pitch off it), the round hole at +y, the
+    slot at -y (along y: it takes the print's scale error over the flange's width). It is drilled in
+    place: the dome is indicated in from the sample bore first, then the plate is drilled and reamed
+    through the flange's hole and slot. The dome lifts off and goes back on the pins: the calibration
+    screens go in on the plate while it is off."""
     shell, d = profile.dome_shell, profile.datum
     pins = _pins(layout)
     slot = 2 * (2 * d.print_position + d.print_scale * 2 * layout.bolt_circle_r)
     reg = DowelRegister("dome_register", "dome", "base_plate", d.dowel_diameter, pins,
                         (0.0, shell.flange_thickness), (-profile.base_plate.thickness, 0.0), slot,
-                        "datum.dowel_diameter")
+                        "datum.dowel_diameter", drilled=True)
     bolt_r = flange_bolt_hole(profile, layout) / 2
     for x, y in flange_joint(profile, layout).points:
         for (px, py) in reg.points:
@@ -65,13 +91,110 @@ def register(profile: Profile, layout: RigLayout) -> DowelRegister:
 
 def flange_bolt_hole(profile: Profile, layout: RigLayout) -> float:
     """The flange's bolt holes (mm): ``dome_shell.bolt_diameter``, opened where the print's errors
-    need it (rigcad.parts.locating.bolt_hole, at the farthest bolt from the register's round pin): the
-    register locates the dome, the bolts only clamp it."""
+    need it (rigcad.parts.locating.bolt_hole, at the farthest bolt from the register's round pin), and
+    by :data:`INDICATE_TRAVEL_MM` each way, so that the dome can be indicated in from the bore: the
+    register locates the dome, the bolts only clamp it (on large washers, ISO 7093)."""
     d = profile.datum
     joint = flange_joint(profile, layout)
     (px, py) = _pins(layout)[0]
     far = max(math.hypot(x - px, y - py) for x, y in joint.points)
-    return max(profile.dome_shell.bolt_diameter, bolt_hole(joint.thread, far, d.print_position, d.print_scale))
+    printed = max(profile.dome_shell.bolt_diameter, bolt_hole(joint.thread, far, d.print_position, d.print_scale))
+    return printed + 2 * INDICATE_TRAVEL_MM
+
+
+def indicate_travel(profile: Profile, layout: RigLayout, shrink: float = 0.0) -> float:
+    """How far the dome can be moved on the plate each way when indicated in (mm): the bolt holes'
+    room (printed ``shrink`` mm under their drawn size) less what the print's errors already take."""
+    d = profile.datum
+    joint = flange_joint(profile, layout)
+    (px, py) = _pins(layout)[0]
+    far = max(math.hypot(x - px, y - py) for x, y in joint.points)
+    used = bolt_hole(joint.thread, far, d.print_position, d.print_scale) - THREADS[joint.thread].major
+    return max(0.0, (flange_bolt_hole(profile, layout) - shrink - THREADS[joint.thread].major - used) / 2)
+
+
+def indicating(profile: Profile, layout: RigLayout) -> ShimStop:
+    """The dome's centring as the tolerance stack reads it: indicated in from the bore to the dial
+    indicator's graduation and held there by the register drilled in place (its pins' fit), over
+    :func:`indicate_travel` each way."""
+    return ShimStop("dome indicated in from the sample bore, its register drilled in place", "dome", "lateral",
+                    indicate_travel(profile, layout), INDICATOR_MM + PIN_FIT_MM / 2, 0.0,
+                    f"a dial test indicator ({INDICATOR_MM:g} mm) on an arm turning in the sample bore sweeps the "
+                    "mirror's lower edge; tap the dome over until it reads within one graduation all round, bolt it, "
+                    "drill and ream the plate through the flange's round hole and slot, press the pins in")
+
+
+@dataclass(frozen=True)
+class BeamSeats:
+    """The beam's two seats on the dome (mm, rig frame): the ``blocks`` (one at +x, one at -x), the
+    ``tunnels`` the beam passes through, the set screws' insert ``pockets`` and bores, the screws'
+    length (ISO 4026), where the screws press (``x``, each side), the seats' ``span`` (between the
+    screws) and the floor pack (``pack``)."""
+
+    blocks: tuple[Box, Box]
+    tunnels: tuple[Box, Box]
+    pockets: tuple
+    screw_length: int
+    x: float
+    span: float
+    pack: float
+
+    def stops(self) -> tuple[ShimStop, ShimStop]:
+        """Height (both floor packs alike) and tilt along the beam (one against the other)."""
+        step = foil_step()
+        return (ShimStop("paraboloid height: shim foil under the beam in both seats", "paraboloid", "vertical",
+                         self.pack, step / 2, self.pack,
+                         f"{self.pack:g} mm of foil on each seat's floor at the design setting; a change at one seat "
+                         "moves the paraboloid half as much"),
+                ShimStop("paraboloid tilt along the beam: shim foil under one seat against the other", "paraboloid",
+                         "tilt", 2 * self.pack / self.span, step / self.span, self.pack,
+                         f"foil taken from one seat and added to the other over the {self.span:.0f} mm between "
+                         "their screws"))
+
+
+def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
+    """The beam's seats (see the module): within the flange's rim where it leaves :data:`SEAT_DEPTH_MM`
+    outside the mirror, else reaching past it onto the base plate (the beam then reaches through
+    them: rigcad.parts.beam)."""
+    from rigcad.parts.paraboloid import set_screw_length
+
+    shell, beam = profile.dome_shell, profile.beam
+    z0, z1 = layout.beam_z
+    c, p, w = shell.slot_clearance, SHIM_PACK_MM, beam.width / 2
+    ins = INSERTS[SEAT_SCREW]
+    side = ins.pocket_depth + 1.0
+    y_lo, y_hi = -w - shell.wall, w + 2 * c + side
+    floor, roof = z0 - p, z1 + p + c
+    top = roof + side
+    u = layout.as_printed_dome.sample(4001)
+    pts = layout.as_printed_dome.points(u)
+    band = (pts[:, 1] >= shell.flange_thickness) & (pts[:, 1] <= top)
+    x_in = float(pts[band, 0].max()) + 1.0  # a millimetre outside the mirror wherever the block stands
+    # within the flange's rim where it leaves room (the footprint does not grow), else past it, on the plate
+    x_out = max(math.sqrt(layout.flange_outer_r ** 2 - max(-y_lo, y_hi) ** 2) - 0.5, x_in + SEAT_DEPTH_MM)
+    xm = 0.5 * (x_in + x_out)
+    blocks, tunnels, pockets = [], [], []
+    for s in (1.0, -1.0):
+        lo, hi = sorted((s * x_in, s * x_out))
+        blocks.append(Box((lo, y_lo, 0.0), (hi, y_hi, top)))  # standing on the plate, through the flange
+        tunnels.append(Box((lo - 1.0, -w, floor), (hi + 1.0, w + 2 * c, roof)))
+        pockets += [Cylinder((s * xm, 0.0, top - ins.pocket_depth), ins.hole / 2, ins.pocket_depth + 1.0),
+                    Cylinder((s * xm, 0.0, roof - 1.0), THREADS[SEAT_SCREW].clearance / 2, side + 2.0),
+                    teardrop_along_y((s * xm, y_hi - ins.pocket_depth / 2 + 0.5, 0.5 * (z0 + z1)), ins.hole / 2,
+                                     ins.pocket_depth + 1.0),
+                    teardrop_along_y((s * xm, w + 2 * c + side / 2, 0.5 * (z0 + z1)),
+                                     THREADS[SEAT_SCREW].clearance / 2, side + 2.0)]
+    screw = set_screw_length(side, c, 2 * p + c)
+    return BeamSeats(tuple(blocks), tuple(tunnels), tuple(pockets), screw, xm, 2 * xm, p)
+
+
+def seat_hardware(profile: Profile, layout: RigLayout) -> tuple[Bought, ...]:
+    """What the beam's seats take, as it is ordered (the foil: rigcad.parts.paraboloid.hardware)."""
+    seats, ins = beam_seats(profile, layout), INSERTS[SEAT_SCREW]
+    return (Bought(f"{SEAT_SCREW} x {seats.screw_length} mm set screw, flat point (ISO 4026)", "ISO 4026", 4,
+                   {"length_mm": seats.screw_length}, "press the beam onto its seats' floors and -y walls"),
+            Bought(f"{SEAT_SCREW} heat-set insert ({ins.length:g} mm long, in a {ins.hole:g} mm hole)", ins.source, 4,
+                   {"hole_mm": ins.hole, "length_mm": ins.length}, "take the seats' set screws"))
 
 
 def dome(profile: Profile, layout: RigLayout) -> Part:
@@ -98,14 +221,36 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
         Line((r_out, 0.0), base_in),
     ))
     z0, z1 = layout.beam_z
-    c = shell.slot_clearance
-    half_w = profile.beam.width / 2 + c
+    c, p = shell.slot_clearance, SHIM_PACK_MM
+    half_w = profile.beam.width / 2 + 2 * c
     reach = layout.slot_r + 5.0
-    slot = Box((-reach, -half_w, z0), (reach, half_w, z1 + c))  # the beam rests on the slot's floor
-    joint, reg = flange_joint(profile, layout), register(profile, layout)
+    # the beam bears on its seats only: the slot leaves it the packs' travel up and down
+    slot = Box((-reach, -half_w, z0 - p - c), (reach, half_w, z1 + p + c))
+    joint, reg, seats = flange_joint(profile, layout), register(profile, layout), beam_seats(profile, layout)
     holes = joint.clearance_holes(flange_bolt_hole(profile, layout))
     lateral, _ = reg.repeatability
-    return Part("dome", Difference(Revolve(section), (slot, *holes, *reg.upper_holes())), (0.82, 0.82, 0.86),
-                "dome: mirror surface inside (paint it), wall, base flange on two dowels in the base plate (a round "
-                f"hole and a slot: it lifts off and goes back to within {lateral:g} mm) and bolted to it, beam slots",
-                mirrors=(("dome", layout.design_dome),), joints=(joint, reg))
+    body = Union_((Revolve(section), *seats.blocks))
+    datums = datums_of("seat", "beam seat", seats.tunnels)
+    return Part("dome", Difference(body, (slot, *seats.tunnels, *seats.pockets, *holes, *reg.upper_holes())),
+                (0.82, 0.82, 0.86),
+                "dome: mirror surface inside (paint it), wall, base flange indicated in from the sample bore, on two "
+                f"dowels drilled in place in the base plate (a round hole and a slot: it lifts off and goes back to "
+                f"within {lateral:g} mm) and bolted to it; beam slots and the beam's two seats (shim foil under and "
+                "beside the beam, set screws)",
+                mirrors=(("dome", layout.design_dome),), joints=(joint, reg), datums=datums)
+
+
+def indicating_text(profile: Profile, layout: RigLayout) -> str:
+    """The manual's shop step for centring the dome on the sample bore and drilling its register in
+    place: one paragraph, the figures the parts' own."""
+    reg, hole = register(profile, layout), flange_bolt_hole(profile, layout)
+    thread = flange_joint(profile, layout).thread
+    return (
+        f"Centre the dome on the sample bore before its register pins go in: stand it on the base plate, its "
+        f"{thread} bolts finger-tight through its {hole:.2f} mm holes on large washers (ISO 7093); put a dial "
+        f"test indicator ({INDICATOR_MM:g} mm graduation) on an arm that turns in the sample bore on a plug of "
+        "the sample holder's size, its tip on the mirror's lower edge; turn it round and tap the dome over "
+        f"until the reading varies by no more than one graduation (it has {INDICATE_TRAVEL_MM:g} mm of travel "
+        f"each way). Tighten the bolts to their torque; check again. Drill the plate {reg.diameter:g} mm through "
+        f"the flange's round hole and its slot, {reg.lower_depth:.1f} mm deep, ream, and press the pins "
+        f"({reg.item}) in. The dome then lifts off and goes back to within {reg.repeatability[0]:g} mm.")

@@ -9,6 +9,17 @@ within the pins' fit; its screws only clamp it (their holes are cleared for the 
 position errors: :func:`bolt_hole`). The parts cut their holes from the declaration
 (:meth:`DowelRegister.lower_holes`, :meth:`DowelRegister.upper_holes`); the manual's bill and steps
 read the same declaration. Frame: mm, rig frame (pins vertical).
+
+A register may be *drilled in place* (``DowelRegister.drilled``): the lower part is printed solid
+where its pins go, the upper part is indicated in (set against another datum with a dial test
+indicator) and clamped, and the pins' holes in the lower part are drilled and reamed through the
+upper part's round hole and slot, which guide the drill. The register then holds the upper part where
+it was indicated, whatever the print errors and glue seams between that datum and the pins.
+
+A :class:`ShimStop` is a stop a part is pressed onto by a set screw through a pack of bought shim foil
+(rigcad.standards.SHIM_FOIL): taking foil out or adding it moves the part in steps of the thinnest
+foil, up to the pack's nominal thickness each way. A screw only presses; the stop and the foil set
+the place, so the setting does not creep with the screw.
 """
 
 from __future__ import annotations
@@ -17,8 +28,8 @@ import math
 from dataclasses import dataclass
 
 from rigcad.errors import GeometryError
-from rigcad.parts.recipe import Box, Cylinder
-from rigcad.standards import THREADS, longest_dowel
+from rigcad.parts.recipe import Box, Cylinder, Line, Prism, Section, Translate
+from rigcad.standards import SHIM_FOIL, THREADS, longest_dowel
 
 #: Worst-case diametral clearance (mm) of an ISO 8734 m6 pin (+0.004..+0.012 mm for 3..6 mm) in a
 #: hole reamed H7 (0..+0.012 mm): 0.012 - 0.004 = 0.008 mm in the upper part's hole; the lower part
@@ -29,6 +40,12 @@ SLOT_FIT_MM = 0.05
 #: The pin stops this far short of the upper part's top face (mm), and its hole in the lower part
 #: this far past the pin's end (mm: room for the chips of reaming and for pressing it home).
 PIN_SHORT_MM, PIN_BOTTOM_MM = 1.0, 0.5
+#: A shim stop's pack at the design setting (mm): the part moves this far each way by taking foil out
+#: or adding as much again (its range). It covers the paraboloid's placement stack from O on the
+#: shipped printers (rigcad.fab.stack: 1.21 mm lateral and 0.64 mm in height worst case on the MK3S).
+SHIM_PACK_MM = 1.5
+#: A dial test indicator's graduation (mm): 0.01 mm, the common lever-type indicator (DIN 2270).
+INDICATOR_MM = 0.01
 
 
 @dataclass(frozen=True)
@@ -47,6 +64,8 @@ class DowelRegister:
     lower_z: tuple[float, float]
     slot: float
     param: str = ""
+    #: Drilled in place (see the module): the lower part is printed without the pins' holes.
+    drilled: bool = False
 
     def __post_init__(self) -> None:
         if len(self.points) != 2:
@@ -100,7 +119,13 @@ class DowelRegister:
         return PIN_FIT_MM / 2, SLOT_FIT_MM / self.spacing
 
     def lower_holes(self) -> tuple[Cylinder, ...]:
-        """The pins' holes in the lower part, from its top face (printed at the pin's size, reamed)."""
+        """The pins' holes in the lower part, from its top face (printed at the pin's size, reamed);
+        none for a register drilled in place (its holes are drilled through the upper part's)."""
+        return () if self.drilled else self.lower_zones()
+
+    def lower_zones(self) -> tuple[Cylinder, ...]:
+        """Where the pins' holes are (or will be drilled) in the lower part, at the nominal places: a
+        split keeps its cuts off them either way."""
         top = self.lower_z[1]
         return tuple(Cylinder((x, y, top - self.lower_depth), self.diameter / 2, self.lower_depth + 1.0)
                      for x, y in self.points)
@@ -127,4 +152,39 @@ def bolt_hole(thread: str, radius: float, position: float, scale: float) -> floa
     return THREADS[thread].clearance + 2 * (2 * position + scale * radius)
 
 
-__all__ = ["DowelRegister", "PIN_FIT_MM", "SLOT_FIT_MM", "bolt_hole"]
+@dataclass(frozen=True)
+class ShimStop:
+    """A shim stop as the tolerance stack reads it: the optical ``element`` it places and the ``axis``
+    it sets ("x", "y", "vertical" or "tilt"), its ``range`` each way and its ``resolution`` (mm, or
+    rad for a tilt: the thinnest foil, through the stop's lever on the element), the nominal ``pack``
+    (mm of foil at the design setting) and ``how`` it is set (for the bill, the steps, the stack)."""
+
+    name: str
+    element: str
+    axis: str
+    range: float
+    resolution: float
+    pack: float
+    how: str
+
+
+def foil_step() -> float:
+    """The thinnest bought shim foil (mm): a shim stop's step."""
+    return min(SHIM_FOIL)
+
+
+def teardrop_along_y(centre: tuple[float, float, float], radius: float, length: float, n: int = 16) -> Translate:
+    """A hole along y (mm) with a printable profile: the circle of ``radius`` (its polygon of ``n``
+    sides drawn about it, so the hole is never under size) closed above by two 45 deg flanks meeting
+    at a point (a teardrop: a horizontal hole prints without support and does not droop into its
+    bore); ``length`` along y, centred on ``centre``."""
+    r = radius / math.cos(math.pi / n)
+    pts = [(r * math.cos(2 * math.pi * (k + 0.5) / n), r * math.sin(2 * math.pi * (k + 0.5) / n)) for k in range(n)]
+    ring = [p for p in pts if p[1] < radius * math.sqrt(0.5)] + [(0.0, radius * math.sqrt(2.0))]
+    ring.sort(key=lambda p: math.atan2(p[1], p[0]) % (2 * math.pi))
+    segs = tuple(Line(ring[k], ring[(k + 1) % len(ring)]) for k in range(len(ring)))
+    return Translate(Prism(Section(segs), length), tuple(float(v) for v in centre))
+
+
+__all__ = ["DowelRegister", "INDICATOR_MM", "PIN_FIT_MM", "SHIM_PACK_MM", "SLOT_FIT_MM", "ShimStop", "bolt_hole",
+           "foil_step", "teardrop_along_y"]

@@ -1,5 +1,5 @@
 """What the mounting hardware hides: the solid angle of incidence directions at the sample point
-that the beam, the clamp and the stem block (kernel-free, numpy).
+that the beam, the clamp, the stem and the clamp's stop pin and set screw block (kernel-free, numpy).
 
 Each direction (theta, phi) at O has one design light path (rotational symmetry): COP -> P on the
 paraboloid -> D on the dome -> O, with P and D in the meridional plane at azimuth phi. A direction
@@ -19,8 +19,8 @@ from rigcad.optics.solids import segments_hit_box
 from rigcad.parts.recipe import Box, Cylinder
 
 #: The occluders counted, by the names their recipes give them (the paraboloid's back lies inside
-#: the occlusion cone of its rim and is not counted).
-COUNTED = ("beam", "clamp", "stem")
+#: the occlusion cone of its rim and is not counted; the beam's seats stand outside the dome).
+COUNTED = ("beam", "clamp", "stem", "pin", "set screw")
 
 
 def bounds(solid: Box | Cylinder) -> tuple[np.ndarray, np.ndarray]:
@@ -47,7 +47,7 @@ def design_path(table: dict[str, np.ndarray], theta: np.ndarray, phi: np.ndarray
 def blocked_solid_angle(occluders: dict[str, tuple], table: dict[str, np.ndarray],
                         n_theta: int = 400, n_phi: int = 1440) -> dict[str, float]:
     """Solid angle (sr) of the measurable zone's incidence directions blocked by the beam,
-    clamp and stem (``occluders``: part name -> ((name, Box or Cylinder), ...), as
+    clamp, stem, stop pin and set screw (``occluders``: part name -> ((name, Box or Cylinder), ...), as
     ``Rig.occluders``), on a midpoint grid of ``n_theta`` x ``n_phi`` cells (sr weights sin(theta)).
     ``table``: the design's profile table (``optics.design.profile_table``)."""
     th_tab = np.radians(np.sort(table["incidence_theta_deg"]))

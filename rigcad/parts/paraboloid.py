@@ -1,20 +1,39 @@
 """The paraboloid mirror with its solid back, stem and the U clamp that grips the beam; and the
-same stem and clamp under the camera-calibration cross that hangs in its place (thesis 4.1.1)."""
+same stem and clamp under the camera-calibration cross that hangs in its place (thesis 4.1.1).
+
+The clamp locates on the beam by two shim stops (rigcad.parts.locating.ShimStop): across the beam
+(y), a flat-point set screw in a heat-set insert in the clamp's +y wall presses the beam against
+the channel's -y wall through a pack of shim foil; along the beam (x), the clamp's -x end bears on a
+dowel pin pressed into the beam's top through a second pack. Foil out or in moves the paraboloid in
+steps of the thinnest foil, each way up to the pack (rigcad.parts.locating.SHIM_PACK_MM). The
+clamp's roof rests on the beam's top; the beam's seats in the dome set the height and the tilt
+(rigcad.parts.dome.beam_seats)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from rigcad.errors import GeometryError
+from rigcad.parts.joints import Bought
 from rigcad.parts.layout import RigLayout
+from rigcad.parts.locating import SHIM_PACK_MM, ShimStop, foil_step, teardrop_along_y
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Solid, Union_
 from rigcad.profile.schema import Profile
+from rigcad.standards import INSERTS, SHIM_FOIL, THREADS, dowel_diameter_for, longest_dowel, shortest_set_screw
 
 
 #: The stem enters the clamp and the paraboloid's back by this much (mm) so that the booleans fuse
 #: overlapping solids rather than faces that merely touch.
 FUSE_OVERLAP = 0.5
+#: The clamp's set screw: its thread (a heat-set insert takes it in the clamp's +y wall, which is the
+#: insert's pocket and a millimetre thick).
+SET_SCREW = "M3"
+#: The x stop's pin (mm, ISO 8734): the largest standard pin up to half the beam's width, so the
+#: beam keeps a quarter of its width of wall each side of the pin's hole.
+PIN_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -27,10 +46,33 @@ class Mount:
     stem: Cylinder
     clamp: Box
     channel: Box
+    #: The x stop's dowel pin, standing up from the beam's top at the clamp's -x end (its pack between).
+    pin: Cylinder
+    #: The set screw's heat-set insert pocket through the clamp's +y wall (a teardrop along y).
+    insert_pocket: Solid
+    #: The set screw where it stands out of the clamp's +y face at its farthest (the y pack at its
+    #: thickest), as a box: it shadows rays too.
+    screw: Box
+    #: The set screw's length (mm, ISO 4026) and the pin's (mm, ISO 8734).
+    screw_length: int
+    pin_length: int
 
     def occluders(self, with_back: bool = True) -> tuple[tuple[str, Box | Cylinder], ...]:
-        """Named convex stand-ins for tracing light past the mount (the clamp as its outer box)."""
-        return ((("back", self.back),) if with_back else ()) + (("stem", self.stem), ("clamp", self.clamp))
+        """Named convex stand-ins for tracing light past the mount (the clamp as its outer box, its set
+        screw inside it; the stop pin as its cylinder)."""
+        return ((("back", self.back),) if with_back else ()) + (("stem", self.stem), ("clamp", self.clamp),
+                                                                ("pin", self.pin), ("set screw", self.screw))
+
+    @property
+    def pin_hole(self) -> Cylinder:
+        """The pin's hole in the beam (drilled to the pin's size, the pin pressed in)."""
+        p = self.pin
+        return Cylinder((p.base[0], p.base[1], p.base[2] - 0.5), p.radius, p.height + 0.5 - self.pin_proud)
+
+    @property
+    def pin_proud(self) -> float:
+        """How far the pin stands above the beam's top (mm): the clamp's roof."""
+        return self.clamp.hi[2] - self.channel.hi[2]
 
 
 def mount(profile: Profile, layout: RigLayout, top_z: float | None = None) -> Mount:
@@ -38,25 +80,93 @@ def mount(profile: Profile, layout: RigLayout, top_z: float | None = None) -> Mo
     pm, beam = profile.paraboloid_mount, profile.beam
     z0, z1 = layout.beam_z
     c = profile.dome_shell.slot_clearance
+    p, w = SHIM_PACK_MM, beam.width / 2
     half_len = pm.clamp_length / 2
-    half_out = beam.width / 2 + c + pm.clamp_wall
+    ins = INSERTS[SET_SCREW]
+    side = ins.pocket_depth + 1.0  # the +y wall: the insert's pocket and a millimetre
+    lo_y, hi_y = -w - p, w + p + c  # the channel: the pack at -y, room for the beam to move the pack's way at +y
+    half_out = clamp_half_width(profile)  # both walls as thick: the clamp stays square under its stem
     clamp_top = z1 + pm.clamp_wall
     back_z = layout.paraboloid_back_z
     top = back_z if top_z is None else top_z
     rim = layout.printed_paraboloid.points(np.array([layout.printed_paraboloid.u_range[0]]))[0]
+    d = dowel_diameter_for(PIN_SHARE * beam.width)
+    pin_len = longest_dowel(pm.clamp_wall + beam.height - 1.0)  # its hole stops a millimetre above the beam's underside
+    pin_x = -half_len - p - d / 2
+    r_s = THREADS[SET_SCREW].major / 2
+    mid = 0.5 * (z0 + z1)
+    pocket = teardrop_along_y((0.0, hi_y + side - ins.pocket_depth / 2 + 0.5, mid), ins.hole / 2, ins.pocket_depth + 1.0)
+    bore = teardrop_along_y((0.0, hi_y + side / 2, mid), THREADS[SET_SCREW].clearance / 2, side + 2.0)
+    screw = set_screw_length(side, c, 2 * p + c)
     return Mount(
         back=Cylinder((0.0, 0.0, back_z), float(rim[0]), float(rim[1]) - back_z),
         stem=Cylinder((0.0, 0.0, clamp_top), pm.stem_radius, top - clamp_top),
         clamp=Box((-half_len, -half_out, z0), (half_len, half_out, clamp_top)),
-        channel=Box((-half_len - 1, -beam.width / 2 - c, z0 - 1), (half_len + 1, beam.width / 2 + c, z1)),
+        channel=Box((-half_len - 1, lo_y, z0 - 1), (half_len + 1, hi_y, z1)),
+        pin=Cylinder((pin_x, 0.0, clamp_top - pin_len), d / 2, pin_len),
+        insert_pocket=Union_((pocket, bore)),
+        screw=Box((-r_s, hi_y + side, mid - r_s), (r_s, hi_y + side + max(0.1, screw - side - c), mid + r_s)),
+        screw_length=screw, pin_length=pin_len,
     )
+
+
+def clamp_half_width(profile: Profile) -> float:
+    """Half the clamp's width across the beam (mm): the beam, the y pack's travel, the slot clearance
+    and the +y wall that holds the set screw's insert (the insert's pocket and a millimetre)."""
+    return (profile.beam.width / 2 + SHIM_PACK_MM + profile.dome_shell.slot_clearance
+            + INSERTS[SET_SCREW].pocket_depth + 1.0)
+
+
+def set_screw_length(wall: float, near: float, far: float) -> int:
+    """A set screw's length (mm, ISO 4026) in an insert through a ``wall`` mm thick, pressing on a face
+    ``near`` to ``far`` mm past the wall as its stop's pack is set: the shortest that stands no more than
+    a millimetre proud of the wall at the near setting; GeometryError when at the far one it would keep
+    under two millimetres of thread in the insert."""
+    length = shortest_set_screw(SET_SCREW, wall + near)
+    ins = INSERTS[SET_SCREW]
+    if length is None or length - wall - near > 1.0 or ins.length - (wall + far - length) < 2.0:
+        raise GeometryError(f"no {SET_SCREW} set screw (ISO 4026) both stays within a millimetre of the "
+                            f"{wall:g} mm wall and keeps two millimetres in its insert over its {far - near:g} mm "
+                            "of travel: a smaller shim pack")
+    return length
+
+
+def stops(profile: Profile, layout: RigLayout) -> tuple[ShimStop, ShimStop]:
+    """The clamp's two shim stops on the beam (x: its end on the pin; y: the beam on the channel's
+    -y wall), as the tolerance stack reads them: each moves the paraboloid one for one."""
+    step = foil_step()
+    m = mount(profile, layout)
+    return (ShimStop("paraboloid along the beam (x): shim foil between the clamp's end and the beam's stop pin",
+                     "paraboloid", "x", SHIM_PACK_MM, step, SHIM_PACK_MM,
+                     f"{SHIM_PACK_MM:g} mm of foil at the design setting; the clamp slid onto the pin and locked by "
+                     f"its set screw"),
+            ShimStop("paraboloid across the beam (y): shim foil between the beam and the clamp's -y wall",
+                     "paraboloid", "y", SHIM_PACK_MM, step, SHIM_PACK_MM,
+                     f"{SHIM_PACK_MM:g} mm of foil at the design setting; the {SET_SCREW} x {m.screw_length} set "
+                     "screw presses the beam onto it"))
+
+
+def hardware(profile: Profile, layout: RigLayout) -> tuple[Bought, ...]:
+    """What the clamp's stops take, as it is ordered."""
+    m, ins = mount(profile, layout), INSERTS[SET_SCREW]
+    d = 2 * m.pin.radius
+    foil = ", ".join(f"{t:g}" for t in SHIM_FOIL)
+    return (Bought(f"{SET_SCREW} x {m.screw_length} mm set screw, flat point (ISO 4026)", "ISO 4026", 1,
+                   {"length_mm": m.screw_length}, "presses the beam onto the clamp's y stop"),
+            Bought(f"{SET_SCREW} heat-set insert ({ins.length:g} mm long, in a {ins.hole:g} mm hole)", ins.source, 1,
+                   {"hole_mm": ins.hole, "length_mm": ins.length}, "takes the set screw in the clamp's +y wall"),
+            Bought(f"dowel pin, ISO 8734 m6, {d:g} x {m.pin_length} mm (hardened steel)", "ISO 8734", 1,
+                   {"diameter_mm": d, "length_mm": m.pin_length}, "the x stop: pressed into the beam's top"),
+            Bought(f"shim foil, stainless steel 1.4310, {foil} mm", "EN 10140", 1,
+                   {"thinnest_mm": min(SHIM_FOIL), "pack_mm": SHIM_PACK_MM},
+                   "the packs of the clamp's two stops and the beam's seats"))
 
 
 def stem_and_clamp(m: Mount) -> Solid:
     """The mount's stem on its U clamp (open at the bottom), as one solid."""
     s = m.stem
     stem = Cylinder((s.base[0], s.base[1], s.base[2] - FUSE_OVERLAP), s.radius, s.height + 2 * FUSE_OVERLAP)
-    return Union_((Difference(m.clamp, (m.channel,)), stem))
+    return Union_((Difference(m.clamp, (m.channel, m.insert_pocket)), stem))
 
 
 def paraboloid(profile: Profile, layout: RigLayout) -> Part:
@@ -79,5 +189,33 @@ def paraboloid(profile: Profile, layout: RigLayout) -> Part:
     hardware = mount(profile, layout)
     body = Union_((Revolve(section), stem_and_clamp(hardware)))
     return Part("paraboloid", body, (0.75, 0.78, 0.85),
-                "paraboloid mirror on its stem; the U clamp sits on the beam at the design height",
+                "paraboloid mirror on its stem; the U clamp sits on the beam at the design height, its end on "
+                "the beam's stop pin and the beam pressed on its -y wall by a set screw, each through a pack of "
+                "shim foil (they set it along and across the beam)",
                 mirrors=(("paraboloid", layout.design_paraboloid),), occluders=hardware.occluders())
+
+
+def setting_text(profile: Profile, layout: RigLayout) -> str:
+    """The manual's step for setting the paraboloid on its stops from a calibration (what the lab
+    reads, and how much foil moves it how far): one paragraph, the figures the stops' own."""
+    from rigcad.parts.dome import beam_seats
+
+    seats, step = beam_seats(profile, layout), foil_step()
+    per_tilt = seats.span * math.radians(0.01)
+    tol = profile.tolerancing
+    return (
+        f"Set the paraboloid from a calibration: `rigcad calibrate {profile.name} --images <folder>` prints, last, "
+        "'against the dome's axis: paraboloid off by x .., y .., z .. mm, tilted x .., y .. deg' "
+        "(calibration.json: against_the_dome.parameters.paraboloid_*). Move it back when an offset exceeds "
+        f"its tolerance ({tol.paraboloid_offset:g} mm sideways, {tol.paraboloid_height:g} mm in height, "
+        f"{math.degrees(tol.paraboloid_tilt):g} deg) and twice its standard error. Foil comes in "
+        f"{', '.join(f'{t:g}' for t in SHIM_FOIL)} mm; build each change from them. "
+        f"x: loosen the clamp's set screw, take out of the pack between the clamp's -x end and the beam's pin as "
+        f"much foil as x reads (add as much when x is negative): 0.01 mm of foil moves it 0.01 mm, in steps of "
+        f"{step:g} mm; slide the clamp back onto the pin and tighten. y: add as much foil as y reads to the pack "
+        f"between the beam and the clamp's -y wall (take out when negative). z: take as much foil as z reads "
+        f"out of the pack on both seats' floors (add when negative); a change at one seat moves the paraboloid "
+        f"half as much ({step / 2:g} mm per {step:g} mm foil). Tilt y (the -x side high when positive): take "
+        f"{per_tilt:.3f} mm of foil per 0.01 deg out of the -x seat's pack, or add it at the +x seat, then "
+        "restore the height. Loosen the seats' set screws before changing their packs and tighten them after. "
+        "Capture and calibrate again.")

@@ -45,16 +45,19 @@ def _holes(rig, part: str, tmp_path, radius: float) -> list[tuple[float, float, 
 def test_the_pins_holes_are_cut_from_the_declaration(table31_rig, tmp_path):
     reg = _register(table31_rig)
     r = table31_rig.layout.bolt_circle_r
-    assert (reg.upper, reg.lower, reg.points) == ("dome", "base_plate", ((r, 0.0), (-r, 0.0)))
-    # the plate: two blind holes of the pin's size, deep enough that the pin stands its engagement proud
-    plate = [h for h in _holes(table31_rig, "base_plate", tmp_path, reg.diameter / 2) if abs(abs(h[0]) - r) < 1e-3]
-    assert [(x, y) for x, y, _ in plate] == [(round(-r, 3), 0.0), (round(r, 3), 0.0)]
-    assert all(abs(h - reg.lower_depth) < 1e-3 for _, _, h in plate)
+    assert (reg.upper, reg.lower, reg.points, reg.drilled) == ("dome", "base_plate", ((0.0, r), (0.0, -r)), True)
+    # the plate: drilled in place through the flange once the dome is indicated in, so no hole is printed
+    # there; a split still keeps off where they go (the plate's register datums)
+    plate = [h for h in _holes(table31_rig, "base_plate", tmp_path, reg.diameter / 2) if abs(abs(h[1]) - r) < 1e-3]
+    assert plate == []
+    datums = [d for d in table31_rig.recipes["base_plate"].datums if d.kind == "register"]
+    assert sorted(round(d.centre[1], 3) for d in datums) == [round(-r, 3), round(r, 3)]
     assert reg.lower_depth + reg.upper_engagement == pytest.approx(reg.length + 0.5)
-    # the flange: a round hole at +x, and the slot's two ends at -x +- half its extra length
-    flange = [h for h in _holes(table31_rig, "dome", tmp_path, reg.diameter / 2) if abs(abs(h[0]) - r) < reg.slot]
-    ends = sorted(round(x, 3) for x, _, _ in flange if x < 0)
-    assert [x for x, _, _ in flange if x > 0] == [round(r, 3)]
+    # the flange: a round hole at +y, and the slot's two ends at -y +- half its extra length
+    flange = [h for h in _holes(table31_rig, "dome", tmp_path, reg.diameter / 2)
+              if abs(h[0]) < 1e-3 and abs(abs(h[1]) - r) < reg.slot]
+    ends = sorted(round(y, 3) for _, y, _ in flange if y < 0)
+    assert [y for _, y, _ in flange if y > 0] == [round(r, 3)]
     assert ends == pytest.approx([-r - reg.slot / 2, -r + reg.slot / 2], abs=1e-3)
 
 

@@ -77,7 +77,8 @@ def test_seams_enter_the_tower_chain_at_the_pins_float(table31_rig, mk3s):
 
 
 def test_the_default_rig_is_refused_and_says_why(table31_rig, mk3s):
-    r = S.stack(table31_rig.profile, table31_rig.layout, mk3s)
+    # without the locating features the parts declare (tests/tolerance/test_paraboloid_dome_stack.py has them)
+    r = S.stack(table31_rig.profile, table31_rig.layout, mk3s, locators=())
     status = {(v.element, v.axis): v for e in r.elements for v in e.axes}
     # nothing holds the paraboloid along the beam
     assert status["paraboloid", "lateral"].status == "refused"
@@ -145,7 +146,7 @@ def test_tables_and_records_agree(table31_rig, mk3s):
         unit = "deg" if row["axis"] == "tilt" else "mm"
         worst = row[f"worst_{unit}"]
         assert cells[2] == ("free" if worst is None else f"{worst:.2f} {unit}")
-    assert rec["ok"] is False and rec["process_errors"]["scale_percent"] == pytest.approx(0.2)
+    assert rec["ok"] is r.ok and rec["process_errors"]["scale_percent"] == pytest.approx(0.2)
 
 
 def test_a_locator_naming_no_link_is_refused(table31_rig, mk3s):
@@ -173,7 +174,8 @@ def test_the_dome_register_the_parts_declare_is_on_the_domes_chain(table31_rig, 
     names = [k.name for k in r.element("dome").links]
     assert not set(S.DOME_FLOATS) & set(names)  # the bolts' float is gone: the pins locate
     (link,) = [k for k in r.element("dome").links if k.name.startswith("dome register")]
-    assert link.lateral == pytest.approx(reg.repeatability[0] + mk3s.process_errors.position)
+    # drilled in place through the flange once the dome is indicated in: the round hole's print error is gone
+    assert link.lateral == pytest.approx(reg.repeatability[0] + (0.0 if reg.drilled else mk3s.process_errors.position))
     # with no locators given, the bolts' float is back
     bare = S.stack(table31_rig.profile, table31_rig.layout, mk3s, locators=())
     assert set(S.DOME_FLOATS) <= {k.name for k in bare.element("dome").links}
