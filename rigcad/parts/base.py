@@ -29,13 +29,13 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
     bore = Cylinder((0.0, 0.0, -t - 1.0), holder.radius + holder.clearance, t + 2.0)
     groove = azimuth_groove(profile, tw.bench_z)
     inserts = flange_joint(profile, layout).thread_holes()  # the dome's screws' insert pockets, as the joint declares
-    pins = register(profile, layout).lower_holes()  # the dome's register pins, pressed in
+    pins = register(profile, layout).lower_holes()  # the dome's register pins, pressed in (none printed when drilled in place)
     holes = inserts + pins
     joint = (*column_joint_cuts(tw, profile, tw.bench_z, -tw.bench_z, "top"), *tongue_underside_cuts(tw, profile, tw.bench_z))
     # the datum features a split keeps off: the sample bore (O), the dome's insert pockets and register pins,
     # the column's dowel holes (or the extrusion's pocket) in the tongue; each is also one of the cuts above
     datums = (Datum("sample bore", "bore", bore), *datums_of("insert", "flange insert pocket", inserts),
-              *datums_of("register", "dome register pin hole", pins),
+              *datums_of("register", "dome register pin hole", register(profile, layout).lower_zones()),
               *column_datums(tw, profile, tw.bench_z, -tw.bench_z, "top", "tongue"))
     b = breadboard.board(profile)
     pads = breadboard.pads(profile, layout) if b else ()
