@@ -29,6 +29,7 @@ from rigcad.errors import GeometryError
 from rigcad.optics.design import MIN_THETA_SPAN_DEG, cop_bundle_radius
 from rigcad.optics.dome import dt_ds, equal_path_t, occlusion_s, reflected_rays, start
 from rigcad.parts.layout import flange_extent
+from rigcad.parts.paraboloid import clamp_half_width
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
 
@@ -158,7 +159,7 @@ def mount_boxes(profile: Profile, geo: Derived) -> tuple[dict, list[tuple[float,
     beam_top = back_z - pm.stem_length
     beam_bottom = beam_top - beam.height
     clamp_top = beam_top + pm.clamp_wall
-    half_out = beam.width / 2 + shell.slot_clearance + pm.clamp_wall
+    half_out = clamp_half_width(profile)  # the clamp's stops and its set screw's wall (parts.paraboloid)
     boxes = [(1e9, beam.width / 2, beam_bottom, beam_top),
              (pm.clamp_length / 2, half_out, beam_bottom, clamp_top),
              (pm.stem_radius, pm.stem_radius, clamp_top, back_z)]
