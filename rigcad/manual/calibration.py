@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import io
 import math
+import re
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -235,3 +237,152 @@ def circle_page(rig, info: dict) -> bytes:
               "r": round(info["radius_px"], 3), "width": w, "height": h}
     title = html.escape(f"{rig.name}: calibration circle ({w} x {h} px)")
     return _CIRCLE_PAGE.replace("@@TITLE@@", title).replace("@@DESIGN@@", json.dumps(design)).encode("utf-8")
+
+
+# -- the calibration kit: every bought or made item section 6 uses, with what to buy ----------------
+#: Section 6's steps (its subsections, as the manual heads them), in the order the manual gives them.
+STEP_CROSSES = "Projector: the crosses and the backplate"
+STEP_CIRCLE = "Projector: the circle on the paraboloid"
+STEP_FILM = "The film at the sample plane"
+STEP_CAMERA = "Camera: the two crosses"
+STEP_CHECKER = "Camera pixels to paraboloid points: the checkerboard"
+STEP_GRAY = "Reflectance (thesis 4.1.2)"
+STEP_AS_BUILT = "Calibrating the as-built rig (deflectometry)"
+#: The optical acceptance test of the finishing (section 3) uses the film test's set-up and items too.
+STEP_ACCEPTANCE = "Optical acceptance test"
+#: The checkerboard's square (mm): 5 mm prints sharply on a laser printer and spans several camera
+#: pixels in the paraboloid's image of the base plate.
+CHECKER_SQUARE_MM = 5.0
+#: ISO 216 A-series sheets (mm, short x long side), small to large: the checkerboard's paper.
+A_SHEETS = (("A4", 210.0, 297.0), ("A3", 297.0, 420.0), ("A2", 420.0, 594.0), ("A1", 594.0, 841.0))
+#: The lifting blocks' least footprint (mm, square): a rig on three blocks must not tip off one.
+BLOCK_FOOTPRINT_MM = 60.0
+
+
+@dataclass(frozen=True)
+class KitItem:
+    """One item of the calibration kit: as it is ordered (or made), how many, what to buy (size,
+    standard or spec), the words section 6 names it by (lower case) and the steps (section 6's
+    subsections) that use it."""
+
+    item: str
+    quantity: str
+    spec: str
+    words: tuple[str, ...]
+    steps: tuple[str, ...]
+
+
+def checkerboard(rig) -> dict:
+    """The checkerboard disc that lies on the base plate inside the dome (mm): the dome's inside at the
+    plate less 1 mm, whole squares across it, the bore's hole, and the smallest ISO A sheet it fits."""
+    lay = rig.layout
+    inside = float(lay.printed_dome.points(np.array([lay.u_inner_base]))[0, 0])  # the dome's inside at the plate
+    r = math.floor(inside - 1.0)
+    n = math.ceil(2 * r / CHECKER_SQUARE_MM)
+    sheet = next((name for name, a, _ in A_SHEETS if a >= 2 * r), None)
+    return {"dome_inside_diameter_mm": 2 * inside, "disc_diameter_mm": float(2 * r), "squares": n,
+            "square_mm": CHECKER_SQUARE_MM, "hole_diameter_mm": 2 * (rig.profile.sample_holder.radius
+                                                                      + rig.profile.sample_holder.clearance),
+            "sheet": sheet or "a plotter roll", "disc_radius_mm": float(r)}
+
+
+def kit_items(rig) -> list[KitItem]:
+    """Every item section 6 (the calibration) uses that is not a printed part of section 1 nor a tool of
+    its tools list: what to buy, sized from the rig (the film and its blocks from :func:`film_setup`, the
+    checkerboard from :func:`checkerboard`, the screens from ``calibration``)."""
+    p = rig.profile
+    f = film_setup(rig)
+    cb = checkerboard(rig)
+    holder = 2 * p.sample_holder.radius
+    items = [
+        KitItem("Matte drafting film, polyester, one side matte", "1 sheet (A4)",
+                f"{1e3 * f['film_thickness_mm']:g} µm thick; a disc of {f['film_diameter_mm']:.0f} mm is cut from it",
+                ("drafting film", "film"), (STEP_CIRCLE, STEP_FILM, STEP_ACCEPTANCE)),
+        KitItem("Low-tack masking tape, 19 mm", "1 roll", "paper, low tack (it comes off the plate clean)",
+                ("tape",), (STEP_FILM, STEP_ACCEPTANCE)),
+        KitItem("Fine pen for film", "1", "permanent fineliner, 0.1-0.3 mm line, that marks polyester",
+                ("fine pen",), (STEP_FILM,)),
+        KitItem("Blocks to lift the rig", "3",
+                f"1 x {f['block_under_tongue_mm']:g} mm and 2 x {f['block_under_disc_mm']:g} mm tall, each at least "
+                f"{BLOCK_FOOTPRINT_MM:g} x {BLOCK_FOOTPRINT_MM:g} mm, top and bottom flat and parallel (hardwood, "
+                "aluminium or printed solid), cut to height within 0.5 mm", ("blocks",), (STEP_FILM, STEP_ACCEPTANCE)),
+        KitItem("Flat mirror for the view from below", "1",
+                f"front- or back-surface mirror at least {10 * math.ceil(2 * f['bore_radius_mm'] / 10):g} mm square, "
+                "propped at 45 deg on the bench (or a phone's camera looking up)", ("45 deg mirror",), (STEP_FILM,)),
+        KitItem("Scalpel with No. 11 blades and a cutting mat", "1", "for the film and the checkerboard",
+                ("scalpel",), (STEP_FILM, STEP_CHECKER)),
+        KitItem("White LED torch", "1", f"a small torch (or a phone's), no taller than {f['block_under_disc_mm']:g} mm "
+                "standing, to light the film from below", ("torch",), (STEP_ACCEPTANCE,)),
+        KitItem("Black paper for the mask, and a leather punch", "1 sheet, 1 punch",
+                f"matte black paper, 120-200 g/m²; a hollow punch of {2 * p.tolerancing.max_spot_radius:g} mm "
+                "(`tolerancing.max_spot_radius`)", ("mask", "leather punch"), (STEP_ACCEPTANCE,)),
+        KitItem("Matte paper for the checkerboard", "1 sheet",
+                f"{cb['sheet']}, matte, laser-printed at 600 dpi: {cb['squares']} x {cb['squares']} squares of "
+                f"{cb['square_mm']:g} mm, cut to a {cb['disc_diameter_mm']:.0f} mm disc with a "
+                f"{cb['hole_diameter_mm']:.0f} mm hole", ("checkerboard",), (STEP_CHECKER,)),
+        KitItem("Circle cutter (compass cutter)", "1", f"cuts circles of {cb['hole_diameter_mm'] / 2:.0f} to "
+                f"{cb['disc_radius_mm']:.0f} mm radius in paper", ("circle cutter",), (STEP_CHECKER,)),
+        KitItem("Gray card, 18 % diffuse reflectance", "1",
+                f"photographic gray card (Kodak R-27 class), cut to a {holder:g} mm disc (the sample holder's "
+                "diameter)", ("gray card",), (STEP_GRAY,)),
+    ]
+    cal = getattr(p, "calibration", None)
+    if cal is not None:
+        from rigcad.calibrate.kit import screen_room, upright_room
+        from rigcad.calibrate.patterns import Sequence
+
+        room = screen_room(rig)
+        w, h = cal.screen_resolution
+        (dw, dh) = room["display_mm"]
+        items += [
+            KitItem("Tablet (the calibration screen)", "1",
+                    f"{w} x {h} px at {cal.screen_pitch:g} mm pitch ({dw:.0f} x {dh:.0f} mm), {cal.screen_thickness:g} mm "
+                    f"from its back to its emitting surface, its body with the bezel within a "
+                    f"{room['body_diameter_mm']:.0f} mm circle; full brightness without auto-brightness "
+                    "(`calibration.screen_*`)", ("tablet",), (STEP_AS_BUILT,)),
+            KitItem("Calibration spacers (printed by `rigcad calibrate --kit`: stl/calibration_spacer_<k>.stl)",
+                    str(len(cal.spacer_heights)), "heights " + ", ".join(f"{v:g}" for v in cal.spacer_heights)
+                    + " mm above the holder's seat (`calibration.spacer_heights`), printed as the sample holder is",
+                    ("spacer",), (STEP_AS_BUILT,))]
+        if cal.upright_turns:
+            seq = Sequence.from_profile(cal, "upright")
+            (uw, uh), (uw_mm, uh_mm) = seq.resolution, seq.size_mm
+            items += [
+                KitItem("Upright display (a small display module)", "1",
+                        f"{uw} x {uh} px at {cal.upright_pitch:g} mm pitch ({uw_mm:.1f} x {uh_mm:.1f} mm), module at most "
+                        f"{cal.upright_thickness:g} mm thick with {cal.upright_border:g} mm of frame beyond the active area "
+                        f"(its slot holds {2 * upright_room(p)['half_width_mm']:.1f} mm wide)", ("upright display",),
+                        (STEP_AS_BUILT,)),
+                KitItem("Upright display's stand (printed by `rigcad calibrate --kit`: "
+                        "stl/calibration_upright_stand.stl)", "1", "printed as the sample holder is",
+                        ("calibration_upright_stand",), (STEP_AS_BUILT,))]
+    return items
+
+
+#: The words the calibration's steps name their bought or made items by (lower case), kept apart from the
+#: bill's lines so that a line missing from the bill shows: every word a step uses must be some line's.
+ITEM_WORDS = ("drafting film", "film", "tape", "fine pen", "blocks", "45 deg mirror", "scalpel", "checkerboard",
+              "circle cutter", "gray card", "tablet", "spacer", "upright display", "calibration_upright_stand",
+              "torch", "mask", "leather punch", "plug")
+
+
+def kit_misses(sections: dict[str, str], items: list[KitItem]) -> list[str]:
+    """What the calibration's text names without its bill line: for each step (heading -> text), every
+    word of ITEM_WORDS the text uses must belong to a kit item that lists that step, and every step an
+    item lists must name it (one line per miss; empty when the text and the bill agree)."""
+    out = [f"{it.item!r}: its word {w!r} is not in ITEM_WORDS" for it in items for w in it.words if w not in ITEM_WORDS]
+    for heading, text in sections.items():
+        low = text.lower()
+        for w in ITEM_WORDS:
+            if re.search(rf"\b{re.escape(w)}s?\b", low) and not any(w in it.words and heading in it.steps for it in items):
+                out.append(f"{heading!r} names {w!r}, and no bill line with that word lists that step")
+    for it in items:
+        for st in it.steps:
+            if st not in sections:
+                out.append(f"{it.item!r}: its step {st!r} is not in the calibration")
+            elif not any(w in sections[st].lower() for w in it.words):
+                out.append(f"{it.item!r}: {st!r} does not name it")
+    return out
+
+
+__all__ += ["CHECKER_SQUARE_MM", "ITEM_WORDS", "STEP_ACCEPTANCE", "KitItem", "checkerboard", "kit_items", "kit_misses"]

@@ -220,6 +220,8 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     bill = B.bill(rig, fab_report, printer)
     steps, solids = plan.steps(rig, meshes)  # once: the bill's hardware and section 5's order both read them
     bill["hardware"] = plan.bill_hardware(rig, steps, bill)  # what the steps fit: one list
+    bill["calibration_kit"] = [{"item": k.item, "quantity": k.quantity, "spec": k.spec, "steps": list(k.steps)}
+                               for k in C.kit_items(rig)]  # what section 6 uses: one list
     c = SimpleNamespace(rig=rig, printer=printer, fab_report=fab_report, p=rig.profile, files={}, meshes=meshes,
                         bill=bill, cut_away=A.encloses(meshes), step=step, steps=steps, solids=solids)
     c.files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
@@ -332,6 +334,13 @@ def _section_bill(d: Doc, c) -> None:
     if bill["purchased"]:
         d.table(["item", "qty", "as the profile gives it", "set in"],
                 [[r["item"], r["quantity"], r["spec"], f"`{r['source']}`"] for r in bill["purchased"]])
+    kit = bill.get("calibration_kit") or []
+    if kit:
+        d.h(3, "Calibration and test kit")
+        d.p("What section 6 (calibration) and the optical acceptance test use besides the printed parts above and "
+            "the tools below: what to buy or make, and the steps that use it.")
+        d.table(["item", "qty", "what to buy", "used in"],
+                [[r["item"], r["quantity"], r["spec"], "; ".join(r["steps"])] for r in kit])
     d.h(3, "Paint and clearcoat")
     d.p(f"Volumes of each layer of `coating.layers` over the mirrors ({', '.join(m['mirror'] for m in bill['mirrors'])}: "
         + ", ".join(f"{m['design_area_mm2'] / 100:.1f} cm²" for m in bill["mirrors"])
@@ -353,10 +362,28 @@ def _bill_consumables(d: Doc, c) -> None:
         if gap > 1e-9:
             gaps.append(gap)
     d.h(3, "Consumables")
-    d.table(["item", "qty"], [list(r) for r in (*B.CONSUMABLES, *B.glue_rows(c.fab_report))])
+    d.table(["item", "qty"], [list(_abrasive() if r[0].startswith("Wet-or-dry") else r)
+                              for r in (*B.CONSUMABLES, *B.glue_rows(c.fab_report))])
     d.h(3, "Tools")
-    d.table(["item", "qty"], [list(r) for r in (*B.TOOLS, B.feeler_gauge([total - gauged_depth(c.p), *gaps]),
-                                                B.dowel_drills(c.fab_report))])
+    d.table(["item", "qty"], [list(_blocks(c.rig) if r[0].startswith("Sanding blocks") else r)
+                              for r in (*B.TOOLS, B.feeler_gauge([total - gauged_depth(c.p), *gaps]),
+                                        B.dowel_drills(c.fab_report))])
+
+
+def _abrasive() -> tuple[str, str]:
+    """The consumables' abrasive line: the film the printed sanding blocks carry (rigcad.manual.finishing)."""
+    from rigcad.manual import finishing as F
+
+    return (f"Abrasive for the sanding blocks: {F.ABRASIVE_SPEC}, grades " + ", ".join(g for g, _ in F.ABRASIVE)
+            + f" (FEPA P, ISO 6344), {F.ABRASIVE_MM:g} mm thick with its grit", "2 sheets of each grade")
+
+
+def _blocks(rig) -> tuple[str, str]:
+    """The tools' sanding blocks line: the printed blocks (rigcad.manual.finishing.sanding_block_set)."""
+    from rigcad.manual import finishing as F
+
+    return ("Sanding blocks: printed from `blocks/*.stl`, faced with the abrasive film (section 3)",
+            str(len(F.sanding_block_set(rig))))
 
 
 def _section_print(d: Doc, c) -> None:
@@ -416,10 +443,7 @@ def _glue_mirror_seams(d: Doc, c) -> None:
 
 def _section_sand(d: Doc, c) -> None:
     """The manual's section: 3 sand."""
-    import numpy as np
-
     from rigcad import plots
-    from rigcad.export import mesh as M
     from rigcad.parts.templates import gauged_depth
 
     rig, fab_report, p, files = c.rig, c.fab_report, c.p, c.files
@@ -439,15 +463,13 @@ def _section_sand(d: Doc, c) -> None:
         f"**{gauged}** layer. Sanded to size, the bare print lies {total - gd:.3f} mm ({_mil(total - gd)}: the layers "
         f"up to and including the {gauged}) behind the template's edge all along it: check with a feeler gauge "
         "or against the light, in several meridional planes.")
-    for name in ("dome_template", "paraboloid_template"):
-        if name in rig.recipes:
-            part = rig.recipes[name]
-            mesh = rig.mesh(part, M.PICTURE_CHORD_ERROR)
-            files[f"images/{name}.png"] = plots.render_mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), name,
-                                                            part.color)
-    for name in ("dome_template", "paraboloid_template"):
-        if f"images/{name}.png" in files:
-            d.img(f"images/{name}.png", f"`{name}`: {rig.recipes[name].description}")
+    from rigcad.manual import finishing as F
+
+    c.templates = F.template_datums(rig)
+    for row in c.templates:  # drawn flat with its datum: the picture and the text read the same row
+        name = row["template"]
+        files[f"images/{name}.png"] = plots.template_drawing(row)
+        d.img(f"images/{name}.png", f"`{name}`: {rig.recipes[name].description}; its datum in red")
 
     c.gauged, c.total, c.gd = gauged, total, gd
 
@@ -483,15 +505,11 @@ MOVES = {"-z (down)": "lower it from above", "+z (up)": "push it up from below",
 #: Fastenings by what takes the thread: what the step says after the bolt.
 TORQUE = "tighten crosswise with a torque screwdriver to the joint's torque (section 5's 'Torques, and what bends')"
 THREAD_IN = {"nut": f"a washer under the head and under the nut; hold the nut with the spanner, {TORQUE}",
-             "insert": "screwed into the insert (its pocket is printed at the hole its maker gives, named with the "
-                       "insert: if it printed small, drill it to that size, never to the insert's outside; melt the "
-                       "insert in flush with a soldering iron at its maker's temperature before the part is closed "
-                       f"in); {TORQUE}",
+             "insert": f"screwed into the heat-set insert set in step {{k}}; {TORQUE}",
              "instrument": "into the instrument's own threaded holes, finger tight until the calibration",
              "bench": "into the bench (on a breadboard: into its tapped holes, on the grid)",
              "tapped": "into the thread tapped in the part",
-             "trap": "a washer under the head; its nut waits in the hexagonal trap printed for it (put it in before "
-                     f"the part with the trap stands on the bench), {TORQUE}"}
+             "trap": f"a washer under the head; its nut waits in the hexagonal trap (put in at step {{k}}), {TORQUE}"}
 
 
 def assembly_order(rig, steps, solids):
@@ -522,32 +540,189 @@ def register_text(reg) -> str:
             "pins. ")
 
 
-def step_text(placed, meshes_by_name: dict) -> str:
+def preparations(rig, order, meshes_by_name: dict) -> dict[str, list[dict]]:
+    """What each step does before its parts go in (step name -> rows, in order): the heat-set inserts
+    melted and the nuts pushed into their traps in the part that takes a later (or this) step's screws
+    (:func:`rigcad.manual.plan.thread_host`), set in the step that places that part; the locating pins
+    and balls the tower's rows fit (``rigcad.parts.tower.hardware``'s unthreaded rows: a row naming
+    several steps is fitted in equal shares, one in each), pressed in before the part they locate; a
+    part's register pins (DowelRegister) before that part; a step that places the bought item itself has it
+    as "placed" (its own text). Each row: kind ("insert", "nut", "pressed", "placed", "register"), item,
+    quantity, the part it goes into (``into``, None when the row does not say) and
+    the step whose part or screws it serves (``for``)."""
+    from rigcad.manual import plan
+
+    step_of = {m: p.step.name for p in order for m in p.step.members}
+    out: dict[str, list[dict]] = {p.step.name: [] for p in order}
+    for p in order:
+        st = p.step
+        for m in st.members:
+            if m in rig.recipes:
+                for j in rig.recipes[m].joints:
+                    if isinstance(j, DowelRegister):
+                        out[st.name].append({"kind": "register", "item": j.item, "quantity": len(j.points),
+                                             "into": j.lower, "for": st.name})
+        for f in st.fasteners:
+            kind = "insert" if f.thread_in == "insert" else "nut" if f.thread_in == "nut" and f.nut_tool is None else None
+            if kind is None:
+                continue
+            host = plan.thread_host(f, meshes_by_name)
+            if host is None or host not in step_of:
+                continue
+            thread = plan.thread_of(f)
+            item = plan.insert_item(thread) if kind == "insert" else f"{thread} hex nut (ISO 4032)"
+            rows = out[step_of[host]]
+            row = next((r for r in rows if (r["kind"], r["item"], r["into"], r["for"]) == (kind, item, host, st.name)),
+                       None)
+            if row is None:
+                rows.append({"kind": kind, "item": item, "quantity": 1, "into": host, "for": st.name})
+            else:
+                row["quantity"] += 1
+    for h in B.tower_hardware(rig):
+        if h.get("thread") or "heat-set insert" in h["item"] or "mounting holes" in h["joins"] or tower_joints.placed(h):
+            continue
+        named = plan.step_names([p.step for p in order], h.get("steps", ()))  # a unit's parts: its step
+        bought = {p.step.name for p in order if p.step.bought}
+        for n in named:  # a bought step places the item itself ("placed"); else it is pressed in before the part
+            out[n].append({"kind": "placed" if n in bought else "pressed", "item": B.tower_item(h),
+                           "quantity": h["quantity"] // len(named), "into": None, "for": n, "joins": h["joins"]})
+    return out
+
+
+def preparation_text(rows: list[dict], number: dict[str, int], here: str) -> str:
+    """What a step says before its parts go in (:func:`preparations`' rows for it)."""
+    text = ""
+    for r in rows:
+        into = (r["into"] or "").replace("_", " ")
+        serves = ("for its own screws below" if r["for"] == here else
+                  f"for the {r['for'].replace('_', ' ')}'s screws in step {number[r['for']]}")
+        if r["kind"] == "insert":
+            text += (f"Before it goes in, melt {r['quantity']} x {r['item']} into the {into}'s pockets ({serves}): "
+                     "the soldering iron's insert tip at the insert maker's temperature, each pressed in square until "
+                     "flush with the face; a pocket that printed small is drilled to the insert's hole size, never "
+                     "to its outside. ")
+        elif r["kind"] == "nut":
+            text += (f"Before it goes in, push {r['quantity']} x {r['item']} into the hexagonal traps of the {into} "
+                     f"({serves}), a drop of cyanoacrylate in each: once the {into} stands on the bench they cannot "
+                     "be reached. ")
+        elif r["kind"] == "pressed":
+            text += f"Before it goes in, fit {r['quantity']} x {r['item']}: {r['joins']}. "
+    return text
+
+
+#: Steps that put shim stacks in: the stacks are drawn as boxes; each holds ``tower.shims_nominal`` shims.
+SHIM_STACKS = ("projector_shims", "camera_shims")
+
+
+def shim_stacks(step, meshes_by_name: dict, shim_mm: float | None) -> tuple[int, int] | None:
+    """(stacks, shims in each) of a step that puts shim stacks in (SHIM_STACKS), else None: the
+    nominal stacks as the tower draws them (boxes), each holding its thickness over one shim's
+    (``shim_mm``, ``tower.shim_thickness``): the picture and the text share that count."""
+    if not shim_mm:
+        return None
+    names = [n for n in step.members if re.sub(r"_\d+$", "", n) in SHIM_STACKS]
+    if not names or len(names) != len(step.members):
+        return None
+    shims = {stack_count(meshes_by_name[n], shim_mm) for n in names}
+    return (len(names), shims.pop()) if len(shims) == 1 else None
+
+
+def stack_count(mesh, shim_mm: float) -> int:
+    """Shims in a stack's box (a PartMesh): its thinnest extent over one shim's thickness (mm)."""
+    return int(round(float(min(mesh.hi - mesh.lo)) / shim_mm))
+
+
+def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_mm: float | None = None) -> str:
     """What a found step says: what goes in, how (its direction), on what, and each group of like
-    fasteners with its tool and what takes its thread."""
+    fasteners with its tool and what takes its thread (``prepared``: (kind, thread host) -> the step
+    number where its inserts or trap nuts were set, :func:`preparations`)."""
     from collections import Counter
 
+    from rigcad.manual import plan
     from rigcad.manual.assembly_check import _dir_name
 
     st = placed.step
-    stems = {re.sub(r"_\d+$", "", n) for n in st.members}
-    parts = (f"{len(st.members)} {stems.pop().replace('_', ' ')}" if len(stems) == 1 and len(st.members) > 1
-             else " with the ".join(n.replace("_", " ") for n in sorted(st.members, key=lambda n: n != st.name)))
+    by_stem: dict[str, list[str]] = {}
+    for n in sorted(st.members, key=lambda n: n != st.name):
+        by_stem.setdefault(re.sub(r"_\d+$", "", n), []).append(n)
+    stacks = shim_stacks(st, meshes_by_name, shim_mm)
+    if stacks:
+        k, each = stacks
+        parts = f"{k} stack{'s' * (k > 1)} of {each} printed `tower_shim`s ({k * each} shims)"
+    else:
+        parts = " with ".join((f"the {len(ns)} {stem.replace('_', ' ')}s" if len(ns) > 1 else
+                               f"the {ns[0].replace('_', ' ')}") for stem, ns in by_stem.items())
     bought = " (bought)" if st.bought else ""
     lead = st.name if st.name in st.members else st.members[0]
-    text = f"Take the {parts}{bought}: {meshes_by_name[lead].description}. "
+    text = f"Take {parts}{bought}: {meshes_by_name[lead].description}. "
+    # screws that carry a bought part of the step (a ball in a push screw's cup) go in before the step's part
+    carried = {n for n in st.members if meshes_by_name[n].bought}
+    first = [f for f in st.fasteners if carried & set(f.passes)]
+    for (item,), n in Counter((f.item,) for f in first).items():
+        balls = sorted(carried & {p for f in first for p in f.passes})
+        what = re.sub(r"_\d+$", "", balls[0]).replace("_", " ")
+        text += (f"Before it goes in, thread its {n} x {item} down into its inserts from above until each one's end "
+                 f"stands out under its boss, and seat a {what} in each one's cup with a drop of retaining "
+                 "compound; turn them from above once it stands (they set its height and tilt). ")
     text += MOVES.get(_dir_name(placed.direction), f"move it in along {_dir_name(placed.direction)}").capitalize()
     text += (f" until it rests on the {', '.join(n.replace('_', ' ') for n in st.needs)}." if st.needs
              else " onto the bench.")
-    groups = Counter((f.item, f.tools[0].name, "trap" if f.thread_in == "nut" and f.nut_tool is None else f.thread_in)
-                     for f in st.fasteners)
-    for (item, tool, thread_in), n in groups.items():
-        text += f" Fix it with {n} x {item}, {THREAD_IN[thread_in]} (tool: {tool} or an L key)."
+    groups = Counter((f.item, f.tools[0].name, "trap" if f.thread_in == "nut" and f.nut_tool is None else f.thread_in,
+                      plan.thread_host(f, meshes_by_name) if f.thread_in in ("insert", "nut") else None)
+                     for f in st.fasteners if f not in first)
+    for (item, tool, thread_in, host), n in groups.items():
+        kind = {"insert": "insert", "trap": "nut"}.get(thread_in)
+        k = (prepared or {}).get((kind, host), "?")
+        text += f" Fix it with {n} x {item}, {THREAD_IN[thread_in].format(k=k)} (tool: {tool} or an L key)."
     lift = max((f.lift_mm for f in st.fasteners), default=0.0)
     if lift:
         text += (f" Its screw goes in from below: lift the rig onto blocks {lift:g} mm high under the tongue (the "
                  "film test's), turn it with the L key's short arm in the socket, then set the rig down.")
     return text
+
+
+#: In a step's picture the shims of a stack are drawn apart by this fraction of the picture's size, so
+#: that each one shows (a 1 mm shim is under a pixel at page width).
+SHIM_SPREAD = 0.025
+
+
+def step_picture(meshes, done: list[int], members: list[int], offsets: dict, direction, shim_mm):
+    """What a step's picture draws: (meshes, the indices that go in, their offsets). A shim stack that
+    goes in (SHIM_STACKS) is drawn as its shims, one box each, ``shim_mm`` thick, spread apart along the
+    step's direction by SHIM_SPREAD of the picture's size: the count the text states."""
+    import dataclasses
+
+    import numpy as np
+
+    stems = {re.sub(r"_\d+$", "", meshes[i].name) for i in members}
+    if not shim_mm or not stems <= set(SHIM_STACKS):
+        return meshes, members, offsets
+    shown = list(meshes)
+    lo = np.min([m.lo for m in meshes], axis=0)
+    hi = np.max([m.hi for m in meshes], axis=0)
+    gap = SHIM_SPREAD * float(np.max(hi - lo))
+    d = np.asarray(direction, float)
+    new, moved = [], {}
+    for i in members:
+        m = meshes[i]
+        axis = int(np.argmin(m.hi - m.lo))
+        n = stack_count(m, shim_mm)
+        for j in range(n):
+            a, b = m.lo.copy(), m.hi.copy()
+            a[axis], b[axis] = m.lo[axis] + j * shim_mm, m.lo[axis] + (j + 1) * shim_mm
+            corners = np.array([[x, y, z] for x in (a[0], b[0]) for y in (a[1], b[1]) for z in (a[2], b[2])])
+            faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                              [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+            shown.append(dataclasses.replace(m, name=f"{m.name}_shim_{j + 1}", vertices=corners, faces=faces))
+            new.append(len(shown) - 1)
+            moved[len(shown) - 1] = offsets[i] - d * gap * (j if d @ np.eye(3)[axis] < 0 else n - 1 - j)
+    return shown, new, moved
+
+
+def _shim_mm(rig) -> float | None:
+    """One printed shim's thickness (mm, ``tower.shim_thickness``); None without the tower."""
+    tower = getattr(rig.profile, "tower", None)
+    return getattr(tower, "shim_thickness", None) if getattr(rig.layout, "tower", None) is not None else None
 
 
 def _section_assemble(d: Doc, c) -> None:
@@ -567,6 +742,10 @@ def _section_assemble(d: Doc, c) -> None:
     index = {m.name: i for i, m in enumerate(c.meshes)}
     by_name = {m.name: m for m in c.meshes}
     tower_at = _tower_rows_by_step(c.rig, [p.step for p in order])
+    prep = preparations(c.rig, order, by_name)
+    number = {p.step.name: k + 1 for k, p in enumerate(order)}
+    prepared = {(r["kind"], r["into"]): number[name] for name, rows in prep.items() for r in rows
+                if r["kind"] in ("insert", "nut")}
     done: list[int] = []
     for k, placed in enumerate(order):
         st = placed.step
@@ -575,7 +754,9 @@ def _section_assemble(d: Doc, c) -> None:
                                              st.members else "")
         text = "".join(register_text(j) for m in st.members if m in c.rig.recipes
                        for j in c.rig.recipes[m].joints if isinstance(j, DowelRegister))
-        text += step_text(placed, by_name)
+        text += preparation_text(prep[st.name], number, st.name)
+        text += step_text(placed, by_name, prepared, _shim_mm(c.rig))
+        text += "".join(f" Press them in: {r['joins']}." for r in prep[st.name] if r["kind"] == "placed")
         if st.name == "projector_body":
             text += plan_mod.projector_screw_text(c.rig)
         if st.name == "beam_splitter":
@@ -590,8 +771,9 @@ def _section_assemble(d: Doc, c) -> None:
         if st.name == "base_plate" and "camera_cross_base" in c.rig.recipes:
             text += (" To calibrate (section 6), lay the film on the plate now, before the dome: see \"The film at "
                      "the sample plane\".")
-        for h in tower_at.get(st.name, []):
-            text += f" {'Fix it with' if h.get('thread') else 'Fit'} {h['quantity']} x {B.tower_item(h)}: {h['joins']}."
+        for h in tower_at.get(st.name, []):  # the threaded rows; the pressed ones came before the part
+            if h.get("thread") and "heat-set insert" not in h["item"]:
+                text += f" Fix it with {h['quantity']} x {B.tower_item(h)}: {h['joins']}."
         d.h(3, f"Step {k + 1}: {label}")
         d.p(text)
         path = f"images/step_{k + 1:02d}_{st.name}.png"
@@ -599,13 +781,20 @@ def _section_assemble(d: Doc, c) -> None:
         shift = offsets[members[0]] if members else 0.0
         bolts = [(np.asarray(f.head) + shift - np.asarray(f.axis) * f.head_height_mm,
                   np.asarray(f.head) + shift + np.asarray(f.axis) * f.length_mm) for f in st.fasteners]
-        c.files[path] = plots.assembly_step(c.meshes, done, members, offsets, f"step {k + 1}: {label}",
+        shown, new, moved = step_picture(c.meshes, done, members, offsets, placed.direction, _shim_mm(c.rig))
+        c.files[path] = plots.assembly_step(shown, done, new, moved, f"step {k + 1}: {label}",
                                             cut_away=c.cut_away, fasteners=bolts)
         d.img(path, f"Step {k + 1}: the {label} (orange) moves along the dashed line to its place")
         done += members
         c.step(f"step {k + 1}")
+    from rigcad.manual import plan as P
+
     c.assembly_order = [{"step": p.step.name, "parts": list(p.step.members), "direction": list(p.direction),
-                         "fasteners": [f.item for f in p.step.fasteners]} for p in order]
+                         "prepare": prep[p.step.name],
+                         "fasteners": [f.item for f in p.step.fasteners],
+                         "threads_into": [{"item": f.item, "kind": f.thread_in, "part": P.thread_host(f, by_name)}
+                                          for f in p.step.fasteners if f.thread_in in ("insert", "nut")
+                                          and (f.thread_in == "insert" or f.nut_tool is None)]} for p in order]
 
 
 def _md_tables(d: Doc, lines: list[str]) -> None:
@@ -699,44 +888,117 @@ def _section_finish(d: Doc, c) -> None:
         "slope test comes before the mirror coat, while a bad area can still be sanded.")
     d.table(["stage", "what", "how", "cure / wait", "check"], [list(r) for r in F.recipe(c.p, stock)])
     blocks = F.sanding_blocks(c.rig)
-    d.p(f"Sanding blocks, from the mirrors' curvature: a flat block of length L stands off a curve of radius R by "
-        f"L²/(8R); keep that under {F.BLOCK_SAG_MM:g} mm (1 mil, the thinnest coat). Longer blocks must be curved "
-        "to the radius given (convex for the concave dome, concave for the convex paraboloid).")
-    d.table(["mirror", "smallest radius along the meridian", "smallest radius across", "longest flat block",
-             "curved block radius"],
-            [[b["mirror"], f"{b['meridional_mm']:.1f} mm", f"{b['sagittal_mm']:.1f} mm",
-              f"{b['flat_block_max_mm']:.1f} mm", f"{b['smallest_radius_mm']:.1f} mm"] for b in blocks])
+    block_set = F.sanding_block_set(c.rig)
+    sanding_blocks(d, c, block_set)
     d.p("The templates: cut them with the cutter's path half a kerf outside the outline (" +
-        ", ".join(f"{k} {v:g} mm" for k, v in F.KERF_MM.items()) + " kerf), so the edge lands on the outline; "
-        "mark the datum on each (the edge that sits on the base plate's top, z = 0, and the axis line) and hold "
-        "the template in a jig: a square block clamped to the base plate with the template's datum edge on the "
-        "plate and its axis line on the plate's centre mark, so it swings about the axis and checks every "
-        "meridian the same way.")
+        ", ".join(f"{k} {v:g} mm" for k, v in F.KERF_MM.items()) + " kerf), so the edge lands on the outline, and "
+        "mark each one's datum as its "
+        "drawing in section 3 shows it. " + " ".join(F.template_text(r) for r in c.templates)
+        + " Check in at least four meridional planes, a quarter turn apart.")
     acc = F.slope_acceptance(c.rig)
-    d.h(3, "Optical acceptance test")
+    d.h(3, C.STEP_ACCEPTANCE)
     d.p("The mirrors' slope must be right, not only their form: in a right rig every ray the camera sees lands on "
-        f"the sample point O. Print a white disc of **{acc['disc_radius_mm']:g} mm radius** "
-        "(`tolerancing.max_spot_radius`) on matte black card, put it in the sample holder centred on O, light it "
-        "from the side through a beam slot, and take the camera's picture through the splitter with the rig "
-        "assembled: first on the polished coat, before the mirror coat (the recipe's slope test: a bad area can "
-        "still be sanded), then again on the finished mirrors. **Pass:** the paraboloid's image is white (outside the occlusion disc of the calibration "
-        f"circle) over at least {100 * acc['pass_fraction']:g} % of its pixels (`tolerancing.min_yield`); black "
-        "patches mark the mirror areas to block and polish again. This holds the dome's slope to "
-        f"{acc['dome_slope_tolerance_mrad']:.1f} mrad at its farthest point from O "
-        f"({acc['dome_farthest_from_o_mm']:.0f} mm): a slope error e turns a ray by 2 e.")
-    c.finishing = {"blocks": blocks, "acceptance": acc}
+        f"the sample point O within `tolerancing.max_spot_radius` ({acc['disc_radius_mm']:g} mm). The test lights a "
+        "disc of that radius at O and looks at it through the mirrors with the rig's own camera:")
+    d.ol([
+        "The rig assembled, the camera in its place on the tower looking down the axis through the splitter, the "
+        "projector off, the room dark. The film of the circle test lies on the base plate's top over the bore, O "
+        "traced on it (section 6, \"The film at the sample plane\": it goes on before the dome).",
+        f"Lift the rig onto the film test's blocks (**{acc['block_under_tongue_mm']:g} mm** under the tongue, "
+        f"**{acc['block_under_disc_mm']:g} mm** under the disc) and take the sample holder out of the bore from below: "
+        f"the film is now the only thing over the bore ({2 * acc['bore_radius_mm']:.1f} mm across), "
+        f"{acc['film_above_bench_mm']:g} mm above the bench.",
+        f"The light: a white LED torch (or a phone's torch) on the bench under the bore, pointing straight up, no "
+        f"taller than {acc['lamp_room_mm']:g} mm (the blocks' height). The film scatters its light up into every "
+        "direction the dome's rays arrive from: the lit film is the sample.",
+        f"The reference picture: with the whole bore lit (radius {acc['bore_radius_mm']:.2f} mm), take the camera's "
+        "picture, its exposure set so the brightest part of the paraboloid's image sits at 80-90 % of full scale.",
+        f"The test picture: tape a black paper mask with a **{2 * acc['disc_radius_mm']:g} mm** hole (a leather "
+        "punch) on the film, the hole centred on O's mark, and take the picture again at the same exposure "
+        "(the film in the hole is as bright as before; only the lit area shrinks).",
+    ])
+    d.p(f"**Pass:** over at least {100 * acc['pass_fraction']:g} % of the paraboloid's image (outside the occlusion "
+        "disc of the calibration circle, `tolerancing.min_yield`), a pixel lit in the reference is lit in the test "
+        "picture too (at least half its reference brightness). A pixel lit in the "
+        f"reference but dark in the test sees a point of the film between {acc['disc_radius_mm']:g} and "
+        f"{acc['bore_radius_mm']:.1f} mm from O: the mirror area it looks at is off in slope by "
+        f"{acc['dome_slope_tolerance_mrad']:.1f} to {acc['bore_slope_mrad']:.1f} mrad at the dome's farthest point "
+        f"from O ({acc['dome_farthest_from_o_mm']:.0f} mm; a slope error e turns a ray by 2 e); block and polish it "
+        "again. A pixel dark in both looks past the bore: farther off still. Run it first on the polished coat, "
+        "before the mirror coat (the recipe's slope test: a bad area can still be sanded), then again on the "
+        "finished mirrors.")
+    c.finishing = {"blocks": blocks, "acceptance": acc, "templates": c.templates,
+                   "block_set": [{k: v for k, v in r.items() if k != "part"} for r in block_set]}
 
 
-#: The checkerboard's square (mm): 5 mm prints sharply on a laser printer and spans several camera
-#: pixels in the paraboloid's image of the base plate.
-CHECKER_SQUARE_MM = 5.0
+CHECKER_SQUARE_MM = C.CHECKER_SQUARE_MM
+
+
+def spring_bolts(rig) -> dict:
+    """What section 6 says to take the splitter holder off its seat and to put it back: its spring bolts
+    (rigcad.parts.tower.hardware's row with the springs: thread, count, the spring's installed length and
+    preload) undone, and set again by their springs' length. ``off``/``on``: the two sentences."""
+    from rigcad.standards import THREADS
+
+    row = next((h for h in B.tower_hardware(rig) if h.get("spring_mm")), None)
+    if row is None:
+        return {"off": "", "on": ""}
+    th = THREADS[row["thread"]]
+    sp = row["spring_mm"]
+    off = (f"Undo the holder's {row['quantity']} spring bolts first: hold each bolt's head under the shelf with the "
+           f"{th.hex_key:g} mm hex key, run its nut off the top with the {th.nut_af:g} mm spanner, and lift off the "
+           "washer, the spring and the washer under it (keep each bolt's set together); the bolts drop out from "
+           "under the shelf. ")
+    on = (f"Put the {row['quantity']} spring bolts back up through the shelf and the holder's flange, a washer, the "
+          f"spring ({sp['wire']:g} mm wire, {sp['outer_diameter']:g} mm outside, {sp['free_length']:g} mm free) and a "
+          f"washer on each, and run each nut down until its spring is **{sp['installed_length']:g} mm** long, measured "
+          f"with the caliper: {row['preload_N']:.1f} N each, the preload the seat is designed for (these bolts are set "
+          "by their springs' length, not by a torque).")
+    return {"off": off, "on": on}
+
+
+def sanding_blocks(d: Doc, c, block_set: list[dict]) -> None:
+    """The printed sanding blocks (rigcad.manual.finishing.sanding_block_set): their STL files into
+    ``blocks/``, how they are printed, faced with the abrasive and used, and their table."""
+    import numpy as np
+
+    from rigcad.export import mesh as EM
+    from rigcad.manual import finishing as F
+
+    for r in block_set:
+        mesh = c.rig.mesh(r["part"])
+        c.files[f"blocks/{r['part'].name}.stl"] = EM.stl_bytes(np.asarray(mesh.vertices), np.asarray(mesh.faces),
+                                                               r["part"].name)
+    mirrors = sorted({r["mirror"] for r in block_set})
+    count = {m: sum(r["mirror"] == m for r in block_set) for m in mirrors}
+    d.p(f"Sanding blocks: print the {len(block_set)} blocks of `blocks/` ("
+        + ", ".join(f"{count[m]} for the {m}" for m in mirrors)
+        + f"; {F.BLOCK_LENGTH_MM:g} mm along the meridian, or the whole meridian where it is shorter, "
+          f"{F.BLOCK_WIDTH_MM:g} mm across, {F.BLOCK_THICKNESS_MM:g} mm thick; neighbours overlap by "
+          f"{F.BLOCK_OVERLAP_MM:g} mm). A block's face is the mirror's own surface over its band of the meridian, "
+          "revolved: it matches both curvatures, along the meridian and across it, by construction, and stands "
+          f"{F.ABRASIVE_MM:g} mm proud of the surface, the abrasive film's thickness. The abrasive: "
+          f"{F.ABRASIVE_SPEC}; " + "; ".join(f"{g} for {what}" for g, what in F.ABRASIVE) + ". Print the blocks "
+          "face up, 0.1 mm layers, 100 % infill. Before first use, true each face on its own band of the "
+          "knocked-down print: P240 film on the block, a pencil scribble over the face, strokes around the axis "
+          "until the scribble is gone everywhere; then the grade of the stage. Sand with strokes around the axis "
+          "(the surface is the same at every azimuth, so the face fits wherever it turns), moving the block along "
+          f"the meridian no further than its slide below, where its face would stand off by {F.BLOCK_SAG_MM:g} mm "
+          "(1 mil, the thinnest coat). The first band starts at the dome's base and at the paraboloid's rim.")
+    d.table(["mirror", "block (blocks/)", "band along the meridian", "least radius along / across",
+             "slide along the meridian"],
+            [[r["mirror"], f"`{r['part'].name}.stl`", f"{r['from_mm']:.0f}-{r['to_mm']:.0f} mm",
+              f"{r['meridional_radius_mm']:.1f} / {r['sagittal_radius_mm']:.1f} mm",
+              f"±{r['slide_mm']:.1f} mm" if r["slide_mm"] > 0 else "none: turn it about the axis only"]
+             for r in block_set])
 
 
 def _film_step(d: Doc, c) -> None:
     """The film test as a lab does it: what holds the dome over the film at the sample plane, how the
     film is registered at O and where it is seen from (rigcad.manual.calibration.film_setup)."""
     f = C.film_setup(c.rig)
-    d.p("**The film at the sample plane.** The dome stands bolted on the base plate over the film: the plate's top "
+    d.h(3, C.STEP_FILM)
+    d.p("The dome stands bolted on the base plate over the film: the plate's top "
         "is the dome's base plane and the sample plane (z = 0) by design, and the plate's bore, which centres the "
         "sample holder, centres the film's mark. The film goes on during the assembly, before the dome, and is seen "
         "from below, through the bore:")
@@ -755,7 +1017,8 @@ def _film_step(d: Doc, c) -> None:
         f"For the test, lift the rig as one piece (plate, dome and tower are one rigid assembly; two people) onto "
         f"three blocks: one **{f['block_under_tongue_mm']:g} mm** tall under the tongue below the column, two "
         f"**{f['block_under_disc_mm']:g} mm** tall under the disc's rim either side of the dome (the tongue reaches "
-        f"{f['tongue_below_disc_mm']:g} mm lower than the disc). Take the plug out of the bore from below.",
+        f"{f['tongue_below_disc_mm']:g} mm lower than the disc). Take the `camera_cross_base` out of the bore from "
+        "below (the film stays taped over the bore, its mark traced).",
         f"Look up through the bore: a 45 deg mirror or a phone's camera on the bench under it (the "
         f"{f['block_under_disc_mm']:g} mm blocks leave room for it). Project the circle and set it as described "
         f"above; {seen}.",
@@ -768,28 +1031,25 @@ def _film_step(d: Doc, c) -> None:
 def _calibration_more(d: Doc, c, cam: dict) -> None:
     """The steps after the crosses: the turned camera crosses, the checkerboard and the gray card
     (thesis 4.1.1, 4.1.2)."""
-    import numpy as np
-
     rig = c.rig
     hidden = cam["base_cross_arm_mrad"] < cam["hung_cross_arm_mrad"]
     d.p("Turn the base cross 45 degrees to the hung one (it turns freely in the holder's bore)"
         + (f": seen from the COP its arms span {cam['base_cross_arm_mrad']:.1f} mrad, less than the hung cross's "
            f"{cam['hung_cross_arm_mrad']:.1f} mrad, so aligned it would hide behind it; turned, its arms show in the "
            "gaps between the hung cross's arms." if hidden else ": its arms then show between the hung cross's."))
-    lay = rig.layout
-    inside = float(lay.printed_dome.points(np.array([lay.u_inner_base]))[0, 0])  # the dome's inside at the plate
-    r = math.floor(inside - 1.0)
-    bore = c.p.sample_holder.radius + c.p.sample_holder.clearance
-    n = math.ceil(2 * r / CHECKER_SQUARE_MM)
-    d.p(f"Camera pixels to paraboloid points: print a checkerboard of {CHECKER_SQUARE_MM:g} mm black and white "
-        f"squares ({n} x {n} squares on matte paper, laser-printed at 600 dpi, checked with the caliper over ten "
-        f"squares) and cut it to a **{2 * r:.0f} mm** disc, a square's corner at its centre, with a {2 * bore:.0f} mm "
-        f"hole there for the bore: it lies on the base plate inside the dome ({2 * inside:.1f} mm across at the plate). "
-        "Lift the dome off its register pins (as for the calibration screens), lay the disc on the plate centred on "
-        "the bore, set the dome back and screw it down. Project the calibrated circle and locate the paraboloid's "
-        "image in the camera's picture: its centre and radius in pixels are the camera's correspondence. Then lift "
-        "the dome again to take the disc out.")
-    d.h(3, "Reflectance (thesis 4.1.2)")
+    cb = C.checkerboard(rig)
+    n = cb["squares"]
+    d.h(3, C.STEP_CHECKER)
+    d.p(f"Print a checkerboard of {cb['square_mm']:g} mm black and white squares ({n} x {n} squares on {cb['sheet']} "
+        "matte paper, laser-printed at 600 dpi, checked with the caliper over ten squares) and cut it with the circle "
+        f"cutter to a **{cb['disc_diameter_mm']:.0f} mm** disc, a square's corner at its centre, with a "
+        f"{cb['hole_diameter_mm']:.0f} mm hole there for the bore (the scalpel finishes the cut): it lies on the base "
+        f"plate inside the dome ({cb['dome_inside_diameter_mm']:.1f} mm across at the plate). Take out the dome's "
+        f"{len(rig.layout.bolt_angles)} flange screws and lift the dome off its register pins (as for the calibration "
+        "screens), lay the disc on the plate centred on the bore, set the dome back and screw it down to its torque "
+        "(section 5). Project the calibrated circle and locate the paraboloid's image in the camera's picture: its "
+        "centre and radius in pixels are the camera's correspondence. Then lift the dome again to take the disc out.")
+    d.h(3, C.STEP_GRAY)
     from rigcad.calibrate.graycard import manual_text
 
     d.p(manual_text(rig))  # the gray card command's own procedure (one home)
@@ -825,10 +1085,12 @@ def _section_calibrate(d: Doc, c) -> None:
         "before this manual is written):")
     d.table(["item", "goes in", "what comes out of its way", "which goes back", "checked"],
             [[r["item"], r["way"], r["out_of_the_way"], r["back"], r["checked"]] for r in C.access(rig)])
-    d.h(3, "Projector: the crosses and the backplate")
+    d.h(3, C.STEP_CROSSES)
     row = pshadow["rows"][0]
-    d.p("Lift the splitter holder, with the camera on it, off its seat (its kinematic seat puts it back in the same "
-        "place; the seat's balls stay on the shelf) and take the focusing lens out of its mount; leave the mount "
+    springs = spring_bolts(rig)
+    d.p(springs["off"] + "Lift the splitter holder, with the camera on it, off its seat (its kinematic seat puts it back "
+        "in the same place; the balls in its push screws' cups go with it, the cone's balls, the vee's pins and the "
+        "flat's gauge block stay on the shelf) and take the focusing lens out of its mount; leave the mount "
         f"where it is. Set the `projector_mounting_plate` ({pshadow['plate_length_mm']:.0f} mm long) on the splitter seat "
         "in the holder's place: the three steel balls pressed into its underside (retaining compound) sit on the seat's "
         "cone, vee and flat where the holder's sat; it stops short of the lens mount's foot and never touches it. Stand "
@@ -843,8 +1105,8 @@ def _section_calibrate(d: Doc, c) -> None:
         f"**{row['separation_per_mm_offset']:.2f} mm**: move the projector on its slots (across) and its shims "
         f"(height) until they coincide. The profile allows `tolerancing.projector_offset` = "
         f"{p.tolerancing.projector_offset:g} mm. Then take the plate, crosses and backplate off, put the lens back "
-        "and set the holder back on its seat.")
-    d.h(3, "Projector: the circle on the paraboloid")
+        "and set the holder back on its seat. " + springs["on"])
+    d.h(3, C.STEP_CIRCLE)
     d.p("Leave the focusing lens in its mount: the circle is set through it, as the basis images are shown. Open "
         "`calibration/circle.html` in a browser on the projector's screen and press f (full screen): arrow keys "
         "move the circle (Shift: 10 px), + and - change its radius, 0 restores the design's circle, and its centre "
@@ -863,7 +1125,7 @@ def _section_calibrate(d: Doc, c) -> None:
     d.img("calibration/circle.png", f"calibration/circle.png: the calibration image, {info['resolution_px'][0]} x "
                                     f"{info['resolution_px'][1]} px, shown at page width")
     _film_step(d, c)
-    d.h(3, "Camera: the two crosses")
+    d.h(3, C.STEP_CAMERA)
     d.p(f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
         f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm) and put the `camera_cross_base` in the sample holder's place "
         f"(its top on z = 0). From the COP (z = {cam['cop_z_mm']:.1f} mm) the hung cross's arms span "

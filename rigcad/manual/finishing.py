@@ -63,16 +63,200 @@ def sanding_blocks(rig) -> list[dict]:
 
 def slope_acceptance(rig) -> dict:
     """The optical acceptance test's figures: every camera pixel's ray lands on the sample plane within
-    ``tolerancing.max_spot_radius`` of O when the mirrors are right, so a white disc of that radius on
-    black, centred on O, fills the paraboloid's whole image white; a pixel that sees black marks a
-    mirror area whose slope is off. The dome's slope tolerance that this test holds: a slope error e
-    turns the ray by 2 e, which lands 2 e D off O, D the dome's farthest point from O (mm)."""
+    ``tolerancing.max_spot_radius`` of O when the mirrors are right, so a lit disc of that radius at O
+    fills the paraboloid's whole image with light; a pixel that stays dark marks a mirror area whose
+    slope is off. The disc is the film of the circle test (rigcad.manual.calibration.film_setup: on the
+    base plate's top, z = 0, over the bore, O traced on it) under a black mask with a hole of that
+    radius, lit from below through the bore by a lamp on the bench, the rig on the film test's blocks.
+    The dome's slope tolerance that this test holds: a slope error e turns the ray by 2 e, which lands
+    2 e D off O, D the dome's farthest point from O (mm). A reference picture with the mask off (the
+    whole bore lit) tells a slope error from a dark corner of the light: a ray that lands past the disc
+    but inside the bore is lit there only."""
+    from rigcad.manual.calibration import film_setup
+
     p = rig.profile
     pts = rig.layout.design_dome.points(rig.layout.design_dome.sample(2001))
     far = float(np.max(np.hypot(pts[:, 0], pts[:, 1])))
     limit = p.tolerancing.max_spot_radius
+    f = film_setup(rig)
     return {"disc_radius_mm": limit, "dome_farthest_from_o_mm": far,
-            "dome_slope_tolerance_mrad": 1e3 * limit / (2.0 * far), "pass_fraction": p.tolerancing.min_yield}
+            "dome_slope_tolerance_mrad": 1e3 * limit / (2.0 * far), "pass_fraction": p.tolerancing.min_yield,
+            "bore_radius_mm": f["bore_radius_mm"], "bore_slope_mrad": 1e3 * f["bore_radius_mm"] / (2.0 * far),
+            "lamp_room_mm": f["block_under_disc_mm"], "film_above_bench_mm": f["block_under_disc_mm"]
+            + f["plate_thickness_mm"], "block_under_disc_mm": f["block_under_disc_mm"],
+            "block_under_tongue_mm": f["block_under_tongue_mm"]}
+
+
+# -- the sanding blocks: printed, their face the mirror's own surface -------------------------------
+#: The abrasive on every block: silicon carbide on a polyester film backing with a pressure-sensitive
+#: adhesive (PSA) back, cut to the block's face; grades by stage (FEPA P, ISO 6344). Film, not paper:
+#: its backing is even in thickness (paper's varies by about its grit), so the face stands where the block
+#: puts it. Its thickness with the grit (mm): the block's face is cut this far in front of the surface.
+ABRASIVE = (("P120, P240, P400", "the print's layer lines"), ("P600, P800", "the primer"),
+            ("P1500, P2000, P3000", "the clear coat"))
+ABRASIVE_SPEC = ("PSA-backed silicon carbide film (polyester backing, e.g. 3M 260L / Mirka Polarstar class "
+                 "sheets, 115 x 230 mm), cut to each block's face")
+ABRASIVE_MM = 0.15
+#: A block's size (mm): along the meridian (a hand's grip, several staircase steps of the print under it),
+#: across it, and its body behind the face. Blocks along one meridian overlap by BLOCK_OVERLAP_MM.
+BLOCK_LENGTH_MM = 40.0
+BLOCK_WIDTH_MM = 25.0
+BLOCK_THICKNESS_MM = 12.0
+BLOCK_OVERLAP_MM = 10.0
+
+
+def _arc(design, samples: int = 4001) -> tuple[np.ndarray, np.ndarray]:
+    """Parameters u (n,) over the meridian and the arc length s (n,) mm from its first end."""
+    u = design.sample(samples)
+    p = design.points(u)
+    return u, np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+
+
+def block_bands(design) -> list[tuple[float, float]]:
+    """The bands (u0, u1) of the meridian the blocks' faces copy: BLOCK_LENGTH_MM of arc each (the whole
+    meridian when it is shorter), overlapping by BLOCK_OVERLAP_MM, the last one ending at the meridian's end."""
+    u, s = _arc(design)
+    total = float(s[-1])
+    if total <= BLOCK_LENGTH_MM:
+        return [(float(u[0]), float(u[-1]))]
+    n = math.ceil((total - BLOCK_OVERLAP_MM) / (BLOCK_LENGTH_MM - BLOCK_OVERLAP_MM))
+    step = (total - BLOCK_LENGTH_MM) / (n - 1)
+    return [(float(np.interp(k * step, s, u)), float(np.interp(k * step + BLOCK_LENGTH_MM, s, u))) for k in range(n)]
+
+
+def _curvatures(design, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Meridional and sagittal curvature (1/mm) of the surface of revolution at ``u``."""
+    p, n = design.points(u), design.normals(u)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sag = np.where(p[:, 0] > 1e-6, np.abs(n[:, 0]) / np.maximum(p[:, 0], 1e-300), design.curvature(u))
+    return design.curvature(u), sag
+
+
+def block_slide(design, band, length: float, width: float) -> float:
+    """How far (mm of arc) a block made on ``band`` may slide along the meridian either way before its
+    face stands off the surface by more than BLOCK_SAG_MM: the curvatures it meets change by dk, and a face
+    of length L stands off by L^2 dk / 8 (meridional, over ``length``; sagittal, over ``width``)."""
+    u, s = _arc(design)
+    km, ks = _curvatures(design, u)
+    inside = (u >= min(band) - 1e-12) & (u <= max(band) + 1e-12)
+    s_in = s[inside]
+    limits, reach = [], [0.0]
+    for sign in (1.0, -1.0):
+        last = 0.0  # the farthest slide this way found within BLOCK_SAG_MM
+        for d in np.linspace(0.0, float(s[-1]), 4001)[1:]:
+            t = s_in + sign * d
+            if t.min() < 0.0 or t.max() > s[-1]:
+                break  # past the mirror's end: the way stops there
+            if block_gap(km, ks, s, inside, t, length, width) > BLOCK_SAG_MM:
+                limits.append(last)
+                break
+            last = float(d)
+            reach.append(last)
+    return min(limits) if limits else max(reach)
+
+
+def block_gap(km, ks, s, inside, t, length: float, width: float) -> float:
+    """The stand-off (mm) of a block's face made where ``inside`` is (a mask on the meridian's arc
+    ``s``, curvatures ``km``, ``ks``) when moved to arc positions ``t``: L^2 dk / 8, both ways."""
+    return float(length ** 2 * np.max(np.abs(np.interp(t, s, km) - km[inside]))
+                 + width ** 2 * np.max(np.abs(np.interp(t, s, ks) - ks[inside]))) / 8.0
+
+
+def block_part(mirror: str, design, k: int, band):
+    """Sanding block ``k`` of a mirror as a recipe Part: its face is the mirror's surface over ``band``
+    moved ABRASIVE_MM to the reflecting side (the abrasive film fills that), its body
+    BLOCK_THICKNESS_MM behind the face on the reflecting side, revolved and cut to BLOCK_WIDTH_MM across
+    (|y| <= width / 2, x >= 0)."""
+    from rigcad.parts.recipe import Box, Curve, Difference, Line, Part, Revolve, Section
+
+    face = design.behind(-ABRASIVE_MM)
+    back = design.behind(-(ABRASIVE_MM + BLOCK_THICKNESS_MM))
+    u0, u1 = band
+    segs = [Curve(face, u0, u1), Line(Curve(face, u0, u1).p1, Curve(back, u1, u0).p0), Curve(back, u1, u0),
+            Line(Curve(back, u1, u0).p1, Curve(face, u0, u1).p0)]
+    big = 10.0 * (BLOCK_LENGTH_MM + BLOCK_THICKNESS_MM + float(np.max(np.abs(design.points(design.sample(64))))))
+    half = BLOCK_WIDTH_MM / 2
+    cuts = (Box((-big, half, -big), (big, big, big)), Box((-big, -big, -big), (big, -half, big)),
+            Box((-big, -big, -big), (0.0, big, big)))
+    return Part(f"sanding_block_{mirror}_{k + 1}", Difference(Revolve(Section(tuple(segs))), cuts), (0.4, 0.6, 0.8),
+                f"sanding block {k + 1} of the {mirror}: its face is the {mirror}'s surface over its band, "
+                f"{ABRASIVE_MM:g} mm proud for the abrasive film", in_rig=False)
+
+
+def sanding_block_set(rig) -> list[dict]:
+    """Every mirror's printed sanding blocks: per block its band (arc mm from the meridian's first end:
+    the dome's base, the paraboloid's rim), its face's least radii, how far it may slide along the
+    meridian (:func:`block_slide`) and its recipe Part (``part``)."""
+    rows = []
+    for part_name, part in rig.recipes.items():
+        for mirror, design in part.mirrors:
+            u, s = _arc(design)
+            for k, band in enumerate(block_bands(design)):
+                inside = (u >= band[0]) & (u <= band[1])
+                km, ks = _curvatures(design, u[inside])
+                length = float(np.interp(band[1], u, s) - np.interp(band[0], u, s))
+                rows.append({"mirror": mirror, "block": k + 1, "from_mm": float(np.interp(band[0], u, s)),
+                             "to_mm": float(np.interp(band[1], u, s)), "length_mm": length,
+                             "width_mm": BLOCK_WIDTH_MM, "thickness_mm": BLOCK_THICKNESS_MM,
+                             "meridional_radius_mm": float(1.0 / np.max(km)), "sagittal_radius_mm": float(1.0 / np.max(ks)),
+                             "slide_mm": block_slide(design, band, length, BLOCK_WIDTH_MM),
+                             "part": block_part(mirror, design, k, band)})
+    return rows
+
+
+# -- the templates' datums ------------------------------------------------------------------------
+def template_datums(rig) -> list[dict]:
+    """Each profile template's drawing and datum, read from its recipe's section (the x-z outline of
+    its Prism, mm, in its gauging position: x from the rig's axis, z up from the sample plane): the
+    outline, the gauging edge (the section's curves on the gauged surface, ``templates.gauged_layer``)
+    and the datum: the longest level straight edge when the section has one ("edge": set level, its
+    centre on the axis), else the gauging edge's lowest end ("corner": it stands on the base plate's
+    top, z = 0, where the mirror meets the plate)."""
+    from rigcad.parts.recipe import Curve, Line
+    from rigcad.parts.templates import gauged_depth
+
+    out = []
+    depth = gauged_depth(rig.profile)
+    for name in ("dome_template", "paraboloid_template"):
+        part = rig.recipes.get(name)
+        if part is None:
+            continue
+        section = part.solid.section
+        outline = section.polygon(0.05)
+        gauge = [seg.dense(401) for seg in section.segments
+                 if isinstance(seg, Curve) and abs(seg.meridian.offset - depth) < 1e-9]
+        level = [seg for seg in section.segments if isinstance(seg, Line) and abs(seg.p0[1] - seg.p1[1]) < 1e-9]
+        edge = np.concatenate(gauge)
+        row = {"template": name, "outline_mm": outline.tolist(), "gauging_edge_mm": [g.tolist() for g in gauge],
+               "axis_x_mm": 0.0, "width_mm": float(np.ptp(outline[:, 0])), "height_mm": float(np.ptp(outline[:, 1]))}
+        if level:
+            seg = max(level, key=lambda g: abs(g.p1[0] - g.p0[0]))
+            row.update(datum="edge", datum_mm=[list(seg.p0), list(seg.p1)], datum_z_mm=float(seg.p0[1]),
+                       datum_length_mm=float(abs(seg.p1[0] - seg.p0[0])),
+                       datum_centre_x_mm=float(0.5 * (seg.p0[0] + seg.p1[0])))
+        else:
+            low = edge[int(np.argmin(edge[:, 1]))]
+            high = edge[int(np.argmax(edge[:, 1]))]
+            row.update(datum="corner", datum_mm=[low.tolist()], datum_z_mm=float(low[1]),
+                       datum_r_mm=float(abs(low[0])), top_r_mm=float(abs(high[0])), top_z_mm=float(high[1]))
+        out.append(row)
+    return out
+
+
+def template_text(row: dict) -> str:
+    """How a template is held, from its datum (:func:`template_datums`)."""
+    name = row["template"].replace("_template", "")
+    if row["datum"] == "edge":
+        return (f"`{row['template']}`: the datum is its straight edge, **{row['datum_length_mm']:.1f} mm** long at "
+                f"z = {row['datum_z_mm']:.1f} mm (red in its drawing), with the axis line at its middle (dashed: scribe "
+                f"it on the template). Hold the template in a meridional plane over the {name}, the datum edge level (the "
+                "spirit level on it) and its axis line over the vertex: the cut-out then lies on the gauged surface.")
+    return (f"`{row['template']}`: the datum is the lower corner of its curved edge (red in its drawing), "
+            f"{row['datum_r_mm']:.1f} mm from the axis at z = {row['datum_z_mm']:.1f} mm: the {name} stands on the base "
+            "plate, and the template stands upright in a meridional plane (the engineer's square against its face), "
+            "that corner on the plate's top where the mirror meets the plate; its curved edge then runs along the "
+            f"mirror up to {row['top_r_mm']:.1f} mm from the axis at z = {row['top_z_mm']:.1f} mm. The axis lies "
+            f"{row['top_r_mm']:.1f} mm beyond its upper end (dashed in the drawing).")
 
 
 #: Specular reflectance of a polished clear coat over a black base at normal incidence: Fresnel's
@@ -115,8 +299,9 @@ def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str,
     total = float(sum(t for _, t in layers))
     gap = total - gauged_depth(profile)
     stock = "" if not stock_mm else " (" + ", ".join(f"{k} {v:.3f} mm" for k, v in stock_mm.items()) + " of stock)"
-    rows = [("1. Knock down the layer lines", "wet-or-dry SiC paper P120, P240, P400 (ISO 6344) on the sanding blocks "
-             "below", "wet, a drop of soap in the water; strokes along the meridian, then across", "-",
+    rows = [("1. Knock down the layer lines", "SiC abrasive film P120, P240, P400 (ISO 6344) on the printed sanding "
+             "blocks below", "wet, a drop of soap in the water; strokes around the axis, each block within its "
+             "slide along the meridian", "-",
              f"guide coat (dry black powder, e.g. 3M 05861) gone everywhere; the template's gap {gap:.3f} mm "
              f"({gap / 0.0254:.1f} mil) all along it: the print's staircase is gone{stock}")]
     for k, (name, t) in enumerate(layers):
@@ -138,5 +323,6 @@ def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str,
     return rows
 
 
-__all__ = ["BLOCK_SAG_MM", "CLEAR_REFLECTANCE", "KERF_MM", "LAYER_METHODS", "principal_radii", "recipe",
+__all__ = ["ABRASIVE", "ABRASIVE_MM", "BLOCK_LENGTH_MM", "BLOCK_SAG_MM", "block_bands", "block_part", "block_slide",
+           "sanding_block_set", "template_datums", "template_text", "CLEAR_REFLECTANCE", "KERF_MM", "LAYER_METHODS", "principal_radii", "recipe",
            "sanding_blocks", "slope_acceptance"]

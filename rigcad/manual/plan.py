@@ -34,8 +34,9 @@ from rigcad.parts.joints import ScrewJoint
 from rigcad.parts.locating import DowelRegister
 from rigcad.standards import INSERTS, THREADS, longest_screw, shortest_screw
 
-#: Units one step places together: an instrument with the lens built onto it.
-UNITS = (("projector_body", "projector_lens"), ("camera_body", "camera_lens"))
+#: Units one step places together: an instrument with the lens built onto it; the splitter holder with the
+#: balls its push screws hold in their cups (seat_ball_1..3: a name stands for the parts named alike).
+UNITS = (("projector_body", "projector_lens"), ("camera_body", "camera_lens"), ("splitter_holder", "seat_ball"))
 #: Parts that slide in from the side into slots or grooves before anything is lowered onto them.
 SIDEWAYS_FIRST = ("beam", "beam_splitter")
 SIDEWAYS = ((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1.0, 0.0))
@@ -58,9 +59,40 @@ def groups(meshes) -> list[tuple[str, tuple[str, ...]]]:
     for m in meshes:
         if m.marker:
             continue
-        key = unit_of.get(m.name, _stem(m.name))
+        key = unit_of.get(m.name, unit_of.get(_stem(m.name), _stem(m.name)))
         out.setdefault(key, []).append(m.name)
     return [(k, tuple(v)) for k, v in out.items()]
+
+
+def insert_item(thread: str) -> str:
+    """A heat-set insert as the bill lists it (its size from rigcad.standards.INSERTS)."""
+    ins = INSERTS[thread]
+    return f"{thread} heat-set insert for printed parts, {ins.length:g} mm long, {ins.hole:g} mm hole"
+
+
+def thread_of(fastener) -> str:
+    """The thread of a fastener's item (its item starts with it: "M4 x 12 mm ...")."""
+    return fastener.item.split(" x ")[0]
+
+
+def thread_host(fastener, meshes_by_name: dict) -> str | None:
+    """The printed part that takes a fastener's thread in an insert or a nut trap: of the printed parts
+    its shank passes, the one whose material about the screw's axis (within its head's radius and 2 mm)
+    reaches farthest along the axis from the head (the insert's pocket or the trap is at the far end).
+    None when no printed part is near the axis."""
+    head, axis = np.asarray(fastener.head, float), np.asarray(fastener.axis, float)
+    best, depth = None, -np.inf
+    for name in fastener.passes:
+        m = meshes_by_name.get(name)
+        if m is None or m.bought:
+            continue
+        rel = np.asarray(m.vertices, float) - head
+        t = rel @ axis
+        radial = np.linalg.norm(rel - np.outer(t, axis), axis=1)
+        near = (radial < fastener.head_radius_mm + 2.0) & (t > 0.0)
+        if near.any() and t[near].max() > depth:
+            best, depth = name, float(t[near].max())
+    return best
 
 
 def bolt_fasteners(bolt: dict) -> tuple[Fastener, ...]:
@@ -305,7 +337,7 @@ def assembly(rig, meshes) -> Assembly:
     return Assembly(solids, declared)
 
 
-__all__ = ["assembly", "bolt_fasteners", "groups", "instrument_fasteners", "joint_fasteners", "spanner", "steps"]
+__all__ = ["assembly", "bolt_fasteners", "groups", "insert_item", "thread_host", "thread_of", "instrument_fasteners", "joint_fasteners", "spanner", "steps"]
 
 
 def hardware(steps: list[Step], rig=None) -> list[dict]:
@@ -345,6 +377,18 @@ def hardware(steps: list[Step], rig=None) -> list[dict]:
     return out + [{"item": k, "quantity": v, "steps": "with the bolts above"} for k, v in extra.items()]
 
 
+def step_names(steps: list[Step], named) -> list[str]:
+    """The steps that ``named`` (parts' or steps' names, as a hardware row's ``steps`` gives them) stand
+    for: a step of that name, else the step whose members are named alike (a unit's seat_ball_1..3)."""
+    out = []
+    for n in named:
+        hit = next((st.name for st in steps if st.name == n), None) or next(
+            (st.name for st in steps if any(_stem(m) == n for m in st.members)), None)
+        if hit and hit not in out:
+            out.append(hit)
+    return out
+
+
 def bill_hardware(rig, steps: list[Step], bill: dict) -> list[dict]:
     """The manual's one hardware list, for its table and manual.json alike: the plan's fasteners and
     what they need (:func:`hardware`: what the assembly steps fit, so the bill and the steps cannot
@@ -356,10 +400,9 @@ def bill_hardware(rig, steps: list[Step], bill: dict) -> list[dict]:
     rows = [{"item": r["item"], "quantity": r["quantity"], "where": f"assembly steps: {r['steps']}",
              "note": "as the assembly check fitted it", "steps": [s.split(" (")[0] for s in r["steps"].split(", ")]}
             for r in hardware(steps, rig)]
-    have = {st.name for st in steps}
     rows += [{"item": f["item"], "quantity": f["quantity"],
-              "where": (f"assembly steps: {', '.join(s for s in f['steps'] if s in have)}: " if f.get("steps") else "")
-              + f["use"], "note": f["note"], "steps": [s for s in f.get("steps", ()) if s in have]}
+              "where": (f"assembly steps: {', '.join(step_names(steps, f['steps']))}: " if f.get("steps") else "")
+              + f["use"], "note": f["note"], "steps": step_names(steps, f.get("steps", ()))}
              for f in bill["fasteners"] if f.get("tower") and "mounting holes" not in f["use"]
              and not tower_joints.placed({"joins": f["use"]}) and "heat-set insert" not in f["item"]]
     for part in rig.recipes.values():  # the locating pins the parts declare, in the step of the part they locate
@@ -376,4 +419,4 @@ def bill_hardware(rig, steps: list[Step], bill: dict) -> list[dict]:
     return rows
 
 
-__all__ += ["bill_hardware", "hardware", "projector_screw_rows", "projector_screw_text"]
+__all__ += ["bill_hardware", "hardware", "projector_screw_rows", "projector_screw_text", "step_names"]

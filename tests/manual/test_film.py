@@ -41,7 +41,7 @@ def test_film_setup_matches_the_parts(table31_rig):
 def test_the_manual_writes_the_film_step(table31_rig):
     d = Doc()
     _film_step(d, _Ctx(table31_rig))
-    text = " ".join(b[1] if isinstance(b[1], str) else " ".join(b[1]) for b in d.blocks)
+    text = " ".join(b[-1] if isinstance(b[-1], str) else " ".join(b[-1]) for b in d.blocks)
     f = C.film_setup(table31_rig)
     for want in ("camera_cross_base", f"{f['block_under_tongue_mm']:g} mm", f"{f['block_under_disc_mm']:g} mm",
                  f"{f['film_diameter_mm']:.0f} mm", "before the dome", "through the bore"):

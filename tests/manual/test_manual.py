@@ -355,3 +355,96 @@ def test_every_hardware_line_has_its_step_and_every_bought_step_its_line(table31
     for st in steps:
         if st.bought and st.name not in optics:
             assert any(st.name in r["steps"] for r in rows), st.name
+
+
+def _h3_sections(md: str, start: str, stop: str | None = None) -> dict[str, str]:
+    """The ``### `` subsections of manual.md from the heading ``start`` on (to ``stop``): heading -> text."""
+    text = md[md.index(start):]
+    if stop:
+        text = text[:text.index(stop)]
+    parts = re.split(r"^### (.*)$", text, flags=re.M)
+    return {parts[i]: parts[i + 1] for i in range(1, len(parts), 2)}
+
+
+def test_every_item_a_calibration_step_names_has_its_bill_line(written, table31_rig):
+    """Section 6's steps (and the finishing's optical acceptance test) name their items by the words of the
+    calibration kit (calibration.kit_items); each named item has its bill line listing that step, with what
+    to buy; nothing undefined ('plug') is used."""
+    import json
+
+    out, _ = written
+    md = (out / "manual.md").read_text(encoding="utf-8")
+    doc = json.loads((out / "manual.json").read_text(encoding="utf-8"))
+    sections = _h3_sections(md, "## 6. Calibrate")
+    sections[C.STEP_ACCEPTANCE] = _h3_sections(md, "## 3. ", "## 4. ")[C.STEP_ACCEPTANCE]  # the finishing's test
+    items = C.kit_items(table31_rig)
+    assert C.kit_misses(sections, items) == []
+    # the bill's lines: manual.md's table and manual.json hold every item, its quantity, spec and steps
+    table = {r[0]: r for r in _md_table(md, "Calibration and test kit")}
+    held = {r["item"]: r for r in doc["bill"]["calibration_kit"]}
+    for it in items:
+        assert it.spec and it.quantity, it
+        assert table[it.item][1:] == [it.quantity, it.spec, "; ".join(it.steps)], it.item
+        assert held[it.item]["steps"] == list(it.steps) and held[it.item]["spec"] == it.spec
+    for want in ("tablet", "upright display", "gray card", "drafting film", "blocks", "spacer"):
+        assert any(want in it.words for it in items), want
+    assert not re.search(r"\bplug\b", md[md.index("## 6. Calibrate"):]), "section 6 uses an undefined 'plug'"
+    # planted: an item dropped from the bill, and an item named in a step that does not list it
+    assert C.kit_misses(sections, [it for it in items if "tape" not in it.words])
+    film = C.STEP_FILM
+    assert C.kit_misses({**sections, film: sections[film] + " Lay the tablet on it."}, items)
+
+
+def test_inserts_nuts_and_pins_go_in_before_what_needs_them(written):
+    """From manual.json's order: every insert or trap nut a step's screws thread into was set in an earlier
+    step (or this step, before its part goes in), in the step that places the part holding it, as many as the
+    screws; every pin or ball a step presses is pressed before its part (the text says so first); the seat's
+    balls go in with the splitter holder, in the cups of its push screws."""
+    import json
+
+    out, _ = written
+    md = (out / "manual.md").read_text(encoding="utf-8")
+    order = json.loads((out / "manual.json").read_text(encoding="utf-8"))["assembly_order"]
+    at = {m: k for k, st in enumerate(order) for m in st["parts"]}
+    threaded = 0
+    for k, st in enumerate(order):
+        for t in st["threads_into"]:
+            threaded += 1
+            assert t["part"] in at and at[t["part"]] <= k, (st["step"], t)
+            kind = "insert" if t["kind"] == "insert" else "nut"
+            prep = [r for r in order[at[t["part"]]]["prepare"] if r["kind"] == kind and r["into"] == t["part"]
+                    and r["for"] == st["step"]]
+            assert len(prep) == 1, (st["step"], t)
+            assert prep[0]["quantity"] == sum(1 for u in st["threads_into"] if u["part"] == t["part"]
+                                              and u["kind"] == t["kind"]), prep
+    assert threaded >= 8 + 4 + 4 + 3  # the dome's 8, the column's 4 trap nuts, the shelf's 4, the seat's 3
+    steps = _h3_sections(md, "## 5. Assemble", "### Torques")
+    for k, st in enumerate(order):
+        text = next(v for h, v in steps.items() if h.startswith(f"Step {k + 1}:"))
+        for r in st["prepare"]:
+            if r["kind"] in ("insert", "nut", "pressed"):
+                assert text.index("Before it goes in") < text.index("Take "), st["step"]
+            if r["kind"] == "register":
+                assert text.index("register pins") < text.index("Take "), st["step"]
+    # the column's dowels: half before the column (in the tongue), half before the shelf
+    dowels = {st["step"]: r["quantity"] for st in order for r in st["prepare"]
+              if r["kind"] == "pressed" and r["item"].startswith("dowel pin") and "4 x" in r["item"]}
+    assert dowels == {"tower_column": 2, "tower_shelf": 2}, dowels
+    holder = next(st for st in order if "splitter_holder" in st["parts"])
+    assert sum(p.startswith("seat_ball_") for p in holder["parts"]) == 3, holder["parts"]
+
+
+def test_section_6_undoes_the_spring_bolts_and_sets_them_back(written, table31_rig):
+    """Lifting the splitter holder off its seat: its spring bolts' nuts come off first and go back to the
+    spring's installed length (its preload), the figures of the tower's row."""
+    from rigcad.manual.document import spring_bolts
+
+    out, _ = written
+    md = (out / "manual.md").read_text(encoding="utf-8")
+    text = _h3_sections(md, "## 6. Calibrate")[C.STEP_CROSSES]
+    row = next(h for h in B.tower_hardware(table31_rig) if h.get("spring_mm"))
+    words = spring_bolts(table31_rig)
+    assert words["off"] and words["on"]
+    assert text.index(words["off"]) < text.index("Lift the splitter holder") < text.index(words["on"])
+    assert f"**{row['spring_mm']['installed_length']:g} mm**" in words["on"]
+    assert f"{row['preload_N']:.1f} N" in words["on"] and f"{row['quantity']} spring bolts" in words["off"]
