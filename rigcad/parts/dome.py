@@ -14,12 +14,12 @@ lower edge; the flange's bolt holes leave it :data:`INDICATE_TRAVEL_MM` of trave
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from rigcad.errors import GeometryError
-from rigcad.parts.joints import Bought, ScrewJoint, datums_of
+from rigcad.parts.joints import ScrewJoint, datums_of
 from rigcad.parts.locating import (INDICATOR_MM, PIN_FIT_MM, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole,
                                    foil_step, teardrop_along_y)
 from rigcad.parts.layout import RigLayout, u_at_height
@@ -86,7 +86,7 @@ def register(profile: Profile, layout: RigLayout) -> DowelRegister:
                 raise GeometryError(f"the dome's register pin at ({px:.1f}, {py:.1f}) mm comes within {gap:.1f} mm of a "
                                     f"flange bolt: fewer bolts (dome_shell.bolts) or thinner pins (datum.dowel_diameter)",
                                     where=profile.where("dome_shell", "bolts"))
-    return reg
+    return replace(reg, procedure=indicating_text(profile, layout, reg))
 
 
 def flange_bolt_hole(profile: Profile, layout: RigLayout) -> float:
@@ -188,15 +188,6 @@ def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
     return BeamSeats(tuple(blocks), tuple(tunnels), tuple(pockets), screw, xm, 2 * xm, p)
 
 
-def seat_hardware(profile: Profile, layout: RigLayout) -> tuple[Bought, ...]:
-    """What the beam's seats take, as it is ordered (the foil: rigcad.parts.paraboloid.hardware)."""
-    seats, ins = beam_seats(profile, layout), INSERTS[SEAT_SCREW]
-    return (Bought(f"{SEAT_SCREW} x {seats.screw_length} mm set screw, flat point (ISO 4026)", "ISO 4026", 4,
-                   {"length_mm": seats.screw_length}, "press the beam onto its seats' floors and -y walls"),
-            Bought(f"{SEAT_SCREW} heat-set insert ({ins.length:g} mm long, in a {ins.hole:g} mm hole)", ins.source, 4,
-                   {"hole_mm": ins.hole, "length_mm": ins.length}, "take the seats' set screws"))
-
-
 def dome(profile: Profile, layout: RigLayout) -> Part:
     """Printed dome: inner face = the coated mirror surface moved behind by the coating (and forward
     by the layout's sanding stock: ``as_printed_dome``)."""
@@ -240,14 +231,15 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
                 mirrors=(("dome", layout.design_dome),), joints=(joint, reg), datums=datums)
 
 
-def indicating_text(profile: Profile, layout: RigLayout) -> str:
+def indicating_text(profile: Profile, layout: RigLayout, reg: DowelRegister | None = None) -> str:
     """The manual's shop step for centring the dome on the sample bore and drilling its register in
     place: one paragraph, the figures the parts' own."""
-    reg, hole = register(profile, layout), flange_bolt_hole(profile, layout)
+    reg = register(profile, layout) if reg is None else reg
+    hole = flange_bolt_hole(profile, layout)
     thread = flange_joint(profile, layout).thread
     return (
         f"Centre the dome on the sample bore before its register pins go in: stand it on the base plate, its "
-        f"{thread} bolts finger-tight through its {hole:.2f} mm holes on large washers (ISO 7093); put a dial "
+        f"{thread} bolts snug (a quarter of their torque) through its {hole:.2f} mm holes on large washers (ISO 7093); put a dial "
         f"test indicator ({INDICATOR_MM:g} mm graduation) on an arm that turns in the sample bore on a plug of "
         "the sample holder's size, its tip on the mirror's lower edge; turn it round and tap the dome over "
         f"until the reading varies by no more than one graduation (it has {INDICATE_TRAVEL_MM:g} mm of travel "

@@ -66,6 +66,8 @@ class DowelRegister:
     param: str = ""
     #: Drilled in place (see the module): the lower part is printed without the pins' holes.
     drilled: bool = False
+    #: How the register is made when it is drilled in place (the manual's shop step), from the part.
+    procedure: str = ""
 
     def __post_init__(self) -> None:
         if len(self.points) != 2:

@@ -17,7 +17,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigcad.errors import GeometryError
-from rigcad.parts.joints import Bought
 from rigcad.parts.layout import RigLayout
 from rigcad.parts.locating import SHIM_PACK_MM, ShimStop, foil_step, teardrop_along_y
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Solid, Union_
@@ -146,20 +145,36 @@ def stops(profile: Profile, layout: RigLayout) -> tuple[ShimStop, ShimStop]:
                      "screw presses the beam onto it"))
 
 
-def hardware(profile: Profile, layout: RigLayout) -> tuple[Bought, ...]:
-    """What the clamp's stops take, as it is ordered."""
-    m, ins = mount(profile, layout), INSERTS[SET_SCREW]
+def hardware(profile: Profile, layout: RigLayout) -> list[dict]:
+    """The paraboloid's stops' and the beam's seats' bought hardware as rows (mm; units in keys; the
+    form of rigcad.parts.tower.hardware, which the manual's bill and steps read): the clamp's set
+    screw and insert, the beam's stop pin, the seats' set screws and inserts, the shim foil; ``steps``:
+    the assembly steps (by part) that fit each item."""
+    from rigcad.parts.dome import SEAT_SCREW, beam_seats
+
+    m, seats = mount(profile, layout), beam_seats(profile, layout)
     d = 2 * m.pin.radius
     foil = ", ".join(f"{t:g}" for t in SHIM_FOIL)
-    return (Bought(f"{SET_SCREW} x {m.screw_length} mm set screw, flat point (ISO 4026)", "ISO 4026", 1,
-                   {"length_mm": m.screw_length}, "presses the beam onto the clamp's y stop"),
-            Bought(f"{SET_SCREW} heat-set insert ({ins.length:g} mm long, in a {ins.hole:g} mm hole)", ins.source, 1,
-                   {"hole_mm": ins.hole, "length_mm": ins.length}, "takes the set screw in the clamp's +y wall"),
-            Bought(f"dowel pin, ISO 8734 m6, {d:g} x {m.pin_length} mm (hardened steel)", "ISO 8734", 1,
-                   {"diameter_mm": d, "length_mm": m.pin_length}, "the x stop: pressed into the beam's top"),
-            Bought(f"shim foil, stainless steel 1.4310, {foil} mm", "EN 10140", 1,
-                   {"thinnest_mm": min(SHIM_FOIL), "pack_mm": SHIM_PACK_MM},
-                   "the packs of the clamp's two stops and the beam's seats"))
+    return [
+        {"item": "set screw, flat point (ISO 4026)", "thread": SET_SCREW, "length_mm": m.screw_length, "quantity": 1,
+         "steps": ("paraboloid",), "joins": "the paraboloid's clamp to the beam: in the insert in the clamp's +y wall, "
+                                            "it presses the beam onto the y stop's shim foil"},
+        {"item": f"heat-set insert (ruthex, {INSERTS[SET_SCREW].length:g} mm long)", "thread": SET_SCREW,
+         "length_mm": None, "quantity": 1 + 4, "steps": ("paraboloid", "dome"),
+         "joins": "the set screws' inserts: one in the clamp's +y wall, two in each of the beam's seats"},
+        {"item": "dowel pin, ISO 8734 m6 (hardened steel)", "thread": None, "length_mm": m.pin_length,
+         "diameter_mm": d, "quantity": 1, "steps": ("beam",),
+         "joins": f"the paraboloid's x stop: drill the beam's hole {d:g} mm and press the pin in until "
+                  f"{m.pin_proud:g} mm stands proud of its top"},
+        {"item": "set screw, flat point (ISO 4026)", "thread": SEAT_SCREW, "length_mm": seats.screw_length,
+         "quantity": 4, "steps": ("beam",), "joins": "the beam on its two seats: in each seat one down through its "
+                                                     "roof, one across through its +y wall"},
+        {"item": f"shim foil, stainless steel 1.4310 (EN 10140), {foil} mm, one sheet each", "thread": None,
+         "length_mm": None, "quantity": 1, "steps": ("beam", "paraboloid"),
+         "joins": f"the packs of the paraboloid's stops ({SHIM_PACK_MM:g} mm each at the design setting: on each "
+                  "seat's floor, between the beam and the clamp's -y wall, between the clamp's end and the pin), "
+                  "cut to the faces with scissors"},
+    ]
 
 
 def stem_and_clamp(m: Mount) -> Solid:

@@ -193,3 +193,26 @@ def test_the_mechanics_page_states_the_codes_figures(table31_rig, mk3s):
     assert f"what the indicating takes up ({v['dome', 'lateral'].worst:.2f} mm with the plate's print error)" in text
     reg = dome.register(p, lay)
     assert f"the pins then hold it to {reg.repeatability[0] * 1e3:.0f} um" in text
+
+
+def test_the_bill_orders_the_stops_hardware_and_the_register_step_is_the_shop_step(table31_rig):
+    from rigcad.manual import bom as B
+    from rigcad.manual.document import register_text
+
+    p, lay = table31_rig.profile, table31_rig.layout
+    m, seats = paraboloid.mount(p, lay), dome.beam_seats(p, lay)
+    bill = B.fasteners(table31_rig)
+    rows = {r["item"]: r for r in bill}
+    # the clamp's set screw (1) and the seats' (2 each), the inserts that take them, the stop pin, the foil
+    screws = [r for r in bill if "flat point (ISO 4026)" in r["item"]]
+    assert sorted(r["quantity"] for r in screws) == [1, 4]
+    assert {r["item"] for r in screws} == {f"M3 x {n} mm set screw, flat point (ISO 4026)"
+                                           for n in (m.screw_length, seats.screw_length)}
+    assert sum(r["quantity"] for r in bill if r["item"].startswith("heat-set insert (ruthex")) == 5
+    assert any(i.startswith("dowel pin, ISO 8734") and f"{2 * m.pin.radius:g} x {m.pin_length} mm" in i for i in rows)
+    assert any(i.startswith("shim foil") and f"{min(SHIM_FOIL):g}," in i for i in rows)
+    # the register is drilled in place: the step says how (indicate in, then drill), not 'press into printed holes'
+    reg = dome.register(p, lay)
+    text = register_text(reg)
+    assert "dial test indicator" in text and f"{dome.INDICATE_TRAVEL_MM:g} mm of travel" in text
+    assert "printed at the pin's size" not in text
