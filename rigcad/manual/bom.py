@@ -270,6 +270,13 @@ def fasteners(rig) -> list[dict]:
         rows.append({"item": item, "short": item, "quantity": h["quantity"],
                      "use": h["joins"], "length_mm": h.get("length_mm"), "note": "COP tower (parts.tower.hardware)",
                      "thread": h["thread"], "tower": True, "steps": list(h.get("steps", ()))})
+    from rigcad.parts.paraboloid import hardware as stop_hardware
+
+    for h in stop_hardware(rig.profile, rig.layout) if "paraboloid" in (getattr(rig, "recipes", None) or {}) else ():
+        item = tower_item(h)
+        rows.append({"item": item, "short": item, "quantity": h["quantity"], "use": h["joins"],
+                     "length_mm": h.get("length_mm"), "thread": h["thread"], "steps": list(h["steps"]),
+                     "note": "the paraboloid's shim stops and the beam's seats (parts.paraboloid.hardware)"})
     return rows
 
 
