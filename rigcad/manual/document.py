@@ -530,6 +530,8 @@ def register_text(reg) -> str:
     """What a step says of the register a part sits on (rigcad.parts.locating.DowelRegister)."""
     lateral, turn = reg.repeatability
     lower, upper = reg.lower.replace("_", " "), reg.upper.replace("_", " ")
+    if getattr(reg, "drilled", False) and getattr(reg, "procedure", ""):
+        return reg.procedure + " "  # drilled in place once the part is indicated in: the part's own shop step
     return (f"Before the {upper}: press its {len(reg.points)} register pins ({reg.item}) into the {lower}'s two "
             f"holes, printed at the pin's size, with a vise or a soft hammer until {reg.upper_engagement:g} mm stands "
             f"proud ({reg.length - reg.upper_engagement:g} mm in); a pin that goes in loose is glued in with epoxy: it "
