@@ -252,6 +252,7 @@ the image's columns and rows, the screen's axes at each turn and the patterns ar
    "the corrected map is filled from the fit"}.
 
 {_after_the_fit(p.tolerancing)}
+{_setting_the_paraboloid(rig)}
 {_measuring_the_seating(p)}"""
 
 
@@ -338,6 +339,13 @@ which the rig moved. A seat that settles tighter than the profile states makes t
 tighter when the profile says so; one that settles looser must be stated, or the frame's standard
 errors claim too much.
 """
+
+
+def _setting_the_paraboloid(rig) -> str:
+    """How the offsets the fit prints move the paraboloid on its shim stops (rigcad.parts.paraboloid)."""
+    from rigcad.parts.paraboloid import setting_text
+
+    return setting_text(rig.profile, rig.layout) + "\n"
 
 
 def _after_the_fit(tol) -> str:
