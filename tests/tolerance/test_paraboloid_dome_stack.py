@@ -216,3 +216,16 @@ def test_the_bill_orders_the_stops_hardware_and_the_register_step_is_the_shop_st
     text = register_text(reg)
     assert "dial test indicator" in text and f"{dome.INDICATE_TRAVEL_MM:g} mm of travel" in text
     assert "printed at the pin's size" not in text
+
+
+def test_the_calibration_page_says_how_to_set_the_paraboloid(table31_rig):
+    from rigcad.calibrate.kit import manual_page
+
+    p, lay = table31_rig.profile, table31_rig.layout
+    text = manual_page(table31_rig)
+    assert paraboloid.setting_text(p, lay) in text
+    # the figures it gives are the stops': a change at one seat moves the paraboloid half the foil
+    step = min(SHIM_FOIL)
+    assert f"({step / 2:g} mm per {step:g} mm foil)" in text
+    span = dome.beam_seats(p, lay).span
+    assert f"take {span * math.radians(0.01):.3f} mm of foil per 0.01 deg" in text
