@@ -634,7 +634,8 @@ def stack_count(mesh, shim_mm: float) -> int:
     return int(round(float(min(mesh.hi - mesh.lo)) / shim_mm))
 
 
-def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_mm: float | None = None) -> str:
+def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_mm: float | None = None,
+              spring: str = "") -> str:
     """What a found step says: what goes in, how (its direction), on what, and each group of like
     fasteners with its tool and what takes its thread (``prepared``: (kind, thread host) -> the step
     number where its inserts or trap nuts were set, :func:`preparations`)."""
@@ -675,7 +676,11 @@ def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_m
     for (item, tool, thread_in, host), n in groups.items():
         kind = {"insert": "insert", "trap": "nut"}.get(thread_in)
         k = (prepared or {}).get((kind, host), "?")
-        text += f" Fix it with {n} x {item}, {THREAD_IN[thread_in].format(k=k)} (tool: {tool} or an L key)."
+        how = THREAD_IN[thread_in].format(k=k)
+        if spring and "compression spring" in item:  # the seat's spring bolts: set by the spring's length
+            how = ("a washer under the head, the spring, a washer and the nut on top; hold the nut with the spanner "
+                   f"and {spring}")
+        text += f" Fix it with {n} x {item}, {how} (tool: {tool} or an L key)."
     lift = max((f.lift_mm for f in st.fasteners), default=0.0)
     if lift:
         text += (f" Its screw goes in from below: lift the rig onto blocks {lift:g} mm high under the tongue (the "
@@ -690,8 +695,8 @@ SHIM_SPREAD = 0.025
 
 def step_picture(meshes, done: list[int], members: list[int], offsets: dict, direction, shim_mm):
     """What a step's picture draws: (meshes, the indices that go in, their offsets). A shim stack that
-    goes in (SHIM_STACKS) is drawn as its shims, one box each, ``shim_mm`` thick, spread apart along the
-    step's direction by SHIM_SPREAD of the picture's size: the count the text states."""
+    goes in (SHIM_STACKS) is drawn as its shims, one box each, ``shim_mm`` thick, fanned out along the
+    stack's own axis (its thinnest extent) by SHIM_SPREAD of the picture's size: the count the text states."""
     import dataclasses
 
     import numpy as np
@@ -703,7 +708,6 @@ def step_picture(meshes, done: list[int], members: list[int], offsets: dict, dir
     lo = np.min([m.lo for m in meshes], axis=0)
     hi = np.max([m.hi for m in meshes], axis=0)
     gap = SHIM_SPREAD * float(np.max(hi - lo))
-    d = np.asarray(direction, float)
     new, moved = [], {}
     for i in members:
         m = meshes[i]
@@ -717,7 +721,7 @@ def step_picture(meshes, done: list[int], members: list[int], offsets: dict, dir
                               [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
             shown.append(dataclasses.replace(m, name=f"{m.name}_shim_{j + 1}", vertices=corners, faces=faces))
             new.append(len(shown) - 1)
-            moved[len(shown) - 1] = offsets[i] - d * gap * (j if d @ np.eye(3)[axis] < 0 else n - 1 - j)
+            moved[len(shown) - 1] = offsets[i] + np.eye(3)[axis] * gap * j  # fanned out along the stack's own axis
     return shown, new, moved
 
 
@@ -752,12 +756,13 @@ def _section_assemble(d: Doc, c) -> None:
     for k, placed in enumerate(order):
         st = placed.step
         members = [index[n] for n in st.members]
-        label = st.name.replace("_", " ") + (f" (x{len(members)})" if len(members) > 1 and st.name not in
-                                             st.members else "")
+        stacks = shim_stacks(st, by_name, _shim_mm(c.rig))
+        label = st.name.replace("_", " ") + (f" ({stacks[0]} stacks of {stacks[1]})" if stacks else f" (x{len(members)})"
+                                             if len(members) > 1 and st.name not in st.members else "")
         text = "".join(register_text(j) for m in st.members if m in c.rig.recipes
                        for j in c.rig.recipes[m].joints if isinstance(j, DowelRegister))
         text += preparation_text(prep[st.name], number, st.name)
-        text += step_text(placed, by_name, prepared, _shim_mm(c.rig))
+        text += step_text(placed, by_name, prepared, _shim_mm(c.rig), spring_bolts(c.rig).get("set", ""))
         text += "".join(f" Press them in: {r['joins']}." for r in prep[st.name] if r["kind"] == "placed")
         if st.name == "projector_body":
             text += plan_mod.projector_screw_text(c.rig)
@@ -949,14 +954,19 @@ def spring_bolts(rig) -> dict:
     sp = row["spring_mm"]
     off = (f"Undo the holder's {row['quantity']} spring bolts first: hold each bolt's head under the shelf with the "
            f"{th.hex_key:g} mm hex key, run its nut off the top with the {th.nut_af:g} mm spanner, and lift off the "
-           "washer, the spring and the washer under it (keep each bolt's set together); the bolts drop out from "
-           "under the shelf. ")
-    on = (f"Put the {row['quantity']} spring bolts back up through the shelf and the holder's flange, a washer, the "
-          f"spring ({sp['wire']:g} mm wire, {sp['outer_diameter']:g} mm outside, {sp['free_length']:g} mm free) and a "
-          f"washer on each, and run each nut down until its spring is **{sp['installed_length']:g} mm** long, measured "
-          f"with the caliper: {row['preload_N']:.1f} N each, the preload the seat is designed for (these bolts are set "
-          "by their springs' length, not by a torque).")
-    return {"off": off, "on": on}
+           "washer and the spring (keep each bolt's set together); the bolts drop out from under the shelf with the "
+           "washers under their heads. ")
+    on = (f"Put the {row['quantity']} spring bolts back up through the shelf and the holder's flange, a washer under "
+          f"each head, then on top the spring ({sp['wire']:g} mm wire, {sp['outer_diameter']:g} mm outside, "
+          f"{sp['free_length']:g} mm free), a washer and the nut, and " + spring_setting(row))
+    return {"off": off, "on": on, "set": spring_setting(row)}
+
+
+def spring_setting(row: dict) -> str:
+    """How a spring bolt's nut is set (the tower's row with ``spring_mm``): to the spring's installed length."""
+    return (f"run each nut down until its spring is **{row['spring_mm']['installed_length']:g} mm** long, measured "
+            f"with the caliper: {row['preload_N']:.1f} N each, the preload the seat is designed for (these bolts are "
+            "set by their springs' length, not by a torque).")
 
 
 def sanding_blocks(d: Doc, c, block_set: list[dict]) -> None:
