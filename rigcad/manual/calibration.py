@@ -135,8 +135,10 @@ def access(rig) -> list[dict]:
     if getattr(rig.layout, "tower", None) is not None:
         f = cross_fixture(p, rig.layout)
         rows.append({"item": "projector crosses, backplate and their plate", "way": "onto the shelf, from above",
-                     "out_of_the_way": "the splitter holder (with the camera) and the focusing lens",
-                     "back": "the holder on its kinematic seat; the lens in its pocket",
+                     "out_of_the_way": "the splitter holder (with the camera; its spring bolts undone first) and the "
+                                       "focusing lens",
+                     "back": "the holder on its kinematic seat, its spring bolts set back to the springs' length; the "
+                             "lens in its pocket",
                      "checked": f"the plate ({f.plate_x[1] - f.plate_x[0]:.0f} mm) sits on the splitter seat's cone, vee and "
                                 "flat on its three balls, short of the lens mount at either end of its slots; the "
                                 "crosses' centres on the projector's axis"})
