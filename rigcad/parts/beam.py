@@ -21,5 +21,5 @@ def beam(profile: Profile, layout: RigLayout) -> Part:
     pin = mount(profile, layout).pin_hole
     return Part("beam", Difference(box, (pin,)), (0.35, 0.35, 0.38),
                 "mounting beam along x through the dome's slots, on its two seats; the paraboloid's stop pin "
-                f"(ISO 8734, {2 * pin.radius:g} mm) pressed into its top, drilled to size",
+                f"(ISO 8734, {2 * mount(profile, layout).pin.radius:g} mm) pressed into its top, drilled to size",
                 occluders=(("beam", box),))

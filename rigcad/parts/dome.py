@@ -21,7 +21,7 @@ import numpy as np
 from rigcad.errors import GeometryError
 from rigcad.parts.joints import ScrewJoint, datums_of
 from rigcad.parts.locating import (INDICATOR_MM, PIN_FIT_MM, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole,
-                                   foil_step, teardrop_along_y)
+                                   foil_step, stepped_hole, teardrop_along_y)
 from rigcad.parts.layout import RigLayout, u_at_height
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Union_
 from rigcad.profile.schema import Profile
@@ -178,8 +178,9 @@ def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
         lo, hi = sorted((s * x_in, s * x_out))
         blocks.append(Box((lo, y_lo, 0.0), (hi, y_hi, top)))  # standing on the plate, through the flange
         tunnels.append(Box((lo - 1.0, -w, floor), (hi + 1.0, w + 2 * c, roof)))
-        pockets += [Cylinder((s * xm, 0.0, top - ins.pocket_depth), ins.hole / 2, ins.pocket_depth + 1.0),
-                    Cylinder((s * xm, 0.0, roof - 1.0), THREADS[SEAT_SCREW].clearance / 2, side + 2.0),
+        # the roof's screw: its bore up from the tunnel, the insert's pocket over it, open at the top
+        pockets += [stepped_hole(s * xm, 0.0, roof - 1.0, ((THREADS[SEAT_SCREW].clearance / 2, top - ins.pocket_depth - roof + 1.0),
+                                                             (ins.hole / 2, ins.pocket_depth + 1.0))),
                     teardrop_along_y((s * xm, y_hi - ins.pocket_depth / 2 + 0.5, 0.5 * (z0 + z1)), ins.hole / 2,
                                      ins.pocket_depth + 1.0),
                     teardrop_along_y((s * xm, w + 2 * c + side / 2, 0.5 * (z0 + z1)),

@@ -28,7 +28,7 @@ import math
 from dataclasses import dataclass
 
 from rigcad.errors import GeometryError
-from rigcad.parts.recipe import Box, Cylinder, Line, Prism, Section, Translate
+from rigcad.parts.recipe import Box, Cylinder, Line, Prism, Revolve, Section, Translate
 from rigcad.standards import SHIM_FOIL, THREADS, longest_dowel
 
 #: Worst-case diametral clearance (mm) of an ISO 8734 m6 pin (+0.004..+0.012 mm for 3..6 mm) in a
@@ -141,7 +141,8 @@ class DowelRegister:
         hole = Cylinder((x0, y0, z0 - 1.0), r, z1 - z0 + 2.0)
         along_x = abs(y1 - y0) < 1e-9
         dx, dy = (self.slot / 2, 0.0) if along_x else (0.0, self.slot / 2)
-        ends = tuple(Cylinder((x1 + s * dx, y1 + s * dy, z0 - 1.0), r, z1 - z0 + 2.0) for s in (-1, 1))
+        # the slot's round ends (revolved: the bill does not take them for bolts' holes)
+        ends = tuple(stepped_hole(x1 + s * dx, y1 + s * dy, z0 - 1.0, ((r, z1 - z0 + 2.0),)) for s in (-1, 1))
         web = Box((x1 - dx - (0.0 if along_x else r), y1 - dy - (r if along_x else 0.0), z0 - 1.0),
                   (x1 + dx + (0.0 if along_x else r), y1 + dy + (r if along_x else 0.0), z1 + 1.0))
         return (hole, *ends, web)
@@ -175,6 +176,19 @@ def foil_step() -> float:
     return min(SHIM_FOIL)
 
 
+def stepped_hole(x: float, y: float, z0: float, steps: tuple[tuple[float, float], ...]) -> Translate:
+    """A vertical hole (mm) of ``steps`` (radius, height) from ``z0`` up, one on the other (an insert's
+    pocket over a screw's bore, a pin's hole), drawn as one revolved section: a blind or stepped hole
+    that is not a through bolt's (the bill finds bolts by their plain vertical cylinders)."""
+    pts, z = [(0.0, 0.0)], 0.0
+    for r, h in steps:
+        pts += [(r, z), (r, z + h)]
+        z += h
+    pts.append((0.0, z))
+    segs = tuple(Line(pts[k], pts[(k + 1) % len(pts)]) for k in range(len(pts)) if pts[k] != pts[(k + 1) % len(pts)])
+    return Translate(Revolve(Section(segs)), (float(x), float(y), float(z0)))
+
+
 def teardrop_along_y(centre: tuple[float, float, float], radius: float, length: float, n: int = 16) -> Translate:
     """A hole along y (mm) with a printable profile: the circle of ``radius`` (its polygon of ``n``
     sides drawn about it, so the hole is never under size) closed above by two 45 deg flanks meeting
@@ -189,4 +203,4 @@ def teardrop_along_y(centre: tuple[float, float, float], radius: float, length: 
 
 
 __all__ = ["DowelRegister", "INDICATOR_MM", "PIN_FIT_MM", "SHIM_PACK_MM", "SLOT_FIT_MM", "ShimStop", "bolt_hole",
-           "foil_step", "teardrop_along_y"]
+           "foil_step", "stepped_hole", "teardrop_along_y"]

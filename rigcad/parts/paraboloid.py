@@ -18,7 +18,7 @@ import numpy as np
 
 from rigcad.errors import GeometryError
 from rigcad.parts.layout import RigLayout
-from rigcad.parts.locating import SHIM_PACK_MM, ShimStop, foil_step, teardrop_along_y
+from rigcad.parts.locating import SHIM_PACK_MM, ShimStop, foil_step, stepped_hole, teardrop_along_y
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Solid, Union_
 from rigcad.profile.schema import Profile
 from rigcad.standards import INSERTS, SHIM_FOIL, THREADS, dowel_diameter_for, longest_dowel, shortest_set_screw
@@ -63,10 +63,11 @@ class Mount:
                                                                 ("pin", self.pin), ("set screw", self.screw))
 
     @property
-    def pin_hole(self) -> Cylinder:
-        """The pin's hole in the beam (drilled to the pin's size, the pin pressed in)."""
+    def pin_hole(self) -> Solid:
+        """The pin's blind hole in the beam (drilled to the pin's size, the pin pressed in), open at the
+        beam's top."""
         p = self.pin
-        return Cylinder((p.base[0], p.base[1], p.base[2] - 0.5), p.radius, p.height + 0.5 - self.pin_proud)
+        return stepped_hole(p.base[0], p.base[1], p.base[2] - 0.5, ((p.radius, p.height + 0.5 - self.pin_proud + 1.0),))
 
     @property
     def pin_proud(self) -> float:
