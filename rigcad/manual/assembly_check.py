@@ -226,6 +226,12 @@ def penetration(a, b) -> float:
     return 2.0 * x.volume() / area if area > 0 else 0.0
 
 
+def _boxes_overlap(a, b) -> bool:
+    """Whether two boxes (lo x, y, z, hi x, y, z; mm) share a volume: boxes that only touch do not (their
+    solids' overlap is then empty or flat, a penetration of 0)."""
+    return all(a[i] < b[i + 3] and b[i] < a[i + 3] for i in range(3))
+
+
 def _union(solids):
     import manifold3d as m3
 
@@ -250,8 +256,7 @@ def swept(solid, direction, travel: float, near=None):
     import manifold3d as m3
 
     d = np.asarray(direction, float)
-    hull = solid.hull()
-    if hull.volume() <= solid.volume() * (1 + 1e-9) + 1e-9:  # convex: the exact sweep is one hull
+    if is_convex(solid):  # the exact sweep is one hull
         return m3.Manifold.batch_hull([solid, solid.translate(tuple(-d * travel))])
     s = _near_positions(solid, d, travel, near)
     return _union([solid.translate(tuple(-d * v)) for v in s])
@@ -262,17 +267,54 @@ def swept(solid, direction, travel: float, near=None):
 COARSE = 32
 
 
-def sweep_penetration(solid, direction, travel: float, other) -> float:
-    """Penetration (mm) of ``solid`` swept along ``direction`` (see :func:`swept`) into ``other``."""
+def is_convex(solid) -> bool:
+    """Whether ``solid`` is its own convex hull (to the volume's last 1e-9): its sweep is then one hull."""
+    return solid.hull().volume() <= solid.volume() * (1 + 1e-9) + 1e-9
+
+
+def sweep_penetration(solid, direction, travel: float, other, convex: bool | None = None, hull_sweep=None) -> float:
+    """Penetration (mm) of ``solid`` swept along ``direction`` (see :func:`swept`) into ``other``:
+    :func:`coarse_penetration` when its copies find a collision, else :func:`whole_sweep_penetration`.
+    ``convex`` (:func:`is_convex`) and, for a convex solid, ``hull_sweep`` (its :func:`swept`) may be
+    given when known: a caller measuring one sweep against many solids computes them once."""
+    first = coarse_penetration(solid, direction, travel, other, convex)
+    return first if first is not None else whole_sweep_penetration(solid, direction, travel, other, convex, hull_sweep)
+
+
+def whole_sweep_penetration(solid, direction, travel: float, other, convex: bool | None = None,
+                            hull_sweep=None) -> float:
+    """Penetration (mm) of the whole sweep of ``solid`` (:func:`swept`, near ``other`` only) into ``other``;
+    0 when the sweep's box does not meet ``other``'s."""
+    if not _boxes_overlap(_reach(solid, direction, travel), other.bounding_box()):
+        return 0.0
     d = np.asarray(direction, float)
-    hull = solid.hull()
-    if hull.volume() <= solid.volume() * (1 + 1e-9) + 1e-9:
-        return penetration(swept(solid, d, travel), other)
+    if convex if convex is not None else is_convex(solid):
+        return penetration(hull_sweep if hull_sweep is not None else swept(solid, d, travel), other)
+    return penetration(swept(solid, d, travel, [other.bounding_box()]), other)
+
+
+def coarse_penetration(solid, direction, travel: float, other, convex: bool | None = None) -> float | None:
+    """The first part of :func:`sweep_penetration`, cheap: a non-convex ``solid`` is first tried at
+    every COARSE-th sampled position, one copy at a time, and the first copy that runs more than
+    CLEARANCE_MM into ``other`` gives the sweep's penetration (mm; a lower bound of the whole sweep's).
+    None when that finds nothing (a convex solid, or no copy in the way): the whole sweep decides."""
+    if convex if convex is not None else is_convex(solid):
+        return None
+    if not _boxes_overlap(_reach(solid, direction, travel), other.bounding_box()):
+        return None
+    d = np.asarray(direction, float)
     for s in _near_positions(solid, d, travel, [other.bounding_box()])[::COARSE]:
         pen = penetration(solid.translate(tuple(-d * s)), other)
         if pen > CLEARANCE_MM:
             return pen
-    return penetration(swept(solid, d, travel, [other.bounding_box()]), other)
+    return None
+
+
+def _reach(solid, direction, travel: float) -> tuple[float, ...]:
+    """The box (lo x, y, z, hi x, y, z; mm) of ``solid`` swept back along ``direction`` by ``travel``."""
+    box = np.asarray(solid.bounding_box(), float)
+    moved = box - np.tile(np.asarray(direction, float) * travel, 2)
+    return (*np.minimum(box[:3], moved[:3]), *np.maximum(box[3:], moved[3:]))
 
 
 def _near_positions(solid, d: np.ndarray, travel: float, near) -> np.ndarray:
@@ -303,6 +345,9 @@ class Refusal:
     #: How far (mm) the way in that comes nearest still runs into something: the least penetration
     #: over the step's directions, or the deepest of its fasteners' collisions (0: waiting, not blocked).
     depth: float = 0.0
+    #: Each way in tried, (direction, mm it still runs into something): a direction's sweep, or for
+    #: the direction found clear, its fasteners' deepest collision (empty: waiting, not blocked).
+    depths: tuple[tuple[tuple[float, float, float], float], ...] = ()
 
     def __str__(self) -> str:
         return self.reason
@@ -330,6 +375,13 @@ class Assembly:
         self.bench_top = float(min(s.bounding_box()[2] for s in solids.values())) if with_bench else None
         self._memo: dict = {}
         self._pairs: dict = {}
+        #: Solids made once per assembly: each step's solids in place (its parts and fitted fasteners),
+        #: each fastener's body, paths and tool paths, each part's convexity and convex sweeps.
+        self._placed: dict[str, list] = {}
+        self._fittings: dict[tuple[str, int], tuple] = {}
+        self._convex: dict[str, bool] = {}
+        self._hull_sweeps: dict = {}
+        self._coarse: dict = {}
         #: A fitted fastener's name -> the step that fits it (an obstacle is named by its part or step).
         self._owner = {_fastener_name(s, k): s.name for s in self.steps for k in range(len(s.fasteners))}
 
@@ -337,18 +389,50 @@ class Assembly:
         """The part or step an obstacle's name stands for (a fastener: the step that fits it)."""
         return self._owner.get(obstacle, obstacle)
 
+    def _fitting(self, step: Step, k: int) -> tuple:
+        """Fastener ``k`` of ``step``: its solids in place, its paths and its tools' paths (made once)."""
+        key = (step.name, k)
+        if key not in self._fittings:
+            f = step.fasteners[k]
+            self._fittings[key] = (f.solids(), f.paths(), f.tool_paths())
+        return self._fittings[key]
+
+    def _in_place(self, name: str) -> list[tuple[str, object]]:
+        """The named solids step ``name`` leaves in place: its parts and its fitted fasteners."""
+        if name not in self._placed:
+            step = self.by_name[name]
+            self._placed[name] = ([(m, self.solids[m]) for m in step.members]
+                                  + [(_fastener_name(step, k), self._fitting(step, k)[0])
+                                     for k in range(len(step.fasteners))])
+        return self._placed[name]
+
     def _obstacles(self, done: frozenset[str], extra: tuple[str, ...] = ()) -> list[tuple[str, object]]:
         """Named solids in place once the steps ``done`` are: parts, fitted fasteners, the bench."""
         out = []
         for name in sorted(done):
-            step = self.by_name[name]
-            out += [(m, self.solids[m]) for m in step.members]
-            out += [(_fastener_name(step, k), f.solids()) for k, f in enumerate(step.fasteners)]
+            out += self._in_place(name)
         out += [(m, self.solids[m]) for m in extra]
         return out
 
+    def _sweep_into(self, member: str, d, travel: float, name: str, other) -> float:
+        """:func:`sweep_penetration` of part ``member`` into solid ``name``, with its convexity, its
+        convex sweep and its coarse copies' answer made once."""
+        key = (("sweep", member, d, travel), name)
+        if key not in self._coarse:
+            self._coarse[key] = coarse_penetration(self.solids[member], d, travel, other, self._is_convex(member))
+        if self._coarse[key] is not None:
+            return self._coarse[key]
+        hull_sweep = None
+        if self._is_convex(member):
+            hk = (member, tuple(d), travel)
+            if hk not in self._hull_sweeps:
+                self._hull_sweeps[hk] = swept(self.solids[member], d, travel)
+            hull_sweep = self._hull_sweeps[hk]
+        return whole_sweep_penetration(self.solids[member], d, travel, other, True, hull_sweep) if hull_sweep is not None \
+            else whole_sweep_penetration(self.solids[member], d, travel, other, False)
+
     def _into(self, key: tuple, make, named: list[tuple[str, object]], low: float | None = None) -> tuple[float, str]:
-        """The deepest penetration (mm) of a solid into the named solids (``make(other)`` measures it,
+        """The deepest penetration (mm) of a solid into the named solids (``make(other, its name)`` measures it,
         remembered under ``key``) and the bench (``low``: the solid's lowest point, None: the bench is not in
         its way), and the name of the one it runs into deepest. Each pair is computed once: a solid
         in place is the same whatever came before it."""
@@ -358,7 +442,7 @@ class Assembly:
         for name, other in named:
             pair = (key, name)
             if pair not in self._pairs:
-                self._pairs[pair] = make(other)
+                self._pairs[pair] = make(other, name)
             if self._pairs[pair] > worst[0]:
                 worst = (self._pairs[pair], name)
         return worst
@@ -370,18 +454,84 @@ class Assembly:
             self._memo[key] = self._attempt(step, done)
         return self._memo[key]
 
-    def _attempt(self, step: Step, done: frozenset[str]) -> Placed | Refusal:
+    def blocked(self, step: Step, done: frozenset[str]) -> bool:
+        """Whether :meth:`attempt` refuses ``step`` after ``done`` as blocked (something in place is in
+        its way), found with fewer solids: a way in is given up at the first solid it runs into
+        (solids already measured first), not measured against them all for the refusal's depth."""
+        known = self._memo.get((step.name, done))
+        if known is not None:
+            return isinstance(known, Refusal) and known.blocked
+        if self._missing(step, done):
+            return False
+        obstacles = self._obstacles(done)
+        if not any(self._clear(step, d, obstacles) for d in step.directions):
+            return True
+        return bool(self._fastener_problems(step, self._obstacles(done, step.members), []))
+
+    def place(self, step: Step, done: frozenset[str]) -> Placed | None:
+        """:meth:`attempt`'s Placed for ``step`` after ``done``, or None where it refuses; with fewer
+        solids (no refusal's depths are measured: see :meth:`blocked`)."""
+        known = self._memo.get((step.name, done))
+        if known is not None:
+            return known if isinstance(known, Placed) else None
+        if self._missing(step, done):
+            return None
+        obstacles = self._obstacles(done)
+        direction = next((d for d in step.directions if self._clear(step, d, obstacles)), None)
+        if direction is None or self._fastener_problems(step, self._obstacles(done, step.members), []):
+            return None
+        return Placed(step, tuple(float(v) for v in direction))
+
+    def _clear(self, step: Step, d, obstacles: list) -> bool:
+        """Whether ``step``'s parts swept along ``d`` stay within CLEARANCE_MM of everything in
+        ``obstacles`` and the bench (:meth:`_attempt`'s test of a direction, to the same bits). The
+        cheap evidence first: the bench, the penetrations already measured, then each sweep's coarse
+        copies (:func:`coarse_penetration`: a hit there is the sweep's own value); only then whole
+        sweeps, the costly part, which a clear way in needs against every solid near it."""
+        for m in step.members:
+            key = ("sweep", m, d, step.travel_mm)
+            low = self.solids[m].bounding_box()[2] - max(0.0, d[2]) * step.travel_mm
+            if self.bench_top is not None and self.bench_top - low > CLEARANCE_MM:
+                return False
+            if any(self._pairs.get((key, name), 0.0) > CLEARANCE_MM for name, _ in obstacles):
+                return False
+        todo = [(m, ("sweep", m, d, step.travel_mm), name, other) for m in step.members for name, other in obstacles
+                if (("sweep", m, d, step.travel_mm), name) not in self._pairs]
+        for m, key, name, other in todo:
+            if (key, name) not in self._coarse:
+                self._coarse[(key, name)] = coarse_penetration(self.solids[m], d, step.travel_mm, other,
+                                                               self._is_convex(m))
+            if self._coarse[(key, name)] is not None:
+                self._pairs[(key, name)] = self._coarse[(key, name)]
+                return False
+        for m, key, name, other in todo:
+            self._pairs[(key, name)] = self._sweep_into(m, d, step.travel_mm, name, other)
+            if self._pairs[(key, name)] > CLEARANCE_MM:
+                return False
+        return True
+
+    def _is_convex(self, member: str) -> bool:
+        if member not in self._convex:
+            self._convex[member] = is_convex(self.solids[member])
+        return self._convex[member]
+
+    def _missing(self, step: Step, done: frozenset[str]) -> list[str]:
+        """The parts ``step`` needs in place (its own needs, the parts its fasteners pass through)
+        that ``done`` has not put in."""
         in_place = {m for n in done for m in self.by_name[n].members} | set(step.members)
         wanted = [*step.needs, *(p for f in step.fasteners for p in f.passes)]
-        missing = sorted({n for n in wanted if n not in in_place})
+        return sorted({n for n in wanted if n not in in_place})
+
+    def _attempt(self, step: Step, done: frozenset[str]) -> Placed | Refusal:
+        missing = self._missing(step, done)
         if missing:
             return Refusal(f"needs {', '.join(missing)} in place first", False)
         obstacles = self._obstacles(done)
         direction, reasons, hits = None, [], []
         for d in step.directions:
             worst = max((self._into(("sweep", m, d, step.travel_mm),
-                                    lambda other, m=m, d=d: sweep_penetration(self.solids[m], d, step.travel_mm,
-                                                                              other), obstacles,
+                                    lambda other, name, m=m, d=d: self._sweep_into(m, d, step.travel_mm, name, other),
+                                    obstacles,
                                     self.solids[m].bounding_box()[2] - max(0.0, d[2]) * step.travel_mm)
                          for m in step.members), key=lambda t: t[0])
             if worst[0] <= CLEARANCE_MM:
@@ -389,12 +539,15 @@ class Assembly:
                 break
             reasons.append(f"moved in along {_dir_name(d)} it runs {worst[0]:.2f} mm into {worst[1]}")
             hits.append(worst)
+        tried = tuple((d, h[0]) for d, h in zip(step.directions, hits))
         if direction is None:
             return Refusal("; ".join(reasons) or "no direction declared", True, self._named(hits),
-                           min((h[0] for h in hits), default=float("inf")))
+                           min((h[0] for h in hits), default=float("inf")), tried)
         blocked = self._fastener_problems(step, self._obstacles(done, step.members), hits)
         if blocked:
-            return Refusal("; ".join(blocked), True, self._named(hits), max((h[0] for h in hits), default=0.0))
+            fitting = max((h[0] for h in hits[len(tried):]), default=0.0)
+            return Refusal("; ".join(blocked), True, self._named(hits), max((h[0] for h in hits), default=0.0),
+                           (*tried, (direction, fitting)))
         return Placed(step, tuple(float(v) for v in direction))
 
     def _named(self, hits: list[tuple[float, str]]) -> tuple[str, ...]:
@@ -415,21 +568,21 @@ class Assembly:
             # a screw's thread runs into the bench or into the instrument's socket by design
             into = [(n, s) for n, s in fitted
                     if not (f.thread_in == "instrument" and n in step.members) and n not in f.pierces]
-            body = f.solids()
-            pen, what_in = self._into(("body", name), lambda other: penetration(body, other), into,
+            body, paths, tool_paths = self._fitting(step, k)
+            pen, what_in = self._into(("body", name), lambda other, _: penetration(body, other), into,
                                       None if f.thread_in == "bench" else body.bounding_box()[2])
             if pen > CLEARANCE_MM:
                 out.append(f"{f.item} #{k + 1} at {_at(f.head)} runs {pen:.2f} mm into {what_in}")
                 hits.append((pen, what_in))
-            for what, path in f.paths():
-                pen, by = self._into(("path", name, what), lambda other, path=path: penetration(path, other), fitted,
+            for what, path in paths:
+                pen, by = self._into(("path", name, what), lambda other, _, path=path: penetration(path, other), fitted,
                                      path.bounding_box()[2] + f.lift_mm)
                 if pen > CLEARANCE_MM:
                     out.append(f"{f.item} #{k + 1} at {_at(f.head)}: {what} is blocked by {by} ({pen:.2f} mm)")
                     hits.append((pen, by))
             tried, tool_hits = [], []
-            for tool, path in f.tool_paths():
-                pen, by = self._into(("tool", name, tool.name), lambda other, path=path: penetration(path, other), fitted,
+            for tool, path in tool_paths:
+                pen, by = self._into(("tool", name, tool.name), lambda other, _, path=path: penetration(path, other), fitted,
                                      path.bounding_box()[2] + f.lift_mm)
                 if pen <= CLEARANCE_MM:
                     break
@@ -476,24 +629,41 @@ def check_order(assembly: Assembly, names: list[str]) -> list[Placed]:
 
 
 def find_order(assembly: Assembly) -> list[Placed]:
-    """A feasible order of every step (depth-first over the sets of steps done, the declared order
-    first at each choice; sets that lead nowhere are remembered). A set where a step left is blocked
-    leads nowhere: parts only ever add obstacles. GeometryError when there is no order, naming the
-    steps left and why each cannot go next."""
+    """A feasible order of every step: depth-first over the sets of steps done, the declared order
+    first at each choice, so the order found is the first feasible one in that search. GeometryError
+    when there is no order, naming the steps left and why each cannot go next (:func:`_stuck`).
+
+    Bounded by necessary conditions, each exact because parts only ever add obstacles (a step
+    blocked with a set in place is blocked with any larger set): a step blocked with only what it
+    must come after in place refuses the rig at once; :func:`must_precede` finds, pair by pair, the
+    steps that must go in before others (one put in first would block the other), and a loop among
+    them refuses the rig without a search; the search puts a step in only after every step it must
+    come after, and gives up a set when a step left would be blocked by that set with what it must
+    come after added. Sets that lead nowhere are remembered."""
     _refuse_cycles(assembly)
     _refuse_blocked_at_first(assembly)
+    must = must_precede(assembly)
+    if must is None:
+        raise _stuck(assembly)
     dead: set[frozenset[str]] = set()
     total = len(assembly.steps)
+
+    def hopeless(done: frozenset[str]) -> bool:
+        """A step left is blocked with ``done`` and what it must come after in place."""
+        return any(assembly.blocked(step, done | must[step.name]) for step in assembly.steps
+                   if step.name not in done)
 
     def search(done: frozenset[str], path: list[Placed]) -> list[Placed] | None:
         if len(path) == total:
             return path
         if done in dead:
             return None
-        left = [(step, assembly.attempt(step, done)) for step in assembly.steps if step.name not in done]
-        if not any(isinstance(r, Refusal) and r.blocked for _, r in left):
-            for step, r in left:
-                if isinstance(r, Placed):
+        if not hopeless(done):
+            for step in assembly.steps:
+                if step.name in done or not must[step.name] <= done:
+                    continue
+                r = assembly.place(step, done)
+                if r is not None:
                     found = search(done | {step.name}, [*path, r])
                     if found is not None:
                         return found
@@ -504,6 +674,35 @@ def find_order(assembly: Assembly) -> list[Placed]:
     if order is None:
         raise _stuck(assembly)
     return order
+
+
+def must_precede(assembly: Assembly) -> dict[str, frozenset[str]] | None:
+    """For each step, the steps that must be in place before it in every feasible order: what it
+    needs (transitively), and each step ``t`` such that ``s`` put in after ``t`` (with all that must
+    precede either) would be blocked, so ``s`` must come before ``t``; repeated until nothing is
+    added. None when no order exists: steps would have to precede each other, or a step is blocked
+    with only what must precede it in place."""
+    before = _before(assembly)
+    names = [s.name for s in assembly.steps]
+    must = {n: set(before[n]) for n in names}
+    changed = True
+    while changed:
+        changed = False
+        for s in names:
+            for t in names:
+                if t == s or t in must[s] or s in must[t]:
+                    continue
+                if not assembly.blocked(assembly.by_name[s], frozenset(must[s] | must[t] | {t})):
+                    continue
+                # s must precede t, and so must everything that must precede s; and all after t
+                ahead = must[s] | {s}
+                grown = [u for u in names if (u == t or t in must[u]) and not ahead <= must[u]]
+                for u in grown:
+                    must[u] |= ahead
+                    if u in must[u] or assembly.blocked(assembly.by_name[u], frozenset(must[u])):
+                        return None  # u must precede itself, or is blocked by what must precede it
+                changed = True
+    return {n: frozenset(v) for n, v in must.items()}
 
 
 def _refuse_cycles(assembly: Assembly) -> None:
@@ -576,4 +775,4 @@ def _stuck(assembly: Assembly) -> AssemblyError:
 
 
 __all__ = ["Assembly", "CLEARANCE_MM", "Fastener", "Placed", "Refusal", "SWEEP_STEP_MM", "Step", "Tool", "check_order",
-           "cylinder", "find_order", "manifold", "penetration", "swept"]
+           "cylinder", "find_order", "is_convex", "manifold", "must_precede", "penetration", "swept"]
