@@ -71,9 +71,8 @@ def cmd_optimize(args: argparse.Namespace) -> int:
         bar.set_postfix_str(f"best merit {best:.6g}")
 
     try:
-        # the assembly gate (assembly_gate) is not passed as certify_also yet: on a design it refuses, the
-        # check's order search backtracks for many minutes (measured: over 12 min on one certified design)
-        run = run_optimize(args.profile, Path(args.exports), engine, overrides, progress)
+        # every design the certified path checks must pass the assembly gate: a refused one gives way to the next
+        run = run_optimize(args.profile, Path(args.exports), engine, overrides, progress, certify_also=assembly_gate)
     finally:
         bar.close()
     rep = run.report
@@ -93,6 +92,8 @@ def cmd_optimize(args: argparse.Namespace) -> int:
         print(f"  {label:<24} {fmt(b):>12} {fmt(c):>12}")
     for key, value in chosen["parameters"].items():
         print(f"  {key:<32} {value:.6g}  (base {base['parameters'][key]:.6g})")
+    for refused in rep["rejected_by_certified_path"]:
+        print(f"  refused on the certified path: evaluation {refused['index']}: {refused['error']}")
     cert = rep["certified_check"]["fast_minus_certified"]
     print("  certified path (converged DOP853 dome) minus fast path: "
           + ", ".join(f"{k} {-v:+.2g}" for k, v in cert.items()))

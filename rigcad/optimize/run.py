@@ -226,7 +226,8 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
         report["design_profile"] = str(profile_path)
     elif rejected:
         report["infeasible"] = (f"the {len(rejected)} best designs were refused by the certified path "
-                                f"(Rig.from_profile); the first: {rejected[0]['error']}")
+                                f"(Rig.from_profile{' and the further check' if certify_also else ''}); "
+                                f"the first: {rejected[0]['error']}")
     else:
         report["infeasible"] = infeasible_message(problem, result.history)
     files["optimize.json"] = json_bytes(report)
