@@ -140,6 +140,7 @@ bench: $(VENV)/.installed stl
 	$(PY) bench/make_stl.py --out $(BENCH_OUT)
 	$(PY) bench/basis.py --out $(BENCH_OUT)
 	$(PY) bench/optimize.py --out $(BENCH_OUT)
+	$(PY) bench/assembly_order.py --out $(BENCH_OUT)
 	$(PY) bench/startup.py --out $(BENCH_OUT)
 	$(PY) bench/hugepages.py --out $(BENCH_OUT)
 	$(PY) bench/commands.py --out $(BENCH_OUT)
