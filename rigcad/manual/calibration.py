@@ -328,6 +328,12 @@ def kit_items(rig) -> list[KitItem]:
                 f"photographic gray card (Kodak R-27 class), cut to a {holder:g} mm disc (the sample holder's "
                 "diameter)", ("gray card",), (STEP_GRAY,)),
     ]
+    if getattr(rig.layout, "tower", None) is not None:  # the crosses' plate sits on the splitter seat on its balls
+        from rigcad.parts.crosses import cross_fixture
+
+        (ball,) = cross_fixture(p, rig.layout).bought
+        items.append(KitItem(f"Steel balls, {ball.size_mm['diameter']:g} mm, grade G10 ({ball.standard})",
+                             str(ball.quantity), ball.role, ("steel balls",), (STEP_CROSSES,)))
     cal = getattr(p, "calibration", None)
     if cal is not None:
         from rigcad.calibrate.kit import screen_room, upright_room

@@ -181,3 +181,14 @@ def test_the_plate_lists_its_balls_to_buy(rig):
     (ball,) = f.bought
     assert ball.quantity == 3 and ball.standard == "ISO 3290-1"
     assert ball.size_mm == {"diameter": rig.profile.adjusters.seat_ball}  # the seat's own balls' size
+
+
+def test_the_calibration_kit_lists_the_plates_balls(rig):
+    """The manual's calibration kit (rigcad.manual.calibration.kit_items) carries the plate's balls,
+    for the crosses' step, by the words that step names them with."""
+    from rigcad.manual import calibration as C
+
+    f = cross_fixture(rig.profile, rig.layout)
+    (item,) = [k for k in C.kit_items(rig) if "steel balls" in k.words]
+    assert item.quantity == str(len(f.balls)) == "3" and item.steps == (C.STEP_CROSSES,)
+    assert f"{rig.profile.adjusters.seat_ball:g} mm" in item.item and "ISO 3290-1" in item.item
