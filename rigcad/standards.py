@@ -134,6 +134,17 @@ INCH_SCREW_LENGTHS = ((0.5, "1/2 in"), (0.625, "5/8 in"), (0.75, "3/4 in"), (0.8
 #: ISO 7093-1 large washers (outer diameter, thickness; mm) per thread; the size-6 washer (6.4 mm bore)
 #: also takes a 1/4 in screw.
 LARGE_WASHERS = {"M3": (9.0, 0.8), "M4": (12.0, 1.0), "M5": (15.0, 1.2), "M6": (18.0, 1.6), "1/4-20 UNC": (18.0, 1.6)}
+#: ISO 7093-1 large washers by size, with their bores: bore d1, outside diameter d2, thickness h (mm; the
+#: standard's nominal figures), for the stacks that bridge a slot (rigcad.parts.washers).
+ISO_7093 = {"M3": (3.2, 9.0, 0.8), "M4": (4.3, 12.0, 1.0), "M5": (5.3, 15.0, 1.2), "M6": (6.4, 18.0, 1.6),
+            "M8": (8.4, 24.0, 2.0), "M10": (10.5, 30.0, 2.5), "M12": (13.0, 37.0, 3.0)}
+#: ISO 7089 plain washers' bores (mm): ISO 273's fine clearance.
+ISO_7089_BORE = {"M2": 2.2, "M2.5": 2.7, "M3": 3.2, "M4": 4.3, "M5": 5.3, "M6": 6.4, "M8": 8.4, "M10": 10.5,
+                 "M12": 13.0}
+#: A camera's mounting socket's thread depth (mm) by its thread, when no figure is at hand: M3 from the
+#: FLIR Blackfly S's "M3x2.5" holes (profiles/instruments, its cited source); the others assumed (a
+#: tripod socket 1/4-20 or 3/8-16: 5 mm; a metric hole: one diameter). Measure yours.
+CAMERA_SOCKET_DEPTH = {"1/4-20 UNC": 5.0, "3/8-16 UNC": 5.0, "M3": 2.5, "M4": 4.0, "M5": 5.0, "M6": 6.0}
 
 #: ISO 8734 dowel pins' preferred lengths (mm).
 DOWEL_LENGTHS = (3, 4, 5, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30, 32, 35, 40, 45, 50, 55, 60)
@@ -249,7 +260,7 @@ DRIVER_BLADE_MM = 100.0
 #: An open-end spanner's reach (mm; DIN 3110 spanners for M3-M6 nuts are 90-120 mm long).
 SPANNER_MM = 80.0
 
-__all__ = ["CUP_POINT", "SHIM_FOIL", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
+__all__ = ["CAMERA_SOCKET_DEPTH", "ISO_7089_BORE", "ISO_7093", "CUP_POINT", "SHIM_FOIL", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
            "SPRING_STEEL_G", "dowel_diameter_for", "shortest_set_screw", "spring_rate", "INCH_SCREW_LENGTHS", "LARGE_WASHERS", "DOWEL_LENGTHS", "longest_dowel", "DRIVER_BLADE_MM", "HEX_KEYS", "HexKey", "INCH", "INSERTS",
            "Insert", "METRIC_THREADS", "MOUNT_THREADS", "SCREW_LENGTHS", "SCREW_LENGTH_RANGE", "SPANNER_MM", "THREADS",
            "Thread", "longest_screw", "screw_lengths", "shortest_screw", "thread", "thread_for_hole"]
