@@ -45,7 +45,7 @@ from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part
 from rigcad.profile.instruments import size_origin
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
-from rigcad.standards import (CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for, longest_dowel,
+from rigcad.standards import (CAMERA_SOCKET_DEPTH, CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for, longest_dowel,
                               longest_screw, screw_lengths, shortest_screw, shortest_set_screw, spring_rate)
 
 #: Gap around the splitter plate in its grooves (mm): a printed groove comes out ~0.1 mm narrow.
@@ -451,8 +451,8 @@ def shelf_bolt_length(profile: Profile) -> float:
 
     # the large washer the column's opened hole takes (column_bolt_hole, before the layout: its largest)
     d = profile.datum
-    hole = bolt_hole("M4", 2 * (profile.tower.column_width / 2 + 1.5 * profile.tower.bolt_diameter), d.print_position,
-                     d.print_scale)
+    far = 2 * (profile.tower.column_width / 2 + 1.5 * profile.tower.bolt_diameter)
+    hole = bolt_hole("M4", far, d.print_position, d.print_scale)
     reach = profile.tower.wall + washers_over("M4", ("round", hole)).thickness + SHELF_INSERT.length - 0.5
     return float(longest_screw("M4", reach))
 
@@ -1034,10 +1034,7 @@ MAX_EXTRA_WASHERS = 3
 MAX_EXTRA_WASHER_MM = 5.0
 
 
-#: A camera's mounting socket's thread depth (mm) by its thread, when no figure is at hand: M3 from the
-#: FLIR Blackfly S's "M3x2.5" holes (profiles/instruments, its cited source); the others assumed (a
-#: tripod socket 1/4-20 or 3/8-16: 5 mm; a metric hole: one diameter). Measure yours.
-CAMERA_SOCKET_DEPTH = {"1/4-20 UNC": 5.0, "3/8-16 UNC": 5.0, "M3": 2.5, "M4": 4.0, "M5": 5.0, "M6": 6.0}
+#: A camera's mounting socket's thread depth by its thread: rigcad.standards.CAMERA_SOCKET_DEPTH.
 
 
 def slot_openings(profile: Profile, layout) -> dict[str, tuple]:
@@ -1193,7 +1190,7 @@ def hardware(profile: Profile, layout) -> list[dict]:
         *_projector_screw_rows(profile, layout),
         *_screw_rows(camera_stack_screws(profile, layout), cm.mount_thread, 2, "camera_body",
                      f"the camera's two mounting holes ({cm.mount_spacing:g} mm apart along its axis; "
-                     f"{camera_socket_depth(profile):g} mm deep, rigcad.parts.tower.CAMERA_SOCKET_DEPTH)",
+                     f"{camera_socket_depth(profile):g} mm deep, rigcad.standards.CAMERA_SOCKET_DEPTH)",
                      ("camera", "mount_thread"), profile, washers["camera"], "for_camera_stacks_of_shims"),
         *_fine_shim_rows(profile),
         {"item": "plate beam splitter", "thread": None, "length_mm": None, "quantity": 1,

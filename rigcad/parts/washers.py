@@ -18,12 +18,8 @@ import math
 from dataclasses import dataclass
 
 from rigcad.errors import GeometryError
-from rigcad.standards import THREADS
+from rigcad.standards import ISO_7089_BORE, ISO_7093, THREADS
 
-#: ISO 7093-1 large washers, by size: bore d1, outside diameter d2, thickness h (mm; the standard's
-#: nominal figures). Size 6 also serves 1/4-20 UNC (6.4 mm bore over 6.35 mm).
-ISO_7093 = {"M3": (3.2, 9.0, 0.8), "M4": (4.3, 12.0, 1.0), "M5": (5.3, 15.0, 1.2), "M6": (6.4, 18.0, 1.6),
-            "M8": (8.4, 24.0, 2.0), "M10": (10.5, 30.0, 2.5), "M12": (13.0, 37.0, 3.0)}
 #: The large washer a thread takes (its own size, or the one whose bore passes it).
 OWN_SIZE = {"1/4-20 UNC": "M6", "3/8-16 UNC": "M10"}
 
@@ -76,9 +72,8 @@ def plain(thread: str) -> Washer:
 
 
 def _iso7089_bore(thread: str) -> float:
-    """ISO 7089's bore: the fine clearance hole (ISO 273 fine: d + 0.2..0.4 mm)."""
-    return {"M2": 2.2, "M2.5": 2.7, "M3": 3.2, "M4": 4.3, "M5": 5.3, "M6": 6.4, "M8": 8.4, "M10": 10.5,
-            "M12": 13.0}.get(thread, THREADS[thread].clearance)
+    """ISO 7089's bore: the fine clearance hole (rigcad.standards.ISO_7089_BORE)."""
+    return ISO_7089_BORE.get(thread, THREADS[thread].clearance)
 
 
 def large(size: str) -> Washer:
