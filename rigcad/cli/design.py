@@ -1,4 +1,5 @@
-"""``rigcad design PROFILE``: the 2D optical design (dome profile, ray diagram, derived figures)."""
+"""``rigcad design PROFILE``: the 2D optical design (dome profile, ray diagram, derived figures), and
+every refusal of the rig's placements and part recipes that `rigcad stl` would make later."""
 
 from __future__ import annotations
 
@@ -39,7 +40,24 @@ def cmd_design(args: argparse.Namespace) -> int:
     _suggest_lens(rig, args.fill)
     for p in paths:
         print(f"  wrote {p}")
-    return 0
+    return _early_refusals(rig)
+
+
+def _early_refusals(rig) -> int:
+    """The refusals `rigcad stl` would make later that need no part's solid (rigcad.manual.gate.
+    early_refusals: the layout, every part's recipe), all of them, each on its own line naming the
+    key to change: exit 1 when there is one (the design's files stay written: its optics stand)."""
+    from rigcad.errors import one_line
+    from rigcad.manual.gate import early_refusals
+
+    found = early_refusals(rig)
+    if not found:
+        return 0
+    print(f"rigcad: error: {rig.name}: `rigcad stl` would refuse this rig: {len(found)} refusal(s) found before any "
+          "part is built, each below (the design's own files are written)", file=sys.stderr)
+    for r in found:
+        print(f"  {one_line(r.line())}", file=sys.stderr)
+    return 1
 
 
 def _suggest_lens(rig, fill: float) -> None:
@@ -80,7 +98,9 @@ def register(subparsers) -> None:
         description="Integrate the dome profile, trace the design in 2D (pinhole, thin lens, misalignment) "
                     "and write exports/<profile>/design.json, dome_profile.csv, rays.png and incidence.png; "
                     "say how much of the camera's sensor the paraboloid's image fills, and the focal length "
-                    "that fills --fill of it.")
+                    "that fills --fill of it. Then run the checks `rigcad stl` makes before any solid is built (the "
+                    "layout of the tower and the instruments against the dome, every part's recipe) and report "
+                    "every refusal at once, each naming the key to change; exit 1 when there is one.")
     p.add_argument("--fill", type=fill_fraction, default=0.9, metavar="FRACTION",
                    help="the fraction of the camera sensor's short side the suggested lens fills with the "
                         "paraboloid's image (default: 0.9)")

@@ -12,7 +12,7 @@ splitter, the focusing lens) and, of the keys the rig's layout read (``RigLayout
 the profile's files set. Keys the profile's own file sets come first: they are what the user chose.
 
 The nearest value: the length keys the profile sets are ranked by how much a move of each (one
-probe each way) cuts the blocked step's overlap; for the :data:`SEARCH_KEYS` that cut it most, the
+probe each way) cuts the blocked step's overlap along one of its ways in (per direction); for the :data:`SEARCH_KEYS` that cut it most, the
 value is moved away from the profile's own in growing steps each way (``STEP_MM`` doubling, at most
 ``MAX_PROBES`` probes) until the blocked step goes in with what it needs in place (the exact test
 the check uses to refuse it), then bisected to ``RESOLUTION_MM``. Each probe rebuilds the rig's
@@ -149,10 +149,11 @@ def _with(profile, key: str, value: float):
     return dataclasses.replace(profile, **{section: dataclasses.replace(getattr(profile, section), **{name: value})})
 
 
-def _depth(rig, profile, step: str) -> float:
+def _ways_in(rig, profile, step: str) -> dict | None:
     """How far (mm) ``step``, with only what it needs in place, still runs into something on the rig
-    of ``profile`` (its dome kept from ``rig``): 0 when it goes in (the check's own test for a
-    blocked step), inf when the layout refuses the profile."""
+    of ``profile`` (its dome kept from ``rig``) along each way in the check tried (direction -> mm;
+    every direction 0 when it goes in: the check's own test for a blocked step); None when the layout
+    refuses the profile or the step waits for a part that never comes."""
     from rigcad.manual import assembly_check, plan
     from rigcad.manual.assembly import picture_meshes
     from rigcad.rig import Rig
@@ -161,15 +162,26 @@ def _depth(rig, profile, step: str) -> float:
         other = Rig.from_profile(profile, previous=rig)
         a = plan.assembly(other, picture_meshes(other))
     except GeometryError:  # the layout refuses the value: not a way in
-        return float("inf")
+        return None
     if step not in a.by_name:
-        return float("inf")
+        return None
     r = a.attempt(a.by_name[step], assembly_check._before(a)[step])
-    return 0.0 if isinstance(r, assembly_check.Placed) else (r.depth if r.blocked else float("inf"))
+    if isinstance(r, assembly_check.Placed):
+        return {d: 0.0 for d in a.by_name[step].directions}
+    return dict(r.depths) if r.blocked else None
 
 
 def _goes_in(rig, profile, step: str) -> bool:
-    return _depth(rig, profile, step) == 0.0
+    ways = _ways_in(rig, profile, step)
+    return ways is not None and not any(ways.values())
+
+
+def _gain(base: dict, moved: dict | None) -> float:
+    """How much (mm) a move cuts the step's overlap along the way in it helps most: the largest drop
+    of one direction's depth (a move that frees one direction counts, whatever blocks the others)."""
+    if moved is None:
+        return 0.0
+    return max((base[d] - moved[d] for d in base if d in moved), default=0.0)
 
 
 def _set_lengths(rig, keys) -> list[tuple[str, str, float]]:
@@ -187,18 +199,22 @@ def _set_lengths(rig, keys) -> list[tuple[str, str, float]]:
 def nearest_values(rig, err: AssemblyError, keys, progress=None):
     """Fixes for the SEARCH_KEYS length keys the profile sets whose move brings the blocked step
     nearest to going in: each of the first RANK_KEYS of them is moved RANK_STEP_MM each way once,
-    and the keys are ranked by how much that cuts the step's overlap (a key that does not cut it is
-    not searched: it is not what blocks the part)."""
+    and the keys are ranked by how much that cuts the step's overlap along one of its ways in (per
+    direction: a part blocked one way by what the key moves and another way by what it does not is
+    freed by the key all the same); a key that cuts no direction's overlap is not searched: it is
+    not what blocks the part."""
     p = rig.profile
-    base = _depth(rig, p, err.step)
+    base = _ways_in(rig, p, err.step)
+    if base is None:
+        return
     gains = []
     for key, where, now in _set_lengths(rig, keys)[:RANK_KEYS]:
         if progress:
             progress(f"assembly gate: how {key} moves {err.step}")
-        best = min(_depth(rig, _with(p, key, now + s * RANK_STEP_MM), err.step) for s in (1.0, -1.0)
+        best = max(_gain(base, _ways_in(rig, _with(p, key, now + s * RANK_STEP_MM), err.step)) for s in (1.0, -1.0)
                    if now + s * RANK_STEP_MM > 0.0)
-        if best < base - 1e-6:
-            gains.append((base - best, key, where, now))
+        if best > 1e-6:
+            gains.append((best, key, where, now))
     for _, key, where, now in sorted(gains, key=lambda g: -g[0])[:SEARCH_KEYS]:
         yield Fix(key, where, now, _search(rig, p, key, now, err.step, progress))
 
@@ -226,6 +242,47 @@ def _search(rig, p, key: str, now: float, step: str, progress) -> float | None:
                         bad = mid
                 return round(good + (0.05 if good > bad else -0.05), 1)  # rounded away from the failing side
     return None
+
+
+# -- the checks that need no part's solid: what `rigcad design` reports early ---------------------
+@dataclass(frozen=True)
+class EarlyRefusal:
+    """A refusal `rigcad stl` would make that needs no solid: what refused (``the layout`` or a part's
+    recipe), its one-line message (file:line first when it names a key the profile set) and the key
+    to change (None when the message names several)."""
+
+    what: str
+    message: str
+    key: str | None
+
+    def line(self) -> str:
+        return f"{self.what}: {self.message}"
+
+
+def early_refusals(rig) -> tuple[EarlyRefusal, ...]:
+    """Every refusal of the rig's placements and part recipes, the checks `rigcad stl` (and the gate
+    after it) makes before any solid is built: the layout (the tower, the splitter and the
+    instruments against the dome; its first refusal only, as every later placement stands on the
+    earlier ones), else each part's recipe on its own (the focusing lens, the seats, the flange, ...),
+    all of them at once, the parts refused for one reason named together. Empty when none refuses.
+    No solid is made."""
+    from rigcad.parts import PARTS, make_recipe
+
+    def refusal(what: str, err: GeometryError) -> EarlyRefusal:
+        return EarlyRefusal(what, str(err.located(rig.profile.marks)), err.param)
+
+    try:
+        layout = rig.layout
+    except GeometryError as err:
+        return (refusal("the layout", err),)
+    found: dict[str, tuple[list[str], EarlyRefusal]] = {}  # parts refused for one reason are named together
+    for name in PARTS:
+        try:
+            make_recipe(rig.profile, layout, name)
+        except GeometryError as err:
+            r = refusal(name, err)
+            found.setdefault(r.message, ([], r))[0].append(name)
+    return tuple(EarlyRefusal(", ".join(names), r.message, r.key) for names, r in found.values())
 
 
 # -- the verdict kept beside the export: stl, fab and manual check a profile once -----------------
@@ -299,5 +356,5 @@ def gate(rig, root, progress=None) -> Verdict:
     return v
 
 
-__all__ = ["Fix", "VERDICT_FILE", "Verdict", "candidate_keys", "checked", "gate", "kept_gate", "nearest_values", "read_verdict",
-           "refused", "verdict", "verdict_path"]
+__all__ = ["EarlyRefusal", "Fix", "VERDICT_FILE", "Verdict", "candidate_keys", "checked", "early_refusals", "gate", "kept_gate",
+           "nearest_values", "read_verdict", "refused", "verdict", "verdict_path"]
