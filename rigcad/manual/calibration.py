@@ -371,7 +371,7 @@ def kit_items(rig) -> list[KitItem]:
 #: bill's lines so that a line missing from the bill shows: every word a step uses must be some line's.
 ITEM_WORDS = ("drafting film", "film", "tape", "fine pen", "blocks", "45 deg mirror", "scalpel", "checkerboard",
               "circle cutter", "gray card", "tablet", "spacer", "upright display", "calibration_upright_stand",
-              "torch", "mask", "leather punch", "plug")
+              "torch", "mask", "leather punch", "plug", "steel balls")
 
 
 def kit_misses(sections: dict[str, str], items: list[KitItem]) -> list[str]:

@@ -245,7 +245,7 @@ def projector_mounting_plate(profile: Profile, layout: RigLayout) -> Part:
         for a, b, b0, b1 in _footprints(f))
     return Part("projector_mounting_plate", Difference(Union_((plate, *fences)), pockets), (0.55, 0.57, 0.6),
                 "mounting plate for the projector crosses and backplate, set on the splitter seat in the holder's place: "
-                f"{len(f.balls)} {f.ball_diameter:g} mm steel balls pressed into its underside sit on the seat's cone, vee "
+                f"the {len(f.balls)} balls of the calibration kit ({f.ball_diameter:g} mm steel) pressed into its underside sit on the seat's cone, vee "
                 f"and flat; fences place the crosses on the projector's axis, {f.spacing:.1f} mm apart; the axis is "
                 f"{f.axis_height:.1f} mm above its top face", in_rig=False)
 
