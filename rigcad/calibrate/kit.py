@@ -181,13 +181,7 @@ def manual_page(rig) -> str:
     plan = M.Plan.of(p)
     w, h = cal.screen_resolution
     frames = seq.names()
-    turned = (", turned a half turn (the spacer in its bore, its narrow notch at the groove, and the screen on it, "
-              "each by 180 deg)")
-    steps = "\n".join(
-        f"{c + 1}. spacer {k} ({cal.spacer_heights[k]:g} mm)"
-        f"{turned if plan.repeats(c) is not None else ', its wide notch at the groove'}: "
-        f"screen surface {z:g} mm above the sample point; files `{label}_<frame>.png`"
-        for c, (k, z, label) in enumerate(zip(plan.spacers, plan.heights, plan.labels)))
+    steps = _flat_steps(cal, plan)
     side = min(seq.size_mm)
     reach = math.degrees(math.atan((side / 2) / max(plan.heights)))
     room = check_screen_fits(rig)
@@ -254,6 +248,17 @@ the image's columns and rows, the screen's axes at each turn and the patterns ar
 {_after_the_fit(p.tolerancing)}
 {_setting_the_paraboloid(rig)}
 {_measuring_the_seating(p)}"""
+
+
+def _flat_steps(cal, plan) -> str:
+    """The capture order's steps for the flat screen, one per spacer and turn (Markdown list)."""
+    turned = (", turned a half turn (the spacer in its bore, its narrow notch at the groove, and the screen on it, "
+              "each by 180 deg)")
+    return "\n".join(
+        f"{c + 1}. spacer {k} ({cal.spacer_heights[k]:g} mm)"
+        f"{turned if plan.repeats(c) is not None else ', its wide notch at the groove'}: "
+        f"screen surface {z:g} mm above the sample point; files `{label}_<frame>.png`"
+        for c, (k, z, label) in enumerate(zip(plan.spacers, plan.heights, plan.labels)))
 
 
 def _upright_kit(p, flat: int) -> str:
