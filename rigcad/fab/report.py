@@ -55,6 +55,14 @@ def markdown(report: dict) -> str:
     for name, e in report["parts"].items():
         if e.get("staircase_map"):
             lines += _staircase_section(name, e, report["printer"])
+    if report.get("stack"):
+        st = report["stack"]
+        lines += ["## Tolerance stack", "",
+                  "Each optical element's placement error from the base plate's bore through every printed link, "
+                  "seam, pin, clearance and joint, on this printer's process errors, against the profile's "
+                  "`tolerancing:` (rigcad.fab.stack; docs/rig-mechanics.md). Seams: "
+                  + ", ".join(f"{k} {v} ({st['seams_from'][k]})" for k, v in st["seams"].items()) + ".", "",
+                  *st["table_md"], ""]
     if report["problems"]:
         lines += ["## Problems", ""] + [f"- {p}" for p in report["problems"]] + [""]
     return "\n".join(lines)
@@ -68,7 +76,8 @@ def _parts_table(report: dict) -> list[str]:
              f"layer {pr['layer_height_mm']:.4g} mm; material {pr['material']}. Source: `{pr['source']}`.", "",
              "| part | qty | pieces | orientation | layers | time | material | mirror cusp mean / max (mm) | sanding depth / stock printed (mm) |",
              "|---|---|---|---|---|---|---|---|---|"]
-    for name, e in report["parts"].items():
+    for label, e in report["parts"].items():
+        name = label + (" (earlier run)" if e.get("from_earlier_run") else "")
         if "error" in e:
             lines.append(f"| {name} | | | **not printable:** {e['error']} | | | | | |")
             continue
@@ -76,7 +85,7 @@ def _parts_table(report: dict) -> list[str]:
             lines.append(f"| {name} | {e['quantity']} | bought | {e['stock']} | | | | | |")
             continue
         if "pieces" not in e:
-            lines.append(f"| {name} | {e['quantity']} | cut | {e['process']}: `outlines/{name}.dxf`, `.svg` "
+            lines.append(f"| {name} | {e['quantity']} | cut | {e['process']}: `outlines/{label}.dxf`, `.svg` "
                          f"({e['outline_size_mm'][0]:.1f} x {e['outline_size_mm'][1]:.1f} mm, plate {e['plate_thickness_mm']:g} mm) | | | | | |")
             continue
         pcs = e["pieces"]

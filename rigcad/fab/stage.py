@@ -148,6 +148,8 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
             problems += seams.problems(name, done[name].entry.get("seams"))
             timings.update(done[name].timings)
             say(name)
+        if parts:
+            report_parts = _with_earlier_parts(report_parts, old, out, rig.profile)
         jobs = [job for d in done.values() for job in d.jobs]
         report_gcode = {"requested": gcode, "slicer": printer.slicer}
         slicer_s: dict[str, float] = {}
@@ -168,7 +170,7 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
             report_gcode["note"] = (f"printer '{printer.name}' has no slicer rigcad can run (slicer: {printer.slicer}); "
                                     "time and material are rigcad's estimates")
         t = time.perf_counter()
-        report = fab_report(profile.name, printer, chord, run.tol_mirror, report_gcode, report_parts, problems)
+        report = _report(rig, printer, run, report_gcode, report_parts, problems)
         stage.write_bytes(out / "fab.json", json_bytes(report))
         stage.write_bytes(out / "fab.md", markdown(report).encode())
         if key is not None and not problems:  # a run with problems is never read back: the next one retries
@@ -176,6 +178,26 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
         timings["report"] = time.perf_counter() - t
         written = stage.commit()
     return FabResult(report, written, timings, slicer_s, problems)
+
+
+def _with_earlier_parts(report_parts: dict, old: dict, out: Path, profile) -> dict:
+    """A run of some parts (``--parts``) into a folder where an earlier run made others from the same
+    profile keeps their files (Staging carries them over), so the report keeps their entries too,
+    marked ``from_earlier_run``: one report for the whole folder, never one that disagrees with the
+    files beside it. An earlier run from another profile has its files dropped, and its entries."""
+    from rigcad.export.atomic import read_made_from
+    from rigcad.export.build import PARTS
+
+    earlier = old.get("parts") if isinstance(old.get("parts"), dict) else {}
+    if not earlier or read_made_from(out) != profile_digest(profile):
+        return report_parts
+    out_parts = {}
+    for name in PARTS:
+        if name in report_parts:
+            out_parts[name] = report_parts[name]
+        elif isinstance(earlier.get(name), dict):
+            out_parts[name] = {**earlier[name], "from_earlier_run": True}
+    return out_parts
 
 
 def _previous_report(out: Path) -> dict:
@@ -347,6 +369,46 @@ def _with_stock(rig, part, run: _Run) -> tuple[PartFab, float]:
                                                 (new.get("pin_fit") or {}).get("pin_diameter_mm")))
     done.timings = {**first.timings, f"{name}:orient_for_stock": stock_s, **done.timings}
     return done, stock
+
+
+def _report(rig, printer: Printer, run: _Run, report_gcode: dict, report_parts: dict, problems: list[str]) -> dict:
+    """fab.json's content: the parts, the G-code and the tolerance stack with this run's seams (its
+    refusals are added to ``problems``)."""
+    stack_record, stack_problems = tolerance_stack(rig, printer, report_parts)
+    problems += stack_problems
+    report = fab_report(rig.profile.name, printer, run.chord, run.tol_mirror, report_gcode, report_parts, problems)
+    if stack_record is not None:
+        report["stack"] = stack_record
+    return report
+
+
+def tolerance_stack(rig, printer: Printer, report_parts: dict) -> tuple[dict | None, list[str]]:
+    """The rig's tolerance stack on this printer (rigcad.fab.stack): the seams a chain crosses in each
+    chain part from this run's split plans (``seams_from_fab``; estimated for a chain part the run did
+    not make; the dome's, its band cuts only, as ``estimate_seams`` counts them: its sectors are each
+    screwed to the base plate and glued on the gauge, rigcad.fab.seams), with the adjusters and locating features the parts declare. Returns fab.json's record
+    (with the table as Markdown lines) and the problems: one line naming each placement the printed
+    rig can neither hold nor adjust, its dominating links and the ``buy:`` option. A printer file
+    without ``process_errors`` has no stack (None, no problem: nothing to reckon with)."""
+    from rigcad.fab import stack as ST
+
+    if printer.process_errors is None:
+        return None, []
+    seams = ST.estimate_seams(rig.profile, rig.layout, printer)
+    made = {k: e for k, e in report_parts.items()
+            if k in ST.CHAIN_PARTS and "error" not in e and e.get("process") != "bought" and "split" in e}
+    seams.update(ST.seams_from_fab(made))
+    if "dome" in made:  # its sectors are each screwed down and glued on the gauge: only band cuts are on a chain
+        seams["dome"] = max(0, int(made["dome"]["split"].get("bands", 1)) - 1)
+    report = ST.stack(rig.profile, rig.layout, printer, seams=seams)
+    rec = ST.record(report)
+    rec["seams_from"] = {k: ("this run's split plans" if k in made else "estimated") for k in sorted(seams)}
+    rec["table_md"] = ST.table_lines(report)
+    try:
+        ST.refuse(report)
+    except FabricationError as err:
+        return rec, [f"tolerance stack: {err}"]
+    return rec, []
 
 
 def stock_bound(layer: float, steepest: float, chord: float) -> float:
