@@ -21,7 +21,7 @@ import numpy as np
 from rigcad.errors import GeometryError
 from rigcad.parts.joints import ScrewJoint, datums_of
 from rigcad.parts.locating import (INDICATOR_MM, PIN_FIT_MM, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole,
-                                   foil_step, stepped_hole, teardrop_along_y)
+                                   foil_step, set_screw_length, stepped_hole, teardrop_along_y)
 from rigcad.parts.layout import RigLayout, u_at_height
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Union_
 from rigcad.profile.schema import Profile
@@ -156,8 +156,6 @@ def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
     """The beam's seats (see the module): within the flange's rim where it leaves :data:`SEAT_DEPTH_MM`
     outside the mirror, else reaching past it onto the base plate (the beam then reaches through
     them: rigcad.parts.beam)."""
-    from rigcad.parts.paraboloid import set_screw_length
-
     shell, beam = profile.dome_shell, profile.beam
     z0, z1 = layout.beam_z
     c, p, w = shell.slot_clearance, SHIM_PACK_MM, beam.width / 2
@@ -185,7 +183,7 @@ def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
                                      ins.pocket_depth + 1.0),
                     teardrop_along_y((s * xm, w + 2 * c + side / 2, 0.5 * (z0 + z1)),
                                      THREADS[SEAT_SCREW].clearance / 2, side + 2.0)]
-    screw = set_screw_length(side, c, 2 * p + c)
+    screw = set_screw_length(SEAT_SCREW, side, c, 2 * p + c)
     return BeamSeats(tuple(blocks), tuple(tunnels), tuple(pockets), screw, xm, 2 * xm, p)
 
 

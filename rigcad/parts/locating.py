@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 from rigcad.errors import GeometryError
 from rigcad.parts.recipe import Box, Cylinder, Line, Prism, Revolve, Section, Translate
-from rigcad.standards import SHIM_FOIL, THREADS, longest_dowel
+from rigcad.standards import INSERTS, SHIM_FOIL, THREADS, longest_dowel, shortest_set_screw
 
 #: Worst-case diametral clearance (mm) of an ISO 8734 m6 pin (+0.004..+0.012 mm for 3..6 mm) in a
 #: hole reamed H7 (0..+0.012 mm): 0.012 - 0.004 = 0.008 mm in the upper part's hole; the lower part
@@ -171,6 +171,20 @@ class ShimStop:
     how: str
 
 
+def set_screw_length(thread: str, wall: float, near: float, far: float) -> int:
+    """A set screw's length (mm, ISO 4026) in a heat-set insert through a ``wall`` mm thick, pressing on a
+    face ``near`` to ``far`` mm past the wall as its stop's pack is set: the shortest that stands no more
+    than a millimetre proud of the wall at the near setting; GeometryError when at the far one it would
+    keep under two millimetres of thread in the insert."""
+    length = shortest_set_screw(thread, wall + near)
+    ins = INSERTS[thread]
+    if length is None or length - wall - near > 1.0 or ins.length - (wall + far - length) < 2.0:
+        raise GeometryError(f"no {thread} set screw (ISO 4026) both stays within a millimetre of the {wall:g} mm "
+                            f"wall and keeps two millimetres in its insert over its {far - near:g} mm of travel: a "
+                            "smaller shim pack")
+    return length
+
+
 def foil_step() -> float:
     """The thinnest bought shim foil (mm): a shim stop's step."""
     return min(SHIM_FOIL)
@@ -203,4 +217,4 @@ def teardrop_along_y(centre: tuple[float, float, float], radius: float, length: 
 
 
 __all__ = ["DowelRegister", "INDICATOR_MM", "PIN_FIT_MM", "SHIM_PACK_MM", "SLOT_FIT_MM", "ShimStop", "bolt_hole",
-           "foil_step", "stepped_hole", "teardrop_along_y"]
+           "foil_step", "set_screw_length", "stepped_hole", "teardrop_along_y"]

@@ -16,12 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigcad.errors import GeometryError
 from rigcad.parts.layout import RigLayout
-from rigcad.parts.locating import SHIM_PACK_MM, ShimStop, foil_step, stepped_hole, teardrop_along_y
+from rigcad.parts.locating import SHIM_PACK_MM, ShimStop, foil_step, set_screw_length, stepped_hole, teardrop_along_y
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Solid, Union_
 from rigcad.profile.schema import Profile
-from rigcad.standards import INSERTS, SHIM_FOIL, THREADS, dowel_diameter_for, longest_dowel, shortest_set_screw
+from rigcad.standards import INSERTS, SHIM_FOIL, THREADS, dowel_diameter_for, longest_dowel
 
 
 #: The stem enters the clamp and the paraboloid's back by this much (mm) so that the booleans fuse
@@ -97,7 +96,7 @@ def mount(profile: Profile, layout: RigLayout, top_z: float | None = None) -> Mo
     mid = 0.5 * (z0 + z1)
     pocket = teardrop_along_y((0.0, hi_y + side - ins.pocket_depth / 2 + 0.5, mid), ins.hole / 2, ins.pocket_depth + 1.0)
     bore = teardrop_along_y((0.0, hi_y + side / 2, mid), THREADS[SET_SCREW].clearance / 2, side + 2.0)
-    screw = set_screw_length(side, c, 2 * p + c)
+    screw = set_screw_length(SET_SCREW, side, c, 2 * p + c)
     return Mount(
         back=Cylinder((0.0, 0.0, back_z), float(rim[0]), float(rim[1]) - back_z),
         stem=Cylinder((0.0, 0.0, clamp_top), pm.stem_radius, top - clamp_top),
@@ -115,20 +114,6 @@ def clamp_half_width(profile: Profile) -> float:
     and the +y wall that holds the set screw's insert (the insert's pocket and a millimetre)."""
     return (profile.beam.width / 2 + SHIM_PACK_MM + profile.dome_shell.slot_clearance
             + INSERTS[SET_SCREW].pocket_depth + 1.0)
-
-
-def set_screw_length(wall: float, near: float, far: float) -> int:
-    """A set screw's length (mm, ISO 4026) in an insert through a ``wall`` mm thick, pressing on a face
-    ``near`` to ``far`` mm past the wall as its stop's pack is set: the shortest that stands no more than
-    a millimetre proud of the wall at the near setting; GeometryError when at the far one it would keep
-    under two millimetres of thread in the insert."""
-    length = shortest_set_screw(SET_SCREW, wall + near)
-    ins = INSERTS[SET_SCREW]
-    if length is None or length - wall - near > 1.0 or ins.length - (wall + far - length) < 2.0:
-        raise GeometryError(f"no {SET_SCREW} set screw (ISO 4026) both stays within a millimetre of the "
-                            f"{wall:g} mm wall and keeps two millimetres in its insert over its {far - near:g} mm "
-                            "of travel: a smaller shim pack")
-    return length
 
 
 def stops(profile: Profile, layout: RigLayout) -> tuple[ShimStop, ShimStop]:
