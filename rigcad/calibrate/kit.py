@@ -245,8 +245,7 @@ the image's columns and rows, the screen's axes at each turn and the patterns ar
   {"the lower spacer's and then the upright display's captures take over" if cal.upright_turns else
    "the corrected map is filled from the fit"}.
 
-{_after_the_fit(p.tolerancing)}
-{_setting_the_paraboloid(rig)}
+{_after_the_fit(p.tolerancing)}{_setting_the_paraboloid(rig)}
 {_measuring_the_seating(p)}"""
 
 
@@ -350,7 +349,7 @@ def _setting_the_paraboloid(rig) -> str:
     """How the offsets the fit prints move the paraboloid on its shim stops (rigcad.parts.paraboloid)."""
     from rigcad.parts.paraboloid import setting_text
 
-    return setting_text(rig.profile, rig.layout) + "\n"
+    return "\n" + setting_text(rig.profile, rig.layout) + "\n"
 
 
 def _after_the_fit(tol) -> str:
