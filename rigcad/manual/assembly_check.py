@@ -637,14 +637,16 @@ def find_order(assembly: Assembly) -> list[Placed]:
     blocked with a set in place is blocked with any larger set): a step blocked with only what it
     must come after in place refuses the rig at once; :func:`must_precede` finds, pair by pair, the
     steps that must go in before others (one put in first would block the other), and a loop among
-    them refuses the rig without a search; the search puts a step in only after every step it must
-    come after, and gives up a set when a step left would be blocked by that set with what it must
-    come after added. Sets that lead nowhere are remembered."""
+    them refuses the rig (found at the first set that leads nowhere: a search that never turns back
+    does without them); the search puts a step in only after every step it must come after, and
+    gives up a set when a step left would be blocked by that set with what it must come after added.
+    Sets that lead nowhere are remembered."""
     _refuse_cycles(assembly)
     _refuse_blocked_at_first(assembly)
-    must = must_precede(assembly)
-    if must is None:
-        raise _stuck(assembly)
+    # what each step needs, until the first set that leads nowhere: the pairs cost solids a search that
+    # never turns back does not need (most rigs that pass), so they are found only when it turns back
+    must = {name: frozenset(v) for name, v in _before(assembly).items()}
+    bounded = False
     dead: set[frozenset[str]] = set()
     total = len(assembly.steps)
 
@@ -668,7 +670,17 @@ def find_order(assembly: Assembly) -> list[Placed]:
                     if found is not None:
                         return found
         dead.add(done)
+        tighten()
         return None
+
+    def tighten() -> None:
+        nonlocal bounded
+        if not bounded:
+            bounded = True
+            pairs = must_precede(assembly)
+            if pairs is None:
+                raise _stuck(assembly)
+            must.update(pairs)
 
     order = search(frozenset(), [])
     if order is None:
