@@ -20,7 +20,7 @@ of the useful annulus whose light path crosses the beam, clamp or stem boxes: th
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
@@ -28,6 +28,7 @@ import numpy as np
 from rigcad.errors import GeometryError
 from rigcad.optics.design import MIN_THETA_SPAN_DEG, cop_bundle_radius
 from rigcad.optics.dome import dt_ds, equal_path_t, occlusion_s, reflected_rays, start
+from rigcad.parts.dome import seat_top
 from rigcad.parts.layout import flange_extent
 from rigcad.parts.paraboloid import clamp_half_width
 from rigcad.profile.derived import Derived
@@ -50,9 +51,13 @@ class Outline:
     outer: np.ndarray
     inner: np.ndarray
     flange: np.ndarray
+    #: The beam's two seats (rigcad.parts.dome.beam_seats: blocks standing on the plate at the flange's
+    #: rim, up to over the beam), as their outer edge (r, z): revolved with the rest, so the printer
+    #: fit counts them wherever a sector puts them (it may then miss a fit, never claim a false one).
+    seats: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
     def points(self) -> np.ndarray:
-        return np.concatenate([self.outer, self.inner, self.flange])
+        return np.concatenate([self.outer, self.inner, self.flange, self.seats])
 
 
 @dataclass(frozen=True)
@@ -241,6 +246,7 @@ def fast_design(profile: Profile, geo: Derived, nodes: int = DEFAULT_NODES) -> F
 
     # the pixels the mount hides: pixel-area weights over the annulus, rho drho ds
     info, boxes = mount_boxes(profile, geo)
+    outline = replace(outline, seats=np.array([[fl_out, 0.0], [fl_out, seat_top(profile, info["beam_top_z_mm"])]]))
     blocked = 4.0 * _blocked_quadrant(rays.P[:n], D[:n], boxes) / (2 * math.pi)
     area_w = w * rho[:n] * np.abs(drho[:n])
     occluded = float(np.sum(area_w * blocked) / np.sum(area_w))

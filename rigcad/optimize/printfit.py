@@ -30,10 +30,12 @@ _COS, _SIN = np.cos(SPINS), np.sin(SPINS)
 
 
 def _polylines(outline: Outline) -> tuple[np.ndarray, np.ndarray]:
-    """The section's three polylines (outer wall, mirror, flange ring) as one array of (r, z) rows and
+    """The section's polylines (outer wall, mirror, flange ring, the seats' edge) as one array of (r, z) rows and
     the mask of the segments that join consecutive rows of the same polyline."""
     fl = outline.flange
     lines = [outline.outer, outline.inner, np.concatenate([fl, fl[:1]])]
+    if len(outline.seats):
+        lines.append(outline.seats)
     pts = np.concatenate(lines)
     joined = np.ones(len(pts) - 1, bool)
     ends = np.cumsum([len(x) for x in lines])[:-1]

@@ -152,6 +152,13 @@ class BeamSeats:
                          "their screws"))
 
 
+def seat_top(profile: Profile, beam_top: float) -> float:
+    """The beam seats' top (mm above the plate) for a beam whose top is at ``beam_top``: the roof's
+    shim pack and clearance over the beam, and the roof's insert under it (the optimiser's fast
+    outline reads it too: rigcad.optimize.fast)."""
+    return beam_top + SHIM_PACK_MM + profile.dome_shell.slot_clearance + INSERTS[SEAT_SCREW].pocket_depth + 1.0
+
+
 def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
     """The beam's seats (see the module): within the flange's rim where it leaves :data:`SEAT_DEPTH_MM`
     outside the mirror, else reaching past it onto the base plate (the beam then reaches through
@@ -163,7 +170,7 @@ def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
     side = ins.pocket_depth + 1.0
     y_lo, y_hi = -w - shell.wall, w + 2 * c + side
     floor, roof = z0 - p, z1 + p + c
-    top = roof + side
+    top = seat_top(profile, z1)
     u = layout.as_printed_dome.sample(4001)
     pts = layout.as_printed_dome.points(u)
     band = (pts[:, 1] >= shell.flange_thickness) & (pts[:, 1] <= top)

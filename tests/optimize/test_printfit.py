@@ -85,5 +85,8 @@ def test_cell_margins_match_the_meshed_dome_cut_by_the_fabrication_stage(table31
             real = max(fit_margin(cv, o.direction, usable) for o in mirror_candidates(plan.sector_range(0)))
             model = PF._cell_margin(PF._hull(PF._section_in_band(pts, joined, cuts[j], cuts[j + 1])), sectors, usable)
             # the mesh's chords (0.018 mm) and the outline's sampling; the slots and bolt holes only
-            # remove material (measured: 0.001-0.03 mm on this dome and an optimised one)
-            assert abs(model - real) < 0.1, (sectors, j, model, real)
+            # remove material (measured: 0.001-0.03 mm on this dome and an optimised one). The beam's two
+            # seats are revolved over the sector in the model: it may claim less room than the mesh
+            # has where a sector holds one (measured 0.52 mm, two sectors' upper band), never more
+            assert model - real < 0.1, (sectors, j, model, real)
+            assert real - model < 1.0, (sectors, j, model, real)
