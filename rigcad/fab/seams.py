@@ -18,8 +18,9 @@ key the glue, and the glue fills the float. What remains is the gauge's: the thi
 can be felt and the edge's squareness across the template's thickness (:func:`seam_steps`).
 
 Glue faces printed oblique to the layers are stepped (``layer x |n . D|``, n the cut face's normal,
-D the build direction; faces in a layer plane or across the layers print smooth), and two such
-faces meet ridge on ridge: the glue must fill twice that. :func:`glue_for` picks the first glue of
+D the build direction; faces in a layer plane or across the layers print smooth), each is flat only
+to the printer's position error, and two such faces meet ridge on ridge: the glue must fill twice
+the sum. :func:`glue_for` picks the first glue of
 GLUES whose gap fill covers it.
 """
 
@@ -137,10 +138,13 @@ def seam_steps(pin, position: float, stock: float, template_thickness: float) ->
 
 def glue_record(printer, plan, pieces, oriented) -> dict:
     """fab.json's glue for a split part: its glue faces' deepest staircase (``oriented``: each piece's
-    chosen orientation, with ``best.direction``), the gap two of them leave, the glue that fills it."""
+    chosen orientation, with ``best.direction``), the gap two of them leave (each face's staircase and
+    its printed position error: a face is flat to the printer's ``process_errors.position``), the glue
+    that fills it."""
     layer = printer.layer_height
     face = max(glue_face_step(layer, cut_normals(plan, pc), o.best.direction) for pc, o in zip(pieces, oriented))
-    gap = 2.0 * face
+    errors = getattr(printer, "process_errors", None)
+    gap = 2.0 * (face + (errors.position if errors is not None else 0.0))
     glue = glue_for(gap)
     return {"glue_face_step_mm": face, "glue_gap_mm": gap, "glue": glue.name, "glue_gap_fill_mm": glue.gap_fill,
             "glue_open_min": glue.open_min, "glue_source": glue.source, "glue_fills": glue.gap_fill >= gap}

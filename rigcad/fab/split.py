@@ -276,12 +276,13 @@ def pin_fit(printer, pins, pin: AlignmentPin | None = None) -> dict:
     else:
         shrink, source = DEFAULT_HOLE_SHRINK.get(printer.process, 0.3), "rigcad's default (no process errors stated)"
     printed = hole - shrink
+    floats = pin.clearance > printer.alignment_pin.clearance + 1e-9
+    after = "float (the glue fills it)" if floats else ("clearance" if pin.clearance > 0 else "press")
     return {"pin_diameter_mm": d, "hole_drawn_mm": hole, "hole_shrink_mm": shrink, "shrink_source": source,
-            "hole_as_printed_mm": printed, "class_as_printed": "slip" if printed > d else "press",
-            "class_after_drilling": "slip" if pin.clearance > 0 else "press",
+            "hole_as_printed_mm": printed, "class_as_printed": "clearance" if printed > d else "press",
+            "class_after_drilling": after,
             "step": f"drill every pin hole {hole:g} mm, {pin.depth:g} mm deep, by hand after printing "
-                    f"(it prints about {printed:.2f} mm), then push a {d:g} mm pin in: a "
-                    f"{'slip' if pin.clearance > 0 else 'press'} fit"}
+                    f"(it prints about {printed:.2f} mm), then push a {d:g} mm pin in: a {after} fit"}
 
 
 def keepouts(datums) -> list[tuple[np.ndarray, np.ndarray]]:

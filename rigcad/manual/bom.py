@@ -276,7 +276,8 @@ def fasteners(rig) -> list[dict]:
         item = tower_item(h)
         rows.append({"item": item, "short": item, "quantity": h["quantity"], "use": h["joins"],
                      "length_mm": h.get("length_mm"), "thread": h["thread"], "steps": list(h["steps"]),
-                     "note": "the paraboloid's shim stops and the beam's seats (parts.paraboloid.hardware)"})
+                     "note": "the paraboloid's shim stops and the beam's seats (parts.paraboloid.hardware)",
+                     "stops": True})
     return rows
 
 

@@ -367,7 +367,8 @@ def hardware(steps: list[Step], rig=None) -> list[dict]:
             if f.thread_in == "nut":
                 extra[f"{thread} hex nut (ISO 4032)"] = extra.get(f"{thread} hex nut (ISO 4032)", 0) + 1
             if f.washer_count:
-                washer = f"{thread} large washer (ISO 7093)" if "ISO 7093" in f.item else f"{thread} washer (ISO 7089)"
+                large = "ISO 7093" in f.item or "large washer" in f.item
+                washer = f"{thread} large washer (ISO 7093)" if large else f"{thread} washer (ISO 7089)"
                 extra[washer] = extra.get(washer, 0) + f.washer_count
             if f.thread_in == "insert":
                 ins = INSERTS[thread]
@@ -393,7 +394,9 @@ def bill_hardware(rig, steps: list[Step], bill: dict) -> list[dict]:
     """The manual's one hardware list, for its table and manual.json alike: the plan's fasteners and
     what they need (:func:`hardware`: what the assembly steps fit, so the bill and the steps cannot
     disagree), then the COP tower's items no step fits (dowels, balls, springs; the tower's heat-set
-    inserts are counted from the steps' fasteners, not again), then the split pieces' dowel pins.
+    inserts are counted from the steps' fasteners, not again), the paraboloid's shim stops' and the beam
+    seats' hardware (set screws, their inserts, the stop pin, the foil: no step's fastener), then the split
+    pieces' dowel pins.
     Each row: item, quantity, where (the steps, or what it joins) and a note."""
     from rigcad.manual import tower_joints
 
@@ -403,8 +406,8 @@ def bill_hardware(rig, steps: list[Step], bill: dict) -> list[dict]:
     rows += [{"item": f["item"], "quantity": f["quantity"],
               "where": (f"assembly steps: {', '.join(step_names(steps, f['steps']))}: " if f.get("steps") else "")
               + f["use"], "note": f["note"], "steps": step_names(steps, f.get("steps", ()))}
-             for f in bill["fasteners"] if f.get("tower") and "mounting holes" not in f["use"]
-             and not tower_joints.placed({"joins": f["use"]}) and "heat-set insert" not in f["item"]]
+             for f in bill["fasteners"] if (f.get("tower") and "mounting holes" not in f["use"]
+             and not tower_joints.placed({"joins": f["use"]}) and "heat-set insert" not in f["item"]) or f.get("stops")]
     for part in rig.recipes.values():  # the locating pins the parts declare, in the step of the part they locate
         for j in part.joints:
             if isinstance(j, DowelRegister) and any(j.upper in st.members for st in steps):

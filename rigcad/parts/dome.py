@@ -23,6 +23,7 @@ from rigcad.parts.joints import ScrewJoint, datums_of
 from rigcad.parts.locating import (INDICATOR_MM, PIN_FIT_MM, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole,
                                    foil_step, set_screw_length, stepped_hole, teardrop_along_y)
 from rigcad.parts.layout import RigLayout, u_at_height
+from rigcad.parts.washers import washers_over
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Union_
 from rigcad.profile.schema import Profile
 from rigcad.standards import INSERTS, THREADS, thread_for_hole
@@ -224,7 +225,9 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
     # the beam bears on its seats only: the slot leaves it the packs' travel up and down
     slot = Box((-reach, -half_w, z0 - p - c), (reach, half_w, z1 + p + c))
     joint, reg, seats = flange_joint(profile, layout), register(profile, layout), beam_seats(profile, layout)
-    holes = joint.clearance_holes(flange_bolt_hole(profile, layout))
+    hole = flange_bolt_hole(profile, layout)
+    holes = joint.clearance_holes(hole)
+    joint = replace(joint, washer_spec="a " + " on ".join(w.name() for w in washers_over(joint.thread, ("round", hole)).washers))
     lateral, _ = reg.repeatability
     body = Union_((Revolve(section), *seats.blocks))
     datums = datums_of("seat", "beam seat", seats.tunnels)

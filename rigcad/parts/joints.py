@@ -39,6 +39,9 @@ class ScrewJoint:
     lower_z: tuple[float, float]
     into: str = "insert"
     param: str = ""
+    #: The washer under each head as ordered (rigcad.parts.washers: large ones over an opened hole); a
+    #: plain ISO 7089 washer when empty.
+    washer_spec: str = ""
 
     def __post_init__(self) -> None:
         if self.thread not in THREADS:
@@ -96,7 +99,8 @@ class ScrewJoint:
         """The screw as it is ordered, with what takes its thread."""
         if self.into == "insert":
             ins = INSERTS[self.thread]
-            return (f"{self.thread} x {self.length} mm socket-head bolt (ISO 4762) with a washer (ISO 7089) into a "
+            return (f"{self.thread} x {self.length} mm socket-head bolt (ISO 4762) with "
+                    f"{self.washer_spec or 'a washer (ISO 7089)'} into a "
                     f"{self.thread} heat-set insert ({ins.length:g} mm long, in a {ins.hole:g} mm hole) melted into "
                     f"{self.lower}")
         return (f"{self.thread} x {self.length} mm socket-head bolt (ISO 4762) with 2 washers (ISO 7089) and a nut "
