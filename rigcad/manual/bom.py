@@ -291,12 +291,22 @@ def dowel_pins(fab_report: dict, printer) -> dict | None:
     length = 2 * pin.depth - PIN_END_GAP_MM
     per_part = {n: len(e["pins"]) * e.get("quantity", 1) for n, e in fab_report["parts"].items() if e.get("pins")}
     filament = math.isclose(pin.diameter, getattr(printer, "filament_diameter", float("nan")) or float("nan"))
-    return {"item": f"dowel pin {pin.diameter:g} mm x {length:g} mm", "quantity": count,
+    by_d: dict[float, int] = {}  # a thin shell takes thinner pins than the printer's (fab.json's pins)
+    for e in fab_report["parts"].values():
+        for p in e.get("pins", []):
+            d = float(p.get("diameter_mm") or pin.diameter) if isinstance(p, dict) else pin.diameter
+            by_d[d] = by_d.get(d, 0) + e.get("quantity", 1)
+    sizes = " and ".join(f"{k} x {d:g} mm" for d, k in sorted(by_d.items(), reverse=True)) if len(by_d) > 1 else ""
+    return {"item": f"dowel pin {pin.diameter:g} mm x {length:g} mm" if not sizes else
+            f"dowel pins {length:g} mm long: {sizes}", "quantity": count,
             "diameter_mm": pin.diameter, "length_mm": length, "per_part": per_part,
+            "by_diameter_mm": {f"{d:g}": k for d, k in sorted(by_d.items(), reverse=True)},
             "use": ", ".join(f"{n}: {k}" for n, k in per_part.items()),
             "note": (f"holes {_pin_holes(fab_report)} x {pin.depth:g} mm deep into each piece "
                      f"(alignment_pin in {printer.source}; a split mirror's wider: its seams are glued on a gauge)"
-                     + ("; cut from the printer's own filament" if filament else ""))}
+                     + (("; cut from the printer's own filament" if not sizes else
+                         f"; the {pin.diameter:g} mm ones cut from the printer's own filament, the others bought") if filament
+                        else ""))}
 
 
 def _pin_holes(fab_report: dict) -> str:

@@ -410,8 +410,10 @@ def _section_print(d: Doc, c) -> None:
         + f"; `fab/{printer.name}/fab.md` has the staircase maps.")
     d.ul(items)
     if bill["pins"]:
+        sizes = bill["pins"].get("by_diameter_mm") or {f"{bill['pins']['diameter_mm']:g}": bill["pins"]["quantity"]}
+        rods = " and ".join(f"{k} x {dia} mm" for dia, k in sizes.items())
         d.p(f"Split pieces: cut {bill['pins']['quantity']} pins of {bill['pins']['length_mm']:g} mm from "
-            f"{bill['pins']['diameter_mm']:g} mm rod (or filament), drill each part's pin holes to the size "
+            f"{rods} rod (or filament), drill each part's pin holes to the size "
             "the tools list gives, push the pins into one piece's holes, join the next piece on them and glue "
             "the cut faces with the glue the consumables list names for that part.")
         _glue_mirror_seams(d, c)

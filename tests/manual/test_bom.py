@@ -341,7 +341,8 @@ def test_dowel_pins_count_per_part_times_its_quantity():
     note = ("holes 1.9 mm (plate), 2.1 mm (dome) x 6 mm deep into each piece (alignment_pin in printers/x.yaml; a "
             "split mirror's wider: its seams are glued on a gauge)")
     assert pins == {"item": "dowel pin 1.75 mm x 11.5 mm", "quantity": 7, "diameter_mm": 1.75, "length_mm": 11.5,
-                    "per_part": {"plate": 6, "dome": 1}, "use": "plate: 6, dome: 1", "note": note}
+                    "per_part": {"plate": 6, "dome": 1}, "use": "plate: 6, dome: 1", "note": note,
+                    "by_diameter_mm": {"1.75": 7}}
     assert B.dowel_pins(report, _printer(filament=1.75))["note"] == note + "; cut from the printer's own filament"
     assert B.dowel_pins(report, _printer(filament=2.85))["note"] == pins["note"]
     assert B.dowel_pins(report, _printer(filament=0.0))["note"] == pins["note"]  # no filament diameter
@@ -349,6 +350,13 @@ def test_dowel_pins_count_per_part_times_its_quantity():
     none.filament_diameter = None
     assert B.dowel_pins(report, none)["note"] == pins["note"]
     assert B.dowel_pins({"parts": {"a": {"pins": []}, "b": {}}}, _printer()) is None
+    thin = {"parts": {"plate": {"pins": [{"diameter_mm": 1.75}] * 3, "quantity": 2},
+                      "dome": {"pins": [{"diameter_mm": 1.5}] * 4}}}  # a thin shell takes thinner pins
+    two = B.dowel_pins(thin, _printer())
+    assert two["by_diameter_mm"] == {"1.75": 6, "1.5": 4} and two["quantity"] == 10
+    assert two["item"] == "dowel pins 11.5 mm long: 6 x 1.75 mm and 4 x 1.5 mm"
+    assert B.dowel_pins(thin, _printer(filament=1.75))["note"].endswith(
+        "the 1.75 mm ones cut from the printer's own filament, the others bought")
     assert B.dowel_drills(report) == ("HSS twist drills (DIN 338) for the pin holes: 1.9 mm (plate), 2.1 mm (dome); "
                                       "4 mm H7 reamer for the column's dowel holes", "1 each")
 
