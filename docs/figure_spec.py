@@ -154,6 +154,12 @@ def _fab(printer: str, run: str) -> list[Figure]:
            f("dome.cusp_mean_mm", "parts.dome.staircase_map.cusp_mean_mm", "mm", ".3f"),
            f("dome.sanding_depth_mm", "parts.dome.polishing.sanding_depth_mm", "mm", ".3f"),
            f("dome.stock_mm", "parts.dome.sanding_stock.stock_mm", "mm", ".3f")]
+    if printer == MK3S:  # the dome is split on the desktop printer only
+        out += [f("dome.seam_step_on_pins_mm", "parts.dome.seams.step_on_pins_mm", "mm", ".2f"),
+                f("dome.seam_step_on_gauge_mm", "parts.dome.seams.step_on_gauge_mm", "mm", ".3f"),
+                f("dome.glue_face_step_mm", "parts.dome.seams.glue_face_step_mm", "mm", ".3f"),
+                f("dome.glue_gap_mm", "parts.dome.seams.glue_gap_mm", "mm", ".2f"),
+                f("dome.pin_hole_mm", "parts.dome.pin_fit.hole_drawn_mm", "mm", ".2f")]
     for name in _parts():
         out += [f(f"{name}.pieces", lambda j, n=name: len(j["parts"][n].get("pieces") or []), "pieces", "d", True),
                 f(f"{name}.pins", lambda j, n=name: len(j["parts"][n].get("pins", [])), "pins", "d", True)]
