@@ -127,3 +127,15 @@ def test_rigcad_starts_numpy_without_huge_page_advice_unless_told(given, advised
     done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip().splitlines()[-1] == f"advised {advised}"
+
+
+def test_design_warns_when_the_projector_gives_fewer_pixels_per_degree_than_check_asks(tmp_path, capsys):
+    """The newcomer's rig passed `design` at 0.75 px/deg and failed `check` at 0.9: design says so,
+    naming the key and its file:line; the default rig (1.1 px/deg at the fewest) gets no such line."""
+    assert main(["design", "achutha2006", "--exports", str(tmp_path / "a")]) == 0
+    assert "pixels per degree" not in capsys.readouterr().err
+    strict = tmp_path / "strict.yaml"
+    strict.write_text("extends: achutha2006\nraycheck:\n  min_px_per_deg: 5\n")
+    assert main(["design", str(strict), "--exports", str(tmp_path / "b")]) == 0  # a warning, not a refusal
+    err = capsys.readouterr().err
+    assert "under raycheck.min_px_per_deg 5 (" in err and "strict.yaml:3" in err and "`rigcad check` will fail" in err

@@ -37,6 +37,13 @@ def cmd_design(args: argparse.Namespace) -> int:
     if not rng["targets_met"]:
         print(f"warning: the design covers theta {rng['theta_min_deg']:.2f}..{rng['theta_max_deg']:.2f} deg, "
               f"not the target {rng['target_theta_min_deg']:g}..{rng['target_theta_max_deg']:g} deg", file=sys.stderr)
+    low = px.get("px_per_deg_min")
+    need = rig.profile.raycheck.min_px_per_deg
+    if low is not None and low < need:
+        where = rig.profile.where("raycheck", "min_px_per_deg")
+        print(f"warning: {low:.3g} projector pixels per degree of theta at the fewest, under raycheck.min_px_per_deg "
+              f"{need:g}{f' ({where})' if where else ''}: `rigcad check` will fail this rig; projector.throw_ratio "
+              "(a longer throw), projector.resolution or the paraboloid's size set it", file=sys.stderr)
     _suggest_lens(rig, args.fill)
     for p in paths:
         print(f"  wrote {p}")
