@@ -219,7 +219,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
 
     bill = B.bill(rig, fab_report, printer)
     steps, solids = plan.steps(rig, meshes)  # once: the bill's hardware and section 5's order both read them
-    bill["hardware"] = plan.bill_hardware(rig, steps, bill)  # what the steps fit: one list
+    bill["hardware"] = plan.bill_hardware(rig, steps, bill) + _spring_washers(rig, printer)  # one list
     bill["calibration_kit"] = [{"item": k.item, "quantity": k.quantity, "spec": k.spec, "steps": list(k.steps)}
                                for k in C.kit_items(rig)]  # what section 6 uses: one list
     c = SimpleNamespace(rig=rig, printer=printer, fab_report=fab_report, p=rig.profile, files={}, meshes=meshes,
@@ -417,6 +417,23 @@ def _section_print(d: Doc, c) -> None:
             "the tools list gives, push the pins into one piece's holes, join the next piece on them and glue "
             "the cut faces with the glue the consumables list names for that part.")
         _glue_mirror_seams(d, c)
+
+
+def _spring_washers(rig, printer) -> list[dict]:
+    """The conical spring washers (DIN 6796) the torque table puts under the joints that locate a
+    datum (rigcad.fab.loads: creep would relax them), one per screw: bill rows like the hardware's."""
+    from rigcad.fab import loads as L
+
+    if printer.process_errors is None or getattr(rig.layout, "tower", None) is None:
+        return []
+    by: dict[str, list] = {}
+    for b in L.loads(rig.profile, rig.layout, printer).bolts:
+        if b.spring_washer:
+            by.setdefault(b.thread, []).append(b)
+    return [{"item": f"{thread} conical spring washer (DIN 6796)", "quantity": sum(b.count for b in bolts),
+             "where": "under the heads of " + ", ".join(b.joint for b in bolts),
+             "note": "section 5's torque table: the joints that locate a datum", "steps": []}
+            for thread, bolts in by.items()]
 
 
 def _glue_mirror_seams(d: Doc, c) -> None:
@@ -834,8 +851,8 @@ def _section_mechanics(d: Doc, c) -> None:
     report = S.stack(c.p, c.rig.layout, c.printer)
     d.h(3, "Torques, and what bends")
     d.p("Tighten every bolt into printed plastic with a torque screwdriver to the torque below, never hand-tight: "
-        "a hand-tight M4 presses the plastic past half its yield, and it creeps. Put a spring washer (DIN 127) "
-        "under the joints marked yes: they locate a datum, and creep would relax them.")
+        "a hand-tight M4 presses the plastic past half its yield, and it creeps. Put a conical spring washer (DIN 6796, "
+        "in the bill) under the heads of the joints marked yes: they locate a datum, and creep would relax them.")
     _md_tables(d, loads.table_lines())
     d.h(3, "The tolerance stack on this printer")
     d.p(f"Each optical element's position and tilt error from the datum (the base plate's bore) through every printed "

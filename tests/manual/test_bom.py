@@ -488,3 +488,20 @@ def test_the_bill_names_the_focusing_lens_by_its_focal_length(table31_rig):
     assert "curved side towards the projector" in row["spec"]
     (row,) = [r for r in B.purchased(table31_rig) if r["item"].startswith("plate beam splitter")]
     assert "coated face towards the projector" in row["spec"]
+
+
+def test_the_bill_has_a_conical_spring_washer_for_every_screw_the_torque_table_marks(table31_rig):
+    """Section 5's torque table puts a spring washer under the joints that locate a datum; the bill
+    lists one per screw of those joints, per thread (the machinist found none in the bill)."""
+    from pathlib import Path
+
+    from rigcad.fab import loads as L
+    from rigcad.fab.printers import load_printer
+    from rigcad.manual.document import _spring_washers
+
+    prusa = load_printer(Path(__file__).resolve().parents[2] / "profiles" / "printers" / "prusa_mk3s.yaml")
+    rows = _spring_washers(table31_rig, prusa)
+    marked = [b for b in L.loads(table31_rig.profile, table31_rig.layout, prusa).bolts if b.spring_washer]
+    assert marked and sum(r["quantity"] for r in rows) == sum(b.count for b in marked)
+    assert all("DIN 6796" in r["item"] for r in rows)
+    assert {r["item"].split(" ")[0] for r in rows} == {b.thread for b in marked}
