@@ -56,11 +56,11 @@ def _check_the_numbers(ns: dict) -> None:
     assert ns["holder"].volume - ns["drilled"].volume == pytest.approx(math.pi * 4 * 14, rel=1e-7)
     # CadQuery's view is the same B-rep (one OCP solid): the same volume to rounding
     assert ns["wp"].val().Volume() == pytest.approx(ns["paraboloid"].volume, rel=1e-12)
-    # the beam's mesh (manifold3d, from the recipe) against its B-rep (OpenCascade): flat faces,
-    # so the same volume to rounding; 12 triangles = a box
+    # the beam's mesh (manifold3d, from the recipe) against its B-rep (OpenCascade): a box with its
+    # stop pin's round hole, so within area x the chord error of it (flat but for the hole)
     beam = rig.part("beam")
-    assert ns["mesh"].is_watertight and len(ns["mesh"].faces) == 12
-    assert ns["mesh"].volume == pytest.approx(beam.volume, rel=1e-9)
+    assert ns["mesh"].is_watertight and len(ns["mesh"].faces) > 12
+    assert abs(ns["mesh"].volume - beam.volume) <= ns["mesh"].area * rig.profile.tessellation.chord_error
     # the paraboloid's mesh is within the chord error e of its curved faces: the volumes differ by
     # at most area x e (measured 0.15 %, 20 mm^3 of 13,382)
     pmesh = rig.part("paraboloid").mesh()

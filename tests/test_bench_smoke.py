@@ -36,8 +36,10 @@ def _float32(data: dict) -> None:
 def _tessellation(data: dict) -> None:
     rows = sorted(data["stl"], key=lambda r: r["chord_error_mm"])
     for row in rows:
-        # the beam is a box: flat faces, so its mesh has the B-rep's volume to rounding
-        assert abs(row["parts"]["beam"]["volume_rel_error"]) < 1e-12
+        # the beam is a box with its stop pin's small round hole: flat but for the hole, so its mesh
+        # loses less volume than the curved parts' (measured 7.5e-5)
+        others = max(abs(p["volume_rel_error"]) for n, p in row["parts"].items() if n != "beam")
+        assert abs(row["parts"]["beam"]["volume_rel_error"]) <= others, row["chord_error_mm"]
     # an inscribed mesh loses ~ (2/3) chord x area of volume: first order in the chord error. The
     # worst part's error scales with the chord ratio, within 2x either way (measured 1.2x)
     fine, coarse = rows[0], rows[-1]

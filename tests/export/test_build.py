@@ -172,11 +172,12 @@ def test_manifest_reports_each_part(built):
     for name, e in m["parts"].items():
         assert len(e["bbox_min_mm"]) == 3 and all(len(h) == 64 for h in e["files"].values())
         # each figure against the written files, read back by other readers: the STEP by
-        # OpenCascade's reader (the same solid: its volume to OCCT's integration, 1e-9), the STL by
+        # OpenCascade's reader (the same solid: its volume to OCCT's integration, 1e-8: measured
+        # 4.8e-9 on the dome with its beam seats' tunnels and teardrops), the STL by
         # trimesh (float32 vertices: ~1e-7 relative, 1e-6 allowed; its bounds to float32 at
         # <= 400 mm, 1e-4 mm)
         v_step = volume(_read_step(out / "step" / f"{name}.step"))
-        assert e["volume_mm3"] == pytest.approx(v_step, rel=1e-9), name
+        assert e["volume_mm3"] == pytest.approx(v_step, rel=1e-8), name
         mesh = trimesh.load(out / "stl" / f"{name}.stl")
         assert e["stl_volume_mm3"] == pytest.approx(mesh.volume, rel=1e-6), name
         assert e["triangles"] == len(mesh.faces), name
@@ -225,8 +226,11 @@ def test_stl_lies_on_the_step_surface_within_the_chord_error(built, name):
         return BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex(), shell).Value()
 
     chord = rig.profile.tessellation.chord_error
-    # vertices sit on the exact surfaces (float32 STL rounding ~1e-5 mm, plus the 0.1 um B-spline fit)
-    assert max(dist(p) for p in verts) < 1e-4
+    # vertices sit on the exact surfaces (float32 STL rounding ~1e-5 mm, plus the 0.1 um B-spline fit),
+    # but where a boolean cut two curved tessellated faces (the dome's seat teardrops through its wall)
+    # the cut's vertices lie on facets: within the chord error (measured up to 0.0082 mm)
+    d = np.array([dist(p) for p in verts])
+    assert (d < 1e-4).mean() >= 0.95 and d.max() <= rig.profile.tessellation.chord_error * 1.01, sorted(d)[-5:]
     # facet interiors are within the chord error (the polygons are inscribed); 1 % for float32
     assert max(dist(p) for p in cents) <= chord * 1.01
 
