@@ -402,7 +402,7 @@ def _section_print(d: Doc, c) -> None:
         elif e.get("process") == "bought":
             items.append(f"`{name}`: bought, not printed: {e['stock']}")
         elif "error" not in e:
-            items.append(f"`{name}`: cut from a {e['plate_thickness_mm']:g} mm plate (`outlines/{name}.dxf`, `.svg`)")
+            items.append(_cut_line(name, e))
         else:
             items.append(f"`{name}`: **not printable on {printer.name}**: {e['error']}")
     d.p(f"Print files: `fab/{printer.name}/stl/` (each piece in its print orientation)"
@@ -417,6 +417,15 @@ def _section_print(d: Doc, c) -> None:
             "the tools list gives, push the pins into one piece's holes, join the next piece on them and glue "
             "the cut faces with the glue the consumables list names for that part.")
         _glue_mirror_seams(d, c)
+
+
+def _cut_line(name: str, e: dict) -> str:
+    """The print section's line for a template cut from plate, with its printed-stage outline when the
+    fab run wrote one (the gauge a split mirror's seams are glued on: rigcad.fab.seams)."""
+    printed = [f for f in ((e.get("stages") or {}).get("printed") or {}).get("files") or () if f.endswith(".dxf")]
+    return (f"`{name}`: cut from a {e['plate_thickness_mm']:g} mm plate (`outlines/{name}.dxf`, `.svg`)"
+            + (f"; cut its printed stage too (`{printed[0]}`: the surface as printed, the gauge a split mirror's "
+               "seams are glued on)" if printed else ""))
 
 
 def _spring_washers(rig, printer) -> list[dict]:

@@ -505,3 +505,14 @@ def test_the_bill_has_a_conical_spring_washer_for_every_screw_the_torque_table_m
     assert marked and sum(r["quantity"] for r in rows) == sum(b.count for b in marked)
     assert all("DIN 6796" in r["item"] for r in rows)
     assert {r["item"].split(" ")[0] for r in rows} == {b.thread for b in marked}
+
+
+def test_the_print_section_asks_for_the_printed_stage_template_the_seams_are_glued_on():
+    """The dome's seams are glued on its printed-stage template (rigcad.fab.seams): the print section's
+    cut list names its outline when the fab run wrote one, and not when it did not."""
+    from rigcad.manual.document import _cut_line
+
+    e = {"plate_thickness_mm": 3.0, "stages": {"printed": {"files": {"outlines/dome_template_printed.dxf": "x",
+                                                                     "outlines/dome_template_printed.svg": "y"}}}}
+    assert "`outlines/dome_template_printed.dxf`" in _cut_line("dome_template", e)
+    assert "printed stage" not in _cut_line("dome_template", {"plate_thickness_mm": 3.0, "stages": {"printed": {"note": "n"}}})
