@@ -13,31 +13,15 @@ import build123d as bd
 import pytest
 
 from rigcad.fab import stack as S
-from rigcad.fab.printers import load_printer
 from rigcad.parts import locating as LOC
-from rigcad.profile import load_profile
-from rigcad.rig import Rig
 from rigcad.standards import INSERTS, SHIM_FOIL
 
 paraboloid = importlib.import_module("rigcad.parts.paraboloid")
 dome = importlib.import_module("rigcad.parts.dome")
 
 ELEMENTS = ("paraboloid", "dome")
-#: A rig with other instruments (as tests/tolerance/test_tower_stack.py): a short-throw projector and
-#: a machine-vision camera.
-OTHER = "projector:\n  model: benq_mw632st\ncamera:\n  model: flir_blackfly_s_bfs_u3_32s4c\n"
 
-
-@pytest.fixture(scope="module")
-def mk3s():
-    return load_printer("prusa_mk3s")
-
-
-@pytest.fixture(scope="module")
-def other_rig(tmp_path_factory, table31_text):
-    path = tmp_path_factory.mktemp("other") / "other.yaml"
-    path.write_text(table31_text + OTHER, encoding="utf-8")
-    return Rig.from_profile(load_profile(path))
+# mk3s and other_rig (the second rig, other instruments): tests/tolerance/conftest.py
 
 
 def _axes(report):
