@@ -272,10 +272,13 @@ def seams_from_fab(parts: dict[str, dict]) -> dict[str, int]:
     """Seams on a chain from a fab run's record of its parts (fab.json's ``parts``): a part's
     ``datum_seams`` (rigcad.fab.split.datum_seams: the seams between two of its datum features), the
     most any two of them cross; a split part that declares no datum features, its pieces less one
-    (:func:`seams_from_pieces`); a whole part, none."""
+    (:func:`seams_from_pieces`); a whole part, none; the dome, its band cuts (as :func:`estimate_seams`
+    counts them: its sectors are each screwed to the plate and glued on a gauge, rigcad.fab.seams)."""
     out = {}
     for name, entry in parts.items():
-        if entry.get("datum_seams"):
+        if name == "dome":  # its sectors are each screwed down and glued on the gauge: its band cuts only
+            out[name] = max(0, int((entry.get("split") or {}).get("bands", 1)) - 1)
+        elif entry.get("datum_seams"):
             out[name] = max(int(s.get("count", 0)) for s in entry["datum_seams"])
         else:
             pieces = int((entry.get("split") or {}).get("pieces", 1))

@@ -385,8 +385,7 @@ def _report(rig, printer: Printer, run: _Run, report_gcode: dict, report_parts: 
 def tolerance_stack(rig, printer: Printer, report_parts: dict) -> tuple[dict | None, list[str]]:
     """The rig's tolerance stack on this printer (rigcad.fab.stack): the seams a chain crosses in each
     chain part from this run's split plans (``seams_from_fab``; estimated for a chain part the run did
-    not make; the dome's, its band cuts only, as ``estimate_seams`` counts them: its sectors are each
-    screwed to the base plate and glued on the gauge, rigcad.fab.seams), with the adjusters and locating features the parts declare. Returns fab.json's record
+    not make), with the adjusters and locating features the parts declare. Returns fab.json's record
     (with the table as Markdown lines) and the problems: one line naming each placement the printed
     rig can neither hold nor adjust, its dominating links and the ``buy:`` option. A printer file
     without ``process_errors`` has no stack (None, no problem: nothing to reckon with)."""
@@ -398,8 +397,6 @@ def tolerance_stack(rig, printer: Printer, report_parts: dict) -> tuple[dict | N
     made = {k: e for k, e in report_parts.items()
             if k in ST.CHAIN_PARTS and "error" not in e and e.get("process") != "bought" and "split" in e}
     seams.update(ST.seams_from_fab(made))
-    if "dome" in made:  # its sectors are each screwed down and glued on the gauge: only band cuts are on a chain
-        seams["dome"] = max(0, int(made["dome"]["split"].get("bands", 1)) - 1)
     report = ST.stack(rig.profile, rig.layout, printer, seams=seams)
     rec = ST.record(report)
     rec["seams_from"] = {k: ("this run's split plans" if k in made else "estimated") for k in sorted(seams)}
