@@ -430,8 +430,22 @@ def _describe(obj, profile=None, section: str = "") -> str:
         set_by = getattr(profile, "set_by", None)
         assumed = ("assumed" in (getattr(spec, "doc", "") or "").lower()
                    and (set_by is None or set_by(section, f.name) == "default"))
-        out.append(f"{f.name.replace('_', ' ')} {text}" + (" (assumed)" if assumed else ""))
+        out.append(f"{f.name.replace('_', ' ')} {text}" + (" (assumed)" if assumed else "")
+                   + _inherited(profile, section, f.name))
     return "; ".join(out)
+
+
+def _inherited(profile, section: str, key: str) -> str:
+    """" (set in FILE:LINE, not with the model)" for a figure a profile file set other than the file that
+    chose the section's instrument (``section.model``): a base profile's figure for its own instrument
+    (its throw ratio) that a profile extending it inherits with another model; "" otherwise."""
+    origin = getattr(profile, "origin", None)
+    if origin is None or key == "model" or getattr(profile, "set_by", lambda *k: "")(section, key) != "profile":
+        return ""
+    model, here = origin(section, "model"), origin(section, key)
+    if model == "default" or here.rsplit(":", 1)[0] == model.rsplit(":", 1)[0]:
+        return ""
+    return f" (set in `{here}`, not with the model: check it is this {section.replace('_', ' ')}'s)"
 
 
 def bill(rig, fab_report: dict, printer) -> dict:

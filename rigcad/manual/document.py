@@ -640,6 +640,25 @@ def preparation_text(rows: list[dict], number: dict[str, int], here: str) -> str
     return text
 
 
+def placed_text(rows: list[dict]) -> str:
+    """What a step says of the bought items it fits itself (:func:`preparations`' "placed" rows): rows whose
+    use reads the same but for its leading count (the precision shims, one row per thickness) are one
+    sentence naming each item with its count, so no sentence of the step repeats."""
+    groups: dict[str, list[tuple[str, str]]] = {}
+    for r in rows:
+        m = re.match(r"(\d+) (.*)", r["joins"], re.S)
+        count, use = (m.group(1), m.group(2)) if m else ("", r["joins"])
+        groups.setdefault(use, []).append((count, r["item"]))
+    text = ""
+    for use, items in groups.items():
+        if len(items) == 1 and not items[0][0]:
+            text += f" Press them in: {use}."
+            continue
+        named = "; ".join(f"{n} x {item}" if n else item for n, item in items)
+        text += f" Fit {named}, {use}."
+    return text
+
+
 #: Steps that put shim stacks in: the stacks are drawn as boxes; each holds ``tower.shims_nominal`` shims.
 SHIM_STACKS = ("projector_shims", "camera_shims")
 
@@ -791,7 +810,7 @@ def _section_assemble(d: Doc, c) -> None:
                        for j in c.rig.recipes[m].joints if isinstance(j, DowelRegister))
         text += preparation_text(prep[st.name], number, st.name)
         text += step_text(placed, by_name, prepared, _shim_mm(c.rig), spring_bolts(c.rig).get("set", ""))
-        text += "".join(f" Press them in: {r['joins']}." for r in prep[st.name] if r["kind"] == "placed")
+        text += placed_text([r for r in prep[st.name] if r["kind"] == "placed"])
         if st.name == "projector_body":
             text += plan_mod.projector_screw_text(c.rig)
         if st.name == "beam_splitter":
