@@ -50,7 +50,7 @@ from rigcad.parts import adjusters as A
 from rigcad.parts.datum import DOWEL_FIT, datum_chain
 from rigcad.parts.dome import flange_joint
 from rigcad.parts.process import ProcessErrors
-from rigcad.parts.tower import LAPPED_FLATNESS, _projector_feet, _shelf_extent, splitter_seat
+from rigcad.parts.tower import LAPPED_FLATNESS, _projector_feet, _shelf_extent, seat_pocket_fits, splitter_seat
 from rigcad.standards import THREADS
 
 #: The optical elements, in the order the tables list them.
@@ -422,10 +422,12 @@ def _tower_links(profile, layout, process: ProcessErrors, seams, holder: bool = 
         seat = splitter_seat(profile, layout)
         kinds = [c.kind for c in seat.contacts]
         kinds = f"{', a '.join(kinds[:-1])} and a {kinds[-1]}"
+        cone = next(f for f in seat_pocket_fits(profile, process) if f["pocket"] == "cone")
         out.append(Link("splitter seat", "joint",
                         f"kinematic: ball-ended screws on a {kinds} (sprung, {seat.preload:.0f} N): it repeats on "
-                        f"lift-off to {KINEMATIC_REPEAT * 1000:g} um (assumed)", KINEMATIC_REPEAT,
-                        buy="a bought kinematic mount"))
+                        f"lift-off to {KINEMATIC_REPEAT * 1000:g} um (assumed); the cone's balls bonded in a pocket "
+                        f"printed {cone['gap_mm']:.2f} mm over them (half of it each way)",
+                        KINEMATIC_REPEAT + max(cone["gap_mm"], 0.0) / 2, buy="a bought kinematic mount"))
     return tuple(out)
 
 

@@ -594,20 +594,82 @@ def seat_gap(profile: Profile) -> float:
     return seat_geometry(profile).gap
 
 
+#: The seat's pockets in the shelf (the cone's round pocket, the vee's channel, the flat's pocket) are
+#: drawn larger than the hard parts they hold by the hole shrink the design allows the printed process
+#: (SEAT_POCKET_SHRINK, mm diametral: the largest a shipped printer file's ``process_errors`` states, its
+#: horizontal axis's 0.3 mm; the shelf prints flat, its pockets' axes vertical, 0.1-0.2 mm) and a
+#: clearance (SEAT_POCKET_CLEARANCE, mm): on every shipped printer each prints a clearance fit the part
+#: drops into by hand, and the part is bonded in with gap-filling epoxy (SEAT_BOND), seated under load.
+#: Drawn at the hardware's own size they printed 0.1-0.3 mm under it (an interference a printed wall
+#: cracks on). :func:`seat_pocket_fits` states each fit on a given process; a process whose shrink exceeds
+#: the allowance gets the shop step that opens the pocket to its drawn size.
+SEAT_POCKET_SHRINK = 0.3
+SEAT_POCKET_CLEARANCE = 0.1
+#: The bond: a two-part gap-filling epoxy (Loctite EA 3430 class: its data sheet's gap fill taken at
+#: 0.5 mm, the figure rigcad.fab.seams's epoxy carries), the largest printed gap it fills (mm).
+SEAT_BOND = ("two-part gap-filling epoxy (Loctite EA 3430 class)", 0.5)
+
+
+def _pocket_sizes(profile: Profile) -> dict[str, tuple[str, tuple[float, ...]]]:
+    """Each seat pocket's hardware, and the sizes (mm, across the pocket) the hardware fills: the cone's
+    three balls touching (their circumscribed circle), the vee's two pins side by side (width, length),
+    the flat's gauge block (its face)."""
+    g = seat_geometry(profile)
+    pad_y, pad_x = GAUGE_BLOCK_FACE
+    return {"cone": (f"three {g.ball:g} mm balls (ISO 3290-1) touching", (2 * g.cone_radius,)),
+            "vee": (f"two {g.pin:g} mm dowel pins (ISO 8734 m6) side by side", (2 * g.pin, float(SEAT_PIN_LENGTH))),
+            "flat": (f"a {SEAT_PAD_LENGTH:g} mm gauge block (ISO 3650)", (pad_x, pad_y))}
+
+
+def seat_pocket_fits(profile: Profile, process=None) -> list[dict]:
+    """The seat's pockets as a fit table (mm, diametral): each pocket's hardware and its sizes, the drawn
+    sizes (the hardware's + SEAT_POCKET_SHRINK + SEAT_POCKET_CLEARANCE), and, given a printer's
+    ``process`` (rigcad.parts.process.ProcessErrors), the sizes as printed (its shrink for a vertical
+    axis: the shelf prints flat), the smallest gap and the fit's class ("clearance" within the bond's gap,
+    "loose" past it, "interference"), with the shop step that makes it right."""
+    allow = SEAT_POCKET_SHRINK + SEAT_POCKET_CLEARANCE
+    glue, most = SEAT_BOND
+    rows = []
+    for pocket, (what, sizes) in _pocket_sizes(profile).items():
+        drawn = tuple(v + allow for v in sizes)
+        row = {"pocket": pocket, "hardware": what, "hardware_mm": list(sizes), "drawn_mm": list(drawn),
+               "allowance_mm": {"shrink": SEAT_POCKET_SHRINK, "clearance": SEAT_POCKET_CLEARANCE},
+               "source": "drawn = hardware + the process shrink allowed (the shipped printers' largest, "
+                         "process_errors) + a clearance; bonded with " + glue}
+        step = (f"bond {what} into the {pocket}'s pocket with {glue}: butter the pocket's walls and floor, press the "
+                "part to the floor, and let it cure with the holder standing on its seat (its screws' balls then seat "
+                "it where they bear)")
+        if process is not None:
+            printed = tuple(v - process.shrink(v, "vertical") for v in drawn)
+            gap = min(p - h for p, h in zip(printed, sizes))
+            cls = "interference" if gap < 0 else ("loose" if gap > most else "clearance")
+            if cls == "interference":
+                step = (f"open the {pocket}'s pocket to its drawn {' x '.join(f'{v:.2f}' for v in drawn)} mm (it prints "
+                        f"{' x '.join(f'{v:.2f}' for v in printed)} mm: a file, or a drill for the round one), then "
+                        + step)
+            row.update(printed_mm=list(printed), gap_mm=gap, fit=cls)
+        row["step"] = step
+        rows.append(row)
+    return rows
+
+
 def _seat_cuts(t: TowerLayout, profile: Profile) -> tuple:
     """The shelf's seats (cone, vee, flat): a round pocket that holds three balls touching (the cone:
     a ball on three balls), a channel that holds two dowel pins side by side along the line to the
-    cone (the vee), a pocket the gauge block fills flush with the shelf's top (the flat). Drawn at the
-    nominal sizes: a printed hole's shrink is the balls' and pins' press fit."""
+    cone (the vee), a pocket the gauge block fills flush with the shelf's top (the flat). Each drawn
+    SEAT_POCKET_SHRINK + SEAT_POCKET_CLEARANCE over its hardware (:func:`seat_pocket_fits`): a
+    clearance fit on every shipped printer, the hardware bonded in."""
     g = seat_geometry(profile)
     top = t.shelf_top_z
     pts = seat_points(t, profile)
     (cx, cy), (vx, vy), (fx, fy) = pts["cone"], pts["vee"], pts["flat"]
-    half = SEAT_PIN_LENGTH / 2
+    e = (SEAT_POCKET_SHRINK + SEAT_POCKET_CLEARANCE) / 2  # each side
+    half = SEAT_PIN_LENGTH / 2 + e
     pad_y, pad_x = GAUGE_BLOCK_FACE  # the block's long side along y, under the back flange
-    return (Cylinder((cx, cy, top + g.cone_floor), g.cone_radius, -g.cone_floor + 1.0),
-            Box((vx - g.pin, vy - half, top + g.vee_floor), (vx + g.pin, vy + half, top + 1.0)),
-            Box((fx - pad_x / 2, fy - pad_y / 2, top - SEAT_PAD_LENGTH), (fx + pad_x / 2, fy + pad_y / 2, top + 1.0)))
+    return (Cylinder((cx, cy, top + g.cone_floor), g.cone_radius + e, -g.cone_floor + 1.0),
+            Box((vx - g.pin - e, vy - half, top + g.vee_floor), (vx + g.pin + e, vy + half, top + 1.0)),
+            Box((fx - pad_x / 2 - e, fy - pad_y / 2 - e, top - SEAT_PAD_LENGTH),
+                (fx + pad_x / 2 + e, fy + pad_y / 2 + e, top + 1.0)))
 
 
 def _seat_boss(profile: Profile) -> tuple[float, float]:
@@ -662,13 +724,13 @@ def splitter_seat(profile: Profile, layout) -> KinematicSeat:
                {"length": seat_screw_length(profile), "cup_diameter": CUP_POINT[thread]},
                "the seat's push screws, in the holder's bosses' heat-set inserts, turned from above"),
         Bought(f"{g.ball:g} mm steel ball, grade G10", "ISO 3290-1", 6, {"diameter": g.ball},
-               "three in the screws' cups (a drop of retaining compound holds each), three pressed into the "
-               "shelf's cone pocket, touching"),
+               "three in the screws' cups (a drop of retaining compound holds each), three bonded into the "
+               "shelf's cone pocket, touching (its drawn size: seat_pocket_fits)"),
         Bought(f"dowel pin {g.pin:g} m6 x {SEAT_PIN_LENGTH} mm", "ISO 8734", 2,
-               {"diameter": g.pin, "length": SEAT_PIN_LENGTH}, "the vee: pressed side by side into the shelf's channel"),
+               {"diameter": g.pin, "length": SEAT_PIN_LENGTH}, "the vee: bonded side by side into the shelf's channel"),
         Bought(f"gauge block {SEAT_PAD_LENGTH:g} mm, grade 2, steel", "ISO 3650", 1,
                {"length": SEAT_PAD_LENGTH, "face": list(GAUGE_BLOCK_FACE)},
-               "the flat: pressed into its pocket, flush with the shelf's top"),
+               "the flat: bonded into its pocket, flush with the shelf's top"),
         Bought(f"compression spring, wire {sp['wire']:g} mm, {sp['outer_diameter']:g} mm outside, "
                f"{sp['free_length']:g} mm free, {sp['active_coils']} active coils, ends closed and ground",
                "EN 13906-1 (wire EN 10270-1)", len(springs),
@@ -998,6 +1060,7 @@ def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
     g = seat_geometry(profile)
     std = "ISO 4029" if a.seat_thread.startswith("M") else "ASME B18.3"
     force = spring_force(1)
+    fits = {f["pocket"]: f for f in seat_pocket_fits(profile)}
     return [
         {"item": f"set screw, {std} (cup point), a {g.ball:g} mm ball held in its cup", "thread": a.seat_thread,
          "length_mm": seat_screw_length(profile), "quantity": 3,
@@ -1007,13 +1070,15 @@ def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
          "hole_mm": INSERTS[a.seat_thread].hole, "steps": ('splitter_holder',), "joins": "pressed into the holder's three seat bosses from above"},
         {"item": "steel ball, ISO 3290-1 grade G10", "thread": None, "length_mm": None, "quantity": 6,
          "diameter_mm": g.ball,
-         "steps": ('seat_cone_ball', 'seat_ball'), "joins": "three in the seat screws' cups (a drop of retaining compound), three pressed into the shelf's cone "
-                  "pocket, touching"},
+         "steps": ('seat_cone_ball', 'seat_ball'), "joins": "three in the seat screws' cups (a drop of retaining compound), three bonded into the shelf's cone "
+                  "pocket, touching: " + fits["cone"]["step"], "fit_mm": fits["cone"]},
         {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": g.pin, "length_mm": float(SEAT_PIN_LENGTH),
-         "quantity": 2, "steps": ('seat_vee_pin',), "joins": "the seat's vee: pressed side by side into the shelf's channel"},
+         "quantity": 2, "steps": ('seat_vee_pin',), "joins": "the seat's vee: bonded side by side into the shelf's channel: " + fits["vee"]["step"],
+         "fit_mm": fits["vee"]},
         {"item": f"gauge block, ISO 3650 grade 2, {SEAT_PAD_LENGTH:g} mm", "thread": None, "length_mm": None,
          "quantity": 1, "size_mm": [*GAUGE_BLOCK_FACE, SEAT_PAD_LENGTH],
-         "steps": ('seat_flat_pad',), "joins": "the seat's flat: pressed into its pocket in the shelf, flush with its top"},
+         "steps": ('seat_flat_pad',), "joins": "the seat's flat: bonded into its pocket in the shelf, flush with its top: " + fits["flat"]["step"],
+         "fit_mm": fits["flat"]},
         {"item": "bolt, two washers, nut and compression spring", "thread": "M4",
          "length_mm": _length("M4", t.shelf_thickness + gap + tw.wall + spring["free_length"], nut), "quantity": 2,
          "spring_mm": {"inner_diameter": spring["outer_diameter"] - 2 * spring["wire"], "wire": spring["wire"],
@@ -1241,8 +1306,9 @@ def _pin_along_y(centre, r: float, length: float, n: int = 16) -> Translate:
                      tuple(float(v) for v in centre))
 
 
-#: The seat's balls and pins are drawn this much (mm) under their radius: their pockets are cut at the
-#: nominal size (a press fit in print), and a mesh's facets would otherwise show them pressing in.
+#: The seat's balls and pins are drawn this much (mm) under their radius: the screws' balls touch the
+#: cone's balls, the vee's pins and the gauge block, and a mesh's facets would otherwise show them
+#: pressing into each other.
 DRAWN_UNDER = 0.1
 
 
@@ -1263,7 +1329,7 @@ def _seat_balls(profile: Profile, t: TowerLayout) -> tuple[Part, ...]:
         ang = math.pi / 2 + 2 * math.pi * k / 3
         out.append(Part(f"seat_cone_ball_{k + 1}", _sphere((cx + rc * math.cos(ang), cy + rc * math.sin(ang),
                                                             S + g.centre - g.cone_drop), g.ball / 2 - DRAWN_UNDER),
-                        steel, f"{g.ball:g} mm steel ball (ISO 3290) pressed into the shelf's cone pocket: one of the "
+                        steel, f"{g.ball:g} mm steel ball (ISO 3290) bonded into the shelf's cone pocket: one of the "
                         "three the seat's cone is made of"))
     for k, side in enumerate((-1, 1)):
         out.append(Part(f"seat_vee_pin_{k + 1}", _pin_along_y((vx + side * g.pin / 2, vy, S + g.centre - g.vee_drop),

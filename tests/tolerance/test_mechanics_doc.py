@@ -131,3 +131,25 @@ def test_the_tower_figures_are_the_codes(page, table31_rig, mk3s_stack):
     assert f"lapped flat to {T.LAPPED_FLATNESS:g} mm" in text
     assert f"unlapped ({p.datum.foot_flatness:g} mm) they would lean the column " \
            f"{math.degrees(2 * p.datum.foot_flatness / p.tower.column_width):.2f} deg" in text
+
+
+def test_the_seat_pockets_prose_is_the_codes(page, table31):
+    """The seat pockets' sizes and fits the page states, from rigcad.parts.tower.seat_pocket_fits."""
+    from rigcad.parts import tower as T
+
+    text = " ".join(page.split())
+    fits = {f["pocket"]: f for f in T.seat_pocket_fits(table31, load_printer("prusa_mk3s").process_errors)}
+    form3 = {f["pocket"]: f for f in T.seat_pocket_fits(table31, load_printer("form3").process_errors)}
+    vee = fits["vee"]["hardware_mm"]
+    flat = fits["flat"]["hardware_mm"]
+    assert f"balls touching: {fits['cone']['hardware_mm'][0]:.2f} mm)" in text
+    assert f"(two 3 mm pins: {vee[0]:g} x {vee[1]:g} mm)" in text and f"face) are drawn" in text
+    assert f"gauge block's {flat[0]:g} x {flat[1]:g} mm face" in text
+    assert f"drawn {T.SEAT_POCKET_SHRINK + T.SEAT_POCKET_CLEARANCE:g} mm over their hardware" in text
+    assert f"(`SEAT_POCKET_SHRINK` {T.SEAT_POCKET_SHRINK:g} mm" in text
+    assert f"(`SEAT_POCKET_CLEARANCE` {T.SEAT_POCKET_CLEARANCE:g} mm)" in text
+    assert len({round(f["gap_mm"], 9) for f in fits.values()}) == 1 and len({round(f["gap_mm"], 9) for f in form3.values()}) == 1
+    assert (f"prints {fits['cone']['gap_mm']:.1f} mm over its hardware on the MK3S and the Vantage i, "
+            f"{form3['cone']['gap_mm']:.1f} mm on the Form 3") in text
+    assert f"within the {T.SEAT_BOND[1]:g} mm the gap-filling epoxy fills" in text
+    assert f"half the gap its cone's balls are bonded in ({fits['cone']['gap_mm'] / 2:.1f} mm on the MK3S" in text
