@@ -145,6 +145,11 @@ ISO_7089_BORE = {"M2": 2.2, "M2.5": 2.7, "M3": 3.2, "M4": 4.3, "M5": 5.3, "M6": 
 #: FLIR Blackfly S's "M3x2.5" holes (profiles/instruments, its cited source); the others assumed (a
 #: tripod socket 1/4-20 or 3/8-16: 5 mm; a metric hole: one diameter). Measure yours.
 CAMERA_SOCKET_DEPTH = {"1/4-20 UNC": 5.0, "3/8-16 UNC": 5.0, "M3": 2.5, "M4": 4.0, "M5": 5.0, "M6": 6.0}
+#: DIN 6796 conical spring washers by thread: bore d1, outside d2, thickness s, free height h max (mm;
+#: DIN 6796:1987-10 Table 1, as Aspen Fasteners' "Metric DIN 6796 spec" prints it). Under a preload far
+#: below its flattening force the washer stands near its free height: a bolt's grip counts h max.
+CONICAL_SPRING_WASHERS = {"M3": (3.2, 7.0, 0.6, 0.85), "M4": (4.3, 9.0, 1.0, 1.3), "M5": (5.3, 11.0, 1.2, 1.55),
+                          "M6": (6.4, 14.0, 1.5, 2.0), "M8": (8.4, 18.0, 2.0, 2.6)}
 
 #: ISO 8734 dowel pins' preferred lengths (mm).
 DOWEL_LENGTHS = (3, 4, 5, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30, 32, 35, 40, 45, 50, 55, 60)
