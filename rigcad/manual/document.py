@@ -229,14 +229,14 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     step("rig picture")
     d = Doc()
     _introduction(d, c)
-    for section in (_section_bill, _bill_consumables, _section_print, _section_sand, _section_finish, _section_coat,
+    for section in (_section_bill, _bill_consumables, _section_schedule, _section_print, _section_sand, _section_finish, _section_coat,
                     _section_assemble, _section_mechanics, _section_calibrate):
         section(d, c)
     figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
                # the hardware as the steps fit it; bom.fasteners' candidate joints stay internal
                "bill": {k: v for k, v in c.bill.items() if k != "fasteners"}, "calibration": c.calibration, "finishing": c.finishing,
                "coating_gauged_layer": c.gauged, "coating_total_mm": c.total, "mechanics": c.mechanics,
-               "assembly_order": getattr(c, "assembly_order", None)}
+               "assembly_order": getattr(c, "assembly_order", None), "schedule": c.schedule}
     return d, c.files, figures
 
 
@@ -368,6 +368,24 @@ def _bill_consumables(d: Doc, c) -> None:
     d.table(["item", "qty"], [list(_blocks(c.rig) if r[0].startswith("Sanding blocks") else r)
                               for r in (*B.TOOLS, B.feeler_gauge([total - gauged_depth(c.p), *gaps]),
                                         B.dowel_drills(c.fab_report))])
+
+
+def _section_schedule(d: Doc, c) -> None:
+    """The one schedule from print to calibrated rig (rigcad.manual.schedule): each stage with the rig
+    state it needs and leaves, checked in order before it is written."""
+    from rigcad.manual import schedule as S
+
+    stages = S.schedule(c.rig, c.fab_report)
+    S.check(stages)
+    d.h(2, "The schedule: from print to calibrated rig")
+    d.p("Do the work in this order, one stage after the other; the sections after it say how (named at the end "
+        "of each stage). Each stage needs the rig as the stages before it leave it: which parts are whole, in or "
+        "off, what is cured or coated. rigcad checks that every stage finds the state it needs before it writes "
+        "this list.")
+    d.ol([f"{st.what} ({st.where}; needs: {', '.join(sorted(st.needs)) or 'nothing'}; leaves: "
+          f"{', '.join(sorted(st.makes))}" + (f"; undoes: {', '.join(sorted(st.ends))}" if st.ends else "") + ")"
+          for st in stages])
+    c.schedule = [st.record() for st in stages]
 
 
 def _abrasive() -> tuple[str, str]:

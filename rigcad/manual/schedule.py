@@ -1,0 +1,165 @@
+"""The one schedule from print to calibrated rig: every stage of the manual's work as data, each with
+the rig state it needs (which parts are whole, in, off, what is cured or coated) and the state it
+leaves, in the one order the manual is written in.
+
+A state is a set of facts (short phrases: "dome on its register", "clear coat polished"). A stage
+needs some facts, ends some (the dome lifted off ends "dome on its register") and makes others. The
+order is right when every stage finds what it needs made by an earlier stage and not ended since
+(:func:`unmet`); the manual refuses to write itself in an order that is not (:func:`check`), and a test
+walks ``manual.json``'s ``schedule`` the same way.
+
+Why an order is needed at all: the dome's seams are glued standing on the base plate on its flange
+screws (the plate's inserts first), before the dome's own inserts (the beam seats') are melted; the
+film goes on the plate before the dome; the slope test needs the whole rig with its camera, on the
+polished clear coat, before the mirror coat; the mirror coat needs the dome and the paraboloid off
+again; the projector is aligned before the circle is set, the circle before the film is cut out, the
+camera's hung cross replaces the paraboloid, which goes back after it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from rigcad.errors import AssemblyError
+from rigcad.manual import calibration as C
+
+#: The manual's section for each kind of stage (its headings, as the document writes them).
+BEFORE = "0. Before printing: measure or choose"
+PRINT = "2. Print"
+SAND = "3. Sand the mirrors to the template"
+RECIPE = "Finishing recipe, stage by stage"
+COAT = "4. Coat, layer by layer, checking with the template"
+ASSEMBLE = "5. Assemble"
+#: The splitter seat's adjustment (section 6).
+STEP_SEAT = "Projector: the splitter seat's three push screws"
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One stage of the schedule: ``what`` to do (one sentence), the manual's section that says how
+    (``where``), the facts it ``needs`` in the rig's state, those it ``ends`` and those it ``makes``."""
+
+    what: str
+    where: str
+    needs: frozenset[str] = frozenset()
+    makes: frozenset[str] = frozenset()
+    ends: frozenset[str] = frozenset()
+
+    def record(self) -> dict:
+        return {"what": self.what, "where": self.where, "needs": sorted(self.needs), "makes": sorted(self.makes),
+                "ends": sorted(self.ends)}
+
+
+def _s(what: str, where: str, needs=(), makes=(), ends=()) -> Stage:
+    return Stage(what, where, frozenset(needs), frozenset(makes), frozenset(ends))
+
+
+def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
+    """The rig's schedule, print to calibrated rig (see the module docstring): the tower's stages when
+    the rig has the COP tower, the dome's seams when the fab report split it, the deflectometry when the
+    profile has a calibration section."""
+    tower = getattr(rig.layout, "tower", None) is not None
+    parts = (fab_report or {}).get("parts", {})
+    seams = "step_on_gauge_mm" in ((parts.get("dome") or {}).get("seams") or {})
+    split = sorted(n for n, e in parts.items() if len(e.get("pieces") or ()) > 1 and n != "dome")
+    out = [
+        _s("Measure the sizes the profile assumes and build again.", BEFORE, makes={"sizes measured"}),
+        _s("Print every piece; cut the templates, the dome's printed-stage template with them.", PRINT,
+           needs={"sizes measured"}, makes={"pieces printed", "templates cut"}),
+    ]
+    if tower:
+        out.append(_s("Lap the column's foot-side and flange-side glue faces flat (float glass, P240).",
+                      "5. Assemble (tower column)", needs={"pieces printed"}, makes={"column faces lapped"}))
+    out.append(_s("Join the split flat parts on their pins with the glue the consumables name"
+                  + (f" ({', '.join(split)})" if split else "") + "; let them cure.", PRINT,
+                  needs={"pieces printed"} | ({"column faces lapped"} if tower else set()),
+                  makes={"flat parts whole"}))
+    out.append(_s("Melt the base plate's heat-set inserts and push the nuts into its traps (step 2's preparation).",
+                  ASSEMBLE, needs={"flat parts whole"}, makes={"base plate inserts"}))
+    if seams:
+        out.append(_s("Glue the dome's seams one at a time on the printed-stage template, its pieces standing on the "
+                      "base plate on their flange screws, finger-tight; let each cure.", PRINT,
+                      needs={"base plate inserts", "templates cut", "pieces printed"}, makes={"dome whole"}))
+    else:
+        out.append(_s("Take the dome as printed (one piece).", PRINT, needs={"pieces printed"}, makes={"dome whole"}))
+    out += [
+        _s("Melt the dome's beam-seat inserts and the clamp's insert; press the beam's stop pin.", ASSEMBLE,
+           needs={"dome whole"}, makes={"dome inserts"}),
+        _s("Knock down the mirrors' layer lines on the printed sanding blocks to the template's gap.", SAND,
+           needs={"dome whole", "templates cut"}, makes={"mirrors sanded"}),
+        _s("Spray the base, the primer (blocked) and the clear coat; cure, wet-sand and polish the clear coat.",
+           RECIPE, needs={"mirrors sanded"}, makes={"clear coat polished"}),
+        _s("Put the sample holder in the base plate's bore and the plate on the bench (steps 1-2).", ASSEMBLE,
+           needs={"base plate inserts"}, makes={"base plate down", "dome off"}),
+        _s("Stand the camera_cross_base in the bore, lay the film on the plate and trace O on it.", C.STEP_FILM,
+           needs={"base plate down", "dome off"}, makes={"film laid"}),
+        _s("Indicate the dome in from the bore, drill and ream its register, press the pins, bolt it down "
+           "(step 3).", ASSEMBLE, needs={"base plate down", "dome off", "dome inserts", "clear coat polished"},
+           makes={"dome on its register"}, ends={"dome off"}),
+        _s("Put in the beam and the paraboloid on it (steps 4-5).", ASSEMBLE, needs={"dome on its register"},
+           makes={"paraboloid on the beam"}),
+    ]
+    if tower:
+        out.append(_s("Build the tower: column, shelf, seat, lens mount, shims, splitter holder, projector, lens, "
+                      "splitter, camera (the steps after the paraboloid).", ASSEMBLE,
+                      needs={"base plate down", "flat parts whole"}, makes={"projector on", "camera on"}))
+    out += [
+        _s("Slope test on the polished clear coat, before the mirror coat.", C.STEP_ACCEPTANCE,
+           needs={"clear coat polished", "film laid", "camera on", "dome on its register", "paraboloid on the beam"},
+           makes={"slope passed"}),
+        _s("Lift the dome off its register (the beam and the paraboloid with it), take the paraboloid off the beam, "
+           "spray the mirror coat on both; let it cure; set the paraboloid back and the dome on its pins.",
+           RECIPE, needs={"slope passed", "dome on its register"}, makes={"mirrors coated"}),
+    ]
+    if tower:
+        out += [
+            _s("Align the projector on the crosses (the splitter holder off its seat, then back).", C.STEP_CROSSES,
+               needs={"projector on"}, makes={"projector aligned"}),
+            _s("Set the splitter's tilt with the seat's push screws; lock them.", STEP_SEAT,
+               needs={"projector aligned", "mirrors coated", "film laid"}, makes={"splitter set"}),
+        ]
+    out += [
+        _s("Set the circle on the paraboloid, judged on the film from below.", C.STEP_CIRCLE,
+           needs={"mirrors coated", "film laid"} | ({"splitter set"} if tower else set()), makes={"circle set"}),
+        _s("Cut the film out of the bore; the camera_cross_base stays in it.", C.STEP_FILM,
+           needs={"circle set", "film laid"}, makes={"bore open"}, ends={"film laid"}),
+        _s("Lift the dome off, hang the camera cross on the beam in the paraboloid's place, set the dome back; align "
+           "the camera; then put the paraboloid back the same way and the sample holder in the bore.",
+           C.STEP_CAMERA, needs={"bore open", "dome on its register"} | ({"camera on"} if tower else set()),
+           makes={"camera aligned"}),
+        _s("Lay the checkerboard disc under the lifted dome, capture, take it out.", C.STEP_CHECKER,
+           needs={"camera aligned", "circle set", "dome on its register"}, makes={"camera correspondence"}),
+        _s("Capture the gray card in the sample holder and run rigcad calibrate --gray-card.", C.STEP_GRAY,
+           needs={"camera aligned", "mirrors coated"}, makes={"reflectance scaled"}),
+    ]
+    if getattr(rig.profile, "calibration", None) is not None:
+        out.append(_s("Capture the screens on their spacers and the upright display, run rigcad calibrate --images; "
+                      "re-seat the paraboloid by what it reads.", C.STEP_AS_BUILT,
+                      needs={"camera aligned", "mirrors coated", "dome on its register"}, makes={"rig calibrated"}))
+    return tuple(out)
+
+
+def unmet(stages) -> list[tuple[int, str, list[str]]]:
+    """The stages (1-based number, what, the facts missing) that need a fact no earlier stage made, or
+    one an earlier stage ended since. ``stages``: Stage objects or their records (manual.json's)."""
+    state: set[str] = set()
+    out = []
+    for k, st in enumerate(stages, 1):
+        rec = st.record() if isinstance(st, Stage) else st
+        missing = sorted(set(rec["needs"]) - state)
+        if missing:
+            out.append((k, rec["what"], missing))
+        state = (state - set(rec["ends"])) | set(rec["makes"])
+    return out
+
+
+def check(stages) -> None:
+    """AssemblyError naming the first stage whose state no earlier stage made."""
+    bad = unmet(stages)
+    if bad:
+        k, what, missing = bad[0]
+        raise AssemblyError(f"the manual's schedule is out of order: stage {k} ({what}) needs "
+                            f"{', '.join(missing)}, which no earlier stage leaves")
+
+
+__all__ = ["STEP_SEAT", "Stage", "check", "schedule", "unmet"]

@@ -1,0 +1,88 @@
+"""The one schedule from print to calibrated rig (rigcad.manual.schedule): every stage finds the rig in the
+state it needs, made by an earlier stage; a stage planted out of order is caught; the manual writes the
+schedule it checked, and manual.json's copy walks clean."""
+
+from __future__ import annotations
+
+import pytest
+
+from rigcad.errors import AssemblyError
+from rigcad.manual import calibration as C
+from rigcad.manual import schedule as S
+
+#: A fab report as the MK3S run leaves it, for what the schedule reads: the dome's seams glued on the
+#: gauge, the flat parts split.
+SPLIT = {"parts": {"dome": {"pieces": [1, 2, 3, 4], "seams": {"step_on_gauge_mm": 0.046}},
+                   "base_plate": {"pieces": [1, 2, 3, 4]}, "tower_column": {"pieces": [1, 2]}}}
+
+
+@pytest.fixture(scope="module")
+def stages(table31_rig):
+    return S.schedule(table31_rig, SPLIT)
+
+
+def _index(stages, where: str, word: str) -> int:
+    return next(k for k, st in enumerate(stages) if st.where == where and word in st.what)
+
+
+def test_every_stage_finds_the_state_it_needs(stages):
+    assert S.unmet(stages) == []
+    S.check(stages)
+    # the orders the lab technician could not untangle, as the schedule puts them
+    glue = _index(stages, S.PRINT, "seams")
+    inserts = _index(stages, S.ASSEMBLE, "beam-seat inserts")
+    plate = _index(stages, S.ASSEMBLE, "base plate's heat-set inserts")
+    slope = _index(stages, C.STEP_ACCEPTANCE, "Slope")
+    coat = _index(stages, S.RECIPE, "mirror coat")
+    film = _index(stages, C.STEP_FILM, "lay the film")
+    dome = _index(stages, S.ASSEMBLE, "register")
+    lap = _index(stages, "5. Assemble (tower column)", "Lap")
+    join = _index(stages, S.PRINT, "Join")
+    camera = _index(stages, C.STEP_CAMERA, "camera cross")
+    assert plate < glue < inserts, "the dome is glued on the plate's screws, before its own inserts"
+    assert lap < join, "the column's faces are lapped before they are glued"
+    assert film < dome < slope < coat < camera, "film before the dome; slope test before the mirror coat"
+
+
+def test_a_stage_out_of_order_is_refused(stages):
+    for before, after in (((C.STEP_ACCEPTANCE, "Slope"), (S.RECIPE, "Spray the base")),  # slope test on bare print
+                          ((C.STEP_FILM, "lay the film"), (S.ASSEMBLE, "sample holder")),  # film with no plate down
+                          ((S.PRINT, "seams"), (S.ASSEMBLE, "base plate's heat-set"))):  # dome glued, no screws
+        stages_ = list(stages)
+        moved = stages_.pop(_index(stages_, *before))
+        stages_.insert(_index(stages_, *after), moved)
+        assert S.unmet(stages_), f"{moved.what} planted before {after} passed"
+        with pytest.raises(AssemblyError, match="out of order"):
+            S.check(stages_)
+    # a stage that needs what an earlier one ended: the film laid after the dome went on its register
+    stages_ = list(stages)
+    film = stages_.pop(_index(stages_, C.STEP_FILM, "lay the film"))
+    stages_.insert(_index(stages_, S.ASSEMBLE, "beam and the paraboloid"), film)
+    assert any("dome off" in missing for _, _, missing in S.unmet(stages_))
+
+
+def test_the_dome_glued_whole_needs_no_gauge(table31_rig):
+    """A printer that prints the dome whole: no seams stage, and the schedule still walks clean."""
+    stages = S.schedule(table31_rig, {"parts": {}})
+    assert not any("seams" in st.what for st in stages)
+    assert S.unmet(stages) == []
+
+
+@pytest.mark.e2e
+def test_the_manual_writes_and_records_the_schedule_it_checked(table31_rig, tmp_path_factory):
+    """manual.json's schedule walks clean and manual.md lists the same stages in the same order."""
+    import json
+
+    from rigcad.fab.printers import load_printer
+    from rigcad.manual.document import write_manual
+
+    fab = table31_rig.fab("prusa_mk3s", tmp_path_factory.mktemp("fab") / "fab", parts=["base_plate"]).report
+    out = tmp_path_factory.mktemp("manual") / "prusa_mk3s"
+    write_manual(table31_rig, load_printer("prusa_mk3s"), fab, out)
+    doc = json.loads((out / "manual.json").read_text(encoding="utf-8"))
+    md = (out / "manual.md").read_text(encoding="utf-8")
+    assert doc["schedule"] and S.unmet(doc["schedule"]) == []
+    at = [md.index(f"{k}. {st['what']}") for k, st in enumerate(doc["schedule"], 1)]
+    assert at == sorted(at), "manual.md lists the schedule in manual.json's order"
+    doc["schedule"].insert(0, doc["schedule"].pop(-1))  # planted: the last stage first
+    assert S.unmet(doc["schedule"])
