@@ -39,6 +39,8 @@ MAX_COATING_LAYER_MM = 1.0
 MOUNTS = ("base_plate", "breadboard_m6_25mm", "breadboard_imperial_1in")
 
 _POS = {"lo": 0, "lo_open": True}
+#: Most holes a ``holes`` key lists: an instrument's mounting pattern has 2 to 6.
+MAX_HOLES = 16
 
 
 @dataclass(frozen=True)
@@ -48,8 +50,9 @@ class Spec:
     ``kind`` is ``length`` (mm), ``angle`` (rad), ``int``, ``float``, ``choice``, ``pixels``
     (a ``[width, height]`` pair of positive integers), ``layers`` (a list of named thicknesses),
     ``lengths`` (a list of lengths, mm, each within the bounds), ``ints`` (a list of whole numbers,
-    each within the bounds), ``name`` (an instrument file's name, rigcad.profile.instruments) or
-    ``point`` (an ``[x, y]`` pair of pixel coordinates, each 0..MAX_PIXELS).
+    each within the bounds), ``name`` (an instrument file's name, rigcad.profile.instruments),
+    ``point`` (an ``[x, y]`` pair of pixel coordinates, each 0..MAX_PIXELS) or ``holes`` (a list of
+    ``[along, across]`` pairs of lengths, mm, at most MAX_HOLES).
     Bounds are in internal units.
     """
 
@@ -71,6 +74,8 @@ class Spec:
             return "the name of a file under instruments/, without .yaml"
         if self.kind == "point":
             return f"[x, y] in pixels, each 0..{MAX_PIXELS}"
+        if self.kind == "holes":
+            return f"a list of 1..{MAX_HOLES} [along, across] pairs of lengths"
         parts = []
         if self.lo is not None:
             parts.append(f"{'>' if self.lo_open else '>='} {self.lo / scale:g} {unit}".rstrip())
@@ -149,6 +154,10 @@ class ProjectorParams:
                              choices=tuple(MOUNT_THREADS))
     mount_depth: float = spec("length", "depth of thread in the body's mounting holes (assumed: 8 mm, a ceiling "
                               "mount's brass insert)", "8 mm", **_POS)
+    mount_holes: tuple[tuple[float, float], ...] | None = spec(
+        "holes", "the body's mounting holes in its bottom face, each [along, across]: along the optical axis back "
+        "from the COP (the entrance pupil), across it to the right seen from behind (looking where the projector "
+        "projects); default: four, 30 mm in from the bottom face's corners (assumed)", None)
     focus_min: float = spec("length", "nearest distance the projector's own lens focuses, from its COP (assumed: "
                             "1 m, a business projector's)", "1 m", **_POS)
     focus_max: float = spec("length", "farthest distance it focuses, from its COP (assumed: 10 m)", "10 m", **_POS,
@@ -734,7 +743,7 @@ class Profile:
             for f in fields(obj):
                 s: Spec = f.metadata["spec"]
                 value = getattr(obj, f.name)
-                suffix = {"length": "_mm", "lengths": "_mm", "angle": "_rad"}.get(s.kind, "")
+                suffix = {"length": "_mm", "lengths": "_mm", "holes": "_mm", "angle": "_rad"}.get(s.kind, "")
                 if isinstance(value, float) and math.isinf(value):
                     value = "inf"
                 if s.kind == "layers":
@@ -829,6 +838,14 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
             raise fail(f"expected a list of {'lengths' if s.kind == 'lengths' else 'whole numbers'} "
                        f"({one.describe_range()}), got {_r(value)}")
         return tuple(convert_value(one, v, f"{key}[{i}]", where) for i, v in enumerate(value))
+    elif s.kind == "holes":
+        pair = Spec("length", s.doc)
+        if not isinstance(value, list) or not 1 <= len(value) <= MAX_HOLES or not all(
+                isinstance(v, list) and len(v) == 2 for v in value):
+            raise fail(f"expected {s.describe_range()} (e.g. [[40 mm, -112 mm], [40 mm, 112 mm], [215 mm, 0 mm]]), "
+                       f"got {_r(value)}")
+        return tuple(tuple(convert_value(pair, v, f"{key}[{i}][{j}]", where) for j, v in enumerate(hole))
+                     for i, hole in enumerate(value))
     elif s.kind == "pixels":
         ok = (isinstance(value, list) and len(value) == 2
               and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= MAX_PIXELS for v in value))
