@@ -269,3 +269,8 @@ __all__ = ["CAMERA_SOCKET_DEPTH", "ISO_7089_BORE", "ISO_7093", "CUP_POINT", "SHI
            "SPRING_STEEL_G", "dowel_diameter_for", "shortest_set_screw", "spring_rate", "INCH_SCREW_LENGTHS", "LARGE_WASHERS", "DOWEL_LENGTHS", "longest_dowel", "DRIVER_BLADE_MM", "HEX_KEYS", "HexKey", "INCH", "INSERTS",
            "Insert", "METRIC_THREADS", "MOUNT_THREADS", "SCREW_LENGTHS", "SCREW_LENGTH_RANGE", "SPANNER_MM", "THREADS",
            "Thread", "longest_screw", "screw_lengths", "shortest_screw", "thread", "thread_for_hole"]
+
+#: Hex socket set screws (ISO 4026 flat point, ISO 4029 cup point): the hex key (mm, ISO 2936, s nominal)
+#: their socket takes.
+SET_SCREW_KEY = {"M3": 1.5, "M4": 2.0, "M5": 2.5, "M6": 3.0, "M8": 4.0}
+__all__ += ["SET_SCREW_KEY"]
