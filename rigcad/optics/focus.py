@@ -28,8 +28,16 @@ sag over ``lens.diameter``; n its glass's index), so H' - H = t (n - 1) / n. A t
 s_H = s) gives s^2 / (f - s): 2.27 mm for Table 3.1 (f = 300 mm, s = 25 mm). The thick one moves
 the other way: its principal planes stand 2.7 mm apart, and the COP appears 1.31 mm nearer the
 lens, its pixels' angles x 1/1.071 (tests/optics/test_focus_cop.py: an exact Snell trace agrees to
-2e-6 mm paraxially, 0.007 mm at the rim's angle). The circle of thesis 4.1.1, which the basis is
-shown through, is set with the lens in place (rigcad.manual.calibration).
+2e-6 mm paraxially, 0.007 mm at the rim's angle).
+
+So the COP tower does not put the real COP at the design COP: it keeps the lens's centre
+``lens.distance`` before the design COP (folded onto the projector's axis) and puts the real COP
+:func:`cop_distance_for` that before the lens's centre (26.14 mm for Table 3.1's 25 mm), where the
+paraboloid, through the lens, sees it at the design COP (:attr:`FocusingLens.cop_distance`). Seen
+through its lens, the placed projector is a pinhole at the design COP whose focal length in pixels
+is f / (f - s_H) times its own (x 1.0757 for Table 3.1): :func:`lensed_focal_px`, the one home of the
+projector's pixel map through its lens (rigcad.basis draws the zonal images on it; the circle of
+thesis 4.1.1 is set with the lens in place, rigcad.manual.calibration).
 """
 
 from __future__ import annotations
@@ -75,9 +83,17 @@ class FocusingLens:
     edge_thickness: float = 0.0  #: mm, at ``diameter`` (0, 0: a thin lens)
     diameter: float = 0.0
 
+    @property
+    def cop_distance(self) -> float:
+        """Where (mm before the lens's centre) the tower puts the projector's real COP so that the
+        paraboloid, through this lens, sees it ``lens_distance`` before the lens's centre: at the
+        design COP (:func:`cop_distance_for`)."""
+        return cop_distance_for(self.lens_distance, self.focal_length, self.edge_thickness, self.diameter)
+
     def describe(self) -> dict:
         shift, scale = self.through()
         return {"focal_length_mm": self.focal_length, "lens_distance_mm": self.lens_distance,
+                "projector_cop_from_lens_mm": self.cop_distance,
                 "paraboloid_from_lens_mm": [self.image_near, self.image_far],
                 "projector_focus_mm": [self.focus_near, _finite(self.focus_far)],
                 "projector_focus_range_mm": [self.focus_min, _finite(self.focus_max)],
@@ -86,23 +102,25 @@ class FocusingLens:
 
     def through(self) -> tuple[float, float]:
         """(COP shift away from the lens, mm; growth of the projector's focal length in pixels) of
-        this lens (:func:`through_lens`)."""
-        return through_lens(self.focal_length, self.lens_distance, self.edge_thickness, self.diameter)
+        this lens with the projector's real COP where the tower puts it, :attr:`cop_distance` before
+        the lens's centre (:func:`through_lens`): the shift takes it to ``lens_distance``."""
+        return through_lens(self.focal_length, self.cop_distance, self.edge_thickness, self.diameter)
 
     def projector(self, focal_px: float, cop_z: float) -> "LensedProjector":
-        """The projector seen through this lens, its real COP at height ``cop_z`` (mm, rig frame: the
-        projector's axis folded onto the optical axis, the lens below the COP) with ``focal_px`` (px)
-        of its own: where its chief rays seem to come from, and its focal length in pixels."""
+        """The projector seen through this lens as the tower places it, with ``focal_px`` (px) of its
+        own: a pinhole at the design COP, height ``cop_z`` (mm, rig frame: the projector's axis folded
+        onto the optical axis, the lens ``lens_distance`` below the COP), its real COP
+        :attr:`cop_distance` - ``lens_distance`` above it, and its focal length in pixels through the lens."""
         shift, scale = self.through()
-        return LensedProjector(cop_z + shift, focal_px * scale, shift, scale)
+        return LensedProjector(cop_z, focal_px * scale, shift, scale)
 
 
 @dataclass(frozen=True)
 class LensedProjector:
     """The projector and its focusing lens as one pinhole (paraxial): ``cop_z`` (mm) where its chief
-    rays seem to come from, ``focal_px`` its focal length in pixels, ``cop_shift`` (mm) how far that
-    point stands beyond the real COP (away from the lens; negative: nearer), ``pixel_scale`` the
-    focal length's growth through the lens."""
+    rays seem to come from (the design COP, where the tower puts it), ``focal_px`` its focal length in
+    pixels, ``cop_shift`` (mm) how far that point stands beyond the real COP (away from the lens;
+    negative: nearer), ``pixel_scale`` the focal length's growth through the lens."""
 
     cop_z: float
     focal_px: float
@@ -116,11 +134,11 @@ class LensedProjector:
 
     def ring_radius(self, geometry, alpha: float) -> float:
         """How far (px) from the image centre the projector, through its lens, shows the paraboloid's
-        point that the design's chief ray at ``alpha`` (rad from the axis at the real COP, the lens
-        out) meets: the rim for the rim's angle (``geometry``: profile.derived.Derived; the
+        point that the design's chief ray at ``alpha`` (rad from the axis at the COP the paraboloid
+        sees) meets: the rim for the rim's angle (``geometry``: profile.derived.Derived; the
         paraboloid z = z_vertex - r^2 / (4 f_p), thesis 3.2)."""
         t, fp = math.tan(alpha), geometry.focal_length
-        h = (self.cop_z - self.cop_shift) - geometry.vertex_z  # the real COP above the vertex
+        h = self.cop_z - geometry.vertex_z  # the COP seen above the vertex
         r = 2 * h * t / (1 + math.sqrt(1 - h * t * t / fp))  # the nearer root of r^2 t / (4 fp) - r + h t = 0
         return self.pixel_radius(r, geometry.vertex_z - r * r / (4 * fp))
 
@@ -143,6 +161,13 @@ def cop_distance_for(seen: float, focal_length: float, edge_thickness: float = 0
     back = front - (edge_thickness + sag) * (n - 1) / n  # the back one, t (n - 1) / n after it
     c = seen - back
     return front + c * f / (f + c)
+
+
+def lensed_focal_px(profile, geometry) -> float:
+    """The projector's focal length in pixels (px) as the paraboloid sees it through its focusing
+    lens, placed by the tower (:meth:`FocusingLens.projector`): its pixel map is the design's, read
+    about the design COP with this focal length instead of ``geometry.projector_focal_px``."""
+    return focusing_lens(profile, geometry).projector(geometry.projector_focal_px, geometry.cop_z).focal_px
 
 
 def through_lens(focal_length: float, lens_distance: float, edge_thickness: float = 0.0, diameter: float = 0.0,

@@ -38,7 +38,8 @@ from rigcad.profile.paths import INSTRUMENTS_SUBDIR, display, search_path
 #: The keys of ``projector`` / ``camera`` whose values describe the body and its optics (mm, or a
 #: thread name): what an instrument file may source and what :func:`measurements` may ask for.
 PROJECTOR_SIZES = ("body_width", "body_height", "body_depth", "lens_diameter", "lens_length", "pupil_depth",
-                   "pupil_height", "pupil_lateral", "mount_thread", "mount_depth", "focus_min", "focus_max")
+                   "pupil_height", "pupil_lateral", "mount_thread", "mount_depth", "mount_holes", "focus_min",
+                   "focus_max")
 CAMERA_SIZES = ("body_width", "body_height", "body_depth", "lens_diameter", "lens_length", "pupil_depth",
                 "pupil_height", "mount_thread", "mount_spacing")
 
@@ -223,9 +224,35 @@ FIGURES: dict[str, tuple[str, str, str]] = {
     "mount_depth": ("side (cut through a hole)", "mounting hole's mouth", "its bottom (a depth gauge or a screw "
                     "with a nut)"),
     "mount_spacing": ("bottom", "first mounting hole's centre", "second mounting hole's centre"),
+    "mount_holes": ("bottom", "entrance pupil (the COP) on the optical axis, projected onto the bottom face",
+                    "each mounting hole's centre: along the axis back from the pupil, and across it (+ to the right "
+                    "seen from behind)"),
     "focus_min": ("side", "entrance pupil (the COP)", "nearest wall the projector focuses sharply"),
     "focus_max": ("side", "entrance pupil (the COP)", "farthest wall the projector focuses sharply"),
 }
+
+
+#: The assumed mounting pattern when nothing gives ``projector.mount_holes``: four holes this far (mm)
+#: in from the body's bottom corners, along and across.
+DEFAULT_MOUNT_INSET = 30.0
+
+
+def mount_pattern(projector) -> tuple[tuple[float, float], ...]:
+    """The projector's mounting holes (mm), each (along, across): along its optical axis back from
+    its COP, across it to the right seen from behind (``projector.mount_holes``); when nothing gives
+    them, the assumed four, DEFAULT_MOUNT_INSET in from the bottom face's corners of the body that
+    ``body_depth``, ``body_width``, ``lens_length``, ``pupil_depth`` and ``pupil_lateral`` place."""
+    if projector.mount_holes is not None:
+        return tuple(projector.mount_holes)
+    back = projector.lens_length - projector.pupil_depth  # the body's front face, back from the COP
+    left = -projector.pupil_lateral - projector.body_width / 2  # its left side, across from the axis
+    e = DEFAULT_MOUNT_INSET
+    return tuple((a, c) for a in (back + e, back + projector.body_depth - e)
+                 for c in (left + e, left + projector.body_width - e))
+
+
+def _pattern_text(holes) -> str:
+    return "[" + ", ".join(f"[{a:g}, {c:g}]" for a, c in holes) + "]"
 
 
 @dataclass(frozen=True)
@@ -307,6 +334,15 @@ def _front(params, key: str, m: Measurement) -> Sketch:
 def _bottom(params, key: str, m: Measurement) -> Sketch:
     """Bottom view: along the axis from the back face; across from the centre line; the mounting holes."""
     d, w = params.body_depth, params.body_width
+    if key == "mount_holes":  # the projector's pattern, from its COP (at the lens front less the pupil depth)
+        cop = d + params.lens_length - params.pupil_depth
+        lat = params.pupil_lateral
+        holes = [(cop - a, lat + c) for a, c in mount_pattern(params)]
+        circles = tuple((f"mounting hole {k + 1}", p, 2.5) for k, p in enumerate(holes))
+        outlines = (("body", _rect(0.0, -w / 2, d, w / 2)),
+                    ("optical axis", ((-0.05 * d, lat), (d + params.lens_length, lat))))
+        return Sketch(m.key, m.view, ("along the optical axis (mm)", "across (mm)"), outlines, circles,
+                      ((cop, lat), holes[0]), _label(m))
     xs = _holes_along(params)
     circles = tuple((f"mounting hole {k + 1}", (x, 0.0), 2.5) for k, x in enumerate(xs))
     dim = ((xs[0], 0.0), (xs[-1], 0.0)) if key == "mount_spacing" else ((xs[0], 0.0), (xs[0], 0.0))
@@ -362,10 +398,14 @@ def measurements(profile) -> list[Measurement]:
                 continue
             view, a, b = FIGURES[key]
             value = getattr(params, key)
+            if key == "mount_holes":  # the pattern assumed, as [along, across] pairs
+                value = _pattern_text(mount_pattern(params))
             out.append(Measurement(f"{section}.{key}", docs[key].doc, value,
-                                   "" if isinstance(value, str) else "mm", view, (a, b)))
+                                   "mm" if key == "mount_holes" else "" if isinstance(value, str) else "mm", view,
+                                   (a, b)))
     return out
 
 
-__all__ = ["CAMERA_SIZES", "C_MOUNT_FLANGE", "FIGURES", "FIGURE_KEYS", "Instrument", "Measurement", "NAMED_BY",
-           "PROJECTOR_SIZES", "Sketch", "find", "folders", "measurements", "read", "shipped", "size_origin", "sketch"]
+__all__ = ["CAMERA_SIZES", "C_MOUNT_FLANGE", "DEFAULT_MOUNT_INSET", "FIGURES", "FIGURE_KEYS", "Instrument", "Measurement",
+           "NAMED_BY", "PROJECTOR_SIZES", "Sketch", "find", "folders", "measurements", "mount_pattern", "read", "shipped",
+           "size_origin", "sketch"]

@@ -125,7 +125,11 @@ def test_no_real_image_is_inf_and_describe_names_every_figure():
     from rigcad.optics.focus import FocusingLens
 
     lens = FocusingLens(200.0, 25.0, 250.0, 270.0, 1500.0, 2500.0, 1000.0, 3000.0, True)
+    # a thin lens: the real COP s f / (f + s) before it is seen s before it (the Gaussian inverse), the
+    # pixels' angles x (f + s) / f
     assert lens.describe() == {"focal_length_mm": 200.0, "lens_distance_mm": 25.0,
+                               "projector_cop_from_lens_mm": pytest.approx(25.0 * 200.0 / 225.0),
                                "paraboloid_from_lens_mm": [250.0, 270.0], "projector_focus_mm": [1500.0, 2500.0],
                                "projector_focus_range_mm": [1000.0, 3000.0], "from_catalogue": True,
-                               "cop_shift_mm": pytest.approx(25.0 ** 2 / 175.0), "pixel_scale": pytest.approx(200 / 175)}
+                               "cop_shift_mm": pytest.approx(25.0 - 25.0 * 200.0 / 225.0),
+                               "pixel_scale": pytest.approx(225 / 200)}

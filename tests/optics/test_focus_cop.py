@@ -54,14 +54,14 @@ def test_a_thin_lens_moves_the_cop_to_its_virtual_image(f, s):
 
 def test_the_ordered_lens_moves_the_cop_as_an_exact_trace_finds(table31):
     """The default rig's lens as the bill orders it (f = 300 mm N-BK7, 6 mm edge over 50 mm, curved
-    side towards the projector, 25 mm from the COP): every chief ray, extended back from where it
-    leaves the lens, crosses the axis 1.31 mm NEARER the lens than the real COP (the thin-lens sum's
-    2.27 mm away from it is the lens's thickness left out: its principal planes stand 2.7 mm apart),
-    and its angle's tan is 1/1.071 of the COP's."""
+    side towards the projector), a real COP 25 mm from its centre: every chief ray, extended back from
+    where it leaves the lens, crosses the axis 1.31 mm NEARER the lens than the real COP (the thin-lens
+    sum's 2.27 mm away from it is the lens's thickness left out: its principal planes stand 2.7 mm
+    apart), and its angle's tan is 1/1.071 of the COP's."""
     lens = focusing_lens(table31, derive(table31))
     args = (lens.focal_length, lens.lens_distance, table31.lens.thickness, table31.lens.diameter)
     assert args == (300.0, 25.0, 6.0, 50.0)
-    shift, scale = lens.through()
+    shift, scale = through_lens(*args)
     x, ratio = _seen_from(math.radians(0.05), *args)  # paraxial
     assert -x == pytest.approx(shift, abs=1e-5)  # mm: a 0.05 deg ray is paraxial to ~2e-6 mm
     assert 1 / ratio == pytest.approx(scale, abs=1e-6)
@@ -72,15 +72,41 @@ def test_the_ordered_lens_moves_the_cop_as_an_exact_trace_finds(table31):
     assert abs(-x - shift) < 0.02 and abs(1 / ratio - scale) < 1e-3
 
 
+@pytest.mark.parametrize("degrees", [0.05, 1.0, 2.0, None])
+def test_the_placed_projector_is_seen_at_the_design_cop(table31, degrees):
+    """Where the tower places the projector (its real COP FocusingLens.cop_distance before the lens's
+    centre, 26.14 mm for Table 3.1), every chief ray, traced exactly through the ordered lens (Snell at
+    both faces) and extended back from where it leaves it, crosses the axis at the design COP,
+    lens.distance (25 mm) before the lens's centre; and its angle's tan is the lensed pixel map's
+    (LensedProjector.focal_px, rigcad.optics.focus.lensed_focal_px) over the bare one's."""
+    from rigcad.optics.focus import lensed_focal_px
+
+    geo = derive(table31)
+    lens = focusing_lens(table31, geo)
+    placed = (lens.focal_length, lens.cop_distance, table31.lens.thickness, table31.lens.diameter)
+    assert lens.cop_distance == pytest.approx(26.138, abs=1e-3)
+    angle = geo.rim_angle_at_cop if degrees is None else math.radians(degrees)
+    x, ratio = _seen_from(angle, *placed)
+    seen = lens.cop_distance - x  # the traced COP seen, before the lens's centre
+    scale = lensed_focal_px(table31, geo) / geo.projector_focal_px
+    if degrees == 0.05:  # paraxial: the closed form holds to the trace's round-off (measured 3e-7 mm, 4e-9)
+        assert abs(seen - table31.lens.distance) < 1e-5 and abs(1 / ratio - scale) < 1e-6
+    else:  # up to the rim's 3.2 deg the lens's spherical aberration: measured 0.0073 mm and 5.1e-4 at the rim
+        assert abs(seen - table31.lens.distance) < 0.01 and abs(1 / ratio - scale) < 6e-4
+    # the design COP within the tolerance the tower holds it to by a wide margin (it was 1.14 mm off)
+    assert abs(seen - table31.lens.distance) < 0.01 * table31.tolerancing.projector_height
+
+
 def test_the_projector_through_its_lens_shows_the_rim_where_a_trace_puts_it(table31):
     """The pixel radius of the paraboloid's rim through the lens (LensedProjector.pixel_radius) from
     the exact trace: the COP ray whose traced exit ray meets the rim, found by bisection, read in the
-    projector's own pixels (focal_px tan of its angle at the real COP)."""
+    projector's own pixels (focal_px tan of its angle at the real COP, where the tower puts it)."""
     geo = derive(table31)
     lens = focusing_lens(table31, geo)
     lensed = lens.projector(geo.projector_focal_px, geo.cop_z)
-    args = (lens.focal_length, lens.lens_distance, table31.lens.thickness, table31.lens.diameter)
-    depth = geo.cop_z - geo.rim_z  # the rim's plane from the real COP, along the unfolded axis
+    args = (lens.focal_length, lens.cop_distance, table31.lens.thickness, table31.lens.diameter)
+    # the rim's plane from the real COP, along the unfolded axis: the real COP stands behind the design's
+    depth = geo.cop_z - geo.rim_z + (lens.cop_distance - lens.lens_distance)
 
     def height_at_rim(a):  # the exit ray's distance from the axis at the rim's plane
         p, d = _trace(a, *args)
@@ -91,10 +117,10 @@ def test_the_projector_through_its_lens_shows_the_rim_where_a_trace_puts_it(tabl
         mid = (lo + hi) / 2
         lo, hi = (mid, hi) if height_at_rim(mid) < geo.rim_radius else (lo, mid)
     traced = geo.projector_focal_px * math.tan(lo)
-    bare = geo.projector_focal_px * geo.rim_radius / depth
+    bare = geo.projector_focal_px * geo.rim_radius / (geo.cop_z - geo.rim_z)  # the design's map, no lens
     # 0.1 px: the paraxial model leaves out the spherical aberration at the rim (0.05 px measured, 5e-4 of it)
     assert lensed.pixel_radius(geo.rim_radius, geo.rim_z) == pytest.approx(traced, abs=0.1)
-    assert traced / bare == pytest.approx(1.076, abs=1e-3)  # the lens out, the circle would be 7.6 % small
+    assert traced / bare == pytest.approx(1.0757, abs=1e-3)  # the bare map's circle would be 7.6 % small
 
 
 def test_a_design_ray_is_shown_through_the_lens_where_its_paraboloid_point_is(table31):
@@ -135,17 +161,44 @@ def test_where_the_real_cop_must_stand_for_the_paraboloid_to_see_it_at_the_desig
 
 
 def test_the_figures_docs_states(table31):
-    """docs/calibration-focusing-lens.md's figures: the rim 100.3 px bare and 108.0 px through the
-    lens (x 1.076), the centre thickness 8.03 mm, the principal planes 2.7 mm apart, a 0.5 mm
-    decentred lens moving the COP's image 0.04 mm."""
+    """docs/calibration-focusing-lens.md's figures: the rim 100.3 px bare and 107.9 px through the
+    placed lens (x 1.076), the COP 1.14 mm behind the design's (26.14 mm from the lens), the centre
+    thickness 8.03 mm, the principal planes 2.7 mm apart, a 0.5 mm decentred lens moving the COP's
+    image 0.04 mm."""
     geo = derive(table31)
     lens = focusing_lens(table31, geo)
     seen = lens.projector(geo.projector_focal_px, geo.cop_z)
     bare = geo.projector_focal_px * geo.rim_radius / (geo.cop_z - geo.rim_z)
     through = seen.ring_radius(geo, geo.rim_angle_at_cop)
-    assert (round(bare, 1), round(through, 1), round(through / bare, 3)) == (100.3, 108.0, 1.076)
+    assert (round(bare, 1), round(through, 1), round(through / bare, 3)) == (100.3, 107.9, 1.076)
+    assert (round(lens.cop_distance, 2), round(-seen.cop_shift, 2)) == (26.14, 1.14)
+    assert (round(through_lens(300.0, 25.0, 6.0, 50.0)[0], 2), round(through_lens(300.0, 25.0, 6.0, 50.0)[1], 3)) == \
+        (-1.31, 1.071)
     radius = 300.0 * (LENS_INDEX - 1)
     centre = 6.0 + radius - math.sqrt(radius ** 2 - 25.0 ** 2)
     assert round(centre, 2) == 8.03 and round(centre * (LENS_INDEX - 1) / LENS_INDEX, 1) == 2.7
     s_h = 25.0 - 3.0 - (centre - 6.0)
     assert round(0.5 * s_h / (300.0 - s_h), 2) == 0.04
+
+
+def test_the_tower_puts_the_cop_the_paraboloid_sees_at_the_design_cop(table31_rig):
+    """The COP tower as placed (rigcad.parts.tower.tower_layout): the chief rays from the projector's
+    real COP (TowerLayout.projector_cop, looking -x), traced exactly through the ordered lens centred
+    at TowerLayout.lens_x and extended back, cross the projector's axis at a point whose image in the
+    splitter's front face is the design COP. Before the tower placed it through the lens, this point
+    stood 1.31 mm off along the axis (tolerancing.projector_height: 1 mm)."""
+    from rigcad.optics.splitter import mirror_point
+
+    rig = table31_rig
+    t, p = rig.layout.tower, rig.profile
+    lens = focusing_lens(p, rig.geometry)
+    distance = t.projector_cop[0] - t.lens_x  # the real COP before the lens's centre, along -x
+    design = np.array([0.0, 0.0, rig.geometry.cop_z])
+    for degrees, bound in ((0.05, 1e-5), (1.0, 0.01), (math.degrees(rig.geometry.rim_angle_at_cop), 0.01)):
+        x, _ = _seen_from(math.radians(degrees), lens.focal_length, distance, p.lens.thickness, p.lens.diameter)
+        seen = (t.projector_cop[0] - x, t.projector_cop[1], t.projector_cop[2])  # x: from the real COP towards -x
+        err = float(np.linalg.norm(mirror_point(t.plate, seen) - design))
+        # paraxial: the closed form to the trace's round-off; to the rim: the lens's spherical aberration
+        # (0.0073 mm measured), a hundredth of tolerancing.projector_height
+        assert err < bound, (degrees, err)
+    assert err < 0.01 * p.tolerancing.projector_height
