@@ -47,14 +47,18 @@ class KernelError(GeometryError):
 class AssemblyError(GeometryError):
     """No order puts the rig together: ``step`` (the assembly step that cannot be done, placing the
     parts ``members``) runs into ``obstacles`` (parts, or the steps whose fasteners are in the way).
-    Exit code 1: the profile was valid, the rig it describes cannot be assembled."""
+    Exit code 1: the profile was valid, the rig it describes cannot be assembled. ``summary``: the
+    real blocker in one phrase (the parts that collide, and why no order avoids it); ``detail``: the
+    check's whole reason when the message is a one-line digest of it."""
 
     exit_code = 1
 
     def __init__(self, message: str, *, step: str | None = None, members: tuple[str, ...] = (),
-                 obstacles: tuple[str, ...] = (), where: str | None = None, param: str | None = None) -> None:
+                 obstacles: tuple[str, ...] = (), where: str | None = None, param: str | None = None,
+                 summary: str = "", detail: str = "") -> None:
         super().__init__(message, where=where, param=param)
         self.step, self.members, self.obstacles = step, tuple(members), tuple(obstacles)
+        self.summary, self.detail = summary, detail
 
 
 class IntegrationError(RigcadError):
