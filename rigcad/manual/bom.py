@@ -484,6 +484,8 @@ CONSUMABLES = (
     ("Foam polishing pads, 75 mm, cutting and finishing", "2 each"),
     ("Isopropyl alcohol 99 %, 500 ml, and lint-free wipes (degreasing before each coat)", "1"),
     ("Tack cloths", "5"),
+    ("Wicking threadlocker, low strength (Loctite 290 class), 10 ml: locks the splitter seat's push screws once set",
+     "1"),
 )
 #: Tools with an orderable spec.
 TOOLS = (

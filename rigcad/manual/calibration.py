@@ -394,3 +394,71 @@ def kit_misses(sections: dict[str, str], items: list[KitItem]) -> list[str]:
 
 
 __all__ += ["CHECKER_SQUARE_MM", "ITEM_WORDS", "STEP_ACCEPTANCE", "KitItem", "checkerboard", "kit_items", "kit_misses"]
+
+
+# -- the splitter seat: three push screws and two spring bolts --------------------------------------
+
+
+def seat_lean(rig, screw: str) -> np.ndarray:
+    """Which way (a unit (dx, dy) in the rig frame) the projector's axis, folded down the optical axis
+    by the splitter, leans when ``screw`` ("flat" or "vee") is screwed in: its ball lifts the holder
+    about the line through the other two (rigcad.parts.tower.seat_points), the plate's normal turns with
+    it, and the axis reflected off the plate (the law of reflection, the projector looking -x) moves."""
+    from rigcad.parts.tower import seat_points
+
+    pts = seat_points(rig.layout.tower, rig.profile)
+    others = {"flat": ("cone", "vee"), "vee": ("cone", "flat")}[screw]
+    p1, p2 = (np.array([*pts[o], 0.0]) for o in others)
+    arm = np.array([*pts[screw], 0.0]) - p1
+    axis = (p2 - p1) / np.linalg.norm(p2 - p1)
+    if np.cross(axis, arm)[2] < 0:  # turn the sense so the screw's ball rises (a right-hand turn about axis)
+        axis = -axis
+    n = np.asarray(rig.layout.tower.plate.normal, float)
+    d = np.array([-1.0, 0.0, 0.0])
+    reflect = lambda m: d - 2.0 * (d @ m) * m  # noqa: E731
+    eps = 1e-6
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    turned = n + eps * (k @ n)  # the normal turned by eps about the axis (first order)
+    lean = (reflect(turned) - reflect(n))[:2] / eps
+    return lean / np.linalg.norm(lean)
+
+
+def splitter_seat(rig) -> dict | None:
+    """The splitter seat's adjustment, as section 6 gives it: for the flat's and the vee's push screws
+    (rigcad.parts.adjusters.splitter_adjusters: lever, the reflected axis's turn per step, range) the
+    turn of the projector's axis per ``adjusters.turn_fraction`` of a turn (mrad), which way it leans
+    (:func:`seat_lean`) and the shift (px) of the circle that re-centres the spot for it, along the
+    projector image's rows (the plane of incidence, x) and columns (y), from the projector's focal length
+    in pixels through the focusing lens; the holder's lift per step with all three screws together
+    (the thread's pitch x turn_fraction), its nominal gap over the shelf (rigcad.parts.tower.seat_gap),
+    and ``tolerancing.projector_tilt`` in px. None without the COP tower."""
+    t = getattr(rig.layout, "tower", None)
+    if t is None:
+        return None
+    from rigcad.optics.focus import focusing_lens
+    from rigcad.parts.adjusters import splitter_adjusters
+    from rigcad.parts.tower import seat_gap
+    from rigcad.standards import THREADS
+
+    p, g = rig.profile, rig.geometry
+    a = p.adjusters
+    px_per_rad = focusing_lens(p, g).projector(g.projector_focal_px, g.cop_z).focal_px
+    screws = {}
+    for adj, screw in zip(splitter_adjusters(p, rig.layout), ("flat", "vee")):
+        lean = seat_lean(rig, screw)
+        shift = px_per_rad * adj.resolution
+        words = " and ".join(f"{'+' if v > 0 else '-'}{ax}" for ax, v in zip("xy", lean) if abs(v) > 0.05)
+        screws[screw] = {"adjuster": adj.name, "how": adj.how, "axis_turn_per_step_mrad": 1e3 * adj.resolution,
+                         "circle_shift_per_step_px": shift, "rows_px_per_step": shift * abs(lean[0]),
+                         "columns_px_per_step": shift * abs(lean[1]), "range_each_way_mrad": 1e3 * adj.range,
+                         "range_each_way_steps": adj.range / adj.resolution, "leans": words,
+                         "lean_xy": [float(v) for v in lean]}
+    pitch = THREADS[a.seat_thread].pitch
+    return {"thread": a.seat_thread, "pitch_mm": pitch, "turn_fraction": a.turn_fraction,
+            "lift_per_step_mm": pitch * a.turn_fraction, "travel_each_way_mm": a.seat_travel,
+            "gap_mm": seat_gap(p), "px_per_mrad": px_per_rad * 1e-3,
+            "tolerance_mrad": 1e3 * p.tolerancing.projector_tilt,
+            "tolerance_px": px_per_rad * p.tolerancing.projector_tilt, "screws": screws}
+
+
+__all__ += ["seat_lean", "splitter_seat"]

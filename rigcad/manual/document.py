@@ -1183,6 +1183,9 @@ def _section_calibrate(d: Doc, c) -> None:
         f"(height) until they coincide. The profile allows `tolerancing.projector_offset` = "
         f"{p.tolerancing.projector_offset:g} mm. Then take the plate, crosses and backplate off, put the lens back "
         "and set the holder back on its seat. " + springs["on"])
+    seat = C.splitter_seat(rig)
+    if seat:
+        _seat_section(d, c, seat, springs)
     d.h(3, C.STEP_CIRCLE)
     d.p("Leave the focusing lens in its mount: the circle is set through it, as the basis images are shown. Open "
         "`calibration/circle.html` in a browser on the projector's screen and press f (full screen): arrow keys "
@@ -1221,7 +1224,59 @@ def _section_calibrate(d: Doc, c) -> None:
     _calibration_more(d, c, cam)
     _as_built(d, c)
     step("calibration")
-    c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam}
+    c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam,
+                     "splitter_seat": seat}
+
+
+def _seat_section(d: Doc, c, seat: dict, springs: dict) -> None:
+    """Section 6's adjustment of the splitter seat (rigcad.manual.calibration.splitter_seat): when, what to
+    watch, which screw moves what and by how much per step, when to stop, how to lock."""
+    from rigcad.manual import schedule as S
+    from rigcad.manual.calibration import circle_image
+    from rigcad.standards import SET_SCREW_KEY
+
+    _, info = circle_image(c.rig)
+    cx, cy = info["centre_px_from_top_left"]
+    flat, vee = seat["screws"]["flat"], seat["screws"]["vee"]
+    step = f"1/{round(1 / seat['turn_fraction']):d}" if seat["turn_fraction"] < 1 else f"{seat['turn_fraction']:g}"
+    key = SET_SCREW_KEY.get(seat["thread"])
+    row = next((h for h in B.tower_hardware(c.rig) if h.get("spring_mm")), None)
+    spring = f"{row['spring_mm']['installed_length']:g} mm" if row else "its installed length"
+    d.h(3, S.STEP_SEAT)
+    d.p(f"**When:** after the crosses, the holder back on its seat with its spring bolts set, the focusing lens in, "
+        "the mirrors coated and the film under the dome, O traced on it (the circle's set-up, next). The two spring "
+        f"bolts only hold the holder down on its three balls: never turn them to adjust; each spring stays {spring} "
+        f"long (the caliper), before and after. The three push screws ({seat['thread']}, {seat['pitch_mm']:g} mm "
+        f"pitch, turned from above with the {key:g} mm hex key) carry it: screwed in (clockwise seen from above) a "
+        f"screw lifts the holder at its ball by **{seat['lift_per_step_mm']:.4f} mm per {step} turn**. They start "
+        f"where the splitter holder's step left them: the holder's underside {seat['gap_mm']:.2f} mm above the shelf beside each "
+        "screw (the caliper's depth rod).")
+    d.p("**What to watch:** `calibration/circle.html` on the projector (next section) and the film from below. "
+        f"Press 0 (the design's circle, centred on pixel ({cx:g}, {cy:g})) and move the circle with the arrow keys "
+        "until the spot on the film is symmetric about O's mark: the read-out's centre less the design's is how far "
+        f"the projector's axis leans, **{seat['px_per_mrad']:.2f} px per mrad**.")
+    d.ol([
+        f"The vee's screw (its ball at +y): {step} turn in leans the axis towards {vee['leans']} by "
+        f"{vee['axis_turn_per_step_mrad']:.2f} mrad: the circle that centres the spot moves "
+        f"**{vee['columns_px_per_step']:.1f} px along the image's columns and {vee['rows_px_per_step']:.1f} px along "
+        f"its rows**. Turn it first, by the columns' offset over {vee['columns_px_per_step']:.1f} px per {step} turn.",
+        f"The flat's screw (its ball behind the holder, -x): {step} turn in leans the axis towards {flat['leans']} by "
+        f"{flat['axis_turn_per_step_mrad']:.2f} mrad: **{flat['rows_px_per_step']:.1f} px along the rows**, "
+        f"{flat['columns_px_per_step']:.1f} px along the columns. Turn it second, by what the rows' offset is then.",
+        f"Which way: the projector's menu may mirror its image (ceiling or rear projection). Turn {step} in, "
+        "re-centre the circle, and see the offset fall by about that many pixels; if it grows, turn the other way.",
+        f"The cone's screw: leave it. Turned with the other two by the same amount it lifts the whole holder "
+        f"{seat['lift_per_step_mm']:.4f} mm per {step} turn; use it so only to bring a screw back into its range "
+        f"(each has {seat['travel_each_way_mm']:g} mm each way: {flat['range_each_way_steps']:.0f} steps of {step} turn, "
+        f"{flat['range_each_way_mrad']:.0f} mrad on the flat, {vee['range_each_way_mrad']:.0f} mrad on the vee).",
+        f"**Stop** when the centre is within one step of the design's both ways (re-centre after each turn): "
+        f"{flat['rows_px_per_step']:.1f} px along the rows, {vee['columns_px_per_step']:.1f} px along the columns, "
+        f"a quarter or less of `tolerancing.projector_tilt` ({seat['tolerance_mrad']:.1f} mrad, "
+        f"{seat['tolerance_px']:.0f} px).",
+        f"**Lock:** check both springs at {spring} again; put a drop of wicking threadlocker (the consumables) where "
+        "each push screw enters its insert, leave it 10 min, then re-centre the circle once more: the centre must "
+        "not have moved by a step. Then go on with the circle.",
+    ])
 
 
 def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = None, progress=None) -> list[Path]:
