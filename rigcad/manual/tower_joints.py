@@ -60,7 +60,7 @@ def _nut_bolt(item: str, head, axis, length: float, thread: str, grip: float, pa
 def column_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
     """The printed column's joints: foot to the tongue (step tower_column), shelf to the top flange
     (step tower_shelf)."""
-    from rigcad.parts.tower import NUT_TRAP_DEPTH, _column_flange_points
+    from rigcad.parts.tower import _column_flange_points, nut_trap_depth
 
     t, tw = rig.layout.tower, rig.profile.tower
     if rig.profile.buy.column != "print":
@@ -69,8 +69,9 @@ def column_fasteners(rig) -> dict[str, tuple[Fastener, ...]]:
     washer = foot.get("washer_mm", THREADS[foot["thread"]].washer_thickness)
     pts = _column_flange_points(t, rig.profile)
     z_foot = t.column_base_z + tw.wall + washer
-    grip_foot = washer + tw.wall + (t.column_base_z - t.bench_z) - NUT_TRAP_DEPTH
-    item = "{} x {:g} mm socket-head bolt (ISO 4762) with a large washer (ISO 7093-1) and a nut (ISO 4032){}"
+    grip_foot = washer + tw.wall + (t.column_base_z - t.bench_z) - nut_trap_depth(rig.profile, t)
+    item = ("{} x {:g} mm socket-head bolt (ISO 4762) with a conical spring washer (DIN 6796), a large washer "
+            "(ISO 7093-1) and a nut (ISO 4032){}")
     feet = tuple(_nut_bolt(item.format(foot["thread"], foot["length_mm"], " in the trap under the tongue"),
                            (x, y, z_foot), DOWN, foot["length_mm"], foot["thread"], grip_foot,
                            ("base_plate", "tower_column")) for x, y in pts)

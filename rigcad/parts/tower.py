@@ -5,11 +5,8 @@ Layout (mm, rig frame: O at the origin, optical axis +z; every number from the p
 
 * the plate beam splitter (``optics.splitter``) at 45 deg on the axis, ``tower.splitter_distance``
   below the COP, its coated front face towards +x and down;
-* the projector on its side of the splitter at 90 deg, looking -x: the focusing lens's centre
-  ``lens.distance`` from the design COP's image in the splitter's front face, and the real COP
-  behind it where the paraboloid, through the lens, sees it at that image (rigcad.optics.focus:
-  ``FocusingLens.cop_distance``, 1.14 mm farther back for Table 3.1); it stands on its mounting holes
-  (``projector.mount_holes``, rigcad.profile.instruments.mount_pattern), each over a slot in the shelf;
+* the projector on its side of the splitter at 90 deg: its COP on the x axis as far from the axis as
+  the splitter is below the COP (its image in the front face is the design COP), looking -x;
 * the camera behind the splitter on the axis, looking down through the plate, its COP moved by the
   plate's compensation (``optics.splitter.camera_cop``: 0.34 mm across and 0.47 mm up for 1 mm of
   N-BK7) so that it sees the rig from the design COP;
@@ -45,10 +42,10 @@ from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_po
 from rigcad.parts.joints import Bought, Datum, KinematicSeat, SeatContact, datums_of
 from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Translate,
                                  Union_)
-from rigcad.profile.instruments import mount_pattern, size_origin
+from rigcad.profile.instruments import size_origin
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
-from rigcad.standards import (CAMERA_SOCKET_DEPTH, CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for, longest_dowel,
+from rigcad.standards import (CAMERA_SOCKET_DEPTH, CONICAL_SPRING_WASHERS, CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for, longest_dowel,
                               longest_screw, screw_lengths, shortest_screw, shortest_set_screw, spring_rate)
 
 #: Gap around the splitter plate in its grooves (mm): a printed groove comes out ~0.1 mm narrow.
@@ -57,6 +54,8 @@ GROOVE_GAP = 0.2
 GROOVE_DEPTH = 2.0
 #: Square adjustment shims (mm): side; the U slot takes the screw without removing it.
 SHIM_SIDE = 30.0
+#: Inset of the projector's shim stacks (and the shelf's slots under them) from its body's corners (mm).
+FOOT_INSET = 30.0
 
 
 def clearance_hole(thread: str) -> float:
@@ -68,10 +67,8 @@ def clearance_hole(thread: str) -> float:
 @dataclass(frozen=True)
 class TowerLayout:
     """Placements of the tower and its instruments (mm). ``plate``: the splitter; ``camera``: the
-    compensated camera placement; ``projector_cop``: the projector's real COP (through the focusing
-    lens, its image in the plate's front face is the design COP); ``*_z``: heights of the shelf, the
-    bench and the holder; ``projector_feet``: (x, y) of the projector's mounting holes, each over a
-    shim stack and a slot in the shelf."""
+    compensated camera placement; ``projector_cop``: the projector's real COP (its image in the
+    plate's front face is the design COP); ``*_z``: heights of the shelf, the bench and the holder."""
 
     plate: Plate
     camera: CameraPlacement
@@ -96,7 +93,6 @@ class TowerLayout:
     bundle_radius_at_shelf: float  #: the projector's ray bundle (pinhole cone + aperture) at the shelf
     shims_nominal: int  #: shims under the projector and behind the camera at the nominal placement
     shims_per_stack: int  #: shims printed per stack: the full travel both ways
-    projector_feet: tuple[tuple[float, float], ...] = ()  #: the projector's mounting holes (x, y)
 
     def describe(self) -> dict:
         """Placements for the manifest (mm)."""
@@ -200,13 +196,12 @@ def _camera_boxes(profile: Profile, camera: CameraPlacement, plate_top_z: float,
     return body, lens, face_y
 
 
-def _projector_boxes(profile: Profile, p_cop, plate_x1: float, cop_distance: float):
-    """The focusing lens's x (``cop_distance`` before the real COP ``p_cop``) and the projector body's
-    and lens's boxes (looking -x at the splitter)."""
+def _projector_boxes(profile: Profile, p_cop, plate_x1: float):
+    """The focusing lens's x and the projector body's and lens's boxes (looking -x at the splitter)."""
     tw, pj, ln = profile.tower, profile.projector, profile.lens
     z_s = p_cop[2]
     front = p_cop[0] - pj.pupil_depth
-    lens_x = float(p_cop[0] - cop_distance)
+    lens_x = float(p_cop[0] - ln.distance)
     half = ln.thickness / 2 + tw.wall / 2  # the lens's pocket and its lips
     if lens_x - half < plate_x1 + tw.clearance or lens_x + half > front - tw.clearance:
         raise GeometryError(
@@ -252,13 +247,11 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
     cop_z, L = geometry.cop_z, tw.splitter_distance
     plate = splitter_plate(cop_z, L, bs.width, bs.length, bs.thickness, bs.index)
     camera = camera_cop(plate, cop_z, geometry.rim_angle_at_cop)
-    seen = mirror_point(plate, (0.0, 0.0, cop_z))  # = (L, 0, cop_z - L): the COP the paraboloid must see
-    focus = focusing_lens(profile, geometry)
-    p_cop = np.asarray(seen, float) + (focus.cop_distance - focus.lens_distance, 0.0, 0.0)  # the real COP, behind
+    p_cop = mirror_point(plate, (0.0, 0.0, cop_z))  # = (L, 0, cop_z - L): the projector's real COP
     px0, px1, pz0, pz1 = _plate_extent(plate)
     _check_splitter_size(profile, geometry)
     camera_box, camera_lens_box, face_y = _camera_boxes(profile, camera, pz1, L)
-    lens_x, projector_box, projector_lens_box = _projector_boxes(profile, p_cop, px1, focus.cop_distance)
+    lens_x, projector_box, projector_lens_box = _projector_boxes(profile, p_cop, px1)
     shims = shims_nominal(profile)
     shelf_t = 2 * tw.wall
     shelf_top = _shelf_top(profile, cop_z, pz0, dome_top_z)
@@ -279,8 +272,7 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
         projector_box=projector_box, projector_lens_box=projector_lens_box, camera_box=camera_box,
         camera_lens_box=camera_lens_box, lens_x=lens_x,
         bundle_radius_at_shelf=_bundle_radius(profile, geometry, cop_z - (shelf_top - shelf_t)),
-        shims_nominal=shims, shims_per_stack=2 * shims,
-        projector_feet=tuple((float(p_cop[0] + a), float(c)) for a, c in mount_pattern(profile.projector)))
+        shims_nominal=shims, shims_per_stack=2 * shims)
 
 
 # -- the printed parts -----------------------------------------------------------------------------
@@ -345,13 +337,58 @@ def _countersink() -> Revolve:
 
 #: Hexagonal nut traps under the tongue (mm): the M4 nut's 7.0 mm across flats and a printed fit's gap
 #: (0.2 mm) on each flat; a corner on +x (NUT_TRAP_TURN, rad). The nut (4.04 mm to a corner) cannot turn
-#: in it (3.7 mm to a flat). The depth puts the nut so high that a stocked 20 mm bolt reaches through it
-#: and ends 0.8 mm above the bench; the tongue then stands on the bench (the assembly check,
-#: rigcad.manual.tower_joints, verifies both, the nut drawn as its hexagon).
+#: in it (3.7 mm to a flat). Its depth (:func:`nut_trap_depth`) puts the nut so high that the longest
+#: stocked bolt that ends BENCH_CLEAR above the bench stands one thread out of it (every thread of the
+#: nut engaged); the tongue then stands on the bench (the assembly check, rigcad.manual.tower_joints,
+#: verifies both, the nut drawn as its hexagon).
 NUT_TRAP_GAP = 0.2
 NUT_TRAP = THREADS["M4"].nut_af + 2 * NUT_TRAP_GAP
 NUT_TRAP_TURN = 0.0
-NUT_TRAP_DEPTH = 5.6
+#: A bolt that ends in a nut stands out of it by at least this many threads (pitches): the nut's every
+#: thread engaged, and the length left for the conical spring washer's free height.
+NUT_PROUD_PITCHES = 1
+#: The column foot's bolts end at least this far (mm) above the bench: the tongue stands on the bench.
+BENCH_CLEAR = 0.5
+#: The least printed roof (mm) left over a nut trap in the tongue: the nut's bearing face presses on it
+#: (six 0.45 mm perimeters' worth of solid layers: not a skin).
+TRAP_ROOF_MIN = 3.0
+
+
+def spring_washer(thread: str) -> tuple[str, float]:
+    """The DIN 6796 conical spring washer under the head of a bolt that locates a datum (creep would relax
+    the joint: rigcad.fab.loads marks them): its name and its free height h max (mm), which the grip counts
+    (the tower's preloads, under 1.2 kN, leave it near free: DIN 6796 M4 flattens at about 3 kN)."""
+    d1, d2, s, h = CONICAL_SPRING_WASHERS[thread]
+    return f"{thread} conical spring washer (DIN 6796, {d2:g} mm outside, {h:g} mm free height)", h
+
+
+def column_foot_bolt(profile: Profile, t: TowerLayout) -> dict:
+    """The printed column's foot bolts (mm): down through the conical spring washer and the large washer
+    (:func:`spring_washer`, the column's opened hole's washers), the foot and the tongue into a nut in
+    its trap: the longest stocked ISO 4762 length that ends BENCH_CLEAR above the bench (the head stands
+    on the foot, so the bolt's end depends on its length alone), and the trap deep enough that the bolt
+    stands NUT_PROUD_PITCHES threads out of the nut (depth rounded up to 0.1 mm). GeometryError, naming
+    ``base_plate.thickness``, when the trap would leave less than TRAP_ROOF_MIN of roof."""
+    from rigcad.parts.washers import washers_over
+
+    th = THREADS["M4"]
+    stack = washers_over("M4", ("round", column_bolt_hole(t, profile))).thickness + spring_washer("M4")[1]
+    head = stack + profile.tower.wall - t.bench_z  # the head's face over the bench
+    length = longest_screw("M4", head - BENCH_CLEAR)
+    depth = math.ceil((NUT_PROUD_PITCHES * th.pitch + th.nut_height + head - length) * 10 - 1e-6) / 10
+    depth = max(depth, th.nut_height)
+    if -t.bench_z - depth < TRAP_ROOF_MIN:
+        raise GeometryError(f"the column foot's nut traps ({depth:.1f} mm deep) would leave {-t.bench_z - depth:.1f} mm "
+                            f"of the {-t.bench_z:g} mm tongue over the nut (at least {TRAP_ROOF_MIN:g} mm): thicken "
+                            "base_plate.thickness", where=profile.where("base_plate", "thickness"))
+    grip = head - depth
+    return {"length_mm": float(length), "trap_depth_mm": depth, "grip_mm": grip, "washers_mm": stack,
+            "proud_mm": length - grip - th.nut_height, "above_bench_mm": head - length}
+
+
+def nut_trap_depth(profile: Profile, t: TowerLayout) -> float:
+    """The column foot's nut traps' depth (mm) from the bench: :func:`column_foot_bolt`."""
+    return column_foot_bolt(profile, t)["trap_depth_mm"]
 #: Counterbore under the tongue for the extrusion's M8 socket head (13 mm, 8 mm tall; ISO 4762):
 #: diameter, depth (mm). An ISO 7089 M8 washer (16 mm) does not fit it: the head bears on the floor.
 CORE_HEAD_BORE = (14.0, 8.5)
@@ -378,7 +415,8 @@ def tongue_underside_cuts(t: TowerLayout, profile: Profile, z_bottom: float) -> 
     if profile.buy.column != "print":
         d, depth = CORE_HEAD_BORE
         return (Cylinder((t.column_x, 0.0, z_bottom - 1.0), d / 2, depth + 1.0),)
-    return tuple(HexPrism((x, y, z_bottom - 1.0), NUT_TRAP, NUT_TRAP_DEPTH + 1.0, NUT_TRAP_TURN)
+    depth = nut_trap_depth(profile, t)
+    return tuple(HexPrism((x, y, z_bottom - 1.0), NUT_TRAP, depth + 1.0, NUT_TRAP_TURN)
                  for x, y in _column_flange_points(t, profile))
 
 
@@ -453,7 +491,8 @@ def shelf_joint_cuts(t: TowerLayout, profile: Profile, z0: float) -> tuple:
 
 def shelf_bolt_length(profile: Profile) -> float:
     """The shelf joint's bolt (mm): the longest stocked ISO 4762 length that stops 0.5 mm short of the
-    insert's end, through the column's flange and a washer."""
+    insert's end, through the column's flange, its large washer and the conical spring washer
+    (:func:`spring_washer`) under its head."""
     from rigcad.parts.locating import bolt_hole
     from rigcad.parts.washers import washers_over
 
@@ -461,7 +500,8 @@ def shelf_bolt_length(profile: Profile) -> float:
     d = profile.datum
     far = 2 * (profile.tower.column_width / 2 + 1.5 * profile.tower.bolt_diameter)
     hole = bolt_hole("M4", far, d.print_position, d.print_scale)
-    reach = profile.tower.wall + washers_over("M4", ("round", hole)).thickness + SHELF_INSERT.length - 0.5
+    reach = (profile.tower.wall + washers_over("M4", ("round", hole)).thickness + spring_washer("M4")[1]
+             + SHELF_INSERT.length - 0.5)
     return float(longest_screw("M4", reach))
 
 
@@ -777,8 +817,8 @@ def _lens_foot(t: TowerLayout, profile: Profile):
 
 
 def _projector_feet(t: TowerLayout):
-    """(x, y) of the projector's mounting holes (rigcad.parts.projector_mount checks the shelf carries them)."""
-    return list(t.projector_feet)
+    (x0, y0, _), (x1, y1, _) = t.projector_box
+    return [(x, y) for x in (x0 + FOOT_INSET, x1 - FOOT_INSET) for y in (y0 + FOOT_INSET, y1 - FOOT_INSET)]
 
 
 def _shelf_extent(t: TowerLayout, profile: Profile):
@@ -1028,22 +1068,26 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
 
     hole = column_bolt_hole(t, profile)
     big = washers_over("M4", ("round", hole))
-    extra = big.thickness - THREADS["M4"].washer_thickness
+    cone, cone_h = spring_washer("M4")
+    foot = column_foot_bolt(profile, t)
     lap = (f"lap the column's foot-side and flange-side glue faces flat before they are glued: wet P240 paper on "
            f"float glass, figure-of-eight strokes, until a steel straightedge laid across each face in four directions "
            f"admits no {LAPPED_FLATNESS:g} mm feeler leaf")
     return [
-        {"item": "bolt and large washer (ISO 7093-1)", "thread": "M4", "length_mm": shelf_bolt_length(profile),
-         "quantity": 4, "washer_mm": big.thickness, "washers": [w.name() for w in big.washers],
+        {"item": "bolt, conical washer (DIN 6796) and large washer (ISO 7093-1)", "thread": "M4",
+         "length_mm": shelf_bolt_length(profile), "quantity": 4, "washer_mm": big.thickness + cone_h,
+         "washers": [w.name() for w in big.washers], "spring_washer": cone,
          "steps": ('tower_shelf',), "joins": "the column's top flange to the shelf: up from under the flange into "
                   + ("heat-set inserts pressed into the shelf's underside" if profile.buy.shelf == "print" else
                      "M4 threads tapped in the shelf's underside (8 mm deep)")
-                  + f" ({big.describe()}: the dowels locate, the bolts only clamp)"},
-        {"item": "bolt, large washer (ISO 7093-1) and nut", "thread": "M4",
-         "length_mm": _length("M4", tw.wall + tongue - NUT_TRAP_DEPTH + extra, nut_allowance("M4", washers=1)),
-         "quantity": 4, "washer_mm": big.thickness, "washers": [w.name() for w in big.washers],
+                  + f" ({cone} on {big.describe()}: the dowels locate, the bolts only clamp)"},
+        {"item": "bolt, conical washer (DIN 6796), large washer (ISO 7093-1) and nut", "thread": "M4",
+         "length_mm": foot["length_mm"], "quantity": 4, "washer_mm": foot["washers_mm"],
+         "washers": [w.name() for w in big.washers], "spring_washer": cone,
          "steps": ('tower_column',), "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
-                  f"under the tongue, put in before it stands on the bench; {big.describe()})"},
+                  f"under the tongue, {foot['trap_depth_mm']:g} mm deep, put in before it stands on the bench: the bolt stands "
+                  f"{foot['proud_mm']:.1f} mm out of its nut and ends {foot['above_bench_mm']:.1f} mm above the bench; "
+                  f"{cone} on {big.describe()})"},
         *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT.hole,
             "steps": ('tower_shelf',), "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]
           if profile.buy.shelf == "print" else []),
@@ -1276,6 +1320,62 @@ def hardware(profile: Profile, layout) -> list[dict]:
                  "least spherical aberration)",
          "steps": ('focusing_lens',), "joins": "drops into the lens mount's pocket"},
     ]
+
+
+def screw_engagements(profile: Profile, layout) -> list[dict]:
+    """Every screw joint of the tower with how its thread is engaged (mm): a bolt into a nut stands at
+    least NUT_PROUD_PITCHES threads out of it (``proud_mm`` against ``least_mm``: the nut's every thread
+    engaged, the conical spring washer at its free height counted in the grip); a bolt into an insert or a
+    tapped core engages at least one diameter and ends short of the insert's (or the tapping's) end; a
+    screw into an instrument engages it as :func:`_stack_screws` asks (``ok`` per shim stack). ``ok``: the
+    joint keeps to it."""
+    t, tw = layout.tower, profile.tower
+    th = THREADS["M4"]
+    rows = []
+
+    def nut(joint, length, grip, extra=""):
+        proud = length - grip - th.nut_height
+        least = NUT_PROUD_PITCHES * th.pitch
+        rows.append({"joint": joint, "thread": "M4", "length_mm": length, "grip_mm": grip, "into": "nut",
+                     "proud_mm": proud, "least_mm": least, "ok": proud >= least - 1e-9, "note": extra})
+
+    def threaded(joint, thread, length, grip, depth, into):
+        engaged = length - grip
+        least = THREADS[thread].major
+        rows.append({"joint": joint, "thread": thread, "length_mm": length, "grip_mm": grip, "into": into,
+                     "engaged_mm": engaged, "least_mm": least, "most_mm": depth,
+                     "ok": least - 1e-9 <= engaged <= depth + 1e-9})
+
+    hw = hardware(profile, layout)
+    if profile.buy.column == "print":
+        foot = column_foot_bolt(profile, t)
+        nut("column foot on the tongue", foot["length_mm"], foot["grip_mm"],
+            f"ends {foot['above_bench_mm']:.1f} mm above the bench")
+        rows[-1]["ok"] = rows[-1]["ok"] and foot["above_bench_mm"] >= BENCH_CLEAR - 1e-9
+        top = next(h for h in hw if h["joins"].startswith("the column's top flange to the shelf"))
+        threaded("column top under the shelf", "M4", top["length_mm"], tw.wall + top["washer_mm"],
+                 SHELF_INSERT.length - 0.5 if profile.buy.shelf == "print" else t.shelf_thickness - 2.0,
+                 "heat-set insert" if profile.buy.shelf == "print" else "tapped thread")
+    else:
+        core = core_bolt_lengths(profile, t)
+        threaded("extrusion's foot core screw", "M8", core["foot"], -t.bench_z - CORE_HEAD_BORE[1] - POCKET_DEPTH,
+                 CORE_TAP_DEPTH - 1.0, "tapped core")
+        threaded("extrusion's top core screw", "M8", core["top"], t.shelf_thickness - POCKET_DEPTH, CORE_TAP_DEPTH - 1.0,
+                 "tapped core")
+    washers = joint_washers(profile, layout)
+    lens = next(h for h in hw if h["joins"].startswith("the lens mount's slotted foot"))
+    nut("lens mount's foot on the shelf", lens["length_mm"],
+        tw.wall + t.shelf_thickness + washers["lens"].thickness + th.washer_thickness)
+    spring = next(h for h in hw if h["joins"].startswith("from under the shelf up through the holder's flange"))
+    nut("splitter holder's spring bolts (spring free)", spring["length_mm"],
+        2 * th.washer_thickness + t.shelf_thickness + seat_gap(profile) + tw.wall + SEAT_SPRING["free_length"])
+    for joint, screws in (("projector on its shims", projector_screws(profile, layout)),
+                          ("camera on its shims", camera_stack_screws(profile, layout))):
+        for r in screws:
+            rows.append({"joint": f"{joint} ({r['shims']} printed shims)", "thread": None, "length_mm": r["length_mm"],
+                         "grip_mm": r["grip_mm"], "into": "the instrument's socket", "engaged_mm": r["engagement_mm"],
+                         "least_mm": r["least_engagement_mm"], "ok": r["ok"]})
+    return rows
 
 
 def splitter_spec(profile: Profile) -> str:

@@ -71,13 +71,14 @@ def test_the_tongue_stands_on_the_bench_with_nut_traps(table31_rig):
 
     from rigcad.export import mesh as M
     from rigcad.parts.recipe import HexPrism
-    from rigcad.parts.tower import NUT_TRAP_DEPTH, NUT_TRAP_TURN, _column_flange_points
+    from rigcad.parts.tower import NUT_TRAP_TURN, _column_flange_points, nut_trap_depth
 
     t = table31_rig.layout.tower
     plate = M.build(table31_rig.recipe("base_plate").solid, 0.05)
     assert plate.bounding_box()[2] == pytest.approx(t.bench_z, abs=1e-9)
     for x, y in _column_flange_points(t, table31_rig.profile):
-        nut = M.build(HexPrism((x, y, t.bench_z + 0.01), 7.0, NUT_TRAP_DEPTH - 0.02, NUT_TRAP_TURN), 0.05)
+        nut = M.build(HexPrism((x, y, t.bench_z + 0.01), 7.0, nut_trap_depth(table31_rig.profile, t) - 0.02,
+                               NUT_TRAP_TURN), 0.05)
         assert (plate ^ nut).volume() < 1e-9
         assert (plate ^ nut).status() == m3d.Error.NoError
 

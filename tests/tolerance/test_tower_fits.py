@@ -55,3 +55,40 @@ def test_the_shelf_cuts_the_pockets_at_their_drawn_size(table31_rig):
     rows = [h for h in T.hardware(p, table31_rig.layout) if "fit_mm" in h]
     assert sorted(h["fit_mm"]["pocket"] for h in rows) == ["cone", "flat", "vee"]
     assert all("bond" in h["joins"] for h in rows)
+
+
+def _rigs(table31_rig, other_rig):
+    return (("default", table31_rig), ("second", other_rig))
+
+
+def test_every_tower_screw_joint_engages_its_nut_insert_or_socket(table31_rig, other_rig):
+    """Each screw joint of the tower, on the default rig and the second: a nut stands a thread under the
+    bolt's end (the conical spring washer's free height counted), an insert is engaged a diameter or
+    more and never bottomed, an instrument's socket as its stack asks."""
+    for name, rig in _rigs(table31_rig, other_rig):
+        rows = T.screw_engagements(rig.profile, rig.layout)
+        assert {r["into"] for r in rows} >= {"nut", "heat-set insert", "the instrument's socket"}
+        bad = [r for r in rows if not r["ok"]]
+        assert not bad, f"{name}: {bad}"
+
+
+def test_the_column_foot_bolt_is_long_enough_by_the_standards_figures(table31_rig, other_rig):
+    """Independently of the code's grip: the row's bolt length less the DIN 6796 washer's free height,
+    the ISO 7093-1 M4 washer, the foot and the tongue over the trap leaves the ISO 4032 nut's height and
+    at least one pitch; and the bolt ends above the bench. (Planted once: NUT_PROUD_PITCHES = 0, the
+    trap as shallow as 'just reaches' fails here: the old 5.6 mm trap left 0.3 mm with the conical washer.)"""
+    from rigcad.standards import CONICAL_SPRING_WASHERS, ISO_7093, THREADS
+
+    for name, rig in _rigs(table31_rig, other_rig):
+        p, t = rig.profile, rig.layout.tower
+        row = next(h for h in T.hardware(p, rig.layout) if h["joins"].startswith("the column's foot"))
+        assert "DIN 6796" in row["spring_washer"] and "DIN 6796" in row["item"]
+        trap = T.nut_trap_depth(p, t)
+        tongue = -t.bench_z
+        grip = CONICAL_SPRING_WASHERS["M4"][3] + ISO_7093["M4"][2] + p.tower.wall + tongue - trap
+        proud = row["length_mm"] - grip - THREADS["M4"].nut_height
+        assert proud >= THREADS["M4"].pitch - 1e-9, f"{name}: the bolt stands {proud:.2f} mm out of its nut"
+        # the bolt's end above the bench (the tongue stands on it): its head over the bench less its length
+        above = CONICAL_SPRING_WASHERS["M4"][3] + ISO_7093["M4"][2] + p.tower.wall + tongue - row["length_mm"]
+        assert above >= T.BENCH_CLEAR - 1e-9
+        assert tongue - trap >= T.TRAP_ROOF_MIN  # a printed roof over the nut, not a skin
