@@ -5,8 +5,11 @@ Layout (mm, rig frame: O at the origin, optical axis +z; every number from the p
 
 * the plate beam splitter (``optics.splitter``) at 45 deg on the axis, ``tower.splitter_distance``
   below the COP, its coated front face towards +x and down;
-* the projector on its side of the splitter at 90 deg: its COP on the x axis as far from the axis as
-  the splitter is below the COP (its image in the front face is the design COP), looking -x;
+* the projector on its side of the splitter at 90 deg, looking -x: the focusing lens's centre
+  ``lens.distance`` from the design COP's image in the splitter's front face, and the real COP
+  behind it where the paraboloid, through the lens, sees it at that image (rigcad.optics.focus:
+  ``FocusingLens.cop_distance``, 1.14 mm farther back for Table 3.1); it stands on its mounting holes
+  (``projector.mount_holes``, rigcad.profile.instruments.mount_pattern), each over a slot in the shelf;
 * the camera behind the splitter on the axis, looking down through the plate, its COP moved by the
   plate's compensation (``optics.splitter.camera_cop``: 0.34 mm across and 0.47 mm up for 1 mm of
   N-BK7) so that it sees the rig from the design COP;
@@ -42,7 +45,7 @@ from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_po
 from rigcad.parts.joints import Bought, Datum, KinematicSeat, SeatContact, datums_of
 from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Translate,
                                  Union_)
-from rigcad.profile.instruments import size_origin
+from rigcad.profile.instruments import mount_pattern, size_origin
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
 from rigcad.standards import (CAMERA_SOCKET_DEPTH, CONICAL_SPRING_WASHERS, CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for, longest_dowel,
@@ -54,8 +57,6 @@ GROOVE_GAP = 0.2
 GROOVE_DEPTH = 2.0
 #: Square adjustment shims (mm): side; the U slot takes the screw without removing it.
 SHIM_SIDE = 30.0
-#: Inset of the projector's shim stacks (and the shelf's slots under them) from its body's corners (mm).
-FOOT_INSET = 30.0
 
 
 def clearance_hole(thread: str) -> float:
@@ -67,8 +68,10 @@ def clearance_hole(thread: str) -> float:
 @dataclass(frozen=True)
 class TowerLayout:
     """Placements of the tower and its instruments (mm). ``plate``: the splitter; ``camera``: the
-    compensated camera placement; ``projector_cop``: the projector's real COP (its image in the
-    plate's front face is the design COP); ``*_z``: heights of the shelf, the bench and the holder."""
+    compensated camera placement; ``projector_cop``: the projector's real COP (through the focusing
+    lens, its image in the plate's front face is the design COP); ``*_z``: heights of the shelf, the
+    bench and the holder; ``projector_feet``: (x, y) of the projector's mounting holes, each over a
+    shim stack and a slot in the shelf."""
 
     plate: Plate
     camera: CameraPlacement
@@ -93,6 +96,7 @@ class TowerLayout:
     bundle_radius_at_shelf: float  #: the projector's ray bundle (pinhole cone + aperture) at the shelf
     shims_nominal: int  #: shims under the projector and behind the camera at the nominal placement
     shims_per_stack: int  #: shims printed per stack: the full travel both ways
+    projector_feet: tuple[tuple[float, float], ...] = ()  #: the projector's mounting holes (x, y)
 
     def describe(self) -> dict:
         """Placements for the manifest (mm)."""
@@ -196,12 +200,13 @@ def _camera_boxes(profile: Profile, camera: CameraPlacement, plate_top_z: float,
     return body, lens, face_y
 
 
-def _projector_boxes(profile: Profile, p_cop, plate_x1: float):
-    """The focusing lens's x and the projector body's and lens's boxes (looking -x at the splitter)."""
+def _projector_boxes(profile: Profile, p_cop, plate_x1: float, cop_distance: float):
+    """The focusing lens's x (``cop_distance`` before the real COP ``p_cop``) and the projector body's
+    and lens's boxes (looking -x at the splitter)."""
     tw, pj, ln = profile.tower, profile.projector, profile.lens
     z_s = p_cop[2]
     front = p_cop[0] - pj.pupil_depth
-    lens_x = float(p_cop[0] - ln.distance)
+    lens_x = float(p_cop[0] - cop_distance)
     half = ln.thickness / 2 + tw.wall / 2  # the lens's pocket and its lips
     if lens_x - half < plate_x1 + tw.clearance or lens_x + half > front - tw.clearance:
         raise GeometryError(
@@ -247,11 +252,13 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
     cop_z, L = geometry.cop_z, tw.splitter_distance
     plate = splitter_plate(cop_z, L, bs.width, bs.length, bs.thickness, bs.index)
     camera = camera_cop(plate, cop_z, geometry.rim_angle_at_cop)
-    p_cop = mirror_point(plate, (0.0, 0.0, cop_z))  # = (L, 0, cop_z - L): the projector's real COP
+    seen = mirror_point(plate, (0.0, 0.0, cop_z))  # = (L, 0, cop_z - L): the COP the paraboloid must see
+    focus = focusing_lens(profile, geometry)
+    p_cop = np.asarray(seen, float) + (focus.cop_distance - focus.lens_distance, 0.0, 0.0)  # the real COP, behind
     px0, px1, pz0, pz1 = _plate_extent(plate)
     _check_splitter_size(profile, geometry)
     camera_box, camera_lens_box, face_y = _camera_boxes(profile, camera, pz1, L)
-    lens_x, projector_box, projector_lens_box = _projector_boxes(profile, p_cop, px1)
+    lens_x, projector_box, projector_lens_box = _projector_boxes(profile, p_cop, px1, focus.cop_distance)
     shims = shims_nominal(profile)
     shelf_t = 2 * tw.wall
     shelf_top = _shelf_top(profile, cop_z, pz0, dome_top_z)
@@ -272,7 +279,8 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
         projector_box=projector_box, projector_lens_box=projector_lens_box, camera_box=camera_box,
         camera_lens_box=camera_lens_box, lens_x=lens_x,
         bundle_radius_at_shelf=_bundle_radius(profile, geometry, cop_z - (shelf_top - shelf_t)),
-        shims_nominal=shims, shims_per_stack=2 * shims)
+        shims_nominal=shims, shims_per_stack=2 * shims,
+        projector_feet=tuple((float(p_cop[0] + a), float(c)) for a, c in mount_pattern(profile.projector)))
 
 
 # -- the printed parts -----------------------------------------------------------------------------
@@ -817,8 +825,8 @@ def _lens_foot(t: TowerLayout, profile: Profile):
 
 
 def _projector_feet(t: TowerLayout):
-    (x0, y0, _), (x1, y1, _) = t.projector_box
-    return [(x, y) for x in (x0 + FOOT_INSET, x1 - FOOT_INSET) for y in (y0 + FOOT_INSET, y1 - FOOT_INSET)]
+    """(x, y) of the projector's mounting holes (rigcad.parts.projector_mount checks the shelf carries them)."""
+    return list(t.projector_feet)
 
 
 def _shelf_extent(t: TowerLayout, profile: Profile):
