@@ -203,6 +203,9 @@ def rig_layout(profile: Profile, geometry: Derived, dome: DomeProfile) -> RigLay
     dome_top_z = max(float(printed_dome.points(np.array([u_top]))[0, 1]),
                      float(dome_outer.points(np.array([u_top]))[0, 1]))
     tower = tower_layout(profile, geometry, plate_r, dome_top_z)
+    from rigcad.parts.projector_mount import check_mount
+
+    check_mount(profile, tower)  # the shelf carries the projector by its own mounting holes
     return RigLayout(
         geometry=geometry, coating=coating, design_dome=design_dome, design_paraboloid=design_para,
         printed_dome=printed_dome, printed_paraboloid=printed_para, dome_outer=dome_outer,

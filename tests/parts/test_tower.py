@@ -84,8 +84,14 @@ def test_both_centres_of_projection_sit_at_cop_z(rig):
 
     t = rig.layout.tower
     cop = np.array([0.0, 0.0, rig.geometry.cop_z])
-    # the projector: its real COP's image in the plate's front face is the design COP
-    assert np.allclose(mirror_point(t.plate, t.projector_cop), cop, atol=1e-9)
+    # the projector: its real COP stands behind the COP the paraboloid sees through the focusing lens
+    # (rigcad.optics.focus.FocusingLens.cop_distance; tests/parts/test_projector_mount.py traces it), whose
+    # image in the plate's front face is the design COP: the real COP's image is that far above it
+    from rigcad.optics.focus import focusing_lens
+
+    lens = focusing_lens(rig.profile, rig.geometry)
+    behind = lens.cop_distance - lens.lens_distance
+    assert np.allclose(mirror_point(t.plate, t.projector_cop), cop + (0.0, 0.0, behind), atol=1e-9)
     # the camera: its rays through the plate meet (least squares) at the design COP
     dirs = cone_dirs(rig.geometry.rim_angle_at_cop)
     p, d, inside = transmit(t.plate, np.tile(t.camera.cop, (len(dirs), 1)), dirs)
@@ -112,7 +118,8 @@ def test_projector_slots_travel_covers_the_tolerances(rig, shapes):
     (x0, y0, _), (x1, y1, _) = t.projector_box
     z0 = t.shelf_top_z - t.shelf_thickness - 1.0
     shelf = shapes["tower_shelf"]
-    x, y = x0 + 30.0, y0 + 30.0  # a foot (FOOT_INSET)
+    x, y = t.projector_feet[0]  # a foot (the assumed pattern: 30 mm in from the body's corners)
+    assert (x, y) == pytest.approx((x0 + 30.0, y0 + 30.0))
     for dx, dy in ((tw.travel_along, 0), (-tw.travel_along, 0), (0, tw.travel_across), (0, -tw.travel_across)):
         assert _bolt_fits(shelf, x + dx, y + dy, z0, t.shelf_thickness + 2, d), (dx, dy)
     assert not _bolt_fits(shelf, x + tw.travel_along + 0.3 + 0.25, y, z0, t.shelf_thickness + 2, d)
