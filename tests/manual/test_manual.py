@@ -137,11 +137,11 @@ def test_calibration_circle_is_the_rim_at_the_projectors_resolution(table31_rig)
     w, h = table31_rig.profile.projector.resolution
     assert img.shape == (h, w) and set(np.unique(img)) == {0, 255}
     # the derived figures' closed form (profile.derived, not the design map) gives the rim's pixel radius
-    # without the focusing lens; the circle is set through it, x its pixel scale at the COP it moves
+    # without the focusing lens; the circle is set through it, x its pixel scale (the tower places the
+    # projector so that, through the lens, the paraboloid sees its COP at the design COP)
     g = table31_rig.geometry
     assert info["radius_without_lens_px"] == pytest.approx(g.pixels_vertex_to_rim, rel=1e-9)
-    moved = (g.cop_z - g.rim_z) / (g.cop_z + info["lens_cop_shift_mm"] - g.rim_z)
-    assert info["radius_px"] == pytest.approx(g.pixels_vertex_to_rim * info["lens_pixel_scale"] * moved, rel=1e-9)
+    assert info["radius_px"] == pytest.approx(g.pixels_vertex_to_rim * info["lens_pixel_scale"], rel=1e-9)
     assert info["radius_px"] / info["radius_without_lens_px"] == pytest.approx(1.076, abs=1e-3)
     lit = int((img == 255).sum())
     r = info["radius_px"]
