@@ -180,6 +180,8 @@ def run_raycheck(rig, exports: Path | None = None, rays: int | None = None, mode
         "meshes": None if meshes is None else _mesh_figures(meshes),
         "readings": readings,
         "pixels_per_degree": fan["summary"],
+        # the 2D design's exact theta range (deg), against targets: the figure `rigcad design` reports
+        "design_range": rig.design.report["measurable_range"],
         "pixel_grid": grid_report,
         "thin_lens": lens,
         "tower": tower,

@@ -80,9 +80,9 @@ def evaluate(profile, report: dict) -> list[Row]:
                     "raycheck.theta_coverage_tolerance", th_hi, tg.theta_max / DEG - cov, ">=", "deg",
                     w("raycheck", "theta_coverage_tolerance"),
                     f"traced theta up to {th_hi:.2f} deg; targets.theta_max {tg.theta_max / DEG:g} deg"))
-    rows.append(Row("pixels per degree (min along theta)", "raycheck.min_px_per_deg",
-                    report["pixels_per_degree"]["px_per_deg_min"], rc.min_px_per_deg, ">=", "px/deg",
-                    w("raycheck", "min_px_per_deg"), "projector.throw_ratio or the paraboloid's size set it"))
+    if "design_range" in report:
+        rows += theta_range_rows(profile, report["design_range"])
+    rows.append(px_per_deg_row(profile, report["pixels_per_degree"]["px_per_deg_min"]))
     rows.append(Row("rays lost (occluded, escaped)", "raycheck.max_lost_fraction", main["lost_fraction"],
                     rc.max_lost_fraction, "<=", "", w("raycheck", "max_lost_fraction"),
                     "see readings.<mode>.losses for where; the beam's width sets most of it"))
@@ -113,6 +113,49 @@ def evaluate(profile, report: dict) -> list[Row]:
                         f"p90 spot {mc['max_spot_radius_mm']['p90']:.3g} mm, p90 angle "
                         f"{mc['max_mirror_angle_error_rad']['p90'] / DEG:.3g} deg: tighten the tolerancing.* placements"))
     return rows
+
+
+#: Slack (rad) of the design's theta range against the targets: a design "reaches" 90 deg when its
+#: first ray is grazing to float precision (rigcad.optics.design's measurable range uses the same).
+THETA_RANGE_SLACK = 1e-9
+
+
+def theta_range_rows(profile, rng: dict) -> list[Row]:
+    """The design's theta range (``rng``: the design report's ``measurable_range``, deg: the 2D
+    design's exact range, what `rigcad design` reports) against ``targets.theta_min/theta_max``,
+    within THETA_RANGE_SLACK only: the range is the design's own, not a sample of rays."""
+    tg, w = profile.targets, profile.where
+    lo, hi = rng["theta_min_deg"], rng["theta_max_deg"]
+    slack = THETA_RANGE_SLACK / DEG
+    return [
+        Row("design's smallest theta", "targets.theta_min", lo,
+            tg.theta_min / DEG + slack, "<=", "deg", w("targets", "theta_min"),
+            f"the paraboloid's own shadow on the sample starts at {lo:.3g} deg (atan of its rim radius over "
+            f"layout.sample_to_rim): raise layout.sample_to_rim or take a smaller paraboloid; targets.theta_min "
+            f">= {_up(lo, 2)} deg would pass"),
+        Row("design's largest theta", "targets.theta_max", hi,
+            tg.theta_max / DEG - slack, ">=", "deg", w("targets", "theta_max"),
+            f"the dome's rim ends the range at {hi:.3g} deg: a dome reaching lower (layout); targets.theta_max "
+            f"<= {_down(hi, 2)} deg would pass"),
+    ]
+
+
+def px_per_deg_row(profile, px_per_deg_min: float) -> Row:
+    """The projector's fewest pixels per degree of theta (the check's fan) against raycheck.min_px_per_deg."""
+    return Row("pixels per degree (min along theta)", "raycheck.min_px_per_deg", px_per_deg_min,
+               profile.raycheck.min_px_per_deg, ">=", "px/deg", profile.where("raycheck", "min_px_per_deg"),
+               "projector.throw_ratio (a longer throw), projector.resolution or the paraboloid's size set it; "
+               f"raycheck.min_px_per_deg <= {_down(px_per_deg_min, 3)} would pass")
+
+
+def _up(value: float, digits: int) -> str:
+    """``value`` rounded up at ``digits`` decimals (a bound that passes, shown short)."""
+    return f"{math.ceil(value * 10 ** digits) / 10 ** digits:g}" if math.isfinite(value) else "nan"
+
+
+def _down(value: float, digits: int) -> str:
+    """``value`` rounded down at ``digits`` decimals."""
+    return f"{math.floor(value * 10 ** digits) / 10 ** digits:g}" if math.isfinite(value) else "nan"
 
 
 def camera_rows(profile, cam: dict) -> list[Row]:

@@ -107,6 +107,34 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
+def criteria_refusal(rig, exports, command: str, written: bool = False):
+    """Judge ``rig`` by the ray check's criteria before it is printed (rigcad.check.criteria.judge):
+    when it fails one, print one line per failed criterion (its key, file:line, the figure and the
+    value that would pass) under one 'rigcad: error:' line saying what ``command`` did (``written``:
+    its files are written for inspection only). Returns the verdict (``.ok``; ``.notes``, what was not
+    judged, for :func:`criteria_notes` once the command's work is done)."""
+    from rigcad.check.criteria import judge
+    from rigcad.errors import one_line
+
+    verdict = judge(rig, exports)
+    if not verdict.ok:
+        what = ("its files are written for inspection only: do not print them" if written
+                else "nothing is written for printing")
+        print(f"rigcad: error: {rig.name}: the rig fails {len(verdict.refusals)} of the ray check's criteria, each "
+              f"below; `rigcad {command}` refuses it ({what})", file=sys.stderr)
+        for line in verdict.refusals:
+            print(f"  {one_line(line)}", file=sys.stderr)
+    return verdict
+
+
+def criteria_notes(verdict) -> None:
+    """Print what the ray check's criteria left unjudged (no `rigcad check` written for the profile)."""
+    from rigcad.errors import one_line
+
+    for note in verdict.notes:
+        print(f"note: {one_line(note)}", file=sys.stderr)
+
+
 def register(subparsers) -> argparse.ArgumentParser:
     """Add ``check`` to rigcad's subcommands."""
     from rigcad.arguments import positive_int, profile_command

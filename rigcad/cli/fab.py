@@ -25,12 +25,17 @@ def cmd_fab(args: argparse.Namespace) -> int:
     names = select_parts(args.parts)  # a bad part name costs no rig
     from rigcad.manual.gate import gate, kept_gate
 
+    from rigcad.cli.check import criteria_notes, criteria_refusal
+
     out = api.default_folder(profile.name, "fab", printer.name, root=args.exports)
-    # a verdict and a fab run both kept from these inputs: read back, no rig built
+    rig = load(profile)
+    criteria = criteria_refusal(rig, args.exports, "fab")
+    if not criteria.ok:  # a rig that fails its own check gets no print files
+        return 1
+    # a verdict and a fab run both kept from these inputs: read back
     res = (api.fab_published(profile, printer, out, gcode=args.gcode, parts=args.parts)
            if kept_gate(args.exports, profile) else None)
     if res is None:
-        rig = load(profile)
         gate(rig, args.exports)  # a rig that cannot be put together is refused before a piece is sliced
         with stages(len(names), f"fab {profile.name}") as step:
             def progress(msg: str) -> None:
@@ -77,6 +82,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
             print(f"  time {k}: {v:.2f} s")
         for k, v in sorted(res.slicer_s.items()):
             print(f"  slicer {k}: {v:.2f} s")
+    criteria_notes(criteria)
     for p in res.problems:
         print(f"rigcad: fab: {p}", file=sys.stderr)
     if res.problems:  # the verdict, on one line of its own: the problems above are its details

@@ -21,8 +21,12 @@ def cmd_manual(args: argparse.Namespace) -> int:
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "manual")  # a planted link or lock: one line now, not after the work
     rig = load(profile)
+    from rigcad.cli.check import criteria_notes, criteria_refusal
     from rigcad.manual.gate import gate
 
+    criteria = criteria_refusal(rig, args.exports, "manual")
+    if not criteria.ok:  # a rig that fails its own check gets no manual
+        return 1
     gate(rig, args.exports)  # a rig that cannot be put together gets no manual
     root = Path(args.exports) / rig.name
     total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
@@ -35,6 +39,7 @@ def cmd_manual(args: argparse.Namespace) -> int:
     html_path = out / "manual.html"
     print(f"{rig.name}: manual for {printer.name} -> {out}/ (manual.md, manual.html "
           f"{html_path.stat().st_size / 1e6:.1f} MB, {len(written)} files)")
+    criteria_notes(criteria)
     return 0
 
 

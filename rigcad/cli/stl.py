@@ -22,7 +22,9 @@ def cmd_stl(args: argparse.Namespace) -> int:
         kept = gate.read_verdict(args.exports, profile)
         if kept is not None:
             print(f"{profile.name}: up to date ({out}/manifest.json)")
-            return _verdict_exit(kept)
+            from rigcad.rig import load
+
+            return max(_verdict_exit(kept), _criteria_exit(load(profile), args.exports))
     from rigcad.parts import PARTS
     from rigcad.rig import Rig
 
@@ -38,7 +40,17 @@ def cmd_stl(args: argparse.Namespace) -> int:
     print(f"{profile.name}: dome mirror {env['width_in']:.2f} x {env['height_in']:.2f} in; "
           f"{len(result.rebuilt)} part(s) built, {len(result.reused)} unchanged -> {out}/")
     print("\n".join(part_lines(result, list(PARTS))))
-    return _verdict_exit(verdict)
+    return max(_verdict_exit(verdict), _criteria_exit(rig, args.exports))
+
+
+def _criteria_exit(rig, exports) -> int:
+    """1 when the rig fails the ray check's criteria (rigcad.cli.check.criteria_refusal: its lines,
+    the parts written for inspection only), else 0 with a note of what was not judged."""
+    from rigcad.cli.check import criteria_notes, criteria_refusal
+
+    verdict = criteria_refusal(rig, exports, "stl", written=True)
+    criteria_notes(verdict)
+    return 0 if verdict.ok else 1
 
 
 def _verdict_exit(verdict) -> int:

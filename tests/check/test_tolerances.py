@@ -65,6 +65,27 @@ def test_the_analytic_rows_name_their_keys_readings_and_limits():
     ]
 
 
+def test_the_designs_theta_range_is_held_to_the_targets_themselves():
+    """The newcomer's case: the design reaches theta 10.3 deg against targets.theta_min 10 deg, while
+    the traced rays' coverage row lets it through (11.0 within 10 + 1.5): the design's own range is
+    exact, so its rows take no coverage tolerance and fail it, naming the targets' keys and lines."""
+    where = {**WHERE, ("targets", "theta_min"): "p.yaml:50", ("targets", "theta_max"): "p.yaml:51"}
+    report = {**_report(), "design_range": {"theta_min_deg": 10.3, "theta_max_deg": 80.0}}
+    rows = {r.key: r for r in evaluate(_profile(where=where), report)}
+    cov = [r for r in evaluate(_profile(where=where), report) if r.key == "raycheck.theta_coverage_tolerance"]
+    assert all(r.ok for r in cov)  # the traced rows alone would pass it
+    lo, hi = rows["targets.theta_min"], rows["targets.theta_max"]
+    assert not lo.ok and lo.measured == 10.3 and lo.where == "p.yaml:50", lo
+    assert "targets.theta_min >= 10.3 deg would pass" in lo.hint and "layout.sample_to_rim" in lo.hint, lo.hint
+    assert hi.ok and hi.where == "p.yaml:51"  # 80 reaches 80: only float rounding is allowed for
+    report["design_range"] = {"theta_min_deg": 10.0 + 1e-6, "theta_max_deg": 80.0 - 1e-6}
+    rows = {r.key: r for r in evaluate(_profile(where=where), report)}
+    # a micro-degree short is short: the slack is float rounding (1e-9 rad = 5.7e-8 deg), no tolerance
+    assert not rows["targets.theta_min"].ok and not rows["targets.theta_max"].ok
+    with pytest.raises(CheckError, match=r"targets\.theta_min \(p\.yaml:50\)"):
+        raise_if_failed(list(rows.values()), "p")
+
+
 def test_each_failed_rows_hint():
     rows = evaluate(_profile(), _report(spot=0.06, angle=0.3 * DEG, lo=12.0, hi=78.0, lost=0.3, px=1.0))
     assert not any(r.ok for r in rows)
@@ -72,7 +93,8 @@ def test_each_failed_rows_hint():
         "reading analytic; the design itself", "reading analytic",
         "traced theta from 12.00 deg; targets.theta_min 10 deg",
         "traced theta up to 78.00 deg; targets.theta_max 80 deg",
-        "projector.throw_ratio or the paraboloid's size set it",
+        "projector.throw_ratio (a longer throw), projector.resolution or the paraboloid's size set it; "
+        "raycheck.min_px_per_deg <= 1 would pass",
         "see readings.<mode>.losses for where; the beam's width sets most of it"]
     assert "hint" not in Row("a", "k", 1.0, 0.0, ">=", "", None, "why").as_dict()  # hints only on failure
     assert "hint" not in Row("a", "k", 1.0, 2.0, ">=", "", None).as_dict()  # and only when there is one
