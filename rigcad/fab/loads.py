@@ -18,7 +18,21 @@ Closed forms, each from a textbook:
   slope P a^2 / (2 E I) (Roark Table 8.1 case 1a, fixed-free); a uniform load q over length l:
   q l^4 / (8 E I) and q l^3 / (6 E I) at its end;
 * the column: a cantilever under the shelf's moment M at its top, deflection M H^2 / (2 E I),
-  rotation M H / (E I); its sway mode with a tip mass and 33/140 of its own mass (Blevins Table 8-2).
+  rotation M H / (E I); its sway mode with a tip mass and 33/140 of its own mass (Blevins Table 8-2);
+* the shelf's first mode by Rayleigh's quotient on its static deflection curve under its loads,
+  omega^2 = g sum(m_i y_i) / sum(m_i y_i^2) (Blevins, Formulas for Natural Frequency and Mode Shape,
+  eq. 4-24: the static deflection as the trial shape, an upper bound within a few per cent of the first
+  mode of a cantilever), its own mass lumped in SHELF_LUMPS segments;
+* the column's bolted foot and top under the shelf's overturning moment M: the flange a rigid plate
+  turning about its compressed edge, the bolts' extra tension in proportion to their distance from it,
+  F_i = M d_i / sum(d_j^2) (VDI 2230 Part 1's eccentric-load model taken rigid; Shigley section 8-12's
+  bolt group), against the joint's preload (it stays closed while the preload exceeds it) and the
+  pressure under the nut and the washer with the whole extra tension in the bolt;
+* a lab's uniform temperature swing dT: every printed length grows by alpha dT; the projector's
+  virtual COP then moves along the axis against the paraboloid's vertex by alpha dT times the COP's
+  height above it (both stand on the same base plate), across by the difference of the base plate's
+  and the shelf's growth between the bore and the seat (nothing, both printed; a bought aluminium shelf
+  grows less). No gradient (the machinist judged a uniform +-3 C the lab's case).
 
 A printed section is stiffer than its infill and weaker than solid: its second moment of area is
 the solid one less (1 - infill) of its core, the core being the section less :data:`SKIN_MM`
@@ -66,22 +80,37 @@ SPLITTER_TURN = 2.0
 @dataclass(frozen=True)
 class Material:
     """A printed material's published figures: modulus range (MPa), yield strength (MPa; the weaker
-    direction), and where they come from."""
+    direction), linear thermal expansion (1/K) and where they come from."""
 
     name: str
     modulus_low: float
     modulus_high: float
     yield_strength: float
     source: str
+    expansion: float = 0.0
 
 
 #: Materials by the printer file's ``material`` (case-insensitive).
 MATERIALS = {
     "pla": Material("PLA", 2539.0, 3039.0, 26.0, "Stratasys PLA data sheet (ASTM D638): tensile modulus 2,539 MPa XY, "
-                    "3,039 MPa XZ; yield 26 MPa XY"),
+                    "3,039 MPa XZ; yield 26 MPa XY; thermal expansion (ASTM E831) 101e-6 /K flow, 102e-6 /K across",
+                    102e-6),
     "abs": Material("ABS", 1443.0, 2482.0, 22.1, "Stratasys P400 ABS (FDM 2000 manual, App. M1): 360,000 psi, 5,000 "
-                    "psi; printed ABS 1,443 MPa (Kimya, ISO 527); yield the low end of MatWeb's ABS (22.1 MPa)"),
+                    "psi; printed ABS 1,443 MPa (Kimya, ISO 527); yield the low end of MatWeb's ABS (22.1 MPa); thermal "
+                    "expansion the top of omnexus's ABS range (7-15e-5 /K)", 150e-6),
 }
+
+
+#: The bought shelf's plate (``buy.shelf: aluminium_plate``): EN AW-5083-H111, solid; modulus 71 GPa (both ends
+#: of the range: a rolled plate), 0.2 % proof 125 MPa, expansion 24.2e-6 /K, density 2.66 g/cm3 (EN 485-2's
+#: minimum proof; the others as aluminium suppliers' 5083 data sheets give them, e.g. Aalco's).
+ALUMINIUM = Material("EN AW-5083", 71000.0, 71000.0, 125.0, "EN 485-2 (proof); suppliers' 5083 data sheets (modulus, "
+                     "expansion)", 24.2e-6)
+ALUMINIUM_DENSITY = 2.66e-6  #: kg/mm3
+#: The shelf's mass lumped in this many equal segments for its Rayleigh quotient.
+SHELF_LUMPS = 60
+#: A lab's uniform temperature swing over a day (K, each way): the machinist's figure for a lab.
+LAB_SWING_K = 3.0
 
 
 def material(printer: Printer) -> Material:
@@ -300,38 +329,89 @@ def deflections(profile, layout, printer: Printer, masses: dict[str, float] | No
     return (beam, *_tower_deflections(profile, layout, printer, mat, masses))
 
 
-def _tower_deflections(profile, layout, printer: Printer, mat: Material, masses) -> tuple[Deflection, Deflection]:
-    """The shelf: a cantilever from its column flange's edge towards the axis, as wide as it is,
-    under the projector's near feet (a quarter of its weight each), the holder and camera at the
-    seat and its own weight. The column: a cantilever from the tongue under the shelf's moment about
-    its axis; its sway with the top's mass."""
-    t, tw, tol = layout.tower, profile.tower, profile.tolerancing
-    E, rho = mat.modulus_low, printer.material_density_g_cm3 * 1e-6
+def _shelf_model(profile, layout, printer: Printer, mat: Material, masses, option: str | None = None) -> dict:
+    """The shelf as a cantilever from its column flange's edge towards the axis, as wide as it is, under
+    the projector's near feet (a quarter of its weight each), the holder and camera at the seat and its
+    own weight, printed (``option`` "print": ``mat`` at its low modulus, the printed section) or bought
+    ("aluminium_plate": ALUMINIUM, solid); default the profile's ``buy.shelf``. Returns its sag and tilt
+    under the seat, its first mode (Rayleigh on the static curve), its root moment (N mm), the largest
+    bending stress (MPa) and the figures the tables state."""
+    t = layout.tower
+    option = option or profile.buy.shelf
     m_pj, m_cam, m_hold = (_mass(profile, k, masses) for k in ("projector", "camera", "holder"))
     root = t.column_x - t.column_foot_half
     seat = seat_points(t, profile)["cone"][0]
     x0, x1, y0, y1 = _shelf_extent(t, profile)
-    width, overhang, a_seat = y1 - y0, root - x0, root - seat
+    width, overhang, a_seat, th = y1 - y0, root - x0, root - seat, t.shelf_thickness
+    if option == "print":
+        E, rho, I, what = mat.modulus_low, printer.material_density_g_cm3 * 1e-6, printed_inertia(width, th), "printed"
+    else:
+        E, rho, I, what = ALUMINIUM.modulus_low, ALUMINIUM_DENSITY, width * th ** 3 / 12, ALUMINIUM.name
     feet = [x for x, _ in _projector_feet(t)]
-    loads = [(m_pj * G / 4, root - x) for x in feet if x < root] + [((m_cam + m_hold) * G, a_seat)]
-    EI = E * printed_inertia(width, t.shelf_thickness)
-    sag, tilt = cantilever(loads, rho * width * t.shelf_thickness * G, overhang, a_seat, EI)
-    shelf = Deflection("shelf", f"cantilever {overhang:.0f} mm from the column's flange, {width:.0f} x "
-                       f"{t.shelf_thickness:g} mm printed; the holder and camera ({(m_cam + m_hold) * G:.1f} N) at the seat "
-                       f"{a_seat:.0f} mm out, the projector's near feet, its own weight; its tilt under the seat turns "
-                       f"the splitter, whose reflected axis turns {SPLITTER_TURN:g} x as much", sag, tilt, math.nan,
-                       "projector_height, projector_tilt", tol.projector_height,
-                       max(sag / tol.projector_height, SPLITTER_TURN * tilt / tol.projector_tilt), "buy.shelf: aluminium_plate")
+    near = [(m_pj / 4, root - x) for x in feet if x < root]
+    points = near + [(m_cam + m_hold, a_seat)]
+    loads = [(m * G, a) for m, a in points]
+    q = rho * width * th * G
+    EI = E * I
+    sag, tilt = cantilever(loads, q, overhang, a_seat, EI)
+    # Rayleigh's quotient on the static curve: the point masses and the shelf's own, lumped
+    seg = overhang / SHELF_LUMPS
+    lumps = points + [(rho * width * th * seg, (k + 0.5) * seg) for k in range(SHELF_LUMPS)]
+    ys = [cantilever(loads, q, overhang, a, EI)[0] for _, a in lumps]
+    num = sum(m * y for (m, _), y in zip(lumps, ys)) * G * 1000.0  # N mm -> the m/s2 of g over mm: x1000 for Hz
+    den = sum(m * y * y for (m, _), y in zip(lumps, ys))
+    mode = math.sqrt(num / den) / (2 * math.pi) if den > 0 else math.inf
+    moment = sum(P * a for P, a in loads) + q * overhang ** 2 / 2
+    c = th / 2
+    stress = moment * c / I
+    return {"option": option, "material": what, "sag_mm": sag, "tilt_rad": tilt, "first_mode_hz": mode,
+            "root_moment_nmm": moment, "stress_mpa": stress, "width": width, "overhang": overhang, "a_seat": a_seat,
+            "thickness": th, "seat_load_n": (m_cam + m_hold) * G, "EI_nmm2": EI, "mass_per_mm_kg": rho * width * th,
+            "point_masses": tuple(points), "expansion": mat.expansion if option == "print"
+            else ALUMINIUM.expansion}
+
+
+def _shelf_deflection(profile, model: dict) -> Deflection:
+    tol = profile.tolerancing
+    section = "printed" if model["option"] == "print" else f"{model['material']}, solid"
+    return Deflection("shelf", f"cantilever {model['overhang']:.0f} mm from the column's flange, {model['width']:.0f} x "
+                      f"{model['thickness']:g} mm {section}; the holder and camera ({model['seat_load_n']:.1f} N) at the "
+                      f"seat {model['a_seat']:.0f} mm out, the projector's near feet, its own weight; its tilt under the seat "
+                      f"turns the splitter, whose reflected axis turns {SPLITTER_TURN:g} x as much; first mode by Rayleigh's "
+                      f"quotient on its static curve; bending stress {model['stress_mpa']:.2f} MPa",
+                      model["sag_mm"], model["tilt_rad"], model["first_mode_hz"], "projector_height, projector_tilt",
+                      tol.projector_height, max(model["sag_mm"] / tol.projector_height,
+                                                SPLITTER_TURN * model["tilt_rad"] / tol.projector_tilt),
+                      "buy.shelf: aluminium_plate" if model["option"] == "print" else "")
+
+
+def _shelf_moment(profile, layout, printer: Printer, masses) -> tuple[float, float]:
+    """The moment (N mm) the shelf and what stands on it put on the column's axis, and the top's mass (kg)."""
+    t = layout.tower
+    m_pj, m_cam, m_hold = (_mass(profile, k, masses) for k in ("projector", "camera", "holder"))
+    seat = seat_points(t, profile)["cone"][0]
+    x0, x1, y0, y1 = _shelf_extent(t, profile)
+    rho = (printer.material_density_g_cm3 * 1e-6 if profile.buy.shelf == "print" else ALUMINIUM_DENSITY)
+    m_shelf = rho * (x1 - x0) * (y1 - y0) * t.shelf_thickness
+    feet = [x for x, _ in _projector_feet(t)]
+    points = [(m_pj * G / 4, x) for x in feet] + [((m_cam + m_hold) * G, seat), (m_shelf * G, (x0 + x1) / 2)]
+    return abs(sum(P * (t.column_x - x) for P, x in points)), m_pj + m_cam + m_hold + m_shelf
+
+
+def _tower_deflections(profile, layout, printer: Printer, mat: Material, masses) -> tuple[Deflection, Deflection]:
+    """The shelf (:func:`_shelf_model` as the profile buys it). The column: a cantilever from the tongue
+    under the shelf's moment about its axis; its sway with the top's mass."""
+    t, tw, tol = layout.tower, profile.tower, profile.tolerancing
+    E, rho = mat.modulus_low, printer.material_density_g_cm3 * 1e-6
+    shelf = _shelf_deflection(profile, _shelf_model(profile, layout, printer, mat, masses))
+    seat = seat_points(t, profile)["cone"][0]
     H = t.shelf_top_z - t.shelf_thickness - t.column_base_z
     EI_col = E * printed_tube_inertia(tw.column_width, tw.wall)
-    m_shelf = rho * (x1 - x0) * width * t.shelf_thickness
-    points = [(m_pj * G / 4, x) for x in feet] + [((m_cam + m_hold) * G, seat), (m_shelf * G, (x0 + x1) / 2)]
-    moment = abs(sum(P * (t.column_x - x) for P, x in points))
+    moment, top = _shelf_moment(profile, layout, printer, masses)
     rot = moment * H / EI_col
     drop = rot * (t.column_x - seat)
     m_col = rho * 4 * tw.column_width * tw.wall * H
     k = 3 * EI_col / H ** 3 * 1000.0
-    top = m_pj + m_cam + m_hold + m_shelf
     f_col = math.sqrt(k / (top + 33 / 140 * m_col)) / (2 * math.pi)
     column = Deflection("column", f"cantilever {H:.0f} mm, {tw.column_width:g} mm square tube, {tw.wall:g} mm printed "
                         f"wall, under the shelf's moment {moment / 1000:.2f} N m (the seat drops by its turn over "
@@ -341,6 +421,74 @@ def _tower_deflections(profile, layout, printer: Printer, mat: Material, masses)
     return shelf, column
 
 
+def thermal(profile, layout, printer: Printer, swing: float = LAB_SWING_K) -> Deflection:
+    """A uniform ``swing`` K (each way) over the printed rig (see the module docstring): the virtual COP
+    along the axis against the paraboloid's vertex (alpha dT times the COP's height over the vertex) and
+    across (the base plate's growth from the bore to the column less the shelf's from the column to the
+    seat), against ``tolerancing.projector_height`` and ``projector_offset``; no tilt (uniform)."""
+    tol = profile.tolerancing
+    a = material(printer).expansion
+    along = a * swing * profile.layout.cop_to_vertex
+    across = _thermal_across(profile, layout, printer, swing)
+    share = max(along / tol.projector_height, across / tol.projector_offset)
+    shelf = "printed" if profile.buy.shelf == "print" else f"{ALUMINIUM.name} ({ALUMINIUM.expansion * 1e6:.1f}e-6 /K)"
+    return Deflection(f"thermal, +-{swing:g} K uniform", f"{material(printer).name} {a * 1e6:.0f}e-6 /K: the COP moves "
+                      f"{along:.3f} mm along the axis against the vertex ({profile.layout.cop_to_vertex:.0f} mm below it) "
+                      f"and {across:.3f} mm across (the shelf {shelf}); a uniform swing tilts nothing", along, 0.0,
+                      math.nan, "projector_height, projector_offset", tol.projector_height, share,
+                      "buy.shelf: aluminium_plate" if profile.buy.shelf == "print" else "")
+
+
+@dataclass(frozen=True)
+class FlangeJoint:
+    """A bolted column flange under the shelf's overturning moment (N mm, mm, N, MPa): the most loaded
+    bolt's extra tension against the joint's preload (``margin``: preload over it; the joint stays closed
+    above 1), and the pressure under its nut (or insert's flange) and washer with that tension added."""
+
+    joint: str
+    moment_nmm: float
+    bolt_force_n: float
+    preload_n: float
+    pressure_mpa: float
+    yield_mpa: float
+
+    @property
+    def margin(self) -> float:
+        return self.preload_n / self.bolt_force_n if self.bolt_force_n > 0 else math.inf
+
+    @property
+    def holds(self) -> bool:
+        return self.margin > 1.0 and self.pressure_mpa < self.yield_mpa
+
+    def describe(self) -> dict:
+        return {"joint": self.joint, "moment_nm": self.moment_nmm / 1000.0, "bolt_force_n": self.bolt_force_n,
+                "preload_n": self.preload_n, "preload_over_load": self.margin, "pressure_mpa": self.pressure_mpa,
+                "yield_mpa": self.yield_mpa, "holds": self.holds}
+
+
+def flange_joints(profile, layout, printer: Printer, masses: dict[str, float] | None = None) -> tuple[FlangeJoint, ...]:
+    """The printed column's foot (on the tongue) and top (under the shelf) under the shelf's overturning
+    moment: each flange turns about its edge on the shelf's side; each bolt row at d_i from that edge
+    takes F_i = M d_i / sum(d_j^2) (two bolts a row); the most loaded against its preload
+    (:func:`bolt_loads`) and its bearing face. None for a bought extrusion (one core screw each end)."""
+    if profile.buy.column != "print":
+        return ()
+    from rigcad.parts.tower import _column_flange_points
+
+    t = layout.tower
+    mat = material(printer)
+    moment, _ = _shelf_moment(profile, layout, printer, masses)
+    edge = t.column_x - t.column_foot_half  # the shelf reaches out on -x: the flange turns about its -x edge
+    d = [x - edge for x, _ in _column_flange_points(t, profile)]
+    force = moment * max(d) / sum(v * v for v in d)
+    bolts = {b.joint: b for b in bolt_loads(profile, layout, printer)}
+    out = []
+    for name in ("column foot on the tongue", "column top under the shelf"):
+        b = bolts[name]
+        out.append(FlangeJoint(name, moment, force, b.preload_n, (b.preload_n + force) / b.area_mm2, mat.yield_strength))
+    return tuple(out)
+
+
 @dataclass(frozen=True)
 class Loads:
     """The loads report: the material, every bolted joint and every deflection."""
@@ -348,6 +496,8 @@ class Loads:
     material: Material
     bolts: tuple[BoltLoad, ...]
     deflections: tuple[Deflection, ...]
+    flanges: tuple[FlangeJoint, ...] = ()
+    shelf_options: tuple[dict, ...] = ()
 
     def record(self) -> dict:
         """JSON-able, units in the keys (a first mode not computed is null)."""
@@ -356,7 +506,9 @@ class Loads:
                              "yield_strength_mpa": self.material.yield_strength, "source": self.material.source},
                 "bolts": [b.describe() for b in self.bolts],
                 "deflections": [{k: (None if isinstance(v, float) and math.isnan(v) else v)
-                                 for k, v in d.describe().items()} for d in self.deflections]}
+                                 for k, v in d.describe().items()} for d in self.deflections],
+                "flanges": [f.describe() for f in self.flanges],
+                "shelf_options": [{k: v for k, v in o.items()} for o in self.shelf_options]}
 
     def table_lines(self) -> list[str]:
         """Markdown: the torques, then the deflections."""
@@ -371,22 +523,69 @@ class Loads:
             mode = "-" if math.isnan(d.first_mode_hz) else f"{d.first_mode_hz:.0f} Hz"
             out.append(f"| {d.part} | {d.model} | {d.sag_mm:.3f} mm | {math.degrees(d.tilt_rad):.3f} deg | {mode} | "
                        f"{d.eats} | {100 * d.share:.0f} % | {'yes' if d.holds else 'no: ' + d.buy} |")
+        if self.flanges:
+            out += ["", "| flange joint | overturning moment | most loaded bolt | preload | preload / load | "
+                    "pressure with it | yield | holds |", "|---|---|---|---|---|---|---|---|"]
+            for f in self.flanges:
+                out.append(f"| {f.joint} | {f.moment_nmm / 1000:.2f} N m | {f.bolt_force_n:.0f} N | {f.preload_n:.0f} N | "
+                           f"{f.margin:.1f} | {f.pressure_mpa:.1f} MPa | {f.yield_mpa:.0f} MPa | {'yes' if f.holds else 'no'} |")
+        if self.shelf_options:
+            out += ["", "| buy.shelf | sag | tilt (its reflected axis 2 x) | first mode | share | bending stress | "
+                    "thermal, across |", "|---|---|---|---|---|---|---|"]
+            for o in self.shelf_options:
+                out.append(f"| {o['option']} | {o['sag_mm']:.3f} mm | {o['tilt_deg']:.3f} deg | {o['first_mode_hz']:.0f} Hz | "
+                           f"{100 * o['share']:.0f} % | {o['stress_mpa']:.2f} MPa | {o['thermal_across_mm']:.3f} mm |")
         return out
 
 
+def shelf_options(profile, layout, printer: Printer, masses: dict[str, float] | None = None) -> tuple[dict, ...]:
+    """The shelf under each ``buy.shelf`` option (print, aluminium_plate), whichever the profile takes: its
+    sag, tilt, first mode, share of the tolerance, bending stress and the COP's move across under
+    LAB_SWING_K (mm, deg, Hz, MPa): the figures the choice is made on."""
+    from dataclasses import replace as _replace
+
+    mat, out = material(printer), []
+    for option in ("print", "aluminium_plate"):
+        m = _shelf_model(profile, layout, printer, mat, masses, option)
+        d = _shelf_deflection(profile, m)
+        bought = _replace(profile, buy=_replace(profile.buy, shelf=option))
+        out.append({"option": option, "sag_mm": d.sag_mm, "tilt_deg": math.degrees(d.tilt_rad),
+                    "first_mode_hz": d.first_mode_hz, "share": d.share, "stress_mpa": m["stress_mpa"],
+                    "thermal_across_mm": _thermal_across(bought, layout, printer)})
+    return tuple(out)
+
+
+def _thermal_across(profile, layout, printer: Printer, swing: float = LAB_SWING_K) -> float:
+    """The COP's move across (mm) under a uniform ``swing`` K: :func:`thermal`'s."""
+    t = layout.tower
+    a = material(printer).expansion
+    a_shelf = a if profile.buy.shelf == "print" else ALUMINIUM.expansion
+    seat = seat_points(t, profile)["cone"][0]
+    return abs(a * t.column_x - a_shelf * (t.column_x - seat) - a * seat) * swing
+
+
 def loads(profile, layout, printer: Printer, masses: dict[str, float] | None = None) -> Loads:
-    """Torques and deflections of the printed rig on ``printer``'s material."""
-    return Loads(material(printer), bolt_loads(profile, layout, printer), deflections(profile, layout, printer, masses))
+    """Torques, deflections (the beam, the shelf, the column, a lab's +-LAB_SWING_K), the column flanges
+    under the overturning moment and the shelf's two options, on ``printer``'s material."""
+    return Loads(material(printer), bolt_loads(profile, layout, printer),
+                 (*deflections(profile, layout, printer, masses), thermal(profile, layout, printer)),
+                 flange_joints(profile, layout, printer, masses), shelf_options(profile, layout, printer, masses))
 
 
 def refuse(report: Loads) -> None:
     """Raise FabricationError when a printed part cannot hold the tolerance its static sag or tilt
     eats, naming the part and its ``buy:`` option."""
     bad = [d for d in report.deflections if not d.holds]
+    flanges = [f for f in report.flanges if not f.holds]
+    if flanges:
+        raise FabricationError("column flange joints the shelf's overturning moment opens or crushes: " + "; ".join(
+            f"{f.joint} (its most loaded bolt {f.bolt_force_n:.0f} N against {f.preload_n:.0f} N of preload, "
+            f"{f.pressure_mpa:.1f} MPa under it against {f.yield_mpa:.0f} MPa); buy: buy.column: extrusion_40x40"
+            for f in flanges))
     if bad:
         raise FabricationError("printed parts that bend past the tolerance they eat: " + "; ".join(
             f"{d.part} ({100 * d.share:.0f} % of tolerancing.{d.eats}); buy: {d.buy}" for d in bad))
 
 
-__all__ = ["refuse", "ASSUMED_MASS_KG", "BoltLoad", "Deflection", "Loads", "MATERIALS", "Material", "bolt_loads", "cantilever",
+__all__ = ["ALUMINIUM", "FlangeJoint", "LAB_SWING_K", "flange_joints", "shelf_options", "thermal", "refuse", "ASSUMED_MASS_KG", "BoltLoad", "Deflection", "Loads", "MATERIALS", "Material", "bolt_loads", "cantilever",
            "deflections", "loads", "material", "printed_inertia", "printed_tube_inertia", "simply_supported"]

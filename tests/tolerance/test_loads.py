@@ -106,8 +106,10 @@ def test_the_default_rig_holds_its_loads_and_the_record_is_json(table31_rig):
     assert 0 < d["beam"].sag_mm < table31_rig.profile.tolerancing.paraboloid_height
     assert d["beam"].first_mode_hz > 20 and d["column"].first_mode_hz > 10
     rec = json.loads(json.dumps(r.record()))
-    assert rec["deflections"][1]["first_mode_hz"] is None  # the shelf's mode is not computed
-    assert len(r.table_lines()) == 2 + len(r.bolts) + 3 + len(r.deflections)
+    assert rec["deflections"][1]["first_mode_hz"] > 20  # the shelf's mode, by Rayleigh
+    assert rec["deflections"][3]["first_mode_hz"] is None  # a temperature swing has no mode
+    assert len(r.table_lines()) == (2 + len(r.bolts) + 3 + len(r.deflections) + 3 + len(r.flanges)
+                                    + 3 + len(r.shelf_options))
 
 
 def test_a_softer_material_eats_more_and_an_unknown_one_is_refused(table31_rig):
@@ -150,3 +152,66 @@ def test_a_breadboard_adds_its_screws_on_large_washers(write_profile, table31_te
     plain = Rig.from_profile(load_profile(write_profile(table31_text)))
     assert "the rig on the breadboard" not in {x.joint for x in L.bolt_loads(plain.profile, plain.layout,
                                                                               load_printer("prusa_mk3s"))}
+
+
+@pytest.mark.parametrize("option", ["print", "aluminium_plate"])
+def test_the_shelfs_first_mode_matches_a_finite_element_model(table31_rig, option):
+    """Rayleigh's quotient on the shelf's static curve (rigcad.fab.loads._shelf_model) against the first
+    eigenvalue of the same cantilever in Hermite beam elements with consistent mass and the point
+    masses at their nodes: an upper bound, within 2 % (the static curve is close to the first mode's)."""
+    mk3s = load_printer("prusa_mk3s")
+    m = L._shelf_model(table31_rig.profile, table31_rig.layout, mk3s, L.material(mk3s), None, option)
+    n = 400
+    K, M, free = _fe_beam(m["overhang"], n, m["EI_nmm2"], m["mass_per_mm_kg"], "cantilever")
+    le = m["overhang"] / n
+    for mass, a in m["point_masses"]:
+        M[2 * round(a / le), 2 * round(a / le)] += mass
+    w2 = scipy.linalg.eigh(K[np.ix_(free, free)] * 1000.0, M[np.ix_(free, free)], eigvals_only=True)[0]
+    fe = math.sqrt(w2) / (2 * math.pi)
+    assert fe <= m["first_mode_hz"] * (1 + 1e-6)  # Rayleigh bounds the first mode from above
+    assert m["first_mode_hz"] == pytest.approx(fe, rel=0.02)  # and the static curve is near its shape
+
+
+def test_the_column_flanges_hold_the_overturning_moment(table31_rig, other_rig):
+    """The shelf's overturning moment on the column's foot and top: the most loaded bolt's extra tension
+    from the bolt group's rigid-flange model, re-derived here, far under the preload; the pressure under
+    the nut with it added under the yield."""
+    from rigcad.parts.tower import _column_flange_points
+
+    mk3s = load_printer("prusa_mk3s")
+    for rig in (table31_rig, other_rig):
+        t = rig.layout.tower
+        joints = L.flange_joints(rig.profile, rig.layout, mk3s)
+        assert [j.joint for j in joints] == ["column foot on the tongue", "column top under the shelf"]
+        moment = L.deflections(rig.profile, rig.layout, mk3s)[2].model.split("moment ")[1].split(" N m")[0]
+        assert joints[0].moment_nmm / 1000 == pytest.approx(float(moment), abs=0.005)
+        edge = t.column_x - t.column_foot_half
+        d = sorted(x - edge for x, _ in _column_flange_points(t, rig.profile))
+        # two rows of two bolts, at d[0] and d[2] from the edge it turns about
+        assert joints[0].bolt_force_n == pytest.approx(joints[0].moment_nmm * d[-1] / (2 * d[0] ** 2 + 2 * d[-1] ** 2))
+        for j in joints:
+            assert j.holds and j.margin > 10  # the preload is over ten times the moment's pull: the joint stays shut
+            assert j.pressure_mpa < j.yield_mpa
+    # planted: 30 kg at the seat (a hundred times the camera) pulls the foot's bolts past their preload: refused
+    heavy = L.loads(table31_rig.profile, table31_rig.layout, mk3s, {"camera": 30.0})
+    assert not heavy.flanges[0].holds
+    with pytest.raises(FabricationError, match="column foot on the tongue.*buy: buy.column: extrusion_40x40"):
+        L.refuse(heavy)
+
+
+def test_a_lab_swing_of_three_kelvin_moves_the_cop_by_alpha_dt_times_its_height(table31_rig):
+    """A uniform +-3 K on a printed rig: the COP along the axis against the vertex by PLA's 102e-6 /K
+    (Stratasys's data sheet) x 3 K x cop_to_vertex; across nothing when base plate and shelf are both PLA,
+    the PLA-aluminium difference over the column-to-seat span with the bought shelf."""
+    from rigcad.parts.tower import seat_points
+
+    mk3s = load_printer("prusa_mk3s")
+    p, t = table31_rig.profile, table31_rig.layout.tower
+    th = L.thermal(p, table31_rig.layout, mk3s)
+    assert th.sag_mm == pytest.approx(102e-6 * 3 * p.layout.cop_to_vertex) and th.tilt_rad == 0
+    assert th.holds and th.share < 0.2  # under a fifth of projector_height: the machinist's 'fine'
+    opts = {o["option"]: o for o in L.shelf_options(p, table31_rig.layout, mk3s)}
+    assert opts["print"]["thermal_across_mm"] == pytest.approx(0.0, abs=1e-12)
+    span = t.column_x - seat_points(t, p)["cone"][0]
+    assert opts["aluminium_plate"]["thermal_across_mm"] == pytest.approx((102e-6 - 24.2e-6) * 3 * span)
+    assert opts["aluminium_plate"]["share"] < 0.05 < opts["print"]["share"]
