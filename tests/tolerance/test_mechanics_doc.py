@@ -153,3 +153,30 @@ def test_the_seat_pockets_prose_is_the_codes(page, table31):
             f"{form3['cone']['gap_mm']:.1f} mm on the Form 3") in text
     assert f"within the {T.SEAT_BOND[1]:g} mm the gap-filling epoxy fills" in text
     assert f"half the gap its cone's balls are bonded in ({fits['cone']['gap_mm'] / 2:.1f} mm on the MK3S" in text
+
+
+def test_the_loads_prose_is_the_codes(page, table31_rig):
+    """The bolts', flanges', thermal and shelf-option figures the Loads section's prose states."""
+    from rigcad.parts import tower as T
+
+    p, lay = table31_rig.profile, table31_rig.layout
+    text = " ".join(page.split())
+    mk3s = load_printer("prusa_mk3s")
+    foot = T.column_foot_bolt(p, lay.tower)
+    assert (f"the column foot's M4 bolts are {foot['length_mm']:g} mm long, end {foot['above_bench_mm']:.1f} mm above "
+            f"the bench, and their nut traps are {foot['trap_depth_mm']:g} mm deep") in text
+    r = L.loads(p, lay, mk3s)
+    opts = {o["option"]: o for o in r.shelf_options}
+    shelf, column = r.deflections[1], r.deflections[2]
+    assert f"its static tilt takes {100 * shelf.share:.0f} % of `tolerancing.projector_tilt`" in text
+    assert (f"its bending stress is {opts['print']['stress_mpa']:.2f} MPa, "
+            f"{100 * opts['print']['stress_mpa'] / L.MATERIALS['pla'].yield_strength:.1f} % of PLA's yield") in text
+    assert f"the static tilt again: {100 * shelf.share:.0f} % of the tolerance" in text and shelf.share < 1
+    assert f"Its first mode, {shelf.first_mode_hz:.0f} Hz, is above the column's {column.first_mode_hz:.0f} Hz sway" in text
+    assert shelf.first_mode_hz > column.first_mode_hz
+    al = opts["aluminium_plate"]
+    assert f"it would take {100 * al['share']:.0f} % and ring at {al['first_mode_hz']:.0f} Hz" in text
+    assert f"({al['thermal_across_mm']:.3f} mm across for +-3 K)" in text
+    assert f"with the preload {r.flanges[0].margin:.0f} times the most loaded bolt's pull (foot) and more at the top" in text
+    assert r.flanges[1].margin > r.flanges[0].margin
+    assert f"PLA {L.MATERIALS['pla'].expansion * 1e6:.0f}e-6 /K, Stratasys's data sheet" in text
