@@ -60,6 +60,10 @@ SLOT_CLEARANCE_MM = 0.2
 SLOT_WALL_MM = 1.0
 #: How far above the sample plane the stand's back holds the upright display (mm).
 STAND_BACK_MM = 12.0
+#: The slot's floor keeps this much (mm) under the module's frame, beyond the active area's edge, at
+#: each side of the cable channel that runs down from it through the stand: the module stands on those
+#: two ledges, its flat cable down the channel and out below the base plate.
+CABLE_LEDGE_MM = 2.0
 
 
 def upright_room(profile) -> dict:
@@ -72,8 +76,10 @@ def upright_room(profile) -> dict:
     front = cal.upright_offset + SLOT_CLEARANCE_MM
     back = cal.upright_offset - cal.upright_thickness - SLOT_CLEARANCE_MM
     corner = max(math.hypot(front, half), math.hypot(back, half))
+    cable = half - cal.upright_border - SLOT_CLEARANCE_MM - CABLE_LEDGE_MM
     return {"corner_mm": corner, "room_mm": holder.radius - SLOT_WALL_MM, "half_width_mm": half,
-            "front_mm": front, "back_mm": back, "fits": corner <= holder.radius - SLOT_WALL_MM}
+            "front_mm": front, "back_mm": back, "fits": corner <= holder.radius - SLOT_WALL_MM,
+            "cable_half_mm": max(cable, 0.0)}
 
 
 def check_upright_fits(profile) -> dict:
@@ -111,10 +117,13 @@ def upright_stand(profile):
     rise = Difference(Cylinder((0.0, 0.0, top - 1.0), r, STAND_BACK_MM - top + 1.0),
                       (Box((back, -r - 1.0, top - 2.0), (r + 1.0, r + 1.0, STAND_BACK_MM + 1.0)),))
     slot = Box((back, -half, floor), (front, half, STAND_BACK_MM + 1.0))
-    return Part("calibration_upright_stand", Difference(Union_((body, rise)), (slot,)), (0.6, 0.45, 0.2),
+    bottom = -profile.base_plate.thickness - profile.sample_holder.stop_thickness
+    cable = Box((back, -room["cable_half_mm"], bottom - 1.0), (front, room["cable_half_mm"], floor + 1.0))
+    return Part("calibration_upright_stand", Difference(Union_((body, rise)), (slot, cable)), (0.6, 0.45, 0.2),
                 f"calibration stand for the upright display: replaces the sample holder; the display's module stands "
                 f"in its slot, face out {cal.upright_offset:g} mm from the axis, its active area from {cal.upright_depth:g} mm "
-                "under the sample plane", in_rig=False)
+                "under the sample plane; its cable runs down the channel under the slot, out below the plate",
+                in_rig=False)
 
 
 def screen_room(rig) -> dict:
@@ -179,7 +188,6 @@ def manual_page(rig) -> str:
     cal = p.calibration
     seq = Sequence.from_profile(cal)
     plan = M.Plan.of(p)
-    w, h = cal.screen_resolution
     frames = seq.names()
     steps = _flat_steps(cal, plan)
     side = min(seq.size_mm)
@@ -200,11 +208,7 @@ What it measures: each camera pixel's incidence direction at the sample, through
 the dome as they were built and placed; the fit of the misalignment; the dome's residual slopes.
 
 ## The kit
-- A flat screen (a tablet): {w} x {h} px at {cal.screen_pitch:g} mm pitch, {cal.screen_thickness:g} mm from its
-  back to its emitting surface. It lies inside the dome: its body, bezel included, must fit in a
-  {room['body_diameter_mm']:.0f} mm circle (the dome's inside at z = {room['tightest']['z_mm']:.1f} mm, where spacer
-  {room['tightest']['spacer']} puts it). Set it to its full brightness, no night shift, no auto-brightness, and a
-  linear (gamma 1) response if it offers one; show each PNG of `patterns/` full screen, unscaled.
+{_screen_kit(rig, room)}
 - The spacers (`stl/calibration_spacer_<k>.stl`): each replaces the sample holder in the base plate's bore.
   Turn it, from below, by the notches in its collar's rim: the wide one faces the groove under the
   base plate (on the tongue's side, +x) for its first capture, the narrow one after its half turn:
@@ -249,6 +253,56 @@ the image's columns and rows, the screen's axes at each turn and the patterns ar
 {_measuring_the_seating(p)}"""
 
 
+#: Displays of a known format, by (resolution (width, height) px, pitch in 0.1 µm): what to ask for by name.
+KNOWN_DISPLAYS = {((2266, 1488), 779): "the display of Apple's iPad mini (6th generation and later)",
+                  ((240, 320), 1275): "a 2.0-inch IPS SPI module with an ST7789 driver (e.g. Waveshare's 2inch LCD "
+                                     "Module)"}
+
+
+def display_spec(resolution, pitch: float) -> dict:
+    """What to buy for a display the calibration shows its frames on unscaled: its resolution (px), pitch
+    (mm), density (ppi), active area (mm) and diagonal (inches), and the display of that format by name
+    (KNOWN_DISPLAYS) when rigcad knows one."""
+    w, h = resolution
+    return {"resolution_px": [w, h], "pitch_mm": pitch, "ppi": 25.4 / pitch, "size_mm": [w * pitch, h * pitch],
+            "diagonal_in": math.hypot(w, h) * pitch / 25.4,
+            "known_as": KNOWN_DISPLAYS.get(((w, h), round(1e4 * pitch)))}
+
+
+def display_text(spec: dict) -> str:
+    """A display's buying line (:func:`display_spec`)."""
+    (w, h), (a, b) = spec["resolution_px"], spec["size_mm"]
+    size = f"{spec['diagonal_in']:.1f}"
+    return (f"{'an' if size.startswith(('8', '11', '18')) else 'a'} {size}-inch display of exactly {w} x {h} px at "
+            f"{spec['pitch_mm']:g} mm pitch "
+            f"({spec['ppi']:.0f} ppi, {a:.1f} x {b:.1f} mm)" + (f": {spec['known_as']}" if spec["known_as"] else ""))
+
+
+def _screen_kit(rig, room: dict) -> str:
+    """The kit's item for the flat screen: what to buy, how it lies in the dome, and how its frames
+    advance while the dome is on (rigcad.calibrate.slideshow)."""
+    from rigcad.calibrate.slideshow import DELAY_S, HOLD_S
+
+    cal = rig.profile.calibration
+    spec = display_spec(cal.screen_resolution, cal.screen_pitch)
+    frames = len(Sequence.from_profile(cal).names())
+    return f"""- A flat screen (a tablet): {display_text(spec)}; the frames are drawn for those pixels,
+  so a screen of another resolution or pitch cannot show them: set `calibration.screen_resolution` and
+  `screen_pitch` to yours and run `--kit` again. {cal.screen_thickness:g} mm from its back to its emitting
+  surface (`screen_thickness`). It lies inside the dome: its body, bezel and corners included, must fit in a
+  {room['body_diameter_mm']:.0f} mm circle (the dome's inside at z = {room['tightest']['z_mm']:.1f} mm, where spacer
+  {room['tightest']['spacer']} puts it): lay it on a circle of that size drawn on paper before you buy.
+  Set it to its full brightness, no night shift, no auto-brightness, auto-lock off, and a linear (gamma 1)
+  response if it offers one.
+- Its frames advance by themselves, with the dome on: nobody may touch the screen once it lies on its
+  spacer (a touch moves it), and the dome stays on its register for a whole capture. Open
+  `patterns/slideshow.html` on the tablet (it holds the {frames} frames), and press Start before the dome
+  goes back on: it counts down {DELAY_S} s (the buttons change it), then shows each frame full screen,
+  unscaled, for {HOLD_S} s, in capture order, then black. Set the camera's interval timer to {HOLD_S} s and
+  start it {HOLD_S / 2:g} s after the white frame appears in its live view: {frames} pictures, one in the middle
+  of each frame; name them in that order."""
+
+
 def _flat_steps(cal, plan) -> str:
     """The capture order's steps for the flat screen, one per spacer and turn (Markdown list)."""
     turned = (", turned a half turn (the spacer in its bore, its narrow notch at the groove, and the screen on it, "
@@ -267,14 +321,19 @@ def _upright_kit(p, flat: int) -> str:
         return ""
     seq = Sequence.from_profile(cal, "upright")
     (w, h), (w_mm, h_mm) = seq.resolution, seq.size_mm
-    return f"""- A small display stood on edge, the upright display: {w} x {h} px at {cal.upright_pitch:g} mm pitch
-  ({w_mm:.1f} x {h_mm:.1f} mm), its module {cal.upright_thickness:g} mm thick with
-  {cal.upright_border:g} mm of frame beyond the active area at the sides and below. Its stand
-  (`stl/calibration_upright_stand.stl`) replaces the sample holder in the bore: stand the module in the
-  slot, face out, on the slot's floor, against the stand's back; the active area then starts
-  {cal.upright_depth:g} mm under the sample plane, {cal.upright_offset:g} mm from the axis. It meets the rays
-  that reach the sample near grazing, which pass under the flat screen or meet it past its edge.
-  Show the PNGs of `patterns_upright/` on it full screen, unscaled (the same frames, at its size).
+    spec = display_spec((w, h), cal.upright_pitch)
+    return f"""- A small display stood on edge, the upright display: {display_text(spec)}, its module
+  {cal.upright_thickness:g} mm thick with {cal.upright_border:g} mm of frame beyond the active area at the sides
+  and below. Its stand (`stl/calibration_upright_stand.stl`) replaces the sample holder in the bore: stand
+  the module in the slot, face out, on the slot's floor, against the stand's back, its flat cable down the
+  channel under the slot and out below the base plate; the active area then starts {cal.upright_depth:g} mm
+  under the sample plane, {cal.upright_offset:g} mm from the axis. It meets the rays that reach the sample
+  near grazing, which pass under the flat screen or meet it past its edge.
+- The upright display is driven from outside, below the plate (the rig on the film test's blocks, the
+  dome on throughout): a Raspberry Pi with the module on its SPI pins as a framebuffer (the kernel's
+  fbtft overlay for its driver), showing the PNGs of `patterns_upright/` full screen, unscaled, in the
+  order of `patterns_upright/order.txt` (`fbi -T 1 -d /dev/fb1 -a -noverbose $(cat order.txt)`, run in that
+  folder; the space bar steps to the next frame). Step it once per camera picture from the Pi's keyboard.
 """
 
 
@@ -397,6 +456,16 @@ def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
                 data = pattern_png(ups.seq, name)
                 st.write_bytes(out / "patterns_upright" / f"{name}.png", data)
                 files[f"patterns_upright/{name}.png"] = sha256_hex(data)
+        from rigcad.calibrate.slideshow import slideshow_page
+
+        show = slideshow_page(f"{p.name}: calibration screen", [(n, pattern_png(seq, n)) for n in seq.names()],
+                              seq.resolution)
+        st.write_bytes(out / "patterns" / "slideshow.html", show)
+        files["patterns/slideshow.html"] = sha256_hex(show)
+        if len(ups):
+            order = ("".join(f"{n}.png\n" for n in seq.names())).encode()
+            st.write_bytes(out / "patterns_upright" / "order.txt", order)
+            files["patterns_upright/order.txt"] = sha256_hex(order)
         tools = [spacer(p, k) for k in range(len(p.calibration.spacer_heights))]
         for part in tools + ([upright_stand(p)] if len(ups) else []):
             say(part.name)

@@ -336,34 +336,35 @@ def kit_items(rig) -> list[KitItem]:
                              str(ball.quantity), ball.role, ("steel balls",), (STEP_CROSSES,)))
     cal = getattr(p, "calibration", None)
     if cal is not None:
-        from rigcad.calibrate.kit import screen_room, upright_room
+        from rigcad.calibrate.kit import display_spec, display_text, screen_room, upright_room
         from rigcad.calibrate.patterns import Sequence
 
         room = screen_room(rig)
-        w, h = cal.screen_resolution
-        (dw, dh) = room["display_mm"]
         items += [
             KitItem("Tablet (the calibration screen)", "1",
-                    f"{w} x {h} px at {cal.screen_pitch:g} mm pitch ({dw:.0f} x {dh:.0f} mm), {cal.screen_thickness:g} mm "
-                    f"from its back to its emitting surface, its body with the bezel within a "
-                    f"{room['body_diameter_mm']:.0f} mm circle; full brightness without auto-brightness "
-                    "(`calibration.screen_*`)", ("tablet",), (STEP_AS_BUILT,)),
+                    display_text(display_spec(cal.screen_resolution, cal.screen_pitch)) + f", {cal.screen_thickness:g} "
+                    f"mm from its back to its emitting surface, its body with the bezel and corners within a "
+                    f"{room['body_diameter_mm']:.0f} mm circle; full brightness without auto-brightness; a browser "
+                    "for the kit's slideshow (`calibration.screen_*`)", ("tablet",), (STEP_AS_BUILT,)),
             KitItem("Calibration spacers (printed by `rigcad calibrate --kit`: stl/calibration_spacer_<k>.stl)",
                     str(len(cal.spacer_heights)), "heights " + ", ".join(f"{v:g}" for v in cal.spacer_heights)
                     + " mm above the holder's seat (`calibration.spacer_heights`), printed as the sample holder is",
                     ("spacer",), (STEP_AS_BUILT,))]
         if cal.upright_turns:
             seq = Sequence.from_profile(cal, "upright")
-            (uw, uh), (uw_mm, uh_mm) = seq.resolution, seq.size_mm
             items += [
                 KitItem("Upright display (a small display module)", "1",
-                        f"{uw} x {uh} px at {cal.upright_pitch:g} mm pitch ({uw_mm:.1f} x {uh_mm:.1f} mm), module at most "
+                        display_text(display_spec(seq.resolution, cal.upright_pitch)) + ", module at most "
                         f"{cal.upright_thickness:g} mm thick with {cal.upright_border:g} mm of frame beyond the active area "
                         f"(its slot holds {2 * upright_room(p)['half_width_mm']:.1f} mm wide)", ("upright display",),
                         (STEP_AS_BUILT,)),
                 KitItem("Upright display's stand (printed by `rigcad calibrate --kit`: "
                         "stl/calibration_upright_stand.stl)", "1", "printed as the sample holder is",
-                        ("calibration_upright_stand",), (STEP_AS_BUILT,))]
+                        ("calibration_upright_stand",), (STEP_AS_BUILT,)),
+                KitItem("Raspberry Pi (any model with the 40-pin header) with its power supply, a micro-SD card with "
+                        "Raspberry Pi OS, a USB keyboard and female-female jumper wires, 30 cm", "1",
+                        "drives the upright display from below the plate (SPI, the kernel's fbtft overlay for the "
+                        "module's driver; fbi shows the frames)", ("raspberry pi",), (STEP_AS_BUILT,))]
     return items
 
 
@@ -371,7 +372,7 @@ def kit_items(rig) -> list[KitItem]:
 #: bill's lines so that a line missing from the bill shows: every word a step uses must be some line's.
 ITEM_WORDS = ("drafting film", "film", "tape", "fine pen", "blocks", "45 deg mirror", "scalpel", "checkerboard",
               "circle cutter", "gray card", "tablet", "spacer", "upright display", "calibration_upright_stand",
-              "torch", "mask", "leather punch", "plug", "steel balls")
+              "torch", "mask", "leather punch", "plug", "steel balls", "raspberry pi")
 
 
 def kit_misses(sections: dict[str, str], items: list[KitItem]) -> list[str]:

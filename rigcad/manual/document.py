@@ -1162,27 +1162,8 @@ def _section_calibrate(d: Doc, c) -> None:
         "before this manual is written):")
     d.table(["item", "goes in", "what comes out of its way", "which goes back", "checked"],
             [[r["item"], r["way"], r["out_of_the_way"], r["back"], r["checked"]] for r in C.access(rig)])
-    d.h(3, C.STEP_CROSSES)
-    row = pshadow["rows"][0]
     springs = spring_bolts(rig)
-    d.p(springs["off"] + "Lift the splitter holder, with the camera on it, off its seat (its kinematic seat puts it back "
-        "in the same place; the balls in its push screws' cups go with it, the cone's balls, the vee's pins and the "
-        "flat's gauge block stay on the shelf) and take the focusing lens out of its mount; leave the mount "
-        f"where it is. Set the `projector_mounting_plate` ({pshadow['plate_length_mm']:.0f} mm long) on the splitter seat "
-        "in the holder's place: the three steel balls pressed into its underside (retaining compound) sit on the seat's "
-        "cone, vee and flat where the holder's sat; it stops short of the lens mount's foot and never touches it. Stand "
-        "the `projector_backplate` in the fence at the shelf's end, its cut cross towards the projector, and the "
-        "two `projector_cross`es in the other two fences: their centres are then on the projector's axis, "
-        f"{pshadow['axis_height_mm']:.1f} mm above the plate, {pshadow['spacing_mm']:.1f} mm apart, the far one "
-        f"{pshadow['backplate_distance_mm']:.1f} mm in front of the backplate.")
-    d.p(f"Project a white image. The near cross stands {row['projector_to_near_cross_mm']:.1f} mm from the projector's "
-        f"COP: its shadow's arms reach {row['near_shadow_arm_mm']:.1f} mm on the backplate, the far cross's "
-        f"{row['far_shadow_arm_mm']:.1f} mm. Aligned, the two shadows' centres coincide on the backplate's cut cross. "
-        f"A projector off the crosses' line by 1 mm across the axis separates them by "
-        f"**{row['separation_per_mm_offset']:.2f} mm**: move the projector on its slots (across) and its shims "
-        f"(height) until they coincide. The profile allows `tolerancing.projector_offset` = "
-        f"{p.tolerancing.projector_offset:g} mm. Then take the plate, crosses and backplate off, put the lens back "
-        "and set the holder back on its seat. " + springs["on"])
+    _crosses(d, pshadow, springs, p)
     seat = C.splitter_seat(rig)
     if seat:
         _seat_section(d, c, seat, springs)
@@ -1226,6 +1207,31 @@ def _section_calibrate(d: Doc, c) -> None:
     step("calibration")
     c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam,
                      "splitter_seat": seat}
+
+
+def _crosses(d: Doc, pshadow: dict, springs: dict, p) -> None:
+    """Section 6's projector crosses: the holder off its seat, the plate, crosses and backplate on it, the
+    shadows' separation per mm of projector offset (rigcad.manual.calibration.projector_shadows)."""
+    d.h(3, C.STEP_CROSSES)
+    row = pshadow["rows"][0]
+    d.p(springs["off"] + "Lift the splitter holder, with the camera on it, off its seat (its kinematic seat puts it back "
+        "in the same place; the balls in its push screws' cups go with it, the cone's balls, the vee's pins and the "
+        "flat's gauge block stay on the shelf) and take the focusing lens out of its mount; leave the mount "
+        f"where it is. Set the `projector_mounting_plate` ({pshadow['plate_length_mm']:.0f} mm long) on the splitter seat "
+        "in the holder's place: the three steel balls pressed into its underside (retaining compound) sit on the seat's "
+        "cone, vee and flat where the holder's sat; it stops short of the lens mount's foot and never touches it. Stand "
+        "the `projector_backplate` in the fence at the shelf's end, its cut cross towards the projector, and the "
+        "two `projector_cross`es in the other two fences: their centres are then on the projector's axis, "
+        f"{pshadow['axis_height_mm']:.1f} mm above the plate, {pshadow['spacing_mm']:.1f} mm apart, the far one "
+        f"{pshadow['backplate_distance_mm']:.1f} mm in front of the backplate.")
+    d.p(f"Project a white image. The near cross stands {row['projector_to_near_cross_mm']:.1f} mm from the projector's "
+        f"COP: its shadow's arms reach {row['near_shadow_arm_mm']:.1f} mm on the backplate, the far cross's "
+        f"{row['far_shadow_arm_mm']:.1f} mm. Aligned, the two shadows' centres coincide on the backplate's cut cross. "
+        f"A projector off the crosses' line by 1 mm across the axis separates them by "
+        f"**{row['separation_per_mm_offset']:.2f} mm**: move the projector on its slots (across) and its shims "
+        f"(height) until they coincide. The profile allows `tolerancing.projector_offset` = "
+        f"{p.tolerancing.projector_offset:g} mm. Then take the plate, crosses and backplate off, put the lens back "
+        "and set the holder back on its seat. " + springs["on"])
 
 
 def _seat_section(d: Doc, c, seat: dict, springs: dict) -> None:

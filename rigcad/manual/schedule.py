@@ -111,6 +111,12 @@ def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
            "spray the mirror coat on both; let it cure; set the paraboloid back and the dome on its pins.",
            RECIPE, needs={"slope passed", "dome on its register"}, makes={"mirrors coated"}),
     ]
+    return tuple(out + _calibration(rig, tower))
+
+
+def _calibration(rig, tower: bool) -> list[Stage]:
+    """The schedule's calibration stages, after the mirror coat (section 6)."""
+    out = []
     if tower:
         out += [
             _s("Align the projector on the crosses (the splitter holder off its seat, then back).", C.STEP_CROSSES,
@@ -136,7 +142,7 @@ def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
         out.append(_s("Capture the screens on their spacers and the upright display, run rigcad calibrate --images; "
                       "re-seat the paraboloid by what it reads.", C.STEP_AS_BUILT,
                       needs={"camera aligned", "mirrors coated", "dome on its register"}, makes={"rig calibrated"}))
-    return tuple(out)
+    return out
 
 
 def unmet(stages) -> list[tuple[int, str, list[str]]]:
