@@ -500,7 +500,18 @@ TOOLS = (
     ("Respirator, half mask with A2P3 filters (EN 14387); supplied-air hood for 2K isocyanate coats", "1"),
     ("Nitrile gloves and safety glasses (EN 166)", "1 box / 1"),
     ("Sanding blocks: flat rubber block and blocks curved to the mirrors' radii (section 3)", "see section 3"),
+    ("Tin snips, straight cut, and scissors (the shim stock and the shim foil)", "1 each"),
+    ("Files: a 150 mm flat file (cut 2) and a needle file set, flat and round (slots, deburring)", "1 set"),
+    ("Float glass plate 300 x 300 x 6 mm and a steel straightedge 300 mm (DIN 874, grade 1), for lapping glue "
+     "faces flat", "1 each"),
+    ("Drill press, or a hand drill in a drill stand, with a depth stop; a tap wrench to turn the hand reamers", "1"),
+    ("Bench vise with soft jaws and a soft-faced hammer (pressing dowel pins and balls in)", "1 each"),
 )
+#: The words section 2-6 name a tool by (lower case, as a word): each must be in some line of the tools
+#: (or of the calibration kit), so a tool a step uses and the bill forgets shows (tests/manual).
+TOOL_WORDS = ("caliper", "engineer's square", "spirit level", "hex key", "spanner", "torque screwdriver",
+              "soldering iron", "feeler", "tin snips", "scissors", "file", "float glass", "straightedge", "drill",
+              "reamer", "dial test indicator", "vise", "hammer", "scalpel", "circle cutter", "leather punch")
 
 
 def feeler_gauge(gaps_mm: list[float]) -> tuple[str, str]:
@@ -515,11 +526,47 @@ def feeler_gauge(gaps_mm: list[float]) -> tuple[str, str]:
             "1")
 
 
-def dowel_drills(fab_report: dict) -> tuple[str, str]:
-    """The drills for the split pieces' pin holes (each part's hole as drawn, fab.json's ``pin_fit``)."""
+def dowel_drills(fab_report: dict, rig=None) -> tuple[str, str]:
+    """The drills for the split pieces' pin holes (each part's hole as drawn, fab.json's ``pin_fit``), and
+    with ``rig`` the reamer of the COP tower's dowels (``datum.dowel_diameter``)."""
     holes = _pin_holes(fab_report)
-    return (f"HSS twist drills (DIN 338) for the pin holes: {holes or 'none'}; 4 mm H7 reamer "
-            "for the column's dowel holes", "1 each")
+    dowel = getattr(getattr(getattr(rig, "profile", None), "datum", None), "dowel_diameter", None)
+    tower = getattr(getattr(rig, "layout", None), "tower", None) is not None
+    return (f"HSS twist drills (DIN 338) for the pin holes: {holes or 'none'}"
+            + (f"; {dowel:g} mm H7 hand reamer for the column's dowel holes" if dowel and tower else ""), "1 each")
 
 
-__all__ += ["CONSUMABLES", "TOOLS", "dowel_drills", "feeler_gauge", "glue_rows"]
+def register_tools(rig) -> list[tuple[str, str]]:
+    """The tools each locating register needs (rigcad.parts.locating.DowelRegister, read from the parts'
+    joints): its pins' drill and reamers (``locating.reamers``), and for a register drilled in place (the
+    part indicated in first) the dial test indicator that centres it."""
+    from rigcad.parts import locating
+
+    out = []
+    for part in rig.recipes.values():
+        for reg in part.joints:
+            if not isinstance(reg, locating.DowelRegister):
+                continue
+            tools = (locating.reamers(reg.diameter) if hasattr(locating, "reamers") else
+                     f"a {reg.diameter:g} mm twist drill (DIN 338) and a {reg.diameter:g} mm H7 hand reamer")
+            out.append((f"For the {reg.upper.replace('_', ' ')}'s register on the {reg.lower.replace('_', ' ')} "
+                        f"({len(reg.points)} x {reg.diameter:g} mm pins): {tools}", "1 each"))
+            if reg.drilled:
+                out.append(("Dial test indicator, 0.01 mm graduation (DIN 2270), on an articulated arm clamped to a "
+                            f"plug of the sample holder's size that turns in the bore (a second `sample_holder`, "
+                            f"printed): it centres the {reg.upper.replace('_', ' ')} before its register is drilled",
+                            "1"))
+    return out
+
+
+def set_screw_keys(hardware_rows: list[dict]) -> tuple[str, str] | None:
+    """The hex keys the bill's set screws take (rigcad.standards.SET_SCREW_KEY, by each row's thread)."""
+    from rigcad.standards import SET_SCREW_KEY
+
+    threads = sorted({r["item"].split(" x ")[0] for r in hardware_rows if "set screw" in r["item"]})
+    keys = [f"{SET_SCREW_KEY[t]:g} mm ({t})" for t in threads if t in SET_SCREW_KEY]
+    return (f"Hex keys for the set screws (ISO 4026 / 4029, ISO 2936 keys): {', '.join(keys)}", "1 each") if keys else None
+
+
+__all__ += ["CONSUMABLES", "TOOLS", "TOOL_WORDS", "dowel_drills", "feeler_gauge", "glue_rows", "register_tools",
+            "set_screw_keys"]

@@ -365,9 +365,11 @@ def _bill_consumables(d: Doc, c) -> None:
     d.table(["item", "qty"], [list(_abrasive() if r[0].startswith("Wet-or-dry") else r)
                               for r in (*B.CONSUMABLES, *B.glue_rows(c.fab_report))])
     d.h(3, "Tools")
+    keys = B.set_screw_keys(c.bill["hardware"])
     d.table(["item", "qty"], [list(_blocks(c.rig) if r[0].startswith("Sanding blocks") else r)
                               for r in (*B.TOOLS, B.feeler_gauge([total - gauged_depth(c.p), *gaps]),
-                                        B.dowel_drills(c.fab_report))])
+                                        B.dowel_drills(c.fab_report, c.rig), *B.register_tools(c.rig),
+                                        *([keys] if keys else []))])
 
 
 def _section_schedule(d: Doc, c) -> None:

@@ -64,3 +64,65 @@ def test_an_inherited_instrument_figure_is_flagged_with_its_file(tmp_path):
     assert re.search(r"throw ratio 1\.75 \(set in `profiles/achutha2006\.yaml:\d+`, not with the model", spec), spec
     own = rigcad.load("achutha2006")
     assert "not with the model" not in B._describe(own.profile.projector, own.profile, "projector")
+
+
+def _table_after(md: str, heading: str) -> list[str]:
+    """The rows (lower case) of the first table after ``heading`` in a manual.md."""
+    if heading not in md:
+        return []
+    rest = md.split(heading, 1)[1]
+    rows, started = [], False
+    for line in rest.splitlines():
+        if line.startswith("|"):
+            started = True
+            rows.append(line.lower())
+        elif started:
+            break
+    return rows
+
+
+def tool_misses(md: str) -> list[str]:
+    """The tools (B.TOOL_WORDS) sections 2-6 of a manual.md name that no line of its tools or calibration
+    kit tables holds."""
+    body = md.split("## 2. Print", 1)[1]
+    lines = _table_after(md, "### Tools") + _table_after(md, "### Calibration and test kit")
+    return [w for w in B.TOOL_WORDS if re.search(rf"\b{re.escape(w)}", body, re.I) and not any(w in r for r in lines)]
+
+
+def test_a_tool_missing_from_the_bill_is_found():
+    md = ("### Tools\n\n| item | qty |\n|---|---|\n| Digital caliper | 1 |\n\n## 2. Print\n\n"
+          "Measure it with the caliper.\n")
+    assert tool_misses(md) == []
+    assert tool_misses(md + "Ream the hole with the reamer.\n") == ["reamer"]
+
+
+@pytest.fixture(scope="module")
+def written(table31_rig, tmp_path_factory):
+    from rigcad.fab.printers import load_printer
+
+    fab = table31_rig.fab("prusa_mk3s", tmp_path_factory.mktemp("fab") / "fab", parts=["base_plate"]).report
+    out = tmp_path_factory.mktemp("manual") / "prusa_mk3s"
+    D.write_manual(table31_rig, load_printer("prusa_mk3s"), fab, out)
+    return out
+
+
+@pytest.mark.e2e
+def test_every_tool_a_step_names_is_in_the_bill(written):
+    md = (written / "manual.md").read_text(encoding="utf-8")
+    assert tool_misses(md) == []
+    # the dome's register: its drill and reamers, and the indicator that centres it, are tools lines
+    tools = " ".join(_table_after(md, "### Tools"))
+    assert "dial test indicator" in tools and "twist drill" in tools and "reamer" in tools
+    # planted: the tools table without its reamer lines misses the reamer the dome's step names
+    planted = "\n".join(line for line in md.splitlines() if not (line.startswith("|") and "reamer" in line.lower()))
+    assert "reamer" in tool_misses(planted)
+
+
+@pytest.mark.e2e
+def test_no_step_of_the_manual_says_a_sentence_twice(written):
+    md = (written / "manual.md").read_text(encoding="utf-8")
+    steps = re.split(r"\n### ", md.split("## 5. Assemble", 1)[1].split("\n## ", 1)[0])
+    assert len(steps) > 10
+    for step in steps:
+        text = " ".join(line for line in step.splitlines()[1:] if line and not line.startswith(("!", "*")))
+        assert repeated_sentences(text) == [], step.splitlines()[0]
