@@ -102,6 +102,10 @@ class Printer:
     #: The process's dimensional errors (``process_errors:``; rigcad.parts.process), or the
     #: process's published defaults (DEFAULT_PROCESS) when the file states none.
     process_errors: ProcessErrors | None = None
+    #: The machine the file is for ('' when it does not say), and why another printer's presets
+    #: stand in for it ('' when they do not).
+    model: str = ""
+    stand_in: str = ""
 
     @property
     def usable(self) -> tuple[float, float, float]:
@@ -113,6 +117,7 @@ class Printer:
         """Resolved values for fab.json, units in the keys."""
         v = self.build_volume
         out = {"name": self.name, "description": self.description, "process": self.process,
+               "model": self.model or None, "stand_in": self.stand_in or None,
                "source": self.source, "build_volume_mm": [v.x, v.y, v.z], "bed_margin_mm": self.bed_margin,
                "layer_height_mm": self.layer_height, "first_layer_height_mm": self.first_layer_height,
                "nozzle_mm": self.nozzle, "pixel_mm": self.pixel, "filament_diameter_mm": self.filament_diameter,
@@ -153,6 +158,10 @@ _TOP: dict[str, Spec] = {
     "layer_time_s": Spec("float", "time per layer beyond the deposition, for estimates (s)", 0.0, lo=0, hi=3600),
     "slicer": Spec("choice", "slicer rigcad runs for G-code (or a mapping of PrusaSlicer presets)", "none",
                    choices=("none", "prusa-slicer")),
+    "model": Spec("str", "the machine this file is for, as its maker names it (e.g. 'Original Prusa MK4'); with "
+                  "slicer presets, refused when they are another printer's unless stand_in says why", ""),
+    "stand_in": Spec("str", "why the slicer presets of another printer are used for this one (one line); left out, "
+                     "presets for another model than 'model' are refused", ""),
     "sanding_stock": Spec("str", "material printed in front of every mirror surface, sanded off down to the "
                           "templates before the coating: 'auto' (the stock the staircase of each part needs in its "
                           "print orientation) or a length such as '0.1 mm' ('0 mm': none)", "auto"),
@@ -226,74 +235,65 @@ def available_printers() -> list[str]:
 
 
 def load_printer(name: str | Path) -> Printer:
-    """Read and validate a printer profile; errors name the file:line, key, value and what is valid."""
+    """Read and validate a printer profile; errors name the file:line, key, value and what is valid.
+    Every problem of the file is reported at once (rigcad.fab.vendor.Problems): its unknown keys,
+    bad values, presets the installed slicer lacks, figures that disagree with them, a model the
+    presets are not for."""
     path = printer_path(name)
     raw = load_raw(path)
+    problems: list = []
     valid = sorted([*_TOP, *_SECTIONS, "process_errors"])
     for key in raw.data:
         if key not in valid:
-            raise ProfileError(f"unknown printer key {unknown_key(key)}{suggest(str(key), valid)}; valid: "
-                               f"{', '.join(valid)}",
-                               where=raw.where((key,)))
+            problems.append(ProfileError(f"unknown printer key {unknown_key(key)}{suggest(str(key), valid)}; valid: "
+                                         f"{', '.join(valid)}", where=raw.where((key,))))
     slicer_cfg, unavailable = None, None
     if isinstance(raw.data.get("slicer"), dict):
-        slicer_cfg, unavailable = _read_slicer(raw, path)
-    preset = _preset_figures(slicer_cfg, raw) if slicer_cfg else {}
+        try:
+            slicer_cfg, unavailable = _read_slicer(raw, path)
+        except (ProfileError, FabricationError) as err:
+            V.gather(problems, err)
+    preset: dict[str, Any] = {}
+    if slicer_cfg:
+        try:
+            preset = _preset_figures(slicer_cfg, raw)
+        except ProfileError as err:
+            problems.append(err)
     top: dict[str, Any] = {}
     from_preset = []
     for key, s in _TOP.items():
-        if key == "sanding_stock":
-            continue  # 'auto' or a length, read below
-        if key == "slicer" and (slicer_cfg or unavailable):
-            top[key] = "prusa-slicer"
-            continue
-        if key not in raw.data:
-            if key in preset:
-                top[key] = preset[key]
-                from_preset.append(key)
-                continue
-            if s.default is REQUIRED:
-                need = " (or name a PrusaSlicer print preset, which states it)" if key in _PRESET_FIGURES else ""
-                if unavailable:
-                    need = f" (the slicer presets would state it, but {unavailable})"
-                raise ProfileError(f"printer key {key!r} is missing: {s.doc} ({s.describe_range()}){need}",
-                                   where=f"{path}:1")
-            top[key] = s.default if s.default is None or s.kind == "str" else convert_value(s, s.default, key, None)
-            continue
-        top[key] = convert_value(s, raw.data[key], key, raw.where((key,)))
-        if s.kind == "str" and isinstance(top[key], str) and _CONTROL.search(top[key]):
-            raise ProfileError(f"{key}: one line of text, without line breaks or control characters (it is written "
-                               "into the slicer's configuration)", where=raw.where((key,)))
-    stock = raw.data.get("sanding_stock", "auto")
-    if stock == "auto":
-        top["sanding_stock"] = None
-    else:  # 'auto' or a length: a bare number or other text gets the length rules' message
-        top["sanding_stock"] = convert_value(Spec("length", "'auto' or " + _TOP["sanding_stock"].doc, lo=0,
-                                                  hi=MAX_SANDING_STOCK),
-                                             stock, "sanding_stock", raw.where(("sanding_stock",)))
-    sections = {k: read_section(raw, k, cls) for k, cls in _SECTIONS.items()}
-    if top["first_layer_height"] is None:
-        top["first_layer_height"] = top["layer_height"]
+        try:
+            _top_value(key, s, raw, path, top, preset, from_preset, slicer_cfg, unavailable)
+        except ProfileError as err:
+            problems.append(err)
+            top[key] = None
+    try:
+        top["sanding_stock"] = _sanding_stock(raw)
+    except ProfileError as err:
+        problems.append(err)
+    sections = {}
+    for k, cls in _SECTIONS.items():
+        try:
+            sections[k] = read_section(raw, k, cls)
+        except ProfileError as err:
+            problems.append(err)
+    if top.get("first_layer_height") is None:
+        top["first_layer_height"] = top.get("layer_height")
+    if slicer_cfg and "build_volume" in sections:
+        problems += _check_agreement(top, sections["build_volume"], preset, slicer_cfg, raw)
+    problems += _check_process(top, sections, raw, path)
     if slicer_cfg:
-        _check_agreement(top, sections["build_volume"], preset, slicer_cfg, raw)
-    if top["process"] == "fdm" and top["nozzle"] is None:
-        raise ProfileError("an fdm printer needs 'nozzle' (e.g. '0.4 mm')", where=f"{path}:1")
-    if top["process"] == "sla" and top["pixel"] is None:
-        raise ProfileError("an sla printer needs 'pixel' (pixel or laser spot, e.g. '85 um')", where=f"{path}:1")
-    if top["slicer"] == "prusa-slicer" and (top["process"] != "fdm" or top["filament_diameter"] is None):
-        raise ProfileError("slicer 'prusa-slicer' needs process 'fdm' and 'filament_diameter' (e.g. '1.75 mm')",
-                           where=raw.where(("slicer",)))
-    if top["process"] == "fdm" and top["slicer"] == "none" and top["deposition_rate_mm3_s"] <= 0:
-        raise ProfileError("deposition_rate_mm3_s: an fdm printer without a slicer needs a deposition rate > 0 "
-                           "(mm3/s) for its time estimate", where=raw.where(("deposition_rate_mm3_s",)) or f"{path}:1")
-    vol = sections["build_volume"]
-    margin = top["bed_margin"]
-    if 2 * margin >= min(vol.x, vol.y):
-        raise ProfileError(f"bed_margin: {margin:g} mm leaves no bed ({vol.x:g} x {vol.y:g} mm)",
-                           where=raw.where(("bed_margin",)))
-    process = read_process_errors(raw, top["process"], top["layer_height"], path)
-    return Printer(name=raw.name, description=top["description"], process=top["process"], build_volume=vol,
-                   bed_margin=margin, layer_height=top["layer_height"],
+        problems += _check_model(top, slicer_cfg, raw)
+    process = None
+    if top.get("process") in DEFAULT_PROCESS and top.get("layer_height") is not None:
+        try:
+            process = read_process_errors(raw, top["process"], top["layer_height"], path)
+        except ProfileError as err:
+            problems.append(err)
+    V.raise_problems(problems, f"printer file {display(path)}")
+    return Printer(name=raw.name, description=top["description"], process=top["process"],
+                   build_volume=sections["build_volume"], bed_margin=top["bed_margin"],
+                   layer_height=top["layer_height"],
                    first_layer_height=top["first_layer_height"], nozzle=top["nozzle"], pixel=top["pixel"],
                    filament_diameter=top["filament_diameter"], material=top["material"],
                    material_density_g_cm3=top["material_density_g_cm3"],
@@ -301,7 +301,105 @@ def load_printer(name: str | Path) -> Printer:
                    slicer=top["slicer"], alignment_pin=sections["alignment_pin"], sanding_stock=top["sanding_stock"],
                    source=" <- ".join(str(s) for s in raw.sources), marks=dict(raw.marks),
                    slicer_config=slicer_cfg, slicer_unavailable=unavailable, from_preset=tuple(from_preset),
-                   process_errors=process)
+                   process_errors=process, model=top["model"], stand_in=top["stand_in"])
+
+
+def _top_value(key: str, s: Spec, raw: RawProfile, path: Path, top: dict, preset: dict, from_preset: list,
+               slicer_cfg, unavailable: str | None) -> None:
+    """``top[key]``: the printer file's value, else the preset's, else the default (ProfileError
+    when required and given nowhere)."""
+    if key == "sanding_stock":
+        return  # 'auto' or a length: _sanding_stock
+    if key == "slicer" and (slicer_cfg or unavailable or isinstance(raw.data.get("slicer"), dict)):
+        top[key] = "prusa-slicer"
+        return
+    if key not in raw.data:
+        if key in preset:
+            top[key] = preset[key]
+            from_preset.append(key)
+            return
+        if s.default is REQUIRED:
+            top[key] = None
+            if key in _PRESET_FIGURES and isinstance(raw.data.get("slicer"), dict) and not (slicer_cfg or unavailable):
+                return  # the presets that would state it are refused: that problem is reported
+            need = " (or name a PrusaSlicer print preset, which states it)" if key in _PRESET_FIGURES else ""
+            if unavailable:
+                need = f" (the slicer presets would state it, but {unavailable})"
+            raise ProfileError(f"printer key {key!r} is missing: {s.doc} ({s.describe_range()}){need}",
+                               where=f"{path}:1")
+        top[key] = s.default if s.default is None or s.kind == "str" else convert_value(s, s.default, key, None)
+        return
+    top[key] = convert_value(s, raw.data[key], key, raw.where((key,)))
+    if s.kind == "str" and isinstance(top[key], str) and _CONTROL.search(top[key]):
+        raise ProfileError(f"{key}: one line of text, without line breaks or control characters (it is written "
+                           "into the slicer's configuration)", where=raw.where((key,)))
+
+
+def _sanding_stock(raw: RawProfile) -> float | None:
+    """``sanding_stock``: None for 'auto', else a length (a bare number or other text gets the
+    length rules' message)."""
+    stock = raw.data.get("sanding_stock", "auto")
+    if stock == "auto":
+        return None
+    return convert_value(Spec("length", "'auto' or " + _TOP["sanding_stock"].doc, lo=0, hi=MAX_SANDING_STOCK),
+                         stock, "sanding_stock", raw.where(("sanding_stock",)))
+
+
+def _check_process(top: dict, sections: dict, raw: RawProfile, path: Path) -> list:
+    """The figures a process needs (FDM: nozzle, and a slicer's filament or a deposition rate; SLA:
+    pixel) and a bed left by the margin: every problem, as a list."""
+    out = []
+    process = top.get("process")
+    if process == "fdm" and top.get("nozzle") is None and "nozzle" not in raw.data:
+        out.append(ProfileError("an fdm printer needs 'nozzle' (e.g. '0.4 mm')", where=f"{path}:1"))
+    if process == "sla" and top.get("pixel") is None and "pixel" not in raw.data:
+        out.append(ProfileError("an sla printer needs 'pixel' (pixel or laser spot, e.g. '85 um')", where=f"{path}:1"))
+    if top.get("slicer") == "prusa-slicer" and process is not None and (
+            process != "fdm" or (top.get("filament_diameter") is None and "filament_diameter" not in raw.data)):
+        out.append(ProfileError("slicer 'prusa-slicer' needs process 'fdm' and 'filament_diameter' (e.g. '1.75 mm')",
+                                where=raw.where(("slicer",))))
+    rate = top.get("deposition_rate_mm3_s")
+    if process == "fdm" and top.get("slicer") == "none" and rate is not None and rate <= 0:
+        out.append(ProfileError("deposition_rate_mm3_s: an fdm printer without a slicer needs a deposition rate > 0 "
+                                "(mm3/s) for its time estimate",
+                                where=raw.where(("deposition_rate_mm3_s",)) or f"{path}:1"))
+    vol, margin = sections.get("build_volume"), top.get("bed_margin")
+    if vol is not None and margin is not None and 2 * margin >= min(vol.x, vol.y):
+        out.append(ProfileError(f"bed_margin: {margin:g} mm leaves no bed ({vol.x:g} x {vol.y:g} mm)",
+                                where=raw.where(("bed_margin",))))
+    return out
+
+
+def _tokens(text: str) -> set[str]:
+    return set(re.findall(r"[a-z0-9]+", text.lower().replace("&&", "&")))
+
+
+def model_matches(model: str, model_id: str, model_name: str) -> bool:
+    """Whether a printer file's ``model`` is the printer a preset is for (its bundle's printer_model
+    ``model_id`` and that model's name): the ID, letters and digits only, within the model's
+    ("Original Prusa i3 MK3S+" holds MK3S), or every word of the model in the name ("Creality
+    Ender-3 V2" in "Creality Ender-3 V2")."""
+    compact = "".join(sorted(_tokens(model), key=lambda t: model.lower().find(t)))
+    mid = "".join(re.findall(r"[a-z0-9]+", model_id.lower()))
+    return bool(mid) and mid in compact or bool(_tokens(model)) and _tokens(model) <= _tokens(model_name)
+
+
+def _check_model(top: dict, cfg: V.VendorConfig, raw: RawProfile) -> list:
+    """A printer file's ``model`` against the printer model its presets are for (the preset's
+    printer_model, which its G-code names): refused when they differ, unless ``stand_in`` says why."""
+    model, eff = top.get("model") or "", cfg.effective()
+    model_id = eff.get("printer_model", "").strip()
+    if not model or not model_id or cfg.kind != "bundle":
+        return []
+    name = V.load_bundle(cfg.source).model_name(model_id)
+    if model_matches(model, model_id, name) or top.get("stand_in"):
+        return []
+    return [ProfileError(
+        f"model: {model!r}, but slicer.printer_preset {cfg.printer_preset!r} is PrusaSlicer's preset for the "
+        f"{name} (printer_model {model_id}): its G-code says printer_model = {model_id} and carries that printer's "
+        f"start G-code, bed and limits. Name your printer's preset, give the machine's own settings (a .ini exported "
+        f"from PrusaSlicer as slicer.vendor_bundle), or, when the stand-in is deliberate, say why in stand_in: "
+        f"(docs/instruments.md, 'Your printer')", where=raw.where(("model",)))]
 
 
 def _percent(raw: RawProfile, key: tuple[str, ...], lo: float = 0.0) -> float:
@@ -453,21 +551,23 @@ def _preset_figures(cfg: V.VendorConfig, raw: RawProfile) -> dict[str, Any]:
     return out
 
 
-def _check_agreement(top: dict, vol: BuildVolume, preset: dict, cfg: V.VendorConfig, raw: RawProfile) -> None:
-    """Figures the printer file states must agree with the resolved preset (see the module doc)."""
+def _check_agreement(top: dict, vol: BuildVolume, preset: dict, cfg: V.VendorConfig, raw: RawProfile) -> list:
+    """Figures the printer file states must agree with the resolved preset (see the module doc): every
+    disagreement, as a list of errors."""
+    out: list = []
     eff = cfg.effective()
     names = (f"{cfg.printer_preset} / {cfg.print_preset} / {cfg.filament_preset}" if cfg.kind == "bundle"
              else str(cfg.source))
     for key, pkey in _PRESET_FIGURES.items():
-        if key not in preset or key not in raw.data:
+        if key not in preset or key not in raw.data or top.get(key) is None:
             continue
         mine, theirs = top[key], preset[key]
         same = (mine.lower() == theirs.lower()) if key == "material" else abs(mine - theirs) < AGREE_TOL
         if not same:
-            raise ProfileError(f"{key}: {mine!r} disagrees with the slicer preset's {pkey} = {eff[pkey]!r} ({names}); "
-                               f"PrusaSlicer prints with the preset, so state the same value, leave {key} out, "
-                               f"choose a matching preset or set slicer.overrides.{pkey}",
-                               where=raw.where((key,)) or raw.where(("slicer",)))
+            out.append(ProfileError(
+                f"{key}: {mine!r} disagrees with the slicer preset's {pkey} = {eff[pkey]!r} ({names}); PrusaSlicer "
+                f"prints with the preset, so state the same value, leave {key} out, choose a matching preset or set "
+                f"slicer.overrides.{pkey}", where=raw.where((key,)) or raw.where(("slicer",))))
     if "bed_shape" in eff:
         try:
             pts = [tuple(float(c) for c in p.split("x")) for p in eff["bed_shape"].split(",")]
@@ -477,11 +577,12 @@ def _check_agreement(top: dict, vol: BuildVolume, preset: dict, cfg: V.VendorCon
             size = (max(p[0] for p in pts) - min(p[0] for p in pts), max(p[1] for p in pts) - min(p[1] for p in pts))
             for axis, mine, theirs in (("x", vol.x, size[0]), ("y", vol.y, size[1])):
                 if abs(mine - theirs) >= AGREE_TOL:
-                    raise ProfileError(f"build_volume.{axis}: {mine:g} mm disagrees with the preset's bed_shape = "
-                                       f"{eff['bed_shape']} ({theirs:g} mm; {names})",
-                                       where=raw.where(("build_volume", axis)))
+                    out.append(ProfileError(f"build_volume.{axis}: {mine:g} mm disagrees with the preset's "
+                                            f"bed_shape = {eff['bed_shape']} ({theirs:g} mm; {names})",
+                                            where=raw.where(("build_volume", axis))))
     if "max_print_height" in eff:
         h = _number(cfg, "max_print_height", eff["max_print_height"], raw.where(("slicer",)))
         if abs(vol.z - h) >= AGREE_TOL:
-            raise ProfileError(f"build_volume.z: {vol.z:g} mm disagrees with the preset's max_print_height = {h:g} mm "
-                               f"({names})", where=raw.where(("build_volume", "z")))
+            out.append(ProfileError(f"build_volume.z: {vol.z:g} mm disagrees with the preset's max_print_height = "
+                                    f"{h:g} mm ({names})", where=raw.where(("build_volume", "z"))))
+    return out

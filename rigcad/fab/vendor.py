@@ -48,6 +48,35 @@ BUNDLE_ONLY = frozenset({"inherits", "renamed_from", "alias", "compatible_printe
                          "compatible_prints", "compatible_prints_condition"})
 
 
+class Problems(ProfileError):
+    """Every problem found in one file (a printer file and the presets it names), reported at once:
+    ``problems`` the errors, each with its own file:line; the message lists them all on one line."""
+
+    def __init__(self, problems: list, what: str) -> None:
+        self.problems = list(problems)
+        super().__init__(f"{what}: {len(self.problems)} problems, each with its file:line: "
+                         + " | ".join(f"({i}) {p}" for i, p in enumerate(self.problems, 1)))
+
+
+def gather(problems: list, err: Exception) -> None:
+    """Add ``err`` (or each problem of a :class:`Problems`) to ``problems``."""
+    problems.extend(err.problems if isinstance(err, Problems) else [err])
+
+
+def raise_problems(problems: list, what: str) -> None:
+    """Raise the one problem as it is, several as one :class:`Problems`; nothing when there is none."""
+    if len(problems) == 1:
+        raise problems[0]
+    if problems:
+        raise Problems(sorted(problems, key=_place), what)
+
+
+def _place(err: Exception) -> tuple:
+    """Where an error points, as (file, line) for sorting: in the file's order, those without a place last."""
+    file, _, line = (getattr(err, "where", None) or "\uffff").rpartition(":")
+    return (file, int(line)) if line.isdigit() else ("\uffff", 0)
+
+
 # -- the INI reader ---------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
@@ -259,6 +288,12 @@ def find_bundle(spec: str, base: Path | None = None, where: str | None = None,
 
 # -- bundles and their presets -----------------------------------------------------------------------
 
+#: A printer preset name this close to one the bundle has (difflib's ratio) is a slip of the pen
+#: ("MK3S & MK3S" for "MK3S & MK3S+": 0.98); below, another printer ("Original Prusa MK4" against
+#: "Original Prusa i3 MK3": 0.87), which the bundle lacks.
+MISSPELT = 0.9
+
+
 @dataclass(frozen=True)
 class Bundle:
     """A parsed vendor bundle; :meth:`flatten` gives a preset with its inherits chain applied."""
@@ -280,6 +315,10 @@ class Bundle:
 
     def printer_models(self) -> dict[str, dict[str, str]]:
         return {k.split(":", 1)[1]: v for k, v in self.ini.sections.items() if k.startswith("printer_model:")}
+
+    def model_name(self, model_id: str) -> str:
+        """The printer model's name as PrusaSlicer shows it (``&&`` is its escaped ``&``), or the ID."""
+        return self.printer_models().get(model_id, {}).get("name", model_id).replace("&&", "&")
 
     def presets(self, group: str, abstract: bool = False) -> list[str]:
         """Preset names of ``group`` in file order; ``abstract`` also lists the ``*name*`` ones."""
@@ -340,10 +379,24 @@ class Bundle:
         for other in names:
             if self._section(group, other).get("renamed_from", "").strip('"') == name:
                 return f"{group}_preset {name!r} was renamed to {other!r} in {self.path.name} ({self.label()})"
+        if group == "printer" and not difflib.get_close_matches(name, names, n=1, cutoff=MISSPELT):
+            return self._unknown_printer(name, names)
         close = difflib.get_close_matches(name, names, n=3, cutoff=0.6)
         hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
         return (f"{group}_preset {name!r} is not in {self.path} ({self.label()}, {len(names)} {group} presets){hint}"
                 f" (list them with `python -m rigcad.fab.vendor {self.path.stem} {group}`)")
+
+    def _unknown_printer(self, name: str, names: list[str]) -> str:
+        """A printer the installed bundle has no preset for: the nearest it has, and what to do."""
+        fff = [n for n in names if self.flatten("printer", n).get("printer_technology", "FFF") == "FFF"]
+        close = difflib.get_close_matches(name, fff, n=3, cutoff=0.4)
+        near = f"; the nearest it has: {', '.join(repr(c) for c in close)}" if close else ""
+        return (f"printer_preset {name!r} is not in the installed PrusaSlicer's bundle {self.path} ({self.label()}, "
+                f"{len(names)} printer presets): this PrusaSlicer has no presets for that printer{near} (all: "
+                f"`python -m rigcad.fab.vendor {self.path.stem} printer`). Either give the machine's own settings: "
+                "export them from a PrusaSlicer that knows it (File > Export > Export Config) and name that .ini as "
+                "slicer.vendor_bundle, without the *_preset keys; or name the nearest printer's presets with "
+                "`model:` your printer and `stand_in:` why its G-code suits it (docs/instruments.md, 'Your printer')")
 
 
 def load_bundle(path: str | Path) -> Bundle:
@@ -512,10 +565,16 @@ def resolve(source: Path, printer: str | None, print_: str | None, filament: str
                                where=where.get("vendor_bundle"))
         merged: dict[str, str] = {}
         group_of: dict[str, str] = {}
+        problems: list = []
         for g in GROUPS:
-            flat = b.flatten(g, names[g], where.get(f"{g}_preset"))
+            try:
+                flat = b.flatten(g, names[g], where.get(f"{g}_preset"))
+            except ProfileError as err:  # every unknown preset at once
+                problems.append(err)
+                continue
             merged.update(flat)
             group_of.update(dict.fromkeys(flat, g))
+        raise_problems(problems, f"slicer presets in {path}")
         kind, vendor = "bundle", b.label()
 
         def line_of(key: str) -> str:
@@ -536,26 +595,35 @@ def resolve(source: Path, printer: str | None, print_: str | None, filament: str
         settings.update({"print_settings_id": print_, "printer_settings_id": printer,
                          "filament_settings_id": '"' + filament.replace('"', '\\"') + '"'})
     over: dict[str, str] = {}
+    problems = []
     for key, value in overrides.items():
-        at = where.get(f"overrides.{key}")
-        if key in BUNDLE_ONLY:
-            raise ProfileError(f"slicer.overrides.{key}: a bundle's bookkeeping key, not a PrusaSlicer setting",
-                               where=at)
-        if key not in A.ALLOWED_KEYS and key not in A.REFUSED:
-            if key in (set(merged) | slicer_keys()) - BUNDLE_ONLY:  # PrusaSlicer knows it: not a print setting
-                raise ProfileError(f"slicer.overrides.{key}: refused: {A.why_refused(key)}", where=at)
-            close = difflib.get_close_matches(key, sorted(A.ALLOWED_KEYS), n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
-            raise ProfileError(f"slicer.overrides: unknown PrusaSlicer setting {key!r}{hint}; valid keys are the "
-                               f"{len(A.ALLOWED_KEYS)} settings that shape a print (rigcad.fab.allowlist.ALLOWED, "
-                               "PrusaSlicer's names as in `prusa-slicer --help-fff` with '_' for '-')", where=at)
-        text = ini_value(value, key, at)
-        A.check_override(key, text, at)
-        over[key] = text
+        try:
+            over[key] = _override(key, value, where.get(f"overrides.{key}"), merged)
+        except ProfileError as err:  # every refused override at once
+            problems.append(err)
+    raise_problems(problems, "slicer.overrides")
     check_values(over, {k: where.get(f"overrides.{k}") for k in over})
     return VendorConfig(source=path, kind=kind, vendor=vendor, printer_preset=printer, print_preset=print_,
                         filament_preset=filament, settings=tuple(sorted(settings.items())),
                         overrides=tuple(sorted(over.items())))
+
+
+def _override(key: str, value, at: str | None, merged: dict[str, str]) -> str:
+    """One of the printer file's ``slicer.overrides``, checked, in PrusaSlicer's text form."""
+    if key in BUNDLE_ONLY:
+        raise ProfileError(f"slicer.overrides.{key}: a bundle's bookkeeping key, not a PrusaSlicer setting",
+                           where=at)
+    if key not in A.ALLOWED_KEYS and key not in A.REFUSED:
+        if key in (set(merged) | slicer_keys()) - BUNDLE_ONLY:  # PrusaSlicer knows it: not a print setting
+            raise ProfileError(f"slicer.overrides.{key}: refused: {A.why_refused(key)}", where=at)
+        close = difflib.get_close_matches(key, sorted(A.ALLOWED_KEYS), n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise ProfileError(f"slicer.overrides: unknown PrusaSlicer setting {key!r}{hint}; valid keys are the "
+                           f"{len(A.ALLOWED_KEYS)} settings that shape a print (rigcad.fab.allowlist.ALLOWED, "
+                           "PrusaSlicer's names as in `prusa-slicer --help-fff` with '_' for '-')", where=at)
+    text = ini_value(value, key, at)
+    A.check_override(key, text, at)
+    return text
 
 
 def main(argv: list[str] | None = None) -> int:
