@@ -100,9 +100,12 @@ def _parts_table(report: dict) -> list[str]:
         lines.append(f"| {name} | {e['quantity']} | {len(pcs)} | {orient} | {e['layers_total']} | {hours_minutes(t)} ({src}) | "
                      f"{g:.0f} g | {cusp} | {pol} |")
     tot = report["totals"]
-    lines += ["", f"Totals (with quantities): {tot['pieces']} pieces, {hours_minutes(tot['estimate_print_time_s'])} and "
-              f"{tot['estimate_material_g']:.0f} g by rigcad's estimate (rigcad.fab.estimate, fitted to PrusaSlicer)"
-              + (f"; slicer: {hours_minutes(tot['slicer_print_time_s'])}, {tot['slicer_filament_g']:.0f} g" if "slicer_print_time_s" in tot else "")
+    # the slicer's figures when every piece was sliced; rigcad's estimate only when none was
+    lines += ["", f"Totals (with quantities): {tot['pieces']} pieces, "
+              + (f"{hours_minutes(tot['slicer_print_time_s'])} and {tot['slicer_filament_g']:.0f} g by the slicer"
+                 if "slicer_print_time_s" in tot else
+                 f"{hours_minutes(tot['estimate_print_time_s'])} and {tot['estimate_material_g']:.0f} g by rigcad's "
+                 "estimate (rigcad.fab.estimate, fitted to PrusaSlicer; not every piece was sliced)")
               + ".", ""]
     return lines
 
