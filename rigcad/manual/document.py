@@ -1131,6 +1131,19 @@ def _calibration_more(d: Doc, c, cam: dict) -> None:
     d.h(3, C.STEP_GRAY)
     from rigcad.calibrate.graycard import manual_text
 
+    card = gray_card_seat(rig)
+    c.gray_card = card
+    d.p(f"**Where the card sits.** O, the sample point, is on the base plate's top face (z = 0). The sample holder's "
+        f"top stands **{-card['holder_top_z_mm']:g} mm under it** (`sample_holder.sample_thickness`), at the bottom "
+        f"of the bore's {card['bore_diameter_mm']:.1f} mm pocket, so that a sample of that thickness has its face at "
+        f"O. Measure the card's thickness with the caliper and lay a pack of the shim foil (the bill's: "
+        f"{', '.join(f'{v:g}' for v in card['foil_mm'])} mm sheets, cut to a {card['card_diameter_mm']:g} mm disc) "
+        f"of {-card['holder_top_z_mm']:g} mm less the card's thickness on the holder's top, the card on it: its face is "
+        f"then at O's height, to the thinnest foil's {card['foil_mm'][0]:g} mm. Check with the steel straightedge "
+        f"across the bore, on the plate's top either side: a {card['feeler_mm']:g} mm feeler leaf passes under it "
+        "neither over the plate nor over the card. A card thicker than that pocket cannot reach O: use a thinner one. "
+        "It goes in from below, the dome on: the rig on the film test's blocks, take the sample holder out of the "
+        "bore, lay the foil and the card on its top and push it back up until its collar stops.")
     d.p(manual_text(rig))  # the gray card command's own procedure (one home)
 
 
@@ -1160,6 +1173,18 @@ def _section_calibrate(d: Doc, c) -> None:
     pshadow = C.projector_shadows(rig)
     cam = C.camera_crosses(rig)
     d.h(2, "6. Calibrate (thesis 4.1.1)")
+    thermal = lab_temperature(c)
+    if thermal:
+        d.p(f"**The lab's temperature.** Align, calibrate and measure within **±{thermal['swing_K']:g} C** of one "
+            f"temperature (a lab's swing over a day, at its working 20-25 C, where the coats were cured): every printed length grows by "
+            f"{thermal['expansion_per_K'] * 1e6:.0f}e-6 per degree ({thermal['material']}), and a uniform "
+            f"±{thermal['swing_K']:g} C moves the projector's centre of projection {thermal['along_mm']:.3f} mm along "
+            f"the axis against the paraboloid (both stand on the base plate): {100 * thermal['share']:.0f} % of its "
+            f"tolerance (`tolerancing.projector_height`, `projector_offset`; "
+            f"rigcad.fab.loads.thermal). A uniform change takes the whole tolerance only at ±{thermal['limit_K']:.0f} C "
+            "(align and calibrate again past that), so what sets the range is what a uniform swing does not do: a "
+            "gradient across the rig tilts it. Keep it out of sunlight, off a radiator's draught and out of the "
+            "projector's exhaust, and let it settle an hour after the projector is switched on.")
     d.p("How each calibration item gets to its place, and what rigcad checked (a rig where one cannot is refused "
         "before this manual is written):")
     d.table(["item", "goes in", "what comes out of its way", "which goes back", "checked"],
@@ -1208,7 +1233,7 @@ def _section_calibrate(d: Doc, c) -> None:
     _as_built(d, c)
     step("calibration")
     c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam,
-                     "splitter_seat": seat}
+                     "splitter_seat": seat, "gray_card": c.gray_card, "lab_temperature": thermal}
 
 
 def _crosses(d: Doc, pshadow: dict, springs: dict, p) -> None:
@@ -1234,6 +1259,36 @@ def _crosses(d: Doc, pshadow: dict, springs: dict, p) -> None:
         f"(height) until they coincide. The profile allows `tolerancing.projector_offset` = "
         f"{p.tolerancing.projector_offset:g} mm. Then take the plate, crosses and backplate off, put the lens back "
         "and set the holder back on its seat. " + springs["on"])
+
+
+def gray_card_seat(rig) -> dict:
+    """Where the gray card sits (mm): the sample holder's top (its recipe's top face, under O by the sample's
+    thickness), the bore's pocket it lies in, the card's disc (the holder's diameter), the shim foil that
+    packs it up to O (rigcad.standards.SHIM_FOIL) and the feeler leaf that checks it flush."""
+    from rigcad.fab.seams import FEELER_LEAF
+    from rigcad.standards import SHIM_FOIL
+
+    import numpy as np
+
+    mesh = rig.mesh(rig.recipes["sample_holder"])
+    h = rig.profile.sample_holder
+    return {"holder_top_z_mm": float(np.asarray(mesh.vertices)[:, 2].max()), "face_z_mm": 0.0,
+            "bore_diameter_mm": 2 * (h.radius + h.clearance), "card_diameter_mm": 2 * h.radius,
+            "foil_mm": list(SHIM_FOIL), "feeler_mm": FEELER_LEAF}
+
+
+def lab_temperature(c) -> dict | None:
+    """The lab's temperature range: a uniform swing of rigcad.fab.loads.LAB_SWING_K each way, what it moves the
+    projector's COP by (loads.thermal) and its share of the tolerance, and the swing that would take the whole
+    tolerance (the share grows with the swing). None without the COP tower or the printer's process errors."""
+    from rigcad.fab import loads as L
+
+    if c.printer.process_errors is None or getattr(c.rig.layout, "tower", None) is None:
+        return None
+    t = L.thermal(c.p, c.rig.layout, c.printer)
+    mat = L.material(c.printer)
+    return {"swing_K": L.LAB_SWING_K, "material": mat.name.split(",")[0], "expansion_per_K": mat.expansion,
+            "along_mm": t.sag_mm, "share": t.share, "limit_K": L.LAB_SWING_K / t.share, "model": t.model}
 
 
 def _seat_section(d: Doc, c, seat: dict, springs: dict) -> None:

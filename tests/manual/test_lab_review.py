@@ -126,3 +126,48 @@ def test_no_step_of_the_manual_says_a_sentence_twice(written):
     for step in steps:
         text = " ".join(line for line in step.splitlines()[1:] if line and not line.startswith(("!", "*")))
         assert repeated_sentences(text) == [], step.splitlines()[0]
+
+
+def test_the_gray_card_sits_at_o_on_the_holder(tmp_path, table31_rig):
+    """The card's seat: the holder's top (read from its mesh) is the sample's thickness under O, in every
+    profile (a 2 mm sample puts it 2 mm under)."""
+    card = D.gray_card_seat(table31_rig)
+    p = table31_rig.profile
+    assert abs(card["holder_top_z_mm"] + p.sample_holder.sample_thickness) < 1e-6, card  # the mesh's top, to 1e-6 mm
+    assert card["face_z_mm"] == 0.0 and card["card_diameter_mm"] == 2 * p.sample_holder.radius
+    thick = _profile(tmp_path, "thick_sample", """
+        sample_holder:
+          sample_thickness: 2 mm
+        """)
+    assert abs(D.gray_card_seat(thick)["holder_top_z_mm"] + 2.0) < 1e-6
+
+
+def test_the_lab_temperature_is_the_expansion_over_the_cop_height(table31_rig):
+    """alpha x dT x (COP to vertex): the closed form of a uniform swing (both stand on the base plate); the
+    limit is the swing at which it takes the whole tolerance."""
+    from types import SimpleNamespace
+
+    from rigcad.fab import loads as L
+    from rigcad.fab.printers import load_printer
+
+    printer = load_printer("prusa_mk3s")
+    p = table31_rig.profile
+    t = D.lab_temperature(SimpleNamespace(rig=table31_rig, p=p, printer=printer))
+    along = L.material(printer).expansion * L.LAB_SWING_K * p.layout.cop_to_vertex
+    assert abs(t["along_mm"] - along) < 1e-12 and t["swing_K"] == 3.0  # the machinist's +-3 C
+    assert t["share"] >= along / p.tolerancing.projector_height - 1e-12
+    assert abs(t["limit_K"] * t["share"] - L.LAB_SWING_K) < 1e-9
+
+
+@pytest.mark.e2e
+def test_section_6_states_the_lab_temperature_and_the_gray_cards_height(written):
+    import json
+
+    md = (written / "manual.md").read_text(encoding="utf-8")
+    doc = json.loads((written / "manual.json").read_text(encoding="utf-8"))
+    cal = doc["calibration"]
+    assert f"within **±{cal['lab_temperature']['swing_K']:g} C**" in md
+    assert f"{cal['lab_temperature']['along_mm']:.3f} mm along" in md
+    assert f"top stands **{-cal['gray_card']['holder_top_z_mm']:g} mm under it**" in md
+    seat = cal["splitter_seat"]["screws"]
+    assert f"**{seat['flat']['rows_px_per_step']:.1f} px along the rows**" in md
