@@ -721,7 +721,11 @@ def template_drawing(row: dict) -> bytes:
         g = np.asarray(g, float)
         ax.plot(g[:, 0], g[:, 1], color="tab:blue", lw=2.4)
     d = np.asarray(row["datum_mm"], float)
-    if row["datum"] == "edge":
+    if row["datum"] == "rim":  # the feet from the cut-out's ends, in the rim's plane
+        for x, z in d:
+            ax.plot([x, x + np.sign(x) * row["datum_length_mm"]], [z, z], color="tab:red", lw=3.0)
+        label = f"datum: the feet in the rim's plane, z = {row['datum_z_mm']:.1f} mm"
+    elif row["datum"] == "edge":
         ax.plot(d[:, 0], d[:, 1], color="tab:red", lw=3.0)
         label = f"datum edge, z = {row['datum_z_mm']:.1f} mm"
     else:
