@@ -209,9 +209,10 @@ def template_datums(rig) -> list[dict]:
     """Each profile template's drawing and datum, read from its recipe's section (the x-z outline of
     its Prism, mm, in its gauging position: x from the rig's axis, z up from the sample plane): the
     outline, the gauging edge (the section's curves on the gauged surface, ``templates.gauged_layer``)
-    and the datum: the longest level straight edge when the section has one ("edge": set level, its
-    centre on the axis), else the gauging edge's lowest end ("corner": it stands on the base plate's
-    top, z = 0, where the mirror meets the plate)."""
+    and the datum: the level straight edges that run from the gauging edge's ends when the section has
+    them ("rim": the template's feet in the plane of the mirror's rim, where it meets the part's side), else
+    the longest level straight edge ("edge": set level, its centre on the axis), else the gauging edge's
+    lowest end ("corner": it stands on the base plate's top, z = 0, where the mirror meets the plate)."""
     from rigcad.parts.recipe import Curve, Line
     from rigcad.parts.templates import gauged_depth
 
@@ -229,7 +230,18 @@ def template_datums(rig) -> list[dict]:
         edge = np.concatenate(gauge)
         row = {"template": name, "outline_mm": outline.tolist(), "gauging_edge_mm": [g.tolist() for g in gauge],
                "axis_x_mm": 0.0, "width_mm": float(np.ptp(outline[:, 0])), "height_mm": float(np.ptp(outline[:, 1]))}
-        if level:
+        ends = [edge[0], edge[-1]] if len(gauge) == 1 else [gauge[0][0], gauge[-1][-1]]
+        def touching(seg):  # the end of a level edge that is an end of the gauging edge, or None
+            return next((list(q) for q in (seg.p0, seg.p1) if any(np.hypot(*(np.asarray(q) - e)) < 1e-6 for e in ends)),
+                        None)
+
+        feet = [seg for seg in level if touching(seg) is not None]
+        if feet:  # the cut-out's ends at the mirror's rim, the feet level from them: the rim's plane
+            corners = sorted((touching(seg) for seg in feet), key=lambda q: q[0])
+            row.update(datum="rim", datum_mm=corners, datum_z_mm=float(corners[0][1]),
+                       datum_r_mm=float(max(abs(q[0]) for q in corners)),
+                       datum_length_mm=float(max(abs(seg.p1[0] - seg.p0[0]) for seg in feet)))
+        elif level:
             seg = max(level, key=lambda g: abs(g.p1[0] - g.p0[0]))
             row.update(datum="edge", datum_mm=[list(seg.p0), list(seg.p1)], datum_z_mm=float(seg.p0[1]),
                        datum_length_mm=float(abs(seg.p1[0] - seg.p0[0])),
@@ -246,6 +258,14 @@ def template_datums(rig) -> list[dict]:
 def template_text(row: dict) -> str:
     """How a template is held, from its datum (:func:`template_datums`)."""
     name = row["template"].replace("_template", "")
+    if row["datum"] == "rim":
+        return (f"`{row['template']}`: the datum is the {name}'s rim, the circle where its mirror meets its side, "
+                f"{2 * row['datum_r_mm']:.1f} mm across at z = {row['datum_z_mm']:.1f} mm: the template's two feet "
+                f"(red in its drawing, {row['datum_length_mm']:.1f} mm each) run level from the cut-out's ends, in the "
+                f"rim's plane. Lower the template over the {name} in a meridional plane (the engineer's square on the "
+                "beam's or the bench's top against its face) until its cut-out rests on the mirror: it centres itself. "
+                "Then both feet must lie level with the rim's edge on each side (sight along them against the light): "
+                "that is the height; the gap under the cut-out is the form.")
     if row["datum"] == "edge":
         return (f"`{row['template']}`: the datum is its straight edge, **{row['datum_length_mm']:.1f} mm** long at "
                 f"z = {row['datum_z_mm']:.1f} mm (red in its drawing), with the axis line at its middle (dashed: scribe "

@@ -74,9 +74,20 @@ def test_the_templates_datums_are_on_their_outlines_and_in_their_text(table31_ri
     dome = rows["dome_template"]
     assert dome["datum"] == "corner" and abs(dome["datum_z_mm"]) < 1e-9  # on the plate's top
     assert f"{dome['datum_r_mm']:.1f} mm from the axis" in F.template_text(dome)
-    para = rows["paraboloid_template"]  # its straight top edge, centred on the axis, level
-    assert para["datum"] == "edge" and abs(para["datum_centre_x_mm"]) < 1e-9
-    assert para["datum_z_mm"] > table31_rig.geometry.vertex_z
+    # the paraboloid's datum is on the paraboloid: its feet in the plane of its rim (the top edge it had before
+    # hung in the air 15 mm over the vertex, level with nothing on the rig)
+    para = rows["paraboloid_template"]
+    assert para["datum"] == "rim" and len(para["datum_mm"]) == 2
+    (x0, z0), (x1, z1) = para["datum_mm"]
+    assert abs(x0 + x1) < 1e-9 and abs(z0 - z1) < 1e-9  # one each side, symmetric about the axis, level
+    part = np.asarray(table31_rig.mesh(table31_rig.recipes["paraboloid"]).vertices)
+    r = np.hypot(part[:, 0], part[:, 1])
+    side = part[r > r.max() - 0.05]  # the paraboloid's outermost vertices: its side up to the rim edge
+    # the rim edge (the side's top) lies in the feet's plane: within the coats' total (the print stands
+    # behind the design, 0.14 mm) and the mesher's chord
+    coats = sum(t for _, t in table31_rig.profile.coating.layers)
+    assert abs(side[:, 2].max() - para["datum_z_mm"]) < coats + 0.05, (side[:, 2].max(), para["datum_z_mm"])
+    assert f"{2 * para['datum_r_mm']:.1f} mm across" in F.template_text(para)
 
 
 def test_the_sanding_blocks_faces_are_the_mirrors_surfaces_over_bands_that_cover_them(table31_rig):
