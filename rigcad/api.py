@@ -101,13 +101,14 @@ def write_check(rig, result, folder: str | Path | None = None) -> list[Path]:
     return write_raycheck(result, out, writer_lock(out, rig.name, ("check",)), made_from=profile_digest(rig.profile))
 
 
-def basis(rig, order: int = 6, alpha: float | None = None, progress=None):
+def basis(rig, order: int = 6, alpha: float | None = None, progress=None, measured=None):
     """The zonal basis up to ``order`` as ``rig``'s projector shows it (thesis 3.3, 4.2.1): images,
     Gram matrices over the lit pixels, latitude-longitude maps; ``alpha`` rad the zone's lower
-    edge (default: the occlusion limit). See :func:`rigcad.basis.projector.projector_basis`."""
+    edge (default: the occlusion limit); ``measured``: the rig as calibrated
+    (rigcad.basis.measured.load_measured). See :func:`rigcad.basis.projector.projector_basis`."""
     from rigcad.basis.projector import projector_basis
 
-    return projector_basis(rig, order, alpha_rad=alpha, progress=progress)
+    return projector_basis(rig, order, alpha_rad=alpha, progress=progress, measured=measured)
 
 
 def write_basis(rig, result, folder: str | Path | None = None, lowdin_images: bool = False,
