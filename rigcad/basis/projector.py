@@ -13,7 +13,11 @@ Pixels (rigcad.optics.incidence): pixel (column i, row j) of a W x H image has i
 x = i + 0.5 - W/2, y = H/2 - j - 0.5 px; its pinhole ray leaves the centre of projection (COP) at
 the angle a = atan(r / f) from the axis (r = hypot(x, y), f the focal length in px) and at the
 azimuth psi = atan2(y, x); the design brings it to O from theta = T(a) (T: the design's quintic
-spline through its profile table), phi = psi.
+spline through its profile table), phi = psi. The projector is seen through its focusing lens,
+which the tower places so that the paraboloid sees its COP at the design COP: its f is the lensed
+one (rigcad.optics.focus.lensed_focal_px, x 1.0757 for Table 3.1), not the bare projector's
+W x throw_ratio. A measured calibration circle (:class:`MeasuredCircle`) moves the image centre to
+the circle's and scales f so the rim falls on the circle's radius.
 
 Solid angle of a pixel (the map's Jacobian): d omega = sin(theta) d theta d phi, with
 d theta = T'(a) da, da = f / (f^2 + r^2) dr, d phi = d psi and dx dy = r dr d psi, so
@@ -109,12 +113,15 @@ def zone_of(rig, alpha_rad: float | None = None) -> Zone:
 
 def device_map(rig, device: str, focal_px: float | None = None):
     """The design's incidence map (:class:`rigcad.optics.incidence.DesignMap`) read in ``device``'s
-    pixels: the projector's own, or the camera's (same COP and map, :func:`camera_focal_px`)."""
+    pixels: the projector's through its focusing lens (rigcad.optics.focus.lensed_focal_px), or the
+    camera's (same COP and map, :func:`camera_focal_px`)."""
+    from rigcad.optics.focus import lensed_focal_px
+
     if device not in DEVICES:
         raise BasisError(f"device {device!r}: need one of {', '.join(DEVICES)}")
     m = rig.incidence
     if focal_px is None and device == "projector":
-        return m
+        return dataclasses.replace(m, focal_px=lensed_focal_px(rig.profile, rig.geometry))
     f = float(focal_px) if focal_px is not None else camera_focal_px(rig)
     if not (math.isfinite(f) and f > 0):
         raise BasisError(f"{device} focal_px = {focal_px!r}: need a positive focal length in pixels")
@@ -164,6 +171,8 @@ class PixelMap:
     jacobian_sr: np.ndarray
     status: np.ndarray
     arrival: np.ndarray
+    #: where the optical axis meets the image (x, y px from its top-left corner): x_px, y_px are from it
+    centre: tuple[float, float] | None = None
 
     @property
     def size(self) -> int:
@@ -204,9 +213,11 @@ def _optics(rig, as_built: bool):
 
 
 def trace_pixels(rig, device: str = "projector", *, as_built: bool = False, stride: int = 1,
-                 focal_px: float | None = None, optics=None) -> PixelMap:
+                 focal_px: float | None = None, optics=None, centre: tuple[float, float] | None = None) -> PixelMap:
     """Trace ``device``'s pixel centres through ``rig`` (see :class:`PixelMap`); ``optics``: the
-    analytic optics to reuse (placed as ``as_built`` asks)."""
+    analytic optics to reuse (placed as ``as_built`` asks); ``centre``: where the optical axis meets
+    the image (px from its top-left; default the camera's principal point, the projector's image
+    centre; a measured calibration circle's centre, rigcad.basis.measured)."""
     from rigcad.check.sources import pixel_rays
     from rigcad.check.trace3d import trace
 
@@ -220,7 +231,8 @@ def trace_pixels(rig, device: str = "projector", *, as_built: bool = False, stri
     w, h = min(width, side), min(height, side)
     # about the device's principal point (the camera's lens may move it; the projector's is the centre),
     # kept on the device ((W - w) // 2 for the centre)
-    cx, cy = camera_principal_point(rig) if device == "camera" else (width / 2, height / 2)
+    cx, cy = (centre if centre is not None else camera_principal_point(rig) if device == "camera"
+              else (width / 2, height / 2))
     c0 = min(max(math.floor(cx - w / 2), 0), width - w)
     r0 = min(max(math.floor(cy - h / 2), 0), height - h)
     rows = np.arange(r0 + stride // 2, r0 + h, stride)
@@ -234,7 +246,7 @@ def trace_pixels(rig, device: str = "projector", *, as_built: bool = False, stri
     J, _ = pixel_jacobian(design, x, y)
     return PixelMap(device, as_built, float(design.focal_px), resolution, (int(r0), int(c0), int(h), int(w)), int(stride),
                     (len(rows), len(cols)), row, col, x, y, design.direction(rays.chief), J, tr.status,
-                    np.where(tr.ok[:, None], tr.arrival, np.nan))
+                    np.where(tr.ok[:, None], tr.arrival, np.nan), (float(cx), float(cy)))
 
 
 def traced_jacobian(pixels: PixelMap) -> np.ndarray:
@@ -339,7 +351,8 @@ def illumination(rig, zone: Zone, *, as_built: bool = False, design: PixelMap | 
     edges = int(edge.sum())
     if as_built:
         optics = _optics(rig, True)
-        built = trace_pixels(rig, "projector", as_built=True, optics=optics)
+        built = trace_pixels(rig, "projector", as_built=True, optics=optics, focal_px=design.focal_px,
+                             centre=design.centre)
         with np.errstate(invalid="ignore", divide="ignore"):
             ratio = traced_jacobian(built) / traced_jacobian(design)
         ratio = np.where(np.isfinite(ratio), ratio, 1.0)
@@ -546,17 +559,24 @@ def latlong_grid(zone: Zone, step_deg: float = LATLONG_STEP_DEG) -> tuple[np.nda
 
 
 def projector_basis(rig, order: int = 6, *, alpha_rad: float | None = None,
-                    latlong_step_deg: float = LATLONG_STEP_DEG, progress: Progress = None) -> ProjectorBasis:
+                    latlong_step_deg: float = LATLONG_STEP_DEG, progress: Progress = None,
+                    measured=None) -> ProjectorBasis:
     """The projector images of the zonal basis up to ``order`` for ``rig`` as designed (module
-    docstring), their Gram matrices over the lit pixels and the latitude-longitude maps.
-    ``alpha_rad``: the zone's lower edge (default: the rig's occlusion limit). ``progress(label)`` is
-    called after each of BASIS_STEPS stages."""
+    docstring), or as ``measured`` (rigcad.basis.measured.Measured: the calibration circle read in the
+    projector's pixels, the deflectometric fit's moved rig on which each lit pixel's light is traced),
+    their Gram matrices over the lit pixels and the latitude-longitude maps. ``alpha_rad``: the zone's
+    lower edge (default: the rig's occlusion limit). ``progress(label)`` is called after each of
+    BASIS_STEPS stages."""
+    from rigcad.basis.measured import measured_rig, projector_frame
+
     L = check_basis_order(order)
     step = progress_step(progress)
     zone = zone_of(rig, alpha_rad)
-    design = trace_pixels(rig, "projector")
+    focal, centre = projector_frame(rig, measured)
+    rig = measured_rig(rig, measured)
+    design = trace_pixels(rig, "projector", focal_px=focal, centre=centre)
     step("projector pixels traced")
-    illum = illumination(rig, zone, design=design)
+    illum = illumination(rig, zone, design=design, as_built=measured is not None and measured.theta is not None)
     step("edge pixels supersampled")
     s = illum.sampling
     values = basis_images(s, L, zone)
@@ -609,6 +629,9 @@ def projector_basis(rig, order: int = 6, *, alpha_rad: float | None = None,
                        "images times lowdin_transform are coefficients in that set",
         "latlong": _latlong_figures(zone, th, ph),
         "functions_index": [{"k": k, "l": int(l), "m": int(m)} for k, (l, m) in enumerate(basis_indices(L))],
+        "measured": {"about": "what the images were drawn for besides the design (rigcad.basis.measured): the "
+                              "calibration circle, the deflectometric fit's rig; empty: as designed",
+                     **({} if measured is None else measured.describe())},
     }
     return ProjectorBasis(rig.name, L, zone, illum, values, images, lowdin, lowdin_images, latlong, th, ph,
                           latlong_images, report)

@@ -1,6 +1,8 @@
-"""``rigcad basis PROFILE [--order N] [--exports DIR] [--alpha-deg A] [--lowdin] [--simulate]``: the
-projector images of the zonal basis, their Gram matrices and (``--simulate``) the simulated
-acquisition on the rig, from the command line."""
+"""``rigcad basis PROFILE [--order N] [--exports DIR] [--alpha-deg A] [--lowdin] [--simulate]
+[--circle CX CY R] [--calibration PATH] [--as-designed]``: the projector images of the zonal basis,
+their Gram matrices and (``--simulate``) the simulated acquisition on the rig, from the command line;
+drawn for the rig as measured when the calibration circle or ``rigcad calibrate``'s fit is given or
+found beside (rigcad.basis.measured)."""
 
 from __future__ import annotations
 
@@ -84,13 +86,17 @@ def cmd_basis(args: argparse.Namespace) -> int:
 
         corrected = load_corrected_map(args.exports, profile.name, tuple(profile.camera.resolution))
     rig = load(profile)
+    from rigcad.basis.measured import load_measured
+
+    measured = load_measured(rig, args.exports, args.circle, args.calibration, args.as_designed)
+    _print_measured(measured)
     # written under the one lock of everything under exports/<profile>: a design or build publishing
     # the whole folder meanwhile waits, instead of deleting this run's staging folder
     out = api.default_folder(rig.name, "basis", root=args.exports)
     total = BASIS_STEPS + (order + 1) ** 2 + 1 + (simulation_steps() if args.simulate else 0)
     t0 = time.perf_counter()
     with stages(total, f"basis {rig.name}") as step:
-        basis = api.basis(rig, order, alpha, progress=step)
+        basis = api.basis(rig, order, alpha, progress=step, measured=measured)
         sim, t_sim = None, time.perf_counter()
         if args.simulate:  # simulated first: the images and the simulation are one run's, published together
             print("  camera exitant directions: " + (f"the corrected map {corrected.path}" if corrected else
@@ -106,6 +112,15 @@ def cmd_basis(args: argparse.Namespace) -> int:
     if sim is not None:
         _print_simulation(sim, t_sim)
     return 0
+
+
+def _print_measured(measured) -> None:
+    """Which measurements the images are drawn for (rigcad.basis.measured), one line."""
+    c, fit = measured.circle, measured.fit_source
+    circle = (f"the measured circle ({c.radius_px:.1f} px about ({c.centre_px[0]:g}, {c.centre_px[1]:g}), "
+              f"{c.source})" if c else "the design's circle (no --circle, no calibrate/circle.json)")
+    rig = f"the calibrated rig ({fit})" if fit else "the rig as designed (no calibrate/calibration.json)"
+    print(f"  projector images drawn for {circle} on {rig}")
 
 
 def _print_basis(rig, basis, order: int) -> None:
@@ -175,6 +190,15 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--lowdin", action="store_true", help="also write the re-orthonormalised (Loewdin) images")
     p.add_argument("--simulate", action="store_true", help="simulated acquisition: five analytic BRDFs, the rig "
                                                            "as designed and moved by its tolerances")
+    p.add_argument("--circle", type=float, nargs=3, metavar=("CX", "CY", "R"),
+                   help="the calibration circle as measured (manual section 6, calibration/circle.html): its centre "
+                        "and radius in projector pixels from the image's top-left corner (default: "
+                        "exports/<profile>/calibrate/circle.json when there, else the design's)")
+    p.add_argument("--calibration", metavar="PATH",
+                   help="rigcad calibrate's calibration.json (or its folder): the images are drawn on the rig as "
+                        "fitted (default: exports/<profile>/calibrate/calibration.json when there)")
+    p.add_argument("--as-designed", action="store_true",
+                   help="ignore the circle.json and calibration.json found beside: draw the rig as designed")
     p.add_argument("--camera-stride-px", type=positive_int, default=CAMERA_STRIDE_PX,
                    help=f"simulate every N-th camera pixel in both directions (default {CAMERA_STRIDE_PX}: ~50 "
                         "exitant directions)")

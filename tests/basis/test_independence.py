@@ -12,10 +12,10 @@ PKG = Path(rigcad.__file__).parent
 #: The mathematical core: numpy/scipy and each other only.
 PURE = {"__init__.py", "zonal.py", "gram.py", "brdf.py", "merl.py", "sh.py", "simulate.py"}
 #: The wiring to the rig: may import the Rig's stages (optics, check, parts, export, plots).
-WIRED = {"projector.py", "acquire.py", "card_light.py"}
+WIRED = {"projector.py", "acquire.py", "card_light.py", "measured.py"}
 #: What the pure modules must not import: the rig's stages, the wiring, and CAD kernels.
 FORBIDDEN = ("rigcad.check", "rigcad.parts", "rigcad.export", "rigcad.fab", "rigcad.profile", "rigcad.optics",
-             "rigcad.cli", "rigcad.plots", "rigcad.rig", "rigcad.basis.projector", "rigcad.basis.acquire",
+             "rigcad.cli", "rigcad.plots", "rigcad.rig", "rigcad.basis.projector", "rigcad.basis.acquire", "rigcad.basis.measured",
              "build123d", "OCP", "cadquery", "manifold3d", "trimesh")
 
 
