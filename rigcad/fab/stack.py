@@ -482,7 +482,9 @@ CHAINS = {"paraboloid": _paraboloid_links, "dome": _dome_links, "cop": _cop_link
 def default_adjusters(profile, layout) -> tuple[AdjusterSpec, ...]:
     """The tower's adjusters (rigcad.parts.adjusters) as the stack reads them: the camera's and
     projector's slots and shims, the splitter seat's screws (serving the splitter and the COP,
-    whose slots also take up the splitter's placement). The paraboloid and the dome have none."""
+    whose slots also take up the splitter's placement), the camera's tilt (the seat's flat screw
+    turning the holder and its bracket) and the projector's own tilt (its feet's shims, serving the
+    COP). The paraboloid and the dome have none."""
     out = []
     for adj in A.slot_adjusters(profile, layout):
         element = "camera" if adj.tolerance_key.startswith("tolerancing.camera") else "cop"
@@ -494,6 +496,9 @@ def default_adjusters(profile, layout) -> tuple[AdjusterSpec, ...]:
     for adj in A.splitter_adjusters(profile, layout):
         for element in ("splitter", "cop"):
             out.append(AdjusterSpec(adj.name, element, "tilt", adj.range, adj.resolution, adj.how))
+    cam, pj = A.camera_tilt(profile, layout), A.projector_tilt(profile, layout)
+    out.append(AdjusterSpec(cam.name, "camera", "tilt", cam.range, cam.resolution, cam.how))
+    out.append(AdjusterSpec(pj.name, "cop", "tilt", pj.range, pj.resolution, pj.how))
     return tuple(out)
 
 

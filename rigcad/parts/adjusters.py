@@ -146,9 +146,51 @@ def camera_mount_tilt(profile) -> Adjuster:
                     a.hand_slide / cm.mount_spacing, 0.0)
 
 
+def camera_tilt(profile, layout) -> Adjuster:
+    """The camera's tilt in its bracket's plane (the x-z plane: where the tower's lean, the column's glue
+    faces, the shelf's sag and the camera's two screws all tilt it): the seat's flat screw turns the holder,
+    and the camera's bracket on it, about the cone-vee line (along y), so the camera's axis turns as much
+    as the holder (once: it looks through the plate, it is not reflected). Range and resolution: the flat
+    screw's travel and step over its lever, against ``tolerancing.camera_tilt``; the range it needs is the
+    tower's tilt links and the two screws' setting (rigcad.fab.stack reads it as the camera's tilt
+    adjuster). Set first, it moves the projector's reflected axis by twice the turn: the projector's own
+    tilt then takes that back (:func:`projector_tilt`)."""
+    t, a, tol = layout.tower, profile.adjusters, profile.tolerancing
+    pts = seat_points(t, profile)
+    step = THREADS[a.seat_thread].pitch * a.turn_fraction
+    arm = _lever(pts["flat"], pts["cone"], pts["vee"])
+    cm = profile.camera
+    return Adjuster("camera tilt in its bracket's plane: the seat's flat screw turns the holder and bracket",
+                    f"{a.seat_thread} x {THREADS[a.seat_thread].pitch:g} mm push screw over the flat's ball, "
+                    f"{a.turn_fraction:g} turn, on a {arm:.1f} mm lever: the holder, its bracket and the camera turn "
+                    "together about the cone-vee line; set before the camera's slot and the projector's shims",
+                    "tolerancing.camera_tilt", tol.camera_tilt, "rad", a.seat_travel / arm, step / arm,
+                    a.hand_slide / cm.mount_spacing)
+
+
+def projector_tilt(profile, layout) -> Adjuster:
+    """The projector's own tilt in the plane of incidence (about y): the bought shims of its near feet's
+    stacks against its far feet's (rigcad.parts.tower.fine_shims); its reflected axis turns as much. It
+    takes back what the seat's flat screw turned the plate by when it set the camera's tilt
+    (:func:`camera_tilt`: twice the camera's turn on the reflected axis). Range: the nominal printed stack
+    under one pair of feet against none under the other; resolution: the thinnest bought shim; both over the
+    feet's spacing along the projector's axis."""
+    t, tw, tol = layout.tower, profile.tower, profile.tolerancing
+    xs = sorted({round(x, 9) for x, _ in t.projector_feet})
+    span = xs[-1] - xs[0]
+    fine = fine_shims(profile)
+    return Adjuster("projector tilt in the plane of incidence: its near feet's shims against its far feet's",
+                    f"the bought shims ({fine[0]:g} mm the thinnest) of the stacks under its near feet against those "
+                    f"under its far feet, {span:.0f} mm apart along its axis; the printed shims for the range",
+                    "tolerancing.projector_tilt", tol.projector_tilt, "rad",
+                    t.shims_nominal * tw.shim_thickness / span, fine[0] / span,
+                    2 * camera_tilt(profile, layout).needed_range)
+
+
 def adjusters(profile, layout) -> list[Adjuster]:
     """Every adjuster of the tower, with its range and resolution against the tolerance it serves."""
-    return [*splitter_adjusters(profile, layout), *slot_adjusters(profile, layout), camera_mount_tilt(profile)]
+    return [*splitter_adjusters(profile, layout), *slot_adjusters(profile, layout), camera_tilt(profile, layout),
+            projector_tilt(profile, layout), camera_mount_tilt(profile)]
 
 
-__all__ = ["Adjuster", "adjusters", "camera_mount_tilt", "projector_screws", "slot_adjusters", "splitter_adjusters"]
+__all__ = ["Adjuster", "adjusters", "camera_mount_tilt", "camera_tilt", "projector_tilt", "projector_screws", "slot_adjusters", "splitter_adjusters"]

@@ -1125,7 +1125,10 @@ def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
         {"item": f"set screw, {std} (cup point), a {g.ball:g} mm ball held in its cup", "thread": a.seat_thread,
          "length_mm": seat_screw_length(profile), "quantity": 3,
          "steps": ('splitter_holder',), "joins": "the splitter holder's seat: a ball-ended push screw on the shelf's cone, vee or flat, turned from "
-                  "above (tip/tilt and height)"},
+                  "above (tip/tilt and height). In the alignment the flat's screw sets the camera's tilt first (it turns "
+                  "the holder, with the camera's bracket, in the bracket's plane: rigcad.parts.adjusters.camera_tilt), "
+                  "then the camera's slot its place; the projector's own tilt (its feet's shims) then takes back what "
+                  "the turn did to its reflected axis, and the vee's screw the tilt across the plane of incidence"},
         {"item": "heat-set insert", "thread": a.seat_thread, "length_mm": None, "quantity": 3,
          "hole_mm": INSERTS[a.seat_thread].hole, "steps": ('splitter_holder',), "joins": "pressed into the holder's three seat bosses from above"},
         {"item": "steel ball, ISO 3290-1 grade G10", "thread": None, "length_mm": None, "quantity": 6,
@@ -1285,7 +1288,9 @@ def _fine_shim_rows(profile: Profile) -> list[dict]:
              "steps": ("projector_body", "camera_body"),
              "joins": f"{n} with each of the five shim stacks (four under the projector's feet, one behind the camera): "
                       f"in the stack, between the printed {profile.tower.shim_thickness:g} mm shims, the fine steps of the "
-                      "alignment; the rest under the screw's washers, so its reach stays the same "
+                      "alignment (the projector's near feet's stacks against its far feet's tilt it in the plane of "
+                      "incidence: rigcad.parts.adjusters.projector_tilt); the rest under the screw's washers, so its reach "
+                      "stays the same "
                       f"(cut {SHIM_SIDE:g} x {SHIM_SIDE:g} mm from the sheet with tin snips, the printed shim as the "
                       "template for its U slot; deburr with a file)"}
             for v, n in sorted(counts.items())]

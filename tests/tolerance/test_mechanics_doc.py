@@ -180,3 +180,20 @@ def test_the_loads_prose_is_the_codes(page, table31_rig):
     assert f"with the preload {r.flanges[0].margin:.0f} times the most loaded bolt's pull (foot) and more at the top" in text
     assert r.flanges[1].margin > r.flanges[0].margin
     assert f"PLA {L.MATERIALS['pla'].expansion * 1e6:.0f}e-6 /K, Stratasys's data sheet" in text
+
+
+def test_the_tilt_adjusters_prose_is_the_codes(page, table31_rig, mk3s_stack):
+    """The camera's and the projector's tilt adjusters as the page states them."""
+    from rigcad.parts import adjusters as A
+
+    p, lay = table31_rig.profile, table31_rig.layout
+    text = " ".join(page.split())
+    cam, pj = A.camera_tilt(p, lay), A.projector_tilt(p, lay)
+    v = {(x.element, x.axis): x for e in mk3s_stack.elements for x in e.axes}
+    assert (f"in that plane: {math.degrees(cam.range):.1f} deg each way in steps of {math.degrees(cam.resolution):.2f} "
+            f"deg, against the camera's {math.degrees(v['camera', 'tilt'].worst):.2f} deg stack") in text
+    xs = sorted({round(x, 9) for x, _ in lay.tower.projector_feet})
+    assert f"against its far feet ({xs[-1] - xs[0]:.0f} mm apart)" in text
+    assert (f"take that back: {math.degrees(pj.range):.0f} deg each way in steps of "
+            f"{math.degrees(pj.resolution):.2f} deg") in text
+    assert v["camera", "tilt"].adjuster.name == cam.name
