@@ -165,6 +165,9 @@ def test_the_loads_prose_is_the_codes(page, table31_rig):
     foot = T.column_foot_bolt(p, lay.tower)
     assert (f"the column foot's M4 bolts are {foot['length_mm']:g} mm long, end {foot['above_bench_mm']:.1f} mm above "
             f"the bench, and their nut traps are {foot['trap_depth_mm']:g} mm deep") in text
+    assert (f"Four M4 x {foot['length_mm']:g} bolts hold it (their nuts in hexagonal traps, {T.NUT_TRAP:.1f} mm across "
+            f"flats and {foot['trap_depth_mm']:g} mm deep") in text
+    assert f"held by four M4 x {T.shelf_bolt_length(p):g} bolts up from under the flange" in text
     r = L.loads(p, lay, mk3s)
     opts = {o["option"]: o for o in r.shelf_options}
     shelf, column = r.deflections[1], r.deflections[2]
