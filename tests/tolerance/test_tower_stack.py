@@ -25,14 +25,17 @@ def _axes(report):
 
 def test_the_tower_holds_on_every_axis_for_the_default_and_another_rig(table31_rig, other_rig, mk3s):
     assert other_rig.profile.camera.mount_thread == "M3" and other_rig.profile.projector.model == "benq_mw632st"
+    from rigcad.fab.printers import load_printer
+
     for rig in (table31_rig, other_rig):
-        v = _axes(S.stack(rig.profile, rig.layout, mk3s))
-        for e in TOWER:
-            for a in S.AXES:
-                assert v[e, a].status in ("held", "adjusted"), (rig.profile.name, e, a, v[e, a].reason)
-                if v[e, a].status == "adjusted":  # the adjuster's range covers the worst case, its step a quarter
-                    adj = v[e, a].adjuster
-                    assert adj.range >= v[e, a].worst and adj.resolution <= 0.25 * v[e, a].tolerance
+        for printer in (mk3s, load_printer("vantage_i")):
+            v = _axes(S.stack(rig.profile, rig.layout, printer))
+            for e in TOWER:
+                for a in S.AXES:
+                    assert v[e, a].status in ("held", "adjusted"), (rig.profile.name, printer.name, e, a, v[e, a].reason)
+                    if v[e, a].status == "adjusted":  # the adjuster's range covers the worst case, its step a quarter
+                        adj = v[e, a].adjuster
+                        assert adj.range >= v[e, a].worst and adj.resolution <= 0.25 * v[e, a].tolerance
         # and with the seams the split planner really leaves (fewer than the estimate)
         real = S.stack(rig.profile, rig.layout, mk3s, seams={"base_plate": 1, "tower_column": 1, "tower_shelf": 2})
         assert all(_axes(real)[e, a].ok for e in TOWER for a in S.AXES)
