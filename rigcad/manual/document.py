@@ -979,7 +979,8 @@ def _section_finish(d: Doc, c) -> None:
         "projector off, the room dark. The film of the circle test lies on the base plate's top over the bore, O "
         "traced on it (section 6, \"The film at the sample plane\": it goes on before the dome).",
         f"Lift the rig onto the film test's blocks (**{acc['block_under_tongue_mm']:g} mm** under the tongue, "
-        f"**{acc['block_under_disc_mm']:g} mm** under the disc) and take the sample holder out of the bore from below: "
+        f"**{acc['block_under_disc_mm']:g} mm** under the disc) and take what stands in the bore out from below "
+        "(the `camera_cross_base` the film was traced on): "
         f"the film is now the only thing over the bore ({2 * acc['bore_radius_mm']:.1f} mm across), "
         f"{acc['film_above_bench_mm']:g} mm above the bench.",
         f"The light: a white LED torch (or a phone's torch) on the bench under the bore, pointing straight up, no "

@@ -74,7 +74,7 @@ def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
                   + (f" ({', '.join(split)})" if split else "") + "; let them cure.", PRINT,
                   needs={"pieces printed"} | ({"column faces lapped"} if tower else set()),
                   makes={"flat parts whole"}))
-    out.append(_s("Melt the base plate's heat-set inserts and push the nuts into its traps (step 2's preparation).",
+    out.append(_s("Melt the base plate's heat-set inserts and push the nuts into its traps (the base plate's step: before it goes in).",
                   ASSEMBLE, needs={"flat parts whole"}, makes={"base plate inserts"}))
     if seams:
         out.append(_s("Glue the dome's seams one at a time on the printed-stage template, its pieces standing on the "
@@ -89,14 +89,14 @@ def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
            needs={"dome whole", "templates cut"}, makes={"mirrors sanded"}),
         _s("Spray the base, the primer (blocked) and the clear coat; cure, wet-sand and polish the clear coat.",
            RECIPE, needs={"mirrors sanded"}, makes={"clear coat polished"}),
-        _s("Put the sample holder in the base plate's bore and the plate on the bench (steps 1-2).", ASSEMBLE,
+        _s("Put the sample holder in the base plate's bore and the plate on the bench (their steps).", ASSEMBLE,
            needs={"base plate inserts"}, makes={"base plate down", "dome off"}),
         _s("Stand the camera_cross_base in the bore, lay the film on the plate and trace O on it.", C.STEP_FILM,
            needs={"base plate down", "dome off"}, makes={"film laid"}),
         _s("Indicate the dome in from the bore, drill and ream its register, press the pins, bolt it down "
-           "(step 3).", ASSEMBLE, needs={"base plate down", "dome off", "dome inserts", "clear coat polished"},
+           "(the dome's step).", ASSEMBLE, needs={"base plate down", "dome off", "dome inserts", "clear coat polished"},
            makes={"dome on its register"}, ends={"dome off"}),
-        _s("Put in the beam and the paraboloid on it (steps 4-5).", ASSEMBLE, needs={"dome on its register"},
+        _s("Put in the beam and the paraboloid on it (their steps).", ASSEMBLE, needs={"dome on its register"},
            makes={"paraboloid on the beam"}),
     ]
     if tower:
