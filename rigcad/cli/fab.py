@@ -47,6 +47,12 @@ def cmd_fab(args: argparse.Namespace) -> int:
                           progress=progress, slicing=lambda total: stages(total, f"slicing ({printer.slicer})"))
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")
+    cfg = printer.slicer_config
+    if args.gcode and cfg is not None:  # which machine the G-code is for, never silently another's
+        model = cfg.effective().get("printer_model")
+        print(f"  G-code with PrusaSlicer's presets {cfg.printer_preset or cfg.source}"
+              + (f" (printer_model {model})" if model else "")
+              + (f", standing in for the {printer.model}: {printer.stand_in}" if printer.stand_in else ""))
     for name, e in res.report["parts"].items():
         if "pieces" in e:
             orient = ", ".join(sorted({pc["orientation"] for pc in e["pieces"]}))
@@ -71,12 +77,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
             print(f"  {name}: bought, not printed ({e['stock']})")
         elif "error" not in e:
             print(f"  {name}: outlines/{name}.dxf, .svg" + (" (+ _printed, _sanded stages)" if "stages" in e else ""))
-    if "slicer_print_time_s" in tot:
-        print(f"  total ({printer.slicer}, with quantities): {hours_minutes(tot['slicer_print_time_s'])}, "
-              f"{tot['slicer_filament_g']:.0f} g filament")
-    else:
-        print(f"  total (rigcad estimate, with quantities): {hours_minutes(tot['estimate_print_time_s'])}, "
-              f"{tot['estimate_material_g']:.0f} g")
+    print(total_line(res.report, printer))
     if args.timings:
         for k, v in sorted(res.timings_s.items()):
             print(f"  time {k}: {v:.2f} s")
@@ -89,6 +90,35 @@ def cmd_fab(args: argparse.Namespace) -> int:
         print(f"rigcad: error: fab found {len(res.problems)} problem(s), listed above; the outputs are written, "
               f"with the problems in {out}/fab.json", file=sys.stderr)
     return 1 if res.problems else 0
+
+
+def total_line(report: dict, printer) -> str:
+    """The run's print time and material, with quantities: the slicer's wherever it ran, rigcad's
+    estimate (rigcad.fab.estimate, its volume terms scaled by the printer's deposition_rate_mm3_s)
+    only for the pieces no slicer ran on, and labelled so, with why."""
+    pieces = [(pc, e.get("quantity", 1)) for e in report["parts"].values() for pc in e.get("pieces", [])]
+    sliced = [(pc, q) for pc, q in pieces if pc.get("gcode", {}).get("estimates", {}).get("print_time_s")]
+    rest = [(pc, q) for pc, q in pieces if not pc.get("gcode", {}).get("estimates", {}).get("print_time_s")]
+    slicer_t = sum(pc["gcode"]["estimates"]["print_time_s"] * q for pc, q in sliced)
+    slicer_g = sum(pc["gcode"]["estimates"].get("filament_g", 0) * q for pc, q in sliced)
+    est_t = sum(pc["estimate"]["print_time_s"] * q for pc, q in rest)
+    est_g = sum(pc["estimate"]["material_g"] * q for pc, q in rest)
+    if printer.slicer != "prusa-slicer":
+        why = f"{printer.name} has no slicer rigcad runs"
+    elif not report.get("gcode", {}).get("requested"):
+        why = "no slicer ran: --gcode for PrusaSlicer's own time"
+    else:
+        why = "not sliced: see the problems"
+    rate = (f", its volume terms at deposition_rate_mm3_s {printer.deposition_rate_mm3_s:g}"
+            if printer.process == "fdm" and printer.deposition_rate_mm3_s else "")
+    estimate = f"rigcad's estimate ({why}{rate})"
+    if not sliced:
+        return f"  total ({estimate}; with quantities): {hours_minutes(est_t)}, {est_g:.0f} g"
+    line = (f"  total ({printer.slicer}, with quantities): {hours_minutes(slicer_t)}, {slicer_g:.0f} g filament"
+            + (f" for {sum(q for _, q in sliced)} of {sum(q for _, q in pieces)} pieces" if rest else ""))
+    if rest:
+        line += f"; the other {sum(q for _, q in rest)} by {estimate}: {hours_minutes(est_t)}, {est_g:.0f} g"
+    return line
 
 
 def register(subparsers) -> argparse.ArgumentParser:

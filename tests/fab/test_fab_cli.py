@@ -23,7 +23,9 @@ def test_fab_reports_progress_per_part_and_a_summary(tmp_path):
     assert proc.returncode == 0, proc.stderr[-2000:]
     events = [ln.split(": ", 1)[1] for ln in proc.stderr.splitlines() if ln.startswith("rigcad-event: ")]
     assert events == ["beam", "sample_holder", "dome_template"]  # one progress step per part, in order
-    assert "total (rigcad estimate, with quantities):" in proc.stdout
+    # no slicer ran: rigcad's estimate, labelled with why and the rate it scales by
+    assert "total (rigcad's estimate (vantage_i has no slicer rigcad runs, its volume terms at " \
+           "deposition_rate_mm3_s 14.9); with quantities):" in proc.stdout, proc.stdout
     assert "beam: 1 piece(s)" in proc.stdout and "est. " in proc.stdout
 
 
@@ -35,6 +37,8 @@ def test_fab_gcode_reports_each_piece_sliced_and_the_slicers_figures(tmp_path):
     assert events[:2] == ["beam", "sample_holder"]
     assert sorted(events[2:]) == ["sliced beam", "sliced sample_holder"]  # as each piece is done
     assert "total (prusa-slicer, with quantities):" in proc.stdout and " g filament" in proc.stdout
+    assert "estimate" not in proc.stdout.split("total (prusa-slicer", 1)[1]  # the slicer ran: its time only
+    assert "G-code with PrusaSlicer's presets Original Prusa i3 MK3S & MK3S+ (printer_model MK3S)" in proc.stdout
     assert "; slicer " in proc.stdout  # per part: the slicer's time and filament
 
 

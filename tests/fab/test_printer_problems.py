@@ -119,3 +119,15 @@ def test_fab_refuses_the_printer_file_in_one_line_before_any_rig(tmp_path, monke
     lines = err.getvalue().splitlines()
     assert code == 2 and len(lines) == 1 and lines[0].startswith("rigcad: error:"), lines
     assert "mk4.yaml:4" in lines[0] and "mk4.yaml:5" in lines[0]
+
+
+def test_a_printer_named_without_its_nozzle_is_shown_its_presets():
+    """Creality's presets are per nozzle: 'Creality Ender-3 V2' is no preset, but four start with it."""
+    if "Creality" not in V.available_bundles():
+        pytest.skip("PrusaSlicer's Creality bundle is not installed (apt-get install prusa-slicer)")
+    b = V.load_bundle(V.find_bundle("Creality"))
+    with pytest.raises(ProfileError) as err:
+        b.flatten("printer", "Creality Ender-3 V2")
+    msg = str(err.value)
+    assert "'Creality Ender-3 V2 (0.4 mm nozzle)'" in msg and "name the one for your nozzle" in msg, msg
+    assert "no presets for that printer" not in msg  # it has them
