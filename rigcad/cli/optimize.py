@@ -48,8 +48,9 @@ def assembly_gate(rig) -> None:
     from rigcad.manual import gate
 
     v = gate.verdict(rig, search=False)
-    if not v.ok:
-        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles)
+    if not v.ok:  # its line points to no file (none is written here): the whole reason goes into optimize.json
+        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles, summary=v.summary,
+                            detail=v.reason)
 
 
 def cmd_optimize(args: argparse.Namespace) -> int:

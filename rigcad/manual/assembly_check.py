@@ -677,9 +677,9 @@ def find_order(assembly: Assembly) -> list[Placed]:
         nonlocal bounded
         if not bounded:
             bounded = True
-            pairs = must_precede(assembly)
-            if pairs is None:
-                raise _stuck(assembly)
+            pairs, no_order = _precedences(assembly)
+            if no_order is not None:
+                raise no_order
             must.update(pairs)
 
     order = search(frozenset(), [])
@@ -693,10 +693,21 @@ def must_precede(assembly: Assembly) -> dict[str, frozenset[str]] | None:
     needs (transitively), and each step ``t`` such that ``s`` put in after ``t`` (with all that must
     precede either) would be blocked, so ``s`` must come before ``t``; repeated until nothing is
     added. None when no order exists: steps would have to precede each other, or a step is blocked
-    with only what must precede it in place."""
+    with only what must precede it in place (:func:`_precedences` says which and why)."""
+    must, no_order = _precedences(assembly)
+    return None if no_order is not None else must
+
+
+def _precedences(assembly: Assembly) -> tuple[dict[str, frozenset[str]], AssemblyError | None]:
+    """:func:`must_precede`'s precedences, and when they admit no order the AssemblyError naming the
+    real blocker: the two steps that would each have to go in before the other, what blocks each
+    (the part or the fastener that collides) and the chain of precedences that closes the loop; or
+    the step blocked by what must precede it, and why each of those must."""
     before = _before(assembly)
     names = [s.name for s in assembly.steps]
     must = {n: set(before[n]) for n in names}
+    #: why a must precede b: ("needs",) or ("blocked", s, t): s after t (with what precedes either) is blocked
+    cause: dict[tuple[str, str], tuple] = {(a, b): ("needs",) for b in names for a in before[b]}
     changed = True
     while changed:
         changed = False
@@ -707,14 +718,56 @@ def must_precede(assembly: Assembly) -> dict[str, frozenset[str]] | None:
                 if not assembly.blocked(assembly.by_name[s], frozenset(must[s] | must[t] | {t})):
                     continue
                 # s must precede t, and so must everything that must precede s; and all after t
+                with_t = frozenset(must[s] | must[t] | {t})
                 ahead = must[s] | {s}
                 grown = [u for u in names if (u == t or t in must[u]) and not ahead <= must[u]]
                 for u in grown:
+                    for a in ahead - must[u]:
+                        cause.setdefault((a, u), ("blocked", s, t, with_t))
                     must[u] |= ahead
-                    if u in must[u] or assembly.blocked(assembly.by_name[u], frozenset(must[u])):
-                        return None  # u must precede itself, or is blocked by what must precede it
+                    if u in must[u]:
+                        return {}, _loop_error(assembly, s, t, u, with_t, cause)
+                    if assembly.blocked(assembly.by_name[u], frozenset(must[u])):
+                        return {}, _blocked_error(assembly, u, must, cause)
                 changed = True
-    return {n: frozenset(v) for n, v in must.items()}
+    return {n: frozenset(v) for n, v in must.items()}, None
+
+
+def _why(assembly: Assembly, a: str, b: str, cause: dict) -> str:
+    """Why step ``a`` must go in before step ``b`` (a clause)."""
+    c = cause.get((a, b), ("needs",))
+    if c[0] == "needs":
+        return f"{b} needs {a} in place first"
+    _, s, t, done = c
+    r = assembly.attempt(assembly.by_name[s], done)
+    into = ", ".join(getattr(r, "obstacles", ())) or t
+    if (s, t) == (a, b):
+        return f"{a} must go in before {b}: put in after it, {a} runs into {into} ({r})"
+    return f"{a} must go in before {b} (as {s} must before {t}: put in after it, {s} runs into {into})"
+
+
+def _loop_error(assembly: Assembly, s: str, t: str, u: str, with_t: frozenset, cause: dict) -> AssemblyError:
+    """The loop found by :func:`_precedences`: ``s`` must precede ``t`` (blocked after it, with
+    ``with_t`` in place), while ``t`` precedes ``u`` and ``u`` precedes ``s``: no order puts both in."""
+    r = assembly.attempt(assembly.by_name[s], with_t)
+    into = tuple(getattr(r, "obstacles", ())) or (t,)
+    back = [(t, u), (u, s)] if u != t else [(t, s)]
+    chain = "; ".join(_why(assembly, a, b, cause) for a, b in back if a != b)
+    summary = (f"{s} must go in before {t} (put in after it, {s} runs into {', '.join(into)}), yet {t} must go in "
+               f"before {s}" + (f" (through {u})" if u not in (s, t) else ""))
+    return AssemblyError(f"no feasible assembly order: {summary}: {s} after {t}: {r}; {chain}", step=s,
+                         members=assembly.by_name[s].members, obstacles=into, summary=summary)
+
+
+def _blocked_error(assembly: Assembly, u: str, must: dict, cause: dict) -> AssemblyError:
+    """Step ``u`` is blocked by what must precede it (:func:`_precedences`)."""
+    r = assembly.attempt(assembly.by_name[u], frozenset(must[u]))
+    owner = {m: st.name for st in assembly.steps for m in st.members}
+    into = tuple(getattr(r, "obstacles", ()))
+    chain = "; ".join(_why(assembly, owner.get(o, o), u, cause) for o in into if owner.get(o, o) in must[u])
+    summary = f"{u} runs into {', '.join(into) or 'what is in place'}, which must go in before it"
+    return AssemblyError(f"no feasible assembly order: {summary}: {r}" + (f"; {chain}" if chain else ""), step=u,
+                         members=assembly.by_name[u].members, obstacles=into, summary=summary)
 
 
 def _refuse_cycles(assembly: Assembly) -> None:
@@ -730,9 +783,14 @@ def _refuse_cycles(assembly: Assembly) -> None:
         for nxt in sorted(after[name]):
             if state.get(nxt) == 1:
                 loop = trail[trail.index(nxt):] + [nxt] if nxt in trail else [name, nxt]
+                ring = loop[:-1]
+                summary = (f"{' and '.join(ring)} each need the other in place first (each rests on the other or is "
+                           "fastened through it)" if len(ring) == 2 else
+                           f"{', '.join(ring)} each need the next in place first, in a loop")
                 raise AssemblyError("no feasible assembly order: the steps need each other in a loop: "
                                     + " needs ".join(loop), step=loop[0],
-                                    members=assembly.by_name[loop[0]].members, obstacles=tuple(loop[1:-1]))
+                                    members=assembly.by_name[loop[0]].members, obstacles=tuple(loop[1:-1]),
+                                    summary=summary)
             if nxt not in state:
                 visit(nxt, [*trail, nxt])
         state[name] = 2
@@ -770,14 +828,20 @@ def _refuse_blocked_at_first(assembly: Assembly) -> None:
 
 
 def _stuck(assembly: Assembly) -> AssemblyError:
-    """The longest feasible prefix the declared order first allows, and why each step left fails: the
-    error naming the first step left that is blocked (else the first left) and what it runs into."""
+    """Why no order exists: the precedences' loop or blocked step when they admit no order
+    (:func:`_precedences`: the parts that collide, named exactly); else the longest feasible prefix
+    the declared order first allows, each step put in only after the steps that must precede it,
+    and why each step left fails: the error naming the first step left that is blocked (else the
+    first left) and what it runs into."""
+    must, no_order = _precedences(assembly)
+    if no_order is not None:
+        return no_order
     done: frozenset[str] = frozenset()
     progress = True
     while progress:
         progress = False
         for step in assembly.steps:
-            if step.name not in done and isinstance(assembly.attempt(step, done), Placed):
+            if step.name not in done and must[step.name] <= done and isinstance(assembly.attempt(step, done), Placed):
                 done, progress = done | {step.name}, True
                 break
     left = [(s, assembly.attempt(s, done)) for s in assembly.steps if s.name not in done]

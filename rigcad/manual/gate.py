@@ -22,6 +22,7 @@ layout and meshes (the dome is kept), about 2 s on 2 cores. Frame and units: mm.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from dataclasses import dataclass
 
 from rigcad.errors import AssemblyError, GeometryError
@@ -37,6 +38,8 @@ MAX_PROBES = 6
 #: The bisection stops when the passing and failing values are this close (mm): a tenth of a
 #: printed fit's gap, finer than anyone sets an instrument's size.
 RESOLUTION_MM = 0.1
+#: Keys a refusal's line names (the rest are in the verdict's keys).
+SHOWN_KEYS = 8
 #: Instruments' parts -> the profile section that sizes them (the recipes name their own keys).
 INSTRUMENT_SECTIONS = {"projector": "projector", "camera": "camera", "beam_splitter": "beam_splitter",
                        "focusing_lens": "lens", "projector_shims": "tower", "camera_shims": "tower"}
@@ -68,28 +71,36 @@ class Verdict:
     reason: str = ""
     keys: tuple[str, ...] = ()
     fixes: tuple[Fix, ...] = ()
+    #: The real blocker in one phrase, as the check found it (AssemblyError.summary): the parts that
+    #: collide and why no order avoids it ("" when the check gave none: then members and obstacles).
+    summary: str = ""
+    #: Where the check's whole reason is kept (the verdict's file, once written); None: nowhere, and
+    #: the line points to no file.
+    kept: str | None = None
 
     @property
     def ok(self) -> bool:
         return self.step is None and not self.reason
 
     def line(self) -> str:
-        """One line: which parts collide, the keys that would fix it, the nearest values found."""
+        """One line: which parts collide, the keys that would fix it, the nearest values found, and
+        where the check's whole reason is kept (only when it was written: ``kept``)."""
         if self.ok:
             return f"{self.profile}: the assembly check finds an order of {len(self.order)} steps"
         what = " + ".join(self.members) or (self.step or "a step")
         into = ", ".join(self.obstacles) or "what is in place"
         found = [f"{f.key} {f.now:g} -> {f.value:g} mm ({f.where})" for f in self.fixes if f.value is not None]
-        keys = ", ".join(self.keys[:6]) + (", ..." if len(self.keys) > 6 else "")
-        return (f"{self.profile} cannot be assembled: {what} cannot go in, it runs into {into}"
+        keys = ", ".join(self.keys[:SHOWN_KEYS]) + (", ..." if len(self.keys) > SHOWN_KEYS else "")
+        return (f"{self.profile} cannot be assembled: "
+                + (self.summary if self.summary else f"{what} cannot go in, it runs into {into}")
                 + (f"; nearest values that let it in: {'; '.join(found)}" if found else "")
                 + (f"; keys that move it: {keys}" if keys else "")
-                + f" (the check's whole reason: {VERDICT_FILE} beside the export)")
+                + (f" (the check's whole reason: {self.kept})" if self.kept else ""))
 
     def as_json(self) -> dict:
         """The verdict as the writers store it (assembly.json; units in the keys)."""
         return {"ok": self.ok, "order": list(self.order), "step": self.step, "members": list(self.members),
-                "obstacles": list(self.obstacles), "reason": self.reason, "keys": list(self.keys),
+                "obstacles": list(self.obstacles), "reason": self.reason, "summary": self.summary, "keys": list(self.keys),
                 "fixes": [{"key": f.key, "where": f.where, "now_mm": f.now, "value_mm": f.value} for f in self.fixes],
                 "line": self.line()}
 
@@ -116,24 +127,35 @@ def verdict(rig, meshes=None, search: bool = True, progress=None) -> Verdict:
 
 def refused(rig, err: AssemblyError, search: bool = True, progress=None) -> Verdict:
     """The verdict for the check's refusal ``err``: the keys and, with ``search``, the fixes."""
-    keys = candidate_keys(rig, (*err.members, *err.obstacles))
+    keys = candidate_keys(rig, err.members, err.obstacles)
     fixes = tuple(nearest_values(rig, err, keys, progress)) if search and err.step else ()
     return Verdict(rig.name, step=err.step, members=err.members, obstacles=err.obstacles, reason=str(err),
-                   keys=keys, fixes=fixes)
+                   keys=keys, fixes=fixes, summary=getattr(err, "summary", ""))
 
 
-def candidate_keys(rig, names) -> tuple[str, ...]:
-    """The profile keys that move or size the parts ``names`` (see the module docstring): the keys
-    the profile's own file sets that the layout or the parts read, then the parts' own keys."""
+def candidate_keys(rig, members, obstacles=()) -> tuple[str, ...]:
+    """The profile keys that move or size the colliding parts (see the module docstring): the keys
+    the profile's own file sets that the layout or the parts read, then the parts' own keys, those
+    that shape both sides of the collision first, then the two sides' in turn (so the line's first
+    keys name both the parts that go in and what they run into)."""
     p = rig.profile
-    own: list[str] = []
-    for name in names:
-        recipe = rig.recipes.get(name)
-        if recipe is not None:
-            own += list(recipe.shaped_by)
-        section = next((s for prefix, s in INSTRUMENT_SECTIONS.items() if name.startswith(prefix)), None)
-        if section is not None:
-            own += [k for k in rig.layout.shaped_by if k.startswith(section + ".")]
+
+    def keys_of(names) -> list[str]:
+        out: list[str] = []
+        for name in names:
+            recipe = rig.recipes.get(name)
+            if recipe is not None:
+                out += list(recipe.shaped_by)
+            section = next((s for prefix, s in INSTRUMENT_SECTIONS.items() if name.startswith(prefix)), None)
+            if section is not None:
+                out += [k for k in rig.layout.shaped_by if k.startswith(section + ".")]
+        return list(dict.fromkeys(out))
+
+    a, b = keys_of(members), keys_of(obstacles)
+    both = [k for k in a if k in b]
+    turns = [k for pair in itertools.zip_longest([k for k in a if k not in both], [k for k in b if k not in both])
+             for k in pair if k is not None]
+    own = [*both, *turns]
     read = list(dict.fromkeys([*own, *rig.layout.shaped_by]))
     leaf = p.sources[0] if p.sources else None
 
@@ -149,11 +171,13 @@ def _with(profile, key: str, value: float):
     return dataclasses.replace(profile, **{section: dataclasses.replace(getattr(profile, section), **{name: value})})
 
 
-def _ways_in(rig, profile, step: str) -> dict | None:
-    """How far (mm) ``step``, with only what it needs in place, still runs into something on the rig
-    of ``profile`` (its dome kept from ``rig``) along each way in the check tried (direction -> mm;
-    every direction 0 when it goes in: the check's own test for a blocked step); None when the layout
-    refuses the profile or the step waits for a part that never comes."""
+def _ways_in(rig, profile, step: str, obstacles=()) -> dict | None:
+    """How far (mm) ``step``, with what it needs and the steps of what it ran into (``obstacles``,
+    with what they need) in place, still runs into something on the rig of ``profile`` (its dome
+    kept from ``rig``) along each way in the check tried (direction -> mm; every direction 0 when it
+    goes in: the check's own test for a blocked step); None when the layout refuses the profile or
+    the step waits for a part that never comes. With what it ran into in place, a step that must go
+    in before a part that blocks it (a bolt's way in under the dome) is judged with that part there."""
     from rigcad.manual import assembly_check, plan
     from rigcad.manual.assembly import picture_meshes
     from rigcad.rig import Rig
@@ -165,14 +189,18 @@ def _ways_in(rig, profile, step: str) -> dict | None:
         return None
     if step not in a.by_name:
         return None
-    r = a.attempt(a.by_name[step], assembly_check._before(a)[step])
+    before = assembly_check._before(a)
+    owner = {m: s.name for s in a.steps for m in s.members}
+    blockers = {owner.get(o, o) for o in obstacles} & set(before) - {step}
+    done = frozenset(before[step]).union(*(before[b] | {b} for b in blockers)) - {step}
+    r = a.attempt(a.by_name[step], done)
     if isinstance(r, assembly_check.Placed):
         return {d: 0.0 for d in a.by_name[step].directions}
     return dict(r.depths) if r.blocked else None
 
 
-def _goes_in(rig, profile, step: str) -> bool:
-    ways = _ways_in(rig, profile, step)
+def _goes_in(rig, profile, step: str, obstacles=()) -> bool:
+    ways = _ways_in(rig, profile, step, obstacles)
     return ways is not None and not any(ways.values())
 
 
@@ -204,22 +232,23 @@ def nearest_values(rig, err: AssemblyError, keys, progress=None):
     freed by the key all the same); a key that cuts no direction's overlap is not searched: it is
     not what blocks the part."""
     p = rig.profile
-    base = _ways_in(rig, p, err.step)
+    base = _ways_in(rig, p, err.step, err.obstacles)
     if base is None:
         return
     gains = []
     for key, where, now in _set_lengths(rig, keys)[:RANK_KEYS]:
         if progress:
             progress(f"assembly gate: how {key} moves {err.step}")
-        best = max(_gain(base, _ways_in(rig, _with(p, key, now + s * RANK_STEP_MM), err.step)) for s in (1.0, -1.0)
+        best = max(_gain(base, _ways_in(rig, _with(p, key, now + s * RANK_STEP_MM), err.step, err.obstacles))
+                   for s in (1.0, -1.0)
                    if now + s * RANK_STEP_MM > 0.0)
         if best > 1e-6:
             gains.append((best, key, where, now))
     for _, key, where, now in sorted(gains, key=lambda g: -g[0])[:SEARCH_KEYS]:
-        yield Fix(key, where, now, _search(rig, p, key, now, err.step, progress))
+        yield Fix(key, where, now, _search(rig, p, key, now, err.step, progress, err.obstacles))
 
 
-def _search(rig, p, key: str, now: float, step: str, progress) -> float | None:
+def _search(rig, p, key: str, now: float, step: str, progress, obstacles=()) -> float | None:
     """The value nearest ``now`` at which ``step`` goes in (within RESOLUTION_MM), or None."""
     for k in range(MAX_PROBES):
         delta = STEP_MM * 2 ** k
@@ -229,14 +258,14 @@ def _search(rig, p, key: str, now: float, step: str, progress) -> float | None:
                 continue
             if progress:
                 progress(f"assembly gate: {key} = {v:g} mm")
-            if _goes_in(rig, _with(p, key, v), step):
+            if _goes_in(rig, _with(p, key, v), step, obstacles):
                 bad = now + sign * (delta / 2 if k else 0.0)
                 good = v
                 while abs(good - bad) > RESOLUTION_MM:
                     mid = 0.5 * (good + bad)
                     if progress:
                         progress(f"assembly gate: {key} = {mid:g} mm")
-                    if _goes_in(rig, _with(p, key, mid), step):
+                    if _goes_in(rig, _with(p, key, mid), step, obstacles):
                         good = mid
                     else:
                         bad = mid
@@ -301,7 +330,7 @@ def _from_json(data: dict, name: str) -> Verdict:
                       None if f["value_mm"] is None else float(f["value_mm"])) for f in data["fixes"])
     return Verdict(name, order=tuple(map(str, data["order"])), step=data["step"], members=tuple(map(str, data["members"])),
                    obstacles=tuple(map(str, data["obstacles"])), reason=str(data["reason"]),
-                   keys=tuple(map(str, data["keys"])), fixes=fixes)
+                   keys=tuple(map(str, data["keys"])), fixes=fixes, summary=str(data.get("summary", "")))
 
 
 def read_verdict(root, profile) -> Verdict | None:
@@ -316,7 +345,7 @@ def read_verdict(root, profile) -> Verdict | None:
     try:
         if not isinstance(doc, dict) or doc.get("inputs_key") != inputs_key(profile):
             return None
-        return _from_json(doc, profile.name)
+        return dataclasses.replace(_from_json(doc, profile.name), kept=f"{VERDICT_FILE} beside the export")
     except (ValueError, TypeError, KeyError, AttributeError):
         return None
 
@@ -334,7 +363,7 @@ def checked(rig, root, progress=None) -> Verdict:
     path = verdict_path(root, rig.name)
     path.parent.mkdir(parents=True, exist_ok=True)
     write_json(path, {"inputs_key": inputs_key(rig.profile), **found.as_json()})
-    return found
+    return dataclasses.replace(found, kept=f"{VERDICT_FILE} beside the export")  # written: the line may point to it
 
 
 def kept_gate(root, profile) -> bool:
@@ -343,7 +372,8 @@ def kept_gate(root, profile) -> bool:
     the kept verdict refuses it. No rig is built."""
     v = read_verdict(root, profile)
     if v is not None and not v.ok:
-        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles)
+        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles, summary=v.summary,
+                            detail=v.reason)
     return v is not None
 
 
@@ -352,7 +382,8 @@ def gate(rig, root, progress=None) -> Verdict:
     the rig cannot be put together: what ``fab`` and ``manual`` call before any work."""
     v = checked(rig, root, progress)
     if not v.ok:
-        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles)
+        raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles, summary=v.summary,
+                            detail=v.reason)
     return v
 
 

@@ -23,8 +23,12 @@ from rigcad.optimize.search import OptimizeError, Result, infeasible_message, op
 from rigcad.optimize.spec import COATING_TOTAL, OBJECTIVES, read_optimize
 from rigcad.units import DEG
 
-#: Designs tried on the certified path, best first, before the run gives up.
+#: Designs the assembly gate (the costly check, seconds to a minute each) judges, best first, before
+#: the run gives up.
 MAX_CERTIFY = 8
+#: Designs tried on the certified path at most (the layout, the recipes and fab's tolerance stack
+#: cost about a second each): designs these refuse give way to the next without counting in MAX_CERTIFY.
+MAX_TRIED = 40
 #: Relative change below which a free parameter counts as unchanged (not written to the profile).
 UNCHANGED_RTOL = 1e-9
 
@@ -160,22 +164,27 @@ def certify(problem: Problem, row: dict, also=None) -> dict:
     command passes the assembly gate, rigcad.manual.gate, which lives on a floor this one cannot import)."""
     from rigcad.parts.tower import shelf_bottom_z
 
+    import dataclasses
+
+    from rigcad.rig import Rig
+
     rig, tol = certified_rig(problem, row)
-    # the refusals `rigcad build` makes, on the certified dome (GeometryError: the next design is tried):
-    # the layout (beam over the flange, holder inside the base, the tower's shelf over the dome's top),
-    # every part's recipe and the focusing lens; the search's constraints hold GEOMETRY_RESERVE mm short of them
+    # the focusing lens first (the optics alone): the tower is laid out about it, so a design that
+    # names its custom lens is laid out and checked with that lens on the same dome
+    row["focal_length_mm"] = _custom_focal_length(rig.profile, rig.geometry)
+    if row["focal_length_mm"] is not None:
+        p = rig.profile
+        rig = Rig.from_profile(dataclasses.replace(p, lens=dataclasses.replace(p.lens, focal_length=row["focal_length_mm"])),
+                               previous=rig)  # the same dome: only the lens changes
+    # the refusals `rigcad design` and `stl` make before any solid, on the certified dome (GeometryError:
+    # the next design is tried): the layout (beam over the flange, holder inside the base, the tower:
+    # its shelf over the dome's top, the splitter, the instruments), every part's recipe; the search's
+    # constraints hold GEOMETRY_RESERVE mm short of the ones it models
     layout = rig.layout
     rig.recipes
-    row["focal_length_mm"] = _custom_focal_length(rig.profile, layout.geometry)
+    # `rigcad fab`'s tolerance stack on the run's printer (FabricationError: the next design is tried)
+    row["tolerance_stack"] = tolerance_stack(problem, rig)
     if also is not None:
-        if row["focal_length_mm"] is not None:  # the design names its custom lens: check the rig with it
-            import dataclasses
-
-            from rigcad.rig import Rig
-
-            p = rig.profile
-            rig = Rig.from_profile(dataclasses.replace(p, lens=dataclasses.replace(p.lens, focal_length=row["focal_length_mm"])),
-                                   previous=rig)  # the same dome: only the lens changes
         also(rig)
     row["dome_tolerance_mm"] = tol
     r = rig.design.report
@@ -190,11 +199,35 @@ def certify(problem: Problem, row: dict, also=None) -> dict:
                     "path's is exact at its nodes", "dome_rows": int(len(rig.dome.s)),
             "dome_error_estimate_mm": rig.dome.error_estimate, "dome_tolerance_mm": rig.dome.tolerance,
             "dome_tolerance_loosened": tol is not None,
+            "tolerance_stack": row["tolerance_stack"],  # fab's stack on the run's printer: held or adjusted
             # a focal length no stock lens has, written into the design (None: a stock lens focuses it)
             "custom_focal_length_mm": row["focal_length_mm"],
             # room left between the projector's shelf and the dome's top beyond tower.clearance (mm)
             "tower_room_mm": None if rig.geometry.cop_at_infinity else
             shelf_bottom_z(rig.profile, rig.geometry.cop_z) - layout.dome_top_z - rig.profile.tower.clearance}
+
+
+#: The printer whose tolerance stack a design must hold when the optimize section names none.
+DEFAULT_STACK_PRINTER = "prusa_mk3s"
+
+
+def tolerance_stack(problem: Problem, rig) -> dict:
+    """`rigcad fab`'s tolerance stack (rigcad.fab.stack.stack, closed forms: seams estimated from
+    the parts' extents against the bed, as fab estimates a part it did not split) of ``rig`` on the
+    optimize section's printer, else DEFAULT_STACK_PRINTER; FabricationError (the stack's own
+    refusal, naming the element, axis and dominating links) when the printed rig can neither hold
+    nor adjust a placement. Returns what optimize.json records: the printer and each refused or
+    adjusted axis (none refused)."""
+    from rigcad.fab import stack as ST
+    from rigcad.fab.printers import load_printer
+
+    printer = load_printer(problem.spec.constraints.printer or DEFAULT_STACK_PRINTER)
+    if printer.process_errors is None:
+        return {"printer": printer.name, "note": "no process_errors in the printer file: no stack to reckon"}
+    report = ST.stack(rig.profile, rig.layout, printer)
+    ST.refuse(report)
+    return {"printer": printer.name, "adjusted": [f"{v.element} {v.axis}" for e in report.elements for v in e.axes
+                                                  if v.status == "adjusted"]}
 
 
 def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine | None = None, overrides=None,
@@ -225,9 +258,12 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
             files[f"{stem}.yaml"] = text
         report["design_profile"] = str(profile_path)
     elif rejected:
-        report["infeasible"] = (f"the {len(rejected)} best designs were refused by the certified path "
-                                f"(Rig.from_profile{' and the further check' if certify_also else ''}); "
-                                f"the first: {rejected[0]['error']}")
+        stages: dict[str, int] = {}
+        for r in rejected:
+            stages[r["stage"]] = stages.get(r["stage"], 0) + 1
+        report["infeasible"] = (f"the {len(rejected)} best designs were refused by the later stages ("
+                                + ", ".join(f"{n} by the {s}" for s, n in stages.items())
+                                + f"); the first: {rejected[0]['error']}")
     else:
         report["infeasible"] = infeasible_message(problem, result.history)
     files["optimize.json"] = json_bytes(report)
@@ -277,14 +313,19 @@ def _report(problem, result, engine: Engine) -> dict:
 def _certify_choice(problem, result, report: dict, also=None) -> list[dict]:
     """Certify the search's choice: the certified path (converged DOP853 dome at the profile's
     dome.tolerance) has the last word, and a design it refuses (e.g. a tolerance float64 cannot
-    certify there) gives way to the next in preference, up to MAX_CERTIFY. Sets ``result.chosen``
+    certify there, a tolerance stack fab refuses, a rig the further check refuses) gives way to the next
+    in preference, up to MAX_TRIED designs of which MAX_CERTIFY reach the further check. Sets ``result.chosen``
     and ``.reason`` (None: every one refused) and the report's verdict; returns the refused designs."""
     rejected = []
-    for row, why in preference(problem, result)[:MAX_CERTIFY]:
+    for row, why in preference(problem, result)[:MAX_TRIED]:
+        if sum(1 for r in rejected if r["stage"].startswith("assembly")) >= MAX_CERTIFY:
+            break
         try:
             report["certified_check"] = certify(problem, row, also)
         except RigcadError as err:
-            rejected.append({"index": row["index"], "error": str(err)})
+            # the stage that refused it (the constraint that bound) and, for a one-line digest, the whole reason
+            rejected.append({"index": row["index"], "error": str(err), "stage": _stage_of(err),
+                             **({"detail": err.detail} if getattr(err, "detail", "") else {})})
             continue
         result.chosen, result.reason = row, why
         break
@@ -295,6 +336,18 @@ def _certify_choice(problem, result, report: dict, also=None) -> list[dict]:
     report["reason"] = result.reason
     report["status"] = "ok" if result.chosen is not None else "infeasible"
     return rejected
+
+
+def _stage_of(err: RigcadError) -> str:
+    """Which later stage refused a certified design: the assembly gate, fab's tolerance stack, or the
+    rig's layout and part recipes (what `rigcad design` and `stl` refuse before any solid)."""
+    from rigcad.errors import AssemblyError, FabricationError
+
+    if isinstance(err, AssemblyError):
+        return "assembly gate (rigcad stl, fab, manual)"
+    if isinstance(err, FabricationError):
+        return "tolerance stack (rigcad fab)"
+    return "layout and part recipes (rigcad design, stl)"
 
 
 def _design_home(profile_spec, name: str, out: Path) -> Path:

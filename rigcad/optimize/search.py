@@ -157,11 +157,22 @@ def choose(problem: Problem, front: list[dict], ref: dict | None) -> tuple[dict,
 
 def preference(problem: Problem, result: "Result") -> list[tuple[dict, str]]:
     """Every feasible design worth writing, best first: the chosen one, then (two or more objectives)
-    the rest of the front by the same rule, or (one objective) the others by merit."""
+    the rest of the front by the same rule, with the feasible designs off the front by that rule among
+    themselves (what the later stages try when they refuse the front's): those that beat the base in
+    every objective before the front's that do not; or (one objective) the others by merit."""
     if result.chosen is None:
         return []
     if len(problem.spec.objectives) > 1:
-        return ranked(problem, result.front, result.base)
+        # the front by that rule; the feasible designs off it that beat the base in every objective come
+        # before the front's designs that do not (the later stages may refuse the front's best), the rest last
+        on = {r["index"] for r in result.front}
+        rest = [r for r in result.history if r["feasible"] and r["index"] not in on]
+        front = ranked(problem, result.front, result.base)
+        off = [(r, f"off the Pareto front (the designs before it were refused by later stages): {why}")
+               for r, why in (ranked(problem, rest, result.base) if rest else [])]
+        beats = [(r, w) for r, w in front if improvement(problem, r, result.base) > 0]
+        better = [(r, w) for r, w in off if improvement(problem, r, result.base) > 0]
+        return beats + better + [x for x in front if x not in beats] + [x for x in off if x not in better]
     feas = sorted((r for r in result.history if r["feasible"]), key=lambda r: (r["merit"], r["index"]))
     return [(r, "lowest merit of the feasible designs" if i == 0 else f"feasible design {i + 1} by merit")
             for i, r in enumerate(feas)]

@@ -191,3 +191,28 @@ def test_two_parts_that_lock_each_other_are_refused_without_trying_every_set(mon
         AC.find_order(locked_pair(10))
     assert e.value.step in ("wall", "pin")
     assert len(seen) < 50, len(seen)
+
+
+def test_the_refusal_names_the_parts_that_lock_not_a_part_the_declared_order_put_in_wrong():
+    """A planted lock (the wall and the pin through it: each blocks the other's every way in) behind a
+    decoy: a lid declared before the cup it covers, so the declared order's greedy prefix puts the lid
+    in first and then finds the cup blocked by it. The refusal names the wall and the pin, the parts
+    that collide, not the cup (which only has to go in before its lid). Seen to fail with the greedy
+    prefix naming the first blocked step (the cup, into the lid)."""
+    a = locked_pair(0)
+    solids = dict(a.solids)
+    solids["cup"] = box((40, -10, 0), (60, 10, 10))
+    solids["lid"] = box((38, -12, 10), (62, 12, 12)) + box((38, -12, 0), (40, 12, 10)) + box((60, -12, 0), (62, 12, 10)) \
+        + box((40, -12, 0), (60, -10, 10)) + box((40, 10, 0), (60, 12, 10))
+    steps = [a.by_name["floor"], AC.Step("lid", ("lid",), (DOWN,), 50.0, needs=("floor",)),
+             AC.Step("cup", ("cup",), (DOWN, *SIDES), 50.0, needs=("floor",)), a.by_name["wall"], a.by_name["pin"]]
+    with pytest.raises(AssemblyError) as e:
+        AC.find_order(AC.Assembly(solids, steps, with_bench=False))
+    err = e.value
+    assert {err.step, *err.obstacles} == {"wall", "pin"}, (err.step, err.obstacles, str(err))
+    assert "cup" not in err.summary and "wall" in err.summary and "pin" in err.summary
+    assert "must go in before" in err.summary  # why no order avoids it: each would have to precede the other
+    # the decoy alone (no lock) goes together: the cup before its lid
+    order = AC.find_order(AC.Assembly({k: v for k, v in solids.items() if k not in ("wall", "pin")},
+                                      steps[:3], with_bench=False))
+    assert [p.step.name for p in order].index("cup") < [p.step.name for p in order].index("lid")

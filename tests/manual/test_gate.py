@@ -7,6 +7,7 @@ in one line and exit 1, `stl` keeping its parts for inspection and the others wr
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import io
 import json
 
@@ -60,9 +61,13 @@ def test_the_verdict_is_read_back_only_for_the_same_profile_and_code(tmp_path, l
         return real(rig, meshes, search=False)
 
     monkeypatch.setattr(gate, "verdict", counted)
+    # a verdict not written anywhere points to no file; once checked() has written it, its line does
+    assert "assembly.json" not in real(low_rig, search=False).line()
+    calls.clear()
     first = gate.checked(low_rig, tmp_path)
     again = gate.checked(low_rig, tmp_path)
     assert calls == ["low"] and again == first  # read back: the same verdict, field for field
+    assert gate.verdict_path(tmp_path, "low").is_file() and "(the check's whole reason: assembly.json" in first.line()
     path = gate.verdict_path(tmp_path, "low")
     doc = json.loads(path.read_text())
     doc["inputs_key"] = "0" * 64  # another profile or another rigcad made it
@@ -97,7 +102,8 @@ def test_the_nearest_value_found_lets_the_whole_rig_go_together(low_rig):
     assert not gate.verdict(short, search=False).ok
     # docs/assembly.md quotes this line, with the profile's folder left out
     page = (ROOT / "docs" / "assembly.md").read_text(encoding="utf-8")
-    quoted = f"rigcad: error: {v.line()}".replace(fix.where.rsplit("/", 1)[0] + "/", "")
+    shown = dataclasses.replace(v, kept=f"{gate.VERDICT_FILE} beside the export")  # as stl, fab and manual print it
+    quoted = f"rigcad: error: {shown.line()}".replace(fix.where.rsplit("/", 1)[0] + "/", "")
     assert quoted in page, quoted
 
 

@@ -29,12 +29,56 @@ def test_a_design_the_gate_refuses_gives_way_to_the_next(monkeypatch):
     result, report = SimpleNamespace(chosen=rows[0], reason=None), {}
     rejected = R._certify_choice(None, result, report, gate)
     assert result.chosen is rows[1] and result.reason == "preferred 2"
-    assert rejected == [{"index": 1, "error": "beam_splitter cannot go in, it runs into splitter_holder"}]
+    assert rejected == [{"index": 1, "error": "beam_splitter cannot go in, it runs into splitter_holder",
+                         "stage": "assembly gate (rigcad stl, fab, manual)"}]
     assert report["certified_check"] == {"index": 2} and report["status"] == "ok"
     # every design refused: no design, and the report says so
     result, report = SimpleNamespace(chosen=rows[0], reason=None), {}
     rejected = R._certify_choice(None, result, report, lambda rig: gate(SimpleNamespace(index=1)))
     assert result.chosen is None and len(rejected) == 2 and report["status"] == "infeasible"
+
+
+def test_a_design_whose_tolerance_stack_fab_refuses_gives_way_without_counting_against_the_gate(monkeypatch):
+    """fab's tolerance stack refuses the first designs (FabricationError from the certified path):
+    each gives way to the next and is recorded with the stage that refused it; it does not use up
+    the MAX_CERTIFY designs the costly assembly gate may judge."""
+    from rigcad.errors import FabricationError
+
+    rows = [{"index": k} for k in range(R.MAX_CERTIFY + 3)]
+    monkeypatch.setattr(R, "preference", lambda problem, result: [(r, f"preferred {r['index']}") for r in rows])
+    monkeypatch.setattr(R, "_row_json", lambda problem, r: r)
+
+    def certify(problem, row, also=None):
+        if row["index"] < R.MAX_CERTIFY + 2:  # more refusals than the gate's budget: all by the stack
+            raise FabricationError("on prusa_mk3s, 1 placement(s) the printed rig cannot hold or adjust: dome lateral")
+        return {"index": row["index"]}
+
+    monkeypatch.setattr(R, "certify", certify)
+    result, report = SimpleNamespace(chosen=rows[0], reason=None), {}
+    rejected = R._certify_choice(None, result, report, None)
+    assert result.chosen is rows[-1] and report["status"] == "ok"
+    assert {r["stage"] for r in rejected} == {"tolerance stack (rigcad fab)"} and len(rejected) == R.MAX_CERTIFY + 2
+
+
+def test_the_certified_path_refuses_a_design_whose_stack_the_printer_cannot_hold(monkeypatch):
+    """optimize.run.tolerance_stack is fab's stack (rigcad.fab.stack) on the run's printer: the
+    default rig is held or adjusted on the MK3S; the same rig on a process 5x less accurate in scale
+    (as tests/fab refuses) is refused with fab's own FabricationError."""
+    from rigcad.errors import FabricationError
+    from rigcad.fab import printers, stack as ST
+    from rigcad.optimize.run import load_problem
+
+    problem = load_problem("achutha2006_optimize")
+    import rigcad
+
+    rig = rigcad.load("achutha2006")
+    ok = R.tolerance_stack(problem, rig)
+    assert ok["printer"] == "prusa_mk3s" and "paraboloid lateral" in ok["adjusted"]
+    mk3s = printers.load_printer("prusa_mk3s")
+    worse = ST.with_process(mk3s, scale=5 * mk3s.process_errors.scale)
+    monkeypatch.setattr(printers, "load_printer", lambda name: worse)
+    with pytest.raises(FabricationError, match="cannot hold or adjust"):
+        R.tolerance_stack(problem, rig)
 
 
 def test_the_command_passes_the_assembly_gate_to_the_certified_path(monkeypatch, tmp_path):
