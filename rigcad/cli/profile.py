@@ -67,7 +67,9 @@ def cmd_show(args: argparse.Namespace) -> int:
     for key, inst in profile.instruments.items():
         print(f"  {key}: {inst.name} = {inst.title} ({inst.file})")
     table = {section: [(f.name, _fmt(f.metadata["spec"], getattr(getattr(profile, section), f.name)),
-                        profile.origin(section, f.name), _doc(profile, section, f))
+                        profile.origin(section, f.name)
+                        + (f" (not with {section}.model)" if profile.apart_from_model(section, f.name) else ""),
+                        _doc(profile, section, f))
                        for f in fields(getattr(profile, section))] for section in SECTIONS}
     if camera is not None and camera.focal_from == "derived":  # no lens stated: the one rigcad derives
         table["camera"] = [(n, f"({camera.focal_px:.5g} px)", "derived", d) if n == "focal_length" else (n, v, o, d)

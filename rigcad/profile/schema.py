@@ -717,6 +717,16 @@ class Profile:
         the instrument file's file:line, or "default"."""
         return self.marks.get((section, key)) or self.instrument_marks.get((section, key)) or "default"
 
+    def apart_from_model(self, section: str, key: str) -> str | None:
+        """The file:line of ``section.key`` when a profile file set it other than the file that chose the
+        section's instrument (``section.model``): a base profile's figure for its own instrument that a
+        profile extending it inherits with another model (the thesis's throw ratio under another
+        projector); None otherwise."""
+        here, model = self.marks.get((section, key)), self.marks.get((section, "model"))
+        if key == "model" or here is None or model is None:
+            return None
+        return None if here.rsplit(":", 1)[0] == model.rsplit(":", 1)[0] else here
+
     def source(self, section: str, key: str) -> str | None:
         """Where the instrument file that set ``section.key`` read it (a datasheet), if it says."""
         mark = self.instrument_marks.get((section, key))
