@@ -439,13 +439,8 @@ def _inherited(profile, section: str, key: str) -> str:
     """" (set in FILE:LINE, not with the model)" for a figure a profile file set other than the file that
     chose the section's instrument (``section.model``): a base profile's figure for its own instrument
     (its throw ratio) that a profile extending it inherits with another model; "" otherwise."""
-    origin = getattr(profile, "origin", None)
-    if origin is None or key == "model" or getattr(profile, "set_by", lambda *k: "")(section, key) != "profile":
-        return ""
-    model, here = origin(section, "model"), origin(section, key)
-    if model == "default" or here.rsplit(":", 1)[0] == model.rsplit(":", 1)[0]:
-        return ""
-    return f" (set in `{here}`, not with the model: check it is this {section.replace('_', ' ')}'s)"
+    here = profile.apart_from_model(section, key) if hasattr(profile, "apart_from_model") else None
+    return f" (set in `{here}`, not with the model: check it is this {section.replace('_', ' ')}'s)" if here else ""
 
 
 def bill(rig, fab_report: dict, printer) -> dict:

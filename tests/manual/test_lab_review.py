@@ -171,3 +171,23 @@ def test_section_6_states_the_lab_temperature_and_the_gray_cards_height(written)
     assert f"top stands **{-cal['gray_card']['holder_top_z_mm']:g} mm under it**" in md
     seat = cal["splitter_seat"]["screws"]
     assert f"**{seat['flat']['rows_px_per_step']:.1f} px along the rows**" in md
+
+
+def test_profile_show_marks_an_inherited_figure_not_with_the_model(tmp_path):
+    """`rigcad profile show` credits the throw ratio to the base profile's line, and says it did not come with
+    the projector the profile names; on the thesis's own profile no line says so."""
+    import subprocess
+    import sys
+
+    path = tmp_path / "epson.yaml"
+    path.write_text("extends: achutha2006\nprojector:\n  model: epson_eb_w52\n", encoding="utf-8")
+    epson = rigcad.load(path).profile
+    assert re.fullmatch(r"profiles/achutha2006\.yaml:\d+", epson.apart_from_model("projector", "throw_ratio") or "")
+    assert epson.apart_from_model("projector", "resolution") is None  # the Epson's file set it
+    out = subprocess.run([sys.executable, "-m", "rigcad", "profile", "show", str(path)], capture_output=True,
+                         text=True, check=True).stdout
+    line = next(x for x in out.splitlines() if x.strip().startswith("throw_ratio"))
+    assert "achutha2006.yaml" in line and "(not with projector.model)" in line, line
+    own = subprocess.run([sys.executable, "-m", "rigcad", "profile", "show", "achutha2006"], capture_output=True,
+                         text=True, check=True).stdout
+    assert "not with" not in own
