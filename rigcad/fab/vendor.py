@@ -380,10 +380,11 @@ class Bundle:
             if self._section(group, other).get("renamed_from", "").strip('"') == name:
                 return f"{group}_preset {name!r} was renamed to {other!r} in {self.path.name} ({self.label()})"
         variants = [n for n in names if n.lower().startswith(name.lower().strip())]
-        if variants:  # a printer whose presets are per nozzle (or MMU): "Creality Ender-3 V2 (0.4 mm nozzle)"
+        misspelt = difflib.get_close_matches(name, names, n=1, cutoff=MISSPELT)
+        if variants and not misspelt:  # a printer whose presets are per nozzle (or MMU): "Creality Ender-3 V2 (0.4 mm nozzle)"
             return (f"{group}_preset {name!r} names no preset of {self.path} ({self.label()}), but {len(variants)} "
                     f"start with it: {', '.join(repr(v) for v in variants[:6])}; name the one for your nozzle")
-        if group == "printer" and not difflib.get_close_matches(name, names, n=1, cutoff=MISSPELT):
+        if group == "printer" and not misspelt:
             return self._unknown_printer(name, names)
         close = difflib.get_close_matches(name, names, n=3, cutoff=0.6)
         hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""

@@ -376,9 +376,9 @@ def test_a_rig_part_on_the_mk3s_gets_vendor_gcode_and_a_project(table31_rig, tmp
     from rigcad.fab.stage import run_fab
 
     p = load_printer("prusa_mk3s")
-    res = run_fab(table31_rig, p, tmp_path, parts=["sample_holder"], gcode=True, workers=1)
+    res = run_fab(table31_rig, p, tmp_path, parts=["beam"], gcode=True, workers=1)  # printed whatever the profile buys
     assert res.problems == [], res.problems
-    for pc in res.report["parts"]["sample_holder"]["pieces"]:
+    for pc in res.report["parts"]["beam"]["pieces"]:
         text = (tmp_path / "gcode" / f"{pc['name']}.gcode").read_text()
         assert 'M862.3 P "MK3S"' in text and "G80 ; mesh bed leveling" in text
         assert comments(text)["bed_temperature"] == "60"
