@@ -230,7 +230,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     d = Doc()
     _introduction(d, c)
     for section in (_section_bill, _bill_consumables, _section_schedule, _section_print, _section_sand, _section_finish, _section_coat,
-                    _section_assemble, _section_mechanics, _section_calibrate):
+                    _section_assemble, _section_mechanics, _section_acceptance, _section_calibrate):
         section(d, c)
     figures = {"rigcad_version": __version__, "profile": rig.name, "printer": printer.name,
                # the hardware as the steps fit it; bom.fasteners' candidate joints stay internal
@@ -435,8 +435,18 @@ def _section_print(d: Doc, c) -> None:
         d.p(f"Split pieces: cut {bill['pins']['quantity']} pins of {bill['pins']['length_mm']:g} mm from "
             f"{rods} rod (or filament), drill each part's pin holes to the size "
             "the tools list gives, push the pins into one piece's holes, join the next piece on them and glue "
-            "the cut faces with the glue the consumables list names for that part.")
+            "the cut faces with the glue the consumables list names for that part."
+            + (" Lap the tower column's glue faces flat before you glue them: wet P240 paper on the float glass, "
+               "figure-of-eight strokes, until the steel straightedge laid across each face in four directions admits "
+               f"no {_lapped():g} mm feeler leaf." if "tower_column" in (bill["pins"].get("use") or "") else ""))
         _glue_mirror_seams(d, c)
+
+
+def _lapped() -> float:
+    """How flat a lapped glue face is (mm, rigcad.parts.tower.LAPPED_FLATNESS): the feeler leaf that checks it."""
+    from rigcad.parts.tower import LAPPED_FLATNESS
+
+    return LAPPED_FLATNESS
 
 
 def _cut_line(name: str, e: dict) -> str:
@@ -479,7 +489,9 @@ def _glue_mirror_seams(d: Doc, c) -> None:
             f"{s['step_on_pins_mm']:.2f} mm ({s['step_on_pins_how']}) against {s['stock_mm']:.3f} mm of sanding "
             f"stock: sanding to the template would leave the lower side as a groove. So its pin holes are drawn "
             f"wide and the glue fills them. Cut `outlines/{template}.dxf` from the same plate as the templates (its "
-            f"edge is the surface as printed) and glue one seam at a time, the pieces standing on the base plate "
+            f"edge is the surface as printed). First melt the base plate's heat-set inserts (as its step in section 5 "
+            f"says, before it goes on the bench): the dome's flange screws go into them. Then glue one seam at a time, "
+            f"before the dome's own inserts, the pieces standing on the base plate "
             f"(packing tape over the plate under the seam, so no glue reaches it) with their flange screws in, "
             f"finger-tight: mix the {s['glue']} ({s['glue_open_min']:g} min to set the seam), butter both cut faces "
             f"and the pins, push the pieces together, stand the template in the seam's plane with its datum edge on "
@@ -969,8 +981,19 @@ def _section_finish(d: Doc, c) -> None:
         "mark each one's datum as its "
         "drawing in section 3 shows it. " + " ".join(F.template_text(r) for r in c.templates)
         + " Check in at least four meridional planes, a quarter turn apart.")
-    acc = F.slope_acceptance(c.rig)
+    c.finishing = {"blocks": blocks, "acceptance": F.slope_acceptance(c.rig), "templates": c.templates,
+                   "block_set": [{k: v for k, v in r.items() if k != "part"} for r in block_set]}
+
+
+def _section_acceptance(d: Doc, c) -> None:
+    """The optical acceptance test (rigcad.manual.finishing.slope_acceptance), where the schedule does it:
+    on the assembled rig with its camera, on the polished clear coat, before the mirror coat."""
+    acc = c.finishing["acceptance"]
     d.h(3, C.STEP_ACCEPTANCE)
+    d.p("Here, with the rig assembled and the mirrors' clear coat polished, before their mirror coat (the schedule's "
+        "order): if it fails, lift the dome off its register, take the paraboloid off the beam, block and polish the "
+        "area again and repeat; once it passes, lift them off again for the mirror coat (section 4's last layer), "
+        "set them back and repeat the test on the finished mirrors.")
     d.p("The mirrors' slope must be right, not only their form: in a right rig every ray the camera sees lands on "
         f"the sample point O within `tolerancing.max_spot_radius` ({acc['disc_radius_mm']:g} mm). The test lights a "
         "disc of that radius at O and looks at it through the mirrors with the rig's own camera:")
@@ -1002,8 +1025,6 @@ def _section_finish(d: Doc, c) -> None:
         "again. A pixel dark in both looks past the bore: farther off still. Run it first on the polished coat, "
         "before the mirror coat (the recipe's slope test: a bad area can still be sanded), then again on the "
         "finished mirrors.")
-    c.finishing = {"blocks": blocks, "acceptance": acc, "templates": c.templates,
-                   "block_set": [{k: v for k, v in r.items() if k != "part"} for r in block_set]}
 
 
 CHECKER_SQUARE_MM = C.CHECKER_SQUARE_MM
