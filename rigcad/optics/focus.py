@@ -167,7 +167,7 @@ def lensed_focal_px(profile, geometry) -> float:
     """The projector's focal length in pixels (px) as the paraboloid sees it through its focusing
     lens, placed by the tower (:meth:`FocusingLens.projector`): its pixel map is the design's, read
     about the design COP with this focal length instead of ``geometry.projector_focal_px``."""
-    return focusing_lens(profile, geometry).projector(geometry.projector_focal_px, geometry.cop_z).focal_px
+    return placed_lens(profile, geometry).projector(geometry.projector_focal_px, geometry.cop_z).focal_px
 
 
 def through_lens(focal_length: float, lens_distance: float, edge_thickness: float = 0.0, diameter: float = 0.0,
@@ -230,30 +230,40 @@ def ideal_focal_length(profile, geometry) -> float:
     return _ideal(near, far, profile.projector.focus_min - s, profile.projector.focus_max - s)
 
 
-def focusing_lens(profile, geometry) -> FocusingLens:
+def placed_lens(profile, geometry) -> FocusingLens:
+    """The focusing lens the COP tower places the projector through (:func:`focusing_lens`'s choice),
+    whether or not the projector can focus through it: that is :func:`focusing_lens`'s verdict, given
+    where the lens is bought (the bill) and judged by the optimiser, not where the tower is laid out."""
+    return focusing_lens(profile, geometry, judge=False)
+
+
+def focusing_lens(profile, geometry, *, judge: bool = True) -> FocusingLens:
     """The focusing lens for ``profile`` (its ``lens.focal_length`` when given, else the catalogue
     value centred best on the paraboloid, in dioptres) and ``geometry`` (profile.derived.Derived);
-    raise GeometryError naming the key when the paraboloid cannot be brought into focus."""
+    raise GeometryError naming the key when the paraboloid cannot be brought into focus (``judge``
+    False: the choice alone, :func:`placed_lens`)."""
     pj, ln = profile.projector, profile.lens
     s = ln.distance
     near = geometry.cop_z - geometry.vertex_z - s  # the vertex, on the axis
     far = math.hypot(geometry.rim_radius, geometry.cop_z - geometry.rim_z) - s  # the rim
     d_min, d_max = pj.focus_min, pj.focus_max
-    if d_min - s <= 0 or d_max < d_min:
+    if judge and (d_min - s <= 0 or d_max < d_min):
         raise GeometryError(f"projector.focus_min ({d_min:g} mm) must lie beyond the focusing lens (lens.distance "
                             f"{s:g} mm) and below projector.focus_max", where=profile.where("projector", "focus_min"))
     if ln.focal_length is not None:
         lens = _lens(ln.focal_length, s, near, far, d_min, d_max, False, ln.thickness, ln.diameter)
-        if not _reachable(lens):
+        if judge and not _reachable(lens):
             raise GeometryError(
                 f"lens.focal_length {ln.focal_length:g} mm needs the projector focused at {lens.focus_near:.0f}.."
                 f"{lens.focus_far:.0f} mm, outside its range {d_min:g}..{d_max:g} mm (projector.focus_min, "
                 "focus_max); leave lens.focal_length out to have it computed", where=profile.where("lens", "focal_length"))
         return lens
-    ideal = _ideal(near, far, d_min - s, d_max - s)
-    best = min(CATALOGUE_FOCAL_LENGTHS, key=lambda f: abs(1.0 / f - 1.0 / ideal))
+    # the power (1/mm) centred best, in dioptres (1 / _ideal's focal length, without its division)
+    power = 0.5 * (_dioptres(near) + _dioptres(far)) - 0.5 * (_dioptres(d_min - s) + _dioptres(d_max - s))
+    best = min(CATALOGUE_FOCAL_LENGTHS, key=lambda f: abs(1.0 / f - power))
     lens = _lens(best, s, near, far, d_min, d_max, True, ln.thickness, ln.diameter)
-    if not _reachable(lens):
+    if judge and not _reachable(lens):
+        ideal = _ideal(near, far, d_min - s, d_max - s)
         raise GeometryError(
             f"no catalogue focusing lens brings the paraboloid ({near:.0f}..{far:.0f} mm from the lens) into the "
             f"projector's focus range {d_min:g}..{d_max:g} mm (projector.focus_min, focus_max): the nearest, f = {best:g} mm, needs "

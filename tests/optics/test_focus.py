@@ -133,3 +133,17 @@ def test_no_real_image_is_inf_and_describe_names_every_figure():
                                "projector_focus_range_mm": [1000.0, 3000.0], "from_catalogue": True,
                                "cop_shift_mm": pytest.approx(25.0 - 25.0 * 200.0 / 225.0),
                                "pixel_scale": pytest.approx(225 / 200)}
+
+
+def test_the_tower_places_the_projector_through_the_lens_chosen_even_one_it_cannot_focus_through(
+        table31, table31_geometry, write_profile, table31_text):
+    """placed_lens is focusing_lens's choice without its verdict: the same lens where the projector can
+    focus through it; where it cannot (the COP 30 cm from the vertex: f = 300 mm needs 3.3..43 m) the
+    tower is still laid out through it, and focusing_lens (the bill, the optimiser) refuses it."""
+    from rigcad.optics.focus import placed_lens
+
+    assert placed_lens(table31, table31_geometry) == focusing_lens(table31, table31_geometry)
+    p = load_profile(write_profile(table31_text.replace("27 cm", "30 cm")))
+    with pytest.raises(GeometryError, match="no catalogue focusing lens"):
+        focusing_lens(p, derive(p))
+    assert placed_lens(p, derive(p)).focal_length == 300.0
