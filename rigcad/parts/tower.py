@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigcad.errors import GeometryError
-from rigcad.optics.focus import focusing_lens
+from rigcad.optics.focus import focusing_lens, placed_lens
 from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_point, splitter_plate
 from rigcad.parts.joints import Bought, Datum, KinematicSeat, SeatContact, datums_of
 from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Translate,
@@ -253,7 +253,7 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
     plate = splitter_plate(cop_z, L, bs.width, bs.length, bs.thickness, bs.index)
     camera = camera_cop(plate, cop_z, geometry.rim_angle_at_cop)
     seen = mirror_point(plate, (0.0, 0.0, cop_z))  # = (L, 0, cop_z - L): the COP the paraboloid must see
-    focus = focusing_lens(profile, geometry)
+    focus = placed_lens(profile, geometry)  # whether the projector can focus through it: hardware() judges
     p_cop = np.asarray(seen, float) + (focus.cop_distance - focus.lens_distance, 0.0, 0.0)  # the real COP, behind
     px0, px1, pz0, pz1 = _plate_extent(plate)
     _check_splitter_size(profile, geometry)
