@@ -225,8 +225,8 @@ FIGURES: dict[str, tuple[str, str, str]] = {
                     "with a nut)"),
     "mount_spacing": ("bottom", "first mounting hole's centre", "second mounting hole's centre"),
     "mount_holes": ("bottom", "entrance pupil (the COP) on the optical axis, projected onto the bottom face",
-                    "each mounting hole's centre: along the axis back from the pupil, and across it (+ to the right "
-                    "seen from behind)"),
+                    "centre of each mounting hole: along the axis back from the pupil, and across it (+ to the "
+                    "right seen from behind)"),
     "focus_min": ("side", "entrance pupil (the COP)", "nearest wall the projector focuses sharply"),
     "focus_max": ("side", "entrance pupil (the COP)", "farthest wall the projector focuses sharply"),
 }
