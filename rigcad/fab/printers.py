@@ -238,9 +238,78 @@ def load_printer(name: str | Path) -> Printer:
     """Read and validate a printer profile; errors name the file:line, key, value and what is valid.
     Every problem of the file is reported at once (rigcad.fab.vendor.Problems): its unknown keys,
     bad values, presets the installed slicer lacks, figures that disagree with them, a model the
-    presets are not for."""
-    path = printer_path(name)
-    raw = load_raw(path)
+    presets are not for. A name that is no printer file but a printer preset of an installed
+    PrusaSlicer bundle (``"Creality Ender-3 V2 (0.4 mm nozzle)"``) is that printer
+    (:func:`preset_printer`)."""
+    by_preset = preset_printer(name)
+    if by_preset is not None:
+        return _from_raw(*by_preset)
+    try:
+        path = printer_path(name)
+    except ProfileError as err:
+        if " " not in str(name).strip():
+            raise
+        raise ProfileError(f"{err}; nor is it a printer preset of an installed PrusaSlicer bundle (exactly as "
+                           "`python -m rigcad.fab.vendor BUNDLE printer` lists them, e.g. 'Creality Ender-3 V2 "
+                           "(0.4 mm nozzle)')", where=err.where) from None
+    return _from_raw(load_raw(path), path)
+
+
+def _slug(text: str) -> str:
+    """A printer preset's name as a file name (the fab folder's): lower case, letters, digits and '_'."""
+    return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_")[:80] or "printer"
+
+
+def preset_printer(name: str | Path) -> tuple[RawProfile, Path] | None:
+    """The printer file a PrusaSlicer printer preset stands for, when ``name`` is no printer file on
+    the search path but exactly the name of an FFF printer preset of an installed vendor bundle:
+    its bundle's default print and filament presets (the preset's default_print_profile and
+    default_filament_profile), the bed and height from its bed_shape and max_print_height, its
+    printer model's name as ``model``; everything else as a printer file that leaves it out (the
+    figures from the presets, the process errors the published defaults). None otherwise; a name
+    without a space (every printer file's) or a path reads no bundle."""
+    text = str(name)
+    if " " not in text.strip() or "/" in text or "\\" in text or text.endswith((".yaml", ".yml")) or "\x00" in text:
+        return None
+    if any((d / f"{text}.yaml").is_file() for d in search_path(PRINTERS_SUBDIR)):
+        return None
+    for stem, bundle_path in V.available_bundles().items():
+        try:
+            bundle = V.load_bundle(bundle_path)
+            if text not in bundle.presets("printer"):
+                continue
+            flat = bundle.flatten("printer", text)
+        except (ProfileError, FabricationError):
+            continue  # a bundle rigcad cannot read names no printer here
+        if flat.get("printer_technology", "FFF") != "FFF":
+            continue
+        size = _bed_size(flat.get("bed_shape", ""))
+        defaults = {k: flat.get(f"default_{k}_profile", "").strip().strip('"') for k in ("print", "filament")}
+        if size is None or not all(defaults.values()):
+            continue
+        data = {"description": f"{text} (PrusaSlicer's preset, {bundle.label()})",
+                "model": bundle.model_name(flat.get("printer_model", "")) or text, "process": "fdm",
+                "build_volume": {"x": f"{size[0]!r} mm", "y": f"{size[1]!r} mm",
+                                 "z": f"{float(flat.get('max_print_height', '0') or 0)!r} mm"},
+                "slicer": {"vendor_bundle": stem, "printer_preset": text, "print_preset": defaults["print"],
+                           "filament_preset": defaults["filament"]}}
+        return RawProfile(name=_slug(text), data=data, marks={}, sources=(bundle_path,)), bundle_path
+    return None
+
+
+def _bed_size(bed_shape: str) -> tuple[float, float] | None:
+    """The bed's x and y extent (mm) from PrusaSlicer's ``bed_shape`` ("0x0,250x0,250x210,0x210")."""
+    try:
+        pts = [tuple(float(c) for c in p.split("x")) for p in bed_shape.split(",")]
+    except ValueError:
+        return None
+    if not pts or any(len(p) != 2 for p in pts):
+        return None
+    return (max(p[0] for p in pts) - min(p[0] for p in pts), max(p[1] for p in pts) - min(p[1] for p in pts))
+
+
+def _from_raw(raw: RawProfile, path: Path) -> Printer:
+    """A printer from its raw file (or a preset's stand-in for one, :func:`preset_printer`)."""
     problems: list = []
     valid = sorted([*_TOP, *_SECTIONS, "process_errors"])
     for key in raw.data:

@@ -131,3 +131,28 @@ def test_a_printer_named_without_its_nozzle_is_shown_its_presets():
     msg = str(err.value)
     assert "'Creality Ender-3 V2 (0.4 mm nozzle)'" in msg and "name the one for your nozzle" in msg, msg
     assert "no presets for that printer" not in msg  # it has them
+
+
+def test_a_printer_preset_by_its_name_is_a_printer(monkeypatch):
+    """`--printer "Creality Ender-3 V2 (0.4 mm nozzle)"`: the bundle's printer preset with its default
+    print and filament presets; the bed and height from its bed_shape (5x0,215x0,215x220,5x220) and
+    max_print_height (250), the layer, nozzle and material from the presets."""
+    if "Creality" not in V.available_bundles():
+        pytest.skip("PrusaSlicer's Creality bundle is not installed (apt-get install prusa-slicer)")
+    printer = load_printer("Creality Ender-3 V2 (0.4 mm nozzle)")
+    assert printer.name == "creality_ender_3_v2_0_4_mm_nozzle"  # its fab folder's name
+    assert printer.model == "Creality Ender-3 V2" and printer.slicer == "prusa-slicer"
+    v = printer.build_volume
+    assert (v.x, v.y, v.z) == (210.0, 220.0, 250.0)
+    cfg = printer.slicer_config
+    assert cfg.print_preset == "0.16 mm OPTIMAL (0.4 mm nozzle) @CREALITY" and cfg.filament_preset == "Generic PLA @CREALITY"
+    assert printer.layer_height == 0.16 and printer.nozzle == 0.4 and "layer_height" in printer.from_preset
+    assert cfg.effective()["printer_model"] == "ENDER3V2"
+
+    def no_bundles(*args, **kwargs):
+        raise AssertionError("a bundle was read for a printer file's name")
+
+    monkeypatch.setattr(V, "available_bundles", no_bundles)
+    assert load_printer("vantage_i").name == "vantage_i"  # a name without a space reads no bundle
+    with pytest.raises(ProfileError, match="no printer 'nosuch'"):
+        load_printer("nosuch")
