@@ -197,7 +197,8 @@ def _check_made_from(rig, path: Path) -> None:
     made = read_made_from(path.parent)
     if made is not None and made != profile_digest(rig.profile):
         raise BasisError(f"{shown(path)}: made from another version of profile {rig.name} (its "
-                         f"{path.parent.name}.made_from.json): calibrate again, or run rigcad basis --as-designed")
+                         f"{path.parent.name}.made_from.json): calibrate again, name it with --calibration to use it anyway, "
+                         "or run rigcad basis --as-designed")
 
 
 def measured_rig(rig, measured: Measured | None):

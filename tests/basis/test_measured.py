@@ -126,3 +126,20 @@ def test_a_wrong_or_foreign_calibration_is_refused_naming_file_and_key(table31_r
         load_measured(table31_rig, tmp_path, calibration=path)
     with pytest.raises(BasisError, match=r"--calibration .*: no calibration.json there"):
         load_measured(table31_rig, tmp_path, calibration=tmp_path / "nowhere")
+
+
+def test_a_calibration_found_beside_made_from_another_profile_version_is_refused(table31_rig, tmp_path):
+    """calibrate/ records the profile it was made from (calibrate.made_from.json); found beside, a
+    calibration of another version of the profile is refused, named with --calibration it is used."""
+    from rigcad.export.manifest import profile_digest
+
+    folder = tmp_path / table31_rig.name / "calibrate"
+    folder.mkdir(parents=True)
+    (folder / "calibration.json").write_text(json.dumps(_calibration({"dome_dz_mm": 0.2})))
+    record = tmp_path / table31_rig.name / "calibrate.made_from.json"
+    record.write_text(json.dumps({"profile_sha256": profile_digest(table31_rig.profile)}))
+    assert load_measured(table31_rig, tmp_path).theta is not None  # this profile's: read
+    record.write_text(json.dumps({"profile_sha256": "0" * 64}))
+    with pytest.raises(BasisError, match=r"calibration.json: made from another version of profile achutha2006"):
+        load_measured(table31_rig, tmp_path)
+    assert load_measured(table31_rig, tmp_path, calibration=folder).theta is not None
