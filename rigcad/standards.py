@@ -1,7 +1,8 @@
 """Standard hardware: the one home of every figure rigcad takes from a standard or a maker's table.
 
 Threads, clearance holes, socket-head screws, hex nuts, washers, preferred lengths, hex keys,
-heat-set inserts, dowel pins and balls, cup-point set screws, gauge blocks, spring steel. Each table names the standard (or the maker's datasheet)
+heat-set inserts, dowel pins and balls, cup-point set screws, gauge blocks, spring steel, ISO 286 fits
+and reaming allowances. Each table names the standard (or the maker's datasheet)
 its figures come from; nothing else in rigcad states these numbers (tests/test_standards.py greps
 the tree for them). The parts cut their holes from these figures, the bill orders by them and the
 assembly steps fit them, so the solid, the bill and the steps cannot disagree.
@@ -204,6 +205,90 @@ def dowel_diameter_for(at_most: float) -> float:
     return fits[-1]
 
 
+#: ISO 286-2 limit deviations (micrometres) of the hole and shaft tolerance classes rigcad's fits use,
+#: by nominal size range (over, up to] in mm: class -> ((over, up_to, lower, upper), ...). H, F, G
+#: and N holes and m and g shafts for sizes to 50 mm (ISO 286-2:2010, tables of the holes' and
+#: shafts' limit deviations; ISO 8734 dowel pins are made to m6).
+ISO_286 = {
+    "H7": ((1, 3, 0, 10), (3, 6, 0, 12), (6, 10, 0, 15), (10, 18, 0, 18), (18, 30, 0, 21), (30, 50, 0, 25)),
+    "F7": ((1, 3, 6, 16), (3, 6, 10, 22), (6, 10, 13, 28), (10, 18, 16, 34), (18, 30, 20, 41), (30, 50, 25, 50)),
+    "N7": ((1, 3, -14, -4), (3, 6, -16, -4), (6, 10, -19, -4), (10, 18, -23, -5), (18, 30, -28, -7),
+           (30, 50, -33, -8)),
+    "m6": ((1, 3, 2, 8), (3, 6, 4, 12), (6, 10, 6, 15), (10, 18, 7, 18), (18, 30, 8, 21), (30, 50, 9, 25)),
+    "g6": ((1, 3, -8, -2), (3, 6, -12, -4), (6, 10, -14, -5), (10, 18, -17, -6), (18, 30, -20, -7),
+           (30, 50, -25, -9)),
+}
+
+
+def tolerance_zone(size: float, cls: str) -> tuple[float, float]:
+    """The ISO 286-2 zone of class ``cls`` (e.g. "H7", "m6") at nominal ``size`` mm: (lower, upper)
+    deviations in mm. ValueError for a class or size the table does not hold."""
+    try:
+        rows = ISO_286[cls]
+    except KeyError:
+        raise ValueError(f"no ISO 286 class {cls!r} in rigcad's table; valid: {', '.join(ISO_286)}") from None
+    for lo, hi, low, up in rows:
+        if lo < size <= hi:
+            return low / 1000.0, up / 1000.0
+    raise ValueError(f"{size:g} mm is outside rigcad's ISO 286 table ({rows[0][0]} to {rows[-1][1]} mm)")
+
+
+@dataclass(frozen=True)
+class Fit:
+    """An ISO 286 fit of a ``shaft`` class in a ``hole`` class at nominal ``size`` mm (a pin or a
+    plug in its hole): ``kind`` as a machinist names it ("press", "slip", "sliding")."""
+
+    size: float
+    hole: str
+    shaft: str
+    kind: str
+
+    @property
+    def clearance(self) -> tuple[float, float]:
+        """(least, most) diametral clearance (mm; negative: interference) over the two zones."""
+        h_lo, h_hi = tolerance_zone(self.size, self.hole)
+        s_lo, s_hi = tolerance_zone(self.size, self.shaft)
+        return h_lo - s_hi, h_hi - s_lo
+
+    @property
+    def name(self) -> str:
+        """e.g. "4 N7/m6"."""
+        return f"{self.size:g} {self.hole}/{self.shaft}"
+
+    def describe(self) -> str:
+        """e.g. "4 N7/m6 (press: interference 0.008-0.028 mm)" from the zones."""
+        lo, hi = self.clearance
+        span = (f"interference {-hi:.3f}-{-lo:.3f} mm" if hi <= 0 else f"clearance {lo:.3f}-{hi:.3f} mm" if lo >= 0
+                else f"clearance {lo:+.3f} to {hi:+.3f} mm")
+        return f"{self.name} ({self.kind}: {span})"
+
+
+#: The fits of an ISO 8734 (m6) dowel pin: pressed into the part that keeps it, in a hole reamed N7
+#: (interference over the whole zones: the pin never works loose, nor needs glue); sliding in the part
+#: that lifts off it, in a hole reamed F7 (clearance but for the zones' worst pair, 0.002 mm tight on
+#: 3-6 mm, which a printed hole's wall takes up elastically).
+DOWEL_PRESS_HOLE, DOWEL_SLIP_HOLE, DOWEL_SHAFT = "N7", "F7", "m6"
+#: Reaming allowance (mm, on the diameter) left for a reamer by the drill before it, by the hole's
+#: size (over, up to]: the larger figure of the makers' ranges (Guehring and Hoffmann Garant's
+#: reaming guides, as tabulated in Tabellenbuch Metall, Europa-Lehrmittel: to 5 mm 0.1-0.2, 5-20 mm
+#: 0.2-0.3, 20-32 mm 0.3, 32-50 mm 0.5).
+REAMING_ALLOWANCE = ((0, 5, 0.2), (5, 20, 0.3), (20, 32, 0.3), (32, 50, 0.5))
+
+
+def reaming_allowance(size: float) -> float:
+    """The diametral stock (mm) a reamer of ``size`` mm wants from the drill before it; ValueError past 50 mm."""
+    for lo, hi, a in REAMING_ALLOWANCE:
+        if lo < size <= hi:
+            return a
+    raise ValueError(f"no reaming allowance for a {size:g} mm hole (rigcad's table: to 50 mm)")
+
+
+def pre_ream_drill(size: float) -> float:
+    """The twist drill (mm, DIN 338, sold in 0.1 mm steps) before a ``size`` mm reamer: the size less
+    its reaming allowance, rounded down to the 0.1 mm step."""
+    return int(round((size - reaming_allowance(size)) * 10, 9)) / 10.0
+
+
 #: Cup-point socket set screws: the cup's diameter (mm, dp max): ISO 4029 for metric threads, ASME
 #: B18.3 (C max, in inches as printed) for the unified ones. A ball larger than the cup sits on its rim.
 CUP_POINT = {"M3": 1.4, "M4": 2.0, "M5": 2.5, "M6": 3.0, "M8": 5.0,
@@ -265,7 +350,7 @@ DRIVER_BLADE_MM = 100.0
 #: An open-end spanner's reach (mm; DIN 3110 spanners for M3-M6 nuts are 90-120 mm long).
 SPANNER_MM = 80.0
 
-__all__ = ["CAMERA_SOCKET_DEPTH", "ISO_7089_BORE", "ISO_7093", "CUP_POINT", "SHIM_FOIL", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
+__all__ = ["DOWEL_PRESS_HOLE", "DOWEL_SHAFT", "DOWEL_SLIP_HOLE", "Fit", "ISO_286", "REAMING_ALLOWANCE", "pre_ream_drill", "reaming_allowance", "tolerance_zone", "CAMERA_SOCKET_DEPTH", "ISO_7089_BORE", "ISO_7093", "CUP_POINT", "SHIM_FOIL", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
            "SPRING_STEEL_G", "dowel_diameter_for", "shortest_set_screw", "spring_rate", "INCH_SCREW_LENGTHS", "LARGE_WASHERS", "DOWEL_LENGTHS", "longest_dowel", "DRIVER_BLADE_MM", "HEX_KEYS", "HexKey", "INCH", "INSERTS",
            "Insert", "METRIC_THREADS", "MOUNT_THREADS", "SCREW_LENGTHS", "SCREW_LENGTH_RANGE", "SPANNER_MM", "THREADS",
            "Thread", "longest_screw", "screw_lengths", "shortest_screw", "thread", "thread_for_hole"]

@@ -352,13 +352,28 @@ def _paraboloid_links(profile, layout, process: ProcessErrors, seams) -> tuple[L
                  0.0, process.height_error(vertex_z - z1)))
 
 
+def sample_link(profile) -> Link:
+    """The sample point O on its holder in the base plate's bore (the first link of every chain): the
+    holder turned and the bore bored to their ISO 286 sliding fit (rigcad.parts.locating.holder_fit), the
+    holder anywhere within the fit's largest clearance: half of it each way. Machined, so the same on
+    every printer."""
+    from rigcad.parts.locating import holder_fit
+
+    fit = holder_fit(2 * profile.sample_holder.radius, where=profile.where("sample_holder", "radius"))
+    return Link("sample holder in its bore", "clearance",
+                f"the holder turned and the bore bored to {fit.describe()}: half the largest clearance each way",
+                fit.clearance[1] / 2, buy="a three-point register in the bore (two contacts and a spring plunger)")
+
+
 def _dome_seat(profile, layout, process: ProcessErrors, seams) -> tuple[Link, ...]:
-    """O to the dome's flange: the base plate from its bore to the bolt circle, its seams, the bolts' float."""
+    """O to the dome's flange: the sample holder in its bore, the base plate from its bore to the bolt
+    circle, its seams, the bolts' float."""
     flat, r = profile.datum.foot_flatness, layout.bolt_circle_r
     hole = profile.dome_shell.bolt_diameter
     major = THREADS[flange_joint(profile, layout).thread].major
     play, how = _drilled(hole, major, process, "vertical")
-    return (Link("base plate: bore to the dome's bolt circle", "printed",
+    return (sample_link(profile),
+            Link("base plate: bore to the dome's bolt circle", "printed",
                  f"printed: a pattern {r:.0f} mm round the bore (the scale moves its holes out alike, not its centre); "
                  f"out of flat {flat:g} mm (datum.foot_flatness) across the flange", process.position, flat,
                  flat / (2 * layout.flange_outer_r)),
@@ -401,7 +416,7 @@ def _tower_links(profile, layout, process: ProcessErrors, seams, holder: bool = 
     span = t.column_x - t.holder_x[1]
     point = point or (0.0, t.plate.center[2])
     printed_column, printed_shelf = profile.buy.column == "print", profile.buy.shelf == "print"
-    out = [_link(chain["base plate"], "printed", 0.0), *seams("base_plate")]
+    out = [sample_link(profile), _link(chain["base plate"], "printed", 0.0), *seams("base_plate")]
     for name in chain:
         if name.endswith("tongue to column") or name.endswith("column to shelf"):
             out.append(_link(chain[name], "joint", 0.0))  # a turn about the column's axis tilts no axis
@@ -732,5 +747,5 @@ def with_process(printer: Printer, **figures) -> Printer:
 
 
 __all__ = ["AXES", "AdjusterSpec", "AxisVerdict", "ELEMENTS", "ElementStack", "Link", "Locator", "RESOLUTION_SHARE",
-           "DOME_FLOATS", "PARABOLOID_FLOATS", "declared_locators", "located_adjusters", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
+           "DOME_FLOATS", "PARABOLOID_FLOATS", "declared_locators", "sample_link", "located_adjusters", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
            "table_lines", "with_process"]

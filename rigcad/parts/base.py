@@ -1,5 +1,12 @@
 """Base plate (bolted to the dome's flange, its top face is the sample plane z = 0) and the
-sample holder that slides into its bore so the sample's top surface lands on z = 0."""
+sample holder that slides into its bore so the sample's top surface lands on z = 0.
+
+The bore is the sample point O, the datum of everything: drawn at its finished size, it prints under
+by the printer's hole shrink and is bored H7; the holder is turned from aluminium bar to g6, the ISO 286
+sliding fit (rigcad.parts.locating.holder_fit): the sample sits on the bore's axis to half that fit's
+largest clearance, a link of every element's tolerance stack (rigcad.fab.stack). The camera's cross
+and the calibration kit's plugs are printed, ``sample_holder.clearance`` each side under the finished
+bore."""
 
 from __future__ import annotations
 
@@ -9,6 +16,7 @@ from rigcad.parts import breadboard
 from rigcad.parts.dome import flange_joint, register
 from rigcad.parts.joints import Datum, datums_of
 from rigcad.parts.layout import RigLayout
+from rigcad.parts.locating import holder_fit
 from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Union_
 from rigcad.parts.tower import column_datums, column_joint_cuts, tongue_underside_cuts
 from rigcad.profile.schema import Profile
@@ -26,7 +34,7 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
     half = tw.column_foot_half
     x0 = math.sqrt(layout.plate_r ** 2 - half ** 2) - 1.0  # 1 mm inside the disc's rim: one solid
     tongue = Box((x0, -half, tw.bench_z), (tw.column_x + half, half, 0.0))  # down to the bench: the tower's weight
-    bore = Cylinder((0.0, 0.0, -t - 1.0), holder.radius + holder.clearance, t + 2.0)
+    bore = Cylinder((0.0, 0.0, -t - 1.0), bore_drawn(profile) / 2, t + 2.0)
     groove = azimuth_groove(profile, tw.bench_z)
     inserts = flange_joint(profile, layout).thread_holes()  # the dome's screws' insert pockets, as the joint declares
     pins = register(profile, layout).lower_holes()  # the dome's register pins, pressed in (none printed when drilled in place)
@@ -43,8 +51,12 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
     on_board = "" if b is None else (
         f"; it stands on the {b.title}: the sample point over a tapped hole, the tongue along a row of holes, "
         f"screwed down on the grid through its pad and the boss under the disc")
+    fit = holder_fit(2 * holder.radius, where=profile.where("sample_holder", "radius"))
     desc = ("base plate, the rig's datum: the dome's flange screws into its heat-set inserts; the sample holder slides "
-            "into its bore (the groove under the disc on the tongue's side is the calibration parts' turn mark); "
+            f"into its bore, drawn at {bore_drawn(profile):g} mm, printed under by the printer's hole shrink and "
+            f"bored (or reamed) to {fit.size:g} {fit.hole} on a mill, square to the plate's top face, before anything "
+            "is fitted "
+            "(the groove under the disc on the tongue's side is the calibration parts' turn mark); "
             "its tongue locates the tower's column " + (
                 f"by two {profile.datum.dowel_diameter:g} mm dowels (reamed H7) and four bolts"
                 if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core")
@@ -73,13 +85,31 @@ def azimuth_groove(profile: Profile, bench_z: float) -> Box:
     return Box((r0, -w, min(bench_z, -t) - 1.0), (r0 + GROOVE_LENGTH_MM, w, -t + GROOVE_DEPTH_MM))
 
 
-def holder_body(profile: Profile, top_z: float, marks: tuple[tuple[float, float], ...] = ()) -> Cylinder | Union_ | Difference:
-    """Holder cylinder up to ``top_z`` with its stop collar under the plate. ``marks``: notches in the
+def bore_drawn(profile: Profile) -> float:
+    """The sample bore as drawn (mm, its diameter): its finished size, bored (or reamed) to the fit's hole
+    (:func:`rigcad.parts.locating.holder_fit`); a printed hole comes out smaller by the printer's hole
+    shrink (rigcad.parts.process), which is the boring's stock."""
+    return 2 * profile.sample_holder.radius
+
+
+def holder_drawn(profile: Profile, turned: bool) -> float:
+    """A plug's body as drawn (mm, its diameter): ``turned`` (the sample holder, which stands for the
+    sample point O: turned from bar), the finished size, turned to the fit's shaft; else (the camera's
+    cross and the calibration kit's plugs, printed) ``sample_holder.clearance`` each side under the
+    finished bore."""
+    d = 2 * profile.sample_holder.radius
+    return d if turned else d - 2 * profile.sample_holder.clearance
+
+
+def holder_body(profile: Profile, top_z: float, marks: tuple[tuple[float, float], ...] = (),
+                turned: bool = False) -> Cylinder | Union_ | Difference:
+    """Holder cylinder up to ``top_z`` with its stop collar under the plate (its body :func:`holder_drawn`:
+    ``turned`` to the sliding fit, else a printed plug's clearance). ``marks``: notches in the
     collar's rim as (azimuth rad from +x, radius mm) (:data:`NOTCH_MM`): the plug turned so that
     one faces the base plate's groove (:func:`azimuth_groove`) stands at that notch's turn."""
     t = profile.base_plate.thickness
     h = profile.sample_holder
-    body = Cylinder((0.0, 0.0, -t), h.radius, top_z + t)
+    body = Cylinder((0.0, 0.0, -t), holder_drawn(profile, turned) / 2, top_z + t)
     collar = Cylinder((0.0, 0.0, -t - h.stop_thickness), h.stop_radius, h.stop_thickness)
     if not marks:
         return Union_((body, collar))
@@ -90,10 +120,36 @@ def holder_body(profile: Profile, top_z: float, marks: tuple[tuple[float, float]
 
 
 def sample_holder(profile: Profile, layout: RigLayout) -> Part:
-    top = -profile.sample_holder.sample_thickness
-    return Part("sample_holder", holder_body(profile, top), (0.2, 0.45, 0.7),
-                f"sample holder for a {profile.sample_holder.sample_thickness:g} mm sample: its top surface "
-                "lands on the design point")
+    h = profile.sample_holder
+    top = -h.sample_thickness
+    return Part("sample_holder", holder_body(profile, top, turned=True), (0.2, 0.45, 0.7),
+                f"sample holder for a {h.sample_thickness:g} mm sample: its top surface lands on the design point; "
+                + turning_text(profile), bought=holder_stock(profile))
+
+
+#: Turning allowance (mm) on the bar's diameter over the holder's collar, and on its length (facing both ends
+#: and parting off).
+BAR_ALLOWANCE_MM, BAR_LENGTH_ALLOWANCE_MM = 4.0, 5.0
+
+
+def holder_stock(profile: Profile) -> str:
+    """The bar the sample holder is turned from, as one orders it (aluminium EN AW-6082, the collar's
+    diameter and the holder's length with their allowances, rounded up to whole millimetres)."""
+    h, t = profile.sample_holder, profile.base_plate.thickness
+    length = t - h.sample_thickness + h.stop_thickness
+    return (f"aluminium round bar EN AW-6082 T6, {math.ceil(2 * h.stop_radius + BAR_ALLOWANCE_MM):d} mm diameter x "
+            f"{math.ceil(length + BAR_LENGTH_ALLOWANCE_MM):d} mm: turned to the drawing")
+
+
+def turning_text(profile: Profile) -> str:
+    """The shop step for the sample holder, the sample point O in the bore: turned from bar on a lathe, its
+    body to the fit's shaft (:func:`rigcad.parts.locating.holder_fit`) and its top face square to it, so
+    that it sits on the bore's axis to half the fit's largest clearance."""
+    fit = holder_fit(2 * profile.sample_holder.radius, where=profile.where("sample_holder", "radius"))
+    lo, hi = fit.clearance
+    return (f"turned from bar on a lathe ({holder_stock(profile)}): its body {fit.size:g} {fit.shaft} (measured with "
+            f"a micrometer), its top face square to it, in the base plate's bore bored to {fit.size:g} {fit.hole}: "
+            f"{fit.describe()}, so it sits within {hi / 2:.3f} mm of the bore's axis")
 
 
 def base_cross(profile: Profile, layout: RigLayout) -> Part:

@@ -20,8 +20,8 @@ import numpy as np
 
 from rigcad.errors import GeometryError
 from rigcad.parts.joints import ScrewJoint, datums_of
-from rigcad.parts.locating import (INDICATOR_MM, PIN_FIT_MM, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole,
-                                   foil_step, set_screw_length, stepped_hole, teardrop_along_y)
+from rigcad.parts.locating import (INDICATOR_MM, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole, foil_step,
+                                   holder_fit, reamers, set_screw_length, stepped_hole, teardrop_along_y)
 from rigcad.parts.layout import RigLayout, u_at_height
 from rigcad.parts.washers import washers_over
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Union_
@@ -119,7 +119,7 @@ def indicating(profile: Profile, layout: RigLayout) -> ShimStop:
     indicator's graduation and held there by the register drilled in place (its pins' fit), over
     :func:`indicate_travel` each way."""
     return ShimStop("dome indicated in from the sample bore, its register drilled in place", "dome", "lateral",
-                    indicate_travel(profile, layout), INDICATOR_MM + PIN_FIT_MM / 2, 0.0,
+                    indicate_travel(profile, layout), INDICATOR_MM + register(profile, layout).repeatability[0], 0.0,
                     f"a dial test indicator ({INDICATOR_MM:g} mm) on an arm turning in the sample bore sweeps the "
                     "mirror's lower edge; tap the dome over until it reads within one graduation all round, bolt it, "
                     "drill and ream the plate through the flange's round hole and slot, press the pins in")
@@ -249,9 +249,16 @@ def indicating_text(profile: Profile, layout: RigLayout, reg: DowelRegister | No
     return (
         f"Centre the dome on the sample bore before its register pins go in: stand it on the base plate, its "
         f"{thread} bolts snug (a quarter of their torque) through its {hole:.2f} mm holes on large washers (ISO 7093); put a dial "
-        f"test indicator ({INDICATOR_MM:g} mm graduation) on an arm that turns in the sample bore on a plug of "
-        "the sample holder's size, its tip on the mirror's lower edge; turn it round and tap the dome over "
+        f"test indicator ({INDICATOR_MM:g} mm graduation) on an arm on the sample holder, turning in the sample "
+        f"bore ({holder_fit(2 * profile.sample_holder.radius).describe()}: the bore bored and the holder turned "
+        "to it first), its tip on the mirror's lower edge; turn it round and tap the dome over "
         f"until the reading varies by no more than one graduation (it has {INDICATE_TRAVEL_MM:g} mm of travel "
-        f"each way). Tighten the bolts to their torque; check again. Drill the plate {reg.diameter:g} mm through "
-        f"the flange's round hole and its slot, {reg.lower_depth:.1f} mm deep, ream, and press the pins "
-        f"({reg.item}) in. The dome then lifts off and goes back to within {reg.repeatability[0]:g} mm.")
+        f"each way). Tighten the bolts to their torque; check again. With {reamers(reg.diameter)}: drill the "
+        f"plate {reg.drill:g} mm through the flange's round hole (printed at {reg.drill:g} mm: the drill opens it "
+        f"too) and its slot, {reg.lower_depth:.1f} mm deep (a depth stop on the drill: blind holes, whose floors "
+        f"keep the pins from walking), ream both plate holes {reg.diameter:g} {reg.press.hole} through the flange, "
+        f"lift the dome off, ream the flange's round hole {reg.diameter:g} {reg.slip.hole} and file its slot until "
+        f"a pin slides along it but not across. Press the pins ({reg.item}) into the plate with a vise until "
+        f"{reg.upper_engagement:g} mm stands proud: {reg.press.describe()}; the flange slides on them, "
+        f"{reg.slip.describe()}. The dome then lifts off and goes back to within "
+        f"{reg.repeatability[0]:.3f} mm.")

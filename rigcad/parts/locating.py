@@ -2,7 +2,12 @@
 
 A :class:`DowelRegister` is two ISO 8734 dowel pins (m6) pressed into the ``lower`` part, over which
 the ``upper`` part drops: the first pin in a round hole, the second in a slot along the line between
-them. The round hole fixes the upper part's place, the slot its turn, and the slot leaves it free
+them. The fits are ISO 286's (rigcad.standards): the press end, the pin in the lower part's blind hole
+reamed N7 (interference over the whole zones: the pin never works loose, and the hole's floor keeps it
+from walking down); the slip end, the pin in the upper part's round hole reamed F7 (a sliding fit: the
+upper part lifts off); the slot filed until the pin slides along it. Every pin hole is printed at the
+twist drill's size before the reamer (the reamer's size less its reaming allowance, standards.pre_ream_drill):
+whatever a printer's hole shrink, drilling it to that size leaves the reamer its stock. The round hole fixes the upper part's place, the slot its turn, and the slot leaves it free
 along that line, so a printed part's scale error between the two pins cannot bind it (two round holes
 would, by the scale error over their distance). Lifted off and set back, the upper part returns to
 within the pins' fit; its screws only clamp it (their holes are cleared for the print's scale and
@@ -25,16 +30,29 @@ the place, so the setting does not creep with the screw.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from rigcad.errors import GeometryError
 from rigcad.parts.recipe import Box, Cylinder, Line, Prism, Revolve, Section, Translate
-from rigcad.standards import INSERTS, SHIM_FOIL, THREADS, longest_dowel, shortest_set_screw
+from rigcad.standards import (DOWEL_PRESS_HOLE, DOWEL_SHAFT, DOWEL_SLIP_HOLE, INSERTS, SHIM_FOIL, THREADS, Fit,
+                               longest_dowel, pre_ream_drill, shortest_set_screw)
 
-#: Worst-case diametral clearance (mm) of an ISO 8734 m6 pin (+0.004..+0.012 mm for 3..6 mm) in a
-#: hole reamed H7 (0..+0.012 mm): 0.012 - 0.004 = 0.008 mm in the upper part's hole; the lower part
-#: holds its pin by a press fit (the hole reamed a size under, or the pin glued: no play).
-PIN_FIT_MM = 0.008
+
+def press_fit(diameter: float) -> Fit:
+    """An ISO 8734 pin's press end (rigcad.standards.DOWEL_PRESS_HOLE over m6) at ``diameter`` mm."""
+    return Fit(diameter, DOWEL_PRESS_HOLE, DOWEL_SHAFT, "press")
+
+
+def slip_fit(diameter: float) -> Fit:
+    """An ISO 8734 pin's slip end (rigcad.standards.DOWEL_SLIP_HOLE over m6) at ``diameter`` mm."""
+    return Fit(diameter, DOWEL_SLIP_HOLE, DOWEL_SHAFT, "slip")
+
+
+def reamers(diameter: float) -> str:
+    """The tools a ``diameter`` mm pin's holes take, as the bill and the steps name them."""
+    return (f"a {pre_ream_drill(diameter):g} mm twist drill (DIN 338), {diameter:g} mm {DOWEL_PRESS_HOLE} and "
+            f"{diameter:g} mm {DOWEL_SLIP_HOLE} hand reamers")
+
 #: The slot across its pin (mm): printed at the pin's size and filed until the pin slides in it.
 SLOT_FIT_MM = 0.05
 #: The pin stops this far short of the upper part's top face (mm), and its hole in the lower part
@@ -46,6 +64,25 @@ PIN_SHORT_MM, PIN_BOTTOM_MM = 1.0, 0.5
 SHIM_PACK_MM = 1.5
 #: A dial test indicator's graduation (mm): 0.01 mm, the common lever-type indicator (DIN 2270).
 INDICATOR_MM = 0.01
+
+
+#: The sample holder's fit in the base plate's bore (ISO 286, the preferred sliding fit): the bore bored
+#: (or reamed) H7 and the holder turned from bar g6, so that the sample point O sits on the bore's axis to half the
+#: fit's largest clearance (a printed holder in a printed bore floats by their clearance and both prints'
+#: errors).
+HOLDER_HOLE, HOLDER_SHAFT = "H7", "g6"
+
+
+def holder_fit(diameter: float, param: str = "sample_holder.radius", where: str | None = None) -> Fit:
+    """The sample holder's fit at its ``diameter`` mm (:data:`HOLDER_HOLE` over :data:`HOLDER_SHAFT`);
+    GeometryError naming ``param`` when ISO 286's table in rigcad.standards does not reach it."""
+    fit = Fit(diameter, HOLDER_HOLE, HOLDER_SHAFT, "sliding")
+    try:
+        fit.clearance
+    except ValueError as err:
+        raise GeometryError(f"the sample holder's {diameter:g} mm fit: {err}; a holder of at most 50 mm across",
+                            param=param, where=where) from err
+    return fit
 
 
 @dataclass(frozen=True)
@@ -112,18 +149,52 @@ class DowelRegister:
 
     @property
     def item(self) -> str:
-        return f"dowel pin, ISO 8734 m6, {self.diameter:g} x {self.length} mm (hardened steel)"
+        return (f"dowel pin, ISO 8734 m6, {self.diameter:g} x {self.length} mm (hardened steel; pressed in "
+                f"{self.diameter:g} {DOWEL_PRESS_HOLE}, slides in {self.diameter:g} {DOWEL_SLIP_HOLE})")
+
+    @property
+    def press(self) -> Fit:
+        """The press end: a pin in the lower part's hole (ISO 286)."""
+        return press_fit(self.diameter)
+
+    @property
+    def slip(self) -> Fit:
+        """The slip end: a pin in the upper part's round hole (ISO 286)."""
+        return slip_fit(self.diameter)
+
+    @property
+    def drill(self) -> float:
+        """The holes' printed size and the twist drill before the reamers (mm): standards.pre_ream_drill."""
+        return pre_ream_drill(self.diameter)
 
     @property
     def repeatability(self) -> tuple[float, float]:
         """(lateral mm, turn rad) to which the upper part returns when set back on its pins, worst case:
-        half the round hole's fit, and the slot's fit across its pin over the pins' spacing."""
-        return PIN_FIT_MM / 2, SLOT_FIT_MM / self.spacing
+        half the round hole's slip fit at its loosest, and the slot's fit across its pin over the pins'
+        spacing."""
+        return self.slip.clearance[1] / 2, SLOT_FIT_MM / self.spacing
+
+    def shop_text(self) -> str:
+        """The manual's shop step for a register whose holes are printed (one paragraph, the fits and
+        tools by name); a register drilled in place has its part's own (``procedure``)."""
+        if self.procedure:
+            return self.procedure
+        lower, upper = self.lower.replace("_", " "), self.upper.replace("_", " ")
+        return (f"The {lower}'s two pin holes and the {upper}'s round hole print at {self.drill:g} mm: drill each "
+                f"{self.drill:g} mm (a hole that printed small), ream the {lower}'s holes {self.diameter:g} "
+                f"{DOWEL_PRESS_HOLE} (their blind floors, {self.lower_depth:.1f} mm deep, stop the pins) and the "
+                f"{upper}'s round hole {self.diameter:g} {DOWEL_SLIP_HOLE}; file its slot until a pin slides along "
+                f"it but not across. Press the pins ({self.item}) into the {lower} with a vise until "
+                f"{self.upper_engagement:g} mm stands proud: {self.press.describe()}; the {upper} slides on them, "
+                f"{self.slip.describe()}.")
 
     def lower_holes(self) -> tuple[Cylinder, ...]:
-        """The pins' holes in the lower part, from its top face (printed at the pin's size, reamed);
-        none for a register drilled in place (its holes are drilled through the upper part's)."""
-        return () if self.drilled else self.lower_zones()
+        """The pins' blind holes in the lower part, from its top face, printed at :attr:`drill`'s size
+        (drilled, then reamed to the press fit); none for a register drilled in place (its holes are
+        drilled through the upper part's)."""
+        if self.drilled:
+            return ()
+        return tuple(replace(c, radius=self.drill / 2) for c in self.lower_zones())
 
     def lower_zones(self) -> tuple[Cylinder, ...]:
         """Where the pins' holes are (or will be drilled) in the lower part, at the nominal places: a
@@ -133,12 +204,13 @@ class DowelRegister:
                      for x, y in self.points)
 
     def upper_holes(self) -> tuple:
-        """The round hole over the first pin and the slot over the second (along the line from the
-        first, which runs along x or y), through the upper part."""
+        """The round hole over the first pin (printed at :attr:`drill`'s size, drilled and reamed to the
+        slip fit) and the slot over the second (along the line from the first, which runs along x or y;
+        printed at the pin's width and filed until it slides), through the upper part."""
         z0, z1 = self.upper_z
         r = self.diameter / 2
         (x0, y0), (x1, y1) = self.points
-        hole = Cylinder((x0, y0, z0 - 1.0), r, z1 - z0 + 2.0)
+        hole = Cylinder((x0, y0, z0 - 1.0), self.drill / 2, z1 - z0 + 2.0)
         along_x = abs(y1 - y0) < 1e-9
         dx, dy = (self.slot / 2, 0.0) if along_x else (0.0, self.slot / 2)
         # the slot's round ends (revolved: the bill does not take them for bolts' holes)
@@ -216,5 +288,5 @@ def teardrop_along_y(centre: tuple[float, float, float], radius: float, length: 
     return Translate(Prism(Section(segs), length), tuple(float(v) for v in centre))
 
 
-__all__ = ["DowelRegister", "INDICATOR_MM", "PIN_FIT_MM", "SHIM_PACK_MM", "SLOT_FIT_MM", "ShimStop", "bolt_hole",
+__all__ = ["DowelRegister", "HOLDER_HOLE", "HOLDER_SHAFT", "holder_fit", "INDICATOR_MM", "SHIM_PACK_MM", "press_fit", "reamers", "slip_fit", "SLOT_FIT_MM", "ShimStop", "bolt_hole",
            "foil_step", "set_screw_length", "stepped_hole", "teardrop_along_y"]

@@ -17,10 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigcad.parts.layout import RigLayout
-from rigcad.parts.locating import SHIM_PACK_MM, ShimStop, foil_step, set_screw_length, stepped_hole, teardrop_along_y
+from rigcad.parts.locating import (SHIM_PACK_MM, ShimStop, foil_step, press_fit, set_screw_length, stepped_hole,
+                                   teardrop_along_y)
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Solid, Union_
 from rigcad.profile.schema import Profile
-from rigcad.standards import INSERTS, SHIM_FOIL, THREADS, dowel_diameter_for, longest_dowel
+from rigcad.standards import INSERTS, SHIM_FOIL, THREADS, dowel_diameter_for, longest_dowel, pre_ream_drill
 
 
 #: The stem enters the clamp and the paraboloid's back by this much (mm) so that the booleans fuse
@@ -63,10 +64,17 @@ class Mount:
 
     @property
     def pin_hole(self) -> Solid:
-        """The pin's blind hole in the beam (drilled to the pin's size, the pin pressed in), open at the
-        beam's top."""
+        """The pin's blind hole in the beam, open at the beam's top: printed at the drill's size before
+        the reamer (rigcad.standards.pre_ream_drill), drilled, reamed to the press fit
+        (rigcad.parts.locating.press_fit) and the pin pressed in; its floor stops the pin walking down."""
         p = self.pin
-        return stepped_hole(p.base[0], p.base[1], p.base[2] - 0.5, ((p.radius, p.height + 0.5 - self.pin_proud + 1.0),))
+        drill = pre_ream_drill(2 * p.radius)
+        return stepped_hole(p.base[0], p.base[1], p.base[2] - 0.5, ((drill / 2, p.height + 0.5 - self.pin_proud + 1.0),))
+
+    @property
+    def pin_depth(self) -> float:
+        """How deep the pin's blind hole runs into the beam from its top (mm)."""
+        return self.pin.height + 0.5 - self.pin_proud
 
     @property
     def pin_proud(self) -> float:
@@ -148,10 +156,12 @@ def hardware(profile: Profile, layout: RigLayout) -> list[dict]:
         {"item": f"heat-set insert (ruthex, {INSERTS[SET_SCREW].length:g} mm long)", "thread": SET_SCREW,
          "length_mm": None, "quantity": 1 + 4, "steps": ("paraboloid", "dome"),
          "joins": "the set screws' inserts: one in the clamp's +y wall, two in each of the beam's seats"},
-        {"item": "dowel pin, ISO 8734 m6 (hardened steel)", "thread": None, "length_mm": m.pin_length,
-         "diameter_mm": d, "quantity": 1, "steps": ("beam",),
-         "joins": f"the paraboloid's x stop: drill the beam's hole {d:g} mm and press the pin in until "
-                  f"{m.pin_proud:g} mm stands proud of its top"},
+        {"item": f"dowel pin, ISO 8734 m6 (hardened steel; pressed in {d:g} {press_fit(d).hole})", "thread": None,
+         "length_mm": m.pin_length, "diameter_mm": d, "quantity": 1, "steps": ("beam",),
+         "joins": f"the paraboloid's x stop: the beam's blind hole prints at {pre_ream_drill(d):g} mm; drill it "
+                  f"{pre_ream_drill(d):g} mm, {m.pin_depth:g} mm deep, ream it {d:g} {press_fit(d).hole} "
+                  f"(a {d:g} mm {press_fit(d).hole} hand reamer) and press the pin in with a vise until {m.pin_proud:g} mm stands proud of its "
+                  f"top: {press_fit(d).describe()}"},
         {"item": "set screw, flat point (ISO 4026)", "thread": SEAT_SCREW, "length_mm": seats.screw_length,
          "quantity": 4, "steps": ("beam",), "joins": "the beam on its two seats: in each seat one down through its "
                                                      "roof, one across through its +y wall"},

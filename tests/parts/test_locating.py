@@ -53,11 +53,14 @@ def test_the_pins_holes_are_cut_from_the_declaration(table31_rig, tmp_path):
     datums = [d for d in table31_rig.recipes["base_plate"].datums if d.kind == "register"]
     assert sorted(round(d.centre[1], 3) for d in datums) == [round(-r, 3), round(r, 3)]
     assert reg.lower_depth + reg.upper_engagement == pytest.approx(reg.length + 0.5)
-    # the flange: a round hole at +y, and the slot's two ends at -y +- half its extra length
+    # the flange: a round hole at +y printed at the drill's size before the reamers (3.8 mm for 4 mm pins:
+    # a 0.2 mm reaming allowance), and the slot's two ends at -y +- half its extra length, at the pin's width
+    assert reg.drill == pytest.approx(reg.diameter - 0.2) if reg.diameter <= 5 else reg.drill < reg.diameter
+    hole = [h for h in _holes(table31_rig, "dome", tmp_path, reg.drill / 2) if abs(h[0]) < 1e-3 and abs(h[1] - r) < 1e-3]
     flange = [h for h in _holes(table31_rig, "dome", tmp_path, reg.diameter / 2)
               if abs(h[0]) < 1e-3 and abs(abs(h[1]) - r) < reg.slot]
     ends = sorted(round(y, 3) for _, y, _ in flange if y < 0)
-    assert [y for _, y, _ in flange if y > 0] == [round(r, 3)]
+    assert [y for _, y, _ in hole] == [round(r, 3)] and not [y for _, y, _ in flange if y > 0]
     assert ends == pytest.approx([-r - reg.slot / 2, -r + reg.slot / 2], abs=1e-3)
 
 
@@ -74,7 +77,7 @@ def test_moving_the_declaration_moves_both_parts_holes_the_bill_and_the_step(tab
     monkeypatch.setattr(base, "register", moved)
     rig = Rig.from_profile(table31)
     reg = _register(rig)
-    plate = [(x, y) for x, y, _ in _holes(rig, "base_plate", tmp_path, reg.diameter / 2) if abs(x) < 1e-3]
+    plate = [(x, y) for x, y, _ in _holes(rig, "base_plate", tmp_path, reg.drill / 2) if abs(x) < 1e-3]
     assert plate == [(0.0, round(-reg.points[0][1], 3)), (0.0, round(reg.points[0][1], 3))]
     steps = plan.steps(rig, picture_meshes(rig))[0]
     rows = plan.bill_hardware(rig, steps, {"fasteners": [], "pins": None})
@@ -108,3 +111,53 @@ def test_pins_among_crowded_bolts_are_refused_naming_the_key(tmp_path):
     rig = rigcad.load(path)
     with pytest.raises(GeometryError, match="dome_shell.bolts"):
         rig.recipe("dome")
+
+
+def test_each_pin_end_has_its_iso_286_fit_its_reamer_and_a_blind_hole(table31_rig):
+    """The press end interferes over the whole zones (N7 over m6), the slip end slides but for the zones'
+    worst pair (F7 over m6: at most 2 um tight, which the printed wall takes); the repeatability is half
+    the slip end's loosest; the lower part's holes are blind (their floor stops the pin), printed at the
+    drill's size; the step names the drill and both reamers, the bill's line both fits."""
+    reg = _register(table31_rig)
+    press, slip = reg.press.clearance, reg.slip.clearance
+    # ISO 286-2 at 4 mm (3-6 mm): N7 -0.016..-0.004, F7 +0.010..+0.022, m6 +0.004..+0.012
+    assert press == pytest.approx((-0.028, -0.008), abs=1e-12) and press[1] < 0
+    assert slip == pytest.approx((-0.002, 0.018), abs=1e-12) and slip[1] > 0 and slip[0] >= -0.002
+    assert reg.repeatability[0] == pytest.approx(slip[1] / 2)
+    assert "N7" in reg.item and "F7" in reg.item
+    text = dome.indicating_text(table31_rig.profile, table31_rig.layout, reg)
+    for words in (f"{reg.drill:g} mm twist drill", f"{reg.diameter:g} N7", f"{reg.diameter:g} F7", "blind",
+                  f"{reg.lower_depth:.1f} mm deep"):
+        assert words in text, words
+    # a register whose holes are printed (not drilled in place): blind holes from the lower part's top face,
+    # at the drill's size, their floors above the lower part's underside
+    printed = DowelRegister("r", "a", "b", 4.0, ((0.0, 0.0), (30.0, 0.0)), (0.0, 8.0), (-10.0, 0.0), 0.3)
+    for c in printed.lower_holes():
+        assert c.radius == pytest.approx(printed.drill / 2)
+        assert c.base[2] > -10.0 and c.base[2] == pytest.approx(-printed.lower_depth)
+    assert "N7" in printed.shop_text() and "F7" in printed.shop_text() and "blind" in printed.shop_text()
+
+
+def test_the_parts_page_states_the_fits_the_code_computes(table31_rig):
+    """docs/parts.md's fits paragraph, figure by figure, from the code (the holder's fit, the register's,
+    the drawn sizes, the stop pin's)."""
+    from pathlib import Path
+
+    from rigcad.fab.stack import sample_link
+    from rigcad.parts.locating import holder_fit, press_fit
+    from rigcad.standards import pre_ream_drill
+
+    paraboloid = importlib.import_module("rigcad.parts.paraboloid")
+    text = " ".join((Path(__file__).resolve().parents[2] / "docs" / "parts.md").read_text(encoding="utf-8").split())
+    p, lay = table31_rig.profile, table31_rig.layout
+    fit, reg = holder_fit(2 * p.sample_holder.radius), _register(table31_rig)
+    pin = 2 * paraboloid.mount(p, lay).pin.radius
+    for words in (f"drawn at {base.bore_drawn(p):g} mm, it prints under by the printer's hole shrink and is bored to "
+                  f"{fit.size:g} {fit.hole}", f"turned from aluminium bar (a bought part, never printed) to {fit.size:g} "
+                  f"{fit.shaft}: {fit.describe()}", f"within {sample_link(p).lateral:.3f} mm of the bore's axis",
+                  f"plugs are printed, at {base.holder_drawn(p, False):g} mm",
+                  f"reamed N7, {reg.press.describe()}", f"reamed F7, {reg.slip.describe()}",
+                  f"returns to within {reg.repeatability[0]:.3f} mm", f"at the {reg.drill:g} mm drill's size",
+                  f"a {reg.diameter - reg.drill:.1f} mm reaming allowance", f"the beam's {pin:g} mm stop pin",
+                  f"{press_fit(pin).describe()}, in a {pre_ream_drill(pin):g} mm hole"):
+        assert words in text, words

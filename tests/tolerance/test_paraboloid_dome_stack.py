@@ -63,7 +63,7 @@ def test_each_stop_serves_its_axis_at_a_quarter_of_the_tolerance(table31_rig):
     assert stops["tilt"].resolution == pytest.approx(step / seats.span) and stops["tilt"].resolution <= tol.paraboloid_tilt / 4
     assert stops["tilt"].range == pytest.approx(2 * LOC.SHIM_PACK_MM / seats.span)
     ind = dome.indicating(p, lay)
-    assert ind.resolution == LOC.INDICATOR_MM + LOC.PIN_FIT_MM / 2 <= tol.dome_offset / 4
+    assert ind.resolution == LOC.INDICATOR_MM + dome.register(p, lay).repeatability[0] <= tol.dome_offset / 4
 
 
 @pytest.mark.parametrize("planted, element, axis, why", [
