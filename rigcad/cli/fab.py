@@ -13,6 +13,12 @@ def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.fab.printers import load_printer
 
     printer = load_printer(args.printer)  # first: a refused printer file costs no rig and no CAD kernel import
+    if args.gcode and printer.slicer == "prusa-slicer" and printer.slicer_config is None \
+            and printer.slicer_unavailable is None:  # no start G-code, no temperatures: refused before the work
+        from rigcad.errors import FabricationError
+        from rigcad.fab.slicer import generic_refusal
+
+        raise FabricationError(generic_refusal(printer))
     from rigcad import api
     from rigcad.export.build import select_parts
     from rigcad.progress import stages

@@ -15,7 +15,8 @@ order, later keys winning:
 3. the printer file's ``slicer.overrides``.
 
 A printer without presets (``slicer: prusa-slicer``) gets rigcad's generic configuration instead
-(no start G-code, no temperatures: only for trying a mesh).
+(no start G-code, no temperatures: only for trying a mesh by hand, ``printer.ini``); no G-code is
+made with it (:func:`generic_refusal`).
 
 Brim rule (presets only): a piece gets a BRIM_WIDTH brim when its contact with the bed is small
 (area below BRIM_MIN_CONTACT) or it is slender (height above BRIM_MAX_SLENDERNESS times the
@@ -128,6 +129,17 @@ def _generic(printer: Printer, support: bool) -> dict[str, str]:
         "fill_density": "20%",
         "perimeters": "3",
     }
+
+
+def generic_refusal(printer: Printer) -> str:
+    """Why rigcad's generic configuration (``slicer: prusa-slicer``, no presets) makes no G-code to
+    print: it states no start G-code (no homing, no bed levelling) and no temperatures, so PrusaSlicer
+    writes a cold bed (bed_temperature = 0) and its default nozzle temperature for whatever the
+    filament is."""
+    return (f"printer '{printer.name}' has no PrusaSlicer presets (slicer: prusa-slicer is rigcad's generic "
+            "configuration: no start G-code, no temperatures, the bed at 0 C), so no G-code is made for it; name "
+            "the machine's presets (slicer: vendor_bundle, printer_preset, ...), a PrusaSlicer printer preset as "
+            "--printer, or its own settings exported from PrusaSlicer as a .ini (docs/instruments.md, 'Your printer')")
 
 
 def printer_ini(printer: Printer, support: bool, piece: dict[str, str] | None = None) -> str:
@@ -259,7 +271,8 @@ def slice_job(printer: Printer, name: str, stl: bytes, support: bool, center: tu
     """The slicing job for one piece in print position: its configuration with rigcad's
     per-piece settings (printers with presets) and the reason it cannot run, if any."""
     if printer.slicer_config is None:
-        return SliceJob(name, stl, printer_ini(printer, support), center, problem=printer.slicer_unavailable)
+        return SliceJob(name, stl, printer_ini(printer, support), center,
+                        problem=printer.slicer_unavailable or generic_refusal(printer))
     settings, rec = placement(printer, footprint(stl))
     rec["support_material"] = support
     return SliceJob(name, stl, printer_ini(printer, support, settings), center, tuple(sorted(rec.items())))

@@ -156,3 +156,31 @@ def test_a_printer_preset_by_its_name_is_a_printer(monkeypatch):
     assert load_printer("vantage_i").name == "vantage_i"  # a name without a space reads no bundle
     with pytest.raises(ProfileError, match="no printer 'nosuch'"):
         load_printer("nosuch")
+
+
+GENERIC = ("process: fdm\nbuild_volume: {x: 256 mm, y: 256 mm, z: 256 mm}\nlayer_height: 0.2 mm\nnozzle: 0.4 mm\n"
+           "filament_diameter: 1.75 mm\nmaterial_density_g_cm3: 1.24\nslicer: prusa-slicer\n")
+
+
+def test_no_gcode_without_start_gcode_and_temperatures(tmp_path, monkeypatch):
+    """A printer with no presets (an X1C written as `slicer: prusa-slicer`) would get G-code with a cold
+    bed and no start code: `fab --gcode` refuses it in one line before any rig, and the slicing job
+    carries the same refusal for a caller of the fab stage."""
+    from rigcad.cli import main
+    from rigcad.fab import slicer as S
+    from rigcad.rig import Rig
+
+    path = tmp_path / "x1c.yaml"
+    path.write_text(GENERIC)
+
+    def no_rig(*args, **kwargs):
+        raise AssertionError("a rig was built")
+
+    monkeypatch.setattr(Rig, "from_profile", no_rig)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        code = main(["fab", "achutha2006", "--printer", str(path), "--gcode", "--exports", str(tmp_path / "x")])
+    lines = err.getvalue().splitlines()
+    assert code != 0 and len(lines) == 1 and "no start G-code" in lines[0] and "bed at 0 C" in lines[0], lines
+    job = S.slice_job(load_printer(path), "cube", b"", False, (128.0, 128.0))
+    assert job.problem and "no G-code is made" in job.problem
