@@ -36,7 +36,14 @@ PRINT_RESERVE = 0.5
 #: otherwise decide whether the written design builds. 1 um: 1e4 times those, nothing a print resolves.
 GEOMETRY_RESERVE = 1e-3
 #: Scale of one unit of violation, per unit, for the penalty merit (a constraint's g / scale).
-UNIT_SCALE = {"mm": 1.0, "deg": 0.1, "px/deg": 0.01, "": 0.001}
+UNIT_SCALE = {"mm": 1.0, "deg": 0.1, "px/deg": 0.01, "": 0.001, "count": 1.0}
+#: Rows of the closed-form dome (optics.dome.build_equal_path) the later stages' layout is made on:
+#: the layout reads the dome's meridian at a few heights (the flange, the seats, the top), which the
+#: closed form gives to the DOP853 dome's 2e-9 mm; the stack's verdicts on the certified and the
+#: closed-form rig agreed on all 8 preferred designs of achutha2006_optimize (measured).
+LATER_DOME_ROWS = 201
+#: The printer whose tolerance stack a design must hold when the optimize section names none.
+DEFAULT_STACK_PRINTER = "prusa_mk3s"
 
 
 @dataclass(frozen=True)
@@ -54,6 +61,8 @@ class Problem:
     base: Profile
     spec: OptimizeSpec
     printer: PrinterFacts | None
+    #: The printer fab's tolerance stack is reckoned on (rigcad.fab.printers.Printer; None: no later stages).
+    stack_printer: object = None
 
     @property
     def names(self) -> list[str]:
@@ -80,14 +89,58 @@ class Problem:
 
 
 def make_problem(profile: Profile, spec: OptimizeSpec) -> Problem:
+    from rigcad.fab.printers import load_printer
+
     facts = None
     if spec.constraints.printer is not None:
-        from rigcad.fab.printers import load_printer
-
         p = load_printer(spec.constraints.printer)
         facts = PrinterFacts(p.name, p.usable, float(p.nozzle if p.nozzle is not None else p.pixel),
                              float(p.material_density_g_cm3))
-    return Problem(profile, spec, facts)
+    stack_printer = load_printer(spec.constraints.printer or DEFAULT_STACK_PRINTER) if spec.constraints.later_stages \
+        else None
+    return Problem(profile, spec, facts, stack_printer)
+
+
+def custom_focal_length(profile: Profile, geometry: Derived) -> float | None:
+    """None when a stock focusing lens brings the design's paraboloid into the projector's focus range;
+    else the focal length (mm, to 0.1 mm) centred on it, checked to be reachable: the written design
+    names it (a custom lens). Raises GeometryError when no focal length can."""
+    from rigcad.errors import GeometryError
+    from rigcad.optics.focus import focusing_lens, ideal_focal_length
+
+    try:
+        focusing_lens(profile, geometry)
+        return None
+    except GeometryError:
+        f = round(ideal_focal_length(profile, geometry), 1)
+        focusing_lens(dataclasses.replace(profile, lens=dataclasses.replace(profile.lens, focal_length=f)), geometry)
+        return f
+
+
+def later_stages(problem: Problem, profile: Profile, geometry: Derived) -> dict[str, float]:
+    """The later stages' rules on one design, as constraint values (<= 0 when met): the rig's layout
+    and every part's recipe (what `rigcad design` and `stl` refuse before any solid: the tower and its
+    shelf, the splitter and its holder, the instruments against the dome, the seats, the flange; 1
+    when one refuses, else 0) and `rigcad fab`'s tolerance stack on the run's printer (the placements
+    it can neither hold nor adjust, counted), made on the closed-form dome (LATER_DOME_ROWS) with the
+    design's focusing lens (a custom one when no stock lens focuses it, as the written design names).
+    The same code those stages run; about 0.5 s a design (the layout's meridian searches)."""
+    from rigcad.errors import GeometryError
+    from rigcad.fab import stack as ST
+    from rigcad.optics.dome import build_equal_path
+    from rigcad.parts import make_layout, make_recipes
+
+    try:
+        f = custom_focal_length(profile, geometry)
+        if f is not None:
+            profile = dataclasses.replace(profile, lens=dataclasses.replace(profile.lens, focal_length=f))
+        layout = make_layout(profile, geometry, build_equal_path(geometry, LATER_DOME_ROWS))
+        make_recipes(profile, layout)
+    except GeometryError:
+        return {"later.layout_and_parts": 1.0}
+    pr = problem.stack_printer
+    refused = 0 if pr.process_errors is None else len(ST.stack(profile, layout, pr).refused)
+    return {"later.layout_and_parts": 0.0, "later.tolerance_stack": float(refused)}
 
 
 def apply(profile: Profile, keys: list[str], x) -> Profile:
@@ -161,6 +214,10 @@ def evaluate(problem: Problem, x) -> dict:
         g["raycheck.theta_max_coverage"] = (tg.theta_max - k * rc.theta_coverage_tolerance) / DEG - fig["theta_max_deg"]
         g["raycheck.min_px_per_deg"] = rc.min_px_per_deg / k - fig["px_per_deg_min"]
         g["raycheck.max_lost_fraction"] = fig["occluded_fraction"] - k * rc.max_lost_fraction
+    if problem.stack_printer is not None and all(v <= 0 for v in g.values()):
+        # the later stages' rules, on designs that meet every closed-form constraint (absent otherwise:
+        # the design is refused already, and they cost about half a second)
+        g.update(later_stages(problem, profile, geo))
     objectives = {name: float(fig[OBJECTIVES[name][0]]) for name, _ in spec.objectives}
     row.update(figures=fig, objectives=objectives, constraints=g, feasible=all(v <= 0 for v in g.values()),
                time_s=time.perf_counter() - t0, cpu_s=time.process_time() - c0)
@@ -174,6 +231,7 @@ CONSTRAINT_UNITS = {
     "printer.pieces": "mm", "min_feature.dome_wall": "mm", "min_feature.paraboloid_vertex": "mm",
     "max_cop_height": "mm", "max_occluded_fraction": "", "raycheck.theta_min_coverage": "deg",
     "raycheck.theta_max_coverage": "deg", "raycheck.min_px_per_deg": "px/deg", "raycheck.max_lost_fraction": "",
+    "later.layout_and_parts": "count", "later.tolerance_stack": "count",
 }
 #: What each constraint means, for messages (the profile key that sets its limit).
 CONSTRAINT_KEYS = {
@@ -195,6 +253,11 @@ CONSTRAINT_KEYS = {
     "raycheck.theta_max_coverage": "raycheck.theta_coverage_tolerance: theta must reach targets.theta_max",
     "raycheck.min_px_per_deg": "raycheck.min_px_per_deg: fewest projector pixels per degree",
     "raycheck.max_lost_fraction": "raycheck.max_lost_fraction: pixels the mount hides",
+    "later.layout_and_parts": "optimize.constraints.later_stages: the rig's layout and part recipes build (the "
+                              "tower, the splitter and the instruments against the dome; what rigcad design and stl "
+                              "refuse before any solid)",
+    "later.tolerance_stack": "optimize.constraints.later_stages: rigcad fab's tolerance stack on the printer holds or "
+                             "adjusts every placement (value: the placements refused)",
 }
 
 

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rigcad.engine import Engine
-from rigcad.optimize.problem import CONSTRAINT_UNITS, Problem, apply, make_problem
+from rigcad.optimize.problem import (CONSTRAINT_UNITS, DEFAULT_STACK_PRINTER, Problem, apply, custom_focal_length,
+                                     make_problem)
 from rigcad.errors import RigcadError
 from rigcad.optimize.search import OptimizeError, Result, infeasible_message, optimize, preference
 from rigcad.optimize.spec import COATING_TOTAL, OBJECTIVES, read_optimize
@@ -139,22 +140,8 @@ def certified_rig(problem: Problem, row: dict):
     raise AssertionError("unreachable")
 
 
-def _custom_focal_length(profile, geometry) -> float | None:
-    """None when a stock focusing lens brings the design's paraboloid into the projector's focus range;
-    else the focal length (mm, to 0.1 mm) centred on it, checked to be reachable: the written design
-    names it (a custom lens). Raises GeometryError when no focal length can."""
-    import dataclasses
-
-    from rigcad.errors import GeometryError
-    from rigcad.optics.focus import focusing_lens, ideal_focal_length
-
-    try:
-        focusing_lens(profile, geometry)
-        return None
-    except GeometryError:
-        f = round(ideal_focal_length(profile, geometry), 1)
-        focusing_lens(dataclasses.replace(profile, lens=dataclasses.replace(profile.lens, focal_length=f)), geometry)
-        return f
+#: The design's focusing lens (rigcad.optimize.problem.custom_focal_length), under its old name.
+_custom_focal_length = custom_focal_length
 
 
 def certify(problem: Problem, row: dict, also=None) -> dict:
@@ -205,10 +192,6 @@ def certify(problem: Problem, row: dict, also=None) -> dict:
             # room left between the projector's shelf and the dome's top beyond tower.clearance (mm)
             "tower_room_mm": None if rig.geometry.cop_at_infinity else
             shelf_bottom_z(rig.profile, rig.geometry.cop_z) - layout.dome_top_z - rig.profile.tower.clearance}
-
-
-#: The printer whose tolerance stack a design must hold when the optimize section names none.
-DEFAULT_STACK_PRINTER = "prusa_mk3s"
 
 
 def tolerance_stack(problem: Problem, rig) -> dict:

@@ -187,7 +187,10 @@ def _polish(ev: Evaluator, x0_unit: np.ndarray, budget: int, objective, bounds_o
 
     problem = ev.problem
     cache: dict[bytes, dict] = {}
-    names = [k for k in CONSTRAINT_UNITS]
+    # a fixed list for COBYLA: every constraint some design so far was judged on (a later stage's is judged
+    # only on designs that meet the closed-form ones: where it was not, it counts as met)
+    judged = set().union(*(r["constraints"] for r in ev.history.rows if r["constraints"]))
+    names = [k for k in CONSTRAINT_UNITS if k in judged]
 
     def row_at(u):
         u = np.clip(np.asarray(u, float), 0.0, 1.0)
@@ -208,7 +211,7 @@ def _polish(ev: Evaluator, x0_unit: np.ndarray, budget: int, objective, bounds_o
         r = row_at(u)
         if r["constraints"] is None:
             return -np.ones(len(names) + len(bounds_on)) * 1e3
-        vals = [-r["constraints"][k] / UNIT_SCALE[CONSTRAINT_UNITS[k]] for k in names if k in r["constraints"]]
+        vals = [-r["constraints"].get(k, 0.0) / UNIT_SCALE[CONSTRAINT_UNITS[k]] for k in names]
         sc = scaled_objectives(problem, r) if r["objectives"] is not None else None
         vals += [lim - sc[i] for i, lim in bounds_on]
         return np.array(vals, float)

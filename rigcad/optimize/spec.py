@@ -17,6 +17,7 @@ constraints and the search settings, validated with the profile's own rules (uni
         max_occluded_fraction: 0.06    # pixels the mount hides
         raycheck: true                 # the design-level checks of the raycheck section pass
         raycheck_margin: 0.03          # ... with 3 % of each limit to spare
+        later_stages: true             # the layout, part recipes and fab's tolerance stack hold (default)
       seed: 2006
       evaluations: 300                 # budget: global search + local polish
       workers: 1                       # processes (rigcad.engine); 0 = every core
@@ -50,7 +51,7 @@ OBJECTIVES: dict[str, tuple[str, str, float]] = {
 COATING_TOTAL = "coating.total"
 _SEARCH = {"parameters", "objectives", "constraints", "seed", "evaluations", "workers", "nodes"}
 _CONSTRAINTS = {"printer", "max_pieces", "max_cop_height", "min_feature_nozzles", "max_occluded_fraction",
-                "raycheck", "raycheck_margin"}
+                "raycheck", "raycheck_margin", "later_stages"}
 #: Default share of each raycheck limit kept in reserve (the 3D check measures on a finite fan of
 #: pixels and 1e5 seeded rays: its px/deg minimum and lost fraction differ from the exact ones by
 #: ~1e-3; see docs/optimize.md).
@@ -93,6 +94,9 @@ class Constraints:
     max_occluded_fraction: float | None = None
     raycheck: bool = True
     raycheck_margin: float = RAYCHECK_MARGIN
+    #: The later stages' rules as constraints of the search (rigcad.optimize.problem.later_stages):
+    #: the rig's layout and part recipes and fab's tolerance stack, on the closed-form dome.
+    later_stages: bool = True
 
 
 @dataclass(frozen=True)
@@ -113,7 +117,7 @@ class OptimizeSpec:
                 "constraints": {"printer": c.printer, "max_pieces": c.max_pieces,
                                 "max_cop_height_mm": c.max_cop_height, "min_feature_nozzles": c.min_feature_nozzles,
                                 "max_occluded_fraction": c.max_occluded_fraction, "raycheck": c.raycheck,
-                                "raycheck_margin": c.raycheck_margin},
+                                "raycheck_margin": c.raycheck_margin, "later_stages": c.later_stages},
                 "seed": self.seed, "evaluations": self.evaluations, "workers": self.workers,
                 "quadrature_nodes": self.nodes}
 
@@ -286,4 +290,8 @@ def _constraints(data, raw: RawProfile) -> Constraints:
     if data.get("raycheck_margin") is not None:
         margin = convert_value(Spec("float", "share", lo=0, hi=0.5), data["raycheck_margin"],
                                "optimize.constraints.raycheck_margin", at("raycheck_margin"))
-    return Constraints(printer, pieces, ceiling, nozzles, occluded, rc, margin)
+    later = data.get("later_stages", True)
+    if not isinstance(later, bool):
+        raise ProfileError(f"optimize.constraints.later_stages: expected true or false, got {later!r}"[:200],
+                           where=at("later_stages"))
+    return Constraints(printer, pieces, ceiling, nozzles, occluded, rc, margin, later)
