@@ -329,8 +329,8 @@ def _upright_kit(p, flat: int) -> str:
   channel under the slot and out below the base plate; the active area then starts {cal.upright_depth:g} mm
   under the sample plane, {cal.upright_offset:g} mm from the axis. It meets the rays that reach the sample
   near grazing, which pass under the flat screen or meet it past its edge.
-- The upright display is driven from outside, below the plate (the rig on the film test's blocks, the
-  dome on throughout): a Raspberry Pi with the module on its SPI pins as a framebuffer (the kernel's
+- The upright display is driven from outside, below the plate (the rig on its lifting blocks, the dome
+  on throughout): a Raspberry Pi with the module on its SPI pins as a framebuffer (the kernel's
   fbtft overlay for its driver), showing the PNGs of `patterns_upright/` full screen, unscaled, in the
   order of `patterns_upright/order.txt` (`fbi -T 1 -d /dev/fb1 -a -noverbose $(cat order.txt)`, run in that
   folder; the space bar steps to the next frame). Step it once per camera picture from the Pi's keyboard.

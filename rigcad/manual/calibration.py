@@ -245,6 +245,7 @@ def circle_page(rig, info: dict) -> bytes:
 #: Section 6's steps (its subsections, as the manual heads them), in the order the manual gives them.
 STEP_CROSSES = "Projector: the crosses and the backplate"
 STEP_CIRCLE = "Projector: the circle on the paraboloid"
+STEP_SEAT = "Projector: the splitter seat's three push screws"
 STEP_FILM = "The film at the sample plane"
 STEP_CAMERA = "Camera: the two crosses"
 STEP_CHECKER = "Camera pixels to paraboloid points: the checkerboard"
@@ -296,10 +297,13 @@ def kit_items(rig) -> list[KitItem]:
     f = film_setup(rig)
     cb = checkerboard(rig)
     holder = 2 * p.sample_holder.radius
+    seat = (STEP_SEAT,) if getattr(rig.layout, "tower", None) is not None else ()  # the seat is watched on the film
+    cal = getattr(p, "calibration", None)
+    upright = (STEP_AS_BUILT,) if cal is not None and cal.upright_turns else ()  # driven from below the lifted rig
     items = [
         KitItem("Matte drafting film, polyester, one side matte", "1 sheet (A4)",
                 f"{1e3 * f['film_thickness_mm']:g} µm thick; a disc of {f['film_diameter_mm']:.0f} mm is cut from it",
-                ("drafting film", "film"), (STEP_CIRCLE, STEP_FILM, STEP_ACCEPTANCE)),
+                ("drafting film", "film"), (*seat, STEP_CIRCLE, STEP_FILM, STEP_ACCEPTANCE)),
         KitItem("Low-tack masking tape, 19 mm", "1 roll", "paper, low tack (it comes off the plate clean)",
                 ("tape",), (STEP_FILM, STEP_ACCEPTANCE)),
         KitItem("Fine pen for film", "1", "permanent fineliner, 0.1-0.3 mm line, that marks polyester",
@@ -307,7 +311,8 @@ def kit_items(rig) -> list[KitItem]:
         KitItem("Blocks to lift the rig", "3",
                 f"1 x {f['block_under_tongue_mm']:g} mm and 2 x {f['block_under_disc_mm']:g} mm tall, each at least "
                 f"{BLOCK_FOOTPRINT_MM:g} x {BLOCK_FOOTPRINT_MM:g} mm, top and bottom flat and parallel (hardwood, "
-                "aluminium or printed solid), cut to height within 0.5 mm", ("blocks",), (STEP_FILM, STEP_ACCEPTANCE)),
+                "aluminium or printed solid), cut to height within 0.5 mm", ("blocks",),
+                (STEP_FILM, STEP_ACCEPTANCE, STEP_GRAY, *upright)),
         KitItem("Flat mirror for the view from below", "1",
                 f"front- or back-surface mirror at least {10 * math.ceil(2 * f['bore_radius_mm'] / 10):g} mm square, "
                 "propped at 45 deg on the bench (or a phone's camera looking up)", ("45 deg mirror",), (STEP_FILM,)),

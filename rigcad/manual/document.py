@@ -1164,7 +1164,7 @@ def _calibration_more(d: Doc, c, cam: dict) -> None:
         f"then at O's height, to the thinnest foil's {card['foil_mm'][0]:g} mm. Check with the steel straightedge "
         f"across the bore, on the plate's top either side: a {card['feeler_mm']:g} mm feeler leaf passes under it "
         "neither over the plate nor over the card. A card thicker than that pocket cannot reach O: use a thinner one. "
-        "It goes in from below, the dome on: the rig on the film test's blocks, take the sample holder out of the "
+        "It goes in from below, the dome on: the rig on its lifting blocks, take the sample holder out of the "
         "bore, lay the foil and the card on its top and push it back up until its collar stops.")
     d.p(manual_text(rig))  # the gray card command's own procedure (one home)
 
@@ -1327,7 +1327,7 @@ def _seat_section(d: Doc, c, seat: dict, springs: dict) -> None:
     key = SET_SCREW_KEY.get(seat["thread"])
     row = next((h for h in B.tower_hardware(c.rig) if h.get("spring_mm")), None)
     spring = f"{row['spring_mm']['installed_length']:g} mm" if row else "its installed length"
-    d.h(3, S.STEP_SEAT)
+    d.h(3, C.STEP_SEAT)
     d.p(f"**When:** after the crosses, the holder back on its seat with its spring bolts set, the focusing lens in, "
         "the mirrors coated and the film under the dome, O traced on it (the circle's set-up, next). The two spring "
         f"bolts only hold the holder down on its three balls: never turn them to adjust; each spring stays {spring} "

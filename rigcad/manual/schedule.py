@@ -30,8 +30,6 @@ SAND = "3. Sand the mirrors to the template"
 RECIPE = "Finishing recipe, stage by stage"
 COAT = "4. Coat, layer by layer, checking with the template"
 ASSEMBLE = "5. Assemble"
-#: The splitter seat's adjustment (section 6).
-STEP_SEAT = "Projector: the splitter seat's three push screws"
 
 
 @dataclass(frozen=True)
@@ -121,7 +119,7 @@ def _calibration(rig, tower: bool) -> list[Stage]:
         out += [
             _s("Align the projector on the crosses (the splitter holder off its seat, then back).", C.STEP_CROSSES,
                needs={"projector on"}, makes={"projector aligned"}),
-            _s("Set the splitter's tilt with the seat's push screws; lock them.", STEP_SEAT,
+            _s("Set the splitter's tilt with the seat's push screws; lock them.", C.STEP_SEAT,
                needs={"projector aligned", "mirrors coated", "film laid"}, makes={"splitter set"}),
         ]
     out += [
@@ -168,4 +166,4 @@ def check(stages) -> None:
                             f"{', '.join(missing)}, which no earlier stage leaves")
 
 
-__all__ = ["STEP_SEAT", "Stage", "check", "schedule", "unmet"]
+__all__ = ["Stage", "check", "schedule", "unmet"]
