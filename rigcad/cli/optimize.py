@@ -95,6 +95,12 @@ def cmd_optimize(args: argparse.Namespace) -> int:
         print(f"  {key:<32} {value:.6g}  (base {base['parameters'][key]:.6g})")
     for refused in rep["rejected_by_certified_path"]:
         print(f"  refused on the certified path: evaluation {refused['index']}: {refused['error']}")
+    rc = rep["certified_check"].get("ray_check")
+    if rc:
+        print(f"  rigcad check passes: Monte Carlo yield {rc['monte_carlo_yield']:.3g} (tolerancing.min_yield "
+              f"{rc['min_yield']:g}, {rc['builds']} builds), mirror meshes {rc['mirror_normal_error_rad']:g} rad; "
+              f"fab's tolerance stack holds on {rep['certified_check']['tolerance_stack']['printer']}; the assembly "
+              "gate finds an order")
     cert = rep["certified_check"]["fast_minus_certified"]
     print("  certified path (converged DOP853 dome) minus fast path: "
           + ", ".join(f"{k} {-v:+.2g}" for k, v in cert.items()))

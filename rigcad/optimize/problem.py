@@ -121,26 +121,35 @@ def later_stages(problem: Problem, profile: Profile, geometry: Derived) -> dict[
     """The later stages' rules on one design, as constraint values (<= 0 when met): the rig's layout
     and every part's recipe (what `rigcad design` and `stl` refuse before any solid: the tower and its
     shelf, the splitter and its holder, the instruments against the dome, the seats, the flange; 1
-    when one refuses, else 0) and `rigcad fab`'s tolerance stack on the run's printer (the placements
+    when one refuses, else 0), the calibration's screen inside the dome (its half diagonal against
+    the dome's inside radius where the spacers put it, mm: rigcad.calibrate.kit.screen_room, which
+    `rigcad manual` refuses) and `rigcad fab`'s tolerance stack on the run's printer (the placements
     it can neither hold nor adjust, counted), made on the closed-form dome (LATER_DOME_ROWS) with the
     design's focusing lens (a custom one when no stock lens focuses it, as the written design names).
     The same code those stages run; about 0.5 s a design (the layout's meridian searches)."""
+    from types import SimpleNamespace
+
+    from rigcad.calibrate.kit import screen_room
     from rigcad.errors import GeometryError
     from rigcad.fab import stack as ST
     from rigcad.optics.dome import build_equal_path
     from rigcad.parts import make_layout, make_recipes
 
+    dome = build_equal_path(geometry, LATER_DOME_ROWS)
+    # the calibration's screen inside the dome (rigcad manual and calibrate --kit refuse a dome it does not fit)
+    room = screen_room(SimpleNamespace(profile=profile, dome=dome))
+    g = {"later.calibration_screen": room["half_diagonal_mm"] - room["tightest"]["dome_radius_mm"] + GEOMETRY_RESERVE}
     try:
         f = custom_focal_length(profile, geometry)
         if f is not None:
             profile = dataclasses.replace(profile, lens=dataclasses.replace(profile.lens, focal_length=f))
-        layout = make_layout(profile, geometry, build_equal_path(geometry, LATER_DOME_ROWS))
+        layout = make_layout(profile, geometry, dome)
         make_recipes(profile, layout)
     except GeometryError:
-        return {"later.layout_and_parts": 1.0}
+        return {**g, "later.layout_and_parts": 1.0}
     pr = problem.stack_printer
     refused = 0 if pr.process_errors is None else len(ST.stack(profile, layout, pr).refused)
-    return {"later.layout_and_parts": 0.0, "later.tolerance_stack": float(refused)}
+    return {**g, "later.layout_and_parts": 0.0, "later.tolerance_stack": float(refused)}
 
 
 def apply(profile: Profile, keys: list[str], x) -> Profile:
@@ -231,7 +240,7 @@ CONSTRAINT_UNITS = {
     "printer.pieces": "mm", "min_feature.dome_wall": "mm", "min_feature.paraboloid_vertex": "mm",
     "max_cop_height": "mm", "max_occluded_fraction": "", "raycheck.theta_min_coverage": "deg",
     "raycheck.theta_max_coverage": "deg", "raycheck.min_px_per_deg": "px/deg", "raycheck.max_lost_fraction": "",
-    "later.layout_and_parts": "count", "later.tolerance_stack": "count",
+    "later.layout_and_parts": "count", "later.tolerance_stack": "count", "later.calibration_screen": "mm",
 }
 #: What each constraint means, for messages (the profile key that sets its limit).
 CONSTRAINT_KEYS = {
@@ -256,6 +265,8 @@ CONSTRAINT_KEYS = {
     "later.layout_and_parts": "optimize.constraints.later_stages: the rig's layout and part recipes build (the "
                               "tower, the splitter and the instruments against the dome; what rigcad design and stl "
                               "refuse before any solid)",
+    "later.calibration_screen": "optimize.constraints.later_stages: the calibration's screen (calibration.screen_*) "
+                                "lies inside the dome where its spacers put it (value: how far its corners reach in)",
     "later.tolerance_stack": "optimize.constraints.later_stages: rigcad fab's tolerance stack on the printer holds or "
                              "adjusts every placement (value: the placements refused)",
 }

@@ -98,6 +98,10 @@ def design_yaml(problem: Problem, row: dict, base_name: str, note: str) -> str:
         sections.setdefault("dome", []).append(
             f"  tolerance: {row['dome_tolerance_mm']:g} mm   # the base's {problem.base.dome.tolerance:g} mm cannot be "
             "certified in float64 on this geometry")
+    if row.get("mirror_normal_error_rad") is not None:
+        sections.setdefault("tessellation", []).append(
+            f"  mirror_normal_error: {row['mirror_normal_error_rad']:g} rad   # finer mirror meshes: the base's "
+            f"{problem.base.tessellation.mirror_normal_error:g} rad fail rigcad check's mesh-read rows on this design")
     if row.get("focal_length_mm") is not None:
         sections.setdefault("lens", []).append(
             f"  focal_length: {row['focal_length_mm']:g} mm   # no stock 2 in singlet focuses this design: a custom lens")
@@ -144,7 +148,43 @@ def certified_rig(problem: Problem, row: dict):
 _custom_focal_length = custom_focal_length
 
 
-def certify(problem: Problem, row: dict, also=None) -> dict:
+#: Finer mirror meshes tried when the 3D check refuses a design on the profile's own: the profile's
+#: tessellation.mirror_normal_error times each factor in turn (the rows that read the meshes, such as
+#: the camera through the splitter, shrink with the facets; measured on a design of achutha2006_optimize:
+#: 0.0101 deg against the 0.01 deg limit at 0.01 rad, 0.0084 deg at 0.005 rad).
+FINER_MESHES = (0.5, 0.25)
+
+
+def ray_check(rig):
+    """`rigcad check` on ``rig`` in memory (rigcad.api.check: the profile's rays, reading and seeded
+    Monte Carlo yield, the mirrors meshed from the profile), and, when it fails, again with finer
+    mirror meshes (FINER_MESHES). Returns the rig that passed, the mirror_normal_error (rad) it needed
+    when finer than the profile's (else None) and what optimize.json records; CheckError (the
+    check's own message, naming each failed row) when none passes."""
+    import dataclasses
+
+    from rigcad import api
+    from rigcad.check.tolerances import raise_if_failed
+    from rigcad.rig import Rig
+
+    p, first = rig.profile, None
+    for factor in (1.0, *FINER_MESHES):
+        normal = p.tessellation.mirror_normal_error * factor
+        r = rig if factor == 1.0 else Rig.from_profile(
+            dataclasses.replace(p, tessellation=dataclasses.replace(p.tessellation, mirror_normal_error=normal)),
+            previous=rig)  # the same dome: only the meshes change
+        result = api.check(r)
+        first = first or result
+        if result.passed:
+            mc = result.report.get("monte_carlo") or {}
+            return r, (None if factor == 1.0 else normal), {
+                "passed": True, "mirror_normal_error_rad": normal, "monte_carlo_yield": mc.get("yield"),
+                "min_yield": mc.get("min_yield"), "builds": mc.get("builds"), "rays": result.report.get("rays")}
+    raise_if_failed(first.rows, rig.name)  # the profile's own meshes' failures
+    raise AssertionError("unreachable: a failed check raises")
+
+
+def certify(problem: Problem, row: dict, also=None, check: bool = True) -> dict:
     """The chosen design on the certified path (converged DOP853 dome, the 2D design's report) beside
     the fast path's figures: the differences say how far the optimiser's evaluation can be trusted.
     ``also(rig)``: a further check of the design's rig that raises a RigcadError to refuse it (the
@@ -169,10 +209,19 @@ def certify(problem: Problem, row: dict, also=None) -> dict:
     # constraints hold GEOMETRY_RESERVE mm short of the ones it models
     layout = rig.layout
     rig.recipes
+    # the calibration's screen in the dome (ProfileError, as `rigcad manual` refuses it: the next design is tried)
+    from rigcad.calibrate.kit import check_screen_fits
+
+    check_screen_fits(rig)
     # `rigcad fab`'s tolerance stack on the run's printer (FabricationError: the next design is tried)
     row["tolerance_stack"] = tolerance_stack(problem, rig)
     if also is not None:
         also(rig)
+    # `rigcad check` with its yield (CheckError: the next design is tried), finer mirror meshes if they pass it
+    row["ray_check"] = None
+    row["mirror_normal_error_rad"] = None
+    if check:
+        _, row["mirror_normal_error_rad"], row["ray_check"] = ray_check(rig)
     row["dome_tolerance_mm"] = tol
     r = rig.design.report
     f = row["figures"]
@@ -187,6 +236,7 @@ def certify(problem: Problem, row: dict, also=None) -> dict:
             "dome_error_estimate_mm": rig.dome.error_estimate, "dome_tolerance_mm": rig.dome.tolerance,
             "dome_tolerance_loosened": tol is not None,
             "tolerance_stack": row["tolerance_stack"],  # fab's stack on the run's printer: held or adjusted
+            "ray_check": row["ray_check"],  # rigcad check's verdict with its Monte Carlo yield (None: not run)
             # a focal length no stock lens has, written into the design (None: a stock lens focuses it)
             "custom_focal_length_mm": row["focal_length_mm"],
             # room left between the projector's shelf and the dome's top beyond tower.clearance (mm)
@@ -214,10 +264,11 @@ def tolerance_stack(problem: Problem, rig) -> dict:
 
 
 def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine | None = None, overrides=None,
-                 progress=None, certify_also=None) -> OptimizeRun:
+                 progress=None, certify_also=None, check: bool = True) -> OptimizeRun:
     """Search and publish (module docstring). Raises OptimizeError (after publishing the record of
     every evaluation) when no design meets the constraints. ``certify_also``: :func:`certify`'s
-    ``also``, a check every certified design must pass (a design it refuses gives way to the next)."""
+    ``also``, a check every certified design must pass (a design it refuses gives way to the next);
+    ``check``: the certified design must pass `rigcad check` with its Monte Carlo yield (:func:`ray_check`)."""
     from rigcad import plots
     from rigcad.export.atomic import Staging, json_bytes, profile_lock
 
@@ -230,7 +281,7 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
     report = _report(problem, result, engine)
     files: dict[str, bytes] = {}
     profile_path = None
-    rejected = _certify_choice(problem, result, report, certify_also) if result.chosen is not None else []
+    rejected = _certify_choice(problem, result, report, certify_also, check) if result.chosen is not None else []
     if result.chosen is not None:
         note = f"seed {spec.seed}, {len(result.history)} evaluations, {result.method}; {result.reason}"
         stem = f"{name}_design"
@@ -293,7 +344,7 @@ def _report(problem, result, engine: Engine) -> dict:
     }
 
 
-def _certify_choice(problem, result, report: dict, also=None) -> list[dict]:
+def _certify_choice(problem, result, report: dict, also=None, check: bool = True) -> list[dict]:
     """Certify the search's choice: the certified path (converged DOP853 dome at the profile's
     dome.tolerance) has the last word, and a design it refuses (e.g. a tolerance float64 cannot
     certify there, a tolerance stack fab refuses, a rig the further check refuses) gives way to the next
@@ -304,7 +355,7 @@ def _certify_choice(problem, result, report: dict, also=None) -> list[dict]:
         if sum(1 for r in rejected if r["stage"].startswith("assembly")) >= MAX_CERTIFY:
             break
         try:
-            report["certified_check"] = certify(problem, row, also)
+            report["certified_check"] = certify(problem, row, also, check)
         except RigcadError as err:
             # the stage that refused it (the constraint that bound) and, for a one-line digest, the whole reason
             rejected.append({"index": row["index"], "error": str(err), "stage": _stage_of(err),
@@ -324,10 +375,14 @@ def _certify_choice(problem, result, report: dict, also=None) -> list[dict]:
 def _stage_of(err: RigcadError) -> str:
     """Which later stage refused a certified design: the assembly gate, fab's tolerance stack, or the
     rig's layout and part recipes (what `rigcad design` and `stl` refuse before any solid)."""
-    from rigcad.errors import AssemblyError, FabricationError
+    from rigcad.errors import AssemblyError, CheckError, FabricationError, ProfileError
 
+    if isinstance(err, ProfileError):
+        return "calibration screen in the dome (rigcad manual)"
     if isinstance(err, AssemblyError):
         return "assembly gate (rigcad stl, fab, manual)"
+    if isinstance(err, CheckError):
+        return "ray check with its yield (rigcad check)"
     if isinstance(err, FabricationError):
         return "tolerance stack (rigcad fab)"
     return "layout and part recipes (rigcad design, stl)"

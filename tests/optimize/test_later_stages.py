@@ -52,6 +52,21 @@ def test_a_design_whose_stack_fab_refuses_is_infeasible_in_the_search(problem):
         R.tolerance_stack(problem, rig)
 
 
+#: Design 257 of the search before it knew the calibration's screen (beat Table 3.1 by 47 %, passed the
+#: stack, the gate, check and fab): `rigcad manual` refused it, the default tablet's corners 105.6 mm
+#: from the axis where the dome's inside is 85.5 mm.
+NARROW = [200.0, 170.495664293, 23.0637979711, 0.23057]
+
+
+def test_a_design_whose_dome_cannot_hold_the_calibration_screen_is_infeasible_in_the_search(problem):
+    row = evaluate(problem, NARROW)
+    assert _closed_form_met(row) and row["constraints"]["later.tolerance_stack"] == 0
+    # mm: the manual's refusal said 105.6 - 85.5; the closed-form dome agrees with the certified one to nm
+    assert row["constraints"]["later.calibration_screen"] == pytest.approx(105.6 - 85.5, abs=0.1)
+    assert not row["feasible"]
+    assert evaluate(problem, problem.base_x)["constraints"]["later.calibration_screen"] < 0  # Table 3.1's holds it
+
+
 def test_a_design_whose_layout_refuses_is_infeasible_in_the_search(write_profile):
     """A splitter 20 mm from the COP: the tower's layout refuses it (tests/manual/test_gate.py), which
     no closed-form constraint models."""

@@ -104,7 +104,7 @@ def test_written_files_are_the_same_bytes_with_one_and_two_workers(write_profile
     seen = []
     for w in (1, 2):
         out = tmp_path / f"exports{w}"
-        run = run_optimize(path, out, Engine(workers=w))
+        run = run_optimize(path, out, Engine(workers=w), check=False)  # the bytes; the ray check is tested apart
         folder = out / "files" / "optimize"
         rep = json.loads((folder / "optimize.json").read_text())
 
