@@ -302,15 +302,15 @@ def seam_link(part: str, seams: int, printer: Printer, process: ProcessErrors, d
     the cut by the pin's float in its two holes and each hole's position error. The pieces are
     glued face to face (flat parts on a flat table), so a seam adds no step across the cut and no
     tilt (a part cut across its height adds its glue faces' lean: :func:`_column_glue`). With
-    ``dowels``, the ``buy`` option: ISO 8734 m6 steel dowels in holes reamed H7 (the shop step), whose
-    fit (DOWEL_FIT) replaces the pin's float; the holes' printed positions stay."""
+    ``dowels``, the ``buy`` option: ISO 8734 m6 steel dowels pressed N7 in one piece, sliding F7 in the
+    other (the shop step), whose fit (DOWEL_FIT) replaces the pin's float; the holes' printed positions stay."""
     if seams <= 0:
         return None
     buy = "a printer whose bed takes the part whole, or reamed holes and ISO 8734 steel dowels across the seam"
     if dowels:
         e = DOWEL_FIT + 2 * process.position
         return Link(f"{part.replace('_', ' ')} seams", "seam",
-                    f"{seams} seam(s): ISO 8734 m6 dowels in holes reamed H7 ({DOWEL_FIT:g} mm), each hole "
+                    f"{seams} seam(s): ISO 8734 m6 dowels pressed N7, sliding F7 ({DOWEL_FIT:g} mm), each hole "
                     f"+-{process.position:.2f} mm", e, 0.0, 0.0, seams, buy)
     pin = printer.alignment_pin
     hole = pin.diameter + pin.clearance

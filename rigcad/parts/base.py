@@ -58,7 +58,7 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
             "is fitted "
             "(the groove under the disc on the tongue's side is the calibration parts' turn mark); "
             "its tongue locates the tower's column " + (
-                f"by two {profile.datum.dowel_diameter:g} mm dowels (reamed H7) and four bolts"
+                f"by two {profile.datum.dowel_diameter:g} mm dowels (pressed into blind holes reamed N7) and four bolts"
                 if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core")
             + on_board)
     return Part("base_plate", Difference(Union_((plate, tongue, *pads)), (bore, groove, *holes, *joint, *anchors)),

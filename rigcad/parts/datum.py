@@ -34,10 +34,18 @@ from rigcad.parts import breadboard
 from rigcad.parts.process import ProcessErrors
 from rigcad.parts.tower import EXTRUSION, POCKET_GAP
 
-#: Worst-case diametral clearance (mm) of an ISO 8734 dowel (m6: +0.004..+0.012 mm for 3..6 mm) in a
-#: hole reamed H7 (0..+0.012 mm): 0.012 - 0.004. A joint of two such fits (one in each part)
-#: may shift by half of it twice: 0.008 mm.
-DOWEL_FIT = 0.008
+def dowel_fit(diameter: float) -> float:
+    """How far (mm, each way) a joint on ISO 8734 m6 dowels of ``diameter`` mm may shift: the pins pressed
+    into one part (rigcad.parts.locating.press_fit: no play), the other sliding on them (slip_fit): half
+    the slip fit's largest clearance (4 mm pins, F7/m6: 0.018 mm, so 0.009 mm)."""
+    from rigcad.parts.locating import slip_fit
+
+    return slip_fit(diameter).clearance[1] / 2
+
+
+#: :func:`dowel_fit` of the default 4 mm dowels (``datum.dowel_diameter``): the what-if of steel dowels
+#: across a seam (rigcad.fab.stack.seam_link) takes it.
+DOWEL_FIT = dowel_fit(4.0)
 #: A 40 x 40 mm extrusion cut on a saw with a stop (assumed): its ends square to 0.1 mm across 40 mm,
 #: and its length to 0.1 mm.
 EXTRUSION_END_SQUARENESS = 0.1
@@ -109,9 +117,10 @@ def _column_links(profile, t, process: ProcessErrors | None = None) -> tuple[Lin
         foot = 2 * t.column_foot_half
         a, b = column_dowel_points(t, profile)
         yaw = SLOT_FIT_MM / math.dist(a, b)
-        dowels = Link("dowels", f"ISO 8734 m6 in H7: {DOWEL_FIT:g} mm; the second pin in a slot filed to "
-                      f"{SLOT_FIT_MM:g} mm turns the column {yaw * 1e3:.2f} mrad, which swings the axis "
-                      f"{t.column_x:.0f} mm away by {yaw * t.column_x:.2f} mm", DOWEL_FIT + yaw * t.column_x, 0.0)
+        fit = dowel_fit(d.dowel_diameter)
+        dowels = Link("dowels", f"ISO 8734 m6 pressed N7, the column sliding on them F7: {fit:g} mm; the second pin "
+                      f"in a slot filed to {SLOT_FIT_MM:g} mm turns the column {yaw * 1e3:.2f} mrad, which swings the "
+                      f"axis {t.column_x:.0f} mm away by {yaw * t.column_x:.2f} mm", fit + yaw * t.column_x, 0.0)
         pattern = _printed(profile, 0, process)
         return (dowels, Link("column", f"printed: dowel pattern {pattern:.2f} mm; lean: the foot's "
                              f"{d.foot_flatness:g} mm out-of-flat over {foot:.0f} mm, times {height:.0f} mm",

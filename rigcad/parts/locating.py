@@ -196,9 +196,19 @@ class DowelRegister:
             return ()
         return tuple(replace(c, radius=self.drill / 2) for c in self.lower_zones())
 
+    @property
+    def hangs(self) -> bool:
+        """True when the ``lower`` part (the one the pins are pressed into) is above the upper one (a
+        shelf on a column's top flange): its holes then run up from its underside."""
+        return self.lower_z[0] >= self.upper_z[1] - 1e-9
+
     def lower_zones(self) -> tuple[Cylinder, ...]:
-        """Where the pins' holes are (or will be drilled) in the lower part, at the nominal places: a
-        split keeps its cuts off them either way."""
+        """Where the pins' blind holes are (or will be drilled) in the lower part, from the face it shares
+        with the upper part (its top face, or its underside when it :attr:`hangs`), at the nominal places:
+        a split keeps its cuts off them either way."""
+        if self.hangs:
+            face = self.lower_z[0]
+            return tuple(Cylinder((x, y, face - 1.0), self.diameter / 2, self.lower_depth + 1.0) for x, y in self.points)
         top = self.lower_z[1]
         return tuple(Cylinder((x, y, top - self.lower_depth), self.diameter / 2, self.lower_depth + 1.0)
                      for x, y in self.points)

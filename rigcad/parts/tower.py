@@ -474,10 +474,10 @@ def _column_own_holes(t: TowerLayout, profile: Profile, z0: float, height: float
 
 
 def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: float) -> tuple[Cylinder, ...]:
-    """The bolt and dowel holes of a column joint through z0..z0+height: the column's foot on the
-    base plate's tongue, its top flange under the shelf (the same pattern at both)."""
+    """The bolt holes of a column joint through z0..z0+height (the column's foot on the base plate's
+    tongue) and its register's blind dowel holes from the tongue's top (DowelRegister.lower_holes)."""
     return (_holes(_column_flange_points(t, profile), profile.tower.bolt_diameter, z0, height)
-            + _holes(column_dowel_points(t, profile), profile.datum.dowel_diameter, z0, height))
+            + column_register(t, profile, t.column_base_z, profile.tower.wall, "foot").lower_holes())
 
 
 #: The shelf's joint to the printed column's top flange: bolts up from under the flange into M4
@@ -488,13 +488,15 @@ def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: floa
 
 def shelf_joint_cuts(t: TowerLayout, profile: Profile, z0: float) -> tuple:
     """What the column joint cuts into the shelf from its underside (z0): for a printed column, a blind
-    insert hole (SHELF_INSERT, 0.5 mm deeper) at each bolt and a through hole at each dowel; for a
+    insert hole (SHELF_INSERT, 0.5 mm deeper) at each bolt and the register's blind hole at each dowel
+    (rigcad.parts.locating.DowelRegister.lower_holes: its floor stops the pin); for a
     bought extrusion, its pocket and core bolt hole (:func:`column_joint_cuts`)."""
     if profile.buy.column != "print":
         return column_joint_cuts(t, profile, z0, t.shelf_thickness, "bottom")
     d, long = SHELF_INSERT.hole, SHELF_INSERT.length
     blind = tuple(Cylinder((x, y, z0 - 1.0), d / 2, long + 1.5) for x, y in _column_flange_points(t, profile))
-    return blind + _holes(column_dowel_points(t, profile), profile.datum.dowel_diameter, z0, t.shelf_thickness)
+    top = t.shelf_top_z - t.shelf_thickness  # the column's top flange under the shelf: its register's blind holes
+    return blind + column_register(t, profile, top - profile.tower.wall, profile.tower.wall, "top").lower_holes()
 
 
 def shelf_bolt_length(profile: Profile) -> float:
@@ -1075,6 +1077,7 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
     from rigcad.parts.washers import washers_over
 
     hole = column_bolt_hole(t, profile)
+    reg = column_register(t, profile, t.column_base_z, tw.wall, "foot")  # the fits and tools of both ends' registers
     big = washers_over("M4", ("round", hole))
     cone, cone_h = spring_washer("M4")
     foot = column_foot_bolt(profile, t)
@@ -1102,11 +1105,15 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
         {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
          "length_mm": float(longest_dowel(min(tw.wall, t.shelf_thickness) + tw.wall)), "quantity": 4,
          "steps": ('tower_column', 'tower_shelf'), "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf: "
-                  f"pressed into the tongue's and the shelf's holes (ream them {profile.datum.dowel_diameter:g} H7 a size under, "
-                  f"or glue the pins); at each end the column's flange takes the first pin in its round hole (reamed "
-                  f"{profile.datum.dowel_diameter:g} H7) and the second in its slot (file it until the pin slides, "
-                  f"{SLOT_FIT_MM:g} mm across); {lap}",
-         "shop_steps": [f"ream the column's round dowel holes and the tongue's and shelf's {profile.datum.dowel_diameter:g} H7",
+                  f"pressed into the tongue's and the shelf's blind holes (printed at {reg.drill:g} mm: drill them "
+                  f"{reg.drill:g} mm, ream {reg.diameter:g} {reg.press.hole}: {reg.press.describe()}); at each end the "
+                  f"column's flange takes the first pin in its round hole (drilled {reg.drill:g} mm, reamed "
+                  f"{reg.diameter:g} {reg.slip.hole}: {reg.slip.describe()}) and the second in its slot (file it until "
+                  f"the pin slides, {SLOT_FIT_MM:g} mm across); {lap}",
+         "shop_steps": [f"drill the tongue's and the shelf's blind dowel holes {reg.drill:g} mm and ream them "
+                        f"{reg.diameter:g} {reg.press.hole} (the press end)",
+                        f"drill the column's round dowel holes {reg.drill:g} mm and ream them {reg.diameter:g} "
+                        f"{reg.slip.hole} (the slip end)",
                         f"file the column's dowel slots until the pin slides ({SLOT_FIT_MM:g} mm)", lap]},
     ]
 

@@ -161,3 +161,29 @@ def test_the_parts_page_states_the_fits_the_code_computes(table31_rig):
                   f"a {reg.diameter - reg.drill:.1f} mm reaming allowance", f"the beam's {pin:g} mm stop pin",
                   f"{press_fit(pin).describe()}, in a {pre_ream_drill(pin):g} mm hole"):
         assert words in text, words
+
+
+def test_the_columns_dowels_stand_in_blind_holes_reamed_for_their_press_fit(table31_rig):
+    """The column's registers (rigcad.parts.tower.column_register) cut their pins' holes in the tongue (from
+    its top) and in the shelf (up from its underside: the shelf hangs over the column's flange) blind, at
+    the drill's size, their floors at least a millimetre inside the part: a through hole lets a pin walk."""
+    tower = importlib.import_module("rigcad.parts.tower")
+    p, lay = table31_rig.profile, table31_rig.layout
+    t, wall = lay.tower, p.tower.wall
+    foot = tower.column_register(t, p, t.column_base_z, wall, "foot")
+    top = tower.column_register(t, p, t.shelf_top_z - t.shelf_thickness - wall, wall, "top")
+    assert not foot.hangs and top.hangs
+    points = {tuple(round(v, 6) for v in q) for q in tower.column_dowel_points(t, p)}
+    tongue = [c for c in tower.column_joint_cuts(t, p, t.bench_z, -t.bench_z, "top")
+              if (round(c.base[0], 6), round(c.base[1], 6)) in points]
+    shelf = [c for c in tower.shelf_joint_cuts(t, p, t.shelf_top_z - t.shelf_thickness)
+             if hasattr(c, "radius") and (round(c.base[0], 6), round(c.base[1], 6)) in points]
+    assert len(tongue) == len(shelf) == 2
+    for c in tongue:  # open at the tongue's top face (z = 0), its floor above the bench
+        assert c.radius == pytest.approx(foot.drill / 2) and c.base[2] + c.height > 0.0
+        assert c.base[2] >= t.bench_z + 1.0, c.base
+    for c in shelf:  # open at the shelf's underside, its floor under the shelf's top
+        assert c.radius == pytest.approx(top.drill / 2) and c.base[2] < t.shelf_top_z - t.shelf_thickness
+        assert c.base[2] + c.height <= t.shelf_top_z - 1.0, (c.base, c.height)
+    row = next(h for h in tower.hardware(p, lay) if "dowel" in h["item"] and "shop_steps" in h)
+    assert f"{foot.diameter:g} N7" in row["joins"] and f"{foot.diameter:g} F7" in row["joins"] and "H7" not in row["joins"]
