@@ -523,12 +523,29 @@ def feeler_gauge(gaps_mm: list[float]) -> tuple[str, str]:
 
 def dowel_drills(fab_report: dict, rig=None) -> tuple[str, str]:
     """The drills for the split pieces' pin holes (each part's hole as drawn, fab.json's ``pin_fit``), and
-    with ``rig`` the reamer of the COP tower's dowels (``datum.dowel_diameter``)."""
+    with ``rig`` the drill and the press and slip ends' reamers of the COP tower's dowels (``datum.dowel_diameter``,
+    rigcad.parts.locating.reamers)."""
+    from rigcad.parts.locating import reamers
+
     holes = _pin_holes(fab_report)
     dowel = getattr(getattr(getattr(rig, "profile", None), "datum", None), "dowel_diameter", None)
     tower = getattr(getattr(rig, "layout", None), "tower", None) is not None
     return (f"HSS twist drills (DIN 338) for the pin holes: {holes or 'none'}"
-            + (f"; {dowel:g} mm H7 hand reamer for the column's dowel holes" if dowel and tower else ""), "1 each")
+            + (f"; for the column's dowel holes {reamers(dowel)}" if dowel and tower else "") + _stop_pin_tools(rig),
+            "1 each")
+
+
+def _stop_pin_tools(rig) -> str:
+    """The drill and the reamer of the paraboloid's stop pin's hole in the beam (pressed: rigcad.parts.paraboloid)."""
+    if "paraboloid" not in (getattr(rig, "recipes", None) or {}):
+        return ""
+    from rigcad.parts.locating import press_fit
+    from rigcad.parts.paraboloid import mount
+    from rigcad.standards import pre_ream_drill
+
+    d = 2 * mount(rig.profile, rig.layout).pin.radius
+    return (f"; for the beam's stop pin a {pre_ream_drill(d):g} mm twist drill (DIN 338) and a {d:g} mm "
+            f"{press_fit(d).hole} hand reamer")
 
 
 def register_tools(rig) -> list[tuple[str, str]]:
@@ -547,10 +564,9 @@ def register_tools(rig) -> list[tuple[str, str]]:
             out.append((f"For the {reg.upper.replace('_', ' ')}'s register on the {reg.lower.replace('_', ' ')} "
                         f"({len(reg.points)} x {reg.diameter:g} mm pins): {tools}", "1 each"))
             if reg.drilled:
-                out.append(("Dial test indicator, 0.01 mm graduation (DIN 2270), on an articulated arm clamped to a "
-                            f"plug of the sample holder's size that turns in the bore (a second `sample_holder`, "
-                            f"printed): it centres the {reg.upper.replace('_', ' ')} before its register is drilled",
-                            "1"))
+                out.append(("Dial test indicator, 0.01 mm graduation (DIN 2270), on an articulated arm clamped to "
+                            "the sample holder (turned to its sliding fit in the bore), which turns in the bore: it "
+                            f"centres the {reg.upper.replace('_', ' ')} before its register is drilled", "1"))
     return out
 
 

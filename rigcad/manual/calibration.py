@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigcad.errors import GeometryError
+from rigcad.parts.base import bore_drawn
 
 def circle_image(rig) -> tuple[bytes, dict]:
     """The calibration circle at the projector's resolution (8-bit grey PNG: 255 inside the rim's
@@ -91,7 +92,7 @@ def film_setup(rig) -> dict:
     taller than the tongue's. ``direct_light_seen``: whether light past the rim (outside the
     paraboloid's shadow) falls inside the bore."""
     p, t = rig.profile, rig.layout.tower
-    bore = p.sample_holder.radius + p.sample_holder.clearance
+    bore = bore_drawn(p) / 2  # the bore as finished (bored to the sample holder's fit)
     view = 10.0 * math.ceil((2 * bore + VIEW_MARGIN_MM) / 10.0)
     below = (-p.base_plate.thickness) - t.bench_z if t is not None else 0.0
     shadow = film_shadows(rig)["paraboloid_shadow_radius_mm"]
@@ -130,7 +131,7 @@ def access(rig) -> list[dict]:
     lateral, _ = reg.repeatability
     back = (f"on its {len(reg.points)} register pins, within {1e3 * lateral:.0f} µm "
             f"(`tolerancing.dome_offset` {p.tolerancing.dome_offset:g} mm)")
-    bore = f"the base plate's bore ({2 * (p.sample_holder.radius + p.sample_holder.clearance):g} mm), from below"
+    bore = f"the base plate's bore ({bore_drawn(p):g} mm), from below"
     rows = []
     if getattr(rig.layout, "tower", None) is not None:
         f = cross_fixture(p, rig.layout)
@@ -284,8 +285,7 @@ def checkerboard(rig) -> dict:
     n = math.ceil(2 * r / CHECKER_SQUARE_MM)
     sheet = next((name for name, a, _ in A_SHEETS if a >= 2 * r), None)
     return {"dome_inside_diameter_mm": 2 * inside, "disc_diameter_mm": float(2 * r), "squares": n,
-            "square_mm": CHECKER_SQUARE_MM, "hole_diameter_mm": 2 * (rig.profile.sample_holder.radius
-                                                                      + rig.profile.sample_holder.clearance),
+            "square_mm": CHECKER_SQUARE_MM, "hole_diameter_mm": bore_drawn(rig.profile),
             "sheet": sheet or "a plotter roll", "disc_radius_mm": float(r)}
 
 
