@@ -187,3 +187,22 @@ def test_the_columns_dowels_stand_in_blind_holes_reamed_for_their_press_fit(tabl
         assert c.base[2] + c.height <= t.shelf_top_z - 1.0, (c.base, c.height)
     row = next(h for h in tower.hardware(p, lay) if "dowel" in h["item"] and "shop_steps" in h)
     assert f"{foot.diameter:g} N7" in row["joins"] and f"{foot.diameter:g} F7" in row["joins"] and "H7" not in row["joins"]
+
+
+def test_the_beams_stop_pin_is_pressed_in_a_blind_hole_reamed_n7(table31_rig):
+    """The paraboloid's x stop: its ISO 8734 pin's hole in the beam prints at the drill's size before the
+    reamer (2.8 mm for 3 mm), blind (its floor inside the beam), and the row says drill, reamer and fit."""
+    from rigcad.parts.locating import press_fit
+    from rigcad.standards import pre_ream_drill
+
+    paraboloid = importlib.import_module("rigcad.parts.paraboloid")
+    p, lay = table31_rig.profile, table31_rig.layout
+    m = paraboloid.mount(p, lay)
+    d = 2 * m.pin.radius
+    radii = {round(abs(seg.p0[0]), 9) for seg in m.pin_hole.solid.section.segments} - {0.0}
+    assert radii == {round(pre_ream_drill(d) / 2, 9)}, radii
+    z0, _ = lay.beam_z
+    assert m.pin_hole.offset[2] > z0, (m.pin_hole.offset, z0)  # the floor above the beam's underside
+    (row,) = [h for h in paraboloid.hardware(p, lay) if "dowel pin" in h["item"]]
+    assert f"{d:g} N7" in row["item"] and press_fit(d).describe() in row["joins"]
+    assert f"drill it {pre_ream_drill(d):g} mm" in row["joins"] and f"{d:g} mm N7 hand reamer" in row["joins"]
