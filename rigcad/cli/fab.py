@@ -115,8 +115,14 @@ def total_line(report: dict, printer) -> str:
         why = "no slicer ran: --gcode for PrusaSlicer's own time"
     else:
         why = "not sliced: see the problems"
-    rate = (f", its volume terms at deposition_rate_mm3_s {printer.deposition_rate_mm3_s:g}"
-            if printer.process == "fdm" and printer.deposition_rate_mm3_s else "")
+    from rigcad.fab.estimate import CALIBRATION
+
+    rate = ""
+    if printer.process == "fdm":  # the estimate's volume terms scale by the printer's rate (rigcad.fab.estimate)
+        rate = (f", its volume terms at deposition_rate_mm3_s {printer.deposition_rate_mm3_s:g}"
+                if printer.deposition_rate_mm3_s else
+                f", at the {CALIBRATION['printer']} fit's {CALIBRATION['deposition_rate_mm3_s']:g} mm3/s: the printer "
+                "states no deposition_rate_mm3_s")
     estimate = f"rigcad's estimate ({why}{rate})"
     if not sliced:
         return f"  total ({estimate}; with quantities): {hours_minutes(est_t)}, {est_g:.0f} g"

@@ -39,3 +39,11 @@ def test_the_estimate_only_where_no_slicer_ran_and_labelled_so():
     assert part.startswith("  total (prusa-slicer, with quantities): 60h00m, 24 g filament for 2 of 4 pieces; "
                            "the other 2 by rigcad's estimate (not sliced: see the problems"), part
     assert part.endswith(": 100h00m, 20 g"), part
+
+
+def test_a_printer_without_a_rate_says_whose_rate_the_estimate_takes():
+    """A printer named by its PrusaSlicer preset states no deposition rate: the estimate runs at the
+    MK3S fit's (rigcad.fab.estimate.CALIBRATION), and the label says so."""
+    preset = SimpleNamespace(name="ender", slicer="prusa-slicer", process="fdm", deposition_rate_mm3_s=0.0)
+    line = total_line(_report([_piece(10)], False), preset)
+    assert "at the prusa_mk3s fit's 8 mm3/s: the printer states no deposition_rate_mm3_s" in line, line
