@@ -63,7 +63,7 @@ def optimize_designs(limit: int):
         name = f"achutha2006_optimize design {row['index']}"
         try:
             rig, _ = certified_rig(pb, row)
-            f = _custom_focal_length(rig.profile, rig.layout.geometry)
+            f = _custom_focal_length(rig.profile, rig.geometry)  # before the layout: the tower is laid out about the lens
             if f is not None:
                 p = rig.profile
                 rig = Rig.from_profile(dataclasses.replace(p, lens=dataclasses.replace(p.lens, focal_length=f)),
