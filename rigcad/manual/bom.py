@@ -559,8 +559,7 @@ def register_tools(rig) -> list[tuple[str, str]]:
         for reg in part.joints:
             if not isinstance(reg, locating.DowelRegister):
                 continue
-            tools = (locating.reamers(reg.diameter) if hasattr(locating, "reamers") else
-                     f"a {reg.diameter:g} mm twist drill (DIN 338) and a {reg.diameter:g} mm H7 hand reamer")
+            tools = locating.reamers(reg.diameter)
             out.append((f"For the {reg.upper.replace('_', ' ')}'s register on the {reg.lower.replace('_', ' ')} "
                         f"({len(reg.points)} x {reg.diameter:g} mm pins): {tools}", "1 each"))
             if reg.drilled:

@@ -357,8 +357,18 @@ def test_dowel_pins_count_per_part_times_its_quantity():
     assert two["item"] == "dowel pins 11.5 mm long: 6 x 1.75 mm and 4 x 1.5 mm"
     assert B.dowel_pins(thin, _printer(filament=1.75))["note"].endswith(
         "the 1.75 mm ones cut from the printer's own filament, the others bought")
-    assert B.dowel_drills(report) == ("HSS twist drills (DIN 338) for the pin holes: 1.9 mm (plate), 2.1 mm (dome); "
-                                      "4 mm H7 reamer for the column's dowel holes", "1 each")
+    assert B.dowel_drills(report) == ("HSS twist drills (DIN 338) for the pin holes: 1.9 mm (plate), 2.1 mm (dome)",
+                                      "1 each")
+    # with the rig, the COP tower's dowels' reamer at datum.dowel_diameter (it said 4 mm whatever the profile)
+    from types import SimpleNamespace
+
+    rig = SimpleNamespace(profile=SimpleNamespace(datum=SimpleNamespace(dowel_diameter=5.0)),
+                          layout=SimpleNamespace(tower=object()))
+    from rigcad.parts.locating import reamers
+
+    assert B.dowel_drills(report, rig)[0].endswith(f"; for the column's dowel holes {reamers(5.0)}")
+    assert "5 mm" in reamers(5.0)
+    assert "reamer" not in B.dowel_drills(report, SimpleNamespace(profile=rig.profile, layout=SimpleNamespace(tower=None)))[0]
 
 
 def test_each_glue_the_seams_need_is_listed_once_with_its_parts():
