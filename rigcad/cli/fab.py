@@ -13,12 +13,7 @@ def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.fab.printers import load_printer
 
     printer = load_printer(args.printer)  # first: a refused printer file costs no rig and no CAD kernel import
-    if args.gcode and printer.slicer == "prusa-slicer" and printer.slicer_config is None \
-            and printer.slicer_unavailable is None:  # no start G-code, no temperatures: refused before the work
-        from rigcad.errors import FabricationError
-        from rigcad.fab.slicer import generic_refusal
-
-        raise FabricationError(generic_refusal(printer))
+    _refuse_generic_gcode(printer, args.gcode)
     from rigcad import api
     from rigcad.export.build import select_parts
     from rigcad.progress import stages
@@ -29,9 +24,8 @@ def cmd_fab(args: argparse.Namespace) -> int:
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "fab")  # a planted link or lock: one line now, not after the work
     names = select_parts(args.parts)  # a bad part name costs no rig
-    from rigcad.manual.gate import gate, kept_gate
-
     from rigcad.cli.check import criteria_notes, criteria_refusal
+    from rigcad.manual.gate import gate, kept_gate
 
     out = api.default_folder(profile.name, "fab", printer.name, root=args.exports)
     rig = load(profile)
@@ -53,12 +47,8 @@ def cmd_fab(args: argparse.Namespace) -> int:
                           progress=progress, slicing=lambda total: stages(total, f"slicing ({printer.slicer})"))
     tot = res.report["totals"]
     print(f"fab {profile.name} on {printer.name}: {tot['pieces']} pieces -> {out}/ (fab.json, fab.md)")
-    cfg = printer.slicer_config
-    if args.gcode and cfg is not None:  # which machine the G-code is for, never silently another's
-        model = cfg.effective().get("printer_model")
-        print(f"  G-code with PrusaSlicer's presets {cfg.printer_preset or cfg.source}"
-              + (f" (printer_model {model})" if model else "")
-              + (f", standing in for the {printer.model}: {printer.stand_in}" if printer.stand_in else ""))
+    if args.gcode and printer.slicer_config is not None:  # which machine the G-code is for, never silently another's
+        print(_gcode_line(printer))
     for name, e in res.report["parts"].items():
         if "pieces" in e:
             orient = ", ".join(sorted({pc["orientation"] for pc in e["pieces"]}))
@@ -96,6 +86,26 @@ def cmd_fab(args: argparse.Namespace) -> int:
         print(f"rigcad: error: fab found {len(res.problems)} problem(s), listed above; the outputs are written, "
               f"with the problems in {out}/fab.json", file=sys.stderr)
     return 1 if res.problems else 0
+
+
+def _gcode_line(printer) -> str:
+    """Whose PrusaSlicer presets the G-code is made with: the preset, its printer_model, a stand-in's why."""
+    cfg = printer.slicer_config
+    model = cfg.effective().get("printer_model")
+    return (f"  G-code with PrusaSlicer's presets {cfg.printer_preset or cfg.source}"
+            + (f" (printer_model {model})" if model else "")
+            + (f", standing in for the {printer.model}: {printer.stand_in}" if printer.stand_in else ""))
+
+
+def _refuse_generic_gcode(printer, gcode: bool) -> None:
+    """G-code asked of a printer with no presets (no start G-code, no temperatures): refused before
+    the work (rigcad.fab.slicer.generic_refusal)."""
+    if gcode and printer.slicer == "prusa-slicer" and printer.slicer_config is None \
+            and printer.slicer_unavailable is None:
+        from rigcad.errors import FabricationError
+        from rigcad.fab.slicer import generic_refusal
+
+        raise FabricationError(generic_refusal(printer))
 
 
 def total_line(report: dict, printer) -> str:
