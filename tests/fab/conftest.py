@@ -47,7 +47,7 @@ def prusa_run(table31_rig, prusa, shared_build):
 
     def build(folder):
         out = folder / "prusa_mk3s"
-        return out, run_fab(table31_rig, prusa, out, parts=["dome", "paraboloid", "beam", "sample_holder",
+        return out, run_fab(table31_rig, prusa, out, parts=["dome", "paraboloid", "beam", "camera_cross_base",
                                                             "camera_cross_hung", "dome_template", "paraboloid_template"])
 
     return shared_build("prusa_run", build)
