@@ -849,13 +849,7 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
                        f"({one.describe_range()}), got {_r(value)}")
         return tuple(convert_value(one, v, f"{key}[{i}]", where) for i, v in enumerate(value))
     elif s.kind == "holes":
-        pair = Spec("length", s.doc)
-        if not isinstance(value, list) or not 1 <= len(value) <= MAX_HOLES or not all(
-                isinstance(v, list) and len(v) == 2 for v in value):
-            raise fail(f"expected {s.describe_range()} (e.g. [[40 mm, -112 mm], [40 mm, 112 mm], [215 mm, 0 mm]]), "
-                       f"got {_r(value)}")
-        return tuple(tuple(convert_value(pair, v, f"{key}[{i}][{j}]", where) for j, v in enumerate(hole))
-                     for i, hole in enumerate(value))
+        return _holes(s, value, key, where, fail)
     elif s.kind == "pixels":
         ok = (isinstance(value, list) and len(value) == 2
               and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= MAX_PIXELS for v in value))
@@ -869,6 +863,17 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
     if too_low or too_high:
         raise fail(f"{_r(value)} is out of range; valid: {s.describe_range()}")
     return out
+
+
+def _holes(s: Spec, value: Any, key: str, where: str | None, fail) -> tuple[tuple[float, float], ...]:
+    """``value`` read as a list of ``[along, across]`` pairs of lengths (kind ``holes``)."""
+    pair = Spec("length", s.doc)
+    if not isinstance(value, list) or not 1 <= len(value) <= MAX_HOLES or not all(
+            isinstance(v, list) and len(v) == 2 for v in value):
+        raise fail(f"expected {s.describe_range()} (e.g. [[40 mm, -112 mm], [40 mm, 112 mm], [215 mm, 0 mm]]), "
+                   f"got {_r(value)}")
+    return tuple(tuple(convert_value(pair, v, f"{key}[{i}][{j}]", where) for j, v in enumerate(hole))
+                 for i, hole in enumerate(value))
 
 
 def _text_or_point(s: Spec, value: Any, fail) -> Any:
