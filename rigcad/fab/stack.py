@@ -352,17 +352,20 @@ def _paraboloid_links(profile, layout, process: ProcessErrors, seams) -> tuple[L
                  0.0, process.height_error(vertex_z - z1)))
 
 
-def sample_link(profile) -> Link:
+def sample_link(profile, process: ProcessErrors | None = None) -> Link:
     """The sample point O on its holder in the base plate's bore (the first link of every chain): the
     holder turned and the bore bored to their ISO 286 sliding fit (rigcad.parts.locating.holder_fit), the
     holder anywhere within the fit's largest clearance: half of it each way. Machined, so the same on
-    every printer."""
+    every printer; with ``process``, the source states the stock the printer's hole shrink leaves the
+    boring (the bore is drawn at its finished size)."""
     from rigcad.parts.locating import holder_fit
 
     fit = holder_fit(2 * profile.sample_holder.radius, where=profile.where("sample_holder", "radius"))
+    stock = "" if process is None else (f"; the bore prints {process.shrink(fit.size, 'vertical'):.2f} mm under its "
+                                        f"{fit.size:g} mm (the printer's hole shrink): the boring's stock")
     return Link("sample holder in its bore", "clearance",
-                f"the holder turned and the bore bored to {fit.describe()}: half the largest clearance each way",
-                fit.clearance[1] / 2, buy="a three-point register in the bore (two contacts and a spring plunger)")
+                f"the holder turned and the bore bored to {fit.describe()}: half the largest clearance each way"
+                + stock, fit.clearance[1] / 2, buy="a three-point register in the bore (two contacts and a spring plunger)")
 
 
 def _dome_seat(profile, layout, process: ProcessErrors, seams) -> tuple[Link, ...]:
@@ -372,7 +375,7 @@ def _dome_seat(profile, layout, process: ProcessErrors, seams) -> tuple[Link, ..
     hole = profile.dome_shell.bolt_diameter
     major = THREADS[flange_joint(profile, layout).thread].major
     play, how = _drilled(hole, major, process, "vertical")
-    return (sample_link(profile),
+    return (sample_link(profile, process),
             Link("base plate: bore to the dome's bolt circle", "printed",
                  f"printed: a pattern {r:.0f} mm round the bore (the scale moves its holes out alike, not its centre); "
                  f"out of flat {flat:g} mm (datum.foot_flatness) across the flange", process.position, flat,
@@ -416,7 +419,7 @@ def _tower_links(profile, layout, process: ProcessErrors, seams, holder: bool = 
     span = t.column_x - t.holder_x[1]
     point = point or (0.0, t.plate.center[2])
     printed_column, printed_shelf = profile.buy.column == "print", profile.buy.shelf == "print"
-    out = [sample_link(profile), _link(chain["base plate"], "printed", 0.0), *seams("base_plate")]
+    out = [sample_link(profile, process), _link(chain["base plate"], "printed", 0.0), *seams("base_plate")]
     for name in chain:
         if name.endswith("tongue to column") or name.endswith("column to shelf"):
             out.append(_link(chain[name], "joint", 0.0))  # a turn about the column's axis tilts no axis
