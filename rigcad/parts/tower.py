@@ -48,7 +48,7 @@ from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part
 from rigcad.profile.instruments import mount_pattern, size_origin
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
-from rigcad.standards import (CAMERA_SOCKET_DEPTH, CONICAL_SPRING_WASHERS, CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for, longest_dowel,
+from rigcad.standards import (CAMERA_SOCKET_DEPTH, CONICAL_SPRING_WASHERS, CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for,
                               longest_screw, screw_lengths, shortest_screw, shortest_set_screw, spring_rate)
 
 #: Gap around the splitter plate in its grooves (mm): a printed groove comes out ~0.1 mm narrow.
@@ -1078,6 +1078,7 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
 
     hole = column_bolt_hole(t, profile)
     reg = column_register(t, profile, t.column_base_z, tw.wall, "foot")  # the fits and tools of both ends' registers
+    top_reg = column_register(t, profile, t.shelf_top_z - t.shelf_thickness - tw.wall, tw.wall, "top")
     big = washers_over("M4", ("round", hole))
     cone, cone_h = spring_washer("M4")
     foot = column_foot_bolt(profile, t)
@@ -1102,9 +1103,9 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
         *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT.hole,
             "steps": ('tower_shelf',), "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]
           if profile.buy.shelf == "print" else []),
-        {"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
-         "length_mm": float(longest_dowel(min(tw.wall, t.shelf_thickness) + tw.wall)), "quantity": 4,
-         "steps": ('tower_column', 'tower_shelf'), "joins": "two locate the column's foot on the base plate's tongue, two its top flange under the shelf: "
+        *({"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
+         "length_mm": float(length), "quantity": count, "steps": ('tower_column', 'tower_shelf'),
+         "joins": f"{which}: "
                   f"pressed into the tongue's and the shelf's blind holes (printed at {reg.drill:g} mm: drill them "
                   f"{reg.drill:g} mm, ream {reg.diameter:g} {reg.press.hole}: {reg.press.describe()}); at each end the "
                   f"column's flange takes the first pin in its round hole (drilled {reg.drill:g} mm, reamed "
@@ -1114,8 +1115,18 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
                         f"{reg.diameter:g} {reg.press.hole} (the press end)",
                         f"drill the column's round dowel holes {reg.drill:g} mm and ream them {reg.diameter:g} "
                         f"{reg.slip.hole} (the slip end)",
-                        f"file the column's dowel slots until the pin slides ({SLOT_FIT_MM:g} mm)", lap]},
+                        f"file the column's dowel slots until the pin slides ({SLOT_FIT_MM:g} mm)", lap]}
+          for length, count, which in _dowel_rows(reg, top_reg)),
     ]
+
+
+def _dowel_rows(foot, top) -> list[tuple[int, int, str]]:
+    """The column's dowel pins by length (mm, count, which they locate): each end's register
+    (rigcad.parts.locating.DowelRegister.length) sets its own pins' length; one row when both agree."""
+    foot_use = "two locate the column's foot on the base plate's tongue"
+    if foot.length == top.length:
+        return [(foot.length, 4, f"{foot_use}, two its top flange under the shelf")]
+    return [(foot.length, 2, foot_use), (top.length, 2, "two locate the column's top flange under the shelf")]
 
 
 def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:

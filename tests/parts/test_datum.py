@@ -105,3 +105,19 @@ def test_the_plate_has_the_calibration_parts_turn_mark_beside_the_collar(table31
     beside = solid((r0, w, -t), (r0 + L, w + 1.0, -t + d))  # the disc on either side
     assert beside == pytest.approx(L * d, rel=1e-9)
     assert solid((-r0 - L, -w, -t), (-r0, w, -t + d)) == pytest.approx(2 * w * L * d, rel=1e-9)  # no mark at -x
+
+
+def test_the_bill_orders_the_column_dowels_each_register_is_drilled_for(table31_rig):
+    """The tower's dowel rows carry each end's register's own pin length (the register sizes its
+    blind holes from it): a pin ordered shorter or longer than its hole is drilled for would stand
+    short of the column's flange or bottom out before it is home."""
+    from rigcad.parts.tower import column_register, hardware
+
+    p, t = table31_rig.profile, table31_rig.layout.tower
+    foot = column_register(t, p, t.column_base_z, p.tower.wall, "foot")
+    top = column_register(t, p, t.shelf_top_z - t.shelf_thickness - p.tower.wall, p.tower.wall, "top")
+    rows = [h for h in hardware(p, table31_rig.layout)
+            if h["item"] == "dowel pin, ISO 8734 m6" and h.get("diameter_mm") == p.datum.dowel_diameter]
+    ordered = sorted(length for h in rows for length in [h["length_mm"]] * h["quantity"])
+    assert ordered == sorted([foot.length] * 2 + [top.length] * 2)
+    assert foot.length != top.length  # the default rig's ends differ (16 and 12 mm): one row each
