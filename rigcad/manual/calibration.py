@@ -339,6 +339,13 @@ def kit_items(rig) -> list[KitItem]:
         (ball,) = cross_fixture(p, rig.layout).bought
         items.append(KitItem(f"Steel balls, {ball.size_mm['diameter']:g} mm, grade G10 ({ball.standard})",
                              str(ball.quantity), ball.role, ("steel balls",), (STEP_CROSSES,)))
+    return items + _screen_items(rig)
+
+
+def _screen_items(rig) -> list[KitItem]:
+    """The calibration's screens and what drives them (:func:`kit_items`): the tablet and its printed
+    spacers; the upright display, its stand and the computer that drives it, when ``calibration.upright_turns``."""
+    p, items = rig.profile, []
     cal = getattr(p, "calibration", None)
     if cal is not None:
         from rigcad.calibrate.kit import display_spec, display_text, screen_room, upright_room

@@ -404,7 +404,8 @@ def test_kit_patterns_spacers_and_page(tmp_path, small):
         assert mesh.bounds[1][2] == pytest.approx(-p.sample_holder.sample_thickness + h, abs=1e-6)
         hs = p.sample_holder
         notches = sum(_lens(hs.stop_radius, r) for r in (WIDE_NOTCH_MM, NOTCH_MM))  # cut from the collar's rim
-        vol = np.pi * hs.radius ** 2 * (p.base_plate.thickness - hs.sample_thickness + h) + (
+        body = hs.radius - hs.clearance  # a printed plug: the clearance each side under the finished bore
+        vol = np.pi * body ** 2 * (p.base_plate.thickness - hs.sample_thickness + h) + (
             np.pi * hs.stop_radius ** 2 - notches) * hs.stop_thickness
         assert manifest["parts"][f"calibration_spacer_{k}"]["volume_mm3"] == pytest.approx(vol, rel=1e-6)
     page = (out / "calibration.md").read_text()
