@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rigcad.check.tolerances import THETA_RANGE_SLACK
 from rigcad.errors import RigcadError
 from rigcad.optimize.fast import fast_design
 from rigcad.optimize.printfit import dome_fit
@@ -222,6 +223,9 @@ def evaluate(problem: Problem, x) -> dict:
         g["raycheck.theta_min_coverage"] = fig["theta_min_deg"] - (tg.theta_min + k * rc.theta_coverage_tolerance) / DEG
         g["raycheck.theta_max_coverage"] = (tg.theta_max - k * rc.theta_coverage_tolerance) / DEG - fig["theta_max_deg"]
         g["raycheck.min_px_per_deg"] = rc.min_px_per_deg / k - fig["px_per_deg_min"]
+        # the design's own range against the targets themselves, as `rigcad check`, stl, fab and manual judge it
+        g["targets.theta_min"] = fig["theta_min_deg"] - (tg.theta_min + THETA_RANGE_SLACK) / DEG
+        g["targets.theta_max"] = (tg.theta_max - THETA_RANGE_SLACK) / DEG - fig["theta_max_deg"]
         g["raycheck.max_lost_fraction"] = fig["occluded_fraction"] - k * rc.max_lost_fraction
     if problem.stack_printer is not None and all(v <= 0 for v in g.values()):
         # the later stages' rules, on designs that meet every closed-form constraint (absent otherwise:
@@ -240,6 +244,7 @@ CONSTRAINT_UNITS = {
     "printer.pieces": "mm", "min_feature.dome_wall": "mm", "min_feature.paraboloid_vertex": "mm",
     "max_cop_height": "mm", "max_occluded_fraction": "", "raycheck.theta_min_coverage": "deg",
     "raycheck.theta_max_coverage": "deg", "raycheck.min_px_per_deg": "px/deg", "raycheck.max_lost_fraction": "",
+    "targets.theta_min": "deg", "targets.theta_max": "deg",
     "later.layout_and_parts": "count", "later.tolerance_stack": "count", "later.calibration_screen": "mm",
 }
 #: What each constraint means, for messages (the profile key that sets its limit).
@@ -261,6 +266,8 @@ CONSTRAINT_KEYS = {
     "raycheck.theta_min_coverage": "raycheck.theta_coverage_tolerance: theta must reach targets.theta_min",
     "raycheck.theta_max_coverage": "raycheck.theta_coverage_tolerance: theta must reach targets.theta_max",
     "raycheck.min_px_per_deg": "raycheck.min_px_per_deg: fewest projector pixels per degree",
+    "targets.theta_min": "targets.theta_min: the design's smallest theta must not lie above it (deg)",
+    "targets.theta_max": "targets.theta_max: the design's largest theta must reach it (deg)",
     "raycheck.max_lost_fraction": "raycheck.max_lost_fraction: pixels the mount hides",
     "later.layout_and_parts": "optimize.constraints.later_stages: the rig's layout and part recipes build (the "
                               "tower, the splitter and the instruments against the dome; what rigcad design and stl "

@@ -91,3 +91,18 @@ optimize:
     raycheck: false
   evaluations: 20
 """
+
+
+def test_a_design_whose_theta_range_misses_the_targets_is_infeasible_in_the_search(write_profile):
+    """The design's own theta range against targets.theta_min/theta_max themselves (what `rigcad check`,
+    stl, fab and manual refuse on: rigcad.check.criteria), not within the traced rays' coverage
+    tolerance: Table 3.1 starts at 6.92 deg, so a 6.5 deg target is missed by 0.42 deg, which the
+    1.5 deg coverage tolerance alone would let through."""
+    text = OPTIMIZE.replace("raycheck: false", "raycheck: true")
+    row = evaluate(load_problem(write_profile("low", "targets:\n  theta_min: 6.5 deg\n" + text)),
+                   load_problem(write_profile("base", text)).base_x)
+    assert row["constraints"]["targets.theta_min"] == pytest.approx(6.9175 - 6.5, abs=1e-3)
+    assert row["constraints"]["raycheck.theta_min_coverage"] < 0  # the coverage tolerance alone: feasible
+    assert not row["feasible"]
+    met = evaluate(load_problem(write_profile("met", text)), load_problem(write_profile("met2", text)).base_x)
+    assert met["constraints"]["targets.theta_min"] < 0 and met["constraints"]["targets.theta_max"] <= 0
