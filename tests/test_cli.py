@@ -129,13 +129,16 @@ def test_rigcad_starts_numpy_without_huge_page_advice_unless_told(given, advised
     assert done.stdout.strip().splitlines()[-1] == f"advised {advised}"
 
 
-def test_design_warns_when_the_projector_gives_fewer_pixels_per_degree_than_check_asks(tmp_path, capsys):
-    """The newcomer's rig passed `design` at 0.75 px/deg and failed `check` at 0.9: design says so,
-    naming the key and its file:line; the default rig (1.1 px/deg at the fewest) gets no such line."""
+def test_design_refuses_what_check_and_stl_refuse_all_at_once(tmp_path, capsys):
+    """The newcomer's rig passed `design` at 0.75 px/deg and failed `check` at 0.9: design now refuses
+    it as stl would (rigcad.check.criteria), every failed criterion at once, each naming its key and
+    file:line; the default rig (1.1 px/deg at the fewest, theta from 6.92 deg) passes."""
     assert main(["design", "achutha2006", "--exports", str(tmp_path / "a")]) == 0
-    assert "pixels per degree" not in capsys.readouterr().err
+    assert "refus" not in capsys.readouterr().err
     strict = tmp_path / "strict.yaml"
-    strict.write_text("extends: achutha2006\nraycheck:\n  min_px_per_deg: 5\n")
-    assert main(["design", str(strict), "--exports", str(tmp_path / "b")]) == 0  # a warning, not a refusal
+    strict.write_text("extends: achutha2006\nraycheck:\n  min_px_per_deg: 5\ntargets:\n  theta_min: 5 deg\n")
+    assert main(["design", str(strict), "--exports", str(tmp_path / "b")]) == 1
     err = capsys.readouterr().err
-    assert "under raycheck.min_px_per_deg 5 (" in err and "strict.yaml:3" in err and "`rigcad check` will fail" in err
+    assert "2 refusal(s)" in err and (tmp_path / "b" / "strict" / "design.json").is_file()
+    assert "raycheck.min_px_per_deg (" in err and "strict.yaml:3" in err
+    assert "targets.theta_min (" in err and "strict.yaml:5" in err and "targets.theta_min >= 6.92 deg would pass" in err

@@ -34,16 +34,6 @@ def cmd_design(args: argparse.Namespace) -> int:
           f"dome by {r['dome']['method']} (error vs closed form {r['dome']['error_vs_equal_path_mm']:.2g} mm), "
           f"max miss at O {r['convergence']['max_miss_mm']:.2g} mm"
           + (f", {px['vertex_to_rim_px']:.0f} px vertex to rim" if px["vertex_to_rim_px"] else ""))
-    if not rng["targets_met"]:
-        print(f"warning: the design covers theta {rng['theta_min_deg']:.2f}..{rng['theta_max_deg']:.2f} deg, "
-              f"not the target {rng['target_theta_min_deg']:g}..{rng['target_theta_max_deg']:g} deg", file=sys.stderr)
-    low = px.get("px_per_deg_min")
-    need = rig.profile.raycheck.min_px_per_deg
-    if low is not None and low < need:
-        where = rig.profile.where("raycheck", "min_px_per_deg")
-        print(f"warning: {low:.3g} projector pixels per degree of theta at the fewest, under raycheck.min_px_per_deg "
-              f"{need:g}{f' ({where})' if where else ''}: `rigcad check` will fail this rig; projector.throw_ratio "
-              "(a longer throw), projector.resolution or the paraboloid's size set it", file=sys.stderr)
     _suggest_lens(rig, args.fill)
     for p in paths:
         print(f"  wrote {p}")
@@ -51,19 +41,28 @@ def cmd_design(args: argparse.Namespace) -> int:
 
 
 def _early_refusals(rig) -> int:
-    """The refusals `rigcad stl` would make later that need no part's solid (rigcad.manual.gate.
-    early_refusals: the layout, every part's recipe), all of them, each on its own line naming the
+    """The refusals `rigcad stl` would make later that need no part's solid (the ray check's criteria
+    decided without its trace, rigcad.check.criteria.cheap_rows: the design's theta range against the
+    targets, the projector's pixels per degree, the camera; rigcad.manual.gate.early_refusals: the
+    layout, every part's recipe), all of them, each on its own line naming the
     key to change: exit 1 when there is one (the design's files stay written: its optics stand)."""
-    from rigcad.errors import one_line
+    from rigcad.check.criteria import cheap_rows, row_line
+    from rigcad.check.tolerances import theta_range_rows
+    from rigcad.errors import RigcadError, one_line
     from rigcad.manual.gate import early_refusals
 
-    found = early_refusals(rig)
-    if not found:
+    found = [r.line() for r in early_refusals(rig)]
+    try:
+        rows = cheap_rows(rig)
+    except RigcadError:  # the rig's layout is refused (among ``found``): the optics' own rows still stand
+        rows = theta_range_rows(rig.profile, rig.design.report["measurable_range"])
+    lines = [row_line(r) for r in rows if not r.ok] + found
+    if not lines:
         return 0
-    print(f"rigcad: error: {rig.name}: `rigcad stl` would refuse this rig: {len(found)} refusal(s) found before any "
+    print(f"rigcad: error: {rig.name}: `rigcad stl` would refuse this rig: {len(lines)} refusal(s) found before any "
           "part is built, each below (the design's own files are written)", file=sys.stderr)
-    for r in found:
-        print(f"  {one_line(r.line())}", file=sys.stderr)
+    for line in lines:
+        print(f"  {one_line(line)}", file=sys.stderr)
     return 1
 
 
