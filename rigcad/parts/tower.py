@@ -1088,14 +1088,14 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
     return [
         {"item": "bolt, conical washer (DIN 6796) and large washer (ISO 7093-1)", "thread": "M4",
          "length_mm": shelf_bolt_length(profile), "quantity": 4, "washer_mm": big.thickness + cone_h,
-         "washers": [w.name() for w in big.washers], "spring_washer": cone,
+         "washers": [w.name() for w in big.washers], "spring_washer": cone, "nuts": 0, "plain_washers": 0,
          "steps": ('tower_shelf',), "joins": "the column's top flange to the shelf: up from under the flange into "
                   + ("heat-set inserts pressed into the shelf's underside" if profile.buy.shelf == "print" else
                      "M4 threads tapped in the shelf's underside (8 mm deep)")
                   + f" ({cone} on {big.describe()}: the dowels locate, the bolts only clamp)"},
         {"item": "bolt, conical washer (DIN 6796), large washer (ISO 7093-1) and nut", "thread": "M4",
          "length_mm": foot["length_mm"], "quantity": 4, "washer_mm": foot["washers_mm"],
-         "washers": [w.name() for w in big.washers], "spring_washer": cone,
+         "washers": [w.name() for w in big.washers], "spring_washer": cone, "nuts": 1, "plain_washers": 0,
          "steps": ('tower_column',), "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
                   f"under the tongue, {foot['trap_depth_mm']:g} mm deep, put in before it stands on the bench: the bolt stands "
                   f"{foot['proud_mm']:.1f} mm out of its nut and ends {foot['above_bench_mm']:.1f} mm above the bench; "
@@ -1165,7 +1165,7 @@ def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
          "spring_mm": {"inner_diameter": spring["outer_diameter"] - 2 * spring["wire"], "wire": spring["wire"],
                        "outer_diameter": spring["outer_diameter"], "free_length": spring["free_length"],
                        "installed_length": spring["installed_length"], "active_coils": spring["active_coils"]},
-         "spring_rate_N_per_mm": force["rate_N_per_mm"], "preload_N": force["force_N"],
+         "spring_rate_N_per_mm": force["rate_N_per_mm"], "preload_N": force["force_N"], "nuts": 1, "plain_washers": 2,
          "steps": ('splitter_holder',), "joins": "from under the shelf up through the holder's flange; the spring under the nut holds the holder "
                   f"on its three contacts (nut set to {spring['installed_length']:g} mm of spring: "
                   f"{force['force_N']:.1f} N each, EN 13906-1)"},
@@ -1316,7 +1316,9 @@ def _fine_shim_rows(profile: Profile) -> list[dict]:
 
 def hardware(profile: Profile, layout) -> list[dict]:
     """The tower's bought hardware, computed from the parts (mm; units in keys): each item's name,
-    quantity, thread and length (grip plus nut or socket engagement, the shortest preferred length), and
+    quantity, thread and length (grip plus nut or socket engagement, the shortest preferred length), a
+    bolt's ``washers`` (its washer stack's, by name), ``plain_washers`` and ``nuts`` (ISO 7089, ISO 4032:
+    per bolt; the bill counts its lines from them), and
     what it joins: the datum chain's dowels and bolts, the splitter seat's parts, the projector's
     screws per shim stack, the camera's two screws, the splitter and the focusing lens (bought to
     the catalogue specification: ``splitter_spec``, ``rigcad.optics.focus``). ``steps``: the assembly
@@ -1334,6 +1336,7 @@ def hardware(profile: Profile, layout) -> list[dict]:
         *_seat_hardware(profile, t, nut),
         {"item": "bolt, large washer (ISO 7093-1) over its slot, washer and nut", "thread": m4, "length_mm": through,
          "quantity": len(lens_pts), "washers": [w.name() for w in washers["lens"].washers],
+         "nuts": 1, "plain_washers": 1,
          "steps": ('lens_mount',), "joins": f"the lens mount's slotted foot to the shelf ({washers['lens'].describe()})"},
         *_projector_screw_rows(profile, layout),
         *_screw_rows(camera_stack_screws(profile, layout), cm.mount_thread, 2, "camera_body",
