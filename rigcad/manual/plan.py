@@ -374,6 +374,11 @@ def hardware(steps: list[Step], rig=None) -> list[dict]:
                 ins = INSERTS[thread]
                 name = f"{thread} heat-set insert for printed parts, {ins.length:g} mm long, {ins.hole:g} mm hole"
                 extra[name] = extra.get(name, 0) + 1
+    if rig is not None:  # washers and nuts from every bolt's washer stack (the torque table's), not the items' words
+        from rigcad.manual.bom import washer_nut_lines
+
+        extra = {k: v for k, v in extra.items() if "washer" not in k and "hex nut" not in k}
+        extra.update(washer_nut_lines(rig))
     out = [{**r, "steps": ", ".join(r["steps"])} for r in rows.values()]
     return out + [{"item": k, "quantity": v, "steps": "with the bolts above"} for k, v in extra.items()]
 
