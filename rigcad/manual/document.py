@@ -855,8 +855,9 @@ def _section_assemble(d: Doc, c) -> None:
             text += (f" It is the f = {focusing_lens(c.p, c.rig.geometry).focal_length:g} mm plano-convex lens of "
                      "the bill, its curved face towards the projector.")
         if st.name == "base_plate" and "camera_cross_base" in c.rig.recipes:
-            text += (" To calibrate (section 6), lay the film on the plate now, before the dome: see \"The film at "
-                     "the sample plane\".")
+            text += (" To calibrate (section 6), the film goes on the plate once the dome's register is drilled "
+                     "and the dome lifted off its pins again, before it is bolted down: see \"The film at the "
+                     "sample plane\".")
         for h in tower_at.get(st.name, []):  # the threaded rows; the pressed ones came before the part
             if h.get("thread") and "heat-set insert" not in h["item"]:
                 text += f" Fix it with {h['quantity']} x {B.tower_item(h)}: {h['joins']}."
@@ -1000,7 +1001,8 @@ def _section_acceptance(d: Doc, c) -> None:
     d.ol([
         "The rig assembled, the camera in its place on the tower looking down the axis through the splitter, the "
         "projector off, the room dark. The film of the circle test lies on the base plate's top over the bore, O "
-        "traced on it (section 6, \"The film at the sample plane\": it goes on before the dome).",
+        "traced on it (section 6, \"The film at the sample plane\": it goes on once the dome's register is drilled, "
+        "before the dome is bolted down).",
         f"Lift the rig onto the film test's blocks (**{acc['block_under_tongue_mm']:g} mm** under the tongue, "
         f"**{acc['block_under_disc_mm']:g} mm** under the disc) and take what stands in the bore out from below "
         "(the `camera_cross_base` the film was traced on): "
@@ -1101,20 +1103,23 @@ def _film_step(d: Doc, c) -> None:
     d.h(3, C.STEP_FILM)
     d.p("The dome stands bolted on the base plate over the film: the plate's top "
         "is the dome's base plane and the sample plane (z = 0) by design, and the plate's bore, which centres the "
-        "sample holder, centres the film's mark. The film goes on during the assembly, before the dome, and is seen "
-        "from below, through the bore:")
+        "sample holder, centres the film's mark. The film goes on during the assembly, once the dome has been "
+        "indicated in from the bore and its register drilled (the indicator's arm stands on the sample holder "
+        "turning in the bore, so nothing else may be in it then), and is seen from below, through the bore:")
     seen = ("light past the rim falls inside the bore too" if f["direct_light_seen"] else
             f"light past the rim (outside the paraboloid's shadow, {f['paraboloid_shadow_radius_mm']:.1f} mm from O) "
             f"falls on the plate outside the bore ({f['bore_radius_mm']:.2f} mm) and is not seen from below: judge the "
             "circle by the spot, symmetric about the mark and smallest")
     d.ol([
-        "In the assembly, once the base plate is down and before the dome goes on: lift the plate off the sample "
-        "holder, stand the `camera_cross_base` in its place (the same body and collar: the bore centres it the "
-        "same way) and set the plate back over it. The cross's top is z = 0, level with the plate's top.",
+        "In the assembly, once the dome's register is drilled and its pins pressed and the dome lifted off them "
+        "again (the beam and the paraboloid go into it while it is off), before it is set back and bolted down: "
+        "lift the plate off the sample holder, stand the `camera_cross_base` in its place (the same body and "
+        "collar: the bore centres it the same way) and set the plate back over it. The cross's top is z = 0, level "
+        "with the plate's top.",
         f"Lay a disc of matte drafting film ({1e3 * f['film_thickness_mm']:g} µm polyester, "
         f"**{f['film_diameter_mm']:.0f} mm** across) on the plate's top, centred on the bore, and tape its edge to "
-        "the plate. Trace the cross under it with a fine pen: its centre is O. Then go on with the assembly (the "
-        f"dome's flange and its {f['dome_bolts']} bolts are far outside the film).",
+        "the plate. Trace the cross under it with a fine pen: its centre is O. Then set the dome back on its pins "
+        f"and go on with the assembly (the dome's flange and its {f['dome_bolts']} bolts are far outside the film).",
         f"For the test, lift the rig as one piece (plate, dome and tower are one rigid assembly; two people) onto "
         f"three blocks: one **{f['block_under_tongue_mm']:g} mm** tall under the tongue below the column, two "
         f"**{f['block_under_disc_mm']:g} mm** tall under the disc's rim either side of the dome (the tongue reaches "
@@ -1123,9 +1128,11 @@ def _film_step(d: Doc, c) -> None:
         f"Look up through the bore: a 45 deg mirror or a phone's camera on the bench under it (the "
         f"{f['block_under_disc_mm']:g} mm blocks leave room for it). Project the circle and set it as described "
         f"above; {seen}.",
-        "Afterwards cut the film out along the bore's edge from below with a scalpel (the ring under the dome stays: "
-        f"{1e3 * f['film_thickness_mm']:g} µm thick, outside the sample), push the `camera_cross_base` back in for the "
-        "camera's crosses (next), and set the rig down.",
+        "Afterwards push the `camera_cross_base` back in for the camera's crosses (next) and set the rig down. "
+        f"Then take out the dome's {f['dome_bolts']} flange screws, lift it off its register pins, peel the whole film "
+        "and its tape off the plate's top and set the dome back on its pins: the film "
+        f"({1e3 * f['film_thickness_mm']:g} µm) and the tape at its edge would otherwise stand on z = 0 under the "
+        "checkerboard, the gray card's straightedge and the calibration screens.",
     ])
 
 

@@ -10,10 +10,13 @@ walks ``manual.json``'s ``schedule`` the same way.
 
 Why an order is needed at all: the dome's seams are glued standing on the base plate on its flange
 screws (the plate's inserts first), before the dome's own inserts (the beam seats') are melted; the
-film goes on the plate before the dome; the slope test needs the whole rig with its camera, on the
+dome is indicated in from the bore (the holder in it) before the film and the camera_cross_base take the
+holder's place, and the beam and the paraboloid go into the dome while it is off, before it is set back on its
+pins over the film; the slope test needs the whole rig with its camera, on the
 polished clear coat, before the mirror coat; the mirror coat needs the dome and the paraboloid off
-again; the projector is aligned before the circle is set, the circle before the film is cut out, the
-camera's hung cross replaces the paraboloid, which goes back after it.
+again; the projector is aligned before the circle is set, the circle before the film comes off, the
+whole film and its tape come off the plate before anything else lies on z = 0 (the checkerboard, the gray
+card's straightedge, the screens), and the camera's hung cross replaces the paraboloid, which goes back after it.
 """
 
 from __future__ import annotations
@@ -88,14 +91,22 @@ def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
         _s("Spray the base, the primer (blocked) and the clear coat; cure, wet-sand and polish the clear coat.",
            RECIPE, needs={"mirrors sanded"}, makes={"clear coat polished"}),
         _s("Put the sample holder in the base plate's bore and the plate on the bench (their steps).", ASSEMBLE,
-           needs={"base plate inserts"}, makes={"base plate down", "dome off"}),
-        _s("Stand the camera_cross_base in the bore, lay the film on the plate and trace O on it.", C.STEP_FILM,
-           needs={"base plate down", "dome off"}, makes={"film laid"}),
-        _s("Indicate the dome in from the bore, drill and ream its register, press the pins, bolt it down "
-           "(the dome's step).", ASSEMBLE, needs={"base plate down", "dome off", "dome inserts", "clear coat polished"},
-           makes={"dome on its register"}, ends={"dome off"}),
-        _s("Put in the beam and the paraboloid on it (their steps).", ASSEMBLE, needs={"dome on its register"},
+           needs={"base plate inserts"}, makes={"base plate down", "dome off", "sample holder in the bore",
+                                                "plate top clear"}),
+        _s("Indicate the dome in from the bore (the test indicator on its arm on the sample holder, turned in the "
+           "bore), drill and ream its register, press the pins; lift the dome off its pins again (the dome's step).",
+           ASSEMBLE, needs={"base plate down", "dome off", "dome inserts", "clear coat polished",
+                            "sample holder in the bore"},
+           makes={"dome register drilled"}),
+        _s("Take the sample holder out of the bore, stand the camera_cross_base in it, lay the film on the plate and "
+           "trace O on it.", C.STEP_FILM, needs={"base plate down", "dome off", "dome register drilled"},
+           makes={"film laid", "cross in the bore"}, ends={"sample holder in the bore", "plate top clear"}),
+        _s("With the dome still off (upside down on the bench), put in the beam and the paraboloid on it, reaching "
+           "in through the dome's open base (their steps).", ASSEMBLE, needs={"dome off", "dome register drilled"},
            makes={"paraboloid on the beam"}),
+        _s("Set the dome, the beam and the paraboloid in it, back on its register pins over the film and bolt it "
+           "down.", ASSEMBLE, needs={"dome register drilled", "dome off", "paraboloid on the beam"},
+           makes={"dome on its register"}, ends={"dome off"}),
     ]
     if tower:
         out.append(_s("Build the tower: column, shelf, seat, lens mount, shims, splitter holder, projector, lens, "
@@ -125,21 +136,29 @@ def _calibration(rig, tower: bool) -> list[Stage]:
     out += [
         _s("Set the circle on the paraboloid, judged on the film from below.", C.STEP_CIRCLE,
            needs={"mirrors coated", "film laid"} | ({"splitter set"} if tower else set()), makes={"circle set"}),
-        _s("Cut the film out of the bore; the camera_cross_base stays in it.", C.STEP_FILM,
-           needs={"circle set", "film laid"}, makes={"bore open"}, ends={"film laid"}),
+        _s("Lift the dome off its register pins, peel the whole film and its tape off the plate's top (nothing may "
+           "stand on z = 0 under the checkerboard, the gray card's straightedge or the calibration screens), set the "
+           "dome back; the camera_cross_base stays in the bore.", C.STEP_FILM,
+           needs={"circle set", "film laid", "dome on its register"}, makes={"bore open", "plate top clear"},
+           ends={"film laid"}),
         _s("Lift the dome off, hang the camera cross on the beam in the paraboloid's place, set the dome back; align "
-           "the camera; then put the paraboloid back the same way and the sample holder in the bore.",
-           C.STEP_CAMERA, needs={"bore open", "dome on its register"} | ({"camera on"} if tower else set()),
-           makes={"camera aligned"}),
+           "the camera; then put the paraboloid back the same way and the sample holder in the bore in the "
+           "camera_cross_base's place.",
+           C.STEP_CAMERA, needs={"bore open", "dome on its register", "cross in the bore"}
+           | ({"camera on"} if tower else set()),
+           makes={"camera aligned", "sample holder in the bore"}, ends={"cross in the bore"}),
         _s("Lay the checkerboard disc under the lifted dome, capture, take it out.", C.STEP_CHECKER,
-           needs={"camera aligned", "circle set", "dome on its register"}, makes={"camera correspondence"}),
+           needs={"camera aligned", "circle set", "dome on its register", "plate top clear"},
+           makes={"camera correspondence"}),
         _s("Capture the gray card in the sample holder and run rigcad calibrate --gray-card.", C.STEP_GRAY,
-           needs={"camera aligned", "mirrors coated"}, makes={"reflectance scaled"}),
+           needs={"camera aligned", "mirrors coated", "plate top clear", "sample holder in the bore"},
+           makes={"reflectance scaled"}),
     ]
     if getattr(rig.profile, "calibration", None) is not None:
         out.append(_s("Capture the screens on their spacers and the upright display, run rigcad calibrate --images; "
                       "re-seat the paraboloid by what it reads.", C.STEP_AS_BUILT,
-                      needs={"camera aligned", "mirrors coated", "dome on its register"}, makes={"rig calibrated"}))
+                      needs={"camera aligned", "mirrors coated", "dome on its register", "plate top clear"},
+                      makes={"rig calibrated"}))
     return out
 
 

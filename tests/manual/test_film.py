@@ -44,5 +44,6 @@ def test_the_manual_writes_the_film_step(table31_rig):
     text = " ".join(b[-1] if isinstance(b[-1], str) else " ".join(b[-1]) for b in d.blocks)
     f = C.film_setup(table31_rig)
     for want in ("camera_cross_base", f"{f['block_under_tongue_mm']:g} mm", f"{f['block_under_disc_mm']:g} mm",
-                 f"{f['film_diameter_mm']:.0f} mm", "before the dome", "through the bore"):
+                 f"{f['film_diameter_mm']:.0f} mm", "indicated in from the bore", "before it is set back and bolted down",
+                 "through the bore", "peel the whole film"):
         assert want in text, want

@@ -35,13 +35,20 @@ def test_every_stage_finds_the_state_it_needs(stages):
     slope = _index(stages, C.STEP_ACCEPTANCE, "Slope")
     coat = _index(stages, S.RECIPE, "mirror coat")
     film = _index(stages, C.STEP_FILM, "lay the film")
-    dome = _index(stages, S.ASSEMBLE, "register")
+    drill = _index(stages, S.ASSEMBLE, "Indicate the dome")
+    dome = _index(stages, S.ASSEMBLE, "back on its register")
+    paraboloid = _index(stages, S.ASSEMBLE, "the paraboloid on it")
     lap = _index(stages, "5. Assemble (tower column)", "Lap")
     join = _index(stages, S.PRINT, "Join")
     camera = _index(stages, C.STEP_CAMERA, "camera cross")
     assert plate < glue < inserts, "the dome is glued on the plate's screws, before its own inserts"
     assert lap < join, "the column's faces are lapped before they are glued"
-    assert film < dome < slope < coat < camera, "film before the dome; slope test before the mirror coat"
+    assert drill < film < paraboloid < dome < slope < coat < camera, \
+        "dome indicated in, then the film, the paraboloid into the lifted dome, the dome bolted; slope before coat"
+    peel = _index(stages, C.STEP_FILM, "peel the whole film")
+    on_plate = [_index(stages, *at) for at in ((C.STEP_CHECKER, "checkerboard"), (C.STEP_GRAY, "gray card"),
+                                              (C.STEP_AS_BUILT, "screens"))]
+    assert peel < min(on_plate), "the film and its tape are off z = 0 before the checkerboard, card and screens"
 
 
 def test_a_stage_out_of_order_is_refused(stages):
@@ -57,8 +64,27 @@ def test_a_stage_out_of_order_is_refused(stages):
     # a stage that needs what an earlier one ended: the film laid after the dome went on its register
     stages_ = list(stages)
     film = stages_.pop(_index(stages_, C.STEP_FILM, "lay the film"))
-    stages_.insert(_index(stages_, S.ASSEMBLE, "beam and the paraboloid"), film)
+    stages_.insert(_index(stages_, C.STEP_ACCEPTANCE, "Slope"), film)
     assert any("dome off" in missing for _, _, missing in S.unmet(stages_))
+
+
+@pytest.mark.parametrize("moved, after, missing", [
+    # the film and the camera_cross_base in the bore while the dome is indicated in from it (the indicator's
+    # arm stands on the sample holder turning in the bore)
+    ((C.STEP_FILM, "lay the film"), (S.ASSEMBLE, "Indicate the dome"), "sample holder in the bore"),
+    # the paraboloid lowered into the dome once it is bolted down (its top opening too small): it goes in
+    # while the dome is off
+    ((S.ASSEMBLE, "the paraboloid on it"), (C.STEP_ACCEPTANCE, "Slope"), "dome off"),
+    # the film's ring and tape left under the calibration screens, the checkerboard and the gray card
+    ((C.STEP_FILM, "peel the whole film"), (None, None), "plate top clear"),
+])
+def test_each_conflict_the_technician_found_is_caught_if_planted_back(stages, moved, after, missing):
+    stages_ = list(stages)
+    st = stages_.pop(_index(stages_, *moved))
+    at = len(stages_) if after == (None, None) else _index(stages_, *after)
+    stages_.insert(at, st)
+    found = [m for _, _, ms in S.unmet(stages_) for m in ms]
+    assert missing in found, f"{st.what} planted back: {S.unmet(stages_)}"
 
 
 def test_the_dome_glued_whole_needs_no_gauge(table31_rig):
