@@ -580,3 +580,89 @@ def set_screw_keys(hardware_rows: list[dict]) -> tuple[str, str] | None:
 
 __all__ += ["CONSUMABLES", "TOOLS", "TOOL_WORDS", "dowel_drills", "feeler_gauge", "glue_rows", "register_tools",
             "set_screw_keys"]
+
+
+# -- washers and nuts, from the washer stacks -----------------------------------------------------
+def _washer_line(w) -> str:
+    """A washer as the bill orders it (rigcad.parts.washers.Washer): standard, size, outside diameter."""
+    big = "large " if w.standard.startswith("ISO 7093") else ""
+    return f"{w.size} {big}washer ({w.standard}, {w.outer:g} mm outside, {w.thickness:g} mm)"
+
+
+def bolt_stacks(rig) -> list[dict]:
+    """Every bolt and screw row of the rig with what each bolt takes: the washers of its stack
+    (rigcad.parts.washers, as the torque table's loads use them; head side first, plain ones last) and
+    its nuts. Rows: the joints the parts declare (``Part.joints``' ScrewJoint), the bolts found in the
+    recipes (bolt_joints), the breadboard's screws, the COP tower's rows (``rigcad.parts.tower.hardware``:
+    ``washers``, ``plain_washers``, ``nuts``; an instrument's screws with the extra washers their longest
+    stack needs, rigcad.parts.tower.projector_screws / camera_stack_screws: one stack per foot, as the
+    washers go from one screw length to the next). Each: use, thread, count (bolts), washers (bill lines
+    per bolt), nuts (per bolt)."""
+    from rigcad.parts import breadboard
+    from rigcad.parts.joints import ScrewJoint
+    from rigcad.parts.washers import Washer, large, plain
+
+    by_name = {}
+
+    def washer(name_or_washer) -> str:
+        if isinstance(name_or_washer, Washer):
+            return _washer_line(name_or_washer)
+        name = name_or_washer.removeprefix("a ").removeprefix("an ")
+        return by_name.get(name, name)
+
+    for size in standards.ISO_7093:
+        by_name[large(size).name()] = _washer_line(large(size))
+    for thread in standards.THREADS:
+        if standards.THREADS[thread].washer_od:
+            by_name[plain(thread).name()] = _washer_line(plain(thread))
+    rows = []
+    for part in rig.recipes.values():
+        for j in part.joints:
+            if isinstance(j, ScrewJoint):
+                rows.append({"use": j.name, "thread": j.thread, "count": j.count,
+                             "washers": [washer(j.washer_spec or plain(j.thread))], "nuts": int(j.into == "nut")})
+    for j in bolt_joints(rig):
+        per = j["washers"] // j["count"]
+        rows.append({"use": j["joins"], "thread": j["thread"], "count": j["count"],
+                     "washers": [washer(plain(j["thread"]))] * per, "nuts": j["nuts"] // j["count"]})
+    for h in breadboard.hardware(rig.profile, rig.layout) if breadboard.board(rig.profile) else ():
+        rows.append({"use": h["joins"], "thread": h["thread"], "count": h["quantity"], "nuts": 0,
+                     "washers": [f"{h['thread']} large washer ({h['item'].split('large washer (')[1]}"]})
+    extra = {}
+    if getattr(rig.layout, "tower", None) is not None:
+        from rigcad.parts.tower import camera_stack_screws, projector_screws
+
+        extra = {"for_stacks_of_shims": {r["shims"]: r["extra_washers"] or 0
+                                         for r in projector_screws(rig.profile, rig.layout)},
+                 "for_camera_stacks_of_shims": {r["shims"]: r["extra_washers"] or 0
+                                                for r in camera_stack_screws(rig.profile, rig.layout)}}
+    stacked: dict[str, dict] = {}  # an instrument's screws, a row per length: one washer stack per foot
+    for h in tower_hardware(rig):
+        if not h.get("thread") or not any(k in h for k in ("washers", "plain_washers", "nuts")):
+            continue  # an insert, a set screw (no washer, no nut)
+        key = next((k for k in extra if k in h), None)
+        more = max((extra[key][n] for n in extra[key]), default=0) if key else 0
+        row = {"use": h["joins"], "thread": h["thread"], "count": h["quantity"], "nuts": h.get("nuts", 0),
+               "washers": [washer(n) for n in h.get("washers", [])]
+               + [washer(plain(h["thread"]))] * (h.get("plain_washers", 0) + more)}
+        if key is None:
+            rows.append(row)
+        elif key not in stacked or row["count"] > stacked[key]["count"]:
+            stacked[key] = row  # the washers move with the foot's screw from one length to the next
+    return rows + list(stacked.values())
+
+
+def washer_nut_lines(rig) -> dict[str, int]:
+    """The bill's washer and nut lines (item -> quantity), summed over every bolt of :func:`bolt_stacks`:
+    each washer of each stack, and an ISO 4032 hex nut per nut."""
+    out: dict[str, int] = {}
+    for r in bolt_stacks(rig):
+        for w in r["washers"]:
+            out[w] = out.get(w, 0) + r["count"]
+        if r["nuts"]:
+            nut = f"{r['thread']} hex nut (ISO 4032)"
+            out[nut] = out.get(nut, 0) + r["nuts"] * r["count"]
+    return out
+
+
+__all__ += ["bolt_stacks", "washer_nut_lines"]

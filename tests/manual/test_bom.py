@@ -526,3 +526,43 @@ def test_the_print_section_asks_for_the_printed_stage_template_the_seams_are_glu
                                                                      "outlines/dome_template_printed.svg": "y"}}}}
     assert "`outlines/dome_template_printed.dxf`" in _cut_line("dome_template", e)
     assert "printed stage" not in _cut_line("dome_template", {"plate_thickness_mm": 3.0, "stages": {"printed": {"note": "n"}}})
+
+
+def test_the_bills_washers_and_nuts_are_the_sum_of_every_bolt_rows_stack(table31_rig):
+    """The machinist counted 18 M4 large washers in the bill's own rows against 16 ordered, 8 M4 nuts
+    against 6, and no M5/M10 large washer under the projector's and camera's screws though the torque
+    table assumes them. The bill's lines are summed here from the rows themselves: the dome's declared
+    joint, every tower row's washers/nuts per bolt, one washer stack per instrument foot."""
+    from rigcad.manual import plan
+    from rigcad.manual.assembly import picture_meshes
+    from rigcad.parts import tower
+    from rigcad.parts.joints import ScrewJoint
+    from rigcad.parts.washers import large, plain
+
+    rig = table31_rig
+    steps = plan.steps(rig, picture_meshes(rig))[0]
+    rows = plan.bill_hardware(rig, steps, {"fasteners": B.fasteners(rig), "pins": None})
+    line = {r["item"]: r["quantity"] for r in rows if r["steps"] == ["with the bolts above"]}
+    hw = [h for h in tower.hardware(rig.profile, rig.layout) if h.get("thread")]
+    joints = [j for p in rig.recipes.values() for j in p.joints if isinstance(j, ScrewJoint)]
+    feet = {k: [h for h in hw if k in h] for k in ("for_stacks_of_shims", "for_camera_stacks_of_shims")}
+    fixed = [h for h in hw if not any(k in h for k in feet)]
+
+    def n_large(size: str) -> int:
+        name = large(size).name()
+        n = sum(j.count for j in joints if name in j.washer_spec)
+        n += sum(h["quantity"] * h.get("washers", []).count(name) for h in fixed)
+        return n + sum(max(h["quantity"] for h in hs) * hs[0]["washers"].count(name) for hs in feet.values() if hs)
+
+    for size in ("M4", "M5", "M6", "M10"):
+        bill_line = f"{size} large washer (ISO 7093-1, {large(size).outer:g} mm outside, {large(size).thickness:g} mm)"
+        assert line.get(bill_line, 0) == n_large(size) > 0, (size, line)
+    # the review's own count: 8 dome + 4 column top + 4 foot + 2 lens mount + 4 projector feet
+    assert line["M4 large washer (ISO 7093-1, 12 mm outside, 1 mm)"] == 22
+    nuts = sum(h.get("nuts", 0) * h["quantity"] for h in fixed) + sum(j.count for j in joints if j.into == "nut")
+    assert line["M4 hex nut (ISO 4032)"] == nuts == 8  # 4 traps, 2 lens mount, 2 spring bolts
+    # every plain washer: the spring bolts' two, the lens mount's nut's one, the instruments' extra ones
+    m4 = f"M4 washer (ISO 7089, {plain('M4').outer:g} mm outside, {plain('M4').thickness:g} mm)"
+    assert line[m4] == sum(h.get("plain_washers", 0) * h["quantity"] for h in fixed) + 4 * max(
+        r["extra_washers"] or 0 for r in tower.projector_screws(rig.profile, rig.layout))
+    assert not any(k.endswith("washer (ISO 7089)") or "large washer (ISO 7093)" == k[3:] for k in line)  # old words
