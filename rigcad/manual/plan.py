@@ -165,7 +165,7 @@ def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener,
     out: dict[str, tuple[Fastener, ...]] = {}
     nominal = _projector_length(rig, t.shims_nominal)  # the stacks as drawn: shims_nominal shims each
     for h in rows:
-        item = _screw_item(h["thread"], h["length_mm"])
+        item = _screw_item(h["thread"], h["length_mm"], h.get("washers", ()))
         if "projector" in h["joins"] and h["length_mm"] == nominal:
             z = t.shelf_top_z - t.shelf_thickness - 1.0
             shims = sorted(n for n in meshes_by_name if n.startswith("projector_shims_"))
@@ -181,8 +181,11 @@ def instrument_fasteners(rig, meshes_by_name: dict) -> dict[str, tuple[Fastener,
     return out
 
 
-def _screw_item(thread: str, length: float) -> str:
-    return f"{thread} x {length:g} mm socket-head screw (ISO 4762 / ASME B18.3) with a washer"
+def _screw_item(thread: str, length: float, washers=()) -> str:
+    """The screw as ordered, with its washer stack by name, head side first (rigcad.parts.washers: the
+    stack the torque table assumes over the slot), or a plain washer."""
+    on = " on ".join(w.removeprefix("a ") for w in washers) or "a washer"
+    return f"{thread} x {length:g} mm socket-head screw (ISO 4762 / ASME B18.3) with {on}"
 
 
 def _projector_length(rig, shims: int) -> float:
@@ -199,7 +202,7 @@ def projector_screw_rows(rig) -> list[dict]:
     from rigcad.parts.tower import hardware, projector_screws
 
     extra = {r["shims"]: r["extra_washers"] for r in projector_screws(rig.profile, rig.layout)}
-    return [{"item": _screw_item(h["thread"], h["length_mm"]), "length_mm": h["length_mm"], "quantity": h["quantity"],
+    return [{"item": _screw_item(h["thread"], h["length_mm"], h.get("washers", ())), "length_mm": h["length_mm"], "quantity": h["quantity"],
              "stacks": list(h["for_stacks_of_shims"]),
              "extra_washers": {n: extra[n] for n in h["for_stacks_of_shims"] if extra[n]}}
             for h in hardware(rig.profile, rig.layout) if "for_stacks_of_shims" in h]
