@@ -566,3 +566,7 @@ def test_the_bills_washers_and_nuts_are_the_sum_of_every_bolt_rows_stack(table31
     assert line[m4] == sum(h.get("plain_washers", 0) * h["quantity"] for h in fixed) + 4 * max(
         r["extra_washers"] or 0 for r in tower.projector_screws(rig.profile, rig.layout))
     assert not any(k.endswith("washer (ISO 7089)") or "large washer (ISO 7093)" == k[3:] for k in line)  # old words
+    # the steps fit the screws with the stack the torque table assumes, not "a washer" that drops through
+    fitted = {st.name: {f.item for f in st.fasteners} for st in steps}
+    for step, big in (("projector_body", "M5"), ("camera_body", "M10")):
+        assert fitted[step] and all(f"on {large(big).name()}" in item for item in fitted[step]), fitted[step]
