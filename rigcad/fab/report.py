@@ -137,12 +137,14 @@ def _contact_section(report: dict) -> list[str]:
     if not contact:
         return []
     lines = ["## Support contact (from the G-code's support extrusions)", "",
-             "| piece | orientation | on the mirror (mm2) | on other faces (mm2) | model: mirror / other (mm2) | picture |",
-             "|---|---|---|---|---|---|"]
+             "| piece | orientation | on the mirror (mm2) | of it within the seams' faired band (mm2) | "
+             "on other faces (mm2) | model: mirror / other (mm2) | picture |",
+             "|---|---|---|---|---|---|---|"]
     for pc, e in contact:
         sc, sm = pc["gcode"]["support_contact"], pc.get("support_model", {})
         pic = f"![{pc['name']}]({sc['png']})" if "png" in sc else ""
-        lines.append(f"| {pc['name']} | {pc['orientation']} | {sc['mirror_mm2']:.0f} | {sc['other_mm2']:.0f} | "
+        band = f"{sc['mirror_in_band_mm2']:.1f} (band {sc['band_mm']:g} mm)" if "band_mm" in sc else "-"
+        lines.append(f"| {pc['name']} | {pc['orientation']} | {sc['mirror_mm2']:.1f} | {band} | {sc['other_mm2']:.0f} | "
                      f"{sm.get('mirror_mm2', 0):.0f} / {sm.get('other_mm2', 0):.0f} | {pic} |")
     return lines + [""]
 

@@ -33,7 +33,7 @@ from rigcad.errors import FabricationError, RigcadError
 from rigcad.export import reuse
 from rigcad.export.atomic import Staging, json_bytes
 from rigcad.export.manifest import profile_digest, sha256_hex
-from rigcad.fab import choice, estimate, orientation, outlines, seams, slicer, split, staircase
+from rigcad.fab import choice, estimate, orientation, outlines, seams, slicer, split, staircase, support
 from rigcad.fab.mirror import MirrorSurface, mirror_faces
 from rigcad.fab.printers import Printer
 from rigcad.fab.published import FabResult, inputs_key, read_back  # noqa: F401 (FabResult: this module's result)
@@ -164,6 +164,9 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                 for pc in d.entry.get("pieces", []):
                     if pc["name"] in sliced.records:
                         pc["gcode"] = sliced.records[pc["name"]]
+                        if d.entry.get("mirror") and "support_contact" in pc["gcode"]:
+                            problems += support.mirror_problems(pc["name"], pc["gcode"]["support_contact"],
+                                                                pc["support_model"]["mirror_mm2"], printer.source)
             timings["gcode"] = time.perf_counter() - t
             stage.write_bytes(out / "printer.ini", slicer.printer_ini(printer, support=False).encode())
         elif gcode and printer.slicer != "prusa-slicer":
@@ -270,14 +273,15 @@ def _cut_part(rig, part, run: _Run, stocks: dict) -> PartFab:
 
 def _support_contact(name: str, gcode: bytes, mesh: tuple, run: "_Run") -> dict:
     """Support contact of one piece from its G-code's support extrusions (rigcad.fab.support), mm2
-    on its mirror and its other faces; a picture (support/<piece>.png) for pieces with a mirror."""
-    from rigcad.fab import support
-
+    on its mirror (within and outside its meridional seams' faired band, rigcad.fab.seams) and its
+    other faces; a picture (support/<piece>.png) for pieces with a mirror."""
     printer, stage, out = run.printer, run.stage, run.out
-    vertices, faces, mirror_index = mesh
+    vertices, faces, mirror_index, frame_vertices, seam_normals = mesh
     settings = printer.slicer_config.effective() if printer.slicer_config else {}
     beads = support.support_beads(gcode)
-    areas = support.contact_areas(vertices, faces, mirror_index, beads, support.contact_reach(settings, printer.layer_height))
+    band = (frame_vertices, lambda p: seams.seam_distance(p, seam_normals), seams.SEAM_BAND_MM) if seam_normals else None
+    areas = support.contact_areas(vertices, faces, mirror_index, beads, support.contact_reach(settings, printer.layer_height),
+                                  band)
     pts, touched, on_m = areas.pop("_points"), areas.pop("_touched"), areas.pop("_mirror")
     areas["method"] = ("surface samples within reach_mm of the G-code's ;TYPE:Support material / Support material "
                        "interface extrusions (rigcad.fab.support)")
@@ -479,7 +483,8 @@ def _fab_part(part, layout, run: _Run, plan=None, orient_only: bool = False) -> 
     done = PartFab(entry, plan=plan, timings=timings)
     entry["pieces"], maps = [], []
     for pc, o in zip(pieces, oriented):
-        row, done.meshes[pc.name], job, staircase_map = _print_piece(pc, o, mirror, run)
+        seam_normals = seams.cut_normals(plan, pc) if mirror is not None and sectors else []
+        row, done.meshes[pc.name], job, staircase_map = _print_piece(pc, o, mirror, run, seam_normals)
         entry["pieces"].append(row)
         done.jobs += [job] if job is not None else []
         maps += [staircase_map] if staircase_map is not None else []
@@ -503,9 +508,10 @@ def _orient(pc, mirror, plate, sectors: bool, run: _Run) -> _Oriented:
     return _Oriented(pv, pf, mf, best, rows, chosen, steep)
 
 
-def _print_piece(pc, o: _Oriented, mirror, run: _Run) -> tuple[dict, tuple, object, tuple | None]:
+def _print_piece(pc, o: _Oriented, mirror, run: _Run, seam_normals=()) -> tuple[dict, tuple, object, tuple | None]:
     """Slice piece ``pc`` in its orientation and write its STL in print position. Returns its
-    fab.json row, its mesh in print position (vertices, faces, mirror face indices), its slicing
+    fab.json row, its mesh in print position (vertices, faces, mirror face indices, and the same
+    vertices in the part frame with ``seam_normals``, its meridional cut planes' normals), its slicing
     job (None for a printer rigcad cannot slice for) and its mirror's staircase map (points, cusp
     from the slices; None without a mirror)."""
     from rigcad.export import mesh
@@ -540,7 +546,8 @@ def _print_piece(pc, o: _Oriented, mirror, run: _Run) -> tuple[dict, tuple, obje
         staircase_map = (steps.points, steps.cusp_slices)
     job = slicer.slice_job(printer, pc.name, stl, row["needs_support"], run.bed_centre) \
         if printer.slicer == "prusa-slicer" else None
-    piece_mesh = (placed, o.faces, o.mirror_f.index if o.mirror_f is not None else np.zeros(0, int))
+    piece_mesh = (placed, o.faces, o.mirror_f.index if o.mirror_f is not None else np.zeros(0, int),
+                  o.vertices, list(seam_normals))
     return row, piece_mesh, job, staircase_map
 
 

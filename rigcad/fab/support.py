@@ -145,10 +145,13 @@ def contact_reach(settings: dict[str, str], layer_height: float) -> float:
 
 
 def contact_areas(vertices: np.ndarray, faces: np.ndarray, mirror_index: np.ndarray, beads: SupportBeads,
-                  reach: float) -> dict:
+                  reach: float, band: tuple | None = None) -> dict:
     """Support contact (mm2) on the mirror faces (``mirror_index``) and the other faces of a mesh
     in print position (vertices (n, 3) mm, faces (m, 3)), and the touched surface samples for a
-    picture."""
+    picture. ``band``: (the same vertices in another frame (n, 3), a function of points (k, 3) in
+    that frame giving a distance (mm), the band's width (mm)): the mirror's contact is also split
+    into ``mirror_in_band_mm2`` (samples within the width: a split mirror's seams, which their
+    fairing sands, rigcad.fab.seams.SEAM_BAND_MM) and ``mirror_off_band_mm2`` (the rest)."""
     tri = vertices[faces]
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
     total = float(area.sum())
@@ -176,7 +179,34 @@ def contact_areas(vertices: np.ndarray, faces: np.ndarray, mirror_index: np.ndar
             d, _ = cKDTree(near).query(pts, distance_upper_bound=reach)
             touched = np.isfinite(d)
     per = total / count
-    return {"mirror_mm2": float((touched & on_m).sum() * per), "other_mm2": float((touched & ~on_m).sum() * per),
+    split = {}
+    if band is not None:
+        frame_vertices, distance, width = band
+        ft = np.asarray(frame_vertices, float)[faces][face]
+        in_band = on_m & (distance(ft[:, 0] + r1[:, None] * (ft[:, 1] - ft[:, 0])
+                                   + r2[:, None] * (ft[:, 2] - ft[:, 0])) <= width)
+        split = {"mirror_in_band_mm2": float((touched & in_band).sum() * per),
+                 "mirror_off_band_mm2": float((touched & on_m & ~in_band).sum() * per), "band_mm": float(width)}
+    return {**split, "mirror_mm2": float((touched & on_m).sum() * per), "other_mm2": float((touched & ~on_m).sum() * per),
             "mirror_area_mm2": float(area[is_mirror].sum()), "surface_samples": count, "reach_mm": reach,
             "support_extruded_length_mm": beads.length_mm, "support_layers": beads.layers,
             "_points": pts, "_touched": touched, "_mirror": on_m}
+
+
+def mirror_problems(piece: str, contact: dict, model_mm2: float, printer_source: str) -> list[str]:
+    """A fab problem when the slicer's support (``contact``: :func:`contact_areas`' record of the
+    piece's G-code) touches its mirror outside its seams' faired band (the whole mirror for a piece
+    without seams): naming the piece, the area, what rigcad's orientation model predicted
+    (``model_mm2``) and what to change. Support inside the band is stated in fab.md, not refused:
+    the seam's fairing sands it off (rigcad.fab.seams.SEAM_BAND_MM)."""
+    off = contact.get("mirror_off_band_mm2", contact.get("mirror_mm2", 0.0))
+    if off <= 0.0:
+        return []
+    where = (f" outside the {contact['band_mm']:g} mm band its seams' fairing sands "
+             f"({contact['mirror_in_band_mm2']:.1f} mm2 more inside it)" if "band_mm" in contact else "")
+    return [f"{piece}: the slicer's support touches {off:.1f} mm2 of its mirror{where}, measured on its G-code "
+            f"(rigcad.fab.support; picture {contact.get('png', 'support/' + piece + '.png')}), where rigcad's "
+            f"orientation model predicted {model_mm2:.1f} mm2: a scar on the optics. Change the printer's support "
+            f"settings (slicer.overrides in {printer_source}: support_material_threshold, "
+            f"support_material_buildplate_only, support_material_contact_distance) or print it in another "
+            f"orientation; the model that chose this one disagreed with the slicer"]

@@ -110,8 +110,10 @@ def test_prusaslicer_slices_the_small_parts_deterministically_and_caches(table31
 @pytest.mark.skipif(not have_slicer(), reason=NO_SLICER)
 def test_prusaslicer_slices_every_piece_of_every_part(table31_rig, prusa, tmp_path):
     """The whole rig on the desktop printer (the dome's quarters take 1-2 min each): every piece
-    sliced cleanly; the slicer's own support extrusions touch no mirror (issue 14: 0 mm2 on the
-    Prusa for the default profile); rigcad's estimate within 25 % of PrusaSlicer on every piece."""
+    sliced cleanly; the slicer's own support extrusions touch no mirror outside the band its seams'
+    fairing sands (rigcad.fab.seams.SEAM_BAND_MM; the dome's quarters have 0.7-2.4 mm2 of it where
+    a seam meets the mirror, next to a pin hole), which run_fab would report as a problem; rigcad's
+    estimate within 25 % of PrusaSlicer on every piece."""
     from rigcad.fab import estimate as E
     from rigcad.fab.stage import run_fab
 
@@ -122,7 +124,10 @@ def test_prusaslicer_slices_every_piece_of_every_part(table31_rig, prusa, tmp_pa
             g = pc["gcode"]
             assert g["estimates"]["print_time_s"] > 0 and not g["slicer_warnings"]
             if entry["mirror"]:
-                assert g["support_contact"]["mirror_mm2"] == 0.0, (pc["name"], g["support_contact"])
+                sc = g["support_contact"]
+                assert sc.get("mirror_off_band_mm2", sc["mirror_mm2"]) == 0.0, (pc["name"], sc)
+                # measured 0.7-2.4 mm2 per quarter; support along a whole seam would be hundreds
+                assert sc.get("mirror_in_band_mm2", 0.0) < 10.0, (pc["name"], sc)
             t, m = g["estimates"]["print_time_s"], g["estimates"]["filament_g"]
             assert abs(pc["estimate"]["print_time_s"] / t - 1) < E.MAX_REL_ERROR, (pc["name"], pc["estimate"], t)
             assert abs(pc["estimate"]["material_g"] / m - 1) < E.MAX_REL_ERROR, (pc["name"], pc["estimate"], m)
