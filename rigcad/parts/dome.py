@@ -227,7 +227,9 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
     joint, reg, seats = flange_joint(profile, layout), register(profile, layout), beam_seats(profile, layout)
     hole = flange_bolt_hole(profile, layout)
     holes = joint.clearance_holes(hole)
-    joint = replace(joint, washer_spec="a " + " on ".join(w.name() for w in washers_over(joint.thread, ("round", hole)).washers))
+    stack = washers_over(joint.thread, ("round", hole))
+    joint = replace(joint, washer_spec="a " + " on ".join(w.name() for w in stack.washers), washer_mm=stack.thickness,
+                    spring_washer=True)  # the torque table's spring washer (rigcad.fab.loads: the flange's creep)
     lateral, _ = reg.repeatability
     body = Union_((Revolve(section), *seats.blocks))
     datums = datums_of("seat", "beam seat", seats.tunnels)
