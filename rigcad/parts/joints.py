@@ -17,7 +17,7 @@ from rigcad.errors import GeometryError
 import math
 
 from rigcad.parts.recipe import Cylinder, Solid, bounds
-from rigcad.standards import INSERTS, THREADS, longest_screw, shortest_screw
+from rigcad.standards import CONICAL_SPRING_WASHERS, INSERTS, THREADS, longest_screw, shortest_screw
 
 #: What may take a joint's thread.
 INTO = ("insert", "nut")
@@ -42,6 +42,11 @@ class ScrewJoint:
     #: The washer under each head as ordered (rigcad.parts.washers: large ones over an opened hole); a
     #: plain ISO 7089 washer when empty.
     washer_spec: str = ""
+    #: That washer stack's thickness (mm); None: the plain ISO 7089 washer's.
+    washer_mm: float | None = None
+    #: A DIN 6796 conical spring washer under each head (creep would relax the joint: rigcad.fab.loads
+    #: marks it): its free height counts in the grip (standards.CONICAL_SPRING_WASHERS).
+    spring_washer: bool = False
 
     def __post_init__(self) -> None:
         if self.thread not in THREADS:
@@ -64,8 +69,11 @@ class ScrewJoint:
 
     @property
     def washer(self) -> float:
-        """The washer under each head (mm, ISO 7089)."""
-        return THREADS[self.thread].washer_thickness
+        """What stands under each head (mm): its washer stack (ISO 7089 unless ``washer_mm``) and the
+        conical spring washer at its free height (DIN 6796 h, the most it can stand: the screw must
+        still engage with it uncompressed)."""
+        plain = THREADS[self.thread].washer_thickness if self.washer_mm is None else self.washer_mm
+        return plain + (CONICAL_SPRING_WASHERS[self.thread][3] if self.spring_washer else 0.0)
 
     @property
     def head_z(self) -> float:
@@ -73,16 +81,36 @@ class ScrewJoint:
         return self.upper_z[1] + self.washer
 
     @property
+    def grip(self) -> float:
+        """Head's bearing face to the lower part's top face (mm): the washers under the head (:attr:`washer`)
+        and the upper part's clamped span."""
+        return self.washer + (self.upper_z[1] - self.upper_z[0])
+
+    @property
+    def engagement(self) -> float:
+        """How far (mm) the screw runs into the insert (past the lower part's top face, where the insert's
+        top sits); through a nut, what stands out past the nut."""
+        if self.into == "insert":
+            return self.length - self.grip
+        th = THREADS[self.thread]
+        return self.length - (self.grip + (self.lower_z[1] - self.lower_z[0]) + th.washer_thickness + th.nut_height)
+
+    @property
     def length(self) -> int:
-        """The screws' length (mm, ISO 4762 as sold): into an insert, the longest that ends inside it;
-        through a nut, the shortest that shows two pitches past it (washers under head and nut)."""
+        """The screws' length (mm, ISO 4762 as sold): into an insert, the longest that ends inside it
+        and engages it by at least one thread diameter; through a nut, the shortest that shows two
+        pitches past it (the washers under the head as :attr:`washer`, a plain one under the nut)."""
         th = THREADS[self.thread]
         if self.into == "insert":
-            reach = self.washer + (self.upper_z[1] - self.upper_z[0]) + INSERTS[self.thread].length
-            found = longest_screw(self.thread, reach)
+            found = longest_screw(self.thread, self.grip + INSERTS[self.thread].length)
+            if found is not None and found - self.grip < th.major - 1e-9:
+                raise GeometryError(f"joint {self.name}: the longest {self.thread} screw that ends inside its insert "
+                                    f"({found} mm) engages it {found - self.grip:.1f} mm, under one diameter "
+                                    f"({th.major:g} mm): {INSERTS[self.thread].length:g} mm insert under "
+                                    f"{self.grip:.1f} mm of washers and {self.upper}", param=self.param or None)
         else:
-            grip = (self.upper_z[1] - self.upper_z[0]) + (self.lower_z[1] - self.lower_z[0])
-            found = shortest_screw(self.thread, grip + 2 * th.washer_thickness + th.nut_height + 2 * th.pitch)
+            grip = self.grip + (self.lower_z[1] - self.lower_z[0])
+            found = shortest_screw(self.thread, grip + th.washer_thickness + th.nut_height + 2 * th.pitch)
         if found is None:
             raise GeometryError(f"joint {self.name}: no ISO 4762 {self.thread} screw suits it "
                                 f"(lengths {', '.join(map(str, self.lengths_sold))} mm)", param=self.param or None)
@@ -99,7 +127,8 @@ class ScrewJoint:
         """The screw as it is ordered, with what takes its thread."""
         if self.into == "insert":
             ins = INSERTS[self.thread]
-            return (f"{self.thread} x {self.length} mm socket-head bolt (ISO 4762) with "
+            spring = "a conical spring washer (DIN 6796) on " if self.spring_washer else ""
+            return (f"{self.thread} x {self.length} mm socket-head bolt (ISO 4762) with {spring}"
                     f"{self.washer_spec or 'a washer (ISO 7089)'} into a "
                     f"{self.thread} heat-set insert ({ins.length:g} mm long, in a {ins.hole:g} mm hole) melted into "
                     f"{self.lower}")

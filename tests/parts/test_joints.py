@@ -53,8 +53,10 @@ def test_the_flange_joint_is_declared_and_the_plate_is_cut_at_the_insert_makers_
     # ruthex's M4 insert: a 5.6 mm hole, never the insert's 6.3 mm outside
     got = _pockets(table31_rig, tmp_path, INSERTS["M4"].hole / 2)
     assert got == sorted((round(x, 3), round(y, 3)) for x, y in joint.points)
-    # 0.8 washer + 6 flange + 8.1 insert = 14.9 mm of reach: the longest M4 ISO 4762 sells within it is 12
-    assert joint.length == 12
+    # 1.0 large washer (ISO 7093-1 M4) + 1.3 spring washer at its free height (DIN 6796 M4) + 6 flange
+    # + 8.1 insert = 16.4 mm of reach: the longest M4 ISO 4762 sells within it is 16, 7.7 mm in the insert
+    # (the machinist measured M4 x 12: 3.7 mm, under one diameter)
+    assert joint.length == 16 and joint.engagement == pytest.approx(7.7, abs=1e-9)
     quantity, steps = _hardware(table31_rig)[joint.item]
     assert quantity == 8 and steps == "dome"
 
@@ -93,3 +95,41 @@ def test_a_joint_refuses_what_cannot_be_built():
     through = ScrewJoint("j", "dome", "base_plate", "M4", **kw, into="nut")
     # 16 mm grip + 2 washers 0.8 + nut 3.2 + 2 pitches 0.7 = 22.2 mm: the shortest M4 of that or more is 25
     assert through.length == 25 and "nut (ISO 4032)" in through.item
+
+
+def test_every_screw_joint_engages_its_insert_by_a_diameter_and_ends_inside_it(table31_rig):
+    """Every joint the parts declare: the grip counts everything under the head (its washer stack and,
+    where the torque table asks for one, the conical spring washer at its free height); the screw
+    engages an insert by at least one diameter (the common rule for a thread in a softer host) and
+    ends inside it, or shows two pitches past its nut. Summed here from the standards' tables."""
+    from rigcad.parts.washers import washers_over
+    from rigcad.standards import CONICAL_SPRING_WASHERS, THREADS
+
+    joints = [j for p in table31_rig.recipes.values() for j in p.joints if isinstance(j, ScrewJoint)]
+    assert joints
+    for j in joints:
+        th = THREADS[j.thread]
+        under = (j.washer_mm if j.washer_mm is not None else th.washer_thickness) + (
+            CONICAL_SPRING_WASHERS[j.thread][3] if j.spring_washer else 0.0)
+        grip = under + j.upper_z[1] - j.upper_z[0]
+        if j.into == "insert":
+            engaged = j.length - grip
+            assert th.major <= engaged <= INSERTS[j.thread].length, (j.name, j.length, engaged)
+        else:
+            past = j.length - grip - (j.lower_z[1] - j.lower_z[0]) - th.washer_thickness - th.nut_height
+            assert past >= 2 * th.pitch, (j.name, j.length, past)
+    (flange,) = [j for j in joints if j.name == "dome_flange"]
+    # the dome's flange: the large washer over its opened hole and the spring washer the torque table marks
+    hole = dome.flange_bolt_hole(table31_rig.profile, table31_rig.layout)
+    assert flange.spring_washer and flange.washer_mm == washers_over("M4", ("round", hole)).thickness
+
+
+def test_a_joint_too_short_for_one_diameter_in_its_insert_is_refused():
+    # 6 mm flange + 0.8 washer + 1.3 spring: 8.1 mm grip; an M4 insert 8.1 mm long gives 16.2 mm of reach,
+    # the longest M4 is 16: 7.9 mm engaged. 15.5 mm under the head: 21.5 mm grip, 29.6 mm of reach, the
+    # longest M4 within it is 25 (ISO 4762 has no 28): 3.5 mm engaged, under 4: refused
+    kw = dict(points=((0.0, 0.0),), upper_z=(0.0, 6.0), lower_z=(-10.0, 0.0), spring_washer=True)
+    ok = ScrewJoint("j", "dome", "base_plate", "M4", **kw)
+    assert ok.length == 16 and ok.engagement == pytest.approx(7.9, abs=1e-9)
+    with pytest.raises(GeometryError, match="engages it 3.5 mm, under one diameter"):
+        ScrewJoint("j", "dome", "base_plate", "M4", washer_mm=15.5 - 1.3, **kw).length
