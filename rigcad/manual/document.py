@@ -672,6 +672,42 @@ def preparation_text(rows: list[dict], number: dict[str, int], here: str) -> str
     return text
 
 
+#: What a bonded seat part's row asks of the part that stands on the seat while the bond cures.
+CURE_ON_SEAT = "standing on its seat"
+
+
+def cure_on_seat(order, prep: dict[str, list[dict]]) -> tuple[list[str], str | None]:
+    """The steps that bond seat parts which cure with the part they carry standing on them (their
+    "placed" rows say CURE_ON_SEAT), and the later step that places that part (the first whose parts
+    rest on them), or ([], None)."""
+    bonded = [p.step.name for p in order
+              if any(r["kind"] == "placed" and CURE_ON_SEAT in r.get("joins", "") for r in prep[p.step.name])]
+    members = {m for p in order if p.step.name in bonded for m in p.step.members}
+    holder = next((p.step.name for p in order if members & set(p.step.needs)), None)
+    return (bonded, holder) if bonded and holder else ([], None)
+
+
+def cure_text(cure: tuple[list[str], str | None], here: str, number: dict[str, int]) -> str:
+    """What a step says when the bonds of :func:`cure_on_seat` cure under the part of a later step: the
+    first bonding step has that part prepared before it; the part's own step says it was."""
+    bonded, holder = cure
+    if not bonded:
+        return ""
+    name, first, last = holder.replace("_", " "), number[bonded[0]], number[bonded[-1]]
+    span = f"steps {first}-{last}" if last > first else f"step {first}"
+    if here == bonded[0]:
+        return (f"The {name} stands on its seat while the seat's bonds cure ({span}), so prepare it first, before "
+                f"any bonding: do now what step {number[holder]} says before it goes in (its heat-set inserts and its "
+                "ball-ended push screws, their balls in their cups). Then bond the seat's parts of "
+                f"{span} in one session, stand the prepared {name} on them while the bond is wet and let it cure; "
+                f"lift it off again until step {number[holder]}. ")
+    if here in bonded:
+        return f"(This bond cures with the others of {span}, the prepared {name} standing on the seat.) "
+    if here == holder:
+        return f"Prepared before step {first} (its inserts and push screws, as below): now it goes in for good. "
+    return ""
+
+
 def placed_text(rows: list[dict]) -> str:
     """What a step says of the bought items it fits itself (:func:`preparations`' "placed" rows): rows whose
     use reads the same but for its leading count (the precision shims, one row per thickness) are one
@@ -713,11 +749,28 @@ def stack_count(mesh, shim_mm: float) -> int:
     return int(round(float(min(mesh.hi - mesh.lo)) / shim_mm))
 
 
+def lifted_encloser(step, placed_names, meshes_by_name: dict, rig) -> str | None:
+    """The part already in place that holds the whole step (its bounding box holds every member's: the
+    dome round the paraboloid) and sits on a repeatable register, so that the step is done with it lifted
+    off (section 6 handles the paraboloid with the dome off the same way); None when there is none."""
+    import numpy as np
+
+    for name in placed_names:
+        a = meshes_by_name.get(name)
+        reg = any(isinstance(j, DowelRegister) for j in getattr(rig.recipes.get(name), "joints", ()))
+        if a is None or not reg:
+            continue
+        if all(np.all(a.lo <= meshes_by_name[m].lo) and np.all(meshes_by_name[m].hi <= a.hi) for m in step.members):
+            return name
+    return None
+
+
 def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_mm: float | None = None,
-              spring: str = "") -> str:
+              spring: str = "", lifted: str | None = None) -> str:
     """What a found step says: what goes in, how (its direction), on what, and each group of like
     fasteners with its tool and what takes its thread (``prepared``: (kind, thread host) -> the step
-    number where its inserts or trap nuts were set, :func:`preparations`)."""
+    number where its inserts or trap nuts were set, :func:`preparations`). ``lifted``: the part in place
+    round the whole step (:func:`lifted_encloser`): the step is done with it lifted off its register."""
     from collections import Counter
 
     from rigcad.manual import plan
@@ -746,9 +799,17 @@ def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_m
         text += (f"Before it goes in, thread its {n} x {item} down into its inserts from above until each one's end "
                  f"stands out under its boss, and seat a {what} in each one's cup with a drop of retaining "
                  "compound; turn them from above once it stands (they set its height and tilt). ")
-    text += MOVES.get(_dir_name(placed.direction), f"move it in along {_dir_name(placed.direction)}").capitalize()
-    text += (f" until it rests on the {', '.join(n.replace('_', ' ') for n in st.needs)}." if st.needs
-             else " onto the bench.")
+    on = ", ".join(n.replace("_", " ") for n in st.needs)
+    if lifted:
+        outer = lifted.replace("_", " ")
+        text += (f"The {outer} is on its register pins now and closes round this part (its top opening leaves no "
+                 f"room to work through): take out the {outer}'s screws, lift it straight off its pins (what it carries "
+                 f"rides with it) and stand it upside down on the bench; put the part in through the {outer}'s open "
+                 f"base onto the {on}, then set the {outer} back on its pins and screw it down to its torque (section "
+                 f"6 does the same whenever this part is handled).")
+    else:
+        text += MOVES.get(_dir_name(placed.direction), f"move it in along {_dir_name(placed.direction)}").capitalize()
+        text += f" until it rests on the {on}." if st.needs else " onto the bench."
     groups = Counter((f.item, f.tools[0].name, "trap" if f.thread_in == "nut" and f.nut_tool is None else f.thread_in,
                       plan.thread_host(f, meshes_by_name) if f.thread_in in ("insert", "nut") else None)
                      for f in st.fasteners if f not in first)
@@ -831,6 +892,7 @@ def _section_assemble(d: Doc, c) -> None:
     number = {p.step.name: k + 1 for k, p in enumerate(order)}
     prepared = {(r["kind"], r["into"]): number[name] for name, rows in prep.items() for r in rows
                 if r["kind"] in ("insert", "nut")}
+    cure = cure_on_seat(order, prep)
     done: list[int] = []
     for k, placed in enumerate(order):
         st = placed.step
@@ -840,8 +902,10 @@ def _section_assemble(d: Doc, c) -> None:
                                              if len(members) > 1 and st.name not in st.members else "")
         text = "".join(register_text(j) for m in st.members if m in c.rig.recipes
                        for j in c.rig.recipes[m].joints if isinstance(j, DowelRegister))
+        text += cure_text(cure, st.name, number)
         text += preparation_text(prep[st.name], number, st.name)
-        text += step_text(placed, by_name, prepared, _shim_mm(c.rig), spring_bolts(c.rig).get("set", ""))
+        lifted = lifted_encloser(st, [p.step.name for p in order[:k]], by_name, c.rig)
+        text += step_text(placed, by_name, prepared, _shim_mm(c.rig), spring_bolts(c.rig).get("set", ""), lifted)
         text += placed_text([r for r in prep[st.name] if r["kind"] == "placed"])
         if st.name == "projector_body":
             text += plan_mod.projector_screw_text(c.rig)
