@@ -189,9 +189,10 @@ def mirror_record(printer, stock: float, template_thickness: float, pin_diameter
     return seam_steps(pin, errors.position, stock, template_thickness)
 
 
-def problems(part: str, record: dict | None) -> list[str]:
+def problems(part: str, record: dict | None, whole: str = "") -> list[str]:
     """What a fab run must not pass over in a part's seams record: a seam its sanding stock cannot
-    fair, or glue faces no listed glue fills."""
+    fair, or glue faces no listed glue fills (``whole``: what would let the part print whole, with
+    no seam to glue: the keys and their values, rigcad.fab.stage.whole_fit_hint)."""
     if not record:
         return []
     out = []
@@ -201,5 +202,6 @@ def problems(part: str, record: dict | None) -> list[str]:
                    f"least {record['step_on_gauge_mm']:.3f} mm")
     if not record.get("glue_fills", True):
         out.append(f"{part}: its glue faces leave gaps of {record['glue_gap_mm']:.2f} mm, more than any listed glue "
-                   f"fills ({GLUES[-1].gap_fill:g} mm): print it with its cut faces across the layers")
+                   f"fills ({GLUES[-1].gap_fill:g} mm): print it with its cut faces across the layers"
+                   + (f", or avoid the split: {whole}" if whole else ""))
     return out

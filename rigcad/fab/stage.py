@@ -21,6 +21,7 @@ it, reads the folder back instead of doing the work again, while every file is i
 
 from __future__ import annotations
 
+import math
 import time
 from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
@@ -145,7 +146,9 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
                     problems.append(f"{name}: {err}")
                     done[name] = PartFab({"error": str(err)})
             report_parts[name] = done[name].entry
-            problems += seams.problems(name, done[name].entry.get("seams"))
+            rec = done[name].entry.get("seams")
+            whole = whole_fit_hint(rig, name, printer, chord) if rec and not rec.get("glue_fills", True) else ""
+            problems += seams.problems(name, rec, whole)
             timings.update(done[name].timings)
             say(name)
         if parts:
@@ -181,6 +184,48 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
         timings["report"] = time.perf_counter() - t
         written = stage.commit()
     return FabResult(report, written, timings, slicer_s, problems)
+
+
+#: A split part's profile key that sets its length, whose value lets it print whole (the beam's
+#: overhang beyond the dome's wall at each end; rigcad.parts.beam).
+LENGTH_KEYS = {"beam": "beam.overhang"}
+#: The step (mm) a suggested value is rounded down to: a figure one types into a profile.
+SUGGEST_STEP = 0.5
+
+
+def whole_fit_hint(rig, name: str, printer: Printer, chord: float) -> str:
+    """What lets part ``name`` print whole on ``printer`` (no seams to glue), for a problem line:
+    the printer's usable volume to beat with another printer, and for a part whose length a profile
+    key sets (LENGTH_KEYS) the largest value, rounded down to SUGGEST_STEP, with which the part fits
+    (judged by the same fit test as the split, rigcad.fab.choice.fits); none when even 0 does not fit."""
+    from dataclasses import replace as dc_replace
+
+    from rigcad.export import mesh
+    from rigcad.parts.beam import beam as beam_recipe
+
+    u = printer.usable
+    other = f"a printer whose usable volume ({u[0]:g} x {u[1]:g} x {u[2]:g} mm on the {printer.name}) takes it whole (--printer)"
+    key = LENGTH_KEYS.get(name)
+    if key != "beam.overhang":
+        return other
+    layout, profile = rig.layout, rig.profile
+
+    def fits_with(overhang: float) -> bool:
+        part = beam_recipe(profile, dc_replace(layout, beam_half_length=layout.slot_r + overhang))
+        v, _ = mesh.mesh_arrays(mesh.build(part.solid, chord))
+        return choice.fits(v, choice.candidates(False, orientation.plate_axis(v)), printer)
+
+    now = profile.beam.overhang
+    if not fits_with(0.0):
+        return f"{key} cannot (the beam does not fit whole even at 0 mm: its seats set its length); {other}"
+    lo, hi = 0.0, now  # fits at lo, not at hi (the run split it): bisect to a hundredth of the step
+    while hi - lo > 0.01 * SUGGEST_STEP:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if fits_with(mid) else (lo, mid)
+    best = SUGGEST_STEP * math.floor(lo / SUGGEST_STEP)
+    while best > 0.0 and not fits_with(best):  # the fit is monotonic in the length; kept honest anyway
+        best -= SUGGEST_STEP
+    return f"{key} at most {best:g} mm (now {now:g} mm; the beam then fits the bed whole), or {other}"
 
 
 def _with_earlier_parts(report_parts: dict, old: dict, out: Path, profile) -> dict:
