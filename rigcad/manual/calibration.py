@@ -178,7 +178,7 @@ def camera_crosses(rig) -> dict:
             "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
 
 
-__all__ = ["access", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
+__all__ = ["access", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
 
 
 #: The adjustable circle page: a full-screen canvas, the disc drawn in device pixels (the projector's
@@ -287,6 +287,33 @@ def checkerboard(rig) -> dict:
     return {"dome_inside_diameter_mm": 2 * inside, "disc_diameter_mm": float(2 * r), "squares": n,
             "square_mm": CHECKER_SQUARE_MM, "hole_diameter_mm": bore_drawn(rig.profile),
             "sheet": sheet or "a plotter roll", "disc_radius_mm": float(r)}
+
+
+#: How well a rim's edge is read by eye in an image viewer (px): to the nearest pixel. No band of the
+#: checkerboard's comparison is drawn finer than this, which the reading could not judge.
+EDGE_READ_PX = 1.0
+
+
+def camera_correspondence(rig) -> dict:
+    """What the checkerboard step compares (px, camera image; rigcad.optics.camera): the paraboloid's
+    image, the calibrated circle projected on it, seen by the aligned camera, is a disc whose centre
+    should be the principal point and whose radius the design's rim radius f_px tan(rim angle at the
+    COP). Its pass band is what the camera's own tolerances move it by, to first order: a lateral offset
+    ``tolerancing.camera_offset`` shifts the rim's image by f_px offset / (COP to rim plane) and a tilt
+    ``tolerancing.camera_tilt`` by f_px tan(tilt), together the centre's band; a height error
+    ``tolerancing.camera_height`` scales the radius by height / (COP to rim plane), the radius's band.
+    Neither band is finer than EDGE_READ_PX."""
+    from rigcad.optics.camera import camera_model
+
+    g, t = rig.geometry, rig.profile.tolerancing
+    cam = camera_model(rig.profile, g)
+    reach = g.cop_z - g.rim_z  # the COP to the rim's plane (mm)
+    centre_band = cam.focal_px * (t.camera_offset / reach + math.tan(t.camera_tilt))
+    radius_band = cam.image_radius_px * t.camera_height / reach
+    return {"principal_point_px": list(cam.principal_point), "image_radius_px": cam.image_radius_px,
+            "centre_tolerance_px": max(centre_band, EDGE_READ_PX),
+            "radius_tolerance_px": max(radius_band, EDGE_READ_PX),
+            "focal_length_px": cam.focal_px}
 
 
 def kit_items(rig) -> list[KitItem]:

@@ -1219,8 +1219,24 @@ def _calibration_more(d: Doc, c, cam: dict) -> None:
         f"plate inside the dome ({cb['dome_inside_diameter_mm']:.1f} mm across at the plate). Take out the dome's "
         f"{len(rig.layout.bolt_angles)} flange screws and lift the dome off its register pins (as for the calibration "
         "screens), lay the disc on the plate centred on the bore, set the dome back and screw it down to its torque "
-        "(section 5). Project the calibrated circle and locate the paraboloid's image in the camera's picture: its "
-        "centre and radius in pixels are the camera's correspondence. Then lift the dome again to take the disc out.")
+        "(section 5). Then lift the dome again to take the disc out.")
+    corr = C.camera_correspondence(rig)
+    c.correspondence = corr
+    (x0, y0), r0 = corr["principal_point_px"], corr["image_radius_px"]
+    d.p("**What is compared, and what passes.** Project the calibrated circle and take a picture with the camera: "
+        "the paraboloid's image is a lit disc, the checkerboard's squares seen in it through the mirrors. No rigcad "
+        "command reads it: in an image viewer that shows the pointer's pixel (GIMP's status bar, for one), read "
+        "three points on the disc's edge far apart, and take the circle through them (its centre and radius). The "
+        f"design puts the centre on the principal point (**{x0:.1f}, {y0:.1f} px**) and the radius at "
+        f"**{r0:.1f} px** (f = {corr['focal_length_px']:.0f} px x tan(the rim's angle at the COP)). It passes when "
+        f"the centre is within **{corr['centre_tolerance_px']:.1f} px** of the principal point (what "
+        "`tolerancing.camera_offset` and `camera_tilt` move it by) and the radius within "
+        f"**{corr['radius_tolerance_px']:.1f} px** of the design's (`tolerancing.camera_height`, but never finer than "
+        "the pixel an edge is read to), and the squares "
+        "run on unbroken to the disc's edge (a break or a doubled band is a seam or a slope fault of the mirrors). "
+        "Outside either band the camera is off its place: go back to its crosses (and its shims for the radius). "
+        "The circle's centre and radius, as read, are then the camera's correspondence: where the paraboloid's "
+        "rim and vertex fall in its pixels.")
     d.h(3, C.STEP_GRAY)
     from rigcad.calibrate.graycard import manual_text
 
@@ -1326,7 +1342,8 @@ def _section_calibrate(d: Doc, c) -> None:
     _as_built(d, c)
     step("calibration")
     c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam,
-                     "splitter_seat": seat, "gray_card": c.gray_card, "lab_temperature": thermal}
+                     "splitter_seat": seat, "gray_card": c.gray_card, "lab_temperature": thermal,
+                     "camera_correspondence": c.correspondence}
 
 
 def _crosses(d: Doc, pshadow: dict, springs: dict, p) -> None:
