@@ -213,6 +213,10 @@ def setting_text(profile: Profile, layout: RigLayout) -> str:
 
     seats, step = beam_seats(profile, layout), foil_step()
     per_tilt = seats.span * math.radians(0.01)
+    # the roll about the beam: foil under one half of the beam rocks it about its other edge, a lever of
+    # at most its width (too short for a quarter of the tilt tolerance; docs/rig-mechanics.md)
+    width = profile.beam.width
+    roll_per = width * math.radians(0.1)
     tol = profile.tolerancing
     return (
         f"Set the paraboloid from a calibration: `rigcad calibrate {profile.name} --images <folder>` prints, last, "
@@ -228,5 +232,10 @@ def setting_text(profile: Profile, layout: RigLayout) -> str:
         f"out of the pack on both seats' floors (add when negative); a change at one seat moves the paraboloid "
         f"half as much ({step / 2:g} mm per {step:g} mm foil). Tilt y (the -x side high when positive): take "
         f"{per_tilt:.3f} mm of foil per 0.01 deg out of the -x seat's pack, or add it at the +x seat, then "
-        "restore the height. Loosen the seats' set screws before changing their packs and tighten them after. "
+        f"restore the height. Tilt x (the +y side high when positive; a roll about the beam): lay foil under the "
+        f"beam's -y half on both seats' floors (under its +y half when negative), {roll_per:.4f} mm per 0.1 deg "
+        f"over the beam's {width:g} mm: its thinnest ({step:g} mm) rolls it {math.degrees(step / width):.2f} deg, "
+        f"so this lands within {math.degrees(step / width) / 2:.2f} deg of level, coarser than the other "
+        "settings; then restore the height. Loosen the seats' set screws before changing their packs and "
+        "tighten them after. "
         "Capture and calibrate again.")

@@ -10,6 +10,7 @@ from pathlib import Path
 from rigcad.fab.printers import load_printer
 from rigcad.fab.stack import RESOLUTION_SHARE
 from rigcad.parts.locating import foil_step
+from rigcad.parts.paraboloid import setting_text
 
 PAGE = Path(__file__).resolve().parents[2] / "docs" / "rig-mechanics.md"
 
@@ -28,3 +29,18 @@ def test_the_roll_figures_are_the_profiles(table31):
             f"{math.degrees(foil_step() / width):.2f} deg") in text
     assert foil_step() / width > fine  # the finding: too coarse
     assert f"a {math.degrees(fine):.2f} deg step in that foil needs a lever of {foil_step() / fine:.0f} mm" in text
+
+
+def test_the_calibration_says_how_to_set_the_roll_coarsely(table31_rig):
+    p, lay = table31_rig.profile, table31_rig.layout
+    text = " ".join(PAGE.read_text(encoding="utf-8").split())
+    step = foil_step() / p.beam.width  # the thinnest foil under one half of the beam, rocking on its other edge
+    half = step / 2  # a setting lands within half a step of the reading
+    assert half < p.tolerancing.paraboloid_tilt < 4 * step  # inside the tolerance, not within its quarter
+    assert (f"rolls it {math.degrees(step):.2f} deg per {foil_step():g} mm, so it lands within "
+            f"{math.degrees(half):.2f} deg of level") in text
+    step_text = setting_text(p, lay)
+    # the sign: tilt x > 0 lifts the +y side (rigcad.calibrate.conventions), so foil goes under the -y half
+    assert "Tilt x (the +y side high when positive" in step_text and "under the beam's -y half" in step_text
+    assert f"{p.beam.width * math.radians(0.1):.4f} mm per 0.1 deg" in step_text
+    assert f"rolls it {math.degrees(step):.2f} deg, so this lands within {math.degrees(half):.2f} deg" in step_text
