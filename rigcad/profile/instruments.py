@@ -28,6 +28,7 @@ size is assumed. Kernel-free, numpy-free.
 from __future__ import annotations
 
 import difflib
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -232,6 +233,51 @@ FIGURES: dict[str, tuple[str, str, str]] = {
 }
 
 
+#: The projector's entrance pupil cannot be sighted through (the no-parallax point is a camera's method):
+#: it is where the lines through the projected image's side edges cross. Project a full white frame on a
+#: flat wall square to the axis from these two distances (mm, lens barrel's front to the wall) and read
+#: the image's width at each (the width: a projector's lens shift moves the image up, not sideways).
+PUPIL_WALLS_MM = (1000.0, 2000.0)
+#: Each distance and width read with a steel tape to this (mm).
+PUPIL_READ_MM = 1.0
+
+
+def projector_pupil(throw_ratio: float, pupil_depth: float, walls=PUPIL_WALLS_MM, read=PUPIL_READ_MM) -> dict:
+    """The two-wall measure of the projector's pupil (mm): with widths w1, w2 at distances d1, d2 from the
+    barrel's front, w = (d + p) / throw_ratio gives p = (w1 d2 - w2 d1) / (w2 - w1) behind the front. Its
+    uncertainty, every reading off by ``read`` independently (first order, root sum of squares of
+    dp/dw1 = T (d2 + p) / (d2 - d1), dp/dw2 = -T (d1 + p) / (d2 - d1), dp/dd1 = -(d2 + p) / (d2 - d1),
+    dp/dd2 = (d1 + p) / (d2 - d1)), at the assumed ``pupil_depth`` p and ``throw_ratio`` T."""
+    d1, d2 = walls
+    t, p = throw_ratio, pupil_depth
+    a, b = d1 + p, d2 + p
+    sigma = read * math.sqrt((1 + t * t) * (a * a + b * b)) / (d2 - d1)
+    return {"walls_mm": [d1, d2], "widths_mm": [a / t, b / t], "read_mm": read, "uncertainty_mm": sigma}
+
+
+def pupil_from_widths(walls, widths) -> float:
+    """The pupil's depth behind the barrel's front (mm) from the two walls' distances and the image's
+    widths there (:func:`projector_pupil`'s formula)."""
+    (d1, d2), (w1, w2) = walls, widths
+    return (w1 * d2 - w2 * d1) / (w2 - w1)
+
+
+def _projector_pupil_text(projector, height_tolerance: float) -> str:
+    """The measure's text; ``height_tolerance`` (mm, ``tolerancing.projector_height``): the splitter turns an
+    error along the projector's axis into the COP's height."""
+    m = projector_pupil(projector.throw_ratio, projector.pupil_depth)
+    worse = m["uncertainty_mm"] > height_tolerance
+    (d1, d2), (w1, w2) = m["walls_mm"], m["widths_mm"]
+    return (f"entrance pupil (a projector cannot be sighted through, so project a full white frame on a flat wall "
+            f"square to the axis from {d1:g} mm and {d2:g} mm (lens barrel's front to the wall) and read the image's "
+            f"width at each (about {w1:.0f} and {w2:.0f} mm at the assumed sizes); the lines through its edges cross "
+            f"at the pupil, p = (w1 d2 - w2 d1) / (w2 - w1) behind the barrel's front, to ±{m['uncertainty_mm']:.1f} mm "
+            f"with each reading to {m['read_mm']:g} mm"
+            + (f", wider than the COP's height tolerance (`tolerancing.projector_height`, {height_tolerance:g} mm; the "
+               "splitter turns this error into the COP's height): take the maker's figure where it gives one, or "
+               "read more walls and fit the line" if worse else "") + ")")
+
+
 #: The assumed mounting pattern when nothing gives ``projector.mount_holes``: four holes this far (mm)
 #: in from the body's bottom corners, along and across.
 DEFAULT_MOUNT_INSET = 30.0
@@ -397,6 +443,8 @@ def measurements(profile) -> list[Measurement]:
             if profile.set_by(section, key) != "default":
                 continue
             view, a, b = FIGURES[key]
+            if (section, key) == ("projector", "pupil_depth"):
+                b = _projector_pupil_text(params, profile.tolerancing.projector_height)
             value = getattr(params, key)
             if key == "mount_holes":  # the pattern assumed, as [along, across] pairs
                 value = _pattern_text(mount_pattern(params))
@@ -407,5 +455,5 @@ def measurements(profile) -> list[Measurement]:
 
 
 __all__ = ["CAMERA_SIZES", "C_MOUNT_FLANGE", "DEFAULT_MOUNT_INSET", "FIGURES", "FIGURE_KEYS", "Instrument", "Measurement",
-           "NAMED_BY", "PROJECTOR_SIZES", "Sketch", "find", "folders", "measurements", "mount_pattern", "read", "shipped",
+           "NAMED_BY", "PROJECTOR_SIZES", "PUPIL_READ_MM", "PUPIL_WALLS_MM", "Sketch", "find", "folders", "measurements", "mount_pattern", "projector_pupil", "pupil_from_widths", "read", "shipped",
            "size_origin", "sketch"]
