@@ -116,7 +116,7 @@ def flange_extent(flange_in: float, wall: np.ndarray, shell, wall_r_at=None) -> 
     the head and its long arm out from the arm's end, and the key must clear the wall (ISO 2936,
     ``HexKey.room``; the thread is the one the flange's holes are for). One home for the optimiser's
     fast outline (rigcad.optimize.fast) and the parts' layout."""
-    from rigcad.standards import HEX_KEYS, THREADS, thread_for_hole
+    from rigcad.standards import CONICAL_SPRING_WASHERS, HEX_KEYS, ISO_7093, THREADS, thread_for_hole
 
     bolt = flange_in + shell.flange_width / 2
     try:
@@ -124,7 +124,11 @@ def flange_extent(flange_in: float, wall: np.ndarray, shell, wall_r_at=None) -> 
     except ValueError:
         return bolt + shell.flange_width / 2, bolt  # no thread fits the hole: the flange joint refuses it
     key = HEX_KEYS[th.hex_key]
-    shaft = shell.flange_thickness + th.washer_thickness + th.head_height + key.short_arm  # the short arm's end
+    # under the head: the large washer over the opened hole (ISO 7093-1 of its size) and the conical spring
+    # washer at its free height (DIN 6796), as the flange joint has them (rigcad.parts.dome, rigcad.parts.joints)
+    under = (ISO_7093[th.name][2] if th.name in ISO_7093 else th.washer_thickness) + (
+        CONICAL_SPRING_WASHERS[th.name][3] if th.name in CONICAL_SPRING_WASHERS else 0.0)
+    shaft = shell.flange_thickness + under + th.head_height + key.short_arm  # the short arm's end
 
     def widest(z0: float, z1: float) -> float | None:
         band = list(wall[(wall[:, 1] >= z0) & (wall[:, 1] <= z1), 0])
