@@ -207,7 +207,7 @@ def dowel_diameter_for(at_most: float) -> float:
 
 #: ISO 286-2 limit deviations (micrometres) of the hole and shaft tolerance classes rigcad's fits use,
 #: by nominal size range (over, up to] in mm: class -> ((over, up_to, lower, upper), ...). H, F, G
-#: and N holes and m and g shafts for sizes to 50 mm (ISO 286-2:2010, tables of the holes' and
+#: and N holes and m, g and f shafts for sizes to 50 mm (ISO 286-2:2010, tables of the holes' and
 #: shafts' limit deviations; ISO 8734 dowel pins are made to m6).
 ISO_286 = {
     "H7": ((1, 3, 0, 10), (3, 6, 0, 12), (6, 10, 0, 15), (10, 18, 0, 18), (18, 30, 0, 21), (30, 50, 0, 25)),
@@ -217,6 +217,8 @@ ISO_286 = {
     "m6": ((1, 3, 2, 8), (3, 6, 4, 12), (6, 10, 6, 15), (10, 18, 7, 18), (18, 30, 8, 21), (30, 50, 9, 25)),
     "g6": ((1, 3, -8, -2), (3, 6, -12, -4), (6, 10, -14, -5), (10, 18, -17, -6), (18, 30, -20, -7),
            (30, 50, -25, -9)),
+    "f7": ((1, 3, -16, -6), (3, 6, -22, -10), (6, 10, -28, -13), (10, 18, -34, -16), (18, 30, -41, -20),
+           (30, 50, -50, -25)),
 }
 
 

@@ -2,7 +2,7 @@
 sample holder that slides into its bore so the sample's top surface lands on z = 0.
 
 The bore is the sample point O, the datum of everything: drawn at its finished size, it prints under
-by the printer's hole shrink and is bored H7; the holder is turned from aluminium bar to g6, the ISO 286
+by the printer's hole shrink and is bored H7; the holder is turned from aluminium bar to f7, the ISO 286
 sliding fit (rigcad.parts.locating.holder_fit): the sample sits on the bore's axis to half that fit's
 largest clearance, a link of every element's tolerance stack (rigcad.fab.stack). The camera's cross
 and the calibration kit's plugs are printed, ``sample_holder.clearance`` each side under the finished
@@ -130,6 +130,10 @@ def sample_holder(profile: Profile, layout: RigLayout) -> Part:
 #: Turning allowance (mm) on the bar's diameter over the holder's collar, and on its length (facing both ends
 #: and parting off).
 BAR_ALLOWANCE_MM, BAR_LENGTH_ALLOWANCE_MM = 4.0, 5.0
+#: The holder bar's linear thermal expansion (1/K): EN AW-6082 T6, 23.4e-6 /K (20-100 C; suppliers' data
+#: sheets, EN 755-2's alloy). Against the printed bore's (rigcad.fab.loads.MATERIALS) it sets how much the
+#: bore closes on the holder in a cold lab: the holder's fit keeps clearance there (rigcad.parts.locating).
+HOLDER_BAR_EXPANSION = 23.4e-6
 
 
 def holder_stock(profile: Profile) -> str:
