@@ -4,8 +4,8 @@ same stem and clamp under the camera-calibration cross that hangs in its place (
 The clamp locates on the beam by two shim stops (rigcad.parts.locating.ShimStop): across the beam
 (y), a flat-point set screw in a heat-set insert in the clamp's +y wall presses the beam against
 the channel's -y wall through a pack of shim foil; along the beam (x), the clamp's -x end bears on a
-dowel pin pressed into the beam's top through a second pack. Foil out or in moves the paraboloid in
-steps of the thinnest foil, each way up to the pack (rigcad.parts.locating.SHIM_PACK_MM). The
+dowel pin set (a slip fit in retaining compound) into the beam's top through a second pack. Foil out
+or in moves the paraboloid in steps of the thinnest foil, each way up to the pack (rigcad.parts.locating.SHIM_PACK_MM). The
 clamp's roof rests on the beam's top; the beam's seats in the dome set the height and the tilt
 (rigcad.parts.dome.beam_seats)."""
 
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigcad.parts.layout import RigLayout
-from rigcad.parts.locating import (SHIM_PACK_MM, ShimStop, foil_step, press_fit, set_screw_length, stepped_hole,
+from rigcad.parts.locating import (SHIM_PACK_MM, ShimStop, foil_step, slip_fit, set_screw_length, stepped_hole,
                                    teardrop_along_y)
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Solid, Union_
 from rigcad.profile.schema import Profile
@@ -33,6 +33,12 @@ SET_SCREW = "M3"
 #: The x stop's pin (mm, ISO 8734): the largest standard pin up to half the beam's width, so the
 #: beam keeps a quarter of its width of wall each side of the pin's hole.
 PIN_SHARE = 0.5
+#: The stop pin's blind hole keeps at least this floor (mm) over the beam's underside, so a drill run to
+#: the stated depth does not break through (a 0.5 mm floor did, within a drill point's length).
+PIN_FLOOR_MM = 1.0
+#: The stop pin is a slip fit (rigcad.parts.locating.slip_fit) set in retaining compound: pressed (N7/m6)
+#: in the beam's 1.5 mm walls it stressed the printed plastic to about 58 % of its yield (Lame).
+RETAINER = "retaining compound, high strength (Loctite 638 class)"
 
 
 @dataclass(frozen=True)
@@ -66,7 +72,8 @@ class Mount:
     def pin_hole(self) -> Solid:
         """The pin's blind hole in the beam, open at the beam's top: printed at the drill's size before
         the reamer (rigcad.standards.pre_ream_drill), drilled, reamed to the press fit
-        (rigcad.parts.locating.press_fit) and the pin pressed in; its floor stops the pin walking down."""
+        (rigcad.parts.locating.slip_fit) and the pin set in retaining compound; its floor (PIN_FLOOR_MM at
+        least) stops the pin walking down and the drill breaking through."""
         p = self.pin
         drill = pre_ream_drill(2 * p.radius)
         return stepped_hole(p.base[0], p.base[1], p.base[2] - 0.5, ((drill / 2, p.height + 0.5 - self.pin_proud + 1.0),))
@@ -75,6 +82,11 @@ class Mount:
     def pin_depth(self) -> float:
         """How deep the pin's blind hole runs into the beam from its top (mm)."""
         return self.pin.height + 0.5 - self.pin_proud
+
+    @property
+    def pin_floor(self) -> float:
+        """What the pin's blind hole leaves over the beam's underside (mm): at least PIN_FLOOR_MM."""
+        return self.pin.base[2] - 0.5 - self.channel.lo[2] - 1.0
 
     @property
     def pin_proud(self) -> float:
@@ -98,7 +110,7 @@ def mount(profile: Profile, layout: RigLayout, top_z: float | None = None) -> Mo
     top = back_z if top_z is None else top_z
     rim = layout.printed_paraboloid.points(np.array([layout.printed_paraboloid.u_range[0]]))[0]
     d = dowel_diameter_for(PIN_SHARE * beam.width)
-    pin_len = longest_dowel(pm.clamp_wall + beam.height - 1.0)  # its hole stops a millimetre above the beam's underside
+    pin_len = longest_dowel(pm.clamp_wall + beam.height - 0.5 - PIN_FLOOR_MM)  # its hole (0.5 past its end) keeps the floor
     pin_x = -half_len - p - d / 2
     r_s = THREADS[SET_SCREW].major / 2
     mid = 0.5 * (z0 + z1)
@@ -156,12 +168,14 @@ def hardware(profile: Profile, layout: RigLayout) -> list[dict]:
         {"item": f"heat-set insert (ruthex, {INSERTS[SET_SCREW].length:g} mm long)", "thread": SET_SCREW,
          "length_mm": None, "quantity": 1 + 4, "steps": ("paraboloid", "dome"),
          "joins": "the set screws' inserts: one in the clamp's +y wall, two in each of the beam's seats"},
-        {"item": f"dowel pin, ISO 8734 m6 (hardened steel; pressed in {d:g} {press_fit(d).hole})", "thread": None,
+        {"item": f"dowel pin, ISO 8734 m6 (hardened steel; slip fit in {d:g} {slip_fit(d).hole}, set in retaining "
+                 "compound)", "thread": None,
          "length_mm": m.pin_length, "diameter_mm": d, "quantity": 1, "steps": ("beam",),
          "joins": f"the paraboloid's x stop: the beam's blind hole prints at {pre_ream_drill(d):g} mm; drill it "
-                  f"{pre_ream_drill(d):g} mm, {m.pin_depth:g} mm deep, ream it {d:g} {press_fit(d).hole} "
-                  f"(a {d:g} mm {press_fit(d).hole} hand reamer) and press the pin in with a vise until {m.pin_proud:g} mm stands proud of its "
-                  f"top: {press_fit(d).describe()}"},
+                  f"{pre_ream_drill(d):g} mm, {m.pin_depth:g} mm deep (a depth stop: its floor, "
+                  f"{m.pin_floor:g} mm, stays), ream it {d:g} {slip_fit(d).hole} "
+                  f"(a {d:g} mm {slip_fit(d).hole} hand reamer), wet the pin with {RETAINER} and slide it in until "
+                  f"{m.pin_proud:g} mm stands proud of its top: {slip_fit(d).describe()}"},
         {"item": "set screw, flat point (ISO 4026)", "thread": SEAT_SCREW, "length_mm": seats.screw_length,
          "quantity": 4, "steps": ("beam",), "joins": "the beam on its two seats: in each seat one down through its "
                                                      "roof, one across through its +y wall"},
