@@ -481,6 +481,8 @@ CONSUMABLES = (
     ("Tack cloths", "5"),
     ("Wicking threadlocker, low strength (Loctite 290 class), 10 ml: locks the splitter seat's push screws once set",
      "1"),
+    ("Retaining compound, high strength (Loctite 638 class), 10 ml: the beam's stop pin in its slip-fit hole, the "
+     "seat screws' balls in their cups", "1"),
 )
 #: Tools with an orderable spec.
 TOOLS = (
@@ -536,16 +538,17 @@ def dowel_drills(fab_report: dict, rig=None) -> tuple[str, str]:
 
 
 def _stop_pin_tools(rig) -> str:
-    """The drill and the reamer of the paraboloid's stop pin's hole in the beam (pressed: rigcad.parts.paraboloid)."""
+    """The drill and the reamer of the paraboloid's stop pin's hole in the beam (a slip fit set in retaining
+    compound: rigcad.parts.paraboloid)."""
     if "paraboloid" not in (getattr(rig, "recipes", None) or {}):
         return ""
-    from rigcad.parts.locating import press_fit
+    from rigcad.parts.locating import slip_fit
     from rigcad.parts.paraboloid import mount
     from rigcad.standards import pre_ream_drill
 
     d = 2 * mount(rig.profile, rig.layout).pin.radius
     return (f"; for the beam's stop pin a {pre_ream_drill(d):g} mm twist drill (DIN 338) and a {d:g} mm "
-            f"{press_fit(d).hole} hand reamer")
+            f"{slip_fit(d).hole} hand reamer")
 
 
 def register_tools(rig) -> list[tuple[str, str]]:

@@ -1,6 +1,6 @@
 """The narrow mounting beam (thesis Figure 3.3): spans the dome through its wall slots, rests on the
 two seats outside them (rigcad.parts.dome.beam_seats), and carries the paraboloid's clamp at the
-design height, its end against a dowel pin pressed into the beam's top (rigcad.parts.paraboloid)."""
+design height, its end against a dowel pin set into the beam's top (rigcad.parts.paraboloid)."""
 
 from __future__ import annotations
 
@@ -21,5 +21,5 @@ def beam(profile: Profile, layout: RigLayout) -> Part:
     pin = mount(profile, layout).pin_hole
     return Part("beam", Difference(box, (pin,)), (0.35, 0.35, 0.38),
                 "mounting beam along x through the dome's slots, on its two seats; the paraboloid's stop pin "
-                f"(ISO 8734, {2 * mount(profile, layout).pin.radius:g} mm) pressed into its top, drilled to size",
+                f"(ISO 8734, {2 * mount(profile, layout).pin.radius:g} mm) set into its top in retaining compound, drilled and reamed to a slip fit",
                 occluders=(("beam", box),))

@@ -570,3 +570,28 @@ def test_the_bills_washers_and_nuts_are_the_sum_of_every_bolt_rows_stack(table31
     fitted = {st.name: {f.item for f in st.fasteners} for st in steps}
     for step, big in (("projector_body", "M5"), ("camera_body", "M10")):
         assert fitted[step] and all(f"on {large(big).name()}" in item for item in fitted[step]), fitted[step]
+
+
+def test_the_stop_pin_is_a_slip_fit_in_retaining_compound_over_a_floor(table31_rig):
+    """The beam's stop pin: pressed N7/m6 into a 6 mm beam's 1.5 mm walls it loaded the plastic to ~58 % of
+    yield, and its blind hole ended 0.5 mm over the underside (the drill broke through). Now: a slip fit
+    (at most the m6/F7 tables' 2 um of interference) set in retaining compound, a floor of at least
+    PIN_FLOOR_MM under the hole as the beam is cut, and the compound and the slip reamer in the bill."""
+    from rigcad.parts.paraboloid import PIN_FLOOR_MM, hardware, mount
+    from rigcad.parts.recipe import bounds
+
+    rig = table31_rig
+    m = mount(rig.profile, rig.layout)
+    lo, _ = bounds(m.pin_hole)
+    floor = lo[2] - rig.layout.beam_z[0]  # the hole's bottom over the beam's underside
+    assert floor >= PIN_FLOOR_MM - 1e-9 and PIN_FLOOR_MM >= 1.0, floor
+    assert floor == pytest.approx(m.pin_floor, abs=1e-9)
+    (row,) = [h for h in hardware(rig.profile, rig.layout) if h["item"].startswith("dowel pin")]
+    assert "slip fit" in row["item"] and "retaining compound" in row["joins"] and "press" not in row["joins"]
+    assert f"its floor, {m.pin_floor:g} mm" in row["joins"]
+    d = 2 * m.pin.radius
+    from rigcad.parts.locating import slip_fit
+
+    assert slip_fit(d).clearance[0] >= -0.002 - 1e-12  # ISO 286 F7/m6 at 3 mm: -0.002..+0.014 mm
+    assert any(c[0].startswith("Retaining compound") and "stop pin" in c[0] for c in B.CONSUMABLES)
+    assert f"{d:g} mm {slip_fit(d).hole} hand reamer" in B.dowel_drills({"parts": {}}, rig)[0]
