@@ -404,6 +404,10 @@ def _screen_items(rig) -> list[KitItem]:
                         "Raspberry Pi OS, a USB keyboard and female-female jumper wires, 30 cm", "1",
                         "drives the upright display from below the plate (SPI, the kernel's fbtft overlay for the "
                         "module's driver; fbi shows the frames)", ("raspberry pi",), (STEP_AS_BUILT,))]
+    items.append(KitItem("Turntable: a ball-bearing lazy susan or a rotary table", "1",
+                         "flat, turning without wobble, at least as wide as the dome's flange: the dome stands on it "
+                         "upside down while the paraboloid is indicated in on its axis", ("turntable",),
+                         (STEP_ACCEPTANCE,)))
     return items
 
 
@@ -411,7 +415,7 @@ def _screen_items(rig) -> list[KitItem]:
 #: bill's lines so that a line missing from the bill shows: every word a step uses must be some line's.
 ITEM_WORDS = ("drafting film", "film", "tape", "fine pen", "blocks", "45 deg mirror", "scalpel", "checkerboard",
               "circle cutter", "gray card", "tablet", "spacer", "upright display", "calibration_upright_stand",
-              "torch", "mask", "leather punch", "plug", "steel balls", "raspberry pi")
+              "torch", "mask", "leather punch", "plug", "steel balls", "raspberry pi", "turntable")
 
 
 def kit_misses(sections: dict[str, str], items: list[KitItem]) -> list[str]:

@@ -1059,6 +1059,19 @@ def _section_acceptance(d: Doc, c) -> None:
         "order): if it fails, lift the dome off its register, take the paraboloid off the beam, block and polish the "
         "area again and repeat; once it passes, lift them off again for the mirror coat (section 4's last layer), "
         "set them back and repeat the test on the finished mirrors.")
+    d.p(f"**Place the paraboloid first** (to `tolerancing.paraboloid_offset`, {acc['placement_offset_mm']:g} mm): "
+        "unplaced, its lateral stack alone throws rays past the disc and the test could not tell a slope error from "
+        "a misplaced paraboloid. With the dome off its pins, the beam and the paraboloid in it, stand the dome upside "
+        "down on the turntable and centre it: the dial test indicator on the inside of the dome's base (the circle "
+        "it was indicated in by on the plate, so its axis is O's), turn and tap the dome until the reading stays "
+        "within one graduation. Then bring the indicator's tip onto the paraboloid's rim edge and read it at the "
+        "four turns 45 deg off the beam (the beam stops the arm at the others): half the difference of two opposite "
+        "readings is the paraboloid's offset along that diagonal. Move the clamp by its foil packs (the stop pin's "
+        "along the beam, the set screw's across) until both are under the tolerance, and set the dome back on its "
+        f"pins. Placed so, its placement alone lands the rays within **{acc['placement_spot_mm']:.2f} mm** of O "
+        f"(the design's chief rays, traced with the paraboloid {acc['placement_offset_mm']:g} mm off), which leaves "
+        f"**{acc['slope_room_mm']:.2f} mm** of the disc to the slopes. After the mirror coat the deflectometry "
+        "(section 6) reads the placement again and re-seats it.")
     d.p("The mirrors' slope must be right, not only their form: in a right rig every ray the camera sees lands on "
         f"the sample point O within `tolerancing.max_spot_radius` ({acc['disc_radius_mm']:g} mm). The test lights a "
         "disc of that radius at O and looks at it through the mirrors with the rig's own camera:")

@@ -61,6 +61,22 @@ def sanding_blocks(rig) -> list[dict]:
     return rows
 
 
+#: Chief rays of the meridional trace that gives the paraboloid's placement spot (placement_spot).
+PLACEMENT_RAYS = 2000
+
+
+def placement_spot(rig, offset: float) -> float:
+    """How far (mm) the design's chief rays land from O, at most, when the paraboloid alone sits ``offset``
+    mm off the axis (the meridional trace of rigcad.optics.misalignment, the design's chief rays across
+    the paraboloid's useful annulus): the spot the slope test sees from the paraboloid's placement alone."""
+    from rigcad.optics.design import chief_rays
+    from rigcad.optics.misalignment import Offsets, misaligned_trace
+
+    origins, dirs = chief_rays(rig.geometry, rig.paraboloid, rig.dome, PLACEMENT_RAYS)
+    tr = misaligned_trace(rig.paraboloid, rig.curve, origins, dirs, Offsets(paraboloid_dx=offset))
+    return float(np.max(np.abs(tr.miss[tr.ok])))
+
+
 def slope_acceptance(rig) -> dict:
     """The optical acceptance test's figures: every camera pixel's ray lands on the sample plane within
     ``tolerancing.max_spot_radius`` of O when the mirrors are right, so a lit disc of that radius at O
@@ -71,7 +87,11 @@ def slope_acceptance(rig) -> dict:
     The dome's slope tolerance that this test holds: a slope error e turns the ray by 2 e, which lands
     2 e D off O, D the dome's farthest point from O (mm). A reference picture with the mask off (the
     whole bore lit) tells a slope error from a dark corner of the light: a ray that lands past the disc
-    but inside the bore is lit there only."""
+    but inside the bore is lit there only.
+    The paraboloid is indicated in on the dome's axis before the test, to ``tolerancing.paraboloid_offset``:
+    unplaced, its lateral stack alone throws rays past the disc, and the test could not tell a slope error
+    from a misplaced paraboloid; placed, what its placement alone adds is ``placement_spot_mm``
+    (:func:`placement_spot`), and ``slope_room_mm`` of the disc is left to the slopes."""
     from rigcad.manual.calibration import film_setup
 
     p = rig.profile
@@ -79,7 +99,9 @@ def slope_acceptance(rig) -> dict:
     far = float(np.max(np.hypot(pts[:, 0], pts[:, 1])))
     limit = p.tolerancing.max_spot_radius
     f = film_setup(rig)
-    return {"disc_radius_mm": limit, "dome_farthest_from_o_mm": far,
+    placed = placement_spot(rig, p.tolerancing.paraboloid_offset)
+    return {"disc_radius_mm": limit, "placement_offset_mm": p.tolerancing.paraboloid_offset,
+            "placement_spot_mm": placed, "slope_room_mm": limit - placed, "dome_farthest_from_o_mm": far,
             "dome_slope_tolerance_mrad": 1e3 * limit / (2.0 * far), "pass_fraction": p.tolerancing.min_yield,
             "bore_radius_mm": f["bore_radius_mm"], "bore_slope_mrad": 1e3 * f["bore_radius_mm"] / (2.0 * far),
             "lamp_room_mm": f["block_under_disc_mm"], "film_above_bench_mm": f["block_under_disc_mm"]
@@ -345,4 +367,4 @@ def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str,
 
 __all__ = ["ABRASIVE", "ABRASIVE_MM", "BLOCK_LENGTH_MM", "BLOCK_SAG_MM", "block_bands", "block_part", "block_slide",
            "sanding_block_set", "template_datums", "template_text", "CLEAR_REFLECTANCE", "KERF_MM", "LAYER_METHODS", "principal_radii", "recipe",
-           "sanding_blocks", "slope_acceptance"]
+           "placement_spot", "sanding_blocks", "slope_acceptance"]

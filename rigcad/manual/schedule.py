@@ -104,6 +104,9 @@ def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
         _s("With the dome still off (upside down on the bench), put in the beam and the paraboloid on it, reaching "
            "in through the dome's open base (their steps).", ASSEMBLE, needs={"dome off", "dome register drilled"},
            makes={"paraboloid on the beam"}),
+        _s("Indicate the paraboloid in on the dome's axis (the dome upside down on the turntable, centred on its base) "
+           "and set the clamp's foil packs to the placement tolerance (the optical acceptance test's first step).",
+           C.STEP_ACCEPTANCE, needs={"paraboloid on the beam", "dome off"}, makes={"paraboloid placed"}),
         _s("Set the dome, the beam and the paraboloid in it, back on its register pins over the film and bolt it "
            "down.", ASSEMBLE, needs={"dome register drilled", "dome off", "paraboloid on the beam"},
            makes={"dome on its register"}, ends={"dome off"}),
@@ -114,7 +117,8 @@ def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
                       needs={"base plate down", "flat parts whole"}, makes={"projector on", "camera on"}))
     out += [
         _s("Slope test on the polished clear coat, before the mirror coat.", C.STEP_ACCEPTANCE,
-           needs={"clear coat polished", "film laid", "camera on", "dome on its register", "paraboloid on the beam"},
+           needs={"clear coat polished", "film laid", "camera on", "dome on its register", "paraboloid on the beam",
+                  "paraboloid placed"},
            makes={"slope passed"}),
         _s("Lift the dome off its register (the beam and the paraboloid with it), take the paraboloid off the beam, "
            "spray the mirror coat on both; let it cure; set the paraboloid back and the dome on its pins.",

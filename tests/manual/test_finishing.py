@@ -65,3 +65,42 @@ def test_the_recipe_sprays_the_profiles_coats_only_and_tests_slope_before_the_mi
     rows = F.recipe(table31)
     (flush,) = [r for r in rows if r[4].startswith("template flush")]
     assert table31.templates.gauged_layer in flush[0]
+
+
+def test_the_slope_test_sees_the_paraboloids_placement_within_its_disc(table31_rig):
+    """The paraboloid is indicated in before the slope test: what its placement tolerance alone adds to the
+    spot stays well inside the disc, where its unadjusted lateral stack (0.62 mm RSS) would not."""
+    from rigcad.manual import finishing as F
+
+    acc = F.slope_acceptance(table31_rig)
+    t = table31_rig.profile.tolerancing
+    assert acc["placement_offset_mm"] == t.paraboloid_offset
+    assert F.placement_spot(table31_rig, 0.0) < 1e-3  # the design's chief rays meet O (its integration error)
+    # small offsets act linearly: twice the offset, twice the spot, to 5 % (the trace's second order)
+    one, two = F.placement_spot(table31_rig, 0.05), F.placement_spot(table31_rig, 0.1)
+    assert abs(two / one - 2.0) < 0.1, (one, two)
+    # placed to its 0.1 mm tolerance: under a tenth of the 3 mm disc, the rest left to the slopes
+    assert acc["placement_spot_mm"] < 0.1 * acc["disc_radius_mm"], acc["placement_spot_mm"]
+    assert abs(acc["slope_room_mm"] - (acc["disc_radius_mm"] - acc["placement_spot_mm"])) < 1e-12
+    # unplaced, the stack's 0.62 mm RSS alone takes half the disc or more: why the placement comes first
+    assert F.placement_spot(table31_rig, 0.62) > 0.5 * acc["disc_radius_mm"]
+
+
+def test_the_acceptance_step_places_the_paraboloid_first_and_bills_the_turntable(table31_rig):
+    from rigcad.manual import calibration as C
+    from rigcad.manual import finishing as F
+    from rigcad.manual.document import Doc, _section_acceptance
+
+    class _Ctx:
+        rig = table31_rig
+        finishing = {"acceptance": F.slope_acceptance(table31_rig)}
+
+    d = Doc()
+    _section_acceptance(d, _Ctx())
+    text = " ".join(b[-1] if isinstance(b[-1], str) else " ".join(b[-1]) for b in d.blocks)
+    acc = _Ctx.finishing["acceptance"]
+    assert f"**{acc['placement_spot_mm']:.2f} mm**" in text and f"**{acc['slope_room_mm']:.2f} mm**" in text
+    assert text.index("Place the paraboloid first") < text.index("The test lights a disc")
+    assert "turntable" in text
+    items = [it for it in C.kit_items(table31_rig) if C.STEP_ACCEPTANCE in it.steps]
+    assert not [m for m in C.kit_misses({C.STEP_ACCEPTANCE: text}, items) if "turntable" in m]  # its bill line

@@ -77,6 +77,8 @@ def test_a_stage_out_of_order_is_refused(stages):
     ((S.ASSEMBLE, "the paraboloid on it"), (C.STEP_ACCEPTANCE, "Slope"), "dome off"),
     # the film's ring and tape left under the calibration screens, the checkerboard and the gray card
     ((C.STEP_FILM, "peel the whole film"), (None, None), "plate top clear"),
+    # the slope test on an unplaced paraboloid (its lateral stack alone throws rays past the disc)
+    ((C.STEP_ACCEPTANCE, "Indicate the paraboloid"), (None, None), "paraboloid placed"),
 ])
 def test_each_conflict_the_technician_found_is_caught_if_planted_back(stages, moved, after, missing):
     stages_ = list(stages)
