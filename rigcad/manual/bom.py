@@ -483,6 +483,9 @@ CONSUMABLES = (
      "1"),
     ("Retaining compound, high strength (Loctite 638 class), 10 ml: the beam's stop pin in its slip-fit hole, the "
      "seat screws' balls in their cups", "1"),
+    ("Cyanoacrylate glue, medium viscosity, 20 g: a drop in each nut trap before its nut goes in", "1"),
+    ("Packing tape, polypropylene, 48 mm, 1 roll: over the base plate under the dome's seams while they are glued",
+     "1"),
 )
 #: Tools with an orderable spec.
 TOOLS = (
@@ -503,12 +506,20 @@ TOOLS = (
      "faces flat", "1 each"),
     ("Drill press, or a hand drill in a drill stand, with a depth stop; a tap wrench to turn the hand reamers", "1"),
     ("Bench vise with soft jaws and a soft-faced hammer (pressing dowel pins and balls in)", "1 each"),
+    ("Lathe (bench lathe whose chuck takes the holder's bar) with turning and parting tools and a boring bar, "
+     "for the sample holder; the base plate's H7 bore is bored with the boring bar on the lathe's faceplate, or "
+     "with a boring head on a mill", "1 (or a machine shop)"),
+    ("Outside micrometer covering the sample holder's diameter (25-50 mm for the default's 40 mm), 0.001 mm "
+     "(DIN 863): the holder's f7 body", "1"),
+    ("Airbrush 0.3-0.5 mm, or an HVLP gun with a 0.8-1.0 mm nozzle at about 1 bar: the MirraChrome coat "
+     "(its maker's low-pressure spray)", "1"),
 )
 #: The words section 2-6 name a tool by (lower case, as a word): each must be in some line of the tools
 #: (or of the calibration kit), so a tool a step uses and the bill forgets shows (tests/manual).
 TOOL_WORDS = ("caliper", "engineer's square", "spirit level", "hex key", "spanner", "torque screwdriver",
               "soldering iron", "feeler", "tin snips", "scissors", "file", "float glass", "straightedge", "drill",
-              "reamer", "dial test indicator", "vise", "hammer", "scalpel", "circle cutter", "leather punch")
+              "reamer", "dial test indicator", "vise", "hammer", "scalpel", "circle cutter", "leather punch", "lathe",
+              "boring bar", "boring head", "micrometer", "airbrush")
 
 
 def feeler_gauge(gaps_mm: list[float]) -> tuple[str, str]:

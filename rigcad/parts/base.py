@@ -152,7 +152,8 @@ def turning_text(profile: Profile) -> str:
     fit = holder_fit(2 * profile.sample_holder.radius, where=profile.where("sample_holder", "radius"))
     lo, hi = fit.clearance
     return (f"turned from bar on a lathe ({holder_stock(profile)}): its body {fit.size:g} {fit.shaft} (measured with "
-            f"a micrometer), its top face square to it, in the base plate's bore bored to {fit.size:g} {fit.hole}: "
+            f"an outside micrometer), its top face square to it, in the base plate's bore bored to {fit.size:g} {fit.hole} "
+            "(a boring bar on the lathe's faceplate, or a boring head on a mill; checked with the holder itself): "
             f"{fit.describe()}, so it sits within {hi / 2:.3f} mm of the bore's axis")
 
 

@@ -595,3 +595,23 @@ def test_the_stop_pin_is_a_slip_fit_in_retaining_compound_over_a_floor(table31_r
     assert slip_fit(d).clearance[0] >= -0.002 - 1e-12  # ISO 286 F7/m6 at 3 mm: -0.002..+0.014 mm
     assert any(c[0].startswith("Retaining compound") and "stop pin" in c[0] for c in B.CONSUMABLES)
     assert f"{d:g} mm {slip_fit(d).hole} hand reamer" in B.dowel_drills({"parts": {}}, rig)[0]
+
+
+def test_the_tools_and_consumables_the_shop_steps_name_have_bill_lines(table31_rig):
+    """The lab review found steps naming a lathe, a boring bar, a micrometer, an airbrush, cyanoacrylate in
+    the nut traps and packing tape under the seams with no bill line. Each word the step texts use
+    (read from where they are made) is a TOOL_WORDS word with a tools line, or a consumables line."""
+    import re
+
+    from rigcad.manual.finishing import LAYER_METHODS
+    from rigcad.parts.base import turning_text
+
+    texts = turning_text(table31_rig.profile)
+    for word in ("lathe", "boring bar", "micrometer"):
+        assert re.search(rf"\b{word}", texts), word
+        assert word in B.TOOL_WORDS and any(word in line.lower() for line, _ in B.TOOLS), word
+    assert "airbrush" in LAYER_METHODS["MirraChrome"][1]
+    assert "airbrush" in B.TOOL_WORDS and any("airbrush" in line.lower() and "0.8-1.0 mm" in line for line, _ in B.TOOLS)
+    consumables = " ".join(line.lower() for line, _ in B.CONSUMABLES)
+    for what in ("cyanoacrylate", "packing tape", "retaining compound"):
+        assert what in consumables, what
