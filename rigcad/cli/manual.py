@@ -31,7 +31,7 @@ def cmd_manual(args: argparse.Namespace) -> int:
     root = Path(args.exports) / rig.name
     total = len(rig.recipes) + 3 + sum(1 for p in [*rig.recipes.values(), *rig.instruments] if p.in_rig)
     with stages(total, f"manual {rig.name} ({printer.name})") as step:
-        fab = api.fab(rig, printer, root / "fab" / printer.name, gcode=args.gcode, progress=step)
+        fab = _fab_report(api, rig, profile, printer, root / "fab" / printer.name, args.gcode, step)
         for problem in fab.problems:
             print(f"rigcad: fab: {problem}", file=sys.stderr)
         out = root / "manual" / printer.name
@@ -40,7 +40,36 @@ def cmd_manual(args: argparse.Namespace) -> int:
     print(f"{rig.name}: manual for {printer.name} -> {out}/ (manual.md, manual.html "
           f"{html_path.stat().st_size / 1e6:.1f} MB, {len(written)} files)")
     criteria_notes(criteria)
+    if fab.problems:  # a manual whose bill glues what cannot be glued, or prints what fab refused, is no pass
+        print(f"rigcad: error: fab found {len(fab.problems)} problem(s), listed above; the manual is written, "
+              f"and follows {root / 'fab' / printer.name}/fab.json, which lists them", file=sys.stderr)
+        return 1
     return 0
+
+
+def _fab_report(api, rig, profile, printer, folder: Path, gcode: bool, step):
+    """The fab run the manual follows. Without ``gcode``, a sliced report is never replaced by an
+    unsliced one: a run with the slicer's G-code published in ``folder`` from the same profile,
+    printer and code (rigcad.api.fab_published: fresh and intact) is kept as it is, with its slicer
+    figures and support table; a report there that was sliced but cannot be kept so (a run with
+    problems is never read back, or its inputs changed) is made again with the slicer, whose G-code
+    is cached per piece (only changed pieces are sliced). Otherwise the fab stage for ``gcode``
+    (which reads back its own published run)."""
+    from rigcad.export.readback import own_json
+    from rigcad.optics.frames import Misalignment
+
+    if not gcode and rig.misalignment == Misalignment.none():
+        sliced = api.fab_published(profile, printer, folder, gcode=True, progress=step)
+        if sliced is not None:
+            return sliced
+        old = own_json(folder / "fab.json")  # read as data: anything unreadable is no sliced report
+        was = old.get("gcode") if isinstance(old, dict) else None
+        if isinstance(was, dict) and was.get("requested") is True and was.get("slicer") == "prusa-slicer" \
+                and printer.slicer == "prusa-slicer":
+            print(f"rigcad: manual: {folder}/fab.json was made with the slicer's G-code (--gcode): made again "
+                  "with it (cached per piece), not replaced by rigcad's estimate", file=sys.stderr)
+            gcode = True
+    return api.fab(rig, printer, folder, gcode=gcode, progress=step)
 
 
 def register(subparsers) -> None:
