@@ -1194,7 +1194,8 @@ def _film_step(d: Doc, c) -> None:
         "collar: the bore centres it the same way) and set the plate back over it. The cross's top is z = 0, level "
         "with the plate's top.",
         f"Lay a disc of matte drafting film ({1e3 * f['film_thickness_mm']:g} µm polyester, "
-        f"**{f['film_diameter_mm']:.0f} mm** across) on the plate's top, centred on the bore, and tape its edge to "
+        f"**{f['film_diameter_mm']:.0f} mm** across, cut from the sheet with the scalpel) on the plate's top, "
+        "centred on the bore, and tape its edge to "
         "the plate. Trace the cross under it with a fine pen: its centre is O. Then set the dome back on its pins "
         f"and go on with the assembly (the dome's flange and its {f['dome_bolts']} bolts are far outside the film).",
         f"For the test, lift the rig as one piece (plate, dome and tower are one rigid assembly; two people) onto "
@@ -1208,8 +1209,8 @@ def _film_step(d: Doc, c) -> None:
         "Afterwards push the `camera_cross_base` back in for the camera's crosses (next) and set the rig down. "
         f"Then take out the dome's {f['dome_bolts']} flange screws, lift it off its register pins, peel the whole film "
         "and its tape off the plate's top and set the dome back on its pins: the film "
-        f"({1e3 * f['film_thickness_mm']:g} µm) and the tape at its edge would otherwise stand on z = 0 under the "
-        "checkerboard, the gray card's straightedge and the calibration screens.",
+        f"({1e3 * f['film_thickness_mm']:g} µm) and the tape at its edge would otherwise stand on z = 0 under "
+        "everything section 6 lays on the plate or checks against its top.",
     ])
 
 
