@@ -163,13 +163,7 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
             report_gcode.update(sliced.report)
             problems += sliced.problems
             slicer_s = sliced.seconds
-            for name, d in done.items():
-                for pc in d.entry.get("pieces", []):
-                    if pc["name"] in sliced.records:
-                        pc["gcode"] = sliced.records[pc["name"]]
-                        if d.entry.get("mirror") and "support_contact" in pc["gcode"]:
-                            problems += support.mirror_problems(pc["name"], pc["gcode"]["support_contact"],
-                                                                pc["support_model"]["mirror_mm2"], printer.source)
+            problems += _with_gcode(done, sliced.records, printer)
             timings["gcode"] = time.perf_counter() - t
             stage.write_bytes(out / "printer.ini", slicer.printer_ini(printer, support=False).encode())
         elif gcode and printer.slicer != "prusa-slicer":
@@ -191,6 +185,20 @@ def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: lis
 LENGTH_KEYS = {"beam": "beam.overhang"}
 #: The step (mm) a suggested value is rounded down to: a figure one types into a profile.
 SUGGEST_STEP = 0.5
+
+
+def _with_gcode(done: dict, records: dict, printer: Printer) -> list[str]:
+    """Each sliced piece's G-code record put in its fab.json row; the problems: support the G-code
+    puts on a mirror outside its seams' faired band (rigcad.fab.support.mirror_problems)."""
+    problems = []
+    for d in done.values():
+        for pc in d.entry.get("pieces", []):
+            if pc["name"] in records:
+                pc["gcode"] = records[pc["name"]]
+                if d.entry.get("mirror") and "support_contact" in pc["gcode"]:
+                    problems += support.mirror_problems(pc["name"], pc["gcode"]["support_contact"],
+                                                        pc["support_model"]["mirror_mm2"], printer.source)
+    return problems
 
 
 def whole_fit_hint(rig, name: str, printer: Printer, chord: float) -> str:
