@@ -1104,7 +1104,7 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
             "steps": ('tower_shelf',), "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]
           if profile.buy.shelf == "print" else []),
         *({"item": "dowel pin, ISO 8734 m6", "thread": None, "diameter_mm": profile.datum.dowel_diameter,
-         "length_mm": float(length), "quantity": count, "steps": ('tower_column', 'tower_shelf'),
+         "length_mm": float(length), "quantity": count, "steps": steps,
          "joins": f"{which}: "
                   f"pressed into the tongue's and the shelf's blind holes (printed at {reg.drill:g} mm: drill them "
                   f"{reg.drill:g} mm, ream {reg.diameter:g} {reg.press.hole}: {reg.press.describe()}); at each end the "
@@ -1116,17 +1116,19 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
                         f"drill the column's round dowel holes {reg.drill:g} mm and ream them {reg.diameter:g} "
                         f"{reg.slip.hole} (the slip end)",
                         f"file the column's dowel slots until the pin slides ({SLOT_FIT_MM:g} mm)", lap]}
-          for length, count, which in _dowel_rows(reg, top_reg)),
+          for length, count, which, steps in _dowel_rows(reg, top_reg)),
     ]
 
 
-def _dowel_rows(foot, top) -> list[tuple[int, int, str]]:
-    """The column's dowel pins by length (mm, count, which they locate): each end's register
-    (rigcad.parts.locating.DowelRegister.length) sets its own pins' length; one row when both agree."""
+def _dowel_rows(foot, top) -> list[tuple[int, int, str, tuple[str, ...]]]:
+    """The column's dowel pins by length (mm, count, which they locate, the steps that press them in):
+    each end's register (rigcad.parts.locating.DowelRegister.length) sets its own pins' length; one
+    row when both agree, its pins shared between the column's and the shelf's steps."""
     foot_use = "two locate the column's foot on the base plate's tongue"
     if foot.length == top.length:
-        return [(foot.length, 4, f"{foot_use}, two its top flange under the shelf")]
-    return [(foot.length, 2, foot_use), (top.length, 2, "two locate the column's top flange under the shelf")]
+        return [(foot.length, 4, f"{foot_use}, two its top flange under the shelf", ('tower_column', 'tower_shelf'))]
+    return [(foot.length, 2, foot_use, ('tower_column',)),
+            (top.length, 2, "two locate the column's top flange under the shelf", ('tower_shelf',))]
 
 
 def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
