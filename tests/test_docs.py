@@ -220,7 +220,7 @@ def test_fab_figures_are_the_current_codes(tools, data, shared_build, table31_ri
     from rigcad.fab.printers import load_printer
     from rigcad.fab.stage import run_fab
 
-    parts = ["dome", "paraboloid", "beam", "sample_holder", "camera_cross_hung", "dome_template",
+    parts = ["dome", "paraboloid", "beam", "camera_cross_base", "camera_cross_hung", "dome_template",
              "paraboloid_template"]
 
     def build(folder):  # the same run as tests/fab/conftest.py's prusa_run: one run serves both

@@ -104,8 +104,8 @@ def test_the_flange_joint_is_declared_and_sized_from_the_standards(tmp_path, tab
     p = table31_rig.profile
     j = _dome_joint(table31_rig)
     assert j.count == p.dome_shell.bolts == 8 and (j.thread, j.into) == ("M4", "insert")
-    # into an insert: 0.8 washer + 6 flange + 8.1 insert = 14.9 mm of reach -> the longest M4 sold within it, 12
-    assert j.length == 12 and j.item.startswith("M4 x 12 mm")
+    # M4: 1.0 large washer + 1.3 conical spring washer (free height) + 6 flange, into the 8.1 mm insert -> 16 mm
+    assert j.length == 16 and j.item.startswith("M4 x 16 mm")
     other = _profile(tmp_path, "bolts", "base_plate:\n  thickness: 20 mm\ndome_shell:\n  bolt_diameter: 5.5 mm\n"
                                         "  bolts: 12\n  flange_width: 24 mm\n")
     j = _dome_joint(other)
