@@ -152,6 +152,39 @@ CAMERA_SOCKET_DEPTH = {"1/4-20 UNC": 5.0, "3/8-16 UNC": 5.0, "M3": 2.5, "M4": 4.
 CONICAL_SPRING_WASHERS = {"M3": (3.2, 7.0, 0.6, 0.85), "M4": (4.3, 9.0, 1.0, 1.3), "M5": (5.3, 11.0, 1.2, 1.55),
                           "M6": (6.4, 14.0, 1.5, 2.0), "M8": (8.4, 18.0, 2.0, 2.6)}
 
+@dataclass(frozen=True)
+class Limiter:
+    """A compression limiter for a bolt through a printed part: a plain steel spacer sleeve (mm) cut
+    from cold-drawn precision tube of ``outer`` x ``wall``, faced to length on a lathe; ``source``:
+    where its size comes from. Its bore passes the bolt at ISO 273's fine clearance or more, and is
+    smaller than the thread's heat-set insert (rigcad.standards.INSERTS), so that the sleeve's end
+    bears on the insert's brass top, not on plastic: the bolt's preload runs head, washer, sleeve,
+    insert, thread, a loop of metal that the plastic's creep cannot relax."""
+
+    thread: str
+    outer: float
+    wall: float
+    source: str
+
+    @property
+    def bore(self) -> float:
+        return self.outer - 2 * self.wall
+
+    def name(self) -> str:
+        return f"{self.thread} compression limiter: steel sleeve {self.outer:g} x {self.wall:g} mm ({self.bore:g} mm bore)"
+
+
+_LIMITER_SOURCE = ("EN 10305-1 cold-drawn seamless precision steel tube, E235+C (outside x wall as stocked; outside "
+                   "diameter +-0.08 mm)")
+#: Compression limiters by thread: steel sleeves of standard precision tube (outside x wall, mm).
+COMPRESSION_LIMITERS = {
+    "M3": Limiter("M3", 5.0, 0.8, _LIMITER_SOURCE),
+    "M4": Limiter("M4", 6.0, 0.8, _LIMITER_SOURCE),
+    "M5": Limiter("M5", 8.0, 1.0, _LIMITER_SOURCE),
+    "M6": Limiter("M6", 10.0, 1.5, _LIMITER_SOURCE),
+}
+
+
 #: ISO 8734 dowel pins' preferred lengths (mm).
 DOWEL_LENGTHS = (3, 4, 5, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30, 32, 35, 40, 45, 50, 55, 60)
 
@@ -360,4 +393,4 @@ __all__ = ["DOWEL_PRESS_HOLE", "DOWEL_SHAFT", "DOWEL_SLIP_HOLE", "Fit", "ISO_286
 #: Hex socket set screws (ISO 4026 flat point, ISO 4029 cup point): the hex key (mm, ISO 2936, s nominal)
 #: their socket takes.
 SET_SCREW_KEY = {"M3": 1.5, "M4": 2.0, "M5": 2.5, "M6": 3.0, "M8": 4.0}
-__all__ += ["SET_SCREW_KEY"]
+__all__ += ["SET_SCREW_KEY", "COMPRESSION_LIMITERS", "Limiter"]

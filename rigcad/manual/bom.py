@@ -666,10 +666,27 @@ def bolt_stacks(rig) -> list[dict]:
     return rows + list(stacked.values())
 
 
+def limiter_lines(rig) -> dict[str, int]:
+    """The bill's compression limiter lines (item -> quantity): one sleeve per screw of every joint the
+    parts declare with limiters (``ScrewJoint.limiter``), summed from the joints as the washers are."""
+    from rigcad.parts.joints import ScrewJoint
+
+    out: dict[str, int] = {}
+    for part in rig.recipes.values():
+        for j in part.joints:
+            if isinstance(j, ScrewJoint) and j.limiter:
+                lim = j.limiter_part
+                item = (f"{lim.name()}, cut from tube ({lim.source}) and faced to {j.limiter_length:.2f} mm "
+                        f"(under {j.upper}'s bolts)")
+                out[item] = out.get(item, 0) + j.count
+    return out
+
+
 def washer_nut_lines(rig) -> dict[str, int]:
     """The bill's washer and nut lines (item -> quantity), summed over every bolt of :func:`bolt_stacks`:
-    each washer of each stack, and an ISO 4032 hex nut per nut."""
-    out: dict[str, int] = {}
+    each washer of each stack, and an ISO 4032 hex nut per nut; and the compression limiters
+    (:func:`limiter_lines`), which stand under the washers."""
+    out: dict[str, int] = dict(limiter_lines(rig))
     for r in bolt_stacks(rig):
         for w in r["washers"]:
             out[w] = out.get(w, 0) + r["count"]
@@ -679,4 +696,4 @@ def washer_nut_lines(rig) -> dict[str, int]:
     return out
 
 
-__all__ += ["bolt_stacks", "washer_nut_lines"]
+__all__ += ["bolt_stacks", "limiter_lines", "washer_nut_lines"]

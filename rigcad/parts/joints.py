@@ -17,10 +17,27 @@ from rigcad.errors import GeometryError
 import math
 
 from rigcad.parts.recipe import Cylinder, Solid, bounds
-from rigcad.standards import CONICAL_SPRING_WASHERS, INSERTS, THREADS, longest_screw, shortest_screw
+from rigcad.standards import (COMPRESSION_LIMITERS, CONICAL_SPRING_WASHERS, INSERTS, THREADS, Limiter, longest_screw,
+                               shortest_screw)
 
 #: What may take a joint's thread.
 INTO = ("insert", "nut")
+
+#: Which joints take compression limiters, the rule: every bolted joint on a datum chain (``datum``: it
+#: locates a part that places an optical element, as the dome's flange on the base plate and the COP
+#: tower's column on its tongue and under its shelf do). A preload worth having puts PLA's creep limit
+#: under the washer (rigcad.fab.loads: half its yield, 13 MPa), so the clamped plastic creeps and the
+#: joint relaxes; a conical spring washer follows only a few hundredths of a millimetre of that. A
+#: steel sleeve through the clamped part (rigcad.standards.COMPRESSION_LIMITERS) carries the preload
+#: instead, head to insert (or to the nut), and the plastic keeps only the squeeze below.
+#:
+#: The sleeve is faced this much (mm) under the clamped part's thickness measured at its hole, so that
+#: the washer seats on the plastic and then on the sleeve (the compression limiter makers' rule: the
+#: limiter equal to or slightly under its host). The squeeze strains the plastic by LIMITER_SQUEEZE_MM
+#: over the part's span: PLA at its creep limit (13 MPa) and its stiffest modulus (3.04 GPa, Stratasys' XZ
+#: figure) strains 0.43 %, 0.026 mm over the 6 mm dome flange, 0.021 mm over a 5 mm column wall; 0.02 mm keeps
+#: a part of 5 mm or more under it (tests/parts/test_joints_limiters.py checks it against rigcad.fab.loads).
+LIMITER_SQUEEZE_MM = 0.02
 
 
 @dataclass(frozen=True)
@@ -47,10 +64,21 @@ class ScrewJoint:
     #: A DIN 6796 conical spring washer under each head (creep would relax the joint: rigcad.fab.loads
     #: marks it): its free height counts in the grip (standards.CONICAL_SPRING_WASHERS).
     spring_washer: bool = False
+    #: The joint is on a datum chain (see :data:`LIMITER_SQUEEZE_MM`): it must have a compression limiter.
+    datum: bool = False
+    #: A compression limiter (standards.COMPRESSION_LIMITERS) through ``upper`` at each screw: the preload
+    #: runs head, washers, sleeve, insert (or nut), not through the plastic.
+    limiter: bool = False
 
     def __post_init__(self) -> None:
         if self.thread not in THREADS:
             raise GeometryError(f"joint {self.name}: unknown thread {self.thread!r}", param=self.param or None)
+        if self.datum and not self.limiter:
+            raise GeometryError(f"joint {self.name}: it locates a datum, so its bolts need compression limiters "
+                                f"(limiter=True: a steel sleeve through {self.upper} at each bolt); without them the "
+                                "plastic under the washers creeps and the joint relaxes", param=self.param or None)
+        if self.limiter:
+            self._check_limiter()
         if self.into not in INTO:
             raise GeometryError(f"joint {self.name}: a thread goes into one of {INTO}, not {self.into!r}")
         if self.into == "insert":
@@ -63,9 +91,48 @@ class ScrewJoint:
                                     f"({INSERTS[self.thread].pocket_depth:g} mm) is deeper than {self.lower} "
                                     f"({depth:g} mm)", param=self.param or None)
 
+    def _check_limiter(self) -> None:
+        if self.thread not in COMPRESSION_LIMITERS:
+            raise GeometryError(f"joint {self.name}: no compression limiter for {self.thread} (rigcad.standards."
+                                f"COMPRESSION_LIMITERS has {', '.join(COMPRESSION_LIMITERS)})", param=self.param or None)
+        lim = COMPRESSION_LIMITERS[self.thread]
+        if lim.bore < THREADS[self.thread].clearance_fine - 1e-9:
+            raise GeometryError(f"joint {self.name}: the {lim.name()} does not pass the {self.thread} bolt "
+                                f"(bore under ISO 273 fine, {THREADS[self.thread].clearance_fine:g} mm)")
+        if self.into == "insert" and lim.bore >= INSERTS[self.thread].outer:
+            raise GeometryError(f"joint {self.name}: the {lim.name()} would bear on plastic around its insert "
+                                f"({INSERTS[self.thread].outer:g} mm outside), not on the insert")
+        if self.limiter_length <= 0:
+            raise GeometryError(f"joint {self.name}: {self.upper} is too thin for a compression limiter "
+                                f"({self.upper_z[1] - self.upper_z[0]:g} mm)", param=self.param or None)
+
     @property
     def count(self) -> int:
         return len(self.points)
+
+    @property
+    def limiter_part(self) -> Limiter | None:
+        """The compression limiter at each screw (rigcad.standards), or None."""
+        return COMPRESSION_LIMITERS[self.thread] if self.limiter else None
+
+    @property
+    def limiter_length(self) -> float:
+        """The sleeve's finished length (mm): the upper part's span less :data:`LIMITER_SQUEEZE_MM` (as
+        drawn; the shop faces it to the part's thickness measured at the hole less the squeeze)."""
+        return (self.upper_z[1] - self.upper_z[0]) - LIMITER_SQUEEZE_MM
+
+    def limiter_step(self) -> str:
+        """The shop step that fits the limiters ("" without them)."""
+        lim = self.limiter_part
+        if lim is None:
+            return ""
+        seat = (f"the {self.thread} inserts pressed flush with {self.lower}'s face (the sleeve's end bears on the "
+                "insert's top)" if self.into == "insert" else "the sleeve's lower end on the part under it")
+        return (f"Cut {self.count} sleeves from {lim.outer:g} x {lim.wall:g} mm steel tube ({lim.source}) and face "
+                f"each on the lathe to {self.upper}'s thickness measured with a micrometer at its hole less "
+                f"{LIMITER_SQUEEZE_MM:g} mm ({self.limiter_length:.2f} mm as drawn), square and deburred; drop one "
+                f"into each of {self.upper}'s bolt holes, {seat}; the washer seats on the plastic and then on the "
+                "sleeve: tighten to the torque table's figure")
 
     @property
     def washer(self) -> float:
@@ -83,8 +150,9 @@ class ScrewJoint:
     @property
     def grip(self) -> float:
         """Head's bearing face to the lower part's top face (mm): the washers under the head (:attr:`washer`)
-        and the upper part's clamped span."""
-        return self.washer + (self.upper_z[1] - self.upper_z[0])
+        and the upper part's clamped span, or the compression limiter's length through it (the plastic
+        is squeezed to it)."""
+        return self.washer + (self.limiter_length if self.limiter else self.upper_z[1] - self.upper_z[0])
 
     @property
     def engagement(self) -> float:
@@ -128,17 +196,25 @@ class ScrewJoint:
         if self.into == "insert":
             ins = INSERTS[self.thread]
             spring = "a conical spring washer (DIN 6796) on " if self.spring_washer else ""
+            sleeve = (f" through a steel compression limiter ({self.limiter_part.outer:g} x {self.limiter_part.wall:g} mm "
+                      f"sleeve, {self.limiter_length:.2f} mm long)" if self.limiter else "")
             return (f"{self.thread} x {self.length} mm socket-head bolt (ISO 4762) with {spring}"
-                    f"{self.washer_spec or 'a washer (ISO 7089)'} into a "
+                    f"{self.washer_spec or 'a washer (ISO 7089)'}{sleeve} into a "
                     f"{self.thread} heat-set insert ({ins.length:g} mm long, in a {ins.hole:g} mm hole) melted into "
                     f"{self.lower}")
-        return (f"{self.thread} x {self.length} mm socket-head bolt (ISO 4762) with 2 washers (ISO 7089) and a nut "
-                "(ISO 4032)")
+        sleeve = (f" through a steel compression limiter ({self.limiter_part.outer:g} x {self.limiter_part.wall:g} mm "
+                  f"sleeve, {self.limiter_length:.2f} mm long)" if self.limiter else "")
+        return (f"{self.thread} x {self.length} mm socket-head bolt (ISO 4762) with 2 washers (ISO 7089){sleeve} and "
+                "a nut (ISO 4032)")
 
     def clearance_holes(self, diameter: float | None = None) -> tuple[Cylinder, ...]:
         """The holes through the upper part (the thread's medium clearance, ISO 273, unless
-        ``diameter`` mm), 1 mm past each face."""
+        ``diameter`` mm), 1 mm past each face. With a compression limiter, each is wider by the sleeve's
+        two walls: the sleeve rides on the bolt and keeps the room around it that the bolt had (a float:
+        it locates nothing, the joint's register does), however much the hole was opened."""
         d = THREADS[self.thread].clearance if diameter is None else diameter
+        if self.limiter:
+            d += self.limiter_part.outer - THREADS[self.thread].major
         z0, z1 = self.upper_z
         return tuple(Cylinder((x, y, z0 - 1.0), d / 2, z1 - z0 + 2.0) for x, y in self.points)
 
