@@ -23,6 +23,7 @@ from pathlib import Path
 from rigcad._version import __version__
 from rigcad.manual import bom as B
 from rigcad.manual import calibration as C
+from rigcad.manual import camera_lens
 from rigcad.manual import tower_joints
 from rigcad.parts.locating import DowelRegister
 from rigcad.units import hours_minutes
@@ -218,6 +219,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
     from rigcad.manual import plan
 
     bill = B.bill(rig, fab_report, printer)
+    bill["purchased"] = camera_lens.with_camera_lens(rig, bill["purchased"])  # the lens to buy when none is named
     steps, solids = plan.steps(rig, meshes)  # once: the bill's hardware and section 5's order both read them
     bill["hardware"] = plan.bill_hardware(rig, steps, bill) + _spring_washers(rig, printer)  # one list
     bill["calibration_kit"] = [{"item": k.item, "quantity": k.quantity, "spec": k.spec, "steps": list(k.steps)}

@@ -449,3 +449,16 @@ def test_section_6_undoes_the_spring_bolts_and_sets_them_back(written, table31_r
     assert text.index(words["off"]) < text.index("Lift the splitter holder") < text.index(words["on"])
     assert f"**{row['spring_mm']['installed_length']:g} mm**" in words["on"]
     assert f"{row['preload_N']:.1f} N" in words["on"] and f"{row['quantity']} spring bolts" in words["off"]
+
+
+def test_the_bill_names_a_camera_lens_to_buy(written, table31_rig):
+    """The thesis's profile knows its lens in pixels only: the optics table names one in mm (the line of
+    rigcad.manual.camera_lens), after the camera's own line."""
+    from rigcad.manual import camera_lens
+
+    out, _ = written
+    optics = _md_table((out / "manual.md").read_text(encoding="utf-8"), "Optics and instruments")
+    row = camera_lens.bill_row(table31_rig)
+    items = [r[0] for r in optics]
+    assert row["item"] in items, items
+    assert items[items.index(row["item"]) - 1].startswith("camera"), items
