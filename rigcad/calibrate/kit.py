@@ -249,6 +249,7 @@ the image's columns and rows, the screen's axes at each turn and the patterns ar
   {"the lower spacer's and then the upright display's captures take over" if cal.upright_turns else
    "the corrected map is filled from the fit"}.
 
+{_what_passes(rig)}
 {_after_the_fit(p.tolerancing)}{_setting_the_paraboloid(rig)}
 {_measuring_the_seating(p)}"""
 
@@ -409,6 +410,86 @@ def _setting_the_paraboloid(rig) -> str:
     from rigcad.parts.paraboloid import setting_text
 
     return "\n" + setting_text(rig.profile, rig.layout) + "\n"
+
+
+#: The placements against the dome the pass criterion judges, by the name the report gives each
+#: (calibration.json's ``against_the_dome``) -> the ``tolerancing`` key that bounds it.
+PLACEMENT_TOLERANCES = {f"{part}_{axis}": f"{part}_{key}" for part in ("paraboloid", "camera")
+                        for axis, key in (("dx_mm", "offset"), ("dy_mm", "offset"), ("dz_mm", "height"),
+                                          ("tilt_x_deg", "tilt"), ("tilt_y_deg", "tilt"))}
+#: How many standard errors a placement must stay inside its tolerance to pass (about 95 % one-sided
+#: confidence for a normal error: a reading that lands within tolerance by less cannot tell).
+PASS_STANDARD_ERRORS = 2.0
+
+
+def dome_slope_tolerance(rig) -> float:
+    """The dome's slope tolerance (mrad): a slope error e turns a ray by 2 e, which lands 2 e D from O, D
+    the dome's farthest point from O; e stays within ``tolerancing.max_spot_radius`` / (2 D). The same
+    figure the optical acceptance test holds before the calibration (rigcad.manual.finishing)."""
+    pts = rig.layout.design_dome.points(rig.layout.design_dome.sample(2001))
+    return 1e3 * rig.profile.tolerancing.max_spot_radius / (2.0 * float(np.max(np.hypot(pts[:, 0], pts[:, 1]))))
+
+
+def pass_criterion(rig) -> dict:
+    """What a calibration (``rigcad calibrate --images``) must show to pass: each placement against the
+    dome within its tolerance (report units: mm, deg) by :data:`PASS_STANDARD_ERRORS` standard errors,
+    and the dome's residual slope p99 (mrad) within :func:`dome_slope_tolerance`."""
+    tol = rig.profile.tolerancing
+    bounds = {}
+    for name, key in PLACEMENT_TOLERANCES.items():
+        v = getattr(tol, key)
+        bounds[name] = math.degrees(v) if name.endswith("_deg") else v
+    return {"placements": bounds, "standard_errors": PASS_STANDARD_ERRORS,
+            "residual_slope_p99_mrad": dome_slope_tolerance(rig)}
+
+
+def judge(rig, report: dict) -> list[tuple[str, bool, str]]:
+    """``report`` (a calibration.json, as read) against :func:`pass_criterion`: (check, passed, what it
+    found and what to do) per placement and for the dome's slopes."""
+    crit = pass_criterion(rig)
+    k, out = crit["standard_errors"], []
+    params = report["against_the_dome"]["parameters"]
+    for name, bound in crit["placements"].items():
+        v, se = params[name]["value"], params[name]["standard_error"]
+        ok = abs(v) + k * se <= bound
+        act = ("" if ok else "re-seat it: move it back by the offset, then capture again" if abs(v) > max(bound, k * se)
+               else "unresolved: capture again (both half turns of each spacer)")
+        out.append((name, ok, f"{v:+.4g} ± {se:.2g} against ±{bound:g}" + (f": {act}" if act else "")))
+    slope, bound = report["residual_slopes"]["residual_slope_p99_mrad"], crit["residual_slope_p99_mrad"]
+    ok = bool(slope <= bound)
+    out.append(("residual_slope_p99_mrad", ok, f"{slope:.3g} mrad against {bound:.3g} mrad"
+                + ("" if ok else ": sand the dome's marked area back to its template, coat again, capture again")))
+    return out
+
+
+def verdict_line(rig, report: dict) -> str:
+    """One line: PASS, or FAIL with each failing check (:func:`judge`)."""
+    fails = [f"{name} {text}" for name, ok, text in judge(rig, report) if not ok]
+    return "calibration: PASS (docs: the manual's 'What passes')" if not fails else "calibration: FAIL: " + "; ".join(fails)
+
+
+def _what_passes(rig) -> str:
+    """The calibration page's pass criterion (:func:`pass_criterion`), with what to do when it fails."""
+    crit = pass_criterion(rig)
+    k = crit["standard_errors"]
+    rows = "\n".join(f"- `{name}`: within ±{bound:g} {'deg' if name.endswith('_deg') else 'mm'} "
+                     f"(`tolerancing.{PLACEMENT_TOLERANCES[name]}`)" for name, bound in crit["placements"].items())
+    return f"""## What passes
+The calibration passes when every line below holds (calibration.json holds each figure): each
+placement against the dome (`against_the_dome`) inside its tolerance by {k:g} standard errors at
+least (|value| + {k:g} x standard_error within the bound), and the dome's residual slopes at most
+the slope that throws a ray `tolerancing.max_spot_radius` off O from the dome's farthest point (the
+bound the optical acceptance test holds).
+
+{rows}
+- `residual_slopes`' `residual_slope_p99_mrad`: at most {crit['residual_slope_p99_mrad']:.3g} mrad
+
+When one fails: a placement out by more than its bound (and by more than {k:g} standard errors) is
+re-seated as below, then the rig is captured and calibrated again; a placement inside its bound
+but with too wide a standard error is captured again (both half turns of each spacer, the room
+dark); a slope p99 over its bound marks the dome's area that `maps.png` shows in its residual
+slope panel: sand it back to its template, coat it again and calibrate again.
+"""
 
 
 def _after_the_fit(tol) -> str:
