@@ -190,7 +190,10 @@ STEP_TEXT = {
     "projector_shims_1": "Put a stack of the printed `tower_shim`s on each of the projector's four slots in the "
                          "shelf (the nominal stack; add or remove shims to set the projector's height).",
     "projector_body": "Stand the projector on its shim stacks, its lens towards the beam splitter (looking -x), and "
-                      "screw it down through the shelf's slots, finger tight until the calibration.",
+                      "screw it down through the shelf's slots, finger tight until the calibration. A projector that "
+                      "throws its image off its lens axis (`projector.lens_offset`) stands level all the same, never "
+                      "tilted to centre its image: the rig's axis is its lens axis, and rigcad draws its images about "
+                      "that axis's pixel (set a lens shift, if it has one, to the offset the profile states).",
     "camera_shims": "Put the camera's shim stack against the bracket (more or fewer shims move the camera across "
                     "the axis in y).",
     "camera_body": "Screw the camera to the bracket above the beam splitter through its slot, looking down the "
