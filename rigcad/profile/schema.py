@@ -76,6 +76,8 @@ class Spec:
             return f"[x, y] in pixels, each 0..{MAX_PIXELS}"
         if self.kind == "holes":
             return f"a list of 1..{MAX_HOLES} [along, across] pairs of lengths"
+        if self.kind == "fraction":
+            return f"{self.lo * 100:g} % to {self.hi * 100:g} % (or {self.lo:g} to {self.hi:g})"
         parts = []
         if self.lo is not None:
             parts.append(f"{'>' if self.lo_open else '>='} {self.lo / scale:g} {unit}".rstrip())
@@ -136,6 +138,13 @@ class ProjectorParams:
     resolution: tuple[int, int] = spec("pixels", "[width, height] in pixels", [1024, 768])
     throw_ratio: float = spec("float", "throw distance / image width (sets the field of view)", 1.75,
                               lo=0, lo_open=True, hi=100)
+    lens_offset: float = spec(
+        "fraction", "the image's centre above its lens axis, in half image heights, as the datasheet's offset "
+        "(100 % or 1: the image's bottom edge on the axis; 0: centred, or a lens shift set to the centre; "
+        "assumed 0); the paraboloid's image is a disc about the axis's pixel (rigcad.profile.derived)", 0.0, lo=0, hi=2)
+    native_resolution: tuple[int, int] | None = spec(
+        "pixels", "[width, height] of the mirror array or panel itself, when the projector shifts it to show more "
+        "(4K XPR, e-shift); default: none given (projector.resolution is native)", None)
     aperture: float = spec("length", "thin-lens aperture diameter (thesis 3.2.2)", "0.5 cm", lo=0)
     # The body as the COP tower holds it (rigcad.parts.tower). The thesis names the BenQ PB6210 and
     # its resolution only; these sizes are ASSUMED (a 2006 XGA DLP of its class), no datasheet at hand.
@@ -817,6 +826,15 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
             out = math.inf
         if not math.isfinite(out):
             raise fail(f"must be finite, got {_r(value)} ({s.describe_range()})")
+    elif s.kind == "fraction":  # a plain number, or a percentage as datasheets write it ("100 %")
+        text = value.strip() if isinstance(value, str) else None
+        try:
+            out = (float(text[:-1]) / 100 if text and text.endswith("%") else None if text is not None
+                   else float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None)
+        except (ValueError, OverflowError):
+            out = None
+        if out is None or not math.isfinite(out):
+            raise fail(f"expected a fraction such as 0.5 or 50 %, got {_r(value)} ({s.describe_range()})")
     elif s.kind == "choice":
         if value not in s.choices:
             raise fail(f"{_r(value)} is not valid; {s.describe_range()}{suggest(str(value), list(s.choices))}")
@@ -1017,6 +1035,31 @@ def _check_camera(cam: CameraParams, where) -> None:
                                f"[{w / 2:g}, {h / 2:g}]", where=where("principal_point"))
 
 
+#: Addressable resolutions that projectors mostly make by shifting a smaller array within a frame
+#: (pixel shifting), with the native arrays behind them: TI's 4K UHD DMDs (DLP471TP, 0.47 inch: 1920 x
+#: 1080 mirrors shifted four ways; DLP660TE, 0.66 inch: 2716 x 1528, two ways) and e-shift panels.
+PIXEL_SHIFTED = {(3840, 2160): "1920 x 1080 mirrors on a 0.47-inch DMD shifted four ways, or 2716 x 1528 on a "
+                               "0.66-inch one shifted two ways"}
+
+
+def _check_projector(pj: ProjectorParams, where) -> None:
+    """The projector's resolution is its native array's: the distinct directions a pixel-shifting
+    projector lights are its mirrors' (or panel pixels'), however many it addresses."""
+    (w, h), native = pj.resolution, pj.native_resolution
+    if native is not None and tuple(native) != (w, h):
+        raise ProfileError(f"projector.resolution {w} x {h} px is not the {native[0]} x {native[1]} px array that "
+                           "projector.native_resolution gives: a pixel-shifting projector lights the sample from as "
+                           "many directions as its mirrors (or panel pixels), not its addressed pixels; enter "
+                           f"projector.resolution: [{native[0]}, {native[1]}] with the datasheet's throw ratio",
+                           where=where("resolution"))
+    if native is None and (w, h) in PIXEL_SHIFTED:
+        raise ProfileError(f"projector.resolution {w} x {h} px is a pixel-shifted figure for most projectors that "
+                           f"state it ({PIXEL_SHIFTED[w, h]}): enter the native array the projector's or chip's "
+                           "datasheet gives, e.g. projector.resolution: [1920, 1080] for a 0.47-inch DMD; a projector "
+                           f"whose own panel has {w} x {h} pixels says so with projector.native_resolution: [{w}, {h}]",
+                           where=where("resolution"))
+
+
 def validate(raw: RawProfile) -> Profile:
     """Check every key of ``raw`` and return the frozen :class:`Profile`."""
     valid_top = sorted(set(SECTIONS) | TOP_LEVEL)
@@ -1030,6 +1073,8 @@ def validate(raw: RawProfile) -> Profile:
     marks = _profile_marks(raw.marks, instrument_marks)
     _check_camera(sections["camera"], lambda key: marks.get(("camera", key)) or instrument_marks.get(("camera", key))
                   or raw.where(("camera",)))
+    _check_projector(sections["projector"], lambda key: marks.get(("projector", key))
+                     or instrument_marks.get(("projector", key)) or raw.where(("projector",)))
     par: ParaboloidParams = sections["paraboloid"]
     pair_a = (par.vertical_extent, par.tangent_angle)
     pair_b = (par.focal_length, par.rim_radius)
