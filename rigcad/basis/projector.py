@@ -216,10 +216,11 @@ def trace_pixels(rig, device: str = "projector", *, as_built: bool = False, stri
                  focal_px: float | None = None, optics=None, centre: tuple[float, float] | None = None) -> PixelMap:
     """Trace ``device``'s pixel centres through ``rig`` (see :class:`PixelMap`); ``optics``: the
     analytic optics to reuse (placed as ``as_built`` asks); ``centre``: where the optical axis meets
-    the image (px from its top-left; default the camera's principal point, the projector's image
-    centre; a measured calibration circle's centre, rigcad.basis.measured)."""
+    the image (px from its top-left; default the camera's principal point, the projector's lens axis,
+    rigcad.profile.derived.projector_principal_point; a measured calibration circle's centre, rigcad.basis.measured)."""
     from rigcad.check.sources import pixel_rays
     from rigcad.check.trace3d import trace
+    from rigcad.profile.derived import projector_principal_point
 
     if isinstance(stride, bool) or not isinstance(stride, (int, np.integer)) or stride < 1:
         raise BasisError(f"pixel stride = {stride!r}: need an integer >= 1 (1 traces every pixel)")
@@ -229,10 +230,10 @@ def trace_pixels(rig, device: str = "projector", *, as_built: bool = False, stri
     r_out = float(design.pixel_radius(np.array([design.alpha_max]))[0])
     side = 2 * math.ceil(r_out) + 2 * WINDOW_MARGIN_PX
     w, h = min(width, side), min(height, side)
-    # about the device's principal point (the camera's lens may move it; the projector's is the centre),
-    # kept on the device ((W - w) // 2 for the centre)
+    # about the device's principal point (the camera's lens may move it; the projector's lens offset moves
+    # its own below the image's centre), kept on the device ((W - w) // 2 for the centre)
     cx, cy = (centre if centre is not None else camera_principal_point(rig) if device == "camera"
-              else (width / 2, height / 2))
+              else projector_principal_point(rig.profile.projector))
     c0 = min(max(math.floor(cx - w / 2), 0), width - w)
     r0 = min(max(math.floor(cy - h / 2), 0), height - h)
     rows = np.arange(r0 + stride // 2, r0 + h, stride)

@@ -62,6 +62,48 @@ class Derived:
 MIN_PIXELS_ACROSS = 10
 
 
+def projector_principal_point(projector) -> tuple[float, float]:
+    """Where the projector's lens axis meets its image (px from the image's top-left corner, x right,
+    y down, in the projector's own orientation): the centre, moved down by ``lens_offset`` half heights
+    (an image thrown above its axis has the axis below its centre; 100 %: on the bottom edge). The rig
+    holds the projector's lens axis on its own, so the paraboloid's image is a disc about this pixel."""
+    w, h = projector.resolution
+    return w / 2, h / 2 * (1.0 + projector.lens_offset)
+
+
+def projector_disc_room(projector) -> float:
+    """The largest disc about the lens axis's pixel that the projector's image holds (px): the
+    distance from :func:`projector_principal_point` to the image's nearest edge (<= 0: the axis is
+    on or below the image's edge)."""
+    (x, y), (w, h) = projector_principal_point(projector), projector.resolution
+    return min(x, w - x, y, h - y)
+
+
+def _check_disc(profile: Profile, pixels: float) -> None:
+    """Refuse a projector whose image does not hold the paraboloid's disc of ``pixels`` radius about
+    its lens axis: its rim's pixels (the grazing directions) or all of them would light nothing."""
+    pj = profile.projector
+    room = projector_disc_room(pj)
+    if not math.isfinite(pixels) or pixels <= room:
+        return
+    (w, h), off = pj.resolution, pj.lens_offset
+    best = 1.0 - 2.0 * pixels / h  # the largest offset whose image still holds the disc below the axis
+    if off > 0 and pixels <= w / 2 and best >= 0:
+        way = (f"it needs an offset of at most {best:.0%} (projector.lens_offset: a lens shift set nearer the centre, "
+               "or another projector), or a lower projector.throw_ratio (zoom wider)")
+    elif off > 0:
+        way = ("a projector with a lens shift set to the centre (projector.lens_offset: 0) and a shorter throw, "
+               "or a smaller paraboloid image (a smaller paraboloid, or a larger layout.cop_to_vertex)")
+    else:
+        way = ("a shorter projector.throw_ratio (zoom wider), or a smaller paraboloid image (lower the paraboloid's "
+               "rim radius or raise layout.cop_to_vertex)")
+    axis = (f"its lens axis at row {h / 2 * (1 + off):.0f} of {h} (projector.lens_offset {off:.0%})" if off > 0
+            else "its lens axis at the image's centre")
+    raise GeometryError(f"the projector's {w} x {h} px image cannot hold the paraboloid's image, a disc {pixels:.0f} px "
+                        f"in radius about {axis}: {max(room, 0.0):.0f} px from there to the image's nearest edge; "
+                        + way, where=profile.where("projector", "lens_offset" if off > 0 else "throw_ratio"))
+
+
 def derive(profile: Profile) -> Derived:
     """Compute the paraboloid and layout figures; raise GeometryError naming the parameter."""
     par = profile.paraboloid
@@ -90,6 +132,7 @@ def derive(profile: Profile) -> Derived:
             f"from {cop_z - rim_z:.4g} mm): at least {MIN_PIXELS_ACROSS} are needed to light the sample from distinct "
             f"directions; raise paraboloid.{keys[0]} or paraboloid.{keys[1]}, or lower layout.cop_to_vertex",
             where=profile.where("paraboloid", keys[0]))
+    _check_disc(profile, pixels)
     return Derived(
         focal_length=f, rim_radius=r_rim, vertical_extent=d_p, tangent_angle=tau,
         vertex_z=vertex_z, rim_z=rim_z, focus_z=vertex_z - f, cop_z=cop_z,

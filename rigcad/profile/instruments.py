@@ -55,7 +55,7 @@ NAMED_BY: dict[str, tuple[str, str]] = {"projector": ("projector", "model"), "ca
                                         "lens": ("camera", "lens"), "splitter": ("beam_splitter", "model")}
 #: The figures each kind of file may give, as the keys of the section it fills.
 FIGURE_KEYS: dict[str, tuple[str, ...]] = {
-    "projector": ("resolution", "throw_ratio") + PROJECTOR_SIZES,
+    "projector": ("resolution", "native_resolution", "throw_ratio", "lens_offset") + PROJECTOR_SIZES,
     "camera": ("resolution", "pixel_pitch") + CAMERA_SIZES,
     "lens": ("focal_length", "lens_diameter", "lens_length", "pupil_depth", "min_working_distance"),
     "splitter": ("width", "length", "thickness", "reflectance", "coating", "index"),
