@@ -784,3 +784,67 @@ def measurement_figure(sketch, what: str) -> bytes:
     ax.set_title(f"{sketch.key} ({sketch.view} view{detail})\n" + "\n".join(textwrap.wrap(what, 58)), fontsize=8)
     fig.tight_layout()
     return _png(fig, dpi=100)
+
+
+def turned_part_drawing(drawing, fmt: str = "png") -> bytes:
+    """A part turned from bar (rigcad.manual.drawings.TurnedDrawing) as a dimensioned side view: its
+    outline and axis, each diameter across its step, each length beside the part (the labels as the
+    drawing states them, tolerances included), a 10 mm scale bar and the notes under it. ``fmt``: "png",
+    or "svg" with its text kept as text (a reader can read the dimensions back); both deterministic."""
+    import textwrap
+
+    steps = drawing.steps
+    width = max(d for d, _ in steps)
+    total = sum(h for _, h in steps)
+    with plt.rc_context({"svg.fonttype": "none", "svg.hashsalt": "rigcad"}):
+        fig, ax = plt.subplots(figsize=(6.4, 3.6))
+        z = 0.0
+        outline = []
+        for d, h in steps:  # the right half, bottom up, then mirrored
+            outline += [(d / 2, z), (d / 2, z + h)]
+            z += h
+        right = np.array([(0.0, 0.0), *outline, (0.0, total)])
+        xy = np.vstack([right, right[::-1] * [-1, 1]])
+        ax.fill(xy[:, 0], xy[:, 1], color=(0.8, 0.85, 0.9), lw=0)
+        ax.plot(xy[:, 0], xy[:, 1], color="0.1", lw=1.4)
+        z = 0.0
+        for d, h in steps[:-1]:  # the shoulders between the steps
+            z += h
+            ax.plot([-d / 2, d / 2], [z, z], color="0.1", lw=1.0)
+        ax.plot([0, 0], [-0.15 * total, 1.15 * total], "-.", color="0.3", lw=0.8)
+        arrow = {"arrowstyle": "<->", "color": "tab:red", "lw": 1.0, "shrinkA": 0, "shrinkB": 0}
+        red = {"color": "tab:red", "fontsize": 8, "ha": "center",
+               "bbox": {"fc": "white", "ec": "none", "alpha": 0.9, "pad": 1}}
+        dims = {dim.name: dim for dim in drawing.dimensions}
+        diameters = [dim for dim in drawing.dimensions if dim.diameter]
+        z = 0.0
+        for (d, h), dim in zip(steps, sorted(diameters, key=lambda m: m.value)[::-1] if len(steps) > 1 else diameters):
+            ax.annotate("", (d / 2, z + h / 2), (-d / 2, z + h / 2), arrowprops=arrow)
+            ax.text(0, z + h / 2, dim.label, va="center", **red)
+            z += h
+        x = width / 2
+        z = 0.0
+        for k, ((_, h), name) in enumerate(zip(steps, ("collar_thickness", "body_length"))):
+            if name in dims:
+                ax.annotate("", (x + 4, z), (x + 4, z + h), arrowprops=arrow)
+                ax.text(x + 5, z + h / 2, dims[name].label, va="center", **{**red, "ha": "left"})
+            z += h
+        if "overall_length" in dims:
+            ax.annotate("", (x + 16, 0), (x + 16, total), arrowprops=arrow)
+            ax.text(x + 17, total / 2, dims["overall_length"].label, va="center", **{**red, "ha": "left"})
+        ax.plot([-width / 2, -width / 2 + 10], [-0.12 * total] * 2, color="0.1", lw=3)  # the scale bar
+        ax.text(-width / 2 + 5, -0.12 * total - 1.0, "10 mm", ha="center", va="top", fontsize=8)
+        ax.set_aspect("equal")
+        ax.set_xlim(-width / 2 - 4, width / 2 + 30)
+        ax.set_ylim(-0.3 * total - 2, 1.2 * total)
+        ax.axis("off")
+        ax.set_title(drawing.title, fontsize=10)
+        fig.text(0.04, 0.02, "\n".join(textwrap.fill(n, 100) for n in drawing.notes), fontsize=7, va="bottom")
+        fig.subplots_adjust(left=0.02, right=0.98, bottom=0.3, top=0.9)
+        buf = io.BytesIO()
+        if fmt == "svg":
+            fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None})
+        else:
+            fig.savefig(buf, format="png", dpi=130, metadata=_PNG_META)
+        plt.close(fig)
+    return buf.getvalue()
