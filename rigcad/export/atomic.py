@@ -11,6 +11,8 @@ of another profile (:func:`stale_results`).
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import ctypes
 import errno
 import fcntl
@@ -94,6 +96,24 @@ def json_bytes(data: Any) -> bytes:
 def write_json(path: Path, data: Any) -> Path:
     """Write ``data`` as deterministic JSON, atomically."""
     return write_bytes(path, json_bytes(data))
+
+
+#: What a run publishing a given folder stages last, just before its exchange: (absolute folder,
+#: hook(staging)) pairs set by :func:`before_commit`.
+_BEFORE_COMMIT: contextvars.ContextVar[tuple] = contextvars.ContextVar("before_commit", default=())
+
+
+@contextlib.contextmanager
+def before_commit(folder: Path, hook: Callable[["Staging"], None]):
+    """Within the block, every :class:`Staging` of this thread publishing ``folder`` calls
+    ``hook(staging)`` at :meth:`Staging.commit`, once its files are staged and before the exchange,
+    so that what the hook stages is published with them, under the same lock (a stage's published
+    record, rigcad.export.reuse.recording, whichever writer publishes the folder)."""
+    token = _BEFORE_COMMIT.set((*_BEFORE_COMMIT.get(), (Path(folder).absolute(), hook)))
+    try:
+        yield
+    finally:
+        _BEFORE_COMMIT.reset(token)
 
 
 class Staging:
@@ -231,6 +251,9 @@ class Staging:
     def commit(self) -> list[Path]:
         """Carry the untouched files over, exchange the folders, delete the old tree."""
         new = self._staged()
+        for folder, hook in _BEFORE_COMMIT.get():
+            if folder == self.folder.absolute():
+                hook(self)
         refuse_links(self.folder, self._root())  # the folder may have been swapped for a link meanwhile
         if self.folder.is_dir() and self._carry_previous:
             _guard(self.folder, lambda: _carry_over(self.folder, new, self._carries))
