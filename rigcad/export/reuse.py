@@ -9,18 +9,21 @@ there, a plain file, unchanged, and the folder still records the profile it was 
 code), with whatever else the stage reads folded in by the stage (:func:`stage_key`).
 
 Whichever command published a result (``rigcad fab``, ``rigcad manual``, the API), every other
-reads it back alike: the record lives with the result, not with the command.
+reads it back alike: the record lives with the result, not with the command. A stage whose writer
+is not its own (``check``, ``view``, ``manual``, ``calibrate --kit``) records through
+:func:`recording`, around whichever writer publishes its folder, and asks :func:`read_back` first.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import os
 import stat
 from pathlib import Path
 
-from rigcad.export.atomic import Staging, hold_lock, json_bytes, read_made_from
+from rigcad.export.atomic import Staging, before_commit, hold_lock, json_bytes, read_made_from
 from rigcad.errors import ExportError
 from rigcad.export.manifest import code_version, profile_digest, sha256_hex
 from rigcad.export.readback import parse_json
@@ -44,16 +47,46 @@ def running_code() -> str:
     return code_version("**/*.py")
 
 
-def record(stage: Staging, folder: Path, key: str) -> None:
+def input_files(paths: dict[str, Path]) -> dict[str, str | None]:
+    """For a stage's key: the SHA-256 of each file a stage reads besides the profile (by name;
+    None for a file that is not there, or not a plain file)."""
+    digests = {}
+    for name, path in sorted(paths.items()):
+        try:
+            digests[name] = sha256_hex(_read_plain(Path(path)))
+        except OSError:
+            digests[name] = None
+    return digests
+
+
+@contextlib.contextmanager
+def recording(folder: Path, key: str | None, summary: dict | None = None):
+    """Within the block, the run publishing ``folder`` (an export.atomic.Staging, whichever writer
+    makes it) publishes :data:`RECORD` with it: ``key``, the SHA-256 of every file the run staged,
+    and ``summary`` (JSON: what the command says of a result read back). ``key`` None: nothing
+    recorded (a result that must never be read back: a moved rig, a run with problems)."""
+    if key is None:
+        yield
+        return
+    with before_commit(Path(folder), lambda stage: record(stage, Path(folder), key, summary)):
+        yield
+
+
+def record(stage: Staging, folder: Path, key: str, summary: dict | None = None) -> None:
     """Stage :data:`RECORD` into ``folder``: ``key`` and the SHA-256 of every file this run has
-    staged so far (the files of an earlier run carried over at commit are not vouched for)."""
+    staged so far (the files of an earlier run carried over at commit are not vouched for), and
+    ``summary`` when given."""
     staged = stage.temp_path(Path(folder))
     files = {}
     for dirpath, _, filenames in os.walk(staged):
         for name in filenames:
             path = Path(dirpath) / name
             files[path.relative_to(staged).as_posix()] = sha256_hex(path.read_bytes())
-    stage.write_bytes(Path(folder) / RECORD, json_bytes({"inputs_key": key, "files": dict(sorted(files.items()))}))
+    files.pop(RECORD, None)  # a record never vouches for itself
+    rec = {"inputs_key": key, "files": dict(sorted(files.items()))}
+    if summary is not None:
+        rec["summary"] = summary
+    stage.write_bytes(Path(folder) / RECORD, json_bytes(rec))
 
 
 def carried(rel: Path) -> bool:
@@ -65,8 +98,9 @@ def carried(rel: Path) -> bool:
 def read_back(folder: Path, key: str, made_from: str, lock: Path, read: tuple[str, ...] = ()) -> dict[str, bytes] | None:
     """The published result in ``folder`` when its record's key is ``key``, it records the profile
     ``made_from`` and every file it lists is intact: the bytes of the files named in ``read``
-    (each among the listed ones), all read under ``lock``, so that no writer replaces the folder
-    meanwhile. None when anything differs or is missing: the stage then runs."""
+    (each among the listed ones; :data:`RECORD` itself for the record, with its ``summary``), all
+    read under ``lock``, so that no writer replaces the folder meanwhile. None when anything
+    differs or is missing: the stage then runs."""
     folder = Path(folder)
     if folder.is_symlink() or not _plain(folder / RECORD):
         return None  # nothing published with a record: no lock taken, nothing created
@@ -75,14 +109,17 @@ def read_back(folder: Path, key: str, made_from: str, lock: Path, read: tuple[st
         if read_made_from(folder) != made_from:
             return None
         try:
-            rec = parse_json(_read_plain(folder / RECORD), str(folder / RECORD))
+            raw = _read_plain(folder / RECORD)
+            rec = parse_json(raw, str(folder / RECORD))
         except (OSError, ExportError):  # unreadable, or not JSON rigcad could have written (a nesting bomb)
             return None
-        files = rec.get("files") if isinstance(rec, dict) else None
-        if rec.get("inputs_key") != key or not isinstance(files, dict) or not files \
-                or any(name not in files for name in read):
+        if not isinstance(rec, dict):
             return None
-        out = {}
+        files = rec.get("files")
+        if rec.get("inputs_key") != key or not isinstance(files, dict) or not files \
+                or any(name not in files and name != RECORD for name in read):
+            return None
+        out = {RECORD: raw} if RECORD in read else {}
         for rel, digest in files.items():
             try:
                 data = _read_plain(folder / rel)
