@@ -24,6 +24,7 @@ from rigcad._version import __version__
 from rigcad.manual import bom as B
 from rigcad.manual import calibration as C
 from rigcad.manual import camera_lens
+from rigcad.manual import drawings
 from rigcad.manual import tower_joints
 from rigcad.parts.locating import DowelRegister
 from rigcad.units import hours_minutes
@@ -229,6 +230,7 @@ def build_manual(rig, printer, fab_report: dict, progress=None) -> tuple[Doc, di
                                for k in C.kit_items(rig)]  # what section 6 uses: one list
     c = SimpleNamespace(rig=rig, printer=printer, fab_report=fab_report, p=rig.profile, files={}, meshes=meshes,
                         bill=bill, cut_away=A.encloses(meshes), step=step, steps=steps, solids=solids)
+    c.files.update(drawings.drawings(rig))  # the machined parts' shop drawings (drawings/<part>.svg, .png)
     c.files["images/rig.png"] = plots.rig_picture(meshes, traced_rays(rig), f"{rig.name}: the assembled rig",
                                                   cut_away=c.cut_away)
     step("rig picture")
@@ -317,7 +319,8 @@ def _section_bill(d: Doc, c) -> None:
     for r in bill["printed"]:
         if r.get("time_s") is None:
             kind = "bought" if r["process"] == "bought" else "cut" if r["quantity"] else "-"
-            rows.append([f"`{r['part']}`", r["use"], r["quantity"] or "-", kind, r["process"], "-", "-", r["note"]])
+            note = r["note"] + (f" (`drawings/{r['part']}.svg`)" if f"drawings/{r['part']}.svg" in c.files else "")
+            rows.append([f"`{r['part']}`", r["use"], r["quantity"] or "-", kind, r["process"], "-", "-", note])
         else:
             rows.append([f"`{r['part']}`", r["use"], r["quantity"], r["pieces"], r["process"], hours_minutes(r["time_s"]),
                          f"{r['material_g']:.0f} g", f"{r['note']} ({r['source']})"])
@@ -941,6 +944,7 @@ def _section_assemble(d: Doc, c) -> None:
         c.files[path] = plots.assembly_step(shown, done, new, moved, f"step {k + 1}: {label}",
                                             cut_away=c.cut_away, fasteners=bolts)
         d.img(path, f"Step {k + 1}: the {label} (orange) moves along the dashed line to its place")
+        _drawing(d, c, st.name)
         done += members
         c.step(f"step {k + 1}")
     from rigcad.manual import plan as P
@@ -951,6 +955,15 @@ def _section_assemble(d: Doc, c) -> None:
                          "threads_into": [{"item": f.item, "kind": f.thread_in, "part": P.thread_host(f, by_name)}
                                           for f in p.step.fasteners if f.thread_in in ("insert", "nut")
                                           and (f.thread_in == "insert" or f.nut_tool is None)]} for p in order]
+
+
+def _drawing(d: Doc, c, part: str) -> None:
+    """The shop drawing of a machined part (rigcad.manual.drawings), at the step that places it."""
+    if f"drawings/{part}.png" not in c.files:
+        return
+    d.p(f"It is turned to its drawing, `drawings/{part}.svg` (or `.png`, shown here): take it to the lathe or "
+        "to the machine shop with the bar the bill names.")
+    d.img(f"drawings/{part}.png", f"`{part}`: its shop drawing (mm; the fit and the tolerances its recipe states)")
 
 
 def _md_tables(d: Doc, lines: list[str]) -> None:

@@ -462,3 +462,16 @@ def test_the_bill_names_a_camera_lens_to_buy(written, table31_rig):
     items = [r[0] for r in optics]
     assert row["item"] in items, items
     assert items[items.index(row["item"]) - 1].startswith("camera"), items
+
+
+def test_the_holders_drawing_is_written_and_linked_where_it_is_turned(written):
+    """drawings/sample_holder.svg and .png are in the manual's folder, the bill's row of the bar and the
+    holder's assembly step link them (rigcad.manual.drawings)."""
+    out, _ = written
+    md = (out / "manual.md").read_text(encoding="utf-8")
+    assert (out / "drawings" / "sample_holder.svg").is_file() and (out / "drawings" / "sample_holder.png").is_file()
+    bill = _md_table(md, "Printed and cut parts")
+    (row,) = [r for r in bill if r[0] == "`sample_holder`"]
+    assert "`drawings/sample_holder.svg`" in row[-1], row
+    step = next(s for s in md.split("\n### Step ")[1:] if s.split("\n", 1)[0].split(": ", 1)[1].startswith("sample holder"))
+    assert "`drawings/sample_holder.svg`" in step and "](drawings/sample_holder.png)" in step, step[:400]
