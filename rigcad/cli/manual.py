@@ -40,11 +40,21 @@ def cmd_manual(args: argparse.Namespace) -> int:
     print(f"{rig.name}: manual for {printer.name} -> {out}/ (manual.md, manual.html "
           f"{html_path.stat().st_size / 1e6:.1f} MB, {len(written)} files)")
     criteria_notes(criteria)
+    _parts_note(profile, args.exports)
     if fab.problems:  # a manual whose bill glues what cannot be glued, or prints what fab refused, is no pass
         print(f"rigcad: error: fab found {len(fab.problems)} problem(s), listed above; the manual is written, "
               f"and follows {root / 'fab' / printer.name}/fab.json, which lists them", file=sys.stderr)
         return 1
     return 0
+
+
+def _parts_note(profile, exports) -> None:
+    """The note when the parts the manual refers to (STEP, STL: ``rigcad stl``) are missing or stale."""
+    from rigcad.manual.document import parts_note
+
+    note = parts_note(profile, exports)
+    if note:
+        print(f"note: {note}", file=sys.stderr)
 
 
 def _fab_report(api, rig, profile, printer, folder: Path, gcode: bool, step):

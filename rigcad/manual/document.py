@@ -303,11 +303,40 @@ def _introduction(d: Doc, c) -> None:
     d.h(1, f"{rig.name}: assembly and calibration manual ({printer.name})")
     d.p(f"The rig of profile `{rig.name}` ({' <- '.join(p.sources)}), printed on **{printer.description}** "
         f"(`{printer.source}`). Every figure below is computed by rigcad {__version__} from the profile, the "
-        f"part recipes and the printer; the print files are in `fab/{printer.name}/` beside this folder, the "
-        "parts (STEP, STL) in `step/` and `stl/`, the 3D view in `view/rig.html` (`rigcad view`).")
+        f"part recipes and the printer. " + parts_text(rig.name, printer.name))
     d.img("images/rig.png", "The assembled rig (front of the dome cut away) with rays traced from the centre of "
                             "projection, coloured by their incidence angle at the sample")
     measure_first(d, c)
+
+
+#: The folders of ``exports/<profile>/`` that ``rigcad stl`` writes and the manual refers to, not writes.
+PARTS_FOLDERS = ("step", "stl")
+
+
+def parts_text(profile: str, printer: str) -> str:
+    """Where the files the manual refers to are, from its own folder (``exports/<profile>/manual/<printer>/``)
+    and which command writes each: the print files (``rigcad fab``, run by ``rigcad manual``), the parts
+    (``rigcad stl``: :data:`PARTS_FOLDERS`), the 3D view (``rigcad view``)."""
+    return (f"The other files are in `exports/{profile}/`, two folders up from this one (`../../`): the print files "
+            f"in `../../fab/{printer}/` (written with this manual: `rigcad manual` runs `rigcad fab {profile} --printer "
+            f"{printer}`); the parts as `../../step/<part>.step` and `../../stl/<part>.stl`, written by `rigcad stl "
+            f"{profile}`, not by `rigcad manual`, which says when they are missing or not made from this profile; the "
+            f"3D view in `../../view/rig.html`, written by `rigcad view {profile}`.")
+
+
+def parts_note(profile, exports) -> str | None:
+    """None when ``<exports>/<profile>/`` holds the parts of ``profile`` (a loaded Profile) as this code makes
+    them, intact (rigcad.api.export_up_to_date: the manifest's inputs key and every file it lists); else
+    the note ``rigcad manual`` prints: which folders, and the command that writes them."""
+    from rigcad import api
+
+    folder = Path(exports) / profile.name
+    if api.export_up_to_date(profile, folder):
+        return None
+    state = ("missing" if not any((folder / f).is_dir() for f in PARTS_FOLDERS) else
+             "not made from this profile by this rigcad, or incomplete")
+    return (f"{profile.name}: the parts the manual refers to ({', '.join(f'{folder / f}/' for f in PARTS_FOLDERS)}) "
+            f"are {state}: run `rigcad stl {profile.name} --exports {exports}` before printing")
 
 
 def _section_bill(d: Doc, c) -> None:
@@ -1502,4 +1531,4 @@ def write_manual(rig, printer, fab_report: dict, out: Path, lock: Path | None = 
         return stage.commit()
 
 
-__all__ = ["Doc", "build_manual", "write_manual"]
+__all__ = ["PARTS_FOLDERS", "Doc", "build_manual", "parts_note", "parts_text", "write_manual"]
