@@ -159,7 +159,8 @@ def ray_check(rig):
     """`rigcad check` on ``rig`` in memory (rigcad.api.check: the profile's rays, reading and seeded
     Monte Carlo yield, the mirrors meshed from the profile), and, when it fails, again with finer
     mirror meshes (FINER_MESHES). Returns the rig that passed, the mirror_normal_error (rad) it needed
-    when finer than the profile's (else None) and what optimize.json records; CheckError (the
+    when finer than the profile's (else None), what optimize.json records and the check's result
+    (a RayCheck, for :func:`publish_check`); CheckError (the
     check's own message, naming each failed row) when none passes."""
     import dataclasses
 
@@ -179,7 +180,7 @@ def ray_check(rig):
             mc = result.report.get("monte_carlo") or {}
             return r, (None if factor == 1.0 else normal), {
                 "passed": True, "mirror_normal_error_rad": normal, "monte_carlo_yield": mc.get("yield"),
-                "min_yield": mc.get("min_yield"), "builds": mc.get("builds"), "rays": result.report.get("rays")}
+                "min_yield": mc.get("min_yield"), "builds": mc.get("builds"), "rays": result.report.get("rays")}, result
     raise_if_failed(first.rows, rig.name)  # the profile's own meshes' failures
     raise AssertionError("unreachable: a failed check raises")
 
@@ -221,7 +222,8 @@ def certify(problem: Problem, row: dict, also=None, check: bool = True) -> dict:
     row["ray_check"] = None
     row["mirror_normal_error_rad"] = None
     if check:
-        _, row["mirror_normal_error_rad"], row["ray_check"] = ray_check(rig)
+        checked, row["mirror_normal_error_rad"], row["ray_check"], result = ray_check(rig)
+        row["checked"] = (checked, result)  # published for the written design (publish_check)
     row["dome_tolerance_mm"] = tol
     r = rig.design.report
     f = row["figures"]
@@ -313,7 +315,28 @@ def run_optimize(profile_spec, exports: Path = Path("exports"), engine: Engine |
         written.append(write_bytes(profile_path, text))
     if result.chosen is None:
         raise OptimizeError(f"{name}: {report['infeasible']} (every evaluation in {out / 'optimize.json'})")
+    if result.chosen.get("checked") is not None:
+        written += publish_check(exports, profile_path, *result.chosen["checked"])
     return OptimizeRun(report, written, profile_path, result)
+
+
+def publish_check(exports, design_path: Path, checked_rig, result, recheck=None) -> list[Path]:
+    """Publish the check of the written design where `rigcad fab`, `stl` and `manual` read the last
+    `rigcad check` of a profile (``exports/<design>/check/``, rigcad.check.criteria.written_check),
+    recorded as made from the design as its file reads back (export.manifest.profile_digest). The
+    certified check (``result`` on ``checked_rig``) is published as it is when the file reads back to
+    the same resolved parameters; else (the file's rounded figures) the design as written is checked
+    again (``recheck``, default rigcad.api.check) and that result is published, passed or not."""
+    from rigcad import api
+    from rigcad.export.manifest import profile_digest
+    from rigcad.profile import load_profile
+    from rigcad.rig import Rig
+
+    design = load_profile(design_path)
+    rig = Rig.from_profile(design, previous=checked_rig)  # the same dome when the figures agree
+    if profile_digest(design) != profile_digest(checked_rig.profile):
+        result = (recheck or api.check)(rig)
+    return api.write_check(rig, result, Path(exports) / design.name / "check")
 
 
 def _report(problem, result, engine: Engine) -> dict:
