@@ -84,24 +84,22 @@ def _check_disc(profile: Profile, pixels: float) -> None:
     its lens axis: its rim's pixels (the grazing directions) or all of them would light nothing."""
     pj = profile.projector
     room = projector_disc_room(pj)
-    if not math.isfinite(pixels) or pixels <= room:
+    # a centred image is judged by the later checks (the design's openings, the px/deg fan), which name
+    # what is wrong with an extreme geometry more precisely than the disc would
+    if pj.lens_offset == 0 or not math.isfinite(pixels) or pixels <= room:
         return
     (w, h), off = pj.resolution, pj.lens_offset
     best = 1.0 - 2.0 * pixels / h  # the largest offset whose image still holds the disc below the axis
-    if off > 0 and pixels <= w / 2 and best >= 0:
+    if pixels <= w / 2 and best >= 0:
         way = (f"it needs an offset of at most {best:.0%} (projector.lens_offset: a lens shift set nearer the centre, "
                "or another projector), or a lower projector.throw_ratio (zoom wider)")
-    elif off > 0:
+    else:
         way = ("a projector with a lens shift set to the centre (projector.lens_offset: 0) and a shorter throw, "
                "or a smaller paraboloid image (a smaller paraboloid, or a larger layout.cop_to_vertex)")
-    else:
-        way = ("a shorter projector.throw_ratio (zoom wider), or a smaller paraboloid image (lower the paraboloid's "
-               "rim radius or raise layout.cop_to_vertex)")
-    axis = (f"its lens axis at row {h / 2 * (1 + off):.0f} of {h} (projector.lens_offset {off:.0%})" if off > 0
-            else "its lens axis at the image's centre")
+    axis = f"its lens axis at row {h / 2 * (1 + off):.0f} of {h} (projector.lens_offset {off:.0%})"
     raise GeometryError(f"the projector's {w} x {h} px image cannot hold the paraboloid's image, a disc {pixels:.0f} px "
                         f"in radius about {axis}: {max(room, 0.0):.0f} px from there to the image's nearest edge; "
-                        + way, where=profile.where("projector", "lens_offset" if off > 0 else "throw_ratio"))
+                        + way, where=profile.where("projector", "lens_offset"))
 
 
 def derive(profile: Profile) -> Derived:

@@ -49,10 +49,10 @@ def test_an_offset_the_image_holds_keeps_the_design(write_profile):
     assert (a.projector_focal_px, a.pixels_vertex_to_rim) == (b.projector_focal_px, b.pixels_vertex_to_rim)
 
 
-def test_a_centred_image_too_small_for_the_disc_is_refused(write_profile):
-    # throw 7: f = 7168 px, the disc ~400 px in radius, more than the 384 px to the image's top and bottom
-    with pytest.raises(GeometryError, match=r"projector.throw_ratio .*zoom wider"):
-        derive(_profile(write_profile, "throw_ratio: 7"))
+def test_an_offset_image_too_small_for_the_disc_names_another_way(write_profile):
+    # throw 7: f = 7168 px, the disc ~400 px in radius, more than the 384 px half height: no offset holds it
+    with pytest.raises(GeometryError, match=r"projector.lens_offset 10%.*lens shift set to the centre"):
+        derive(_profile(write_profile, "throw_ratio: 7, lens_offset: 0.1"))
 
 
 def test_lens_offset_that_is_not_a_fraction_is_refused(write_profile):
