@@ -5,6 +5,7 @@ so the same result gives the same bytes."""
 from __future__ import annotations
 
 import io
+import math
 
 import matplotlib
 
@@ -745,14 +746,48 @@ def template_drawing(row: dict) -> bytes:
                              "gauging edge blue, datum red")
 
 
-def measurement_figure(sketch, what: str) -> bytes:
+def scale_bar_length(extent: float) -> float:
+    """A scale bar's length (mm) for a drawing ``extent`` mm across: the largest 1, 2 or 5 x 10^k at most a
+    quarter of it."""
+    target = extent / 4.0
+    k = 10.0 ** math.floor(math.log10(target))
+    return max(m * k for m in (1.0, 2.0, 5.0) if m * k <= target)
+
+
+def _scale_bar(ax) -> float:
+    """A scale bar in the axes' lower left corner (data units: mm), labelled; returns its length."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    length = scale_bar_length(x1 - x0)
+    bx, by = x0 + 0.05 * (x1 - x0), y0 + 0.06 * (y1 - y0)
+    ax.plot([bx, bx + length], [by, by], color="0.1", lw=3, solid_capstyle="butt")
+    ax.text(bx + length / 2, by + 0.02 * (y1 - y0), f"{length:g} mm", ha="center", va="bottom", fontsize=7)
+    return length
+
+
+def measurement_figure(sketch, what: str, extra=(), dims=(), fmt: str = "png") -> bytes:
     """One size to measure before printing (rigcad.profile.instruments.sketch): the instrument's
     outline in its view (or the sketch's detail window), the dimension drawn between its two
     features (an arrow at each end; a call-out when the two are one feature), labelled with its
-    assumed value; ``what`` (the features in words) under the title."""
+    assumed value; ``what`` (the features in words) under the title; a scale bar (mm). ``extra``:
+    named outlines drawn dashed blue over it (what receives the feature: the shelf's slots);
+    ``dims``: further dimensions ((x0, y0), (x1, y1), label) drawn thin with their labels. ``fmt``:
+    "png", or "svg" with its text kept as text (a reader can read the labels back)."""
     import textwrap
 
+    with plt.rc_context({"svg.fonttype": "none", "svg.hashsalt": "rigcad"}):
+        return _measurement_figure(sketch, what, extra, dims, fmt, textwrap)
+
+
+def _measurement_figure(sketch, what: str, extra, dims, fmt: str, textwrap) -> bytes:
     fig, ax = plt.subplots(figsize=(4.4, 3.6))
+    for _name, pts in extra:
+        xy = np.asarray(pts, float)
+        ax.plot(xy[:, 0], xy[:, 1], "--", color="tab:blue", lw=0.9)
+    for (dx0, dy0), (dx1, dy1), text in dims:
+        ax.annotate("", (dx1, dy1), (dx0, dy0), arrowprops={"arrowstyle": "<->", "color": "0.15", "lw": 0.8,
+                                                             "shrinkA": 0, "shrinkB": 0})
+        ax.text(0.5 * (dx0 + dx1), 0.5 * (dy0 + dy1), text, ha="center", va="center", fontsize=7, color="0.1",
+                bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1})
     for name, pts in sketch.outlines:
         xy = np.asarray(pts, float)
         dashed = name in ("centre line", "wall") or "(cut)" in name
@@ -783,6 +818,14 @@ def measurement_figure(sketch, what: str) -> bytes:
     detail = ", detail" if sketch.window is not None else ""
     ax.set_title(f"{sketch.key} ({sketch.view} view{detail})\n" + "\n".join(textwrap.wrap(what, 58)), fontsize=8)
     fig.tight_layout()
+    ax.apply_aspect()  # the limits as drawn, before the bar is placed in them
+    ax.set_autoscale_on(False)
+    _scale_bar(ax)
+    if fmt == "svg":
+        buf = io.BytesIO()
+        fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None})
+        plt.close(fig)
+        return buf.getvalue()
     return _png(fig, dpi=100)
 
 

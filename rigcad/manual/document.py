@@ -292,9 +292,39 @@ def measurement_figures(profile, files: dict) -> list[tuple[str, str]]:
     for m in measurements(profile):
         path = f"images/measure/{m.key.replace('.', '_')}.png"
         what = f"from: {m.between[0]}; to: {m.between[1]}"
-        files[path] = plots.measurement_figure(sketch(profile, m), what)
-        out.append((path, f"`{m.key}` ({m.view} view): {m.what}, {what}"))
+        s = sketch(profile, m)
+        extra, dims, note = hole_pattern_marks(profile, s)
+        files[path] = plots.measurement_figure(s, what, extra, dims)
+        out.append((path, f"`{m.key}` ({m.view} view): {m.what}, {what}{note}"))
     return out
+
+
+def hole_pattern_marks(profile, s) -> tuple[tuple, tuple, str]:
+    """For the projector's mounting-hole figure (``projector.mount_holes``): the shelf's slot around each hole
+    (rigcad.parts.tower's: the thread's clearance hole plus ``tower.travel_along`` / ``travel_across`` each
+    way), the holes' spacings along and across as dimensions ((x0, y0), (x1, y1), label), and the caption's
+    words for them; nothing for another figure."""
+    if s.key != "projector.mount_holes" or not s.circles or getattr(profile, "tower", None) is None:
+        return (), (), ""
+    from rigcad.parts.tower import clearance_hole
+
+    d, tw = clearance_hole(profile.projector.mount_thread), profile.tower
+    hx, hy = d / 2 + tw.travel_along, d / 2 + tw.travel_across
+    centres = [c for _, c, _ in s.circles]
+    extra = tuple((f"shelf slot {k + 1}", ((x - hx, y - hy), (x + hx, y - hy), (x + hx, y + hy), (x - hx, y + hy),
+                                           (x - hx, y - hy))) for k, (x, y) in enumerate(centres))
+    xs, ys = sorted({round(x, 6) for x, _ in centres}), sorted({round(y, 6) for _, y in centres})
+    dims = []
+    if len(xs) > 1:
+        y = ys[0] + hy + 10.0  # inside the body, just off the first row's slots
+        dims.append(((xs[0], y), (xs[-1], y), f"{xs[-1] - xs[0]:g} mm"))
+    if len(ys) > 1:
+        x = xs[0] + hx + 10.0
+        dims.append(((x, ys[0]), (x, ys[-1]), f"{ys[-1] - ys[0]:g} mm"))
+    return extra, tuple(dims), (f"; the holes' spacings dimensioned (black), the shelf's slots dashed blue around them "
+                                f"({2 * hx:g} x {2 * hy:g} mm: the {profile.projector.mount_thread} clearance hole "
+                                f"{d:g} mm plus `tower.travel_along` ±{tw.travel_along:g} mm and `tower.travel_across` "
+                                f"±{tw.travel_across:g} mm), and a scale bar")
 
 
 def _introduction(d: Doc, c) -> None:
