@@ -58,12 +58,18 @@ ELEMENTS = ("paraboloid", "dome", "cop", "splitter", "camera")
 #: What each element is, for the tables.
 ELEMENT_NAMES = {"paraboloid": "paraboloid", "dome": "dome", "cop": "projector's (virtual) COP",
                  "splitter": "splitter", "camera": "camera"}
-#: The axes of a stack.
+#: The axes of a stack: "tilt" is an element's tilt of its axis; the paraboloid's is along its beam
+#: (in the x-z plane, which its seats' packs set one against the other) and it has a second, "roll",
+#: about the beam's axis (x: in the y-z plane, which the roll bars' packs under the beam set).
 AXES = ("lateral", "vertical", "tilt")
+#: Each element's axes, in the tables' order.
+ELEMENT_AXES = {e: AXES for e in ("dome", "cop", "splitter", "camera")} | {"paraboloid": (*AXES, "roll")}
+#: The angular axes (rad inside, deg in tables).
+ANGLES = ("tilt", "roll")
 #: The tolerancing key each element's axes are held to (``tolerancing.<key>``): the splitter's
 #: placement moves the virtual COP, so it serves the projector's.
 TOLERANCE_KEYS = {
-    "paraboloid": ("paraboloid_offset", "paraboloid_height", "paraboloid_tilt"),
+    "paraboloid": ("paraboloid_offset", "paraboloid_height", "paraboloid_tilt", "paraboloid_tilt"),
     "dome": ("dome_offset", "dome_height", "dome_tilt"),
     "cop": ("projector_offset", "projector_height", "projector_tilt"),
     "splitter": ("projector_offset", "projector_height", "projector_tilt"),
@@ -93,12 +99,19 @@ DOMINANT_SHARE = 0.5
 MAX_NAMED = 3
 
 
+def _roll_buy(profile) -> str:
+    """What would remove the paraboloid's printed roll links (each a printed face's error across the beam's
+    narrow width or the roll bars' lever)."""
+    return "a bought tip-tilt mount under the stem (two fine screws, the paraboloid's roll and its tilt along the beam)"
+
+
 @dataclass(frozen=True)
 class Link:
     """One link of a chain. ``lateral``, ``vertical``: worst-case error each way (mm; ``math.inf``
     when nothing holds the element along that axis); ``tilt``: worst-case tilt (rad); ``count``:
     how many such links the chain holds (each independent); ``kind``: printed, seam, joint,
-    clearance, free or bought; ``buy``: the purchase (or ``buy:`` key) that would remove it."""
+    clearance, free or bought; ``buy``: the purchase (or ``buy:`` key) that would remove it; ``roll``:
+    worst-case tilt about the paraboloid's beam (rad; its ``tilt`` is then along the beam)."""
 
     name: str
     kind: str
@@ -108,6 +121,7 @@ class Link:
     tilt: float = 0.0
     count: int = 1
     buy: str = ""
+    roll: float = 0.0
 
     def worst(self, axis: str) -> float:
         """This link's share of the worst case on ``axis`` (mm or rad): count times its error."""
@@ -121,13 +135,14 @@ class Link:
     def describe(self) -> dict:
         return {"name": self.name, "kind": self.kind, "source": self.source, "count": self.count,
                 "lateral_mm": _finite(self.lateral), "vertical_mm": _finite(self.vertical),
-                "tilt_deg": _finite(math.degrees(self.tilt)), "buy": self.buy}
+                "tilt_deg": _finite(math.degrees(self.tilt)), "roll_deg": _finite(math.degrees(self.roll)),
+                "buy": self.buy}
 
 
 @dataclass(frozen=True)
 class AdjusterSpec:
     """An adjuster as the stack reads it: the element it moves, the axis ("lateral": x and y;
-    "x" or "y" alone; "vertical"; "tilt"), its range each way and its resolution (mm, or rad for
+    "x" or "y" alone; "vertical"; "tilt"; "roll": about the paraboloid's beam), its range each way and its resolution (mm, or rad for
     a tilt; a tilt of the splitter's reflected axis for the splitter and the COP)."""
 
     name: str
@@ -173,8 +188,8 @@ class AxisVerdict:
         return self.status != "refused"
 
     def describe(self) -> dict:
-        unit = "deg" if self.axis == "tilt" else "mm"
-        f = math.degrees if self.axis == "tilt" else float
+        unit = "deg" if self.axis in ANGLES else "mm"
+        f = math.degrees if self.axis in ANGLES else float
         adj = self.adjuster
         return {"element": self.element, "axis": self.axis, "tolerance_key": f"tolerancing.{self.tolerance_key}",
                 f"tolerance_{unit}": f(self.tolerance), f"worst_{unit}": _finite(f(self.worst)),
@@ -324,8 +339,11 @@ def seam_link(part: str, seams: int, printer: Printer, process: ProcessErrors, d
 def _paraboloid_links(profile, layout, process: ProcessErrors, seams) -> tuple[Link, ...]:
     """O to the paraboloid's vertex: the base plate, the dome on it, the beam in the dome's slots,
     the clamp on the beam, the stem."""
+    from rigcad.parts.dome import ROLL_BAR, roll_lever
+
     pm, shell = profile.paraboloid_mount, profile.dome_shell
     z0, z1 = layout.beam_z
+    lever = roll_lever()
     vertex_z = layout.tower.cop[2] - profile.layout.cop_to_vertex
     clear = 2 * shell.slot_clearance
     slot_play, slot_how = _drilled(profile.beam.width + clear, profile.beam.width, process, "unknown")
@@ -334,6 +352,14 @@ def _paraboloid_links(profile, layout, process: ProcessErrors, seams) -> tuple[L
                  f"printed: the beam's seats (or slots) {z0:.0f} mm above the flange, {2 * layout.slot_r:.0f} mm apart, "
                  "centred on the axis (the scale moves both alike), their floors each within half a layer",
                  process.position, process.height_error(z0), process.layer_step / (2 * layout.slot_r)),
+            Link("seats' floors under the roll bars' ends", "printed",
+                 f"printed: each floor flat to {process.position:.2f} mm across the {lever:g} mm between the roll "
+                 "bar's foil packs", roll=process.position / lever, buy=_roll_buy(profile)),
+            Link("roll bars", "bought", f"{ROLL_BAR.name}: its ends' thickness within {ROLL_BAR.thickness_tolerance:g} mm "
+                 f"over its {lever:g} mm lever", roll=ROLL_BAR.thickness_tolerance / lever),
+            Link("beam's underside across its roll bars", "printed",
+                 f"printed: the beam's underside flat to {process.position:.2f} mm across its {profile.beam.width:g} mm "
+                 "width (it rolls on the bars)", roll=process.position / profile.beam.width, buy=_roll_buy(profile)),
             *seams("dome"),
             Link("beam across its slots", "clearance",
                  f"the slots' {shell.slot_clearance:g} mm clearance each side ({slot_how})", slot_play / 2),
@@ -348,6 +374,10 @@ def _paraboloid_links(profile, layout, process: ProcessErrors, seams) -> tuple[L
                  buy="a locating feature with an adjuster in x, y and height (screws or a printed flexure)"),
             Link("clamp along the beam", "free", "no screw and no stop hold the clamp along the beam", math.inf,
                  buy="a locating feature with an adjuster in x, y and height (screws or a printed flexure)"),
+            Link("clamp's roof across the beam's top", "printed",
+                 f"printed: the roof and the beam's top each flat to {process.position:.2f} mm across the beam's "
+                 f"{profile.beam.width:g} mm width (the clamp rolls on it)", roll=process.position / profile.beam.width,
+                 buy=_roll_buy(profile)),
             Link("stem and back", "printed", f"printed: {vertex_z - z1:.0f} mm from the beam's top to the vertex",
                  0.0, process.height_error(vertex_z - z1)))
 
@@ -379,7 +409,7 @@ def _dome_seat(profile, layout, process: ProcessErrors, seams) -> tuple[Link, ..
             Link("base plate: bore to the dome's bolt circle", "printed",
                  f"printed: a pattern {r:.0f} mm round the bore (the scale moves its holes out alike, not its centre); "
                  f"out of flat {flat:g} mm (datum.foot_flatness) across the flange", process.position, flat,
-                 flat / (2 * layout.flange_outer_r)),
+                 flat / (2 * layout.flange_outer_r), roll=flat / (2 * layout.flange_outer_r)),
             *seams("base_plate"),
             Link("dome's bolts in their holes", "clearance",
                  f"{profile.dome_shell.bolts} bolts ({major:g} mm) in {hole:g} mm holes ({how}): nothing else centres "
@@ -571,7 +601,7 @@ def _verdict(element: str, axis: str, links: tuple[Link, ...], key: str, tol: fl
                            buys)
     if best is not None:
         return AxisVerdict(element, axis, key, tol, worst, rss, "adjusted", best, names, buys)
-    unit, f = ("deg", math.degrees) if axis == "tilt" else ("mm", float)
+    unit, f = ("deg", math.degrees) if axis in ANGLES else ("mm", float)
     if math.isinf(worst):
         reason = "nothing holds it"
     elif not cands:
@@ -682,7 +712,7 @@ def stack(profile, layout, printer: Printer, *, seams: dict[str, int] | None = N
                                        f"chain; its links: {', '.join(k.name for k in links)}")
             links = tuple(k for k in links if k.name not in loc.replaces) + (loc.link,)
         axes = tuple(_verdict(element, axis, links, key, getattr(tol, key), adj)
-                     for axis, key in zip(AXES, TOLERANCE_KEYS[element]))
+                     for axis, key in zip(ELEMENT_AXES[element], TOLERANCE_KEYS[element]))
         elements.append(ElementStack(element, links, axes))
     return StackReport(printer.name, proc, tuple(sorted(counts.items())), estimated, tuple(elements),
                        tuple(x.name for x in locators))
@@ -716,7 +746,7 @@ def check(profile, layout, printer: Printer, **options) -> StackReport:
 def _fmt(v: float, axis: str) -> str:
     if math.isinf(v):
         return "free"
-    return f"{math.degrees(v):.2f} deg" if axis == "tilt" else f"{v:.2f} mm"
+    return f"{math.degrees(v):.2f} deg" if axis in ANGLES else f"{v:.2f} mm"
 
 
 def table_lines(report: StackReport) -> list[str]:
@@ -749,6 +779,6 @@ def with_process(printer: Printer, **figures) -> Printer:
     return replace(printer, process_errors=replace(printer.process_errors, **figures))
 
 
-__all__ = ["AXES", "AdjusterSpec", "AxisVerdict", "ELEMENTS", "ElementStack", "Link", "Locator", "RESOLUTION_SHARE",
+__all__ = ["ANGLES", "AXES", "ELEMENT_AXES", "AdjusterSpec", "AxisVerdict", "ELEMENTS", "ElementStack", "Link", "Locator", "RESOLUTION_SHARE",
            "DOME_FLOATS", "PARABOLOID_FLOATS", "declared_locators", "sample_link", "located_adjusters", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
            "table_lines", "with_process"]

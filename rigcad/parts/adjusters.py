@@ -187,10 +187,37 @@ def projector_tilt(profile, layout) -> Adjuster:
                     2 * camera_tilt(profile, layout).needed_range)
 
 
+def paraboloid_roll_needed(profile, layout, position: float) -> float:
+    """The paraboloid's roll about its beam that the printed faces it rolls on can leave (rad, worst case)
+    when each prints flat to ``position`` mm: the clamp's roof and the beam's underside across the beam's
+    width, the seats' floors across the roll bars' lever, the bars' thickness band over that lever, and
+    the base plate's flatness (``datum.foot_flatness``) across the flange (rigcad.fab.stack sums the same
+    links on a printer's process)."""
+    from rigcad.parts.dome import ROLL_BAR, roll_lever
+
+    lever = roll_lever()
+    return (2 * position / profile.beam.width + (position + ROLL_BAR.thickness_tolerance) / lever
+            + profile.datum.foot_flatness / (2 * layout.flange_outer_r))
+
+
+def paraboloid_roll(profile, layout) -> Adjuster:
+    """The paraboloid's roll about its beam (the y-z plane): shim foil under the roll bars' -y ends against
+    their +y ends in both beam seats (rigcad.parts.dome.beam_seats, ROLL_BAR), the thinnest foil over the
+    bars' lever, against ``tolerancing.paraboloid_tilt``; the range it needs, the printed faces' roll on the
+    profile's print accuracy (``datum.print_position``: :func:`paraboloid_roll_needed`)."""
+    from rigcad.parts.dome import beam_seats
+
+    stop = next(s for s in beam_seats(profile, layout).stops() if s.axis == "roll")
+    return Adjuster("paraboloid roll about the beam", stop.how, "tolerancing.paraboloid_tilt",
+                    profile.tolerancing.paraboloid_tilt, "rad", stop.range, stop.resolution,
+                    paraboloid_roll_needed(profile, layout, profile.datum.print_position))
+
+
 def adjusters(profile, layout) -> list[Adjuster]:
-    """Every adjuster of the tower, with its range and resolution against the tolerance it serves."""
+    """Every adjuster of the tower, with its range and resolution against the tolerance it serves, and
+    the paraboloid's roll (its one adjuster set by hand that no shim stop of the mount's covers)."""
     return [*splitter_adjusters(profile, layout), *slot_adjusters(profile, layout), camera_tilt(profile, layout),
-            projector_tilt(profile, layout), camera_mount_tilt(profile)]
+            projector_tilt(profile, layout), camera_mount_tilt(profile), paraboloid_roll(profile, layout)]
 
 
-__all__ = ["Adjuster", "adjusters", "camera_mount_tilt", "camera_tilt", "projector_tilt", "projector_screws", "slot_adjusters", "splitter_adjusters"]
+__all__ = ["Adjuster", "adjusters", "camera_mount_tilt", "camera_tilt", "paraboloid_roll", "paraboloid_roll_needed", "projector_tilt", "projector_screws", "slot_adjusters", "splitter_adjusters"]

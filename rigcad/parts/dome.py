@@ -4,8 +4,14 @@ wall, a bolted base flange, the slots the mounting beam passes through, and the 
 Each seat is a block standing on the flange outside the wall at a slot, within the flange's radius
 (the dome's footprint on a bed does not grow): the beam passes through its tunnel and rests on a
 pack of shim foil on the tunnel's floor, pressed down by a set screw in the roof and against the
-tunnel's -y wall by a set screw in its +y wall (heat-set inserts take both). Both packs together set
-the paraboloid's height, one against the other its tilt along the beam (rigcad.parts.locating.ShimStop).
+tunnel's -y wall by a set screw in its +y wall (heat-set inserts take both). Under the beam, across it,
+lies a bought steel roll bar (:data:`ROLL_BAR`) on two packs of foil, one under each of its ends, in a
+wide slot at the bottom of the tunnel: the bar's packs together set the paraboloid's height, one seat's
+against the other's its tilt along the beam, and the -y ends' packs against the +y ends' its roll about the
+beam, over the bar's lever (:func:`roll_lever`) rather than the beam's narrow width, which is too short for
+the thinnest foil to step a quarter of ``tolerancing.paraboloid_tilt`` (rigcad.parts.locating.ShimStop).
+The bars stand outside the dome's mirror, as the seats do: the light inside it never reaches them, so
+the beam inside the dome stays as narrow as the thesis hangs the paraboloid on.
 
 The dome is centred on the sample bore by indicating it in, and its register is then drilled in place
 (rigcad.parts.locating): a dial test indicator on an arm turning in the bore sweeps the mirror's
@@ -37,7 +43,31 @@ INDICATE_TRAVEL_MM = 1.0
 SEAT_SCREW = "M3"
 #: The least radial depth of a seat (mm): room for its set screws' inserts (a 4 mm hole, 4.6 mm over
 #: the knurl) and 2 mm walls.
-SEAT_DEPTH_MM = 9.0
+SEAT_DEPTH_MM = 9.0  # also holds the roll bar's 8 mm width (ROLL_BAR)
+
+
+@dataclass(frozen=True)
+class RollBar:
+    """A bought flat bar laid across the beam in a seat (mm): ``width`` along the beam (x),
+    ``thickness`` (z), ``length`` across it (y); ``thickness_tolerance``: the bar's thickness band
+    (its two ends differ by at most this); ``pad``: the width of the foil strip under each end."""
+
+    name: str
+    width: float
+    thickness: float
+    length: float
+    thickness_tolerance: float
+    pad: float
+
+
+#: The seats' roll bars: bright drawn steel flat bar 8 x 3 mm (EN 10278, thickness h11: 0/-0.060 mm at
+#: 3 mm, ISO 286-2 IT11 up to 3 mm), cut 30 mm long, each end on a 4 mm wide strip of foil.
+ROLL_BAR = RollBar("bright steel flat bar 8 x 3 mm (EN 10278, h11)", 8.0, 3.0, 30.0, 0.060, 4.0)
+
+
+def roll_lever() -> float:
+    """The roll bar's lever (mm): between the middles of the foil strips under its two ends."""
+    return ROLL_BAR.length - ROLL_BAR.pad
 
 
 def _pt(m, u) -> tuple[float, float]:
@@ -130,7 +160,8 @@ class BeamSeats:
     """The beam's two seats on the dome (mm, rig frame): the ``blocks`` (one at +x, one at -x), the
     ``tunnels`` the beam passes through, the set screws' insert ``pockets`` and bores, the screws'
     length (ISO 4026), where the screws press (``x``, each side), the seats' ``span`` (between the
-    screws) and the floor pack (``pack``)."""
+    screws), the pack under each end of each roll bar (``pack``) and the ``bars`` at the design setting
+    (:data:`ROLL_BAR`, across the beam under it)."""
 
     blocks: tuple[Box, Box]
     tunnels: tuple[Box, Box]
@@ -139,18 +170,28 @@ class BeamSeats:
     x: float
     span: float
     pack: float
+    bars: tuple[Box, Box]
+    #: How far the beam can roll in its tunnels before its section's corners meet both walls (rad).
+    roll_room: float
 
-    def stops(self) -> tuple[ShimStop, ShimStop]:
-        """Height (both floor packs alike) and tilt along the beam (one against the other)."""
-        step = foil_step()
-        return (ShimStop("paraboloid height: shim foil under the beam in both seats", "paraboloid", "vertical",
+    def stops(self) -> tuple[ShimStop, ShimStop, ShimStop]:
+        """Height (every pack alike), tilt along the beam (one seat's packs against the other's) and roll
+        about the beam (the roll bars' -y ends' packs against their +y ends', both seats alike)."""
+        step, lever = foil_step(), roll_lever()
+        return (ShimStop("paraboloid height: shim foil under the roll bars in both seats", "paraboloid", "vertical",
                          self.pack, step / 2, self.pack,
-                         f"{self.pack:g} mm of foil on each seat's floor at the design setting; a change at one seat "
-                         "moves the paraboloid half as much"),
-                ShimStop("paraboloid tilt along the beam: shim foil under one seat against the other", "paraboloid",
-                         "tilt", 2 * self.pack / self.span, step / self.span, self.pack,
+                         f"{self.pack:g} mm of foil under each end of each seat's roll bar at the design setting; a "
+                         "change at one seat moves the paraboloid half as much"),
+                ShimStop("paraboloid tilt along the beam: shim foil under one seat's roll bar against the other's",
+                         "paraboloid", "tilt", 2 * self.pack / self.span, step / self.span, self.pack,
                          f"foil taken from one seat and added to the other over the {self.span:.0f} mm between "
-                         "their screws"))
+                         "their screws"),
+                ShimStop("paraboloid roll about the beam: shim foil under the roll bars' -y ends against their +y ends",
+                         "paraboloid", "roll", min(2 * self.pack / lever, self.roll_room), step / lever, self.pack,
+                         f"foil taken from under one end of both seats' roll bars and added under the other ends, "
+                         f"over the bars' {lever:g} mm lever ({ROLL_BAR.name}, {ROLL_BAR.length:g} mm long, across "
+                         "the beam; the beam's section rolls at most "
+                         f"{math.degrees(self.roll_room):.1f} deg in its tunnels)"))
 
 
 def seat_top(profile: Profile, beam_top: float) -> float:
@@ -169,8 +210,11 @@ def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
     c, p, w = shell.slot_clearance, SHIM_PACK_MM, beam.width / 2
     ins = INSERTS[SEAT_SCREW]
     side = ins.pocket_depth + 1.0
-    y_lo, y_hi = -w - shell.wall, w + 2 * c + side
-    floor, roof = z0 - p, z1 + p + c
+    bar, half_bar = ROLL_BAR, ROLL_BAR.length / 2
+    # the block holds the roll bar's slot (its ends' travel and the clearance each side) inside a wall
+    y_side = w + 2 * c + side  # the tunnel's +y wall's outer face: its set screw's insert stands in it
+    y_lo, y_hi = -max(w, half_bar + c) - shell.wall, max(y_side, half_bar + c + shell.wall)
+    floor, roof = z0 - bar.thickness - p, z1 + p + c
     top = seat_top(profile, z1)
     u = layout.as_printed_dome.sample(4001)
     pts = layout.as_printed_dome.points(u)
@@ -179,20 +223,28 @@ def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
     # within the flange's rim where it leaves room (the footprint does not grow), else past it, on the plate
     x_out = max(math.sqrt(layout.flange_outer_r ** 2 - max(-y_lo, y_hi) ** 2) - 0.5, x_in + SEAT_DEPTH_MM)
     xm = 0.5 * (x_in + x_out)
-    blocks, tunnels, pockets = [], [], []
+    blocks, tunnels, pockets, bars = [], [], [], []
     for s in (1.0, -1.0):
         lo, hi = sorted((s * x_in, s * x_out))
         blocks.append(Box((lo, y_lo, 0.0), (hi, y_hi, top)))  # standing on the plate, through the flange
         tunnels.append(Box((lo - 1.0, -w, floor), (hi + 1.0, w + 2 * c, roof)))
+        # the roll bar's slot across the tunnel's bottom: room for an end to rise by a whole pack
+        pockets.append(Box((lo - 1.0, -half_bar - c, floor), (hi + 1.0, half_bar + c, z0 + p + c)))
+        bars.append(Box((s * xm - bar.width / 2, -half_bar, z0 - bar.thickness), (s * xm + bar.width / 2, half_bar, z0)))
         # the roof's screw: its bore up from the tunnel, the insert's pocket over it, open at the top
         pockets += [stepped_hole(s * xm, 0.0, roof - 1.0, ((THREADS[SEAT_SCREW].clearance / 2, top - ins.pocket_depth - roof + 1.0),
                                                              (ins.hole / 2, ins.pocket_depth + 1.0))),
-                    teardrop_along_y((s * xm, y_hi - ins.pocket_depth / 2 + 0.5, 0.5 * (z0 + z1)), ins.hole / 2,
-                                     ins.pocket_depth + 1.0),
+                    # the +y screw's insert where a side wall would hold it, reached from the block's +y face
+                    # (its far side holds the roll bar's slot) through a bore the insert's size
+                    teardrop_along_y((s * xm, 0.5 * (y_side - ins.pocket_depth + y_hi + 1.0), 0.5 * (z0 + z1)),
+                                     ins.hole / 2, y_hi + 1.0 - (y_side - ins.pocket_depth)),
                     teardrop_along_y((s * xm, w + 2 * c + side / 2, 0.5 * (z0 + z1)),
                                      THREADS[SEAT_SCREW].clearance / 2, side + 2.0)]
     screw = set_screw_length(SEAT_SCREW, side, c, 2 * p + c)
-    return BeamSeats(tuple(blocks), tuple(tunnels), tuple(pockets), screw, xm, 2 * xm, p)
+    # the beam's w x h section turned by t spans w cos t + h sin t across: the tunnel's width bounds the roll
+    diag = math.hypot(beam.width, beam.height)
+    room = math.asin(min(1.0, (beam.width + 2 * c) / diag)) - math.atan2(beam.width, beam.height)
+    return BeamSeats(tuple(blocks), tuple(tunnels), tuple(pockets), screw, xm, 2 * xm, p, tuple(bars), room)
 
 
 def dome(profile: Profile, layout: RigLayout) -> Part:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rigcad.parts.dome import ROLL_BAR, roll_lever
 from rigcad.parts.layout import RigLayout
 from rigcad.parts.locating import (SHIM_PACK_MM, ShimStop, foil_step, slip_fit, set_screw_length, stepped_hole,
                                    teardrop_along_y)
@@ -179,11 +180,17 @@ def hardware(profile: Profile, layout: RigLayout) -> list[dict]:
         {"item": "set screw, flat point (ISO 4026)", "thread": SEAT_SCREW, "length_mm": seats.screw_length,
          "quantity": 4, "steps": ("beam",), "joins": "the beam on its two seats: in each seat one down through its "
                                                      "roof, one across through its +y wall"},
+        {"item": f"{ROLL_BAR.name}, cut {ROLL_BAR.length:g} mm long", "thread": None,
+         "length_mm": ROLL_BAR.length, "quantity": 2, "steps": ("beam",),
+         "joins": f"the beam's roll bars: one across each seat's tunnel under the beam, its ends on foil packs "
+                  f"{roll_lever():g} mm apart (the paraboloid's roll about the beam: "
+                  f"{math.degrees(foil_step() / roll_lever()):.3f} deg per {foil_step():g} mm of foil); slid into the "
+                  "slot at the tunnel's bottom before the beam, deburred, its ends square"},
         {"item": f"shim foil, stainless steel 1.4310 (EN 10140), {foil} mm, one sheet each", "thread": None,
          "length_mm": None, "quantity": 1, "steps": ("beam", "paraboloid"),
-         "joins": f"the packs of the paraboloid's stops ({SHIM_PACK_MM:g} mm each at the design setting: on each "
-                  "seat's floor, between the beam and the clamp's -y wall, between the clamp's end and the pin), "
-                  "cut to the faces with scissors"},
+         "joins": f"the packs of the paraboloid's stops ({SHIM_PACK_MM:g} mm each at the design setting: under each "
+                  f"end of each seat's roll bar, in {ROLL_BAR.pad:g} mm strips, between the beam and the clamp's -y "
+                  "wall, between the clamp's end and the pin), cut to the faces with scissors"},
     ]
 
 
@@ -227,10 +234,10 @@ def setting_text(profile: Profile, layout: RigLayout) -> str:
 
     seats, step = beam_seats(profile, layout), foil_step()
     per_tilt = seats.span * math.radians(0.01)
-    # the roll about the beam: foil under one half of the beam rocks it about its other edge, a lever of
-    # at most its width (too short for a quarter of the tilt tolerance; docs/rig-mechanics.md)
-    width = profile.beam.width
-    roll_per = width * math.radians(0.1)
+    # the roll about the beam: foil under one end of each seat's roll bar against its other end, over the
+    # bar's lever (the beam's own width is too short a lever for the thinnest foil: docs/rig-mechanics.md)
+    lever = roll_lever()
+    roll_per = lever * math.radians(0.1)
     tol = profile.tolerancing
     return (
         f"Set the paraboloid from a calibration: `rigcad calibrate {profile.name} --images <folder>` prints, last, "
@@ -243,13 +250,15 @@ def setting_text(profile: Profile, layout: RigLayout) -> str:
         f"much foil as x reads (add as much when x is negative): 0.01 mm of foil moves it 0.01 mm, in steps of "
         f"{step:g} mm; slide the clamp back onto the pin and tighten. y: add as much foil as y reads to the pack "
         f"between the beam and the clamp's -y wall (take out when negative). z: take as much foil as z reads "
-        f"out of the pack on both seats' floors (add when negative); a change at one seat moves the paraboloid "
-        f"half as much ({step / 2:g} mm per {step:g} mm foil). Tilt y (the -x side high when positive): take "
-        f"{per_tilt:.3f} mm of foil per 0.01 deg out of the -x seat's pack, or add it at the +x seat, then "
-        f"restore the height. Tilt x (the +y side high when positive; a roll about the beam): lay foil under the "
-        f"beam's -y half on both seats' floors (under its +y half when negative), {roll_per:.4f} mm per 0.1 deg "
-        f"over the beam's {width:g} mm: its thinnest ({step:g} mm) rolls it {math.degrees(step / width):.2f} deg, "
-        f"so this lands within {math.degrees(step / width) / 2:.2f} deg of level, coarser than the other "
-        "settings; then restore the height. Loosen the seats' set screws before changing their packs and "
-        "tighten them after. "
+        f"out of the packs under both ends of both seats' roll bars (add when negative); a change at one seat moves "
+        f"the paraboloid half as much ({step / 2:g} mm per {step:g} mm foil). Tilt y (the -x side high when "
+        f"positive): take {per_tilt:.3f} mm of foil per 0.01 deg out of the -x seat's packs (under both ends of its "
+        f"roll bar), or add it at the +x seat, then restore the height. Tilt x (the +y side high when positive; a "
+        f"roll about the beam): add foil under the -y ends of both seats' roll bars, or take it from under their +y "
+        f"ends (the other way when negative), {roll_per:.4f} mm per 0.1 deg over the bars' {lever:g} mm lever: the "
+        f"thinnest foil ({step:g} mm) rolls it {math.degrees(step / lever):.3f} deg, so it lands within "
+        f"{math.degrees(step / lever) / 2:.3f} deg of level; change both seats alike (one alone twists the beam), "
+        "then restore the height. Loosen the seats' set screws before changing their packs; tighten the roof "
+        "screws first and then the side screws only until the beam touches its -y wall (pressed harder they roll it "
+        "off the bars). "
         "Capture and calibrate again.")

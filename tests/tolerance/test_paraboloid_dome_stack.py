@@ -52,7 +52,7 @@ def test_each_stop_serves_its_axis_at_a_quarter_of_the_tolerance(table31_rig):
     p, lay = table31_rig.profile, table31_rig.layout
     tol = p.tolerancing
     stops = {s.axis: s for s in (*paraboloid.stops(p, lay), *dome.beam_seats(p, lay).stops())}
-    assert set(stops) == {"x", "y", "vertical", "tilt"}
+    assert set(stops) == {"x", "y", "vertical", "tilt", "roll"}
     step = min(SHIM_FOIL)
     # along and across the beam the stop moves the paraboloid one for one: the thinnest foil is the step
     assert stops["x"].resolution == stops["y"].resolution == step <= tol.paraboloid_offset / 4
@@ -62,6 +62,9 @@ def test_each_stop_serves_its_axis_at_a_quarter_of_the_tolerance(table31_rig):
     seats = dome.beam_seats(p, lay)
     assert stops["tilt"].resolution == pytest.approx(step / seats.span) and stops["tilt"].resolution <= tol.paraboloid_tilt / 4
     assert stops["tilt"].range == pytest.approx(2 * LOC.SHIM_PACK_MM / seats.span)
+    # the roll: the roll bars' -y ends' packs against their +y ends', over the strips' middles
+    lever = dome.ROLL_BAR.length - dome.ROLL_BAR.pad
+    assert stops["roll"].resolution == pytest.approx(step / lever) and stops["roll"].resolution <= tol.paraboloid_tilt / 4
     ind = dome.indicating(p, lay)
     assert ind.resolution == LOC.INDICATOR_MM + dome.register(p, lay).repeatability[0] <= tol.dome_offset / 4
 
@@ -116,7 +119,17 @@ def test_the_stops_are_geometry_in_the_parts(table31_rig):
     # each seat: the floor a pack under the beam, the tunnel's -y wall at the beam's -y face, the roof's insert
     for block in seats.blocks:
         x = 0.5 * (block.lo[0] + block.hi[0])
-        assert _inside(shell, (x, 0.0, z0 - pk - 0.05), (x, 0.0, z0 - pk + 0.05)) == [True, False]
+        # the floor a roll bar and a pack under the beam, across the bar's length and its clearance
+        bar, c = dome.ROLL_BAR, p.dome_shell.slot_clearance
+        floor = z0 - bar.thickness - pk
+        for y in (0.0, bar.length / 2 - bar.pad / 2, -bar.length / 2 + bar.pad / 2):
+            assert _inside(shell, (x, y, floor - 0.05), (x, y, floor + 0.05)) == [True, False]
+        edge = bar.length / 2 + c
+        assert _inside(shell, (x, edge - 0.05, floor + 0.5), (x, edge + 0.05, floor + 0.5)) == [False, True]
+        # the slot leaves a bar's end room to rise by a whole pack
+        assert _inside(shell, (x, edge - 0.5, z0 + pk + c - 0.05), (x, edge - 0.5, z0 + pk + c + 0.05)) == [False, True]
+        # the +y set screw's insert is reached from the block's +y face
+        assert _inside(shell, (math.copysign(seats.x, x), block.hi[1] - 0.5, mid)) == [False]
         xo = x + math.copysign(3.0, x)  # outside the wall's slot
         assert _inside(shell, (xo, -w - 0.05, mid), (xo, -w + 0.05, mid)) == [True, False]
         assert _inside(shell, (math.copysign(seats.x, x), 0.0, block.hi[2] - 1.0)) == [False]
@@ -152,7 +165,15 @@ def test_the_parts_page_states_the_codes_figures(table31_rig, mk3s):
     assert f"| {st['vertical'].range:g} mm | {st['vertical'].resolution:g} mm |" in text
     assert (f"one seat's pack against the other's, {seats.span:.0f} mm apart | {math.degrees(st['tilt'].range):.2f} deg "
             f"| {math.degrees(st['tilt'].resolution):.3f} deg |") in text
+    lever = dome.roll_lever()
+    assert (f"the packs under the roll bars' -y ends against their +y ends, {lever:g} mm apart (`rigcad.parts.dome.ROLL_BAR`: "
+            f"bright steel flat bar {dome.ROLL_BAR.width:g} x {dome.ROLL_BAR.thickness:g} mm, {dome.ROLL_BAR.length:g} mm "
+            f"long) | {math.degrees(st['roll'].range):.1f} deg | {math.degrees(st['roll'].resolution):.3f} deg |") in text
     v = _axes(S.stack(p, lay, mk3s))
+    faces = 2 * mk3s.process_errors.position / p.beam.width  # the beam's underside and the clamp's roof
+    assert (f"its roll {math.degrees(v['paraboloid', 'roll'].worst):.2f} deg, of which {math.degrees(faces):.2f} deg are "
+            f"the beam's {p.beam.width:g} mm width printed flat to {mk3s.process_errors.position:.1f} mm") in text
+    assert f"the bars give it {lever:g} mm" in text
     assert (f"({v['paraboloid', 'lateral'].worst:.2f} mm sideways, {v['paraboloid', 'vertical'].worst:.2f} mm in height "
             f"and {math.degrees(v['paraboloid', 'tilt'].worst):.2f} deg on the MK3S)") in text
     assert (f"bolt holes ({dome.flange_bolt_hole(p, lay):.2f} mm for M4, on ISO 7093 large washers) leaving it "

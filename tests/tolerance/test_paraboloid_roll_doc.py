@@ -1,46 +1,63 @@
-"""docs/rig-mechanics.md's figures for the paraboloid's roll about its beam (an open finding: the roll is
-not yet an axis of the stack) are the profile's and the printer's: the printed faces it rolls on, and
-what a shim-foil adjuster across the beam could reach."""
+"""docs/rig-mechanics.md's figures for the paraboloid's roll about its beam are the profile's, the
+printer's and the roll bars': the printed faces it rolls on, why foil under the beam alone cannot set
+it, and what the roll bars (rigcad.parts.dome.ROLL_BAR) reach; the calibration's "Tilt x" step says the
+same."""
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
+from rigcad.fab import stack as ST
 from rigcad.fab.printers import load_printer
 from rigcad.fab.stack import RESOLUTION_SHARE
+from rigcad.parts.dome import beam_seats, roll_lever
 from rigcad.parts.locating import foil_step
 from rigcad.parts.paraboloid import setting_text
 
 PAGE = Path(__file__).resolve().parents[2] / "docs" / "rig-mechanics.md"
 
 
-def test_the_roll_figures_are_the_profiles(table31):
-    text = " ".join(PAGE.read_text(encoding="utf-8").split())
+def _text() -> str:
+    return " ".join(PAGE.read_text(encoding="utf-8").split())
+
+
+def test_the_roll_figures_are_the_profiles(table31_rig):
+    p, lay = table31_rig.profile, table31_rig.layout
+    text = _text()
     pos = load_printer("prusa_mk3s").process_errors.position
-    width, tol = table31.beam.width, table31.tolerancing.paraboloid_tilt
+    width, tol = p.beam.width, p.tolerancing.paraboloid_tilt
     face = pos / width  # one printed face flat to the position error across the beam's width (rad)
-    assert (f"each printed flat to {pos:.2f} mm across the beam's {width:g} mm width on the MK3S, "
-            f"{math.degrees(face):.2f} deg each against the {math.degrees(tol):g} deg of") in text
+    assert (f"printed flat to {pos:.2f} mm across the beam's {width:g} mm width on the MK3S (the beam's underside "
+            f"on its seats, the clamp's roof on the beam's top), {math.degrees(face):.2f} deg each against the "
+            f"{math.degrees(tol):g} deg of") in text
+    v = next(a for a in ST.stack(p, lay, load_printer("prusa_mk3s")).element("paraboloid").axes if a.axis == "roll")
+    assert f"{math.degrees(v.worst):.2f} deg worst case, {math.degrees(v.rss):.2f} deg RSS" in text
     fine = RESOLUTION_SHARE * tol
     assert f"cannot set it to a quarter of that ({math.degrees(fine):.2f} deg)" in text
-    # the widest lever foil under the beam can have is the beam's width
+    # the widest lever foil under the beam alone can have is the beam's width
     assert (f"the thinnest foil ({foil_step():g} mm) over the beam's whole width turns it "
             f"{math.degrees(foil_step() / width):.2f} deg") in text
-    assert foil_step() / width > fine  # the finding: too coarse
+    assert foil_step() / width > fine  # why the bars: too coarse
     assert f"a {math.degrees(fine):.2f} deg step in that foil needs a lever of {foil_step() / fine:.0f} mm" in text
+    lever = roll_lever()
+    assert f"its two ends on foil packs {lever:g} mm apart" in text and lever >= foil_step() / fine
+    assert f"rolls the paraboloid {math.degrees(foil_step() / lever):.3f} deg per {foil_step():g} mm" in text
+    room = beam_seats(p, lay).roll_room
+    assert f"range {math.degrees(min(v.adjuster.range, room)):.1f} deg each way" in text
+    assert f"{math.degrees(v.adjuster.resolution):.2f} deg steps" in text
 
 
-def test_the_calibration_says_how_to_set_the_roll_coarsely(table31_rig):
+def test_the_calibration_says_how_to_set_the_roll(table31_rig):
     p, lay = table31_rig.profile, table31_rig.layout
-    text = " ".join(PAGE.read_text(encoding="utf-8").split())
-    step = foil_step() / p.beam.width  # the thinnest foil under one half of the beam, rocking on its other edge
+    lever = roll_lever()
+    step = foil_step() / lever  # the thinnest foil under one end of the bars, against the other end
     half = step / 2  # a setting lands within half a step of the reading
-    assert half < p.tolerancing.paraboloid_tilt < 4 * step  # inside the tolerance, not within its quarter
-    assert (f"rolls it {math.degrees(step):.2f} deg per {foil_step():g} mm, so it lands within "
-            f"{math.degrees(half):.2f} deg of level") in text
+    assert half < RESOLUTION_SHARE * p.tolerancing.paraboloid_tilt
+    assert f"it lands within {math.degrees(half):.3f} deg of level" in _text()
     step_text = setting_text(p, lay)
-    # the sign: tilt x > 0 lifts the +y side (rigcad.calibrate.conventions), so foil goes under the -y half
-    assert "Tilt x (the +y side high when positive" in step_text and "under the beam's -y half" in step_text
-    assert f"{p.beam.width * math.radians(0.1):.4f} mm per 0.1 deg" in step_text
-    assert f"rolls it {math.degrees(step):.2f} deg, so this lands within {math.degrees(half):.2f} deg" in step_text
+    # the sign: tilt x > 0 lifts the +y side (rigcad.calibrate.conventions), so foil goes under the -y ends
+    assert "Tilt x (the +y side high when positive" in step_text
+    assert "add foil under the -y ends of both seats' roll bars" in step_text
+    assert f"{lever * math.radians(0.1):.4f} mm per 0.1 deg" in step_text
+    assert f"rolls it {math.degrees(step):.3f} deg, so it lands within {math.degrees(half):.3f} deg" in step_text
