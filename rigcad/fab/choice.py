@@ -56,12 +56,18 @@ def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer, keep_ou
         return fits(cell_vertices, candidates(has_mirror, plate, sector if isinstance(plan, split.SplitPlan) else None),
                     printer)
 
-    if split.is_off_axis(man):
-        return split.plan_grid(man, cell_fits, keep_out)
     try:
-        return split.plan_split(man, cell_fits, keep_out)
-    except FabricationError:
-        return split.plan_grid(man, cell_fits, keep_out)
+        if split.is_off_axis(man):
+            return split.plan_grid(man, cell_fits, keep_out)
+        try:
+            return split.plan_split(man, cell_fits, keep_out)
+        except FabricationError:
+            return split.plan_grid(man, cell_fits, keep_out)
+    except FabricationError as err:
+        v = printer.build_volume
+        raise FabricationError(f"{err} on printer '{printer.name}' ({v.x:g} x {v.y:g} x {v.z:g} mm): choose a printer "
+                               "with a larger build volume (--printer; the printer file's build_volume), or buy the "
+                               "part where the profile's buy section offers it") from err
 
 
 def evaluate(vertices, faces, orient: orientation.Orientation, printer: Printer, mirror_f) -> dict:

@@ -13,9 +13,12 @@ inside the part) and, on a mirror part, at least ``MIRROR_CLEARANCE`` from the m
 (measured on the exact surface). The booleans are manifold3d's on the part's mesh.
 
 No cut crosses a datum feature (rigcad.parts.joints.Datum: a dowel hole, a bore, a seat, an insert
-pocket, a register, declared on the part): the planner treats each feature's box, grown by
-``DATUM_MARGIN``, as a keep-out zone, moving a grid's cut to the nearer clear position (or the
-farther) and leaving out the sector phases and band heights that would cross one. The seams that
+pocket, a register, declared on the part): the planner treats each feature's box, grown by its
+:func:`datum_margin` (the feature's wall and the glue's squeeze-out; round a hole that takes a fit, the
+sample bore bored after gluing or a reamed dowel hole, a hub of twice its diameter), as a keep-out
+zone, moving a grid's cut to the nearer clear position (or the farther) and leaving out the sector
+phases and band heights that would cross one; when no plan keeps off them the part is refused
+(rigcad.fab.choice names the printer and its build volume). The seams that
 remain between two datum features of one part (a glue line on its datum chain) are listed by
 :func:`datum_seams`.
 Frame: the part's working position, mm, rad.
@@ -33,15 +36,30 @@ import numpy as np
 from rigcad.errors import FabricationError
 from rigcad.fab.mirror import MirrorSurface
 from rigcad.fab.printers import AlignmentPin
+from rigcad.parts.recipe import Cylinder
 
 #: Material kept around a pin hole (mm) when no printer says more: an SLA part's thinnest unsupported
 #: wall (Formlabs' design guide: 0.6 mm). An FDM printer's is two perimeters (:func:`pin_wall`).
 MIN_WALL = 0.6
 #: PrusaSlicer's automatic perimeter width: 1.125 x the nozzle (its "extrusion width = 0" rule).
 AUTO_WIDTH_OVER_NOZZLE = 1.125
-#: A seam keeps this far (mm) from a datum feature's box: the feature's own wall stays whole (two
-#: perimeters, ~0.9 mm) and glue squeezed out of the seam (about 1 mm) does not reach it.
-DATUM_MARGIN = 2.0
+#: How far (mm) glue squeezed out of a seam spreads along the cut face (about 1 mm): a seam keeps at
+#: least this beyond a datum feature's own wall, so no glue reaches the feature.
+GLUE_SQUEEZE_MM = 1.0
+#: A datum feature's own wall (mm): two perimeters of an FDM print (~0.9 mm), rounded up.
+FEATURE_WALL_MM = 1.0
+#: A seam keeps this far (mm) from a datum feature's box: its own wall stays whole and the squeeze-out
+#: does not reach it (:func:`datum_margin`: more round a hole that takes a fit).
+DATUM_MARGIN = FEATURE_WALL_MM + GLUE_SQUEEZE_MM
+#: A round hole that takes a fit (the sample bore, bored H7 on a mill after the pieces are glued; the
+#: dowel and register pins' reamed holes) keeps a hub of one printed piece round it, as a hub keeps its
+#: bore: "an ordinary rule is to make the outside diameter of the hub twice the diameter of the shaft"
+#: (Shop Practice vol. 1, American Technical Society, "Hubs"). So its wall is half its diameter (20 mm
+#: round the 40 mm sample bore), the cutting and clamping of its boring or reaming bear on one piece, and
+#: no glue line runs inside the hub.
+HUB_OVER_BORE = 2.0
+#: The datum kinds whose round features take a fit (their keep-out is :func:`datum_margin`'s hub).
+FIT_KINDS = ("bore", "dowel", "register")
 #: Grid cut positions tried per plan (each cut at its equal-slab place or moved off a keep-out).
 KEEPOUT_TRIES = 6
 #: Distance kept between a pin hole and the printed mirror surface (mm): sanding removes up to
@@ -285,10 +303,22 @@ def pin_fit(printer, pins, pin: AlignmentPin | None = None) -> dict:
                     f"(it prints about {printed:.2f} mm), then push a {d:g} mm pin in: a {after} fit"}
 
 
+def datum_margin(datum) -> float:
+    """How far (mm) every seam keeps from a datum feature (rigcad.parts.joints.Datum): DATUM_MARGIN,
+    or round a round hole that takes a fit (FIT_KINDS, a vertical Cylinder) its hub's wall
+    ((HUB_OVER_BORE - 1) / 2 x its diameter) plus GLUE_SQUEEZE_MM, whichever is more: 21 mm round the
+    default 40 mm sample bore."""
+    shape = datum.shape
+    if datum.kind in FIT_KINDS and isinstance(shape, Cylinder):
+        hub = 0.5 * (HUB_OVER_BORE - 1.0) * 2.0 * shape.radius
+        return max(DATUM_MARGIN, hub + GLUE_SQUEEZE_MM)
+    return DATUM_MARGIN
+
+
 def keepouts(datums) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The keep-out boxes (lo, hi; mm) of a part's datum features: each feature's bounds grown by
-    DATUM_MARGIN."""
-    return [(np.asarray(d.bounds[0], float) - DATUM_MARGIN, np.asarray(d.bounds[1], float) + DATUM_MARGIN)
+    """The keep-out boxes (lo, hi; mm) of a part's datum features: each feature's bounds grown by its
+    :func:`datum_margin`. A cut plane that misses a box misses the feature by at least that margin."""
+    return [(np.asarray(d.bounds[0], float) - datum_margin(d), np.asarray(d.bounds[1], float) + datum_margin(d))
             for d in datums]
 
 
@@ -337,9 +367,10 @@ def plan_grid(man: m3d.Manifold, fits, keep_out=()) -> GridPlan:
             plan = GridPlan(*cuts)
             if all(fits(grid_cell(man, plan, i, j, k), plan, i, j) for i, j, k in plan.cells()):
                 return plan
-    kept = f" whose cuts keep off its {len(keep_out)} datum features" if len(keep_out) else ""
-    raise FabricationError(f"no grid of up to {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} pieces{kept} "
-                           "fits this printer; use a larger printer or buy the part (the profile's buy section)")
+    kept = (f" whose cuts keep off its {len(keep_out)} datum features (each by its split.datum_margin: "
+            f"{FEATURE_WALL_MM:g} mm of wall, a hub of half its diameter round a hole that takes a fit, and "
+            f"{GLUE_SQUEEZE_MM:g} mm for the glue)") if len(keep_out) else ""
+    raise FabricationError(f"no grid of up to {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} pieces{kept} fits")
 
 
 def _grid_interfaces(plan: GridPlan):
@@ -482,8 +513,7 @@ def plan_split(man: m3d.Manifold, fits, keep_out=()) -> SplitPlan:
             plan = SplitPlan(s, b, phases[s], cuts)
             if all(fits(cell(man, plan, i, j), plan, i, j) for i in range(s) for j in range(b)):
                 return plan
-    raise FabricationError(f"no split into up to {SECTOR_COUNTS[-1]} sectors x {BAND_COUNTS[-1]} bands fits this "
-                           "printer; use a larger printer")
+    raise FabricationError(f"no split into up to {SECTOR_COUNTS[-1]} sectors x {BAND_COUNTS[-1]} bands fits")
 
 
 def _cylinder(pin_axis: np.ndarray, centre: np.ndarray, radius: float, half_length: float) -> m3d.Manifold:

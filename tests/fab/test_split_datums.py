@@ -51,21 +51,164 @@ def _pieces_holding(feature: m3d.Manifold, plan) -> int:
     return sum(cut(feature).volume() > 1e-6 * v for cut in _cells(plan))
 
 
-@pytest.mark.parametrize("printer_name", PRINTERS)
-def test_no_split_crosses_a_datum_feature_on_any_printer(table31_rig, printer_name):
-    printer = load_printer(ROOT / "profiles" / "printers" / f"{printer_name}.yaml")
+ENDER = "Creality Ender-3 V2 (0.4 mm nozzle)"
+#: The precision machinist's review: a glue seam at least 10 mm from the sample bore, which is bored
+#: to its H7 fit after the pieces are glued (a figure from outside the code under test).
+BORE_SEAM_FLOOR_MM = 10.0
+
+
+def _printer(name):
+    if name == ENDER:  # a printer by its PrusaSlicer preset name, when the slicer's bundle is installed
+        from rigcad.fab import vendor
+
+        if "Creality" not in vendor.available_bundles():
+            pytest.skip("PrusaSlicer's Creality bundle is not installed (apt-get install prusa-slicer)")
+        return load_printer(ENDER)
+    return load_printer(ROOT / "profiles" / "printers" / f"{name}.yaml")
+
+
+def _cut_planes(plan):
+    """The plan's cut planes as (unit normal, offset, radial or None): points p on one have n . p =
+    offset (and, for a sector's half-plane, p . radial >= 0), mm."""
+    out = []
+    if isinstance(plan, SP.GridPlan):
+        for a in range(3):
+            out += [(np.eye(3)[a], float(c), None) for c in plan.cuts(a)]
+        return out
+    if plan.sectors > 1:
+        for i in range(plan.sectors):
+            a = plan.sector_range(i)[0]
+            out.append((np.array([-math.sin(a), math.cos(a), 0.0]), 0.0, np.array([math.cos(a), math.sin(a), 0.0])))
+    out += [(np.array([0.0, 0.0, 1.0]), float(z), None) for z in plan.band_z[1:-1]]
+    return out
+
+
+def _seam_faces(pieces, plan) -> np.ndarray:
+    """The triangles (n, 3, 3) of the pieces' meshes that lie on a cut plane (to 1e-5 mm): the glue
+    faces as cut, read off the pieces, not off the plan."""
+    tris = []
+    for pc in pieces:
+        v, f = M.mesh_arrays(pc)
+        t = np.asarray(v, float)[np.asarray(f)]
+        for n, off, radial in _cut_planes(plan):
+            on = np.all(np.abs(t @ n - off) < 1e-5, axis=1)
+            if radial is not None:
+                on &= np.all(t @ radial > -1e-5, axis=1)
+            tris.append(t[on])
+    return np.concatenate(tris) if tris else np.zeros((0, 3, 3))
+
+
+def _point_triangle(p: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Least distance (mm) from each point p (n, 3) to the triangles t (m, 3, 3): to the plane where
+    the foot lies inside a triangle, else to its nearest edge (closed forms, by hand: the only
+    library that does this, trimesh's proximity, needs rtree, which the venv does not have)."""
+    out = np.full(len(p), np.inf)
+    a, b, c = t[:, 0], t[:, 1], t[:, 2]
+    n = np.cross(b - a, c - a)
+    area2 = np.linalg.norm(n, axis=1)
+    keep = area2 > 1e-12
+    a, b, c, n, area2 = a[keep], b[keep], c[keep], n[keep] / area2[keep, None], area2[keep]
+
+    def seg(q, u, w):  # q (k, 1, 3) to the segments u-w (1, m, 3)
+        d = w - u
+        s = np.clip(np.einsum("kmj,kmj->km", q - u, np.broadcast_to(d, (q.shape[0], *d.shape[1:])))
+                    / np.maximum(np.einsum("mj,mj->m", d[0], d[0]), 1e-300), 0.0, 1.0)
+        return np.linalg.norm(q - (u + s[..., None] * d), axis=2)
+
+    for k in range(0, len(p), 64):
+        q = p[k:k + 64, None, :]
+        h = np.einsum("kmj,mj->km", q - a, n)
+        foot = q - h[..., None] * n
+        # the foot inside the triangle: each sub-triangle's normal points along n
+        inside = np.ones(h.shape, bool)
+        for u, w in ((a, b), (b, c), (c, a)):
+            inside &= np.einsum("kmj,mj->km", np.cross(w - u, foot - u), n) >= 0.0
+        d = np.where(inside, np.abs(h), np.inf)
+        d = np.minimum(d, np.minimum(seg(q, a[None], b[None]), np.minimum(seg(q, b[None], c[None]), seg(q, c[None], a[None]))))
+        out[k:k + 64] = d.min(axis=1)
+    return out
+
+
+def _distance(feature: m3d.Manifold, seams: np.ndarray) -> float:
+    """The least distance (mm) between a feature's mesh and the seam faces: from each of the feature's
+    vertices to the faces and from each face vertex to the feature's facets. The feature's vertices lie
+    on the true feature, so this is at most its true distance plus the chord error of its facets."""
+    v, f = M.mesh_arrays(feature)
+    v = np.asarray(v, float)
+    a = _point_triangle(v, seams).min()
+    b = _point_triangle(np.unique(seams.reshape(-1, 3), axis=0), v[np.asarray(f)]).min()
+    return float(min(a, b))
+
+
+@pytest.mark.parametrize("printer_name", [*PRINTERS, ENDER])
+def test_every_seam_keeps_its_margin_off_every_datum_feature_on_any_printer(table31_rig, printer_name):
+    """On every printer shipped (and the Ender-3 V2 by preset name): each part with datum features is
+    cut into its pieces; the glue faces found on the pieces' meshes keep at least the feature's
+    split.datum_margin from each feature's own mesh, the sample bore at least the machinist's 10 mm,
+    and each feature lies in one piece."""
+    printer = _printer(printer_name)
     chord = table31_rig.profile.tessellation.chord_error
-    checked = 0
+    checked, split_parts, nearest_bore = 0, 0, math.inf
     for name, part in table31_rig.recipes.items():
         if not part.datums or part.bought:
             continue
-        _, plan = _plan(table31_rig, part, printer)
-        for d in part.datums:
-            # the feature's own solid lies in one piece: no cut plane runs through it
-            assert _pieces_holding(_man(d.shape, chord), plan) == 1, (printer_name, name, d.name, plan.describe())
-            checked += 1
+        man, plan = _plan(table31_rig, part, printer)
         assert SP.crossed(part.datums, plan) == [], (printer_name, name)
+        if plan.count == 1:
+            checked += len(part.datums)  # whole: no seam at all
+            continue
+        split_parts += 1
+        cells = [cut(man) for cut in _cells(plan)]
+        seams = _seam_faces([c for c in cells if not c.is_empty()], plan)
+        area = 0.5 * np.linalg.norm(np.cross(seams[:, 1] - seams[:, 0], seams[:, 2] - seams[:, 0]), axis=1).sum()
+        assert area > 100.0, (printer_name, name)  # the cut faces were found on the pieces (mm^2)
+        for d in part.datums:
+            feature = _man(d.shape, chord)
+            # the feature's own solid lies in one piece: no cut plane runs through it
+            assert _pieces_holding(feature, plan) == 1, (printer_name, name, d.name, plan.describe())
+            gap = _distance(feature, seams)
+            # its margin, less 1e-6 mm of rounding (the measured distance may exceed the true one by
+            # the chord error, 0.018 mm, where a cut stands exactly at the margin: see _distance)
+            assert gap >= SP.datum_margin(d) - 1e-6, (printer_name, name, d.name, gap, SP.datum_margin(d))
+            if d.kind == "bore":
+                assert gap >= BORE_SEAM_FLOOR_MM, (printer_name, name, d.name, gap)
+                nearest_bore = min(nearest_bore, gap)
+            checked += 1
     assert checked == 13 + 9 + 4 + 4 + 2  # base plate, shelf, column, holder, the dome's two beam seats: every one judged
+    if printer_name in ("prusa_mk3s", ENDER):
+        assert split_parts >= 2  # the base plate and the shelf are cut on the small beds: the measurement ran
+        # the base plate's y cut at the 20 mm hub + 1 mm of glue off the bore; measured from the bore's
+        # polygon, whose vertices may miss its extreme point by the polygon's sagitta (0.03 mm here)
+        assert 21.0 - 1e-6 <= nearest_bore < 21.0 + 0.05, nearest_bore
+
+
+def test_the_keep_out_round_a_hole_that_takes_a_fit_is_its_hub():
+    """datum_margin: a hub twice the hole's diameter (a wall of half the diameter) plus the glue's
+    1 mm round a bore, a dowel or a register pin's hole; the feature's 1 mm wall plus the glue's 1 mm
+    round anything else, and never less than that."""
+    bore = Datum("sample bore", "bore", Cylinder((0.0, 0.0, -10.0), 20.0, 12.0))
+    assert SP.datum_margin(bore) == pytest.approx(20.0 + 1.0)  # 40 mm bore: 20 mm of hub wall, 1 mm of glue
+    assert SP.datum_margin(bore) >= BORE_SEAM_FLOOR_MM
+    assert SP.datum_margin(Datum("d", "dowel", Cylinder((0.0, 0.0, 0.0), 3.0, 5.0))) == pytest.approx(3.0 + 1.0)
+    assert SP.datum_margin(Datum("d", "dowel", Cylinder((0.0, 0.0, 0.0), 0.5, 5.0))) == pytest.approx(2.0)
+    assert SP.datum_margin(Datum("i", "insert", Cylinder((0.0, 0.0, 0.0), 2.5, 5.0))) == pytest.approx(2.0)
+    assert SP.datum_margin(Datum("s", "seat", Box((0.0, 0.0, 0.0), (9.0, 9.0, 3.0)))) == pytest.approx(2.0)
+
+
+def test_a_part_no_cut_can_keep_off_is_refused_naming_the_printer_and_the_key(prusa):
+    """A 400 mm plate (larger than the MK3S's bed) whose 300 mm bore's keep-out covers all of it: no
+    grid keeps off it, and the refusal names the printer, its build_volume key and the datum rule."""
+    from rigcad.errors import FabricationError
+
+    plate = m3d.Manifold.cube((400.0, 400.0, 5.0), True)
+    v, _ = M.mesh_arrays(plate)
+    bore = Datum("sample bore", "bore", Cylinder((0.0, 0.0, -3.5), 150.0, 7.0))
+    free = choice.split_plan(plate, v, False, orientation.plate_axis(v), prusa)
+    assert free.count > 1  # without the keep-out it splits
+    with pytest.raises(FabricationError) as e:
+        choice.split_plan(plate, v, False, orientation.plate_axis(v), prusa, SP.keepouts([bore]))
+    msg = str(e.value)
+    assert "prusa_mk3s" in msg and "build_volume" in msg and "datum_margin" in msg and "\n" not in msg, msg
 
 
 def test_equal_slabs_would_cut_the_sample_bore_and_the_dowels(table31_rig, prusa):
@@ -91,8 +234,8 @@ def test_a_grid_cut_moves_to_the_nearer_edge_of_a_keep_out():
     assert SP.clear_cuts((0.0, 2.0), -100.0, 100.0, [(-5.0, 3.0)]) == [(-5.0, 3.0)]
     assert SP.clear_cuts((98.0,), -100.0, 99.0, [(95.0, 120.0)]) == [(95.0,)]
     boxes = SP.keepouts([Datum("d", "dowel", Cylinder((1.0, 0.0, 0.0), 2.0, 5.0))])
-    # a cylinder of radius 2 at x = 1 grown by the margin on each side
-    assert SP._blocked(boxes, 0) == [(-1.0 - SP.DATUM_MARGIN, 3.0 + SP.DATUM_MARGIN)]
+    # a dowel hole of radius 2 at x = 1 grown by its hub's 2 mm wall and the glue's 1 mm on each side
+    assert SP._blocked(boxes, 0) == [(-1.0 - 3.0, 3.0 + 3.0)]
 
 
 def test_the_sector_phase_keeps_off_a_keep_out():
