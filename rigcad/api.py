@@ -163,3 +163,46 @@ def fab_published(profile, printer, folder: str | Path | None = None, gcode: boo
     out = Path(folder) if folder is not None else default_folder(profile.name, "fab", p.name)
     return read_back(profile, p, out, gcode=gcode, parts=parts, progress=progress,
                      lock=writer_lock(out, profile.name, ("fab", p.name)))
+
+
+def manual_key(profile, printer, root: str | Path, gcode: bool) -> str:
+    """The key of a manual for ``printer`` (a loaded Printer) of the rig of ``profile`` as designed, into
+    ``<root>/<profile>/manual/<printer>`` (rigcad.export.reuse.stage_key): the resolved profile and rigcad's
+    code, the printer's resolved settings and ``gcode``, and what the manual follows from the earlier
+    stages: the record of the fab run published in ``fab/<printer>`` (its inputs' key and every file's
+    SHA-256, rigcad.export.reuse) and the ray check written in ``check`` (raycheck.json and the profile it
+    records: the criteria the manual is judged by). A changed fab run or check changes the key."""
+    from rigcad.export import reuse
+    from rigcad.export.atomic import made_from_path
+
+    fab_folder = default_folder(profile.name, "fab", printer.name, root=root)
+    check_folder = default_folder(profile.name, "check", root=root)
+    reads = {"fab": fab_folder / reuse.RECORD, "check": check_folder / "raycheck.json",
+             "check_made_from": made_from_path(check_folder)}
+    return reuse.stage_key(profile, "manual", {"printer": printer.describe(), "gcode": bool(gcode),
+                                               "reads": reuse.input_files(reads)})
+
+
+def manual_published(profile, printer, root: str | Path, gcode: bool = False) -> dict | None:
+    """The manual for ``printer`` (a loaded Printer) of the rig of ``profile`` (a loaded Profile) as
+    designed, published in ``<root>/<profile>/manual/<printer>`` by an earlier run from the same inputs
+    (:func:`manual_key`) and intact, while the fab run it follows is still published and intact
+    (:func:`fab_published`: the sliced run first, as the manual keeps it): the record's ``summary``
+    with ``files`` (the paths), read under :func:`writer_lock`; None otherwise. Builds no rig."""
+    import json
+
+    from rigcad.export import reuse
+    from rigcad.export.manifest import profile_digest
+
+    fab_folder = default_folder(profile.name, "fab", printer.name, root=root)
+    if fab_published(profile, printer, fab_folder, gcode=True) is None and \
+            (gcode or fab_published(profile, printer, fab_folder, gcode=False) is None):
+        return None
+    out = default_folder(profile.name, "manual", printer.name, root=root)
+    back = reuse.read_back(out, manual_key(profile, printer, root, gcode), profile_digest(profile),
+                           writer_lock(out, profile.name, ("manual", printer.name)), read=(reuse.RECORD,))
+    if back is None:
+        return None
+    rec = json.loads(back[reuse.RECORD])
+    summary = rec.get("summary") if isinstance(rec.get("summary"), dict) else {}
+    return {**summary, "files": [out / rel for rel in sorted(rec["files"])]}
