@@ -20,6 +20,14 @@ def cmd_manual(args: argparse.Namespace) -> int:
     printer = load_printer(args.printer)  # a refused printer file costs no rig
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "manual")  # a planted link or lock: one line now, not after the work
+    back = api.manual_published(profile, printer, args.exports, args.gcode)
+    if back is not None:  # the same inputs, fab run and check as the published manual: nothing redone, nothing written
+        print(f"{profile.name}: manual for {printer.name} up to date in {Path(args.exports) / profile.name / 'manual'}"
+              f"/{printer.name}/ ({len(back['files'])} files; nothing written)")
+        for note in back.get("notes", []):
+            print(f"note: {note}", file=sys.stderr)
+        _parts_note(profile, args.exports)
+        return 0
     rig = load(profile)
     from rigcad.cli.check import criteria_notes, criteria_refusal
     from rigcad.manual.gate import gate
@@ -35,7 +43,12 @@ def cmd_manual(args: argparse.Namespace) -> int:
         for problem in fab.problems:
             print(f"rigcad: fab: {problem}", file=sys.stderr)
         out = root / "manual" / printer.name
-        written = write_manual(rig, printer, fab.report, out, profile_lock(args.exports, rig.name), progress=step)
+        from rigcad.errors import one_line
+        from rigcad.export import reuse
+
+        key = None if fab.problems else api.manual_key(profile, printer, args.exports, args.gcode)  # problems: never kept
+        with reuse.recording(out, key, {"notes": [one_line(n) for n in criteria.notes]}):
+            written = write_manual(rig, printer, fab.report, out, profile_lock(args.exports, rig.name), progress=step)
     html_path = out / "manual.html"
     print(f"{rig.name}: manual for {printer.name} -> {out}/ (manual.md, manual.html "
           f"{html_path.stat().st_size / 1e6:.1f} MB, {len(written)} files)")
