@@ -32,13 +32,18 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
             raise ExportError(f"--{flag.replace('_', '-')}: only with --gray-card, --gray-card-simulate or "
                               "--gray-card-kit (the gray card's exposures)")
+    if _kit_alone(args) and _kit_read_back(args):
+        return 0
     rig, runs = _before_any_work(args)
     capture_out = getattr(args, "write_capture", None)
     if runs is not None:
         return _seating(rig, args, runs)
     if getattr(args, "kit", False):
+        from rigcad.export import reuse
+
         out = Path(args.exports) / rig.name / "calibrate_kit"
-        manifest = write_kit(rig, out, say=print)
+        with reuse.recording(out, _kit_key(rig.profile) if _kit_alone(args) else None):
+            manifest = write_kit(rig, out, say=print)
         print(f"calibration kit for {rig.name}: {len(manifest['files'])} files in {out}")
         return 0
     seq = Sequence.from_profile(rig.profile.calibration)
@@ -128,6 +133,47 @@ def check_simulation_memory(profile, memory: int | None = None, simulate: bool =
                         f"would need about {need / 2 ** 30:.3g} GiB of memory, more than this machine's "
                         f"{memory / 2 ** 30:.3g} GiB; the largest camera that fits has {int(pixels):,} px "
                         f"([{fit_w}, {fit_h}] at this aspect)", param="camera.resolution")
+
+
+def _kit_alone(args: argparse.Namespace) -> bool:
+    """``--kit`` with no option that could refuse it after the rig is built (--seating, --laying,
+    --write-capture): a kit whose result depends on the profile and rigcad's code alone."""
+    return bool(getattr(args, "kit", False)) and not any(getattr(args, k, None) for k in ("seating", "laying",
+                                                                                          "write_capture"))
+
+
+def _kit_key(profile) -> str:
+    """The key of the calibration kit (rigcad.export.reuse.stage_key): the resolved profile and rigcad's code."""
+    from rigcad.export import reuse
+
+    return reuse.stage_key(profile, "calibrate_kit", {})
+
+
+def _kit_read_back(args: argparse.Namespace) -> bool:
+    """``--kit``: when the kit published in ``<exports>/<profile>/calibrate_kit`` was made from the same
+    inputs (:func:`_kit_key`) and is intact, say so and return True, with no rig built and nothing written."""
+    from rigcad.errors import ExportError
+    from rigcad.export import reuse
+    from rigcad.export.atomic import check_exports, profile_lock
+    from rigcad.export.manifest import profile_digest
+    from rigcad.export.readback import parse_json
+    from rigcad.profile import load_profile
+
+    profile = load_profile(args.profile)
+    check_exports(args.exports, profile.name, "calibrate_kit")
+    out = Path(args.exports) / profile.name / "calibrate_kit"
+    back = reuse.read_back(out, _kit_key(profile), profile_digest(profile), profile_lock(Path(args.exports),
+                                                                                         profile.name),
+                           read=("manifest.json",))
+    try:
+        manifest = parse_json(back["manifest.json"], str(out / "manifest.json")) if back is not None else None
+    except ExportError:
+        return False
+    if not isinstance(manifest, dict) or not isinstance(manifest.get("files"), dict):
+        return False
+    print(f"calibration kit for {profile.name}: {len(manifest['files'])} files in {out} (up to date: the same "
+          "profile and code as when it was written; nothing written)")
+    return True
 
 
 def _before_any_work(args: argparse.Namespace):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -58,9 +59,49 @@ def checked_counts(profile, rays: int | None, builds: int | None) -> None:
         check_override("tolerancing", "builds", builds, "--builds")
 
 
+def check_key(profile, args: argparse.Namespace, exports: Path) -> str:
+    """The key of a check's result (rigcad.export.reuse.stage_key): the resolved profile and
+    rigcad's code, the command's options, and the SHA-256 of each exported file the check traces
+    (the mirrors' PLYs, the paraboloid's and the beam's STLs as occluders; None when absent)."""
+    from rigcad.export import reuse
+
+    root = Path(exports) / profile.name
+    reads = {f"mirrors/{n}.ply": root / "mirrors" / f"{n}.ply" for n in ("paraboloid", "dome")}
+    reads.update({f"stl/{n}.stl": root / "stl" / f"{n}.stl" for n in ("paraboloid", "beam")})
+    return reuse.stage_key(profile, "check", {"rays": args.rays, "mode": args.mode, "builds": args.builds,
+                                              "monte_carlo": not args.no_monte_carlo,
+                                              "reads": reuse.input_files(reads)})
+
+
+def _read_back(profile, args: argparse.Namespace, exports: Path, key: str):
+    """The check published in ``exports/<profile>/check`` from the same inputs (:func:`check_key`)
+    and intact: its report and rows, with nothing traced; None otherwise."""
+    from rigcad import api
+    from rigcad.check.tolerances import Row
+    from rigcad.errors import ExportError
+    from rigcad.export import reuse
+    from rigcad.export.manifest import profile_digest
+    from rigcad.export.readback import parse_json
+
+    out = api.default_folder(profile.name, "check", root=exports)
+    back = reuse.read_back(out, key, profile_digest(profile), api.writer_lock(out, profile.name, ("check",)),
+                           read=("raycheck.json", reuse.RECORD))
+    if back is None:
+        return None
+    try:
+        rep = parse_json(back["raycheck.json"], str(out / "raycheck.json"))
+        rows = [Row(c["check"], c["profile_key"], c["measured"], c["limit"], c["relation"], c["unit"], c["where"],
+                    c.get("hint", "")) for c in rep["checks"]]
+        rep["readings"][rep["mode"]]["max_spot_radius_mm"]
+    except (ExportError, KeyError, TypeError, IndexError):  # not a report rigcad could have written: check again
+        return None
+    return rep, rows, [out / rel for rel in sorted(json.loads(back[reuse.RECORD])["files"])]
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     from rigcad import api
     from rigcad.check.tolerances import raise_if_failed, table
+    from rigcad.export import reuse
     from rigcad.export.atomic import check_exports
     from rigcad.profile import load_profile
     from rigcad.rig import load
@@ -68,27 +109,39 @@ def cmd_check(args: argparse.Namespace) -> int:
     profile = load_profile(args.profile)
     checked_counts(profile, args.rays, args.builds)
     check_exports(args.exports, profile.name, "check")  # a planted link or lock: one line now, not after the work
-    rig = load(profile)
-    profile = rig.profile
-    from rigcad.check.trace3d import counting
-
     exports = Path(args.exports)
     mirrors = api.default_folder(profile.name, "mirrors", root=exports)
     missing = [n for n in ("paraboloid", "dome") if not (mirrors / f"{n}.ply").is_file()]
     if missing and (args.mode or profile.raycheck.mode) != "analytic":
         print(f"note: no exported {' and '.join(missing)} mesh in {mirrors}/ (run `rigcad stl {args.profile}`): "
               "meshing the mirrors from the profile", file=sys.stderr)
-    with _rays_bar(f"check {profile.name}") as (bar, stage):
-        def step(label: str) -> None:
-            stage(label)
-            if args.verbose:
-                print(f"  {label} ...", file=sys.stderr)
+    key = check_key(profile, args, exports)
+    back = _read_back(profile, args, exports, key)
+    if back is not None:  # published from the same inputs and intact: nothing traced, nothing written
+        rep, rows, paths = back
+        if args.verbose:
+            print(f"  read back {api.default_folder(profile.name, 'check', root=exports)}/ (nothing changed since "
+                  "it was written)", file=sys.stderr)
+    else:
+        from rigcad.check.trace3d import counting
 
-        with counting(bar):
-            result = api.check(rig, args.rays, args.mode, exports, monte_carlo=not args.no_monte_carlo,
-                               builds=args.builds, progress=step)
-    paths = api.write_check(rig, result, api.default_folder(profile.name, "check", root=exports))
-    rep = result.report
+        rig = load(profile)
+        with _rays_bar(f"check {profile.name}") as (bar, stage):
+            def step(label: str) -> None:
+                stage(label)
+                if args.verbose:
+                    print(f"  {label} ...", file=sys.stderr)
+
+            with counting(bar):
+                result = api.check(rig, args.rays, args.mode, exports, monte_carlo=not args.no_monte_carlo,
+                                   builds=args.builds, progress=step)
+        out = api.default_folder(profile.name, "check", root=exports)
+        with reuse.recording(out, key if rig.profile is profile else None):
+            paths = api.write_check(rig, result, out)
+        rep, rows = result.report, result.rows
+        if args.verbose:  # the run's times: not in raycheck.json, which is the same bytes on every run
+            for stage, seconds in result.timings_s.items():
+                print(f"  time {stage}: {seconds:.2f} s", file=sys.stderr)
     main = rep["readings"][rep["mode"]]
     print(f"{profile.name}: mode {rep['mode']}, {rep['rays']} rays, backend {rep['backend']}")
     print(f"  spot radius max {main['max_spot_radius_mm']:.3g} mm (rms {main['rms_spot_radius_mm']:.3g}), "
@@ -97,13 +150,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     meshed = sorted(n for n, src in (rep["meshes"] or {}).get("sources", {}).items() if not src.startswith(str(exports)))
     if meshed and not missing:
         print(f"  note: meshed from the profile, not the exports: {', '.join(meshed)}", file=sys.stderr)
-    print(table(result.rows))
-    if args.verbose:  # the run's times: not in raycheck.json, which is the same bytes on every run
-        for stage, seconds in result.timings_s.items():
-            print(f"  time {stage}: {seconds:.2f} s", file=sys.stderr)
+    print(table(rows))
     for p in paths:
-        print(f"  wrote {p}")
-    raise_if_failed(result.rows, profile.name)
+        print(f"  wrote {p}" if back is None else f"  up to date {p}")
+    raise_if_failed(rows, profile.name)
     return 0
 
 

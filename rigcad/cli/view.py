@@ -15,7 +15,9 @@ VIEW_MAX_RAYS = 100_000
 def cmd_view(args: argparse.Namespace) -> int:
     from rigcad.progress import stages
     from rigcad.errors import ProfileError
+    from rigcad.export import reuse
     from rigcad.export.atomic import check_exports, profile_lock
+    from rigcad.export.manifest import profile_digest
     from rigcad.manual.view import write_view
     from rigcad.profile import load_profile
     from rigcad.rig import load
@@ -25,11 +27,19 @@ def cmd_view(args: argparse.Namespace) -> int:
                            f"HTML file and is drawn at once); valid: 1..{VIEW_MAX_RAYS}", param="--rays")
     profile = load_profile(args.profile)
     check_exports(args.exports, profile.name, "view")  # a planted link or lock: one line now, not after the work
+    out = Path(args.exports) / profile.name / "view"
+    lock = profile_lock(args.exports, profile.name)
+    key = reuse.stage_key(profile, "view", {"rays": args.rays, "glb": bool(args.glb)})
+    back = reuse.read_back(out, key, profile_digest(profile), lock)
+    if back is not None:  # published from the same inputs and intact: nothing drawn, nothing written
+        print(f"{profile.name}: 3D view up to date in {out}/ (the same profile, options and code as when it was "
+              "written; nothing written)")
+        return 0
     with stages(5, "view") as step:
         rig = load(profile)
         step("dome integrated")
-        out = Path(args.exports) / rig.name / "view"
-        r = write_view(rig, out, profile_lock(args.exports, rig.name), progress=step, rays=args.rays, glb=args.glb)
+        with reuse.recording(out, key):
+            r = write_view(rig, out, lock, progress=step, rays=args.rays, glb=args.glb)
     print(f"{rig.name}: 3D view of {len(r['parts'])} part(s) ({', '.join(r['parts'])}), {r['triangles']} triangles, "
           f"{r['rays']} of {r['rays_traced']} rays reach the sample")
     print(f"  wrote {r['html']} ({r['html_bytes'] / 1e6:.2f} MB, self-contained: open it in a browser, offline)")
