@@ -25,6 +25,9 @@ STEP_MS = 30
 #: How long the watch blocks in Rust before checking for Ctrl-C, the stop event and the files'
 #: signatures (ms).
 RUST_TIMEOUT_MS = 500
+#: How far a file's modification time may lag the clock (ns): the kernel stamps it from a coarse
+#: clock, up to one tick (4-10 ms) behind; twice the slowest tick.
+MTIME_LAG_NS = 20_000_000
 
 
 class Watcher:
@@ -39,8 +42,17 @@ class Watcher:
 
     def rebuild(self) -> None:
         """One update: parts first (published at once), then the check rows, then the extras."""
-        self._seen = self._signature()
+        before = {entry[0]: entry for entry in self._signature()}
+        start = time.time_ns() - MTIME_LAG_NS
         frame = self.session.update()
+        # what this rebuild has seen, over the files it found (the update may find more, or fewer when the
+        # profile no longer reads): a file watched before keeps its entry from before the update (an edit
+        # made during the update still counts); a file the update found, its entry now, unless its content
+        # changed after the update started (then unknown: the next check rebuilds). A signature over another
+        # set than the loop compares with would read as an edit no one made: a spurious frame after the
+        # start, and each error said twice.
+        self._seen = tuple(before.get(entry[0], entry if entry[3] is not None and entry[3] < start
+                                      else (entry[0], None, None, None, None)) for entry in self._signature())
         self._publish(frame)
         if frame.error is not None:
             return
