@@ -61,3 +61,23 @@ def test_the_calibration_says_how_to_set_the_roll(table31_rig):
     assert "add foil under the -y ends of both seats' roll bars" in step_text
     assert f"{lever * math.radians(0.1):.4f} mm per 0.1 deg" in step_text
     assert f"rolls it {math.degrees(step):.3f} deg, so it lands within {math.degrees(half):.3f} deg" in step_text
+
+
+def test_the_shadow_a_wide_beam_would_cast_is_the_occlusion_models(table31_rig):
+    """The way out not taken, measured: the beam widened to the roll bars' lever inside the dome, through
+    the same occlusion model the parts page's beam figure comes from."""
+    from rigcad.optics.design import profile_table
+    from rigcad.parts.occlusion import blocked_solid_angle
+    from rigcad.parts.recipe import Box
+
+    occ = dict(table31_rig.occluders)
+    table = profile_table(table31_rig.geometry, table31_rig.dome)
+    half = roll_lever() / 2
+    wide = tuple((n, Box((s.lo[0], -half, s.lo[2]), (s.hi[0], half, s.hi[2])) if n == "beam" else s)
+                 for n, s in occ["beam"])
+    narrow, widened = blocked_solid_angle(occ, table), blocked_solid_angle({**occ, "beam": wide}, table)
+    assert widened["blocked_fraction"] > 4 * narrow["blocked_fraction"]  # 26 mm against 6 mm: about their ratio
+    text = _text()
+    assert (f"shadow it did: {100 * narrow['blocked_fraction']:.2f} % of the measurable zone's incidence directions, "
+            f"where a beam {roll_lever():g} mm wide inside the dome (the lever, in the beam itself) would hide "
+            f"{100 * widened['blocked_fraction']:.2f} %") in text
