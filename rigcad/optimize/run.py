@@ -4,8 +4,8 @@ the certified path (``Rig.from_profile`` + the 2D design), and publish, all toge
 
 * ``<profile>_design.yaml``: the chosen design as a profile that ``extends:`` PROFILE and sets only
   the parameters that changed (``rigcad stl exports/<profile>/optimize/<profile>_design.yaml``); when
-  PROFILE is not on the profile search path by name, it is written beside PROFILE's file instead,
-  where its ``extends:`` resolves;
+  PROFILE is not shipped with rigcad, it is written beside PROFILE's file instead, where its
+  ``extends:`` resolves from any folder, and goes with it when the folder moves;
 * ``optimize.json``: the settings, every evaluation (parameters, objectives, constraint values,
   time), the Pareto set, the base and chosen designs, the certified check of the chosen one;
 * ``history.png`` (merit per evaluation) and ``pareto.png`` (objectives, front, base, chosen).
@@ -412,18 +412,20 @@ def _stage_of(err: RigcadError) -> str:
 
 
 def _design_home(profile_spec, name: str, out: Path) -> Path:
-    """Where the design profile goes: ``out`` when its ``extends: name`` resolves from there to the
-    searched profile (a name on the search path: ./profiles, $RIGCAD_PROFILES, the shipped ones),
-    else beside the searched profile's own file, where the name always resolves."""
+    """Where the design profile goes: ``out`` when its ``extends: name`` names a profile shipped with
+    rigcad (found by name from any folder), else beside the searched profile's own file, where the
+    name resolves wherever the folder is moved or the command is run from (a name found through
+    ./profiles or $RIGCAD_PROFILES resolves only from that folder or with that variable set)."""
     from rigcad.errors import ProfileError
     from rigcad.profile.loader import find_file, resolve_profile_path
+    from rigcad.profile.paths import SHIPPED_PROFILES
 
     base = resolve_profile_path(profile_spec).resolve()
     try:
         found = find_file(name, "profile", near=out, as_path=False).resolve()
     except ProfileError:
         found = None
-    return out if found == base else base.parent
+    return out if found == base and base.parent == SHIPPED_PROFILES.resolve() else base.parent
 
 
 def _time_stats(rows: list[dict]) -> dict:
