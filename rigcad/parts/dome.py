@@ -252,7 +252,10 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
     by the layout's sanding stock: ``as_printed_dome``)."""
     shell = profile.dome_shell
     inner, outer = layout.as_printed_dome, layout.dome_outer
-    u_base = u_at_height(inner, 0.0) if layout.dome_stock else layout.u_inner_base
+    u_base = layout.u_inner_base
+    if layout.dome_stock:  # where the stocked surface meets the plate; stocked past the coating, its start
+        # stands microns above the plate (the base line closes the section under it)
+        u_base = inner.u_range[0] if _pt(inner, inner.u_range[0])[1] >= 0.0 else u_at_height(inner, 0.0)
     u_top_in = inner.u_range[1]
     top_in = _pt(inner, u_top_in)
     # The top edge runs along the mirror's normal: the outer curve's end is the inner's end moved by the wall.
