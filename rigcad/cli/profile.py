@@ -100,6 +100,7 @@ def cmd_show(args: argparse.Namespace) -> int:
         ("occlusion_theta", f"{geo.occlusion_theta / DEG:.6g} deg"),
         ("rim_angle_at_cop", f"{geo.rim_angle_at_cop / DEG:.6g} deg"),
         ("pixels_vertex_to_rim", "-" if geo.cop_at_infinity else f"{geo.pixels_vertex_to_rim:.4g} px"),
+        _projector_axis_row(profile),
     ]
     width = max(len(name) for name, _ in rows)
     for name, value in rows:
@@ -114,6 +115,16 @@ def cmd_show(args: argparse.Namespace) -> int:
         for key, source in sourced:
             print(f"  {key:<{width}} {source}")
     return 0
+
+
+def _projector_axis_row(profile) -> tuple[str, str]:
+    """Where the projector's lens axis meets its image (rigcad.profile.derived): the paraboloid's image
+    is a disc about that pixel, and the image holds a disc this wide about it."""
+    from rigcad.profile.derived import projector_disc_room, projector_principal_point
+
+    (x, y), pj = projector_principal_point(profile.projector), profile.projector
+    return ("projector_axis_pixel", f"[{x:g}, {y:g}] px of {pj.resolution[0]} x {pj.resolution[1]} (lens_offset "
+                                    f"{pj.lens_offset:.0%}); room for a disc {projector_disc_room(pj):g} px in radius")
 
 
 def _print_camera(camera) -> None:

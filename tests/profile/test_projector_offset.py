@@ -88,3 +88,12 @@ def test_the_instruments_page_states_the_default_rigs_figures(write_profile):
     radius, (w, h) = derive(p).pixels_vertex_to_rim, p.projector.resolution
     best = 1 - 2 * radius / h
     assert f"a disc {radius:.0f} px in radius on a {w} x {h} image) that is {best * 100:.0f} %" in text
+
+
+def test_profile_show_states_the_axis_pixel_and_the_room(write_profile, capsys):
+    from rigcad.cli import main
+
+    path = write_profile("extends: achutha2006\nprojector: {lens_offset: 50 %}\n", "shown")
+    assert main(["profile", "show", str(path)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "projector_axis_pixel" in x)
+    assert "[512, 576] px of 1024 x 768 (lens_offset 50%); room for a disc 192 px in radius" in line, line
