@@ -224,9 +224,10 @@ def bolt_loads(profile, layout, printer: Printer) -> tuple[BoltLoad, ...]:
                      _faces(washers_over(fj.thread, ("round", flange_hole))), mat, True)]
     washers = joint_washers(profile, layout)
     if profile.buy.column == "print":
+        # the foot's nuts bear on the bolts' compression limiters (rigcad.parts.tower.COLUMN_LIMITER), not on
+        # the traps' roofs: the washer over the column's hole is the face on plastic
         column = _faces(washers["column"])
-        out.append(bolt_load("column foot on the tongue", "M4", 4,
-                             {**column, "nut (in its trap)": nut_area("M4", hole)}, mat, True))
+        out.append(bolt_load("column foot on the tongue", "M4", 4, column, mat, True))
         out.append(bolt_load("column top under the shelf", "M4", 4, column, mat, True))
     lens = len(_lens_foot(layout.tower, profile)[3])
     out.append(bolt_load("lens mount's foot on the shelf", "M4", lens,

@@ -668,7 +668,8 @@ def bolt_stacks(rig) -> list[dict]:
 
 def limiter_lines(rig) -> dict[str, int]:
     """The bill's compression limiter lines (item -> quantity): one sleeve per screw of every joint the
-    parts declare with limiters (``ScrewJoint.limiter``), summed from the joints as the washers are."""
+    parts declare with limiters (``ScrewJoint.limiter``) and of the COP tower's rows that carry one
+    (``limiter``, ``limiter_mm``: rigcad.parts.tower.hardware), summed from the joints as the washers are."""
     from rigcad.parts.joints import ScrewJoint
 
     out: dict[str, int] = {}
@@ -676,9 +677,13 @@ def limiter_lines(rig) -> dict[str, int]:
         for j in part.joints:
             if isinstance(j, ScrewJoint) and j.limiter:
                 lim = j.limiter_part
-                item = (f"{lim.name()}, cut from tube ({lim.source}) and faced to {j.limiter_length:.2f} mm "
+                item = (f"{lim.name()}, parted off from tube ({lim.source}) and faced to {j.limiter_length:.2f} mm "
                         f"(under {j.upper}'s bolts)")
                 out[item] = out.get(item, 0) + j.count
+    for h in tower_hardware(rig):  # the COP tower's column joints (rigcad.parts.tower.COLUMN_LIMITER)
+        if h.get("limiter"):
+            item = f"{h['limiter']}, parted off from tube and faced to {h['limiter_mm']:.2f} mm ({h['joins'].split(' (')[0].split(':')[0]})"
+            out[item] = out.get(item, 0) + h["quantity"]
     return out
 
 

@@ -42,13 +42,13 @@ import numpy as np
 from rigcad.errors import GeometryError
 from rigcad.optics.focus import focusing_lens, placed_lens
 from rigcad.optics.splitter import CameraPlacement, Plate, camera_cop, mirror_point, splitter_plate
-from rigcad.parts.joints import Bought, Datum, KinematicSeat, SeatContact, datums_of
+from rigcad.parts.joints import LIMITER_SQUEEZE_MM, Bought, Datum, KinematicSeat, SeatContact, datums_of
 from rigcad.parts.recipe import (Box, Cylinder, Difference, HexPrism, Line, Part, Prism, Revolve, Section, Translate,
                                  Union_)
 from rigcad.profile.instruments import mount_pattern, size_origin
 from rigcad.profile.derived import Derived
 from rigcad.profile.schema import Profile
-from rigcad.standards import (CAMERA_SOCKET_DEPTH, CONICAL_SPRING_WASHERS, CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for,
+from rigcad.standards import (CAMERA_SOCKET_DEPTH, COMPRESSION_LIMITERS, CONICAL_SPRING_WASHERS, CUP_POINT, GAUGE_BLOCK_FACE, INSERTS, THREADS, dowel_diameter_for,
                               longest_screw, screw_lengths, shortest_screw, shortest_set_screw, spring_rate)
 
 #: Gap around the splitter plate in its grooves (mm): a printed groove comes out ~0.1 mm narrow.
@@ -381,7 +381,8 @@ def column_foot_bolt(profile: Profile, t: TowerLayout) -> dict:
 
     th = THREADS["M4"]
     stack = washers_over("M4", ("round", column_bolt_hole(t, profile))).thickness + spring_washer("M4")[1]
-    head = stack + profile.tower.wall - t.bench_z  # the head's face over the bench
+    # the head's face over the bench: the washers on the compression limiter, the plastic squeezed to it
+    head = stack + profile.tower.wall - t.bench_z - LIMITER_SQUEEZE_MM
     length = longest_screw("M4", head - BENCH_CLEAR)
     depth = math.ceil((NUT_PROUD_PITCHES * th.pitch + th.nut_height + head - length) * 10 - 1e-6) / 10
     depth = max(depth, th.nut_height)
@@ -391,7 +392,8 @@ def column_foot_bolt(profile: Profile, t: TowerLayout) -> dict:
                             "base_plate.thickness", where=profile.where("base_plate", "thickness"))
     grip = head - depth
     return {"length_mm": float(length), "trap_depth_mm": depth, "grip_mm": grip, "washers_mm": stack,
-            "proud_mm": length - grip - th.nut_height, "above_bench_mm": head - length}
+            "proud_mm": length - grip - th.nut_height, "above_bench_mm": head - length,
+            "limiter_mm": grip - stack}
 
 
 def nut_trap_depth(profile: Profile, t: TowerLayout) -> float:
@@ -454,16 +456,26 @@ def column_register(t: TowerLayout, profile: Profile, z0: float, height: float, 
                          2 * (2 * d.print_position + d.print_scale * spacing), param="datum.dowel_diameter")
 
 
+#: The printed column's joints are on the datum chain (the rule: rigcad.parts.joints.LIMITER_SQUEEZE_MM), so
+#: each of their M4 bolts runs through a steel compression limiter (rigcad.standards.COMPRESSION_LIMITERS): at
+#: the foot, through the foot's flange and the tongue down to the nut in its trap (the nut bears on the
+#: sleeve, not on the trap's roof); at the top, through the top flange up to the shelf's insert (a tapped
+#: aluminium shelf: its face). Each hole the sleeve passes is wider than the bolt's by the sleeve's walls.
+COLUMN_LIMITER = COMPRESSION_LIMITERS["M4"]
+LIMITER_WALLS = COLUMN_LIMITER.outer - THREADS["M4"].major
+
+
 def column_bolt_hole(t: TowerLayout, profile: Profile) -> float:
     """The printed column's bolt holes (mm): opened past the M4 clearance by both parts' print position
     errors and the scale error out to the farthest bolt from the round pin, each side
-    (rigcad.parts.locating.bolt_hole), so the dowels locate and the bolts only clamp."""
+    (rigcad.parts.locating.bolt_hole), so the dowels locate and the bolts only clamp; and wider by the
+    compression limiter's walls (:data:`COLUMN_LIMITER`), which rides on the bolt."""
     from rigcad.parts.locating import bolt_hole
 
     d = profile.datum
     pin = column_dowel_points(t, profile)[0]
     far = max(math.dist(pin, q) for q in _column_flange_points(t, profile))
-    return bolt_hole("M4", far, d.print_position, d.print_scale)
+    return bolt_hole("M4", far, d.print_position, d.print_scale) + LIMITER_WALLS
 
 
 def _column_own_holes(t: TowerLayout, profile: Profile, z0: float, height: float, end: str) -> tuple:
@@ -476,7 +488,7 @@ def _column_own_holes(t: TowerLayout, profile: Profile, z0: float, height: float
 def column_joint_holes(t: TowerLayout, profile: Profile, z0: float, height: float) -> tuple[Cylinder, ...]:
     """The bolt holes of a column joint through z0..z0+height (the column's foot on the base plate's
     tongue) and its register's blind dowel holes from the tongue's top (DowelRegister.lower_holes)."""
-    return (_holes(_column_flange_points(t, profile), profile.tower.bolt_diameter, z0, height)
+    return (_holes(_column_flange_points(t, profile), profile.tower.bolt_diameter + LIMITER_WALLS, z0, height)
             + column_register(t, profile, t.column_base_z, profile.tower.wall, "foot").lower_holes())
 
 
@@ -501,18 +513,33 @@ def shelf_joint_cuts(t: TowerLayout, profile: Profile, z0: float) -> tuple:
 
 def shelf_bolt_length(profile: Profile) -> float:
     """The shelf joint's bolt (mm): the longest stocked ISO 4762 length that stops 0.5 mm short of the
-    insert's end, through the column's flange, its large washer and the conical spring washer
-    (:func:`spring_washer`) under its head."""
+    insert's end, through the column's flange (its compression limiter: the flange squeezed to it), its
+    large washer and the conical spring washer (:func:`spring_washer`) under its head."""
     from rigcad.parts.locating import bolt_hole
     from rigcad.parts.washers import washers_over
 
     # the large washer the column's opened hole takes (column_bolt_hole, before the layout: its largest)
     d = profile.datum
     far = 2 * (profile.tower.column_width / 2 + 1.5 * profile.tower.bolt_diameter)
-    hole = bolt_hole("M4", far, d.print_position, d.print_scale)
-    reach = (profile.tower.wall + washers_over("M4", ("round", hole)).thickness + spring_washer("M4")[1]
+    hole = bolt_hole("M4", far, d.print_position, d.print_scale) + LIMITER_WALLS
+    reach = (shelf_limiter_length(profile) + washers_over("M4", ("round", hole)).thickness + spring_washer("M4")[1]
              + SHELF_INSERT.length - 0.5)
     return float(longest_screw("M4", reach))
+
+
+def shelf_limiter_length(profile: Profile) -> float:
+    """The top joint's compression limiter (mm, as drawn): the column's top flange less the squeeze."""
+    return profile.tower.wall - LIMITER_SQUEEZE_MM
+
+
+def limiter_step(where: str, count: int, length: float, seat: str) -> str:
+    """The shop step that fits ``count`` of the column's compression limiters (:data:`COLUMN_LIMITER`)
+    ``where``, faced to ``length`` mm as drawn, the sleeve's end on ``seat``."""
+    lim = COLUMN_LIMITER
+    return (f"part off {count} compression limiters from {lim.outer:g} x {lim.wall:g} mm steel tube ({lim.source}) on "
+            f"the lathe and face each to the printed span measured with a micrometer at its hole ({where}) less "
+            f"{LIMITER_SQUEEZE_MM:g} mm ({length:.2f} mm as drawn), square and deburred; drop one into each bolt hole, "
+            f"its end on {seat}, before the bolt")
 
 
 def _holder_flange_points(t: TowerLayout, profile: Profile):
@@ -1082,24 +1109,35 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
     big = washers_over("M4", ("round", hole))
     cone, cone_h = spring_washer("M4")
     foot = column_foot_bolt(profile, t)
+    top_step = limiter_step("the column's top flange", 4, shelf_limiter_length(profile),
+                            "the shelf's insert, pressed flush with its underside" if profile.buy.shelf == "print"
+                            else "the shelf's underside")
+    foot_step = limiter_step("the column's foot and the tongue, from the foot's top face to the trap's roof", 4,
+                             foot["limiter_mm"], "the nut in its trap")
     lap = (f"lap the column's foot-side and flange-side glue faces flat before they are glued: wet P240 paper on "
            f"float glass, figure-of-eight strokes, until a steel straightedge laid across each face in four directions "
            f"admits no {LAPPED_FLATNESS:g} mm feeler leaf")
     return [
-        {"item": "bolt, conical washer (DIN 6796) and large washer (ISO 7093-1)", "thread": "M4",
+        {"item": "bolt, conical washer (DIN 6796) and large washer (ISO 7093-1) on a compression limiter", "thread": "M4",
          "length_mm": shelf_bolt_length(profile), "quantity": 4, "washer_mm": big.thickness + cone_h,
          "washers": [w.name() for w in big.washers], "spring_washer": cone, "nuts": 0, "plain_washers": 0,
+         "limiter": COLUMN_LIMITER.name(), "limiter_mm": shelf_limiter_length(profile),
          "steps": ('tower_shelf',), "joins": "the column's top flange to the shelf: up from under the flange into "
                   + ("heat-set inserts pressed into the shelf's underside" if profile.buy.shelf == "print" else
                      "M4 threads tapped in the shelf's underside (8 mm deep)")
-                  + f" ({cone} on {big.describe()}: the dowels locate, the bolts only clamp)"},
-        {"item": "bolt, conical washer (DIN 6796), large washer (ISO 7093-1) and nut", "thread": "M4",
-         "length_mm": foot["length_mm"], "quantity": 4, "washer_mm": foot["washers_mm"],
+                  + f" ({cone} on {big.describe()}, through a steel compression limiter "
+                    f"{shelf_limiter_length(profile):.2f} mm long: the dowels locate, the bolts only clamp); " + top_step,
+         "shop_steps": [top_step]},
+        {"item": "bolt, conical washer (DIN 6796), large washer (ISO 7093-1), compression limiter and nut",
+         "thread": "M4", "length_mm": foot["length_mm"], "quantity": 4, "washer_mm": foot["washers_mm"],
          "washers": [w.name() for w in big.washers], "spring_washer": cone, "nuts": 1, "plain_washers": 0,
+         "limiter": COLUMN_LIMITER.name(), "limiter_mm": foot["limiter_mm"],
          "steps": ('tower_column',), "joins": "the column's foot to the base plate's datum tongue (the nuts in the hexagonal traps "
                   f"under the tongue, {foot['trap_depth_mm']:g} mm deep, put in before it stands on the bench: the bolt stands "
                   f"{foot['proud_mm']:.1f} mm out of its nut and ends {foot['above_bench_mm']:.1f} mm above the bench; "
-                  f"{cone} on {big.describe()})"},
+                  f"{cone} on {big.describe()}, through a steel compression limiter {foot['limiter_mm']:.2f} mm long "
+                  "down through the foot and the tongue to the nut, which bears on it, not on the trap's roof); " + foot_step,
+         "shop_steps": [foot_step]},
         *([{"item": "heat-set insert", "thread": "M4", "length_mm": None, "quantity": 4, "hole_mm": SHELF_INSERT.hole,
             "steps": ('tower_shelf',), "joins": "pressed into the shelf's four blind holes from below (the column joint's bolts)"}]
           if profile.buy.shelf == "print" else []),
