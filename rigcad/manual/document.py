@@ -444,7 +444,7 @@ def _section_schedule(d: Doc, c) -> None:
     state it needs and leaves, checked in order before it is written."""
     from rigcad.manual import schedule as S
 
-    stages = S.schedule(c.rig, c.fab_report)
+    stages = S.schedule(c.rig, c.fab_report, c.steps)
     S.check(stages)
     d.h(2, "The schedule: from print to calibrated rig")
     d.p("Do the work in this order, one stage after the other; the sections after it say how (named at the end "

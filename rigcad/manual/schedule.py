@@ -45,20 +45,46 @@ class Stage:
     needs: frozenset[str] = frozenset()
     makes: frozenset[str] = frozenset()
     ends: frozenset[str] = frozenset()
+    #: The assembly steps (rigcad.manual.plan's, by name) this stage first puts in place, in section 5's sense.
+    places: tuple[str, ...] = ()
 
     def record(self) -> dict:
         return {"what": self.what, "where": self.where, "needs": sorted(self.needs), "makes": sorted(self.makes),
-                "ends": sorted(self.ends)}
+                "ends": sorted(self.ends), "places": list(self.places)}
 
 
-def _s(what: str, where: str, needs=(), makes=(), ends=()) -> Stage:
-    return Stage(what, where, frozenset(needs), frozenset(makes), frozenset(ends))
+def _s(what: str, where: str, needs=(), makes=(), ends=(), places=()) -> Stage:
+    return Stage(what, where, frozenset(needs), frozenset(makes), frozenset(ends), tuple(places))
 
 
-def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
+#: The assembly steps the schedule's own stages place before the rest (the tower) goes up: each stage
+#: that places them names them, and :func:`rest` takes every other step of the plan.
+PLACED_FIRST = ("sample_holder", "base_plate", "dome", "beam", "paraboloid")
+
+
+def rest(steps) -> tuple[str, ...]:
+    """The plan's steps (rigcad.manual.plan.steps, in its order) that no stage before the tower's places."""
+    return tuple(st.name for st in steps if st.name not in PLACED_FIRST)
+
+
+def _rest_stage(steps, tower: bool) -> Stage | None:
+    """The stage that builds what stands on the plate after the dome: the tower's parts, named from the
+    plan's steps when given (so a step the plan gains is in the schedule), else as the thesis's tower has them."""
+    names = rest(steps) if steps is not None else ()
+    if not tower and not names:
+        return None
+    listed = (", ".join(n.replace("_", " ") for n in names) if steps is not None else
+              "column, shelf, seat, lens mount, shims, splitter holder, projector, lens, splitter, camera")
+    return _s(f"Build the {'tower' if tower else 'rest'}: {listed} (the steps after the paraboloid).", ASSEMBLE,
+              needs={"base plate down", "flat parts whole"}, makes={"projector on", "camera on"} if tower else (),
+              places=names)
+
+
+def schedule(rig, fab_report: dict | None = None, steps=None) -> tuple[Stage, ...]:
     """The rig's schedule, print to calibrated rig (see the module docstring): the tower's stages when
     the rig has the COP tower, the dome's seams when the fab report split it, the deflectometry when the
-    profile has a calibration section."""
+    profile has a calibration section. ``steps``: the assembly plan's (rigcad.manual.plan.steps), which
+    the stages' ``places`` cover, each step once; without them the tower's stage names no steps."""
     tower = getattr(rig.layout, "tower", None) is not None
     parts = (fab_report or {}).get("parts", {})
     seams = "step_on_gauge_mm" in ((parts.get("dome") or {}).get("seams") or {})
@@ -92,18 +118,18 @@ def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
            RECIPE, needs={"mirrors sanded"}, makes={"clear coat polished"}),
         _s("Put the sample holder in the base plate's bore and the plate on the bench (their steps).", ASSEMBLE,
            needs={"base plate inserts"}, makes={"base plate down", "dome off", "sample holder in the bore",
-                                                "plate top clear"}),
+                                                "plate top clear"}, places=("sample_holder", "base_plate")),
         _s("Indicate the dome in from the bore (the test indicator on its arm on the sample holder, turned in the "
            "bore), drill and ream its register, press the pins; lift the dome off its pins again (the dome's step).",
            ASSEMBLE, needs={"base plate down", "dome off", "dome inserts", "clear coat polished",
                             "sample holder in the bore"},
-           makes={"dome register drilled"}),
+           makes={"dome register drilled"}, places=("dome",)),
         _s("Take the sample holder out of the bore, stand the camera_cross_base in it, lay the film on the plate and "
            "trace O on it.", C.STEP_FILM, needs={"base plate down", "dome off", "dome register drilled"},
            makes={"film laid", "cross in the bore"}, ends={"sample holder in the bore", "plate top clear"}),
         _s("With the dome still off (upside down on the bench), put in the beam and the paraboloid on it, reaching "
            "in through the dome's open base (their steps).", ASSEMBLE, needs={"dome off", "dome register drilled"},
-           makes={"paraboloid on the beam"}),
+           makes={"paraboloid on the beam"}, places=("beam", "paraboloid")),
         _s("Indicate the paraboloid in on the dome's axis (the dome upside down on the turntable, centred on its base) "
            "and set the clamp's foil packs to the placement tolerance (the optical acceptance test's first step).",
            C.STEP_ACCEPTANCE, needs={"paraboloid on the beam", "dome off"}, makes={"paraboloid placed"}),
@@ -111,10 +137,9 @@ def schedule(rig, fab_report: dict | None = None) -> tuple[Stage, ...]:
            "down.", ASSEMBLE, needs={"dome register drilled", "dome off", "paraboloid on the beam"},
            makes={"dome on its register"}, ends={"dome off"}),
     ]
-    if tower:
-        out.append(_s("Build the tower: column, shelf, seat, lens mount, shims, splitter holder, projector, lens, "
-                      "splitter, camera (the steps after the paraboloid).", ASSEMBLE,
-                      needs={"base plate down", "flat parts whole"}, makes={"projector on", "camera on"}))
+    built = _rest_stage(steps, tower)
+    if built is not None:
+        out.append(built)
     out += [
         _s("Slope test on the polished clear coat, before the mirror coat.", C.STEP_ACCEPTANCE,
            needs={"clear coat polished", "film laid", "camera on", "dome on its register", "paraboloid on the beam",
@@ -189,4 +214,4 @@ def check(stages) -> None:
                             f"{', '.join(missing)}, which no earlier stage leaves")
 
 
-__all__ = ["Stage", "check", "schedule", "unmet"]
+__all__ = ["PLACED_FIRST", "Stage", "check", "rest", "schedule", "unmet"]
