@@ -32,12 +32,18 @@ def dome_template(profile: Profile, layout: RigLayout, depth: float | None = Non
     the profile's gauged layer (the fab stage's printed and sanded stages)."""
     g = layout.design_dome.behind(gauged_depth(profile) if depth is None else depth)
     front = g.behind(-profile.templates.band)  # on the reflecting side: the template's body
-    u0, u1 = u_at_height(g, 0.0), g.u_range[1]
+    u1 = g.u_range[1]
+    lifted = _pt(g, g.u_range[0])[1] >= 0.0  # a surface in front of the design by more than the coating
+    # (the printed stage under a deep sanding stock) starts microns above the plate: the template's datum
+    # edge stays on z = 0, its gauging edge runs straight down to it from the surface's start
+    u0 = g.u_range[0] if lifted else u_at_height(g, 0.0)
+    base = ((Line(_pt(front, u0), (_pt(front, u0)[0], 0.0)), Line((_pt(front, u0)[0], 0.0), (_pt(g, u0)[0], 0.0)),
+             Line((_pt(g, u0)[0], 0.0), _pt(g, u0))) if lifted else (Line(_pt(front, u0), _pt(g, u0)),))
     section = Section((
         Curve(g, u0, u1),
         Line(_pt(g, u1), _pt(front, u1)),
         Curve(front, u1, u0),
-        Line(_pt(front, u0), _pt(g, u0)),
+        *base,
     ))
     return Part("dome_template", Prism(section, profile.templates.thickness), (0.95, 0.85, 0.3),
                 f"dome profile template: its curved edge is the {profile.templates.gauged_layer} surface "
