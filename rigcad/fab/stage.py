@@ -97,7 +97,8 @@ def sanding_stock(printer: Printer, needed: float) -> tuple[float, str]:
     orientation (:func:`stock_bound`: no valley behind the sanded surface)."""
     if printer.sanding_stock is not None:
         return printer.sanding_stock, "printer file (sanding_stock)"
-    return needed, "auto: the staircase's bound in the chosen orientations (stock_bound)"
+    return needed, ("auto: the staircase's bound in the chosen orientations (stock_bound), the seams' step on the "
+                    "gluing gauge and the sanding margin (seams.stock_needed)")
 
 
 def run_fab(rig, printer: Printer, out: Path, *, gcode: bool = False, parts: list[str] | None = None,
@@ -399,8 +400,10 @@ def _with_stock(rig, part, run: _Run) -> tuple[PartFab, float]:
     pieces = first.entry["pieces"]
     steep = [pc["mirror_max_abs_normal_along_build"] for pc in pieces if pc["mirror_max_abs_normal_along_build"] is not None]
     bound = stock_bound(run.printer.layer_height, max(steep, default=0.0), run.chord)
-    stock, source = sanding_stock(run.printer, bound)
-    record = {"stock_mm": stock, "source": source, "needed_bound_mm": bound,
+    step = seams.step_on_gauge(rig.profile.templates.thickness) if first.plan.count > 1 else 0.0  # a split mirror's seams
+    stock, source = sanding_stock(run.printer, seams.stock_needed(bound, step))
+    record = {"stock_mm": stock, "source": source, "needed_bound_mm": bound, "seam_step_mm": step,
+              "sanding_margin_mm": seams.SANDING_MARGIN_MM, "needed_mm": seams.stock_needed(bound, step),
               "needed_bound_formula": "layer/2 x max |n . D| over the mirror + STL chord error",
               "part_volume_without_stock_mm3": first.entry["volume_mm3"],
               "mirror_area_without_stock_mm2": sum(pc["mirror_area_mm2"] for pc in pieces)}
@@ -423,7 +426,8 @@ def _with_stock(rig, part, run: _Run) -> tuple[PartFab, float]:
     new["sanding_stock"] = record
     if "seams" in new:
         new["seams"].update(seams.mirror_record(run.printer, stock, rig.profile.templates.thickness,
-                                                (new.get("pin_fit") or {}).get("pin_diameter_mm")))
+                                                (new.get("pin_fit") or {}).get("pin_diameter_mm"), bound,
+                                                (new.get("reassembly") or {}).get("pin_hole_min_clearance_to_mirror_mm")))
     done.timings = {**first.timings, f"{name}:orient_for_stock": stock_s, **done.timings}
     return done, stock
 
