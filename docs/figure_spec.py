@@ -157,6 +157,9 @@ def _fab(printer: str, run: str) -> list[Figure]:
     if printer == MK3S:  # the dome is split on the desktop printer only
         out += [f("dome.seam_step_on_pins_mm", "parts.dome.seams.step_on_pins_mm", "mm", ".2f"),
                 f("dome.seam_step_on_gauge_mm", "parts.dome.seams.step_on_gauge_mm", "mm", ".3f"),
+                f("dome.staircase_bound_mm", "parts.dome.sanding_stock.needed_bound_mm", "mm", ".3f"),
+                f("dome.pin_hole_behind_printed_mm", "parts.dome.seams.pin_hole_behind_printed_mm", "mm", ".2f"),
+                f("dome.pin_hole_cover_mm", "parts.dome.seams.pin_hole_cover_after_sanding_mm", "mm", ".2f"),
                 f("dome.glue_face_step_mm", "parts.dome.seams.glue_face_step_mm", "mm", ".3f"),
                 f("dome.glue_gap_mm", "parts.dome.seams.glue_gap_mm", "mm", ".2f"),
                 f("dome.pin_hole_mm", "parts.dome.pin_fit.hole_drawn_mm", "mm", ".2f")]

@@ -5,9 +5,9 @@ A split mirror (the dome's sectors) is cut along meridional half-planes, so the 
 in each cut plane and any shift of one piece against the next within the plane is a step in the
 mirror. Its pins cannot hold that step below the sanding stock: a pin in its two holes floats by
 the holes' clearance, and each hole is off by the printer's position error, so the pins alone
-allow ``clearance + 2 x position`` (0.35 mm on the MK3S against 0.093 mm of stock). Sanding to the
-template then leaves the lower side's surface behind the sanded one: a groove the coating cannot
-fill.
+allow ``clearance + 2 x position`` (over half a millimetre on the MK3S, against a stock under
+0.2 mm). Sanding to the template then leaves the lower side's surface behind the sanded one: a
+groove the coating cannot fill.
 
 So each seam is glued on a gauge, not on its pins: the printed-stage template
 (``outlines/<mirror>_template_printed``, whose edge is the surface as printed) stands in the seam's
@@ -16,6 +16,12 @@ feeler leaf must not pass under it on either side. The pin holes of a mirror par
 twice the position error (:func:`float_pin`) so the pins never hold the pieces off the gauge: they
 key the glue, and the glue fills the float. What remains is the gauge's: the thinnest leaf that
 can be felt and the edge's squareness across the template's thickness (:func:`seam_steps`).
+
+That step sets one piece's staircase behind the other's, so the sanding stock must cover both: the
+staircase's valleys (rigcad.fab.stage.stock_bound) plus the seam's step plus SANDING_MARGIN_MM
+(:func:`stock_needed`); a stock below it is a fab problem naming ``sanding_stock``. The pin holes lie
+behind the printed surface; sanding takes the stock and may go a leaf deeper, and what is left over
+a hole must stay a wall (:func:`pin_cover`).
 
 Glue faces printed oblique to the layers are stepped (``layer x |n . D|``, n the cut face's normal,
 D the build direction; faces in a layer plane or across the layers print smooth), each is flat only
@@ -42,6 +48,14 @@ EDGE_LEAN_DEG = 0.5
 #: Twist drills (DIN 338) are sold in 0.05 mm steps up to 3 mm: a floating pin's clearance is rounded
 #: up to it.
 DRILL_STEP = 0.05
+#: Sanding stock (mm) kept over the staircase's valleys and the seam's step: the knock-down is judged
+#: on the template with the thinnest feeler leaf, so the sanded surface may stand a leaf proud of the
+#: template where the check passes (a valley that deep would stay) or lie a leaf deeper (what a pin
+#: hole's cover loses).
+SANDING_MARGIN_MM = FEELER_LEAF
+#: The thinnest wall (mm) left over a pin hole after sanding: rigcad.fab.split.MIN_WALL, the thinnest
+#: unsupported wall that stands (Formlabs' design guide); thinner, the block breaks through.
+PIN_COVER_MIN_MM = 0.6
 #: How far either side of a split mirror's seam (the cut plane) its fairing sands (mm): the seam is
 #: glued with its faces buttered, and the squeeze-out the gap pushes out onto the mirror is sanded
 #: flush with the seam's step down to the template (the manual's gluing step), so whatever the
@@ -144,14 +158,41 @@ def glue_for(gap: float) -> Glue:
     return GLUES[-1]
 
 
-def seam_steps(pin, position: float, stock: float, template_thickness: float) -> dict:
+def step_on_gauge(template_thickness: float) -> float:
+    """The step (mm) a seam glued on the gauge may leave: the thinnest leaf plus the template edge's
+    lean (EDGE_LEAN_DEG) across its ``template_thickness`` (mm)."""
+    return FEELER_LEAF + template_thickness * math.tan(math.radians(EDGE_LEAN_DEG))
+
+
+def stock_needed(staircase: float, step: float) -> float:
+    """The sanding stock (mm) a mirror needs: its staircase's bound (``staircase``, the deepest valley
+    behind the printed surface), the seam's ``step`` (one piece's surface behind the other's; 0 for a
+    whole mirror) and SANDING_MARGIN_MM, so that sanding to the template leaves no valley on either
+    side of a seam."""
+    return staircase + step + SANDING_MARGIN_MM
+
+
+def pin_cover(clearance: float | None, stock: float) -> dict:
+    """What is left over a split mirror's pin holes after sanding (mm): the holes lie ``clearance``
+    behind the printed surface (measured on the pieces), sanding takes the ``stock`` and may go
+    SANDING_MARGIN_MM deeper; ``pins_stay_covered``: at least PIN_COVER_MIN_MM is left."""
+    if clearance is None:
+        return {}
+    left = clearance - stock - SANDING_MARGIN_MM
+    return {"pin_hole_behind_printed_mm": clearance, "pin_hole_cover_after_sanding_mm": left,
+            "pin_cover_min_mm": PIN_COVER_MIN_MM, "pins_stay_covered": left >= PIN_COVER_MIN_MM}
+
+
+def seam_steps(pin, position: float, stock: float, template_thickness: float, staircase: float = 0.0) -> dict:
     """The step across a split mirror's seams (mm): on its pins alone (``pin`` as drawn: the
     :func:`float_pin`; the holes each off by ``position``) and on the gluing gauge (the leaf and the edge's lean across half the
-    template's ``template_thickness`` each side), against the sanding ``stock``; ``fairs``: the gauge's
-    step lies within the stock, so sanding to the template leaves no groove."""
+    template's ``template_thickness`` each side), against the sanding ``stock``; ``fairs``: the stock
+    covers the ``staircase`` (its bound, mm), the gauge's step and the margin (:func:`stock_needed`),
+    so sanding to the template leaves no groove and no valley."""
     on_pins = pin.clearance + 2.0 * position
     lean = template_thickness * math.tan(math.radians(EDGE_LEAN_DEG))
-    on_gauge = FEELER_LEAF + lean
+    on_gauge = step_on_gauge(template_thickness)
+    need = stock_needed(staircase, on_gauge)
     return {"step_on_pins_mm": on_pins,
             "step_on_pins_how": f"{pin.diameter:g} mm pins in {pin.diameter + pin.clearance:.2f} mm holes, each hole "
                                 f"+-{position:.2f} mm",
@@ -159,7 +200,8 @@ def seam_steps(pin, position: float, stock: float, template_thickness: float) ->
             "step_on_gauge_how": f"glued on the printed-stage template: a {FEELER_LEAF:g} mm feeler leaf passes under "
                                  f"its edge on neither side; the edge square to {EDGE_LEAN_DEG:g} deg across its "
                                  f"{template_thickness:g} mm ({lean:.3f} mm)",
-            "stock_mm": stock, "fairs": on_gauge <= stock}
+            "staircase_mm": staircase, "sanding_margin_mm": SANDING_MARGIN_MM, "stock_needed_mm": need,
+            "stock_mm": stock, "fairs": need <= stock + 1e-12}
 
 
 def glue_record(printer, plan, pieces, oriented) -> dict:
@@ -176,17 +218,19 @@ def glue_record(printer, plan, pieces, oriented) -> dict:
             "glue_open_min": glue.open_min, "glue_source": glue.source, "glue_fills": glue.gap_fill >= gap}
 
 
-def mirror_record(printer, stock: float, template_thickness: float, pin_diameter: float | None = None) -> dict:
-    """fab.json's seam steps for a split mirror printed with ``stock`` mm of sanding stock, its pins
-    ``pin_diameter`` mm (default the printer's; a thin shell takes thinner ones); empty when the
-    printer states no process errors: no position error to reckon with."""
+def mirror_record(printer, stock: float, template_thickness: float, pin_diameter: float | None = None,
+                  staircase: float = 0.0, pin_clearance: float | None = None) -> dict:
+    """fab.json's seam steps for a split mirror printed with ``stock`` mm of sanding stock over a
+    ``staircase`` mm deep (its bound), its pins ``pin_diameter`` mm (default the printer's; a thin shell
+    takes thinner ones), their holes ``pin_clearance`` mm behind the printed surface (:func:`pin_cover`);
+    empty when the printer states no process errors: no position error to reckon with."""
     errors = getattr(printer, "process_errors", None)
     if errors is None:
         return {}
     pin = float_pin(printer.alignment_pin, errors.position)
     if pin_diameter:
         pin = replace(pin, diameter=pin_diameter)
-    return seam_steps(pin, errors.position, stock, template_thickness)
+    return {**seam_steps(pin, errors.position, stock, template_thickness, staircase), **pin_cover(pin_clearance, stock)}
 
 
 def problems(part: str, record: dict | None, whole: str = "") -> list[str]:
@@ -197,9 +241,18 @@ def problems(part: str, record: dict | None, whole: str = "") -> list[str]:
         return []
     out = []
     if record.get("fairs") is False:
-        out.append(f"{part}: its seams step {record['step_on_gauge_mm']:.3f} mm on the gluing gauge, more than its "
-                   f"{record['stock_mm']:.3f} mm of sanding stock: raise the printer file's sanding_stock to at "
-                   f"least {record['step_on_gauge_mm']:.3f} mm")
+        out.append(f"{part}: its {record['stock_mm']:.3f} mm of sanding stock does not cover its staircase "
+                   f"({record.get('staircase_mm', 0.0):.3f} mm), its seams' step on the gluing gauge "
+                   f"({record['step_on_gauge_mm']:.3f} mm) and the sanding margin "
+                   f"({record.get('sanding_margin_mm', 0.0):.3f} mm): sanding would leave valleys; raise the printer "
+                   f"file's sanding_stock to at least {record.get('stock_needed_mm', record['step_on_gauge_mm']):.3f} "
+                   "mm (or set it to auto)")
+    if record.get("pins_stay_covered") is False:
+        out.append(f"{part}: its pin holes lie {record['pin_hole_behind_printed_mm']:.2f} mm behind the printed "
+                   f"mirror; sanding its {record['stock_mm']:.3f} mm of stock (and a leaf deeper) leaves "
+                   f"{record['pin_hole_cover_after_sanding_mm']:.2f} mm over them, under "
+                   f"{record['pin_cover_min_mm']:g} mm: set a smaller sanding_stock in the printer file, or print thinner "
+                   "layers (its layer_height sets the staircase the auto stock covers)")
     if not record.get("glue_fills", True):
         out.append(f"{part}: its glue faces leave gaps of {record['glue_gap_mm']:.2f} mm, more than any listed glue "
                    f"fills ({GLUES[-1].gap_fill:g} mm): print it with its cut faces across the layers"

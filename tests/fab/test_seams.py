@@ -73,6 +73,15 @@ def test_the_dome_seams_fair_and_its_glue_fills_read_from_the_printed_pieces(pru
     rec = e["seams"]
     assert rec["fairs"] and rec["glue_fills"] and rec["step_on_gauge_mm"] < rec["stock_mm"]
     assert rec["step_on_pins_mm"] > rec["stock_mm"]  # why the gauge: the pins alone would not do
+    # the auto stock covers the staircase's bound, the gauge's step and a leaf (to rounding)
+    st = e["sanding_stock"]
+    assert st["stock_mm"] == pytest.approx(st["needed_bound_mm"] + rec["step_on_gauge_mm"] + S.FEELER_LEAF, abs=1e-12)
+    assert rec["staircase_mm"] == st["needed_bound_mm"] and rec["stock_needed_mm"] <= rec["stock_mm"] + 1e-12
+    # the pin holes keep split.MIRROR_CLEARANCE (1 mm) behind the printed surface; sanding the stock and a
+    # leaf deeper leaves at least 0.6 mm over them
+    assert rec["pin_hole_behind_printed_mm"] >= 1.0 - 1e-9 and rec["pins_stay_covered"]
+    assert rec["pin_hole_cover_after_sanding_mm"] == pytest.approx(
+        rec["pin_hole_behind_printed_mm"] - rec["stock_mm"] - S.FEELER_LEAF, abs=1e-12)
     pin = prusa.alignment_pin
     float_clearance = e["pin_fit"]["hole_drawn_mm"] - e["pin_fit"]["pin_diameter_mm"]
     need = pin.clearance + 2 * prusa.process_errors.position
@@ -91,3 +100,36 @@ def test_the_dome_seams_fair_and_its_glue_fills_read_from_the_printed_pieces(pru
         assert m.area_faces[on_cut].sum() > 1000.0  # the two cut faces, found on the mesh
         worst = max(worst, float(prusa.layer_height * np.abs(m.face_normals[on_cut, 2]).max()))
     assert rec["glue_face_step_mm"] == pytest.approx(worst, abs=1e-4)
+
+
+def test_the_stock_covers_the_staircase_the_seam_step_and_a_leaf():
+    """A seam glued on the gauge leaves one piece's surface up to the gauge's step behind the other's,
+    and its staircase's valleys reach the staircase's bound behind that: sanding to the template leaves
+    no valley only if the stock covers the bound + the step + one leaf (the template's check). The
+    MK3S's figures: a 0.093 mm bound, the 3 mm template's 0.046 mm step."""
+    step = S.step_on_gauge(3.0)
+    assert step == pytest.approx(0.02 + 3.0 * math.tan(math.radians(0.5)), abs=1e-12)  # leaf + lean, closed form
+    need = S.stock_needed(0.093, step)
+    assert need == pytest.approx(0.093 + step + S.FEELER_LEAF, abs=1e-12)
+    pin = S.float_pin(AlignmentPin(1.5, 0.15, 6.0), 0.1)
+    assert S.seam_steps(pin, 0.1, need, 3.0, staircase=0.093)["fairs"] is True
+    # planted: the stock equal to the staircase's bound (the old rule), and the bound + step without the
+    # leaf, are refused, and the refusal names the key and the stock that would do
+    for short in (0.093, 0.093 + step, need - 1e-4):
+        rec = S.seam_steps(pin, 0.1, short, 3.0, staircase=0.093)
+        assert rec["fairs"] is False, short
+        (msg,) = S.problems("dome", {**rec, "glue_fills": True})
+        assert "dome" in msg and "sanding_stock" in msg and f"{need:.3f}" in msg and "\n" not in msg, msg
+
+
+def test_sanding_cannot_open_the_pin_holes():
+    """Holes 1.03 mm behind the printed surface (the machinist's measure), a 0.159 mm stock and a leaf
+    deeper: 0.851 mm of cover left, over the 0.6 mm floor; holes 0.7 mm behind are refused."""
+    rec = S.pin_cover(1.03, 0.159)
+    assert rec["pin_hole_cover_after_sanding_mm"] == pytest.approx(1.03 - 0.159 - S.FEELER_LEAF, abs=1e-12)
+    assert rec["pins_stay_covered"] is True
+    thin = S.pin_cover(0.7, 0.159)  # 0.521 mm left
+    assert thin["pins_stay_covered"] is False
+    (msg,) = S.problems("dome", {**thin, "fairs": True, "glue_fills": True, "stock_mm": 0.159})
+    assert "pin holes" in msg and "sanding_stock" in msg, msg
+    assert S.pin_cover(None, 0.159) == {}  # no pins: nothing to cover

@@ -66,8 +66,10 @@ def test_the_fab_mirrors_lie_the_stock_in_front_of_the_sanded_surface(prusa_run,
         e = rep["parts"][part]
         st = e["sanding_stock"]
         stock = st["stock_mm"]
-        # auto: the staircase's bound, layer/2 x max|n.D| + chord; between the chord and a layer + chord
-        assert chord < stock <= prusa.layer_height / 2 + chord + 1e-12
+        # auto: the staircase's bound, layer/2 x max|n.D| + chord (between the chord and a layer + chord),
+        # the seams' step on the gluing gauge (a split mirror's) and one feeler leaf
+        assert chord < st["needed_bound_mm"] <= prusa.layer_height / 2 + chord + 1e-12
+        assert stock == pytest.approx(st["needed_bound_mm"] + st["seam_step_mm"] + st["sanding_margin_mm"], abs=1e-12)
         sanded = design.behind(lay.coating)
         area = 0.0
         for pc in e["pieces"]:
