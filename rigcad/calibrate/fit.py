@@ -334,15 +334,19 @@ def posterior_covariance(jac: np.ndarray, fun: np.ndarray, root: np.ndarray,
     itself, whatever the fit's ridge weight (:data:`PRIOR_MM`) did to the solve.
 
     ``clusters`` (an int per data row): rows that share one are not taken as independent. The
-    covariance is then the cluster-robust sandwich A^-1 (sum_c g_c g_c^T / s^4 * m / (m - 1) + R^T R)
-    A^-1, g_c = J_c^T r_c over cluster c's rows, m clusters (Liang and Zeger, Biometrika 73, 1986;
-    the m / (m - 1) of Cameron and Miller, J. Human Resources 50, 2015). With independent rows it
-    tends to A^-1."""
+    covariance is then the cluster-robust sandwich A^-1 (sum_c g*_c g*_c^T / s^4 * (m - 1) / m +
+    R^T R) A^-1 over m clusters (Liang and Zeger, Biometrika 73, 1986), each cluster's score
+    g_c = J_c^T r_c over its rows with its own leverage taken out, g*_c = A (A - A_c)^-1 g_c, A_c =
+    J_c^T J_c / s^2 (CR3, the jackknife's: Bell and McCaffrey, Survey Methodology 28, 2002; Cameron
+    and Miller, J. Human Resources 50, 2015). With few clusters, each fixing a good share of the
+    parameters, the plain scores miss what the fit absorbed of each cluster's residual (the window
+    holds a few dozen tiles). With independent rows it tends to A^-1."""
     p = jac.shape[1]
     jd, rd = jac[:-p], fun[:-p]
     s2 = max(float(rd @ rd) / max(len(rd) - p, 1), 1e-300)
     prior = root.T @ root
-    inverse = np.linalg.inv(jd.T @ jd / s2 + prior)
+    information = jd.T @ jd / s2 + prior
+    inverse = np.linalg.inv(information)
     if clusters is None:
         return inverse
     _, index = np.unique(clusters, return_inverse=True)
@@ -351,7 +355,14 @@ def posterior_covariance(jac: np.ndarray, fun: np.ndarray, root: np.ndarray,
         raise ValueError("the cluster-robust covariance needs at least two clusters of residuals")
     g = np.zeros((m, p))
     np.add.at(g, index, jd * rd[:, None])
-    meat = g.T @ g / s2 ** 2 * (m / (m - 1)) + prior
+    # each cluster's score with its own leverage taken out (CR3: Bell and McCaffrey, Survey
+    # Methodology 28, 2002): the fit absorbs part of a cluster's residual into the parameters, the
+    # more so the more the cluster alone fixes them, and the plain score misses that part. A_c its
+    # rows' information: g*_c = A (A - A_c)^-1 g_c, the scores of the fit without the cluster
+    for c in range(m):
+        rows = index == c
+        g[c] = information @ np.linalg.solve(information - jd[rows].T @ jd[rows] / s2, g[c])
+    meat = g.T @ g / s2 ** 2 * ((m - 1) / m) + prior
     return inverse @ meat @ inverse
 
 
