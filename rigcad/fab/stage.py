@@ -427,7 +427,7 @@ def _with_stock(rig, part, run: _Run) -> tuple[PartFab, float]:
     if "seams" in new:
         new["seams"].update(seams.mirror_record(run.printer, stock, rig.profile.templates.thickness,
                                                 (new.get("pin_fit") or {}).get("pin_diameter_mm"), bound,
-                                                (new.get("reassembly") or {}).get("pin_hole_min_clearance_to_mirror_mm")))
+                                                (new.get("reassembly") or {}).get("pin_hole_wall_min_depth_behind_mirror_mm")))
     done.timings = {**first.timings, f"{name}:orient_for_stock": stock_s, **done.timings}
     return done, stock
 
@@ -658,4 +658,7 @@ def reassembly(man, drilled, pieces, mirror, tol, pins, printer) -> dict:
             out["pin_centre_min_depth_behind_mirror_mm"] = float(-mirror.signed_distance(c).max())
             r = np.array([p.hole_diameter / 2 or printer.alignment_pin.hole_radius for p in pins])
             out["pin_hole_min_clearance_to_mirror_mm"] = float((-mirror.signed_distance(c) - r).min())
+            # the holes' walls along their whole depth (the ends of a hole in a curved shell come nearest)
+            out["pin_hole_wall_min_depth_behind_mirror_mm"] = split.hole_clearance(
+                pins, printer.alignment_pin.depth, mirror)
     return out
