@@ -8,6 +8,7 @@ import pytest
 
 from rigcad.fab import seams as S
 from rigcad.fab.printers import AlignmentPin
+from rigcad.fab import split as SP
 from rigcad.fab.split import GridPlan, Piece, SplitPlan
 
 
@@ -77,9 +78,10 @@ def test_the_dome_seams_fair_and_its_glue_fills_read_from_the_printed_pieces(pru
     st = e["sanding_stock"]
     assert st["stock_mm"] == pytest.approx(st["needed_bound_mm"] + rec["step_on_gauge_mm"] + S.FEELER_LEAF, abs=1e-12)
     assert rec["staircase_mm"] == st["needed_bound_mm"] and rec["stock_needed_mm"] <= rec["stock_mm"] + 1e-12
-    # the pin holes keep split.MIRROR_CLEARANCE (1 mm) behind the printed surface; sanding the stock and a
-    # leaf deeper leaves at least 0.6 mm over them
-    assert rec["pin_hole_behind_printed_mm"] >= 1.0 - 1e-9 and rec["pins_stay_covered"]
+    # the pin holes' walls keep split.MIRROR_CLEARANCE (1 mm) behind the printed surface, as placed (1.49 mm
+    # measured on 25 x 36 points of each wall; the placement checked 7 x 12: 0.05 mm allows what lies between);
+    # sanding the stock and a leaf deeper leaves at least 0.6 mm over them
+    assert rec["pin_hole_behind_printed_mm"] >= SP.MIRROR_CLEARANCE - 0.05 and rec["pins_stay_covered"]
     assert rec["pin_hole_cover_after_sanding_mm"] == pytest.approx(
         rec["pin_hole_behind_printed_mm"] - rec["stock_mm"] - S.FEELER_LEAF, abs=1e-12)
     pin = prusa.alignment_pin
