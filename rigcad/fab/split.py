@@ -252,20 +252,10 @@ def _grid_options(size: np.ndarray) -> list[tuple[int, int, int]]:
                   key=lambda n: (n[0] * n[1] * n[2], tuple(-n[a] for a in order)))
 
 
-#: A pin hole's wall on an FDM print: PIN_WALL_PERIMETERS of the printer's perimeter lines, and never
-#: under PIN_WALL_MIN_MM. Every pin hole is drilled to its drawn size after printing (:func:`pin_fit`);
-#: the drill, run in by hand, trues a hole that drooped or printed small and can take a line's width
-#: off one side, and two perimeters must remain round it (the least that holds a pin without breaking
-#: out: the machinist's review measured 0.60-0.90 mm walls break out, and asked more than 0.90-1.20 mm),
-#: so three; 1.5 mm, the machinist's figure, when three lines are thinner.
-PIN_WALL_PERIMETERS, PIN_WALL_MIN_MM = 3, 1.5
-
-
 def pin_wall(printer) -> float:
-    """Wall (mm) kept around every pin hole: on an FDM printer PIN_WALL_PERIMETERS perimeters (its
-    perimeter line width: the PrusaSlicer preset's ``perimeter_extrusion_width`` when it states one in
-    mm, else AUTO_WIDTH_OVER_NOZZLE x the nozzle) or PIN_WALL_MIN_MM, whichever is more; MIN_WALL for a
-    resin printer."""
+    """Wall (mm) kept around every pin hole: two perimeters of an FDM printer (2 x its perimeter
+    line width: the PrusaSlicer preset's ``perimeter_extrusion_width`` when it states one in mm, else
+    AUTO_WIDTH_OVER_NOZZLE x the nozzle), or MIN_WALL for a resin printer; never under MIN_WALL."""
     if getattr(printer, "process", "fdm") != "fdm" or not getattr(printer, "nozzle", None):
         return MIN_WALL
     width = AUTO_WIDTH_OVER_NOZZLE * printer.nozzle
@@ -278,7 +268,7 @@ def pin_wall(printer) -> float:
             stated = 0.0
         if stated > 0:
             width = stated
-    return max(MIN_WALL, PIN_WALL_MIN_MM, PIN_WALL_PERIMETERS * width)
+    return max(MIN_WALL, 2.0 * width)
 
 
 #: Hole shrink (mm, diametral) assumed when the printer file states no process errors: FDM holes print
