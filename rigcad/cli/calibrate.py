@@ -39,13 +39,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if runs is not None:
         return _seating(rig, args, runs)
     if getattr(args, "kit", False):
-        from rigcad.export import reuse
-
-        out = Path(args.exports) / rig.name / "calibrate_kit"
-        with reuse.recording(out, _kit_key(rig.profile) if _kit_alone(args) else None):
-            manifest = write_kit(rig, out, say=print)
-        print(f"calibration kit for {rig.name}: {len(manifest['files'])} files in {out}")
-        return 0
+        return _kit(rig, args, write_kit)
     seq = Sequence.from_profile(rig.profile.calibration)
     plan = M.Plan.of(rig.profile)
     ups = Uprights.of(rig.profile)
@@ -147,6 +141,18 @@ def _kit_key(profile) -> str:
     from rigcad.export import reuse
 
     return reuse.stage_key(profile, "calibrate_kit", {})
+
+
+def _kit(rig, args: argparse.Namespace, write_kit) -> int:
+    """``--kit``: write the kit (``write_kit``: rigcad.calibrate.kit.write_kit), recorded with its key
+    (:func:`_kit_key`) when nothing but ``--kit`` was asked, so that the next run reads it back."""
+    from rigcad.export import reuse
+
+    out = Path(args.exports) / rig.name / "calibrate_kit"
+    with reuse.recording(out, _kit_key(rig.profile) if _kit_alone(args) else None):
+        manifest = write_kit(rig, out, say=print)
+    print(f"calibration kit for {rig.name}: {len(manifest['files'])} files in {out}")
+    return 0
 
 
 def _kit_read_back(args: argparse.Namespace) -> bool:
