@@ -3,10 +3,11 @@ wall, a bolted base flange, the slots the mounting beam passes through, and the 
 
 Each seat is a block standing on the flange outside the wall at a slot, within the flange's radius
 (the dome's footprint on a bed does not grow): the beam passes through its tunnel and rests on a
-pack of shim foil on the tunnel's floor, pressed down by a set screw in the roof and against the
-tunnel's -y wall by a set screw in its +y wall (heat-set inserts take both). Under the beam, across it,
-lies a bought steel roll bar (:data:`ROLL_BAR`) on two packs of foil, one under each of its ends, in a
-wide slot at the bottom of the tunnel: the bar's packs together set the paraboloid's height, one seat's
+bought steel roll bar (:data:`ROLL_BAR`) laid across it in a wide slot at the tunnel's bottom, the bar on
+two packs of shim foil on the slot's floor, one under each of its ends; a set screw in the roof presses
+the beam onto the bar's middle and the bar onto both packs, and a set screw in the +y wall the beam
+against the tunnel's -y wall (heat-set inserts take both; the side screw only snug, so that it does not
+roll the beam off the bar). The bars' packs together set the paraboloid's height, one seat's
 against the other's its tilt along the beam, and the -y ends' packs against the +y ends' its roll about the
 beam, over the bar's lever (:func:`roll_lever`) rather than the beam's narrow width, which is too short for
 the thinnest foil to step a quarter of ``tolerancing.paraboloid_tilt`` (rigcad.parts.locating.ShimStop).
