@@ -1,6 +1,6 @@
 """The narrow mounting beam (thesis Figure 3.3): spans the dome through its wall slots, rests on the
 two seats outside them on a bought roll bar in each (rigcad.parts.dome.beam_seats, ROLL_BAR: the
-paraboloid's roll is set there, on the bars' lever, not on the beam's 6 mm width), and carries the paraboloid's clamp at the
+paraboloid's roll is set there, on the bars' lever, not on the beam's narrow width), and carries the paraboloid's clamp at the
 design height, its end against a dowel pin set into the beam's top (rigcad.parts.paraboloid)."""
 
 from __future__ import annotations
