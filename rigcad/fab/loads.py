@@ -117,9 +117,12 @@ def material(printer: Printer) -> Material:
     """The printer's material's figures; FabricationError naming the known ones otherwise."""
     m = MATERIALS.get(printer.material.strip().lower())
     if m is None:
+        known = ", ".join(v.name for v in MATERIALS.values())
+        where = printer.marks.get(("material",)) or printer.source
         raise FabricationError(f"printer {printer.name}: no published strength and stiffness for material "
-                               f"{printer.material!r} in rigcad.fab.loads.MATERIALS (known: "
-                               f"{', '.join(v.name for v in MATERIALS.values())}), so no loads")
+                               f"{printer.material!r} in rigcad.fab.loads.MATERIALS (known: {known}), so no loads; "
+                               f"state the printed material with the printer file's `material:` key (one of {known}; "
+                               f"{where})")
     return m
 
 
