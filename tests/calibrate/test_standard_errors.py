@@ -7,6 +7,7 @@ clusters, tiles of the camera window holding every row of a pixel."""
 
 from __future__ import annotations
 
+import json
 from types import SimpleNamespace
 
 import numpy as np
@@ -98,3 +99,32 @@ def test_the_fit_clusters_tiles_of_the_window_with_every_row_of_a_pixel():
     tiles = Problem.clusters(prob)
     per_row = np.repeat([0, 0, 1, 3, 4], captures * 2)[keep]
     assert np.array_equal(tiles, per_row)
+
+
+def _placement_coverage(run: dict) -> tuple[int, float, float, float]:
+    """The placements against the dome over a bench run's trials: how many values, the share within
+    one and two standard errors, and the binomial standard error of the first at 68 %."""
+    z = np.array([p["error_over_standard_error"] for t in run["per_trial"]
+                  for p in t["dome_frame"]["parameters"].values()])
+    return len(z), float(np.mean(z <= 1)), float(np.mean(z <= 2)), float(np.sqrt(0.68 * 0.32 / len(z)))
+
+
+def test_the_bench_placements_standard_errors_cover_their_errors():
+    """bench/results/calibrate_standard_errors.json (bench/calibrate.py on the code that states
+    them, docs/calibrate-notes.md, "The placements' standard errors"): the paraboloid's and the
+    camera's placements against the dome within one standard error for about 68 % of the values,
+    within 2.5 binomial standard errors of it (the ten values of one trial share its surface, so
+    the binomial error is a floor), and within two for at least 85 %; and docs/calibrate.md states
+    those figures."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    run = json.loads((root / "bench" / "results" / "calibrate_standard_errors.json").read_text(encoding="utf-8"))
+    n, within_1, within_2, sd = _placement_coverage(run)
+    assert n == 10 * run["trials"] and run["trials"] >= 6, n
+    assert abs(within_1 - 0.68) <= 2.5 * sd, (within_1, sd)
+    assert within_2 >= 0.85, within_2
+    page = (root / "docs" / "calibrate.md").read_text(encoding="utf-8")
+    stated = (f"{100 * within_1:.0f} % within one standard error and {100 * within_2:.0f} % within two "
+              f"({n} values, {run['trials']} trials")
+    assert stated in page, stated
