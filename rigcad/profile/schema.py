@@ -799,7 +799,7 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
 
     if value is None:
         raise fail(f"has no value; expected {s.doc} ({s.describe_range()})")
-    if s.kind in ("str", "name", "point"):  # text, an instrument file's name, a pixel point: no range after
+    if s.kind in ("str", "name", "point", "pixels"):  # text, an instrument file's name, pixels: no range after
         return _text_or_point(s, value, fail)
     if s.kind in ("length", "angle"):
         try:
@@ -826,15 +826,8 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
             out = math.inf
         if not math.isfinite(out):
             raise fail(f"must be finite, got {_r(value)} ({s.describe_range()})")
-    elif s.kind == "fraction":  # a plain number, or a percentage as datasheets write it ("100 %")
-        text = value.strip() if isinstance(value, str) else None
-        try:
-            out = (float(text[:-1]) / 100 if text and text.endswith("%") else None if text is not None
-                   else float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None)
-        except (ValueError, OverflowError):
-            out = None
-        if out is None or not math.isfinite(out):
-            raise fail(f"expected a fraction such as 0.5 or 50 %, got {_r(value)} ({s.describe_range()})")
+    elif s.kind == "fraction":
+        out = _fraction(s, value, fail)
     elif s.kind == "choice":
         if value not in s.choices:
             raise fail(f"{_r(value)} is not valid; {s.describe_range()}{suggest(str(value), list(s.choices))}")
@@ -868,18 +861,26 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
         return tuple(convert_value(one, v, f"{key}[{i}]", where) for i, v in enumerate(value))
     elif s.kind == "holes":
         return _holes(s, value, key, where, fail)
-    elif s.kind == "pixels":
-        ok = (isinstance(value, list) and len(value) == 2
-              and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= MAX_PIXELS for v in value))
-        if not ok:
-            raise fail(f"expected [width, height] in whole pixels, each 1..{MAX_PIXELS}, got {_r(value)}")
-        return (value[0], value[1])
     else:  # pragma: no cover - a programming error in a Spec
         raise AssertionError(s.kind)
     too_low = s.lo is not None and (out < s.lo or (s.lo_open and out == s.lo))
     too_high = s.hi is not None and (out > s.hi or (s.hi_open and out == s.hi))
     if too_low or too_high:
         raise fail(f"{_r(value)} is out of range; valid: {s.describe_range()}")
+    return out
+
+
+def _fraction(s: Spec, value: Any, fail) -> float:
+    """``value`` read as a fraction (kind ``fraction``): a plain number, or a percentage as datasheets
+    write it ("100 %")."""
+    text = value.strip() if isinstance(value, str) else None
+    try:
+        out = (float(text[:-1]) / 100 if text and text.endswith("%") else None if text is not None
+               else float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None)
+    except (ValueError, OverflowError):
+        out = None
+    if out is None or not math.isfinite(out):
+        raise fail(f"expected a fraction such as 0.5 or 50 %, got {_r(value)} ({s.describe_range()})")
     return out
 
 
@@ -895,8 +896,9 @@ def _holes(s: Spec, value: Any, key: str, where: str | None, fail) -> tuple[tupl
 
 
 def _text_or_point(s: Spec, value: Any, fail) -> Any:
-    """``value`` read as text (kind ``str``), an instrument file's name (``name``) or an ``[x, y]``
-    pixel point (``point``); ``fail(message)`` makes the error naming the key."""
+    """``value`` read as text (kind ``str``), an instrument file's name (``name``), an ``[x, y]``
+    pixel point (``point``) or a ``[width, height]`` in whole pixels (``pixels``); ``fail(message)``
+    makes the error naming the key."""
     if s.kind == "str":
         if not isinstance(value, str) or not value:
             raise fail(f"expected text, got {_r(value)}")
@@ -906,6 +908,12 @@ def _text_or_point(s: Spec, value: Any, fail) -> Any:
             raise fail(f"{_r(value)} is not an instrument's name; {s.describe_range()} (letters, digits, '_', '.', "
                        "'+', '-')")
         return value
+    if s.kind == "pixels":
+        ok = (isinstance(value, list) and len(value) == 2
+              and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= MAX_PIXELS for v in value))
+        if not ok:
+            raise fail(f"expected [width, height] in whole pixels, each 1..{MAX_PIXELS}, got {_r(value)}")
+        return (value[0], value[1])
     ok = (isinstance(value, list) and len(value) == 2
           and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
                   and 0 <= v <= MAX_PIXELS for v in value))
