@@ -50,7 +50,8 @@ from rigcad.parts import adjusters as A
 from rigcad.parts.datum import DOWEL_FIT, datum_chain
 from rigcad.parts.dome import flange_joint
 from rigcad.parts.process import ProcessErrors
-from rigcad.parts.tower import LAPPED_FLATNESS, _projector_feet, _shelf_extent, seat_pocket_fits, splitter_seat
+from rigcad.parts.tower import (LAPPED_FLATNESS, PLATE_RETAINER, _projector_feet, _shelf_extent, plate_float_tilt,
+                                 plate_play, seat_pocket_fits, splitter_seat)
 from rigcad.standards import THREADS
 
 #: The optical elements, in the order the tables list them.
@@ -94,6 +95,10 @@ KINEMATIC_REPEAT = 0.005
 PARABOLOID_FLOATS = ("beam across its slots", "beam along its slots", "clamp on the beam", "clamp along the beam")
 DOME_FLOATS = ("dome's bolts in their holes",)
 SEAT_FLOATS = ("splitter seat",)
+#: The splitter plate's play in its grooves (rigcad.parts.tower.plate_play): a float (kind "float": it moves
+#: after any setting, so no adjuster takes it out), on the splitter's and the COP's chains until a retainer
+#: holds the plate on its datum flank (rigcad.parts.tower.PLATE_RETAINER: :func:`declared_locators`).
+PLATE_FLOATS = ("splitter plate in its grooves",)
 #: Dominating links named in a refusal: the fewest largest links making this share of the stack, at most MAX_NAMED.
 DOMINANT_SHARE = 0.5
 MAX_NAMED = 3
@@ -110,7 +115,8 @@ class Link:
     """One link of a chain. ``lateral``, ``vertical``: worst-case error each way (mm; ``math.inf``
     when nothing holds the element along that axis); ``tilt``: worst-case tilt (rad); ``count``:
     how many such links the chain holds (each independent); ``kind``: printed, seam, joint,
-    clearance, free or bought; ``buy``: the purchase (or ``buy:`` key) that would remove it; ``roll``:
+    clearance, free, bought or float (a play that moves after any setting: no adjuster takes it out, so
+    the floats on an axis alone must be within its tolerance); ``buy``: the purchase (or ``buy:`` key) that would remove it; ``roll``:
     worst-case tilt about the paraboloid's beam (rad; its ``tilt`` is then along the beam)."""
 
     name: str
@@ -487,10 +493,16 @@ def _link(k, kind: str, tilt: float, buy: str = "") -> Link:
 def _splitter_links(profile, layout, process: ProcessErrors, seams) -> tuple[Link, ...]:
     holder = {k.name: k for k in datum_chain(profile, layout, process).links}["splitter holder"]
     groove = 2 * process.position / profile.beam_splitter.length
+    play, length = plate_play(profile, layout)
     return (*_tower_links(profile, layout, process, seams, mirror=2.0), *seams("splitter_holder"),
             Link(holder.name, "printed", holder.source + f"; the grooves' faces +-{process.position:.2f} mm over "
                  f"the {profile.beam_splitter.length:g} mm plate (the reflected axis turns twice)",
-                 holder.lateral, holder.vertical, 2 * groove))
+                 holder.lateral, holder.vertical, 2 * groove),
+            Link(PLATE_FLOATS[0], "float", f"the grooves {play:g} mm wider than the plate over {length:.1f} mm: "
+                 f"loose, it turns {math.degrees(plate_float_tilt(profile, layout)):.2f} deg in them (the reflected axis "
+                 "twice), and moves after any setting", 0.0, 0.0, 2 * plate_float_tilt(profile, layout),
+                 buy="a retainer holding the plate on its datum flank (RTV dots, a spring tab or a nylon-tipped set "
+                     "screw)"))
 
 
 def _cop_links(profile, layout, process: ProcessErrors, seams) -> tuple[Link, ...]:
@@ -596,6 +608,14 @@ def _verdict(element: str, axis: str, links: tuple[Link, ...], key: str, tol: fl
         return a.range >= worst and a.resolution <= fine
 
     best = next((a for a in cands if serves(a)), None)
+    floats = tuple(k for k in links if k.kind == "float" and k.worst(axis) > 0)
+    drift = sum(k.worst(axis) for k in floats)
+    if drift > tol:  # it moves after any setting: no adjuster holds it
+        unit, f = ("deg", math.degrees) if axis in ANGLES else ("mm", float)
+        return AxisVerdict(element, axis, key, tol, worst, rss, "refused", cands[0] if cands else None,
+                           tuple(k.name for k in floats), tuple(dict.fromkeys(k.buy for k in floats if k.buy)),
+                           f"{', '.join(k.name for k in floats)} float {f(drift):.3g} {unit} after any setting, past the "
+                           f"{f(tol):.3g} {unit} tolerance: an adjuster cannot hold what moves after it is set")
     if worst <= tol:
         return AxisVerdict(element, axis, key, tol, worst, rss, "held", best or (cands[0] if cands else None), names,
                            buys)
@@ -637,10 +657,16 @@ def declared_locators(profile, layout, process: ProcessErrors) -> tuple[Locator,
                 f"two {reg.diameter:g} mm ISO 8734 m6 pins: {lateral * 1e3:.0f} um of fit; {how}", lateral + printed, 0.0,
                 turn)
     # the paraboloid rides on the dome: its chain passes the same register
+    play, _ = plate_play(profile, layout)
+    seated = Link("splitter plate on its datum flank", "joint",
+                  f"held on the grooves' lower flanks by {PLATE_RETAINER['item']} dots cured in the {play:g} mm of play "
+                  "over its back face (rigcad.parts.tower.PLATE_RETAINER): the play is taken out; the flanks' printed "
+                  "position stays, in the splitter holder's link")
     return (Locator("dome register", "dome", DOME_FLOATS, pins),
             Locator("dome register", "paraboloid", DOME_FLOATS, pins),
             Locator("paraboloid on its stops", "paraboloid", PARABOLOID_FLOATS,
-                    _paraboloid_held(profile, layout, process)))
+                    _paraboloid_held(profile, layout, process)),
+            *(Locator("splitter plate retainer", e, PLATE_FLOATS, seated) for e in ("splitter", "cop")))
 
 
 def _paraboloid_held(profile, layout, process: ProcessErrors) -> Link:
@@ -780,5 +806,5 @@ def with_process(printer: Printer, **figures) -> Printer:
 
 
 __all__ = ["ANGLES", "AXES", "ELEMENT_AXES", "AdjusterSpec", "AxisVerdict", "ELEMENTS", "ElementStack", "Link", "Locator", "RESOLUTION_SHARE",
-           "DOME_FLOATS", "PARABOLOID_FLOATS", "declared_locators", "sample_link", "located_adjusters", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
+           "DOME_FLOATS", "PARABOLOID_FLOATS", "PLATE_FLOATS", "declared_locators", "sample_link", "located_adjusters", "SEAT_FLOATS", "StackReport", "check", "default_adjusters", "estimate_seams", "record", "refuse", "seam_link", "seams_from_fab", "seams_from_pieces", "stack",
            "table_lines", "with_process"]

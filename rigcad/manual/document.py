@@ -200,7 +200,9 @@ STEP_TEXT = {
     "camera_body": "Screw the camera to the bracket above the beam splitter through its slot, looking down the "
                    "optical axis.",
     "beam_splitter": "Slide the plate beam splitter into the holder's 45 deg grooves through the +y wall, coated "
-                     "face towards the projector (+x) and down. Handle it by its edges.",
+                     "face towards the projector (+x) and down. Handle it by its edges. Then fix it on its datum flank (the grooves' "
+                     "lower flanks, under its coated face) with the dots of silicone RTV its bill row states, the holder "
+                     "upright while they cure.",
     "focusing_lens": "Drop the focusing lens into the lens mount's square pocket.",
 }
 

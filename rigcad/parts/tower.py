@@ -956,6 +956,46 @@ def _groove(t: TowerLayout) -> Translate:
     return Translate(slab, (0.0, 0.5 * (y0 + y1), 0.0))
 
 
+#: The splitter plate's retainer. The plate lies in its grooves on its coated face (the face that
+#: reflects the projector's light), on the grooves' lower flanks: the datum flank. The grooves are
+#: GROOVE_GAP wider than the plate each side, so, left loose, only gravity seats it and it can turn
+#: across that play (:func:`plate_play`), its reflected axis twice as far. Dots of a neutral-cure
+#: silicone RTV in the gap over its back face, near each end of each groove, dispensed with the holder
+#: standing upright on the bench (the plate then lies on its datum flanks under its own weight, pressed
+#: on with a finger at each edge) and cured there, fill the play: the plate cannot leave its datum flank,
+#: and what remains is the flanks' printed position. Neutral (alkoxy) cure, not acetoxy: acetoxy RTV gives
+#: off acetic acid, which attacks a dielectric or metal coating. The dots sit on the uncoated back face
+#: inside the grooves, outside the clear aperture; a blade takes them off to change the plate.
+PLATE_RETAINER = {"item": "silicone RTV, one-part, neutral (alkoxy) cure, non-corrosive (DOWSIL 3145 class)",
+                  "standard": "MIL-A-46146 (non-corrosive RTV silicone)", "dots_per_groove": 2, "cure_h": 24}
+
+
+def plate_play(profile: Profile, layout) -> tuple[float, float]:
+    """The splitter plate's play in its grooves (mm): the grooves' width across the plate less its
+    thickness (2 GROOVE_GAP, as :func:`_groove` cuts them), and the length of groove it turns over (its
+    own plus GROOVE_GAP at each end)."""
+    p = layout.tower.plate
+    return 2 * GROOVE_GAP, 2 * (p.half_length + GROOVE_GAP)
+
+
+def plate_float_tilt(profile: Profile, layout) -> float:
+    """How far (rad) the plate turns in its grooves when nothing holds it on its datum flank: its play
+    across the grooves over their length (:func:`plate_play`), in the plane of incidence."""
+    play, length = plate_play(profile, layout)
+    return math.atan2(play, length)
+
+
+def plate_retainer_step(profile: Profile) -> str:
+    """The shop step that holds the plate on its datum flank (PLATE_RETAINER), with its figures."""
+    r = PLATE_RETAINER
+    return (f"with the holder upright on the bench and the plate lying on the grooves' lower flanks (its coated face "
+            f"down on them: the datum flank), press each edge onto its flank with a finger and put {r['dots_per_groove']} "
+            f"dots of {r['item']} into each groove's gap over the plate's back face, one near each end (in the grooves, "
+            f"outside the clear aperture); leave the holder upright {r['cure_h']} h while they cure. The cured dots fill "
+            f"the grooves' {2 * GROOVE_GAP:g} mm of play, so the plate cannot turn off its datum flank; cut them with a "
+            "blade to change the plate")
+
+
 def _camera_bracket(t: TowerLayout, profile: Profile) -> tuple[tuple[Box, Box], Box]:
     """The camera bracket on the holder's -y wall (a ledge into the wall's top and an upright) and its
     slot: both camera screws slide in it by travel_along along the axis and travel_across across."""
@@ -1387,6 +1427,9 @@ def hardware(profile: Profile, layout) -> list[dict]:
         {"item": "plate beam splitter", "thread": None, "length_mm": None, "quantity": 1,
          "size_mm": [bs.width, bs.length, bs.thickness], "index": bs.index, "spec": splitter_spec(profile),
          "steps": ('beam_splitter',), "joins": "slides into the splitter holder's grooves through its +y wall, coated face towards the projector"},
+        {"item": PLATE_RETAINER["item"], "thread": None, "length_mm": None, "quantity": 1,
+         "standard": PLATE_RETAINER["standard"], "steps": ('beam_splitter',),
+         "joins": "holds the beam splitter on its datum flank: " + plate_retainer_step(profile)},
         {"item": "focusing lens", "thread": None, "length_mm": None, "quantity": 1,
          "size_mm": [ln.diameter, ln.thickness], "focal_length_mm": focus.focal_length,
          "spec": f"plano-convex singlet, {ln.diameter:g} mm diameter, f = {focus.focal_length:g} mm, N-BK7, "
