@@ -17,15 +17,21 @@ from rigcad.basis.projector import illumination, zone_of
 from rigcad.basis.zonal import basis_indices, check_order
 
 
-def card_light(rig, order: int = 2, bits: int = 8):
+def card_light(rig, order: int = 2, bits: int = 8, circle=None):
     """The :class:`rigcad.calibrate.graycard.Light` of ``rig``'s projector showing the zonal basis
     up to ``order`` (the frames' levels, positive and negative, ``bits`` deep) on its lit pixels,
-    with each pixel's zonal values up to the same order, incidence direction and solid angle (sr)."""
+    with each pixel's zonal values up to the same order, incidence direction and solid angle (sr).
+    ``circle``: the calibration circle as measured (rigcad.basis.measured.MeasuredCircle), whose
+    centre and radius set the projector's image centre and focal length as ``rigcad basis`` reads
+    them (rigcad.basis.measured.projector_frame); None: the design's circle."""
+    from rigcad.basis.measured import Measured, projector_frame
+    from rigcad.basis.projector import trace_pixels
     from rigcad.calibrate.graycard import Light
 
     L = check_order(order)
     zone = zone_of(rig)
-    illum = illumination(rig, zone)
+    focal, centre = projector_frame(rig, None if circle is None else Measured(circle, None, None))
+    illum = illumination(rig, zone, design=trace_pixels(rig, "projector", focal_px=focal, centre=centre))
     s = illum.sampling
     values = basis_images(s, L, zone)
     q = quantise_images(values, bits)
