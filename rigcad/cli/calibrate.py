@@ -26,12 +26,12 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
     if any(getattr(args, k, None) for k in ("gray_card", "gray_card_kit", "gray_card_simulate")):
         return _gray_card(args)
-    for flag in ("exposures_ms", "response_exposures_ms"):
+    for flag in ("exposures_ms", "response_exposures_ms", "circle", "design_circle"):
         if getattr(args, flag, None):
             from rigcad.errors import ExportError
 
             raise ExportError(f"--{flag.replace('_', '-')}: only with --gray-card, --gray-card-simulate or "
-                              "--gray-card-kit (the gray card's exposures)")
+                              "--gray-card-kit (the gray card's exposures and projector circle)")
     if _kit_alone(args) and _kit_read_back(args):
         return 0
     rig, runs = _before_any_work(args)
@@ -502,6 +502,13 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--response-exposures-ms", nargs="+", type=float, metavar="MS", default=None,
                    help="with --gray-card*: the white field's bracket for the response curve "
                         "(default 7.8125 15.625 31.25 62.5 125 250 500)")
+    p.add_argument("--circle", type=float, nargs=3, metavar=("CX", "CY", "R"),
+                   help="with --gray-card*: the calibration circle as measured (manual section 6, "
+                        "calibration/circle.html), its centre and radius in projector pixels from the image's top-left "
+                        "corner, as rigcad basis takes it (default: exports/<profile>/calibrate/circle.json when there, "
+                        "else the design's)")
+    p.add_argument("--design-circle", action="store_true",
+                   help="with --gray-card*: ignore the calibrate/circle.json found beside: the design's circle")
     p.add_argument("--seed", type=int, default=2006, help="seed of the simulated misalignment and noise")
     p.add_argument("--laying", type=int, default=0, metavar="K", help="with --simulate: the screens laid anew the "
                    "K-th time on --seed's rig (its misalignment, surface, spacers and wedges kept; the hand's "
@@ -546,9 +553,11 @@ def _gray_card(args: argparse.Namespace) -> int:
     else:
         plan = dataclasses.replace(plan, turned=True)  # the kit asks for it; the simulation rehearses it
     rig = load(args.profile)
-    light = card_light(rig, plan.order)
+    circle = gray_card_circle(rig, args)
+    light = card_light(rig, plan.order, circle=circle)
+    print(f"  projector images drawn for {_circle_words(circle)}")
     if args.gray_card_kit:
-        return _gray_card_kit(rig, plan, light, Path(args.exports))
+        return _gray_card_kit(rig, plan, light, Path(args.exports), circle)
     view = G.view_of(rig)
     truth = None
     if args.gray_card_simulate:
@@ -560,7 +569,8 @@ def _gray_card(args: argparse.Namespace) -> int:
     else:
         capture = G.read(Path(args.gray_card), plan, view)
     result = G.analyse(plan, capture, view, light)
-    report = {"profile": rig.name, "source": "simulated" if truth else str(args.gray_card), **result.report}
+    report = {"profile": rig.name, "source": "simulated" if truth else str(args.gray_card),
+              "projector_circle": _circle_record(circle), **result.report}
     if truth is not None:
         report["simulation"] = {"seed": args.seed, "planted": "gamma 2.2 camera, 18 % card lying flat, captured again "
                                 "turned a half turn, the camera side falling 20 % to grazing, the light 15 % "
@@ -614,7 +624,38 @@ def _write_gray_capture(folder: Path, plan, view, images: dict, profile: str) ->
           f"--gray-card {folder} reads them)")
 
 
-def _gray_card_kit(rig, plan, light, exports: Path) -> int:
+def gray_card_circle(rig, args: argparse.Namespace):
+    """The calibration circle the gray card's projector images are drawn for, as ``rigcad basis``
+    reads it (rigcad.basis.measured): ``--circle CX CY R``, else ``<exports>/<profile>/calibrate/circle.json``
+    when there (not with ``--design-circle``), else None (the design's circle)."""
+    from rigcad.basis.measured import CIRCLE_JSON, check_circle, read_circle
+
+    given = getattr(args, "circle", None)
+    if given is not None:
+        return check_circle(rig, given[:2], given[2], "--circle")
+    path = Path(args.exports) / rig.name / CIRCLE_JSON
+    if not getattr(args, "design_circle", False) and path.exists():
+        return read_circle(rig, path)
+    return None
+
+
+def _circle_words(circle) -> str:
+    """Which circle, in words, for the command's output."""
+    if circle is None:
+        return "the design's circle (no --circle, no calibrate/circle.json)"
+    return (f"the measured circle ({circle.radius_px:.1f} px about ({circle.centre_px[0]:g}, {circle.centre_px[1]:g}), "
+            f"{circle.source})")
+
+
+def _circle_record(circle) -> dict:
+    """Which circle, for graycard.json and capture_plan.json (px from the image's top-left corner)."""
+    if circle is None:
+        return {"source": "the design's"}
+    return {"centre_px_from_top_left": list(circle.centre_px), "radius_px": circle.radius_px,
+            "source": str(circle.source)}
+
+
+def _gray_card_kit(rig, plan, light, exports: Path, circle=None) -> int:
     """The gray card's kit: the projector images (white.png, z_<l>_<m>_<pos|neg>.png), capture_plan.json
     (every file to capture) and procedure.md, into ``<exports>/<profile>/calibrate_graycard_kit/``."""
     from rigcad.calibrate import graycard as G
@@ -631,7 +672,8 @@ def _gray_card_kit(rig, plan, light, exports: Path) -> int:
                              "file": plan.path(Path("."), f, (plan.response_exposures_ms if f == G.WHITE
                                                               else plan.exposures_ms).index(ms)).name,
                              **({"card": "turned a half turn in the holder"} if f.startswith(G.TURNED) else {})}
-                            for f, ms in files]}
+                            for f, ms in files],
+               "projector_circle": _circle_record(circle)}
     with Staging(out, lock=profile_lock(exports, rig.name), carry=lambda rel: False,
                  made_from=profile_digest(rig.profile)) as st:
         for f in (G.WHITE,) + plan.frames():
