@@ -63,6 +63,9 @@ class RawProfile:
     files: tuple[Path, ...] = ()
     #: For each key of ``marks``, the index in ``sources`` of the file that set it (0: the profile itself).
     depths: dict[Key, int] = field(default_factory=dict)
+    #: What each file of the chain itself says (child first, ``extends`` removed): the value a
+    #: key had in the file that set it, beside the values that file set with it (its own model).
+    layers: tuple[dict[str, Any], ...] = ()
 
     def where(self, key: Key) -> str | None:
         """The file:line that set ``key`` or, failing that, its nearest parent; None if unknown."""
@@ -351,4 +354,4 @@ def load_raw(spec: str | Path) -> RawProfile:
         marks.update({k: v for k, v in layer_marks.items() if k != ("extends",)})
         depths.update({k: depth for k in layer_marks if k != ("extends",)})
     return RawProfile(name=path.stem, data=data, marks=marks, sources=tuple(Path(_display(p)) for p in chain),
-                      files=tuple(chain), depths=depths)
+                      files=tuple(chain), depths=depths, layers=tuple(layer for layer, _ in layers))

@@ -1068,6 +1068,34 @@ def _check_projector(pj: ProjectorParams, where) -> None:
                            where=where("resolution"))
 
 
+def _check_inherited_figures(raw: RawProfile, sections: dict, instrument_marks: dict[Key, str]) -> None:
+    """A projector's or camera's figure (its throw ratio, lens offset, pixel pitch, sizes) that a profile
+    inherits from a file which set it for another model is refused: the figure describes that file's
+    instrument, not the one this profile names. The profile itself may set it (the lab's measurement),
+    and a figure the named instrument file gives wins over the inherited one anyway."""
+    if not raw.layers:
+        return
+    for section in ("projector", "camera"):
+        model_now = getattr(sections[section], "model")
+        default = next(f.metadata["spec"].default for f in fields(SECTIONS[section]) if f.name == "model")
+        for key in instrument_files.FIGURE_KEYS[section]:
+            depth = raw.depth((section, key))
+            if not depth or (section, key) in instrument_marks:
+                continue
+            model_then = next((layer[section]["model"] for layer in raw.layers[depth:]
+                               if isinstance(layer.get(section), dict) and "model" in layer[section]), default)
+            if str(model_then) == str(model_now):
+                continue
+            model_mark = raw.marks.get((section, "model"))
+            raise ProfileError(
+                f"{section}.{key} {_r(raw.data[section][key], 30)} is inherited from {raw.marks[(section, key)]}, "
+                f"where it was set with {section}.model {_r(str(model_then), 40)}, but this profile's {section} is "
+                f"{_r(str(model_now), 40)}" + (f" (set in {model_mark})" if model_mark else "")
+                + f": set {section}.{key} in this profile (your {section}'s own figure, from its datasheet or "
+                f"measured), or name a {section} file that gives it",
+                where=str(raw.sources[0]) if raw.sources else None)
+
+
 def validate(raw: RawProfile) -> Profile:
     """Check every key of ``raw`` and return the frozen :class:`Profile`."""
     valid_top = sorted(set(SECTIONS) | TOP_LEVEL)
@@ -1079,6 +1107,7 @@ def validate(raw: RawProfile) -> Profile:
     sections = {name: read_section(raw, name, cls) for name, cls in SECTIONS.items()}
     chosen, instrument_marks = _with_instruments(raw, sections)
     marks = _profile_marks(raw.marks, instrument_marks)
+    _check_inherited_figures(raw, sections, instrument_marks)
     _check_camera(sections["camera"], lambda key: marks.get(("camera", key)) or instrument_marks.get(("camera", key))
                   or raw.where(("camera",)))
     _check_projector(sections["projector"], lambda key: marks.get(("projector", key))

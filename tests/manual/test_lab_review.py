@@ -54,13 +54,14 @@ def test_the_bought_items_a_step_fits_are_one_sentence_per_use(table31_rig):
 
 
 def test_an_inherited_instrument_figure_is_flagged_with_its_file(tmp_path):
-    """A profile that extends the thesis's and names another projector inherits the BenQ's throw ratio:
-    the bill says which file set it (the base profile's line), not the file that chose the projector."""
-    epson = _profile(tmp_path, "epson", """
+    """A profile that extends the thesis's and restates its projector inherits the BenQ's throw ratio: the
+    bill says which file set it (the base profile's line), not the file that named the projector. (Named
+    with another projector, the inherited figure is refused: tests/profile/test_precedence.py.)"""
+    restated = _profile(tmp_path, "restated", """
         projector:
-          model: epson_eb_w52
+          model: benq_pb6210
         """)
-    spec = B._describe(epson.profile.projector, epson.profile, "projector")
+    spec = B._describe(restated.profile.projector, restated.profile, "projector")
     assert re.search(r"throw ratio 1\.75 \(set in `profiles/achutha2006\.yaml:\d+`, not with the model", spec), spec
     own = rigcad.load("achutha2006")
     assert "not with the model" not in B._describe(own.profile.projector, own.profile, "projector")
@@ -175,15 +176,16 @@ def test_section_6_states_the_lab_temperature_and_the_gray_cards_height(written)
 
 def test_profile_show_marks_an_inherited_figure_not_with_the_model(tmp_path):
     """`rigcad profile show` credits the throw ratio to the base profile's line, and says it did not come with
-    the projector the profile names; on the thesis's own profile no line says so."""
+    the file that names the projector; on the thesis's own profile no line says so. Named with another
+    projector, the inherited throw ratio stops the command in one line, no traceback."""
     import subprocess
     import sys
 
-    path = tmp_path / "epson.yaml"
-    path.write_text("extends: achutha2006\nprojector:\n  model: epson_eb_w52\n", encoding="utf-8")
-    epson = rigcad.load(path).profile
-    assert re.fullmatch(r"profiles/achutha2006\.yaml:\d+", epson.apart_from_model("projector", "throw_ratio") or "")
-    assert epson.apart_from_model("projector", "resolution") is None  # the Epson's file set it
+    path = tmp_path / "restated.yaml"
+    path.write_text("extends: achutha2006\nprojector:\n  model: benq_pb6210\n", encoding="utf-8")
+    restated = rigcad.load(path).profile
+    assert re.fullmatch(r"profiles/achutha2006\.yaml:\d+", restated.apart_from_model("projector", "throw_ratio") or "")
+    assert restated.apart_from_model("projector", "resolution") is None  # the BenQ's file set it
     out = subprocess.run([sys.executable, "-m", "rigcad", "profile", "show", str(path)], capture_output=True,
                          text=True, check=True).stdout
     line = next(x for x in out.splitlines() if x.strip().startswith("throw_ratio"))
@@ -191,3 +193,8 @@ def test_profile_show_marks_an_inherited_figure_not_with_the_model(tmp_path):
     own = subprocess.run([sys.executable, "-m", "rigcad", "profile", "show", "achutha2006"], capture_output=True,
                          text=True, check=True).stdout
     assert "not with" not in own
+    epson = tmp_path / "epson.yaml"
+    epson.write_text("extends: achutha2006\nprojector:\n  model: epson_eb_w52\n", encoding="utf-8")
+    run = subprocess.run([sys.executable, "-m", "rigcad", "profile", "show", str(epson)], capture_output=True, text=True)
+    assert run.returncode != 0 and "Traceback" not in run.stderr, run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1 and "projector.throw_ratio" in run.stderr, run.stderr

@@ -21,6 +21,7 @@ extends: achutha2006
 description: the thesis's rig with the lab's projector, camera and lens
 projector:
   model: epson_eb_w52
+  throw_ratio: 1.75   # the lab's own figure: the base's, inherited with the BenQ, is refused
 camera:
   model: basler_ace_u_aca2040_55uc
   lens: c_mount_16mm
@@ -48,9 +49,10 @@ def test_a_named_instrument_wins_over_the_figures_the_base_profile_states(techni
     assert p.origin("camera", "resolution") == "profiles/instruments/basler_ace_u_aca2040_55uc.yaml:6"
     assert p.source("camera", "resolution").startswith("https://docs.baslerweb.com/aca2040-55uc/")
     assert p.camera.focal_length == 16.0 and p.origin("camera", "focal_length").endswith("c_mount_16mm.yaml:7")
-    # what no file names stays inherited, and says so: the base's throw ratio, the base's file:line
+    # what the lab's profile states wins and is credited to its own line
     assert p.projector.throw_ratio == 1.75 and p.set_by("projector", "throw_ratio") == "profile"
-    assert p.origin("projector", "throw_ratio") == "profiles/achutha2006.yaml:23"
+    assert p.origin("projector", "throw_ratio") == "tech.yaml:5"
+    assert p.origin("projector", "aperture") == "profiles/achutha2006.yaml:24"  # no instrument figure: inherited
     # the inherited value's mark is gone: an error about it points at the file that set it
     assert p.where("projector", "resolution") == "profiles/instruments/epson_eb_w52.yaml:4"
 
@@ -59,7 +61,7 @@ def test_the_design_and_the_bill_use_the_instruments_figures(technician):
     from rigcad.manual.bom import purchased
 
     geo = derive(technician)
-    assert geo.projector_focal_px == pytest.approx(1280 * 1.75)  # the Epson's 1280 columns, the base's throw ratio
+    assert geo.projector_focal_px == pytest.approx(1280 * 1.75)  # the Epson's 1280 columns, the lab's throw ratio
     rows = {r["item"].split(":")[0]: r for r in purchased(SimpleNamespace(profile=technician))}
     assert rows["projector"]["item"].startswith("projector: Epson EB-W52")
     assert rows["camera"]["item"].startswith("camera: Basler ace U acA2040-55uc")
@@ -70,7 +72,7 @@ def test_the_profiles_own_value_wins_over_the_instrument_it_names(tmp_path, monk
     monkeypatch.chdir(tmp_path)
     p = load_profile(_write(tmp_path, "tech", TECHNICIAN + "  resolution: [1920, 1200]\n"))  # camera.resolution
     assert p.camera.resolution == (1920, 1200) and p.set_by("camera", "resolution") == "profile"
-    assert p.origin("camera", "resolution") == "tech.yaml:8"
+    assert p.origin("camera", "resolution") == "tech.yaml:9"
     assert p.camera.pixel_pitch == pytest.approx(3.45e-3)  # the file still gives what the profile does not
 
 
@@ -130,7 +132,7 @@ def test_profile_show_says_where_each_value_in_force_came_from(technician, capsy
         "set_by": "instrument", "where": "profiles/instruments/epson_eb_w52.yaml:4",
         "source": "WXGA, the format Epson sells it as (product page not found by the stored-page search)"}
     assert out["origins"]["camera"]["resolution"]["where"].endswith("basler_ace_u_aca2040_55uc.yaml:6")
-    assert out["origins"]["projector"]["throw_ratio"] == {"set_by": "profile", "where": "profiles/achutha2006.yaml:23"}
+    assert out["origins"]["projector"]["throw_ratio"] == {"set_by": "profile", "where": "tech.yaml:5"}
     assert cmd_show(argparse.Namespace(profile="tech.yaml", json=False)) == 0
     text = capsys.readouterr().out
     rows = text.splitlines()
@@ -149,3 +151,22 @@ def test_a_swept_key_is_the_profiles_own_and_the_rest_keeps_its_precedence(tmp_p
     p = profile_with(raw, parse_set("camera.body_width=20mm..30mm:2"), 20.0)
     assert p.camera.body_width == 20.0 and p.origin("camera", "body_width") == "--set camera.body_width"
     assert p.projector.resolution == (1280, 800)  # still the Epson's, not the base's
+
+
+def test_a_figure_inherited_with_another_model_is_refused(tmp_path, monkeypatch):
+    """A profile that extends the thesis's and names another projector would inherit the BenQ's throw
+    ratio (set beside benq_pb6210 in achutha2006.yaml): refused in one line naming the key, the file:line
+    it came from, the model it was set with, and the two ways out. Restating the same model is no change
+    of projector and is not refused."""
+    from rigcad.errors import ProfileError
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ProfileError) as info:
+        load_profile(_write(tmp_path, "short", "extends: achutha2006\nprojector:\n  model: benq_mw632st\n"))
+    text = str(info.value)
+    assert "\n" not in text, text
+    for part in ("projector.throw_ratio", "profiles/achutha2006.yaml:23", "'benq_pb6210'", "'benq_mw632st'",
+                 "short.yaml:3", "set projector.throw_ratio in this profile", "name a projector file that gives it"):
+        assert part in text, (part, text)
+    same = load_profile(_write(tmp_path, "same", "extends: achutha2006\nprojector:\n  model: benq_pb6210\n"))
+    assert same.projector.throw_ratio == 1.75
