@@ -178,8 +178,23 @@ def camera_crosses(rig) -> dict:
             "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
 
 
-__all__ = ["access", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
+__all__ = ["access", "record_circle", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
 
+
+def record_circle(rig, info: dict) -> str:
+    """The circle step's last paragraph: record the measured circle (centre and radius, px from the
+    image's top-left corner) where ``rigcad basis`` and ``rigcad calibrate --gray-card-kit`` read it
+    (rigcad.basis.measured.CIRCLE_JSON, or their ``--circle CX CY R``)."""
+    from rigcad.basis.measured import CIRCLE_JSON
+
+    w, h = info["resolution_px"]
+    return ("**Record the circle.** When the spot is a point on the mark, write down the centre and radius the page "
+            "shows (h brings the read-out back): they are the projector's measured frame, and every later projector "
+            f"image is drawn for them. Write them into `exports/{rig.name}/{CIRCLE_JSON}` as "
+            f"`{{\"centre_px_from_top_left\": [CX, CY], \"radius_px\": R, \"resolution_px\": [{w}, {h}]}}` (or give "
+            f"them as `--circle CX CY R` to each command): `rigcad basis {rig.name}` draws the basis images and "
+            f"`rigcad calibrate {rig.name} --gray-card-kit` the gray card's for that circle, and each prints which "
+            "circle it used (the design's when it found none).")
 
 #: The adjustable circle page: a full-screen canvas, the disc drawn in device pixels (the projector's
 #: own pixels when the page fills its screen). Keys: arrows move by 1 px (Shift: 10 px), + and - change

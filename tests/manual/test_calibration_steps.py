@@ -1,0 +1,29 @@
+"""Section 6's calibration steps as rigcad.manual.calibration writes them: the measured circle is
+recorded where ``rigcad basis`` and ``rigcad calibrate --gray-card-kit`` read it, in the format they
+read; the gray card's placement is one physically consistent procedure; the instruments are focused
+and locked."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from rigcad.manual import calibration as C
+
+
+def test_the_recorded_circle_is_in_the_format_and_place_basis_reads(table31_rig, tmp_path):
+    from rigcad.basis.measured import CIRCLE_JSON, load_measured
+
+    _, info = C.circle_image(table31_rig)
+    text = C.record_circle(table31_rig, info)
+    assert f"`exports/achutha2006/{CIRCLE_JSON}`" in text
+    assert "`rigcad basis achutha2006`" in text and "`rigcad calibrate achutha2006 --gray-card-kit`" in text
+    template = re.search(r"`(\{.*?\})`", text).group(1)
+    path = tmp_path / "achutha2006" / CIRCLE_JSON
+    path.parent.mkdir(parents=True)
+    path.write_text(template.replace("CX", "515").replace("CY", "380").replace("R", "109"))
+    circle = load_measured(table31_rig, tmp_path).circle  # what rigcad basis reads, found beside
+    assert (circle.centre_px, circle.radius_px) == ((515.0, 380.0), 109.0)
+    assert json.loads(path.read_text())["resolution_px"] == list(table31_rig.profile.projector.resolution)
