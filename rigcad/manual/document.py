@@ -1414,6 +1414,7 @@ def _section_calibrate(d: Doc, c) -> None:
         f"{info['occlusion_radius_px']:.1f} px from the centre are hidden by the paraboloid itself (occlusion limit).")
     d.img("calibration/circle.png", f"calibration/circle.png: the calibration image, {info['resolution_px'][0]} x "
                                     f"{info['resolution_px'][1]} px, shown at page width")
+    d.p(C.record_circle(rig, info))
     _film_step(d, c)
     d.h(3, C.STEP_CAMERA)
     d.p(f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
