@@ -147,8 +147,13 @@ def access(rig) -> list[dict]:
         {"item": "camera cross on the beam", "way": "onto the beam in the paraboloid's place",
          "out_of_the_way": "the dome (the beam and the paraboloid come off with it)", "back": back,
          "checked": "the same clamp as the paraboloid's, at its vertex height"},
-        {"item": "camera cross in the base plate, gray card", "way": bore, "out_of_the_way": "the sample holder",
+        {"item": "camera cross in the base plate", "way": bore, "out_of_the_way": "the sample holder",
          "back": "the holder in the bore", "checked": "the holder's own body and collar"},
+        {"item": "gray card and its foil", "way": "onto the sample holder's top, from above, the first time (to check "
+         "it flush with the plate's top); afterwards on the holder, through " + bore,
+         "out_of_the_way": "the dome the first time; afterwards the sample holder", "back": back + "; the holder in "
+         "the bore", "checked": "the card's face flush with the plate's top (straightedge and feeler leaf); the "
+         "holder's collar sets its height after"},
         {"item": "film at the sample plane, checkerboard disc", "way": "onto the base plate, from above",
          "out_of_the_way": "the dome", "back": back,
          "checked": "the disc cut to the dome's inside at the plate, less 1 mm"},
@@ -178,7 +183,7 @@ def camera_crosses(rig) -> dict:
             "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
 
 
-__all__ = ["access", "record_circle", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
+__all__ = ["access", "gray_card_placement", "record_circle", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
 
 
 def record_circle(rig, info: dict) -> str:
@@ -195,6 +200,31 @@ def record_circle(rig, info: dict) -> str:
             f"them as `--circle CX CY R` to each command): `rigcad basis {rig.name}` draws the basis images and "
             f"`rigcad calibrate {rig.name} --gray-card-kit` the gray card's for that circle, and each prints which "
             "circle it used (the design's when it found none).")
+
+def gray_card_placement(rig, card: dict) -> str:
+    """The gray card step's placement (``card``: rigcad.manual.document.gray_card_seat, mm): the card
+    packed up to O on the sample holder's top and checked flush with the straightedge on the plate's top,
+    which only the dome lifted off lays bare; afterwards the holder's collar, not the dome, sets the card's
+    height, so it comes out and goes back with the holder from below, the dome on."""
+    bolts = len(rig.layout.bolt_angles)
+    top = -card["holder_top_z_mm"]
+    return (f"**Where the card sits.** O, the sample point, is on the base plate's top face (z = 0). The sample "
+            f"holder's top stands **{top:g} mm under it** (`sample_holder.sample_thickness`), at the bottom of the "
+            f"bore's {card['bore_diameter_mm']:.1f} mm pocket, so that a sample of that thickness has its face at O. "
+            "Measure the card's thickness with the caliper and cut a pack of the shim foil (the bill's: "
+            f"{', '.join(f'{v:g}' for v in card['foil_mm'])} mm sheets, cut to a {card['card_diameter_mm']:g} mm "
+            f"disc) of {top:g} mm less the card's thickness: on the holder's top, the card on it, its face is then at "
+            f"O's height, to the thinnest foil's {card['foil_mm'][0]:g} mm. A card thicker than that pocket cannot "
+            "reach O: use a thinner one. "
+            f"**Set it the first time with the dome off**, the one way to reach the plate's top: take out the dome's "
+            f"{bolts} flange screws and lift it off its register pins (as for the checkerboard), the sample holder in "
+            "its bore, its collar home. Lay the foil and the card on the holder's top from above and check with the "
+            "steel straightedge across the bore, on the plate's top either side: a "
+            f"{card['feeler_mm']:g} mm feeler leaf passes under it neither over the plate nor over the card (add or "
+            "take out foil until it does). Set the dome back on its pins and screw it down to its torque (section 5). "
+            "**Afterwards, the dome on:** the holder's collar, not the dome, sets the card's height, so to take the "
+            "card out or put it back (the rig on its lifting blocks) draw the sample holder down out of the bore with "
+            "the foil and the card on its top, and push it back up until its collar stops.")
 
 #: The adjustable circle page: a full-screen canvas, the disc drawn in device pixels (the projector's
 #: own pixels when the page fills its screen). Keys: arrows move by 1 px (Shift: 10 px), + and - change

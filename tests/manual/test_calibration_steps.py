@@ -27,3 +27,18 @@ def test_the_recorded_circle_is_in_the_format_and_place_basis_reads(table31_rig,
     circle = load_measured(table31_rig, tmp_path).circle  # what rigcad basis reads, found beside
     assert (circle.centre_px, circle.radius_px) == ((515.0, 380.0), 109.0)
     assert json.loads(path.read_text())["resolution_px"] == list(table31_rig.profile.projector.resolution)
+
+
+def test_the_gray_card_is_checked_flush_only_while_the_plate_top_is_bare(table31_rig):
+    from rigcad.manual.document import gray_card_seat
+
+    text = C.gray_card_placement(table31_rig, gray_card_seat(table31_rig))
+    lift, check = text.index("lift it off its register pins"), text.index("steel straightedge across the bore")
+    back, below = text.index("Set the dome back on its pins"), text.index("out of the bore")
+    # the straightedge lies on the plate's top: only between the dome coming off and going back on
+    assert lift < check < back, text
+    # from below (through the bore) only once the card's height is checked and the dome is back on
+    assert back < below and "from below" not in text[:back] and "dome on" in text[back:], text
+    assert f"{len(table31_rig.layout.bolt_angles)} flange screws" in text
+    rows = {r["item"]: r for r in C.access(table31_rig)}
+    assert "the dome the first time" in rows["gray card and its foil"]["out_of_the_way"]
