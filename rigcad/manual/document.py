@@ -1335,17 +1335,7 @@ def _calibration_more(d: Doc, c, cam: dict) -> None:
 
     card = gray_card_seat(rig)
     c.gray_card = card
-    d.p(f"**Where the card sits.** O, the sample point, is on the base plate's top face (z = 0). The sample holder's "
-        f"top stands **{-card['holder_top_z_mm']:g} mm under it** (`sample_holder.sample_thickness`), at the bottom "
-        f"of the bore's {card['bore_diameter_mm']:.1f} mm pocket, so that a sample of that thickness has its face at "
-        f"O. Measure the card's thickness with the caliper and lay a pack of the shim foil (the bill's: "
-        f"{', '.join(f'{v:g}' for v in card['foil_mm'])} mm sheets, cut to a {card['card_diameter_mm']:g} mm disc) "
-        f"of {-card['holder_top_z_mm']:g} mm less the card's thickness on the holder's top, the card on it: its face is "
-        f"then at O's height, to the thinnest foil's {card['foil_mm'][0]:g} mm. Check with the steel straightedge "
-        f"across the bore, on the plate's top either side: a {card['feeler_mm']:g} mm feeler leaf passes under it "
-        "neither over the plate nor over the card. A card thicker than that pocket cannot reach O: use a thinner one. "
-        "It goes in from below, the dome on: the rig on its lifting blocks, take the sample holder out of the "
-        "bore, lay the foil and the card on its top and push it back up until its collar stops.")
+    d.p(C.gray_card_placement(rig, card))
     d.p(manual_text(rig))  # the gray card command's own procedure (one home)
 
 
