@@ -269,6 +269,7 @@ def measure_first(d: Doc, c) -> None:
     """What must be measured or chosen before anything is printed: the assumed sizes."""
     rows = assumed_sizes(c.p)
     d.h(2, "0. Before printing: measure or choose")
+    _optics_figures(d, c.p)
     if not rows:
         d.p("Every instrument size in this profile is given, none assumed: nothing to measure first.")
         return
@@ -282,6 +283,23 @@ def measure_first(d: Doc, c) -> None:
         "from and to:")
     for path, caption in measurement_figures(c.p, c.files):
         d.img(path, caption)
+
+
+def _optics_figures(d: Doc, profile) -> None:
+    """The figures that decide the optics (rigcad.profile.instruments.optics_figures), each with where it came
+    from: a figure the profile assumes or does not know is one to read off a datasheet or measure first."""
+    from rigcad.profile.instruments import optics_figures
+
+    said = {"datasheet": "from the instrument file's datasheet", "instrument file": "from the instrument file (no "
+            "source given: check it)", "profile": "set in the profile", "assumed": "**assumed**: read or measure it",
+            "unknown": "**not known**: read or measure it"}
+    figures = optics_figures(profile)
+    open_ = sum(f.state in ("assumed", "unknown") for f in figures)
+    d.p(f"The figures that decide the optics: the field of view, where the paraboloid's disc sits in the image, "
+        f"the camera's lens in millimetres and how near it focuses. **{open_} of {len(figures)} are assumed or not "
+        "known**; write each one you read or measure into the profile under its key and build again.")
+    d.table(["key", "value", "what it is", "where it came from", "how to read or check it"],
+            [[f"`{f.key}`", f.value, f.what, f"{said[f.state]} (`{f.origin}`)", f.how] for f in figures])
 
 
 def measurement_figures(profile, files: dict) -> list[tuple[str, str]]:

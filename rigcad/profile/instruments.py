@@ -429,6 +429,59 @@ def size_origin(profile, section: str, keys: tuple[str, ...]) -> str:
     return f"size from {', '.join(files)}" + (" and the profile" if "profile" in by.values() else "")
 
 
+#: The figures that decide the optics (the field of view, where the paraboloid's disc sits in the image,
+#: the lens in millimetres, what the camera can focus on), with how a lab reads or checks each: not sizes
+#: of a body, so no outline figure; the manual lists them before printing with where each came from.
+OPTICS_FIGURES: dict[str, str] = {
+    "projector.throw_ratio": "the projector's datasheet, or: project a full white image on a wall square to the "
+                             "axis, throw distance (wall to the lens's pupil) / the image's width",
+    "projector.lens_offset": "the datasheet's offset, or: on that wall, (the image's centre height - the lens "
+                             "axis's height) / half the image's height",
+    "camera.pixel_pitch": "the camera's or its sensor's datasheet (sensor width / pixels across)",
+    "camera.min_working_distance": "the lens's datasheet (MOD), or: focus at its nearest setting and measure from "
+                                   "the lens's front to the nearest sharp object",
+}
+
+
+@dataclass(frozen=True)
+class OpticsFigure:
+    """One figure that decides the optics, as section 0 of the manual lists it: its key, its value in
+    force (text with its unit), what it is, how a lab reads or checks it, where it came from
+    (``profile.origin``: a file:line or "default") and ``state``: "datasheet" (an instrument file
+    gives it with its source), "instrument file" (given without a source), "profile" (the profile's
+    file states it), "assumed" (the schema's default) or "unknown" (no default: not checked)."""
+
+    key: str
+    value: str
+    what: str
+    how: str
+    origin: str
+    state: str
+
+
+def optics_figures(profile) -> list[OpticsFigure]:
+    """The figures of :data:`OPTICS_FIGURES` for ``profile`` (a validated Profile), each with where it
+    came from; the throw ratio, lens offset, pixel pitch and the camera lens's closest focus."""
+    from dataclasses import fields
+
+    out = []
+    for key, how in OPTICS_FIGURES.items():
+        section, name = key.split(".")
+        params = getattr(profile, section)
+        spec = next(f.metadata["spec"] for f in fields(params) if f.name == name)
+        value = getattr(params, name)
+        by = profile.set_by(section, name)
+        if value is None:
+            text, state = "unknown", "unknown"
+        else:
+            text = {"length": f"{value * 1000:g} um" if name == "pixel_pitch" else f"{value:g} mm",
+                    "fraction": f"{value:g} half image heights", "float": f"{value:g}"}.get(spec.kind, f"{value}")
+            state = {"profile": "profile", "default": "assumed"}.get(
+                by, "datasheet" if profile.source(section, name) else "instrument file")
+        out.append(OpticsFigure(key, text, spec.doc, how, profile.origin(section, name), state))
+    return out
+
+
 def measurements(profile) -> list[Measurement]:
     """What must be measured before printing, for ``profile`` (a validated Profile): each projector
     and camera size that neither an instrument file the profile names gives nor the profile sets
@@ -455,5 +508,5 @@ def measurements(profile) -> list[Measurement]:
 
 
 __all__ = ["CAMERA_SIZES", "C_MOUNT_FLANGE", "DEFAULT_MOUNT_INSET", "FIGURES", "FIGURE_KEYS", "Instrument", "Measurement",
-           "NAMED_BY", "PROJECTOR_SIZES", "PUPIL_READ_MM", "PUPIL_WALLS_MM", "Sketch", "find", "folders", "measurements", "mount_pattern", "projector_pupil", "pupil_from_widths", "read", "shipped",
+           "NAMED_BY", "OPTICS_FIGURES", "OpticsFigure", "PROJECTOR_SIZES", "PUPIL_READ_MM", "PUPIL_WALLS_MM", "Sketch", "find", "folders", "measurements", "mount_pattern", "optics_figures", "projector_pupil", "pupil_from_widths", "read", "shipped",
            "size_origin", "sketch"]
