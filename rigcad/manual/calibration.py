@@ -183,7 +183,7 @@ def camera_crosses(rig) -> dict:
             "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
 
 
-__all__ = ["access", "gray_card_placement", "record_circle", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
+__all__ = ["access", "checker_text", "gray_card_placement", "record_circle", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
 
 
 def record_circle(rig, info: dict) -> str:
@@ -347,18 +347,73 @@ def camera_correspondence(rig) -> dict:
     ``tolerancing.camera_offset`` shifts the rim's image by f_px offset / (COP to rim plane) and a tilt
     ``tolerancing.camera_tilt`` by f_px tan(tilt), together the centre's band; a height error
     ``tolerancing.camera_height`` scales the radius by height / (COP to rim plane), the radius's band.
-    Neither band is finer than EDGE_READ_PX."""
+    Neither band is finer than EDGE_READ_PX.
+
+    The disc is read against the checkerboard, which the camera sees directly (not through the mirrors:
+    every ray through them lands on O, in the bore's hole) in a ring about it: the plate from the
+    paraboloid's shadow out to where the dome's top opening cuts the view from the COP
+    (``direct_ring_mm``, mm from O on z = 0; ``ring_px`` in each lens's pixels). ``lenses``: the figures
+    for the camera model's focal length and, when the bill names a lens to buy
+    (rigcad.manual.camera_lens), for that lens too (every figure scales with f_px)."""
+    from rigcad.manual.camera_lens import camera_lens
     from rigcad.optics.camera import camera_model
 
-    g, t = rig.geometry, rig.profile.tolerancing
+    g, t, lay = rig.geometry, rig.profile.tolerancing, rig.layout
     cam = camera_model(rig.profile, g)
     reach = g.cop_z - g.rim_z  # the COP to the rim's plane (mm)
-    centre_band = cam.focal_px * (t.camera_offset / reach + math.tan(t.camera_tilt))
-    radius_band = cam.image_radius_px * t.camera_height / reach
-    return {"principal_point_px": list(cam.principal_point), "image_radius_px": cam.image_radius_px,
-            "centre_tolerance_px": max(centre_band, EDGE_READ_PX),
-            "radius_tolerance_px": max(radius_band, EDGE_READ_PX),
-            "focal_length_px": cam.focal_px}
+    shadow = g.rim_radius * g.cop_z / reach  # the paraboloid's shadow on the plate, seen from the COP
+    dome = lay.printed_dome
+    top_r, top_z = (float(v) for v in dome.points(np.array([dome.u_range[1]]))[0])
+    outer = min(top_r * g.cop_z / (g.cop_z - top_z), checkerboard(rig)["disc_radius_mm"])
+
+    def figures(name: str, f_px: float) -> dict:
+        centre_band = f_px * (t.camera_offset / reach + math.tan(t.camera_tilt))
+        radius_band = f_px * g.rim_radius / reach * t.camera_height / reach
+        return {"lens": name, "focal_length_px": f_px, "image_radius_px": f_px * g.rim_radius / reach,
+                "centre_tolerance_px": max(centre_band, EDGE_READ_PX),
+                "radius_tolerance_px": max(radius_band, EDGE_READ_PX),
+                "ring_px": [f_px * shadow / g.cop_z, f_px * outer / g.cop_z]}
+
+    lenses = [figures("the camera model's", cam.focal_px)]
+    buy = camera_lens(rig)
+    if buy is not None and buy["buy_focal_length_mm"] != buy["focal_length_mm"]:
+        lenses.append(figures(f"the bill's {buy['buy_focal_length_mm']:g} mm",
+                              cam.focal_px * buy["buy_focal_length_mm"] / buy["focal_length_mm"]))
+    out = {"principal_point_px": list(cam.principal_point), **{k: v for k, v in lenses[0].items() if k != "lens"}}
+    out.update({"direct_ring_mm": [shadow, outer], "squares_across_ring": (outer - shadow) / CHECKER_SQUARE_MM,
+                "lenses": lenses})
+    out["image_radius_px"] = cam.image_radius_px
+    return out
+
+
+def checker_text(corr: dict) -> str:
+    """The checkerboard step's comparison and pass (``corr``: :func:`camera_correspondence`): what the
+    camera sees of the board (directly, in the ring about the paraboloid's image: the background the
+    disc's edge is read against, thesis 4.1 and Figure 4.2) and the pass figures for each lens."""
+    (x0, y0) = corr["principal_point_px"]
+    inner, outer = corr["direct_ring_mm"]
+    per_lens = "; ".join(
+        f"with {lens['lens']} lens (f = {lens['focal_length_px']:.0f} px), the design's radius **{lens['image_radius_px']:.1f} px**, "
+        f"the centre within **{lens['centre_tolerance_px']:.1f} px** of the principal point and the radius within "
+        f"**{lens['radius_tolerance_px']:.1f} px** of that, the board's ring {lens['ring_px'][0]:.0f} to "
+        f"{lens['ring_px'][1]:.0f} px from the centre" for lens in corr["lenses"])
+    which = (" Use the figures of the lens on the camera: the first are the camera model's focal length, the second "
+             "the lens the bill names to buy." if len(corr["lenses"]) > 1 else "")
+    return ("**What is compared, and what passes.** Project the calibrated circle and take a picture with the camera: "
+            "the paraboloid's image is a lit disc. The camera does not see the checkerboard through the mirrors (every "
+            "ray through them lands on O, in the disc's hole over the bore): it sees it directly, through the dome's "
+            f"top opening, in a ring about the lit disc, the plate from {inner:.1f} mm (the paraboloid's shadow) to "
+            f"{outer:.1f} mm from O, about {corr['squares_across_ring']:.0f} squares across, crossed by the beam's "
+            "shadow. That ring is the background the disc's bright edge is read against (thesis 4.1, Figure 4.2). No "
+            "rigcad command reads it: in an image viewer that shows the pointer's pixel (GIMP's status bar, for one), "
+            "read three points on the disc's edge far apart, where the lit disc meets the squares, and take the circle "
+            f"through them (its centre and radius). The design puts the centre on the principal point (**{x0:.1f}, "
+            f"{y0:.1f} px**). It passes when the centre and radius read are within the bands of the lens on the camera: "
+            f"{per_lens} (the centre's band is what `tolerancing.camera_offset` and "
+            "`camera_tilt` move it by, the radius's `tolerancing.camera_height`, never finer than the pixel an edge is "
+            f"read to).{which} Outside either band the camera is off its place: go back to its crosses (and its shims "
+            "for the radius). The circle's centre and radius, as read, are then the camera's correspondence: where "
+            "the paraboloid's rim and vertex fall in its pixels.")
 
 
 def kit_items(rig) -> list[KitItem]:
