@@ -1333,21 +1333,7 @@ def _calibration_more(d: Doc, c, cam: dict) -> None:
         "(section 5). Then lift the dome again to take the disc out.")
     corr = C.camera_correspondence(rig)
     c.correspondence = corr
-    (x0, y0), r0 = corr["principal_point_px"], corr["image_radius_px"]
-    d.p("**What is compared, and what passes.** Project the calibrated circle and take a picture with the camera: "
-        "the paraboloid's image is a lit disc, the checkerboard's squares seen in it through the mirrors. No rigcad "
-        "command reads it: in an image viewer that shows the pointer's pixel (GIMP's status bar, for one), read "
-        "three points on the disc's edge far apart, and take the circle through them (its centre and radius). The "
-        f"design puts the centre on the principal point (**{x0:.1f}, {y0:.1f} px**) and the radius at "
-        f"**{r0:.1f} px** (f = {corr['focal_length_px']:.0f} px x tan(the rim's angle at the COP)). It passes when "
-        f"the centre is within **{corr['centre_tolerance_px']:.1f} px** of the principal point (what "
-        "`tolerancing.camera_offset` and `camera_tilt` move it by) and the radius within "
-        f"**{corr['radius_tolerance_px']:.1f} px** of the design's (`tolerancing.camera_height`, but never finer than "
-        "the pixel an edge is read to), and the squares "
-        "run on unbroken to the disc's edge (a break or a doubled band is a seam or a slope fault of the mirrors). "
-        "Outside either band the camera is off its place: go back to its crosses (and its shims for the radius). "
-        "The circle's centre and radius, as read, are then the camera's correspondence: where the paraboloid's "
-        "rim and vertex fall in its pixels.")
+    d.p(C.checker_text(corr))
     d.h(3, C.STEP_GRAY)
     from rigcad.calibrate.graycard import manual_text
 
