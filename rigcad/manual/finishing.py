@@ -25,10 +25,6 @@ import numpy as np
 #: Largest stand-off (mm) of a flat sanding block from the design curve: 1 mil (0.0254 mm), the
 #: thinnest coat: a sanding error a coat cannot fill must stay under it.
 BLOCK_SAG_MM = 0.0254
-#: Kerf (mm, the width the cut removes) by cutting process, for the templates' outline offset: the
-#: cutter's path runs half a kerf outside the outline. Typical figures from the processes' practice:
-#: CO2 / fibre laser in 1-3 mm sheet, abrasive waterjet, a 3 mm end mill on a CNC router.
-KERF_MM = {"laser": 0.2, "waterjet": 0.9, "router": 3.0}
 
 
 def principal_radii(meridian, samples: int = 4001) -> dict:
@@ -328,6 +324,79 @@ LAYER_METHODS = {
 }
 
 
+# -- the templates' material, cutting and check ---------------------------------------------------------
+#: What the templates are made of: stainless sheet keeps its edge (a file and an oil stone finish it, it does
+#: not dent under a feeler leaf, and it does not rust under the wet sanding).
+TEMPLATE_MATERIAL = "stainless steel sheet 1.4301 (AISI 304), cold rolled"
+#: How far (mm) a laser or waterjet cut edge lands from its path, typical of job-shop cutting in 1-3 mm sheet:
+#: far coarser than the gaps a template must show, so the gauging edge is cut this much proud and finished.
+CUT_EDGE_MM = 0.1
+#: An optical comparator (profile projector) with a measuring stage reads an edge point to (3 + L / 50) um
+#: over a stage travel of L mm (the stage accuracy makers state for 20x profile projectors, e.g. Mitutoyo's
+#: PJ-A3000 series): the check of a template's edge against its drawing's coordinates.
+COMPARATOR_UM = (3.0, 1.0 / 50.0)
+#: A template's edge may stand off its outline by at most this share of the smallest gap it must show: a
+#: quarter, so that an edge error cannot turn a right gap into a leaf's wrong reading.
+EDGE_SHARE = 0.25
+
+
+def template_gaps(profile) -> list[float]:
+    """The gaps (mm) a template must show, in the recipe's order: the bare print sanded to size (every layer up
+    to and including the gauged one still to come), then after each layer up to the gauged one (0: flush)."""
+    from rigcad.parts.templates import gauged_depth
+
+    gap = float(sum(t for _, t in profile.coating.layers)) - gauged_depth(profile)
+    out = [gap]
+    for _, t in profile.coating.layers:
+        if gap <= 1e-9:
+            break
+        gap -= t
+        out.append(max(0.0, gap) if abs(gap) > 1e-9 else 0.0)
+    return out
+
+
+def template_making(profile, templates: list[dict]) -> list[dict]:
+    """How each template (a :func:`template_datums` row) is made and checked: its material and sheet thickness
+    (``templates.thickness``), the cut with CUT_EDGE_MM left on the gauging edge, the edge finished to its
+    outline and checked on an optical comparator, whose accuracy over the template's width (COMPARATOR_UM)
+    must be within the edge tolerance: EDGE_SHARE of the smallest non-zero gap the template shows (mm)."""
+    gaps = template_gaps(profile)
+    smallest = min(g for g in gaps if g > 1e-9) if any(g > 1e-9 for g in gaps) else 0.0
+    tolerance = EDGE_SHARE * smallest
+    out = []
+    for row in templates:
+        span = max(row["width_mm"], row["height_mm"])
+        accuracy = 1e-3 * (COMPARATOR_UM[0] + COMPARATOR_UM[1] * span)
+        out.append({"template": row["template"], "material": TEMPLATE_MATERIAL, "thickness_mm": profile.templates.thickness,
+                    "cut_edge_mm": CUT_EDGE_MM, "gaps_mm": gaps, "smallest_gap_mm": smallest,
+                    "edge_tolerance_mm": tolerance, "span_mm": span, "comparator_accuracy_mm": accuracy,
+                    "checkable": accuracy <= tolerance})
+    return out
+
+
+def template_making_text(rows: list[dict]) -> str:
+    """The manual's paragraph on making the templates, from :func:`template_making`'s rows."""
+    if not rows:
+        return ""
+    r0 = rows[0]
+    each = "; ".join(f"`{r['template']}` {r['span_mm']:.0f} mm across: {r['comparator_accuracy_mm']:.4f} mm"
+                     + ("" if r["checkable"] else " (**more than its edge tolerance: check it in sections of at most "
+                        f"{(r['edge_tolerance_mm'] * 1e3 - COMPARATOR_UM[0]) / COMPARATOR_UM[1]:.0f} mm of stage travel, "
+                        "re-zeroed on the drawing between them**)") for r in rows)
+    gaps = ", ".join("flush" if g <= 1e-9 else f"{g:.3f} mm" for g in r0["gaps_mm"])
+    return (f"**The templates' material and accuracy.** Each template is {r0['material']}, {r0['thickness_mm']:g} mm "
+            f"(`templates.thickness`), laser or waterjet cut from its `outlines/<template>.dxf` with the cutter's path "
+            f"half a kerf outside the outline and the gauging edge left {r0['cut_edge_mm']:g} mm proud (a cut edge "
+            f"lands within about {r0['cut_edge_mm']:g} mm of its path, coarser than any gap it must show). The gauging "
+            f"edge is then filed and stoned to its outline on an optical comparator (a profile projector with a "
+            f"measuring stage, 20x), point by point against the drawing's coordinates, and the datum marked as its "
+            f"drawing shows it. The gaps it must show are {gaps}: its edge must lie within "
+            f"**{r0['edge_tolerance_mm']:.4f} mm** of the outline ({EDGE_SHARE:g} of the smallest gap, "
+            f"{r0['smallest_gap_mm']:.3f} mm), and the comparator's stage reads to (3 + L/50) um over L: {each}. "
+            "A laser-cut edge unfinished, or one checked against a paper print (a printer places a line to about "
+            "0.1 mm), cannot show these gaps.")
+
+
 def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str, str, str, str, str]]:
     """The finishing recipe, stage by stage, from print to mirror: (stage, what, how, cure / wait, check).
 
@@ -366,5 +435,6 @@ def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str,
 
 
 __all__ = ["ABRASIVE", "ABRASIVE_MM", "BLOCK_LENGTH_MM", "BLOCK_SAG_MM", "block_bands", "block_part", "block_slide",
-           "sanding_block_set", "template_datums", "template_text", "CLEAR_REFLECTANCE", "KERF_MM", "LAYER_METHODS", "principal_radii", "recipe",
-           "placement_spot", "sanding_blocks", "slope_acceptance"]
+           "sanding_block_set", "template_datums", "template_text", "CLEAR_REFLECTANCE", "LAYER_METHODS", "principal_radii", "recipe",
+           "placement_spot", "sanding_blocks", "slope_acceptance", "COMPARATOR_UM", "CUT_EDGE_MM",
+           "EDGE_SHARE", "TEMPLATE_MATERIAL", "template_gaps", "template_making", "template_making_text"]
