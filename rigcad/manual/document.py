@@ -602,9 +602,13 @@ def _section_sand(d: Doc, c) -> None:
     for name, e in fab_report["parts"].items():
         if "polishing" in e:
             stock = printed_stock(e)
-            sand.append(f"`{name}`: sand away the print's staircase, {e['polishing']['sanding_depth_mm']:.3f} mm "
-                        "deep at most (the steps' height; the mirror was printed forward by "
-                        f"{stock:.3f} mm of sanding stock, so sanding stops before the design)")
+            need = e["polishing"]["stock_to_add_mm"]
+            sand.append(f"`{name}`: sand the print's staircase flat. Its steps stand up to "
+                        f"{e['polishing']['sanding_depth_mm']:.3f} mm from crest to valley; the whole mirror was "
+                        f"printed {stock:.3f} mm forward of the design (its sanding stock), which keeps even the "
+                        f"deepest valley {max(0.0, stock - need):.3f} mm in front of the design. So the sanding takes "
+                        "the crests down, more at a crest than the stock, and stops where the guide coat is gone from "
+                        "the valleys and the template shows its first gap: it never reaches the design surface")
     d.ul(sand)
     d.p(f"The templates (`dome_template`, `paraboloid_template`, cut from plate) carry the surface of the "
         f"**{gauged}** layer. Sanded to size, the bare print lies {total - gd:.3f} mm ({_mil(total - gd)}: the layers "
@@ -1138,12 +1142,12 @@ def _section_finish(d: Doc, c) -> None:
     blocks = F.sanding_blocks(c.rig)
     block_set = F.sanding_block_set(c.rig)
     sanding_blocks(d, c, block_set)
-    d.p("The templates: cut them with the cutter's path half a kerf outside the outline (" +
-        ", ".join(f"{k} {v:g} mm" for k, v in F.KERF_MM.items()) + " kerf), so the edge lands on the outline, and "
-        "mark each one's datum as its "
-        "drawing in section 3 shows it. " + " ".join(F.template_text(r) for r in c.templates)
-        + " Check in at least four meridional planes, a quarter turn apart.")
+    making = F.template_making(c.p, c.templates)
+    d.p(F.template_making_text(making))
+    d.p(" ".join(F.template_text(r) for r in c.templates) + " Check in at least four meridional planes, a quarter "
+        "turn apart.")
     c.finishing = {"blocks": blocks, "acceptance": F.slope_acceptance(c.rig), "templates": c.templates,
+                   "template_making": [{k: v for k, v in r.items()} for r in making],
                    "block_set": [{k: v for k, v in r.items() if k != "part"} for r in block_set]}
 
 
