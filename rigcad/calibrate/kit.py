@@ -244,7 +244,9 @@ the image's columns and rows, the screen's axes at each turn and the patterns ar
   {100 * p.coating.reflectance ** 2:.0f} % of the ring's light. That is expected; do not raise the exposure for it.
 {_upright_exposure(p)}- Keep the room dark: stray light lowers the fringes' modulation (pixels under
   {cal.min_modulation:g} modulation are not decoded).
-- Focus between the two screen heights; a little defocus is harmless.
+- Leave the camera's focus where section 6 set it, on the hung cross, its ring taped: refocusing moves the
+  camera's COP (its lens's entrance pupil) and changes its focal length in pixels, which the fit holds.
+  The screens, seen through the two mirrors, may look a little soft: that is harmless.
 - The screen reaches rays up to {reach:.0f} deg from the axis at the highest spacer: beyond that
   {"the lower spacer's and then the upright display's captures take over" if cal.upright_turns else
    "the corrected map is filled from the fit"}.

@@ -183,7 +183,7 @@ def camera_crosses(rig) -> dict:
             "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
 
 
-__all__ = ["access", "checker_text", "gray_card_placement", "record_circle", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
+__all__ = ["access", "camera_focus_and_lock", "checker_text", "instrument_torques", "projector_focus", "projector_focus_text", "projector_lock", "gray_card_placement", "record_circle", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
 
 
 def record_circle(rig, info: dict) -> str:
@@ -414,6 +414,73 @@ def checker_text(corr: dict) -> str:
             f"read to).{which} Outside either band the camera is off its place: go back to its crosses (and its shims "
             "for the radius). The circle's centre and radius, as read, are then the camera's correspondence: where "
             "the paraboloid's rim and vertex fall in its pixels.")
+
+
+def projector_focus(rig) -> dict:
+    """The projector's focus setting (mm from its COP, rigcad.optics.focus.focusing_lens): the paraboloid,
+    through the focusing lens, needs the projector focused at ``focus_near`` (its vertex) to ``focus_far``
+    (its rim); ``focus_mm`` is the setting midway between them in dioptres, which leaves both ends equally
+    out of focus, set on a card without the lens (the lens then images that distance onto the paraboloid);
+    ``from_front_mm``: the same from the lens barrel's front (``projector.pupil_depth`` behind it)."""
+    from rigcad.optics.focus import focusing_lens
+
+    lens = focusing_lens(rig.profile, rig.geometry)
+    mid = 2.0 / (1.0 / lens.focus_near + 1.0 / lens.focus_far)
+    return {"focus_near_mm": lens.focus_near, "focus_far_mm": lens.focus_far, "focus_mm": mid,
+            "from_front_mm": mid - rig.profile.projector.pupil_depth, "lens_focal_length_mm": lens.focal_length}
+
+
+def instrument_torques(rig, printer) -> dict:
+    """The projector's and the camera's screws: (count, thread, torque N m) from the torque table
+    (rigcad.fab.loads.bolt_loads), keyed "projector" and "camera"."""
+    from rigcad.fab.loads import bolt_loads
+
+    rows = {b.joint: b for b in bolt_loads(rig.profile, rig.layout, printer)}
+    pj, cm = rows["projector on the shelf's slots"], rows["camera on its bracket's slot"]
+    return {"projector": (pj.count, pj.thread, pj.torque_nm), "camera": (cm.count, cm.thread, cm.torque_nm)}
+
+
+def projector_lock(rig, printer) -> str:
+    """The crosses step, before the plate and the crosses come off: the projector's screws locked to the
+    torque table's torque (:func:`instrument_torques`), the shadows checked again after."""
+    n, thread, torque = instrument_torques(rig, printer)["projector"]
+    return (f"**Lock the projector:** tighten its {n} {thread} screws crosswise with the torque screwdriver to "
+            f"**{torque:.2f} N m** (section 5's torque table), in two passes, and project the white image again: the "
+            "two shadows must still coincide on the backplate's cut cross; if tightening moved them, loosen, correct "
+            "and tighten again.")
+
+
+def projector_focus_text(rig) -> str:
+    """The crosses step, the plate and crosses off, the holder still off and the focusing lens out: the
+    projector focused with its own lens on a card at :func:`projector_focus`'s distance."""
+    f = projector_focus(rig)
+    return (f"**Focus the projector** now, the holder still off and the focusing lens out: through the f = "
+            f"{f['lens_focal_length_mm']:g} mm lens the paraboloid needs the projector focused at "
+            f"{f['focus_near_mm'] / 1e3:.2f} m (its vertex) to {f['focus_far_mm'] / 1e3:.2f} m (its rim) from its COP. "
+            f"Show the circle page and hold a white card square to the beam where it runs on past the shelf's end, "
+            f"**{f['from_front_mm'] / 1e3:.2f} m** from the lens barrel's front along the beam ({f['focus_mm'] / 1e3:.2f} m "
+            "from the COP, `projector.pupil_depth` behind the front: midway in dioptres, both ends equally soft; a "
+            "flat mirror may fold the beam if something stands in its way, the distance along the beam counts). Turn "
+            "the projector's focus until the circle's edge is sharpest on the card, then tape its focus ring.")
+
+
+def camera_focus_and_lock(rig, printer) -> str:
+    """The camera crosses step's end: one focus rule (the hung cross, thesis 4.1: the camera's pixels are
+    read as points of the paraboloid, whose vertex it marks) kept for the rest of the calibration and the
+    measurements, and the camera's screws locked to the torque table's torque, the crosses checked after."""
+    g = rig.geometry
+    vertex = g.cop_z - g.vertex_z
+    rim = math.hypot(g.rim_radius, g.cop_z - g.rim_z)
+    n, thread, torque = instrument_torques(rig, printer)["camera"]
+    return (f"**Focus the camera** on the hung cross, once (thesis 4.1): it stands at the paraboloid's vertex, "
+            f"{vertex:.0f} mm from the COP (the rim {rim:.0f} mm), and the camera's pixels are read as points of the "
+            "paraboloid (the checkerboard's correspondence, next). Stop the lens down until the cross's arms stay "
+            "sharp out to their ends. Then tape the focus ring and leave it for the rest of the calibration and every "
+            "measurement: refocusing moves the lens's entrance pupil, the camera's COP, and changes its focal length "
+            "in pixels, which the correspondence and `rigcad calibrate`'s fit both hold. "
+            f"**Lock the camera:** tighten its {n} {thread} screws to **{torque:.2f} N m** (section 5's torque table), "
+            "in two passes, and check that the two crosses still overlap symmetrically; if tightening moved them, "
+            "loosen, correct and tighten again.")
 
 
 def kit_items(rig) -> list[KitItem]:

@@ -6,6 +6,7 @@ and locked."""
 from __future__ import annotations
 
 import json
+import math
 import re
 
 import pytest
@@ -69,3 +70,40 @@ def test_the_checkerboard_is_judged_where_the_camera_sees_it_with_the_bills_lens
         assert f"the design's radius **{lens_['image_radius_px']:.1f} px**" in text
         assert f"within **{lens_['centre_tolerance_px']:.1f} px**" in text
     assert f"{inner:.1f} mm (the paraboloid's shadow) to {outer:.1f} mm from O" in text
+
+
+def test_the_projector_is_focused_at_the_distance_the_lens_images_onto_the_paraboloid(table31_rig):
+    from rigcad.optics.focus import focusing_lens
+
+    g, s = table31_rig.geometry, table31_rig.profile.lens.distance
+    f = C.projector_focus(table31_rig)
+    lens = focusing_lens(table31_rig.profile, g)
+    # thin lens (1/u = 1/f + 1/(D - s)): the card's distance D lands between the vertex and the rim
+    u = 1.0 / (1.0 / lens.focal_length + 1.0 / (f["focus_mm"] - s))
+    vertex, rim = g.cop_z - g.vertex_z - s, math.hypot(g.rim_radius, g.cop_z - g.rim_z) - s
+    assert vertex < u < rim, (vertex, u, rim)
+    # midway in dioptres: the vertex and the rim equally out of focus
+    assert 1 / f["focus_near_mm"] - 1 / f["focus_mm"] == pytest.approx(1 / f["focus_mm"] - 1 / f["focus_far_mm"])
+    assert (round(f["focus_near_mm"] / 1e3, 2), round(f["focus_far_mm"] / 1e3, 2)) == (1.36, 2.53)  # rig-mechanics.md
+    text = C.projector_focus_text(table31_rig)
+    assert f"**{f['from_front_mm'] / 1e3:.2f} m** from the lens barrel's front" in text and "focusing lens out" in text
+
+
+def test_the_instruments_are_locked_to_the_torque_tables_torque_and_the_camera_focused_once(table31_rig):
+    from rigcad.fab.loads import bolt_loads
+    from rigcad.fab.printers import load_printer
+
+    printer = load_printer("prusa_mk3s")
+    rows = {b.joint: b for b in bolt_loads(table31_rig.profile, table31_rig.layout, printer)}
+    lock = C.projector_lock(table31_rig, printer)
+    cam = C.camera_focus_and_lock(table31_rig, printer)
+    pj, cm = rows["projector on the shelf's slots"], rows["camera on its bracket's slot"]
+    assert f"its {pj.count} {pj.thread} screws" in lock and f"**{pj.torque_nm:.2f} N m**" in lock
+    assert f"its {cm.count} {cm.thread} screws" in cam and f"**{cm.torque_nm:.2f} N m**" in cam
+    assert "still coincide" in lock and "still overlap" in cam  # the alignment checked after tightening
+    # one camera focus rule: the hung cross, kept; the deflectometry page no longer refocuses it
+    assert "on the hung cross" in cam and "tape the focus ring" in cam
+    from rigcad.calibrate.kit import manual_page
+
+    page = manual_page(table31_rig)
+    assert "Focus between" not in page and "section 6 set it, on the hung cross" in page
