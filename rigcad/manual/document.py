@@ -1390,7 +1390,7 @@ def _section_calibrate(d: Doc, c) -> None:
     d.table(["item", "goes in", "what comes out of its way", "which goes back", "checked"],
             [[r["item"], r["way"], r["out_of_the_way"], r["back"], r["checked"]] for r in C.access(rig)])
     springs = spring_bolts(rig)
-    _crosses(d, pshadow, springs, p)
+    _crosses(d, pshadow, springs, p, rig, c.printer)
     seat = C.splitter_seat(rig)
     if seat:
         _seat_section(d, c, seat, springs)
@@ -1419,9 +1419,10 @@ def _section_calibrate(d: Doc, c) -> None:
         f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm) and put the `camera_cross_base` in the sample holder's place "
         f"(its top on z = 0). From the COP (z = {cam['cop_z_mm']:.1f} mm) the hung cross's arms span "
         f"{cam['hung_cross_arm_mrad']:.1f} mrad and the base cross's {cam['base_cross_arm_mrad']:.1f} mrad. Move the "
-        "camera until the two overlap symmetrically in its image, then focus on the hung cross. A camera off the "
+        "camera until the two overlap symmetrically in its image. A camera off the "
         f"axis by 1 mm shows them {cam['separation_mrad_per_mm_offset']:.2f} mrad apart "
         f"(`tolerancing.camera_offset` = {p.tolerancing.camera_offset:g} mm).")
+    d.p(C.camera_focus_and_lock(rig, c.printer))
     for name in ("projector_cross", "projector_backplate", "projector_mounting_plate", "camera_cross_hung",
                  "camera_cross_base"):
         if name in rig.recipes:
@@ -1438,7 +1439,7 @@ def _section_calibrate(d: Doc, c) -> None:
                      "camera_correspondence": c.correspondence}
 
 
-def _crosses(d: Doc, pshadow: dict, springs: dict, p) -> None:
+def _crosses(d: Doc, pshadow: dict, springs: dict, p, rig, printer) -> None:
     """Section 6's projector crosses: the holder off its seat, the plate, crosses and backplate on it, the
     shadows' separation per mm of projector offset (rigcad.manual.calibration.projector_shadows)."""
     d.h(3, C.STEP_CROSSES)
@@ -1459,8 +1460,9 @@ def _crosses(d: Doc, pshadow: dict, springs: dict, p) -> None:
         f"A projector off the crosses' line by 1 mm across the axis separates them by "
         f"**{row['separation_per_mm_offset']:.2f} mm**: move the projector on its slots (across) and its shims "
         f"(height) until they coincide. The profile allows `tolerancing.projector_offset` = "
-        f"{p.tolerancing.projector_offset:g} mm. Then take the plate, crosses and backplate off, put the lens back "
-        "and set the holder back on its seat. " + springs["on"])
+        f"{p.tolerancing.projector_offset:g} mm. " + C.projector_lock(rig, printer) + " Then take the plate, crosses "
+        "and backplate off. " + C.projector_focus_text(rig) + " Put the lens back and set the holder back on its "
+        "seat. " + springs["on"])
 
 
 def gray_card_seat(rig) -> dict:
