@@ -44,6 +44,7 @@ import math
 from dataclasses import dataclass, field, replace
 
 from rigcad.errors import FabricationError
+from rigcad.fab import seat_hold
 from rigcad.fab.printers import Printer
 from rigcad.fab.split import PIN_SPACING
 from rigcad.parts import adjusters as A
@@ -477,8 +478,11 @@ def _tower_links(profile, layout, process: ProcessErrors, seams, holder: bool = 
         kinds = [c.kind for c in seat.contacts]
         kinds = f"{', a '.join(kinds[:-1])} and a {kinds[-1]}"
         cone = next(f for f in seat_pocket_fits(profile, process) if f["pocket"] == "cone")
+        hold = seat_hold.check(profile, layout)  # refused when the design's side pull at the camera lifts a ball
         out.append(Link("splitter seat", "joint",
-                        f"kinematic: ball-ended screws on a {kinds} (sprung, {seat.preload:.0f} N): it repeats on "
+                        f"kinematic: ball-ended screws on a {kinds} (sprung, {seat.preload:.0f} N: "
+                        f"{hold.lift_pull_n:.1f} N at the camera lifts a ball, {seat_hold.SIDE_PULL_N:g} N designed "
+                        "for): it repeats on "
                         f"lift-off to {KINEMATIC_REPEAT * 1000:g} um (assumed); the cone's balls bonded in a pocket "
                         f"printed {cone['gap_mm']:.2f} mm over them (half of it each way)",
                         KINEMATIC_REPEAT + max(cone["gap_mm"], 0.0) / 2, buy="a bought kinematic mount"))

@@ -198,7 +198,8 @@ STEP_TEXT = {
     "camera_shims": "Put the camera's shim stack against the bracket (more or fewer shims move the camera across "
                     "the axis in y).",
     "camera_body": "Screw the camera to the bracket above the beam splitter through its slot, looking down the "
-                   "optical axis.",
+                   "optical axis. Tie its cable to the column with the cable ties its bill row states, a slack loop "
+                   "left between the camera and the upper tie.",
     "beam_splitter": "Slide the plate beam splitter into the holder's 45 deg grooves through the +y wall, coated "
                      "face towards the projector (+x) and down. Handle it by its edges. Then fix it on its datum flank (the grooves' "
                      "lower flanks, under its coated face) with the dots of silicone RTV its bill row states, the holder "

@@ -617,10 +617,37 @@ SEAT_BOSS_WALL = 2.0
 SEAT_PAD_LENGTH = 2.0
 #: The vee's two ISO 8734 dowel pins (mm long) side by side in a channel along the line to the cone.
 SEAT_PIN_LENGTH = 10
-#: The two preload springs: helical compression springs of patented spring steel wire (EN 10270-1),
-#: ends closed and ground, over the M4 spring bolts (inner diameter 5.4 mm), as ordered: wire, outer
-#: diameter, free length (mm), active coils; and the length (mm) the nut sets them to.
-SEAT_SPRING = {"wire": 0.8, "outer_diameter": 7.0, "free_length": 12.0, "active_coils": 5, "installed_length": 8.0}
+#: The two preload springs: helical compression springs of patented spring steel wire (EN 10270-1 SH),
+#: ends closed and ground, over the M4 spring bolts (inner diameter 6.2 mm), as ordered: wire, outer
+#: diameter, free length (mm), active coils; and the length (mm) the nut sets them to, which the manual
+#: keeps through the seat's adjustment (each spring measured with the caliper before and after). Sized so
+#: that a side pull of rigcad.fab.seat_hold.SIDE_PULL_N at the camera lifts no ball
+#: (rigcad.fab.seat_hold.check): 22.3 N/mm, 58 N each at 10.9 mm (0.8 mm wire springs at 14 N each let a
+#: 3 N pull lift one); the free length the longest an ISO 4762 M4 bolt (40 mm) carries through the shelf,
+#: the gap and the flange. While the screws are turned (+-``adjusters.seat_travel``, before the nuts are
+#: reset) they run 25-91 N, clear of solid length and under 0.5 Rm of the wire in shear
+#: (:func:`spring_preloads`, :func:`spring_stress`).
+SEAT_SPRING = {"wire": 1.4, "outer_diameter": 9.0, "free_length": 13.5, "active_coils": 4, "installed_length": 10.9}
+#: The least tensile strength (MPa) of EN 10270-1 SH wire 1.4 mm thick (the standard's table: 1,990-2,230 MPa);
+#: EN 13906-1 allows a statically loaded spring 0.5 of it in (Wahl-corrected) shear.
+SEAT_SPRING_RM = 1990.0
+#: The camera's cable: tied to the column so that its pull and weight bear there, not on the camera on
+#: its seat (rigcad.fab.seat_hold.SIDE_PULL_N is what is left: the loop between the tie and the camera).
+#: Cable ties (IEC 62275, polyamide 6.6, 4.8 mm wide), two round the column under the shelf, 100 mm apart;
+#: the loop from the camera to the upper tie left slack by this much (mm) over the straight run.
+CABLE_TIE = {"width": 4.8, "lengths": (100, 140, 200, 300, 370, 450), "count": 2, "slack": 50.0, "cable": 8.0}
+
+
+def cable_tie_length(profile: Profile) -> int:
+    """The shortest stocked cable tie (mm, CABLE_TIE) that goes round the column (its printed side, or
+    the bought extrusion's) and the camera's cable with 30 mm for the head and the tail to pull."""
+    side = profile.tower.column_width if profile.buy.column == "print" else EXTRUSION
+    need = 4 * side + math.pi * CABLE_TIE["cable"] + 30.0
+    fits = [n for n in CABLE_TIE["lengths"] if n >= need]
+    if not fits:
+        raise GeometryError(f"no stocked cable tie ({max(CABLE_TIE['lengths'])} mm the longest) goes round the "
+                            f"{side:g} mm column: {need:.0f} mm needed", where=profile.where("tower", "column_width"))
+    return fits[0]
 
 
 @dataclass(frozen=True)
@@ -786,6 +813,27 @@ def spring_force(k: int = 1) -> dict:
     return {"rate_N_per_mm": rate, "force_N": k * rate * (sp["free_length"] - sp["installed_length"])}
 
 
+def spring_preloads(profile: Profile) -> dict:
+    """One seat spring's preload (N) at the nominal setting and at the ends of the seat's travel
+    (``adjusters.seat_travel`` each way: the holder raised compresses it, lowered lets it out)."""
+    sp, travel = SEAT_SPRING, profile.adjusters.seat_travel
+    rate = spring_force(1)["rate_N_per_mm"]
+    defl = sp["free_length"] - sp["installed_length"]
+    return {"least_N": rate * (defl - travel), "nominal_N": rate * defl, "most_N": rate * (defl + travel),
+            "shortest_mm": sp["installed_length"] - travel}
+
+
+def spring_stress(force: float) -> float:
+    """A seat spring's shear stress (MPa) under ``force`` (N): 8 F D / (pi d^3), Wahl-corrected
+    (EN 13906-1), D the mean coil diameter and d the wire (mm)."""
+    sp = SEAT_SPRING
+    d = sp["wire"]
+    mean = sp["outer_diameter"] - d
+    c = mean / d
+    wahl = (4 * c - 1) / (4 * c - 4) + 0.615 / c
+    return wahl * 8 * force * mean / (math.pi * d ** 3)
+
+
 def splitter_seat(profile: Profile, layout) -> KinematicSeat:
     """The splitter holder's kinematic seat as data (rigcad.parts.joints.KinematicSeat): its three
     contacts, its screws' range and resolution, its springs' preload, and every bought hard part
@@ -822,7 +870,8 @@ def splitter_seat(profile: Profile, layout) -> KinematicSeat:
                {"wire": sp["wire"], "outer_diameter": sp["outer_diameter"], "free_length": sp["free_length"],
                 "installed_length": sp["installed_length"]},
                f"preload: on each spring bolt under its nut, set to {sp['installed_length']:g} mm "
-               f"({force['force_N']:.1f} N each, {force['rate_N_per_mm']:.2f} N/mm)"),
+               f"({force['force_N']:.1f} N each, {force['rate_N_per_mm']:.2f} N/mm): the seat takes a side pull at the "
+               "camera without lifting a ball (rigcad.fab.seat_hold)"),
     )
     return KinematicSeat("splitter seat", "splitter_holder", "tower_shelf", contacts, thread, a.seat_travel,
                          a.turn_fraction, len(springs), force["rate_N_per_mm"],
@@ -1427,6 +1476,13 @@ def hardware(profile: Profile, layout) -> list[dict]:
         {"item": "plate beam splitter", "thread": None, "length_mm": None, "quantity": 1,
          "size_mm": [bs.width, bs.length, bs.thickness], "index": bs.index, "spec": splitter_spec(profile),
          "steps": ('beam_splitter',), "joins": "slides into the splitter holder's grooves through its +y wall, coated face towards the projector"},
+        {"item": f"cable tie, IEC 62275, polyamide 6.6, {CABLE_TIE['width']:g} x {cable_tie_length(profile)} mm",
+         "thread": None, "length_mm": None, "quantity": CABLE_TIE["count"], "standard": "IEC 62275",
+         "steps": ('camera_body',),
+         "joins": f"the camera's cable to the column: {CABLE_TIE['count']} ties round the column and the cable, the "
+                  "upper just under the shelf, the lower 100 mm below it, pulled tight; leave the cable from the camera "
+                  f"to the upper tie {CABLE_TIE['slack']:g} mm longer than the straight run (a slack loop), so that its "
+                  "pull and weight bear on the column, not on the camera on the splitter's seat"},
         {"item": PLATE_RETAINER["item"], "thread": None, "length_mm": None, "quantity": 1,
          "standard": PLATE_RETAINER["standard"], "steps": ('beam_splitter',),
          "joins": "holds the beam splitter on its datum flank: " + plate_retainer_step(profile)},
