@@ -193,5 +193,23 @@ def encloses(meshes: list[PartMesh]) -> set[str]:
     return out
 
 
-__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "hex_color", "picture_meshes", "ray_colors",
+def group_description(members, lead: str, meshes_by_name: dict) -> str:
+    """What a step says its parts are: the ``lead`` part's description or, when the step puts in several
+    parts named alike but for a trailing number (projector_shims_1..4, one per foot), each one's in their
+    numbers' order, so a figure that belongs to one part (the shims under one foot) is said for each part
+    and never read as the whole step's; descriptions that are the same are said once."""
+    import re
+
+    def stem(name: str) -> str:
+        return re.sub(r"_\d+$", "", name)
+
+    def number(name: str) -> int:
+        m = re.search(r"_(\d+)$", name)
+        return int(m.group(1)) if m else 0
+
+    alike = sorted((n for n in members if stem(n) == stem(lead)), key=number) or [lead]
+    return "; ".join(dict.fromkeys(meshes_by_name[n].description for n in alike))
+
+
+__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "group_description", "hex_color", "picture_meshes", "ray_colors",
            "step_offsets", "steps"]

@@ -881,7 +881,9 @@ def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_m
                                f"the {ns[0].replace('_', ' ')}") for stem, ns in by_stem.items())
     bought = " (bought)" if st.bought else ""
     lead = st.name if st.name in st.members else st.members[0]
-    text = f"Take {parts}{bought}: {meshes_by_name[lead].description}. "
+    from rigcad.manual.assembly import group_description
+
+    text = f"Take {parts}{bought}: {group_description(st.members, lead, meshes_by_name)}. "
     # screws that carry a bought part of the step (a ball in a push screw's cup) go in before the step's part
     carried = {n for n in st.members if meshes_by_name[n].bought}
     first = [f for f in st.fasteners if carried & set(f.passes)]
