@@ -449,9 +449,12 @@ def _bill_consumables(d: Doc, c) -> None:
         gap -= t
         if gap > 1e-9:
             gaps.append(gap)
+    from rigcad.manual import finishing as F
+
     d.h(3, "Consumables")
     d.table(["item", "qty"], [list(_abrasive() if r[0].startswith("Wet-or-dry") else r)
-                              for r in (*B.CONSUMABLES, *B.glue_rows(c.fab_report))])
+                              for r in (*B.CONSUMABLES, *F.paint_companions(c.bill["coating"]),
+                                        *B.glue_rows(c.fab_report))])
     d.h(3, "Tools")
     keys = B.set_screw_keys(c.bill["hardware"])
     d.table(["item", "qty"], [list(_blocks(c.rig) if r[0].startswith("Sanding blocks") else r)

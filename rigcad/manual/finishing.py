@@ -397,6 +397,32 @@ def template_making_text(rows: list[dict]) -> str:
             "0.1 mm), cannot show these gaps.")
 
 
+#: The two-component (2K) coats of LAYER_METHODS: each is bought with its own system's hardener and reducer
+#: (thinner), by the product's data sheet. The most each can take by volume, as a share of the paint, for the
+#: quantities to order: 2K polyurethane primers and clears mix 2:1 to 4:1 paint : hardener (at most half the
+#: paint's volume) and take up to 20 % reducer.
+TWO_COMPONENT = ("polyurethane primer", "polyurethane clearcoat")
+HARDENER_SHARE = 0.5
+REDUCER_SHARE = 0.2
+
+
+def paint_companions(coat_rows) -> list[tuple[str, str]]:
+    """The consumables a 2K coat needs besides itself: per TWO_COMPONENT layer of ``coat_rows`` (the bill's
+    coating rows: ``layer`` and ``to_buy_cm3`` per mirror), its hardener and its reducer, with the most the
+    paint bought can take (ml, HARDENER_SHARE and REDUCER_SHARE of the paint's volume)."""
+    paint: dict[str, float] = {}
+    for r in coat_rows:
+        if r["layer"] in TWO_COMPONENT:
+            paint[r["layer"]] = paint.get(r["layer"], 0.0) + r["to_buy_cm3"]
+    out = []
+    for layer, ml in paint.items():
+        out.append((f"Hardener (activator) of the {layer}'s own 2K system, mixed by its data sheet's ratio (2:1 to 4:1 "
+                    f"paint : hardener by volume)", f"{math.ceil(HARDENER_SHARE * ml)} ml for the {ml:.0f} ml of paint (in proportion to what you mix)"))
+        out.append((f"Reducer (thinner) of the {layer}'s own system, up to {100 * REDUCER_SHARE:g} % by its data sheet",
+                    f"{math.ceil(REDUCER_SHARE * ml)} ml for the {ml:.0f} ml of paint (in proportion to what you mix)"))
+    return out
+
+
 def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str, str, str, str, str]]:
     """The finishing recipe, stage by stage, from print to mirror: (stage, what, how, cure / wait, check).
 
@@ -437,4 +463,5 @@ def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str,
 __all__ = ["ABRASIVE", "ABRASIVE_MM", "BLOCK_LENGTH_MM", "BLOCK_SAG_MM", "block_bands", "block_part", "block_slide",
            "sanding_block_set", "template_datums", "template_text", "CLEAR_REFLECTANCE", "LAYER_METHODS", "principal_radii", "recipe",
            "placement_spot", "sanding_blocks", "slope_acceptance", "COMPARATOR_UM", "CUT_EDGE_MM",
-           "EDGE_SHARE", "TEMPLATE_MATERIAL", "template_gaps", "template_making", "template_making_text"]
+           "EDGE_SHARE", "TEMPLATE_MATERIAL", "template_gaps", "template_making", "template_making_text",
+           "HARDENER_SHARE", "REDUCER_SHARE", "TWO_COMPONENT", "paint_companions"]
