@@ -183,7 +183,7 @@ def camera_crosses(rig) -> dict:
             "base_cross_arm_mrad": 1e3 * rig.profile.crosses.arm_length / g.cop_z}
 
 
-__all__ = ["access", "camera_focus_and_lock", "checker_text", "instrument_torques", "projector_focus", "projector_focus_text", "projector_lock", "gray_card_placement", "record_circle", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
+__all__ = ["access", "camera_focus_and_lock", "circle_radius_px", "cop_height_check", "shared_cop", "shared_cop_text", "checker_text", "instrument_torques", "projector_focus", "projector_focus_text", "projector_lock", "gray_card_placement", "record_circle", "camera_correspondence", "camera_crosses", "circle_image", "circle_page", "film_setup", "film_shadows", "projector_shadows"]
 
 
 def record_circle(rig, info: dict) -> str:
@@ -481,6 +481,100 @@ def camera_focus_and_lock(rig, printer) -> str:
             f"**Lock the camera:** tighten its {n} {thread} screws to **{torque:.2f} N m** (section 5's torque table), "
             "in two passes, and check that the two crosses still overlap symmetrically; if tightening moved them, "
             "loosen, correct and tighten again.")
+
+
+def circle_radius_px(rig, dh: float = 0.0) -> float:
+    """The paraboloid rim's radius (px) in the projector's image, seen through the focusing lens, with
+    the projector's real COP ``dh`` mm farther from the lens along its axis than the tower puts it (the
+    fold turns that into a COP ``dh`` x the lens's longitudinal magnification higher on the dome's axis):
+    the focusing lens (rigcad.optics.focus.through_lens) moves the COP the paraboloid sees and scales the
+    focal length in pixels; the rim at ``geometry.rim_radius``, ``rim_z``. ``dh`` = 0: the calibration
+    circle's design radius (:func:`circle_image`)."""
+    from rigcad.optics.focus import focusing_lens, through_lens
+
+    g = rig.geometry
+    lens = focusing_lens(rig.profile, g)
+    u = lens.cop_distance + dh
+    shift, scale = through_lens(lens.focal_length, u, lens.edge_thickness, lens.diameter)
+    cop_z = g.cop_z + (u + shift - lens.lens_distance)  # the COP the paraboloid sees
+    return g.projector_focal_px * scale * g.rim_radius / (cop_z - g.rim_z)
+
+
+def cop_height_check(rig) -> dict:
+    """What the measured circle's radius says about the projector COP's height (px, mm): the radius's
+    change per mm of the projector moved along its axis, d R / d h = R (1 / (f - s) - m^2 / Z) with the
+    lens's focal length f, s the real COP's distance to its front principal plane, m = f / (f - s) its
+    pixel scale (m^2 the longitudinal magnification) and Z the seen COP's height above the rim's plane;
+    the radius band of ``tolerancing.projector_height``; and the height one pixel of the page's read-out
+    stands for."""
+    from rigcad.optics.focus import focusing_lens
+
+    g = rig.geometry
+    lens = focusing_lens(rig.profile, g)
+    from rigcad.optics.focus import LENS_INDEX as n
+
+    f = lens.focal_length
+    radius = f * (n - 1)
+    sag = radius - math.sqrt(radius * radius - (lens.diameter / 2) ** 2)
+    s = lens.cop_distance - lens.edge_thickness / 2 - sag
+    m = f / (f - s)
+    r0 = circle_radius_px(rig)
+    per_mm = r0 * (1.0 / (f - s) - m * m / (g.cop_z - g.rim_z))
+    tol = rig.profile.tolerancing.projector_height
+    return {"radius_px": r0, "radius_px_per_mm": per_mm, "tolerance_mm": tol, "tolerance_px": abs(per_mm) * tol,
+            "mm_per_px_read": 1.0 / abs(per_mm) if per_mm else math.inf, "read_px": EDGE_READ_PX,
+            "cop_z_per_mm": m * m}
+
+
+def shared_cop(rig) -> dict:
+    """The projector's COP on the dome's axis, checked against the camera's (mm, px): the camera, set on
+    the dome's axis by its crosses, sees the hung cross's shadow (the projector's white light, the
+    paraboloid off) on the base plate exactly behind the cross when the projector's COP is its own (a
+    light casts no shadow seen from where it stands). A projector ``d`` mm across the axis throws the
+    hung cross's centre (height z_h) on z = 0 at d z_h / (Z - z_h) from O (Z the COP's height), which the
+    camera sees f_cam d z_h / ((Z - z_h) Z) px from the cross's centre; the pass band is
+    ``tolerancing.projector_offset`` so mapped, never finer than EDGE_READ_PX."""
+    from rigcad.optics.camera import camera_model
+
+    g, t = rig.geometry, rig.profile.tolerancing
+    cam = camera_model(rig.profile, g)
+    zh, z = g.vertex_z, g.cop_z
+    mm = zh / (z - zh)
+    px = cam.focal_px * mm / z
+    return {"hung_cross_z_mm": zh, "shadow_mm_per_mm": mm, "camera_px_per_mm": px,
+            "tolerance_mm": t.projector_offset, "shadow_tolerance_mm": mm * t.projector_offset,
+            "tolerance_px": max(px * t.projector_offset, EDGE_READ_PX), "camera_focal_px": cam.focal_px}
+
+
+def shared_cop_text(rig, printer) -> str:
+    """The camera crosses step's last paragraph: the projector referenced to the dome's axis through
+    the camera's COP (:func:`shared_cop`), re-locked, and what the circle's radius can say of the COP's
+    height (:func:`cop_height_check`)."""
+    c, h = shared_cop(rig), cop_height_check(rig)
+    n, thread, torque = instrument_torques(rig, printer)["projector"]
+    return ("**Projector and camera on one COP, on the dome's axis.** The projector's crosses put it on the shelf's "
+            "seat, not on the dome; the camera is now on the dome's axis. Leave the hung cross and the base cross in, "
+            "the paraboloid off, the focusing lens in and the holder on its seat, and show the circle page's design "
+            "circle (0): a white disc about the projector's axis pixel, whose light runs down the axis past the hung "
+            "cross onto the plate. Seen from the projector's own COP a light casts no visible shadow: in the camera's "
+            "image the hung cross's shadow on the base cross lies exactly behind the hung cross when the two COPs are "
+            f"one. A projector 1 mm across the axis throws the shadow's centre {c['shadow_mm_per_mm']:.2f} mm from O, "
+            f"which the camera shows **{c['camera_px_per_mm']:.2f} px** from the hung cross's centre. It passes when "
+            f"the shadow's centre is within **{c['tolerance_px']:.1f} px** of the hung cross's centre "
+            f"(`tolerancing.projector_offset` = {c['tolerance_mm']:g} mm, {c['shadow_tolerance_mm']:.2f} mm at O). "
+            f"If not, loosen the projector's {n} {thread} screws a quarter turn, move it in its slots (across its "
+            "axis) or change its shims (height) until the shadow hides behind the cross, and tighten them again to "
+            f"**{torque:.2f} N m**; then go back to the splitter seat's step and the circle (their figures are read "
+            "on this projector). **Its height along the axis** (the COP's height, `tolerancing.projector_height` "
+            f"= {h['tolerance_mm']:g} mm) the circle cannot check: through the focusing lens the rim's radius "
+            f"changes by only {abs(h['radius_px_per_mm']):.3f} px per mm the projector moves along its axis "
+            f"({h['tolerance_px']:.2f} px over the tolerance), so one pixel of the page's read-out stands for "
+            f"{h['mm_per_px_read']:.0f} mm. A recorded radius more than 1 px from the design's "
+            f"{h['radius_px']:.1f} px is not a height error (that would take {h['mm_per_px_read']:.0f} mm): it is a "
+            "wrong throw ratio or lens, or a `projector.pupil_depth` off by tens of mm; find which before going on. "
+            "The height rests on the projector's place along its own axis, which the fold and the lens turn into "
+            f"{h['cop_z_per_mm']:.2f} mm of COP height per mm: on `projector.pupil_depth` measured as section 0 asks "
+            "and on the tower's vertical stack (section 5), not on a calibration reading.")
 
 
 def kit_items(rig) -> list[KitItem]:

@@ -107,3 +107,32 @@ def test_the_instruments_are_locked_to_the_torque_tables_torque_and_the_camera_f
 
     page = manual_page(table31_rig)
     assert "Focus between" not in page and "section 6 set it, on the hung cross" in page
+
+
+def test_the_cop_heights_effect_on_the_circle_by_finite_differences(table31_rig):
+    _, info = C.circle_image(table31_rig)
+    assert C.circle_radius_px(table31_rig) == pytest.approx(info["radius_px"], rel=1e-12)  # the design's circle
+    h = C.cop_height_check(table31_rig)
+    step = 0.01  # mm: central difference of the function the closed form differentiates
+    fd = (C.circle_radius_px(table31_rig, step) - C.circle_radius_px(table31_rig, -step)) / (2 * step)
+    assert h["radius_px_per_mm"] == pytest.approx(fd, rel=1e-4), (h["radius_px_per_mm"], fd)
+    # the lens nearly cancels it: far under the pixel the page reads, so the text says the circle cannot check it
+    assert abs(h["tolerance_px"]) < 0.1 * C.EDGE_READ_PX
+    text = C.shared_cop_text(table31_rig, __import__("rigcad.fab.printers", fromlist=["x"]).load_printer("prusa_mk3s"))
+    assert "the circle cannot check" in text and f"{h['mm_per_px_read']:.0f} mm" in text
+
+
+def test_the_projector_is_referenced_to_the_dome_axis_through_the_cameras_cop(table31_rig):
+    g, t = table31_rig.geometry, table31_rig.profile.tolerancing
+    c = C.shared_cop(table31_rig)
+    # ray geometry: a COP d across the axis at height Z, through the hung cross's centre (0, z_h), to z = 0
+    d, Z, zh = 0.37, g.cop_z, g.vertex_z
+    x0 = d + (0.0 - d) * Z / (Z - zh)  # where the shadow of the hung cross's centre lands
+    assert abs(x0) == pytest.approx(c["shadow_mm_per_mm"] * d, rel=1e-12)
+    # the camera at the design COP (on the axis) sees that point at atan(|x0| / Z) from the hung cross's centre
+    assert c["camera_px_per_mm"] * d == pytest.approx(c["camera_focal_px"] * abs(x0) / Z, rel=1e-12)
+    assert c["tolerance_px"] == pytest.approx(max(c["camera_px_per_mm"] * t.projector_offset, C.EDGE_READ_PX))
+    from rigcad.fab.printers import load_printer
+
+    text = C.shared_cop_text(table31_rig, load_printer("prusa_mk3s"))
+    assert f"within **{c['tolerance_px']:.1f} px**" in text and "dome's axis" in text
