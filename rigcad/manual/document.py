@@ -1429,6 +1429,7 @@ def _section_calibrate(d: Doc, c) -> None:
         f"axis by 1 mm shows them {cam['separation_mrad_per_mm_offset']:.2f} mrad apart "
         f"(`tolerancing.camera_offset` = {p.tolerancing.camera_offset:g} mm).")
     d.p(C.camera_focus_and_lock(rig, c.printer))
+    d.p(C.shared_cop_text(rig, c.printer))
     for name in ("projector_cross", "projector_backplate", "projector_mounting_plate", "camera_cross_hung",
                  "camera_cross_base"):
         if name in rig.recipes:
