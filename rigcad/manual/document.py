@@ -1202,8 +1202,11 @@ def _section_acceptance(d: Doc, c) -> None:
         "(the film in the hole is as bright as before; only the lit area shrinks).",
     ])
     d.p(f"**Pass:** over at least {100 * acc['pass_fraction']:g} % of the paraboloid's image (outside the occlusion "
-        "disc of the calibration circle, `tolerancing.min_yield`), a pixel lit in the reference is lit in the test "
-        "picture too (at least half its reference brightness). A pixel lit in the "
+        "disc of the calibration circle), a pixel lit in the reference is lit in the test picture too (at least half "
+        "its reference brightness). That is the pass the calibration holds the finished mirrors to, with the same "
+        f"camera: the dome's slope error's 99th percentile within {acc['dome_slope_tolerance_mrad']:.2f} mrad "
+        "(`rigcad calibrate`'s `residual_slope_p99_mrad`), so a dome that passes here is not sent back under its "
+        "coat by the calibration for its slopes. A pixel lit in the "
         f"reference but dark in the test sees a point of the film between {acc['disc_radius_mm']:g} and "
         f"{acc['bore_radius_mm']:.1f} mm from O: the mirror area it looks at is off in slope by "
         f"{acc['dome_slope_tolerance_mrad']:.1f} to {acc['bore_slope_mrad']:.1f} mrad at the dome's farthest point "
