@@ -1423,16 +1423,7 @@ def _section_calibrate(d: Doc, c) -> None:
                                     f"{info['resolution_px'][1]} px, shown at page width")
     d.p(C.record_circle(rig, info))
     _film_step(d, c)
-    d.h(3, C.STEP_CAMERA)
-    d.p(f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
-        f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm) and put the `camera_cross_base` in the sample holder's place "
-        f"(its top on z = 0). From the COP (z = {cam['cop_z_mm']:.1f} mm) the hung cross's arms span "
-        f"{cam['hung_cross_arm_mrad']:.1f} mrad and the base cross's {cam['base_cross_arm_mrad']:.1f} mrad. Move the "
-        "camera until the two overlap symmetrically in its image. A camera off the "
-        f"axis by 1 mm shows them {cam['separation_mrad_per_mm_offset']:.2f} mrad apart "
-        f"(`tolerancing.camera_offset` = {p.tolerancing.camera_offset:g} mm).")
-    d.p(C.camera_focus_and_lock(rig, c.printer))
-    d.p(C.shared_cop_text(rig, c.printer))
+    _camera_crosses_step(d, c, cam)
     for name in ("projector_cross", "projector_backplate", "projector_mounting_plate", "camera_cross_hung",
                  "camera_cross_base"):
         if name in rig.recipes:
@@ -1447,6 +1438,22 @@ def _section_calibrate(d: Doc, c) -> None:
     c.calibration = {"circle": info, "film": film, "projector_crosses": pshadow, "camera_crosses": cam,
                      "splitter_seat": seat, "gray_card": c.gray_card, "lab_temperature": thermal,
                      "camera_correspondence": c.correspondence}
+
+
+def _camera_crosses_step(d: Doc, c, cam: dict) -> None:
+    """Section 6's camera crosses (rigcad.manual.calibration.camera_crosses): the camera set on the dome's
+    axis, focused once and locked, then the projector referenced to the same axis through its COP."""
+    rig, p = c.rig, c.p
+    d.h(3, C.STEP_CAMERA)
+    d.p(f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
+        f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm) and put the `camera_cross_base` in the sample holder's place "
+        f"(its top on z = 0). From the COP (z = {cam['cop_z_mm']:.1f} mm) the hung cross's arms span "
+        f"{cam['hung_cross_arm_mrad']:.1f} mrad and the base cross's {cam['base_cross_arm_mrad']:.1f} mrad. Move the "
+        "camera until the two overlap symmetrically in its image. A camera off the "
+        f"axis by 1 mm shows them {cam['separation_mrad_per_mm_offset']:.2f} mrad apart "
+        f"(`tolerancing.camera_offset` = {p.tolerancing.camera_offset:g} mm).")
+    d.p(C.camera_focus_and_lock(rig, c.printer))
+    d.p(C.shared_cop_text(rig, c.printer))
 
 
 def _crosses(d: Doc, pshadow: dict, springs: dict, p, rig, printer) -> None:
