@@ -280,6 +280,12 @@ def template_datums(rig) -> list[dict]:
     return out
 
 
+#: Steel straightedges as sold (mm, DIN 874 / DIN 866 lengths), for laying across a dome's open base; each
+#: stands this far (mm) past the base's edge on either side to rest on it.
+STRAIGHTEDGES_MM = (300.0, 500.0, 750.0, 1000.0)
+STRAIGHTEDGE_OVERHANG_MM = 10.0
+
+
 def template_text(row: dict) -> str:
     """How a template is held, from its datum (:func:`template_datums`)."""
     name = row["template"].replace("_template", "")
@@ -296,12 +302,22 @@ def template_text(row: dict) -> str:
                 f"z = {row['datum_z_mm']:.1f} mm (red in its drawing), with the axis line at its middle (dashed: scribe "
                 f"it on the template). Hold the template in a meridional plane over the {name}, the datum edge level (the "
                 "spirit level on it) and its axis line over the vertex: the cut-out then lies on the gauged surface.")
+    reach = 2 * row["datum_r_mm"] + 2 * STRAIGHTEDGE_OVERHANG_MM
+    rule = next((n for n in STRAIGHTEDGES_MM if n >= reach), None)
+    rule_text = f"a {rule:g} mm steel straightedge" if rule else f"a steel straightedge at least {reach:.0f} mm long"
     return (f"`{row['template']}`: the datum is the lower corner of its curved edge (red in its drawing), "
-            f"{row['datum_r_mm']:.1f} mm from the axis at z = {row['datum_z_mm']:.1f} mm: the {name} stands on the base "
-            "plate, and the template stands upright in a meridional plane (the engineer's square against its face), "
-            "that corner on the plate's top where the mirror meets the plate; its curved edge then runs along the "
-            f"mirror up to {row['top_r_mm']:.1f} mm from the axis at z = {row['top_z_mm']:.1f} mm. The axis lies "
-            f"{row['top_r_mm']:.1f} mm beyond its upper end (dashed in the drawing).")
+            f"{row['datum_r_mm']:.1f} mm from the axis at z = {row['datum_z_mm']:.1f} mm: the plane of the {name}'s "
+            f"base, where the mirror meets the face that stands on the base plate. A closed {name} cannot be read from "
+            f"its top opening, so it is sanded and gauged **upside down, its open base up**, standing on three blocks "
+            f"on the bench round its top opening (the schedule's sanding and coating stages; the seams are glued by "
+            f"then). Lay {rule_text} across the base's face through the axis (its centre mark), stand the template "
+            "upright under it in that meridional plane (the engineer's square standing on the straightedge, against "
+            "the template's face) and hold its datum corner up against the straightedge's underside where the mirror "
+            f"meets the base; its curved edge then runs down along the mirror to {row['top_r_mm']:.1f} mm from the "
+            f"axis, {row['top_z_mm']:.1f} mm down, by the top opening (the axis {row['top_r_mm']:.1f} mm beyond its "
+            "end, dashed in the drawing). Read the gap against the light: a torch on the bench under the top opening "
+            "lights the mirror behind the template; look along the edge from the open base, and slide the feeler leaf "
+            "in from there. Turn the straightedge a quarter turn for the next plane.")
 
 
 #: Specular reflectance of a polished clear coat over a black base at normal incidence: Fresnel's
@@ -471,4 +487,4 @@ __all__ = ["ABRASIVE", "ABRASIVE_MM", "BLOCK_LENGTH_MM", "BLOCK_SAG_MM", "block_
            "sanding_block_set", "template_datums", "template_text", "CLEAR_REFLECTANCE", "LAYER_METHODS", "principal_radii", "recipe",
            "placement_spot", "sanding_blocks", "slope_acceptance", "COMPARATOR_UM", "CUT_EDGE_MM",
            "EDGE_SHARE", "TEMPLATE_MATERIAL", "template_gaps", "template_making", "template_making_text",
-           "HARDENER_SHARE", "REDUCER_SHARE", "SLOPE_PASS_FRACTION", "TWO_COMPONENT", "paint_companions"]
+           "HARDENER_SHARE", "REDUCER_SHARE", "SLOPE_PASS_FRACTION", "STRAIGHTEDGES_MM", "STRAIGHTEDGE_OVERHANG_MM", "TWO_COMPONENT", "paint_companions"]
