@@ -36,7 +36,8 @@ MIL = 0.0254  # mm
 
 class Doc:
     """Blocks: ("h", level, text), ("p", text), ("ul", [text]), ("ol", [text]), ("table", header,
-    rows), ("img", relative path, caption). Inline: `code` and **bold**."""
+    rows), ("img", relative path, caption), ("box", title, [text]): a framed warning. Inline: `code` and
+    **bold**."""
 
     def __init__(self) -> None:
         self.blocks: list[tuple] = []
@@ -58,6 +59,10 @@ class Doc:
 
     def img(self, path: str, caption: str) -> None:
         self.blocks.append(("img", path, caption))
+
+    def box(self, title: str, items) -> None:
+        """A framed warning: its title in bold and its items (a blockquote in Markdown)."""
+        self.blocks.append(("box", title, list(items)))
 
     def page(self, text: str, shift: int = 1) -> None:
         """Blocks from a Markdown page of headings (their level moved down by ``shift``), lists (``-`` or
@@ -111,6 +116,8 @@ class Doc:
                                      + ["| " + " | ".join(str(c) for c in r) + " |" for r in b[2]]))
             elif kind == "img":
                 out.append(f"![{b[2]}]({b[1]})\n\n*{b[2]}*")
+            elif kind == "box":
+                out.append("\n".join([f"> **{b[1]}**", ">", *(f"> - {t}" for t in b[2])]))
             out.append("")
         return "\n".join(out)
 
@@ -134,6 +141,9 @@ class Doc:
                 data = base64.b64encode(images[b[1]]).decode("ascii")
                 body.append(f'<figure><img src="data:image/png;base64,{data}" alt="{html.escape(b[2])}">'
                             f"<figcaption>{_inline(b[2])}</figcaption></figure>")
+            elif kind == "box":
+                body.append(f'<div class="box"><p><b>{_inline(b[1])}</b></p><ul>'
+                            + "".join(f"<li>{_inline(t)}</li>" for t in b[2]) + "</ul></div>")
         return _HTML.replace("@@TITLE@@", html.escape(title)).replace("@@BODY@@", "\n".join(body))
 
 
@@ -160,6 +170,7 @@ _HTML = """<!DOCTYPE html>
   figure { margin: 0.8em 0; text-align: center; page-break-inside: avoid; }
   figure img { max-width: 100%; max-height: 150mm; }
   figcaption { font-size: 9pt; color: #444; }
+  .box { border: 2px solid #b00; background: #fff4f4; padding: 0 8px; margin: 0.8em 0; }
   @media print { body { margin: 0; max-width: none; } h2 { page-break-before: always; }
                  h2:first-of-type { page-break-before: avoid; } tr { page-break-inside: avoid; } }
 </style>
@@ -355,9 +366,28 @@ def _introduction(d: Doc, c) -> None:
     d.p(f"The rig of profile `{rig.name}` ({' <- '.join(p.sources)}), printed on **{printer.description}** "
         f"(`{printer.source}`). Every figure below is computed by rigcad {__version__} from the profile, the "
         f"part recipes and the printer. " + parts_text(rig.name, printer.name))
+    problems = fab_problems(c.fab_report)
+    if problems:
+        d.box(f"rigcad fab found {len(problems)} problem(s) on the {printer.name}: this rig cannot be built as "
+              f"printed until each is solved (fab/{printer.name}/fab.json lists them; the sections below follow it)",
+              problems)
     d.img("images/rig.png", "The assembled rig (front of the dome cut away) with rays traced from the centre of "
                             "projection, coloured by their incidence angle at the sample")
     measure_first(d, c)
+
+
+def fab_problems(fab_report: dict) -> list[str]:
+    """fab's problems (fab.json's ``problems``) as the manual's top box lists them: one item per problem,
+    the tolerance stack's refusal one item per placement it refuses."""
+    out = []
+    for problem in fab_report.get("problems") or ():
+        head, sep, rest = problem.partition(" placement(s) the printed rig cannot hold or adjust: ")
+        if problem.startswith("tolerance stack: ") and sep:
+            out += [f"{head.removeprefix('tolerance stack: ')} the printed rig can neither hold nor adjust the {x}"
+                    for x in rest.split(" | ")]
+        else:
+            out.append(problem)
+    return out
 
 
 #: The folders of ``exports/<profile>/`` that ``rigcad stl`` writes and the manual refers to, not writes.
@@ -1074,13 +1104,15 @@ def _section_mechanics(d: Doc, c) -> None:
     stack of every optical element on this printer (rigcad.fab.stack), as findings the lab reads
     before it aligns."""
     from rigcad.fab import loads as L
-    from rigcad.fab import stack as S
+    from rigcad.fab.stage import tolerance_stack
 
     c.mechanics = None
     if c.printer.process_errors is None or getattr(c.rig.layout, "tower", None) is None:
         return
     loads = L.loads(c.p, c.rig.layout, c.printer)
-    report = S.stack(c.p, c.rig.layout, c.printer)
+    stack = c.fab_report.get("stack")
+    if stack is None:  # a report fab wrote without a stack: the call fab makes, on the report's parts
+        stack = tolerance_stack(c.rig, c.printer, c.fab_report.get("parts", {}))[0]
     d.h(3, "Torques, and what bends")
     d.p("Tighten every bolt into printed plastic with a torque screwdriver to the torque below, never hand-tight: "
         "a hand-tight M4 presses the plastic past half its yield, and it creeps. Put a conical spring washer (DIN 6796, "
@@ -1092,8 +1124,8 @@ def _section_mechanics(d: Doc, c) -> None:
         "measure yours with the calibration print, docs/rig-mechanics.md), against `tolerancing:`. 'adjusted': an "
         "adjuster's range covers it at a quarter of the tolerance or finer; 'refused': neither a locating feature "
         "nor an adjuster holds it yet, and the last column names the links that dominate.")
-    _md_tables(d, S.table_lines(report))
-    c.mechanics = {"loads": loads.record(), "stack": S.record(report)}
+    _md_tables(d, stack["table_md"])  # fab's own table, with the seams of its split plans: one stack
+    c.mechanics = {"loads": loads.record(), "stack": {k: v for k, v in stack.items() if k != "table_md"}}
 
 
 def _approach(meshes, done: list[int], new: list[int], direction) -> dict:
@@ -1421,7 +1453,6 @@ def _section_calibrate(d: Doc, c) -> None:
         f"{info['occlusion_radius_px']:.1f} px from the centre are hidden by the paraboloid itself (occlusion limit).")
     d.img("calibration/circle.png", f"calibration/circle.png: the calibration image, {info['resolution_px'][0]} x "
                                     f"{info['resolution_px'][1]} px, shown at page width")
-    d.p(C.record_circle(rig, info))
     _film_step(d, c)
     _camera_crosses_step(d, c, cam)
     for name in ("projector_cross", "projector_backplate", "projector_mounting_plate", "camera_cross_hung",

@@ -107,6 +107,10 @@ def schedule(rig, fab_report: dict | None = None, steps=None) -> tuple[Stage, ..
         out.append(_s("Glue the dome's seams one at a time on the printed-stage template, its pieces standing on the "
                       "base plate on their flange screws, finger-tight; let each cure.", PRINT,
                       needs={"base plate inserts", "templates cut", "pieces printed"}, makes={"dome whole"}))
+    elif "error" in (parts.get("dome") or {}):  # fab could not print it: never 'as printed'
+        out.append(_s(f"The dome is not printable on this printer ({parts['dome']['error']}): solve that (the box at "
+                      "the top of the manual) and print it before this stage; nothing below holds until it is whole.",
+                      PRINT, needs={"pieces printed"}, makes={"dome whole"}))
     else:
         out.append(_s("Take the dome as printed (one piece).", PRINT, needs={"pieces printed"}, makes={"dome whole"}))
     out += [
