@@ -45,15 +45,18 @@ def circle_image(rig) -> tuple[bytes, dict]:
     width, height = rig.profile.projector.resolution
     lensed = focusing_lens(rig.profile, g).projector(g.projector_focal_px, g.cop_z)  # set with the lens in place
     radius = lensed.ring_radius(g, design.alpha_max)
-    x = np.arange(width) + 0.5 - width / 2
-    y = height / 2 - np.arange(height) - 0.5
+    from rigcad.profile.derived import projector_disc_room, projector_principal_point
+
+    cx, cy = projector_principal_point(rig.profile.projector)  # the lens axis's pixel: the disc's centre
+    x = np.arange(width) + 0.5 - cx
+    y = cy - np.arange(height) - 0.5
     inside = x[None, :] ** 2 + y[:, None] ** 2 <= radius ** 2
-    if radius > min(width, height) / 2:
-        raise GeometryError(f"the paraboloid's rim is {radius:.1f} px from the image centre, outside the "
-                            f"{width} x {height} px projector image", param="projector.throw_ratio")
+    if radius > projector_disc_room(rig.profile.projector):
+        raise GeometryError(f"the paraboloid's rim is {radius:.1f} px from the lens axis's pixel ({cx:g}, {cy:g}), "
+                            f"outside the {width} x {height} px projector image", param="projector.throw_ratio")
     buf = io.BytesIO()
     Image.fromarray(np.where(inside, 255, 0).astype(np.uint8), mode="L").save(buf, format="PNG")
-    info = {"resolution_px": [width, height], "centre_px_from_top_left": [width / 2, height / 2],
+    info = {"resolution_px": [width, height], "centre_px_from_top_left": [cx, cy],
             "radius_px": radius, "lit_pixels": int(inside.sum()),
             "rim_angle_at_cop_deg": math.degrees(design.alpha_max),
             "occlusion_radius_px": lensed.ring_radius(g, design.alpha_min),

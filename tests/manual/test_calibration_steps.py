@@ -136,3 +136,22 @@ def test_the_projector_is_referenced_to_the_dome_axis_through_the_cameras_cop(ta
 
     text = C.shared_cop_text(table31_rig, load_printer("prusa_mk3s"))
     assert f"within **{c['tolerance_px']:.1f} px**" in text and "dome's axis" in text
+
+
+def test_the_calibration_circle_is_drawn_about_the_lens_axis_pixel(write_profile):
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    from rigcad.profile import load_profile
+    from rigcad.profile.derived import projector_principal_point
+    from rigcad.rig import Rig
+
+    rig = Rig.from_profile(load_profile(write_profile("extends: achutha2006\nprojector: {lens_offset: 30 %}\n", "o")))
+    png, info = C.circle_image(rig)
+    cx, cy = projector_principal_point(rig.profile.projector)
+    assert (cx, cy) == pytest.approx((512.0, 384 * 1.3)) and info["centre_px_from_top_left"] == [cx, cy]
+    rows, cols = np.nonzero(np.asarray(Image.open(io.BytesIO(png))))
+    assert cols.mean() + 0.5 == pytest.approx(cx, abs=0.05) and rows.mean() + 0.5 == pytest.approx(cy, abs=0.05)
+    assert f'"cy": {json.dumps(cy)}'.encode() in C.circle_page(rig, info)  # the page's design circle, its 0 key, the same
