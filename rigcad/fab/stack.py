@@ -43,7 +43,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
-from rigcad.errors import FabricationError
+from rigcad.errors import FabricationError, GeometryError
 from rigcad.fab import seat_hold
 from rigcad.fab.printers import Printer
 from rigcad.fab.split import PIN_SPACING
@@ -158,6 +158,7 @@ class AdjusterSpec:
     range: float
     resolution: float
     how: str = ""
+    range_key: str = ""  #: the profile key whose value (mm) is this range each way ("": none sets it)
 
 
 @dataclass(frozen=True)
@@ -176,7 +177,8 @@ class AxisVerdict:
     """One element's stack on one axis: ``worst`` and ``rss`` (mm, or rad for ``tilt``) against
     ``tolerance`` (``tolerancing.<tolerance_key>``, same unit); ``status``: held, adjusted or
     refused; ``adjuster``: the adjuster that serves it (None: none); ``dominating``: the links that
-    dominate it (names); ``buy``: what would remove them; ``reason``: why it is refused (or "")."""
+    dominate it (names); ``buy``: what would remove them; ``reason``: why it is refused (or "");
+    ``cure``: the profile settings that would pass it as it stands (``key >= value unit``)."""
 
     element: str
     axis: str
@@ -189,6 +191,7 @@ class AxisVerdict:
     dominating: tuple[str, ...]
     buy: tuple[str, ...]
     reason: str = ""
+    cure: tuple[str, ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -204,7 +207,8 @@ class AxisVerdict:
                 "adjuster": None if adj is None else {
                     "name": adj.name, f"range_each_way_{unit}": _finite(f(adj.range)),
                     f"resolution_{unit}": f(adj.resolution)},
-                "dominating": list(self.dominating), "buy": list(self.buy), "reason": self.reason}
+                "dominating": list(self.dominating), "buy": list(self.buy), "reason": self.reason,
+                "cure": list(self.cure)}
 
 
 @dataclass(frozen=True)
@@ -328,7 +332,7 @@ def seam_link(part: str, seams: int, printer: Printer, process: ProcessErrors, d
     other (the shop step), whose fit (DOWEL_FIT) replaces the pin's float; the holes' printed positions stay."""
     if seams <= 0:
         return None
-    buy = "a printer whose bed takes the part whole, or reamed holes and ISO 8734 steel dowels across the seam"
+    buy = SEAM_BUY.get(part, f"a printer whose bed takes the {part.replace('_', ' ')} whole (rigcad fab --printer)")
     if dowels:
         e = DOWEL_FIT + 2 * process.position
         return Link(f"{part.replace('_', ' ')} seams", "seam",
@@ -537,6 +541,9 @@ def _camera_links(profile, layout, process: ProcessErrors, seams) -> tuple[Link,
                  buy="a camera mount with a pin or a keyed plate"))
 
 
+#: What removes a chain part's seams besides a larger bed: the ``buy:`` key that buys it whole.
+SEAM_BUY = {"tower_column": "buy.column: extrusion_40x40", "tower_shelf": "buy.shelf: aluminium_plate"}
+
 CHAINS = {"paraboloid": _paraboloid_links, "dome": _dome_links, "cop": _cop_links, "splitter": _splitter_links,
           "camera": _camera_links}
 
@@ -554,9 +561,10 @@ def default_adjusters(profile, layout) -> tuple[AdjusterSpec, ...]:
         element = "camera" if adj.tolerance_key.startswith("tolerancing.camera") else "cop"
         axis = ("vertical" if adj.tolerance_key.endswith("_height") else
                 "y" if "(y)" in adj.name or adj.name.startswith("projector across") else "x")
-        out.append(AdjusterSpec(adj.name, element, axis, adj.range, adj.resolution, adj.how))
+        key = "tower.travel_along" if axis == "vertical" else "tower.travel_across"  # slots' and shims' range
+        out.append(AdjusterSpec(adj.name, element, axis, adj.range, adj.resolution, adj.how, key))
         if element == "cop":
-            out.append(AdjusterSpec(adj.name, "splitter", axis, adj.range, adj.resolution, adj.how))
+            out.append(AdjusterSpec(adj.name, "splitter", axis, adj.range, adj.resolution, adj.how, key))
     for adj in A.splitter_adjusters(profile, layout):
         for element in ("splitter", "cop"):
             out.append(AdjusterSpec(adj.name, element, "tilt", adj.range, adj.resolution, adj.how))
@@ -575,7 +583,8 @@ def _candidates(adjusters, element: str, axis: str) -> list[AdjusterSpec]:
         xs = [a for a in adjusters if a.element == element and a.axis == "x"]
         ys = [a for a in adjusters if a.element == element and a.axis == "y"]
         own += [AdjusterSpec(f"{x.name}; {y.name}", element, axis, min(x.range, y.range),
-                             max(x.resolution, y.resolution)) for x in xs for y in ys]
+                             max(x.resolution, y.resolution),
+                             range_key=x.range_key if x.range_key == y.range_key else "") for x in xs for y in ys]
     if axis == "tilt" and len(own) > 1:
         own = [AdjusterSpec("; ".join(a.name for a in own), element, axis, min(a.range for a in own),
                             max(a.resolution for a in own))]
@@ -639,6 +648,8 @@ def _verdict(element: str, axis: str, links: tuple[Link, ...], key: str, tol: fl
             why.append(f"its resolution {f(a.resolution):.3g} {unit} exceeds a quarter of the {f(tol):.3g} {unit} "
                        "tolerance")
         reason = f"{a.name}: " + " and ".join(why)
+        if a.range < worst and a.range_key and a.resolution <= fine:  # its range's key may pass it: stack() solves
+            return AxisVerdict(element, axis, key, tol, worst, rss, "refused", a, names, buys, reason, (a.range_key,))
     return AxisVerdict(element, axis, key, tol, worst, rss, "refused", cands[0] if cands else None, names, buys,
                        reason)
 
@@ -711,13 +722,15 @@ def located_adjusters(profile, layout, process: ProcessErrors | None = None) -> 
 
 def stack(profile, layout, printer: Printer, *, seams: dict[str, int] | None = None,
           adjusters: tuple[AdjusterSpec, ...] | None = None, locators: tuple[Locator, ...] | None = None,
-          process: ProcessErrors | None = None) -> StackReport:
+          process: ProcessErrors | None = None, cures: bool = True) -> StackReport:
     """Every optical element's stack on ``printer`` (its ``process_errors``, or ``process``): the
     seams on each chain part from ``seams`` (part -> seams a chain crosses: :func:`seams_from_pieces`
     of a fab run; default :func:`estimate_seams`), against ``tolerancing``, with ``adjusters``
     (default :func:`default_adjusters`) and the ``locators`` (each replaces links on its element's
     chain; default: the ones the parts declare, :func:`declared_locators`). The default adjusters
-    add the paraboloid's and the dome's (:func:`located_adjusters`)."""
+    add the paraboloid's and the dome's (:func:`located_adjusters`). With ``cures`` (and the default
+    adjusters), a refused axis whose adjuster's range a profile key sets names that key and the value that
+    passes it on the tower re-laid with it (:func:`_cured`)."""
     proc = process or printer.process_errors
     if proc is None:
         raise FabricationError(f"printer {printer.name}: no process_errors, so no tolerance stack")
@@ -744,21 +757,62 @@ def stack(profile, layout, printer: Printer, *, seams: dict[str, int] | None = N
         axes = tuple(_verdict(element, axis, links, key, getattr(tol, key), adj)
                      for axis, key in zip(ELEMENT_AXES[element], TOLERANCE_KEYS[element]))
         elements.append(ElementStack(element, links, axes))
+    if cures and adjusters is None:
+        elements = [replace(e, axes=tuple(_cured(profile, layout, printer, counts, locators, proc, v) for v in e.axes))
+                    for e in elements]
+    else:
+        elements = [replace(e, axes=tuple(replace(v, cure=()) for v in e.axes)) for e in elements]
     return StackReport(printer.name, proc, tuple(sorted(counts.items())), estimated, tuple(elements),
                        tuple(x.name for x in locators))
 
 
+#: Rounds of re-laying the tower when solving a range key's value (the stack grows a little with the travel).
+CURE_ROUNDS = 8
+
+
+def _cured(profile, layout, printer, counts, locators, proc, v: AxisVerdict) -> AxisVerdict:
+    """``v`` with its cure as ``key >= value mm``: the least travel (to 0.1 mm) whose re-laid tower's stack
+    (the same seams, locators and process) its adjuster covers, found by raising the key to the stack until
+    the range covers it; no cure when it does not converge within CURE_ROUNDS, the adjuster's resolution
+    fails, or the tower cannot be laid out with that travel (GeometryError)."""
+    from rigcad.parts.tower import tower_layout
+
+    if not v.cure:
+        return v
+    key = v.cure[0]
+    section, name = key.split(".")
+    value = getattr(getattr(profile, section), name)
+    worst = v.worst
+    for _ in range(CURE_ROUNDS):
+        value = max(value, math.ceil(worst * 10 - 1e-9) / 10)
+        p2 = replace(profile, **{section: replace(getattr(profile, section), **{name: value})})
+        try:
+            lay2 = replace(layout, tower=tower_layout(p2, layout.geometry, layout.plate_r, layout.dome_top_z))
+        except GeometryError:  # the tower cannot take that travel: the key alone is no cure
+            break
+        again = stack(p2, lay2, printer, seams=counts, locators=locators, process=proc, cures=False)
+        w = next(x for e in again.elements for x in e.axes if (x.element, x.axis) == (v.element, v.axis))
+        if w.ok:
+            return replace(v, cure=(f"{key} >= {value:g} mm",))
+        if w.adjuster is None or w.adjuster.resolution > w.tolerance * RESOLUTION_SHARE or math.isinf(w.worst):
+            break
+        worst = w.worst
+    return replace(v, cure=())
+
+
 def refuse(report: StackReport) -> None:
     """Raise FabricationError when an element's stack is refused: one line naming each refused
-    element and axis, the links that dominate it and the ``buy:`` options that would remove them."""
+    element and axis, the links that dominate it, the setting that would pass it (its adjuster's range
+    key and the value, when one sets the range) and the ``buy:`` options that would remove the links."""
     bad = report.refused
     if not bad:
         return
     parts = []
     for v in bad:
-        buy = f"; buy: {' / '.join(v.buy)}" if v.buy else ""
+        cure = f"; set {' or '.join(v.cure)}" if v.cure else ""
+        buy = f"; {'or ' if v.cure else ''}buy: {' / '.join(v.buy)}" if v.buy else ""
         parts.append(f"{ELEMENT_NAMES[v.element]} {v.axis} (tolerancing.{v.tolerance_key}): {v.reason}; dominated by "
-                     f"{', '.join(v.dominating)}{buy}")
+                     f"{', '.join(v.dominating)}{cure}{buy}")
     raise FabricationError(f"on {report.printer}, {len(bad)} placement(s) the printed rig cannot hold or adjust: "
                            + " | ".join(parts))
 
