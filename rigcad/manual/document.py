@@ -773,6 +773,19 @@ def preparations(rig, order, meshes_by_name: dict) -> dict[str, list[dict]]:
         for n in named:  # a bought step places the item itself ("placed"); else it is pressed in before the part
             out[n].append({"kind": "placed" if n in bought else "pressed", "item": B.tower_item(h),
                            "quantity": h["quantity"] // len(named), "into": None, "for": n, "joins": h["joins"]})
+    from rigcad.parts.paraboloid import hardware as stop_hardware
+
+    # the paraboloid's stops' and the beam seats' bought items (set screws, roll bars, the stop pin, the foil), in
+    # the first step the bill assigns each to (the inserts: that step melts them); a later step says where it was listed
+    for h in stop_hardware(rig.profile, rig.layout) if "paraboloid" in rig.recipes else ():
+        named = plan.step_names([p.step for p in order], h.get("steps", ()))
+        named = sorted(named, key=list(out).index)
+        if named and "heat-set insert" not in h["item"]:
+            out[named[0]].append({"kind": "pressed", "item": B.tower_item(h), "quantity": h["quantity"], "into": None,
+                                  "for": named[0], "joins": h["joins"]})
+        for n in named[1:]:  # a later step that uses it says where it was listed
+            out[n].append({"kind": "listed", "item": B.tower_item(h), "quantity": h["quantity"], "into": None,
+                           "for": n, "at": named[0]})
     return out
 
 
@@ -794,6 +807,8 @@ def preparation_text(rows: list[dict], number: dict[str, int], here: str) -> str
                      "be reached. ")
         elif r["kind"] == "pressed":
             text += f"Before it goes in, fit {r['quantity']} x {r['item']}: {r['joins']}. "
+        elif r["kind"] == "listed":
+            text += f"It takes its share of the {r['item']} listed at step {number[r['at']]}. "
     return text
 
 
