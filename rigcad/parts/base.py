@@ -18,15 +18,16 @@ from rigcad.parts.joints import Datum, datums_of
 from rigcad.parts.layout import RigLayout
 from rigcad.parts.locating import holder_fit
 from rigcad.parts.recipe import Box, Cylinder, Difference, Part, Union_
-from rigcad.parts.tower import column_datums, column_joint_cuts, tongue_underside_cuts
+from rigcad.parts.tower import COLLAR_BENCH_GAP_MM, column_datums, column_joint_cuts, tongue_underside_cuts
 from rigcad.profile.schema import Profile
 
 
 def base_plate(profile: Profile, layout: RigLayout) -> Part:
     """The rig's datum: a disc bolted to the dome's flange, bored for the sample holder, with a tongue
     out to the COP tower's column, whose foot it locates by two dowels and holds by four bolts (nuts
-    in hexagonal traps underneath). The tongue reaches down to the bench (the sample holder's stop
-    collar's level): the tower's weight goes into the bench, not through the disc."""
+    in hexagonal traps underneath). The tongue reaches down to the bench (COLLAR_BENCH_GAP_MM under
+    the sample holder's stop collar): the tower's weight goes into the bench, not through the disc; two feet
+    under the rim (:func:`feet`) make it three supports."""
     t = profile.base_plate.thickness
     holder = profile.sample_holder
     plate = Cylinder((0.0, 0.0, -t), layout.plate_r, t)
@@ -46,7 +47,7 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
               *datums_of("register", "dome register pin hole", register(profile, layout).lower_zones()),
               *column_datums(tw, profile, tw.bench_z, -tw.bench_z, "top", "tongue"))
     b = breadboard.board(profile)
-    pads = breadboard.pads(profile, layout) if b else ()
+    pads = (*feet(profile, layout), *(breadboard.pads(profile, layout) if b else ()))
     anchors = breadboard.holes(profile, layout) if b else ()
     on_board = "" if b is None else (
         f"; it stands on the {b.title}: the sample point over a tapped hole, the tongue along a row of holes, "
@@ -60,9 +61,29 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
             "its tongue locates the tower's column " + (
                 f"by two {profile.datum.dowel_diameter:g} mm dowels (pressed into blind holes reamed N7) and four bolts"
                 if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core")
-            + on_board)
+            + on_board + "; it stands on three feet: the tongue's underside and two pads under the disc's rim, "
+            f"the sample holder's collar {COLLAR_BENCH_GAP_MM:g} mm clear of the bench")
     return Part("base_plate", Difference(Union_((plate, tongue, *pads)), (bore, groove, *holes, *joint, *anchors)),
                 (0.55, 0.57, 0.6), desc, datums=datums)
+
+
+#: The base plate's two printed feet under the disc's rim (with the tongue, the rig's three supports):
+#: their azimuths (rad from +x, the tongue's side; 120 deg each side, so the three supports stand about
+#: equally round O), their radius, and how far (mm) each stays inside the disc's rim.
+FOOT_AZIMUTHS = (2.0 * math.pi / 3.0, -2.0 * math.pi / 3.0)
+FOOT_RADIUS_MM, FOOT_RIM_INSET_MM = 10.0, 4.0
+#: A foot reaches this far (mm) up into the disc (one solid), short of the dome's insert pockets above it.
+FOOT_OVERLAP_MM = 0.5
+
+
+def feet(profile: Profile, layout: RigLayout) -> tuple[Cylinder, ...]:
+    """The disc's two feet (:data:`FOOT_AZIMUTHS`): printed pads from the bench (the tongue's underside,
+    ``layout.tower.bench_z``) up into the disc, FOOT_RIM_INSET_MM inside its rim. With the tongue they are
+    the rig's three supports; the sample holder's collar stands COLLAR_BENCH_GAP_MM over the bench."""
+    t, bench = profile.base_plate.thickness, layout.tower.bench_z
+    r = layout.plate_r - FOOT_RIM_INSET_MM - FOOT_RADIUS_MM
+    return tuple(Cylinder((r * math.cos(a), r * math.sin(a), bench), FOOT_RADIUS_MM, -t + FOOT_OVERLAP_MM - bench)
+                 for a in FOOT_AZIMUTHS)
 
 
 #: The turn mark under the base plate: a groove across the disc's underside along +x (the tongue's

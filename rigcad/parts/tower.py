@@ -57,6 +57,10 @@ GROOVE_GAP = 0.2
 GROOVE_DEPTH = 2.0
 #: Square adjustment shims (mm): side; the U slot takes the screw without removing it.
 SHIM_SIDE = 30.0
+#: The bench lies this far (mm) under the sample holder's stop collar: the rig stands on three feet (the
+#: tongue and two pads under the disc's rim, rigcad.parts.base.feet), never on the collar. 2 mm is 20 times
+#: a printed foot's out-of-flat (``datum.foot_flatness``, 0.1 mm by default), so no warp brings it down.
+COLLAR_BENCH_GAP_MM = 2.0
 
 
 def clearance_hole(thread: str) -> float:
@@ -271,7 +275,8 @@ def tower_layout(profile: Profile, geometry: Derived, plate_r: float, dome_top_z
     foot_half = tw.column_width / 2 + 3 * tw.bolt_diameter
     return TowerLayout(
         plate=plate, camera=camera, projector_cop=tuple(float(v) for v in p_cop), cop=(0.0, 0.0, cop_z),
-        bench_z=-(profile.base_plate.thickness + profile.sample_holder.stop_thickness), shelf_top_z=shelf_top,
+        bench_z=-(profile.base_plate.thickness + profile.sample_holder.stop_thickness + COLLAR_BENCH_GAP_MM),
+        shelf_top_z=shelf_top,
         shelf_thickness=shelf_t, holder_x=(px0 - GROOVE_GAP - 1.0 - tw.wall, px1 + tw.wall), holder_top_z=pz1 + tw.wall,
         plate_bottom_z=pz0,
         wall_y=(bs.width / 2 - GROOVE_DEPTH, wall_out), bracket_y=bracket_y,
