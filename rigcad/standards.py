@@ -324,6 +324,27 @@ def pre_ream_drill(size: float) -> float:
     return int(round((size - reaming_allowance(size)) * 10, 9)) / 10.0
 
 
+#: The reamer that sizes a dowel's blind hole, turned in a drill press at low speed: a machine (chucking)
+#: reamer, whose lead is a short 45 deg chamfer. A hand reamer (DIN 206) starts on a long taper, several
+#: millimetres of under-size flutes, and cannot bring a blind hole a few millimetres deep to size.
+MACHINE_REAMER, MACHINE_REAMER_SPEC = "machine (chucking) reamer", "DIN 212, HSS, straight shank, 45 deg chamfer lead"
+#: The machine reamer's lead along its axis (mm): the under-size zone it leaves at a blind hole's floor,
+#: so a blind hole is at least the pin's engagement and this deep. 1.0 mm: assumed for a 45 deg chamfer on
+#: the 3-6 mm sizes (no maker's table was at hand to cite; the manual's step says to hold the bought
+#: reamer's chamfer against it, and a longer one needs deeper holes).
+REAMER_LEAD_MM = 1.0
+#: The gauge pins that check a reamed hole (DIN 2269 cylindrical gauge pins, class 1, +-0.001 mm; sold in
+#: 0.001 mm steps): the go pin at the hole class's lower limit enters, the no-go pin at its upper limit does not.
+GAUGE_PIN, GAUGE_PIN_SPEC = "cylindrical gauge pin", "DIN 2269, class 1"
+
+
+def gauge_pins(size: float, hole: str) -> tuple[float, float]:
+    """The go and no-go gauge pins (mm, to 0.001 mm) of a ``size`` mm hole of ISO 286 class ``hole``: its
+    zone's lower and upper limits (:func:`tolerance_zone`)."""
+    lo, hi = tolerance_zone(size, hole)
+    return round(size + lo, 3), round(size + hi, 3)
+
+
 #: Cup-point socket set screws: the cup's diameter (mm, dp max): ISO 4029 for metric threads, ASME
 #: B18.3 (C max, in inches as printed) for the unified ones. A ball larger than the cup sits on its rim.
 CUP_POINT = {"M3": 1.4, "M4": 2.0, "M5": 2.5, "M6": 3.0, "M8": 5.0,
@@ -385,7 +406,7 @@ DRIVER_BLADE_MM = 100.0
 #: An open-end spanner's reach (mm; DIN 3110 spanners for M3-M6 nuts are 90-120 mm long).
 SPANNER_MM = 80.0
 
-__all__ = ["DOWEL_PRESS_HOLE", "DOWEL_SHAFT", "DOWEL_SLIP_HOLE", "Fit", "ISO_286", "REAMING_ALLOWANCE", "pre_ream_drill", "reaming_allowance", "tolerance_zone", "CAMERA_SOCKET_DEPTH", "ISO_7089_BORE", "ISO_7093", "CUP_POINT", "SHIM_FOIL", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
+__all__ = ["GAUGE_PIN", "GAUGE_PIN_SPEC", "MACHINE_REAMER", "MACHINE_REAMER_SPEC", "REAMER_LEAD_MM", "gauge_pins", "DOWEL_PRESS_HOLE", "DOWEL_SHAFT", "DOWEL_SLIP_HOLE", "Fit", "ISO_286", "REAMING_ALLOWANCE", "pre_ream_drill", "reaming_allowance", "tolerance_zone", "CAMERA_SOCKET_DEPTH", "ISO_7089_BORE", "ISO_7093", "CUP_POINT", "SHIM_FOIL", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
            "SPRING_STEEL_G", "dowel_diameter_for", "shortest_set_screw", "spring_rate", "INCH_SCREW_LENGTHS", "LARGE_WASHERS", "DOWEL_LENGTHS", "longest_dowel", "DRIVER_BLADE_MM", "HEX_KEYS", "HexKey", "INCH", "INSERTS",
            "Insert", "METRIC_THREADS", "MOUNT_THREADS", "SCREW_LENGTHS", "SCREW_LENGTH_RANGE", "SPANNER_MM", "THREADS",
            "Thread", "longest_screw", "screw_lengths", "shortest_screw", "thread", "thread_for_hole"]

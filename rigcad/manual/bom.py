@@ -504,7 +504,10 @@ TOOLS = (
     ("Files: a 150 mm flat file (cut 2) and a needle file set, flat and round (slots, deburring)", "1 set"),
     ("Float glass plate 300 x 300 x 6 mm and a steel straightedge 300 mm (DIN 874, grade 1), for lapping glue "
      "faces flat", "1 each"),
-    ("Drill press, or a hand drill in a drill stand, with a depth stop; a tap wrench to turn the hand reamers", "1"),
+    ("Drill press with a depth stop and a vise for it: the dowels' blind holes are drilled and machine-reamed "
+     "in the drill press at low speed (a machine reamer's short lead sizes a blind hole; a hand reamer's long taper cannot); "
+     "a hand drill for the holes drilled in place through a part that guides it; a tap wrench to turn the hand "
+     "reamer of a pin set in retaining compound", "1 each"),
     ("Bench vise with soft jaws and a soft-faced hammer (pressing dowel pins and balls in)", "1 each"),
     ("Lathe (bench lathe whose chuck takes the holder's bar) with turning and parting tools and a boring bar, "
      "for the sample holder; the base plate's H7 bore is bored with the boring bar on the lathe's faceplate, or "
@@ -518,7 +521,8 @@ TOOLS = (
 #: (or of the calibration kit), so a tool a step uses and the bill forgets shows (tests/manual).
 TOOL_WORDS = ("caliper", "engineer's square", "spirit level", "hex key", "spanner", "torque screwdriver",
               "soldering iron", "feeler", "tin snips", "scissors", "file", "float glass", "straightedge", "drill",
-              "reamer", "dial test indicator", "vise", "hammer", "scalpel", "circle cutter", "leather punch", "lathe",
+              "reamer", "machine reamer", "drill press", "gauge pin",
+              "dial test indicator", "vise", "hammer", "scalpel", "circle cutter", "leather punch", "lathe",
               "boring bar", "boring head", "micrometer", "airbrush")
 
 

@@ -34,7 +34,8 @@ from dataclasses import dataclass, replace
 
 from rigcad.errors import GeometryError
 from rigcad.parts.recipe import Box, Cylinder, Line, Prism, Revolve, Section, Translate
-from rigcad.standards import (DOWEL_PRESS_HOLE, DOWEL_SHAFT, DOWEL_SLIP_HOLE, INSERTS, SHIM_FOIL, THREADS, Fit,
+from rigcad.standards import (DOWEL_PRESS_HOLE, DOWEL_SHAFT, DOWEL_SLIP_HOLE, GAUGE_PIN, GAUGE_PIN_SPEC, INSERTS,
+                               MACHINE_REAMER, MACHINE_REAMER_SPEC, REAMER_LEAD_MM, SHIM_FOIL, THREADS, Fit, gauge_pins,
                                longest_dowel, pre_ream_drill, shortest_set_screw)
 
 
@@ -49,15 +50,39 @@ def slip_fit(diameter: float) -> Fit:
 
 
 def reamers(diameter: float) -> str:
-    """The tools a ``diameter`` mm pin's holes take, as the bill and the steps name them."""
+    """The tools a ``diameter`` mm pin's holes take, as the bill and the steps name them: the drill, the
+    press and slip ends' machine reamers (rigcad.standards.MACHINE_REAMER: short lead, for blind holes) and
+    the gauge pins that check each hole (:func:`gauge_text`)."""
     return (f"a {pre_ream_drill(diameter):g} mm twist drill (DIN 338), {diameter:g} mm {DOWEL_PRESS_HOLE} and "
-            f"{diameter:g} mm {DOWEL_SLIP_HOLE} hand reamers")
+            f"{diameter:g} mm {DOWEL_SLIP_HOLE} {MACHINE_REAMER}s ({MACHINE_REAMER_SPEC}), and "
+            f"{gauge_text(diameter)}")
+
+
+def gauge_text(diameter: float) -> str:
+    """The go and no-go gauge pins (rigcad.standards.GAUGE_PIN) of a ``diameter`` mm pin's press and slip holes."""
+    (pg, pn), (sg, sn) = gauge_pins(diameter, DOWEL_PRESS_HOLE), gauge_pins(diameter, DOWEL_SLIP_HOLE)
+    return (f"{GAUGE_PIN}s ({GAUGE_PIN_SPEC}), go and no-go: {pg:.3f} and {pn:.3f} mm for {diameter:g} {DOWEL_PRESS_HOLE}, "
+            f"{sg:.3f} and {sn:.3f} mm for {diameter:g} {DOWEL_SLIP_HOLE}")
+
+
+def check_blind_hole(name: str, depth: float, engagement: float, diameter: float, param: str | None = None) -> None:
+    """Refuse (GeometryError naming the register and ``param``) a pin's blind hole ``depth`` mm deep that
+    does not hold the pin's ``engagement`` (at least its ``diameter``) and the machine reamer's lead under
+    it (rigcad.standards.REAMER_LEAD_MM: the reamer leaves that much under size at the floor)."""
+    if engagement < diameter - 1e-9 or depth < engagement + REAMER_LEAD_MM - 1e-9:
+        raise GeometryError(f"register {name}: its pins' blind holes, {depth:.1f} mm deep, must hold the pin "
+                            f"{max(engagement, diameter):g} mm (at least its {diameter:g} mm diameter) and the "
+                            f"machine reamer's {REAMER_LEAD_MM:g} mm lead under it: a thicker lower part or "
+                            "a smaller datum.dowel_diameter", param=param)
 
 #: The slot across its pin (mm): printed at the pin's size and filed until the pin slides in it.
 SLOT_FIT_MM = 0.05
 #: The pin stops this far short of the upper part's top face (mm), and its hole in the lower part
-#: this far past the pin's end (mm: room for the chips of reaming and for pressing it home).
-PIN_SHORT_MM, PIN_BOTTOM_MM = 1.0, 0.5
+#: this far past the pin's end (mm): the machine reamer's lead, which leaves the floor's last millimetre
+#: under size (rigcad.standards.REAMER_LEAD_MM), and room for the chips and for pressing it home.
+PIN_SHORT_MM, PIN_BOTTOM_MM = 1.0, REAMER_LEAD_MM
+#: A register's return is measured by lifting the upper part off and setting it back this many times.
+REPEAT_TRIALS = 5
 #: A shim stop's pack at the design setting (mm): the part moves this far each way by taking foil out
 #: or adding as much again (its range). It covers the paraboloid's placement stack from O on the
 #: shipped printers (rigcad.fab.stack: 1.21 mm lateral and 0.64 mm in height worst case on the MK3S).
@@ -125,6 +150,7 @@ class DowelRegister:
             self.length
         except ValueError as err:
             raise GeometryError(f"register {self.name}: {err}", param=self.param or None) from err
+        check_blind_hole(self.name, self.lower_depth, self.lower_engagement, self.diameter, self.param or None)
 
     @property
     def spacing(self) -> float:
@@ -143,6 +169,11 @@ class DowelRegister:
         (and a millimetre of floor under it)."""
         room = self.upper_engagement + (self.lower_z[1] - self.lower_z[0]) - PIN_BOTTOM_MM - 1.0
         return longest_dowel(room)
+
+    @property
+    def lower_engagement(self) -> float:
+        """How far each pin stands down into the lower part, pressed (mm)."""
+        return self.length - self.upper_engagement
 
     @property
     def lower_depth(self) -> float:
@@ -183,12 +214,43 @@ class DowelRegister:
             return self.procedure
         lower, upper = self.lower.replace("_", " "), self.upper.replace("_", " ")
         return (f"The {lower}'s two pin holes and the {upper}'s round hole print at {self.drill:g} mm: drill each "
-                f"{self.drill:g} mm (a hole that printed small), ream the {lower}'s holes {self.diameter:g} "
-                f"{DOWEL_PRESS_HOLE} (their blind floors, {self.lower_depth:.1f} mm deep, stop the pins) and the "
-                f"{upper}'s round hole {self.diameter:g} {DOWEL_SLIP_HOLE}; file its slot until a pin slides along "
-                f"it but not across. Press the pins ({self.item}) into the {lower} with a vise until "
-                f"{self.upper_engagement:g} mm stands proud: {self.press.describe()}; the {upper} slides on them, "
-                f"{self.slip.describe()}.")
+                f"{self.drill:g} mm in the drill press (a hole that printed small), then, in the drill press at low "
+                f"speed, ream the {lower}'s holes {self.diameter:g} {DOWEL_PRESS_HOLE} to the depth stop "
+                f"({self.reaming_text()}) and the {upper}'s round hole {self.diameter:g} {DOWEL_SLIP_HOLE}; "
+                f"{self.gauge_step()} File its slot until a pin slides along it but not across. Press the pins "
+                f"({self.item}) into the {lower} with a vise until {self.upper_engagement:g} mm stands proud: "
+                f"{self.press.describe()}; the {upper} slides on them, {self.slip.describe()}. {self.repeat_step()}")
+
+    def reaming_text(self) -> str:
+        """The blind holes' depth and what it holds: the pin's engagement and the machine reamer's lead."""
+        return (f"blind, {self.lower_depth:.1f} mm deep: the pin's {self.lower_engagement:g} mm and the "
+                f"{MACHINE_REAMER}'s {REAMER_LEAD_MM:g} mm lead under it; hold the bought reamer's chamfer against "
+                f"that figure: a longer lead leaves the pin's end in an under-size hole")
+
+    def gauge_step(self) -> str:
+        """The check of each reamed hole with its go and no-go gauge pins (rigcad.standards.gauge_pins)."""
+        (pg, pn), (sg, sn) = self.press_gauges, gauge_pins(self.diameter, DOWEL_SLIP_HOLE)
+        return (f"check each hole with the {GAUGE_PIN}s: in the {self.diameter:g} {DOWEL_PRESS_HOLE} holes the "
+                f"{pg:.3f} mm go pin enters to the floor and the {pn:.3f} mm no-go pin does not start; in the "
+                f"{self.diameter:g} {DOWEL_SLIP_HOLE} hole the {sg:.3f} mm pin goes through and the {sn:.3f} mm "
+                "pin does not (a hole that takes the no-go pin is drilled out and the part reprinted, or its pin "
+                "set in retaining compound).")
+
+    @property
+    def press_gauges(self) -> tuple[float, float]:
+        return gauge_pins(self.diameter, DOWEL_PRESS_HOLE)
+
+    def repeat_step(self) -> str:
+        """The measurement of the register's return that the tolerance stack's figure stands on: indicate the
+        upper part, lift it off and set it back REPEAT_TRIALS times, and record each reading."""
+        lateral, _ = self.repeatability
+        upper = self.upper.replace("_", " ")
+        return (f"Measure its return: a dial test indicator ({INDICATOR_MM:g} mm graduation) on the "
+                f"{self.lower.replace('_', ' ')}, its tip on a side of the {upper} square to the line between "
+                f"the pins, zeroed; part the two off the pins and set them back together {REPEAT_TRIALS} times, reading "
+                f"the indicator each time, and record the {REPEAT_TRIALS} readings. The tolerance stack takes "
+                f"{lateral:.3f} mm each way (half the slip fit's largest clearance): each reading must be within "
+                f"one graduation of zero; a larger one means a hole is over size (check it with the gauge pins).")
 
     def lower_holes(self) -> tuple[Cylinder, ...]:
         """The pins' blind holes in the lower part, from its top face, printed at :attr:`drill`'s size
@@ -300,5 +362,5 @@ def teardrop_along_y(centre: tuple[float, float, float], radius: float, length: 
     return Translate(Prism(Section(segs), length), tuple(float(v) for v in centre))
 
 
-__all__ = ["DowelRegister", "HOLDER_HOLE", "HOLDER_SHAFT", "holder_fit", "INDICATOR_MM", "SHIM_PACK_MM", "press_fit", "reamers", "slip_fit", "SLOT_FIT_MM", "ShimStop", "bolt_hole",
+__all__ = ["DowelRegister", "REPEAT_TRIALS", "check_blind_hole", "gauge_text", "HOLDER_HOLE", "HOLDER_SHAFT", "holder_fit", "INDICATOR_MM", "SHIM_PACK_MM", "press_fit", "reamers", "slip_fit", "SLOT_FIT_MM", "ShimStop", "bolt_hole",
            "foil_step", "set_screw_length", "stepped_hole", "teardrop_along_y"]

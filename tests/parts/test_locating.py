@@ -16,9 +16,10 @@ import rigcad
 from rigcad.errors import GeometryError
 from rigcad.manual import plan
 from rigcad.manual.assembly import picture_meshes
+from rigcad.parts import locating
 from rigcad.parts.locating import DowelRegister
 from rigcad.rig import Rig
-from rigcad.standards import THREADS
+from rigcad.standards import REAMER_LEAD_MM, THREADS
 
 dome = importlib.import_module("rigcad.parts.dome")
 base = importlib.import_module("rigcad.parts.base")
@@ -52,7 +53,8 @@ def test_the_pins_holes_are_cut_from_the_declaration(table31_rig, tmp_path):
     assert plate == []
     datums = [d for d in table31_rig.recipes["base_plate"].datums if d.kind == "register"]
     assert sorted(round(d.centre[1], 3) for d in datums) == [round(-r, 3), round(r, 3)]
-    assert reg.lower_depth + reg.upper_engagement == pytest.approx(reg.length + 0.5)
+    # the blind hole runs the machine reamer's lead past the pin's end (its floor's under-size zone)
+    assert reg.lower_depth + reg.upper_engagement == pytest.approx(reg.length + REAMER_LEAD_MM)
     # the flange: a round hole at +y printed at the drill's size before the reamers (3.8 mm for 4 mm pins:
     # a 0.2 mm reaming allowance), and the slot's two ends at -y +- half its extra length, at the pin's width
     assert reg.drill == pytest.approx(reg.diameter - 0.2) if reg.diameter <= 5 else reg.drill < reg.diameter
@@ -157,7 +159,10 @@ def test_the_parts_page_states_the_fits_the_code_computes(table31_rig):
                   f"{fit.shaft}: {fit.describe()}", f"within {sample_link(p).lateral:.3f} mm of the bore's axis",
                   f"plugs are printed, at {base.holder_drawn(p, False):g} mm",
                   f"reamed N7, {reg.press.describe()}", f"reamed F7, {reg.slip.describe()}",
-                  f"returns to within {reg.repeatability[0]:.3f} mm", f"at the {reg.drill:g} mm drill's size",
+                  f"takes the dome's return as {reg.repeatability[0]:.3f} mm each way",
+                  f"set back {locating.REPEAT_TRIALS} times", f"plus that {REAMER_LEAD_MM:g} mm lead",
+                  "({:.3f} / {:.3f} mm for {:g} N7".format(*reg.press_gauges, reg.diameter),
+                  f"at the {reg.drill:g} mm drill's size",
                   f"a {reg.diameter - reg.drill:.1f} mm reaming allowance", f"the beam's {pin:g} mm stop pin",
                   f"{press_fit(pin).describe()}, in a {pre_ream_drill(pin):g} mm hole"):
         assert words in text, words
