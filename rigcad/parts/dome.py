@@ -314,9 +314,9 @@ def indicating_text(profile: Profile, layout: RigLayout, reg: DowelRegister | No
         f"each way). Tighten the bolts to their torque; check again. With {reamers(reg.diameter)}: drill the "
         f"plate {reg.drill:g} mm through the flange's round hole (printed at {reg.drill:g} mm: the drill opens it "
         f"too) and its slot, {reg.lower_depth:.1f} mm deep (a depth stop on the drill: blind holes, whose floors "
-        f"keep the pins from walking), ream both plate holes {reg.diameter:g} {reg.press.hole} through the flange, "
-        f"lift the dome off, ream the flange's round hole {reg.diameter:g} {reg.slip.hole} and file its slot until "
-        f"a pin slides along it but not across. Press the pins ({reg.item}) into the plate with a vise until "
-        f"{reg.upper_engagement:g} mm stands proud: {reg.press.describe()}; the flange slides on them, "
-        f"{reg.slip.describe()}. The dome then lifts off and goes back to within "
-        f"{reg.repeatability[0]:.3f} mm.")
+        f"keep the pins from walking), ream both plate holes {reg.diameter:g} {reg.press.hole} through the flange "
+        f"with the machine reamer in a hand drill at its lowest speed, the flange's holes guiding it, to the depth "
+        f"stop ({reg.reaming_text()}); lift the dome off, ream the flange's round hole {reg.diameter:g} "
+        f"{reg.slip.hole}, {reg.gauge_step()} File its slot until a pin slides along it but not across. Press the "
+        f"pins ({reg.item}) into the plate with a vise until {reg.upper_engagement:g} mm stands proud: "
+        f"{reg.press.describe()}; the flange slides on them, {reg.slip.describe()}. {reg.repeat_step()}")
