@@ -134,23 +134,52 @@ def later_stages(problem: Problem, profile: Profile, geometry: Derived) -> dict[
     from rigcad.errors import GeometryError
     from rigcad.fab import stack as ST
     from rigcad.optics.dome import build_equal_path
-    from rigcad.parts import make_layout, make_recipes
+    from rigcad.parts import make_recipes
 
     dome = build_equal_path(geometry, LATER_DOME_ROWS)
     # the calibration's screen inside the dome (rigcad manual and calibrate --kit refuse a dome it does not fit)
     room = screen_room(SimpleNamespace(profile=profile, dome=dome))
     g = {"later.calibration_screen": room["half_diagonal_mm"] - room["tightest"]["dome_radius_mm"] + GEOMETRY_RESERVE}
     try:
-        f = custom_focal_length(profile, geometry)
-        if f is not None:
-            profile = dataclasses.replace(profile, lens=dataclasses.replace(profile.lens, focal_length=f))
-        layout = make_layout(profile, geometry, dome)
+        profile, layout = _later_layout(profile, geometry, dome)
         make_recipes(profile, layout)
     except GeometryError:
         return {**g, "later.layout_and_parts": 1.0}
     pr = problem.stack_printer
-    refused = 0 if pr.process_errors is None else len(ST.stack(profile, layout, pr).refused)
+    refused = 0 if pr.process_errors is None else len(ST.stack(profile, layout, pr, cures=False).refused)
     return {**g, "later.layout_and_parts": 0.0, "later.tolerance_stack": float(refused)}
+
+
+def _later_layout(profile: Profile, geometry: Derived, dome):
+    """The profile with the design's focusing lens (a custom one when no stock lens focuses it) and the
+    rig's layout on ``dome``, as :func:`later_stages` judges them (GeometryError when it refuses)."""
+    from rigcad.parts import make_layout
+
+    f = custom_focal_length(profile, geometry)
+    if f is not None:
+        profile = dataclasses.replace(profile, lens=dataclasses.replace(profile.lens, focal_length=f))
+    return profile, make_layout(profile, geometry, dome)
+
+
+def stack_refusals(problem: Problem, x) -> list[str]:
+    """The placements `rigcad fab`'s tolerance stack refuses for the design at ``x`` (internal units) on the
+    run's printer, as :func:`later_stages` counts them: each as 'element axis (tolerancing.key)', with the
+    setting that would pass it where one does; empty when the layout itself refuses or nothing is refused."""
+    from rigcad.errors import GeometryError
+    from rigcad.fab import stack as ST
+    from rigcad.optics.dome import build_equal_path
+
+    pr = problem.stack_printer
+    if pr is None or pr.process_errors is None:
+        return []
+    profile = apply(problem.base, problem.names, [float(v) for v in x])
+    geometry = derive(profile)
+    try:
+        profile, layout = _later_layout(profile, geometry, build_equal_path(geometry, LATER_DOME_ROWS))
+    except GeometryError:
+        return []
+    return [f"{ST.ELEMENT_NAMES[v.element]} {v.axis} (tolerancing.{v.tolerance_key}"
+            + (f"; set {' or '.join(v.cure)})" if v.cure else ")") for v in ST.stack(profile, layout, pr).refused]
 
 
 def apply(profile: Profile, keys: list[str], x) -> Profile:

@@ -357,7 +357,7 @@ def _report(problem, result, engine: Engine) -> dict:
             f"designs {1e6:g} x (1 + scaled violation) above; refused designs 1e12"},
         "objective_scales": {n: OBJECTIVES[n][2] for n, _ in spec.objectives},
         "status": "ok" if result.chosen is not None else "infeasible",
-        "reason": result.reason,
+        "reason": result.reason if result.chosen is not None else (result.reason or "no design met the constraints"),
         "base": _row_json(problem, result.base),
         "chosen": _row_json(problem, result.chosen) if result.chosen else None,
         "pareto": [_row_json(problem, r) for r in result.front],
@@ -373,7 +373,7 @@ def _certify_choice(problem, result, report: dict, also=None, check: bool = True
     certify there, a tolerance stack fab refuses, a rig the further check refuses) gives way to the next
     in preference, up to MAX_TRIED designs of which MAX_CERTIFY reach the further check. Sets ``result.chosen``
     and ``.reason`` (None: every one refused) and the report's verdict; returns the refused designs."""
-    rejected = []
+    rejected, certified = [], None
     for row, why in preference(problem, result)[:MAX_TRIED]:
         if sum(1 for r in rejected if r["stage"].startswith("assembly")) >= MAX_CERTIFY:
             break
@@ -384,10 +384,14 @@ def _certify_choice(problem, result, report: dict, also=None, check: bool = True
             rejected.append({"index": row["index"], "error": str(err), "stage": _stage_of(err),
                              **({"detail": err.detail} if getattr(err, "detail", "") else {})})
             continue
-        result.chosen, result.reason = row, why
+        certified = (row, why)
         break
-    else:
+    if certified is not None:
+        result.chosen, result.reason = certified
+    else:  # every design tried was refused (or none was tried): the search's reason no longer holds
         result.chosen = None
+        result.reason = (f"none of the {len(rejected)} designs tried passed the later stages"
+                         if rejected else "no design to certify")
     report["rejected_by_certified_path"] = rejected
     report["chosen"] = _row_json(problem, result.chosen) if result.chosen else None
     report["reason"] = result.reason

@@ -26,7 +26,8 @@ import numpy as np
 
 from rigcad.engine import Engine, run, split
 from rigcad.errors import RigcadError
-from rigcad.optimize.problem import CONSTRAINT_KEYS, CONSTRAINT_UNITS, UNIT_SCALE, Problem, evaluate_task, violation
+from rigcad.optimize.problem import (CONSTRAINT_KEYS, CONSTRAINT_UNITS, UNIT_SCALE, Problem, evaluate_task,
+                                     stack_refusals, violation)
 from rigcad.optimize.spec import OBJECTIVES, target_of
 
 #: Merit of a design that violates a constraint: above every feasible design's merit (objectives
@@ -277,7 +278,7 @@ def optimize(problem: Problem, engine: Engine = Engine(), progress=None) -> Resu
             _polish(ev, problem.to_unit(best["x"]), spec.evaluations - len(ev.history.rows), 0, [])
         feas = [r for r in ev.history.rows if r["feasible"]]
         chosen = min(feas, key=lambda r: r["merit"]) if feas else None
-        reason = "lowest merit of the feasible designs"
+        reason = "lowest merit of the feasible designs" if chosen is not None else ""
         front = pareto(problem, ev.history.rows) if chosen else []
     else:
         method = "optuna NSGA-II + COBYLA"
@@ -362,8 +363,12 @@ def infeasible_message(problem: Problem, rows: list[dict]) -> str:
         if best > 0:
             unit = CONSTRAINT_UNITS[name]
             at = ", ".join(f"{p.key} = {p.shown(v)}" for p, v in zip(problem.spec.parameters, row["x"]))
+            which = ""
+            if name == "later.tolerance_stack":  # the count names placements: say which, at that design
+                refused = stack_refusals(problem, row["x"])
+                which = f": {'; '.join(refused)}" if refused else ""
             parts.append(f"{name} ({CONSTRAINT_KEYS[name]}): never met; best value reached {best:+.4g} {unit} over its "
-                         f"limit (at {at})".replace("  ", " "))
+                         f"limit (at {at}){which}".replace("  ", " "))
     if not parts:  # each met somewhere, never all together
         worst = min(valued, key=violation)
         missed = [k for k, v in worst["constraints"].items() if v > 0]
