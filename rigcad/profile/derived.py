@@ -90,7 +90,10 @@ def _check_disc(profile: Profile, pixels: float) -> None:
         return
     (w, h), off = pj.resolution, pj.lens_offset
     best = 1.0 - 2.0 * pixels / h  # the largest offset whose image still holds the disc below the axis
-    if pixels <= w / 2 and best >= 0:
+    if pixels <= w / 2 and best >= 0 and room <= 0:  # no disc about an axis off the image: no throw ratio helps
+        way = (f"the axis lies outside the image, so no projector.throw_ratio can help: it needs a projector with its "
+               f"lens shift set to at most {best:.0%} (projector.lens_offset)")
+    elif pixels <= w / 2 and best >= 0:
         way = (f"it needs an offset of at most {best:.0%} (projector.lens_offset: a lens shift set nearer the centre, "
                "or another projector), or a lower projector.throw_ratio (zoom wider)")
     else:
