@@ -193,6 +193,29 @@ def encloses(meshes: list[PartMesh]) -> set[str]:
     return out
 
 
+#: The half turn about x that stands a part upside down (y -> -y, z -> -z): a lifted dome on the bench.
+UPSIDE_DOWN = np.diag([1.0, -1.0, -1.0])
+
+
+def lifted_view(meshes: list[PartMesh], done: list[int], encloser: str) -> tuple[list[PartMesh], list[int], np.ndarray]:
+    """A step's picture when it is done with ``encloser`` (the dome) lifted off its register and stood upside
+    down: every mesh turned a half turn about x (UPSIDE_DOWN, about the origin), the parts in place kept to the
+    encloser and what rides with it (the parts in place standing no lower than its base with their centre over it:
+    the beam on its seats; the base plate under it stays), and the way in
+    straight down (-z) into its open base, now on top. Returns (meshes, done, direction)."""
+    import dataclasses
+
+    turned = [dataclasses.replace(m, vertices=m.vertices @ UPSIDE_DOWN.T) for m in meshes]
+    outer = next(i for i in done if meshes[i].name == encloser)
+    lo, hi = meshes[outer].lo, meshes[outer].hi
+    def rides(m: PartMesh) -> bool:
+        centre = 0.5 * (m.lo + m.hi)
+        return bool(m.lo[2] >= lo[2] - 1e-6 and np.all(lo[:2] <= centre[:2]) and np.all(centre[:2] <= hi[:2]))
+
+    riding = [i for i in done if i == outer or rides(meshes[i])]
+    return turned, riding, np.array([0.0, 0.0, -1.0])
+
+
 def group_description(members, lead: str, meshes_by_name: dict) -> str:
     """What a step says its parts are: the ``lead`` part's description or, when the step puts in several
     parts named alike but for a trailing number (projector_shims_1..4, one per foot), each one's in their
@@ -211,5 +234,5 @@ def group_description(members, lead: str, meshes_by_name: dict) -> str:
     return "; ".join(dict.fromkeys(meshes_by_name[n].description for n in alike))
 
 
-__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "group_description", "hex_color", "picture_meshes", "ray_colors",
+__all__ = ["PartMesh", "assembly_order", "encloses", "explode_offsets", "group_description", "lifted_view", "UPSIDE_DOWN", "hex_color", "picture_meshes", "ray_colors",
            "step_offsets", "steps"]

@@ -1070,14 +1070,20 @@ def _section_assemble(d: Doc, c) -> None:
         d.h(3, f"Step {k + 1}: {label}")
         d.p(text)
         path = f"images/step_{k + 1:02d}_{st.name}.png"
-        offsets = _approach(c.meshes, done, members, placed.direction)
+        # a step done with its encloser lifted off is drawn as done: the encloser upside down, the part going in
+        pic, pic_done, way, turn = c.meshes, done, placed.direction, np.eye(3)
+        if lifted:
+            pic, pic_done, way = A.lifted_view(c.meshes, done, lifted)
+            turn = A.UPSIDE_DOWN
+        offsets = _approach(pic, pic_done, members, way)
         shift = offsets[members[0]] if members else 0.0
-        bolts = [(np.asarray(f.head) + shift - np.asarray(f.axis) * f.head_height_mm,
-                  np.asarray(f.head) + shift + np.asarray(f.axis) * f.length_mm) for f in st.fasteners]
-        shown, new, moved = step_picture(c.meshes, done, members, offsets, placed.direction, _shim_mm(c.rig))
-        c.files[path] = plots.assembly_step(shown, done, new, moved, f"step {k + 1}: {label}",
+        bolts = [(turn @ np.asarray(f.head) + shift - turn @ np.asarray(f.axis) * f.head_height_mm,
+                  turn @ np.asarray(f.head) + shift + turn @ np.asarray(f.axis) * f.length_mm) for f in st.fasteners]
+        shown, new, moved = step_picture(pic, pic_done, members, offsets, way, _shim_mm(c.rig))
+        c.files[path] = plots.assembly_step(shown, pic_done, new, moved, f"step {k + 1}: {label}",
                                             cut_away=c.cut_away, fasteners=bolts)
-        d.img(path, f"Step {k + 1}: the {label} (orange) moves along the dashed line to its place")
+        d.img(path, f"Step {k + 1}: the {label} (orange) moves along the dashed line to its place"
+              + (f", the {lifted.replace('_', ' ')} lifted off and upside down" if lifted else ""))
         _drawing(d, c, st.name)
         done += members
         c.step(f"step {k + 1}")
