@@ -176,7 +176,8 @@ def camera_rows(profile, cam: dict) -> list[Row]:
                 f"{short} px", "camera.focal_length", cam["reach_over_room"], 1.0, "<=", "",
                 w("camera", "focal_length") or w("camera", "lens"),
                 f"{lens} puts the rim {radius:.0f} px from the principal point, {radius / cam['reach_over_room']:g} px "
-                f"from the sensor's nearest edge: a shorter camera.focal_length; {fill} fills {DEFAULT_FILL:.0%}")]
+                f"from the sensor's nearest edge: {fill}, a {'shorter' if fill_px < f_px else 'longer'} "
+                f"camera.focal_length, fills {DEFAULT_FILL:.0%}")]
     if cam["min_working_distance_mm"] is not None:
         rows.append(Row("camera: lens front to vertex vs closest focus", "camera.min_working_distance",
                         cam["working_distance_mm"], cam["min_working_distance_mm"], ">=", "mm",

@@ -68,7 +68,9 @@ def cmd_show(args: argparse.Namespace) -> int:
         print(f"  {key}: {inst.name} = {inst.title} ({inst.file})")
     table = {section: [(f.name, _fmt(f.metadata["spec"], getattr(getattr(profile, section), f.name)),
                         profile.origin(section, f.name)
-                        + (f" (not with {section}.model)" if profile.apart_from_model(section, f.name) else ""),
+                        + (f" (that file's figure for its own {section}, not from {section}.model "
+                           f"{getattr(getattr(profile, section), 'model', '')}: check it)"
+                           if profile.apart_from_model(section, f.name) else ""),
                         _doc(profile, section, f))
                        for f in fields(getattr(profile, section))] for section in SECTIONS}
     if camera is not None and camera.focal_from == "derived":  # no lens stated: the one rigcad derives

@@ -189,10 +189,11 @@ def test_profile_show_marks_an_inherited_figure_not_with_the_model(tmp_path):
     out = subprocess.run([sys.executable, "-m", "rigcad", "profile", "show", str(path)], capture_output=True,
                          text=True, check=True).stdout
     line = next(x for x in out.splitlines() if x.strip().startswith("throw_ratio"))
-    assert "achutha2006.yaml" in line and "(not with projector.model)" in line, line
+    assert "achutha2006.yaml" in line and "(that file's figure for its own projector, not from projector.model " \
+        "benq_pb6210: check it)" in line, line
     own = subprocess.run([sys.executable, "-m", "rigcad", "profile", "show", "achutha2006"], capture_output=True,
                          text=True, check=True).stdout
-    assert "not with" not in own
+    assert "not from projector.model" not in own
     epson = tmp_path / "epson.yaml"
     epson.write_text("extends: achutha2006\nprojector:\n  model: epson_eb_w52\n", encoding="utf-8")
     run = subprocess.run([sys.executable, "-m", "rigcad", "profile", "show", str(epson)], capture_output=True, text=True)
