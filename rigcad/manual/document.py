@@ -273,8 +273,21 @@ def assumed_sizes(profile) -> list[dict]:
         value = f"{m.assumed:g} {m.unit}" if isinstance(m.assumed, (int, float)) else f"{m.assumed} {m.unit}".strip()
         out.append({"key": m.key, "value": value,
                     "doc": f"{m.what} ({m.view} view: from the {m.between[0]} to the {m.between[1]})",
-                    "set_in": (profile.where(section, key) if section else None) or "default"})
+                    "set_in": _write_in(profile, section, key)})
     return out
+
+
+def _write_in(profile, section: str, key: str) -> str:
+    """Where an assumed size is written once measured: the file:line that sets it, else the instrument file
+    the profile chose for its section (a projector's or camera's own file, not the profile's section line),
+    else "default"."""
+    if not section:
+        return "default"
+    origin = profile.origin(section, key)
+    if origin != "default":
+        return origin
+    files = sorted(i.file for i in profile.instruments.values() if i.section == section and i.kind == section)
+    return files[0] if files else "default"
 
 
 def measure_first(d: Doc, c) -> None:
@@ -289,7 +302,7 @@ def measure_first(d: Doc, c) -> None:
         "your own instrument (a caliper; a lens's pupil from the maker's data sheet), write it into the profile "
         "under its key and build again before you print: a wrong size puts the centre of projection in the wrong "
         "place.")
-    d.table(["key", "assumed", "what it is", "set in"],
+    d.table(["key", "assumed", "what it is", "set in (or write it in)"],
             [[f"`{r['key']}`", r["value"], r["doc"], f"`{r['set_in']}`"] for r in rows])
     d.p("Each size drawn on the instrument's outline (at the assumed sizes), between the two features to measure "
         "from and to:")
