@@ -36,7 +36,9 @@ Closed forms, each from a textbook:
 
 A printed section is stiffer than its infill and weaker than solid: its second moment of area is
 the solid one less (1 - infill) of its core, the core being the section less :data:`SKIN_MM`
-of perimeters each side (:func:`printed_inertia`). The modulus is taken at the low end of the
+of perimeters each side (:func:`printed_inertia`); the shelf, printed flat, less its perimeters and its
+top and bottom solid layers as the printer's resolved slicer settings lay them (:func:`skin`,
+:func:`printed_plate`). The modulus is taken at the low end of the
 material's published range (the largest sag) and the strength as published.
 """
 
@@ -61,10 +63,63 @@ NUT_FACTOR = 0.2
 #: (assumed; thermoplastics creep under sustained stress well below their short-term yield).
 BEARING_SHARE = 0.5
 #: Perimeters each side of a printed section (mm): 3 perimeters of a 0.45 mm extrusion (the MK3S
-#: file's 3 perimeters; PrusaSlicer's extrusion width for a 0.4 mm nozzle).
+#: file's 3 perimeters; PrusaSlicer's extrusion width for a 0.4 mm nozzle). Used as the skin all round
+#: when a printer has no resolved slicer settings (:func:`skin`).
 SKIN_MM = 1.35
-#: Infill of a printed core (the MK3S file's 20 %).
+#: Infill of a printed core (the MK3S file's 20 %), the same fallback.
 INFILL = 0.20
+#: PrusaSlicer's automatic extrusion width, as a multiple of the nozzle, for a width set to 0 (auto).
+AUTO_WIDTH = 1.125
+
+
+@dataclass(frozen=True)
+class Skin:
+    """A printed section's solid skin (mm): ``side`` (its perimeters, each side), ``top`` and ``bottom`` (its
+    solid layers), its core's ``infill`` (fraction) and where the figures were read (``source``)."""
+
+    side: float
+    top: float
+    bottom: float
+    infill: float
+    source: str
+
+
+def _width(value: str, nozzle: float, fallback: str | None = None) -> float:
+    """A PrusaSlicer extrusion width (mm): a length, a percentage of the nozzle, or 0 for the fallback key's
+    value or, failing it, the automatic width (AUTO_WIDTH x nozzle)."""
+    v = str(value).strip()
+    w = nozzle * float(v[:-1]) / 100.0 if v.endswith("%") else float(v)
+    if w > 0:
+        return w
+    return _width(fallback, nozzle) if fallback not in (None, "") else AUTO_WIDTH * nozzle
+
+
+def skin(printer: Printer) -> Skin:
+    """The solid skin a printer's resolved PrusaSlicer settings (presets and overrides) lay round a section:
+    ``perimeters`` x ``perimeter_extrusion_width`` each side; on top ``top_solid_layers`` x ``layer_height`` or
+    ``top_solid_min_thickness``, whichever is more; underneath the same with the first layer at
+    ``first_layer_height``; ``fill_density``. A printer without them (no preset, or PrusaSlicer not
+    installed) keeps SKIN_MM all round and INFILL, as assumed."""
+    cfg = printer.slicer_config
+    if cfg is None:
+        return Skin(SKIN_MM, SKIN_MM, SKIN_MM, INFILL, "assumed (no resolved slicer settings)")
+    e = cfg.effective()
+    try:
+        nozzle = float(str(e.get("nozzle_diameter", printer.nozzle or 0.4)).split(",")[0])
+        layer = float(e.get("layer_height", printer.layer_height))
+        first = _width(e.get("first_layer_height", layer), layer)  # a percentage of the layer height, or mm
+        side = int(e["perimeters"]) * _width(e.get("perimeter_extrusion_width", "0"), nozzle, e.get("extrusion_width"))
+        top = max(int(e["top_solid_layers"]) * layer, float(e.get("top_solid_min_thickness", 0)))
+        n_bottom = int(e["bottom_solid_layers"])
+        bottom = max(first + max(n_bottom - 1, 0) * layer if n_bottom else 0.0,
+                     float(e.get("bottom_solid_min_thickness", 0)))
+        density = str(e.get("fill_density", "20%")).strip()
+        infill = float(density[:-1]) / 100.0 if density.endswith("%") else float(density)
+    except (KeyError, ValueError) as err:
+        raise FabricationError(f"printer {printer.name}: its slicer settings give no solid skin ({err}): "
+                               "perimeters, top_solid_layers, bottom_solid_layers and their widths and heights "
+                               "must be numbers") from err
+    return Skin(side, top, bottom, infill, f"{printer.name}'s resolved slicer settings")
 #: A hand-tight screw with a hex key (N m): the torque a lab applies when no figure is given.
 HAND_TIGHT_NM = 1.0
 #: Instruments' and printed parts' masses the profile does not state (kg; assumed: a desktop
@@ -128,9 +183,25 @@ def material(printer: Printer) -> Material:
 
 def printed_inertia(width: float, height: float, skin: float = SKIN_MM, infill: float = INFILL) -> float:
     """Second moment of area (mm^4) of a printed ``width`` x ``height`` mm rectangle bending about
-    its horizontal axis: the solid one less (1 - infill) of its core's."""
+    its horizontal axis: the solid one less (1 - infill) of its core's (``skin`` mm all round)."""
     core_w, core_h = max(width - 2 * skin, 0.0), max(height - 2 * skin, 0.0)
     return (width * height ** 3 - (1 - infill) * core_w * core_h ** 3) / 12
+
+
+def printed_plate(width: float, height: float, s: Skin) -> tuple[float, float]:
+    """A ``width`` x ``height`` mm rectangle printed flat (its height along the print's z) with skin ``s``,
+    bending about its horizontal axis: its second moment of area (mm^4) about its own neutral axis and the
+    largest distance (mm) from that axis to a face. The core (``s.side`` in from each side, ``s.top`` under
+    its top, ``s.bottom`` over its underside) has ``s.infill`` of the solid's stiffness; a thinner top than
+    bottom moves the neutral axis down."""
+    core_w = max(width - 2 * s.side, 0.0)
+    core_h = max(height - s.top - s.bottom, 0.0)
+    zc = s.bottom + core_h / 2  # the core's centre above the underside
+    a_solid, a_void = width * height, (1 - s.infill) * core_w * core_h
+    z = (a_solid * height / 2 - a_void * zc) / (a_solid - a_void)
+    inertia = (width * height ** 3 / 12 + a_solid * (height / 2 - z) ** 2
+               - (1 - s.infill) * (core_w * core_h ** 3 / 12 + core_w * core_h * (zc - z) ** 2))
+    return inertia, max(z, height - z)
 
 
 def printed_tube_inertia(side: float, wall: float, skin: float = SKIN_MM, infill: float = INFILL) -> float:
@@ -348,9 +419,10 @@ def _shelf_model(profile, layout, printer: Printer, mat: Material, masses, optio
     x0, x1, y0, y1 = _shelf_extent(t, profile)
     width, overhang, a_seat, th = y1 - y0, root - x0, root - seat, t.shelf_thickness
     if option == "print":
-        E, rho, I, what = mat.modulus_low, printer.material_density_g_cm3 * 1e-6, printed_inertia(width, th), "printed"
+        I, c = printed_plate(width, th, skin(printer))  # printed flat: its skin as the slicer lays it
+        E, rho, what = mat.modulus_low, printer.material_density_g_cm3 * 1e-6, "printed"
     else:
-        E, rho, I, what = ALUMINIUM.modulus_low, ALUMINIUM_DENSITY, width * th ** 3 / 12, ALUMINIUM.name
+        E, rho, I, what, c = ALUMINIUM.modulus_low, ALUMINIUM_DENSITY, width * th ** 3 / 12, ALUMINIUM.name, th / 2
     feet = [x for x, _ in _projector_feet(t)]
     near = [(m_pj / 4, root - x) for x in feet if x < root]
     points = near + [(m_cam + m_hold, a_seat)]
@@ -366,7 +438,6 @@ def _shelf_model(profile, layout, printer: Printer, mat: Material, masses, optio
     den = sum(m * y * y for (m, _), y in zip(lumps, ys))
     mode = math.sqrt(num / den) / (2 * math.pi) if den > 0 else math.inf
     moment = sum(P * a for P, a in loads) + q * overhang ** 2 / 2
-    c = th / 2
     stress = moment * c / I
     return {"option": option, "material": what, "sag_mm": sag, "tilt_rad": tilt, "first_mode_hz": mode,
             "root_moment_nmm": moment, "stress_mpa": stress, "width": width, "overhang": overhang, "a_seat": a_seat,
@@ -591,5 +662,5 @@ def refuse(report: Loads) -> None:
             f"{d.part} ({100 * d.share:.0f} % of tolerancing.{d.eats}); buy: {d.buy}" for d in bad))
 
 
-__all__ = ["ALUMINIUM", "FlangeJoint", "LAB_SWING_K", "flange_joints", "shelf_options", "thermal", "refuse", "ASSUMED_MASS_KG", "BoltLoad", "Deflection", "Loads", "MATERIALS", "Material", "bolt_loads", "cantilever",
+__all__ = ["ALUMINIUM", "FlangeJoint", "Skin", "skin", "printed_plate", "LAB_SWING_K", "flange_joints", "shelf_options", "thermal", "refuse", "ASSUMED_MASS_KG", "BoltLoad", "Deflection", "Loads", "MATERIALS", "Material", "bolt_loads", "cantilever",
            "deflections", "loads", "material", "printed_inertia", "printed_tube_inertia", "simply_supported"]
