@@ -61,8 +61,10 @@ def base_plate(profile: Profile, layout: RigLayout) -> Part:
             "its tongue locates the tower's column " + (
                 f"by two {profile.datum.dowel_diameter:g} mm dowels (pressed into blind holes reamed N7) and four bolts"
                 if profile.buy.column == "print" else "(an extrusion) in a square pocket, an M8 bolt into its core")
-            + on_board + "; it stands on three feet: the tongue's underside and two pads under the disc's rim, "
-            f"the sample holder's collar {COLLAR_BENCH_GAP_MM:g} mm clear of the bench")
+            + on_board + ("; it stands on three feet: the tongue's underside and two pads under the disc's rim, "
+                          if b is None else "; its tongue, its two feet under the disc's rim and the boss bear on the "
+                          "board, ") + f"the sample holder's collar {COLLAR_BENCH_GAP_MM:g} mm clear of the "
+            + ("bench" if b is None else "board"))
     return Part("base_plate", Difference(Union_((plate, tongue, *pads)), (bore, groove, *holes, *joint, *anchors)),
                 (0.55, 0.57, 0.6), desc, datums=datums)
 
