@@ -1487,6 +1487,7 @@ def _section_calibrate(d: Doc, c) -> None:
         f"{info['occlusion_radius_px']:.1f} px from the centre are hidden by the paraboloid itself (occlusion limit).")
     d.img("calibration/circle.png", f"calibration/circle.png: the calibration image, {info['resolution_px'][0]} x "
                                     f"{info['resolution_px'][1]} px, shown at page width")
+    d.p(C.record_circle(rig, info))
     _film_step(d, c)
     _camera_crosses_step(d, c, cam)
     for name in ("projector_cross", "projector_backplate", "projector_mounting_plate", "camera_cross_hung",
