@@ -53,6 +53,9 @@ def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer, keep_ou
     wall = split.pin_wall(printer)
 
     def joins(plan):
+        # the thinnest dowel first: a face with no room for it has none for the thicker ones (a refused
+        # plan costs one placement, not one per pin size); then the pins split_part will place
+        split.seam_joints(man, plan, split.pin_choices(pin)[-1], mirror, wall)
         split.seam_joints(man, plan, pin, mirror, wall)
 
     if fits(vertices, candidates(has_mirror, plate), printer):
