@@ -155,3 +155,24 @@ def test_the_calibration_circle_is_drawn_about_the_lens_axis_pixel(write_profile
     rows, cols = np.nonzero(np.asarray(Image.open(io.BytesIO(png))))
     assert cols.mean() + 0.5 == pytest.approx(cx, abs=0.05) and rows.mean() + 0.5 == pytest.approx(cy, abs=0.05)
     assert f'"cy": {json.dumps(cy)}'.encode() in C.circle_page(rig, info)  # the page's design circle, its 0 key, the same
+
+
+@pytest.mark.e2e
+def test_section_6_of_the_written_manual_carries_each_step_in_order(table31_rig, tmp_path):
+    """The manual as written (section 6 of manual.md) holds each of these paragraphs, in the order a lab
+    does them: a paragraph dropped from rigcad.manual.document fails here."""
+    from rigcad.fab.printers import load_printer
+    from rigcad.manual.document import gray_card_seat, write_manual
+
+    printer = load_printer("prusa_mk3s")
+    fab = table31_rig.fab("prusa_mk3s", tmp_path / "fab", parts=["base_plate"]).report
+    write_manual(table31_rig, printer, fab, tmp_path / "manual")
+    md = (tmp_path / "manual" / "manual.md").read_text(encoding="utf-8")
+    _, info = C.circle_image(table31_rig)
+    paragraphs = [C.projector_lock(table31_rig, printer), C.projector_focus_text(table31_rig),
+                  C.record_circle(table31_rig, info), C.camera_focus_and_lock(table31_rig, printer),
+                  C.shared_cop_text(table31_rig, printer), C.checker_text(C.camera_correspondence(table31_rig)),
+                  C.gray_card_placement(table31_rig, gray_card_seat(table31_rig))]
+    at = [md.find(p[:120]) for p in paragraphs]
+    assert all(i >= 0 for i in at), [p[:60] for p, i in zip(paragraphs, at) if i < 0]
+    assert at == sorted(at), at
