@@ -38,25 +38,12 @@ def fits(vertices, cands: list[orientation.Orientation], printer: Printer) -> bo
     return any(orientation.fit_spin(vertices, o.direction, printer.usable)[0] is not None for o in cands)
 
 
-def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer, keep_out=(), *, pin=None, mirror=None):
+def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer, keep_out=()):
     """The fewest pieces the part ``man`` (its mesh ``vertices``) prints in: whole when it fits in one
     of its orientations; else sectors and bands about the axis (rigcad.fab.split.plan_split), or a
     grid in its own bounding box for a flat or off-axis part (or when no sector split fits); no cut
-    crosses a ``keep_out`` box (its datum features: rigcad.fab.split.keepouts), and every seam takes
-    its joints as rigcad.fab.split.split_part will make them (rigcad.fab.split.seam_joints: ``pin``,
-    default the printer's alignment pin, with the printer's rigcad.fab.split.pin_wall, clear of the
-    ``mirror`` surface when one is given): a plan with a cut face too small for two pins is passed over
-    for the next cut positions or the next count of pieces, never handed on to be refused."""
+    crosses a ``keep_out`` box (its datum features: rigcad.fab.split.keepouts)."""
     from rigcad.export import mesh
-
-    pin = printer.alignment_pin if pin is None else pin
-    wall = split.pin_wall(printer)
-
-    def joins(plan):
-        # the thinnest dowel first: a face with no room for it has none for the thicker ones (a refused
-        # plan costs one placement, not one per pin size); then the pins split_part will place
-        split.seam_joints(man, plan, split.pin_choices(pin)[-1], mirror, wall)
-        split.seam_joints(man, plan, pin, mirror, wall)
 
     if fits(vertices, candidates(has_mirror, plate), printer):
         return split.SplitPlan(1, 1, 0.0, (float(vertices[:, 2].min()), float(vertices[:, 2].max())))
@@ -71,11 +58,11 @@ def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer, keep_ou
 
     try:
         if split.is_off_axis(man):
-            return split.plan_grid(man, cell_fits, keep_out, joins)
+            return split.plan_grid(man, cell_fits, keep_out)
         try:
-            return split.plan_split(man, cell_fits, keep_out, joins)
+            return split.plan_split(man, cell_fits, keep_out)
         except FabricationError:
-            return split.plan_grid(man, cell_fits, keep_out, joins)
+            return split.plan_grid(man, cell_fits, keep_out)
     except FabricationError as err:
         v = printer.build_volume
         raise FabricationError(f"{err} on printer '{printer.name}' ({v.x:g} x {v.y:g} x {v.z:g} mm): choose a printer "

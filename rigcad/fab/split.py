@@ -62,13 +62,6 @@ HUB_OVER_BORE = 2.0
 FIT_KINDS = ("bore", "dowel", "register")
 #: Grid cut positions tried per plan (each cut at its equal-slab place or moved off a keep-out).
 KEEPOUT_TRIES = 6
-#: When a grid's cuts fit the printer but a cut face has no room for its pins (a cut that leaves a
-#: sliver of the part between another cut and the part's edge), one cut at a time is moved along its axis
-#: in steps of SHIFT_STEP_MM, up to SHIFT_STEPS steps each way (off the keep-outs it would then cross),
-#: the plans in order of the move, at most SHIFT_TRIES of them, before a grid of more pieces is tried.
-SHIFT_STEP_MM = 2.5
-SHIFT_STEPS = 8
-SHIFT_TRIES = 24
 #: Distance kept between a pin hole and the printed mirror surface (mm): sanding removes up to
 #: ~0.2 mm there and the pin must not print-through as a bump (about five layers of material).
 MIRROR_CLEARANCE = 1.0
@@ -369,84 +362,25 @@ def clear_cuts(base, lo: float, hi: float, blocked) -> list[tuple[float, ...]]:
     return [tuple(float(c) for c in combo) for _, combo in out[:KEEPOUT_TRIES]]
 
 
-def _shifted_plans(base_cuts, bb: np.ndarray, blocked) -> list[GridPlan]:
-    """Grids made from ``base_cuts`` (per axis) by moving one cut along its axis by k SHIFT_STEP_MM,
-    0 < |k| <= SHIFT_STEPS, a position inside a ``blocked`` interval taken to that interval's nearer
-    edge, the cuts of each axis kept inside the part's box ``bb`` and increasing: in order of the move
-    (ties: axis, cut, then the lower position), at most SHIFT_TRIES, each plan once."""
-    out, seen = [], set()
-    for a in range(3):
-        for i, c in enumerate(base_cuts[a]):
-            for k in range(-SHIFT_STEPS, SHIFT_STEPS + 1):
-                p = c + k * SHIFT_STEP_MM
-                hit = next(((lo, hi) for lo, hi in blocked[a] if lo < p < hi), None)
-                p = p if hit is None else min(hit, key=lambda e: (abs(e - p), e))
-                cuts = [tuple(float(v) for v in base_cuts[x]) for x in range(3)]
-                cuts[a] = cuts[a][:i] + (float(p),) + cuts[a][i + 1:]
-                inside = bb[a] < p < bb[a + 3] and all(q - r > 1e-6 for r, q in zip(cuts[a], cuts[a][1:]))
-                if abs(p - c) > 1e-9 and inside and tuple(cuts) not in seen:
-                    seen.add(tuple(cuts))
-                    out.append((round(abs(p - c), 9), a, i, float(p), GridPlan(*cuts)))
-    out.sort(key=lambda t: t[:4])
-    return [t[4] for t in out[:SHIFT_TRIES]]
-
-
-def _joined(plan, joins, refused: list) -> bool:
-    """Whether the plan's seams take their joints: ``joins(plan)`` (None: not asked) returns, or raises a
-    FabricationError, which ``refused`` keeps (the first one names the face of the first plan that fit)."""
-    if joins is None:
-        return True
-    try:
-        joins(plan)
-    except FabricationError as err:
-        refused.append(err)
-        return False
-    return True
-
-
-def _refused(what: str, refused: list) -> FabricationError:
-    """The planner's refusal: nothing fits, or (``refused`` not empty) every plan that fits leaves a seam
-    without its joints, the first such plan's face named."""
-    if not refused:
-        return FabricationError(f"{what} fits")
-    return FabricationError(f"{what} fits and takes its pins on every seam ({len(refused)} that fit do not; the "
-                            f"first: {refused[0]})")
-
-
-def plan_grid(man: m3d.Manifold, fits, keep_out=(), joins=None) -> GridPlan:
+def plan_grid(man: m3d.Manifold, fits, keep_out=()) -> GridPlan:
     """The fewest-pieces grid (the long side cut first; a tall part is cut across its height) whose
     every cell ``fits(cell_manifold, plan, i, j)``: equal slabs, each cut moved off the ``keep_out``
-    boxes (:func:`keepouts`) it would cross (:func:`clear_cuts`), and whose seams take their joints
-    (``joins(plan)`` raises a FabricationError when a cut face has no room for its pins, as
-    :func:`seam_joints`; such a plan is passed over for the next cut positions or the next grid);
-    raises if none."""
+    boxes (:func:`keepouts`) it would cross (:func:`clear_cuts`); raises if none."""
     import itertools
 
     bb = np.asarray(man.bounding_box(), dtype=float)
     blocked = [_blocked(keep_out, a) for a in range(3)]
-    refused: list[FabricationError] = []
     for n in _grid_options(bb[3:] - bb[:3]):
         per_axis = [clear_cuts(tuple(float(v) for v in np.linspace(bb[a], bb[a + 3], n[a] + 1)[1:-1]),
                                float(bb[a]), float(bb[a + 3]), blocked[a]) for a in range(3)]
-        first_fit = None
         for cuts in itertools.islice(itertools.product(*per_axis), KEEPOUT_TRIES):
             plan = GridPlan(*cuts)
             if all(fits(grid_cell(man, plan, i, j, k), plan, i, j) for i, j, k in plan.cells()):
-                first_fit = first_fit or plan
-                if _joined(plan, joins, refused):
-                    return plan
-        if first_fit is None:
-            continue
-        # these cuts fit but leave a face too small for its pins: move them within the room the
-        # keep-outs leave (the first that fits and takes its pins), before a grid of more pieces
-        for plan in _shifted_plans([first_fit.cuts(a) for a in range(3)], bb, blocked):
-            if all(fits(grid_cell(man, plan, i, j, k), plan, i, j) for i, j, k in plan.cells()) and \
-                    _joined(plan, joins, refused):
                 return plan
     kept = (f" whose cuts keep off its {len(keep_out)} datum features (each by its split.datum_margin: "
             f"{FEATURE_WALL_MM:g} mm of wall, a hub of half its diameter round a hole that takes a fit, and "
             f"{GLUE_SQUEEZE_MM:g} mm for the glue)") if len(keep_out) else ""
-    raise _refused(f"no grid of up to {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} pieces{kept}", refused)
+    raise FabricationError(f"no grid of up to {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} x {GRID_COUNTS[-1]} pieces{kept} fits")
 
 
 def _grid_interfaces(plan: GridPlan):
@@ -569,17 +503,15 @@ def band_cuts(z0: float, z1: float, bands: int):
         yield tuple(np.linspace(z0, z1, bands + 1))
 
 
-def plan_split(man: m3d.Manifold, fits, keep_out=(), joins=None) -> SplitPlan:
-    """The fewest-pieces plan whose every cell ``fits(cell_manifold, plan, i, j)``, whose cuts
-    meet no ``keep_out`` box (:func:`keepouts`) and whose seams take their joints (``joins(plan)``,
-    as in :func:`plan_grid`); raises if none."""
+def plan_split(man: m3d.Manifold, fits, keep_out=()) -> SplitPlan:
+    """The fewest-pieces plan whose every cell ``fits(cell_manifold, plan, i, j)`` and whose cuts
+    meet no ``keep_out`` box (:func:`keepouts`); raises if none."""
     bb = np.asarray(man.bounding_box(), dtype=float)
     z0, z1 = bb[2], bb[5]
     options = sorted(((s, b) for s in SECTOR_COUNTS for b in BAND_COUNTS), key=lambda sb: (sb[0] * sb[1], sb[1]))
     phases: dict[int, float | None] = {}
     seen: dict[float, int] = {}  # half-plane angle -> loops, shared by the sector counts
     z_blocked = _blocked(keep_out, 2)
-    refused: list[FabricationError] = []
     for s, b in options:
         if s not in phases:
             phases[s] = choose_phase(man, s, seen=seen, keep_out=keep_out)
@@ -589,10 +521,9 @@ def plan_split(man: m3d.Manifold, fits, keep_out=(), joins=None) -> SplitPlan:
             if any(a < z < c for z in cuts[1:-1] for a, c in z_blocked):
                 continue
             plan = SplitPlan(s, b, phases[s], cuts)
-            if all(fits(cell(man, plan, i, j), plan, i, j) for i in range(s) for j in range(b)) and \
-                    _joined(plan, joins, refused):
+            if all(fits(cell(man, plan, i, j), plan, i, j) for i in range(s) for j in range(b)):
                 return plan
-    raise _refused(f"no split into up to {SECTOR_COUNTS[-1]} sectors x {BAND_COUNTS[-1]} bands", refused)
+    raise FabricationError(f"no split into up to {SECTOR_COUNTS[-1]} sectors x {BAND_COUNTS[-1]} bands fits")
 
 
 def _cylinder(pin_axis: np.ndarray, centre: np.ndarray, radius: float, half_length: float) -> m3d.Manifold:
@@ -929,8 +860,8 @@ def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
     tongues."""
     if plan.count == 1:
         return [Piece(name, 0, 0, None, man)], [], man
-    pins, pin, tg = seam_joints(man, plan, pin, mirror, wall)
     if isinstance(plan, GridPlan):
+        pins, pin = _pins_that_fit(lambda q: place_pins(man, plan, q, mirror, wall=wall), pin)
         holes = [_cylinder(np.array(p.axis), np.array(p.centre), pin.hole_radius, pin.depth) for p in pins]
         drilled = m3d.Manifold.batch_boolean([man, *holes], m3d.OpType.Subtract)
         pieces = []
@@ -941,8 +872,10 @@ def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
             if not piece.is_empty():
                 pieces.append(Piece(f"{name}_{'_'.join(tag)}", cell_index[0], cell_index[1], None, piece))
         return pieces, pins, drilled
+    tg = make_tongues(man, plan, pin, mirror)
     if tongues is not None:
         tongues.extend(tg)
+    pins, pin = _pins_that_fit(lambda q: place_pins(man, plan, q, mirror, tg, wall=wall), pin)
     holes = [_cylinder(np.array(p.axis), np.array(p.centre), pin.hole_radius, pin.depth) for p in pins]
     gaps = [t.groove - t.tongue for t in tg]
     drilled = m3d.Manifold.batch_boolean([man, *holes, *gaps], m3d.OpType.Subtract)
@@ -964,23 +897,6 @@ def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
             pieces.append(Piece(f"{name}_{'_'.join(tag)}", i, j,
                                 plan.sector_range(i) if plan.sectors > 1 else None, piece))
     return pieces, pins, drilled
-
-
-def seam_joints(man: m3d.Manifold, plan, pin: AlignmentPin, mirror: MirrorSurface | None,
-                wall: float | None = None) -> tuple[list[Pin], AlignmentPin, list[Tongue]]:
-    """The joints of a plan's seams, as :func:`split_part` makes them: the band cuts' tongues
-    (:func:`make_tongues`, sector plans) and the pins on every other cut face, of the first of
-    :func:`pin_choices` that :func:`place_pins` can place with ``wall`` round its holes. Returns the
-    pins, the pin they took and the tongues; raises a FabricationError naming the face that takes none
-    (what the planners ask of a candidate plan before they accept it)."""
-    if plan.count == 1:
-        return [], pin, []
-    if isinstance(plan, GridPlan):
-        pins, pin = _pins_that_fit(lambda q: place_pins(man, plan, q, mirror, wall=wall), pin)
-        return pins, pin, []
-    tg = make_tongues(man, plan, pin, mirror)
-    pins, pin = _pins_that_fit(lambda q: place_pins(man, plan, q, mirror, tg, wall=wall), pin)
-    return pins, pin, tg
 
 
 def crossed(datums, plan) -> list[str]:
