@@ -1032,7 +1032,6 @@ def _section_assemble(d: Doc, c) -> None:
 
     from rigcad import plots
     from rigcad.manual import assembly as A
-    from rigcad.manual import plan as plan_mod
 
     d.h(2, "5. Assemble")
     order = assembly_order(c.rig, c.steps, c.solids)
@@ -1062,24 +1061,7 @@ def _section_assemble(d: Doc, c) -> None:
         lifted = lifted_encloser(st, [p.step.name for p in order[:k]], by_name, c.rig)
         text += step_text(placed, by_name, prepared, _shim_mm(c.rig), spring_bolts(c.rig).get("set", ""), lifted)
         text += placed_text([r for r in prep[st.name] if r["kind"] == "placed"])
-        if st.name == "projector_body":
-            text += plan_mod.projector_screw_text(c.rig)
-        if st.name == "beam_splitter":
-            text += (" Its coated face (the reflecting one: the maker marks its edge, or a pen tip touching it shows "
-                     "one reflection, where the uncoated face shows two) goes towards the projector (+x) and down, "
-                     "towards the paraboloid.")
-        if st.name == "focusing_lens":
-            from rigcad.optics.focus import focusing_lens
-
-            text += (f" It is the f = {focusing_lens(c.p, c.rig.geometry).focal_length:g} mm plano-convex lens of "
-                     "the bill, its curved face towards the projector.")
-        if st.name == "base_plate" and "camera_cross_base" in c.rig.recipes:
-            text += (" To calibrate (section 6), the film goes on the plate once the dome's register is drilled "
-                     "and the dome lifted off its pins again, before it is bolted down: see \"The film at the "
-                     "sample plane\".")
-        for h in tower_at.get(st.name, []):  # the threaded rows; the pressed ones came before the part
-            if h.get("thread") and "heat-set insert" not in h["item"]:
-                text += f" Fix it with {h['quantity']} x {B.tower_item(h)}: {h['joins']}."
+        text += _step_extras(c, st.name, tower_at)
         d.h(3, f"Step {k + 1}: {label}")
         d.p(text)
         path = f"images/step_{k + 1:02d}_{st.name}.png"
@@ -1108,6 +1090,33 @@ def _section_assemble(d: Doc, c) -> None:
                          "threads_into": [{"item": f.item, "kind": f.thread_in, "part": P.thread_host(f, by_name)}
                                           for f in p.step.fasteners if f.thread_in in ("insert", "nut")
                                           and (f.thread_in == "insert" or f.nut_tool is None)]} for p in order]
+
+
+def _step_extras(c, name: str, tower_at: dict) -> str:
+    """What a step says about its own part beyond the plan: the projector's screws, the splitter's coated
+    face, the focusing lens, the film at the base plate, and the tower's threaded rows fixed at it."""
+    from rigcad.manual import plan as P
+
+    text = ""
+    if name == "projector_body":
+        text += P.projector_screw_text(c.rig)
+    if name == "beam_splitter":
+        text += (" Its coated face (the reflecting one: the maker marks its edge, or a pen tip touching it shows "
+                 "one reflection, where the uncoated face shows two) goes towards the projector (+x) and down, "
+                 "towards the paraboloid.")
+    if name == "focusing_lens":
+        from rigcad.optics.focus import focusing_lens
+
+        text += (f" It is the f = {focusing_lens(c.p, c.rig.geometry).focal_length:g} mm plano-convex lens of "
+                 "the bill, its curved face towards the projector.")
+    if name == "base_plate" and "camera_cross_base" in c.rig.recipes:
+        text += (" To calibrate (section 6), the film goes on the plate once the dome's register is drilled "
+                 "and the dome lifted off its pins again, before it is bolted down: see \"The film at the "
+                 "sample plane\".")
+    for h in tower_at.get(name, []):  # the threaded rows; the pressed ones came before the part
+        if h.get("thread") and "heat-set insert" not in h["item"]:
+            text += f" Fix it with {h['quantity']} x {B.tower_item(h)}: {h['joins']}."
+    return text
 
 
 def _drawing(d: Doc, c, part: str) -> None:
