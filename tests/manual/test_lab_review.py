@@ -97,16 +97,6 @@ def test_a_tool_missing_from_the_bill_is_found():
     assert tool_misses(md + "Ream the hole with the reamer.\n") == ["reamer"]
 
 
-@pytest.fixture(scope="module")
-def written(table31_rig, tmp_path_factory):
-    from rigcad.fab.printers import load_printer
-
-    fab = table31_rig.fab("prusa_mk3s", tmp_path_factory.mktemp("fab") / "fab", parts=["base_plate"]).report
-    out = tmp_path_factory.mktemp("manual") / "prusa_mk3s"
-    D.write_manual(table31_rig, load_printer("prusa_mk3s"), fab, out)
-    return out
-
-
 @pytest.mark.e2e
 def test_every_tool_a_step_names_is_in_the_bill(written):
     md = (written / "manual.md").read_text(encoding="utf-8")

@@ -8,18 +8,6 @@ import re
 
 import pytest
 
-from rigcad.manual import document as D
-
-
-@pytest.fixture(scope="module")
-def written(table31_rig, tmp_path_factory):
-    from rigcad.fab.printers import load_printer
-
-    fab = table31_rig.fab("prusa_mk3s", tmp_path_factory.mktemp("fab") / "fab", parts=["base_plate"]).report
-    out = tmp_path_factory.mktemp("manual") / "prusa_mk3s"
-    D.write_manual(table31_rig, load_printer("prusa_mk3s"), fab, out)
-    return out
-
 
 def _steps(md: str) -> dict[str, str]:
     """Section 5's steps: name -> text (up to the next heading)."""
