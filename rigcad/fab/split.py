@@ -534,11 +534,25 @@ def _cylinder(pin_axis: np.ndarray, centre: np.ndarray, radius: float, half_leng
 
 def _interfaces(plan: SplitPlan, bb: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray, callable]]:
     """Cut faces between neighbouring cells: (name, normal, origin, keep(points (n,3)) -> bool mask
-    of points on this face's part of the plane, inside the two cells)."""
+    of points on this face's part of the plane, inside the two cells). Two sectors' half-planes lie in
+    one plane and join the same two cells, so a two-sector band has one face, the whole plane: a part
+    that crosses the axis (a beam cut in its middle) takes its pins across the axis, not two pairs
+    crowded into each half of its section."""
     out = []
     for j in range(plan.bands):
         zlo, zhi = plan.band_z[j], plan.band_z[j + 1]
-        if plan.sectors > 1:
+        if plan.sectors == 2:
+            a = plan.sector_range(0)[0]
+
+            def keep(p, zlo=zlo, zhi=zhi, j=j):
+                ok = np.ones(len(p), bool)
+                if plan.bands > 1:
+                    ok &= (p[:, 2] > zlo if j > 0 else True) & (p[:, 2] < zhi if j < plan.bands - 1 else True)
+                return ok
+
+            out.append((f"sector plane {math.degrees(a) % 360:.1f}/{math.degrees(a + math.pi) % 360:.1f} deg, "
+                        f"band {j + 1}", np.array([-math.sin(a), math.cos(a), 0.0]), np.zeros(3), keep))
+        elif plan.sectors > 1:
             for i in range(plan.sectors):
                 a = plan.sector_range(i)[0]
                 n = np.array([-math.sin(a), math.cos(a), 0.0])

@@ -33,9 +33,6 @@ def _beam_with_overhang(tmp_path, overhang: float, ender):
     return res.report["parts"]["beam"], [p for p in res.problems if p.startswith("beam:")]
 
 
-@pytest.mark.xfail(strict=True, reason="open: since split pins keep 1.5 mm walls (split.pin_wall), the Ender-3 V2's "
-                   "beam split is refused for pin room ('no room for two 1.75 mm pins ... use thinner pins') before its "
-                   "glue faces are judged, so the refusal no longer names beam.overhang; strict, so the fix shows")
 def test_the_beam_split_on_a_small_bed_names_the_overhang_that_fits(table31_rig, ender, tmp_path):
     res = run_fab(table31_rig, ender, tmp_path / "default", parts=["beam"])
     assert res.report["parts"]["beam"]["split"]["pieces"] > 1  # 15 mm overhang: too long for the 220 mm bed
