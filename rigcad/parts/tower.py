@@ -1421,9 +1421,40 @@ def _screw_rows(rows: list[dict], thread: str, count: int, step: str, what: str,
             for L, ns in stacks.items()]
 
 
+def _refuse_projector_screws(profile: Profile, layout, rows: list[dict]) -> None:
+    """Why no stocked screw holds the projector on some stack of ``rows`` (:func:`projector_screws`),
+    with the value that passes: a socket too shallow for every length that reaches it (a deeper
+    ``projector.mount_depth``, as measured), or a stack thicker than the longest stocked screw of the
+    projector's thread reaches through (less ``tower.travel_across``, so fewer shims per stack)."""
+    from dataclasses import replace
+
+    pj, tw = profile.projector, profile.tower
+    n = next(r["shims"] for r in rows if not r["ok"])
+
+    def passes(depth: float) -> bool:
+        return all(r["ok"] for r in projector_screws(replace(profile, projector=replace(pj, mount_depth=depth)), layout))
+
+    if passes(1e3):  # the shallowest socket, in 0.1 mm steps, that every stack's screw fits
+        need = next(d / 10 for d in range(math.ceil(pj.mount_depth * 10), 10 ** 4) if passes(d / 10))
+        raise GeometryError(f"no stocked {pj.mount_thread} screw suits the projector's mounting holes on a stack of {n} "
+                            f"shims without bottoming in its {pj.mount_depth:g} mm deep socket; valid: "
+                            f"projector.mount_depth at least {need:g} mm (measure the holes' thread depth)",
+                            where=profile.where("projector", "mount_depth"), param="projector.mount_depth")
+    longest, grip = max(screw_lengths(pj.mount_thread)), rows[n]["grip_mm"]
+    fits = max((k for k in range(len(rows)) if rows[k]["grip_mm"] + SOCKET_ENGAGEMENT <= longest + 1e-9), default=0)
+    raise GeometryError(f"the longest stocked {pj.mount_thread} screw ({longest} mm) cannot hold the projector on a "
+                        f"stack of {n} shims ({grip:.2f} mm through, {SOCKET_ENGAGEMENT:g} mm in its socket); valid: "
+                        f"tower.travel_across at most {fits // 2 * tw.shim_thickness:g} mm ({fits // 2 * 2} shims a "
+                        "stack), or a coarser thread in the projector's holes (projector.mount_thread)",
+                        where=profile.where("tower", "travel_across"), param="tower.travel_across")
+
+
 def _projector_screw_rows(profile: Profile, layout) -> list[dict]:
     """The projector's screws: one row per length the shim stacks need (:func:`projector_screws`)."""
-    return _screw_rows(projector_screws(profile, layout), profile.projector.mount_thread,
+    rows = projector_screws(profile, layout)
+    if not all(r["ok"] for r in rows):
+        _refuse_projector_screws(profile, layout, rows)
+    return _screw_rows(rows, profile.projector.mount_thread,
                        len(_projector_feet(layout.tower)), "projector_body", "the projector's mounting holes",
                        ("projector", "mount_depth"), profile, joint_washers(profile, layout)["projector"])
 
