@@ -292,10 +292,11 @@ def early_refusals(rig) -> tuple[EarlyRefusal, ...]:
     """Every refusal of the rig's placements and part recipes, the checks `rigcad stl` (and the gate
     after it) makes before any solid is built: the layout (the tower, the splitter and the
     instruments against the dome; its first refusal only, as every later placement stands on the
-    earlier ones), else each part's recipe on its own (the focusing lens, the seats, the flange, ...),
-    all of them at once, the parts refused for one reason named together. Empty when none refuses.
+    earlier ones), else each part's recipe on its own (the focusing lens, the seats, the flange, ...)
+    and the tower's bought screws against the instruments' sockets, all of them at once, the parts
+    refused for one reason named together. Empty when none refuses.
     No solid is made."""
-    from rigcad.parts import PARTS, make_recipe
+    from rigcad.parts import PARTS, make_recipe, tower
 
     def refusal(what: str, err: GeometryError) -> EarlyRefusal:
         return EarlyRefusal(what, str(err.located(rig.profile.marks)), err.param)
@@ -311,6 +312,11 @@ def early_refusals(rig) -> tuple[EarlyRefusal, ...]:
         except GeometryError as err:
             r = refusal(name, err)
             found.setdefault(r.message, ([], r))[0].append(name)
+    try:  # the tower's bought screws (their lengths against the instruments' sockets), as `stl`'s bill finds them
+        tower.hardware(rig.profile, layout)
+    except GeometryError as err:  # a reason a part's recipe gave already is not said twice
+        r = refusal("the tower's hardware", err)
+        found.setdefault(r.message, ([r.what], r))
     return tuple(EarlyRefusal(", ".join(names), r.message, r.key) for names, r in found.values())
 
 
