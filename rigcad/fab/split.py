@@ -60,6 +60,13 @@ DATUM_MARGIN = FEATURE_WALL_MM + GLUE_SQUEEZE_MM
 HUB_OVER_BORE = 2.0
 #: The datum kinds whose round features take a fit (their keep-out is :func:`datum_margin`'s hub).
 FIT_KINDS = ("bore", "dowel", "register")
+#: What holds a split mirror's seam that takes no pins (its meridional faces where no pin of
+#: pin_choices keeps its wall: the dome's 4.4 mm shell above its flange on a small bed). Its pins would
+#: not align it anyway: a mirror's pin holes float (rigcad.fab.seams.float_pin) and the seam is glued on
+#: the printed-stage template, which sets the step normal to the mirror; the piece's seat sets the rest.
+PINLESS_WHY = ("a glued butt joint set on the printed-stage template (the gauge sets the step normal to the mirror; "
+               "the pins of a mirror's seam float and only key the glue), the piece seated on the base plate by its "
+               "flange screws or on the band below by its tongue in the groove")
 #: Grid cut positions tried per plan (each cut at its equal-slab place or moved off a keep-out).
 KEEPOUT_TRIES = 6
 #: Distance kept between a pin hole and the printed mirror surface (mm): sanding removes up to
@@ -601,75 +608,107 @@ def _other_planes_clear(pts: np.ndarray, plan: SplitPlan, face_normal: np.ndarra
     return ok
 
 
-def place_pins(man: m3d.Manifold, plan, pin: AlignmentPin, mirror: MirrorSurface | None,
-               tongues: list[Tongue] | None = None, wall: float | None = None) -> list[Pin]:
-    """Pin holes on every cut face (see the module docstring); raises if a face gets fewer than two.
-    With ``tongues``, the band cuts carry those instead of pins, and pins keep clear of them."""
+def _boundary_points(section: m3d.CrossSection, guard: float) -> np.ndarray | None:
+    """Candidate pin centres (k, 2) in a face's plane: the boundary of ``section`` eroded by ``guard`` plus
+    each ERODE_SLACK (a straight pin in a curved wall drifts outwards by depth^2 / (2 radius), so the
+    boundary itself may be too close), resampled every 0.5 mm; None when nothing is left."""
+    cand = []
+    for slack in ERODE_SLACK:
+        for p in section.offset(-(guard + slack), m3d.JoinType.Round).to_polygons():
+            p = np.asarray(p, float)
+            for a, b in zip(p, np.roll(p, -1, axis=0)):
+                k = max(1, int(np.ceil(np.linalg.norm(b - a) / 0.5)))
+                cand.append(a + (b - a) * (np.arange(k) / k)[:, None])
+    return np.concatenate(cand) if cand else None
+
+
+def _swept_section(moved: m3d.Manifold, reach: float, levels: int = 9) -> m3d.CrossSection:
+    """The section common to the part's slices from -``reach`` to +``reach`` mm along the face's normal
+    (``moved``: the part in the face's frame, the face at z = 0): where a straight pin through the face
+    stays in the part over its whole length, at ``levels`` heights (the mesh test decides)."""
+    region = None
+    for h in np.linspace(-reach, reach, levels):
+        sl = moved.slice(float(h))
+        region = sl if region is None else region ^ sl
+    return region
+
+
+def _face_pins(man, face, n, frame, keep, clear, pin, wall, mirror, pins) -> tuple[list, str]:
+    """Pin centres on one cut face (``face``: the section candidates come from): the positions that keep
+    clear of the other planes, the mirror and the holes already placed (``pins``), chosen farthest apart
+    and each passing the mesh test (:func:`_inside`); ([], why) when fewer than two."""
     r = pin.hole_radius
-    wall = MIN_WALL if wall is None else wall
     guard = r + wall
+    c2 = _boundary_points(face, guard)
+    if c2 is None:
+        return [], f"the cut face is too thin for {pin.diameter:g} mm pins (needs {2 * guard:.2f} mm of material)"
+    inv = np.linalg.inv(np.vstack([frame, [0, 0, 0, 1]]))[:3]
+    pts = np.column_stack([c2, np.zeros(len(c2))]) @ inv[:, :3].T + inv[:, 3]
+    # the pin runs +-depth along n: both ends must also stay clear of the other planes
+    mask = keep(pts) & clear(pts) & clear(pts + pin.depth * n) & clear(pts - pin.depth * n)
+    if mirror is not None and mask.any():  # only where the cheap tests pass (same result, faster)
+        idx = np.flatnonzero(mask)
+        idx = idx[mirror.signed_distance(pts[idx]) < -(MIRROR_CLEARANCE + r)]  # a necessary condition
+        mask[:] = False
+        if len(idx):
+            mask[idx] = _mirror_clear(pts[idx], n, pin, mirror)
+    # the hole widened by its wall keeps clear of the holes already placed on other faces (two cut planes
+    # that cross put pins on both near the crossing: their holes can meet inside the part)
+    for q in pins:
+        mask &= _segment_distance(pts, n, pin.depth + wall, np.array(q.centre), np.array(q.axis),
+                                  pin.depth) >= r + wall + q.hole_diameter / 2
+    pts = pts[mask]
+    if len(pts) < 2:
+        return [], (f"no room for two {pin.diameter:g} mm pins" + (f" at {MIRROR_CLEARANCE:g} mm from the mirror and"
+                                                                   if mirror is not None else " with")
+                    + f" {wall:g} mm walls")
+    want = int(min(6, max(2, round(float(np.max(np.ptp(pts, axis=0))) / PIN_SPACING))))
+    # two holes of one face (parallel, in its plane) keep the wall between them
+    chosen = _farthest(pts, want, lambda p: _inside(man, p, n, guard, pin.depth, wall), apart=2 * r + wall)
+    if len(chosen) < 2:
+        return [], f"fewer than two pin positions keep {wall:g} mm of wall around the hole for {pin.diameter:g} mm pins"
+    return chosen, ""
+
+
+def place_pins(man: m3d.Manifold, plan, pin: AlignmentPin, mirror: MirrorSurface | None,
+               tongues: list[Tongue] | None = None, wall: float | None = None, pinless: list | None = None,
+               swept: bool = True) -> list[Pin]:
+    """Pin holes on every cut face (see the module docstring); raises if a face gets fewer than two.
+    With ``tongues``, the band cuts carry those instead of pins, and pins keep clear of them. Candidates
+    come from the face's own section, and (``swept``) when that gives no two positions, from the section
+    common to the pin's whole length (:func:`_swept_section`: a plate's chord near its rim, where the face's outline
+    narrows along the pin). ``pinless``, a list (a split mirror's, glued on its gauge: PINLESS_WHY): a
+    meridional face where no two pins fit is appended to it ({"face", "why"}) instead of refused."""
+    wall = MIN_WALL if wall is None else wall
+    guard = pin.hole_radius + wall
     bb = np.asarray(man.bounding_box(), dtype=float)
     pins: list[Pin] = []
     if isinstance(plan, GridPlan):
         faces = _grid_interfaces(plan)
 
-        def clear(p, n, origin):
-            return _grid_planes_clear(p, plan, n, origin, guard)
+        def clear_of(n, origin):
+            return lambda p: _grid_planes_clear(p, plan, n, origin, guard)
     else:
         faces = _interfaces(plan, bb)
         below = max((t.depth for t in tongues), default=0.0) if tongues else 0.0
         if tongues:
             faces = [f for f in faces if abs(f[1][2]) < 0.5]  # band cuts: tongue and groove
 
-        def clear(p, n, origin):
-            return _other_planes_clear(p, plan, n, origin, guard, below)
+        def clear_of(n, origin):
+            return lambda p: _other_planes_clear(p, plan, n, origin, guard, below)
     for name, n, origin, keep in faces:
         frame = _plane_frame(n, origin)
-        inv = np.linalg.inv(np.vstack([frame, [0, 0, 0, 1]]))[:3]
-        face = man.transform(frame.tolist()).slice(0.0)
-        cand = []
-        # candidate centres on the face eroded by the guard plus a slack: a straight pin in a curved
-        # wall drifts outwards by depth^2 / (2 radius), so the boundary itself may be too close
-        for slack in ERODE_SLACK:
-            for p in face.offset(-(guard + slack), m3d.JoinType.Round).to_polygons():
-                p = np.asarray(p, float)
-                q = np.roll(p, -1, axis=0)
-                for a, b in zip(p, q):  # the eroded boundary resampled every 0.5 mm
-                    k = max(1, int(np.ceil(np.linalg.norm(b - a) / 0.5)))
-                    cand.append(a + (b - a) * (np.arange(k) / k)[:, None])
-        if not cand:
-            raise FabricationError(f"{name}: the cut face is too thin for {pin.diameter:g} mm pins "
-                                   f"(needs {2 * guard:.2f} mm of material)")
-        c2 = np.concatenate(cand)
-        pts = np.column_stack([c2, np.zeros(len(c2))]) @ inv[:, :3].T + inv[:, 3]
-        mask = keep(pts) & clear(pts, n, origin)
-        # the pin runs +-depth along n: both ends must also stay clear of the other planes
-        mask &= clear(pts + pin.depth * n, n, origin)
-        mask &= clear(pts - pin.depth * n, n, origin)
-        if mirror is not None and mask.any():  # only where the cheap tests pass (same result, faster)
-            idx = np.flatnonzero(mask)
-            near = mirror.signed_distance(pts[idx]) < -(MIRROR_CLEARANCE + r)  # a necessary condition
-            idx = idx[near]
-            mask[:] = False
-            if len(idx):
-                mask[idx] = _mirror_clear(pts[idx], n, pin, mirror)
-        # the hole widened by its wall keeps clear of the holes already placed on other faces (two cut planes
-        # that cross put pins on both near the crossing: their holes can meet inside the part)
-        for q in pins:
-            mask &= _segment_distance(pts, n, pin.depth + wall, np.array(q.centre), np.array(q.axis),
-                                      pin.depth) >= r + wall + q.hole_diameter / 2
-        pts = pts[mask]
-        if len(pts) < 2:
-            raise FabricationError(f"{name}: no room for two {pin.diameter:g} mm pins at {MIRROR_CLEARANCE:g} mm from "
-                                   f"the mirror and {wall:g} mm walls; use thinner pins (alignment_pin.diameter)")
-        extent = float(np.max(np.ptp(pts, axis=0)))
-        want = int(min(6, max(2, round(extent / PIN_SPACING))))
-        # two holes of one face (parallel, in its plane) keep the wall between them
-        chosen = _farthest(pts, want, lambda p: _inside(man, p, n, guard, pin.depth, wall), apart=2 * r + wall)
-        if len(chosen) < 2:
-            raise FabricationError(f"{name}: fewer than two pin positions keep {wall:g} mm of wall around the "
-                                   f"hole; use thinner pins (alignment_pin.diameter)")
-        pins += [Pin(tuple(float(v) for v in p), tuple(float(v) for v in n), name, pin.diameter, 2 * r)
+        moved = man.transform(frame.tolist())
+        chosen, why = _face_pins(man, moved.slice(0.0), n, frame, keep, clear_of(n, origin), pin, wall, mirror, pins)
+        if not chosen and swept:
+            chosen, _ = _face_pins(man, _swept_section(moved, pin.depth + wall), n, frame, keep, clear_of(n, origin),
+                                   pin, wall, mirror, pins)
+        if not chosen and pinless is not None and isinstance(plan, SplitPlan) and abs(n[2]) < 0.5:
+            pinless.append({"face": name, "why": why, "held_by": PINLESS_WHY})
+            continue
+        if not chosen:
+            raise FabricationError(f"{name}: {why}")
+        pins += [Pin(tuple(float(v) for v in p), tuple(float(v) for v in n), name, pin.diameter, 2 * pin.hole_radius)
                  for p in chosen]
     return pins
 
@@ -867,15 +906,17 @@ def _farthest(pts: np.ndarray, want: int, valid, apart: float = 0.0) -> list[np.
 
 
 def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
-               mirror: MirrorSurface | None, tongues: list | None = None, wall: float | None = None) -> tuple[list[Piece], list[Pin], m3d.Manifold]:
+               mirror: MirrorSurface | None, tongues: list | None = None, wall: float | None = None,
+               pinless: list | None = None) -> tuple[list[Piece], list[Pin], m3d.Manifold]:
     """Drill the pin holes, sink the band cuts' grooves and cut ``man`` into the plan's pieces.
     Returns the pieces, the pins and the drilled part (what the pieces reassemble to: the part less
     the pin holes and the clearance between tongue and groove); ``tongues``, a list, receives the
-    tongues."""
+    tongues; ``pinless``, a list, a split mirror's faces left without pins (:func:`place_pins`)."""
+    pinless = [] if pinless is None else pinless
     if plan.count == 1:
         return [Piece(name, 0, 0, None, man)], [], man
     if isinstance(plan, GridPlan):
-        pins, pin = _pins_that_fit(lambda q: place_pins(man, plan, q, mirror, wall=wall), pin)
+        pins, pin = _pins_that_fit(lambda q, _, swept: place_pins(man, plan, q, mirror, wall=wall, swept=swept), pin)
         holes = [_cylinder(np.array(p.axis), np.array(p.centre), pin.hole_radius, pin.depth) for p in pins]
         drilled = m3d.Manifold.batch_boolean([man, *holes], m3d.OpType.Subtract)
         pieces = []
@@ -889,7 +930,8 @@ def split_part(man: m3d.Manifold, name: str, plan, pin: AlignmentPin,
     tg = make_tongues(man, plan, pin, mirror)
     if tongues is not None:
         tongues.extend(tg)
-    pins, pin = _pins_that_fit(lambda q: place_pins(man, plan, q, mirror, tg, wall=wall), pin)
+    pins, pin = _pins_that_fit(lambda q, skipped, swept: place_pins(man, plan, q, mirror, tg, wall=wall, pinless=skipped,
+                                                                    swept=swept), pin, pinless if mirror is not None else None)
     holes = [_cylinder(np.array(p.axis), np.array(p.centre), pin.hole_radius, pin.depth) for p in pins]
     gaps = [t.groove - t.tongue for t in tg]
     drilled = m3d.Manifold.batch_boolean([man, *holes, *gaps], m3d.OpType.Subtract)
@@ -978,13 +1020,31 @@ def datum_seams(datums, plan) -> list[dict]:
     return out
 
 
-def _pins_that_fit(place, pin: AlignmentPin) -> tuple[list[Pin], AlignmentPin]:
-    """The first of :func:`pin_choices` whose holes ``place(pin)`` can place with their walls; the
-    printer's pin's refusal when none can."""
-    first = None
-    for q in pin_choices(pin):
-        try:
-            return place(q), q
-        except FabricationError as err:
-            first = first or err
-    raise first
+def _pins_that_fit(place, pin: AlignmentPin, pinless: list | None = None) -> tuple[list[Pin], AlignmentPin]:
+    """The pins a part's faces take, from ``place(pin, skipped, swept)`` (:func:`place_pins`): the first of
+    :func:`pin_choices` whose holes the faces' own sections place with their walls (strict: no face left
+    out); else, candidates also from the section along each pin (``swept``), and with ``pinless`` (a split
+    mirror's list) meridional faces may be left without pins: the first choice that leaves none, else
+    the one that leaves the fewest (the thicker on a tie), its faces appended to ``pinless``. A part the
+    first pass places keeps its pins whatever the second would do. Refused, naming the first face that
+    took no pin of any size and what would help, when none places."""
+    first, best = None, None
+    for swept in (False, True):
+        for q in pin_choices(pin):
+            skipped = [] if pinless is not None and swept else None
+            try:
+                pins = place(q, skipped, swept)
+            except FabricationError as err:
+                first = first or err
+                continue
+            if not skipped:
+                return pins, q
+            if best is None or len(skipped) < len(best[2]):
+                best = (pins, q, skipped)
+    if best is not None:
+        pinless.extend(best[2])
+        return best[0], best[1]
+    sizes = [q.diameter for q in pin_choices(pin)]
+    raise FabricationError(f"{first}, with any pin from {max(sizes):g} mm down to {min(sizes):g} mm (split.pin_choices: "
+                           "no alignment_pin.diameter fits): choose a printer whose build volume cuts the part in fewer "
+                           "or other places (--printer)") from first

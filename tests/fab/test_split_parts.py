@@ -254,8 +254,11 @@ def test_interfaces_of_sectors_and_bands():
     one = SP._interfaces(SP.SplitPlan(1, 2, 0.0, (0.0, 12.0, 30.0)), np.zeros(6))
     assert [f[0] for f in one] == ["band cut z 12.0 mm, sector 1"] and one[0][3](q).tolist() == [True] * 3
     three = SP._interfaces(SP.SplitPlan(2, 3, 0.0, (0.0, 10.0, 20.0, 30.0)), np.zeros(6))
-    mid = [f for f in three if f[0] == "sector plane 0.0 deg, band 2"][0][3]
-    assert mid(np.array([[40.0, 0.0, 15.0], [40.0, 0.0, 9.0], [40.0, 0.0, 21.0]])).tolist() == [True, False, False]
+    # two sectors: their half-planes are one plane joining the same two pieces, one face per band, both sides
+    assert [f[0] for f in three if f[0].startswith("sector")] == [f"sector plane 0.0/180.0 deg, band {j}" for j in (1, 2, 3)]
+    mid = [f for f in three if f[0] == "sector plane 0.0/180.0 deg, band 2"][0][3]
+    assert mid(np.array([[40.0, 0.0, 15.0], [40.0, 0.0, 9.0], [40.0, 0.0, 21.0], [-40.0, 0.0, 15.0]])).tolist() == \
+        [True, False, False, True]
 
 
 def test_interface_masks_at_their_edges():
@@ -282,7 +285,7 @@ def test_interface_masks_at_their_edges():
         [True, False]
     # plane angles past 360 deg are named modulo 360
     names = [f[0] for f in SP._interfaces(SP.SplitPlan(2, 1, math.radians(300), (0.0, 30.0)), np.zeros(6))]
-    assert names == ["sector plane 300.0 deg, band 1", "sector plane 120.0 deg, band 1"]
+    assert names == ["sector plane 300.0/120.0 deg, band 1"]
 
 
 def test_other_planes_clear_keeps_points_off_every_other_cut():
@@ -710,7 +713,7 @@ def test_a_cut_too_near_the_end_has_no_hole_with_its_wall():
     # a cut 3 mm from the plate's end: a hole 5 mm deep each way leaves the part whatever its place
     plate = m3d.Manifold.cube((120.0, 40.0, 12.0)).translate((100.0, 0.0, 0.0))
     with pytest.raises(FabricationError, match=r"^x cut 103\.0 mm, y slab 1, z slab 1: fewer than two pin positions "
-                                               r"keep 0\.6 mm of wall around the hole; use thinner pins"):
+                                               r"keep 0\.6 mm of wall around the hole"):
         SP.place_pins(plate, SP.GridPlan((103.0,), ()), PIN, None)
 
 
