@@ -160,6 +160,7 @@ def _split_line(e: dict, pr: dict) -> str:
             f"(at least {r.get('pin_hole_min_clearance_to_mirror_mm', float('nan')):.2f} mm behind the mirror)"
             + "".join(f"; band cut z = {t['z_mm']:.1f} mm joined by a tongue and groove {t['depth_mm']:g} mm deep "
                       f"({t['min_clearance_to_mirror_mm']:.2f} mm behind the mirror)" for t in e.get("tongues", []))
+            + "".join(f"; {s['face']} takes no pins ({s['why']}): {s['held_by']}" for s in e.get("pinless_seams", []))
             + ".")
 
 

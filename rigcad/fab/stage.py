@@ -513,7 +513,9 @@ def _fab_part(part, layout, run: _Run, plan=None, orient_only: bool = False) -> 
     pin = run.printer.alignment_pin
     if mirror is not None and run.printer.process_errors is not None:
         pin = seams.float_pin(pin, run.printer.process_errors.position)  # glued on a gauge, not on the pins
-    pieces, pins, drilled = split.split_part(man, name, plan, pin, mirror, tongues, wall=split.pin_wall(run.printer))
+    pinless: list = []  # a split mirror's seams that take no pins (split.PINLESS_WHY)
+    pieces, pins, drilled = split.split_part(man, name, plan, pin, mirror, tongues, wall=split.pin_wall(run.printer),
+                                             pinless=pinless)
     timings[f"{name}:fit_split"] = time.perf_counter() - t
     entry = {"process": run.printer.process, "quantity": part.quantity, "description": part.description,
              "volume_mm3": man.volume(), "split": plan.describe(), "mirror": mirror.name if mirror else None}
@@ -525,6 +527,8 @@ def _fab_part(part, layout, run: _Run, plan=None, orient_only: bool = False) -> 
             entry["datum_seams"] = split.datum_seams(datums, plan)
         if tongues:
             entry["tongues"] = [t.describe() for t in tongues]
+        if pinless:
+            entry["pinless_seams"] = pinless
         entry["reassembly"] = reassembly(man, drilled, pieces, mirror, run.tol_mirror, pins, run.printer)
     t = time.perf_counter()
     sectors = isinstance(plan, split.SplitPlan)
