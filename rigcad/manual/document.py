@@ -718,7 +718,7 @@ def assembly_order(rig, steps, solids):
     from rigcad.manual import assembly_check, gate
 
     try:
-        return assembly_check.find_order(assembly_check.Assembly(solids, steps))
+        return gate.order(rig, assembly_check.Assembly(solids, steps))  # the gate's order replayed, when it judged the rig
     except AssemblyError as err:
         v = gate.refused(rig, err, search=False)
         raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles) from err
@@ -919,11 +919,13 @@ def lifted_encloser(step, placed_names, meshes_by_name: dict, rig) -> str | None
 
 
 def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_mm: float | None = None,
-              spring: str = "", lifted: str | None = None) -> str:
+              spring: str = "", lifted: str | None = None, off_since: int | None = None, fix_later: str = "") -> str:
     """What a found step says: what goes in, how (its direction), on what, and each group of like
     fasteners with its tool and what takes its thread (``prepared``: (kind, thread host) -> the step
     number where its inserts or trap nuts were set, :func:`preparations`). ``lifted``: the part in place
-    round the whole step (:func:`lifted_encloser`): the step is done with it lifted off its register."""
+    round the whole step (:func:`lifted_encloser`): the step is done with it lifted off its register;
+    ``off_since``: that part is off already, upside down on the bench since that step (the schedule's state:
+    :func:`dome_steps`). ``fix_later``: the words that put the step's fastening off (its part goes back later)."""
     from collections import Counter
 
     from rigcad.manual import plan
@@ -955,7 +957,14 @@ def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_m
                  f"stands out under its boss, and seat a {what} in each one's cup with a drop of retaining "
                  "compound; turn them from above once it stands (they set its height and tilt). ")
     on = ", ".join(n.replace("_", " ") for n in st.needs)
-    if lifted:
+    if lifted and off_since is not None:
+        outer, way = lifted.replace("_", " "), _dir_name(placed.direction)
+        text += (f"The {outer} is off its register pins, upside down on the bench with its open base up, as step "
+                 f"{off_since} left it: ")
+        text += (f"put the part in through the {outer}'s open base onto the {on}." if way in ("-z (down)", "+z (up)")
+                 else f"{MOVES.get(way, f'move it in along {way}')}, into the upturned {outer}, until it lies "
+                 + (f"in the {outer}'s seats." if on == outer else f"on the {on}."))
+    elif lifted:
         outer = lifted.replace("_", " ")
         text += (f"The {outer} is on its register pins now and closes round this part (its top opening leaves no "
                  f"room to work through): take out the {outer}'s screws, lift it straight off its pins (what it carries "
@@ -975,12 +984,66 @@ def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_m
         if spring and "compression spring" in item:  # the seat's spring bolts: set by the spring's length
             how = ("a washer under the head, the spring, a washer and the nut on top; hold the nut with the spanner "
                    f"and {spring}")
-        text += f" Fix it with {n} x {item}, {how} (tool: {tool} or an L key)."
+        text += f" {fix_later + ', fix' if fix_later else 'Fix'} it with {n} x {item}, {how} (tool: {tool} or an L key)."
     lift = max((f.lift_mm for f in st.fasteners), default=0.0)
     if lift:
         text += (f" Its screw goes in from below: lift the rig onto blocks {lift:g} mm high under the tongue (the "
                  "film test's), turn it with the L key's short arm in the socket, then set the rig down.")
     return text
+
+
+#: The part the schedule lifts off its register for the steps done inside it (rigcad.manual.schedule.DOME_OFF).
+DOME = "dome"
+
+
+def dome_steps(schedule, names: list[str]) -> dict:
+    """Where the dome is at each of section 5's steps (``names``, in its order), read from the schedule
+    (``schedule``: its stages or manual.json's records; rigcad.manual.schedule.placing_states): ``off``, the
+    steps after the dome's own whose stage begins with the dome off (done with it upside down on the bench);
+    ``leaves_off``, whether the dome's own stage leaves it off; ``back``, the stage that sets it back (ends
+    DOME_OFF), and ``between``, the stages from the one after the last step off to that one (their words)."""
+    from rigcad.manual import schedule as S
+
+    states = S.placing_states(schedule)
+    if DOME not in names or DOME not in states:
+        return {"off": [], "leaves_off": False, "back": None, "between": []}
+    off = [n for n in names[names.index(DOME) + 1:] if n in states and S.DOME_OFF in states[n][1]]
+    back = S.stage_ending(schedule, S.DOME_OFF)
+    records = [st.record() if isinstance(st, S.Stage) else st for st in schedule]
+    last = max((states[n][0] for n in off), default=None)
+    between = [r["what"] for r in records[last:back]] if off and back and last < back else []
+    return {"off": off, "leaves_off": S.DOME_OFF in states[DOME][2], "back": back, "between": between}
+
+
+def _numbers(ks: list[int]) -> str:
+    return f"step {ks[0]}" if len(ks) == 1 else f"steps {', '.join(map(str, ks[:-1]))} and {ks[-1]}"
+
+
+def dome_words(name: str, dome: dict, number: dict[str, int]) -> tuple[str, str]:
+    """What step ``name`` says about the dome (:func:`dome_steps`): (the words that put the dome's own
+    fastening off until it goes back, the sentences that close the step)."""
+    off = [number[n] for n in dome["off"]]
+    if name == DOME and dome["leaves_off"] and off:
+        return (f"When it goes back on its pins after step {off[-1]}",
+                f" Then lift the dome off its pins again and stand it upside down on the bench, its open base up: the "
+                f"film goes on the plate now (section 6, \"{C.STEP_FILM}\"), and {_numbers(off)} are done with the "
+                f"dome off; it goes back on its pins after step {off[-1]} (the schedule's stage {dome['back']}).")
+    if off and name == dome["off"][-1] and dome["between"]:
+        return "", (" Then, before the next step: " + "; ".join(w[:1].lower() + w[1:].rstrip(".") for w in dome["between"])
+                    + f" (the schedule's stage{'s' * (len(dome['between']) > 1)} up to {dome['back']}; the dome's "
+                    f"bolts are step {number[DOME]}'s).")
+    return "", ""
+
+
+def lifted_way(direction):
+    """The way a part goes into the upturned dome in its step's picture (assembly.lifted_view's frame): a part
+    lowered or pushed up goes down into its open base, now on top; one slid in level keeps its way, turned."""
+    import numpy as np
+
+    from rigcad.manual.assembly import UPSIDE_DOWN
+
+    d = np.asarray(direction, float)
+    return np.array([0.0, 0.0, -1.0]) if abs(d[2]) > 0.5 else UPSIDE_DOWN @ d
 
 
 #: In a step's picture the shims of a stack are drawn apart by this fraction of the picture's size, so
@@ -1047,6 +1110,7 @@ def _section_assemble(d: Doc, c) -> None:
     prepared = {(r["kind"], r["into"]): number[name] for name, rows in prep.items() for r in rows
                 if r["kind"] in ("insert", "nut")}
     cure = cure_on_seat(order, prep)
+    dome = dome_steps(c.schedule, [p.step.name for p in order])
     done: list[int] = []
     for k, placed in enumerate(order):
         st = placed.step
@@ -1058,9 +1122,12 @@ def _section_assemble(d: Doc, c) -> None:
                        for j in c.rig.recipes[m].joints if isinstance(j, DowelRegister))
         text += cure_text(cure, st.name, number)
         text += preparation_text(prep[st.name], number, st.name)
-        lifted = lifted_encloser(st, [p.step.name for p in order[:k]], by_name, c.rig)
-        text += step_text(placed, by_name, prepared, _shim_mm(c.rig), spring_bolts(c.rig).get("set", ""), lifted)
-        text += placed_text([r for r in prep[st.name] if r["kind"] == "placed"])
+        off = st.name in dome["off"]
+        lifted = DOME if off else lifted_encloser(st, [p.step.name for p in order[:k]], by_name, c.rig)
+        later, closing = dome_words(st.name, dome, number)
+        text += step_text(placed, by_name, prepared, _shim_mm(c.rig), spring_bolts(c.rig).get("set", ""), lifted,
+                          number[DOME] if off else None, later)
+        text += placed_text([r for r in prep[st.name] if r["kind"] == "placed"]) + closing
         text += _step_extras(c, st.name, tower_at)
         d.h(3, f"Step {k + 1}: {label}")
         d.p(text)
@@ -1068,8 +1135,8 @@ def _section_assemble(d: Doc, c) -> None:
         # a step done with its encloser lifted off is drawn as done: the encloser upside down, the part going in
         pic, pic_done, way, turn = c.meshes, done, placed.direction, np.eye(3)
         if lifted:
-            pic, pic_done, way = A.lifted_view(c.meshes, done, lifted)
-            turn = A.UPSIDE_DOWN
+            pic, pic_done, _ = A.lifted_view(c.meshes, done, lifted)
+            way, turn = lifted_way(placed.direction), A.UPSIDE_DOWN
         offsets = _approach(pic, pic_done, members, way)
         shift = offsets[members[0]] if members else 0.0
         bolts = [(turn @ np.asarray(f.head) + shift - turn @ np.asarray(f.axis) * f.head_height_mm,
@@ -1381,8 +1448,9 @@ def _film_step(d: Doc, c) -> None:
         f"Lay a disc of matte drafting film ({1e3 * f['film_thickness_mm']:g} µm polyester, "
         f"**{f['film_diameter_mm']:.0f} mm** across, cut from the sheet with the scalpel) on the plate's top, "
         "centred on the bore, and tape its edge to "
-        "the plate. Trace the cross under it with a fine pen: its centre is O. Then set the dome back on its pins "
-        f"and go on with the assembly (the dome's flange and its {f['dome_bolts']} bolts are far outside the film).",
+        "the plate. Trace the cross under it with a fine pen: its centre is O. Then go on with the assembly: the beam "
+        "and the paraboloid go into the dome while it is still off, and it goes back on its pins over the film after "
+        f"them (section 5; the dome's flange and its {f['dome_bolts']} bolts are far outside the film).",
         f"For the test, lift the rig as one piece (plate, dome and tower are one rigid assembly; two people) onto "
         f"three blocks: one **{f['block_under_tongue_mm']:g} mm** tall under the tongue below the column, two "
         f"**{f['block_under_disc_mm']:g} mm** tall under the disc's rim either side of the dome (the tongue reaches "

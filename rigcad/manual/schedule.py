@@ -132,8 +132,9 @@ def schedule(rig, fab_report: dict | None = None, steps=None) -> tuple[Stage, ..
         _s("Take the sample holder out of the bore, stand the camera_cross_base in it, lay the film on the plate and "
            "trace O on it.", C.STEP_FILM, needs={"base plate down", "dome off", "dome register drilled"},
            makes={"film laid", "cross in the bore"}, ends={"sample holder in the bore", "plate top clear"}),
-        _s("With the dome still off (upside down on the bench), put in the beam and the paraboloid on it, reaching "
-           "in through the dome's open base (their steps).", ASSEMBLE, needs={"dome off", "dome register drilled"},
+        _s("With the dome still off (upside down on the bench, its open base up), slide the beam in through its "
+           "slots onto its seats and put in the paraboloid on it through the dome's open base (their steps).",
+           ASSEMBLE, needs={"dome off", "dome register drilled"},
            makes={"paraboloid on the beam"}, places=("beam", "paraboloid")),
         _s("Indicate the paraboloid in on the dome's axis (the dome upside down on the turntable, centred on its base) "
            "and set the clamp's foil packs to the placement tolerance (the optical acceptance test's first step).",
@@ -210,6 +211,36 @@ def unmet(stages) -> list[tuple[int, str, list[str]]]:
     return out
 
 
+#: The facts that say where the dome is while a step is done: off its register (upside down on the bench,
+#: its open base up) or on its register pins.
+DOME_OFF = "dome off"
+DOME_ON = "dome on its register"
+
+
+def placing_states(stages) -> dict[str, tuple[int, frozenset[str], frozenset[str]]]:
+    """Each assembly step a stage places (by name) -> (that stage's 1-based number, the rig's state when the
+    stage begins, the state it leaves): what section 5 says about the dome at that step must be this.
+    ``stages``: Stage objects or their records (manual.json's)."""
+    state: frozenset[str] = frozenset()
+    out = {}
+    for k, st in enumerate(stages, 1):
+        rec = st.record() if isinstance(st, Stage) else st
+        after = (state - set(rec["ends"])) | set(rec["makes"])
+        for name in rec["places"]:
+            out[name] = (k, state, frozenset(after))
+        state = frozenset(after)
+    return out
+
+
+def stage_ending(stages, fact: str) -> int | None:
+    """The 1-based number of the first stage that ends ``fact`` (the dome set back: it ends DOME_OFF)."""
+    for k, st in enumerate(stages, 1):
+        rec = st.record() if isinstance(st, Stage) else st
+        if fact in rec["ends"]:
+            return k
+    return None
+
+
 def check(stages) -> None:
     """AssemblyError naming the first stage whose state no earlier stage made."""
     bad = unmet(stages)
@@ -219,4 +250,5 @@ def check(stages) -> None:
                             f"{', '.join(missing)}, which no earlier stage leaves")
 
 
-__all__ = ["PLACED_FIRST", "Stage", "check", "rest", "schedule", "unmet"]
+__all__ = ["DOME_OFF", "DOME_ON", "PLACED_FIRST", "Stage", "check", "placing_states", "rest", "schedule", "stage_ending",
+           "unmet"]
