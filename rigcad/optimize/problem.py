@@ -245,6 +245,8 @@ def evaluate(problem: Problem, x) -> dict:
             g["min_feature.paraboloid_vertex"] = need - (geo.vertex_radius_of_curvature - coating)
     if c.max_cop_height is not None:
         g["max_cop_height"] = fig["cop_z_mm"] - c.max_cop_height
+    if c.max_dome_width is not None:
+        g["max_dome_width"] = fig["dome_outer_width_mm"] - c.max_dome_width
     if c.max_occluded_fraction is not None:
         g["max_occluded_fraction"] = fig["occluded_fraction"] - c.max_occluded_fraction
     if c.raycheck:
@@ -271,7 +273,7 @@ CONSTRAINT_UNITS = {
     "design.top_clearance": "mm", "design.cop_above_dome": "mm", "design.beam_above_flange": "mm",
     "design.holder_inside_base": "mm", "design.tower_above_dome": "mm",
     "printer.pieces": "mm", "min_feature.dome_wall": "mm", "min_feature.paraboloid_vertex": "mm",
-    "max_cop_height": "mm", "max_occluded_fraction": "", "raycheck.theta_min_coverage": "deg",
+    "max_cop_height": "mm", "max_dome_width": "mm", "max_occluded_fraction": "", "raycheck.theta_min_coverage": "deg",
     "raycheck.theta_max_coverage": "deg", "raycheck.min_px_per_deg": "px/deg", "raycheck.max_lost_fraction": "",
     "targets.theta_min": "deg", "targets.theta_max": "deg",
     "later.layout_and_parts": "count", "later.tolerance_stack": "count", "later.calibration_screen": "mm",
@@ -291,6 +293,7 @@ CONSTRAINT_KEYS = {
     "min_feature.paraboloid_vertex": "optimize.constraints.min_feature_nozzles: the paraboloid's vertex radius "
                                      "of curvature against the nozzle",
     "max_cop_height": "optimize.constraints.max_cop_height: the COP's height above the sample plane",
+    "max_dome_width": "optimize.constraints.max_dome_width: the dome part's outer width, flange included",
     "max_occluded_fraction": "optimize.constraints.max_occluded_fraction: pixels the mount hides",
     "raycheck.theta_min_coverage": "raycheck.theta_coverage_tolerance: theta must reach targets.theta_min",
     "raycheck.theta_max_coverage": "raycheck.theta_coverage_tolerance: theta must reach targets.theta_max",

@@ -13,6 +13,7 @@ constraints and the search settings, validated with the profile's own rules (uni
         printer: prusa_mk3s            # the dome prints on it ...
         max_pieces: 4                  # ... in at most this many pieces
         max_cop_height: 60 cm          # the COP (projector lens) under a ceiling, above the sample plane
+        max_dome_width: 30 cm          # the dome's outer width (flange included), a hard limit
         min_feature_nozzles: 2         # dome wall and the paraboloid's vertex radius >= 2 nozzles
         max_occluded_fraction: 0.06    # pixels the mount hides
         raycheck: true                 # the design-level checks of the raycheck section pass
@@ -51,7 +52,7 @@ OBJECTIVES: dict[str, tuple[str, str, float]] = {
 COATING_TOTAL = "coating.total"
 _SEARCH = {"parameters", "objectives", "constraints", "seed", "evaluations", "workers", "nodes"}
 _CONSTRAINTS = {"printer", "max_pieces", "max_cop_height", "min_feature_nozzles", "max_occluded_fraction",
-                "raycheck", "raycheck_margin", "later_stages"}
+                "raycheck", "raycheck_margin", "later_stages", "max_dome_width"}
 #: Default share of each raycheck limit kept in reserve (the 3D check measures on a finite fan of
 #: pixels and 1e5 seeded rays: its px/deg minimum and lost fraction differ from the exact ones by
 #: ~1e-3; see docs/optimize.md).
@@ -97,6 +98,7 @@ class Constraints:
     #: The later stages' rules as constraints of the search (rigcad.optimize.problem.later_stages):
     #: the rig's layout and part recipes and fab's tolerance stack, on the closed-form dome.
     later_stages: bool = True
+    max_dome_width: float | None = None  #: mm: the dome part's outer width, flange included
 
 
 @dataclass(frozen=True)
@@ -117,7 +119,8 @@ class OptimizeSpec:
                 "constraints": {"printer": c.printer, "max_pieces": c.max_pieces,
                                 "max_cop_height_mm": c.max_cop_height, "min_feature_nozzles": c.min_feature_nozzles,
                                 "max_occluded_fraction": c.max_occluded_fraction, "raycheck": c.raycheck,
-                                "raycheck_margin": c.raycheck_margin, "later_stages": c.later_stages},
+                                "raycheck_margin": c.raycheck_margin, "later_stages": c.later_stages,
+                                "max_dome_width_mm": c.max_dome_width},
                 "seed": self.seed, "evaluations": self.evaluations, "workers": self.workers,
                 "quadrature_nodes": self.nodes}
 
@@ -272,6 +275,10 @@ def _constraints(data, raw: RawProfile) -> Constraints:
     if data.get("max_cop_height") is not None:
         ceiling = convert_value(Spec("length", "COP height", lo=0, lo_open=True), data["max_cop_height"],
                                 "optimize.constraints.max_cop_height", at("max_cop_height"))
+    width = None
+    if data.get("max_dome_width") is not None:
+        width = convert_value(Spec("length", "dome width", lo=0, lo_open=True), data["max_dome_width"],
+                              "optimize.constraints.max_dome_width", at("max_dome_width"))
     nozzles = None
     if data.get("min_feature_nozzles") is not None:
         nozzles = convert_value(Spec("float", "nozzles", lo=0, hi=100), data["min_feature_nozzles"],
@@ -294,4 +301,4 @@ def _constraints(data, raw: RawProfile) -> Constraints:
     if not isinstance(later, bool):
         raise ProfileError(f"optimize.constraints.later_stages: expected true or false, got {later!r}"[:200],
                            where=at("later_stages"))
-    return Constraints(printer, pieces, ceiling, nozzles, occluded, rc, margin, later)
+    return Constraints(printer, pieces, ceiling, nozzles, occluded, rc, margin, later, width)
