@@ -579,7 +579,8 @@ def register_tools(rig) -> list[tuple[str, str]]:
                 continue
             tools = locating.reamers(reg.diameter)
             out.append((f"For the {reg.upper.replace('_', ' ')}'s register on the {reg.lower.replace('_', ' ')} "
-                        f"({len(reg.points)} x {reg.diameter:g} mm pins): {tools}", "1 each"))
+                        f"({len(reg.points)} x {reg.diameter:g} mm pins): {tools}; a dial test indicator of "
+                        f"{locating.REPEAT_INDICATOR_MM:g} mm graduation (DIN 2270) that reads its return", "1 each"))
             if reg.drilled:
                 out.append(("Dial test indicator, 0.01 mm graduation (DIN 2270), on an articulated arm clamped to "
                             "the sample holder (turned to its sliding fit in the bore), which turns in the bore: it "

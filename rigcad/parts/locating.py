@@ -89,6 +89,12 @@ REPEAT_TRIALS = 5
 SHIM_PACK_MM = 1.5
 #: A dial test indicator's graduation (mm): 0.01 mm, the common lever-type indicator (DIN 2270).
 INDICATOR_MM = 0.01
+#: The finer lever-type dial test indicator (DIN 2270) that reads a register's return (mm graduation):
+#: the return the tolerance stack takes is a few micrometres (half a slip fit's largest clearance,
+#: 0.009 mm for the dome's 4 mm pins), which a 0.01 mm graduation cannot resolve; a reading is
+#: trusted to half a graduation, so the finer indicator's is at most half that figure
+#: (DowelRegister.repeat_step refuses otherwise).
+REPEAT_INDICATOR_MM = 0.002
 
 
 #: The sample holder's fit in the base plate's bore (ISO 286, the preferred close running fit): the bore bored
@@ -231,7 +237,9 @@ class DowelRegister:
         """The check of each reamed hole with its go and no-go gauge pins (rigcad.standards.gauge_pins)."""
         (pg, pn), (sg, sn) = self.press_gauges, gauge_pins(self.diameter, DOWEL_SLIP_HOLE)
         return (f"check each hole with the {GAUGE_PIN}s: in the {self.diameter:g} {DOWEL_PRESS_HOLE} holes the "
-                f"{pg:.3f} mm go pin enters to the floor and the {pn:.3f} mm no-go pin does not start; in the "
+                f"{pg:.3f} mm go pin enters {self.lower_engagement:g} mm deep (the pin's engagement: the reamer's "
+                f"{REAMER_LEAD_MM:g} mm lead leaves the hole's floor under size) and the {pn:.3f} mm no-go pin does "
+                "not start; in the "
                 f"{self.diameter:g} {DOWEL_SLIP_HOLE} hole the {sg:.3f} mm pin goes through and the {sn:.3f} mm "
                 "pin does not (a hole that takes the no-go pin is drilled out and the part reprinted, or its pin "
                 "set in retaining compound).")
@@ -244,13 +252,19 @@ class DowelRegister:
         """The measurement of the register's return that the tolerance stack's figure stands on: indicate the
         upper part, lift it off and set it back REPEAT_TRIALS times, and record each reading."""
         lateral, _ = self.repeatability
+        if REPEAT_INDICATOR_MM > lateral / 2 + 1e-12:
+            raise GeometryError(f"the {self.upper}'s register returns to {lateral:.4f} mm (half its "
+                                f"{self.diameter:g} mm pin's slip fit clearance), under two graduations of the "
+                                f"{REPEAT_INDICATOR_MM:g} mm indicator that must read it: a larger pin "
+                                f"({self.param or 'its diameter'}; a larger pin's slip fit is looser)",
+                                param=self.param or None)
         upper = self.upper.replace("_", " ")
-        return (f"Measure its return: a dial test indicator ({INDICATOR_MM:g} mm graduation) on the "
+        return (f"Measure its return: a dial test indicator ({REPEAT_INDICATOR_MM:g} mm graduation) on the "
                 f"{self.lower.replace('_', ' ')}, its tip on a side of the {upper} square to the line between "
                 f"the pins, zeroed; part the two off the pins and set them back together {REPEAT_TRIALS} times, reading "
                 f"the indicator each time, and record the {REPEAT_TRIALS} readings. The tolerance stack takes "
                 f"{lateral:.3f} mm each way (half the slip fit's largest clearance): each reading must be within "
-                f"one graduation of zero; a larger one means a hole is over size (check it with the gauge pins).")
+                f"{lateral:.3f} mm of zero; a larger one means a hole is over size (check it with the gauge pins).")
 
     def lower_holes(self) -> tuple[Cylinder, ...]:
         """The pins' blind holes in the lower part, from its top face, printed at :attr:`drill`'s size
