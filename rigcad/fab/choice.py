@@ -9,6 +9,7 @@ of those orientations. Frame: the part's working position, mm; directions are un
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -42,13 +43,20 @@ def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer, keep_ou
     """The fewest pieces the part ``man`` (its mesh ``vertices``) prints in: whole when it fits in one
     of its orientations; else sectors and bands about the axis (rigcad.fab.split.plan_split), or a
     grid in its own bounding box for a flat or off-axis part (or when no sector split fits); no cut
-    crosses a ``keep_out`` box (its datum features: rigcad.fab.split.keepouts)."""
+    crosses a ``keep_out`` box (its datum features: rigcad.fab.split.keepouts). A band above a cut is
+    judged with the tongue it carries below the cut (every band cut has one: rigcad.fab.split.make_tongues,
+    at most the printer's pin depth deep), so the piece as made fits, not only its cell."""
     from rigcad.export import mesh
 
     if fits(vertices, candidates(has_mirror, plate), printer):
         return split.SplitPlan(1, 1, 0.0, (float(vertices[:, 2].min()), float(vertices[:, 2].max())))
 
+    reach = printer.alignment_pin.depth  # a band's pieces carry their tongue this far under its cut (at most)
+
     def cell_fits(cell, plan, i, j):
+        if isinstance(plan, split.SplitPlan) and j > 0:  # with the tongue split.make_tongues gives it
+            cell = split.cell(man, replace(plan, band_z=(*plan.band_z[:j], plan.band_z[j] - reach, *plan.band_z[j + 1:])),
+                              i, j)
         if cell.is_empty():
             return True
         cell_vertices, _ = mesh.mesh_arrays(cell)

@@ -1042,7 +1042,9 @@ def _pins_that_fit(place, pin: AlignmentPin, pinless: list | None = None) -> tup
             if best is None or len(skipped) < len(best[2]):
                 best = (pins, q, skipped)
     if best is not None:
-        pinless.extend(best[2])
+        tried = ", ".join(f"{q.diameter:g}" for q in pin_choices(pin))
+        pinless.extend({**s, "why": f"{s['why']}; of the pins tried ({tried} mm) none left fewer faces without pins"}
+                       for s in best[2])
         return best[0], best[1]
     sizes = [q.diameter for q in pin_choices(pin)]
     raise FabricationError(f"{first}, with any pin from {max(sizes):g} mm down to {min(sizes):g} mm (split.pin_choices: "

@@ -96,7 +96,8 @@ def test_a_mirror_shell_too_thin_for_any_pin_is_glued_without_pins():
     pieces, pins, _ = SP.split_part(shell, "shell", plan, pin, Bore(50.0), [], wall=WALL, pinless=pinless)
     assert len(pieces) == 4 and pins == []
     assert [s["face"] for s in pinless] == [f"sector plane {a:.1f} deg, band 1" for a in (45, 135, 225, 315)]
-    assert all("printed-stage template" in s["held_by"] and s["why"] for s in pinless)
+    assert all("printed-stage template" in s["held_by"] and "of the pins tried (1.75, 1.5, 1 mm)" in s["why"]
+               for s in pinless), pinless
     # without a mirror (no gauge holds the seam) the same shell is refused, naming every size and the way out
     with pytest.raises(FabricationError) as err:
         SP.split_part(shell, "shell", plan, pin, None, [], wall=WALL)
@@ -113,3 +114,25 @@ def test_a_mirror_face_with_room_keeps_its_pins():
     _, pins, _ = SP.split_part(shell, "shell", SP.SplitPlan(4, 1, math.radians(45.0), (0.0, 40.0)),
                                AlignmentPin(1.75, 0.4, 6.0), Bore(50.0), [], wall=WALL, pinless=pinless)
     assert pinless == [] and len(pins) == 8
+
+
+def test_a_band_above_a_cut_fits_with_the_tongue_it_carries():
+    # a 295 mm tube on a 180 mm tall printer, too wide to lie down: two bands; the cut at 40 % leaves a
+    # 177 mm upper band that fits as a cell but not with its 6 mm tongue under the cut (183 mm)
+    from types import SimpleNamespace
+
+    from rigcad.export import mesh as M
+    from rigcad.fab import choice
+    from rigcad.fab.printers import BuildVolume
+
+    tube = m3d.Manifold.cylinder(295.0, 50.0, 50.0, 180) - m3d.Manifold.cylinder(297.0, 46.0, 46.0, 180).translate(
+        (0.0, 0.0, -1.0))
+    printer = SimpleNamespace(usable=(120.0, 120.0, 180.0), alignment_pin=FILAMENT, name="tall",
+                              build_volume=BuildVolume(120.0, 120.0, 180.0))
+    v, _ = M.mesh_arrays(tube)
+    plan = choice.split_plan(tube, v, True, None, printer)
+    assert plan.bands == 2, plan
+    pieces, _, _ = SP.split_part(tube, "tube", plan, FILAMENT, None, [], wall=WALL)
+    for pc in pieces:  # each piece as made, standing upright (the fit the plan judged)
+        lo, hi = np.asarray(pc.manifold.bounding_box())[[2, 5]]
+        assert hi - lo <= 180.0, (pc.name, hi - lo)  # the printer's height
