@@ -632,7 +632,9 @@ def _glue_mirror_seams(d: Doc, c) -> None:
             f"the plate and its axis line on the centre mark, and push both pieces against its edge until a "
             f"{FEELER_LEAF:g} mm feeler leaf passes under it on neither "
             f"side, along the whole seam. Tape the seam on the outside and leave it to cure before the next. That "
-            f"holds the step to {s['step_on_gauge_mm']:.3f} mm ({s['step_on_gauge_how']}), within the stock.")
+            f"holds the step to {s['step_on_gauge_mm']:.3f} mm ({s['step_on_gauge_how']}), within the stock."
+            + "".join(f" The seam at {q['face']} has no pins ({q['why']}): glue it the same way, without pins; "
+                      f"what holds it is {q['held_by']}." for q in e.get("pinless_seams", [])))
 
 
 def _section_sand(d: Doc, c) -> None:
