@@ -445,22 +445,45 @@ def pass_criterion(rig) -> dict:
             "residual_slope_p99_mrad": dome_slope_tolerance(rig)}
 
 
-def judge(rig, report: dict) -> list[tuple[str, bool, str]]:
-    """``report`` (a calibration.json, as read) against :func:`pass_criterion`: (check, passed, what it
-    found and what to do) per placement and for the dome's slopes."""
+#: What to do when a criterion fails, by how it fails (the manual's 'When it fails' says how, per adjuster).
+RESEAT = "re-seat it: move it back by the offset, then capture again"
+UNRESOLVED = "unresolved: capture again (both half turns of each spacer)"
+REFINISH = "sand the dome's marked area back to its template, coat it again, capture again"
+
+
+def checks(rig, report: dict) -> list[dict]:
+    """``report`` (a calibration.json, as read) against :func:`pass_criterion`, one row per criterion:
+    ``check`` (the report's name), ``passed``, ``value``, ``standard_error`` (None for the slope), ``figure``
+    (what is held to the bound: |value| + k standard errors, or the slope p99), ``bound``, ``unit`` (mm, deg or
+    mrad), ``key`` (the profile key that sets the bound) and ``action`` (what to do when it fails, else "")."""
     crit = pass_criterion(rig)
     k, out = crit["standard_errors"], []
     params = report["against_the_dome"]["parameters"]
     for name, bound in crit["placements"].items():
-        v, se = params[name]["value"], params[name]["standard_error"]
-        ok = abs(v) + k * se <= bound
-        act = ("" if ok else "re-seat it: move it back by the offset, then capture again" if abs(v) > max(bound, k * se)
-               else "unresolved: capture again (both half turns of each spacer)")
-        out.append((name, ok, f"{v:+.4g} ± {se:.2g} against ±{bound:g}" + (f": {act}" if act else "")))
-    slope, bound = report["residual_slopes"]["residual_slope_p99_mrad"], crit["residual_slope_p99_mrad"]
+        v, se = float(params[name]["value"]), float(params[name]["standard_error"])
+        figure = abs(v) + k * se
+        ok = bool(figure <= bound)
+        act = "" if ok else RESEAT if abs(v) > max(bound, k * se) else UNRESOLVED
+        out.append({"check": name, "passed": ok, "value": v, "standard_error": se, "figure": figure, "bound": bound,
+                    "unit": "deg" if name.endswith("_deg") else "mm", "key": f"tolerancing.{PLACEMENT_TOLERANCES[name]}",
+                    "action": act})
+    slope, bound = float(report["residual_slopes"]["residual_slope_p99_mrad"]), crit["residual_slope_p99_mrad"]
     ok = bool(slope <= bound)
-    out.append(("residual_slope_p99_mrad", ok, f"{slope:.3g} mrad against {bound:.3g} mrad"
-                + ("" if ok else ": sand the dome's marked area back to its template, coat again, capture again")))
+    out.append({"check": "residual_slope_p99_mrad", "passed": ok, "value": slope, "standard_error": None,
+                "figure": slope, "bound": bound, "unit": "mrad", "key": "tolerancing.max_spot_radius",
+                "action": "" if ok else REFINISH})
+    return out
+
+
+def judge(rig, report: dict) -> list[tuple[str, bool, str]]:
+    """:func:`checks` as (check, passed, what it found and what to do) per placement and for the dome's slopes."""
+    out = []
+    for c in checks(rig, report):
+        if c["standard_error"] is None:
+            text = f"{c['value']:.3g} mrad against {c['bound']:.3g} mrad"
+        else:
+            text = f"{c['value']:+.4g} ± {c['standard_error']:.2g} against ±{c['bound']:g}"
+        out.append((c["check"], c["passed"], text + (f": {c['action']}" if c["action"] else "")))
     return out
 
 
@@ -468,6 +491,31 @@ def verdict_line(rig, report: dict) -> str:
     """One line: PASS, or FAIL with each failing check (:func:`judge`)."""
     fails = [f"{name} {text}" for name, ok, text in judge(rig, report) if not ok]
     return "calibration: PASS (docs: the manual's 'What passes')" if not fails else "calibration: FAIL: " + "; ".join(fails)
+
+
+def check_line(c: dict, k: float) -> str:
+    """One criterion's line as ``rigcad calibrate`` prints it: PASS or FAIL, the figure against its bound."""
+    if c["standard_error"] is None:
+        figure, bound = f"{c['figure']:.3g} mrad", f"{c['bound']:.3g} mrad"
+    else:
+        figure = f"|{c['value']:+.4g}| + {k:g} x {c['standard_error']:.2g} = {c['figure']:.4g} {c['unit']}"
+        bound = f"±{c['bound']:g} {c['unit']}"
+    return (f"{'PASS' if c['passed'] else 'FAIL'} {c['check']}: {figure} {'within' if c['passed'] else 'over'} "
+            f"{bound} ({c['key']})" + (f": {c['action']}" if c["action"] else ""))
+
+
+def verdict(rig, report: dict) -> dict:
+    """The calibration's verdict for calibration.json and the command's output: ``passed``, ``lines`` (one per
+    criterion, :func:`check_line`), ``line`` (the verdict in one line) and ``checks`` (:func:`checks`)."""
+    rows, k = checks(rig, report), pass_criterion(rig)["standard_errors"]
+    fails = [c["check"] for c in rows if not c["passed"]]
+    line = (f"calibration: PASS ({len(rows)} of {len(rows)} criteria)" if not fails else
+            f"calibration: FAIL ({len(fails)} of {len(rows)} criteria: {', '.join(fails)}; the manual's 'When it "
+            "fails' says what to turn or redo)")
+    return {"passed": not fails, "line": line, "lines": [check_line(c, k) for c in rows], "checks": rows,
+            "criterion": f"each placement against the dome within its tolerance by {k:g} standard errors (|value| + "
+                         f"{k:g} x standard_error within the bound); the dome's residual slope p99 within the slope "
+                         "the optical acceptance test holds"}
 
 
 def _what_passes(rig) -> str:

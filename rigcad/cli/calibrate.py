@@ -73,6 +73,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
         report["simulation"] = {"seed": args.seed, **compare(optics, rig, result, *truth)}
         extra = truth_maps(optics, rig, result, *truth)
+    from rigcad.calibrate.kit import verdict
+
+    report["verdict"] = verdict(rig, report)  # judged before anything is written: it goes into the report
     picture = _picture(rig.name, result, extra)
     out = Path(args.exports) / rig.name / "calibrate"
     with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
@@ -89,7 +92,20 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
           f"{100 * report['unmeasured']['fraction_of_lit']['measured']:.0f} % of the lit pixels measured "
           f"(the rest, and why: calibration.json 'unmeasured'); wrote {out}")
     print(_against_dome_line(report["against_the_dome"]["parameters"]))
-    return 0
+    return _print_verdict(report["verdict"], simulated=truth is not None)
+
+
+def _print_verdict(judged: dict, simulated: bool) -> int:
+    """Each criterion's line and the verdict (rigcad.calibrate.kit.verdict); the exit status: 1 when a
+    capture (``--images``) fails, 0 when it passes; a simulated capture (``--simulate``, a rehearsal of a rig
+    moved within its tolerances) exits 0 either way and says so."""
+    for line in judged["lines"]:
+        print(f"  {line}")
+    if simulated:
+        print(f"{judged['line']} (a rehearsal on a simulated rig: --simulate exits 0)")
+        return 0
+    print(judged["line"])
+    return 0 if judged["passed"] else 1
 
 
 #: Peak memory of ``rigcad calibrate P --simulate`` and ``--images``: fixed bytes plus bytes per camera
@@ -477,12 +493,18 @@ def register(subparsers) -> argparse.ArgumentParser:
                     "--simulate renders a seeded capture of a moved rig with a planted dome error instead and "
                     "compares; --kit writes the screen patterns, the spacers and the manual's page; --seating "
                     "measures how the screen settles, from the calibration.json of repeated calibrations. "
+                    "--images judges the rig and prints one line per criterion, PASS or FAIL with its figure against its "
+                    "bound (each placement against the dome within its tolerancing key by two standard errors; the "
+                    "dome's residual slope p99 within the optical acceptance test's slope), then the verdict, also "
+                    "written into calibration.json's 'verdict'; it exits 1 on FAIL (the outputs are still written: "
+                    "the manual's 'When it fails' says what to turn or redo), 0 on PASS; --simulate prints the "
+                    "rehearsal's verdict and exits 0. "
                     "--gray-card DIR is the reflectance calibration of thesis 4.1.2 (an 18 % gray card: the camera's "
                     "response curve, the scale factors, PASS or FAIL) into exports/<profile>/calibrate_graycard/; "
                     "--gray-card-kit writes its projector images and capture plan, --gray-card-simulate rehearses it.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--images", help="folder of captured camera images (h<spacer>_<frame>.png|tif, "
-                     "h<spacer>r_<frame>, u<turn>_<frame>)")
+                     "h<spacer>r_<frame>, u<turn>_<frame>); prints PASS or FAIL per criterion and exits 1 on FAIL")
     src.add_argument("--simulate", action="store_true", help="render a seeded simulated capture and calibrate it")
     src.add_argument("--kit", action="store_true", help="write the calibration kit: screen patterns, spacers "
                      "(STL, STEP, manifest), the manual's page, into <exports>/<profile>/calibrate_kit")
