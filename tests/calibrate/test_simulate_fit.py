@@ -319,9 +319,11 @@ def test_a_height_the_images_contradict(tmp_path, capture):
 
 
 def test_a_good_capture_is_written(tmp_path, small, capture, capsys):
-    assert _run(tmp_path, capture, capture["folder"]) == 0
+    code = _run(tmp_path, capture, capture["folder"])
     assert "against the dome's axis: paraboloid off by x " in capsys.readouterr().out
     out = tmp_path / "exports" / "coarse" / "calibrate"
+    # written on PASS and on FAIL alike; the exit status is the verdict's (tests/calibrate/test_verdict.py)
+    assert code == (0 if json.loads((out / "calibration.json").read_text())["verdict"]["passed"] else 1)
     data = np.load(out / "corrected_map.npz")
     assert data["direction"].shape == small["cam"].shape + (3,)
     report = json.loads((out / "calibration.json").read_text())
@@ -359,7 +361,9 @@ def test_a_simulated_capture_written_out_calibrates_the_same_from_its_files(tmp_
         for name, im in frames.items():
             with Image.open(folder / f"{label}_{name}.png") as got:
                 assert np.array_equal(np.asarray(got), im), (label, name)
-    assert _run(tmp_path, capture, folder) == 0
+    code = _run(tmp_path, capture, folder)  # the exit status is the verdict's (tests/calibrate/test_verdict.py)
+    verdict = json.loads((tmp_path / "exports" / "coarse" / "calibrate" / "calibration.json").read_text())["verdict"]
+    assert code == (0 if verdict["passed"] else 1)
     simulated, read = (json.loads((tmp_path / root / "coarse" / "calibrate" / "calibration.json").read_text())["fit"]
                        for root in ("sim", "exports"))
     assert simulated["parameters"] == read["parameters"]
