@@ -80,3 +80,48 @@ def test_every_pin_hole_keeps_its_wall_on_the_real_pieces(table31_rig, printer_n
         assert measured == 0  # its bed takes every part whole: no pins
     else:
         assert measured >= 8, (printer_name, measured)  # the base plate alone has two on each of four faces
+
+
+MINI = "Original Prusa MINI & MINI+"
+
+
+@pytest.fixture(scope="module")
+def mini_run(table31_rig, tmp_path_factory):
+    """The default rig's dome and beam on the Prusa MINI (180 mm cube: both split), no G-code."""
+    from rigcad.fab import vendor as V
+    from rigcad.fab.stage import run_fab
+
+    if "PrusaResearch" not in V.available_bundles():
+        pytest.skip("PrusaSlicer's PrusaResearch bundle is not installed (apt-get install prusa-slicer)")
+    return run_fab(table31_rig, load_printer(MINI), tmp_path_factory.mktemp("mini") / "fab", parts=["dome", "beam"])
+
+
+@pytest.mark.e2e  # the dome's fab on a small bed: two to three minutes on 2 shared cores
+def test_the_mini_splits_and_pins_the_dome_its_thin_band_glued_without_pins(mini_run):
+    dome = mini_run.report["parts"]["dome"]
+    assert "error" not in dome and dome["split"]["sectors"] == 4 and dome["split"]["bands"] == 2, dome.get("error")
+    # the flange band's faces take two pins each; the 4.4 mm shell above has no room for any pin with its
+    # 1.5 mm walls and 1 mm behind the mirror: its four faces are glued on the template without pins
+    faces = {p["face"] for p in dome["pins"]}
+    assert len(dome["pins"]) == 8 and all(f.endswith("band 1") for f in faces), faces
+    skipped = dome["pinless_seams"]
+    assert sorted(s["face"] for s in skipped) == sorted(f.replace("band 1", "band 2") for f in faces), skipped
+    assert all("printed-stage template" in s["held_by"] for s in skipped)
+    assert [p for p in mini_run.problems if p.startswith("dome:")] == [], mini_run.problems
+    # each piece as made (with its tongue) fits the bed
+    assert all(pc["candidates"] and any(c["fits"] for c in pc["candidates"]) for pc in dome["pieces"])
+
+
+@pytest.mark.e2e
+def test_the_mini_splits_the_beam_with_pins_across_its_section(mini_run):
+    beam = mini_run.report["parts"]["beam"]
+    assert beam["split"]["pieces"] == 2 and len(beam["pins"]) == 2, beam.get("error")
+    assert not [p for p in mini_run.problems if p.startswith("beam:") and "pin" in p], mini_run.problems
+
+
+@pytest.mark.e2e
+@pytest.mark.xfail(strict=True, reason="open: the beam's cut plane lies 1.25 deg off square (choose_phase's middle of "
+                   "the run at 88.75 deg), its glue faces print near the layer plane with 0.15 mm steps, and the gap "
+                   "(0.503 mm) passes the epoxy's 0.5 mm by 0.003 mm; strict, so the fix shows")
+def test_the_mini_beam_has_no_fab_problem(mini_run):
+    assert [p for p in mini_run.problems if p.startswith("beam:")] == []
