@@ -108,6 +108,7 @@ VARIANTS = {"steps3": "calibration:\n  phase_steps: 3\n", "steps4": "calibration
             "half_turn_none": "calibration:\n  half_turn: none\n",
             "half_turn_highest": "calibration:\n  half_turn: highest\n",
             "screen_seating_0.05deg": "calibration:\n  screen_seating: 0.05 deg\n",
+            "screen_seating_0.02deg": "calibration:\n  screen_seating: 0.02 deg\n",
             "screen_seating_0.01deg": "calibration:\n  screen_seating: 0.01 deg\n",
             "screen_seating_0.005deg": "calibration:\n  screen_seating: 0.005 deg\n",
             "screen_tilt_0.02deg": "calibration:\n  screen_tilt: 0.02 deg\n",
@@ -142,9 +143,22 @@ def sweep(base: str, trials: int, names: list[str] | None = None) -> dict:
                      "parameters_total": rows[0]["parameters_total"],
                      "unmeasured_causes_fraction_of_lit": cause_medians(rows),
                      "calibration_cpu_s": float(np.median([r["calibration_cpu_s"] for r in rows])),
-                     "render_s": float(np.median([r["render_s"] for r in rows]))}
+                     "render_s": float(np.median([r["render_s"] for r in rows])),
+                     **seat_figures(rows)}
         print(name, out[name], flush=True)
     return out
+
+
+def seat_figures(rows: list) -> dict:
+    """What the screen's seat moves, as medians over a variant's trials: the frame's tilt against the
+    truth (deg), the paraboloid's and the camera's placements against the dome within target (of
+    10), and the measured pixels' error within one and two stated uncertainties (shares)."""
+    cover = [r["uncertainty_coverage"]["measured"] for r in rows]
+    return {"frame_tilt_deg": float(np.median([r["frame"]["tilt_deg"] for r in rows])),
+            "dome_frame_parameters_met": float(np.median([r["dome_frame"]["parameters_met"] for r in rows])),
+            "dome_frame_parameters_total": rows[0]["dome_frame"]["parameters_total"],
+            "measured_within_1": float(np.median([c["within_1"] for c in cover])),
+            "measured_within_2": float(np.median([c["within_2"] for c in cover]))}
 
 
 def variant_rig(base: str, name: str):
@@ -294,6 +308,7 @@ VARIANT_LABELS = {"steps3": "3 phase steps", "steps4": "4 phase steps (the defau
                   "half_turn_none": "no half turn (the earlier capture)",
                   "half_turn_highest": "a half turn at the highest spacer only (3 captures)",
                   "screen_seating_0.05deg": "the screen settling to 0.05 deg, not 0.02",
+                  "screen_seating_0.02deg": "the screen settling to 0.02 deg (the default)",
                   "screen_seating_0.01deg": "the screen settling to 0.01 deg",
                   "screen_seating_0.005deg": "the screen settling to 0.005 deg (a three-point seat)",
                   "screen_tilt_0.02deg": "the screen flat on its spacers to 0.02 deg, not 0.2",
@@ -373,6 +388,34 @@ def sweep_table(summary: dict) -> str:
     return "\n".join(rows) + "\n"
 
 
+#: The seating sweep's variants (``--sweep-only --variants ...`` into
+#: bench/results/calibrate_seating_sweep.json), in the order :func:`seating_table` shows them.
+SEATING_VARIANTS = ("screen_seating_0.05deg", "screen_seating_0.02deg", "screen_seating_0.01deg",
+                    "screen_seating_0.005deg")
+
+
+def seating_table(summary: dict) -> str:
+    """The seating sweep's rows in Markdown (:data:`SEATING_VARIANTS` that ran), as
+    docs/calibrate.md shows them (tests/calibrate/test_seating_sweep.py holds the page to it)."""
+    rows_in = summary.get("sweep_phase_steps_and_heights", {})
+    ran = [n for n in SEATING_VARIANTS if n in rows_in and "frame_tilt_deg" in rows_in[n]]
+    if not ran:
+        return ""
+    k = rows_in[ran[0]]["trials"]
+    seeds = "seed 1000" if k == 1 else f"seeds 1000-{999 + k}"
+    rows = [f"The seat, {k} trial{'s' if k > 1 else ''} a seating ({seeds}; the seating planted and stated alike; "
+            "medians):", "",
+            "| seating | the frame's tilt against the truth | parameters within target | against the dome "
+            "within target | measured pixels within 1; 2 uncertainties | p99 measured |", "|---|---|---|---|---|---|"]
+    for name in ran:
+        r = rows_in[name]
+        rows.append(f"| {VARIANT_LABELS[name].removeprefix('the screen settling to ')} | {r['frame_tilt_deg']:.4f} deg | "
+                    f"{r['parameters_met']:.0f} of {r['parameters_total']} | {r['dome_frame_parameters_met']:.0f} of "
+                    f"{r['dome_frame_parameters_total']} | {100 * r['measured_within_1']:.0f} %; "
+                    f"{100 * r['measured_within_2']:.0f} % | {r['measured_pixels_p99_deg']:.3f} deg |")
+    return "\n".join(rows) + "\n"
+
+
 def aligned_rows(summary: dict) -> list[str]:
     """The summary table's rows on the aligned rig (:func:`aligned_summary`; none without it)."""
     a = summary.get("aligned_rig")
@@ -434,12 +477,17 @@ def _in_group(name: str, group: tuple) -> bool:
 def standard_error_table(summary: dict) -> list[str]:
     """How the fit's standard errors hold its errors against the truth, per group of parameters:
     the median over the trials and the group's parameters of |error| / standard error, and the share
-    within two (a Gaussian: 0.67 and 95 %)."""
+    within two (a Gaussian: 0.67 and 95 %). From the run of the code that states them now
+    (``standard_errors``, :func:`standard_errors_run`) when the summary carries one, else from its
+    own trials."""
     from rigcad.calibrate.model import GAUGE
 
-    trials = summary["per_trial"]
-    rows = ["", "How the fit's standard errors hold its errors against the truth (over the trials and each group's "
-                "parameters; the first screen's height and centre are the gauge, not fitted):", "",
+    run = summary.get("standard_errors")
+    trials = run["per_trial"] if run else summary["per_trial"]
+    where = (f"{len(trials)} trials, seeds {', '.join(str(t['seed']) for t in trials)}, on the code that states "
+             f"them now: {run['source']}" if run else "over the trials")
+    rows = ["", f"How the fit's standard errors hold its errors against the truth ({where}; each group's "
+                "parameters pooled; the first screen's height and centre are the gauge, not fitted):", "",
             "| parameters | error / standard error, p50 | within 1 standard error | within 2 |", "|---|---|---|---|"]
     for label, group in PARAMETER_GROUPS.items():
         z = np.array([p["error_over_standard_error"] for t in trials for n, p in t["parameters"].items()
@@ -450,6 +498,19 @@ def standard_error_table(summary: dict) -> list[str]:
                 f"{100 * np.mean(z <= 2):.0f} % |")
     rows.append("| calibrated (a Gaussian error) | 0.67 | 68 % | 95 % |")
     return rows
+
+
+def standard_errors_run(path: Path) -> dict:
+    """What :func:`standard_error_table` reads of a bench run (``--standard-errors``): per trial,
+    its seed and each parameter's error over its standard error, in the sample frame and against
+    the dome."""
+    run = json.loads(path.read_text(encoding="utf-8"))
+    keep = lambda params: {n: {"error_over_standard_error": p["error_over_standard_error"]}  # noqa: E731
+                           for n, p in params.items()}
+    return {"source": f"bench/results/{path.name}",
+            "per_trial": [{"seed": t["seed"], "parameters": keep(t["parameters"]),
+                           "dome_frame": {"parameters": keep(t["dome_frame"]["parameters"])}}
+                          for t in run["per_trial"]]}
 
 
 #: The map's sources as the coverage table names them.
@@ -534,6 +595,9 @@ def main() -> int:
                          "into --out, without a sweep")
     ap.add_argument("--aligned", type=int, default=0, metavar="K",
                     help="also K trials (seeds --first-seed on) on the rig as designed, with no surface error")
+    ap.add_argument("--standard-errors", metavar="JSON", type=Path,
+                    help="take the standard errors' table from this run (of the code that states them now: "
+                         "bench/results/calibrate_standard_errors.json) into --out, then stop")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "calibrate.json"))
     args = ap.parse_args()
     from rigcad.check.scene import analytic_optics
@@ -541,6 +605,12 @@ def main() -> int:
     from rigcad.rig import load
 
     name = f"{args.profile} + {args.variant}" if args.variant else args.profile
+    if args.standard_errors:
+        summary = json.loads(Path(args.out).read_text(encoding="utf-8"))
+        summary["standard_errors"] = standard_errors_run(args.standard_errors)
+        write_json(Path(args.out), summary)
+        print(tables(summary))
+        return 0
     if args.merge:
         out = Path(args.out)
         kept = json.loads(out.read_text(encoding="utf-8")).get("sweep_phase_steps_and_heights") \
@@ -550,12 +620,13 @@ def main() -> int:
         print(tables(summary))
         return 0
     if args.sweep_only:
-        summary = json.loads(Path(args.out).read_text(encoding="utf-8"))
+        out = Path(args.out)  # a new --out: a sweep of its own (the seating's: bench/results/calibrate_seating_sweep.json)
+        summary = json.loads(out.read_text(encoding="utf-8")) if out.is_file() else {"profile": args.profile}
         rows = summary.get("sweep_phase_steps_and_heights", {}) if args.variants else {}
         rows.update(sweep(args.profile, args.sweep_trials, args.variants))
         summary["sweep_phase_steps_and_heights"] = {n: rows[n] for n in VARIANTS if n in rows}
         write_json(Path(args.out), summary)
-        print(tables(summary))
+        print(tables(summary) if "per_trial" in summary else seating_table(summary))
         return 0
     rig = variant_rig(args.profile, args.variant) if args.variant else load(args.profile)
     optics = analytic_optics(rig)
