@@ -182,8 +182,9 @@ def _dome_off(rig) -> str:
             "mm), so every capture sees the same dome.")
 
 
-def manual_page(rig) -> str:
-    """The manual's page on the calibration (Markdown)."""
+def manual_page(rig, refinish: list[str] | None = None) -> str:
+    """The manual's page on the calibration (Markdown); ``refinish``: the finishing recipe's stages by name, for
+    what to do when the dome's slopes fail (:func:`_when_it_fails`)."""
     p = rig.profile
     cal = p.calibration
     seq = Sequence.from_profile(cal)
@@ -252,6 +253,7 @@ the image's columns and rows, the screen's axes at each turn and the patterns ar
    "the corrected map is filled from the fit"}.
 
 {_what_passes(rig)}
+{_when_it_fails(rig, refinish)}
 {_after_the_fit(p.tolerancing)}{_setting_the_paraboloid(rig)}
 {_measuring_the_seating(p)}"""
 
@@ -534,11 +536,104 @@ bound the optical acceptance test holds).
 {rows}
 - `residual_slopes`' `residual_slope_p99_mrad`: at most {crit['residual_slope_p99_mrad']:.3g} mrad
 
-When one fails: a placement out by more than its bound (and by more than {k:g} standard errors) is
+`rigcad calibrate {rig.profile.name} --images <folder>` prints each line above as PASS or FAIL with its
+figure against its bound, then the verdict; it writes them into calibration.json's `verdict` and exits 1
+on FAIL. When one fails ('When it fails' below says what to turn, by how much): a placement out by more than its bound (and by more than {k:g} standard errors) is
 re-seated as below, then the rig is captured and calibrated again; a placement inside its bound
 but with too wide a standard error is captured again (both half turns of each spacer, the room
 dark); a slope p99 over its bound marks the dome's area that `maps.png` shows in its residual
 slope panel: sand it back to its template, coat it again and calibrate again.
+"""
+
+
+def remedies(rig) -> dict[str, dict]:
+    """What to turn for each placement the calibration judges when it is out (the check's name -> ``adjuster``,
+    ``how`` it moves the part, ``per_step`` (the check's unit moved by one ``step``), ``range`` each way and
+    ``resolution`` in the check's unit), read from the adjusters' and the stops' own declarations
+    (rigcad.parts.adjusters, rigcad.parts.paraboloid.stops, rigcad.parts.dome.beam_seats): nothing restated."""
+    from rigcad.parts import adjusters as A
+    from rigcad.parts.dome import beam_seats
+    from rigcad.parts.paraboloid import foil_step, stops
+    from rigcad.parts.tower import seat_points
+    from rigcad.standards import THREADS
+
+    p, lay = rig.profile, rig.layout
+    foil = foil_step()
+    x, y = stops(p, lay)
+    height, tilt, roll = beam_seats(p, lay).stops()
+
+    def row(adjuster, how, per, step, rng, res, unit):
+        k = math.degrees(1.0) if unit == "deg" else 1.0
+        return {"adjuster": adjuster, "how": how, "per_step": per * k, "step": step, "range": rng * k,
+                "resolution": res * k, "unit": unit}
+
+    out = {"paraboloid_dx_mm": row(x.name, x.how, foil, f"{foil:g} mm of foil", x.range, x.resolution, "mm"),
+           "paraboloid_dy_mm": row(y.name, y.how, foil, f"{foil:g} mm of foil", y.range, y.resolution, "mm"),
+           "paraboloid_dz_mm": row(height.name, height.how, foil / 2, f"{foil:g} mm of foil at one seat", height.range,
+                                   height.resolution, "mm"),
+           "paraboloid_tilt_y_deg": row(tilt.name, tilt.how, tilt.resolution, f"{foil:g} mm of foil", tilt.range,
+                                        tilt.resolution, "deg"),
+           "paraboloid_tilt_x_deg": row(roll.name, roll.how, roll.resolution, f"{foil:g} mm of foil", roll.range,
+                                        roll.resolution, "deg")}
+    if getattr(lay, "tower", None) is None:
+        return out
+    slots = {a.name: a for a in A.slot_adjusters(p, lay)}
+    flat = A.camera_tilt(p, lay)
+    turn = f"{p.adjusters.turn_fraction:g} turn"
+    for name, key, step in (("camera_dx_mm", "camera across (x)", "slide in its slot"),
+                            ("camera_dy_mm", "camera across (y)", "shim"),
+                            ("camera_dz_mm", "camera along the axis", "slide in its slot")):
+        a = slots[key]
+        out[name] = row(a.name, a.how, a.resolution, f"{a.resolution:g} mm {step}", a.range, a.resolution, "mm")
+    out["camera_tilt_y_deg"] = row(flat.name, flat.how, flat.resolution, turn, flat.range, flat.resolution, "deg")
+    # the seat's vee screw turns the holder (and the camera's bracket on it) about the cone-flat line: the share
+    # of that line along x is the camera's turn about x (the rest, about y, the flat screw takes back)
+    pts = seat_points(lay.tower, p)
+    arm = A._lever(pts["vee"], pts["cone"], pts["flat"])
+    (x1, y1), (x2, y2) = pts["cone"], pts["flat"]
+    along_x = abs(x2 - x1) / math.hypot(x2 - x1, y2 - y1)
+    step = THREADS[p.adjusters.seat_thread].pitch * p.adjusters.turn_fraction
+    out["camera_tilt_x_deg"] = row(
+        "camera tilt across its bracket's plane: the seat's vee screw turns the holder and bracket",
+        f"{p.adjusters.seat_thread} push screw over the vee's ball, on a {arm:.1f} mm lever about the cone-flat line "
+        f"({along_x:.2f} of its turn about x); it turns the splitter too: align the projector again after it "
+        "(section 6's crosses, the splitter seat, the circle)",
+        along_x * step / arm, turn, along_x * p.adjusters.seat_travel / arm, along_x * step / arm, "deg")
+    return out
+
+
+def _when_it_fails(rig, refinish: list[str] | None = None) -> str:
+    """The calibration page's section on a failed calibration: per failing line what to turn by how much
+    (:func:`remedies`), a line unresolved, and the dome's slopes: the finishing recipe from the sanding on
+    (``refinish``: its stages' names, rigcad.manual.finishing.recipe's, which the manual and ``--kit`` pass
+    down: this floor does not import the manual; without them the page names the recipe alone)."""
+    rows = []
+    for name, r in remedies(rig).items():
+        rows.append(f"- `{name}` out: {r['adjuster']} ({r['how']}). A step ({r['step']}) moves it {r['per_step']:.3g} "
+                    f"{r['unit']}: turn or change it by |value| / {r['per_step']:.3g} steps, towards zero; it reaches "
+                    f"±{r['range']:.3g} {r['unit']} each way, to within {r['resolution']:.3g} {r['unit']}.")
+    first, redo = (refinish[0], "; ".join(refinish[1:])) if refinish else (
+        "its first stage", "each of its stages after the first, in its order")
+    bound = dome_slope_tolerance(rig)
+    return f"""## When it fails
+`rigcad calibrate {rig.profile.name} --images <folder>` exits 1 on FAIL, its files written all the same; each FAIL
+line names what to do. Work through them in this order, then capture and calibrate again:
+
+1. A line marked *unresolved* (its value inside the bound, but not by two standard errors): nothing is
+   moved. Capture again, both half turns of each spacer, the room dark, the exposure as above.
+2. A placement *re-seat it* (out by more than its bound): move the part back by the value the line prints,
+   with the adjuster below (the paraboloid's stops as the paragraph after 'After the fit' says, in detail):
+
+{chr(10).join(rows)}
+
+3. `residual_slope_p99_mrad` over {bound:.3g} mrad: the dome's slopes, which no adjuster moves. `maps.png`'s
+   residual slope panel marks the area. Sand it back and coat it again, by the finishing recipe (the
+   manual's 'Finishing recipe, stage by stage'), from its first stage on, on that area only:
+   lift the dome off its register (what it carries comes with it), take the paraboloid off the beam, and
+   sand the marked area through the mirror coat back to the template's gap ({first}); then redo the
+   recipe's stages after it: {redo}. The slope test before the mirror coat (the optical acceptance test,
+   on the polished coat) must pass again before the mirror coat goes on. Then set the paraboloid back, the
+   dome on its pins, and capture and calibrate again.
 """
 
 
@@ -558,7 +653,7 @@ wider.
 """
 
 
-def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
+def write_kit(rig, out: Path, say=lambda msg: None, refinish: list[str] | None = None) -> dict:
     """Write the kit into ``out`` (published atomically): patterns/<frame>.png, stl/ and step/
     calibration_spacer_<k>, calibration.md, conventions.png (the capture conventions drawn:
     :mod:`rigcad.calibrate.conventions`), manifest.json (each file's SHA-256, the parts' volumes);
@@ -611,7 +706,7 @@ def write_kit(rig, out: Path, say=lambda msg: None) -> dict:
             files[f"step/{part.name}.step"] = sha256_hex(st.temp_path(step_path).read_bytes())
             parts[part.name] = {"description": part.description, "volume_mm3": K.volume(shape),
                                 "step_reimport": check}
-        page = manual_page(rig).encode()
+        page = manual_page(rig, refinish).encode()
         st.write_bytes(out / "calibration.md", page)
         files["calibration.md"] = sha256_hex(page)
         from rigcad.calibrate import conventions

@@ -73,9 +73,6 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
         report["simulation"] = {"seed": args.seed, **compare(optics, rig, result, *truth)}
         extra = truth_maps(optics, rig, result, *truth)
-    from rigcad.calibrate.kit import verdict
-
-    report["verdict"] = verdict(rig, report)  # judged before anything is written: it goes into the report
     picture = _picture(rig.name, result, extra)
     out = Path(args.exports) / rig.name / "calibrate"
     with Staging(out, lock=profile_lock(Path(args.exports), rig.name), made_from=profile_digest(rig.profile)) as st:
@@ -166,7 +163,9 @@ def _kit(rig, args: argparse.Namespace, write_kit) -> int:
 
     out = Path(args.exports) / rig.name / "calibrate_kit"
     with reuse.recording(out, _kit_key(rig.profile) if _kit_alone(args) else None):
-        manifest = write_kit(rig, out, say=print)
+        from rigcad.manual.finishing import recipe
+
+        manifest = write_kit(rig, out, say=print, refinish=[row[0] for row in recipe(rig.profile)])
     print(f"calibration kit for {rig.name}: {len(manifest['files'])} files in {out}")
     return 0
 
@@ -387,9 +386,10 @@ def _report(result, rig) -> dict:
     from rigcad.calibrate import maps
     from rigcad.calibrate import model as M
     from rigcad.calibrate.fit import against_dome, in_report_units
+    from rigcad.calibrate.kit import verdict
 
     refit = result.map_fit.as_dict()
-    return {"fit": result.fit.as_dict(),
+    report = {"fit": result.fit.as_dict(),
             "against_the_dome": {"about": "the paraboloid's and the camera's offsets (their pivots') and tilts against "
                                           "the dome's axis (model.in_dome_frame): what the images fix apart from the "
                                           "rig's tilt over the sample plane, which only the priors fix; the parameters "
@@ -413,6 +413,8 @@ def _report(result, rig) -> dict:
             "screen_heights_mm": result.plan.heights.tolist(),
             "timings_s": result.timings_s, "camera_window": {"row0": result.cam.row0, "col0": result.cam.col0,
                                                              "shape": list(result.cam.shape)}}
+    report["verdict"] = verdict(rig, report)  # judged before anything is written: it goes into the report
+    return report
 
 
 def _screens_report(rig, result) -> dict:

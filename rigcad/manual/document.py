@@ -1508,7 +1508,9 @@ def _as_built(d: Doc, c) -> None:
         return
     from rigcad.calibrate.kit import manual_page
 
-    d.page(manual_page(c.rig), shift=2)
+    from rigcad.manual.finishing import recipe
+
+    d.page(manual_page(c.rig, [row[0] for row in recipe(c.p)]), shift=2)
 
 
 def _section_calibrate(d: Doc, c) -> None:
