@@ -596,8 +596,9 @@ def remedies(rig) -> dict[str, dict]:
     out["camera_tilt_x_deg"] = row(
         "camera tilt across its bracket's plane: the seat's vee screw turns the holder and bracket",
         f"{p.adjusters.seat_thread} push screw over the vee's ball, on a {arm:.1f} mm lever about the cone-flat line "
-        f"({along_x:.2f} of its turn about x); it turns the splitter too: align the projector again after it "
-        "(section 6's crosses, the splitter seat, the circle)",
+        f"({along_x:.2f} of its turn about x, {math.sqrt(1 - along_x ** 2):.2f} about y: take that back with the flat "
+        "screw); it turns the splitter too: align the projector again after it (section 6's crosses, the splitter "
+        "seat, the circle)",
         along_x * step / arm, turn, along_x * p.adjusters.seat_travel / arm, along_x * step / arm, "deg")
     return out
 
