@@ -3,8 +3,10 @@
 The bench is the plane through the rig's lowest point. A part touches it where its mesh has faces facing
 down within BENCH_TOUCH_MM of that plane; each connected set of such faces is one support patch. The rig
 stands without rocking when those patches span a polygon round its centre of mass: the mass of each part in
-the rig from its mesh's volume times its material's density (printed: the printer's material; bought: the
-aluminium the sample holder is turned from, rigcad.fab.loads.ALUMINIUM_DENSITY) at its mesh's centroid, and
+the rig at its mesh's centroid (printed: its shell, the mesh's area times the printer's perimeters' skin,
+solid, and the rest at the printer's infill share (rigcad.fab.loads.skin), of the printer's material; bought:
+its stated mass (rigcad.parts.recipe.Part.mass_kg: an extrusion), else its volume of the aluminium the
+sample holder is turned from, rigcad.fab.loads.ALUMINIUM_DENSITY), and
 the projector and the camera (rigcad.fab.loads masses) at their bodies' centres. The margin is the
 horizontal distance from the centre of mass to the support polygon's nearest edge; the tip angle, the tilt
 of the bench that would bring the centre of mass over that edge.
@@ -83,6 +85,18 @@ def _polygon_margin(points: np.ndarray, point: np.ndarray) -> tuple[np.ndarray, 
     return points[hull.vertices], float(np.min(-(eq[:, :2] @ point + eq[:, 2])))
 
 
+def part_mass(part, mesh, printer: Printer) -> float:
+    """A part's mass (kg) from its ``mesh``: a bought part's stated mass or its volume of aluminium; a printed
+    part's shell (area x the printer's side skin, at most its volume) solid and its core at the infill share,
+    of the printer's material (rigcad.fab.loads.skin: the slicer settings, else the assumed skin)."""
+    volume = abs(float(mesh.volume))
+    if part.bought:
+        return part.mass_kg if part.mass_kg is not None else loads.ALUMINIUM_DENSITY * volume
+    skin = loads.skin(printer)
+    shell = min(volume, float(mesh.area) * skin.side)
+    return printer.material_density_g_cm3 * 1e-6 * (shell + skin.infill * (volume - shell))
+
+
 def stance(rig, printer: Printer, masses: dict[str, float] | None = None) -> Stance:
     """How ``rig`` stands on the bench (module docstring); ``masses`` (kg) replace the projector's and the
     camera's assumed masses as in rigcad.fab.loads. Meshes at the pictures' chord error (0.3 mm: the
@@ -92,12 +106,8 @@ def stance(rig, printer: Printer, masses: dict[str, float] | None = None) -> Sta
     meshes = {n: rig.mesh(n, PICTURE_CHORD_ERROR) for n, p in rig.recipes.items() if p.in_rig}
     bench_z = min(float(m.vertices[:, 2].min()) for m in meshes.values())
     patches = tuple(p for n, m in meshes.items() for p in _patches(n, m, bench_z))
-    rho_print = printer.material_density_g_cm3 * 1e-6  # kg/mm3
-    weights, centres = [], []
-    for n, m in meshes.items():
-        rho = loads.ALUMINIUM_DENSITY if rig.recipes[n].bought else rho_print
-        weights.append(rho * abs(float(m.volume)))
-        centres.append(np.asarray(m.center_mass, dtype=float))
+    weights = [part_mass(rig.recipes[n], m, printer) for n, m in meshes.items()]
+    centres = [np.asarray(m.center_mass, dtype=float) for m in meshes.values()]
     t = rig.layout.tower
     for key, box in (("projector", t.projector_box), ("camera", t.camera_box)):
         weights.append(loads._mass(rig.profile, key, masses))
@@ -114,4 +124,4 @@ def stance(rig, printer: Printer, masses: dict[str, float] | None = None) -> Sta
                   math.atan2(margin, com[2] - bench_z), clearance)
 
 
-__all__ = ["BENCH_TOUCH_MM", "Patch", "Stance", "stance"]
+__all__ = ["BENCH_TOUCH_MM", "Patch", "Stance", "part_mass", "stance"]

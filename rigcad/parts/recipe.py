@@ -204,6 +204,9 @@ class Part:
     #: The part's datum features (rigcad.parts.joints.Datum: dowel holes, bores, seats, insert pockets,
     #: registers), declared where the part cuts them: a split keeps its cut planes off them.
     datums: tuple = field(default=(), compare=False)
+    #: A bought part's mass (kg) when its drawn solid is not its material all through (an extrusion's
+    #: profile is drawn as its square envelope); None: its solid's volume times its material's density.
+    mass_kg: float | None = field(default=None, compare=False)
 
     def content_hash(self) -> str:
         """SHA-256 of the solid's full definition (every number, every curve's coefficients)."""

@@ -320,6 +320,9 @@ LAPPED_FLATNESS = 0.03
 #: extrusion's nominal 40 mm, whose tolerance is about +-0.2 mm: ream or file the pocket to a slide
 #: fit), held by an M8 bolt into the extrusion's tapped core at each end.
 EXTRUSION = 40.0
+#: The bought extrusion's mass per length (kg/m; assumed: makers' catalogues give 1.4-1.9 kg/m for 40 x
+#: 40 mm slot-8 profiles, light to heavy; the drawn column is its square envelope, 4.3 kg/m as solid).
+EXTRUSION_KG_PER_M = 1.6
 POCKET_DEPTH = 1.5
 POCKET_GAP = 0.1
 CORE_BOLT_HOLE = 9.0  #: M8 clearance (ISO 273 medium)
@@ -961,7 +964,8 @@ def _extrusion_column(profile: Profile, t: TowerLayout) -> Part:
                 f"COP tower: bought {EXTRUSION:g} x {EXTRUSION:g} mm aluminium extrusion column, standing in square "
                 "pockets in the base plate's tongue and under the shelf, an M8 bolt into its core at each end",
                 bought=f"aluminium extrusion {EXTRUSION:g} x {EXTRUSION:g} mm, slot 8, cut to {z1 - z0:.1f} mm, "
-                       "ends sawn square (0.1 mm across 40 mm), core tapped M8 x 20 mm at both ends")
+                       "ends sawn square (0.1 mm across 40 mm), core tapped M8 x 20 mm at both ends",
+                mass_kg=EXTRUSION_KG_PER_M * (z1 - z0) / 1000.0)
 
 
 def tower_shelf(profile: Profile, layout) -> Part:
