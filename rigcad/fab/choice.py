@@ -9,7 +9,6 @@ of those orientations. Frame: the part's working position, mm; directions are un
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 
@@ -45,7 +44,8 @@ def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer, keep_ou
     grid in its own bounding box for a flat or off-axis part (or when no sector split fits); no cut
     crosses a ``keep_out`` box (its datum features: rigcad.fab.split.keepouts). A band above a cut is
     judged with the tongue it carries below the cut (every band cut has one: rigcad.fab.split.make_tongues,
-    at most the printer's pin depth deep), so the piece as made fits, not only its cell."""
+    within the cut face and at most the printer's pin depth deep: the cell's vertices on the cut, moved
+    down by that depth, join its own), so the piece as made fits, not only its cell."""
     from rigcad.export import mesh
 
     if fits(vertices, candidates(has_mirror, plate), printer):
@@ -54,12 +54,12 @@ def split_plan(man, vertices, has_mirror: bool, plate, printer: Printer, keep_ou
     reach = printer.alignment_pin.depth  # a band's pieces carry their tongue this far under its cut (at most)
 
     def cell_fits(cell, plan, i, j):
-        if isinstance(plan, split.SplitPlan) and j > 0:  # with the tongue split.make_tongues gives it
-            cell = split.cell(man, replace(plan, band_z=(*plan.band_z[:j], plan.band_z[j] - reach, *plan.band_z[j + 1:])),
-                              i, j)
         if cell.is_empty():
             return True
         cell_vertices, _ = mesh.mesh_arrays(cell)
+        if isinstance(plan, split.SplitPlan) and j > 0:  # with the tongue split.make_tongues gives it: inside its
+            cut = cell_vertices[np.abs(cell_vertices[:, 2] - plan.band_z[j]) < 1e-6]  # cut face, at most reach deep
+            cell_vertices = np.vstack([cell_vertices, cut - np.array([0.0, 0.0, reach])])
         sector = plan.sector_range(i) if plan.sectors > 1 else None
         return fits(cell_vertices, candidates(has_mirror, plate, sector if isinstance(plan, split.SplitPlan) else None),
                     printer)
