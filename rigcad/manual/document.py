@@ -1592,15 +1592,26 @@ def _camera_crosses_step(d: Doc, c, cam: dict) -> None:
     axis, focused once and locked, then the projector referenced to the same axis through its COP."""
     rig, p = c.rig, c.p
     d.h(3, C.STEP_CAMERA)
-    d.p(f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
-        f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm) and put the `camera_cross_base` in the sample holder's place "
-        f"(its top on z = 0). From the COP (z = {cam['cop_z_mm']:.1f} mm) the hung cross's arms span "
+    bolts = C.film_setup(rig)["dome_bolts"]
+    d.p(f"The beam is inside the dome: take out the dome's {bolts} flange screws, lift the dome off its register pins "
+        "(the beam and the paraboloid come with it) and stand it upside down on the bench, its open base up. Loosen "
+        "the paraboloid clamp's set screw and lift the paraboloid off the beam through the open base, its foil packs "
+        "kept with it (in their places: they hold its setting). "
+        f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
+        f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm), the `camera_cross_base` in the sample holder's place in the bore "
+        "(its top on z = 0; it stays there from the film's steps). Set the dome back on its pins and screw it down to its torque before you look: the cross "
+        "hangs where the paraboloid's vertex is only with the dome on its register. "
+        f"From the COP (z = {cam['cop_z_mm']:.1f} mm) the hung cross's arms span "
         f"{cam['hung_cross_arm_mrad']:.1f} mrad and the base cross's {cam['base_cross_arm_mrad']:.1f} mrad. Move the "
         "camera until the two overlap symmetrically in its image. A camera off the "
         f"axis by 1 mm shows them {cam['separation_mrad_per_mm_offset']:.2f} mrad apart "
         f"(`tolerancing.camera_offset` = {p.tolerancing.camera_offset:g} mm).")
     d.p(C.camera_focus_and_lock(rig, c.printer))
     d.p(C.shared_cop_text(rig, c.printer))
+    d.p(f"**Then put the paraboloid back:** the {bolts} flange screws out, the dome lifted off and upside down again, "
+        "the hung cross off the beam; clamp the paraboloid on the beam as before (its end on the stop pin, its foil "
+        "packs in their places, the set screw tightened), set the dome back on its pins and screw it down to its "
+        "torque. Take the `camera_cross_base` out of the bore and put the sample holder back in its place.")
 
 
 def _crosses(d: Doc, pshadow: dict, springs: dict, p, rig, printer) -> None:

@@ -105,3 +105,36 @@ def test_the_steps_and_pictures_have_the_dome_where_the_schedule_has_it(written)
     planted = md.replace(step_sections(md)[d], step_sections(md)[d].replace("When it goes back on its pins after "
                                                                             f"step {k + 1}, fix", "Fix"))
     assert any(f"step {d} (dome)" in e for e in dome_contradictions(planted, doc))
+
+
+def camera_cross_contradictions(md: str, doc: dict) -> list[str]:
+    """Section 6's camera crosses against the schedule's stage for them: the stage lifts the dome off to hang
+    the cross on the beam and puts the paraboloid back after; the section must say both, in that order."""
+    from rigcad.manual import calibration as C
+
+    stage = next((s for s in doc["schedule"] if s["where"] == C.STEP_CAMERA), None)
+    if stage is None:
+        return []
+    text = md.split(f"### {C.STEP_CAMERA}", 1)[1].split("\n### ", 1)[0]
+    out = []
+    hang = text.find("Hang the `camera_cross_hung`")
+    if "Lift the dome off" in stage["what"] and not 0 <= text.find("lift the dome off its register pins") < hang:
+        out.append("the schedule lifts the dome off to hang the camera cross; the section does not say so first")
+    if "put the paraboloid back" in stage["what"] and "put the paraboloid back" not in text[hang:].lower():
+        out.append("the schedule puts the paraboloid back after the camera cross; the section does not")
+    return out
+
+
+@pytest.mark.e2e
+def test_section_6s_camera_crosses_take_the_dome_off_as_the_schedule_does(written):
+    from rigcad.manual import calibration as C
+
+    md = (written / "manual.md").read_text(encoding="utf-8")
+    doc = json.loads((written / "manual.json").read_text(encoding="utf-8"))
+    assert camera_cross_contradictions(md, doc) == []
+    # planted: the section as it read before (the cross hung with the dome still bolted on, the paraboloid
+    # never put back) is caught
+    old = md.split(f"### {C.STEP_CAMERA}", 1)[1].split("\n### ", 1)[0]
+    body = "\n\nHang the `camera_cross_hung` on the beam in place of the paraboloid."
+    assert len(camera_cross_contradictions(md.replace(old, body), doc)) == 2
+
