@@ -30,7 +30,7 @@ from rigcad.parts.joints import ScrewJoint, datums_of
 from rigcad.parts.locating import (INDICATOR_MM, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole, foil_step,
                                    holder_fit, reamers, set_screw_length, stepped_hole, teardrop_along_y)
 from rigcad.parts.layout import RigLayout, u_at_height
-from rigcad.parts.washers import washers_over
+from rigcad.parts.washers import on_limiter
 from rigcad.parts.recipe import Box, Curve, Cylinder, Difference, Line, Part, Revolve, Section, Union_
 from rigcad.profile.schema import Profile
 from rigcad.standards import INSERTS, THREADS, thread_for_hole
@@ -78,7 +78,9 @@ def _pt(m, u) -> tuple[float, float]:
 def flange_joint(profile: Profile, layout: RigLayout) -> ScrewJoint:
     """The dome's flange on the base plate: ``dome_shell.bolts`` screws on the flange's bolt circle,
     down through the flange into heat-set inserts in the plate (the plate stands on the bench: no
-    nut fits under it); the thread is the largest whose clearance hole is ``dome_shell.bolt_diameter``."""
+    nut fits under it); the thread is the largest whose clearance hole is ``dome_shell.bolt_diameter``.
+    The joint locates the dome, a datum, so each bolt runs through a steel compression limiter
+    (rigcad.parts.joints: the sleeve stands on the insert's top, the flange keeps only its squeeze)."""
     shell = profile.dome_shell
     try:
         thread = thread_for_hole(shell.bolt_diameter).name
@@ -87,7 +89,8 @@ def flange_joint(profile: Profile, layout: RigLayout) -> ScrewJoint:
     r = layout.bolt_circle_r
     points = tuple((r * math.cos(a), r * math.sin(a)) for a in layout.bolt_angles)
     return ScrewJoint("dome_flange", "dome", "base_plate", thread, points, (0.0, shell.flange_thickness),
-                      (-profile.base_plate.thickness, 0.0), "insert", "dome_shell.bolt_diameter")
+                      (-profile.base_plate.thickness, 0.0), "insert", "dome_shell.bolt_diameter", datum=True,
+                      limiter=True)
 
 
 def _pins(layout: RigLayout) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -121,11 +124,12 @@ def register(profile: Profile, layout: RigLayout) -> DowelRegister:
     return replace(reg, procedure=indicating_text(profile, layout, reg))
 
 
-def flange_bolt_hole(profile: Profile, layout: RigLayout) -> float:
-    """The flange's bolt holes (mm): ``dome_shell.bolt_diameter``, opened where the print's errors
-    need it (rigcad.parts.locating.bolt_hole, at the farthest bolt from the register's round pin), and
-    by :data:`INDICATE_TRAVEL_MM` each way, so that the dome can be indicated in from the bore: the
-    register locates the dome, the bolts only clamp it (on large washers, ISO 7093)."""
+def flange_bolt_room(profile: Profile, layout: RigLayout) -> float:
+    """The room each flange bolt needs (mm): ``dome_shell.bolt_diameter``, opened where the print's
+    errors need it (rigcad.parts.locating.bolt_hole, at the farthest bolt from the register's round pin),
+    and by :data:`INDICATE_TRAVEL_MM` each way, so that the dome can be indicated in from the bore: the
+    register locates the dome, the bolts only clamp it. The hole is wider by the compression limiter's
+    walls (:func:`flange_bolt_hole`)."""
     d = profile.datum
     joint = flange_joint(profile, layout)
     (px, py) = _pins(layout)[0]
@@ -134,15 +138,41 @@ def flange_bolt_hole(profile: Profile, layout: RigLayout) -> float:
     return printed + 2 * INDICATE_TRAVEL_MM
 
 
+def flange_bolt_hole(profile: Profile, layout: RigLayout) -> float:
+    """The flange's bolt holes as drawn (mm): the bolt's room (:func:`flange_bolt_room`) widened by the
+    compression limiter's walls (ScrewJoint.clearance_holes: the sleeve rides on the bolt and keeps that
+    room around it). GeometryError, naming ``dome_shell.flange_width``, when the hole or the washer over it
+    (:func:`flange_washers`) leaves the flange under 1 mm of material at its wall or its rim."""
+    joint = flange_joint(profile, layout)
+    hole = 2 * joint.clearance_holes(flange_bolt_room(profile, layout))[0].radius
+    washer = on_limiter(joint.thread, hole, joint.limiter_part, joint.param).bearing.outer
+    r, need = layout.bolt_circle_r, max(hole, washer) / 2 + 1.0
+    if r - need < layout.flange_inner_r or r + need > layout.flange_outer_r:
+        raise GeometryError(f"the dome's flange ({layout.flange_inner_r:.1f} to {layout.flange_outer_r:.1f} mm) leaves "
+                            f"under 1 mm round its {hole:.2f} mm bolt holes (a {joint.limiter_part.outer:g} mm "
+                            f"compression limiter in each) and their {washer:g} mm washers on the {r:.1f} mm bolt "
+                            f"circle: widen dome_shell.flange_width to {2 * need + 1.0:.0f} mm or more",
+                            where=profile.where("dome_shell", "flange_width"))
+    return hole
+
+
+def flange_washers(profile: Profile, layout: RigLayout):
+    """The washer under each flange bolt's head (rigcad.parts.washers.on_limiter: the bolt's own large
+    washer, seated all round on its compression limiter, over the opened hole)."""
+    joint = flange_joint(profile, layout)
+    return on_limiter(joint.thread, flange_bolt_hole(profile, layout), joint.limiter_part, joint.param)
+
+
 def indicate_travel(profile: Profile, layout: RigLayout, shrink: float = 0.0) -> float:
     """How far the dome can be moved on the plate each way when indicated in (mm): the bolt holes'
-    room (printed ``shrink`` mm under their drawn size) less what the print's errors already take."""
+    room round the compression limiters (the holes printed ``shrink`` mm under their drawn size) less
+    what the print's errors already take."""
     d = profile.datum
     joint = flange_joint(profile, layout)
     (px, py) = _pins(layout)[0]
     far = max(math.hypot(x - px, y - py) for x, y in joint.points)
     used = bolt_hole(joint.thread, far, d.print_position, d.print_scale) - THREADS[joint.thread].major
-    return max(0.0, (flange_bolt_hole(profile, layout) - shrink - THREADS[joint.thread].major - used) / 2)
+    return max(0.0, (flange_bolt_hole(profile, layout) - shrink - joint.limiter_part.outer - used) / 2)
 
 
 def indicating(profile: Profile, layout: RigLayout) -> ShimStop:
@@ -281,9 +311,8 @@ def dome(profile: Profile, layout: RigLayout) -> Part:
     # the beam bears on its seats only: the slot leaves it the packs' travel up and down
     slot = Box((-reach, -half_w, z0 - p - c), (reach, half_w, z1 + p + c))
     joint, reg, seats = flange_joint(profile, layout), register(profile, layout), beam_seats(profile, layout)
-    hole = flange_bolt_hole(profile, layout)
-    holes = joint.clearance_holes(hole)
-    stack = washers_over(joint.thread, ("round", hole))
+    holes = joint.clearance_holes(flange_bolt_room(profile, layout))  # wider by the limiters' walls
+    stack = flange_washers(profile, layout)
     joint = replace(joint, washer_spec="a " + " on ".join(w.name() for w in stack.washers), washer_mm=stack.thickness,
                     spring_washer=True)  # the torque table's spring washer (rigcad.fab.loads: the flange's creep)
     lateral, _ = reg.repeatability
@@ -303,10 +332,13 @@ def indicating_text(profile: Profile, layout: RigLayout, reg: DowelRegister | No
     place: one paragraph, the figures the parts' own."""
     reg = register(profile, layout) if reg is None else reg
     hole = flange_bolt_hole(profile, layout)
-    thread = flange_joint(profile, layout).thread
+    joint = flange_joint(profile, layout)
+    thread, washer = joint.thread, flange_washers(profile, layout).bearing
     return (
+        f"{joint.limiter_step()}. "
         f"Centre the dome on the sample bore before its register pins go in: stand it on the base plate, its "
-        f"{thread} bolts snug (a quarter of their torque) through its {hole:.2f} mm holes on large washers (ISO 7093); put a dial "
+        f"{thread} bolts snug (a quarter of their torque) through the sleeves in its {hole:.2f} mm holes, on "
+        f"{washer.size} large washers ({washer.standard}, {washer.outer:g} mm: seated on the sleeves); put a dial "
         f"test indicator ({INDICATOR_MM:g} mm graduation) on an arm on the sample holder, turning in the sample "
         f"bore ({holder_fit(2 * profile.sample_holder.radius).describe()}: the bore bored and the holder turned "
         "to it first), its tip on the mirror's lower edge; turn it round and tap the dome over "

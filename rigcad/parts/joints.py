@@ -126,13 +126,14 @@ class ScrewJoint:
         lim = self.limiter_part
         if lim is None:
             return ""
-        seat = (f"the {self.thread} inserts pressed flush with {self.lower}'s face (the sleeve's end bears on the "
+        upper, lower = self.upper.replace("_", " "), self.lower.replace("_", " ")
+        seat = (f"the {self.thread} inserts pressed flush with the {lower}'s face (the sleeve's end bears on the "
                 "insert's top)" if self.into == "insert" else "the sleeve's lower end on the part under it")
         return (f"Cut {self.count} sleeves from {lim.outer:g} x {lim.wall:g} mm steel tube ({lim.source}) and face "
-                f"each on the lathe to {self.upper}'s thickness measured with a micrometer at its hole less "
+                f"each on the lathe to the {upper}'s thickness measured with a micrometer at its hole less "
                 f"{LIMITER_SQUEEZE_MM:g} mm ({self.limiter_length:.2f} mm as drawn), square and deburred; drop one "
-                f"into each of {self.upper}'s bolt holes, {seat}; the washer seats on the plastic and then on the "
-                "sleeve: tighten to the torque table's figure")
+                f"into each of the {upper}'s bolt holes, {seat}, and put each bolt through its sleeve; tightened to "
+                "the torque table's figure, the washer seats on the plastic and then on the sleeve")
 
     @property
     def washer(self) -> float:

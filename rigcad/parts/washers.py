@@ -132,4 +132,34 @@ def washers_over(thread: str, opening: tuple) -> WasherStack:
                         "opening: make the slot narrower (tower.travel_across)", param="tower.travel_across")
 
 
-__all__ = ["ISO_7093", "Washer", "WasherStack", "bearing_area", "large", "plain", "washers_over"]
+def seat_edge(washer: Washer, major: float, limiter) -> float:
+    """How far (mm) from a compression limiter's axis the washer's bore edge can stand, the washer slid
+    on the bolt (``major`` mm) as far as its bore lets it one way and the sleeve (rigcad.standards.Limiter)
+    the other way: the sleeve's end is seated out from there to its outside."""
+    return washer.bore / 2 + (washer.bore - major) / 2 + (limiter.bore - major) / 2
+
+
+def on_limiter(thread: str, hole: float, limiter, param: str = "") -> WasherStack:
+    """The washer under a ``thread`` bolt's head that runs through a compression limiter (``limiter``:
+    rigcad.standards.Limiter) in a ``hole`` mm across. The preload runs head, washer, sleeve, insert, so
+    the washer must seat on the sleeve's end all round wherever the bolt's clearance lets it slide: its
+    bore edge (:func:`seat_edge`) no farther out than the middle of the sleeve's wall. A larger washer,
+    which would bear more on the plastic, has a wider bore and floats off the sleeve on one side (an ISO
+    7093-1 M5 washer on an M4 bolt: its bore edge 3.5 mm out, past the 6 mm sleeve's 3 mm), and the plastic
+    needs no more: under the washer it carries only the squeeze the sleeve leaves (rigcad.parts.joints
+    .LIMITER_SQUEEZE_MM), which clamps it. So: the thread's own large washer (ISO 7093-1), else its plain
+    one, whichever seats; it must overlap the plastic round the hole. ``target_mm2`` is a plain washer's
+    bearing on its clearance hole, for comparison only. GeometryError (naming ``param``, the key that sizes
+    the hole) when none seats or overlaps."""
+    own = OWN_SIZE.get(thread, thread)
+    major = THREADS[thread].major
+    for w in ([large(own)] if own in ISO_7093 else []) + [plain(thread)]:
+        if seat_edge(w, major, limiter) <= (limiter.outer - limiter.wall) / 2 + 1e-9 and w.outer > hole:
+            target = bearing_area(plain(thread), ("round", THREADS[thread].clearance))
+            return WasherStack((w,), ("round", hole), bearing_area(w, ("round", hole)), target)
+    raise GeometryError(f"no washer under a {thread} bolt both seats on its {limiter.name()} and covers a "
+                        f"{hole:.2f} mm hole: a smaller hole or a larger limiter", param=param or None)
+
+
+__all__ = ["ISO_7093", "Washer", "WasherStack", "bearing_area", "large", "on_limiter", "plain", "seat_edge",
+           "washers_over"]

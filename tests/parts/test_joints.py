@@ -53,10 +53,11 @@ def test_the_flange_joint_is_declared_and_the_plate_is_cut_at_the_insert_makers_
     # ruthex's M4 insert: a 5.6 mm hole, never the insert's 6.3 mm outside
     got = _pockets(table31_rig, tmp_path, INSERTS["M4"].hole / 2)
     assert got == sorted((round(x, 3), round(y, 3)) for x, y in joint.points)
-    # 1.0 large washer (ISO 7093-1 M4) + 1.3 spring washer at its free height (DIN 6796 M4) + 6 flange
-    # + 8.1 insert = 16.4 mm of reach: the longest M4 ISO 4762 sells within it is 16, 7.7 mm in the insert
-    # (the machinist measured M4 x 12: 3.7 mm, under one diameter)
-    assert joint.length == 16 and joint.engagement == pytest.approx(7.7, abs=1e-9)
+    # 1.0 large washer (ISO 7093-1 M4) + 1.3 spring washer at its free height (DIN 6796 M4) + the 5.98 mm
+    # compression limiter through the 6 mm flange + 8.1 insert = 16.38 mm of reach: the longest M4 ISO 4762
+    # sells within it is 16, 7.72 mm in the insert (the machinist measured M4 x 12: 3.7 mm, under one diameter)
+    assert joint.datum and joint.limiter
+    assert joint.length == 16 and joint.engagement == pytest.approx(7.72, abs=1e-9)
     quantity, steps = _hardware(table31_rig)[joint.item]
     assert quantity == 8 and steps == "dome"
 
@@ -102,7 +103,6 @@ def test_every_screw_joint_engages_its_insert_by_a_diameter_and_ends_inside_it(t
     where the torque table asks for one, the conical spring washer at its free height); the screw
     engages an insert by at least one diameter (the common rule for a thread in a softer host) and
     ends inside it, or shows two pitches past its nut. Summed here from the standards' tables."""
-    from rigcad.parts.washers import washers_over
     from rigcad.standards import CONICAL_SPRING_WASHERS, THREADS
 
     joints = [j for p in table31_rig.recipes.values() for j in p.joints if isinstance(j, ScrewJoint)]
@@ -119,9 +119,10 @@ def test_every_screw_joint_engages_its_insert_by_a_diameter_and_ends_inside_it(t
             past = j.length - grip - (j.lower_z[1] - j.lower_z[0]) - th.washer_thickness - th.nut_height
             assert past >= 2 * th.pitch, (j.name, j.length, past)
     (flange,) = [j for j in joints if j.name == "dome_flange"]
-    # the dome's flange: the large washer over its opened hole and the spring washer the torque table marks
-    hole = dome.flange_bolt_hole(table31_rig.profile, table31_rig.layout)
-    assert flange.spring_washer and flange.washer_mm == washers_over("M4", ("round", hole)).thickness
+    # the dome's flange: the large washer seated on its compression limiter over the opened hole
+    # (rigcad.parts.washers.on_limiter) and the spring washer the torque table marks
+    assert flange.spring_washer and flange.washer_mm == dome.flange_washers(table31_rig.profile,
+                                                                            table31_rig.layout).thickness
 
 
 def test_a_joint_too_short_for_one_diameter_in_its_insert_is_refused():
