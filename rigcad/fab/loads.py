@@ -52,7 +52,7 @@ import numpy as np
 from rigcad.errors import FabricationError
 from rigcad.fab.printers import Printer
 from rigcad.parts import breadboard
-from rigcad.parts.dome import flange_joint
+from rigcad.parts.dome import flange_joint, flange_washers
 from rigcad.parts.tower import _lens_foot, _projector_feet, _shelf_extent, seat_points
 from rigcad.standards import LARGE_WASHERS, THREADS
 
@@ -284,18 +284,13 @@ def bolt_loads(profile, layout, printer: Printer) -> tuple[BoltLoad, ...]:
     The splitter holder's two spring bolts are set by their springs' length, not a torque, and its seat
     screws are adjusters (rigcad.parts.adjusters)."""
     from rigcad.parts.tower import joint_washers
-    from rigcad.parts.washers import washers_over
 
     mat, tw = material(printer), profile.tower
     fj = flange_joint(profile, layout)
-    try:
-        from rigcad.parts.dome import flange_bolt_hole
-        flange_hole = flange_bolt_hole(profile, layout)
-    except ImportError:
-        flange_hole = profile.dome_shell.bolt_diameter
     hole = tw.bolt_diameter
-    out = [bolt_load("dome flange on the base plate", fj.thread, fj.count,
-                     _faces(washers_over(fj.thread, ("round", flange_hole))), mat, True)]
+    # the flange's bolts run through compression limiters: their washer is the one that seats on the sleeve
+    out = [bolt_load("dome flange on the base plate", fj.thread, fj.count, _faces(flange_washers(profile, layout)),
+                     mat, True)]
     washers = joint_washers(profile, layout)
     if profile.buy.column == "print":
         # the foot's nuts bear on the bolts' compression limiters (rigcad.parts.tower.COLUMN_LIMITER), not on
