@@ -329,13 +329,26 @@ def pre_ream_drill(size: float) -> float:
 #: millimetres of under-size flutes, and cannot bring a blind hole a few millimetres deep to size.
 MACHINE_REAMER, MACHINE_REAMER_SPEC = "machine (chucking) reamer", "DIN 212, HSS, straight shank, 45 deg chamfer lead"
 #: The machine reamer's lead along its axis (mm): the under-size zone it leaves at a blind hole's floor,
-#: so a blind hole is at least the pin's engagement and this deep. 1.0 mm: assumed for a 45 deg chamfer on
-#: the 3-6 mm sizes (no maker's table was at hand to cite; the manual's step says to hold the bought
-#: reamer's chamfer against it, and a longer one needs deeper holes).
+#: so a blind hole is at least the pin's engagement and this deep. ASSUMED, not sourced: DIN 212 machine
+#: reamers are sold with a 45 deg chamfer lead, but no maker's table of the chamfer's length (nor the
+#: standard's) was at hand; a hand reamer's (DIN 206) long taper lead is not this figure. What bounds it:
+#: a 45 deg chamfer is as long along the axis as it is deep, it must be at least half the reaming
+#: allowance deep to start in the drilled hole (0.1 mm at 4 mm: REAMING_ALLOWANCE), and it cannot be
+#: deeper than the reamer's radius; 1.0 mm, a quarter of a 4 mm reamer's diameter, is taken as a
+#: generous figure for the 3-6 mm sizes. The manual's step says to measure the bought reamer's chamfer
+#: against it (a longer one needs deeper holes; rigcad.parts.locating.check_blind_hole refuses a hole
+#: shorter than the pin's engagement plus this).
 REAMER_LEAD_MM = 1.0
-#: The gauge pins that check a reamed hole (DIN 2269 cylindrical gauge pins, class 1, +-0.001 mm; sold in
-#: 0.001 mm steps): the go pin at the hole class's lower limit enters, the no-go pin at its upper limit does not.
+#: The gauge pins that check a reamed hole (DIN 2269 cylindrical measuring pins, 0.1-20 mm, sold in
+#: 0.001 mm steps): the go pin at the hole class's lower limit enters, the no-go pin at its upper limit does
+#: not. DIN 2269:1998-11 has tolerance classes 0, 1, 2 and the calibration class K (its foreword, read);
+#: class 1 is the shop's class (0 and K are for gauge rooms).
 GAUGE_PIN, GAUGE_PIN_SPEC = "cylindrical gauge pin", "DIN 2269, class 1"
+#: A class 1 gauge pin's diameter limits (mm, +-): a typical gauge-pin maker's catalogue figure for DIN 2269
+#: class 1 up to 20 mm, not read from the standard's own table here. It must stay small against the
+#: zone the pins bracket: at most a tenth of every ISO 286 zone a register's holes are reamed to (the
+#: gauge makers' rule of thumb; tests/parts/test_reaming.py checks it for the dowel sizes).
+GAUGE_PIN_TOLERANCE_MM = 0.001
 
 
 def gauge_pins(size: float, hole: str) -> tuple[float, float]:
@@ -406,7 +419,7 @@ DRIVER_BLADE_MM = 100.0
 #: An open-end spanner's reach (mm; DIN 3110 spanners for M3-M6 nuts are 90-120 mm long).
 SPANNER_MM = 80.0
 
-__all__ = ["GAUGE_PIN", "GAUGE_PIN_SPEC", "MACHINE_REAMER", "MACHINE_REAMER_SPEC", "REAMER_LEAD_MM", "gauge_pins", "DOWEL_PRESS_HOLE", "DOWEL_SHAFT", "DOWEL_SLIP_HOLE", "Fit", "ISO_286", "REAMING_ALLOWANCE", "pre_ream_drill", "reaming_allowance", "tolerance_zone", "CAMERA_SOCKET_DEPTH", "ISO_7089_BORE", "ISO_7093", "CUP_POINT", "SHIM_FOIL", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
+__all__ = ["GAUGE_PIN", "GAUGE_PIN_SPEC", "GAUGE_PIN_TOLERANCE_MM", "MACHINE_REAMER", "MACHINE_REAMER_SPEC", "REAMER_LEAD_MM", "gauge_pins", "DOWEL_PRESS_HOLE", "DOWEL_SHAFT", "DOWEL_SLIP_HOLE", "Fit", "ISO_286", "REAMING_ALLOWANCE", "pre_ream_drill", "reaming_allowance", "tolerance_zone", "CAMERA_SOCKET_DEPTH", "ISO_7089_BORE", "ISO_7093", "CUP_POINT", "SHIM_FOIL", "DOWEL_DIAMETERS", "GAUGE_BLOCK_FACE", "SET_SCREW_LENGTHS", "SET_SCREW_LENGTH_RANGE",
            "SPRING_STEEL_G", "dowel_diameter_for", "shortest_set_screw", "spring_rate", "INCH_SCREW_LENGTHS", "LARGE_WASHERS", "DOWEL_LENGTHS", "longest_dowel", "DRIVER_BLADE_MM", "HEX_KEYS", "HexKey", "INCH", "INSERTS",
            "Insert", "METRIC_THREADS", "MOUNT_THREADS", "SCREW_LENGTHS", "SCREW_LENGTH_RANGE", "SPANNER_MM", "THREADS",
            "Thread", "longest_screw", "screw_lengths", "shortest_screw", "thread", "thread_for_hole"]

@@ -355,8 +355,11 @@ TEMPLATE_MATERIAL = "stainless steel sheet 1.4301 (AISI 304), cold rolled"
 #: far coarser than the gaps a template must show, so the gauging edge is cut this much proud and finished.
 CUT_EDGE_MM = 0.1
 #: An optical comparator (profile projector) with a measuring stage reads an edge point to (3 + L / 50) um
-#: over a stage travel of L mm (the stage accuracy makers state for 20x profile projectors, e.g. Mitutoyo's
-#: PJ-A3000 series): the check of a template's edge against its drawing's coordinates.
+#: over a stage travel of L mm: the check of a template's edge against its drawing's coordinates. A typical
+#: maker's figure, not a standard's: the XY stage accuracy profile-projector makers state for their 20x
+#: measuring projectors ("(3 + 2L/100) um", as Mitutoyo's PJ-A3000 series lists it; taken from that
+#: maker's catalogue as remembered, its table not read here). A shop's own comparator's calibration
+#: certificate replaces it.
 COMPARATOR_UM = (3.0, 1.0 / 50.0)
 #: A template's edge may stand off its outline by at most this share of the smallest gap it must show: a
 #: quarter, so that an edge error cannot turn a right gap into a leaf's wrong reading.
@@ -415,7 +418,8 @@ def template_making_text(rows: list[dict]) -> str:
             f"measuring stage, 20x), point by point against the drawing's coordinates, and the datum marked as its "
             f"drawing shows it. The gaps it must show are {gaps}: its edge must lie within "
             f"**{r0['edge_tolerance_mm']:.4f} mm** of the outline ({EDGE_SHARE:g} of the smallest gap, "
-            f"{r0['smallest_gap_mm']:.3f} mm), and the comparator's stage reads to (3 + L/50) um over L: {each}. "
+            f"{r0['smallest_gap_mm']:.3f} mm), and the comparator's stage reads to (3 + L/50) um over L (a typical "
+            f"maker's figure for a measuring projector's stage: your comparator's calibration certificate wins): {each}. "
             "A laser-cut edge unfinished, or one checked against a paper print (a printer places a line to about "
             "0.1 mm), cannot show these gaps.")
 

@@ -160,8 +160,8 @@ def test_the_parts_page_states_the_fits_the_code_computes(table31_rig):
                   f"plugs are printed, at {base.holder_drawn(p, False):g} mm",
                   f"reamed N7, {reg.press.describe()}", f"reamed F7, {reg.slip.describe()}",
                   f"takes the dome's return as {reg.repeatability[0]:.3f} mm each way",
-                  f"set back {locating.REPEAT_TRIALS} times", f"plus that {REAMER_LEAD_MM:g} mm lead",
-                  "({:.3f} / {:.3f} mm for {:g} N7".format(*reg.press_gauges, reg.diameter),
+                  f"set back {locating.REPEAT_TRIALS} times", f"plus that {REAMER_LEAD_MM:g}<!--given--> mm lead",
+                  "`tests/parts/test_reaming.py`; {:.3f} / {:.3f} mm for {:g} N7".format(*reg.press_gauges, reg.diameter),
                   f"at the {reg.drill:g} mm drill's size",
                   f"a {reg.diameter - reg.drill:.1f} mm reaming allowance", f"the beam's {pin:g} mm stop pin",
                   f"{press_fit(pin).describe()}, in a {pre_ream_drill(pin):g} mm hole"):

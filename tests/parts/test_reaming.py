@@ -77,3 +77,18 @@ def test_the_return_is_measured_not_claimed(rig):
         assert "goes back to within" not in text, reg.name
         assert f"set them back together {locating.REPEAT_TRIALS} times" in text and "record" in text, reg.name
         assert f"takes {reg.repeatability[0]:.3f} mm each way" in text, reg.name
+
+
+def test_the_gauge_pins_own_tolerance_is_a_tenth_of_the_zone_they_bracket_at_most():
+    """DIN 2269 class 1 pins (rigcad.standards.GAUGE_PIN_TOLERANCE_MM, a maker's catalogue figure) against
+    the press and slip holes' ISO 286 zones at every dowel size rigcad's ISO 286 table holds up to DIN 2269's
+    20 mm (over 1 mm): each pin's own error at most a tenth of the zone, the gauge makers' rule."""
+    from rigcad.standards import (DOWEL_DIAMETERS, DOWEL_PRESS_HOLE, DOWEL_SLIP_HOLE, GAUGE_PIN_SPEC,
+                                  GAUGE_PIN_TOLERANCE_MM)
+
+    assert GAUGE_PIN_SPEC == "DIN 2269, class 1"
+    for d in (d for d in DOWEL_DIAMETERS if 1.0 < d <= 20.0):
+        for hole in (DOWEL_PRESS_HOLE, DOWEL_SLIP_HOLE):
+            go, no_go = gauge_pins(d, hole)
+            # the zone the pins bracket (0.012 mm for 4 N7): the pins' own error at most a tenth of it
+            assert GAUGE_PIN_TOLERANCE_MM <= (no_go - go) / 10 + 1e-12, (d, hole, no_go - go)
