@@ -401,11 +401,9 @@ def seating_table(summary: dict) -> str:
     ran = [n for n in SEATING_VARIANTS if n in rows_in and "frame_tilt_deg" in rows_in[n]]
     if not ran:
         return ""
-    k = rows_in[ran[0]]["trials"]
-    seeds = "seed 1000" if k == 1 else f"seeds 1000-{999 + k}"
-    rows = [f"The seat, {k} trial{'s' if k > 1 else ''} a seating ({seeds}; the seating planted and stated alike; "
-            "medians):", "",
-            "| seating | the frame's tilt against the truth | parameters within target | against the dome "
+    k = {rows_in[n]["trials"] for n in ran}
+    seeds = "1000" if k == {1} else f"1000-{999 + max(k)}"
+    rows = [f"| seating ({'/'.join(str(n) for n in sorted(k))} trials, seeds {seeds}; medians) | the frame's tilt against the truth | parameters within target | against the dome "
             "within target | measured pixels within 1; 2 uncertainties | p99 measured |", "|---|---|---|---|---|---|"]
     for name in ran:
         r = rows_in[name]

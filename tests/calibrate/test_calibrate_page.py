@@ -42,3 +42,22 @@ def test_the_page_stays_readable():
     assert text.index("## The procedure") < text.index("## What passes") < text.index("## Capture conventions")
     for page in ("calibrate-method.md", "calibrate-notes.md"):
         assert f"]({page})" in text and (ROOT / "docs" / page).is_file(), page
+
+
+def test_the_seating_table_is_the_benchs():
+    """"What seat is enough" shows bench/calibrate.py's rendering of
+    bench/results/calibrate_seating_sweep.json (the seating sweep on the current code), every
+    seating of bench/calibrate.py's SEATING_VARIANTS with at least two trials."""
+    import importlib.util
+    import json
+    import re
+
+    spec = importlib.util.spec_from_file_location("bench_calibrate", ROOT / "bench" / "calibrate.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    run = json.loads((ROOT / "bench" / "results" / "calibrate_seating_sweep.json").read_text(encoding="utf-8"))
+    rows = run["sweep_phase_steps_and_heights"]
+    assert set(rows) == set(bench.SEATING_VARIANTS) and min(r["trials"] for r in rows.values()) >= 2, rows.keys()
+    text = PAGE.read_text(encoding="utf-8")
+    block = re.search(r"<!-- bench/calibrate.py seating -->\n(.*?)<!-- end of bench/calibrate.py seating -->", text, re.S)
+    assert block and block.group(1) == bench.seating_table(run)
