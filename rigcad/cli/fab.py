@@ -28,14 +28,14 @@ def cmd_fab(args: argparse.Namespace) -> int:
     from rigcad.manual.gate import gate, kept_gate
 
     out = api.default_folder(profile.name, "fab", printer.name, root=args.exports)
-    rig = load(profile)
-    criteria = criteria_refusal(rig, args.exports, "fab")
+    criteria = criteria_refusal(profile, args.exports, "fab")  # the rig built only when its criteria are not kept
     if not criteria.ok:  # a rig that fails its own check gets no print files
         return 1
-    # a verdict and a fab run both kept from these inputs: read back
+    # a verdict and a fab run both kept from these inputs: read back, no rig built
     res = (api.fab_published(profile, printer, out, gcode=args.gcode, parts=args.parts)
            if kept_gate(args.exports, profile) else None)
     if res is None:
+        rig = load(profile)
         gate(rig, args.exports)  # a rig that cannot be put together is refused before a piece is sliced
         with stages(len(names), f"fab {profile.name}") as step:
             def progress(msg: str) -> None:
