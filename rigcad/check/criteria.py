@@ -12,6 +12,11 @@ Two kinds:
   clearance, the Monte Carlo yield): read from the last ``rigcad check`` written for the same
   profile (``exports/<profile>/check/raycheck.json``, made from the same resolved profile), or
   said plainly to be unjudged when there is none (:func:`written_check`).
+
+The cheap rows of the rig as designed are kept beside the export (:data:`KEPT_FILE`, keyed by the
+resolved profile and rigcad's code: rigcad.export.reuse.stage_key), so that a command run again
+with nothing changed judges them without building the rig (the dome integrated, the fan traced:
+about 1.6 s of CPU on the default rig); a changed profile key or code makes them again.
 """
 
 from __future__ import annotations
@@ -97,15 +102,82 @@ class Verdict:
         return not self.refusals
 
 
-def judge(rig, exports: str | Path) -> Verdict:
-    """The criteria of the ray check a rig must meet before it is printed (module docstring)."""
-    from rigcad.export.readback import shown
+#: The cheap rows kept for the rig as designed, in exports/<profile>/: ``{"key", "rows"}``.
+KEPT_FILE = "criteria.json"
 
-    cheap = cheap_rows(rig)
-    failed = [r for r in cheap if not r.ok]
-    refusals = [row_line(r) for r in failed]
-    names = {r.name for r in cheap}
-    written = written_check(exports, rig.profile)
+
+def _kept_key(profile) -> str:
+    from rigcad.export import reuse
+
+    return reuse.stage_key(profile, "criteria", {})
+
+
+def kept_rows(exports: str | Path, profile) -> list[dict] | None:
+    """The cheap rows (Row.as_dict) kept under ``exports`` for the rig of ``profile`` as designed, when
+    this profile and code made them; None otherwise (missing, not a plain file, unreadable, made from
+    another profile or code: they are made anew). Read as rigcad reads back its own files."""
+    from rigcad.export.readback import own_json
+
+    doc = own_json(Path(exports) / profile.name / KEPT_FILE)
+    if not isinstance(doc, dict) or doc.get("key") != _kept_key(profile):
+        return None
+    rows = doc.get("rows")
+    if not isinstance(rows, list) or not all(map(_row_like, rows)) or doc.get("rows_sha256") != _rows_digest(rows):
+        return None  # an edited row is made anew, not trusted
+    return rows
+
+
+def _rows_digest(rows: list) -> str:
+    from rigcad.export.atomic import json_bytes
+    from rigcad.export.manifest import sha256_hex
+
+    return sha256_hex(json_bytes(rows))
+
+
+def _row_like(r) -> bool:
+    """A kept row :func:`line_of` can print: its figures numbers (a NaN figure was kept as null: made anew)."""
+    return (isinstance(r, dict) and isinstance(r.get("ok"), bool) and isinstance(r.get("check"), str)
+            and all(f in r for f in ("profile_key", "relation", "unit", "where"))
+            and all(isinstance(r.get(f), (int, float)) and not isinstance(r.get(f), bool) for f in ("measured", "limit")))
+
+
+def judged_rows(rig, exports: str | Path) -> list[dict]:
+    """The cheap rows (Row.as_dict) of ``rig`` (a Rig, or a loaded Profile for its rig as designed):
+    for the rig as designed, the rows kept under ``exports`` (:func:`kept_rows`) when there are any,
+    else made (the rig built from a Profile only then) and kept, atomically, for the next command."""
+    from rigcad.optics.frames import Misalignment
+    from rigcad.profile.schema import Profile
+
+    profile = rig if isinstance(rig, Profile) else rig.profile
+    designed = isinstance(rig, Profile) or rig.misalignment == Misalignment.none()
+    kept = kept_rows(exports, profile) if designed else None
+    if kept is not None:
+        return kept
+    if isinstance(rig, Profile):
+        from rigcad.rig import Rig
+
+        rig = Rig.from_profile(profile)
+    rows = [r.as_dict() for r in cheap_rows(rig)]
+    if designed:
+        from rigcad.export.atomic import write_json
+
+        path = Path(exports) / profile.name / KEPT_FILE
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_json(path, {"key": _kept_key(profile), "rows": rows, "rows_sha256": _rows_digest(rows)})
+    return rows
+
+
+def judge(rig, exports: str | Path) -> Verdict:
+    """The criteria of the ray check a rig must meet before it is printed (module docstring). ``rig``:
+    a Rig, or a loaded Profile (its rig as designed, built only when no cheap rows are kept for it)."""
+    from rigcad.export.readback import shown
+    from rigcad.profile.schema import Profile
+
+    profile = rig if isinstance(rig, Profile) else rig.profile
+    cheap = judged_rows(rig, exports)
+    refusals = [line_of(r) for r in cheap if not r["ok"]]
+    names = {r["check"] for r in cheap}
+    written = written_check(exports, profile)
     where = shown(written.path)
     notes = []
     if written.state == "failed":

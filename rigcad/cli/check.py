@@ -158,7 +158,8 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def criteria_refusal(rig, exports, command: str, written: bool = False):
-    """Judge ``rig`` by the ray check's criteria before it is printed (rigcad.check.criteria.judge):
+    """Judge ``rig`` (a Rig, or a loaded Profile: its rig as designed, built only when the criteria's
+    cheap rows are not kept for it) by the ray check's criteria before it is printed (rigcad.check.criteria.judge):
     when it fails one, print one line per failed criterion (its key, file:line, the figure and the
     value that would pass) under one 'rigcad: error:' line saying what ``command`` did (``written``:
     its files are written for inspection only). Returns the verdict (``.ok``; ``.notes``, what was not

@@ -22,9 +22,7 @@ def cmd_stl(args: argparse.Namespace) -> int:
         kept = gate.read_verdict(args.exports, profile)
         if kept is not None:
             print(f"{profile.name}: up to date ({out}/manifest.json)")
-            from rigcad.rig import load
-
-            return max(_verdict_exit(kept), _criteria_exit(load(profile), args.exports))
+            return max(_verdict_exit(kept), _criteria_exit(profile, args.exports))  # no rig while the criteria are kept
     from rigcad.parts import PARTS
     from rigcad.rig import Rig
 
@@ -44,8 +42,9 @@ def cmd_stl(args: argparse.Namespace) -> int:
 
 
 def _criteria_exit(rig, exports) -> int:
-    """1 when the rig fails the ray check's criteria (rigcad.cli.check.criteria_refusal: its lines,
-    the parts written for inspection only), else 0 with a note of what was not judged."""
+    """1 when the rig (a Rig, or a loaded Profile: rigcad.cli.check.criteria_refusal) fails the ray
+    check's criteria (its lines, the parts written for inspection only), else 0 with a note of what
+    was not judged."""
     from rigcad.cli.check import criteria_notes, criteria_refusal
 
     verdict = criteria_refusal(rig, exports, "stl", written=True)

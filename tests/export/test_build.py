@@ -117,7 +117,7 @@ def test_clean_rebuild_is_byte_identical(built, tmp_path):
     # a fresh rig in this process; the shared tree was built by `rigcad stl` in whichever worker ran first
     build_rig(Rig.from_profile(rig.profile), tmp_path / "again", **_stl_inputs(rig))
     for path in out.rglob("*"):
-        if path.is_file() and path.name != "assembly.json":  # the gate's verdict: `rigcad stl` writes it, not the build
+        if path.is_file() and path.name not in ("assembly.json", "criteria.json"):  # the gate's verdict, the criteria: `rigcad stl` keeps them, not the build
             twin = tmp_path / "again" / path.relative_to(out)
             assert twin.read_bytes() == path.read_bytes(), path.relative_to(out)
 
