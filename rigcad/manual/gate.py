@@ -77,6 +77,8 @@ class Verdict:
     #: Where the check's whole reason is kept (the verdict's file, once written); None: nowhere, and
     #: the line points to no file.
     kept: str | None = None
+    #: The direction each step of ``order`` goes in along (unit, rig frame), as the check placed it.
+    directions: tuple[tuple[float, float, float], ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -99,7 +101,7 @@ class Verdict:
 
     def as_json(self) -> dict:
         """The verdict as the writers store it (assembly.json; units in the keys)."""
-        return {"ok": self.ok, "order": list(self.order), "step": self.step, "members": list(self.members),
+        return {"ok": self.ok, "order": list(self.order), "directions": [list(d) for d in self.directions], "step": self.step, "members": list(self.members),
                 "obstacles": list(self.obstacles), "reason": self.reason, "summary": self.summary, "keys": list(self.keys),
                 "fixes": [{"key": f.key, "where": f.where, "now_mm": f.now, "value_mm": f.value} for f in self.fixes],
                 "line": self.line()}
@@ -122,7 +124,7 @@ def verdict(rig, meshes=None, search: bool = True, progress=None) -> Verdict:
         order = _order(rig, meshes)
     except AssemblyError as err:
         return refused(rig, err, search, progress)
-    return Verdict(rig.name, order=tuple(p.step.name for p in order))
+    return Verdict(rig.name, order=tuple(p.step.name for p in order), directions=tuple(p.direction for p in order))
 
 
 def refused(rig, err: AssemblyError, search: bool = True, progress=None) -> Verdict:
@@ -336,7 +338,8 @@ def _from_json(data: dict, name: str) -> Verdict:
                       None if f["value_mm"] is None else float(f["value_mm"])) for f in data["fixes"])
     return Verdict(name, order=tuple(map(str, data["order"])), step=data["step"], members=tuple(map(str, data["members"])),
                    obstacles=tuple(map(str, data["obstacles"])), reason=str(data["reason"]),
-                   keys=tuple(map(str, data["keys"])), fixes=fixes, summary=str(data.get("summary", "")))
+                   keys=tuple(map(str, data["keys"])), fixes=fixes, summary=str(data.get("summary", "")),
+                   directions=tuple(tuple(float(v) for v in d) for d in data.get("directions", ())))
 
 
 def read_verdict(root, profile) -> Verdict | None:
@@ -364,12 +367,52 @@ def checked(rig, root, progress=None) -> Verdict:
 
     kept = read_verdict(root, rig.profile)
     if kept is not None:
+        _remember(rig, kept)
         return kept
     found = verdict(rig, progress=progress)
+    _remember(rig, found)
     path = verdict_path(root, rig.name)
     path.parent.mkdir(parents=True, exist_ok=True)
     write_json(path, {"inputs_key": inputs_key(rig.profile), **found.as_json()})
     return dataclasses.replace(found, kept=f"{VERDICT_FILE} beside the export")  # written: the line may point to it
+
+
+#: The orders (names, directions) the gate found or read back in this process, by the resolved
+#: profile of a rig as designed (the last few: a watch or an optimize run judges many): what
+#: :func:`order` hands on.
+_ORDERS: dict[str, tuple[tuple, tuple]] = {}
+ORDERS_KEPT = 8
+
+
+def _remember(rig, v: Verdict) -> None:
+    from rigcad.export.manifest import profile_digest
+    from rigcad.optics.frames import Misalignment
+
+    if v.ok and v.order and len(v.directions) == len(v.order) and rig.misalignment == Misalignment.none():
+        key = profile_digest(rig.profile)
+        _ORDERS.pop(key, None)
+        _ORDERS[key] = (v.order, v.directions)
+        while len(_ORDERS) > ORDERS_KEPT:
+            _ORDERS.pop(next(iter(_ORDERS)))
+
+
+def order(rig, assembly):
+    """The assembly check's order of ``assembly`` (rigcad.manual.plan.assembly of ``rig`` as designed,
+    as the gate checks it; a list of assembly_check.Placed). When the gate judged ``rig``'s profile in
+    this process (:func:`checked`: its verdict found, or read back from the file its key keeps, made by
+    this code from this profile, so from this very assembly), the verdict's steps and directions, with
+    no search and no sweep: the search's own Placed, to the bits. Else, or when the verdict's steps
+    or directions are not the assembly's (another assembly), the search (assembly_check.find_order)."""
+    from rigcad.export.manifest import profile_digest
+    from rigcad.manual import assembly_check
+    from rigcad.optics.frames import Misalignment
+
+    known = _ORDERS.get(profile_digest(rig.profile)) if rig.misalignment == Misalignment.none() else None
+    if known is not None and sorted(known[0]) == sorted(s.name for s in assembly.steps):
+        steps = [assembly.by_name[name] for name in known[0]]
+        if all(any(tuple(float(v) for v in d) == way for d in st.directions) for st, way in zip(steps, known[1])):
+            return [assembly_check.Placed(st, way) for st, way in zip(steps, known[1])]
+    return assembly_check.find_order(assembly)
 
 
 def kept_gate(root, profile) -> bool:
@@ -394,4 +437,4 @@ def gate(rig, root, progress=None) -> Verdict:
 
 
 __all__ = ["EarlyRefusal", "Fix", "VERDICT_FILE", "Verdict", "candidate_keys", "checked", "early_refusals", "gate", "kept_gate",
-           "nearest_values", "read_verdict", "refused", "verdict", "verdict_path"]
+           "nearest_values", "order", "read_verdict", "refused", "verdict", "verdict_path"]
