@@ -720,7 +720,7 @@ def assembly_order(rig, steps, solids):
     from rigcad.manual import assembly_check, gate
 
     try:
-        return gate.order(rig, assembly_check.Assembly(solids, steps))  # the gate's order replayed, when it judged the rig
+        return gate.order(rig, assembly_check.Assembly(solids, steps))  # the gate's order handed on when it judged the rig
     except AssemblyError as err:
         v = gate.refused(rig, err, search=False)
         raise AssemblyError(v.line(), step=v.step, members=v.members, obstacles=v.obstacles) from err
