@@ -1,10 +1,12 @@
 """The camera's lens as a bill line, when the profile names no lens file: the lens rigcad's camera
 model stands for (rigcad.optics.camera: its focal length in pixels) turned into one to buy, in mm.
 
-Its focal length in mm is f_px x the sensor's pixel pitch (``camera.pixel_pitch``; when the profile
-does not give it, the pitch of a 1/2-inch sensor across the camera's width, :data:`ASSUMED_SENSOR_WIDTH`,
-and the line says so), rounded to the nearest catalogue lens among rigcad's shipped C-mount lens
-files whose paraboloid image stays on the sensor. The line also states the image circle the lens
+The lens aimed at is the one the check and ``design`` recommend: the focal length whose paraboloid
+image spans DEFAULT_FILL of the sensor's short side (rigcad.optics.camera.CameraModel.focal_for_fill, in
+pixels), in mm: times the sensor's pixel pitch (``camera.pixel_pitch``; when the profile does not give
+it, the pitch of a 1/2-inch sensor across the camera's width, :data:`ASSUMED_SENSOR_WIDTH`, and the line
+says so), rounded to the nearest catalogue lens among rigcad's shipped C-mount lens files whose
+paraboloid image stays on the sensor. The line also states the image circle the lens
 must cover (the sensor's diagonal) and the distance it must focus at (the camera's working distance,
 its front to the paraboloid's vertex). A profile that names a lens file (``camera.lens``) already has
 its line (rigcad.manual.bom.purchased): no line here. Kernel-free; mm.
@@ -32,7 +34,7 @@ def catalogue() -> list[tuple[float, str]]:
 def camera_lens(rig) -> dict | None:
     """The lens to buy (figures with units in the keys), or None when the profile names a lens file
     (its line is the bill's already) or the COP is at infinity (no camera image)."""
-    from rigcad.optics.camera import camera_model
+    from rigcad.optics.camera import DEFAULT_FILL, camera_model
 
     p = rig.profile
     if p.instrument("camera", "lens") is not None or rig.geometry.cop_at_infinity:
@@ -41,12 +43,16 @@ def camera_lens(rig) -> dict | None:
     w, h = cam.resolution
     pitch, assumed = (cam.pixel_pitch, False) if cam.pixel_pitch else (ASSUMED_SENSOR_WIDTH / w, True)
     f_mm = cam.focal_length if cam.focal_length is not None else cam.focal_px * pitch
+    fill_px, _ = cam.focal_for_fill(DEFAULT_FILL)
+    fill_mm = fill_px * pitch
     on_sensor = [(f, n) for f, n in catalogue() if cam.image_radius_px * f / f_mm <= cam.room_px]
     if not on_sensor:
         return None
-    f_buy, name = min(on_sensor, key=lambda fn: (abs(fn[0] - f_mm), fn[0]))
+    f_buy, name = min(on_sensor, key=lambda fn: (abs(fn[0] - fill_mm), fn[0]))
     return {"focal_length_px": cam.focal_px, "focal_from": cam.focal_from, "pixel_pitch_mm": pitch,
-            "pixel_pitch_assumed": assumed, "focal_length_mm": f_mm, "buy_focal_length_mm": f_buy, "lens_file": name,
+            "pixel_pitch_assumed": assumed, "focal_length_mm": f_mm, "fill": DEFAULT_FILL,
+            "fill_focal_length_px": fill_px, "fill_focal_length_mm": fill_mm, "buy_focal_length_mm": f_buy,
+            "lens_file": name, "buy_fill": cam.fill * f_buy / f_mm,
             "image_radius_px": cam.image_radius_px * f_buy / f_mm, "room_px": cam.room_px,
             "image_circle_mm": pitch * math.hypot(w, h), "working_distance_mm": cam.working_distance,
             "resolution_px": [w, h]}
@@ -64,13 +70,15 @@ def bill_row(rig) -> dict | None:
     spec = (f"**{lens['buy_focal_length_mm']:g} mm focal length, C-mount** (the camera's lens mount), for an image circle "
             f"of at least {lens['image_circle_mm']:.1f} mm (the sensor's diagonal: a lens rated for that format or "
             f"larger), focusing at {lens['working_distance_mm']:.0f} mm (the working distance, its front to the "
-            f"paraboloid's vertex: its closest focus no farther). From the camera model's "
-            f"{lens['focal_length_px']:.0f} px ({lens['focal_from']}) x {pitch} = {lens['focal_length_mm']:.1f} mm: "
-            f"the nearest catalogue lens whose paraboloid image ({lens['image_radius_px']:.0f} px radius) stays on the "
-            f"sensor ({lens['room_px']:.0f} px to its nearest edge). Name it in the profile (`camera.lens: "
+            f"paraboloid's vertex: its closest focus no farther). The lens whose paraboloid image spans "
+            f"{lens['fill']:.0%} of the sensor's short side (as `rigcad check` and `rigcad design` recommend) is "
+            f"{lens['fill_focal_length_px']:.0f} px x {pitch} = {lens['fill_focal_length_mm']:.1f} mm: the nearest "
+            f"catalogue lens whose paraboloid image ({lens['image_radius_px']:.0f} px radius, "
+            f"{lens['buy_fill']:.0%} of the short side) stays on the sensor ({lens['room_px']:.0f} px to its nearest "
+            f"edge). Name it in the profile (`camera.lens: "
             f"{lens['lens_file']}`" + (", with `camera.pixel_pitch`" if lens["pixel_pitch_assumed"] else "")
-            + f") and build again: until then the manual's camera pixel figures are the "
-            f"{lens['focal_length_px']:.0f} px lens's")
+            + f") and build again: until then the manual's camera pixel figures are the camera model's "
+            f"{lens['focal_length_px']:.0f} px lens's ({lens['focal_from']}, {lens['focal_length_mm']:.1f} mm)")
     return {"item": f"camera lens: C-mount, {lens['buy_focal_length_mm']:g} mm focal length", "quantity": 1,
             "spec": spec, "source": "camera.lens (none: rigcad.optics.camera)"}
 

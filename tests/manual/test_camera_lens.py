@@ -1,7 +1,8 @@
 """The camera's lens in the bill (rigcad.manual.camera_lens): a profile that knows its lens only in
-pixels (the thesis's, f = 2389 px) gets a lens to buy in mm, from the pixel pitch (given, or assumed and
-said so), with its mount, image circle and working distance; a profile that names a lens file keeps
-that file's line and gets no second one."""
+pixels (the thesis's, f = 2389 px) gets a lens to buy in mm: the catalogue lens nearest the one whose
+paraboloid image spans 90 % of the sensor's short side (what `check` and `design` recommend), from the
+pixel pitch (given, or assumed and said so), with its mount, image circle and working distance; a
+profile that names a lens file keeps that file's line and gets no second one."""
 
 from __future__ import annotations
 
@@ -36,26 +37,36 @@ def test_the_thesis_camera_gets_a_lens_in_mm_from_an_assumed_pitch(table31_rig):
     assert lens["pixel_pitch_assumed"] and lens["pixel_pitch_mm"] == pytest.approx(pitch, rel=1e-12)
     f_mm = cam.focal_px * pitch  # 2389 px x 4.71 um = 11.2 mm
     assert lens["focal_length_mm"] == pytest.approx(f_mm, rel=1e-12) and 11.0 < f_mm < 11.5
-    nearest = min(CATALOGUE_MM, key=lambda f: abs(f - f_mm))
-    assert lens["buy_focal_length_mm"] == nearest == 12.0
+    # the paraboloid's image radius is linear in f: 90 % of the short side (1024 px) over its fill at 2389 px
+    fill = cam.image_radius_px / 512.0
+    f_fill = f_mm * 0.9 / fill  # 11.2 mm x 0.9 / 0.261 = 38.7 mm
+    assert lens["fill_focal_length_mm"] == pytest.approx(f_fill, rel=1e-12) and 38.0 < f_fill < 39.5
+    on_sensor = [f for f in CATALOGUE_MM if cam.image_radius_px * f / f_mm <= 512.0]
+    nearest = min(on_sensor, key=lambda f: abs(f - f_fill))
+    assert lens["buy_focal_length_mm"] == nearest == 25.0
+    assert lens["buy_fill"] == pytest.approx(fill * 25.0 / f_mm, rel=1e-12)  # 58 % of the short side
     # the image circle is the sensor's diagonal; the working distance the camera model's (COP to vertex less pupil)
     assert lens["image_circle_mm"] == pytest.approx(pitch * math.hypot(1360, 1024), rel=1e-12)
     p = table31_rig.profile
     assert lens["working_distance_mm"] == pytest.approx(p.layout.cop_to_vertex - p.camera.pupil_depth, rel=1e-12)
     # the line says what to buy, and which figure is assumed, and which key sets it
     row = L.bill_row(table31_rig)
-    assert row["item"] == "camera lens: C-mount, 12 mm focal length"
-    for words in ("**12 mm focal length, C-mount**", "image circle of at least 8.0 mm", "focusing at 255 mm",
-                  "**assumed**", "`camera.pixel_pitch`", "`camera.lens: c_mount_12mm`", "= 11.2 mm"):
+    assert row["item"] == "camera lens: C-mount, 25 mm focal length"
+    for words in ("**25 mm focal length, C-mount**", "image circle of at least 8.0 mm", "focusing at 255 mm",
+                  "**assumed**", "`camera.pixel_pitch`", "`camera.lens: c_mount_25mm`", "= 38.7 mm", "90%",
+                  "58% of the short side", "2389 px lens's (derived, 11.2 mm)"):
         assert words in row["spec"], (words, row["spec"])
 
 
 def test_the_line_follows_the_given_pitch(write_profile, table31_text):
     rig = _rig(write_profile, table31_text, "camera:\n  pixel_pitch: 3.45 um\n")
     lens = L.camera_lens(rig)
-    f_mm = camera_model(rig.profile, rig.geometry).focal_px * 3.45e-3  # 8.24 mm
+    cam = camera_model(rig.profile, rig.geometry)
+    f_mm = cam.focal_px * 3.45e-3  # 8.24 mm
     assert not lens["pixel_pitch_assumed"] and lens["focal_length_mm"] == pytest.approx(f_mm, rel=1e-12)
-    assert lens["buy_focal_length_mm"] == 8.0
+    # 90 % of the short side: 8.24 mm x 0.9 / 0.261 = 28.4 mm; 25 mm is the nearest catalogue lens on the sensor
+    assert lens["fill_focal_length_mm"] == pytest.approx(f_mm * 0.9 / cam.fill, rel=1e-12)
+    assert lens["buy_focal_length_mm"] == 25.0
     assert "assumed" not in L.bill_row(rig)["spec"]
 
 
@@ -70,7 +81,7 @@ def test_a_named_lens_file_keeps_its_own_line_and_gets_no_second(write_profile, 
 def test_the_bill_of_the_thesis_rig_has_its_lens_after_the_camera(table31_rig):
     rows = L.with_camera_lens(table31_rig, B.purchased(table31_rig))
     items = [r["item"] for r in rows]
-    lens = items.index("camera lens: C-mount, 12 mm focal length")
+    lens = items.index("camera lens: C-mount, 25 mm focal length")
     assert items[lens - 1].startswith("camera"), items
     # planted back: without the lens line the bill names no camera lens
     assert not any(i.startswith("camera lens") for i in items[:lens] + items[lens + 1:])
