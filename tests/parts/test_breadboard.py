@@ -76,8 +76,11 @@ def test_the_holes_take_the_print_and_the_board_errors(rigs):
     assert datum_chain(rig.profile, rig.layout).describe()["mount"]["board_hole_position_mm"] == 0.15
     rows = {r["claim"]: r for r in check_datum_chain(rig.profile, rig.layout)}
     assert rows["breadboard_holes_take_the_grid"]["ok"]
+    # through the 1.6 mm washer and the tongue, 17 mm deep since the bench lies 2 mm under the
+    # sample holder's collar: 30 mm engages 11.4 mm (at most 12), 35 mm would engage 16.4
+    assert rig.layout.tower.bench_z == pytest.approx(-17.0)
     L, name, engaged = breadboard.screw_length(rig.profile, rig.layout)
-    assert (L, name) == (25.0, "25 mm") and engaged == pytest.approx(25.0 - 1.6 - 15.0)
+    assert (L, name) == (30.0, "30 mm") and engaged == pytest.approx(30.0 - 1.6 - 17.0)
 
 
 @pytest.mark.parametrize("mount", list(PITCH))
@@ -110,7 +113,7 @@ def test_a_lid_over_a_breadboard_screw_is_refused(rigs):
 
     lidded = dataclasses.replace(step, members=(*step.members, "lid"))
     b = AC.Assembly({**a.solids, "lid": lid}, [lidded if s.name == "base_plate" else s for s in a.steps])
-    with pytest.raises(Exception, match=r"base_plate.*M6 x 25 mm socket-head.*blocked by lid"):
+    with pytest.raises(Exception, match=r"base_plate.*M6 x 30 mm socket-head.*blocked by lid"):
         AC.check_order(b, ["sample_holder", "base_plate"])
 
 
