@@ -156,7 +156,10 @@ def test_the_bought_extrusions_core_screws_are_checked_and_a_blocked_one_is_refu
     col = a.by_name["tower_column"]
     flat = dataclasses.replace(col, fasteners=(dataclasses.replace(foot, lift_mm=0.0),))
     c = AC.Assembly(a.solids, [flat if s.name == "tower_column" else s for s in a.steps])
-    with pytest.raises(GeometryError, match=r"tower_column.*M8 x 20 mm socket-head.*blocked by the bench"):
+    # M8 x 25: the tongue is 17 mm deep (the bench 2 mm under the collar), 7 mm under the counterbore
+    # and pocket, so 25 mm engages 18 mm, 1 mm short of the 20 mm tapped core
+    assert foot.length_mm == 25.0 and engaged_foot == pytest.approx(18.0)
+    with pytest.raises(GeometryError, match=r"tower_column.*M8 x 25 mm socket-head.*blocked by the bench"):
         AC.check_order(c, order)
 
 
