@@ -400,15 +400,28 @@ def template_making(profile, templates: list[dict]) -> list[dict]:
     return out
 
 
+def _uncheckable(row: dict) -> str:
+    """What the manual says of a template whose comparator accuracy over its span is more than its edge
+    tolerance: check it in sections short enough, or, when even a zero-length section's (COMPARATOR_UM's
+    constant term) is more, that no comparator of that class can check it."""
+    if row["checkable"]:
+        return ""
+    section = (row["edge_tolerance_mm"] * 1e3 - COMPARATOR_UM[0]) / COMPARATOR_UM[1]
+    if section < 1.0:
+        return (f" (**more than its {row['edge_tolerance_mm'] * 1e3:.1f} um edge tolerance, which is under the "
+                f"comparator's own {COMPARATOR_UM[0]:g} um: no comparator of this class can check it; a coordinate "
+                "measuring machine, or wider gaps (thicker coats in `coating.layers`)**)")
+    return (f" (**more than its edge tolerance: check it in sections of at most {section:.0f} mm of stage travel, "
+            "re-zeroed on the drawing between them**)")
+
+
 def template_making_text(rows: list[dict]) -> str:
     """The manual's paragraph on making the templates, from :func:`template_making`'s rows."""
     if not rows:
         return ""
     r0 = rows[0]
     each = "; ".join(f"`{r['template']}` {r['span_mm']:.0f} mm across: {r['comparator_accuracy_mm']:.4f} mm"
-                     + ("" if r["checkable"] else " (**more than its edge tolerance: check it in sections of at most "
-                        f"{(r['edge_tolerance_mm'] * 1e3 - COMPARATOR_UM[0]) / COMPARATOR_UM[1]:.0f} mm of stage travel, "
-                        "re-zeroed on the drawing between them**)") for r in rows)
+                     + _uncheckable(r) for r in rows)
     gaps = ", ".join("flush" if g <= 1e-9 else f"{g:.3f} mm" for g in r0["gaps_mm"])
     return (f"**The templates' material and accuracy.** Each template is {r0['material']}, {r0['thickness_mm']:g} mm "
             f"(`templates.thickness`), laser or waterjet cut from its `outlines/<template>.dxf` with the cutter's path "
@@ -418,7 +431,8 @@ def template_making_text(rows: list[dict]) -> str:
             f"measuring stage, 20x), point by point against the drawing's coordinates, and the datum marked as its "
             f"drawing shows it. The gaps it must show are {gaps}: its edge must lie within "
             f"**{r0['edge_tolerance_mm']:.4f} mm** of the outline ({EDGE_SHARE:g} of the smallest gap, "
-            f"{r0['smallest_gap_mm']:.3f} mm), and the comparator's stage reads to (3 + L/50) um over L (a typical "
+            f"{r0['smallest_gap_mm']:.3f} mm), and the comparator's stage reads to ({COMPARATOR_UM[0]:g} + "
+            f"L/{1 / COMPARATOR_UM[1]:g}) um over L (a typical "
             f"maker's figure for a measuring projector's stage: your comparator's calibration certificate wins): {each}. "
             "A laser-cut edge unfinished, or one checked against a paper print (a printer places a line to about "
             "0.1 mm), cannot show these gaps.")

@@ -46,3 +46,21 @@ def test_a_template_too_large_for_the_comparator_is_checked_in_sections(rig):
     assert f"sections of at most {travel:.0f} mm" in text, text
     shipped = F.template_making_text(F.template_making(rig.profile, F.template_datums(rig)))
     assert "sections of" not in shipped and "stainless" in shipped and "0.0095 mm" in shipped, shipped
+
+
+def test_a_tolerance_under_the_comparators_own_figure_is_said_to_be_uncheckable_not_given_a_negative_section():
+    """A template's edge tolerance under the comparator's constant term (3 um) leaves no section short enough:
+    the paragraph says so and names a way out, instead of 'sections of at most -N mm'; a tolerance over it gets
+    the section length (tolerance - 3 um) x 50; the stated accuracy formula is the constant's."""
+    from rigcad.manual import finishing as F
+
+    base = {"template": "t", "material": F.TEMPLATE_MATERIAL, "thickness_mm": 1.0, "cut_edge_mm": F.CUT_EDGE_MM,
+            "gaps_mm": [0.002], "smallest_gap_mm": 0.002, "span_mm": 300.0}
+    tight = {**base, "edge_tolerance_mm": 0.0025, "comparator_accuracy_mm": 0.009, "checkable": False}
+    text = F.template_making_text([tight])
+    assert "sections of at most" not in text and "no comparator of this class can check it" in text
+    assert "`coating.layers`" in text
+    loose = {**base, "edge_tolerance_mm": 0.005, "comparator_accuracy_mm": 0.009, "checkable": False}
+    assert "sections of at most 100 mm" in F.template_making_text([loose])  # (5 - 3) um x 50
+    a, b = F.COMPARATOR_UM
+    assert f"({a:g} + L/{1 / b:g}) um over L" in text
