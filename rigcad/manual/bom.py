@@ -487,6 +487,9 @@ CONSUMABLES = (
     ("Packing tape, polypropylene, 48 mm, 1 roll: over the base plate under the dome's seams while they are glued",
      "1"),
 )
+#: The glue faces' lapping straightedge (mm), in TOOLS; a template read against a straightedge of that
+#: length uses the same one (:func:`template_straightedge`).
+LAPPING_STRAIGHTEDGE_MM = 300.0
 #: Tools with an orderable spec.
 TOOLS = (
     ("Digital caliper 150 mm, 0.01 mm (DIN 862)", "1"),
@@ -502,7 +505,8 @@ TOOLS = (
     ("Sanding blocks: flat rubber block and blocks curved to the mirrors' radii (section 3)", "see section 3"),
     ("Tin snips, straight cut, and scissors (the shim stock and the shim foil)", "1 each"),
     ("Files: a 150 mm flat file (cut 2) and a needle file set, flat and round (slots, deburring)", "1 set"),
-    ("Float glass plate 300 x 300 x 6 mm and a steel straightedge 300 mm (DIN 874, grade 1), for lapping glue "
+    (f"Float glass plate 300 x 300 x 6 mm and a steel straightedge {LAPPING_STRAIGHTEDGE_MM:g} mm (DIN 874, grade 1), "
+     "for lapping glue "
      "faces flat", "1 each"),
     ("Drill press with a depth stop and a vise for it: the dowels' blind holes are drilled and machine-reamed "
      "in the drill press at low speed (a machine reamer's short lead sizes a blind hole; a hand reamer's long taper cannot); "
@@ -588,6 +592,24 @@ def register_tools(rig) -> list[tuple[str, str]]:
     return out
 
 
+def template_straightedge(rig) -> tuple[str, str] | None:
+    """The steel straightedge the templates whose datum is the base's corner are read against
+    (rigcad.manual.finishing.straightedge: the longest such template's, laid across the part's base), or None
+    when no template needs one."""
+    from rigcad.manual import finishing as F
+
+    rows = [r for r in F.template_datums(rig) if r["datum"] not in ("rim", "edge")]
+    if not rows:
+        return None
+    rule, reach = F.straightedge(max(rows, key=lambda r: r["datum_r_mm"]))
+    names = ", ".join(f"`{r['template']}`" for r in rows)
+    if rule == LAPPING_STRAIGHTEDGE_MM:
+        return (f"The lapping straightedge ({rule:g} mm, above) also reads the datum of {names}, laid across the "
+                "base", "(same)")
+    size = f"{rule:g} mm" if rule else f"at least {reach:.0f} mm long (longer than DIN 874's lengths: a ground flat bar)"
+    return (f"Steel straightedge {size} (DIN 874, grade 1), laid across the base to read the datum of {names}", "1")
+
+
 def set_screw_keys(hardware_rows: list[dict]) -> tuple[str, str] | None:
     """The hex keys the bill's set screws take (rigcad.standards.SET_SCREW_KEY, by each row's thread)."""
     from rigcad.standards import SET_SCREW_KEY
@@ -598,7 +620,7 @@ def set_screw_keys(hardware_rows: list[dict]) -> tuple[str, str] | None:
 
 
 __all__ += ["CONSUMABLES", "TOOLS", "TOOL_WORDS", "dowel_drills", "feeler_gauge", "glue_rows", "register_tools",
-            "set_screw_keys"]
+            "set_screw_keys", "template_straightedge"]
 
 
 # -- washers and nuts, from the washer stacks -----------------------------------------------------

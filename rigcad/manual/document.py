@@ -499,11 +499,11 @@ def _bill_consumables(d: Doc, c) -> None:
                               for r in (*B.CONSUMABLES, *F.paint_companions(c.bill["coating"]),
                                         *B.glue_rows(c.fab_report))])
     d.h(3, "Tools")
-    keys = B.set_screw_keys(c.bill["hardware"])
+    keys, rule = B.set_screw_keys(c.bill["hardware"]), B.template_straightedge(c.rig)
     d.table(["item", "qty"], [list(_blocks(c.rig) if r[0].startswith("Sanding blocks") else r)
                               for r in (*B.TOOLS, B.feeler_gauge([total - gauged_depth(c.p), *gaps]),
                                         B.dowel_drills(c.fab_report, c.rig), *B.register_tools(c.rig),
-                                        *([keys] if keys else []))])
+                                        *([keys] if keys else []), *([rule] if rule else []))])
 
 
 def _section_schedule(d: Doc, c) -> None:
@@ -1599,7 +1599,7 @@ def _camera_crosses_step(d: Doc, c, cam: dict) -> None:
         "kept with it (in their places: they hold its setting). "
         f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
         f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm), the `camera_cross_base` in the sample holder's place in the bore "
-        "(its top on z = 0; it stays there from the film's steps). Set the dome back on its pins and screw it down to its torque before you look: the cross "
+        "(its top on z = 0; it stays there from the earlier steps). Set the dome back on its pins and screw it down to its torque before you look: the cross "
         "hangs where the paraboloid's vertex is only with the dome on its register. "
         f"From the COP (z = {cam['cop_z_mm']:.1f} mm) the hung cross's arms span "
         f"{cam['hung_cross_arm_mrad']:.1f} mrad and the base cross's {cam['base_cross_arm_mrad']:.1f} mrad. Move the "

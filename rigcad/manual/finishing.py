@@ -286,6 +286,14 @@ STRAIGHTEDGES_MM = (300.0, 500.0, 750.0, 1000.0)
 STRAIGHTEDGE_OVERHANG_MM = 10.0
 
 
+def straightedge(row: dict) -> tuple[float | None, float]:
+    """The straightedge a "corner" template's datum is read from (:func:`template_datums`' row): laid across
+    the part's base, standing STRAIGHTEDGE_OVERHANG_MM past it on each side: (the shortest length sold,
+    STRAIGHTEDGES_MM, or None when none reaches; the reach, mm)."""
+    reach = 2 * row["datum_r_mm"] + 2 * STRAIGHTEDGE_OVERHANG_MM
+    return next((n for n in STRAIGHTEDGES_MM if n >= reach), None), reach
+
+
 def template_text(row: dict) -> str:
     """How a template is held, from its datum (:func:`template_datums`)."""
     name = row["template"].replace("_template", "")
@@ -302,8 +310,7 @@ def template_text(row: dict) -> str:
                 f"z = {row['datum_z_mm']:.1f} mm (red in its drawing), with the axis line at its middle (dashed: scribe "
                 f"it on the template). Hold the template in a meridional plane over the {name}, the datum edge level (the "
                 "spirit level on it) and its axis line over the vertex: the cut-out then lies on the gauged surface.")
-    reach = 2 * row["datum_r_mm"] + 2 * STRAIGHTEDGE_OVERHANG_MM
-    rule = next((n for n in STRAIGHTEDGES_MM if n >= reach), None)
+    rule, reach = straightedge(row)
     rule_text = f"a {rule:g} mm steel straightedge" if rule else f"a steel straightedge at least {reach:.0f} mm long"
     return (f"`{row['template']}`: the datum is the lower corner of its curved edge (red in its drawing), "
             f"{row['datum_r_mm']:.1f} mm from the axis at z = {row['datum_z_mm']:.1f} mm: the plane of the {name}'s "
