@@ -483,15 +483,7 @@ def _section_bill(d: Doc, c) -> None:
 
 
 def _bill_consumables(d: Doc, c) -> None:
-    """The consumables and tools lists, the feeler leaves from the template gaps."""
-    from rigcad.parts.templates import gauged_depth
-
-    total = float(sum(t for _, t in c.p.coating.layers))
-    gap, gaps = total - gauged_depth(c.p), []
-    for _, t in c.p.coating.layers:
-        gap -= t
-        if gap > 1e-9:
-            gaps.append(gap)
+    """The consumables and tools lists, the feeler leaves from the template gaps (finishing.template_gaps)."""
     from rigcad.manual import finishing as F
 
     d.h(3, "Consumables")
@@ -501,7 +493,7 @@ def _bill_consumables(d: Doc, c) -> None:
     d.h(3, "Tools")
     keys, rule = B.set_screw_keys(c.bill["hardware"]), B.template_straightedge(c.rig)
     d.table(["item", "qty"], [list(_blocks(c.rig) if r[0].startswith("Sanding blocks") else r)
-                              for r in (*B.TOOLS, B.feeler_gauge([total - gauged_depth(c.p), *gaps]),
+                              for r in (*B.TOOLS, B.feeler_gauge(F.template_gaps(c.p)),
                                         B.dowel_drills(c.fab_report, c.rig), *B.register_tools(c.rig),
                                         *([keys] if keys else []), *([rule] if rule else []))])
 
