@@ -201,7 +201,7 @@ def record_circle(rig, info: dict) -> str:
             f"image is drawn for them. Write them into `exports/{rig.name}/{CIRCLE_JSON}` as "
             f"`{{\"centre_px_from_top_left\": [CX, CY], \"radius_px\": R, \"resolution_px\": [{w}, {h}]}}` (or give "
             f"them as `--circle CX CY R` to each command): `rigcad basis {rig.name}` draws the basis images and "
-            f"`rigcad calibrate {rig.name} --gray-card-kit` the gray card's for that circle, and each prints which "
+            f"`rigcad calibrate {rig.name} --gray-card-kit` the reflectance step's for that circle, and each prints which "
             "circle it used (the design's when it found none).")
 
 def gray_card_placement(rig, card: dict) -> str:
@@ -220,7 +220,7 @@ def gray_card_placement(rig, card: dict) -> str:
             f"O's height, to the thinnest foil's {card['foil_mm'][0]:g} mm. A card thicker than that pocket cannot "
             "reach O: use a thinner one. "
             f"**Set it the first time with the dome off**, the one way to reach the plate's top: take out the dome's "
-            f"{bolts} flange screws and lift it off its register pins (as for the checkerboard), the sample holder in "
+            f"{bolts} flange screws and lift it off its register pins (as in the step before), the sample holder in "
             "its bore, its collar home. Lay the foil and the card on the holder's top from above and check with the "
             "steel straightedge across the bore, on the plate's top either side: a "
             f"{card['feeler_mm']:g} mm feeler leaf passes under it neither over the plate nor over the card (add or "
@@ -477,7 +477,7 @@ def camera_focus_and_lock(rig, printer) -> str:
     n, thread, torque = instrument_torques(rig, printer)["camera"]
     return (f"**Focus the camera** on the hung cross, once (thesis 4.1): it stands at the paraboloid's vertex, "
             f"{vertex:.0f} mm from the COP (the rim {rim:.0f} mm), and the camera's pixels are read as points of the "
-            "paraboloid (the checkerboard's correspondence, next). Stop the lens down until the cross's arms stay "
+            "paraboloid (the next step's correspondence). Stop the lens down until the cross's arms stay "
             "sharp out to their ends. Then tape the focus ring and leave it for the rest of the calibration and every "
             "measurement: refocusing moves the lens's entrance pupil, the camera's COP, and changes its focal length "
             "in pixels, which the correspondence and `rigcad calibrate`'s fit both hold. "
@@ -596,7 +596,7 @@ def kit_items(rig) -> list[KitItem]:
                 f"{1e3 * f['film_thickness_mm']:g} µm thick; a disc of {f['film_diameter_mm']:.0f} mm is cut from it",
                 ("drafting film", "film"), (*seat, STEP_CIRCLE, STEP_FILM, STEP_ACCEPTANCE)),
         KitItem("Low-tack masking tape, 19 mm", "1 roll", "paper, low tack (it comes off the plate clean)",
-                ("tape",), (STEP_FILM, STEP_ACCEPTANCE)),
+                ("tape",), (STEP_CROSSES, STEP_FILM, STEP_CAMERA, STEP_ACCEPTANCE)),  # the focus rings too
         KitItem("Fine pen for film", "1", "permanent fineliner, 0.1-0.3 mm line, that marks polyester",
                 ("fine pen",), (STEP_FILM,)),
         KitItem("Blocks to lift the rig", "3",
