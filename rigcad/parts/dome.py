@@ -247,8 +247,10 @@ def beam_seats(profile: Profile, layout: RigLayout) -> BeamSeats:
     y_lo, y_hi = -max(w, half_bar + c) - shell.wall, max(y_side, half_bar + c + shell.wall)
     floor, roof = z0 - bar.thickness - p, z1 + p + c
     top = seat_top(profile, z1)
-    u = layout.as_printed_dome.sample(4001)
-    pts = layout.as_printed_dome.points(u)
+    # the surface as designed, not as stocked: the seats are datums and keep their place whatever
+    # sanding stock the printer asks for (the stock only brings the mirror forward)
+    u = layout.printed_dome.sample(4001)
+    pts = layout.printed_dome.points(u)
     band = (pts[:, 1] >= shell.flange_thickness) & (pts[:, 1] <= top)
     x_in = float(pts[band, 0].max()) + 1.0  # a millimetre outside the mirror wherever the block stands
     # within the flange's rim where it leaves room (the footprint does not grow), else past it, on the plate
