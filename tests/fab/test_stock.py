@@ -94,9 +94,13 @@ def test_the_fab_mirrors_lie_the_stock_in_front_of_the_sanded_surface(prusa_run,
             c = p.reshape(-1, 3, 3)[on].mean(axis=1)
             dc = sanded.distance(np.column_stack([np.hypot(c[:, 0], c[:, 1]), c[:, 2]]))
             assert np.abs(dc - stock).max() <= chord, (pc["name"], np.abs(dc - stock).max())
-        # those faces are the whole mirror: the report's area (before the stock; the stock's own
-        # change of area is stock x curvature ~ 1e-3 relative), within 1 %
-        assert abs(area - st["mirror_area_without_stock_mm2"]) < 0.01 * area, (part, area)
+        # those faces are the whole mirror: the stocked surface's area of revolution (its meridian's
+        # 2 pi r ds), within 0.5 % (the chord error and the cut edges). Not the report's area before
+        # the stock: the stock changes it by ~ stock x (k1 + k2), 1.2 % on the paraboloid's convex
+        # 16 mm mirror at 0.113 mm (it grows), -0.2 % on the concave dome at 0.159 mm
+        pts = sanded.behind(-stock).points(sanded.behind(-stock).sample(20001))
+        exact = float(np.sum(np.pi * (pts[1:, 0] + pts[:-1, 0]) * np.hypot(*np.diff(pts, axis=0).T)))
+        assert abs(area - exact) < 0.005 * area, (part, area, exact)
         # volumes grow by mirror area x stock within 1 % (the thin shell; curvature is second order)
         assert abs(st["volume_added_over_area_times_stock"] - 1) < 0.01, st
         # the staircase on the stocked slices leaves no valley behind the sanded surface
