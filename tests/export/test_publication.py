@@ -19,6 +19,8 @@ import pytest
 
 from rigcad.export.atomic import Staging, hold_lock
 from rigcad.export.manifest import listed_files
+from rigcad.check.criteria import KEPT_FILE as CRITERIA_FILE
+from rigcad.manual.gate import VERDICT_FILE
 
 #: Whole commands or the whole rig: `make test-e2e` (and CI) runs these, `make test` does not.
 pytestmark = pytest.mark.e2e
@@ -40,15 +42,31 @@ def _profile(folder: Path, extra: str = "") -> Path:
     return path
 
 
+#: Records kept beside the export outside any run's manifest (the assembly check's verdict, the ray
+#: check's cheap criteria), written whole (atomically) after the parts are published: each carries the
+#: key of the profile and code that made it and is read back only under that key
+#: (rigcad.manual.gate.read_verdict, rigcad.check.criteria.kept_rows), so none is read as another run's.
+KEPT = {VERDICT_FILE: "inputs_key", CRITERIA_FILE: "key"}
+
+
 def _consistent(out: Path) -> list[str]:
-    """Files the manifest lists that do not match it, and files it does not list (besides the
-    check/ and fab/ runs' own folders). Empty: the folder is one run's output."""
+    """Files the manifest lists that do not match it, files it does not list (besides the kept
+    records, :data:`KEPT`), and kept records that are not whole or carry no key. Empty: the folder
+    is one run's output."""
     manifest = json.loads((out / "manifest.json").read_text())
     listed = listed_files(manifest)
     bad = [rel for rel, digest in listed.items()
            if not (out / rel).is_file() or hashlib.sha256((out / rel).read_bytes()).hexdigest() != digest]
     present = {p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()}
-    bad += sorted(present - set(listed) - {"manifest.json"})
+    bad += sorted(present - set(listed) - {"manifest.json"} - set(KEPT))
+    for name, key in KEPT.items():
+        if (out / name).is_file():
+            try:
+                doc = json.loads((out / name).read_text())
+            except ValueError:
+                doc = None
+            if not (isinstance(doc, dict) and isinstance(doc.get(key), str)):
+                bad.append(name)
     return bad
 
 
