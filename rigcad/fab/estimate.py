@@ -106,19 +106,18 @@ def island_layers(layers) -> int:
 
 
 def shell_thickness(printer) -> float:
-    """Perimeters x extrusion width (mm), from the printer's slicer settings, else 3 beads of
-    1.125 x the nozzle (PrusaSlicer's default width); an SLA print is solid (0: all shell)."""
+    """Perimeters (the slicer settings', else 3) x their width (rigcad.fab.printers.perimeter_width: the
+    settings', else PrusaSlicer's automatic 1.125 x the nozzle) (mm); an SLA print is solid (inf: all shell)."""
+    from rigcad.fab.printers import perimeter_width
+
     if printer.process != "fdm":
         return float("inf")
     eff = printer.slicer_config.effective() if printer.slicer_config else {}
-    nozzle = printer.nozzle or 0.4
     try:
         perimeters = int(float(eff.get("perimeters", 3)))
-        width = str(eff.get("perimeter_extrusion_width", eff.get("extrusion_width", "0"))).strip()
-        w = nozzle * float(width[:-1]) / 100 if width.endswith("%") else float(width or 0)
     except ValueError:
-        perimeters, w = 3, 0.0
-    return perimeters * (w if w > 0 else 1.125 * nozzle)
+        perimeters = 3
+    return perimeters * perimeter_width(printer)
 
 
 def estimate(features: Features, printer, fit: Fit = FIT) -> dict:

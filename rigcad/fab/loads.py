@@ -68,8 +68,6 @@ BEARING_SHARE = 0.5
 SKIN_MM = 1.35
 #: Infill of a printed core (the MK3S file's 20 %), the same fallback.
 INFILL = 0.20
-#: PrusaSlicer's automatic extrusion width, as a multiple of the nozzle, for a width set to 0 (auto).
-AUTO_WIDTH = 1.125
 
 
 @dataclass(frozen=True)
@@ -85,13 +83,10 @@ class Skin:
 
 
 def _width(value: str, nozzle: float, fallback: str | None = None) -> float:
-    """A PrusaSlicer extrusion width (mm): a length, a percentage of the nozzle, or 0 for the fallback key's
-    value or, failing it, the automatic width (AUTO_WIDTH x nozzle)."""
-    v = str(value).strip()
-    w = nozzle * float(v[:-1]) / 100.0 if v.endswith("%") else float(v)
-    if w > 0:
-        return w
-    return _width(fallback, nozzle) if fallback not in (None, "") else AUTO_WIDTH * nozzle
+    """A PrusaSlicer width or height (mm): rigcad.fab.printers.extrusion_width."""
+    from rigcad.fab.printers import extrusion_width
+
+    return extrusion_width(value, nozzle, fallback)
 
 
 def skin(printer: Printer) -> Skin:
@@ -109,6 +104,7 @@ def skin(printer: Printer) -> Skin:
         layer = float(e.get("layer_height", printer.layer_height))
         first = _width(e.get("first_layer_height", layer), layer)  # a percentage of the layer height, or mm
         side = int(e["perimeters"]) * _width(e.get("perimeter_extrusion_width", "0"), nozzle, e.get("extrusion_width"))
+        # (the same width as rigcad.fab.printers.perimeter_width, at the preset's own nozzle_diameter)
         top = max(int(e["top_solid_layers"]) * layer, float(e.get("top_solid_min_thickness", 0)))
         n_bottom = int(e["bottom_solid_layers"])
         bottom = max(first + max(n_bottom - 1, 0) * layer if n_bottom else 0.0,

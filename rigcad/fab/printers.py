@@ -205,6 +205,36 @@ DEFAULT_PROCESS = {
 }
 
 
+#: PrusaSlicer's automatic extrusion width: 1.125 x the nozzle (its rule for a width set to 0).
+AUTO_WIDTH_OVER_NOZZLE = 1.125
+
+
+def extrusion_width(value, nozzle: float, fallback=None) -> float:
+    """A PrusaSlicer extrusion width (mm) as the slicer reads it: a length, a percentage of the nozzle, or 0
+    (or empty) for the ``fallback`` key's value or, failing it, the automatic width (AUTO_WIDTH_OVER_NOZZLE x
+    the nozzle). Raises ValueError on text that is none of these."""
+    v = str(value).strip() or "0"
+    w = nozzle * float(v[:-1]) / 100.0 if v.endswith("%") else float(v)
+    if w > 0:
+        return w
+    return extrusion_width(fallback, nozzle) if fallback not in (None, "") else AUTO_WIDTH_OVER_NOZZLE * nozzle
+
+
+def perimeter_width(printer) -> float:
+    """The width (mm) of an FDM printer's perimeter lines: its resolved slicer settings'
+    ``perimeter_extrusion_width``, else ``extrusion_width``, else the automatic width (:func:`extrusion_width`);
+    without slicer settings, or with unreadable ones, the automatic width of its nozzle (0.4 mm when it
+    states none). The one home of this figure: the pin walls (rigcad.fab.split.pin_wall), the printed skin
+    (rigcad.fab.loads.skin) and the print-time model's shell (rigcad.fab.estimate.shell_thickness)."""
+    nozzle = getattr(printer, "nozzle", None) or 0.4
+    cfg = getattr(printer, "slicer_config", None)
+    eff = cfg.effective() if cfg is not None else {}
+    try:
+        return extrusion_width(eff.get("perimeter_extrusion_width", "0"), nozzle, eff.get("extrusion_width"))
+    except ValueError:
+        return AUTO_WIDTH_OVER_NOZZLE * nozzle
+
+
 def printer_path(name: str | Path) -> Path:
     """A printer file by path, or by name under ``printers/`` on the profile search path. Only a
     YAML file (``.yaml``/``.yml``, its link target too) outside the system folders

@@ -35,14 +35,12 @@ import numpy as np
 
 from rigcad.errors import FabricationError
 from rigcad.fab.mirror import MirrorSurface
-from rigcad.fab.printers import AlignmentPin
+from rigcad.fab.printers import AlignmentPin, perimeter_width
 from rigcad.parts.recipe import Cylinder
 
 #: Material kept around a pin hole (mm) when no printer says more: an SLA part's thinnest unsupported
 #: wall (Formlabs' design guide: 0.6 mm). An FDM printer's is two perimeters (:func:`pin_wall`).
 MIN_WALL = 0.6
-#: PrusaSlicer's automatic perimeter width: 1.125 x the nozzle (its "extrusion width = 0" rule).
-AUTO_WIDTH_OVER_NOZZLE = 1.125
 #: How far (mm) glue squeezed out of a seam spreads along the cut face (about 1 mm): a seam keeps at
 #: least this beyond a datum feature's own wall, so no glue reaches the feature.
 GLUE_SQUEEZE_MM = 1.0
@@ -269,23 +267,12 @@ PIN_WALL_PERIMETERS, PIN_WALL_MIN_MM = 3, 1.5
 
 
 def pin_wall(printer) -> float:
-    """Wall (mm) kept around every pin hole: on an FDM printer PIN_WALL_PERIMETERS perimeters (its
-    perimeter line width: the PrusaSlicer preset's ``perimeter_extrusion_width`` when it states one in
-    mm, else AUTO_WIDTH_OVER_NOZZLE x the nozzle) or PIN_WALL_MIN_MM, whichever is more; MIN_WALL for a
-    resin printer."""
+    """Wall (mm) kept around every pin hole: on an FDM printer PIN_WALL_PERIMETERS perimeter lines
+    (rigcad.fab.printers.perimeter_width) or PIN_WALL_MIN_MM, whichever is more; MIN_WALL for a resin
+    printer."""
     if getattr(printer, "process", "fdm") != "fdm" or not getattr(printer, "nozzle", None):
         return MIN_WALL
-    width = AUTO_WIDTH_OVER_NOZZLE * printer.nozzle
-    cfg = getattr(printer, "slicer_config", None)
-    if cfg is not None:
-        text = str(cfg.effective().get("perimeter_extrusion_width", "")).strip()
-        try:
-            stated = float(text)  # "0.45"; "0" is automatic; "112.5%" is not in mm (then the rule)
-        except ValueError:
-            stated = 0.0
-        if stated > 0:
-            width = stated
-    return max(MIN_WALL, PIN_WALL_MIN_MM, PIN_WALL_PERIMETERS * width)
+    return max(MIN_WALL, PIN_WALL_MIN_MM, PIN_WALL_PERIMETERS * perimeter_width(printer))
 
 
 #: Hole shrink (mm, diametral) assumed when the printer file states no process errors: FDM holes print

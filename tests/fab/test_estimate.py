@@ -179,7 +179,9 @@ class _Config:
     ({"perimeters": "2"}, 0.4, 2 * 1.125 * 0.4),            # no width at all: PrusaSlicer's default
     ({"perimeter_extrusion_width": ""}, 0.4, 3 * 1.125 * 0.4),
     ({"perimeter_extrusion_width": "0"}, 0.6, 3 * 1.125 * 0.6),  # 0 = auto
-    ({"perimeters": "abc", "extrusion_width": "0.5"}, 0.4, 3 * 1.125 * 0.4),  # unreadable: the defaults
+    ({"perimeter_extrusion_width": "0", "extrusion_width": "0.5"}, 0.4, 3 * 0.5),  # 0: the general width first
+    ({"perimeters": "abc", "extrusion_width": "0.5"}, 0.4, 3 * 0.5),  # unreadable count: 3 of the width
+    ({"perimeter_extrusion_width": "wide"}, 0.4, 3 * 1.125 * 0.4),  # unreadable width: the automatic one
     ({"perimeters": "1"}, None, 1 * 1.125 * 0.4),           # no nozzle in the file: 0.4 mm
 ])
 def test_the_shell_follows_the_slicer_settings(prusa, settings, nozzle, shell):
