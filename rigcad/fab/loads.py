@@ -251,6 +251,11 @@ def nut_area(thread: str, hole: float) -> float:
     return math.sqrt(3) / 2 * s ** 2 - math.pi / 4 * hole ** 2
 
 
+#: The torque table's rows for the instruments' own screws, by which the manual's lock steps find them
+#: (rigcad.manual.calibration.instrument_torques).
+PROJECTOR_JOINT, CAMERA_JOINT = "projector on the shelf's slots", "camera on its bracket's slot"
+
+
 def bolt_load(joint: str, thread: str, count: int, faces: dict[str, float], mat: Material, datum: bool) -> BoltLoad:
     """The torque for ``count`` ``thread`` screws whose bearing faces on plastic are ``faces``
     (name -> area mm2): the smallest face at BEARING_SHARE of the yield."""
@@ -304,9 +309,9 @@ def bolt_loads(profile, layout, printer: Printer) -> tuple[BoltLoad, ...]:
         out.append(bolt_load("the rig on the breadboard", b.thread, held,
                              {"large washer": washer_area(b.thread, hb, large=True)}, mat, True))
     pj, cm = profile.projector, profile.camera
-    out.append(bolt_load("projector on the shelf's slots", pj.mount_thread, 4, _faces(washers["projector"]), mat,
+    out.append(bolt_load(PROJECTOR_JOINT, pj.mount_thread, 4, _faces(washers["projector"]), mat,
                          False))
-    out.append(bolt_load("camera on its bracket's slot", cm.mount_thread, 2, _faces(washers["camera"]), mat, False))
+    out.append(bolt_load(CAMERA_JOINT, cm.mount_thread, 2, _faces(washers["camera"]), mat, False))
     return tuple(out)
 
 

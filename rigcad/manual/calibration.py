@@ -436,10 +436,10 @@ def projector_focus(rig) -> dict:
 def instrument_torques(rig, printer) -> dict:
     """The projector's and the camera's screws: (count, thread, torque N m) from the torque table
     (rigcad.fab.loads.bolt_loads), keyed "projector" and "camera"."""
-    from rigcad.fab.loads import bolt_loads
+    from rigcad.fab.loads import CAMERA_JOINT, PROJECTOR_JOINT, bolt_loads
 
     rows = {b.joint: b for b in bolt_loads(rig.profile, rig.layout, printer)}
-    pj, cm = rows["projector on the shelf's slots"], rows["camera on its bracket's slot"]
+    pj, cm = rows[PROJECTOR_JOINT], rows[CAMERA_JOINT]
     return {"projector": (pj.count, pj.thread, pj.torque_nm), "camera": (cm.count, cm.thread, cm.torque_nm)}
 
 
