@@ -45,15 +45,17 @@ def circle_image(rig) -> tuple[bytes, dict]:
     width, height = rig.profile.projector.resolution
     lensed = focusing_lens(rig.profile, g).projector(g.projector_focal_px, g.cop_z)  # set with the lens in place
     radius = lensed.ring_radius(g, design.alpha_max)
-    from rigcad.profile.derived import projector_disc_room, projector_principal_point
+    from rigcad.profile.derived import check_disc, projector_disc_room, projector_principal_point
 
     cx, cy = projector_principal_point(rig.profile.projector)  # the lens axis's pixel: the disc's centre
     x = np.arange(width) + 0.5 - cx
     y = cy - np.arange(height) - 0.5
     inside = x[None, :] ** 2 + y[:, None] ** 2 <= radius ** 2
+    check_disc(rig.profile, radius)  # an offset lens: design's refusal and its remedy, for the lensed disc
     if radius > projector_disc_room(rig.profile.projector):
         raise GeometryError(f"the paraboloid's rim is {radius:.1f} px from the lens axis's pixel ({cx:g}, {cy:g}), "
-                            f"outside the {width} x {height} px projector image", param="projector.throw_ratio")
+                            f"outside the {width} x {height} px projector image with the focusing lens in place: a "
+                            "lower projector.throw_ratio (zoom wider)", param="projector.throw_ratio")
     buf = io.BytesIO()
     Image.fromarray(np.where(inside, 255, 0).astype(np.uint8), mode="L").save(buf, format="PNG")
     info = {"resolution_px": [width, height], "centre_px_from_top_left": [cx, cy],

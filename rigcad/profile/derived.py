@@ -79,9 +79,11 @@ def projector_disc_room(projector) -> float:
     return min(x, w - x, y, h - y)
 
 
-def _check_disc(profile: Profile, pixels: float) -> None:
+def check_disc(profile: Profile, pixels: float) -> None:
     """Refuse a projector whose image does not hold the paraboloid's disc of ``pixels`` radius about
-    its lens axis: its rim's pixels (the grazing directions) or all of them would light nothing."""
+    its lens axis: its rim's pixels (the grazing directions) or all of them would light nothing. ``derive``
+    judges the disc without the focusing lens; the manual's calibration circle judges it again with the lens
+    (rigcad.manual.calibration.circle_image), by this same rule and message."""
     pj = profile.projector
     room = projector_disc_room(pj)
     # a centred image is judged by the later checks (the design's openings, the px/deg fan), which name
@@ -133,7 +135,7 @@ def derive(profile: Profile) -> Derived:
             f"from {cop_z - rim_z:.4g} mm): at least {MIN_PIXELS_ACROSS} are needed to light the sample from distinct "
             f"directions; raise paraboloid.{keys[0]} or paraboloid.{keys[1]}, or lower layout.cop_to_vertex",
             where=profile.where("paraboloid", keys[0]))
-    _check_disc(profile, pixels)
+    check_disc(profile, pixels)
     return Derived(
         focal_length=f, rim_radius=r_rim, vertical_extent=d_p, tangent_angle=tau,
         vertex_z=vertex_z, rim_z=rim_z, focus_z=vertex_z - f, cop_z=cop_z,
