@@ -1177,7 +1177,16 @@ def _step_extras(c, name: str, tower_at: dict) -> str:
     for h in tower_at.get(name, []):  # the threaded rows; the pressed ones came before the part
         if h.get("thread") and "heat-set insert" not in h["item"]:
             text += f" Fix it with {h['quantity']} x {B.tower_item(h)}: {h['joins']}."
+    for h in B.tower_hardware(c.rig):  # the tower joints' bolts the plan places: their sleeves, faced first
+        if tower_joints.placed(h) and h.get("shop_steps") and _last_step(h, tower_at["_order"]) == name:
+            text += " Before its bolts: " + "; ".join(h["shop_steps"]) + "."
     return text
+
+
+def _last_step(h: dict, order: list[str]) -> str | None:
+    """The last of a tower hardware row's declared steps (``steps``: data) that this assembly has (``order``)."""
+    named = [s for s in h.get("steps", ()) if s in order]
+    return max(named, key=order.index) if named else None
 
 
 def _drawing(d: Doc, c, part: str) -> None:
@@ -1252,13 +1261,13 @@ def _tower_rows_by_step(rig, steps) -> dict:
     (the tower's own joints), each in the last of the steps it declares (``steps``: data) that this
     assembly has."""
     order = [s.name for s in steps]
-    out: dict = {}
+    out: dict = {"_order": order}  # the steps in order, for _last_step
     for h in B.tower_hardware(rig):
         if "mounting holes" in h["joins"] or tower_joints.placed(h):
             continue  # the instruments' screws and the tower joints' bolts: the plan's
-        named = [s for s in h.get("steps", ()) if s in order]
-        if named:
-            out.setdefault(max(named, key=order.index), []).append(h)
+        last = _last_step(h, order)
+        if last:
+            out.setdefault(last, []).append(h)
     return out
 
 
