@@ -80,6 +80,12 @@ def _rest_stage(steps, tower: bool) -> Stage | None:
               places=names)
 
 
+#: The camera aligned on its crosses before the slope test, the film laid (O's mark traced over the base cross).
+CAMERA_FIRST = ("Lift the dome off, hang the camera cross on the beam in the paraboloid's place, set the dome back; "
+                "align the camera on it and on O's mark on the film over the base cross, before the slope test; then "
+                "put the paraboloid back the same way.")
+
+
 def schedule(rig, fab_report: dict | None = None, steps=None) -> tuple[Stage, ...]:
     """The rig's schedule, print to calibrated rig (see the module docstring): the tower's stages when
     the rig has the COP tower, the dome's seams when the fab report split it, the deflectometry when the
@@ -146,10 +152,14 @@ def schedule(rig, fab_report: dict | None = None, steps=None) -> tuple[Stage, ..
     built = _rest_stage(steps, tower)
     if built is not None:
         out.append(built)
+    if tower:  # the slope test's budget counts the paraboloid's placement only: the camera must be on its place
+        out.append(_s(CAMERA_FIRST, C.STEP_CAMERA, needs={"camera on", "cross in the bore", "dome on its register",
+                                                          "film laid", "paraboloid placed"},
+                      makes={"camera aligned"}))
     out += [
         _s("Slope test on the polished clear coat, before the mirror coat.", C.STEP_ACCEPTANCE,
            needs={"clear coat polished", "film laid", "camera on", "dome on its register", "paraboloid on the beam",
-                  "paraboloid placed"},
+                  "paraboloid placed"} | ({"camera aligned"} if tower else set()),
            makes={"slope passed"}),
         _s("Lift the dome off its register (the beam and the paraboloid with it), take the paraboloid off the beam, "
            "spray the mirror coat on both; let it cure; set the paraboloid back and the dome on its pins.",
@@ -166,7 +176,8 @@ def _calibration(rig, tower: bool) -> list[Stage]:
             _s("Align the projector on the crosses (the splitter holder off its seat, then back).", C.STEP_CROSSES,
                needs={"projector on"}, makes={"projector aligned"}),
             _s("Set the splitter's tilt with the seat's push screws; lock them.", C.STEP_SEAT,
-               needs={"projector aligned", "mirrors coated", "film laid"}, makes={"splitter set"}),
+               needs={"projector aligned", "mirrors coated", "film laid"}, makes={"splitter set"},
+               ends={"camera aligned"}),  # the screws tilt the holder the camera rides on
         ]
     out += [
         _s("Set the circle on the paraboloid, judged on the film from below.", C.STEP_CIRCLE,
@@ -177,7 +188,8 @@ def _calibration(rig, tower: bool) -> list[Stage]:
            needs={"circle set", "film laid", "dome on its register"}, makes={"bore open", "plate top clear"},
            ends={"film laid"}),
         _s("Lift the dome off, hang the camera cross on the beam in the paraboloid's place, set the dome back; align "
-           "the camera; then put the paraboloid back the same way and the sample holder in the bore in the "
+           "the camera" + (" again (the splitter seat's screws tilted it with the holder)" if tower else "")
+           + "; then put the paraboloid back the same way and the sample holder in the bore in the "
            "camera_cross_base's place.",
            C.STEP_CAMERA, needs={"bore open", "dome on its register", "cross in the bore"}
            | ({"camera on"} if tower else set()),

@@ -40,11 +40,14 @@ def test_every_stage_finds_the_state_it_needs(stages):
     paraboloid = _index(stages, S.ASSEMBLE, "the paraboloid on it")
     lap = _index(stages, "5. Assemble (tower column)", "Lap")
     join = _index(stages, S.PRINT, "Join")
-    camera = _index(stages, C.STEP_CAMERA, "camera cross")
+    camera = _index(stages, C.STEP_CAMERA, "before the slope test")
+    again = _index(stages, C.STEP_CAMERA, "align the camera again")
+    seat = _index(stages, C.STEP_SEAT, "push screws")
     assert plate < glue < inserts, "the dome is glued on the plate's screws, before its own inserts"
     assert lap < join, "the column's faces are lapped before they are glued"
-    assert drill < film < paraboloid < dome < slope < coat < camera, \
-        "dome indicated in, then the film, the paraboloid into the lifted dome, the dome bolted; slope before coat"
+    assert drill < film < paraboloid < dome < camera < slope < coat < seat < again, \
+        "dome indicated in, then the film, the paraboloid into the lifted dome, the dome bolted; the camera aligned " \
+        "before the slope test; slope before coat; the camera aligned again after the seat's screws tilted it"
     peel = _index(stages, C.STEP_FILM, "peel the whole film")
     on_plate = [_index(stages, *at) for at in ((C.STEP_CHECKER, "checkerboard"), (C.STEP_GRAY, "gray card"),
                                               (C.STEP_AS_BUILT, "screens"))]
@@ -79,6 +82,11 @@ def test_a_stage_out_of_order_is_refused(stages):
     ((C.STEP_FILM, "peel the whole film"), (None, None), "plate top clear"),
     # the slope test on an unplaced paraboloid (its lateral stack alone throws rays past the disc)
     ((C.STEP_ACCEPTANCE, "Indicate the paraboloid"), (None, None), "paraboloid placed"),
+    # the slope test through a camera not yet on its crosses (its lateral stack alone, 4.43 mm on the default
+    # rig against 0.5 mm, is outside the test's budget, which counts the paraboloid's placement only)
+    ((C.STEP_CAMERA, "before the slope test"), (None, None), "camera aligned"),
+    # the checkerboard read through a camera the splitter seat's push screws tilted after its crosses
+    ((C.STEP_CAMERA, "align the camera again"), (None, None), "camera aligned"),
 ])
 def test_each_conflict_the_technician_found_is_caught_if_planted_back(stages, moved, after, missing):
     stages_ = list(stages)
