@@ -481,8 +481,8 @@ CONSUMABLES = (
     ("Tack cloths", "5"),
     ("Wicking threadlocker, low strength (Loctite 290 class), 10 ml: locks the splitter seat's push screws once set",
      "1"),
-    ("Retaining compound, high strength (Loctite 638 class), 10 ml: the beam's stop pin in its slip-fit hole, the "
-     "seat screws' balls in their cups", "1"),
+    ("Retaining compound, high strength (Loctite 638 class), 10 ml: the registers' dowel pins in their reamed "
+     "holes, the beam's stop pin in its slip-fit hole, the seat screws' balls in their cups", "1"),
     ("Cyanoacrylate glue, medium viscosity, 20 g: a drop in each nut trap before its nut goes in", "1"),
     ("Packing tape, polypropylene, 48 mm, 1 roll: over the base plate under the dome's seams while they are glued",
      "1"),

@@ -721,14 +721,11 @@ def assembly_order(rig, steps, solids):
 def register_text(reg) -> str:
     """What a step says of the register a part sits on (rigcad.parts.locating.DowelRegister)."""
     lateral, turn = reg.repeatability
-    lower, upper = reg.lower.replace("_", " "), reg.upper.replace("_", " ")
+    upper = reg.upper.replace("_", " ")
     if getattr(reg, "drilled", False) and getattr(reg, "procedure", ""):
         return reg.procedure + " "  # drilled in place once the part is indicated in: the part's own shop step
-    return (f"Before the {upper}: press its {len(reg.points)} register pins ({reg.item}) into the {lower}'s two "
-            f"holes, printed at the pin's size, with a vise or a soft hammer until {reg.upper_engagement:g} mm stands "
-            f"proud ({reg.length - reg.upper_engagement:g} mm in); a pin that goes in loose is glued in with epoxy: it "
-            f"must not move. Ream the {upper}'s round hole {reg.diameter:g} mm H7 and file its slot until a pin slides "
-            f"along it but not across. The {upper} drops onto the pins: lifted off and set back (section 6 does, for "
+    return (f"Before the {upper}: {reg.shop_text()} The {upper} drops onto the pins: lifted off and set back "
+            f"(section 6 does, for "
             f"the calibration screens and the checkerboard) it returns to within {1e3 * lateral:.0f} µm and "
             f"{1e3 * math.degrees(turn):.1f} mdeg, whatever its screws do; tighten its screws only once it sits on the "
             "pins. ")

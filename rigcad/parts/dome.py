@@ -27,7 +27,7 @@ import numpy as np
 
 from rigcad.errors import GeometryError
 from rigcad.parts.joints import ScrewJoint, datums_of
-from rigcad.parts.locating import (INDICATOR_MM, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole, foil_step,
+from rigcad.parts.locating import (INDICATOR_MM, PRESS_IN_COMPOUND, SHIM_PACK_MM, DowelRegister, ShimStop, bolt_hole, foil_step,
                                    holder_fit, reamers, set_screw_length, stepped_hole, teardrop_along_y)
 from rigcad.parts.layout import RigLayout, u_at_height
 from rigcad.parts.washers import on_limiter
@@ -352,5 +352,6 @@ def indicating_text(profile: Profile, layout: RigLayout, reg: DowelRegister | No
         f"with the machine reamer in a hand drill at its lowest speed, the flange's holes guiding it, to the depth "
         f"stop ({reg.reaming_text()}); lift the dome off, ream the flange's round hole {reg.diameter:g} "
         f"{reg.slip.hole}, {reg.gauge_step()} File its slot until a pin slides along it but not across. Press the "
-        f"pins ({reg.item}) into the plate with a vise until {reg.upper_engagement:g} mm stands proud: "
+        f"pins ({reg.item}) into the plate with a vise, {PRESS_IN_COMPOUND}, until {reg.upper_engagement:g} mm "
+        "stands proud: "
         f"{reg.press.describe()}; the flange slides on them, {reg.slip.describe()}. {reg.repeat_step()}")

@@ -95,6 +95,12 @@ INDICATOR_MM = 0.01
 #: trusted to half a graduation, so the finer indicator's is at most half that figure
 #: (DowelRegister.repeat_step refuses otherwise).
 REPEAT_INDICATOR_MM = 0.002
+#: How a register's dowel pins are pressed into their reamed N7 holes in a printed part: in retaining compound
+#: by default, not only when a hole came out loose: an N7/m6 press holds by 0.008-0.028 mm of interference,
+#: which relaxes as the plastic creeps round the pin (the machinist's review), and the cured compound fills
+#: what it gives up.
+PRESS_IN_COMPOUND = ("each with a film of retaining compound on it (the press's few micrometres of interference "
+                     "relax as the plastic creeps; the cured compound keeps the pin from walking)")
 
 
 #: The sample holder's fit in the base plate's bore (ISO 286, the preferred close running fit): the bore bored
@@ -224,7 +230,8 @@ class DowelRegister:
                 f"speed, ream the {lower}'s holes {self.diameter:g} {DOWEL_PRESS_HOLE} to the depth stop "
                 f"({self.reaming_text()}) and the {upper}'s round hole {self.diameter:g} {DOWEL_SLIP_HOLE}; "
                 f"{self.gauge_step()} File its slot until a pin slides along it but not across. Press the pins "
-                f"({self.item}) into the {lower} with a vise until {self.upper_engagement:g} mm stands proud: "
+                f"({self.item}) into the {lower} with a vise, {PRESS_IN_COMPOUND}, until {self.upper_engagement:g} mm "
+                "stands proud: "
                 f"{self.press.describe()}; the {upper} slides on them, {self.slip.describe()}. {self.repeat_step()}")
 
     def reaming_text(self) -> str:

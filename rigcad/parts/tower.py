@@ -1198,7 +1198,7 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
                  "length_mm": length["top"], "quantity": 1,
                  "steps": ('tower_shelf',), "joins": "down through the shelf (its head flush in the countersink on top) into the extrusion's core, "
                           f"tapped {CORE_TAP_DEPTH:g} mm deep"}]
-    from rigcad.parts.locating import SLOT_FIT_MM
+    from rigcad.parts.locating import PRESS_IN_COMPOUND, SLOT_FIT_MM
     from rigcad.parts.washers import washers_over
 
     hole = column_bolt_hole(t, profile)
@@ -1243,7 +1243,8 @@ def _column_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]
          "length_mm": float(length), "quantity": count, "steps": steps,
          "joins": f"{which}: "
                   f"pressed into the tongue's and the shelf's blind holes (printed at {reg.drill:g} mm: drill them "
-                  f"{reg.drill:g} mm, ream {reg.diameter:g} {reg.press.hole}: {reg.press.describe()}); at each end the "
+                  f"{reg.drill:g} mm, ream {reg.diameter:g} {reg.press.hole}: {reg.press.describe()}), "
+                  f"{PRESS_IN_COMPOUND}; at each end the "
                   f"column's flange takes the first pin in its round hole (drilled {reg.drill:g} mm, reamed "
                   f"{reg.diameter:g} {reg.slip.hole}: {reg.slip.describe()}) and the second in its slot (file it until "
                   f"the pin slides, {SLOT_FIT_MM:g} mm across); {lap}",
