@@ -551,9 +551,35 @@ def limiter_step(where: str, count: int, length: float, seat: str) -> str:
 
 
 def _holder_flange_points(t: TowerLayout, profile: Profile):
-    """The two spring bolts that hold the splitter holder down on its seat (x, y; mm)."""
-    y = t.wall_y[1] + 1.5 * profile.tower.bolt_diameter
-    return [(t.holder_x[0] + 8.0, s * y) for s in (-1, 1)]
+    """The two spring bolts that hold the splitter holder down on its seat (x, y; mm; -y first), 8 mm
+    inside the holder's back end. The plate slides in along -y over the +y one: where that bolt's top
+    (its end over the nut, washers and spring) would stand in the plate's way in (a low projector raises
+    the shelf, and the holder on it, up to the plate), it stands behind the plate's lowest edge instead,
+    clear by the spring's play on the bolt and GROOVE_GAP; the -y one is never in the way."""
+    tw, m4, sp = profile.tower, THREADS["M4"], SEAT_SPRING
+    y = t.wall_y[1] + 1.5 * tw.bolt_diameter
+    x = t.holder_x[0] + 8.0
+    play = (sp["outer_diameter"] - 2 * sp["wire"] - m4.major) / 2  # the spring off-centre on the bolt
+    reach = max(m4.washer_od, sp["outer_diameter"], 2 * m4.nut_corner_radius) / 2 + play
+    top = t.shelf_top_z - t.shelf_thickness - m4.washer_thickness + spring_bolt_length(profile, t)
+    if top + GROOVE_GAP <= _plate_floor(t, x - reach):
+        return [(x, -y), (x, y)]
+    return [(x, -y), (min(x, _plate_extent(t.plate)[0] - reach - GROOVE_GAP), y)]
+
+
+def _plate_floor(t: TowerLayout, x: float) -> float:
+    """The splitter plate's lowest z (mm) at or past ``x`` (toward +x), anywhere along its way in (a
+    slide along y): its lowest edge, or its front face at ``x`` (splitter_plate's 45 deg plate faces
+    +x and down, so every point of it has z - x >= that of its centre)."""
+    cx, _, cz = t.plate.center
+    return max(t.plate_bottom_z, x + cz - cx)
+
+
+def spring_bolt_length(profile: Profile, t: TowerLayout) -> float:
+    """The splitter holder's spring bolts' length (mm): up through the shelf, the seat's gap, the
+    holder's flange and the spring at its free length, with two washers and a nut past them."""
+    grip = t.shelf_thickness + seat_gap(profile) + profile.tower.wall + SEAT_SPRING["free_length"]
+    return _length("M4", grip, nut_allowance("M4"))
 
 
 #: The shelf's M4 heat-set inserts (rigcad.standards.INSERTS: the maker's hole and the insert's length).
@@ -997,9 +1023,10 @@ def tower_shelf(profile: Profile, layout) -> Part:
                 "on its shim stacks; a hole passes the ray bundle", bought=bought, datums=datums)
 
 
-def _groove(t: TowerLayout) -> Translate:
+def _groove(t: TowerLayout, y1: float) -> Translate:
     """The plate's slab in x-z with GROOVE_GAP around it: blind in the -y wall (GROOVE_DEPTH), through
-    the +y wall, so the plate slides in along -y and rests on the groove's lower 45 deg faces."""
+    the +y wall (to ``y1``, mm), so the plate slides in along -y and rests on the groove's lower 45 deg
+    faces."""
     p = t.plate
     n = np.array([p.normal[0], p.normal[2]])
     l_ = np.array([p.length_dir[0], p.length_dir[2]])
@@ -1009,7 +1036,7 @@ def _groove(t: TowerLayout) -> Translate:
     back = c - (p.thickness + GROOVE_GAP) * n
     pts = [front - a * l_, front + a * l_, back + a * l_, back - a * l_]
     pts = [(float(q[0]), float(q[1])) for q in pts]
-    y0, y1 = -(p.half_width + GROOVE_GAP), t.wall_y[1] + 1.0
+    y0 = -(p.half_width + GROOVE_GAP)
     slab = Prism(Section(tuple(Line(pts[i], pts[(i + 1) % 4]) for i in range(4))), y1 - y0)
     return Translate(slab, (0.0, 0.5 * (y0 + y1), 0.0))
 
@@ -1098,7 +1125,9 @@ def splitter_holder(profile: Profile, layout) -> Part:
     walls = [Box((x0, s0, z0), (x1, s1, z1)) for s0, s1 in ((-yo, -yi), (yi, yo))]
     back = Box((x0, -yo, z0), (x0 + tw.wall, yo, z1))
     fl = 3 * tw.bolt_diameter
-    flanges = [Box((x0, -yo - fl, z0), (x1, -yo, z0 + tw.wall)), Box((x0, yo, z0), (x1, yo + fl, z0 + tw.wall)),
+    springs = _holder_flange_points(t, profile)
+    fx0 = min(x0, springs[1][0] - 1.5 * tw.bolt_diameter)  # the +y flange reaches back under its spring bolt
+    flanges = [Box((x0, -yo - fl, z0), (x1, -yo, z0 + tw.wall)), Box((fx0, yo, z0), (x1, yo + fl, z0 + tw.wall)),
                Box((x0 - _flat_reach(t, profile) - 1.5 * tw.bolt_diameter, -yo, z0), (x0, yo, z0 + tw.wall))]
     bracket, slot = _camera_bracket(t, profile)
     ins = INSERTS[a.seat_thread]
@@ -1109,8 +1138,10 @@ def splitter_holder(profile: Profile, layout) -> Part:
     # each insert's pocket at its maker's hole and depth from the boss's top; the screw on through the floor
     pockets = tuple(Cylinder((x, y, top - ins.pocket_depth), ins.hole / 2, ins.pocket_depth + 1.0) for x, y in pts)
     holes = (_holes(pts, THREADS[a.seat_thread].clearance, z0, tw.wall + boss_h) + pockets
-             + _holes(_holder_flange_points(t, profile), SPRING_HOLE, z0, tw.wall))
-    groove = _groove(t)
+             + _holes(springs, SPRING_HOLE, z0, tw.wall))
+    # the plate slides in over the +y flange: where the flange's top reaches its way in, the groove runs on through it
+    low = z0 + tw.wall > t.plate_bottom_z - GROOVE_GAP - tw.clearance
+    groove = _groove(t, yo + fl + 1.0 if low else t.wall_y[1] + 1.0)
     datums = (*datums_of("insert", "seat screw insert pocket", pockets), Datum("splitter grooves", "seat", groove))
     solid = Difference(Union_((*walls, back, *flanges, *bosses, *bracket)), (groove, slot, *holes))
     return Part("splitter_holder", solid, (0.3, 0.5, 0.75),
@@ -1268,11 +1299,10 @@ def _dowel_rows(foot, top) -> list[tuple[int, int, str, tuple[str, ...]]]:
             (top.length, 2, "two locate the column's top flange under the shelf", ('tower_shelf',))]
 
 
-def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
+def _seat_hardware(profile: Profile, t: TowerLayout) -> list[dict]:
     """The splitter seat's push screws, inserts and spring bolts (threaded: the bill's fasteners), then
     its balls, dowel pins, gauge block and springs (the seat's bought hard parts, :func:`splitter_seat`)."""
-    a, tw = profile.adjusters, profile.tower
-    gap = seat_gap(profile)
+    a = profile.adjusters
     spring = SEAT_SPRING
     g = seat_geometry(profile)
     std = "ISO 4029" if a.seat_thread.startswith("M") else "ASME B18.3"
@@ -1300,7 +1330,7 @@ def _seat_hardware(profile: Profile, t: TowerLayout, nut: float) -> list[dict]:
          "steps": ('seat_flat_pad',), "joins": "the seat's flat: bonded into its pocket in the shelf, flush with its top: " + fits["flat"]["step"],
          "fit_mm": fits["flat"]},
         {"item": "bolt, two washers, nut and compression spring", "thread": "M4",
-         "length_mm": _length("M4", t.shelf_thickness + gap + tw.wall + spring["free_length"], nut), "quantity": 2,
+         "length_mm": spring_bolt_length(profile, t), "quantity": 2,
          "spring_mm": {"inner_diameter": spring["outer_diameter"] - 2 * spring["wire"], "wire": spring["wire"],
                        "outer_diameter": spring["outer_diameter"], "free_length": spring["free_length"],
                        "installed_length": spring["installed_length"], "active_coils": spring["active_coils"]},
@@ -1503,7 +1533,7 @@ def hardware(profile: Profile, layout) -> list[dict]:
     focus = focusing_lens(profile, layout.geometry)
     return [
         *_column_hardware(profile, t, nut),
-        *_seat_hardware(profile, t, nut),
+        *_seat_hardware(profile, t),
         {"item": "bolt, large washer (ISO 7093-1) over its slot, washer and nut", "thread": m4, "length_mm": through,
          "quantity": len(lens_pts), "washers": [w.name() for w in washers["lens"].washers],
          "nuts": 1, "plain_washers": 1,
