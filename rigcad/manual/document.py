@@ -578,10 +578,13 @@ def _lapped() -> float:
 def _cut_line(name: str, e: dict) -> str:
     """The print section's line for a template cut from plate, with its printed-stage outline when the
     fab run wrote one (the gauge a split mirror's seams are glued on: rigcad.fab.seams)."""
-    printed = [f for f in ((e.get("stages") or {}).get("printed") or {}).get("files") or () if f.endswith(".dxf")]
+    printed, sanded = ([f for f in ((e.get("stages") or {}).get(k) or {}).get("files") or () if f.endswith(".dxf")]
+                       for k in ("printed", "sanded"))
     return (f"`{name}`: cut from a {e['plate_thickness_mm']:g} mm plate (`outlines/{name}.dxf`, `.svg`)"
             + (f"; cut its printed stage too (`{printed[0]}`: the surface as printed, the gauge a split mirror's "
-               "seams are glued on)" if printed else ""))
+               "seams are glued on)" if printed else "")
+            + (f"; cut its sanded stage too (`{sanded[0]}`: the surface the coats go on, the gauge section 3 sands "
+               "to)" if sanded else ""))
 
 
 def _spring_washers(rig, printer) -> list[dict]:
@@ -639,6 +642,8 @@ def _section_sand(d: Doc, c) -> None:
     total = float(sum(t for _, t in p.coating.layers))
     gauged = p.templates.gauged_layer
     d.h(2, "3. Sand the mirrors to the template")
+    from rigcad.manual import finishing as F
+
     sand = []
     for name, e in fab_report["parts"].items():
         if "polishing" in e:
@@ -646,17 +651,15 @@ def _section_sand(d: Doc, c) -> None:
             need = e["polishing"]["stock_to_add_mm"]
             sand.append(f"`{name}`: sand the print's staircase flat. Its steps stand up to "
                         f"{e['polishing']['sanding_depth_mm']:.3f} mm from crest to valley; the whole mirror was "
-                        f"printed {stock:.3f} mm forward of the design (its sanding stock), which keeps even the "
-                        f"deepest valley {max(0.0, stock - need):.3f} mm in front of the design. So the sanding takes "
-                        "the crests down, more at a crest than the stock, and stops where the guide coat is gone from "
-                        "the valleys and the template shows its first gap: it never reaches the design surface")
+                        f"printed {stock:.3f} mm forward of the surface the coats go on (its sanding stock), which "
+                        f"keeps even the deepest valley {max(0.0, stock - need):.3f} mm in front of it. So the "
+                        "sanding takes the crests down, more at a crest than the stock; "
+                        + F.sanding_stop(total - gd, (name,)))
     d.ul(sand)
     d.p(f"The templates (`dome_template`, `paraboloid_template`, cut from plate) carry the surface of the "
         f"**{gauged}** layer. Sanded to size, the bare print lies {total - gd:.3f} mm ({_mil(total - gd)}: the layers "
         f"up to and including the {gauged}) behind the template's edge all along it: check with a feeler gauge "
         "or against the light, in several meridional planes.")
-    from rigcad.manual import finishing as F
-
     c.templates = F.template_datums(rig)
     for row in c.templates:  # drawn flat with its datum: the picture and the text read the same row
         name = row["template"]
@@ -1325,7 +1328,9 @@ def _section_acceptance(d: Doc, c) -> None:
         f"the sample point O within `tolerancing.max_spot_radius` ({acc['disc_radius_mm']:g} mm). The test lights a "
         "disc of that radius at O and looks at it through the mirrors with the rig's own camera:")
     d.ol([
-        "The rig assembled, the camera in its place on the tower looking down the axis through the splitter, the "
+        "The rig assembled, the camera aligned on its two crosses (section 6, \"Camera: the two crosses\": the first "
+        "time, just before this test; this test's budget counts the paraboloid's placement only, so an unaligned "
+        "camera's own offset would read as a slope error) looking down the axis through the splitter, the "
         "projector off, the room dark. The film of the circle test lies on the base plate's top over the bore, O "
         "traced on it (section 6, \"The film at the sample plane\": it goes on once the dome's register is drilled, "
         "before the dome is bolted down).",
@@ -1591,6 +1596,12 @@ def _camera_crosses_step(d: Doc, c, cam: dict) -> None:
     rig, p = c.rig, c.p
     d.h(3, C.STEP_CAMERA)
     bolts = C.film_setup(rig)["dome_bolts"]
+    d.p("**Twice.** First before the slope test (the optical acceptance test, on the polished clear coat, the "
+        "schedule's order): that test's budget counts the paraboloid's placement only, so the camera must be on its "
+        "place for it. The film is on the plate then, taped over the bore with the `camera_cross_base` under it: the "
+        "camera looks at O's mark traced over the base cross, which is the base cross; focus and lock the camera as "
+        "below, and leave the projector's check on one COP for the second time. Then again after the splitter "
+        "seat's push screws are set (they tilt the holder the camera rides on), the film off, as follows in full.")
     d.p(f"The beam is inside the dome: take out the dome's {bolts} flange screws, lift the dome off its register pins "
         "(the beam and the paraboloid come with it) and stand it upside down on the bench, its open base up. Loosen "
         "the paraboloid clamp's set screw and lift the paraboloid off the beam through the open base, its foil packs "

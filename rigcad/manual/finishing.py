@@ -471,6 +471,32 @@ def paint_companions(coat_rows) -> list[tuple[str, str]]:
     return out
 
 
+def sanded_template(mirror: str) -> str:
+    """The outline fab writes of the sanded-stage template that gauges ``mirror`` (rigcad.fab.stage's
+    ``outlines/<template>_sanded.dxf``): its edge is the sanded surface, the design surface behind by the
+    whole coating, the surface the coats go on."""
+    from rigcad.fab.stage import TEMPLATE_MIRROR
+
+    name = next(t for t, m in TEMPLATE_MIRROR.items() if m == mirror)
+    return f"outlines/{name}_sanded.dxf"
+
+
+def sanding_stop(gap_mm: float, mirrors=("dome", "paraboloid")) -> str:
+    """The one rule that stops the knock-down of the print's staircase (section 3 and the recipe's first
+    stage both state it): the guide coat gone from the valleys and the sanded-stage template
+    (:func:`sanded_template`) flush along its whole edge, the thinnest feeler leaf (rigcad.fab.seams.
+    FEELER_LEAF, mm) passing under it nowhere. The finished template (the gauged layer's surface) reads the
+    same state as its gap ``gap_mm`` (mm: the layers up to and including the gauged one) all along it."""
+    from rigcad.fab.seams import FEELER_LEAF
+
+    files = " / ".join(f"`{sanded_template(m)}`" for m in mirrors)
+    return (f"stop where the guide coat is gone from the valleys and the sanded-stage template ({files}, the "
+            f"surface the coats go on) sits on its datum and fits flush along its whole edge: a {FEELER_LEAF:g} mm "
+            "feeler leaf passes under it nowhere. Where a leaf does pass, that area is past the surface already: sand "
+            f"it no more. (The finished template reads the same surface as the template's gap {gap_mm:.3f} mm "
+            f"({gap_mm / 0.0254:.1f} mil) all along it: one rule, two gauges.)")
+
+
 def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str, str, str, str, str]]:
     """The finishing recipe, stage by stage, from print to mirror: (stage, what, how, cure / wait, check).
 
@@ -487,8 +513,8 @@ def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str,
     rows = [("1. Knock down the layer lines", "SiC abrasive film P120, P240, P400 (ISO 6344) on the printed sanding "
              "blocks below", "wet, a drop of soap in the water; strokes around the axis, each block within its "
              "slide along the meridian", "-",
-             f"guide coat (dry black powder, e.g. 3M 05861) gone everywhere; the template's gap {gap:.3f} mm "
-             f"({gap / 0.0254:.1f} mil) all along it: the print's staircase is gone{stock}")]
+             f"the print's staircase gone (dry black powder as guide coat, e.g. 3M 05861){stock}: "
+             + sanding_stop(gap, tuple(stock_mm) if stock_mm else ("dome", "paraboloid")))]
     for k, (name, t) in enumerate(layers):
         gap -= t
         what, how, cure = LAYER_METHODS.get(name, (name, "as its maker's data sheet says", "per data sheet"))
@@ -509,7 +535,7 @@ def recipe(profile, stock_mm: dict[str, float] | None = None) -> list[tuple[str,
 
 
 __all__ = ["ABRASIVE", "ABRASIVE_MM", "BLOCK_LENGTH_MM", "BLOCK_SAG_MM", "block_bands", "block_part", "block_slide",
-           "sanding_block_set", "template_datums", "template_text", "CLEAR_REFLECTANCE", "LAYER_METHODS", "principal_radii", "recipe",
+           "sanding_block_set", "sanded_template", "sanding_stop", "template_datums", "template_text", "CLEAR_REFLECTANCE", "LAYER_METHODS", "principal_radii", "recipe",
            "placement_spot", "sanding_blocks", "slope_acceptance", "COMPARATOR_UM", "CUT_EDGE_MM",
            "EDGE_SHARE", "TEMPLATE_MATERIAL", "template_gaps", "template_making", "template_making_text",
            "HARDENER_SHARE", "REDUCER_SHARE", "SLOPE_PASS_FRACTION", "STRAIGHTEDGES_MM", "STRAIGHTEDGE_OVERHANG_MM", "TWO_COMPONENT", "paint_companions"]

@@ -122,8 +122,9 @@ def schedule(rig, fab_report: dict | None = None, steps=None) -> tuple[Stage, ..
     out += [
         _s("Melt the dome's beam-seat inserts and the clamp's insert; press the beam's stop pin.", ASSEMBLE,
            needs={"dome whole"}, makes={"dome inserts"}),
-        _s("Knock down the mirrors' layer lines on the printed sanding blocks to the template's gap (the dome whole, "
-           "upside down on blocks, its open base up: the template reads it from there, section 3).", SAND,
+        _s("Knock down the mirrors' layer lines on the printed sanding blocks until the sanded-stage template fits "
+           "flush (the dome whole, upside down on blocks, its open base up: the template reads it from there, "
+           "section 3).", SAND,
            needs={"dome whole", "templates cut"}, makes={"mirrors sanded"}),
         _s("Spray the base, the primer (blocked) and the clear coat; cure, wet-sand and polish the clear coat.",
            RECIPE, needs={"mirrors sanded"}, makes={"clear coat polished"}),

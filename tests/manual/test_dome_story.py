@@ -122,6 +122,14 @@ def camera_cross_contradictions(md: str, doc: dict) -> list[str]:
         out.append("the schedule lifts the dome off to hang the camera cross; the section does not say so first")
     if "put the paraboloid back" in stage["what"] and "put the paraboloid back" not in text[hang:].lower():
         out.append("the schedule puts the paraboloid back after the camera cross; the section does not")
+    stages = doc["schedule"]
+    slope = next((k for k, s in enumerate(stages) if s["where"] == C.STEP_ACCEPTANCE and "Slope" in s["what"]), None)
+    if slope is not None and any(s["where"] == C.STEP_CAMERA for s in stages[:slope]):
+        if "First before the slope test" not in text:
+            out.append("the schedule aligns the camera before the slope test; its section does not say so")
+        test = md.split(f"### {C.STEP_ACCEPTANCE}", 1)[1].split("\n### ", 1)[0]
+        if "the camera aligned on its two crosses" not in test:
+            out.append("the schedule aligns the camera before the slope test; the test does not ask for it")
     return out
 
 
@@ -136,5 +144,8 @@ def test_section_6s_camera_crosses_take_the_dome_off_as_the_schedule_does(writte
     # never put back) is caught
     old = md.split(f"### {C.STEP_CAMERA}", 1)[1].split("\n### ", 1)[0]
     body = "\n\nHang the `camera_cross_hung` on the beam in place of the paraboloid."
-    assert len(camera_cross_contradictions(md.replace(old, body), doc)) == 2
+    assert len(camera_cross_contradictions(md.replace(old, body), doc)) == 3
+    # planted: the slope test's camera only 'in its place on the tower', as the lab technician read it
+    planted = md.replace("the camera aligned on its two crosses", "the camera in its place on the tower")
+    assert planted != md and len(camera_cross_contradictions(planted, doc)) == 1
 
