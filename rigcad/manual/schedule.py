@@ -153,6 +153,14 @@ def schedule(rig, fab_report: dict | None = None, steps=None) -> tuple[Stage, ..
     built = _rest_stage(steps, tower)
     if built is not None:
         out.append(built)
+    out += _slope_and_coat(tower)
+    return tuple(out + _calibration(rig, tower))
+
+
+def _slope_and_coat(tower: bool) -> list[Stage]:
+    """The slope test on the polished clear coat, the camera aligned first when the tower carries it, then
+    the mirror coat."""
+    out = []
     if tower:  # the slope test's budget counts the paraboloid's placement only: the camera must be on its place
         out.append(_s(CAMERA_FIRST, C.STEP_CAMERA, needs={"camera on", "cross in the bore", "dome on its register",
                                                           "film laid", "paraboloid placed"},
@@ -166,7 +174,7 @@ def schedule(rig, fab_report: dict | None = None, steps=None) -> tuple[Stage, ..
            "spray the mirror coat on both; let it cure; set the paraboloid back and the dome on its pins.",
            RECIPE, needs={"slope passed", "dome on its register"}, makes={"mirrors coated"}),
     ]
-    return tuple(out + _calibration(rig, tower))
+    return out
 
 
 def _calibration(rig, tower: bool) -> list[Stage]:
