@@ -335,9 +335,9 @@ CLEAR_REFLECTANCE = 0.04
 #: gives it: (what, how, cure / wait). A layer not named here is applied as its maker's data sheet says.
 #: A 2K (isocyanate) coat needs a supplied-air or A2/P3 respirator; 1K products are the safer choice.
 LAYER_METHODS = {
-    "black base paint": ("gloss black base (1K acrylic or 2K polyurethane), the ground the mirror coat needs",
-                         "HVLP gun, 1.3-1.4 mm nozzle at ~2 bar (or aerosol), 2-3 thin wet coats, 10 min flash-off "
-                         "between, 20-25 cm from the surface", "1K: 24 h; 2K: per data sheet (about 12 h at 20 C)"),
+    "black base paint": ("2K polyurethane gloss black base with its hardener, the ground the mirror coat needs",
+                         "HVLP gun, 1.3-1.4 mm nozzle at ~2 bar, 2-3 thin wet coats, 10 min flash-off "
+                         "between, 20-25 cm from the surface", "per data sheet (about 12 h at 20 C)"),
     "polyurethane primer": ("2K polyurethane primer-surfacer with its hardener: it fills what sanding left",
                             "HVLP 1.4 mm, 2 coats, 10 min flash; then block it wet P600-P800 on the sanding blocks "
                             "with a guide coat until the guide coat is gone", "per data sheet (about 12 h at 20 C) "
@@ -447,9 +447,9 @@ def template_making_text(rows: list[dict]) -> str:
 
 #: The two-component (2K) coats of LAYER_METHODS: each is bought with its own system's hardener and reducer
 #: (thinner), by the product's data sheet. The most each can take by volume, as a share of the paint, for the
-#: quantities to order: 2K polyurethane primers and clears mix 2:1 to 4:1 paint : hardener (at most half the
+#: quantities to order: 2K polyurethane bases, primers and clears mix 2:1 to 4:1 paint : hardener (at most half the
 #: paint's volume) and take up to 20 % reducer.
-TWO_COMPONENT = ("polyurethane primer", "polyurethane clearcoat")
+TWO_COMPONENT = ("black base paint", "polyurethane primer", "polyurethane clearcoat")
 HARDENER_SHARE = 0.5
 REDUCER_SHARE = 0.2
 

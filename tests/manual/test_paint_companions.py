@@ -15,8 +15,11 @@ def test_every_2k_layer_has_its_hardener_and_reducer():
     rig = rigcad.load("achutha2006")
     coat = [dataclasses.asdict(r) for r in B.coating_rows(rig)]
     rows = F.paint_companions(coat)
-    hardened = [name for name, _ in rig.profile.coating.layers if "hardener" in F.LAYER_METHODS.get(name, ("",))[0]]
-    assert hardened and set(hardened) <= set(F.TWO_COMPONENT)  # the recipe's 'with its hardener' layers are 2K here
+    # the recipe's 'with its hardener' or '2K' layers (the black base was '1K acrylic or 2K polyurethane', its
+    # hardener in no list) are 2K here
+    hardened = [name for name, _ in rig.profile.coating.layers
+                if re.search(r"hardener|\b2K\b", F.LAYER_METHODS.get(name, ("",))[0])]
+    assert "black base paint" in hardened and set(hardened) <= set(F.TWO_COMPONENT), (hardened, F.TWO_COMPONENT)
     for layer in hardened:
         paint = sum(r["to_buy_cm3"] for r in coat if r["layer"] == layer)
         for what, share in (("Hardener", F.HARDENER_SHARE), ("Reducer", F.REDUCER_SHARE)):
