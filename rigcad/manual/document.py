@@ -955,16 +955,16 @@ def step_text(placed, meshes_by_name: dict, prepared: dict | None = None, shim_m
         outer, way = lifted.replace("_", " "), _dir_name(placed.direction)
         text += (f"The {outer} is off its register pins, upside down on the bench with its open base up, as step "
                  f"{off_since} left it: ")
-        text += (f"put the part in through the {outer}'s open base onto the {on}." if way in ("-z (down)", "+z (up)")
+        text += (into_upturned(outer, on, placed.direction) if way in ("-z (down)", "+z (up)")
                  else f"{MOVES.get(way, f'move it in along {way}')}, into the upturned {outer}, until it lies "
                  + (f"in the {outer}'s seats." if on == outer else f"on the {on}."))
     elif lifted:
         outer = lifted.replace("_", " ")
         text += (f"The {outer} is on its register pins now and closes round this part (its top opening leaves no "
                  f"room to work through): take out the {outer}'s screws, lift it straight off its pins (what it carries "
-                 f"rides with it) and stand it upside down on the bench; put the part in through the {outer}'s open "
-                 f"base onto the {on}, then set the {outer} back on its pins and screw it down to its torque (section "
-                 f"6 does the same whenever this part is handled).")
+                 f"rides with it) and stand it upside down on the bench. "
+                 + into_upturned(outer, on, placed.direction) + f" Then set the {outer} back on its pins and screw it "
+                 f"down to its torque (section 6 does the same whenever this part is handled).")
     else:
         text += MOVES.get(_dir_name(placed.direction), f"move it in along {_dir_name(placed.direction)}").capitalize()
         text += f" until it rests on the {on}." if st.needs else " onto the bench."
@@ -1030,14 +1030,30 @@ def dome_words(name: str, dome: dict, number: dict[str, int]) -> tuple[str, str]
 
 
 def lifted_way(direction):
-    """The way a part goes into the upturned dome in its step's picture (assembly.lifted_view's frame): a part
-    lowered or pushed up goes down into its open base, now on top; one slid in level keeps its way, turned."""
+    """The way a part goes onto what carries it in the upturned dome, in its step's picture (assembly.lifted_view's
+    frame): its working ``direction`` turned with the dome (UPSIDE_DOWN). A part lowered onto the beam in the
+    working position (the paraboloid's U clamp, open at the bottom) is pushed up onto it from below in the upturned
+    dome, its opening towards the open base; one slid in level keeps its way, turned."""
     import numpy as np
 
     from rigcad.manual.assembly import UPSIDE_DOWN
 
-    d = np.asarray(direction, float)
-    return np.array([0.0, 0.0, -1.0]) if abs(d[2]) > 0.5 else UPSIDE_DOWN @ d
+    return UPSIDE_DOWN @ np.asarray(direction, float)
+
+
+def into_upturned(outer: str, on: str, direction) -> str:
+    """How a part that goes onto ``on`` along the vertical ``direction`` (its working position's) gets there with
+    ``outer`` (the dome) upside down, its open base up, and what holds it then (:func:`lifted_way`). Lowered onto
+    ``on`` in the working position, it sits under ``on`` in the upturned dome, its opening towards the open base:
+    it goes in beside ``on`` and up onto it from below, and hangs there on its clamping screw alone."""
+    if lifted_way(direction)[2] < 0:  # pushed up in the working position: lowered onto it from above now
+        return f"Put the part in through the {outer}'s open base and lower it onto the {on}."
+    return (f"Upside down, the part belongs under the {on}, its clamp's open side up, towards the {outer}'s open "
+            f"base: lower it through the open base beside the {on}, past the {on}'s side, then push it up onto the "
+            f"{on} from below, its open side first, and hold it there while you tighten its set screw. While the "
+            f"{outer} is upside down nothing else holds it (its clamp hangs under the {on}): lay a folded lint-free "
+            f"cloth in the {outer} under it, tighten the set screw before you let go, and keep a hand under the part "
+            "whenever the set screw is loosened (to set its foil packs, or to take it off).")
 
 
 #: In a step's picture the shims of a stack are drawn apart by this fraction of the picture's size, so
@@ -1603,9 +1619,10 @@ def _camera_crosses_step(d: Doc, c, cam: dict) -> None:
         "below, and leave the projector's check on one COP for the second time. Then again after the splitter "
         "seat's push screws are set (they tilt the holder the camera rides on), the film off, as follows in full.")
     d.p(f"The beam is inside the dome: take out the dome's {bolts} flange screws, lift the dome off its register pins "
-        "(the beam and the paraboloid come with it) and stand it upside down on the bench, its open base up. Loosen "
-        "the paraboloid clamp's set screw and lift the paraboloid off the beam through the open base, its foil packs "
-        "kept with it (in their places: they hold its setting). "
+        "(the beam and the paraboloid come with it) and stand it upside down on the bench, its open base up. The "
+        "paraboloid's clamp hangs under the beam now, its open side up, on its set screw alone: a hand under the "
+        "paraboloid, loosen the set screw, draw the clamp down off the beam and take the paraboloid out past the "
+        "beam's side through the open base, its foil packs kept with it (in their places: they hold its setting). "
         f"Hang the `camera_cross_hung` on the beam in place of the paraboloid (its centre at the paraboloid's "
         f"vertex, z = {cam['hung_cross_z_mm']:.1f} mm), the `camera_cross_base` in the sample holder's place in the bore "
         "(its top on z = 0; it stays there from the earlier steps). Set the dome back on its pins and screw it down to its torque before you look: the cross "
@@ -1618,7 +1635,8 @@ def _camera_crosses_step(d: Doc, c, cam: dict) -> None:
     d.p(C.camera_focus_and_lock(rig, c.printer))
     d.p(C.shared_cop_text(rig, c.printer))
     d.p(f"**Then put the paraboloid back:** the {bolts} flange screws out, the dome lifted off and upside down again, "
-        "the hung cross off the beam; clamp the paraboloid on the beam as before (its end on the stop pin, its foil "
+        "the hung cross off the beam; clamp the paraboloid on the beam as before (in through the open base beside the "
+        "beam, then up onto it from below, a hand under it until the set screw holds; its end on the stop pin, its foil "
         "packs in their places, the set screw tightened), set the dome back on its pins and screw it down to its "
         "torque. Take the `camera_cross_base` out of the bore and put the sample holder back in its place.")
 

@@ -140,7 +140,8 @@ def schedule(rig, fab_report: dict | None = None, steps=None) -> tuple[Stage, ..
            "trace O on it.", C.STEP_FILM, needs={"base plate down", "dome off", "dome register drilled"},
            makes={"film laid", "cross in the bore"}, ends={"sample holder in the bore", "plate top clear"}),
         _s("With the dome still off (upside down on the bench, its open base up), slide the beam in through its "
-           "slots onto its seats and put in the paraboloid on it through the dome's open base (their steps).",
+           "slots onto its seats, and put the paraboloid in through the dome's open base beside the beam and up onto "
+           "it from below (their steps).",
            ASSEMBLE, needs={"dome off", "dome register drilled"},
            makes={"paraboloid on the beam"}, places=("beam", "paraboloid")),
         _s("Indicate the paraboloid in on the dome's axis (the dome upside down on the turntable, centred on its base) "

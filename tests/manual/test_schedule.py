@@ -37,7 +37,7 @@ def test_every_stage_finds_the_state_it_needs(stages):
     film = _index(stages, C.STEP_FILM, "lay the film")
     drill = _index(stages, S.ASSEMBLE, "Indicate the dome")
     dome = _index(stages, S.ASSEMBLE, "back on its register")
-    paraboloid = _index(stages, S.ASSEMBLE, "the paraboloid on it")
+    paraboloid = _index(stages, S.ASSEMBLE, "put the paraboloid in")
     lap = _index(stages, "5. Assemble (tower column)", "Lap")
     join = _index(stages, S.PRINT, "Join")
     camera = _index(stages, C.STEP_CAMERA, "before the slope test")
@@ -77,7 +77,7 @@ def test_a_stage_out_of_order_is_refused(stages):
     ((C.STEP_FILM, "lay the film"), (S.ASSEMBLE, "Indicate the dome"), "sample holder in the bore"),
     # the paraboloid lowered into the dome once it is bolted down (its top opening too small): it goes in
     # while the dome is off
-    ((S.ASSEMBLE, "the paraboloid on it"), (C.STEP_ACCEPTANCE, "Slope"), "dome off"),
+    ((S.ASSEMBLE, "put the paraboloid in"), (C.STEP_ACCEPTANCE, "Slope"), "dome off"),
     # the film's ring and tape left under the calibration screens, the checkerboard and the gray card
     ((C.STEP_FILM, "peel the whole film"), (None, None), "plate top clear"),
     # the slope test on an unplaced paraboloid (its lateral stack alone throws rays past the disc)
