@@ -106,15 +106,15 @@ def test_the_command_passes_the_assembly_gate_to_the_certified_path(monkeypatch,
 @pytest.mark.e2e  # the gate on two whole rigs: ~30 s
 def test_the_real_gate_refuses_a_rig_that_cannot_go_together_and_the_next_design_is_taken(
         monkeypatch, tmp_path, table31_text, table31_rig):
-    """The certified path with the command's own gate on real rigs: the first design is the low-pupil
-    rig whose splitter cannot go in (tests/manual/test_gate.py), the second the default rig; the first
-    gives way, naming the splitter, and the default is chosen."""
+    """The certified path with the command's own gate on real rigs: the first design is the rig whose
+    splitter holder cannot go in (the splitter 55 mm under the COP: tests/manual/test_gate.py), the
+    second the default rig; the first gives way, naming the holder, and the default is chosen."""
     from rigcad.cli.optimize import assembly_gate
     from rigcad.profile import load_profile
     from rigcad.rig import Rig
 
-    path = tmp_path / "low.yaml"
-    path.write_text(table31_text.lstrip("\n") + "projector:\n  pupil_height: 25 mm\n  lens_diameter: 25 mm\n")
+    path = tmp_path / "blocked.yaml"
+    path.write_text(table31_text.lstrip("\n") + "tower:\n  splitter_distance: 55 mm\n")
     rigs = {1: Rig.from_profile(load_profile(path)), 2: table31_rig}
     rows = [{"index": 1}, {"index": 2}]
     monkeypatch.setattr(R, "preference", lambda problem, result: [(r, f"preferred {r['index']}") for r in rows])
@@ -129,4 +129,4 @@ def test_the_real_gate_refuses_a_rig_that_cannot_go_together_and_the_next_design
     rejected = R._certify_choice(None, result, report, assembly_gate)
     assert result.chosen is rows[1] and report["status"] == "ok"
     assert [r["index"] for r in rejected] == [1]
-    assert "beam_splitter cannot go in" in rejected[0]["error"] and "projector.pupil_height" in rejected[0]["error"]
+    assert "splitter_holder cannot go in" in rejected[0]["error"] and "tower.splitter_distance" in rejected[0]["error"]
