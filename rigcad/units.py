@@ -1,8 +1,8 @@
 """Units at the boundary: parse ``"13.5 cm"``, ``"11 in"``, ``"5.5 mil"``, ``"20 deg"``.
 
-Inside rigcad every length is in millimetres and every angle in radians (float64). Profiles must
-say their unit; a bare number is refused for a length or an angle (except ``0``), because a
-silently assumed unit is how a 27 cm distance becomes 27 mm.
+Inside rigcad every length is in millimetres, every angle in radians and every mass in kilograms
+(float64). Profiles must say their unit; a bare number is refused for a length, an angle or a mass
+(except ``0``), because a silently assumed unit is how a 27 cm distance becomes 27 mm.
 """
 
 from __future__ import annotations
@@ -40,7 +40,17 @@ ANGLE_UNITS: dict[str, float] = {
     "urad": 1e-6,
 }
 
-KINDS = {"length": LENGTH_UNITS, "angle": ANGLE_UNITS}
+#: Kilograms per unit of mass (an instrument's weight on the tower; internally kilograms).
+MASS_UNITS: dict[str, float] = {
+    "g": 1e-3,
+    "kg": 1.0,
+    "oz": 0.028349523125,
+    "lb": 0.45359237,
+}
+
+KINDS = {"length": LENGTH_UNITS, "angle": ANGLE_UNITS, "mass": MASS_UNITS}
+#: The unit an error's example shows, per kind.
+EXAMPLE_UNIT = {"length": "mm", "angle": "deg", "mass": "kg"}
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _QUANTITY = re.compile(rf"^\s*(?P<num>{_NUMBER}|[-+]?inf(?:inity)?)\s*(?P<unit>[^\s\d.+-][^\s]*)?\s*$",
@@ -68,7 +78,7 @@ def parse_quantity(text: object, kind: str) -> float:
     if isinstance(text, (int, float)):
         if text == 0 or (kind == "length" and math.isinf(text)):
             return float(text)
-        raise UnitError(f"a {kind} needs a unit, e.g. '{text} {'mm' if kind == 'length' else 'deg'}' (units: {valid})")
+        raise UnitError(f"a {kind} needs a unit, e.g. '{text} {EXAMPLE_UNIT[kind]}' (units: {valid})")
     if not isinstance(text, str):
         raise UnitError(f"expected a {kind} such as '13.5 cm' or '20 deg', got {text!r}")
     for i, ch in enumerate(text):

@@ -21,6 +21,8 @@ def _fmt(spec, value) -> str:
         return "inf" if math.isinf(value) else f"{value:.6g} mm"
     if spec.kind == "angle":
         return f"{value / DEG:.6g} deg"
+    if spec.kind == "mass":
+        return f"{value:.6g} kg"
     if spec.kind == "layers":
         return "; ".join(f"{name} {t / 0.0254:.4g} mil" for name, t in value) + f" (total {sum(t for _, t in value) / 0.0254:.4g} mil)"
     return str(list(value) if isinstance(value, tuple) else value)

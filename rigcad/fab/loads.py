@@ -118,10 +118,10 @@ def skin(printer: Printer) -> Skin:
     return Skin(side, top, bottom, infill, f"{printer.name}'s resolved slicer settings")
 #: A hand-tight screw with a hex key (N m): the torque a lab applies when no figure is given.
 HAND_TIGHT_NM = 1.0
-#: Instruments' and printed parts' masses the profile does not state (kg; assumed: a desktop
-#: projector of the PB6210 class, a machine-vision camera with its lens, the printed splitter holder
-#: with its plate and lens mount). A profile's ``projector.mass`` / ``camera.mass`` replace them.
-ASSUMED_MASS_KG = {"projector": 3.0, "camera": 0.3, "holder": 0.2}
+#: The printed splitter holder's mass with its plate and lens mount (kg; assumed). The instruments' masses
+#: are profile keys, ``projector.mass`` and ``camera.mass`` (their schema defaults are the assumed 3 kg and
+#: 0.3 kg: rigcad.profile.schema), read by :func:`_mass`.
+ASSUMED_MASS_KG = {"holder": 0.2}
 #: A tilt of the shelf under the splitter's seat turns the projector's reflected axis this many times
 #: (the law of reflection; the projector's feet stand elsewhere on the shelf): it eats
 #: ``tolerancing.projector_tilt`` twice. The column's turn tilts the whole tower: once.
@@ -378,7 +378,8 @@ def _mass(profile, key: str, masses) -> float:
     if masses and key in masses:
         return masses[key]
     section = getattr(profile, key, None)
-    return getattr(section, "mass", None) or ASSUMED_MASS_KG[key]
+    mass = getattr(section, "mass", None)
+    return mass if mass is not None else ASSUMED_MASS_KG[key]
 
 
 def deflections(profile, layout, printer: Printer, masses: dict[str, float] | None = None) -> tuple[Deflection, ...]:

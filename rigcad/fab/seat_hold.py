@@ -65,7 +65,7 @@ def seat_hold(profile, layout, masses: dict[str, float] | None = None, preload_n
     """The seat's restoring moments and lift-off side pull (:class:`SeatHold`) from the seat's contacts
     and springs as drawn, the springs' preload (each; default the bought springs' at their installed
     length, rigcad.parts.tower.spring_force), and the holder's and the camera's weights (kg: ``masses``,
-    else the profile's ``camera.mass`` or rigcad.fab.loads.ASSUMED_MASS_KG) at the holder's middle and
+    else the holder's rigcad.fab.loads.ASSUMED_MASS_KG and the profile's ``camera.mass``) at the holder's middle and
     the camera body's centre; the camera's height is its body's centre over the balls' centres."""
     t = layout.tower
     seat = T.splitter_seat(profile, layout)

@@ -423,6 +423,8 @@ def _describe(obj, profile=None, section: str = "") -> str:
             text = f"{v:.4g} mm"
         elif kind == "angle":
             text = f"{v / DEG:.4g} deg"
+        elif kind == "mass":
+            text = f"{v:.4g} kg"
         elif kind == "pixels":
             text = f"{v[0]} x {v[1]} px"
         else:

@@ -295,6 +295,7 @@ def measure_first(d: Doc, c) -> None:
     rows = assumed_sizes(c.p)
     d.h(2, "0. Before printing: measure or choose")
     _optics_figures(d, c.p)
+    _weigh_first(d, c.p)
     if not rows:
         d.p("Every instrument size in this profile is given, none assumed: nothing to measure first.")
         return
@@ -308,6 +309,18 @@ def measure_first(d: Doc, c) -> None:
         "from and to:")
     for path, caption in measurement_figures(c.p, c.files):
         d.img(path, caption)
+
+
+def _weigh_first(d: Doc, profile) -> None:
+    """The instruments' masses the profile only assumes (``projector.mass``, ``camera.mass``: their schema
+    defaults): the shelf's and the column's bending, the seat's hold and the rig's stance are judged with them."""
+    rows = [(f"{section}.mass", getattr(profile, section).mass) for section in ("projector", "camera")
+            if profile.set_by(section, "mass") == "default"]
+    if rows:
+        d.p("Weigh " + " and ".join(f"the {k.split('.')[0]} with its lens (`{k}`, assumed {m:g} kg)" for k, m in rows)
+            + " on a kitchen scale and write the figure into the profile with its unit: the shelf's and the "
+            "column's bending, the splitter seat's hold and the rig's stance are judged with it (section 5's "
+            "'Torques, and what bends'; a heavier projector may need `buy.shelf: aluminium_plate`).")
 
 
 def _optics_figures(d: Doc, profile) -> None:

@@ -67,7 +67,7 @@ class Spec:
     choices: tuple[str, ...] = ()
 
     def describe_range(self) -> str:
-        unit, scale = {"length": ("mm", 1.0), "angle": ("deg", DEG)}.get(self.kind, ("", 1.0))
+        unit, scale = {"length": ("mm", 1.0), "angle": ("deg", DEG), "mass": ("kg", 1.0)}.get(self.kind, ("", 1.0))
         if self.kind == "choice":
             return "one of " + ", ".join(self.choices)
         if self.kind == "name":
@@ -157,6 +157,8 @@ class ProjectorParams:
     pupil_depth: float = spec("length", "entrance pupil (the COP) behind the lens barrel's front, along the axis "
                               "(assumed)", "10 mm", lo=0)
     pupil_height: float = spec("length", "optical axis above the body's bottom face (assumed)", "55 mm", **_POS)
+    mass: float = spec("mass", "mass with its lens, on the shelf (assumed: a desktop projector of the PB6210's class; "
+                       "weigh it)", "3 kg", lo=0.0, lo_open=True)
     pupil_lateral: float = spec("length", "optical axis's offset from the body's centre line, across (assumed)",
                                 "0 mm")
     mount_thread: str = spec("choice", "thread of the body's mounting holes (ceiling mount; assumed)", "M4",
@@ -208,6 +210,8 @@ class CameraParams:
                               "(assumed)", "15 mm", lo=0)
     pupil_height: float = spec("length", "optical axis above the body's mounting (tripod) face (assumed: centred)",
                                "16.5 mm", **_POS)
+    mass: float = spec("mass", "mass with its lens, on its bracket (assumed: a machine-vision camera with a C-mount "
+                       "lens; weigh it)", "0.3 kg", lo=0.0, lo_open=True)
     mount_thread: str = spec("choice", "thread of the tripod hole in the mounting face (assumed)", "1/4-20 UNC",
                              choices=tuple(MOUNT_THREADS))
     mount_spacing: float = spec("length", "between the two screws that hold the camera (its mounting holes, or a "
@@ -801,7 +805,7 @@ def convert_value(s: Spec, value: Any, key: str, where: str | None) -> Any:
         raise fail(f"has no value; expected {s.doc} ({s.describe_range()})")
     if s.kind in ("str", "name", "point", "pixels"):  # text, an instrument file's name, pixels: no range after
         return _text_or_point(s, value, fail)
-    if s.kind in ("length", "angle"):
+    if s.kind in ("length", "angle", "mass"):
         try:
             out = parse_quantity(value, s.kind)
         except UnitError as err:

@@ -28,7 +28,7 @@ def _by_hand(rig, spring: float):
     cam = (0.5 * (t.camera_box[0][0] + t.camera_box[1][0]), 0.0)
     loads_ = [(spring, *xy) for xy in T._holder_flange_points(t, p)] + [
         (loads.ASSUMED_MASS_KG["holder"] * 9.80665, 0.5 * sum(t.holder_x), 0.0),
-        (loads.ASSUMED_MASS_KG["camera"] * 9.80665, *cam)]
+        (rig.profile.camera.mass * 9.80665, *cam)]
     cone_vee = sum(f * (x_cv - x) for f, x, _ in loads_)
     vee = np.array(pts["vee"])
     e = (flat - vee) / np.linalg.norm(flat - vee)
@@ -39,7 +39,7 @@ def _by_hand(rig, spring: float):
 
 def test_the_restoring_moments_are_the_hand_calculation(table31_rig):
     p, lay = table31_rig.profile, table31_rig.layout
-    assert getattr(p.camera, "mass", None) is None  # the assumed masses (loads.ASSUMED_MASS_KG) are the hand calculation's
+    assert p.set_by("camera", "mass") == "default" and p.camera.mass == 0.3  # the assumed mass: the hand calculation's
     for spring in (14.0, T.spring_force(1)["force_N"]):
         hold = H.seat_hold(p, lay, preload_n=spring)
         cone_vee, side = _by_hand(table31_rig, spring)
