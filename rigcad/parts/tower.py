@@ -561,7 +561,9 @@ def _holder_flange_points(t: TowerLayout, profile: Profile):
     x = t.holder_x[0] + 8.0
     play = (sp["outer_diameter"] - 2 * sp["wire"] - m4.major) / 2  # the spring off-centre on the bolt
     reach = max(m4.washer_od, sp["outer_diameter"], 2 * m4.nut_corner_radius) / 2 + play
-    top = t.shelf_top_z - t.shelf_thickness - m4.washer_thickness + spring_bolt_length(profile, t)
+    need = _spring_bolt_grip(profile, t) + nut_allowance("M4")
+    length = shortest_screw("M4", need) or need  # where it stands only: the bill refuses a length none stocks
+    top = t.shelf_top_z - t.shelf_thickness - m4.washer_thickness + length
     if top + GROOVE_GAP <= _plate_floor(t, x - reach):
         return [(x, -y), (x, y)]
     return [(x, -y), (min(x, _plate_extent(t.plate)[0] - reach - GROOVE_GAP), y)]
@@ -575,11 +577,15 @@ def _plate_floor(t: TowerLayout, x: float) -> float:
     return max(t.plate_bottom_z, x + cz - cx)
 
 
+def _spring_bolt_grip(profile: Profile, t: TowerLayout) -> float:
+    """What a spring bolt passes (mm): the shelf, the seat's gap, the holder's flange, the free spring."""
+    return t.shelf_thickness + seat_gap(profile) + profile.tower.wall + SEAT_SPRING["free_length"]
+
+
 def spring_bolt_length(profile: Profile, t: TowerLayout) -> float:
-    """The splitter holder's spring bolts' length (mm): up through the shelf, the seat's gap, the
-    holder's flange and the spring at its free length, with two washers and a nut past them."""
-    grip = t.shelf_thickness + seat_gap(profile) + profile.tower.wall + SEAT_SPRING["free_length"]
-    return _length("M4", grip, nut_allowance("M4"))
+    """The splitter holder's spring bolts' length (mm): through their grip with two washers and a nut
+    past it (GeometryError when no stocked M4 screw is that long)."""
+    return _length("M4", _spring_bolt_grip(profile, t), nut_allowance("M4"))
 
 
 #: The shelf's M4 heat-set inserts (rigcad.standards.INSERTS: the maker's hole and the insert's length).
