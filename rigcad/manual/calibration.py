@@ -596,7 +596,7 @@ def kit_items(rig) -> list[KitItem]:
     items = [
         KitItem("Matte drafting film, polyester, one side matte", "1 sheet (A4)",
                 f"{1e3 * f['film_thickness_mm']:g} µm thick; a disc of {f['film_diameter_mm']:.0f} mm is cut from it",
-                ("drafting film", "film"), (*seat, STEP_CIRCLE, STEP_FILM, STEP_ACCEPTANCE)),
+                ("drafting film", "film"), (*seat, STEP_CIRCLE, STEP_FILM, STEP_CAMERA, STEP_ACCEPTANCE)),
         KitItem("Low-tack masking tape, 19 mm", "1 roll", "paper, low tack (it comes off the plate clean)",
                 ("tape",), (STEP_CROSSES, STEP_FILM, STEP_CAMERA, STEP_ACCEPTANCE)),  # the focus rings too
         KitItem("Fine pen for film", "1", "permanent fineliner, 0.1-0.3 mm line, that marks polyester",
