@@ -32,7 +32,8 @@ def _counted(monkeypatch, module, name: str) -> dict:
     return calls
 
 
-def _run(*args) -> tuple[int, str, str]:
+def run_cli(*args) -> tuple[int, str, str]:
+    """Run the command line in this process: (exit status, stdout, stderr)."""
     from rigcad.cli import main
 
     out, err = io.StringIO(), io.StringIO()
@@ -69,30 +70,30 @@ def test_check_reads_back_and_a_change_redoes_it(tmp_path, monkeypatch):
     calls = _counted(monkeypatch, api, "check")
     ex = tmp_path / "exports"
     opts = ["--exports", str(ex), "--rays", "2000", "--mode", "analytic", "--no-monte-carlo"]
-    code, out, _ = _run("check", "achutha2006", *opts)
+    code, out, _ = run_cli("check", "achutha2006", *opts)
     assert code == 0 and calls["n"] == 1, out
     folder = ex / "achutha2006" / "check"
     before = _state(folder)
-    code, again, _ = _run("check", "achutha2006", *opts)
+    code, again, _ = run_cli("check", "achutha2006", *opts)
     assert code == 0 and calls["n"] == 1  # read back: not traced
     assert _state(folder) == before  # nothing written
     assert again.splitlines()[:-3] == out.splitlines()[:-4]  # the same figures and table (less 'wrote' lines)
-    assert _run("check", "achutha2006", *opts[:3], "2500", *opts[4:])[0] == 0 and calls["n"] == 2  # an option
-    assert _run("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 3
+    assert run_cli("check", "achutha2006", *opts[:3], "2500", *opts[4:])[0] == 0 and calls["n"] == 2  # an option
+    assert run_cli("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 3
     (ex / "achutha2006" / "stl").mkdir(parents=True)
     (ex / "achutha2006" / "stl" / "beam.stl").write_bytes(b"solid beam\nendsolid beam\n")  # an input file
-    assert _run("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 4
+    assert run_cli("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 4
     good = _flip(folder / "spot.png")  # an edited output
-    assert _run("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 5
+    assert run_cli("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 5
     assert (folder / "spot.png").read_bytes() == good  # written anew, the same bytes
     (folder / "theta_map.png").unlink()  # a missing output
-    assert _run("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 6
+    assert run_cli("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 6
     monkeypatch.setattr(reuse, "running_code", lambda: "another version of rigcad")  # the code
-    assert _run("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 7
-    assert _run("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 7
+    assert run_cli("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 7
+    assert run_cli("check", "achutha2006", *opts)[0] == 0 and calls["n"] == 7
     monkeypatch.undo()
     calls = _counted(monkeypatch, api, "check")
-    assert _run("check", str(_changed_profile(tmp_path)), *opts)[0] == 0 and calls["n"] == 1  # a profile key
+    assert run_cli("check", str(_changed_profile(tmp_path)), *opts)[0] == 0 and calls["n"] == 1  # a profile key
 
 
 def test_view_reads_back_and_a_change_redoes_it(tmp_path, monkeypatch):
@@ -101,17 +102,17 @@ def test_view_reads_back_and_a_change_redoes_it(tmp_path, monkeypatch):
     calls = _counted(monkeypatch, view, "write_view")
     ex = tmp_path / "exports"
     opts = ["--exports", str(ex), "--rays", "20"]
-    assert _run("view", "achutha2006", *opts)[0] == 0 and calls["n"] == 1
+    assert run_cli("view", "achutha2006", *opts)[0] == 0 and calls["n"] == 1
     folder = ex / "achutha2006" / "view"
     before = _state(folder)
-    code, out, _ = _run("view", "achutha2006", *opts)
+    code, out, _ = run_cli("view", "achutha2006", *opts)
     assert code == 0 and calls["n"] == 1 and "up to date" in out
     assert _state(folder) == before
-    assert _run("view", "achutha2006", *opts[:2], "--rays", "21")[0] == 0 and calls["n"] == 2  # an option
-    assert _run("view", "achutha2006", *opts)[0] == 0 and calls["n"] == 3
+    assert run_cli("view", "achutha2006", *opts[:2], "--rays", "21")[0] == 0 and calls["n"] == 2  # an option
+    assert run_cli("view", "achutha2006", *opts)[0] == 0 and calls["n"] == 3
     (folder / "rig.png").unlink()
-    assert _run("view", "achutha2006", *opts)[0] == 0 and calls["n"] == 4
-    assert _run("view", str(_changed_profile(tmp_path)), *opts)[0] == 0 and calls["n"] == 5  # a profile key
+    assert run_cli("view", "achutha2006", *opts)[0] == 0 and calls["n"] == 4
+    assert run_cli("view", str(_changed_profile(tmp_path)), *opts)[0] == 0 and calls["n"] == 5  # a profile key
 
 
 def test_calibrate_kit_reads_back_and_a_change_redoes_it(tmp_path, monkeypatch):
@@ -119,19 +120,19 @@ def test_calibrate_kit_reads_back_and_a_change_redoes_it(tmp_path, monkeypatch):
 
     calls = _counted(monkeypatch, kit, "write_kit")
     ex = tmp_path / "exports"
-    assert _run("calibrate", "achutha2006", "--kit", "--exports", str(ex))[0] == 0 and calls["n"] == 1
+    assert run_cli("calibrate", "achutha2006", "--kit", "--exports", str(ex))[0] == 0 and calls["n"] == 1
     folder = ex / "achutha2006" / "calibrate_kit"
     before = _state(folder)
-    code, out, _ = _run("calibrate", "achutha2006", "--kit", "--exports", str(ex))
+    code, out, _ = run_cli("calibrate", "achutha2006", "--kit", "--exports", str(ex))
     assert code == 0 and calls["n"] == 1 and "up to date" in out
     assert _state(folder) == before
     _flip(folder / "calibration.md")
-    assert _run("calibrate", "achutha2006", "--kit", "--exports", str(ex))[0] == 0 and calls["n"] == 2
+    assert run_cli("calibrate", "achutha2006", "--kit", "--exports", str(ex))[0] == 0 and calls["n"] == 2
     assert _state(folder).keys() == before.keys()
     monkeypatch.setattr(reuse, "running_code", lambda: "another version of rigcad")
-    assert _run("calibrate", "achutha2006", "--kit", "--exports", str(ex))[0] == 0 and calls["n"] == 3
+    assert run_cli("calibrate", "achutha2006", "--kit", "--exports", str(ex))[0] == 0 and calls["n"] == 3
     changed = _changed_profile(tmp_path)
-    assert _run("calibrate", str(changed), "--kit", "--exports", str(ex))[0] == 0 and calls["n"] == 4
+    assert run_cli("calibrate", str(changed), "--kit", "--exports", str(ex))[0] == 0 and calls["n"] == 4
 
 
 def test_manual_reads_back_and_follows_fab_and_check(tmp_path, monkeypatch):
@@ -144,27 +145,27 @@ def test_manual_reads_back_and_follows_fab_and_check(tmp_path, monkeypatch):
     fabs = _counted(monkeypatch, stage, "_fab_part")
     ex = tmp_path / "exports"
     man = ["--printer", "prusa_mk3s", "--exports", str(ex)]
-    code, _, err = _run("manual", "achutha2006", *man)
+    code, _, err = run_cli("manual", "achutha2006", *man)
     assert code == 0 and manuals["n"] == 1 and fabs["n"] > 0, err[-2000:]
     assert "no `rigcad check` result" in err  # the criteria not judged without a check
     done = fabs["n"]
     folder = ex / "achutha2006" / "manual" / "prusa_mk3s"
     before = _state(folder)
-    code, out, err = _run("manual", "achutha2006", *man)
+    code, out, err = run_cli("manual", "achutha2006", *man)
     assert code == 0 and manuals["n"] == 1 and fabs["n"] == done and "up to date" in out
     assert "no `rigcad check` result" in err  # the note said again
     assert _state(folder) == before
-    assert _run("check", "achutha2006", "--exports", str(ex), "--rays", "2000", "--mode", "analytic",
+    assert run_cli("check", "achutha2006", "--exports", str(ex), "--rays", "2000", "--mode", "analytic",
                 "--no-monte-carlo")[0] == 0
-    code, _, err = _run("manual", "achutha2006", *man)  # a check now judges it: the manual again, fab read back
+    code, _, err = run_cli("manual", "achutha2006", *man)  # a check now judges it: the manual again, fab read back
     assert code == 0 and manuals["n"] == 2 and fabs["n"] == done and "no `rigcad check`" not in err
-    assert _run("manual", "achutha2006", *man)[0] == 0 and manuals["n"] == 2
+    assert run_cli("manual", "achutha2006", *man)[0] == 0 and manuals["n"] == 2
     text = (ROOT / "profiles" / "printers" / "prusa_mk3s.yaml").read_text()
     assert "layer_time_s: 1.0\n" in text
     printer = tmp_path / "printers" / "prusa_mk3s.yaml"
     printer.parent.mkdir()
     printer.write_text(text.replace("layer_time_s: 1.0\n", "layer_time_s: 2.0\n"))
     man[1] = str(printer)
-    assert _run("manual", "achutha2006", *man)[0] == 0 and manuals["n"] == 3 and fabs["n"] > done  # fab again
+    assert run_cli("manual", "achutha2006", *man)[0] == 0 and manuals["n"] == 3 and fabs["n"] > done  # fab again
     done = fabs["n"]
-    assert _run("manual", "achutha2006", *man)[0] == 0 and manuals["n"] == 3 and fabs["n"] == done
+    assert run_cli("manual", "achutha2006", *man)[0] == 0 and manuals["n"] == 3 and fabs["n"] == done

@@ -7,15 +7,13 @@ tests/cache/test_command_readback.py test those); the e2e test runs fab itself."
 
 from __future__ import annotations
 
-import contextlib
-import io
-
 import pytest
 
 from rigcad import api
 from rigcad.check import criteria
 from rigcad.manual import gate
 from rigcad.rig import Rig
+from tests.cache.test_command_readback import run_cli
 
 
 @pytest.fixture
@@ -31,25 +29,16 @@ def rigs(monkeypatch) -> dict:
     return calls
 
 
-def _run(*args) -> tuple[int, str, str]:
-    from rigcad.cli import main
-
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main(list(args))
-    return code, out.getvalue(), err.getvalue()
-
-
 def test_stl_up_to_date_builds_no_rig_once_the_criteria_are_kept(tmp_path, monkeypatch, rigs):
     monkeypatch.setattr(api, "export_up_to_date", lambda profile, folder: True)
     monkeypatch.setattr(gate, "read_verdict", lambda root, profile: gate.Verdict(profile.name, order=("a",)))
     ex = str(tmp_path / "exports")
-    code, out, err = _run("stl", "achutha2006", "--exports", ex)
+    code, out, err = run_cli("stl", "achutha2006", "--exports", ex)
     assert code == 0 and "up to date" in out and rigs["n"] == 1, (out, err)  # the criteria judged: one rig
-    again = _run("stl", "achutha2006", "--exports", ex)
+    again = run_cli("stl", "achutha2006", "--exports", ex)
     assert again == (code, out, err) and rigs["n"] == 1  # the same words, no rig
     (tmp_path / "exports" / "achutha2006" / criteria.KEPT_FILE).unlink()
-    assert _run("stl", "achutha2006", "--exports", ex) == (code, out, err) and rigs["n"] == 2
+    assert run_cli("stl", "achutha2006", "--exports", ex) == (code, out, err) and rigs["n"] == 2
 
 
 def test_fab_read_back_builds_no_rig_once_the_criteria_are_kept(tmp_path, monkeypatch, rigs):
@@ -59,17 +48,17 @@ def test_fab_read_back_builds_no_rig_once_the_criteria_are_kept(tmp_path, monkey
     monkeypatch.setattr(gate, "kept_gate", lambda root, profile: True)
     monkeypatch.setattr(api, "fab_published", lambda *a, **k: FabResult(report, [], reused=True))
     ex = str(tmp_path / "exports")
-    first = _run("fab", "achutha2006", "--printer", "prusa_mk3s", "--exports", ex)
+    first = run_cli("fab", "achutha2006", "--printer", "prusa_mk3s", "--exports", ex)
     assert first[0] == 0 and rigs["n"] == 1, first  # the criteria judged: one rig
-    assert _run("fab", "achutha2006", "--printer", "prusa_mk3s", "--exports", ex) == first and rigs["n"] == 1
+    assert run_cli("fab", "achutha2006", "--printer", "prusa_mk3s", "--exports", ex) == first and rigs["n"] == 1
 
 
 @pytest.mark.e2e  # the assembly gate on the whole rig and fab of the beam: ~30 s
 def test_fab_again_reads_back_with_no_rig(tmp_path, rigs):
     ex = str(tmp_path / "exports")
     args = ("fab", "achutha2006", "--printer", "prusa_mk3s", "--parts", "beam", "--exports", ex)
-    code, out, err = _run(*args)
+    code, out, err = run_cli(*args)
     assert code == 0 and rigs["n"] >= 1, err[-2000:]
     built = rigs["n"]
-    again = _run(*args)
+    again = run_cli(*args)
     assert again[0] == 0 and again[1] == out and rigs["n"] == built, (rigs, again[2][-2000:])  # no rig built
