@@ -23,7 +23,8 @@ def test_the_play_is_the_grooves_as_cut(table31_rig):
     lay = table31_rig.layout
     p = lay.tower.plate
     # the groove's section as the holder cuts it (x-z corners: front -a, front +a, back +a, back -a)
-    lines = T._groove(lay.tower, lay.tower.wall_y[1] + 1.0).solid.section.segments  # its section is the same whatever its reach along y
+    # its section is the same whatever its reach along y
+    lines = T._groove(lay.tower, lay.tower.wall_y[1] + 1.0).solid.section.segments
     pts = np.array([ln.p0 for ln in lines])
     width = float(np.linalg.norm(pts[2] - pts[1]))  # front face to back face, across the plate
     length = float(np.linalg.norm(pts[1] - pts[0]))
