@@ -426,12 +426,18 @@ PLACEMENT_TOLERANCES = {f"{part}_{axis}": f"{part}_{key}" for part in ("parabolo
 PASS_STANDARD_ERRORS = 2.0
 
 
+def dome_farthest_from_o(rig) -> float:
+    """D (mm): the design dome's farthest point from O, on its meridian sampled at 2001 points."""
+    pts = rig.layout.design_dome.points(rig.layout.design_dome.sample(2001))
+    return float(np.max(np.hypot(pts[:, 0], pts[:, 1])))
+
+
 def dome_slope_tolerance(rig) -> float:
     """The dome's slope tolerance (mrad): a slope error e turns a ray by 2 e, which lands 2 e D from O, D
-    the dome's farthest point from O; e stays within ``tolerancing.max_spot_radius`` / (2 D). The same
-    figure the optical acceptance test holds before the calibration (rigcad.manual.finishing)."""
-    pts = rig.layout.design_dome.points(rig.layout.design_dome.sample(2001))
-    return 1e3 * rig.profile.tolerancing.max_spot_radius / (2.0 * float(np.max(np.hypot(pts[:, 0], pts[:, 1]))))
+    the dome's farthest point from O (:func:`dome_farthest_from_o`); e stays within
+    ``tolerancing.max_spot_radius`` / (2 D). The one home of the figure the optical acceptance test holds
+    before the calibration (rigcad.manual.finishing.slope_acceptance) and the calibration's pass criterion."""
+    return 1e3 * rig.profile.tolerancing.max_spot_radius / (2.0 * dome_farthest_from_o(rig))
 
 
 def pass_criterion(rig) -> dict:

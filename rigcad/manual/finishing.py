@@ -95,17 +95,17 @@ def slope_acceptance(rig) -> dict:
     unplaced, its lateral stack alone throws rays past the disc, and the test could not tell a slope error
     from a misplaced paraboloid; placed, what its placement alone adds is ``placement_spot_mm``
     (:func:`placement_spot`), and ``slope_room_mm`` of the disc is left to the slopes."""
+    from rigcad.calibrate.kit import dome_farthest_from_o, dome_slope_tolerance
     from rigcad.manual.calibration import film_setup
 
     p = rig.profile
-    pts = rig.layout.design_dome.points(rig.layout.design_dome.sample(2001))
-    far = float(np.max(np.hypot(pts[:, 0], pts[:, 1])))
+    far = dome_farthest_from_o(rig)
     limit = p.tolerancing.max_spot_radius
     f = film_setup(rig)
     placed = placement_spot(rig, p.tolerancing.paraboloid_offset)
     return {"disc_radius_mm": limit, "placement_offset_mm": p.tolerancing.paraboloid_offset,
             "placement_spot_mm": placed, "slope_room_mm": limit - placed, "dome_farthest_from_o_mm": far,
-            "dome_slope_tolerance_mrad": 1e3 * limit / (2.0 * far), "pass_fraction": SLOPE_PASS_FRACTION,
+            "dome_slope_tolerance_mrad": dome_slope_tolerance(rig), "pass_fraction": SLOPE_PASS_FRACTION,
             "bore_radius_mm": f["bore_radius_mm"], "bore_slope_mrad": 1e3 * f["bore_radius_mm"] / (2.0 * far),
             "lamp_room_mm": f["block_under_disc_mm"], "film_above_bench_mm": f["block_under_disc_mm"]
             + f["plate_thickness_mm"], "block_under_disc_mm": f["block_under_disc_mm"],
